@@ -1,0 +1,141 @@
+"""Command line: read the -rod_* options, build the scene, run the continuation, write,
+report. Returns the process exit code (0 converged, 2 bad input, 3 not converged,
+4 diverged)."""
+
+import time
+
+import numpy as np
+from petsc4py import PETSc
+
+from . import io, outputs
+from .errors import RodError, RodNotConvergedError
+from .mesh import Mesh
+from .options import help_text, read_options, unused_options
+from .scene import Scene
+from .solver import Settings, UzawaSolver
+
+
+def scene_from_options(values, given):
+    """A validated Scene from parsed option values."""
+    load = np.asarray(values["rod_load"])
+    if load.size % 3:
+        raise_bad("-rod_load", "give 3 values (fx,fy,fz) per load piece")
+    scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
+                  start=values["rod_start"], end=values["rod_end"],
+                  end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
+                  end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
+                  end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
+                  load_breaks=values["rod_load_breaks"])
+    scene.validate(given)
+    return scene
+
+
+def raise_bad(option, why):
+    from .errors import RodInputError
+    raise RodInputError(f"{option}: {why}")
+
+
+def settings_from_options(values, scene):
+    penalty = values["rod_al_penalty"]
+    if penalty is None:
+        penalty = 400.0 * scene.stiffness.max() / scene.length**2
+    return Settings(penalty=penalty, max_it=values["rod_al_max_it"],
+                    rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
+                    monitor=values["rod_al_monitor"])
+
+
+def options_record():
+    """The whole options database as '-name value' lines (the file's ``options``)."""
+    return "\n".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items()))
+
+
+def run(comm=None):
+    comm = comm or PETSc.COMM_WORLD
+    say = lambda text: PETSc.Sys.Print(text, comm=comm)  # noqa: E731
+    database = PETSc.Options()
+    mesh = solver = writer = None
+    try:
+        values, given = read_options()
+        if database.hasName("help"):
+            for line in help_text():
+                say(line)
+        scene = scene_from_options(values, given)
+        settings = settings_from_options(values, scene)
+        mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
+        solver = UzawaSolver(mesh, scene, settings)
+        if database.hasName("help"):
+            return 0
+        if values["rod_initial"]:
+            outputs.set_state(solver, *io.read_state(values["rod_initial"], mesh))
+        else:
+            solver.set_straight()
+        if values["rod_output"]:
+            writer = io.ResultWriter(values["rod_output"], mesh)
+        code = continuation(solver, values["rod_steps"], values["rod_imperfection"], writer,
+                            say, options_record())
+        writer = None
+        for name in unused_options():
+            say(f"petsc_rod: warning: option -{name} was set but not used")
+        return code
+    except RodError as error:
+        say(f"petsc_rod: error: {error}")
+        if writer is not None:
+            writer.abort()
+        database.setValue("options_left", "0")
+        return error.exit_code
+    except KeyboardInterrupt:
+        if writer is not None:
+            writer.abort()
+        raise
+    finally:
+        if solver is not None:
+            solver.destroy()
+        if mesh is not None:
+            mesh.destroy()
+
+
+def continuation(solver, steps, imperfection, writer, say, options):
+    """Reach the scene in ``steps`` equal load increments, each warm-started (§7) from the
+    last state with its cross-sections rolled by ``imperfection`` (see
+    UzawaSolver.roll_cross_sections)."""
+    mesh = solver.mesh
+    clock = time.perf_counter()
+    say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
+        f"R = {solver.settings.penalty:g}, {steps} step(s)")
+    total_iterations = 0
+    for k in range(1, steps + 1):
+        t = k / steps
+        solver.roll_cross_sections(imperfection)
+        try:
+            report = solver.solve_step(t, label=f"step {k}/{steps} ")
+        except RodError:
+            if writer is not None:
+                writer.abort()
+            raise
+        total_iterations += report.iterations
+        vertex = outputs.vertex_fields(solver, t)
+        energy = solver.energy()
+        u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
+        attributes = {"converged": int(report.converged), "iterations": report.iterations,
+                      "constraint_residual": report.constraint_residual,
+                      "change": report.change, "energy": energy,
+                      "wall_time": time.perf_counter() - clock, "ranks": mesh.comm.getSize(),
+                      "options": options, "load_factor": t}
+        say(f"step {k}/{steps}: load factor {t:.4g}, "
+            f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
+            f"iterations, change {report.change:.2e}, constraint residual (RMS) "
+            f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}")
+        if writer is not None:
+            writer.write_step(f"steps/{k}", vertex, outputs.restart_state(solver),
+                              report.history, attributes)
+        if not report.converged:
+            break
+    if writer is not None:
+        writer.finish(f"steps/{k}", attributes)
+    if not report.converged:
+        say(f"petsc_rod: error: step {k}/{steps} did not converge in {report.iterations} "
+            "iterations (-rod_al_max_it); the result file says converged = 0")
+        return RodNotConvergedError.exit_code
+    say(f"petsc_rod: converged, {total_iterations} iterations in "
+        f"{time.perf_counter() - clock:.3g} s")
+    return 0

@@ -1,0 +1,67 @@
+"""Pointwise kernels of the Uzawa iteration (numpy only, vectorised over points).
+
+Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (method.md §3).
+"""
+
+import numpy as np
+
+
+def nearest_rotation(b):
+    """The local step (§3 step 2): tau = argmax_{T in SO(3)} sum_i T_i . b_i.
+
+    b: (..., 3, 3), rows b_i = R d_i + lambda_i. With b = U S V^T (SVD), the maximiser is
+    T = U diag(1, 1, det(U V^T)) V^T: the polar factor of b with the sign fixed so that
+    det T = +1 also when b is singular or a reflection. Returns (..., 3, 3).
+    """
+    u, _, vt = np.linalg.svd(b)
+    sign = np.sign(np.linalg.det(u @ vt))
+    sign[sign == 0] = 1.0
+    u[..., :, 2] *= sign[..., None]
+    return u @ vt
+
+
+def update_multipliers(lam, directors, tau, penalty):
+    """Multiplier update (§3 step 3): lambda_i <- lambda_i + R (d_i - tau_i), in place."""
+    lam += penalty * (directors - tau)
+    return lam
+
+
+def strains(d, dd):
+    """Strains u_i in the director basis from directors and their S-derivatives (§1).
+
+    d, dd: (..., 3, 3) rows d1, d2, d3 and d1', d2', d3'.
+    u1 = d2'.d3, u2 = d3'.d1, u3 = d1'.d2.  Returns (..., 3).
+    """
+    return np.stack([np.einsum("...c,...c->...", dd[..., 1, :], d[..., 2, :]),
+                     np.einsum("...c,...c->...", dd[..., 2, :], d[..., 0, :]),
+                     np.einsum("...c,...c->...", dd[..., 0, :], d[..., 1, :])], axis=-1)
+
+
+def split_coefficients(stiffness):
+    """a_i of the quadratic form w = a1|d1'|^2 + a2|d2'|^2 + a3|r''|^2 (§2).
+
+    a1 = (K2 + K3 - K1)/4, a2 = (K3 + K1 - K2)/4, a3 = (K1 + K2 - K3)/4.
+    """
+    k1, k2, k3 = stiffness
+    return np.array([k2 + k3 - k1, k3 + k1 - k2, k1 + k2 - k3]) / 4.0
+
+
+def rotation_about(axis, angle):
+    """Rotation matrix (3, 3) of ``angle`` rad about the unit vector ``axis`` (Rodrigues)."""
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def rotation_log(q):
+    """Axis-angle vector w (3,) with rotation_about(w/|w|, |w|) = q, |w| in [0, pi]."""
+    cos_angle = np.clip((np.trace(q) - 1) / 2, -1.0, 1.0)
+    angle = np.arccos(cos_angle)
+    if angle < 1e-12:
+        return np.zeros(3)
+    if np.pi - angle < 1e-6:
+        vals, vecs = np.linalg.eigh((q + q.T) / 2)
+        return angle * vecs[:, np.argmax(vals)]
+    skew = np.array([q[2, 1] - q[1, 2], q[0, 2] - q[2, 0], q[1, 0] - q[0, 1]])
+    return angle * skew / (2 * np.sin(angle))

@@ -1,0 +1,79 @@
+"""The 1-D mesh: a DMDA over the vertices, the elements this rank owns, the grading.
+
+Vertex i sits at S_i = L g(i/N). Element e = [S_e, S_e+1] belongs to the rank that owns
+its left vertex; its P2 midpoint dof is stored with that vertex (slot 1), so every
+element's dofs are in the rank's ghosted local vector (ghost width 1). The last
+vertex's slot 1 is a phantom dof, pinned to zero by the assembly.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+
+def graded_coordinates(t, grading):
+    """Map g(t) = t - beta/(2 pi) sin(2 pi t) of [0, 1] onto itself.
+
+    g'(t) = 1 - beta cos(2 pi t): elements are smallest at both ends and largest in the
+    middle, their size ratio being ``grading`` = (1 + beta)/(1 - beta) >= 1. The map is
+    smooth, so the graded mesh keeps the convergence orders of the uniform one.
+    """
+    beta = (grading - 1.0) / (grading + 1.0)
+    return t - beta / (2 * np.pi) * np.sin(2 * np.pi * t)
+
+
+class Mesh:
+    """A distributed mesh of ``n_elements`` elements on [0, length].
+
+    Attributes a kernel needs are plain numpy arrays of this rank's part; the rank
+    itself never appears outside this class (``on_lower_boundary`` and
+    ``on_upper_boundary`` say whether the rank holds S = 0 and S = L).
+    """
+
+    def __init__(self, comm, n_elements, length, grading=1.0):
+        self.n_elements = int(n_elements)
+        self.n_vertices = self.n_elements + 1
+        self.length = float(length)
+        self.grading = float(grading)
+        self.comm = comm
+        self.da = PETSc.DMDA().create(dim=1, sizes=(self.n_vertices,), dof=2,
+                                      stencil_width=1, comm=comm)
+        (self.vertex_start, self.vertex_end), = self.da.getRanges()
+        (self.ghost_start, self.ghost_end), = self.da.getGhostRanges()
+        self.element_start = self.vertex_start
+        self.element_end = min(self.vertex_end, self.n_elements)
+        self.on_lower_boundary = self.vertex_start == 0
+        self.on_upper_boundary = self.vertex_end == self.n_vertices
+        self.vertex_S = self.coordinates(np.arange(self.vertex_start, self.vertex_end))
+        ends = self.coordinates(np.arange(self.element_start, self.element_end + 1))
+        self.element_S = ends[:-1]
+        self.element_h = np.diff(ends)
+        # Local (ghosted) index of each owned element's left vertex.
+        self.element_local = np.arange(self.element_start, self.element_end) - self.ghost_start
+
+    @property
+    def n_local_elements(self):
+        return self.element_end - self.element_start
+
+    def coordinates(self, vertex_index):
+        """S of the given global vertex indices."""
+        t = np.asarray(vertex_index, dtype=float) / self.n_elements
+        return self.length * graded_coordinates(t, self.grading)
+
+    def point_S(self, xi):
+        """S at reference points xi (nq,) of the owned elements, (ne, nq)."""
+        return self.element_S[:, None] + np.asarray(xi)[None, :] * self.element_h[:, None]
+
+    def elements_around_owned_vertices(self):
+        """(first, end) global range of the elements that touch an owned vertex.
+
+        All their dofs are in the ghosted local vector; used to evaluate one-sided
+        limits at the vertices.
+        """
+        return max(self.vertex_start - 1, 0), min(self.vertex_end, self.n_elements)
+
+    def global_sum(self, value):
+        """Sum of a float or array over all ranks."""
+        return self.comm.tompi4py().allreduce(value)
+
+    def destroy(self):
+        self.da.destroy()

@@ -1,0 +1,169 @@
+"""The application's PETSc options: one table drives parsing, defaults and ``-help``.
+
+Every option has the root prefix ``rod_``. The KSPs of the global step have their own
+prefixes (``rod_r_``, ``rod_d1_``, ``rod_d2_``) and read the usual PETSc options. A
+``-rod_*`` name that is not in the table is an error (with the closest known name); any
+other option nobody read is reported at the end of the run.
+"""
+
+import ctypes
+import difflib
+from dataclasses import dataclass
+
+import numpy as np
+from petsc4py import PETSc
+
+from .errors import RodInputError
+
+KSP_PREFIXES = ("rod_r_", "rod_d1_", "rod_d2_")
+
+
+def _real(text):
+    return float(text)
+
+
+def _reals(count=None):
+    def parse(text):
+        values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+        if count is not None and len(values) != count:
+            raise ValueError(f"expected {count} comma-separated numbers")
+        return np.array(values)
+    return parse
+
+
+def _int(text):
+    value = float(text)
+    if value != int(value):
+        raise ValueError("expected a whole number")
+    return int(value)
+
+
+def _bool(text):
+    lowered = text.strip().lower()
+    if lowered in ("", "1", "true", "yes", "on"):
+        return True
+    if lowered in ("0", "false", "no", "off"):
+        return False
+    raise ValueError("expected true or false")
+
+
+def _string(text):
+    if not text:
+        raise ValueError("expected a value")
+    return text
+
+
+@dataclass(frozen=True)
+class Option:
+    name: str
+    parse: object
+    default: object
+    metavar: str
+    help: str
+    check: object = None     # (predicate, what is required)
+
+
+POSITIVE = (lambda v: np.all(np.asarray(v) > 0), "must be positive")
+NONNEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
+
+OPTIONS = [
+    Option("rod_length", _real, 1.0, "L", "length of the cable, m", POSITIVE),
+    Option("rod_elements", _int, 64, "N", "number of elements", POSITIVE),
+    Option("rod_mesh_grading", _real, 1.0, "q",
+           "ratio of the largest to the smallest element; > 1 refines both ends",
+           (lambda v: v >= 1, "must be >= 1")),
+    Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
+           "bending (about d1, d2) and torsion stiffness, N m^2", POSITIVE),
+    Option("rod_start", _string, "clamp", "clamp|pin|free", "condition at S = 0 (at the origin)"),
+    Option("rod_end", _string, "free", "clamp|pin|free", "condition at S = L"),
+    Option("rod_end_position", _reals(3), None, "x,y,z",
+           "position of the end S = L (clamp, pin); default (L,0,0)"),
+    Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
+           "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
+    Option("rod_end_twist", _real, 0.0, "theta",
+           "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
+           "continuation"),
+    Option("rod_end_force", _reals(3), np.zeros(3), "fx,fy,fz", "dead force at a free end S = L, N"),
+    Option("rod_start_force", _reals(3), np.zeros(3), "fx,fy,fz",
+           "dead force at a free start S = 0, N"),
+    Option("rod_load", _reals(), np.zeros(3), "fx,fy,fz[,...]",
+           "distributed dead load, N/m: 3 values, or 3 per piece with -rod_load_breaks"),
+    Option("rod_load_breaks", _reals(), np.zeros(0), "s1,...",
+           "arc lengths where the piecewise-constant load changes, m"),
+    Option("rod_steps", _int, 1, "K", "continuation steps from the straight state", POSITIVE),
+    Option("rod_imperfection", _real, 0.0, "eps",
+           "at the start of each step, roll the cross-sections about the tangent by "
+           "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left"),
+    Option("rod_initial", _string, None, "FILE", "start from (restart) a result file"),
+    Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE"),
+    Option("rod_al_penalty", _real, None, "R",
+           "augmented-Lagrangian penalty R, N; default 400 max(K) / L^2", POSITIVE),
+    Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
+    Option("rod_al_rtol", _real, 1e-5, "tol",
+           "stop when the relative L2 change of (r, r', d1, d2) is below tol", POSITIVE),
+    Option("rod_al_ctol", _real, 1e-3, "tol",
+           "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
+           "below tol", POSITIVE),
+    Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
+]
+BY_NAME = {option.name: option for option in OPTIONS}
+
+
+def read_options():
+    """Parse every ``-rod_*`` option; returns (values by name, set of names the user gave).
+
+    Raises RodInputError for an unknown ``-rod_`` name or a malformed value.
+    """
+    database = PETSc.Options()
+    given = {name for name in database.getAll() if name.startswith("rod_")}
+    for name in sorted(given):
+        if name not in BY_NAME and not name.startswith(KSP_PREFIXES):
+            close = difflib.get_close_matches(name, list(BY_NAME), n=1)
+            hint = f"; did you mean -{close[0]}?" if close else "; see -help"
+            raise RodInputError(f"unknown option -{name}{hint}")
+    values = {}
+    for option in OPTIONS:
+        if option.name not in given:
+            values[option.name] = option.default
+            continue
+        text = database.getString(option.name, "")
+        try:
+            value = option.parse(text)
+        except ValueError as error:
+            raise RodInputError(f"-{option.name} {text!r}: {error}; expected {option.metavar}"
+                                ) from None
+        if option.check is not None and not option.check[0](value):
+            raise RodInputError(f"-{option.name} {text}: {option.check[1]}")
+        values[option.name] = value
+    return values, given
+
+
+def help_text():
+    """The lines -help prints for the application's options."""
+    lines = ["petsc_rod options (prefix rod_):"]
+    for option in OPTIONS:
+        default = option.default
+        if isinstance(default, np.ndarray):
+            default = ",".join(f"{v:g}" for v in default) or "none"
+        lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
+                     f"(default {default})")
+    lines.append("  Global-step solvers: -rod_r_ksp_*, -rod_r_pc_* (r), -rod_d1_*, -rod_d2_* "
+                 "(directors); default preonly + Cholesky (MUMPS on several ranks).")
+    return lines
+
+
+def unused_options():
+    """Names of options in the database that no PETSc object or this program read."""
+    try:
+        library = ctypes.CDLL(PETSc.__file__)
+        used = library.PetscOptionsUsed
+    except (OSError, AttributeError):
+        return []
+    unused = []
+    for name in PETSc.Options().getAll():
+        if name in ("help", "options_left", "options_file"):
+            continue
+        flag = ctypes.c_int(0)
+        if used(None, name.encode(), ctypes.byref(flag)) == 0 and not flag.value:
+            unused.append(name)
+    return unused

@@ -1,0 +1,78 @@
+"""Derived outputs at the mesh vertices: positions, frames, strains, moment, force (§6).
+
+Every array is this rank's owned vertices (or owned elements for the restart state);
+nothing is gathered. Strains at a vertex average the limits from the elements on
+either side (u is discontinuous across elements for P2 directors).
+"""
+
+import numpy as np
+
+from .fe import hermite_basis, p2_basis
+from .kernels import strains
+
+
+def vertex_strains(solver):
+    """u = (u1, u2, u3) at the owned vertices, (n_owned, 3)."""
+    mesh = solver.mesh
+    first, end = mesh.elements_around_owned_vertices()
+    elements = np.arange(first, end)
+    h = mesh.coordinates(elements + 1) - mesh.coordinates(elements)
+    ends = np.array([0.0, 1.0])
+    values = solver.evaluate(elements - mesh.ghost_start, hermite_basis(ends, h),
+                             p2_basis(ends, h))
+    u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
+    n_owned = mesh.vertex_end - mesh.vertex_start
+    total = np.zeros((n_owned, 3))
+    count = np.zeros(n_owned)
+    for side in (0, 1):
+        vertex = elements + side - mesh.vertex_start
+        inside = (vertex >= 0) & (vertex < n_owned)
+        total[vertex[inside]] += u[inside, side]
+        count[vertex[inside]] += 1
+    return total / count[:, None]
+
+
+def load_beyond(scene, S, t):
+    """int_S^L f dS for the piecewise-constant load at factor t, (n, 3)."""
+    ends = scene.load_piece_ends
+    overlap = np.clip(ends[None, 1:] - np.maximum(ends[None, :-1], S[:, None]), 0.0, None)
+    return t * overlap @ scene.load_values
+
+
+def vertex_fields(solver, t):
+    """All vertex datasets of the result file (method.md §6, issue format)."""
+    mesh, scene = solver.mesh, solver.scene
+    r = solver.r.owned()
+    d1 = solver.d1.owned()[:, 0]
+    d2 = solver.d2.owned()[:, 0]
+    d3 = r[:, 1]
+    u = vertex_strains(solver)
+    k = scene.stiffness
+    moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
+    force = solver.end_reaction()[None, :] + load_beyond(scene, mesh.vertex_S, t)
+    return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
+            "m": moment, "n": force}
+
+
+def restart_state(solver):
+    """Dofs not in the vertex datasets: P2 midpoints, tau and lambda, per owned element."""
+    n_local = solver.mesh.n_local_elements
+    return {"d1_mid": solver.d1.owned()[:n_local, 1], "d2_mid": solver.d2.owned()[:n_local, 1],
+            "tau": solver.tau, "lambda": solver.lam}
+
+
+def set_state(solver, vertex, element):
+    """Inverse of vertex_fields + restart_state for owned slices (a restart)."""
+    n_local = solver.mesh.n_local_elements
+    n_owned = vertex["r"].shape[0]
+    r = np.stack([vertex["r"], vertex["d3"]], axis=1)
+    solver.r.set_owned(r)
+    for field, name in ((solver.d1, "d1"), (solver.d2, "d2")):
+        values = np.zeros((n_owned, 2, 3))
+        values[:, 0] = vertex[name]
+        values[:n_local, 1] = element[f"{name}_mid"]
+        field.set_owned(values)
+    solver.tau[:] = element["tau"]
+    solver.lam[:] = element["lambda"]
+    solver.remember_state()
+

@@ -1,0 +1,255 @@
+"""The augmented-Lagrangian (Uzawa, ALG2) driver of method.md §3.
+
+State: r, d1, d2 (VectorFields on the DMDA) and, at the 3 Gauss points of each owned
+element, tau and lambda, arrays (ne, 3 points, 3 directors, 3 components) with director
+rows d1, d2, d3 = r'. One iteration: global step (three scalar SPD solves per field,
+factorisations reused), local step (nearest rotation at every point), multiplier update.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from petsc4py import PETSc
+
+from . import boundary
+from .assembly import ScalarProblem, load_ghosted
+from .errors import RodDivergedError
+from .fe import (GAUSS_POINTS, HERMITE, P2, d_element_matrices, hermite_basis, p2_basis,
+                 quadrature_weights, r_element_matrices)
+from .fields import VectorField, at_points, element_dofs, scatter_element_vectors
+from .kernels import nearest_rotation, split_coefficients, strains, update_multipliers
+from .scene import REFERENCE_FRAME
+
+EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
+          for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}
+
+# An RMS constraint residual this large means the directors are no longer near unit
+# vectors: the iteration has left every meaningful state.
+DIVERGED_RESIDUAL = 1e3
+
+
+@dataclass
+class Settings:
+    penalty: float
+    max_it: int = 2000
+    rtol: float = 1e-5
+    ctol: float = 1e-3
+    monitor: bool = False
+
+
+@dataclass
+class StepReport:
+    converged: bool
+    iterations: int
+    change: float
+    constraint_residual: float
+    history: list = field(default_factory=list)   # (change, residual, wall time) rows
+
+
+class UzawaSolver:
+    """Owns every PETSc object of the solve; ``destroy()`` releases them all."""
+
+    def __init__(self, mesh, scene, settings):
+        self.mesh, self.scene, self.settings = mesh, scene, settings
+        R = settings.penalty
+        a = split_coefficients(scene.stiffness)
+        start, end = scene.start_state(0.0), scene.end_state(0.0)
+        h = mesh.element_h
+        EVENTS["assembly"].begin()
+        self.r_problem = ScalarProblem(
+            mesh, HERMITE, r_element_matrices(h, 2 * a[2], R),
+            boundary.r_prescribed(start, end, mesh.n_elements), "rod_r_")
+        self.d_problems = [ScalarProblem(
+            mesh, P2, d_element_matrices(h, 2 * a[i], R),
+            boundary.director_prescribed(i, start, end, mesh.n_elements), f"rod_d{i + 1}_")
+            for i in range(2)]
+        EVENTS["assembly"].end()
+        self.r, self.d1, self.d2 = (VectorField(mesh, n) for n in ("r", "d1", "d2"))
+        self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("r", "d1", "d2")]
+        self.load = VectorField(mesh, "load")
+        self.hermite = hermite_basis(GAUSS_POINTS, h)
+        self.p2 = p2_basis(GAUSS_POINTS, h)
+        self.weights = quadrature_weights(h)
+        shape = (mesh.n_local_elements, GAUSS_POINTS.size, 3, 3)
+        self.tau = np.zeros(shape)
+        self.lam = np.zeros(shape)
+        self._previous = None
+
+    # --- state ---------------------------------------------------------------------
+    def set_straight(self):
+        """The straight reference state: r = S e_x, frame (e_y, e_z, e_x), lambda = 0."""
+        mesh = self.mesh
+        r = np.zeros((mesh.vertex_S.size, 2, 3))
+        r[:, 0, 0] = mesh.vertex_S
+        r[:, 1] = REFERENCE_FRAME[2]
+        self.r.set_owned(r)
+        for index, director in enumerate((self.d1, self.d2)):
+            director.set_owned(np.broadcast_to(REFERENCE_FRAME[index], r.shape).copy())
+        self.tau[:] = REFERENCE_FRAME
+        self.lam[:] = 0.0
+        self.remember_state()
+
+    def roll_cross_sections(self, amplitude):
+        """Roll the current cross-sections about their tangent by
+        phi(S) = amplitude sin(pi S / 2L) rad (zero at S = 0).
+
+        (d1, d2) -> (cos phi d1 + sin phi d2, -sin phi d1 + cos phi d2), and likewise for
+        (tau1, tau2) and (lambda1, lambda2): a rotation about d1 x d2 = d3. It changes the
+        start of the iteration, not the problem, so that a symmetric start (e.g. a planar
+        one) can leave a symmetric equilibrium that is not a minimiser (§7).
+        """
+        if amplitude == 0.0:
+            return
+        mesh = self.mesh
+        owned = np.arange(mesh.vertex_start, mesh.vertex_end)
+        vertex_angle = np.stack([mesh.coordinates(owned), mesh.coordinates(owned + 0.5)],
+                                axis=1)
+        vertex_angle = amplitude * np.sin(np.pi * vertex_angle / (2 * mesh.length))
+        point_angle = amplitude * np.sin(np.pi * mesh.point_S(GAUSS_POINTS) / (2 * mesh.length))
+        d1, d2 = rolled(self.d1.owned(), self.d2.owned(), vertex_angle[..., None])
+        self.d1.set_owned(d1)
+        self.d2.set_owned(d2)
+        for frames in (self.tau, self.lam):
+            frames[:, :, 0], frames[:, :, 1] = rolled(frames[:, :, 0], frames[:, :, 1],
+                                                      point_angle[..., None])
+        self.remember_state()
+
+    def remember_state(self):
+        """Take the current fields as the reference of the next change test."""
+        self._previous = self._stacked(self.point_values())
+
+    @staticmethod
+    def _stacked(points):
+        """(r, r', d1, d2) at the Gauss points, (ne, nq, 4, 3)."""
+        return np.concatenate([points["r"][:, :, None, :], points["directors"]], axis=2)
+
+    # --- one continuation step ------------------------------------------------------
+    def prepare_step(self, t):
+        """Prescribed values and loads at load factor t (lifting computed once)."""
+        scene, n = self.scene, self.mesh.n_elements
+        start, end = scene.start_state(t), scene.end_state(t)
+        self.start_state, self.end_state = start, end
+        self.r_problem.set_prescribed(boundary.r_prescribed(start, end, n))
+        for i, problem in enumerate(self.d_problems):
+            problem.set_prescribed(boundary.director_prescribed(i, start, end, n))
+        self.load.add_ghosted(load_ghosted(self.mesh, scene.load_piece_ends,
+                                           t * scene.load_values, start.force, end.force))
+
+    def solve_step(self, t, label=""):
+        """Uzawa iterations at load factor t until both stopping tests of §6 hold."""
+        self.prepare_step(t)
+        settings = self.settings
+        history = []
+        clock = time.perf_counter()
+        change = residual = np.inf
+        for iteration in range(1, settings.max_it + 1):
+            self.iterate()
+            change, residual = self._norms()
+            history.append((change, residual, time.perf_counter() - clock))
+            if not (np.isfinite(change) and np.isfinite(residual)) \
+                    or residual > DIVERGED_RESIDUAL:
+                raise RodDivergedError(
+                    f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
+                    f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
+                    "-rod_steps")
+            if settings.monitor:
+                PETSc.Sys.Print(f"  {label}it {iteration:5d}  change {change:.3e}  "
+                                f"constraint {residual:.3e}", comm=self.mesh.comm)
+            if change <= settings.rtol and residual <= settings.ctol:
+                return StepReport(True, iteration, change, residual, history)
+        return StepReport(False, settings.max_it, change, residual, history)
+
+    def iterate(self):
+        """One iteration n: global step, local step, multiplier update."""
+        R = self.settings.penalty
+        mesh, tau, lam = self.mesh, self.tau, self.lam
+        n_ghosted = mesh.ghost_end - mesh.ghost_start
+        EVENTS["rhs"].begin()
+        target = R * tau - lam
+        # r: int (R tau3 - lambda3).p' + load;  d_a: int (R tau_a - lambda_a).g
+        r_vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.hermite[1], target[:, :, 2])
+        self.rhs[0].add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local,
+                                                        HERMITE, r_vectors))
+        for vec, load in zip(self.rhs[0].components, self.load.components):
+            vec.axpy(1.0, load)
+        for a in range(2):
+            d_vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.p2[0], target[:, :, a])
+            self.rhs[1 + a].add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local,
+                                                                P2, d_vectors))
+        EVENTS["rhs"].end()
+        EVENTS["solve"].begin()
+        self.r_problem.solve(self.rhs[0], self.r)
+        self.d_problems[0].solve(self.rhs[1], self.d1)
+        self.d_problems[1].solve(self.rhs[2], self.d2)
+        EVENTS["solve"].end()
+        EVENTS["projection"].begin()
+        self._points = self.point_values()
+        directors = self._points["directors"]
+        tau[:] = nearest_rotation(R * directors + lam)
+        EVENTS["projection"].end()
+        EVENTS["multiplier"].begin()
+        update_multipliers(lam, directors, tau, R)
+        EVENTS["multiplier"].end()
+
+    def point_values(self):
+        """r, directors and their derivatives at the Gauss points of the owned elements."""
+        return self.evaluate(self.mesh.element_local, self.hermite, self.p2)
+
+    def evaluate(self, element_local, hermite, p2):
+        """Fields at points of the given elements (ghosted local indices, (ne,)).
+
+        hermite = (phi, dphi, ddphi), p2 = (phi, dphi) tabulated at the points, (ne, nq, k).
+        Returns r (ne, nq, 3), directors and derivatives (ne, nq, 3, 3), rows d1, d2, r'
+        and d1', d2', r''.
+        """
+        r = element_dofs(self.r.ghosted(), element_local, HERMITE)
+        d = [element_dofs(f.ghosted(), element_local, P2) for f in (self.d1, self.d2)]
+        phi, dphi, ddphi = hermite
+        directors = np.stack([at_points(p2[0], d[0]), at_points(p2[0], d[1]),
+                              at_points(dphi, r)], axis=2)
+        derivatives = np.stack([at_points(p2[1], d[0]), at_points(p2[1], d[1]),
+                                at_points(ddphi, r)], axis=2)
+        return {"r": at_points(phi, r), "directors": directors, "derivatives": derivatives}
+
+    def _norms(self):
+        """Relative L2 change of (r, r', d1, d2) and RMS constraint residual (§6)."""
+        EVENTS["norms"].begin()
+        p = self._points
+        current = self._stacked(p)
+        w = self.weights[:, :, None, None]
+        gap = np.sum(w * (p["directors"] - self.tau) ** 2)
+        size = np.sum(w * current**2)
+        step = np.sum(w * (current - self._previous) ** 2)
+        gap, size, step = self.mesh.global_sum(np.array([gap, size, step]))
+        self._previous = current
+        EVENTS["norms"].end()
+        change = np.sqrt(step / size) if size > 0 else np.inf
+        return change, np.sqrt(gap / self.mesh.length)
+
+    # --- outputs --------------------------------------------------------------------
+    def energy(self):
+        """W = int w dS - int f.r dS - end forces . r (§6), with u from the FE fields."""
+        p = self.point_values()
+        u = strains(p["directors"], p["derivatives"])
+        stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
+        work = sum(load.dot(r) for load, r in zip(self.load.components, self.r.components))
+        return self.mesh.global_sum(stored) - work
+
+    def end_reaction(self):
+        """External force on the cable at S = L (N): the dead force at a free end, else the
+        residual of the r equation at the prescribed position dof (the FE reaction)."""
+        if self.end_state.kind == "free":
+            return self.end_state.force.copy()
+        return self.r_problem.residual_at(self.r, self.rhs[0], 2 * self.mesh.n_elements)
+
+    def destroy(self):
+        for obj in [self.r_problem, *self.d_problems, self.r, self.d1, self.d2, self.load,
+                    *self.rhs]:
+            obj.destroy()
+
+
+def rolled(first, second, angle):
+    """(cos a first + sin a second, -sin a first + cos a second), broadcasting ``angle``."""
+    c, s = np.cos(angle), np.sin(angle)
+    return c * first + s * second, -s * first + c * second
