@@ -14,8 +14,7 @@ def nearest_rotation(b):
     det T = +1 also when b is singular or a reflection. Returns (..., 3, 3).
     """
     u, _, vt = np.linalg.svd(b)
-    sign = np.sign(np.linalg.det(u @ vt))
-    sign[sign == 0] = 1.0
+    sign = np.where(np.linalg.det(u @ vt) < 0, -1.0, 1.0)
     u[..., :, 2] *= sign[..., None]
     return u @ vt
 
@@ -55,13 +54,20 @@ def rotation_about(axis, angle):
 
 
 def rotation_log(q):
-    """Axis-angle vector w (3,) with rotation_about(w/|w|, |w|) = q, |w| in [0, pi]."""
-    cos_angle = np.clip((np.trace(q) - 1) / 2, -1.0, 1.0)
-    angle = np.arccos(cos_angle)
-    if angle < 1e-12:
-        return np.zeros(3)
-    if np.pi - angle < 1e-6:
-        vals, vecs = np.linalg.eigh((q + q.T) / 2)
-        return angle * vecs[:, np.argmax(vals)]
+    """Axis-angle vector w (3,) with rotation_about(w/|w|, |w|) = q, |w| in [0, pi].
+
+    With s = (q - q^T)^vee = 2 sin(a) axis, the angle a = atan2(|s|, tr q - 1) is accurate
+    over the whole range; w = s a / (2 sin a) below a half-turn's neighbourhood, and near
+    a = pi the axis comes from the symmetric part (q + q^T)/2 - cos(a) I = (1 - cos a)
+    axis axis^T, its sign from s.
+    """
     skew = np.array([q[2, 1] - q[1, 2], q[0, 2] - q[2, 0], q[1, 0] - q[0, 1]])
-    return angle * skew / (2 * np.sin(angle))
+    angle = np.arctan2(np.linalg.norm(skew), np.trace(q) - 1.0)
+    if angle < np.pi / 2:
+        return skew / (2.0 * np.sinc(angle / np.pi))
+    outer = (q + q.T) / 2.0 - np.cos(angle) * np.eye(3)
+    column = outer[:, np.argmax(np.diag(outer))]
+    axis = column / np.linalg.norm(column)
+    if axis @ skew < 0:
+        axis = -axis
+    return angle * axis

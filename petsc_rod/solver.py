@@ -145,7 +145,7 @@ class UzawaSolver:
         change = residual = np.inf
         for iteration in range(1, settings.max_it + 1):
             self.iterate()
-            change, residual = self._norms()
+            change, residual = self.norms()
             history.append((change, residual, time.perf_counter() - clock))
             if not (np.isfinite(change) and np.isfinite(residual)) \
                     or residual > DIVERGED_RESIDUAL:
@@ -212,7 +212,7 @@ class UzawaSolver:
                                 at_points(ddphi, r)], axis=2)
         return {"r": at_points(phi, r), "directors": directors, "derivatives": derivatives}
 
-    def _norms(self):
+    def norms(self):
         """Relative L2 change of (r, r', d1, d2) and RMS constraint residual (§6)."""
         EVENTS["norms"].begin()
         p = self._points

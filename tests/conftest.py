@@ -1,0 +1,78 @@
+"""Shared pytest set-up for petsc_rod: PETSc initialisation, communicators, MPI-safe
+temporary folders, the ``serial`` marker and helpers to build a solver.
+
+Every test file must pass both serially and under ``mpiexec -n 2``: collective calls are
+made in the same order on every rank, and skip decisions are identical on all ranks.
+"""
+
+import os
+import shutil
+import sys
+import tempfile
+
+import petsc4py
+
+petsc4py.init(sys.argv[:1])
+
+import pytest  # noqa: E402
+from mpi4py import MPI  # noqa: E402
+from petsc4py import PETSc  # noqa: E402
+
+TESTS_DIR = os.path.dirname(os.path.abspath(__file__))
+REPO_ROOT = os.path.dirname(TESTS_DIR)
+for path in (TESTS_DIR, REPO_ROOT):
+    if path not in sys.path:
+        sys.path.insert(0, path)
+
+from helpers import gather, make_solver  # noqa: E402,F401  (re-exported for tests)
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "serial: spawns processes (or needs the whole machine); skipped when "
+        "the tests themselves run on several MPI ranks")
+
+
+def pytest_collection_modifyitems(config, items):
+    if MPI.COMM_WORLD.size == 1:
+        return
+    skip = pytest.mark.skip(reason="serial test (spawns processes; mpiexec cannot nest): "
+                                   f"skipped on {MPI.COMM_WORLD.size} ranks")
+    for item in items:
+        if "serial" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture
+def comm():
+    return PETSc.COMM_WORLD
+
+
+@pytest.fixture
+def shared_tmp():
+    """A temporary folder with the same path on every rank; removed afterwards."""
+    world = MPI.COMM_WORLD
+    path = tempfile.mkdtemp(prefix="petsc_rod_test_") if world.rank == 0 else None
+    path = world.bcast(path, root=0)
+    yield path
+    world.Barrier()
+    if world.rank == 0:
+        shutil.rmtree(path, ignore_errors=True)
+    world.Barrier()
+
+
+@pytest.fixture
+def solver_factory():
+    """``build(comm, n_elements, scene_kwargs, penalty, rtol, ctol, max_it)`` -> (mesh,
+    solver); every solver built is destroyed (collectively, in reverse order) at the end."""
+    built = []
+
+    def build(*args, **kwargs):
+        mesh, solver = make_solver(*args, **kwargs)
+        built.append((mesh, solver))
+        return mesh, solver
+
+    yield build
+    for mesh, solver in reversed(built):
+        solver.destroy()
+        mesh.destroy()

@@ -1,0 +1,38 @@
+"""Helpers for the tests (importable because conftest puts tests/ on sys.path)."""
+
+import numpy as np
+
+
+def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
+                max_it=5000):
+    """A (mesh, solver) pair for ``Scene(**scene_kwargs)`` on ``comm``.
+
+    The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
+    ``solver_factory`` fixture which does it.
+    """
+    from petsc_rod.mesh import Mesh
+    from petsc_rod.scene import Scene
+    from petsc_rod.solver import Settings, UzawaSolver
+
+    scene = Scene(**scene_kwargs)
+    mesh = Mesh(comm, n_elements, scene.length)
+    settings = Settings(penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
+    solver = UzawaSolver(mesh, scene, settings)
+    return mesh, solver
+
+
+def gather(comm, owned):
+    """All ranks' owned slices of an array (first axis), concatenated in rank order.
+
+    ``comm`` is a PETSc or mpi4py communicator; collective; every rank gets the whole.
+    """
+    mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
+    parts = mpi.allgather(np.asarray(owned))
+    return np.concatenate(parts, axis=0)
+
+
+def global_max(comm, value):
+    """Maximum of a float over all ranks (collective)."""
+    from mpi4py import MPI
+    mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
+    return mpi.allreduce(float(value), op=MPI.MAX)

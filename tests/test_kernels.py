@@ -1,0 +1,289 @@
+"""The pointwise kernels of the Uzawa iteration (method.md §1-§3), numpy only.
+
+nearest_rotation(b) is the local step: the T in SO(3) maximising sum_i T_i . b_i =
+trace(T b^T). It is checked against a brute force (local perturbations along every
+direction of so(3), and 20000 uniformly random rotations), not against the SVD formula
+it is built on.
+"""
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+from scipy.spatial.transform import Rotation
+
+from petsc_rod.kernels import (nearest_rotation, rotation_about, rotation_log,
+                               split_coefficients, strains, update_multipliers)
+
+ROUND_OFF = 1e-12
+
+
+def objective(t, b):
+    """sum_i T_i . b_i = trace(T b^T), broadcast over leading axes."""
+    return np.einsum("...ij,...ij->...", t, b)
+
+
+def hat(w):
+    """Skew matrix with hat(w) x = w x x."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def random_rotations(rng, n):
+    """n uniformly distributed rotations, from uniformly random unit quaternions."""
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return Rotation.from_quat(q).as_matrix()
+
+
+def assert_proper_rotation(t, tol=ROUND_OFF):
+    t = np.asarray(t)
+    eye = np.broadcast_to(np.eye(3), t.shape)
+    assert np.abs(t @ np.swapaxes(t, -1, -2) - eye).max() < tol
+    assert np.abs(np.linalg.det(t) - 1.0).max() < tol
+
+
+def nearest_one(b):
+    """nearest_rotation of one (3, 3) matrix, through the batched path (see
+    test_nearest_rotation_accepts_a_single_matrix for the unbatched call)."""
+    return nearest_rotation(np.asarray(b, dtype=float)[None])[0]
+
+
+def known_optimum(b):
+    """max over SO(3) of trace(T b^T) for b = U S V^T: s1 + s2 + sign(det U V^T) s3."""
+    u, s, vt = np.linalg.svd(b)
+    return s[0] + s[1] + np.sign(np.linalg.det(u @ vt)) * s[2]
+
+
+# --- nearest_rotation ------------------------------------------------------------------
+
+def test_nearest_rotation_is_a_proper_rotation():
+    rng = np.random.default_rng(1)
+    b = rng.normal(size=(500, 3, 3)) * rng.uniform(0.01, 100.0, size=(500, 1, 1))
+    t = nearest_rotation(b)
+    assert t.shape == b.shape
+    assert_proper_rotation(t)
+    # about half of random matrices have det b < 0: the sign fix is exercised
+    assert np.sum(np.linalg.det(b) < 0) > 100
+
+
+def test_nearest_rotation_beats_local_perturbations_and_random_rotations():
+    rng = np.random.default_rng(2)
+    samples = random_rotations(rng, 20000)
+    b = rng.normal(size=(50, 3, 3))
+    b[10:20] = -b[10:20]          # -b has the opposite det: reflections for sure
+    t = nearest_rotation(b)
+    for bk, tk in zip(b, t):
+        best = objective(tk, bk)
+        # every direction of so(3), two step sizes
+        skews = [hat(w) for w in rng.normal(size=(40, 3))]
+        for eps in (1e-1, 1e-3):
+            moved = np.array([tk @ expm(eps * a) for a in skews])
+            assert np.all(best >= objective(moved, bk) - ROUND_OFF)
+        assert best >= objective(samples, bk).max() - ROUND_OFF
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_nearest_rotation_of_a_rotation_is_itself(seed):
+    rng = np.random.default_rng(10 + seed)
+    q = random_rotations(rng, 200)
+    assert np.abs(nearest_rotation(q) - q).max() < ROUND_OFF
+    scale = rng.uniform(1e-3, 1e3, size=(200, 1, 1))
+    assert np.abs(nearest_rotation(scale * q) - q).max() < ROUND_OFF
+
+
+def test_nearest_rotation_of_q_s_pt_is_q_pt():
+    rng = np.random.default_rng(3)
+    q, p = random_rotations(rng, 2)
+    b = q @ np.diag([3.0, 2.0, 1.0]) @ p.T
+    assert np.abs(nearest_one(b) - q @ p.T).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("name", ["zero", "rank1", "rank2", "diag(1,1,-1)", "-I",
+                                  "diag(3,2,-1)", "random reflection", "nearly singular"])
+def test_nearest_rotation_degenerate_inputs(name):
+    rng = np.random.default_rng(4)
+    q, p = random_rotations(rng, 2)
+    x, y = rng.normal(size=(2, 3))
+    b = {"zero": np.zeros((3, 3)),
+         "rank1": np.outer(x, y),
+         "rank2": q @ np.diag([2.0, 0.5, 0.0]) @ p.T,
+         "diag(1,1,-1)": np.diag([1.0, 1.0, -1.0]),
+         "-I": -np.eye(3),
+         "diag(3,2,-1)": np.diag([3.0, 2.0, -1.0]),
+         "random reflection": q @ np.diag([3.0, 1.5, 0.7]) @ p.T @ np.diag([1.0, 1.0, -1.0]),
+         "nearly singular": q @ np.diag([2.0, 1.0, 1e-14]) @ p.T}[name]
+    t = nearest_one(b)
+    assert_proper_rotation(t)
+    best = objective(t, b)
+    samples = random_rotations(rng, 20000)
+    assert best >= objective(samples, b).max() - ROUND_OFF
+    expected = {"zero": 0.0, "rank1": np.linalg.norm(x) * np.linalg.norm(y), "rank2": 2.5,
+                "diag(1,1,-1)": 1.0, "-I": 1.0, "diag(3,2,-1)": 4.0,
+                "random reflection": 3.0 + 1.5 - 0.7, "nearly singular": 3.0}[name]
+    assert best == pytest.approx(expected, abs=1e-12)
+    assert best == pytest.approx(known_optimum(b), abs=1e-12)
+    if name == "diag(3,2,-1)":
+        assert np.abs(t - np.eye(3)).max() < ROUND_OFF
+
+
+def test_nearest_rotation_is_vectorised():
+    rng = np.random.default_rng(5)
+    b = rng.normal(size=(4, 5, 3, 3))
+    b[0, 0] = np.diag([1.0, 1.0, -1.0])
+    b[1, 2] = 0.0
+    t = nearest_rotation(b)
+    assert t.shape == (4, 5, 3, 3)
+    for i in range(4):
+        for j in range(5):
+            assert np.abs(t[i, j] - nearest_one(b[i, j])).max() < ROUND_OFF
+    assert np.abs(nearest_rotation(b[2]) - t[2]).max() < ROUND_OFF
+    assert_proper_rotation(t)
+
+
+def test_nearest_rotation_accepts_a_single_matrix():
+    q = rotation_about([1.0, 2.0, 3.0], 0.7)
+    assert np.abs(nearest_rotation(2.0 * q) - q).max() < ROUND_OFF
+    t = nearest_rotation(np.diag([1.0, 1.0, -1.0]))
+    assert_proper_rotation(t)
+
+
+def test_nearest_rotation_does_not_modify_its_input():
+    rng = np.random.default_rng(6)
+    b = rng.normal(size=(7, 3, 3))
+    copy = b.copy()
+    nearest_rotation(b)
+    assert np.array_equal(b, copy)
+
+
+# --- multipliers -----------------------------------------------------------------------
+
+def test_update_multipliers_in_place():
+    rng = np.random.default_rng(7)
+    lam = rng.normal(size=(6, 3, 3, 3))
+    d = rng.normal(size=lam.shape)
+    tau = rng.normal(size=lam.shape)
+    expected = lam + 400.0 * (d - tau)
+    out = update_multipliers(lam, d, tau, 400.0)
+    assert out is lam
+    assert np.abs(lam - expected).max() < 1e-12
+    # a feasible point (d = tau) leaves lambda unchanged
+    before = lam.copy()
+    update_multipliers(lam, tau, tau, 400.0)
+    assert np.array_equal(lam, before)
+
+
+# --- strains ---------------------------------------------------------------------------
+
+def helix_frame(S, a, b):
+    """Frenet frame of the helix (a cos(S/c), a sin(S/c), b S/c), c = sqrt(a^2 + b^2),
+    as rows d1 = normal, d2 = binormal, d3 = tangent; curvature a/c^2, torsion b/c^2."""
+    c = np.hypot(a, b)
+    phi = np.asarray(S) / c
+    tangent = np.stack([-a * np.sin(phi), a * np.cos(phi), b * np.ones_like(phi)], -1) / c
+    normal = np.stack([-np.cos(phi), -np.sin(phi), np.zeros_like(phi)], -1)
+    binormal = np.cross(tangent, normal)
+    return np.stack([normal, binormal, tangent], axis=-2)
+
+
+def test_strains_of_a_helix():
+    a, b = 0.7, 0.3
+    c2 = a**2 + b**2
+    S = np.linspace(0.0, 5.0, 23)
+    h = 1e-5
+    d = helix_frame(S, a, b)
+    dd = (helix_frame(S + h, a, b) - helix_frame(S - h, a, b)) / (2 * h)
+    u = strains(d, dd)
+    assert u.shape == (23, 3)
+    # Darboux vector tau t + kappa B: no bending about the normal d1
+    expected = np.array([0.0, a / c2, b / c2])
+    assert np.abs(u - expected).max() < 1e-8
+
+
+def test_strains_of_a_frame_with_constant_body_darboux_vector():
+    """Lambda(S) = Lambda0 expm(S hat(kappa)) (columns d_i) has d_i' = u x d_i with
+    u = kappa_j d_j: strains returns kappa, whatever Lambda0."""
+    rng = np.random.default_rng(8)
+    kappa = np.array([0.4, -1.3, 2.1])
+    lam0 = random_rotations(rng, 1)[0]
+    S = np.linspace(-1.0, 2.0, 11)
+    frames = np.array([(lam0 @ expm(s * hat(kappa))).T for s in S])
+    h = 1e-5
+    dd = np.array([((lam0 @ expm((s + h) * hat(kappa))).T
+                    - (lam0 @ expm((s - h) * hat(kappa))).T) / (2 * h) for s in S])
+    u = strains(frames, dd)
+    assert np.abs(u - kappa).max() < 1e-8
+    # and the energy identity of §2: |d_i'|^2 = |u|^2 - u_i^2
+    norms = np.sum(dd**2, axis=-1)
+    assert np.abs(norms - (kappa @ kappa - kappa**2)).max() < 1e-8
+
+
+# --- split coefficients (§2) -------------------------------------------------------------
+
+@pytest.mark.parametrize("stiffness, expected", [
+    ((1.0, 1.5, 0.8), (0.325, 0.075, 0.425)),
+    ((1.0, 1.0, 1.0), (0.25, 0.25, 0.25)),
+    ((235.0, 360.0, 200.0), (81.25, 18.75, 98.75)),
+    ((235.0, 360.0, 100.0), (56.25, -6.25, 123.75)),     # the non-convex reading of §8
+])
+def test_split_coefficients(stiffness, expected):
+    assert np.allclose(split_coefficients(stiffness), expected, rtol=0, atol=1e-12)
+
+
+def test_split_reproduces_the_stored_energy():
+    """a1|d1'|^2 + a2|d2'|^2 + a3|d3'|^2 = 1/2 sum K_i u_i^2 on orthonormal frames."""
+    rng = np.random.default_rng(9)
+    k = np.array([1.0, 1.5, 0.8])
+    a = split_coefficients(k)
+    for _ in range(5):
+        kappa = rng.normal(size=3)
+        lam0 = random_rotations(rng, 1)[0]
+        d = lam0.T
+        dd = (lam0 @ hat(kappa)).T           # derivative at S = 0 of the frame above
+        split = np.sum(a * np.sum(dd**2, axis=-1))
+        stored = 0.5 * np.sum(k * strains(d, dd) ** 2)
+        assert split == pytest.approx(stored, rel=1e-12)
+        assert stored == pytest.approx(0.5 * np.sum(k * kappa**2), rel=1e-12)
+
+
+# --- rotations -------------------------------------------------------------------------
+
+def test_rotation_about_matches_scipy():
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        axis = rng.normal(size=3)
+        angle = rng.uniform(-7.0, 7.0)
+        q = rotation_about(axis, angle)
+        expected = Rotation.from_rotvec(angle * axis / np.linalg.norm(axis)).as_matrix()
+        assert np.abs(q - expected).max() < ROUND_OFF
+        assert_proper_rotation(q)
+    # a quarter turn about e_z takes e_x to e_y
+    assert np.abs(rotation_about([0, 0, 2.0], np.pi / 2) @ [1, 0, 0] - [0, 1, 0]).max() < 1e-15
+
+
+def test_rotation_log_round_trip():
+    rng = np.random.default_rng(12)
+    for angle in np.concatenate([rng.uniform(1e-3, np.pi - 1e-2, 100), [0.3, 1.0, 3.0]]):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        w = rotation_log(rotation_about(axis, angle))
+        assert np.abs(w - angle * axis).max() < 1e-11
+        assert np.abs(rotation_about(w, np.linalg.norm(w))
+                      - rotation_about(axis, angle)).max() < ROUND_OFF
+    assert np.array_equal(rotation_log(np.eye(3)), np.zeros(3))
+    # a half turn: the axis up to sign
+    w = rotation_log(rotation_about([0.0, 0.6, 0.8], np.pi))
+    assert np.linalg.norm(w) == pytest.approx(np.pi, abs=1e-12)
+    assert np.abs(np.abs(w / np.pi) - [0.0, 0.6, 0.8]).max() < 1e-12
+
+
+def test_rotation_log_near_half_turn_and_tiny_angles():
+    rng = np.random.default_rng(13)
+    worst = 0.0
+    for angle in (1e-10, 1e-8, 1e-6, np.pi - 1e-2, np.pi - 1e-4, np.pi - 1e-6,
+                  np.pi - 1e-7, np.pi - 1e-9):
+        for _ in range(50):
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+            q = rotation_about(axis, angle)
+            w = rotation_log(q)
+            worst = max(worst, np.abs(w - angle * axis).max())
+    assert worst < 1e-10
