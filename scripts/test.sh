@@ -6,11 +6,11 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 source "$ROOT/scripts/setup.sh"
 cd "$ROOT"
 echo "== serial =="
-python -m pytest -p no:cacheprovider "$@" tests
+python -m pytest -p no:cacheprovider --color=no "$@" tests
 echo "== mpiexec -n 2 =="
 status=0
-mpiexec -n 1 python -m pytest -p no:cacheprovider "$@" tests \
-  : -n 1 bash -c 'exec python -m pytest -p no:cacheprovider -q "$@" tests > tests-rank1.log 2>&1' \
+mpiexec -n 1 python -m pytest -p no:cacheprovider --color=no "$@" tests \
+  : -n 1 bash -c 'exec python -m pytest -p no:cacheprovider --color=no -q "$@" tests > tests-rank1.log 2>&1' \
     rank1 "$@" || status=$?
 if [ "$status" -ne 0 ]; then
   echo "== rank 1 report (tests-rank1.log) =="
