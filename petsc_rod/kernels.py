@@ -6,13 +6,72 @@ Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (method.md §3).
 import numpy as np
 
 
+# Newton is used where det b > WELL_CONDITIONED |b|_max^3 (the smallest singular value is
+# then not tiny, so a few steps converge); elsewhere, and wherever it has not converged to
+# ORTHOGONALITY, the SVD decides.
+WELL_CONDITIONED = 1e-3
+ORTHOGONALITY = 1e-13
+NEWTON_STEPS = 12
+
+
 def nearest_rotation(b):
     """The local step (§3 step 2): tau = argmax_{T in SO(3)} sum_i T_i . b_i.
 
     b: (..., 3, 3), rows b_i = R d_i + lambda_i. With b = U S V^T (SVD), the maximiser is
     T = U diag(1, 1, det(U V^T)) V^T: the polar factor of b with the sign fixed so that
     det T = +1 also when b is singular or a reflection. Returns (..., 3, 3).
+
+    Where det b > 0 and b is well conditioned (every point of a running iteration, where
+    b is near R times a rotation) T is the polar factor, computed by the scaled Newton
+    iteration X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3), on the nine
+    components as contiguous arrays: several times faster than a batched LAPACK SVD.
+    The other points, and any that Newton leaves unconverged, go through the SVD.
     """
+    b = np.asarray(b, dtype=float)
+    flat = b.reshape(-1, 3, 3)
+    scale = np.abs(flat).max(axis=(1, 2))
+    scale[scale == 0] = 1.0
+    x = np.ascontiguousarray((flat / scale[:, None, None]).transpose(1, 2, 0))  # (3, 3, n)
+    newton = cofactors(x)[1] > WELL_CONDITIONED
+    polar = polar_newton(x[:, :, newton])
+    gram = np.einsum("ikn,jkn->ijn", polar, polar) - np.eye(3)[:, :, None]
+    converged = np.abs(gram).max(axis=(0, 1)) < ORTHOGONALITY
+    t = np.empty_like(flat)
+    t[newton] = polar.transpose(2, 0, 1)
+    rest = ~newton
+    rest[np.flatnonzero(newton)[~converged]] = True
+    t[rest] = nearest_rotation_svd(flat[rest])
+    return t.reshape(b.shape)
+
+
+def cofactors(x):
+    """Cofactor matrices and determinants of matrices stored as (3, 3, n) components.
+
+    Row i of the cofactor matrix is x_{i+1} x x_{i+2} (rows of x), so x^-T = C / det.
+    """
+    (a, b, c), (d, e, f), (g, h, i) = x
+    cofactor = np.array([[e * i - f * h, f * g - d * i, d * h - e * g],
+                         [h * c - i * b, i * a - g * c, g * b - h * a],
+                         [b * f - c * e, c * d - a * f, a * e - b * d]])
+    det = a * cofactor[0, 0] + b * cofactor[0, 1] + c * cofactor[0, 2]
+    return cofactor, det
+
+
+def polar_newton(x):
+    """Orthogonal polar factor of (3, 3, n) matrices with positive determinant."""
+    for _ in range(NEWTON_STEPS):
+        cofactor, det = cofactors(x)
+        zeta = np.cbrt(1.0 / det)
+        x_next = 0.5 * (zeta * x + cofactor / (zeta * det))
+        step = np.abs(x_next - x).max() if x.size else 0.0
+        x = x_next
+        if step < ORTHOGONALITY:
+            break
+    return x
+
+
+def nearest_rotation_svd(b):
+    """The same maximiser by SVD, for any (n, 3, 3), singular or reflected included."""
     u, _, vt = np.linalg.svd(b)
     sign = np.where(np.linalg.det(u @ vt) < 0, -1.0, 1.0)
     u[..., :, 2] *= sign[..., None]
