@@ -8,7 +8,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from . import io, outputs
-from .errors import RodError, RodNotConvergedError
+from .errors import RodError, RodInputError, RodNotConvergedError
 from .mesh import Mesh
 from .options import help_text, read_options, unused_options
 from .scene import Scene
@@ -19,7 +19,7 @@ def scene_from_options(values, given):
     """A validated Scene from parsed option values."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
-        raise_bad("-rod_load", "give 3 values (fx,fy,fz) per load piece")
+        raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
     scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
                   start=values["rod_start"], end=values["rod_end"],
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
@@ -28,11 +28,6 @@ def scene_from_options(values, given):
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
     return scene
-
-
-def raise_bad(option, why):
-    from .errors import RodInputError
-    raise RodInputError(f"{option}: {why}")
 
 
 def settings_from_options(values, scene):
@@ -50,10 +45,15 @@ def options_record():
 
 
 def run(comm=None):
+    """The whole program on ``comm``; returns the exit code. Only this function opens,
+    finishes or aborts the result file, and destroys the PETSc objects."""
     comm = comm or PETSc.COMM_WORLD
-    say = lambda text: PETSc.Sys.Print(text, comm=comm)  # noqa: E731
     database = PETSc.Options()
     mesh = solver = writer = None
+
+    def say(text):
+        PETSc.Sys.Print(text, comm=comm)
+
     try:
         values, given = read_options()
         if database.hasName("help"):
@@ -79,15 +79,11 @@ def run(comm=None):
         return code
     except RodError as error:
         say(f"petsc_rod: error: {error}")
-        if writer is not None:
-            writer.abort()
         database.setValue("options_left", "0")
         return error.exit_code
-    except KeyboardInterrupt:
-        if writer is not None:
-            writer.abort()
-        raise
     finally:
+        if writer is not None:          # any failure before the file was finished
+            writer.abort()
         if solver is not None:
             solver.destroy()
         if mesh is not None:
@@ -106,12 +102,7 @@ def continuation(solver, steps, imperfection, writer, say, options):
     for k in range(1, steps + 1):
         t = k / steps
         solver.roll_cross_sections(imperfection)
-        try:
-            report = solver.solve_step(t, label=f"step {k}/{steps} ")
-        except RodError:
-            if writer is not None:
-                writer.abort()
-            raise
+        report = solver.solve_step(t, label=f"step {k}/{steps} ")
         total_iterations += report.iterations
         vertex = outputs.vertex_fields(solver, t)
         energy = solver.energy()

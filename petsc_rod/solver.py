@@ -103,8 +103,9 @@ class UzawaSolver:
             return
         mesh = self.mesh
         owned = np.arange(mesh.vertex_start, mesh.vertex_end)
-        vertex_angle = np.stack([mesh.coordinates(owned), mesh.coordinates(owned + 0.5)],
-                                axis=1)
+        vertex_S = mesh.coordinates(owned)
+        midpoint_S = (vertex_S + mesh.coordinates(owned + 1)) / 2    # slot 1: P2 midpoint
+        vertex_angle = np.stack([vertex_S, midpoint_S], axis=1)
         vertex_angle = amplitude * np.sin(np.pi * vertex_angle / (2 * mesh.length))
         point_angle = amplitude * np.sin(np.pi * mesh.point_S(GAUSS_POINTS) / (2 * mesh.length))
         d1, d2 = rolled(self.d1.owned(), self.d2.owned(), vertex_angle[..., None])
@@ -144,7 +145,10 @@ class UzawaSolver:
         clock = time.perf_counter()
         change = residual = np.inf
         for iteration in range(1, settings.max_it + 1):
-            self.iterate()
+            try:
+                self.iterate()
+            except RodDivergedError as error:
+                raise RodDivergedError(f"{label}iteration {iteration}: {error}") from None
             change, residual = self.norms()
             history.append((change, residual, time.perf_counter() - clock))
             if not (np.isfinite(change) and np.isfinite(residual)) \
