@@ -1,9 +1,20 @@
 """``python -m petsc_rod -options_file options/<scene>.opts``."""
 
+import os
 import sys
 
 
+def missing_options_files(argv):
+    """Files named after -options_file that do not exist (PETSc would stop with a trace)."""
+    return [path for flag, path in zip(argv, argv[1:])
+            if flag == "-options_file" and not os.path.isfile(path)]
+
+
 def main():
+    for path in missing_options_files(sys.argv):
+        sys.stderr.write(f"petsc_rod: error: -options_file {path}: no such scene file; the "
+                         "scenes are in options/ (e.g. options/paper.opts)\n")
+        return 2
     try:
         import petsc4py
     except ImportError:

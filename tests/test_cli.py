@@ -204,12 +204,12 @@ def test_restart_from_a_different_mesh_is_refused(cantilever, folder):
 
 
 def test_missing_options_file_fails_without_output(folder):
-    """PETSc itself stops at start-up (its own multi-line error report): only a non-zero
-    exit and no result file are required."""
+    """An unknown scene file: one line naming it, exit 2, no result file."""
     path = folder / "nofile.h5"
     process = run(["-options_file", "options/nonexistent.opts", "-rod_output", str(path)])
-    assert process.returncode != 0, describe(process)
-    assert "nonexistent.opts" in process.stdout + process.stderr
+    assert process.returncode == 2, describe(process)
+    lines = (process.stdout + process.stderr).strip().splitlines()
+    assert len(lines) == 1 and "nonexistent.opts" in lines[0], describe(process)
     assert not os.path.exists(path)
     assert not os.path.exists(f"{path}.partial")
 
