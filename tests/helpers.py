@@ -36,3 +36,12 @@ def global_max(comm, value):
     from mpi4py import MPI
     mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
     return mpi.allreduce(float(value), op=MPI.MAX)
+
+
+def continuation(solver, steps=1, imperfection=0.0):
+    """From the straight state to load factor 1 as the CLI does it; the last StepReport."""
+    solver.set_straight()
+    for k in range(1, steps + 1):
+        solver.roll_cross_sections(imperfection)
+        report = solver.solve_step(k / steps)
+    return report

@@ -8,7 +8,7 @@ for the 1-rank / 2-rank round-off difference.
 import numpy as np
 import pytest
 
-from helpers import gather
+from helpers import continuation as solve, gather
 from petsc_rod.closed_forms import cantilever_shape, cantilever_tip
 from petsc_rod.outputs import vertex_fields
 
@@ -16,15 +16,6 @@ from petsc_rod.outputs import vertex_fields
 def fitted_order(n_elements, errors):
     """Slope of log(error) against log(h) by least squares."""
     return -np.polyfit(np.log(n_elements), np.log(errors), 1)[0]
-
-
-def solve(solver, steps=1, imperfection=0.0):
-    """Continuation from the straight state as the CLI does it; the last report."""
-    solver.set_straight()
-    for k in range(1, steps + 1):
-        solver.roll_cross_sections(imperfection)
-        report = solver.solve_step(k / steps)
-    return report
 
 
 def twist_scene(theta):
