@@ -251,3 +251,19 @@ def test_two_ranks_write_the_same_result(cantilever, folder):
             assert np.abs(f[name][:] - g[name][:]).max() < 1e-10, name
         assert np.abs(f["state/tau"][:] - g["state/tau"][:]).max() < 1e-10
         assert g["history/change"].shape == f["history/change"].shape
+
+
+def test_plot_of_a_result_file(cantilever, folder):
+    """python -m petsc_rod.plots draws a PNG from the file alone; a wrong call exits 2."""
+    path, process = cantilever
+    assert process.returncode == 0, describe(process)
+    figure = folder / "c.png"
+    plot = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure)],
+                          cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
+    assert plot.returncode == 0, plot.stderr
+    with open(figure, "rb") as png:
+        assert png.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert figure.stat().st_size > 20000
+    wrong = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path)],
+                           cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
+    assert wrong.returncode == 2 and "usage" in wrong.stderr

@@ -1,0 +1,53 @@
+"""Figures from a result file (matplotlib only; never PETSc, never a running solve).
+
+    python -m petsc_rod.plots paper.h5 paper.png
+
+draws the centreline projected on the xy, xz and yz planes, and the strains u1, u2,
+u3 against S: the paper's Figures 1 and 3 for one solution (method.md §8).
+"""
+
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def plot_result(path, output):
+    """Write the figure of result file ``path`` to ``output`` (PNG)."""
+    with h5py.File(path, "r") as f:
+        S, r, u = f["S"][:], f["r"][:], f["u"][:]
+        converged = int(f.attrs["converged"])
+        energy = float(f.attrs["energy"])
+    figure, axes = plt.subplots(1, 4, figsize=(16, 4), layout="constrained")
+    for axis, (i, j), names in zip(axes, ((0, 1), (0, 2), (1, 2)), ("xy", "xz", "yz")):
+        axis.plot(r[:, i], r[:, j], "-", lw=1.5)
+        axis.plot(r[[0, -1], i], r[[0, -1], j], "o", ms=4)
+        axis.set_xlabel(f"{names[0]} (m)")
+        axis.set_ylabel(f"{names[1]} (m)")
+        axis.set_aspect("equal", adjustable="datalim")
+        axis.set_title(f"projection on the {names} plane")
+    for k in range(3):
+        axes[3].plot(S, u[:, k], label=f"u{k + 1}")
+    axes[3].set_xlabel("S (m)")
+    axes[3].set_ylabel("strain (1/m)")
+    axes[3].legend()
+    axes[3].set_title("bending u1, u2 and twist u3")
+    status = "converged" if converged else "NOT converged"
+    figure.suptitle(f"{path}: {status}, energy {energy:.6g} J")
+    figure.savefig(output, dpi=110)
+    plt.close(figure)
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.stderr.write("usage: python -m petsc_rod.plots RESULT.h5 FIGURE.png\n")
+        return 2
+    plot_result(argv[1], argv[2])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
