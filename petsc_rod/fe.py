@@ -22,7 +22,6 @@ import numpy as np
 
 GAUSS_POINTS = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
 GAUSS_WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
-POINTS_PER_ELEMENT = GAUSS_POINTS.size
 
 
 @dataclass(frozen=True)

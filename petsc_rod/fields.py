@@ -44,10 +44,6 @@ class VectorField:
             glob.zeroEntries()
             self.mesh.da.localToGlobal(loc, glob, addv=PETSc.InsertMode.ADD_VALUES)
 
-    def copy_from(self, other):
-        for mine, theirs in zip(self.components, other.components):
-            theirs.copy(mine)
-
     def destroy(self):
         for vec in self.components + self._local:
             vec.destroy()

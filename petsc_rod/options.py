@@ -64,7 +64,6 @@ class Option:
 
 
 POSITIVE = (lambda v: np.all(np.asarray(v) > 0), "must be positive")
-NONNEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
 
 OPTIONS = [
     Option("rod_length", _real, 1.0, "L", "length of the cable, m", POSITIVE),
