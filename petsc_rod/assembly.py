@@ -64,8 +64,7 @@ class ScalarProblem:
         self.ksp.setOptionsPrefix(prefix)
         self.ksp.setFromOptions()
         self.ksp.setUp()
-        self._work.zeroEntries()
-        self._solve_one(self._work, self._lift[0])     # reports a failed factorisation now
+        self._report_failed_factorisation()
         self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY
                         and pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU)
                         else None)
@@ -103,6 +102,17 @@ class ScalarProblem:
         for c in range(3):
             self._work.getArray()[:] = block[:, c]
             self._solve_one(self._work, solution.components[c])
+
+    def _report_failed_factorisation(self):
+        """One solve with a zero right-hand side: KSPSolve is what reports a failed set-up
+        (this petsc4py has no PCGetFailedReason), and the MatMatSolve path skips it."""
+        zero = self.full.createVecLeft()
+        solution = zero.duplicate()
+        try:
+            self._solve_one(zero, solution)
+        finally:
+            zero.destroy()
+            solution.destroy()
 
     def _solve_one(self, rhs, solution):
         self.ksp.solve(rhs, solution)
