@@ -75,5 +75,15 @@ class Mesh:
         """Sum of a float or array over all ranks."""
         return self.comm.tompi4py().allreduce(value)
 
+    def global_min(self, value):
+        """Minimum of a float over all ranks."""
+        from mpi4py import MPI
+        return self.comm.tompi4py().allreduce(value, op=MPI.MIN)
+
+    @property
+    def smallest_element(self):
+        """The shortest element length over all ranks (m)."""
+        return self.global_min(float(self.element_h.min()) if self.element_h.size else np.inf)
+
     def destroy(self):
         self.da.destroy()

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import RodInputError
-from .kernels import rotation_about, rotation_log, split_coefficients
+from .kernels import rotation_about, rotation_log
 
 REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 END_KINDS = ("clamp", "pin", "free")
@@ -82,9 +82,6 @@ class Scene:
             raise RodInputError(f"-rod_length {self.length:g}: the length must be positive")
         if np.any(self.stiffness <= 0):
             raise RodInputError("-rod_stiffness: K1, K2, K3 must all be positive (N m^2)")
-        a = split_coefficients(self.stiffness)
-        if np.any(a < 0):
-            raise RodInputError(nonconvex_message(a))
         for name, kind in (("-rod_start", self.start), ("-rod_end", self.end)):
             if kind not in END_KINDS:
                 raise RodInputError(f"{name} {kind}: unknown end condition; use one of "
@@ -122,12 +119,3 @@ class Scene:
             raise RodInputError("-rod_load_breaks: the breaks must increase strictly inside "
                                 "(0, -rod_length)")
 
-
-def nonconvex_message(a):
-    """One line naming the violated condition: a_i < 0 <=> K_i > the sum of the other two."""
-    names = ["K1", "K2", "K3"]
-    i = int(np.argmin(a))
-    rest = " + ".join(n for n in names if n != names[i])
-    return (f"-rod_stiffness: {names[i]} > {rest} makes the split of method.md §2 non-convex "
-            f"(a{i + 1} = {a[i]:.6g} < 0), so the global step of the augmented Lagrangian is "
-            "unbounded below; no stiffness may exceed the sum of the other two")

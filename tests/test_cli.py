@@ -171,7 +171,6 @@ BAD_INPUTS = {
     "left-handed frame": (["-rod_end", "clamp", "-rod_end_frame", "0,1,0,0,0,1,-1,0,0"],
                           "-rod_end_frame"),
     "force at a clamp": (["-rod_end", "clamp", "-rod_end_force", "0,1,0"], "-rod_end_force"),
-    "non-convex stiffness": (["-rod_stiffness", "235,360,100"], "K2 > K1 + K3"),
 }
 
 
