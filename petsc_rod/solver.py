@@ -163,8 +163,14 @@ class UzawaSolver:
         self.load.add_ghosted(load_ghosted(self.mesh, scene.load_piece_ends,
                                            t * scene.load_values, start.force, end.force))
 
-    def solve_step(self, t, label=""):
-        """Uzawa iterations at load factor t until both stopping tests of §6 hold."""
+    def solve_step(self, t, label="", observer=None):
+        """Uzawa iterations at load factor t until both stopping tests of §6 hold.
+
+        ``observer(iteration, change, residual)``, if given, is called (collectively)
+        after each iteration's norms, e.g. to record the state at looser tolerances on
+        the way (scripts/error_vs_time.py); if it returns True the step stops there,
+        reported as not converged.
+        """
         self.prepare_step(t)
         settings = self.settings
         history = []
@@ -183,6 +189,8 @@ class UzawaSolver:
                     f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
                     f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
                     "-rod_steps")
+            if observer is not None and observer(iteration, change, residual):
+                return StepReport(False, iteration, change, residual, history)
             if settings.monitor:
                 PETSc.Sys.Print(f"  {label}it {iteration:5d}  change {change:.3e}  "
                                 f"constraint {residual:.3e}", comm=self.mesh.comm)

@@ -1,5 +1,7 @@
 """Helpers for the tests (importable because conftest puts tests/ on sys.path)."""
 
+import os
+
 import numpy as np
 
 
@@ -45,3 +47,17 @@ def continuation(solver, steps=1, imperfection=0.0):
         solver.roll_cross_sections(imperfection)
         report = solver.solve_step(k / steps)
     return report
+
+
+# Variables an enclosing mpiexec sets for its own processes: a child must not inherit
+# them, or it would try to join that job (e.g. when pytest itself runs under mpiexec -n 1).
+LAUNCHER_PREFIXES = ("PMIX_", "OMPI_COMM_WORLD", "OMPI_UNIVERSE_SIZE", "OMPI_FIRST_RANKS",
+                     "OMPI_APP_CTX", "OMPI_NUM_APP_CTX", "OMPI_COMMAND", "OMPI_ARGV",
+                     "OMPI_FILE_LOCATION", "OMPI_MCA_orte_", "OMPI_MCA_ess",
+                     "OMPI_MCA_pmix", "OMPI_MCA_initial_wdir", "OMPI_MCA_shmem_RUNTIME",
+                     "OMPI_MCA_mpi_oversubscribe")
+
+
+def child_env():
+    """This environment without the variables of an enclosing mpiexec."""
+    return {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_PREFIXES)}

@@ -14,6 +14,7 @@ import h5py
 import numpy as np
 import pytest
 
+from helpers import child_env
 from petsc_rod.options import OPTIONS
 
 pytestmark = pytest.mark.serial
@@ -24,18 +25,6 @@ EXPLICIT = ["-rod_length", "1", "-rod_stiffness", "1,1,1", "-rod_end", "free",
             "-rod_end_force", "0,-3,0", "-rod_al_penalty", "100", "-rod_al_rtol", "1e-9",
             "-rod_al_ctol", "1e-4"]
 TIMEOUT = 120
-
-# Variables an enclosing mpiexec sets for its own processes: a child must not inherit
-# them, or it would try to join that job (e.g. when pytest itself runs under mpiexec -n 1).
-LAUNCHER_PREFIXES = ("PMIX_", "OMPI_COMM_WORLD", "OMPI_UNIVERSE_SIZE", "OMPI_FIRST_RANKS",
-                     "OMPI_APP_CTX", "OMPI_NUM_APP_CTX", "OMPI_COMMAND", "OMPI_ARGV",
-                     "OMPI_FILE_LOCATION", "OMPI_MCA_orte_", "OMPI_MCA_ess",
-                     "OMPI_MCA_pmix", "OMPI_MCA_initial_wdir", "OMPI_MCA_shmem_RUNTIME",
-                     "OMPI_MCA_mpi_oversubscribe")
-
-
-def child_env():
-    return {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_PREFIXES)}
 
 
 def cantilever_args():

@@ -1,0 +1,217 @@
+"""The paper's three figures, from petsc_rod solutions (method.md §8, issue 3).
+
+    python scripts/paper_figures.py [--quick] [--out docs/paper]
+
+Runs the paper's continuation, the pinned end moved along y = 20 - x from X_F = 20 down
+to X_F = 2 in 0.5 m steps, for both readings of the torsion stiffness:
+- K3 = 200 on 80 elements, R = 400, rolled by 0.01 rad at each step (options/paper.opts);
+- the same without the roll: the planar branch (u3 = 0; it does not depend on K3);
+- K3 = 100 (non-convex split) on 20 elements: its penalty is raised to 3000 (README,
+  "The non-convex split"), which makes each step about ten times slower, hence the
+  coarser mesh.
+and writes into OUT: steps.csv (one row per run and step: X_F, converged, iterations,
+wall time, u3(0), energy, max |z|), profiles.npz (r and u3 along the cable at X_F = 19,
+16 and 2) and three PNGs:
+- projections.png: the cable on the planes xy, xz, yz at X_F = 19 and 16;
+- twist_at_clamp.png: u3(0) against X_F, with the range where the rolled run leaves the
+  plane (the planar state is then not the stable one) shaded;
+- twist_along_cable.png: u3(S) at X_F = 16 and 2.
+Progress: one line per step. The whole run takes about 20 minutes on one core;
+`--quick` (X_F = 20 to 16 in 2 steps, coarse meshes) takes seconds and is what the tests
+run.
+"""
+
+import argparse
+import csv
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+
+LENGTH = 20.0
+RTOL, CTOL, PENALTY = 1e-7, 1e-5, 400.0
+MAX_ITERATIONS = 200000
+PROFILE_X = (19.0, 16.0, 2.0)
+# |z| above this on a rolled run means the cable has left the plane z = 0 (a roll of
+# 0.01 rad on a stable planar state dies out to |z| below 1e-6).
+OUT_OF_PLANE = 1e-3
+
+FULL = {"end_x": 2.0, "steps": 36,
+        "runs": (("K3 = 200", 200.0, 80, 0.01), ("planar", 200.0, 80, 0.0),
+                 ("K3 = 100", 100.0, 20, 0.01))}
+QUICK = {"end_x": 19.0, "steps": 2,
+         "runs": (("K3 = 200", 200.0, 20, 0.01), ("planar", 200.0, 20, 0.0),
+                  ("K3 = 100", 100.0, 10, 0.01))}
+STEP_COLUMNS = ("run", "K3", "elements", "penalty", "X_F", "converged", "iterations",
+                "wall_time", "u3_clamp", "energy", "max_abs_z", "constraint_residual")
+
+
+def gather(comm, owned):
+    parts = comm.tompi4py().allgather(np.asarray(owned))
+    return np.concatenate(parts, axis=0)
+
+
+def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
+    """One continuation from X_F = 20 to ``end_x``: (step rows, profiles by X_F)."""
+    from petsc_rod.mesh import Mesh
+    from petsc_rod.outputs import vertex_fields
+    from petsc_rod.scene import Scene
+    from petsc_rod.solver import Settings, UzawaSolver
+
+    scene = Scene(length=LENGTH, stiffness=[235.0, 360.0, k3], start="clamp", end="pin",
+                  end_position=[end_x, LENGTH - end_x, 0.0])
+    mesh = Mesh(comm, n_elements, LENGTH)
+    solver = UzawaSolver(mesh, scene, Settings(penalty=PENALTY, max_it=MAX_ITERATIONS,
+                                               rtol=RTOL, ctol=CTOL))
+    rows, profiles = [], {}
+    try:
+        solver.set_straight()
+        clock = time.perf_counter()
+        for k in range(1, steps + 1):
+            t = k / steps
+            solver.roll_cross_sections(imperfection)
+            report = solver.solve_step(t)
+            fields = {key: gather(comm, value)
+                      for key, value in vertex_fields(solver, t).items()}
+            x_f = LENGTH + t * (end_x - LENGTH)
+            rows.append(dict(run=label, K3=k3, elements=n_elements,
+                             penalty=float(solver.penalties.max()), X_F=round(x_f, 6),
+                             converged=int(report.converged), iterations=report.iterations,
+                             wall_time=time.perf_counter() - clock,
+                             u3_clamp=fields["u"][0, 2], energy=solver.energy(),
+                             max_abs_z=np.abs(fields["r"][:, 2]).max(),
+                             constraint_residual=report.constraint_residual))
+            say(f"{label:9s} X_F = {x_f:5.2f}: {'converged' if report.converged else 'NOT converged'}"
+                f" in {report.iterations:6d} its, u3(0) = {fields['u'][0, 2]:+.5f} /m, "
+                f"W = {rows[-1]['energy']:.4f} J, max|z| = {rows[-1]['max_abs_z']:.3g} m "
+                f"({rows[-1]['wall_time']:.1f} s)")
+            for x in PROFILE_X:
+                if abs(x_f - x) < 1e-9:
+                    profiles[x] = {"S": fields["S"], "r": fields["r"], "u3": fields["u"][:, 2]}
+            if not report.converged:
+                say(f"{label}: stopped, step {k} did not converge")
+                break
+    finally:
+        solver.destroy()
+        mesh.destroy()
+    return rows, profiles
+
+
+def out_of_plane_range(rows):
+    """(smallest, largest) X_F at which a rolled run is out of plane, or None."""
+    x = [row["X_F"] for row in rows if row["max_abs_z"] > OUT_OF_PLANE and row["converged"]]
+    return (min(x), max(x)) if x else None
+
+
+def plot(rows, profiles, out):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colours = {"K3 = 200": "tab:blue", "K3 = 100": "tab:red", "planar": "0.4"}
+    labels = [label for label in colours if any(row["run"] == label for row in rows)]
+
+    figure, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    planes = (("x", "y", 0, 1), ("x", "z", 0, 2), ("y", "z", 1, 2))
+    for axis, (a, b, i, j) in zip(axes, planes):
+        for label in labels:
+            for x, style in ((19.0, "--"), (16.0, "-")):
+                if x in profiles.get(label, {}):
+                    r = profiles[label][x]["r"]
+                    axis.plot(r[:, i], r[:, j], style, color=colours[label],
+                              label=f"{label}, X_F = {x:g}")
+        axis.set_xlabel(f"{a} (m)")
+        axis.set_ylabel(f"{b} (m)")
+        axis.set_title(f"projection on the {a}{b} plane")
+        axis.grid(alpha=0.3)
+    axes[0].legend(fontsize=7)
+    figure.tight_layout()
+    figure.savefig(out / "projections.png", dpi=130)
+    plt.close(figure)
+
+    figure, axis = plt.subplots(figsize=(7, 4.5))
+    for label in labels:
+        mine = [row for row in rows if row["run"] == label and row["converged"]]
+        axis.plot([row["X_F"] for row in mine], [row["u3_clamp"] for row in mine], "o-",
+                  ms=3, color=colours[label], label=label)
+        span = out_of_plane_range(mine) if label != "planar" else None
+        if span:
+            axis.axvspan(span[0], span[1], color=colours[label], alpha=0.08,
+                         label=f"{label}: out of plane (planar not stable), "
+                               f"X_F {span[0]:g} to {span[1]:g}")
+    axis.invert_xaxis()
+    axis.set_xlabel("X_F (m), the end moved from 20 towards 2")
+    axis.set_ylabel("u3 at the clamp (rad/m)")
+    axis.set_title("twist at the clamp along the paper's path")
+    axis.grid(alpha=0.3)
+    axis.legend(fontsize=7)
+    figure.tight_layout()
+    figure.savefig(out / "twist_at_clamp.png", dpi=130)
+    plt.close(figure)
+
+    figure, axis = plt.subplots(figsize=(7, 4.5))
+    for label in labels:
+        for x, style in ((16.0, "-"), (2.0, "--")):
+            if x in profiles.get(label, {}):
+                p = profiles[label][x]
+                axis.plot(p["S"], p["u3"], style, color=colours[label],
+                          label=f"{label}, X_F = {x:g}")
+    axis.set_xlabel("S (m)")
+    axis.set_ylabel("u3 (rad/m)")
+    axis.set_title("twist along the cable")
+    axis.grid(alpha=0.3)
+    axis.legend(fontsize=7)
+    figure.tight_layout()
+    figure.savefig(out / "twist_along_cable.png", dpi=130)
+    plt.close(figure)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="a small setting (tests)")
+    parser.add_argument("--out", default=str(HERE.parent / "docs" / "paper"))
+    args = parser.parse_args()
+
+    import petsc4py
+    petsc4py.init([sys.argv[0]])
+    from petsc4py import PETSc
+
+    comm = PETSc.COMM_WORLD
+
+    def say(text):
+        if comm.getRank() == 0:
+            print(text, flush=True)
+
+    plan = QUICK if args.quick else FULL
+    rows, profiles = [], {}
+    for label, k3, n_elements, imperfection in plan["runs"]:
+        run_rows, run_profiles = continuation_run(comm, label, k3, n_elements, imperfection,
+                                                  plan["end_x"], plan["steps"], say)
+        rows += run_rows
+        profiles[label] = run_profiles
+    if comm.getRank() == 0:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        with open(out / "steps.csv", "w", newline="") as stream:
+            writer = csv.DictWriter(stream, fieldnames=STEP_COLUMNS)
+            writer.writeheader()
+            writer.writerows(rows)
+        np.savez(out / "profiles.npz", **{
+            f"{label}|{x:g}|{key}": value for label, by_x in profiles.items()
+            for x, fields in by_x.items() for key, value in fields.items()})
+        plot(rows, profiles, out)
+        for label in profiles:
+            span = out_of_plane_range([row for row in rows if row["run"] == label])
+            if label != "planar":
+                say(f"{label}: out of plane for X_F in {span}" if span
+                    else f"{label}: planar all along")
+        say(f"paper_figures: {len(rows)} steps in {out / 'steps.csv'}; PNGs in {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
