@@ -5,7 +5,8 @@ One command:
 runs the serial sweep in this process, then the same script under `mpiexec -n 2` for the
 2-rank subset, and writes OUT/runs.csv, OUT/error_vs_time.png and OUT/summary.md (the
 tables of docs/error_vs_time.md: discretisation errors, fitted orders, fastest runs per
-target accuracy). `--summarise OUT/runs.csv` redraws the plot and tables only. Progress: one line
+target accuracy). `--summarise OUT/runs.csv` redraws the plot and tables only;
+`--parallel-only` reruns the 2-rank subset into an existing OUT/runs.csv. Progress: one line
 per run. `--quick` is a small setting that finishes in well under a minute (the tests
 run it); without it the sweep takes about half an hour on one idle core.
 
@@ -165,7 +166,7 @@ def distance(mesh, state, final):
 
 
 def run_one(comm, name, n_elements, penalty, reference):
-    """One mesh and penalty: rows for each tolerance reached and the final iterate."""
+    """One mesh and penalty: a row for each tolerance pair the last step reached."""
     from petsc_rod.mesh import Mesh
     from petsc_rod.scene import Scene
     from petsc_rod.solver import Settings, UzawaSolver
@@ -413,6 +414,8 @@ def main():
     parser.add_argument("--worker", help=argparse.SUPPRESS)    # CSV path of an mpiexec part
     parser.add_argument("--summarise", metavar="CSV",
                         help="only redraw the plot and summary.md from an existing runs.csv")
+    parser.add_argument("--parallel-only", action="store_true",
+                        help="rerun only the 2-rank subset, replacing its rows in OUT/runs.csv")
     args = parser.parse_args()
     out = Path(args.out)
     if args.summarise:
@@ -437,7 +440,11 @@ def main():
             write_csv(args.worker, rows)
         return 0
     out.mkdir(parents=True, exist_ok=True)
-    rows = sweep(comm, serial_plan(args.quick), say)
+    if args.parallel_only:
+        rows = [row for row in read_csv(out / "runs.csv") if row["ranks"] == 1]
+    else:
+        rows = sweep(comm, serial_plan(args.quick), say)
+        write_csv(out / "runs-1-rank.csv", rows)      # kept if the 2-rank part fails
     part = out / "runs-2-ranks.partial.csv"
     command = ["mpiexec", "-n", "2", sys.executable, __file__, "--worker", str(part)]
     if args.quick:
@@ -446,6 +453,7 @@ def main():
     subprocess.run(command, check=True, env=os.environ)
     rows += read_csv(part)
     part.unlink()
+    (out / "runs-1-rank.csv").unlink(missing_ok=True)
     write_csv(out / "runs.csv", rows)
     rows = read_csv(out / "runs.csv")             # the same numbers as the file holds
     plot(rows, out / "error_vs_time.png")

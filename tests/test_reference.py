@@ -196,3 +196,4 @@ def test_petsc_rod_paper_scene_agrees_with_the_reference(twisted):
     assert abs(fields["u"][0, 2] - mirror * exact["u"][0, 2]) < 5e-4
     assert abs(energy - ref.energy(twisted)) < 5e-4
     assert np.abs(fields["r"] - exact["r"]).max() < 1e-2                 # measured 6.6e-3 m
+
