@@ -18,7 +18,7 @@ wall time, u3(0), energy, max |z|, constraint residual), profiles.npz (r and u3 
 - twist_along_cable.png: u3(S) at X_F = 16 and 2.
 `--replot` redraws the PNGs from those two files. A step that does not converge (next to a pitchfork the iteration slows down
 sharply) is reported, kept in steps.csv as converged = 0, and skipped: the next X_F
-starts from the last converged state. Progress: one line per step. The whole run takes about 20 minutes on one core;
+starts from the last converged state. Progress: one line per step. The whole run takes about half an hour on one core;
 `--quick` (X_F = 20 to 16 in 2 steps, coarse meshes) takes seconds and is what the tests
 run.
 """
