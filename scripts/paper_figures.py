@@ -16,11 +16,13 @@ wall time, u3(0), energy, max |z|, constraint residual), profiles.npz (r and u3 
 - twist_at_clamp.png: u3(0) against X_F, with the range where the rolled run leaves the
   plane (the planar state is then not the stable one) shaded;
 - twist_along_cable.png: u3(S) at X_F = 16 and 2.
-`--replot` redraws the PNGs from those two files. A step that does not converge (next to a pitchfork the iteration slows down
-sharply) is reported, kept in steps.csv as converged = 0, and skipped: the next X_F
-starts from the last converged state. Progress: one line per step. The whole run takes about half an hour on one core;
-`--quick` (X_F = 20 to 16 in 2 steps, coarse meshes) takes seconds and is what the tests
-run.
+`--replot` redraws the PNGs from those two files.
+
+A step that does not converge (next to a pitchfork the iteration slows down sharply) is
+reported, kept in steps.csv as converged = 0 and left out of the figures, and the next
+X_F starts from the last converged state. Progress: one line per step. The whole run
+takes about half an hour on one core; `--quick` (X_F = 20 to 19 in 2 steps, coarse
+meshes) takes seconds and is what the tests run.
 """
 
 import argparse
