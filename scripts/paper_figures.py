@@ -10,8 +10,8 @@ to X_F = 2 in 0.5 m steps, for both readings of the torsion stiffness:
   "The non-convex split"), which makes each step about ten times slower, hence the
   coarser mesh.
 and writes into OUT: steps.csv (one row per run and step: X_F, converged, iterations,
-wall time, u3(0), energy, max |z|, constraint residual), profiles.npz (r and u3 along the cable at X_F = 19,
-16 and 2) and three PNGs:
+wall time, u3(0), energy, max |z|, constraint residual), profiles.npz (r and u3 along
+the cable at X_F = 19, 16 and 2) and three PNGs:
 - projections.png: the cable on the planes xy, xz, yz at X_F = 19 and 16;
 - twist_at_clamp.png: u3(0) against X_F, with the range where the rolled run leaves the
   plane (the planar state is then not the stable one) shaded;
@@ -94,7 +94,8 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
                              u3_clamp=fields["u"][0, 2], energy=solver.energy(),
                              max_abs_z=np.abs(fields["r"][:, 2]).max(),
                              constraint_residual=report.constraint_residual))
-            say(f"{label:9s} X_F = {x_f:5.2f}: {'converged' if report.converged else 'NOT converged'}"
+            outcome = "converged" if report.converged else "NOT converged"
+            say(f"{label:9s} X_F = {x_f:5.2f}: {outcome}"
                 f" in {report.iterations:6d} its, u3(0) = {fields['u'][0, 2]:+.5f} /m, "
                 f"W = {rows[-1]['energy']:.4f} J, max|z| = {rows[-1]['max_abs_z']:.3g} m "
                 f"({rows[-1]['wall_time']:.1f} s)")

@@ -79,8 +79,8 @@ def test_error_vs_time_tighter_tolerance_smaller_iteration_error(error_vs_time):
     """Within one run, each recorded tolerance is 10 times tighter than the last; the
     distance to the tightest state must fall with it (by at least 3x per decade from
     rtol 1e-4 on, until it reaches 1e-9; between 1e-3 and 1e-4 the paper scene's last
-    step is still in its first few dozen iterations: 0.34 to 0.28), and the cantilever on 50 elements reaches 2e-6 in position
-    (measured 1.4e-6)."""
+    step is still in its first few dozen iterations: 0.34 to 0.28), and the cantilever
+    on 50 elements reaches 2e-6 in position (measured 1.4e-6)."""
     _, rows, _ = error_vs_time
     runs = defaultdict(list)
     for row in rows:
