@@ -98,9 +98,9 @@ def continuation(solver, steps, imperfection, writer, say, options):
     clock = time.perf_counter()
     say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
         f"R = {solver.settings.penalty:g}, {steps} step(s)")
-    if solver.penalties.max() > solver.settings.penalty:
+    if solver.penalty > solver.settings.penalty:
         say(f"petsc_rod: the stiffness split is non-convex (method.md §2): R raised to "
-            f"{solver.penalties.max():.6g} so the global step stays convex on this mesh, and "
+            f"{solver.penalty:.6g} so the global step stays convex on this mesh, and "
             f"the change test tightened to {solver.change_tolerance:.3g} to match "
             "(docs/stability.md)")
     total_iterations = 0

@@ -90,7 +90,7 @@ def gram(weights, a, b):
 
 # Largest generalised eigenvalue of (stiffness, mass) on one element of length h, times
 # h^2, for both pairs of the global step: P2 (int g'.g', int g.g) and Hermite
-# (int p''.p'', int p'.p'); both are 60 (computed in tests/test_kernels.py). The global
+# (int p''.p'', int p'.p'); both are 60 (computed in tests/test_nonconvex.py). The global
 # eigenvalue is bounded by the largest element one.
 STIFFNESS_TO_MASS_MAX = 60.0
 

@@ -25,7 +25,7 @@ EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
           for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}
 
 # A non-convex field gets a penalty this many times the least one that makes its matrix
-# positive definite (field_penalties).
+# positive definite (effective_penalty).
 NONCONVEX_MARGIN = 4.0
 
 # An RMS constraint residual this large means the directors are no longer near unit
@@ -51,22 +51,23 @@ class StepReport:
     history: list = field(default_factory=list)   # (change, residual, wall time) rows
 
 
-def field_penalties(penalty, split, smallest_element):
-    """Penalty R_i of each constraint d_i = tau_i (i = 1, 2, 3 with d3 = r'), N.
+def effective_penalty(penalty, split, smallest_element):
+    """The penalty R used for all three constraints d_i = tau_i (d3 = r'), N.
 
     A field whose split coefficient a_i is negative (a stiffness above the sum of the
     other two, method.md §2) has the matrix 2 a_i K + R M, positive definite only when
     R > 2 |a_i| lambda_max(K, M) = 2 |a_i| 60 / h_min^2 (fe.STIFFNESS_TO_MASS_MAX). The
-    penalty is then raised to NONCONVEX_MARGIN times this floor, so that the global step
+    user's R is then raised to NONCONVEX_MARGIN times this floor, so that the global step
     still minimises a strictly convex quadratic (Cholesky still applies). It is raised for
-    all three fields: the local step and the multiplier update accept unequal R_i, but
-    with a large R_2 and small R_1, R_3 the frames tau oscillate from point to point and
-    the iteration diverges within ten iterations (docs/stability.md). The floor grows like
-    1/h^2: the price of the non-convex split is a penalty, and with it an iteration count,
-    that grows with the mesh.
+    all three fields: the local step and the multiplier update would accept unequal R_i,
+    but with a large R_2 and small R_1, R_3 the frames tau oscillate from point to point
+    and the iteration diverges within ten iterations (docs/stability.md). The floor grows
+    like 1/h^2: the price of the non-convex split is a penalty, and with it an iteration
+    count, that grows with the mesh.
     """
-    floor = 2 * np.abs(np.minimum(split, 0.0)).max() * STIFFNESS_TO_MASS_MAX / smallest_element**2
-    return np.full(3, max(penalty, NONCONVEX_MARGIN * floor))
+    worst = np.abs(np.minimum(split, 0.0)).max()
+    floor = 2 * worst * STIFFNESS_TO_MASS_MAX / smallest_element**2
+    return max(float(penalty), NONCONVEX_MARGIN * floor)
 
 
 class UzawaSolver:
@@ -75,19 +76,19 @@ class UzawaSolver:
     def __init__(self, mesh, scene, settings):
         self.mesh, self.scene, self.settings = mesh, scene, settings
         a = split_coefficients(scene.stiffness)
-        self.penalties = field_penalties(settings.penalty, a, mesh.smallest_element)
+        self.penalty = effective_penalty(settings.penalty, a, mesh.smallest_element)
         # The change per iteration shrinks like 1/R near the solution (the contraction
         # factor is about 1 - c/R), so a raised penalty gets a proportionally tighter
         # change test: the same rtol then stands for the same distance to the solution.
-        self.change_tolerance = settings.rtol * settings.penalty / self.penalties.max()
+        self.change_tolerance = settings.rtol * settings.penalty / self.penalty
         start, end = scene.start_state(0.0), scene.end_state(0.0)
         h = mesh.element_h
         EVENTS["assembly"].begin()
         self.r_problem = ScalarProblem(
-            mesh, HERMITE, r_element_matrices(h, 2 * a[2], self.penalties[2]),
+            mesh, HERMITE, r_element_matrices(h, 2 * a[2], self.penalty),
             boundary.r_prescribed(start, end, mesh.n_elements), "rod_r_")
         self.d_problems = [ScalarProblem(
-            mesh, P2, d_element_matrices(h, 2 * a[i], self.penalties[i]),
+            mesh, P2, d_element_matrices(h, 2 * a[i], self.penalty),
             boundary.director_prescribed(i, start, end, mesh.n_elements), f"rod_d{i + 1}_")
             for i in range(2)]
         EVENTS["assembly"].end()
@@ -200,7 +201,7 @@ class UzawaSolver:
 
     def iterate(self):
         """One iteration n: global step, local step, multiplier update."""
-        R = self.penalties[:, None]       # broadcasts over the director rows
+        R = self.penalty
         mesh, tau, lam = self.mesh, self.tau, self.lam
         n_ghosted = mesh.ghost_end - mesh.ghost_start
         EVENTS["rhs"].begin()

@@ -88,7 +88,7 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
                       for key, value in vertex_fields(solver, t).items()}
             x_f = LENGTH + t * (end_x - LENGTH)
             rows.append(dict(run=label, K3=k3, elements=n_elements,
-                             penalty=float(solver.penalties.max()), X_F=round(x_f, 6),
+                             penalty=solver.penalty, X_F=round(x_f, 6),
                              converged=int(report.converged), iterations=report.iterations,
                              wall_time=time.perf_counter() - clock,
                              u3_clamp=fields["u"][0, 2], energy=solver.energy(),
