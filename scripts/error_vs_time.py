@@ -6,9 +6,10 @@ runs the serial sweep in this process, then the same script under `mpiexec -n 2`
 2-rank subset, and writes OUT/runs.csv, OUT/error_vs_time.png and OUT/summary.md (the
 tables of docs/error_vs_time.md: discretisation errors, fitted orders, fastest runs per
 target accuracy). `--summarise OUT/runs.csv` redraws the plot and tables only;
-`--parallel-only` reruns the 2-rank subset into an existing OUT/runs.csv. Progress: one line
-per run. `--quick` is a small setting that finishes in well under a minute (the tests
-run it); without it the sweep takes about half an hour on one idle core.
+`--parallel-only` reruns the 2-rank subset into an existing OUT/runs.csv. Progress: one
+line per run. `--quick` is a small setting that finishes in about a minute (the tests
+run it); without it the serial sweep takes about half an hour and the 2-rank subset
+about ten minutes on an idle 2-core machine.
 
 Scenes and references:
 - cantilever: P L^2/EI = 3, dead tip force; elliptic-integral elastica (closed_forms)
