@@ -80,6 +80,11 @@ class Mesh:
         from mpi4py import MPI
         return self.comm.tompi4py().allreduce(value, op=MPI.MIN)
 
+    def global_max(self, value):
+        """Maximum of a float over all ranks."""
+        from mpi4py import MPI
+        return self.comm.tompi4py().allreduce(value, op=MPI.MAX)
+
     @property
     def smallest_element(self):
         """The shortest element length over all ranks (m)."""

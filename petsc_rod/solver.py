@@ -77,10 +77,6 @@ class UzawaSolver:
         self.mesh, self.scene, self.settings = mesh, scene, settings
         a = split_coefficients(scene.stiffness)
         self.penalty = effective_penalty(settings.penalty, a, mesh.smallest_element)
-        # The change per iteration shrinks like 1/R near the solution (the contraction
-        # factor is about 1 - c/R), so a raised penalty gets a proportionally tighter
-        # change test: the same rtol then stands for the same distance to the solution.
-        self.change_tolerance = settings.rtol * settings.penalty / self.penalty
         start, end = scene.start_state(0.0), scene.end_state(0.0)
         h = mesh.element_h
         EVENTS["assembly"].begin()
@@ -102,6 +98,13 @@ class UzawaSolver:
         self.tau = np.zeros(shape)
         self.lam = np.zeros(shape)
         self._previous = None
+
+    @property
+    def change_tolerance(self):
+        """The change test's bound: rtol, times R_user / R when R was raised. The change
+        per iteration shrinks like 1/R near the solution (the contraction factor is about
+        1 - c/R), so the same rtol then stands for the same distance to the solution."""
+        return self.settings.rtol * self.settings.penalty / self.penalty
 
     # --- state ---------------------------------------------------------------------
     def set_straight(self):

@@ -36,6 +36,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
+from script_support import start_petsc  # noqa: E402  (scripts/ is sys.path[0])
+
 LENGTH = 20.0
 RTOL, CTOL, PENALTY = 1e-7, 1e-5, 400.0
 MAX_ITERATIONS = 200000
@@ -226,16 +228,7 @@ def main():
         plot(rows, profiles, out)
         return 0
 
-    import petsc4py
-    petsc4py.init([sys.argv[0]])
-    from petsc4py import PETSc
-
-    comm = PETSc.COMM_WORLD
-
-    def say(text):
-        if comm.getRank() == 0:
-            print(text, flush=True)
-
+    comm, say = start_petsc()
     plan = QUICK if args.quick else FULL
     rows, profiles = [], {}
     for label, k3, n_elements, imperfection in plan["runs"]:
