@@ -58,6 +58,7 @@ def centreline_solve_error(solver, t=1.0):
     owned = np.arange(mesh.vertex_start, mesh.vertex_end)
     S = mesh.coordinates(owned)
     slots = np.stack([S, (S + mesh.coordinates(owned + 1)) / 2], axis=1)
+    # theta* at the vertices and midpoints: one P2 element spanning [0, L], at s = S/L
     theta = p2_basis(slots.ravel() / mesh.length, np.ones(1))[0][0] @ nodal
     theta = theta.reshape(-1, 2, 3)
     theta[mesh.n_local_elements:, 1] = 0.0                   # the phantom slot
