@@ -1,41 +1,42 @@
 """PETSc glue of the global step: matrices assembled and factored once, right-hand sides.
 
-Each of r, d1, d2 is one scalar SPD problem A x = b solved for the x, y and z
-components with one factorisation (method.md §3 step 1). Essential conditions keep
-A symmetric: rows and columns of prescribed dofs are zeroed with a unit diagonal, and
-the right-hand side is lifted by the unconstrained matrix times the prescribed values.
+Each of d1, d2 and the slope theta = r' is one scalar SPD problem A x = b (P2) solved for
+the x, y and z components with one factorisation (method.md §3 step 1). Essential
+conditions keep A symmetric: rows and columns of prescribed dofs are zeroed with a unit
+diagonal, and the right-hand side is lifted by the unconstrained matrix times the
+prescribed values. The theta problem of a rod held at both ends is bordered by the
+constraint int theta dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
 """
 
 import numpy as np
 from petsc4py import PETSc
 
 from .errors import RodDivergedError
-from .fe import HERMITE, hermite_integrals
+from .fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
 from .fields import scatter_element_vectors
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
                for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
 
 
-def element_rows(mesh, element):
-    """Global row of each owned element's dofs, (ne, ndofs). DMDA order is natural in 1-D."""
+def element_rows(mesh):
+    """Global row of each owned element's P2 dofs, (ne, 3). DMDA order is natural in 1-D."""
     first = np.arange(mesh.element_start, mesh.element_end)[:, None]
-    return (2 * (first + element.offsets[None, :]) + element.slots[None, :]).astype(
-        PETSc.IntType)
+    return (2 * (first + P2.offsets[None, :]) + P2.slots[None, :]).astype(PETSc.IntType)
 
 
 class ScalarProblem:
     """One scalar SPD operator of the global step with its KSP.
 
-    ``element_matrices`` (ne, k, k) are summed into the DMDA matrix; ``prescribed`` is a
+    ``element_matrices`` (ne, 3, 3) are summed into the DMDA matrix; ``prescribed`` is a
     list of (vertex, slot, value) whose rows are constrained. KSP options are read with
     ``prefix``; the default is a direct Cholesky factorisation (MUMPS on several ranks).
     """
 
-    def __init__(self, mesh, element, element_matrices, prescribed, prefix):
+    def __init__(self, mesh, element_matrices, prescribed, prefix):
         self.mesh = mesh
         self.name = prefix
-        rows = element_rows(mesh, element)
+        self._rows = rows = element_rows(mesh)
         self.full = mesh.da.createMatrix()
         self.full.setValuesRCV(rows, rows, element_matrices, addv=PETSc.InsertMode.ADD_VALUES)
         self.full.assemble()
@@ -68,6 +69,31 @@ class ScalarProblem:
         self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY
                         and pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU)
                         else None)
+        self._border = []            # c and w = A^-1 c of the integral constraint, if any
+
+    def add_integral_constraint(self, element_integrals):
+        """Border A with the row c, c_k = int phi_k dS, for the constraint c.x = target
+        (one per component, the same row for x, y and z): the system becomes
+        [A c; c^T 0] [x; mu] = [b; target].
+
+        It is solved by the Schur complement (solve_constrained); here, once, w = A^-1 c0
+        with c0 = c with the prescribed rows zeroed (so w vanishes there and the
+        correction x - mu w keeps the prescribed values), and c.w = c0^T A^-1 c0 > 0.
+        ``element_integrals`` (ne, 3) are the element contributions int_e phi_k dS.
+        """
+        c = self.full.createVecLeft()
+        c.setValues(self._rows.ravel(), np.ravel(element_integrals),
+                    addv=PETSc.InsertMode.ADD_VALUES)
+        c.assemble()
+        free = c.copy()
+        free.getArray()[self._local_rows] = 0.0
+        w = free.duplicate()
+        try:
+            self._solve_one(free, w)
+        finally:
+            free.destroy()
+        self._border = [c, w]
+        self._c_dot_w = c.dot(w)
 
     def set_prescribed(self, prescribed):
         """New prescribed values (same rows); computes the lifting A_full x_bc once."""
@@ -103,6 +129,22 @@ class ScalarProblem:
             self._work.getArray()[:] = block[:, c]
             self._solve_one(self._work, solution.components[c])
 
+    def solve_constrained(self, rhs, solution, target):
+        """Solve the bordered system of add_integral_constraint for the three components.
+
+        x0 = A^-1 b (solve), then mu = (c.x0 - target) / (c.w) and x = x0 - mu w, so that
+        c.x = target. ``target`` (3,); returns mu (3,), the multiplier of the constraint
+        (one allreduce for the three components).
+        """
+        c, w = self._border
+        self.solve(rhs, solution)
+        local = [c.getArray(readonly=True) @ x.getArray(readonly=True)
+                 for x in solution.components]
+        mu = (self.mesh.global_sum(np.array(local)) - target) / self._c_dot_w
+        for x, value in zip(solution.components, mu):
+            x.axpy(-value, w)
+        return mu
+
     def _report_failed_factorisation(self):
         """One solve with a zero right-hand side: KSPSolve is what reports a failed set-up
         (this petsc4py has no PCGetFailedReason), and the MatMatSolve path skips it."""
@@ -121,46 +163,32 @@ class ScalarProblem:
             raise RodDivergedError(f"linear solver -{self.name} failed: "
                                    f"{KSP_REASONS.get(reason, reason)}")
 
-    def residual_at(self, solution, rhs, row):
-        """(A_full x - b)[row] for the three components: the reaction at a prescribed dof."""
-        values = np.zeros(3)
-        start, end = self.full.getOwnershipRange()
-        for c in range(3):
-            self.full.mult(solution.components[c], self._work)
-            self._work.axpy(-1.0, rhs.components[c])
-            if start <= row < end:
-                values[c] = self._work.getArray(readonly=True)[row - start]
-        return self.mesh.global_sum(values)
-
     def destroy(self):
         for obj in [self.ksp, self.full, self.constrained, self._work, self._rhs_block,
-                    self._solution_block] + self._lift:
+                    self._solution_block] + self._lift + self._border:
             obj.destroy()
 
 
-def load_element_vectors(mesh, piece_ends, piece_values):
-    """Exact int f.p dS over owned elements for a piecewise-constant load, (ne, 4, 3).
+def load_element_vectors(mesh, load, breaks):
+    """Exact int_e F(S) g_k dS over the owned elements, (ne, 3, 3), for a load function
+    F: S (...) -> (..., 3) that is linear between consecutive ``breaks`` (sorted).
 
-    piece_ends: (m + 1,) breaks in S; piece_values: (m, 3) load of each piece, N/m.
+    Each element is cut at the breaks inside it; on each piece F g_k is a cubic, which
+    3-point Gauss integrates exactly. The loop runs over the breaks, not the elements.
     """
-    a = mesh.element_S
-    h = mesh.element_h
-    out = np.zeros((mesh.n_local_elements, HERMITE.ndofs, 3))
-    for lo, hi, f in zip(piece_ends[:-1], piece_ends[1:], piece_values):
-        xi0 = np.clip((lo - a) / h, 0.0, 1.0)
-        xi1 = np.clip((hi - a) / h, 0.0, 1.0)
-        out += hermite_integrals(h, xi0, xi1)[:, :, None] * f[None, None, :]
+    a, h = mesh.element_S[:, None], mesh.element_h[:, None]
+    cuts = np.clip((np.asarray(breaks, dtype=float)[None, :] - a) / h, 0.0, 1.0)
+    cuts = np.concatenate([np.zeros_like(a), cuts, np.ones_like(a)], axis=1)
+    out = np.zeros((mesh.n_local_elements, P2.ndofs, 3))
+    for lo, hi in zip(cuts.T[:-1, :, None], cuts.T[1:, :, None]):
+        x = lo + (hi - lo) * GAUSS_POINTS[None, :]
+        phi, _ = p2_basis(x, mesh.element_h)
+        out += np.einsum("eq,eqk,eqc->ekc", h * (hi - lo) * GAUSS_WEIGHTS, phi, load(a + h * x))
     return out
 
 
-def load_ghosted(mesh, piece_ends, piece_values, start_force, end_force):
-    """Load part of the r right-hand side on the ghosted vertices, (n_ghosted, 2, 3):
-    distributed dead load plus dead forces at free ends (a natural condition, §5)."""
-    n_ghosted = mesh.ghost_end - mesh.ghost_start
-    out = scatter_element_vectors(n_ghosted, mesh.element_local, HERMITE,
-                                  load_element_vectors(mesh, piece_ends, piece_values))
-    if mesh.on_lower_boundary:
-        out[0 - mesh.ghost_start, 0] += start_force
-    if mesh.on_upper_boundary:
-        out[mesh.n_elements - mesh.ghost_start, 0] += end_force
-    return out
+def load_ghosted(mesh, load, breaks):
+    """The load part int F.g of the theta right-hand side on the ghosted vertices,
+    (n_ghosted, 2, 3) (load_element_vectors summed into the vertex slots)."""
+    return scatter_element_vectors(mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+                                   load_element_vectors(mesh, load, breaks))

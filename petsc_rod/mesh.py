@@ -75,6 +75,20 @@ class Mesh:
         """Sum of a float or array over all ranks."""
         return self.comm.tompi4py().allreduce(value)
 
+    def prefix_sum(self, element_values):
+        """Sum of the values of all elements left of each owned vertex.
+
+        element_values: this rank's owned elements, (n_local_elements, ...). Vertex i gets
+        sum_{e < i} v_e: the running sum over this rank's elements plus the total of the
+        ranks before it (one MPI exscan; nothing is gathered). Returns (n_owned, ...).
+        """
+        values = np.asarray(element_values, dtype=float)
+        before = self.comm.tompi4py().exscan(values.sum(axis=0))
+        if self.on_lower_boundary:          # exscan leaves the first rank's result undefined
+            before = np.zeros(values.shape[1:])
+        running = np.concatenate([np.zeros((1,) + values.shape[1:]), np.cumsum(values, axis=0)])
+        return before + running[:self.vertex_end - self.vertex_start]
+
     def global_min(self, value):
         """Minimum of a float over all ranks."""
         from mpi4py import MPI

@@ -7,7 +7,7 @@ either side (u is discontinuous across elements for P2 directors).
 
 import numpy as np
 
-from .fe import hermite_basis, p2_basis
+from .fe import p2_basis, p2_integrals
 from .kernels import strains
 
 
@@ -18,8 +18,8 @@ def vertex_strains(solver):
     elements = np.arange(first, end)
     h = mesh.coordinates(elements + 1) - mesh.coordinates(elements)
     ends = np.array([0.0, 1.0])
-    values = solver.evaluate(elements - mesh.ghost_start, hermite_basis(ends, h),
-                             p2_basis(ends, h))
+    values = solver.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
+                             p2_integrals(ends, h))
     u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
     n_owned = mesh.vertex_end - mesh.vertex_start
     total = np.zeros((n_owned, 3))
@@ -32,13 +32,6 @@ def vertex_strains(solver):
     return total / count[:, None]
 
 
-def load_beyond(scene, S, t):
-    """int_S^L f dS for the piecewise-constant load at factor t, (n, 3)."""
-    ends = scene.load_piece_ends
-    overlap = np.clip(ends[None, 1:] - np.maximum(ends[None, :-1], S[:, None]), 0.0, None)
-    return t * overlap @ scene.load_values
-
-
 def vertex_fields(solver, t):
     """All vertex datasets of the result file (method.md §6, issue format)."""
     mesh, scene = solver.mesh, solver.scene
@@ -49,7 +42,7 @@ def vertex_fields(solver, t):
     u = vertex_strains(solver)
     k = scene.stiffness
     moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
-    force = solver.end_reaction()[None, :] + load_beyond(scene, mesh.vertex_S, t)
+    force = solver.end_reaction()[None, :] + scene.load_beyond(mesh.vertex_S, t)
     return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
             "m": moment, "n": force}
 
@@ -62,11 +55,12 @@ def restart_state(solver):
 
 
 def set_state(solver, vertex, element):
-    """Inverse of vertex_fields + restart_state for owned slices (a restart)."""
+    """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
+    holds r and d3 = r' at the vertices: theta's midpoints are those of the Hermite cubic
+    they define (UzawaSolver.set_centreline)."""
     n_local = solver.mesh.n_local_elements
     n_owned = vertex["r"].shape[0]
-    r = np.stack([vertex["r"], vertex["d3"]], axis=1)
-    solver.r.set_owned(r)
+    solver.set_centreline(vertex["r"], vertex["d3"])
     for field, name in ((solver.d1, "d1"), (solver.d2, "d2")):
         values = np.zeros((n_owned, 2, 3))
         values[:, 0] = vertex[name]

@@ -61,6 +61,16 @@ class Scene:
         """S at the ends of the load pieces, (m + 1,)."""
         return np.concatenate([[0.0], self.load_breaks, [self.length]])
 
+    def load_beyond(self, S, t):
+        """int_S^L f dS of the piecewise-constant load at factor t: S (...) -> (..., 3).
+
+        Piecewise linear in S, with kinks at the load breaks.
+        """
+        ends = self.load_piece_ends
+        S = np.asarray(S, dtype=float)[..., None]
+        overlap = np.clip(ends[1:] - np.maximum(ends[:-1], S), 0.0, None)
+        return t * overlap @ self.load_values
+
     def start_state(self, t):
         return EndState(self.start, np.zeros(3), REFERENCE_FRAME.copy(), t * self.start_force)
 

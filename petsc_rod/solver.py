@@ -1,9 +1,12 @@
 """The augmented-Lagrangian (Uzawa, ALG2) driver of method.md §3.
 
-State: r, d1, d2 (VectorFields on the DMDA) and, at the 3 Gauss points of each owned
-element, tau and lambda, arrays (ne, 3 points, 3 directors, 3 components) with director
-rows d1, d2, d3 = r'. One iteration: global step (three scalar SPD solves per field,
-factorisations reused), local step (nearest rotation at every point), multiplier update.
+State: d1, d2 and the slope theta = r' = d3 (P2 VectorFields on the DMDA), the
+centreline r at the vertices (a VectorField holding the Hermite pair (r, r') of each
+vertex, recovered from theta by integration, centreline.py) and, at the 3 Gauss points
+of each owned element, tau and lambda, arrays (ne, 3 points, 3 directors, 3 components)
+with director rows d1, d2, d3 = r'. One iteration: global step (three scalar SPD solves
+per field, factorisations reused), local step (nearest rotation at every point),
+multiplier update.
 """
 
 import time
@@ -14,9 +17,11 @@ from petsc4py import PETSc
 
 from . import boundary
 from .assembly import ScalarProblem, load_ghosted
+from .centreline import (anchor_work, load_offset, midpoint_slopes, positions_at_points,
+                         vertex_positions)
 from .errors import RodDivergedError
-from .fe import (GAUSS_POINTS, HERMITE, P2, STIFFNESS_TO_MASS_MAX, d_element_matrices,
-                 hermite_basis, p2_basis, quadrature_weights, r_element_matrices)
+from .fe import (GAUSS_POINTS, P2, STIFFNESS_TO_MASS_MAX, element_integrals, p2_basis,
+                 p2_element_matrices, p2_integrals, quadrature_weights)
 from .fields import VectorField, at_points, element_dofs, scatter_element_vectors
 from .kernels import nearest_rotation, split_coefficients, strains, update_multipliers
 from .scene import REFERENCE_FRAME
@@ -80,20 +85,25 @@ class UzawaSolver:
         start, end = scene.start_state(0.0), scene.end_state(0.0)
         h = mesh.element_h
         EVENTS["assembly"].begin()
-        self.r_problem = ScalarProblem(
-            mesh, HERMITE, r_element_matrices(h, 2 * a[2], self.penalty),
-            boundary.r_prescribed(start, end, mesh.n_elements), "rod_r_")
-        self.d_problems = [ScalarProblem(
-            mesh, P2, d_element_matrices(h, 2 * a[i], self.penalty),
-            boundary.director_prescribed(i, start, end, mesh.n_elements), f"rod_d{i + 1}_")
-            for i in range(2)]
+        # frame order: d1, d2, theta = r' = d3
+        self.problems = [ScalarProblem(
+            mesh, p2_element_matrices(h, 2 * a[i], self.penalty),
+            boundary.director_prescribed(i, start, end, mesh.n_elements), prefix)
+            for i, prefix in enumerate(("rod_d1_", "rod_d2_", "rod_r_"))]
+        self.d_problems, self.r_problem = self.problems[:2], self.problems[2]
+        # Both ends held: r(L) - r(0) = int theta dS is a constraint of the theta problem.
+        self.bordered = boundary.is_held(start) and boundary.is_held(end)
+        if self.bordered:
+            self.r_problem.add_integral_constraint(element_integrals(h))
         EVENTS["assembly"].end()
-        self.r, self.d1, self.d2 = (VectorField(mesh, n) for n in ("r", "d1", "d2"))
-        self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("r", "d1", "d2")]
+        self.d1, self.d2, self.theta, self.r = (VectorField(mesh, n)
+                                                for n in ("d1", "d2", "theta", "r"))
+        self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("d1", "d2", "theta")]
         self.load = VectorField(mesh, "load")
-        self.hermite = hermite_basis(GAUSS_POINTS, h)
         self.p2 = p2_basis(GAUSS_POINTS, h)
+        self.p2_integrals = p2_integrals(GAUSS_POINTS, h)
         self.weights = quadrature_weights(h)
+        self._multiplier = np.zeros(3)
         shape = (mesh.n_local_elements, GAUSS_POINTS.size, 3, 3)
         self.tau = np.zeros(shape)
         self.lam = np.zeros(shape)
@@ -107,6 +117,11 @@ class UzawaSolver:
         return self.settings.rtol * self.settings.penalty / self.penalty
 
     # --- state ---------------------------------------------------------------------
+    @property
+    def frame_fields(self):
+        """The P2 fields of the global step in frame order: d1, d2, theta = r' = d3."""
+        return self.d1, self.d2, self.theta
+
     def set_straight(self):
         """The straight reference state: r = S e_x, frame (e_y, e_z, e_x), lambda = 0."""
         mesh = self.mesh
@@ -114,7 +129,7 @@ class UzawaSolver:
         r[:, 0, 0] = mesh.vertex_S
         r[:, 1] = REFERENCE_FRAME[2]
         self.r.set_owned(r)
-        for index, director in enumerate((self.d1, self.d2)):
+        for index, director in enumerate(self.frame_fields):
             director.set_owned(np.broadcast_to(REFERENCE_FRAME[index], r.shape).copy())
         self.tau[:] = REFERENCE_FRAME
         self.lam[:] = 0.0
@@ -146,6 +161,19 @@ class UzawaSolver:
                                                       point_angle[..., None])
         self.remember_state()
 
+    def set_centreline(self, positions, slopes):
+        """r and theta from Hermite vertex data (n_owned, 3) each, e.g. a restart: theta is
+        the slope at the vertices and the cubic's derivative at the midpoints."""
+        mesh = self.mesh
+        self.r.set_owned(np.stack([positions, slopes], axis=1))
+        ghosted, left = self.r.ghosted(), mesh.element_local
+        theta = np.zeros((positions.shape[0], 2, 3))
+        theta[:, 0] = slopes
+        theta[:mesh.n_local_elements, 1] = midpoint_slopes(
+            ghosted[left, 0], ghosted[left, 1], ghosted[left + 1, 0], ghosted[left + 1, 1],
+            mesh.element_h)
+        self.theta.set_owned(theta)
+
     def remember_state(self):
         """Take the current fields as the reference of the next change test."""
         self._previous = self._stacked(self.point_values())
@@ -157,15 +185,22 @@ class UzawaSolver:
 
     # --- one continuation step ------------------------------------------------------
     def prepare_step(self, t):
-        """Prescribed values and loads at load factor t (lifting computed once)."""
+        """Prescribed values and loads at load factor t (lifting computed once).
+
+        The load of the theta problem is int F.g with F(S) = int_S^L f dS + offset
+        (centreline.load_offset), exactly integrated between the load breaks.
+        """
         scene, n = self.scene, self.mesh.n_elements
         start, end = scene.start_state(t), scene.end_state(t)
         self.start_state, self.end_state = start, end
-        self.r_problem.set_prescribed(boundary.r_prescribed(start, end, n))
-        for i, problem in enumerate(self.d_problems):
+        for i, problem in enumerate(self.problems):
             problem.set_prescribed(boundary.director_prescribed(i, start, end, n))
-        self.load.add_ghosted(load_ghosted(self.mesh, scene.load_piece_ends,
-                                           t * scene.load_values, start.force, end.force))
+        total = scene.load_beyond(0.0, t)
+        self._load_offset = load_offset(start, end, total)
+        self._anchor_work = anchor_work(start, end, total)
+        self.load.add_ghosted(load_ghosted(
+            self.mesh, lambda S: scene.load_beyond(S, t) + self._load_offset,
+            scene.load_piece_ends))
 
     def solve_step(self, t, label="", observer=None):
         """Uzawa iterations at load factor t until both stopping tests of §6 hold.
@@ -209,21 +244,18 @@ class UzawaSolver:
         n_ghosted = mesh.ghost_end - mesh.ghost_start
         EVENTS["rhs"].begin()
         target = R * tau - lam
-        # r: int (R tau3 - lambda3).p' + load;  d_a: int (R tau_a - lambda_a).g
-        r_vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.hermite[1], target[:, :, 2])
-        self.rhs[0].add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local,
-                                                        HERMITE, r_vectors))
-        for vec, load in zip(self.rhs[0].components, self.load.components):
+        # field i (d1, d2, theta): int (R tau_i - lambda_i).g, plus the load for theta
+        for i, rhs in enumerate(self.rhs):
+            vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.p2[0], target[:, :, i])
+            rhs.add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local, P2,
+                                                    vectors))
+        for vec, load in zip(self.rhs[2].components, self.load.components):
             vec.axpy(1.0, load)
-        for a in range(2):
-            d_vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.p2[0], target[:, :, a])
-            self.rhs[1 + a].add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local,
-                                                                P2, d_vectors))
         EVENTS["rhs"].end()
         EVENTS["solve"].begin()
-        self.r_problem.solve(self.rhs[0], self.r)
-        self.d_problems[0].solve(self.rhs[1], self.d1)
-        self.d_problems[1].solve(self.rhs[2], self.d2)
+        for problem, rhs, director in zip(self.d_problems, self.rhs[:2], (self.d1, self.d2)):
+            problem.solve(rhs, director)
+        self.solve_centreline()
         EVENTS["solve"].end()
         EVENTS["projection"].begin()
         self._points = self.point_values()
@@ -234,25 +266,35 @@ class UzawaSolver:
         update_multipliers(lam, directors, tau, R)
         EVENTS["multiplier"].end()
 
+    def solve_centreline(self):
+        """theta from its right-hand side ``rhs[2]``, bordered by r(L) - r(0) = int theta
+        when both ends are held (mu kept for end_reaction), then r at the vertices."""
+        if self.bordered:
+            chord = self.end_state.position - self.start_state.position
+            self._multiplier = self.r_problem.solve_constrained(self.rhs[2], self.theta, chord)
+        else:
+            self.r_problem.solve(self.rhs[2], self.theta)
+        theta = element_dofs(self.theta.ghosted(), self.mesh.element_local, P2)
+        positions = vertex_positions(self.mesh, theta, self.start_state, self.end_state)
+        self.r.set_owned(np.stack([positions, self.theta.owned()[:, 0]], axis=1))
+
     def point_values(self):
         """r, directors and their derivatives at the Gauss points of the owned elements."""
-        return self.evaluate(self.mesh.element_local, self.hermite, self.p2)
+        return self.evaluate(self.mesh.element_local, self.p2, self.p2_integrals)
 
-    def evaluate(self, element_local, hermite, p2):
+    def evaluate(self, element_local, p2, integrals):
         """Fields at points of the given elements (ghosted local indices, (ne,)).
 
-        hermite = (phi, dphi, ddphi), p2 = (phi, dphi) tabulated at the points, (ne, nq, k).
-        Returns r (ne, nq, 3), directors and derivatives (ne, nq, 3, 3), rows d1, d2, r'
-        and d1', d2', r''.
+        p2 = (phi, dphi) and integrals (fe.p2_integrals) tabulated at the points,
+        (ne, nq, 3). Returns r (ne, nq, 3), directors and derivatives (ne, nq, 3, 3), rows
+        d1, d2, r' = theta and d1', d2', r'' = theta'; r = r(S_e) + int_{S_e}^S theta.
         """
-        r = element_dofs(self.r.ghosted(), element_local, HERMITE)
-        d = [element_dofs(f.ghosted(), element_local, P2) for f in (self.d1, self.d2)]
-        phi, dphi, ddphi = hermite
-        directors = np.stack([at_points(p2[0], d[0]), at_points(p2[0], d[1]),
-                              at_points(dphi, r)], axis=2)
-        derivatives = np.stack([at_points(p2[1], d[0]), at_points(p2[1], d[1]),
-                                at_points(ddphi, r)], axis=2)
-        return {"r": at_points(phi, r), "directors": directors, "derivatives": derivatives}
+        dofs = [element_dofs(f.ghosted(), element_local, P2) for f in self.frame_fields]
+        left = self.r.ghosted()[element_local, 0]
+        directors = np.stack([at_points(p2[0], d) for d in dofs], axis=2)
+        derivatives = np.stack([at_points(p2[1], d) for d in dofs], axis=2)
+        return {"r": positions_at_points(left, dofs[2], integrals), "directors": directors,
+                "derivatives": derivatives}
 
     def norms(self):
         """Relative L2 change of (r, r', d1, d2) and RMS constraint residual (§6)."""
@@ -271,23 +313,27 @@ class UzawaSolver:
 
     # --- outputs --------------------------------------------------------------------
     def energy(self):
-        """W = int w dS - int f.r dS - end forces . r (§6), with u from the FE fields."""
+        """W = int w dS - int f.r dS - end forces . r (§6), with u from the FE fields.
+
+        The work is r(a).(applied forces) + int F.theta dS (centreline.anchor_work).
+        """
         p = self.point_values()
         u = strains(p["directors"], p["derivatives"])
         stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
-        work = sum(load.dot(r) for load, r in zip(self.load.components, self.r.components))
+        work = self._anchor_work + sum(load.dot(theta) for load, theta
+                                       in zip(self.load.components, self.theta.components))
         return self.mesh.global_sum(stored) - work
 
     def end_reaction(self):
-        """External force on the cable at S = L (N): the dead force at a free end, else the
-        residual of the r equation at the prescribed position dof (the FE reaction)."""
-        if self.end_state.kind == "free":
-            return self.end_state.force.copy()
-        return self.r_problem.residual_at(self.r, self.rhs[0], 2 * self.mesh.n_elements)
+        """External force N on the cable at S = L (N), n(S) = N + int_S^L f dS: F(L) - mu
+        (centreline.py), i.e. the dead force at a free end; -(int_0^L f dS + P_0) at a held
+        end when the start is free (force balance); and -mu, the multiplier of the last
+        global step's constraint r(L) - r(0) = int theta, when both ends are held (the FE
+        reaction, which contains lambda3)."""
+        return self._load_offset - self._multiplier
 
     def destroy(self):
-        for obj in [self.r_problem, *self.d_problems, self.r, self.d1, self.d2, self.load,
-                    *self.rhs]:
+        for obj in [*self.problems, *self.frame_fields, self.r, self.load, *self.rhs]:
             obj.destroy()
 
 

@@ -157,9 +157,10 @@ def test_force_at_a_free_end(solved):
 
 def test_force_at_a_free_start_from_the_reaction(solved):
     """n(S) is the force of the part beyond S on the part before it: at a free start
-    loaded by F, n(0) = -F. The solver reads it off the FE reaction at the clamp S = L,
-    so this checks the reaction (the constant test function is in the Hermite space: the
-    discrete force balance is exact, whatever the Uzawa iterate)."""
+    loaded by F, n(0) = -F. The solver takes the reaction at the clamp S = L from the
+    force balance, N = -(int f + F), which is the FE reaction of the r equation whatever
+    the Uzawa iterate (the constant test function is in the space of r: tests/
+    test_centreline.py compares it with the Hermite residual)."""
     force = np.array(CASES["free-clamp"]["start_force"])
     n = solved["free-clamp"]["fields"]["n"]
     assert np.abs(n[0] + force).max() < 1e-8

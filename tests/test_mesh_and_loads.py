@@ -21,25 +21,33 @@ def test_grading_ratio_and_ends():
 
 
 def test_piecewise_load_is_integrated_exactly(comm):
-    """Breaks inside elements: the load vector reproduces int f dS and int S f dS exactly
-    (Hermite value dofs sum to 1; p(S) = S has values S_i and slopes 1)."""
+    """Breaks inside elements: the theta load vector int F.g of F(S) = int_S^L f dS
+    reproduces, for the P2 functions g = 1 and g = S (exact in P2), int F dS = int S f dS
+    and int S F dS = int S^2/2 f dS exactly."""
     length = 3.0
     mesh = Mesh(comm, 7, length, grading=3.0)
     try:
         breaks = np.array([0.37, 1.1, 2.9])
         values = np.array([[1.0, -2.0, 0.5], [0.0, 3.0, 0.0], [-4.0, 1.0, 2.0], [2.0, 2.0, 2.0]])
-        ends = np.concatenate([[0.0], breaks, [length]])
+        scene = Scene(length=length, stiffness=[1.0, 1.0, 1.0], load_values=values,
+                      load_breaks=breaks)
+        ends = scene.load_piece_ends
         load = VectorField(mesh, "load")
-        load.add_ghosted(load_ghosted(mesh, ends, values, np.zeros(3), np.zeros(3)))
+        load.add_ghosted(load_ghosted(mesh, lambda S: scene.load_beyond(S, 1.0), ends))
         owned = load.owned()
         load.destroy()
-        total = mesh.global_sum(owned[:, 0].sum(axis=0))
-        first_moment = mesh.global_sum((mesh.vertex_S[:, None] * owned[:, 0]
-                                        + owned[:, 1]).sum(axis=0))
-        lengths = np.diff(ends)
-        midpoints = (ends[1:] + ends[:-1]) / 2
-        assert np.abs(total - lengths @ values).max() < 1e-13
-        assert np.abs(first_moment - (lengths * midpoints) @ values).max() < 1e-13
+        n_local = mesh.n_local_elements
+        owned_S = mesh.coordinates(np.arange(mesh.vertex_start, mesh.vertex_end))
+        midpoint_S = (owned_S[:n_local] + mesh.coordinates(
+            np.arange(mesh.vertex_start, mesh.vertex_start + n_local) + 1)) / 2
+        total = mesh.global_sum(owned[:, 0].sum(axis=0) + owned[:n_local, 1].sum(axis=0))
+        first_moment = mesh.global_sum((owned_S[:, None] * owned[:, 0]).sum(axis=0)
+                                       + (midpoint_S[:, None] * owned[:n_local, 1]).sum(axis=0))
+        assert np.abs(owned[n_local:, 1]).max(initial=0.0) == 0.0          # phantom slot
+        expected_total = (np.diff(ends**2) / 2) @ values
+        assert np.abs(total - expected_total).max() < 1e-13
+        assert np.abs(first_moment - (np.diff(ends**3) / 6) @ values).max() < 1e-13
+        assert np.abs(expected_total).max() > 1.0
     finally:
         mesh.destroy()
 
