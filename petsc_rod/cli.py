@@ -7,12 +7,12 @@ import time
 import numpy as np
 from petsc4py import PETSc
 
-from . import io, outputs
+from . import io, outputs, starts
 from .errors import RodError, RodInputError, RodNotConvergedError
 from .mesh import Mesh
 from .options import help_text, read_options, unused_options
 from .scene import Scene
-from .solver import Settings, UzawaSolver
+from .solver import STOP_STALLED, Settings, UzawaSolver
 
 
 def scene_from_options(values, given):
@@ -30,10 +30,23 @@ def scene_from_options(values, given):
     return scene
 
 
+def default_penalty(scene):
+    """R = max(400 max(K) / L^2, applied force / 2), N.
+
+    The first term is the bending scale (the paper's R = 400 for K = 200..360 daN m^2 on
+    20 m, within a factor of 4); the second is the scale of the tension, which the
+    multiplier lambda3 has to reach by steps of at most 2R per iteration: a 3000 m
+    catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges in the first
+    iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at 1.5e6 N
+    (docs/stability.md).
+    """
+    return max(400.0 * scene.stiffness.max() / scene.length**2, 0.5 * scene.applied_force())
+
+
 def settings_from_options(values, scene):
     penalty = values["rod_al_penalty"]
     if penalty is None:
-        penalty = 400.0 * scene.stiffness.max() / scene.length**2
+        penalty = default_penalty(scene)
     return Settings(penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"])
@@ -65,10 +78,7 @@ def run(comm=None):
         solver = UzawaSolver(mesh, scene, settings)
         if database.hasName("help"):
             return 0
-        if values["rod_initial"]:
-            outputs.set_state(solver, *io.read_state(values["rod_initial"], mesh))
-        else:
-            solver.set_straight()
+        start_from(solver, values)
         if values["rod_output"]:
             writer = io.ResultWriter(values["rod_output"], mesh)
         code = continuation(solver, values["rod_steps"], values["rod_imperfection"], writer,
@@ -90,6 +100,40 @@ def run(comm=None):
             mesh.destroy()
 
 
+def not_converged_reason(report, solver):
+    """Why a step stopped without converging, and what to change."""
+    settings = solver.settings
+    numbers = (f"estimated distance {report.distance:.2e} for -rod_al_rtol {settings.rtol:.2g}, "
+               f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
+               f"{settings.ctol:.2g}")
+    if report.reason == STOP_STALLED:
+        return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
+                "would not meet the tolerances within -rod_al_max_it; the mesh's floor (about "
+                "h^3) lies above them: use more -rod_elements or looser tolerances")
+    hint = ""
+    if settings.penalty < 0.1 * default_penalty(solver.scene):
+        hint = (f"; -rod_al_penalty {settings.penalty:g} is far below the problem's scale "
+                f"{default_penalty(solver.scene):.3g} (the default): raise it")
+    return f"did not converge in {report.iterations} iterations ({numbers}){hint}"
+
+
+def start_from(solver, values):
+    """The state the first step starts from: a restart file, or -rod_initial_shape."""
+    shape = values["rod_initial_shape"]
+    if shape not in starts.SHAPES:
+        raise RodInputError(f"-rod_initial_shape {shape}: unknown shape; use one of "
+                            + "|".join(starts.SHAPES))
+    if values["rod_initial"]:
+        if shape != "straight":
+            raise RodInputError("-rod_initial and -rod_initial_shape both set the start; "
+                                "give one of them")
+        outputs.set_state(solver, *io.read_state(values["rod_initial"], mesh=solver.mesh))
+    elif shape == "catenary":
+        solver.set_from_curve(starts.catenary_start(solver.scene, 1.0 / values["rod_steps"]))
+    else:
+        solver.set_straight()
+
+
 def continuation(solver, steps, imperfection, writer, say, options):
     """Reach the scene in ``steps`` equal load increments, each warm-started (§7) from the
     last state with its cross-sections rolled by ``imperfection`` (see
@@ -100,8 +144,7 @@ def continuation(solver, steps, imperfection, writer, say, options):
         f"R = {solver.settings.penalty:g}, {steps} step(s)")
     if solver.penalty > solver.settings.penalty:
         say(f"petsc_rod: the stiffness split is non-convex (method.md §2): R raised to "
-            f"{solver.penalty:.6g} so the global step stays convex on this mesh, and "
-            f"the change test tightened to {solver.change_tolerance:.3g} to match "
+            f"{solver.penalty:.6g} so the global step stays convex on this mesh "
             "(docs/stability.md)")
     total_iterations = 0
     for k in range(1, steps + 1):
@@ -114,12 +157,13 @@ def continuation(solver, steps, imperfection, writer, say, options):
         u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
         attributes = {"converged": int(report.converged), "iterations": report.iterations,
                       "constraint_residual": report.constraint_residual,
-                      "change": report.change, "energy": energy,
+                      "change": report.change, "estimated_distance": report.distance,
+                      "energy": energy,
                       "wall_time": time.perf_counter() - clock, "ranks": mesh.comm.getSize(),
                       "options": options, "load_factor": t}
         say(f"step {k}/{steps}: load factor {t:.4g}, "
             f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
-            f"iterations, change {report.change:.2e}, constraint residual (RMS) "
+            f"iterations, estimated distance {report.distance:.2e}, constraint residual (RMS) "
             f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}")
         if writer is not None:
             writer.write_step(f"steps/{k}", vertex, outputs.restart_state(solver),
@@ -129,8 +173,8 @@ def continuation(solver, steps, imperfection, writer, say, options):
     if writer is not None:
         writer.finish(f"steps/{k}", attributes)
     if not report.converged:
-        say(f"petsc_rod: error: step {k}/{steps} did not converge in {report.iterations} "
-            "iterations (-rod_al_max_it); the result file says converged = 0")
+        say(f"petsc_rod: error: step {k}/{steps} {not_converged_reason(report, solver)}; "
+            "the result file says converged = 0")
         return RodNotConvergedError.exit_code
     say(f"petsc_rod: converged, {total_iterations} iterations in "
         f"{time.perf_counter() - clock:.3g} s")

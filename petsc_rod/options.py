@@ -94,12 +94,18 @@ OPTIONS = [
            "at the start of each step, roll the cross-sections about the tangent by "
            "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left"),
     Option("rod_initial", _string, None, "FILE", "start from (restart) a result file"),
+    Option("rod_initial_shape", _string, "straight", "straight|catenary",
+           "start of the first step: the straight reference, or the inextensible catenary "
+           "of that step with its tension as multiplier (both ends held, uniform load)"),
     Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE"),
     Option("rod_al_penalty", _real, None, "R",
-           "augmented-Lagrangian penalty R, N; default 400 max(K) / L^2", POSITIVE),
+           "augmented-Lagrangian penalty R, N; default the larger of 400 max(K) / L^2 and half "
+           "the applied force int |f| dS + |end forces|", POSITIVE),
     Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
     Option("rod_al_rtol", _real, 1e-5, "tol",
-           "stop when the relative L2 change of (r, r', d1, d2) is below tol", POSITIVE),
+           "stop when the estimated relative L2 distance of (r, r', d1, d2) to the "
+           "iteration's limit, change x rho / (1 - rho) with rho the measured contraction "
+           "per iteration, is below tol", POSITIVE),
     Option("rod_al_ctol", _real, 1e-3, "tol",
            "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
            "below tol", POSITIVE),

@@ -71,6 +71,12 @@ class Scene:
         overlap = np.clip(ends[1:] - np.maximum(ends[:-1], S), 0.0, None)
         return t * overlap @ self.load_values
 
+    def applied_force(self):
+        """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
+        (and of the multiplier lambda3 that converges to it)."""
+        pieces = np.diff(self.load_piece_ends) @ np.linalg.norm(self.load_values, axis=1)
+        return float(pieces + np.linalg.norm(self.start_force) + np.linalg.norm(self.end_force))
+
     def start_state(self, t):
         return EndState(self.start, np.zeros(3), REFERENCE_FRAME.copy(), t * self.start_force)
 

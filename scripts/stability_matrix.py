@@ -1,0 +1,410 @@
+"""The matrix of hard cases of issue 4: each case run as a user runs it, judged.
+
+    python scripts/stability_matrix.py [--before] [--only NAME,...] [--ci] [--out DIR]
+
+Every case is a list of -rod_* options, run in a child process exactly as a user runs
+petsc_rod (``python -m petsc_rod``, or ``mpiexec -n 2 python -m petsc_rod`` for the
+2-rank cases) with its result written to a file. The exit code gives the outcome:
+
+- converged (exit 0) and, where a closed form or the independent reference exists, the
+  error against it within the case's bound: **converged**;
+- converged but the error above the bound: **WRONG** (a wrong answer handed back as
+  right: the one outcome that must never happen);
+- exit 3 (not converged, file marked converged = 0) or 4 (diverged, NaN, KSP failure,
+  no file), with the program's one-line reason: **stopped**;
+- anything else (a crash, a timeout, a converged run without a file): **failed**.
+
+Writes DIR/cases.csv (or cases_before.csv), and the case table into docs/stability.md
+between the markers ``<!-- matrix:begin -->`` and ``<!-- matrix:end -->`` (or
+``<!-- before:begin -->``/``<!-- before:end -->``). ``--before`` runs every case with the
+fixes of issue 4 switched off (the old default penalty 400 max(K)/L^2, the straight
+start, no step halving): the "before" column of docs/stability.md. ``--ci`` runs the
+small subset the tests run on 1 and 2 ranks (tests/test_stability_matrix.py). The full
+matrix takes about half an hour on two cores, most of it the 10^6-element catenary.
+"""
+
+import argparse
+import csv
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))
+
+from petsc_rod import closed_forms  # noqa: E402
+
+TIMEOUT = 1800.0          # s per case; beyond it the case is "failed (timeout)"
+COLUMNS = ("group", "case", "ranks", "elements", "outcome", "reason", "iterations",
+           "constraint_residual", "wall_time", "error", "bound", "what")
+
+# --------------------------------------------------------------------- the cases
+
+
+@dataclass
+class Case:
+    """One hard case: options, rank count, and how to judge its result.
+
+    ``check(result)`` returns (error, bound, what) from the result file's datasets and
+    attributes, or None where nothing independent is known (the outcome then rests on
+    the solver's own convergence report). ``needs`` names a case whose result file is
+    this one's -rod_initial.
+    """
+
+    group: str
+    name: str
+    options: dict
+    check: object = None
+    ranks: int = 1
+    needs: str = None
+    ci: bool = False
+    notes: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def elements(self):
+        return int(float(self.options.get("elements", 64)))
+
+
+def option_list(options):
+    """{'length': 1, ...} -> ['-rod_length', '1', ...]."""
+    words = []
+    for key, value in options.items():
+        words += [f"-rod_{key}", str(value)]
+    return words
+
+
+def max_error(a, b):
+    return float(np.max(np.linalg.norm(np.asarray(a) - np.asarray(b), axis=-1)))
+
+
+# A cantilever bent about its weak axis d1 (the tip force along -z, d1 = e_y): a planar
+# elastica with EI = K1 whatever K2 and K3 are (bending about the stiff axis d2 would
+# buckle sideways, lateral-torsional buckling, and has no planar closed form).
+CANTILEVER_LOAD = 3.0              # P L^2 / K1
+
+
+def cantilever(K2=1.0, K3=1.0, elements=32, **overrides):
+    options = {"length": 1, "stiffness": f"1,{K2:g},{K3:g}", "start": "clamp",
+               "end": "free", "end_force": f"0,0,{-CANTILEVER_LOAD:g}",
+               "elements": elements, "steps": 2, "al_rtol": 1e-7, "al_ctol": 1e-5,
+               "al_max_it": 20000}
+    options.update(overrides)
+    return options
+
+
+def check_cantilever(bound):
+    def check(result):
+        tip = closed_forms.cantilever_tip(1.0, 1.0, CANTILEVER_LOAD)
+        exact = np.array([tip[0], 0.0, tip[1]])      # the -y deflection, turned to -z
+        return max_error(result["r"][-1], exact), bound, "tip position vs elastica, m"
+    return check
+
+
+def twist(K3=1.0, angle=1.0, elements=32, **overrides):
+    options = {"length": 1, "stiffness": f"1,1,{K3:g}", "start": "clamp", "end": "clamp",
+               "end_twist": angle, "elements": elements, "steps": 2, "al_rtol": 1e-8,
+               "al_ctol": 1e-6, "al_max_it": 20000}
+    options.update(overrides)
+    return options
+
+
+def check_twist(angle, K3, bound):
+    def check(result):
+        exact = 0.5 * K3 * angle**2               # W = K3 angle^2 / 2L, L = 1
+        straight = np.outer(result["S"], [1.0, 0.0, 0.0])
+        error = max(abs(float(result["energy"]) - exact) / exact,
+                    max_error(result["r"], straight))
+        return error, bound, "max(|W - K3 angle^2/2L| / W, |r - S e_x|)"
+    return check
+
+
+def check_straight(bound):
+    def check(result):
+        straight = np.outer(result["S"], [1.0, 0.0, 0.0])
+        return max_error(result["r"], straight), bound, "|r - S e_x| (taut: straight), m"
+    return check
+
+
+CATENARY = {"length": 3000, "stiffness": "1e5,1e5,7.5e4", "start": "pin", "end": "pin",
+            "end_position": "2500,0,0", "load": "0,0,-1000", "al_rtol": 1e-10,
+            "al_ctol": 1e-7, "al_max_it": 20000}
+# Away from the ends: 30 m, 100 boundary-layer widths sqrt(EI/T) = 0.29 m.
+CATENARY_INTERIOR = 30.0
+
+
+def catenary(elements, **overrides):
+    options = dict(CATENARY, elements=elements, initial_shape="catenary")
+    options.update(overrides)
+    return options
+
+
+def check_catenary(bound):
+    def check(result):
+        S = result["S"]
+        exact, _, _ = closed_forms.catenary(3000.0, np.array([2500.0, 0.0, 0.0]),
+                                            np.array([0.0, 0.0, -1000.0]), S)
+        inside = (S > CATENARY_INTERIOR) & (S < 3000.0 - CATENARY_INTERIOR)
+        return (max_error(result["r"][inside], exact[inside]), bound,
+                "r vs inextensible catenary, 30 m from the ends, m")
+    return check
+
+
+PAPER = {"length": 20, "stiffness": "235,360,200", "start": "clamp", "end": "pin",
+         "end_position": "16,4,0", "elements": 80, "al_penalty": 400, "al_rtol": 1e-7,
+         "al_ctol": 1e-5, "al_max_it": 200000, "steps": 8, "imperfection": 0.01}
+
+
+def check_paper_reference(bound, stiffness):
+    """Against petsc_rod.reference (collocation, solve_bvp) started from the result."""
+    def check(result):
+        from petsc_rod import reference
+        guess = reference.initial_guess_from_result(result["path"])
+        S, r, frames, n, m = (guess[k] for k in ("S", "r", "frames", "n", "m"))
+        bvp = reference.solve_rod_bvp(20.0, stiffness, r[-1], S, r, frames, n, m, tol=1e-10)
+        if bvp.status != 0:
+            return math.nan, bound, "reference (solve_bvp) did not converge"
+        exact = bvp.sample(result["S"])["r"]
+        return max_error(result["r"], exact), bound, "r vs collocation reference, m"
+    return check
+
+
+def cases():
+    """The matrix (issue 4, point 1)."""
+    matrix = []
+    add = matrix.append
+    # stiffness ratios: K2/K1 on the weak-axis cantilever, K3/K1 on pure twist
+    for ratio in (1, 10, 100, 1000):
+        add(Case("stiffness", f"cantilever K2/K1 = {ratio}", cantilever(K2=ratio),
+                 check_cantilever(1e-5), ci=ratio == 10,
+                 notes="K2 > K1 + K3: non-convex split" if ratio > 2 else ""))
+    for ratio in (0.01, 0.1, 1, 10):
+        add(Case("stiffness", f"twist K3/K1 = {ratio:g}", twist(K3=ratio, elements=16),
+                 check_twist(1.0, ratio, 1e-6), ci=ratio == 10,
+                 notes="K3 > K1 + K2: non-convex split" if ratio > 2 else ""))
+    add(Case("stiffness", "paper K3 = 200", PAPER, check_paper_reference(2e-3, (235, 360, 200))))
+    add(Case("stiffness", "paper K3 = 100", dict(PAPER, stiffness="235,360,100", elements=20),
+             check_paper_reference(1e-2, (235, 360, 100)), notes="non-convex split"))
+    # penalty R from 1e-3 to 1e3 times the stiffness scale K/L^2 = 1
+    for exponent in range(-3, 4):
+        add(Case("penalty", f"cantilever R = 1e{exponent:+d} K/L^2",
+                 cantilever(al_penalty=f"1e{exponent}"), check_cantilever(1e-5),
+                 ci=exponent == 2))
+    # tolerances
+    for rtol in (1e-6, 1e-8, 1e-10):
+        add(Case("tolerance", f"cantilever rtol = {rtol:g}, ctol = {100 * rtol:g}",
+                 cantilever(al_penalty=100, al_rtol=rtol, al_ctol=100 * rtol, elements=64),
+                 check_cantilever(1e-6 if rtol < 1e-7 else 1e-3)))
+    add(Case("tolerance", "twist rtol = 1e-10, ctol = 1e-10",
+             twist(elements=64, al_rtol=1e-10, al_ctol=1e-10), check_twist(1.0, 1.0, 1e-8)))
+    add(Case("tolerance", "twist on 2 elements, ctol = 1e-8 (below the mesh's floor)",
+             twist(elements=2, al_ctol=1e-8), notes="expected: stopped, stalled"))
+    # nearly folded and taut
+    folded = math.sqrt(0.5) * 0.2
+    add(Case("folded", "paper, end 0.2 m (1% of L) from the clamp",
+             dict(PAPER, end_position=f"{folded:.6f},{folded:.6f},0", steps=40),
+             notes="no closed form"))
+    add(Case("folded", "taut: the bent paper state pulled to r(L) = (20, 0, 0)",
+             dict(PAPER, end_position="20,0,0", steps=1),
+             check_straight(1e-6), needs="paper K3 = 200"))
+    # large twist: Greenhill
+    greenhill = 2.861 * math.pi                  # clamped-clamped, K1 = K2 = K3
+    for angle in (6.0, 4 * math.pi):
+        add(Case("twist", f"clamped-clamped, chord 0.98 L, twist {angle:.3g} rad",
+                 twist(angle=angle, elements=64, end_position="0.98,0,0", steps=40,
+                       imperfection=0.01, al_rtol=1e-9, al_ctol=1e-7),
+                 notes=("beyond" if angle > greenhill else "below")
+                 + f" the Greenhill angle {greenhill:.3g} rad"))
+    # mesh extremes
+    coarse = {"al_rtol": 1e-5, "al_ctol": 1e-3}             # the paper's tolerances
+    add(Case("mesh", "cantilever, 2 elements", cantilever(elements=2, **coarse),
+             check_cantilever(5e-2), ci=True))
+    add(Case("mesh", "twist, 2 elements", twist(elements=2, **coarse),
+             check_twist(1.0, 1.0, 1e-3), ci=True))
+    # long and slender: the 3000 m catenary
+    add(Case("catenary", "uniform, h = 1 m", catenary(3000), check_catenary(1e-4), ci=True))
+    add(Case("catenary", "graded 20:1, h = 0.095 m at the pins",
+             catenary(3000, mesh_grading=20), check_catenary(1e-4)))
+    add(Case("catenary", "graded 20:1, straight start, 10 steps",
+             catenary(3000, mesh_grading=20, initial_shape="straight", steps=10),
+             check_catenary(1e-4)))
+    add(Case("catenary", "uniform, 10^5 elements", catenary(100000), check_catenary(1e-4),
+             ranks=2))
+    add(Case("catenary", "uniform, 10^6 elements (h/L = 1e-6)", catenary(1000000),
+             check_catenary(1e-4), ranks=2))
+    return matrix
+
+
+# --------------------------------------------------------------------- running
+
+
+def before_options(case):
+    """The case as it ran before the fixes of issue 4: the old default penalty, the
+    straight start, no step halving."""
+    options = dict(case.options)
+    if "al_penalty" not in options:
+        K = max(float(v) for v in str(options["stiffness"]).split(","))
+        options["al_penalty"] = f"{400 * K / float(options['length'])**2:.6g}"
+    options["initial_shape"] = "straight"
+    options["max_halvings"] = 0
+    return options
+
+
+def python_command(ranks):
+    python = [sys.executable, "-m", "petsc_rod"]
+    return python if ranks == 1 else ["mpiexec", "-n", str(ranks)] + python
+
+
+def read_result(path):
+    import h5py
+    with h5py.File(path, "r") as f:
+        result = {k: np.array(f[k]) for k in ("S", "r", "d1", "d2", "d3", "u")}
+        result.update({k: f.attrs[k] for k in f.attrs})
+        steps = f["steps"]
+        result["total_iterations"] = int(sum(steps[k].attrs["iterations"] for k in steps))
+    result["path"] = path
+    return result
+
+
+def run_case(case, folder, before=False, ranks=None, initial=None, keep=None):
+    """Run one case in a child process; a row of COLUMNS plus the result (or None)."""
+    ranks = ranks or case.ranks
+    options = before_options(case) if before else dict(case.options)
+    output = keep or os.path.join(folder, "result.h5")
+    command = python_command(ranks) + option_list(options) + ["-rod_output", output]
+    if initial:
+        command += ["-rod_initial", initial]
+    row = {"group": case.group, "case": case.name, "ranks": ranks,
+           "elements": case.elements, "iterations": "", "constraint_residual": "",
+           "error": "", "bound": "", "what": "", "reason": ""}
+    clock = time.perf_counter()
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT,
+                              cwd=ROOT)
+        code, text = done.returncode, done.stdout + done.stderr
+    except subprocess.TimeoutExpired:
+        code, text = None, f"timeout after {TIMEOUT:g} s"
+    row["wall_time"] = f"{time.perf_counter() - clock:.1f}"
+    lines = [line for line in text.splitlines() if line.strip()]
+    errors = [line for line in lines if "error:" in line]
+    row["reason"] = (errors[-1] if errors else (lines[-1] if lines else "")).replace(
+        "petsc_rod: error: ", "")
+    result = None
+    if code in (0, 3) and os.path.isfile(output):
+        result = read_result(output)
+        row["iterations"] = result["total_iterations"]
+        row["constraint_residual"] = f"{float(result['constraint_residual']):.2e}"
+    if code == 0 and result is not None:
+        row["outcome"], row["reason"] = "converged", ""
+        if case.check is not None:
+            error, bound, what = case.check(result)
+            row.update(error=f"{error:.2e}", bound=f"{bound:.0e}", what=what)
+            if not error <= bound:
+                row["outcome"] = "WRONG"
+    elif code in (3, 4, 2):
+        row["outcome"] = "stopped"
+        if code == 4:
+            match = re.search(r"iteration (\d+)", row["reason"])
+            row["iterations"] = match.group(1) if match else ""
+    else:
+        row["outcome"] = "failed"
+        row["reason"] = row["reason"] or f"exit code {code}"
+    return row, result
+
+
+def run_matrix(selected, folder, before, say):
+    rows, files = [], {}
+    for case in selected:
+        initial = files.get(case.needs)
+        keep = os.path.join(folder, f"case{len(rows)}.h5")
+        row, _ = run_case(case, folder, before=before, initial=initial, keep=keep)
+        files[case.name] = keep if os.path.isfile(keep) else None
+        rows.append(row)
+        say(f"{row['group']:9s} {row['case']:58s} {row['outcome']:9s} "
+            f"its {row['iterations']!s:>7s}  {row['wall_time']:>7s} s  err {row['error'] or '-':>8s}"
+            f"  {row['reason'][:90]}")
+    return rows
+
+
+# --------------------------------------------------------------------- the document
+
+
+def table(rows):
+    lines = ["| group | case | ranks | N | outcome | iterations | constraint residual | "
+             "time (s) | error (bound) | reason or what |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for row in rows:
+        error = f"{row['error']} ({row['bound']})" if row["error"] else "—"
+        detail = row["reason"] or row["what"]
+        lines.append(f"| {row['group']} | {row['case']} | {row['ranks']} | {row['elements']} "
+                     f"| {row['outcome']} | {row['iterations']} | {row['constraint_residual']} "
+                     f"| {row['wall_time']} | {error} | {detail} |")
+    counts = {o: sum(r["outcome"] == o for r in rows)
+              for o in ("converged", "stopped", "WRONG", "failed")}
+    summary = ", ".join(f"{v} {k}" for k, v in counts.items())
+    return [f"{len(rows)} cases: {summary}.", ""] + lines
+
+
+def write_into(document, marker, lines):
+    text = Path(document).read_text()
+    begin, end = f"<!-- {marker}:begin -->", f"<!-- {marker}:end -->"
+    if begin not in text:
+        text += f"\n{begin}\n{end}\n"
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    Path(document).write_text(head + begin + "\n" + "\n".join(lines) + "\n" + end + tail)
+
+
+def write_csv(path, rows):
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--before", action="store_true",
+                        help="switch the fixes of issue 4 off (docs/stability.md 'before')")
+    parser.add_argument("--only", help="comma-separated substrings of case names to run")
+    parser.add_argument("--ci", action="store_true", help="only the CI subset")
+    parser.add_argument("--out", default=str(ROOT / "docs" / "stability"))
+    parser.add_argument("--document", default=str(ROOT / "docs" / "stability.md"))
+    args = parser.parse_args()
+    selected = [c for c in cases() if (not args.ci or c.ci)]
+    if args.only:
+        wanted = args.only.split(",")
+        names = {c.name for c in selected if any(w in c.name for w in wanted)}
+        needed = {c.needs for c in selected if c.name in names and c.needs}
+        selected = [c for c in selected if c.name in names | needed]
+    os.makedirs(args.out, exist_ok=True)
+
+    def say(text):
+        print(text, flush=True)
+
+    clock = time.perf_counter()
+    with tempfile.TemporaryDirectory() as folder:
+        rows = run_matrix(selected, folder, args.before, say)
+    name = "cases_before.csv" if args.before else "cases.csv"
+    write_csv(os.path.join(args.out, name), rows)
+    if not (args.only or args.ci):
+        command = "python scripts/stability_matrix.py" + (" --before" if args.before else "")
+        lines = [f"Written by `{command}` in {time.perf_counter() - clock:.0f} s "
+                 f"(CSV: `docs/stability/{name}`).", ""] + table(rows)
+        write_into(args.document, "before" if args.before else "matrix", lines)
+    say(f"{len(rows)} cases in {time.perf_counter() - clock:.0f} s; "
+        + table(rows)[0])
+    return 0 if all(r["outcome"] != "WRONG" for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
