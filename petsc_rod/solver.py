@@ -174,6 +174,31 @@ class UzawaSolver:
             mesh.element_h)
         self.theta.set_owned(theta)
 
+    def snapshot(self):
+        """Copies of this rank's share of the state a warm start needs (method.md §3: r,
+        d, tau, lambda; theta = r' with r), so that a failed continuation step can be
+        undone (``restore``). Owned arrays only: nothing is gathered or communicated."""
+        state = {name: field.owned() for name, field in self._state_fields().items()}
+        state.update(tau=self.tau.copy(), lam=self.lam.copy(),
+                     multiplier=self._multiplier.copy())
+        return state
+
+    def restore(self, snapshot):
+        """Put back a ``snapshot`` exactly (bit for bit), e.g. after a step that diverged
+        and left NaN in the fields. The prescribed values and loads stay those of the
+        last ``solve_step``; the next one sets its own."""
+        for name, field in self._state_fields().items():
+            field.set_owned(snapshot[name])
+        self.tau[:] = snapshot["tau"]
+        self.lam[:] = snapshot["lam"]
+        self._multiplier = snapshot["multiplier"].copy()
+        self.remember_state()
+
+    def _state_fields(self):
+        """The VectorFields of the state, by name (the centreline r holds (r, r') at the
+        vertices; theta = r' the P2 slope the global step solves for)."""
+        return {"r": self.r, "theta": self.theta, "d1": self.d1, "d2": self.d2}
+
     def remember_state(self):
         """Take the current fields as the reference of the next change test."""
         self._previous = self._stacked(self.point_values())
@@ -219,7 +244,8 @@ class UzawaSolver:
             try:
                 self.iterate()
             except RodDivergedError as error:
-                raise RodDivergedError(f"{label}iteration {iteration}: {error}") from None
+                raise RodDivergedError(f"{label}iteration {iteration}: {error}",
+                                       iteration) from None
             change, residual = self.norms()
             history.append((change, residual, time.perf_counter() - clock))
             if not (np.isfinite(change) and np.isfinite(residual)) \
@@ -227,7 +253,7 @@ class UzawaSolver:
                 raise RodDivergedError(
                     f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
                     f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
-                    "-rod_steps")
+                    "-rod_steps", iteration)
             if observer is not None and observer(iteration, change, residual):
                 return StepReport(False, iteration, change, residual, history)
             if settings.monitor:
