@@ -20,6 +20,13 @@ class RodNotConvergedError(RodError):
 
 
 class RodDivergedError(RodError):
-    """NaN/Inf or a linear-solver failure; no result is written."""
+    """NaN/Inf or a linear-solver failure; no result is written.
+
+    ``iterations``: how many Uzawa iterations the step had made when it diverged (None
+    when not known), so that a continuation that retries the step can count them."""
 
     exit_code = 4
+
+    def __init__(self, message, iterations=None):
+        super().__init__(message)
+        self.iterations = iterations

@@ -26,6 +26,7 @@ def nearest_rotation(b):
     iteration X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3), on the nine
     components as contiguous arrays: several times faster than a batched LAPACK SVD.
     The other points, and any that Newton leaves unconverged, go through the SVD.
+    A b with NaN or Inf gives NaN.
     """
     b = np.asarray(b, dtype=float)
     flat = b.reshape(-1, 3, 3)
@@ -40,7 +41,11 @@ def nearest_rotation(b):
     t[newton] = polar.transpose(2, 0, 1)
     rest = ~newton
     rest[np.flatnonzero(newton)[~converged]] = True
-    t[rest] = nearest_rotation_svd(flat[rest])
+    # NaN/Inf (a diverged iteration) would make the SVD raise on this rank alone: give
+    # NaN instead, which the iteration's collective norms report as a divergence.
+    finite = np.isfinite(flat).all(axis=(1, 2))
+    t[rest & ~finite] = np.nan
+    t[rest & finite] = nearest_rotation_svd(flat[rest & finite])
     return t.reshape(b.shape)
 
 

@@ -93,6 +93,11 @@ OPTIONS = [
     Option("rod_imperfection", _real, 0.0, "eps",
            "at the start of each step, roll the cross-sections about the tangent by "
            "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left"),
+    Option("rod_max_halvings", _int, 4, "n",
+           "a step that does not converge or diverges is retried from the last converged "
+           "state with half the increment, at most n times per step (smallest increment "
+           "1/(K 2^n)); 0: stop at the first failure",
+           (lambda v: v >= 0, "must be >= 0")),
     Option("rod_initial", _string, None, "FILE", "start from (restart) a result file"),
     Option("rod_initial_shape", _string, "straight", "straight|catenary",
            "start of the first step: the straight reference, or the inextensible catenary "

@@ -24,7 +24,6 @@ from .fe import (GAUSS_POINTS, P2, STIFFNESS_TO_MASS_MAX, element_integrals, p2_
                  p2_element_matrices, p2_integrals, quadrature_weights)
 from .fields import VectorField, at_points, element_dofs, scatter_element_vectors
 from .kernels import nearest_rotation, split_coefficients, strains, update_multipliers
-from .scene import REFERENCE_FRAME
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
           for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}
@@ -62,7 +61,7 @@ STOP_MAX_IT = "max_it"
 STOP_STALLED = "stalled"
 STOP_OBSERVER = "observer"
 # The stall test looks at windows of this many iterations (stalled_projection) ...
-STALL_WINDOW = 200
+STALL_WINDOW = 1000
 # ... and only once both stopping quantities are within this factor of their tolerances
 # (an iterate still far away, e.g. leaving an unstable branch, may see them grow for a
 # while and is not stalled).
@@ -150,6 +149,19 @@ def effective_penalty(penalty, split, smallest_element):
     return max(float(penalty), NONCONVEX_MARGIN * floor)
 
 
+def default_penalty(scene):
+    """R = max(400 max(K) / L^2, applied force / 2), N.
+
+    The first term is the bending scale (the paper's R = 400 for K = 200..360 daN m^2 on
+    20 m, within a factor of 4); the second is the scale of the tension, which the
+    multiplier lambda3 has to reach by steps of at most 2R per iteration: a 3000 m
+    catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges in the first
+    iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at 1.5e6 N
+    (docs/stability.md).
+    """
+    return max(400.0 * scene.stiffness.max() / scene.length**2, 0.5 * scene.applied_force())
+
+
 class UzawaSolver:
     """Owns every PETSc object of the solve; ``destroy()`` releases them all."""
 
@@ -183,6 +195,13 @@ class UzawaSolver:
         self.tau = np.zeros(shape)
         self.lam = np.zeros(shape)
         self._previous = None
+
+    @property
+    def change_tolerance(self):
+        """The change test's bound: rtol, times R_user / R when R was raised. The change
+        per iteration shrinks like 1/R near the solution (the contraction factor is about
+        1 - c/R), so the same rtol then stands for the same distance to the solution."""
+        return self.settings.rtol * self.settings.penalty / self.penalty
 
     # --- state ---------------------------------------------------------------------
     @property
@@ -254,6 +273,31 @@ class UzawaSolver:
             mesh.element_h)
         self.theta.set_owned(theta)
 
+    def snapshot(self):
+        """Copies of this rank's share of the state a warm start needs (method.md §3: r,
+        d, tau, lambda; theta = r' with r), so that a failed continuation step can be
+        undone (``restore``). Owned arrays only: nothing is gathered or communicated."""
+        state = {name: field.owned() for name, field in self._state_fields().items()}
+        state.update(tau=self.tau.copy(), lam=self.lam.copy(),
+                     multiplier=self._multiplier.copy())
+        return state
+
+    def restore(self, snapshot):
+        """Put back a ``snapshot`` exactly (bit for bit), e.g. after a step that diverged
+        and left NaN in the fields. The prescribed values and loads stay those of the
+        last ``solve_step``; the next one sets its own."""
+        for name, field in self._state_fields().items():
+            field.set_owned(snapshot[name])
+        self.tau[:] = snapshot["tau"]
+        self.lam[:] = snapshot["lam"]
+        self._multiplier = snapshot["multiplier"].copy()
+        self.remember_state()
+
+    def _state_fields(self):
+        """The VectorFields of the state, by name (the centreline r holds (r, r') at the
+        vertices; theta = r' the P2 slope the global step solves for)."""
+        return {"r": self.r, "theta": self.theta, "d1": self.d1, "d2": self.d2}
+
     def remember_state(self):
         """Take the current fields as the reference of the next change test."""
         self._previous = self._stacked(self.point_values())
@@ -284,14 +328,14 @@ class UzawaSolver:
 
     def solve_step(self, t, label="", observer=None):
         """Uzawa iterations at load factor t until both stopping tests of §6 hold:
-        change <= rtol and RMS constraint residual <= ctol. The estimated distance to the
-        limit (estimated_distance) is reported with the step, not tested: where the
-        iteration contracts slowly (R large for the problem) the change test stops far
-        from the limit, and the report says so; where the mesh's constraint floor makes
-        the multipliers drift there is no limit to be near (docs/stability.md). A step
-        whose change and residual are within STALL_FACTOR of their tolerances but, at
-        their rate, would not meet them within max_it stops early as stalled
-        (stalled_projection).
+        change <= change_tolerance (rtol) and RMS constraint residual <= ctol. The
+        estimated distance to the limit (estimated_distance) is reported with the step,
+        not tested: where the iteration contracts slowly (R large for the problem) the
+        change test stops far from the limit, and the report says so; where the mesh's
+        constraint floor makes the multipliers drift there is no limit to be near
+        (docs/stability.md). A step whose change and residual are within STALL_FACTOR of
+        their tolerances but, at their rate, would not meet them within max_it stops
+        early as stalled (stalled_projection).
 
         ``observer(iteration, change, residual)``, if given, is called (collectively)
         after each iteration's norms, e.g. to record the state at looser tolerances on
@@ -312,7 +356,8 @@ class UzawaSolver:
             try:
                 self.iterate()
             except RodDivergedError as error:
-                raise RodDivergedError(f"{label}iteration {iteration}: {error}") from None
+                raise RodDivergedError(f"{label}iteration {iteration}: {error}",
+                                       iteration) from None
             change, residual = self.norms()
             history.append((change, residual, time.perf_counter() - clock))
             if not (np.isfinite(change) and np.isfinite(residual)) \
@@ -320,7 +365,7 @@ class UzawaSolver:
                 raise RodDivergedError(
                     f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
                     f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
-                    "-rod_steps")
+                    "-rod_steps", iteration)
             changes.append(change)
             distance = estimated_distance(changes[-RATE_WINDOW - 1:])
             residuals.append(residual)
@@ -329,9 +374,9 @@ class UzawaSolver:
             if settings.monitor:
                 PETSc.Sys.Print(f"  {label}it {iteration:5d}  change {change:.3e}  distance "
                                 f"{distance:.3e}  constraint {residual:.3e}", comm=self.mesh.comm)
-            if change <= settings.rtol and residual <= settings.ctol:
+            if change <= self.change_tolerance and residual <= settings.ctol:
                 return report(True, iteration)
-            if stalled(changes, residuals, settings.rtol, settings.ctol,
+            if stalled(changes, residuals, self.change_tolerance, settings.ctol,
                        settings.max_it - iteration):
                 return report(False, iteration, STOP_STALLED)
         return report(False, settings.max_it, STOP_MAX_IT)

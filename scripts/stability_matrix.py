@@ -9,7 +9,9 @@ petsc_rod (``python -m petsc_rod``, or ``mpiexec -n 2 python -m petsc_rod`` for 
 - converged (exit 0) and, where a closed form or the independent reference exists, the
   error against it within the case's bound: **converged**;
 - converged but the error above the bound: **WRONG** (a wrong answer handed back as
-  right: the one outcome that must never happen);
+  right: the one outcome that must never happen), or **warned** when the run printed a
+  warning that its state may be that far from the solution (a slowly contracting
+  iteration stopped by the change test);
 - exit 3 (not converged, file marked converged = 0) or 4 (diverged, NaN, KSP failure,
   no file), with the program's one-line reason: **stopped**;
 - anything else (a crash, a timeout, a converged run without a file): **failed**.
@@ -185,11 +187,11 @@ def cases():
     # stiffness ratios: K2/K1 on the weak-axis cantilever, K3/K1 on pure twist
     for ratio in (1, 10, 100, 1000):
         add(Case("stiffness", f"cantilever K2/K1 = {ratio}", cantilever(K2=ratio),
-                 check_cantilever(1e-5), ci=ratio == 10,
+                 check_cantilever(1e-5),
                  notes="K2 > K1 + K3: non-convex split" if ratio > 2 else ""))
     for ratio in (0.01, 0.1, 1, 10):
         add(Case("stiffness", f"twist K3/K1 = {ratio:g}", twist(K3=ratio, elements=16),
-                 check_twist(1.0, ratio, 1e-6), ci=ratio == 10,
+                 check_twist(1.0, ratio, 1e-6), ci=ratio == 1,
                  notes="K3 > K1 + K2: non-convex split" if ratio > 2 else ""))
     add(Case("stiffness", "paper K3 = 200", PAPER, check_paper_reference(2e-3, (235, 360, 200))))
     add(Case("stiffness", "paper K3 = 100", dict(PAPER, stiffness="235,360,100", elements=20),
@@ -207,11 +209,12 @@ def cases():
     add(Case("tolerance", "twist rtol = 1e-10, ctol = 1e-10",
              twist(elements=64, al_rtol=1e-10, al_ctol=1e-10), check_twist(1.0, 1.0, 1e-8)))
     add(Case("tolerance", "twist on 2 elements, ctol = 1e-8 (below the mesh's floor)",
-             twist(elements=2, al_ctol=1e-8), notes="expected: stopped, stalled"))
+             twist(elements=2, al_ctol=1e-8), notes="expected: stopped, stalled", ci=True))
     # nearly folded and taut
     folded = math.sqrt(0.5) * 0.2
     add(Case("folded", "paper, end 0.2 m (1% of L) from the clamp",
-             dict(PAPER, end_position=f"{folded:.6f},{folded:.6f},0", steps=40),
+             dict(PAPER, end_position=f"{folded:.6f},{folded:.6f},0", steps=40,
+                  al_max_it=20000),
              notes="no closed form"))
     add(Case("folded", "taut: the bent paper state pulled to r(L) = (20, 0, 0)",
              dict(PAPER, end_position="20,0,0", steps=1),
@@ -221,7 +224,7 @@ def cases():
     for angle in (6.0, 4 * math.pi):
         add(Case("twist", f"clamped-clamped, chord 0.98 L, twist {angle:.3g} rad",
                  twist(angle=angle, elements=64, end_position="0.98,0,0", steps=40,
-                       imperfection=0.01, al_rtol=1e-9, al_ctol=1e-7),
+                       imperfection=0.01, al_rtol=1e-9, al_ctol=1e-6),
                  notes=("beyond" if angle > greenhill else "below")
                  + f" the Greenhill angle {greenhill:.3g} rad"))
     # mesh extremes
@@ -275,8 +278,9 @@ def read_result(path):
     return result
 
 
-def run_case(case, folder, before=False, ranks=None, initial=None, keep=None):
-    """Run one case in a child process; a row of COLUMNS plus the result (or None)."""
+def run_case(case, folder, before=False, ranks=None, initial=None, keep=None, env=None):
+    """Run one case in a child process (environment ``env``, default this one's); a row
+    of COLUMNS plus the result (or None)."""
     ranks = ranks or case.ranks
     options = before_options(case) if before else dict(case.options)
     output = keep or os.path.join(folder, "result.h5")
@@ -289,7 +293,7 @@ def run_case(case, folder, before=False, ranks=None, initial=None, keep=None):
     clock = time.perf_counter()
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT,
-                              cwd=ROOT)
+                              cwd=ROOT, env=env)
         code, text = done.returncode, done.stdout + done.stderr
     except subprocess.TimeoutExpired:
         code, text = None, f"timeout after {TIMEOUT:g} s"
@@ -303,13 +307,18 @@ def run_case(case, folder, before=False, ranks=None, initial=None, keep=None):
         result = read_result(output)
         row["iterations"] = result["total_iterations"]
         row["constraint_residual"] = f"{float(result['constraint_residual']):.2e}"
+    # the slow-contraction warning is itself one of the fixes: not counted --before
+    warnings = [] if before else [line.split("warning: ", 1)[1] for line in lines
+                                  if "warning: " in line]
     if code == 0 and result is not None:
         row["outcome"], row["reason"] = "converged", ""
         if case.check is not None:
             error, bound, what = case.check(result)
             row.update(error=f"{error:.2e}", bound=f"{bound:.0e}", what=what)
             if not error <= bound:
-                row["outcome"] = "WRONG"
+                # handed back as converged: WRONG, unless the run said it may be that far
+                row["outcome"] = "warned" if warnings else "WRONG"
+                row["reason"] = warnings[-1] if warnings else ""
     elif code in (3, 4, 2):
         row["outcome"] = "stopped"
         if code == 4:
@@ -349,7 +358,7 @@ def table(rows):
                      f"| {row['outcome']} | {row['iterations']} | {row['constraint_residual']} "
                      f"| {row['wall_time']} | {error} | {detail} |")
     counts = {o: sum(r["outcome"] == o for r in rows)
-              for o in ("converged", "stopped", "WRONG", "failed")}
+              for o in ("converged", "warned", "stopped", "WRONG", "failed")}
     summary = ", ".join(f"{v} {k}" for k, v in counts.items())
     return [f"{len(rows)} cases: {summary}.", ""] + lines
 

@@ -160,6 +160,14 @@ BAD_INPUTS = {
     "left-handed frame": (["-rod_end", "clamp", "-rod_end_frame", "0,1,0,0,0,1,-1,0,0"],
                           "-rod_end_frame"),
     "force at a clamp": (["-rod_end", "clamp", "-rod_end_force", "0,1,0"], "-rod_end_force"),
+    "unknown initial shape": (["-rod_initial_shape", "helix"], "-rod_initial_shape"),
+    "catenary with a free end": (["-rod_initial_shape", "catenary", "-rod_load", "0,0,-1"],
+                                 "-rod_initial_shape"),
+    "catenary without a load": (["-rod_initial_shape", "catenary", "-rod_end", "pin",
+                                 "-rod_end_position", "0.5,0,0"], "-rod_initial_shape"),
+    "catenary on one vertical": (["-rod_initial_shape", "catenary", "-rod_end", "pin",
+                                  "-rod_end_position", "0,0,-0.5", "-rod_load", "0,0,-1"],
+                                 "-rod_initial_shape"),
 }
 
 

@@ -146,6 +146,18 @@ def test_nearest_rotation_accepts_a_single_matrix():
     assert_proper_rotation(t)
 
 
+def test_nearest_rotation_of_nan_or_inf_is_nan_not_an_error():
+    """A diverged iteration must reach the collective divergence test (the norms), not
+    stop one rank in the SVD (LinAlgError)."""
+    b = np.stack([2.0 * np.eye(3)] * 3)
+    b[1, 0, 0] = np.nan
+    b[2, 1, 2] = np.inf
+    with np.errstate(invalid="ignore"):
+        t = nearest_rotation(b)
+    assert np.array_equal(t[0], np.eye(3))
+    assert np.isnan(t[1:]).all()
+
+
 def test_nearest_rotation_does_not_modify_its_input():
     rng = np.random.default_rng(6)
     b = rng.normal(size=(7, 3, 3))

@@ -1,0 +1,193 @@
+"""The continuation (method.md §7): the load path from the start to the scene in
+``-rod_steps`` steps, each warm-started from the last converged state, halved when a step
+fails, reported one line per step and written one group per step."""
+
+import time
+
+import numpy as np
+
+from . import outputs
+from .errors import RodDivergedError, RodNotConvergedError
+from .solver import STOP_STALLED, default_penalty
+
+
+def not_converged_reason(report, solver):
+    """Why a step stopped without converging, and what to change."""
+    settings = solver.settings
+    numbers = (f"change {report.change:.2e} for -rod_al_rtol {solver.change_tolerance:.2g}, "
+               f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
+               f"{settings.ctol:.2g}")
+    if report.reason == STOP_STALLED:
+        return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
+                "would not meet the tolerances within -rod_al_max_it; the mesh's floor (about "
+                "h^3) lies above them: use more -rod_elements or looser tolerances")
+    hint = ""
+    if settings.penalty < 0.1 * default_penalty(solver.scene):
+        hint = (f"; -rod_al_penalty {settings.penalty:g} is far below the problem's scale "
+                f"{default_penalty(solver.scene):.3g} (the default): raise it")
+    return f"did not converge in {report.iterations} iterations ({numbers}){hint}"
+
+
+class LoadPath:
+    """The load factors of the continuation: ``steps`` regular steps t_k = k/K, and the
+    sub-steps by which a step that failed is retried.
+
+    A failed attempt halves the increment (a smaller step starts nearer its solution,
+    §7), at most ``max_halvings`` times on the way to one t_k; an accepted sub-step keeps
+    the halved increment until t_k is reached, then the regular one is taken again.
+    Load factors are counted in whole units of 1/(K 2^max_halvings), so that every t_k is
+    reached exactly and is k/K to the last bit, as without halving.
+    """
+
+    def __init__(self, steps, max_halvings):
+        self.steps = steps
+        self.units_per_step = 2**max_halvings
+        self.reached = 0                          # units: the last accepted load factor
+        self.increment = self.units_per_step      # units
+        self.halvings = 0                         # in the whole run
+
+    def factor(self, units):
+        """The load factor of a number of units."""
+        return units / (self.steps * self.units_per_step)
+
+    @property
+    def step(self):
+        """The regular step k (from 1) being worked towards."""
+        return self.reached // self.units_per_step + 1
+
+    @property
+    def next_factor(self):
+        """The load factor of the next attempt."""
+        return self.factor(self.reached + self.increment)
+
+    @property
+    def finished(self):
+        return self.reached == self.steps * self.units_per_step
+
+    @property
+    def can_halve(self):
+        return self.increment > 1
+
+    def halve(self):
+        self.increment //= 2
+        self.halvings += 1
+
+    def given_up(self):
+        """What a run's failure message adds once halvings were tried ('' before)."""
+        if not self.halvings:
+            return ""
+        return (f"; load factor {self.next_factor:.6g} after {self.halvings} halving(s) of "
+                "the step (-rod_max_halvings)")
+
+    def accept(self):
+        """The attempt at ``next_factor`` converged: go on from there."""
+        self.reached += self.increment
+        if self.reached % self.units_per_step == 0:
+            self.increment = self.units_per_step
+
+
+def attempt(solver, t, imperfection, label):
+    """One try at load factor t from the current state, its cross-sections rolled first:
+    (report, failure), ``failure`` None when the step converged, the RodDivergedError
+    when it diverged (report None), else a sentence saying how far it got."""
+    solver.roll_cross_sections(imperfection)
+    try:
+        report = solver.solve_step(t, label=label)
+    except RodDivergedError as error:
+        return None, error
+    if report.converged:
+        return report, None
+    return report, (f"not converged in {report.iterations} iterations (change "
+                    f"{report.change:.2e}, constraint residual (RMS) "
+                    f"{report.constraint_residual:.2e})")
+
+
+def continuation(solver, steps, imperfection, writer, say, options, max_halvings):
+    """Reach the scene in ``steps`` equal load increments, each warm-started (§7) from the
+    last state with its cross-sections rolled by ``imperfection`` (see
+    UzawaSolver.roll_cross_sections). A step that does not converge or diverges is undone
+    (UzawaSolver.snapshot/restore) and retried with half the increment, at most
+    ``max_halvings`` times on the way to each t_k (LoadPath); the file has one group
+    ``steps/<n>`` per accepted step, and the failed one that ends a run."""
+    mesh = solver.mesh
+    clock = time.perf_counter()
+    say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
+        f"R = {solver.settings.penalty:g}, {steps} step(s)")
+    if solver.penalty > solver.settings.penalty:
+        say(f"petsc_rod: the stiffness split is non-convex (method.md §2): R raised to "
+            f"{solver.penalty:.6g} so the global step stays convex on this mesh, and "
+            f"the change test tightened to {solver.change_tolerance:.3g} to match "
+            "(docs/stability.md)")
+    path = LoadPath(steps, max_halvings)
+    total_iterations = undone_iterations = written = 0
+    while not path.finished:
+        t, label = path.next_factor, f"step {path.step}/{steps}"
+        saved = solver.snapshot()
+        report, failure = attempt(solver, t, imperfection, f"{label} ")
+        iterations = (failure.iterations or 0) if report is None else report.iterations
+        total_iterations += iterations
+        if failure is not None and path.can_halve and not stalled(report):
+            solver.restore(saved)
+            path.halve()
+            undone_iterations += iterations
+            reason = str(failure).removeprefix(f"{label} ")   # a divergence names the step
+            say(f"petsc_rod: {label} at load factor {t:.6g}: {reason}; halving "
+                f"{path.halvings}: retrying from load factor {path.factor(path.reached):.6g} "
+                f"with increment {path.factor(path.increment):.6g}")
+            continue
+        if report is None:
+            raise RodDivergedError(f"{failure}{path.given_up()}", failure.iterations) from None
+        written += 1
+        attributes = record_step(solver, report, t, label, say, writer, f"steps/{written}",
+                                 wall_time=time.perf_counter() - clock, options=options)
+        if not report.converged:
+            break
+        path.accept()
+    if writer is not None:
+        writer.finish(f"steps/{written}", attributes)
+    if not report.converged:
+        say(f"petsc_rod: error: {label} {not_converged_reason(report, solver)}"
+            f"{path.given_up()}; the result file says converged = 0")
+        return RodNotConvergedError.exit_code
+    say(f"petsc_rod: converged, {total_iterations} iterations in "
+        f"{time.perf_counter() - clock:.3g} s, {path.halvings} halving(s) of the step "
+        f"({undone_iterations} iterations undone)")
+    return 0
+
+
+def stalled(report):
+    """A stalled step is not retried with a smaller increment: the floor that stops it
+    is the mesh's, not the step's."""
+    return report is not None and report.reason == STOP_STALLED
+
+
+# A converged step whose estimated distance to the limit is above this many times rtol is
+# reported as stopped early by the change test (UzawaSolver.solve_step).
+SLOW_CONTRACTION = 10.0
+
+
+def record_step(solver, report, t, label, say, writer, group, **common):
+    """Say the state after a step at load factor t and write it as ``group`` (with the
+    attributes ``common`` to the run: wall_time, options); returns the group's attributes."""
+    mesh = solver.mesh
+    vertex = outputs.vertex_fields(solver, t)
+    energy = solver.energy()
+    u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
+    attributes = {"converged": int(report.converged), "iterations": report.iterations,
+                  "constraint_residual": report.constraint_residual,
+                  "change": report.change, "estimated_distance": report.distance,
+                  "energy": energy, "ranks": mesh.comm.getSize(),
+                  "load_factor": t, **common}
+    say(f"{label}: load factor {t:.4g}, "
+        f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
+        f"iterations, change {report.change:.2e}, constraint residual (RMS) "
+        f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}")
+    if report.converged and SLOW_CONTRACTION * solver.change_tolerance < report.distance < np.inf:
+        say(f"petsc_rod: warning: {label} met the change test, but the iteration still "
+            f"contracts slowly: its estimated distance to the limit is {report.distance:.2e} "
+            f"(change x rho / (1 - rho)), not {solver.change_tolerance:.2g}; for a state that "
+            "close, lower -rod_al_rtol (or -rod_al_penalty, which sets the contraction)")
+    if writer is not None:
+        writer.write_step(group, vertex, outputs.restart_state(solver), report.history,
+                          attributes)
+    return attributes

@@ -1,0 +1,224 @@
+"""Continuation steps that halve themselves when they fail (``-rod_max_halvings``).
+
+Two cantilevers (16 elements, clamped at 0, free end) that one load step cannot do and
+two can, measured when these tests were written:
+
+- BENT, tip force (0, -10, 0) N, R = 25: one step needs 336 iterations, so with
+  ``-rod_al_max_it 300`` it stops unconverged; the half steps converge in 242 and 274.
+- PULLED, pulled along its axis by 1.5e5 N, R = 100: the first global step of one step
+  gives |r'| about 1 + P/R, an RMS constraint residual of 1.4e3 above the divergence
+  bound (solver.DIVERGED_RESIDUAL = 1e3); the half steps (7.5e2) converge in 648 each.
+
+With halvings the run undoes the failed step and gets there in two half steps; since the
+undo is exact, it then does what ``-rod_steps 2`` does, iteration for iteration.
+
+The in-process tests run on any number of ranks; those that spawn ``python -m petsc_rod``
+are marked ``serial`` (tests/conftest.py).
+"""
+
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import child_env, gather
+from petsc_rod.continuation import LoadPath, continuation
+from petsc_rod.errors import RodDivergedError, RodNotConvergedError
+
+N_ELEMENTS = 16
+RTOL, CTOL = 1e-7, 1e-4
+BENT = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                       end_force=(0.0, -10.0, 0.0)),
+            penalty=25.0, max_it=300)
+PULLED = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                         end_force=(1.5e5, 0.0, 0.0)),
+              penalty=100.0, max_it=2000)
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TIMEOUT = 120
+
+
+def build(solver_factory, comm, case):
+    mesh, solver = solver_factory(comm, N_ELEMENTS, case["scene"], case["penalty"], RTOL, CTOL,
+                                  case["max_it"])
+    solver.set_straight()
+    return mesh, solver
+
+
+def run_continuation(solver_factory, comm, case, steps, max_halvings):
+    """continuation.continuation from the straight state, no file: (exit code, printed lines, the
+    final state gathered on every rank)."""
+    mesh, solver = build(solver_factory, comm, case)
+    lines = []
+    code = continuation(solver, steps, 0.0, None, lines.append, "", max_halvings)
+    state = {name: gather(comm, array) for name, array in owned_state(solver).items()}
+    state["energy"] = solver.energy()
+    return code, lines, state
+
+
+def owned_state(solver):
+    """Copies of this rank's share of every field of the Uzawa state."""
+    return {"r": solver.r.owned(), "theta": solver.theta.owned(), "d1": solver.d1.owned(),
+            "d2": solver.d2.owned(), "tau": solver.tau.copy(), "lam": solver.lam.copy()}
+
+
+def step_results(lines):
+    """What the step lines say after their label: load factor, iterations, change,
+    residual, energy (the label names the regular step, which halving changes)."""
+    return [line.split(": ", 1)[1] for line in lines if line.startswith("step ")]
+
+
+def assert_same_state(first, second):
+    for name in ("r", "theta", "d1", "d2", "tau", "lam"):
+        scale = np.abs(second[name]).max()
+        assert np.abs(first[name] - second[name]).max() <= 1e-9 * scale, name
+    assert first["energy"] == pytest.approx(second["energy"], rel=1e-9)
+
+
+# --- the sequence of load factors ------------------------------------------------------
+def test_without_halvings_the_load_factors_are_k_over_K():
+    path = LoadPath(7, 0)
+    factors = []
+    while not path.finished:
+        assert not path.can_halve
+        factors.append(path.next_factor)
+        path.accept()
+    assert factors == [k / 7 for k in range(1, 8)]
+
+
+def test_a_halved_step_goes_on_halved_to_t_k_then_regular():
+    path = LoadPath(3, 2)
+    assert (path.step, path.next_factor) == (1, 1 / 3)
+    path.halve()                                   # step 1 failed at 1/3
+    assert path.next_factor == 1 / 6
+    path.accept()
+    assert (path.step, path.next_factor) == (1, 1 / 3)      # still the halved increment
+    path.accept()
+    assert path.factor(path.reached) == 1 / 3      # t_1 exactly, the regular size again
+    assert (path.step, path.next_factor) == (2, 2 / 3)
+    path.halve()
+    path.halve()
+    assert not path.can_halve and path.halvings == 3
+    assert path.next_factor == pytest.approx(1 / 3 + 1 / 12, rel=1e-15)
+    for _ in range(4):
+        path.accept()
+    assert path.factor(path.reached) == 2 / 3 and path.next_factor == 1.0
+    path.accept()
+    assert path.finished
+
+
+# --- snapshot and restore ---------------------------------------------------------------
+def test_snapshot_restore_is_exact_and_the_next_step_repeats_itself(solver_factory, comm):
+    mesh, solver = build(solver_factory, comm, BENT)
+    assert solver.solve_step(0.5).converged
+    before = owned_state(solver)
+    saved = solver.snapshot()
+    first = solver.solve_step(1.0)
+    moved = owned_state(solver)
+    assert mesh.global_sum(float(np.abs(moved["r"] - before["r"]).max())) > 0.01
+    solver.restore(saved)
+    for name, values in owned_state(solver).items():
+        assert np.array_equal(values, before[name]), name
+    second = solver.solve_step(1.0)               # the change test starts from the restore
+    assert second.iterations == first.iterations
+    assert np.array_equal(np.array(second.history)[:, :2], np.array(first.history)[:, :2])
+    for name, values in owned_state(solver).items():
+        assert np.array_equal(values, moved[name]), name
+
+
+def test_restore_after_a_diverged_attempt_leaves_no_nan(solver_factory, comm):
+    mesh, solver = build(solver_factory, comm, BENT)
+    saved = solver.snapshot()
+    before = owned_state(solver)
+    solver.lam[0, 0, 0, 0] = np.nan                # a state gone bad on every rank
+    with pytest.raises(RodDivergedError) as error:
+        solver.solve_step(1.0)
+    assert error.value.iterations == 1
+    poisoned = [np.isnan(values).any() for values in owned_state(solver).values()]
+    assert mesh.global_sum(float(sum(poisoned))) >= comm.getSize()
+    solver.restore(saved)
+    for name, values in owned_state(solver).items():
+        assert np.isfinite(values).all(), name
+        assert np.array_equal(values, before[name]), name
+    solver.settings.max_it = 2000
+    assert solver.solve_step(1.0).converged
+
+
+# --- the continuation -------------------------------------------------------------------
+@pytest.mark.parametrize("case, failure, exit_code", [
+    (BENT, "not converged in 300 iterations", RodNotConvergedError.exit_code),
+    (PULLED, "diverged", None)], ids=["max_it", "diverged"])
+def test_a_failed_step_is_halved_and_ends_where_two_steps_do(solver_factory, comm, case,
+                                                             failure, exit_code):
+    if exit_code is None:
+        with pytest.raises(RodDivergedError, match="iteration 1: the iteration diverged"):
+            run_continuation(solver_factory, comm, case, 1, 0)
+    else:
+        code, lines, _ = run_continuation(solver_factory, comm, case, 1, 0)
+        assert code == exit_code, "\n".join(lines)
+    code, lines, halved = run_continuation(solver_factory, comm, case, 1, 4)
+    assert code == 0, "\n".join(lines)
+    halvings = [line for line in lines if "halving" in line and "retrying" in line]
+    assert len(halvings) == 1, "\n".join(lines)
+    assert failure in halvings[0] and "increment 0.5" in halvings[0], halvings[0]
+    assert "1 halving(s)" in lines[-1], lines[-1]
+    regular_code, regular_lines, regular = run_continuation(solver_factory, comm, case, 2, 0)
+    assert regular_code == 0, "\n".join(regular_lines)
+    assert step_results(lines) == step_results(regular_lines)
+    assert [r.split(",")[0] for r in step_results(lines)] == ["load factor 0.5", "load factor 1"]
+    assert_same_state(halved, regular)
+
+
+# --- the command line (spawns processes) -------------------------------------------------
+def cli_args(case):
+    scene = case["scene"]
+    return ["-rod_length", "1", "-rod_stiffness", "1,1,1", "-rod_end", "free",
+            "-rod_end_force", ",".join(f"{v:g}" for v in scene["end_force"]),
+            "-rod_elements", str(N_ELEMENTS), "-rod_al_penalty", f"{case['penalty']:g}",
+            "-rod_al_rtol", f"{RTOL:g}", "-rod_al_ctol", f"{CTOL:g}",
+            "-rod_al_max_it", str(case["max_it"])]
+
+
+def run_cli(args):
+    return subprocess.run([sys.executable, "-m", "petsc_rod"] + args, cwd=REPO_ROOT,
+                          env=child_env(), capture_output=True, text=True, timeout=TIMEOUT,
+                          check=False)
+
+
+def describe(process):
+    return f"exit {process.returncode}\nstdout:\n{process.stdout}\nstderr:\n{process.stderr}"
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("case, exit_code", [(BENT, 3), (PULLED, 4)],
+                         ids=["max_it", "diverged"])
+def test_no_halvings_keeps_the_failure_exit_code(tmp_path, case, exit_code):
+    path = tmp_path / "failed.h5"
+    process = run_cli(cli_args(case) + ["-rod_max_halvings", "0", "-rod_output", str(path)])
+    assert process.returncode == exit_code, describe(process)
+    assert "halving" not in process.stdout, describe(process)
+    assert not os.path.exists(f"{path}.partial")
+    if exit_code == 4:
+        assert not path.exists()
+        return
+    with h5py.File(path, "r") as f:
+        assert int(f.attrs["converged"]) == 0
+        assert list(f["steps"]) == ["1"]
+
+
+@pytest.mark.serial
+def test_halved_run_writes_one_group_per_accepted_step(tmp_path):
+    path = tmp_path / "halved.h5"
+    process = run_cli(cli_args(BENT) + ["-rod_output", str(path)])
+    assert process.returncode == 0, describe(process)
+    assert process.stdout.count("halving 1: retrying from load factor 0 with increment 0.5") == 1
+    with h5py.File(path, "r") as f:
+        assert int(f.attrs["converged"]) == 1
+        assert sorted(f["steps"]) == ["1", "2"]
+        assert [float(f[f"steps/{k}"].attrs["load_factor"]) for k in "12"] == [0.5, 1.0]
+        assert all(0 < int(f[f"steps/{k}"].attrs["iterations"]) < BENT["max_it"]
+                   for k in "12")
+        assert float(f.attrs["load_factor"]) == 1.0
+        assert np.array_equal(f["r"][:], f["steps/2/r"][:])
