@@ -19,8 +19,10 @@ def not_converged_reason(report, solver):
                f"{settings.ctol:.2g}")
     if report.reason == STOP_STALLED:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
-                "would not meet the tolerances within -rod_al_max_it; the mesh's floor (about "
-                "h^3) lies above them: use more -rod_elements or looser tolerances")
+                "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
+                "h^3) lies above them (use more -rod_elements or looser tolerances), or a "
+                "symmetry holds the iterate (a straight rod shortened along its axis: move "
+                "the end off the axis)")
     hint = ""
     if settings.penalty < 0.1 * default_penalty(solver.scene):
         hint = (f"; -rod_al_penalty {settings.penalty:g} is far below the problem's scale "

@@ -66,15 +66,21 @@ STALL_WINDOW = 1000
 # (an iterate still far away, e.g. leaving an unstable branch, may see them grow for a
 # while and is not stalled).
 STALL_FACTOR = 10.0
+# A rate that would need more than this many times the remaining budget is a stall; a
+# slower one is given the budget (an iterate leaving a nearly symmetric state speeds up:
+# its rate over one window underestimates it).
+STALL_MARGIN = 10.0
 
 
 def stalled_projection(values, target, budget):
     """Whether ``values`` (one per iteration, newest last), at their rate over the last
-    STALL_WINDOW iterations, would need more than ``budget`` further iterations to fall
-    to ``target``.
+    STALL_WINDOW iterations, would need more than STALL_MARGIN times ``budget`` further
+    iterations to fall to ``target``.
 
     The rate compares the smallest value of the last window with that of the window
-    before (both quantities oscillate from one iteration to the next): if the minimum
+    before (both quantities oscillate from one iteration to the next); no progress at all
+    counts only when it lasts two windows (an iterate leaving a nearly symmetric state
+    can mark time for a while and then go on). If the minimum
     falls by a factor q per window, reaching the target takes log(target / v_min) / log(q)
     windows. Why a step stalls: on a mesh too coarse for the tolerance the discrete
     constraint cannot be met (the residual settles on a floor, about h^3, and creeps down
@@ -82,25 +88,30 @@ def stalled_projection(values, target, budget):
     then drift, which keeps the change per iteration at a floor of its own. This test
     ends such a step with its reason instead of running out -rod_al_max_it.
     """
-    if len(values) < 2 * STALL_WINDOW:
+    if len(values) < 3 * STALL_WINDOW:
         return False
-    recent = min(values[-STALL_WINDOW:])
-    before = min(values[-2 * STALL_WINDOW:-STALL_WINDOW])
+    oldest, before, recent = (min(values[-k * STALL_WINDOW:len(values) - (k - 1) * STALL_WINDOW])
+                              for k in (3, 2, 1))
     if recent <= target:
         return False
     if recent >= before:
-        return True
+        return before >= oldest           # no progress over two windows in a row
     windows = np.log(target / recent) / np.log(recent / before)
-    return windows * STALL_WINDOW > budget
+    return windows * STALL_WINDOW > STALL_MARGIN * budget
 
 
 def stalled(changes, residuals, rtol, ctol, budget):
     """The stall test of UzawaSolver.solve_step: once the change and the constraint
-    residual are within STALL_FACTOR of their tolerances, whether either would not reach
-    its tolerance within ``budget`` iterations (stalled_projection)."""
-    if changes[-1] > STALL_FACTOR * rtol or residuals[-1] > STALL_FACTOR * ctol:
+    residual are within STALL_FACTOR of their tolerances (or the change is below rtol:
+    the iterate no longer moves, e.g. a straight rod whose ends are brought together
+    along its axis, held by its symmetry in a state that cannot meet the constraint),
+    whether either would not reach its tolerance within ``budget`` iterations
+    (stalled_projection)."""
+    if changes[-1] > STALL_FACTOR * rtol:
         return False
-    return any(stalled_projection(values[-2 * STALL_WINDOW:], tolerance, budget)
+    if residuals[-1] > STALL_FACTOR * ctol and changes[-1] > rtol:
+        return False
+    return any(stalled_projection(values[-3 * STALL_WINDOW:], tolerance, budget)
                for values, tolerance in ((changes, rtol), (residuals, ctol)))
 
 

@@ -99,7 +99,7 @@ def cantilever(K2=1.0, K3=1.0, elements=32, **overrides):
     options = {"length": 1, "stiffness": f"1,{K2:g},{K3:g}", "start": "clamp",
                "end": "free", "end_force": f"0,0,{-CANTILEVER_LOAD:g}",
                "elements": elements, "steps": 2, "al_rtol": 1e-7, "al_ctol": 1e-5,
-               "al_max_it": 20000}
+               "al_max_it": 10000}
     options.update(overrides)
     return options
 
@@ -219,12 +219,14 @@ def cases():
     add(Case("folded", "taut: the bent paper state pulled to r(L) = (20, 0, 0)",
              dict(PAPER, end_position="20,0,0", steps=1),
              check_straight(1e-6), needs="paper K3 = 200"))
-    # large twist: Greenhill
+    # large twist: Greenhill. The end is 2 mm off the axis: a straight rod whose ends are
+    # brought together exactly along its axis is held straight by its symmetry (it
+    # stalls at once, with that reason; tests/test_stability_fixes.py).
     greenhill = 2.861 * math.pi                  # clamped-clamped, K1 = K2 = K3
     for angle in (6.0, 4 * math.pi):
         add(Case("twist", f"clamped-clamped, chord 0.98 L, twist {angle:.3g} rad",
-                 twist(angle=angle, elements=64, end_position="0.98,0,0", steps=40,
-                       imperfection=0.01, al_rtol=1e-9, al_ctol=1e-6),
+                 twist(angle=angle, elements=64, end_position="0.98,0.002,0", steps=20,
+                       imperfection=0.01, al_penalty=100, al_rtol=1e-7, al_ctol=1e-5),
                  notes=("beyond" if angle > greenhill else "below")
                  + f" the Greenhill angle {greenhill:.3g} rad"))
     # mesh extremes

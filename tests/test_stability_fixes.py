@@ -8,7 +8,7 @@ import pytest
 from petsc_rod.closed_forms import catenary
 from petsc_rod.errors import RodInputError
 from petsc_rod.scene import Scene
-from petsc_rod.solver import (STALL_WINDOW, default_penalty, estimated_distance,
+from petsc_rod.solver import (STALL_MARGIN, STALL_WINDOW, default_penalty, estimated_distance,
                               stalled_projection)
 from petsc_rod.starts import catenary_start
 
@@ -97,13 +97,19 @@ def test_estimated_distance_is_infinite_when_the_changes_do_not_shrink():
 
 
 def test_stall_projection():
-    """Creeping by 0.1% per window stalls; halving per window does not, unless the
-    budget is too small for the windows it needs; already below target never stalls."""
-    n = 2 * STALL_WINDOW
+    """Creeping by 0.1% per window stalls; halving per window does not, unless
+    STALL_MARGIN times the budget is too small for the windows it needs; no progress
+    stalls only over two windows in a row; already below target never stalls."""
+    n = 3 * STALL_WINDOW
     creeping = list(4.6e-8 * (1 - 1e-6) ** np.arange(n))
-    assert stalled_projection(creeping, 1e-8, budget=10**6)
+    assert stalled_projection(creeping, 1e-8, budget=10**5)
     halving = list(1e-6 * 0.5 ** (np.arange(n) / STALL_WINDOW))
-    assert not stalled_projection(halving, 1e-8, budget=10 * STALL_WINDOW)
-    assert stalled_projection(halving, 1e-8, budget=2 * STALL_WINDOW)
+    needed = np.log2(1.25e-7 / 1e-8) * STALL_WINDOW          # 3.6 windows
+    assert not stalled_projection(halving, 1e-8, budget=needed / STALL_MARGIN * 1.01)
+    assert stalled_projection(halving, 1e-8, budget=needed / STALL_MARGIN * 0.99)
     assert not stalled_projection(halving, 1e-3, budget=1)
     assert not stalled_projection(creeping[:n - 1], 1e-8, budget=1)
+    flat_then_falling = [1e-6] * (2 * STALL_WINDOW) + list(1e-6 * 0.5 ** (np.arange(
+        STALL_WINDOW) / STALL_WINDOW))
+    assert not stalled_projection(flat_then_falling, 1e-8, budget=10**6)
+    assert stalled_projection([1e-6] * n, 1e-8, budget=10**6)
