@@ -104,8 +104,8 @@ OPTIONS = [
            "of that step with its tension as multiplier (both ends held, uniform load)"),
     Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE"),
     Option("rod_al_penalty", _real, None, "R",
-           "augmented-Lagrangian penalty R, N; default the larger of 400 max(K) / L^2 and half "
-           "the applied force int |f| dS + |end forces|", POSITIVE),
+           "augmented-Lagrangian penalty R, N; default the larger of 100 sqrt(min(K) max(K)) / "
+           "L^2 and half the applied force int |f| dS + |end forces|", POSITIVE),
     Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
     Option("rod_al_rtol", _real, 1e-5, "tol",
            "stop when the estimated relative L2 distance of (r, r', d1, d2) to the "

@@ -161,16 +161,23 @@ def effective_penalty(penalty, split, smallest_element):
 
 
 def default_penalty(scene):
-    """R = max(400 max(K) / L^2, applied force / 2), N.
+    """R = max(100 sqrt(min(K) max(K)) / L^2, applied force / 2), N.
 
-    The first term is the bending scale (the paper's R = 400 for K = 200..360 daN m^2 on
-    20 m, within a factor of 4); the second is the scale of the tension, which the
-    multiplier lambda3 has to reach by steps of at most 2R per iteration: a 3000 m
-    catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges in the first
-    iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at 1.5e6 N
-    (docs/stability.md).
+    The first term is the bending and torsion scale. The iteration count grows with R
+    over the softest stiffness and fails when R is far below the stiffest one, hence
+    their geometric mean (measured, docs/stability.md: pure twist with K3 = 0.01 K1
+    converges in 2003 iterations at R = 4 and not in 20000 at the former default
+    400 max(K) / L^2; a cantilever loaded to P L^2 / K1 = 3 with K3 = 0.01 K1 does not
+    converge at R = 1 and does in 1627 at R = 10; K = (1, 1, 1): 473, 1157 and 4016
+    iterations at R = 30, 100 and 400). For the paper's data it gives 67 N, close to the
+    fastest R measured there (90 N, docs/error_vs_time.md). The second term is the scale
+    of the tension, which the multiplier lambda3 has to reach by steps of at most 2R per
+    iteration: a 3000 m catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges
+    in the first iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at
+    1.5e6 N.
     """
-    return max(400.0 * scene.stiffness.max() / scene.length**2, 0.5 * scene.applied_force())
+    bending = 100.0 * np.sqrt(scene.stiffness.min() * scene.stiffness.max()) / scene.length**2
+    return max(bending, 0.5 * scene.applied_force())
 
 
 class UzawaSolver:

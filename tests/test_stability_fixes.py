@@ -75,10 +75,12 @@ def test_catenary_start_needs_held_ends_and_one_uniform_load():
 
 def test_default_penalty_is_the_larger_of_bending_and_load_scales():
     unloaded = Scene(length=20.0, stiffness=[235.0, 360.0, 200.0])
-    assert default_penalty(unloaded) == pytest.approx(400 * 360 / 400)
+    assert default_penalty(unloaded) == pytest.approx(100 * np.sqrt(200 * 360) / 400)
     heavy = Scene(length=LENGTH, stiffness=[1e5, 1e5, 7.5e4], start="pin", end="pin",
                   end_position=CHORD, load_values=[LOAD])
     assert default_penalty(heavy) == pytest.approx(0.5 * 1000.0 * LENGTH)
+    soft = Scene(length=2.0, stiffness=[1.0, 1.0, 0.01])
+    assert default_penalty(soft) == pytest.approx(100 * 0.1 / 4)
     pulled = Scene(length=1.0, stiffness=[1, 1, 1], end_force=[0.0, 3e3, 4e3])
     assert default_penalty(pulled) == pytest.approx(2500.0)
 
