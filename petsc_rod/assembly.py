@@ -38,7 +38,10 @@ class ScalarProblem:
         self.name = prefix
         self._rows = rows = element_rows(mesh)
         self.full = mesh.da.createMatrix()
-        self.full.setValuesRCV(rows, rows, element_matrices, addv=PETSc.InsertMode.ADD_VALUES)
+        if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
+            # petsc4py's setValuesRCV divides by the number of rows
+            self.full.setValuesRCV(rows, rows, element_matrices,
+                                   addv=PETSc.InsertMode.ADD_VALUES)
         self.full.assemble()
         self.full.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.constrained = self.full.duplicate(copy=True)
