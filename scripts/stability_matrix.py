@@ -34,7 +34,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +70,6 @@ class Case:
     needs: str = None
     ci: bool = False
     notes: str = ""
-    extra: dict = field(default_factory=dict)
 
     @property
     def elements(self):
