@@ -348,6 +348,24 @@ def twisted_rod(length, torsion_stiffness, angle):
     return {"u3": twist, "torque": float(torsion_stiffness) * twist}
 
 
+def catenary_axes(length, chord, load):
+    """The unit vectors (e_v, e_h) of a catenary's plane: up (against the load) and along
+    the horizontal part of the chord. ValueError when there is no catenary: a length or
+    load that is not positive, a chord not shorter than the cable, or a chord along the
+    load."""
+    _require_positive("length", length)
+    chord, load = np.asarray(chord, dtype=float), np.asarray(load, dtype=float)
+    weight = np.linalg.norm(load)
+    _require_positive("load", weight)
+    up = -load / weight
+    horizontal = chord - (chord @ up) * up
+    span = np.linalg.norm(horizontal)
+    if not (np.linalg.norm(chord) < length and span > 1e-9 * length):
+        raise ValueError("catenary: the chord must be shorter than the cable and not "
+                         "parallel to the load")
+    return up, horizontal / span
+
+
 def catenary(length, chord, load, s):
     r"""The inextensible catenary through two held ends under a uniform dead load.
 
@@ -370,18 +388,10 @@ def catenary(length, chord, load, s):
     ``n`` is the force the part beyond S exerts on the part before it (method.md §6).
     Returns ``(r, tangent, force)`` at the arc lengths ``s``, each ``s.shape + (3,)``.
     """
-    _require_positive("length", length)
-    chord, load = np.asarray(chord, dtype=float), np.asarray(load, dtype=float)
+    up, along = catenary_axes(length, chord, load)
+    chord = np.asarray(chord, dtype=float)
     weight = np.linalg.norm(load)
-    _require_positive("load", weight)
-    up = -load / weight
-    rise = float(chord @ up)
-    horizontal = chord - rise * up
-    span = np.linalg.norm(horizontal)
-    if not (np.linalg.norm(chord) < length and span > 1e-12 * length):
-        raise ValueError("catenary: the chord must be shorter than the cable and not "
-                         "parallel to the load")
-    along = horizontal / span
+    rise, span = float(chord @ up), float(chord @ along)
     target = np.sqrt(length**2 - rise**2) / span     # 2a sinh(span/2a) / span, > 1
     # q = span / 2a solves sinh(q) / q = target; sinh(q)/q is increasing on q > 0.
     q = brentq(lambda q: np.sinh(q) / q - target, 1e-12, np.arcsinh(target) + 50.0,

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import outputs
 from .errors import RodDivergedError, RodNotConvergedError
-from .solver import STOP_STALLED, default_penalty
+from .solver import default_penalty
 
 
 def not_converged_reason(report, solver):
@@ -17,7 +17,7 @@ def not_converged_reason(report, solver):
     numbers = (f"change {report.change:.2e} for -rod_al_rtol {solver.change_tolerance:.2g}, "
                f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
                f"{settings.ctol:.2g}")
-    if report.reason == STOP_STALLED:
+    if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
                 "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
                 "h^3) lies above them (use more -rod_elements or looser tolerances), or a "
@@ -91,7 +91,8 @@ class LoadPath:
 def attempt(solver, t, imperfection, label):
     """One try at load factor t from the current state, its cross-sections rolled first:
     (report, failure), ``failure`` None when the step converged, the RodDivergedError
-    when it diverged (report None), else a sentence saying how far it got."""
+    when it diverged (report None), else a sentence saying how far it got (short: the
+    run goes on; not_converged_reason is the final one, with its advice)."""
     solver.roll_cross_sections(imperfection)
     try:
         report = solver.solve_step(t, label=label)
@@ -128,7 +129,9 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         report, failure = attempt(solver, t, imperfection, f"{label} ")
         iterations = (failure.iterations or 0) if report is None else report.iterations
         total_iterations += iterations
-        if failure is not None and path.can_halve and not stalled(report):
+        # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
+        stalled = report is not None and report.stalled
+        if failure is not None and path.can_halve and not stalled:
             solver.restore(saved)
             path.halve()
             undone_iterations += iterations
@@ -155,12 +158,6 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         f"{time.perf_counter() - clock:.3g} s, {path.halvings} halving(s) of the step "
         f"({undone_iterations} iterations undone)")
     return 0
-
-
-def stalled(report):
-    """A stalled step is not retried with a smaller increment: the floor that stops it
-    is the mesh's, not the step's."""
-    return report is not None and report.reason == STOP_STALLED
 
 
 # A converged step whose estimated distance to the limit is above this many times rtol is

@@ -11,7 +11,7 @@ n' + f = 0); lambda1 = lambda2 = 0.
 import numpy as np
 
 from .boundary import is_held
-from .closed_forms import catenary
+from .closed_forms import catenary, catenary_axes
 from .errors import RodInputError
 from .scene import REFERENCE_FRAME
 
@@ -43,12 +43,13 @@ def catenary_start(scene, t):
                             "-rod_load (no -rod_load_breaks)")
     load = t * scene.load_values[0]
     chord = end.position - start.position
-    up = -load / np.linalg.norm(load)
-    horizontal = chord - (chord @ up) * up
-    if np.linalg.norm(chord) >= scene.length or np.linalg.norm(horizontal) <= 1e-9 * scene.length:
+    try:
+        up, along = catenary_axes(scene.length, chord, load)
+    except ValueError:
         raise RodInputError("-rod_initial_shape catenary: the ends must be less than "
-                            "-rod_length apart and not on one vertical (along the load)")
-    normal = np.cross(up, horizontal / np.linalg.norm(horizontal))
+                            "-rod_length apart and not on one vertical (along the load)"
+                            ) from None
+    normal = np.cross(up, along)
 
     def curve(S):
         r, tangent, force = catenary(scene.length, chord, load, S)
