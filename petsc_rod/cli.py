@@ -68,7 +68,8 @@ def run(comm=None):
         if values["rod_output"]:
             writer = io.ResultWriter(values["rod_output"], mesh)
         code = continuation(solver, values["rod_steps"], values["rod_imperfection"], writer,
-                            say, options_record(), values["rod_max_halvings"])
+                            say, options_record(), values["rod_max_halvings"],
+                            values["rod_track_link"])
         writer = None
         for name in unused_options():
             say(f"petsc_rod: warning: option -{name} was set but not used")

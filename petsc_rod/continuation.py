@@ -8,7 +8,8 @@ import numpy as np
 
 from . import outputs
 from .errors import RodDivergedError, RodNotConvergedError
-from .solver import default_penalty
+from .link import changed_class
+from .solver import STOP_LINK, default_penalty
 
 
 def not_converged_reason(report, solver):
@@ -17,6 +18,13 @@ def not_converged_reason(report, solver):
     numbers = (f"change {report.change:.2e} for -rod_al_rtol {solver.change_tolerance:.2g}, "
                f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
                f"{settings.ctol:.2g}")
+    if report.reason == STOP_LINK:
+        tw, wr = report.link
+        return (f"converged to a state whose linking number is {tw + wr:.3f} turns (twist "
+                f"{tw:.3f} + writhe {wr:.3f}), not the {report.link_expected:.3f} turns the "
+                "load path leads to: the clamps fix the end roll only modulo a turn, and the "
+                "iteration passed the rod around one of its ends or through itself, which "
+                "walls at the clamps forbid (docs/stability.md); take more -rod_steps")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
                 "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
@@ -88,29 +96,37 @@ class LoadPath:
             self.increment = self.units_per_step
 
 
-def attempt(solver, t, imperfection, label):
+def attempt(solver, t, imperfection, label, expected_link=None):
     """One try at load factor t from the current state, its cross-sections rolled first:
     (report, failure), ``failure`` None when the step converged, the RodDivergedError
     when it diverged (report None), else a sentence saying how far it got (short: the
-    run goes on; not_converged_reason is the final one, with its advice)."""
+    run goes on; not_converged_reason is the final one, with its advice). A converged
+    state whose linking number is not ``expected_link`` (turns, link.py) is a failure."""
     solver.roll_cross_sections(imperfection)
     try:
         report = solver.solve_step(t, label=label)
     except RodDivergedError as error:
         return None, error
     if report.converged:
-        return report, None
+        report.link, report.link_expected = solver.link(), expected_link
+        if not changed_class(report.link, expected_link):
+            return report, None
+        report.converged, report.reason = False, STOP_LINK
+        return report, (f"converged in {report.iterations} iterations to a linking number "
+                        f"of {sum(report.link):.3f} turns, not {expected_link:.3f}")
     return report, (f"not converged in {report.iterations} iterations (change "
                     f"{report.change:.2e}, constraint residual (RMS) "
                     f"{report.constraint_residual:.2e})")
 
 
-def continuation(solver, steps, imperfection, writer, say, options, max_halvings):
+def continuation(solver, steps, imperfection, writer, say, options, max_halvings,
+                 track_link=True):
     """Reach the scene in ``steps`` equal load increments, each warm-started (§7) from the
     last state with its cross-sections rolled by ``imperfection`` (see
     UzawaSolver.roll_cross_sections). A step that does not converge or diverges is undone
     (UzawaSolver.snapshot/restore) and retried with half the increment, at most
-    ``max_halvings`` times on the way to each t_k (LoadPath); the file has one group
+    ``max_halvings`` times on the way to each t_k (LoadPath); so is a step that converged
+    to another linking number (link.py) when ``track_link``. The file has one group
     ``steps/<n>`` per accepted step, and the failed one that ends a run."""
     mesh = solver.mesh
     clock = time.perf_counter()
@@ -126,7 +142,9 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     while not path.finished:
         t, label = path.next_factor, f"step {path.step}/{steps}"
         saved = solver.snapshot()
-        report, failure = attempt(solver, t, imperfection, f"{label} ")
+        report, failure = attempt(solver, t, imperfection, f"{label} ",
+                                  expected_link(solver, path.factor(path.reached), t)
+                                  if track_link else None)
         iterations = (failure.iterations or 0) if report is None else report.iterations
         total_iterations += iterations
         # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
@@ -160,9 +178,28 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     return 0
 
 
+def expected_link(solver, t_from, t):
+    """The linking number (turns) a step from load factor t_from to t should reach: that of
+    the current state plus the end roll over the step over 2 pi (link.py); None when the
+    scene's link is not tracked."""
+    link = solver.link()
+    if link is None:
+        return None
+    scene = solver.scene
+    return sum(link) + (scene.end_roll(t) - scene.end_roll(t_from)) / (2 * np.pi)
+
+
 # A converged step whose estimated distance to the limit is above this many times rtol is
 # reported as stopped early by the change test (UzawaSolver.solve_step).
 SLOW_CONTRACTION = 10.0
+
+
+def link_text(link):
+    """The step line's account of the link, '' where it is not tracked."""
+    if link is None:
+        return ""
+    tw, wr = link
+    return f", link {tw + wr:.4f} turns = twist {tw:.4f} + writhe {wr:.4f}"
 
 
 def record_step(solver, report, t, label, say, writer, group, **common):
@@ -177,10 +214,13 @@ def record_step(solver, report, t, label, say, writer, group, **common):
                   "change": report.change, "estimated_distance": report.distance,
                   "energy": energy, "ranks": mesh.comm.getSize(),
                   "load_factor": t, **common}
+    if report.link is not None:
+        attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
     say(f"{label}: load factor {t:.4g}, "
         f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
         f"iterations, change {report.change:.2e}, constraint residual (RMS) "
-        f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}")
+        f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
+        + link_text(report.link))
     if report.converged and SLOW_CONTRACTION * solver.change_tolerance < report.distance < np.inf:
         say(f"petsc_rod: warning: {label} met the change test, but the iteration still "
             f"contracts slowly: its estimated distance to the limit is {report.distance:.2e} "

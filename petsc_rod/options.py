@@ -98,14 +98,19 @@ OPTIONS = [
            "state with half the increment, at most n times per step (smallest increment "
            "1/(K 2^n)); 0: stop at the first failure",
            (lambda v: v >= 0, "must be >= 0")),
+    Option("rod_track_link", _bool, True, "bool",
+           "ends clamped on a common axis: refuse a step whose linking number Tw + Wr is "
+           "not the last one plus the end roll over 2 pi (the rod passed around an end or "
+           "through itself); 0 for a rod free to pass around its ends"),
     Option("rod_initial", _string, None, "FILE", "start from (restart) a result file"),
     Option("rod_initial_shape", _string, "straight", "straight|catenary",
            "start of the first step: the straight reference, or the inextensible catenary "
            "of that step with its tension as multiplier (both ends held, uniform load)"),
     Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE"),
     Option("rod_al_penalty", _real, None, "R",
-           "augmented-Lagrangian penalty R, N; default the larger of 100 sqrt(min(K) max(K)) / "
-           "L^2 and half the applied force int |f| dS + |end forces|", POSITIVE),
+           "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
+           "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
+           "min(K) with M = max(K) a / L for a clamped end turned by a", POSITIVE),
     Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
     Option("rod_al_rtol", _real, 1e-5, "tol",
            "stop when the estimated relative L2 distance of (r, r', d1, d2) to the "

@@ -77,6 +77,13 @@ class Scene:
         pieces = np.diff(self.load_piece_ends) @ np.linalg.norm(self.load_values, axis=1)
         return float(pieces + np.linalg.norm(self.start_force) + np.linalg.norm(self.end_force))
 
+    def end_rotation(self):
+        """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
+        plus |-rod_end_twist|; 0 at a pinned or free end."""
+        if self.end != "clamp":
+            return 0.0
+        return float(np.linalg.norm(self._end_rotation) + abs(self.end_twist))
+
     def start_state(self, t):
         return EndState(self.start, np.zeros(3), REFERENCE_FRAME.copy(), t * self.start_force)
 
@@ -87,6 +94,23 @@ class Scene:
         frame = REFERENCE_FRAME @ q.T
         frame = frame @ rotation_about(frame[2], t * self.end_twist).T
         return EndState(self.end, position, frame, t * self.end_force)
+
+    @property
+    def link_axis(self):
+        """The common end tangent e of a rod clamped at both ends whose end frame only
+        rolls about it on the whole load path (its d3 stays e), else None: the scenes
+        whose linking number is defined and tracked (link.py)."""
+        axis = REFERENCE_FRAME[2]
+        tilt = self._end_rotation - (self._end_rotation @ axis) * axis
+        if self.start != "clamp" or self.end != "clamp" or np.linalg.norm(tilt) > 1e-12:
+            return None
+        return axis.copy()
+
+    def end_roll(self, t):
+        """The angle (rad) by which the end frame has rolled about link_axis at load
+        factor t, counted continuously from t = 0 (end_state: the rotation of -rod_end_frame
+        about e_x, then -rod_end_twist)."""
+        return t * (self._end_rotation @ REFERENCE_FRAME[2] + self.end_twist)
 
     def validate(self, used):
         """Raise RodInputError on a scene no inextensible cable can realise.

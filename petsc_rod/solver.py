@@ -24,6 +24,7 @@ from .fe import (GAUSS_POINTS, P2, STIFFNESS_TO_MASS_MAX, element_integrals, p2_
                  p2_element_matrices, p2_integrals, quadrature_weights)
 from .fields import VectorField, at_points, element_dofs, scatter_element_vectors
 from .kernels import nearest_rotation, split_coefficients, strains, update_multipliers
+from .link import FULLER_MARGIN, link_integrands
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
           for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}
@@ -55,6 +56,8 @@ class StepReport:
     history: list = field(default_factory=list)   # (change, residual, wall time) rows
     reason: str = ""        # why a step that did not converge stopped (STOP_* below)
     distance: float = np.inf    # the estimated distance to the limit (estimated_distance)
+    link: tuple = None          # (Tw, Wr) after the step, turns (UzawaSolver.link)
+    link_expected: float = None     # the Lk the load path leads to, turns (continuation)
 
     @property
     def stalled(self):
@@ -64,6 +67,7 @@ class StepReport:
 STOP_MAX_IT = "max_it"
 STOP_STALLED = "stalled"
 STOP_OBSERVER = "observer"
+STOP_LINK = "link"              # converged, to a state of another linking number (link.py)
 # The stall test looks at windows of this many iterations (stalled_projection) ...
 STALL_WINDOW = 1000
 # ... and only once both stopping quantities are within this factor of their tolerances
@@ -171,7 +175,7 @@ def effective_penalty(penalty, split, smallest_element):
 
 
 def default_penalty(scene):
-    """R = max(100 sqrt(min(K) max(K)) / L^2, applied force / 2), N.
+    """R = max(100 sqrt(min(K) max(K)) / L^2, applied force / 2, 2 M^2 / min(K)), N.
 
     The first term is the bending and torsion scale. The iteration count grows with R
     over the softest stiffness and fails when R is far below the stiffest one, hence
@@ -184,10 +188,17 @@ def default_penalty(scene):
     of the tension, which the multiplier lambda3 has to reach by steps of at most 2R per
     iteration: a 3000 m catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges
     in the first iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at
-    1.5e6 N.
+    1.5e6 N. The third is the scale of a clamped end turned by an angle a (a twist):
+    M = max(K) a / L, and M^2 / K is four times the axial compression a twisting moment
+    stands for in Greenhill's buckling condition (M / 2K)^2 + P / K = (pi / L)^2. Below
+    it the iteration leaves a twisted rod's branch: clamped 0.9 L apart and twisted,
+    K = 1, R = 100 loses a whole turn of link at 9.75 rad (M^2 / K = 95 N), while R = 300
+    keeps it to 4 pi (158 N; docs/stability.md, fix 9).
     """
-    bending = 100.0 * np.sqrt(scene.stiffness.min() * scene.stiffness.max()) / scene.length**2
-    return max(bending, 0.5 * scene.applied_force())
+    stiffness = scene.stiffness
+    bending = 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2
+    moment = stiffness.max() * scene.end_rotation() / scene.length
+    return max(bending, 0.5 * scene.applied_force(), 2.0 * moment**2 / stiffness.min())
 
 
 class UzawaSolver:
@@ -493,6 +504,20 @@ class UzawaSolver:
         work = self._anchor_work + sum(load.dot(theta) for load, theta
                                        in zip(self.load.components, self.theta.components))
         return self.mesh.global_sum(stored) - work
+
+    def link(self):
+        """Twist and writhe of the current state, (Tw, Wr) in turns, Lk = Tw + Wr
+        (link.py); None when the scene has no common end axis or a tangent comes within
+        FULLER_MARGIN of pointing back along it."""
+        axis = self.scene.link_axis
+        if axis is None:
+            return None
+        p = self.point_values()
+        twist, writhe, margin = link_integrands(p["directors"], p["derivatives"], axis)
+        tw, wr, backward = self.mesh.global_sum(np.array([
+            np.sum(self.weights * twist), np.sum(self.weights * writhe),
+            np.sum(margin < FULLER_MARGIN)]))
+        return None if backward else (float(tw), float(wr))
 
     def end_reaction(self):
         """External force N on the cable at S = L (N), n(S) = N + int_S^L f dS: F(L) - mu

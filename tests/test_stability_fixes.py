@@ -73,7 +73,7 @@ def test_catenary_start_needs_held_ends_and_one_uniform_load():
             catenary_start(scene, 1.0)
 
 
-def test_default_penalty_is_the_larger_of_bending_and_load_scales():
+def test_default_penalty_is_the_largest_of_bending_load_and_twist_scales():
     unloaded = Scene(length=20.0, stiffness=[235.0, 360.0, 200.0])
     assert default_penalty(unloaded) == pytest.approx(100 * np.sqrt(200 * 360) / 400)
     heavy = Scene(length=LENGTH, stiffness=[1e5, 1e5, 7.5e4], start="pin", end="pin",
@@ -83,6 +83,11 @@ def test_default_penalty_is_the_larger_of_bending_and_load_scales():
     assert default_penalty(soft) == pytest.approx(100 * 0.1 / 4)
     pulled = Scene(length=1.0, stiffness=[1, 1, 1], end_force=[0.0, 3e3, 4e3])
     assert default_penalty(pulled) == pytest.approx(2500.0)
+    twisted = Scene(length=1.0, stiffness=[1, 1, 1], end="clamp",
+                    end_position=[0.9, 0.1, 0.0], end_twist=4 * np.pi)
+    assert default_penalty(twisted) == pytest.approx(2 * (4 * np.pi) ** 2)   # M = 4 pi N m
+    one_radian = Scene(length=1.0, stiffness=[1, 1, 1], end="clamp", end_twist=1.0)
+    assert default_penalty(one_radian) == pytest.approx(100.0)
 
 
 @pytest.mark.parametrize("rho", [0.5, 0.9, 0.999])
