@@ -35,7 +35,8 @@ def settings_from_options(values, scene):
         penalty = default_penalty(scene)
     return Settings(penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
-                    monitor=values["rod_al_monitor"])
+                    monitor=values["rod_al_monitor"],
+                    adapt_penalty=values["rod_al_adapt_penalty"])
 
 
 def options_record():

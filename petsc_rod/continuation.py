@@ -9,7 +9,7 @@ import numpy as np
 from . import outputs
 from .errors import RodDivergedError, RodNotConvergedError
 from .link import changed_class
-from .solver import STOP_LINK, default_penalty
+from .solver import ADAPT_WINDOW, STOP_LINK, default_penalty
 
 
 def not_converged_reason(report, solver):
@@ -213,7 +213,7 @@ def record_step(solver, report, t, label, say, writer, group, **common):
                   "constraint_residual": report.constraint_residual,
                   "change": report.change, "estimated_distance": report.distance,
                   "energy": energy, "ranks": mesh.comm.getSize(),
-                  "load_factor": t, **common}
+                  "load_factor": t, "penalty": solver.penalty, **common}
     if report.link is not None:
         attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
     say(f"{label}: load factor {t:.4g}, "
@@ -221,6 +221,12 @@ def record_step(solver, report, t, label, say, writer, group, **common):
         f"iterations, change {report.change:.2e}, constraint residual (RMS) "
         f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
         + link_text(report.link))
+    if report.penalty_raises:
+        raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in report.penalty_raises)
+        say(f"petsc_rod: {label}: the constraint residual fell by less than half in "
+            f"{ADAPT_WINDOW} iterations with R far below the problem's scale "
+            f"{solver.scale:.3g}: R raised to {raised} (matrices refactored; "
+            "-rod_al_adapt_penalty)")
     if report.converged and SLOW_CONTRACTION * solver.change_tolerance < report.distance < np.inf:
         say(f"petsc_rod: warning: {label} met the change test, but the iteration still "
             f"contracts slowly: its estimated distance to the limit is {report.distance:.2e} "

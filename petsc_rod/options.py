@@ -110,7 +110,7 @@ OPTIONS = [
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
-           "min(K) with M = max(K) a / L for a clamped end turned by a", POSITIVE),
+           "min(K1, K2) with M = K3 a / L for a clamped end turned by a", POSITIVE),
     Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
     Option("rod_al_rtol", _real, 1e-5, "tol",
            "stop when the estimated relative L2 distance of (r, r', d1, d2) to the "
@@ -120,6 +120,9 @@ OPTIONS = [
            "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
            "below tol", POSITIVE),
     Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
+    Option("rod_al_adapt_penalty", _bool, True, "bool",
+           "raise R tenfold, refactoring the matrices, while it is below a tenth of the "
+           "default and the constraint residual falls by less than half in 200 iterations"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
 

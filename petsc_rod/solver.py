@@ -45,6 +45,7 @@ class Settings:
     rtol: float = 1e-5
     ctol: float = 1e-3
     monitor: bool = False
+    adapt_penalty: bool = True      # raise a penalty far below the scale (raise_penalty)
 
 
 @dataclass
@@ -56,6 +57,7 @@ class StepReport:
     history: list = field(default_factory=list)   # (change, residual, wall time) rows
     reason: str = ""        # why a step that did not converge stopped (STOP_* below)
     distance: float = np.inf    # the estimated distance to the limit (estimated_distance)
+    penalty_raises: list = field(default_factory=list)  # (iteration, new R) rows
     link: tuple = None          # (Tw, Wr) after the step, turns (UzawaSolver.link)
     link_expected: float = None     # the Lk the load path leads to, turns (continuation)
 
@@ -129,6 +131,25 @@ def stalled(history, rtol, ctol, budget):
                for column, tolerance in ((0, rtol), (1, ctol)))
 
 
+# A convex split's penalty below ADAPT_BELOW times the problem's scale (default_penalty)
+# is multiplied by ADAPT_FACTOR, up to the scale, whenever the constraint residual has
+# fallen by less than the factor ADAPT_PROGRESS over the last ADAPT_WINDOW iterations
+# (UzawaSolver.raise_penalty).
+ADAPT_BELOW = 0.1
+ADAPT_FACTOR = 10.0
+ADAPT_PROGRESS = 0.5
+ADAPT_WINDOW = 200
+
+
+def penalty_too_low(history, penalty, scale):
+    """Whether a step's (change, residual, time) rows call for a larger penalty: R below
+    ADAPT_BELOW times the scale, and the residual of the last row more than ADAPT_PROGRESS
+    times that of ADAPT_WINDOW rows before."""
+    if penalty >= ADAPT_BELOW * scale or len(history) <= ADAPT_WINDOW:
+        return False
+    return history[-1][1] > ADAPT_PROGRESS * history[-1 - ADAPT_WINDOW][1]
+
+
 # The contraction factor of the iteration is measured over this many iterations.
 RATE_WINDOW = 20
 
@@ -175,7 +196,7 @@ def effective_penalty(penalty, split, smallest_element):
 
 
 def default_penalty(scene):
-    """R = max(100 sqrt(min(K) max(K)) / L^2, applied force / 2, 2 M^2 / min(K)), N.
+    """R = max(100 sqrt(min(K) max(K)) / L^2, applied force / 2, 2 M^2 / min(K1, K2)), N.
 
     The first term is the bending and torsion scale. The iteration count grows with R
     over the softest stiffness and fails when R is far below the stiffest one, hence
@@ -188,17 +209,19 @@ def default_penalty(scene):
     of the tension, which the multiplier lambda3 has to reach by steps of at most 2R per
     iteration: a 3000 m catenary under 1 kN/m (tension ~1e6 N, K = 1e5 N m^2) diverges
     in the first iteration at 400 K / L^2 = 4.4 N and converges in 771 iterations at
-    1.5e6 N. The third is the scale of a clamped end turned by an angle a (a twist):
-    M = max(K) a / L, and M^2 / K is four times the axial compression a twisting moment
-    stands for in Greenhill's buckling condition (M / 2K)^2 + P / K = (pi / L)^2. Below
-    it the iteration leaves a twisted rod's branch: clamped 0.9 L apart and twisted,
-    K = 1, R = 100 loses a whole turn of link at 9.75 rad (M^2 / K = 95 N), while R = 300
-    keeps it to 4 pi (158 N; docs/stability.md, fix 9).
+    1.5e6 N. The third is the scale of the twisting moment M = K3 a / L of a clamped end
+    turned by an angle a: M^2 / K_b, K_b = min(K1, K2), is four times the axial
+    compression the moment stands for in Greenhill's buckling condition
+    (M / 2K_b)^2 + P / K_b = (pi / L)^2. Below it the iteration leaves a twisted rod's
+    branch: clamped 0.9 L apart and twisted, K = 1, R = 100 loses a whole turn of link at
+    9.75 rad (M^2 / K_b = 95 N) and R = 150 at 11.9 rad (142 N), while R = 200 keeps it
+    to 4 pi (158 N; docs/stability.md, fix 9).
     """
     stiffness = scene.stiffness
     bending = 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2
-    moment = stiffness.max() * scene.end_rotation() / scene.length
-    return max(bending, 0.5 * scene.applied_force(), 2.0 * moment**2 / stiffness.min())
+    moment = stiffness[2] * scene.end_rotation() / scene.length
+    twist = 2.0 * moment**2 / stiffness[:2].min()
+    return max(bending, 0.5 * scene.applied_force(), twist)
 
 
 class UzawaSolver:
@@ -206,26 +229,19 @@ class UzawaSolver:
 
     def __init__(self, mesh, scene, settings):
         self.mesh, self.scene, self.settings = mesh, scene, settings
-        a = split_coefficients(scene.stiffness)
-        self.penalty = effective_penalty(settings.penalty, a, mesh.smallest_element)
-        start, end = scene.start_state(0.0), scene.end_state(0.0)
-        h = mesh.element_h
-        EVENTS["assembly"].begin()
-        # frame order: d1, d2, theta = r' = d3
-        self.problems = [ScalarProblem(
-            mesh, p2_element_matrices(h, 2 * a[i], self.penalty),
-            boundary.director_prescribed(i, start, end, mesh.n_elements), prefix)
-            for i, prefix in enumerate(("rod_d1_", "rod_d2_", "rod_r_"))]
-        self.d_problems, self.r_problem = self.problems[:2], self.problems[2]
-        # Both ends held: r(L) - r(0) = int theta dS is a constraint of the theta problem.
-        self.bordered = boundary.is_held(start) and boundary.is_held(end)
-        if self.bordered:
-            self.r_problem.add_integral_constraint(element_integrals(h))
-        EVENTS["assembly"].end()
+        self.split = split_coefficients(scene.stiffness)
+        self.penalty = effective_penalty(settings.penalty, self.split, mesh.smallest_element)
+        # the R that rtol refers to (change_tolerance): the user's, or raise_penalty's
+        self.asked_penalty = settings.penalty
+        self.scale = default_penalty(scene)
+        self.start_state, self.end_state = scene.start_state(0.0), scene.end_state(0.0)
+        self.bordered = boundary.is_held(self.start_state) and boundary.is_held(self.end_state)
+        self._build_problems()
         self.d1, self.d2, self.theta, self.r = (VectorField(mesh, n)
                                                 for n in ("d1", "d2", "theta", "r"))
         self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("d1", "d2", "theta")]
         self.load = VectorField(mesh, "load")
+        h = mesh.element_h
         self.p2 = p2_basis(GAUSS_POINTS, h)
         self.p2_integrals = p2_integrals(GAUSS_POINTS, h)
         self.weights = quadrature_weights(h)
@@ -235,12 +251,54 @@ class UzawaSolver:
         self.lam = np.zeros(shape)
         self._previous = None
 
+    def _build_problems(self):
+        """The three scalar problems of the global step at the current R, with the
+        prescribed values of the current end states (the only place they are created)."""
+        mesh, h = self.mesh, self.mesh.element_h
+        EVENTS["assembly"].begin()
+        # frame order: d1, d2, theta = r' = d3
+        self.problems = [ScalarProblem(
+            mesh, p2_element_matrices(h, 2 * self.split[i], self.penalty),
+            boundary.director_prescribed(i, self.start_state, self.end_state,
+                                         mesh.n_elements), prefix)
+            for i, prefix in enumerate(("rod_d1_", "rod_d2_", "rod_r_"))]
+        self.d_problems, self.r_problem = self.problems[:2], self.problems[2]
+        # Both ends held: r(L) - r(0) = int theta dS is a constraint of the theta problem.
+        if self.bordered:
+            self.r_problem.add_integral_constraint(element_integrals(h))
+        self._set_prescribed()
+        EVENTS["assembly"].end()
+
+    def _set_prescribed(self):
+        """The end states' frame rows as the prescribed values of the three problems."""
+        for i, problem in enumerate(self.problems):
+            problem.set_prescribed(boundary.director_prescribed(
+                i, self.start_state, self.end_state, self.mesh.n_elements))
+
+    def _destroy_problems(self):
+        for problem in self.problems:
+            problem.destroy()
+
+    def raise_penalty(self):
+        """R <- min(ADAPT_FACTOR R, scale), the matrices assembled and factored anew.
+
+        A penalty far below the problem's scale (default_penalty) makes the multiplier
+        creep towards the internal forces by at most 2R per iteration: the cantilever at
+        R = 1e-3 K/L^2 ended 10 000 iterations with a constraint residual of 0.25
+        (docs/stability.md, fix 10). tau and lambda are kept: the iteration goes on from
+        where it is, with the new R.
+        """
+        self.penalty = self.asked_penalty = min(ADAPT_FACTOR * self.penalty, self.scale)
+        self._destroy_problems()
+        self._build_problems()
+
     @property
     def change_tolerance(self):
-        """The change test's bound: rtol, times R_user / R when R was raised. The change
+        """The change test's bound: rtol, times R_asked / R when R was raised for a
+        non-convex split (R_asked: the user's R, or the one raise_penalty set). The change
         per iteration shrinks like 1/R near the solution (the contraction factor is about
         1 - c/R), so the same rtol then stands for the same distance to the solution."""
-        return self.settings.rtol * self.settings.penalty / self.penalty
+        return self.settings.rtol * self.asked_penalty / self.penalty
 
     # --- state ---------------------------------------------------------------------
     @property
@@ -353,11 +411,10 @@ class UzawaSolver:
         The load of the theta problem is int F.g with F(S) = int_S^L f dS + offset
         (centreline.load_offset), exactly integrated between the load breaks.
         """
-        scene, n = self.scene, self.mesh.n_elements
+        scene = self.scene
         start, end = scene.start_state(t), scene.end_state(t)
         self.start_state, self.end_state = start, end
-        for i, problem in enumerate(self.problems):
-            problem.set_prescribed(boundary.director_prescribed(i, start, end, n))
+        self._set_prescribed()
         total = scene.load_beyond(0.0, t)
         self._load_offset = load_offset(start, end, total)
         self._anchor_work = anchor_work(start, end, total)
@@ -387,9 +444,11 @@ class UzawaSolver:
         clock = time.perf_counter()
         change = residual = distance = np.inf
 
+        raises = []
+
         def report(converged, iterations, reason=""):
             return StepReport(converged, iterations, change, residual, history, reason,
-                              distance)
+                              distance, raises)
 
         for iteration in range(1, settings.max_it + 1):
             try:
@@ -413,6 +472,11 @@ class UzawaSolver:
                                 f"{distance:.3e}  constraint {residual:.3e}", comm=self.mesh.comm)
             if change <= self.change_tolerance and residual <= settings.ctol:
                 return report(True, iteration)
+            if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
+                    and self.penalty == self.asked_penalty
+                    and penalty_too_low(history, self.penalty, self.scale)):
+                self.raise_penalty()
+                raises.append((iteration, self.penalty))
             if iteration % STALL_CHECK_EVERY == 0 and stalled(
                     history, self.change_tolerance, settings.ctol, settings.max_it - iteration):
                 return report(False, iteration, STOP_STALLED)
@@ -528,7 +592,8 @@ class UzawaSolver:
         return self._load_offset - self._multiplier
 
     def destroy(self):
-        for obj in [*self.problems, *self.frame_fields, self.r, self.load, *self.rhs]:
+        self._destroy_problems()
+        for obj in [*self.frame_fields, self.r, self.load, *self.rhs]:
             obj.destroy()
 
 

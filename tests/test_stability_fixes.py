@@ -1,15 +1,17 @@
 """The pieces of the issue-4 fixes that can be checked without running the matrix
 (docs/stability.md): the catenary closed form and start, the load-scaled default
-penalty, the estimated distance to the limit, and the stall projection."""
+penalty, the estimated distance to the limit, the stall projection, and the penalty
+raised when far below the problem's scale."""
 
 import numpy as np
 import pytest
 
-from petsc_rod.closed_forms import catenary
+from helpers import continuation, gather
+from petsc_rod.closed_forms import cantilever_tip, catenary
 from petsc_rod.errors import RodInputError
 from petsc_rod.scene import Scene
-from petsc_rod.solver import (STALL_MARGIN, STALL_WINDOW, default_penalty, estimated_distance,
-                              stalled_projection)
+from petsc_rod.solver import (ADAPT_WINDOW, STALL_MARGIN, STALL_WINDOW, default_penalty,
+                              estimated_distance, penalty_too_low, stalled_projection)
 from petsc_rod.starts import catenary_start
 
 LENGTH, CHORD, LOAD = 3000.0, np.array([2500.0, 0.0, 400.0]), np.array([0.0, 0.0, -1000.0])
@@ -88,6 +90,8 @@ def test_default_penalty_is_the_largest_of_bending_load_and_twist_scales():
     assert default_penalty(twisted) == pytest.approx(2 * (4 * np.pi) ** 2)   # M = 4 pi N m
     one_radian = Scene(length=1.0, stiffness=[1, 1, 1], end="clamp", end_twist=1.0)
     assert default_penalty(one_radian) == pytest.approx(100.0)
+    soft_torsion = Scene(length=1.0, stiffness=[1, 1, 0.01], end="clamp", end_twist=1.0)
+    assert default_penalty(soft_torsion) == pytest.approx(10.0)     # M^2/K1 = 1e-4 N
 
 
 @pytest.mark.parametrize("rho", [0.5, 0.9, 0.999])
@@ -120,3 +124,36 @@ def test_stall_projection():
         STALL_WINDOW) / STALL_WINDOW))
     assert not stalled_projection(flat_then_falling, 1e-8, budget=10**6)
     assert stalled_projection([1e-6] * n, 1e-8, budget=10**6)
+
+
+def test_penalty_too_low_needs_a_low_penalty_and_a_stuck_residual():
+    stuck = [(1.0, 0.1 * 0.999**k, 0.0) for k in range(ADAPT_WINDOW + 1)]   # 0.82 per window
+    falling = [(1.0, 0.1 * 0.99**k, 0.0) for k in range(ADAPT_WINDOW + 1)]  # 0.13 per window
+    assert penalty_too_low(stuck, 1.0, 100.0)
+    assert not penalty_too_low(falling, 1.0, 100.0)
+    assert not penalty_too_low(stuck, 10.0, 100.0)          # a tenth of the scale: kept
+    assert not penalty_too_low(stuck[:ADAPT_WINDOW], 1.0, 100.0)
+
+
+CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                  end_force=(0.0, -3.0, 0.0))
+
+
+@pytest.mark.parametrize("adapt", [True, False])
+def test_a_penalty_far_below_the_scale_is_raised_and_the_elastica_reached(
+        solver_factory, comm, adapt):
+    """Cantilever P L^2/K = 3 at R = 1e-3 K/L^2 (scale 100): raised tenfold four times to
+    10, the tip meets the elastica to 1e-5; kept at 1e-3 (-rod_al_adapt_penalty 0) the
+    residual is still above 0.1 after 2000 iterations (docs/stability.md, fix 10)."""
+    mesh, solver = solver_factory(comm, 32, CANTILEVER, 1e-3, 1e-7, 1e-5, 2000)
+    solver.settings.adapt_penalty = adapt
+    report = continuation(solver, steps=2)
+    if not adapt:
+        assert not report.converged and report.constraint_residual > 0.1
+        assert solver.penalty == 1e-3
+        return
+    assert report.converged
+    assert solver.penalty == pytest.approx(10.0)
+    tip = gather(comm, solver.r.owned()[:, 0])[-1]
+    x, y = cantilever_tip(1.0, 1.0, 3.0)
+    assert np.abs(tip - [x, y, 0.0]).max() < 1e-5
