@@ -431,7 +431,9 @@ class UzawaSolver:
         constraint floor makes the multipliers drift there is no limit to be near
         (docs/stability.md). A step whose change and residual are within STALL_FACTOR of
         their tolerances but, at their rate, would not meet them within max_it stops
-        early as stalled (stalled_projection).
+        early as stalled (stalled_projection). A penalty far below the problem's scale
+        whose residual hardly falls is raised on the way (penalty_too_low, raise_penalty;
+        the report lists the raises).
 
         ``observer(iteration, change, residual)``, if given, is called (collectively)
         after each iteration's norms, e.g. to record the state at looser tolerances on
@@ -443,7 +445,6 @@ class UzawaSolver:
         history = []
         clock = time.perf_counter()
         change = residual = distance = np.inf
-
         raises = []
 
         def report(converged, iterations, reason=""):
