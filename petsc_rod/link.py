@@ -58,9 +58,9 @@ def changed_class(link, expected):
 
 
 def gauss_writhe(points, axis, reach=50.0):
-    """Writhe (turns) of a centreline, by the Gauss double integral: an independent check
-    of Fuller's formula for checks on a whole curve (tests, scripts/stability_matrix.py;
-    O(n^2) work and memory, n = len(points)).
+    """Writhe (turns) of a whole centreline by the Gauss double integral, an independent
+    check of Fuller's formula (tests, scripts/stability_matrix.py; O(n^2) work and
+    memory, n = len(points)).
 
     points: (n, 3) along a curve whose end tangents are ``axis``. The curve is closed as
     Fuller's formula assumes: rays of length ``reach`` along -axis and +axis from its ends

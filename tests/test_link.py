@@ -63,7 +63,7 @@ def closed_form_curve(n):
 
 def test_fuller_writhe_is_the_gauss_integral():
     """Fuller's integrand (link_integrands) integrated on a fine grid against the Gauss
-    double integral of the curve closed by rays (gauss_writhe), 1500 points."""
+    double integral of the curve closed by rays (gauss_writhe), 1001 points on it."""
     s, tangent, bend = closed_form_curve(20001)
     frames = np.zeros(s.shape + (3, 3))
     frames[:, 2], derivatives = tangent, np.zeros(s.shape + (3, 3))
