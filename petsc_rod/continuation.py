@@ -9,7 +9,7 @@ import numpy as np
 from . import outputs
 from .errors import RodDivergedError, RodNotConvergedError
 from .link import changed_class
-from .solver import ADAPT_WINDOW, STOP_LINK, default_penalty
+from .solver import ADAPT_WINDOW, STOP_LINK
 
 
 def not_converged_reason(report, solver):
@@ -32,9 +32,9 @@ def not_converged_reason(report, solver):
                 "symmetry holds the iterate (a straight rod shortened along its axis: move "
                 "the end off the axis)")
     hint = ""
-    if settings.penalty < 0.1 * default_penalty(solver.scene):
+    if settings.penalty < 0.1 * solver.scale:
         hint = (f"; -rod_al_penalty {settings.penalty:g} is far below the problem's scale "
-                f"{default_penalty(solver.scene):.3g} (the default): raise it")
+                f"{solver.scale:.3g} (the default): raise it")
     return f"did not converge in {report.iterations} iterations ({numbers}){hint}"
 
 
@@ -139,12 +139,13 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
             "(docs/stability.md)")
     path = LoadPath(steps, max_halvings)
     total_iterations = undone_iterations = written = 0
+    # (Tw, Wr) of the last accepted state (of the start, then of each step), or None
+    link = solver.link() if track_link else None
     while not path.finished:
         t, label = path.next_factor, f"step {path.step}/{steps}"
         saved = solver.snapshot()
         report, failure = attempt(solver, t, imperfection, f"{label} ",
-                                  expected_link(solver, path.factor(path.reached), t)
-                                  if track_link else None)
+                                  expected_link(solver.scene, link, path.factor(path.reached), t))
         iterations = (failure.iterations or 0) if report is None else report.iterations
         total_iterations += iterations
         # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
@@ -166,6 +167,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         if not report.converged:
             break
         path.accept()
+        link = report.link if track_link else None
     if writer is not None:
         writer.finish(f"steps/{written}", attributes)
     if not report.converged:
@@ -178,14 +180,12 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     return 0
 
 
-def expected_link(solver, t_from, t):
+def expected_link(scene, link, t_from, t):
     """The linking number (turns) a step from load factor t_from to t should reach: that of
-    the current state plus the end roll over the step over 2 pi (link.py); None when the
-    scene's link is not tracked."""
-    link = solver.link()
+    the state it starts from, (Tw, Wr) ``link``, plus the end roll over the step over 2 pi
+    (link.py); None when that link is not known (not tracked)."""
     if link is None:
         return None
-    scene = solver.scene
     return sum(link) + (scene.end_roll(t) - scene.end_roll(t_from)) / (2 * np.pi)
 
 

@@ -2,9 +2,9 @@
 
 Layout (documented in README.md): vertex datasets S (n,), r, d1, d2, d3, u, m, n (n, 3);
 attributes converged, iterations, constraint_residual, change, estimated_distance, energy,
-wall_time, ranks, options, load_factor; a group ``history``; a group ``state`` with what a
-restart needs beyond the vertex datasets (P2 midpoints, tau, lambda per element); and one group
-``steps/<k>`` per accepted continuation step (halved sub-steps included) and the failed
+wall_time, ranks, options, load_factor, penalty (and twist_turns, writhe_turns where the
+link is tracked); a group ``history``; a group ``state`` with what a restart needs beyond
+the vertex datasets (P2 midpoints, tau, lambda per element); and one group ``steps/<k>`` per accepted continuation step (halved sub-steps included) and the failed
 one that ends a run, with the same content. The root links to the last step. The file
 is written as ``<name>.partial`` and renamed only when complete, so a crash or an
 interrupt never leaves a half-written result under the requested name.

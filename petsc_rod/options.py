@@ -113,9 +113,9 @@ OPTIONS = [
            "min(K1, K2) with M = K3 a / L for a clamped end turned by a", POSITIVE),
     Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
     Option("rod_al_rtol", _real, 1e-5, "tol",
-           "stop when the estimated relative L2 distance of (r, r', d1, d2) to the "
-           "iteration's limit, change x rho / (1 - rho) with rho the measured contraction "
-           "per iteration, is below tol", POSITIVE),
+           "stop when the relative L2 change of (r, r', d1, d2) per iteration is below tol "
+           "(a step that stops while its estimated distance to the limit, change x rho / "
+           "(1 - rho), is above 10 tol says so)", POSITIVE),
     Option("rod_al_ctol", _real, 1e-3, "tol",
            "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
            "below tol", POSITIVE),
@@ -148,8 +148,8 @@ def read_options():
         try:
             value = option.parse(text)
         except ValueError as error:
-            raise RodInputError(f"-{option.name} {text!r}: {error}; expected {option.metavar}"
-                                ) from None
+            expected = "" if "expected" in str(error) else f"; expected {option.metavar}"
+            raise RodInputError(f"-{option.name} {text!r}: {error}{expected}") from None
         if option.check is not None and not option.check[0](value):
             raise RodInputError(f"-{option.name} {text}: {option.check[1]}")
         values[option.name] = value

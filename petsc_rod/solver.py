@@ -444,12 +444,15 @@ class UzawaSolver:
         settings = self.settings
         history = []
         clock = time.perf_counter()
-        change = residual = distance = np.inf
+        change = residual = np.inf
         raises = []
+
+        def distance():
+            return estimated_distance([row[0] for row in history[-RATE_WINDOW - 1:]])
 
         def report(converged, iterations, reason=""):
             return StepReport(converged, iterations, change, residual, history, reason,
-                              distance, raises)
+                              distance(), raises)
 
         for iteration in range(1, settings.max_it + 1):
             try:
@@ -465,12 +468,12 @@ class UzawaSolver:
                     f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
                     f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
                     "-rod_steps", iteration)
-            distance = estimated_distance([row[0] for row in history[-RATE_WINDOW - 1:]])
             if observer is not None and observer(iteration, change, residual):
                 return report(False, iteration, STOP_OBSERVER)
             if settings.monitor:
                 PETSc.Sys.Print(f"  {label}it {iteration:5d}  change {change:.3e}  distance "
-                                f"{distance:.3e}  constraint {residual:.3e}", comm=self.mesh.comm)
+                                f"{distance():.3e}  constraint {residual:.3e}",
+                                comm=self.mesh.comm)
             if change <= self.change_tolerance and residual <= settings.ctol:
                 return report(True, iteration)
             if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
