@@ -25,6 +25,18 @@ def element_rows(mesh):
     return (2 * (first + P2.offsets[None, :]) + P2.slots[None, :]).astype(PETSc.IntType)
 
 
+def assemble_matrix(mesh, element_matrices):
+    """The DMDA matrix sum_e of element matrices (ne, 3, 3) on the P2 dofs."""
+    rows = element_rows(mesh)
+    matrix = mesh.da.createMatrix()
+    if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
+        # petsc4py's setValuesRCV divides by the number of rows
+        matrix.setValuesRCV(rows, rows, element_matrices, addv=PETSc.InsertMode.ADD_VALUES)
+    matrix.assemble()
+    matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    return matrix
+
+
 class ScalarProblem:
     """One scalar SPD operator of the global step with its KSP.
 
@@ -36,14 +48,8 @@ class ScalarProblem:
     def __init__(self, mesh, element_matrices, prescribed, prefix):
         self.mesh = mesh
         self.name = prefix
-        self._rows = rows = element_rows(mesh)
-        self.full = mesh.da.createMatrix()
-        if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
-            # petsc4py's setValuesRCV divides by the number of rows
-            self.full.setValuesRCV(rows, rows, element_matrices,
-                                   addv=PETSc.InsertMode.ADD_VALUES)
-        self.full.assemble()
-        self.full.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self._rows = element_rows(mesh)
+        self.full = assemble_matrix(mesh, element_matrices)
         self.constrained = self.full.duplicate(copy=True)
         start, end = self.full.getOwnershipRange()
         self.fixed_rows = np.array([2 * v + s for v, s, _ in prescribed], dtype=PETSc.IntType)

@@ -9,13 +9,13 @@ import numpy as np
 from . import outputs
 from .errors import RodDivergedError, RodNotConvergedError
 from .link import changed_class
-from .solver import ADAPT_WINDOW, STOP_LINK
+from .solver import ADAPT_WINDOW, STOP_LINK, STOP_SADDLE
 
 
 def not_converged_reason(report, solver):
     """Why a step stopped without converging, and what to change."""
     settings = solver.settings
-    numbers = (f"change {report.change:.2e} for -rod_al_rtol {solver.change_tolerance:.2g}, "
+    numbers = (f"change {report.change:.2e} for -rod_al_rtol {settings.rtol:.2g}, "
                f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
                f"{settings.ctol:.2g}")
     if report.reason == STOP_LINK:
@@ -25,6 +25,10 @@ def not_converged_reason(report, solver):
                 "load path leads to: the clamps fix the end roll only modulo a turn, and the "
                 "iteration passed the rod around one of its ends or through itself, which "
                 "walls at the clamps forbid (docs/stability.md); take more -rod_steps")
+    if report.reason == STOP_SADDLE:
+        return (f"converged {report.escapes + 1} times to a saddle, an equilibrium that is not "
+                "a minimiser, after turning the frames along its direction of negative "
+                "curvature each time: take more -rod_steps, or -rod_imperfection")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
                 "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
@@ -96,6 +100,29 @@ class LoadPath:
             self.increment = self.units_per_step
 
 
+class Predictor:
+    """The start of a step: the state (tau, lambda) extrapolated linearly in the load
+    factor from the last two accepted steps (docs/method.md §7), so that the iteration
+    starts O(dt^2) from its solution instead of O(dt); with fewer than two, the last
+    state as it is."""
+
+    def __init__(self):
+        self.accepted = []          # (t, tau, lambda) of the last two accepted states
+
+    def accept(self, t, solver):
+        self.accepted = self.accepted[-1:] + [(t, solver.tau.copy(), solver.lam.copy())]
+
+    def predict(self, solver, t):
+        """Set the solver's tau and lambda for load factor t (its current state must be
+        the last accepted one)."""
+        if len(self.accepted) < 2:
+            return
+        (t0, tau0, lam0), (t1, tau1, lam1) = self.accepted
+        ratio = (t - t1) / (t1 - t0)
+        solver.tau[:] = tau1 + ratio * (tau1 - tau0)
+        solver.lam[:] = lam1 + ratio * (lam1 - lam0)
+
+
 def attempt(solver, t, imperfection, label, expected_link=None):
     """One try at load factor t from the current state, its cross-sections rolled first:
     (report, failure), ``failure`` None when the step converged, the RodDivergedError
@@ -132,18 +159,16 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     clock = time.perf_counter()
     say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
         f"R = {solver.settings.penalty:g}, {steps} step(s)")
-    if solver.penalty > solver.settings.penalty:
-        say(f"petsc_rod: the stiffness split is non-convex (method.md §2): R raised to "
-            f"{solver.penalty:.6g} so the global step stays convex on this mesh, and "
-            f"the change test tightened to {solver.change_tolerance:.3g} to match "
-            "(docs/stability.md)")
     path = LoadPath(steps, max_halvings)
+    predictor = Predictor()
+    predictor.accept(0.0, solver)
     total_iterations = undone_iterations = written = 0
     # (Tw, Wr) of the last accepted state (of the start, then of each step), or None
     link = solver.link() if track_link else None
     while not path.finished:
         t, label = path.next_factor, f"step {path.step}/{steps}"
         saved = solver.snapshot()
+        predictor.predict(solver, t)
         report, failure = attempt(solver, t, imperfection, f"{label} ",
                                   expected_link(solver.scene, link, path.factor(path.reached), t))
         iterations = (failure.iterations or 0) if report is None else report.iterations
@@ -167,6 +192,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         if not report.converged:
             break
         path.accept()
+        predictor.accept(t, solver)
         link = report.link if track_link else None
     if writer is not None:
         writer.finish(f"steps/{written}", attributes)
@@ -189,9 +215,19 @@ def expected_link(scene, link, t_from, t):
     return sum(link) + (scene.end_roll(t) - scene.end_roll(t_from)) / (2 * np.pi)
 
 
-# A converged step whose estimated distance to the limit is above this many times rtol is
-# reported as stopped early by the change test (UzawaSolver.solve_step).
-SLOW_CONTRACTION = 10.0
+def stability_code(report):
+    """The file's ``stable``: 1 a local minimiser, 0 a saddle, -1 not checked."""
+    return -1 if report.stable is None else int(report.stable)
+
+
+def stability_text(report):
+    """The step line's account of which equilibrium was reached (stability.py)."""
+    if report.stable is None:
+        return ""
+    if not report.stable:
+        return ", a saddle (the second variation has a negative direction)"
+    left = f" after leaving {report.escapes} saddle(s)" if report.escapes else ""
+    return f", stable{left} (second variation positive)"
 
 
 def link_text(link):
@@ -211,7 +247,7 @@ def record_step(solver, report, t, label, say, writer, group, **common):
     u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
     attributes = {"converged": int(report.converged), "iterations": report.iterations,
                   "constraint_residual": report.constraint_residual,
-                  "change": report.change, "estimated_distance": report.distance,
+                  "change": report.change, "stable": stability_code(report),
                   "energy": energy, "ranks": mesh.comm.getSize(),
                   "load_factor": t, "penalty": solver.penalty, **common}
     if report.link is not None:
@@ -220,18 +256,13 @@ def record_step(solver, report, t, label, say, writer, group, **common):
         f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
         f"iterations, change {report.change:.2e}, constraint residual (RMS) "
         f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
-        + link_text(report.link))
+        + link_text(report.link) + stability_text(report))
     if report.penalty_raises:
         raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in report.penalty_raises)
         say(f"petsc_rod: {label}: the constraint residual fell by less than half in "
             f"{ADAPT_WINDOW} iterations with R far below the problem's scale "
             f"{solver.scale:.3g}: R raised to {raised} (matrices refactored; "
             "-rod_al_adapt_penalty)")
-    if report.converged and SLOW_CONTRACTION * solver.change_tolerance < report.distance < np.inf:
-        say(f"petsc_rod: warning: {label} met the change test, but the iteration still "
-            f"contracts slowly: its estimated distance to the limit is {report.distance:.2e} "
-            f"(change x rho / (1 - rho)), not {solver.change_tolerance:.2g}; for a state that "
-            "close, lower -rod_al_rtol (or -rod_al_penalty, which sets the contraction)")
     if writer is not None:
         writer.write_step(group, vertex, outputs.restart_state(solver), report.history,
                           attributes)

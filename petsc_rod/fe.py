@@ -13,8 +13,11 @@ midpoint value of the element to the right of the vertex). ``Element.offsets`` /
 ``Element.slots`` say where element dof k lives: vertex ``e + offsets[k]``, slot
 ``slots[k]``.
 
-The 3-point Gauss rule integrates every product of the global step exactly on a
-straight element (degree <= 5), and tau, lambda live at its points.
+The constraint d_i = tau_i and its multipliers live at the P2 nodes (vertices and
+midpoints), with Simpson's weights h (1/6, 4/6, 1/6): the penalty term of the global step
+is a diagonal (lumped) mass, and the local step acts on the very dofs of the fields
+(docs/method.md §4). The 3-point Gauss rule integrates the stiffness, the loads and the
+energy exactly on a straight element.
 """
 
 from dataclasses import dataclass
@@ -90,19 +93,23 @@ def gram(weights, a, b):
     return np.einsum("eq,eqk,eql->ekl", weights, a, b)
 
 
-# Largest generalised eigenvalue of (stiffness, mass) = (int g'.g', int g.g) on one P2
-# element of length h, times h^2: 60 (computed in tests/test_nonconvex.py). The global
-# eigenvalue is bounded by the largest element one.
-STIFFNESS_TO_MASS_MAX = 60.0
+# Simpson's weights of the P2 nodes (left vertex, midpoint, right vertex) on [0, 1].
+NODE_WEIGHTS = np.array([1.0, 4.0, 1.0]) / 6.0
+
+# Largest generalised eigenvalue of (stiffness, lumped mass) = (int g'.g',
+# sum_n w_n g_n^2) on one P2 element of length h, times h^2: 24 (computed in
+# tests/test_nonconvex.py). The global eigenvalue is bounded by the largest element one.
+STIFFNESS_TO_MASS_MAX = 24.0
 
 
 def p2_element_matrices(h, stiffness, penalty):
-    """Element matrices of one field of the global step (§3 step 1): int s g'.k' + R g.k.
+    """Element matrices of one field of the global step (docs/method.md §3):
+    int s g'.k' dS + R sum_n w_n g_n k_n, the penalty mass lumped at the nodes.
 
     For d_a (a = 1, 2) s = 2 a_a; for the slope theta = r' = d3, s = 2 a3 (the r equation
-    int 2 a3 r''.p'' + R r'.p' with theta = r', g = p'). ``penalty`` is R (N).
-    Returns (ne, 3, 3).
+    int 2 a3 r''.p'' with theta = r', g = p'). ``penalty`` is R (N). Returns (ne, 3, 3).
     """
-    phi, dphi = p2_basis(GAUSS_POINTS, h)
+    _, dphi = p2_basis(GAUSS_POINTS, h)
     w = quadrature_weights(h)
-    return stiffness * gram(w, dphi, dphi) + penalty * gram(w, phi, phi)
+    lumped = np.asarray(h, dtype=float)[:, None, None] * np.diag(NODE_WEIGHTS)[None]
+    return stiffness * gram(w, dphi, dphi) + penalty * lumped

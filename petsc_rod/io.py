@@ -4,7 +4,7 @@ Layout (documented in README.md): vertex datasets S (n,), r, d1, d2, d3, u, m, n
 attributes converged, iterations, constraint_residual, change, estimated_distance, energy,
 wall_time, ranks, options, load_factor, penalty (and twist_turns, writhe_turns where the
 link is tracked); a group ``history``; a group ``state`` with what a restart needs beyond
-the vertex datasets (P2 midpoints, tau, lambda per element); and one group ``steps/<k>`` per accepted continuation step (halved sub-steps included) and the failed
+the vertex datasets (d1, d2 midpoints per element, tau and lambda per P2 node); and one group ``steps/<k>`` per accepted continuation step (halved sub-steps included) and the failed
 one that ends a run, with the same content. The root links to the last step. The file
 is written as ``<name>.partial`` and renamed only when complete, so a crash or an
 interrupt never leaves a half-written result under the requested name.
@@ -18,7 +18,8 @@ import numpy as np
 from .errors import RodInputError
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
-STATE_DATASETS = ("d1_mid", "d2_mid", "tau", "lambda")
+ELEMENT_STATE = ("d1_mid", "d2_mid")       # per element
+NODE_STATE = ("tau", "lambda")              # per P2 node (2 N + 1 of them)
 HISTORY_COLUMNS = ("change", "constraint_residual", "wall_time")
 
 
@@ -57,9 +58,12 @@ class ResultWriter:
             self._dataset(group, key, mesh.n_vertices, np.asarray(vertex[key]),
                           mesh.vertex_start)
         state_group = group.create_group("state")
-        for key in STATE_DATASETS:
+        for key in ELEMENT_STATE:
             self._dataset(state_group, key, mesh.n_elements, np.asarray(state[key]),
                           mesh.element_start)
+        for key in NODE_STATE:
+            self._dataset(state_group, key, 2 * mesh.n_elements + 1, np.asarray(state[key]),
+                          2 * mesh.vertex_start)
         history_group = group.create_group("history")
         table = np.asarray(history, dtype=float).reshape(-1, len(HISTORY_COLUMNS))
         for column, key in enumerate(HISTORY_COLUMNS):
@@ -112,5 +116,7 @@ def read_state(path, mesh):
             raise RodInputError(f"-rod_initial {path}: the file's mesh (length or grading) is "
                                 "not this run's; use the same -rod_length and -rod_mesh_grading")
         vertex = {key: f[key][vs:ve] for key in ("r", "d1", "d2", "d3")}
-        element = {key: f["state"][key][es:ee] for key in STATE_DATASETS}
-    return vertex, element
+        element = {key: f["state"][key][es:ee] for key in ELEMENT_STATE}
+        ns = 2 * vs
+        node = {key: f["state"][key][ns:ns + mesh.n_local_nodes] for key in NODE_STATE}
+    return vertex, element, node

@@ -117,6 +117,20 @@ def rotation_about(axis, angle):
     return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
 
 
+def rotations(omega):
+    """Rotation matrices exp([omega]x) of rotation vectors omega (..., 3) (Rodrigues):
+    I + sin(a) [k]x + (1 - cos a) [k]x^2 with a = |omega|, k = omega / a. (..., 3, 3)."""
+    omega = np.asarray(omega, dtype=float)
+    angle = np.linalg.norm(omega, axis=-1)[..., None, None]
+    k = np.zeros(omega.shape + (3,))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -omega[..., 2], omega[..., 1], -omega[..., 0]
+    k = k - np.swapaxes(k, -1, -2)
+    # sin(a)/a and (1 - cos a)/a^2, well defined at a = 0
+    first = np.sinc(angle / np.pi)
+    second = 0.5 * np.sinc(angle / (2 * np.pi)) ** 2
+    return np.eye(3) + first * k + second * (k @ k)
+
+
 def rotation_log(q):
     """Axis-angle vector w (3,) with rotation_about(w/|w|, |w|) = q, |w| in [0, pi].
 

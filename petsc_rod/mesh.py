@@ -54,6 +54,32 @@ class Mesh:
     def n_local_elements(self):
         return self.element_end - self.element_start
 
+    @property
+    def n_local_nodes(self):
+        """P2 nodes this rank owns: its vertices and the midpoints stored with them, in
+        DMDA order (vertex, midpoint, vertex, ...); the last vertex has no midpoint."""
+        return (self.vertex_end - self.vertex_start) + self.n_local_elements
+
+    def node_S(self):
+        """S of the owned P2 nodes, (n_local_nodes,)."""
+        S = np.empty(self.n_local_nodes)
+        S[0::2] = self.vertex_S
+        S[1::2] = self.element_S + self.element_h / 2
+        return S
+
+    def node_weights(self):
+        """Simpson weights of the owned P2 nodes, (n_local_nodes,): h_e (1/6, 4/6, 1/6) per
+        element, summed at the vertices, so that sum_n w_n g(S_n) = int g dS exactly for
+        a piecewise cubic g (the quadrature of the constraint, docs/method.md §4)."""
+        vertices = np.arange(self.vertex_start, self.vertex_end)
+        left = self.coordinates(vertices) - self.coordinates(np.maximum(vertices - 1, 0))
+        right = self.coordinates(np.minimum(vertices + 1, self.n_elements)) \
+            - self.coordinates(vertices)
+        w = np.empty(self.n_local_nodes)
+        w[0::2] = (left + right) / 6
+        w[1::2] = 4 * self.element_h / 6
+        return w
+
     def coordinates(self, vertex_index):
         """S of the given global vertex indices."""
         t = np.asarray(vertex_index, dtype=float) / self.n_elements

@@ -1,7 +1,8 @@
 """The application's PETSc options: one table drives parsing, defaults and ``-help``.
 
 Every option has the root prefix ``rod_``. The KSPs of the global step have their own
-prefixes (``rod_r_``, ``rod_d1_``, ``rod_d2_``) and read the usual PETSc options. A
+prefixes (``rod_r_``, ``rod_d1_``, ``rod_d2_``), the SNES of the iteration ``rod_snes_``;
+they read the usual PETSc options. A
 ``-rod_*`` name that is not in the table is an error (with the closest known name); any
 other option nobody read is reported at the end of the run.
 """
@@ -15,7 +16,8 @@ from petsc4py import PETSc
 
 from .errors import RodInputError
 
-KSP_PREFIXES = ("rod_r_", "rod_d1_", "rod_d2_")
+# Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
+SOLVER_PREFIXES = ("rod_r_", "rod_d1_", "rod_d2_", "rod_snes_")
 
 
 def _real(text):
@@ -135,7 +137,7 @@ def read_options():
     database = PETSc.Options()
     given = {name for name in database.getAll() if name.startswith("rod_")}
     for name in sorted(given):
-        if name not in BY_NAME and not name.startswith(KSP_PREFIXES):
+        if name not in BY_NAME and not name.startswith(SOLVER_PREFIXES):
             close = difflib.get_close_matches(name, list(BY_NAME), n=1)
             hint = f"; did you mean -{close[0]}?" if close else "; see -help"
             raise RodInputError(f"unknown option -{name}{hint}")
@@ -167,6 +169,9 @@ def help_text():
                      f"(default {default})")
     lines.append("  Global-step solvers: -rod_r_ksp_*, -rod_r_pc_* (r), -rod_d1_*, -rod_d2_* "
                  "(directors); default preonly + Cholesky (MUMPS on several ranks).")
+    lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
+                 "iterates) | nrichardson (the plain iteration) | ngmres, and the SNES "
+                 "options under the same prefix (-rod_snes_anderson_m, -rod_snes_monitor).")
     return lines
 
 

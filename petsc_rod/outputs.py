@@ -1,6 +1,7 @@
 """Derived outputs at the mesh vertices: positions, frames, strains, moment, force (§6).
 
-Every array is this rank's owned vertices (or owned elements for the restart state);
+Every array is this rank's owned vertices (or owned elements and P2 nodes for the
+restart state);
 nothing is gathered. Strains at a vertex average the limits from the elements on
 either side (u is discontinuous across elements for P2 directors).
 """
@@ -48,13 +49,14 @@ def vertex_fields(solver, t):
 
 
 def restart_state(solver):
-    """Dofs not in the vertex datasets: P2 midpoints, tau and lambda, per owned element."""
+    """Dofs not in the vertex datasets: the P2 midpoints of d1, d2 per owned element, and
+    tau, lambda at the owned P2 nodes."""
     n_local = solver.mesh.n_local_elements
     return {"d1_mid": solver.d1.owned()[:n_local, 1], "d2_mid": solver.d2.owned()[:n_local, 1],
             "tau": solver.tau, "lambda": solver.lam}
 
 
-def set_state(solver, vertex, element):
+def set_state(solver, vertex, element, node):
     """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
     holds r and d3 = r' at the vertices: theta's midpoints are those of the Hermite cubic
     they define (UzawaSolver.set_centreline)."""
@@ -66,7 +68,7 @@ def set_state(solver, vertex, element):
         values[:, 0] = vertex[name]
         values[:n_local, 1] = element[f"{name}_mid"]
         field.set_owned(values)
-    solver.tau[:] = element["tau"]
-    solver.lam[:] = element["lambda"]
+    solver.tau[:] = node["tau"]
+    solver.lam[:] = node["lambda"]
     solver.remember_state()
 

@@ -16,22 +16,21 @@ import numpy as np
 from petsc4py import PETSc
 
 from . import boundary, starts
-from .assembly import ScalarProblem, load_ghosted
+from .assembly import ScalarProblem, assemble_matrix, load_ghosted
 from .centreline import (anchor_work, load_offset, midpoint_slopes, positions_at_points,
                          vertex_positions)
 from .errors import RodDivergedError
-from .fe import (GAUSS_POINTS, P2, STIFFNESS_TO_MASS_MAX, element_integrals, p2_basis,
+from .fe import (GAUSS_POINTS, P2, element_integrals, p2_basis,
                  p2_element_matrices, p2_integrals, quadrature_weights)
-from .fields import VectorField, at_points, element_dofs, scatter_element_vectors
-from .kernels import nearest_rotation, split_coefficients, strains, update_multipliers
+from .fields import VectorField, at_points, element_dofs
+from .kernels import (nearest_rotation, rotations, split_coefficients, strains,
+                      update_multipliers)
 from .link import FULLER_MARGIN, link_integrands
+from .stability import SecondVariation
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
           for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}
 
-# A non-convex field gets a penalty this many times the least one that makes its matrix
-# positive definite (effective_penalty).
-NONCONVEX_MARGIN = 4.0
 
 # An RMS constraint residual this large means the directors are no longer near unit
 # vectors: the iteration has left every meaningful state.
@@ -46,6 +45,7 @@ class Settings:
     ctol: float = 1e-3
     monitor: bool = False
     adapt_penalty: bool = True      # raise a penalty far below the scale (raise_penalty)
+    check_stability: bool = True    # test the second variation at convergence (stability.py)
 
 
 @dataclass
@@ -56,15 +56,21 @@ class StepReport:
     constraint_residual: float
     history: list = field(default_factory=list)   # (change, residual, wall time) rows
     reason: str = ""        # why a step that did not converge stopped (STOP_* below)
-    distance: float = np.inf    # the estimated distance to the limit (estimated_distance)
     penalty_raises: list = field(default_factory=list)  # (iteration, new R) rows
     link: tuple = None          # (Tw, Wr) after the step, turns (UzawaSolver.link)
     link_expected: float = None     # the Lk the load path leads to, turns (continuation)
+    stable: bool = None     # the second variation is positive (stability.py); None: unchecked
+    escapes: int = 0        # saddles the step converged to and left
 
     @property
     def stalled(self):
         return self.reason == STOP_STALLED
 
+
+# The SNES type of the iteration unless -rod_snes_type says otherwise.
+DEFAULT_SNES = "anderson"
+SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
+                for name in dir(PETSc.SNES.ConvergedReason) if not name.startswith("_")}
 
 STOP_MAX_IT = "max_it"
 STOP_STALLED = "stalled"
@@ -84,6 +90,37 @@ STALL_MARGIN = 10.0
 # Python work (0.12 ms measured, a seventh of an iteration on 80 elements) stays out of
 # most iterations.
 STALL_CHECK_EVERY = STALL_WINDOW // 10
+
+
+RAISE_PENALTY = "raise_penalty"     # the step goes on with a larger R (raise_penalty)
+CONVERGED = (True, "")
+STOP_SADDLE = "saddle"      # converged, to a saddle, MAX_ESCAPES times
+# A step that converged to a saddle goes on from its frames turned along the negative
+# curvature by this angle at most (rad), at most MAX_ESCAPES times.
+ESCAPE_ANGLE = 0.1
+MAX_ESCAPES = 5
+ESCAPE_GROWTH = 2.0
+
+
+@dataclass
+class StepProgress:
+    """What one step has done so far (UzawaSolver.solve_step): a (change, residual,
+    wall time) row per iteration, the penalty raises, and the outcome once decided:
+    (converged, reason), or RAISE_PENALTY, or the error that ended it."""
+
+    label: str
+    observer: object
+    clock: float = field(default_factory=time.perf_counter)
+    history: list = field(default_factory=list)
+    raises: list = field(default_factory=list)
+    outcome: object = None
+    error: Exception = None
+    stable: bool = None         # a local minimiser (stability.py); None: not checked
+    escapes: int = 0            # saddles left on the way
+
+    @property
+    def finished(self):
+        return self.outcome is not None or self.error is not None
 
 
 def stalled_projection(values, target, budget):
@@ -150,49 +187,17 @@ def penalty_too_low(history, penalty, scale):
     return history[-1][1] > ADAPT_PROGRESS * history[-1 - ADAPT_WINDOW][1]
 
 
-# The contraction factor of the iteration is measured over this many iterations.
-RATE_WINDOW = 20
+def matrix_split(split):
+    """The coefficients c_i of the global step's matrices 2 c_i K + R W (docs/method.md §3).
 
-
-def estimated_distance(changes):
-    """Relative distance of the last iterate to the limit of the iteration, estimated
-    from the changes c_n (newest last) as c_n rho / (1 - rho), rho = (c_n / c_{n-k})^(1/k)
-    the contraction factor over the last k = min(RATE_WINDOW, n - 1) iterations; inf if
-    the changes do not shrink.
-
-    For an iteration that converges linearly, e_n = rho e_{n-1} and c_n = (1 - rho) e_{n-1},
-    so e_n = c_n rho / (1 - rho). The change alone (the paper's test) says nothing about
-    the distance when rho is near 1, as it is for a large R or a slow mode: on a
-    cantilever at R = 400 K/L^2 the change test at 1e-7 stopped 2e-5 away from the
-    limit (docs/stability.md).
+    Where every a_i > 0, c = a. A stiffness above the sum of the other two makes one
+    a_j < 0 (a flat section; K3 > K1 + K2 in torsion): its matrix would be indefinite
+    unless R grew like 1/h^2. Instead c_j = max_i a_i, and the difference
+    2 (c_j - a_j) K tau_j goes to the right-hand side (UzawaSolver._add_lagged_part): the
+    fixed points are those of the a_i, and the matrix of d_j keeps a stiffness of the
+    size of the other two, so that the iteration stays stable at any h.
     """
-    n = len(changes)
-    if n < 2:
-        return np.inf
-    k = min(RATE_WINDOW, n - 1)
-    if not changes[-1] < changes[-1 - k]:
-        return np.inf
-    rate = (changes[-1] / changes[-1 - k]) ** (1.0 / k)
-    return changes[-1] * rate / (1.0 - rate)
-
-
-def effective_penalty(penalty, split, smallest_element):
-    """The penalty R used for all three constraints d_i = tau_i (d3 = r'), N.
-
-    A field whose split coefficient a_i is negative (a stiffness above the sum of the
-    other two, method.md §2) has the matrix 2 a_i K + R M, positive definite only when
-    R > 2 |a_i| lambda_max(K, M) = 2 |a_i| 60 / h_min^2 (fe.STIFFNESS_TO_MASS_MAX). The
-    user's R is then raised to NONCONVEX_MARGIN times this floor, so that the global step
-    still minimises a strictly convex quadratic (Cholesky still applies). It is raised for
-    all three fields: the local step and the multiplier update would accept unequal R_i,
-    but with a large R_2 and small R_1, R_3 the frames tau oscillate from point to point
-    and the iteration diverges within ten iterations (docs/stability.md). The floor grows
-    like 1/h^2: the price of the non-convex split is a penalty, and with it an iteration
-    count, that grows with the mesh.
-    """
-    worst = np.abs(np.minimum(split, 0.0)).max()
-    floor = 2 * worst * STIFFNESS_TO_MASS_MAX / smallest_element**2
-    return max(float(penalty), NONCONVEX_MARGIN * floor)
+    return np.where(split < 0, split.max(), split)
 
 
 def default_penalty(scene):
@@ -230,10 +235,10 @@ class UzawaSolver:
     def __init__(self, mesh, scene, settings):
         self.mesh, self.scene, self.settings = mesh, scene, settings
         self.split = split_coefficients(scene.stiffness)
-        self.penalty = effective_penalty(settings.penalty, self.split, mesh.smallest_element)
-        # the R that rtol refers to (change_tolerance): the user's, or raise_penalty's
-        self.asked_penalty = settings.penalty
+        self.matrix_split = matrix_split(self.split)
+        self.penalty = float(settings.penalty)       # in use: raise_penalty may raise it
         self.scale = default_penalty(scene)
+        self._lagged = None
         self.start_state, self.end_state = scene.start_state(0.0), scene.end_state(0.0)
         self.bordered = boundary.is_held(self.start_state) and boundary.is_held(self.end_state)
         self._build_problems()
@@ -245,10 +250,17 @@ class UzawaSolver:
         self.p2 = p2_basis(GAUSS_POINTS, h)
         self.p2_integrals = p2_integrals(GAUSS_POINTS, h)
         self.weights = quadrature_weights(h)
+        self.node_weights = mesh.node_weights()
         self._multiplier = np.zeros(3)
-        shape = (mesh.n_local_elements, GAUSS_POINTS.size, 3, 3)
+        # tau and lambda at the owned P2 nodes, rows d1, d2, d3 (docs/method.md §4)
+        shape = (mesh.n_local_nodes, 3, 3)
         self.tau = np.zeros(shape)
         self.lam = np.zeros(shape)
+        self._directors = np.zeros(shape)
+        self._positions = np.zeros((mesh.n_local_nodes, 3))
+        self._root_weights = np.sqrt(self.node_weights)[:, None, None]
+        self._step = None
+        self._create_snes()
         self._previous = None
 
     def _build_problems(self):
@@ -258,7 +270,7 @@ class UzawaSolver:
         EVENTS["assembly"].begin()
         # frame order: d1, d2, theta = r' = d3
         self.problems = [ScalarProblem(
-            mesh, p2_element_matrices(h, 2 * self.split[i], self.penalty),
+            mesh, p2_element_matrices(h, 2 * self.matrix_split[i], self.penalty),
             boundary.director_prescribed(i, self.start_state, self.end_state,
                                          mesh.n_elements), prefix)
             for i, prefix in enumerate(("rod_d1_", "rod_d2_", "rod_r_"))]
@@ -267,7 +279,32 @@ class UzawaSolver:
         if self.bordered:
             self.r_problem.add_integral_constraint(element_integrals(h))
         self._set_prescribed()
+        if self._lagged is None and np.any(self.matrix_split != self.split):
+            self._lagged = assemble_matrix(mesh, p2_element_matrices(h, 1.0, 0.0))
         EVENTS["assembly"].end()
+
+    def _create_snes(self):
+        """The SNES that drives the iteration (solve_step): the fixed-point problem
+        x = G(x) as F(x) = x - G(x) on a vector of the node state, options -rod_snes_*.
+        Its default, Anderson mixing, combines the last iterates into the one of least
+        residual; nrichardson with the basic line search is the plain iteration."""
+        size = 18 * self.mesh.n_local_nodes
+        self._x = PETSc.Vec().createMPI((size, PETSc.DECIDE), comm=self.mesh.comm)
+        self._f = self._x.duplicate()
+        snes = self.snes = PETSc.SNES().create(comm=self.mesh.comm)
+        snes.setOptionsPrefix("rod_")
+        snes.setType(DEFAULT_SNES)
+        snes.setFunction(self._fixed_point_residual, self._f)
+        snes.setConvergenceTest(self._converged)
+        # the step's own tests end it (_outcome): SNES's counts must not come first
+        snes.setTolerances(max_it=2**30)
+        snes.setMaxFunctionEvaluations(2**30)
+        database = PETSc.Options()
+        if database.getString("rod_snes_type", DEFAULT_SNES) == PETSc.SNES.Type.NRICHARDSON \
+                and not database.hasName("rod_snes_linesearch_type"):
+            # nrichardson's default line search (secant) is not the plain iteration
+            database.setValue("rod_snes_linesearch_type", "basic")
+        snes.setFromOptions()
 
     def _set_prescribed(self):
         """The end states' frame rows as the prescribed values of the three problems."""
@@ -288,17 +325,9 @@ class UzawaSolver:
         (docs/stability.md, fix 10). tau and lambda are kept: the iteration goes on from
         where it is, with the new R.
         """
-        self.penalty = self.asked_penalty = min(ADAPT_FACTOR * self.penalty, self.scale)
+        self.penalty = min(ADAPT_FACTOR * self.penalty, self.scale)
         self._destroy_problems()
         self._build_problems()
-
-    @property
-    def change_tolerance(self):
-        """The change test's bound: rtol, times R_asked / R when R was raised for a
-        non-convex split (R_asked: the user's R, or the one raise_penalty set). The change
-        per iteration shrinks like 1/R near the solution (the contraction factor is about
-        1 - c/R), so the same rtol then stands for the same distance to the solution."""
-        return self.settings.rtol * self.asked_penalty / self.penalty
 
     # --- state ---------------------------------------------------------------------
     @property
@@ -313,8 +342,8 @@ class UzawaSolver:
     def set_from_curve(self, curve):
         """Start from a smooth curve S -> (r, frame, force) (starts.py): r and theta = d3
         at the vertices (theta's midpoints from the Hermite cubic they define), d1, d2 at
-        the vertices and midpoints, tau = frame at the quadrature points, lambda3 = force
-        there and lambda1 = lambda2 = 0."""
+        the vertices and midpoints, tau = frame at the nodes, lambda3 = force there and
+        lambda1 = lambda2 = 0."""
         mesh = self.mesh
         owned = np.arange(mesh.vertex_start, mesh.vertex_end)
         vertex_S = mesh.coordinates(owned)
@@ -325,10 +354,10 @@ class UzawaSolver:
         for index, director in enumerate(self.frame_fields[:2]):
             director.set_owned(np.stack([vertex_frame[:, index], midpoint_frame[:, index]],
                                         axis=1))
-        _, point_frame, point_force = curve(mesh.point_S(GAUSS_POINTS))
-        self.tau[:] = point_frame
+        _, node_frame, node_force = curve(mesh.node_S())
+        self.tau[:] = node_frame
         self.lam[:] = 0.0
-        self.lam[:, :, 2] = point_force
+        self.lam[:, 2] = node_force
         self.remember_state()
 
     def roll_cross_sections(self, amplitude):
@@ -338,7 +367,7 @@ class UzawaSolver:
         (d1, d2) -> (cos phi d1 + sin phi d2, -sin phi d1 + cos phi d2), and likewise for
         (tau1, tau2) and (lambda1, lambda2): a rotation about d1 x d2 = d3. It changes the
         start of the iteration, not the problem, so that a symmetric start (e.g. a planar
-        one) can leave a symmetric equilibrium that is not a minimiser (§7).
+        one) can leave a symmetric equilibrium that is not a minimiser (docs/method.md §7).
         """
         if amplitude == 0.0:
             return
@@ -348,13 +377,13 @@ class UzawaSolver:
         midpoint_S = (vertex_S + mesh.coordinates(owned + 1)) / 2    # slot 1: P2 midpoint
         vertex_angle = np.stack([vertex_S, midpoint_S], axis=1)
         vertex_angle = amplitude * np.sin(np.pi * vertex_angle / (2 * mesh.length))
-        point_angle = amplitude * np.sin(np.pi * mesh.point_S(GAUSS_POINTS) / (2 * mesh.length))
+        node_angle = amplitude * np.sin(np.pi * mesh.node_S() / (2 * mesh.length))
         d1, d2 = rolled(self.d1.owned(), self.d2.owned(), vertex_angle[..., None])
         self.d1.set_owned(d1)
         self.d2.set_owned(d2)
         for frames in (self.tau, self.lam):
-            frames[:, :, 0], frames[:, :, 1] = rolled(frames[:, :, 0], frames[:, :, 1],
-                                                      point_angle[..., None])
+            frames[:, 0], frames[:, 1] = rolled(frames[:, 0], frames[:, 1],
+                                                node_angle[..., None])
         self.remember_state()
 
     def set_centreline(self, positions, slopes):
@@ -397,12 +426,33 @@ class UzawaSolver:
 
     def remember_state(self):
         """Take the current fields as the reference of the next change test."""
-        self._previous = self._stacked(self.point_values())
+        self._directors = self.node_directors()
+        self._positions = self.node_positions()
+        self._previous = self._stacked()
 
-    @staticmethod
-    def _stacked(points):
-        """(r, r', d1, d2) at the Gauss points, (ne, nq, 4, 3)."""
-        return np.concatenate([points["r"][:, :, None, :], points["directors"]], axis=2)
+    def _stacked(self):
+        """(r, d1, d2, r') at the owned nodes, (n_nodes, 4, 3)."""
+        return np.concatenate([self._positions[:, None, :], self._directors], axis=1)
+
+    def node_directors(self):
+        """d1, d2 and theta = r' = d3 at the owned P2 nodes, rows, (n_nodes, 3, 3): the
+        dofs of the fields themselves (the phantom slot of the last vertex left out)."""
+        n = self.mesh.n_local_nodes
+        return np.stack([np.stack([c.getArray(readonly=True)[:n] for c in f.components],
+                                  axis=-1) for f in self.frame_fields], axis=1)
+
+    def node_positions(self):
+        """r at the owned P2 nodes, (n_nodes, 3): the vertex values, and at each midpoint
+        r(S_e) + int theta over the element's first half, h (5 theta_0 + 8 theta_m -
+        theta_1) / 24 (exact for the P2 slope)."""
+        mesh = self.mesh
+        theta = element_dofs(self.theta.ghosted(), mesh.element_local, P2)
+        vertices = self.r.owned()[:, 0]
+        r = np.empty((mesh.n_local_nodes, 3))
+        r[0::2] = vertices
+        r[1::2] = vertices[:mesh.n_local_elements] + np.einsum(
+            "ek,ekc->ec", p2_integrals(np.array([0.5]), mesh.element_h)[:, 0], theta)
+        return r
 
     # --- one continuation step ------------------------------------------------------
     def prepare_step(self, t):
@@ -423,17 +473,14 @@ class UzawaSolver:
             scene.load_piece_ends))
 
     def solve_step(self, t, label="", observer=None):
-        """Uzawa iterations at load factor t until both stopping tests of §6 hold:
-        change <= change_tolerance (rtol) and RMS constraint residual <= ctol. The
-        estimated distance to the limit (estimated_distance) is reported with the step,
-        not tested: where the iteration contracts slowly (R large for the problem) the
-        change test stops far from the limit, and the report says so; where the mesh's
-        constraint floor makes the multipliers drift there is no limit to be near
-        (docs/stability.md). A step whose change and residual are within STALL_FACTOR of
-        their tolerances but, at their rate, would not meet them within max_it stops
-        early as stalled (stalled_projection). A penalty far below the problem's scale
-        whose residual hardly falls is raised on the way (penalty_too_low, raise_penalty;
-        the report lists the raises).
+        """The iteration at load factor t, driven by the SNES ``-rod_snes_*`` (anderson by
+        default, nrichardson for the plain iteration; docs/method.md §5), until both
+        stopping tests hold: change <= change_tolerance (rtol) and RMS constraint residual
+        <= ctol. A step whose change and residual are within STALL_FACTOR of their
+        tolerances but, at their rate, would not meet them within max_it stops early as
+        stalled (stalled_projection). A penalty far below the problem's scale whose
+        residual hardly falls is raised on the way (penalty_too_low, raise_penalty; the
+        SNES starts again from the current state, and the report lists the raises).
 
         ``observer(iteration, change, residual)``, if given, is called (collectively)
         after each iteration's norms, e.g. to record the state at looser tolerances on
@@ -441,65 +488,153 @@ class UzawaSolver:
         reported as not converged.
         """
         self.prepare_step(t)
+        step = self._step = StepProgress(label, observer)
+        try:
+            self._iterate(step)
+            while step.outcome == CONVERGED and self.settings.check_stability:
+                step.stable, direction = self.check_stability()
+                if step.stable is not False:
+                    break
+                if step.escapes == MAX_ESCAPES:
+                    step.outcome = (False, STOP_SADDLE)
+                    break
+                # a saddle: turn the frames along the negative curvature, and go on
+                angle = ESCAPE_ANGLE * ESCAPE_GROWTH**step.escapes * (-1) ** step.escapes
+                self.turn_frames(angle * direction / self.mesh.global_max(
+                    float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
+                step.escapes += 1
+                step.outcome = None
+                self._iterate(step)
+        finally:
+            self._step = None
+        if step.error is not None:
+            raise step.error
+        converged, reason = step.outcome
+        change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
+        return StepReport(converged, len(step.history), change, residual, step.history,
+                          reason, step.raises, stable=step.stable, escapes=step.escapes)
+
+    def _iterate(self, step):
+        """Run the SNES from the current state until ``step`` has an outcome (a penalty
+        raise starts it again from where it is)."""
+        while True:
+            self._pack(self._x)
+            self.snes.solve(None, self._x)
+            if step.outcome != RAISE_PENALTY:
+                break
+            self.raise_penalty()
+            step.raises.append((len(step.history), self.penalty))
+            step.outcome = None
+        if step.outcome is None and step.error is None:   # the SNES stopped on its own test
+            reason = self.snes.getConvergedReason()
+            step.outcome = (False, f"snes_{SNES_REASONS.get(reason, reason)}")
+
+    def check_stability(self):
+        """(stable, direction) of the current (converged) state (stability.py): True and
+        None for a local minimiser; False and a rotation-vector field (n_nodes, 3) along
+        which the energy decreases to second order for a saddle; None, None where the
+        test cannot decide (a taut, straight rod)."""
+        hessian = SecondVariation(self)
+        try:
+            if not hessian.decidable:
+                return None, None
+            direction = hessian.descent_direction()
+            return direction is None, direction
+        finally:
+            hessian.destroy()
+
+    def turn_frames(self, omega):
+        """Turn tau and lambda at each node by the rotation exp([omega_n]x), (n_nodes, 3):
+        rows t_i -> Q t_i. The next iteration starts from there."""
+        turn = rotations(omega)
+        self.tau[:] = np.einsum("nkl,nil->nik", turn, self.tau)
+        self.lam[:] = np.einsum("nkl,nil->nik", turn, self.lam)
+
+    def _fixed_point_residual(self, snes, x, f):
+        """F(x) = x - G(x) for the SNES, G one iteration (iterate) of the state
+        x = sqrt(w) (tau, lambda / R) at the nodes (sqrt(w): the Euclidean norm of x is
+        the L2 norm of the fields). Records the iteration's norms and decides, for
+        _converged, whether the step is over."""
+        step = self._step
+        if step.finished:
+            f.set(0.0)
+            return
+        self._unpack(x)
+        iteration = len(step.history) + 1
+        try:
+            self.iterate()
+        except RodDivergedError as error:
+            step.error = RodDivergedError(f"{step.label}iteration {iteration}: {error}",
+                                          iteration)
+            f.set(0.0)
+            return
+        change, residual = self.norms()
+        step.history.append((change, residual, time.perf_counter() - step.clock))
+        step.outcome = self._outcome(step, iteration, change, residual)
+        if self.settings.monitor:
+            PETSc.Sys.Print(f"  {step.label}it {iteration:5d}  change {change:.3e}  "
+                            f"constraint {residual:.3e}", comm=self.mesh.comm)
+        self._pack(f)
+        f.aypx(-1.0, x)
+
+    def _outcome(self, step, iteration, change, residual):
+        """What the step does after an iteration: None (go on), RAISE_PENALTY, or
+        (converged, reason); sets step.error when the iteration diverged."""
         settings = self.settings
-        history = []
-        clock = time.perf_counter()
-        change = residual = np.inf
-        raises = []
+        if not (np.isfinite(change) and np.isfinite(residual)) or residual > DIVERGED_RESIDUAL:
+            step.error = RodDivergedError(
+                f"{step.label}iteration {iteration}: the iteration diverged (change "
+                f"{change:.3g}, constraint residual {residual:.3g}); try a larger "
+                "-rod_al_penalty or more -rod_steps", iteration)
+            return None
+        if step.observer is not None and step.observer(iteration, change, residual):
+            return (False, STOP_OBSERVER)
+        if change <= settings.rtol and residual <= settings.ctol:
+            return CONVERGED
+        if iteration >= settings.max_it:
+            return (False, STOP_MAX_IT)
+        if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
+                and penalty_too_low(step.history, self.penalty, self.scale)):
+            return RAISE_PENALTY
+        if iteration % STALL_CHECK_EVERY == 0 and stalled(
+                step.history, settings.rtol, settings.ctol, settings.max_it - iteration):
+            return (False, STOP_STALLED)
+        return None
 
-        def distance():
-            return estimated_distance([row[0] for row in history[-RATE_WINDOW - 1:]])
+    def _converged(self, snes, its, norms):
+        """The SNES convergence test: the decision _fixed_point_residual took."""
+        if self._step.finished:
+            return PETSc.SNES.ConvergedReason.CONVERGED_ITS
+        return PETSc.SNES.ConvergedReason.ITERATING
 
-        def report(converged, iterations, reason=""):
-            return StepReport(converged, iterations, change, residual, history, reason,
-                              distance(), raises)
+    def _pack(self, x):
+        """x = sqrt(w) (tau, lambda / R), (n_nodes, 2, 3, 3) in the SNES vector."""
+        values = x.getArray().reshape(-1, 2, 3, 3)
+        values[:, 0] = self._root_weights * self.tau
+        values[:, 1] = self._root_weights * self.lam / self.penalty
 
-        for iteration in range(1, settings.max_it + 1):
-            try:
-                self.iterate()
-            except RodDivergedError as error:
-                raise RodDivergedError(f"{label}iteration {iteration}: {error}",
-                                       iteration) from None
-            change, residual = self.norms()
-            history.append((change, residual, time.perf_counter() - clock))
-            if not (np.isfinite(change) and np.isfinite(residual)) \
-                    or residual > DIVERGED_RESIDUAL:
-                raise RodDivergedError(
-                    f"{label}iteration {iteration}: the iteration diverged (change {change:.3g}, "
-                    f"constraint residual {residual:.3g}); try a larger -rod_al_penalty or more "
-                    "-rod_steps", iteration)
-            if observer is not None and observer(iteration, change, residual):
-                return report(False, iteration, STOP_OBSERVER)
-            if settings.monitor:
-                PETSc.Sys.Print(f"  {label}it {iteration:5d}  change {change:.3e}  distance "
-                                f"{distance():.3e}  constraint {residual:.3e}",
-                                comm=self.mesh.comm)
-            if change <= self.change_tolerance and residual <= settings.ctol:
-                return report(True, iteration)
-            if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
-                    and self.penalty == self.asked_penalty
-                    and penalty_too_low(history, self.penalty, self.scale)):
-                self.raise_penalty()
-                raises.append((iteration, self.penalty))
-            if iteration % STALL_CHECK_EVERY == 0 and stalled(
-                    history, self.change_tolerance, settings.ctol, settings.max_it - iteration):
-                return report(False, iteration, STOP_STALLED)
-        return report(False, settings.max_it, STOP_MAX_IT)
+    def _unpack(self, x):
+        values = x.getArray(readonly=True).reshape(-1, 2, 3, 3)
+        self.tau[:] = values[:, 0] / self._root_weights
+        self.lam[:] = values[:, 1] * (self.penalty / self._root_weights)
 
     def iterate(self):
-        """One iteration n: global step, local step, multiplier update."""
+        """One iteration n: global step, local step, multiplier update (docs/method.md §3),
+        all three at the owned P2 nodes."""
         R = self.penalty
-        mesh, tau, lam = self.mesh, self.tau, self.lam
-        n_ghosted = mesh.ghost_end - mesh.ghost_start
+        n = self.mesh.n_local_nodes
         EVENTS["rhs"].begin()
-        target = R * tau - lam
-        # field i (d1, d2, theta): int (R tau_i - lambda_i).g, plus the load for theta
+        # field i (d1, d2, theta): sum_n w_n (R tau_i - lambda_i) g_n, plus the load for theta
+        target = self.node_weights[:, None, None] * (R * self.tau - self.lam)
         for i, rhs in enumerate(self.rhs):
-            vectors = np.einsum("eq,eqk,eqc->ekc", self.weights, self.p2[0], target[:, :, i])
-            rhs.add_ghosted(scatter_element_vectors(n_ghosted, mesh.element_local, P2,
-                                                    vectors))
+            for c, vec in enumerate(rhs.components):
+                values = vec.getArray()
+                values[:n] = target[:, i, c]
+                values[n:] = 0.0
         for vec, load in zip(self.rhs[2].components, self.load.components):
             vec.axpy(1.0, load)
+        if self._lagged is not None:
+            self._add_lagged_part()
         EVENTS["rhs"].end()
         EVENTS["solve"].begin()
         for problem, rhs, director in zip(self.d_problems, self.rhs[:2], (self.d1, self.d2)):
@@ -507,13 +642,31 @@ class UzawaSolver:
         self.solve_centreline()
         EVENTS["solve"].end()
         EVENTS["projection"].begin()
-        self._points = self.point_values()
-        directors = self._points["directors"]
-        tau[:] = nearest_rotation(R * directors + lam)
+        self._directors = directors = self.node_directors()
+        self.tau[:] = nearest_rotation(R * directors + self.lam)
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
-        update_multipliers(lam, directors, tau, R)
+        update_multipliers(self.lam, directors, self.tau, R)
         EVENTS["multiplier"].end()
+
+    def _add_lagged_part(self):
+        """2 (c_i - a_i) K tau_i on each field's right-hand side, where the matrix uses c_i
+        instead of a_i: at a fixed point (d = tau) the equations are those of a_i."""
+        n = self.mesh.n_local_nodes
+        work = self._lagged.createVecLeft()
+        product = self._lagged.createVecLeft()
+        for i, rhs in enumerate(self.rhs):
+            factor = 2 * (self.matrix_split[i] - self.split[i])
+            if factor == 0:
+                continue
+            for c, vec in enumerate(rhs.components):
+                values = work.getArray()
+                values[:n] = self.tau[:, i, c]
+                values[n:] = 0.0
+                self._lagged.mult(work, product)
+                vec.axpy(factor, product)
+        work.destroy()
+        product.destroy()
 
     def solve_centreline(self):
         """theta from its right-hand side ``rhs[2]``, bordered by r(L) - r(0) = int theta
@@ -546,14 +699,15 @@ class UzawaSolver:
                 "derivatives": derivatives}
 
     def norms(self):
-        """Relative L2 change of (r, r', d1, d2) and RMS constraint residual (§6)."""
+        """Relative change of (r, r', d1, d2) and RMS constraint residual
+        sqrt(sum_n w_n |d_n - tau_n|^2 / L) at the nodes (docs/method.md §5)."""
         EVENTS["norms"].begin()
-        p = self._points
-        current = self._stacked(p)
-        w = self.weights[:, :, None, None]
-        gap = np.sum(w * (p["directors"] - self.tau) ** 2)
-        size = np.sum(w * current**2)
-        step = np.sum(w * (current - self._previous) ** 2)
+        self._positions = self.node_positions()
+        current = self._stacked()
+        w = self.node_weights
+        gap = w @ np.sum((self._directors - self.tau) ** 2, axis=(1, 2))
+        size = w @ np.sum(current**2, axis=(1, 2))
+        step = w @ np.sum((current - self._previous) ** 2, axis=(1, 2))
         gap, size, step = self.mesh.global_sum(np.array([gap, size, step]))
         self._previous = current
         EVENTS["norms"].end()
@@ -597,6 +751,8 @@ class UzawaSolver:
 
     def destroy(self):
         self._destroy_problems()
+        for obj in (self.snes, self._x, self._f):
+            obj.destroy()
         for obj in [*self.frame_fields, self.r, self.load, *self.rhs]:
             obj.destroy()
 
