@@ -3,76 +3,197 @@
 Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (method.md §3).
 """
 
+import threading
+
 import numpy as np
 
 
-# Newton is used where det b > WELL_CONDITIONED |b|_max^3 (the smallest singular value is
-# then not tiny, so a few steps converge); elsewhere, and wherever it has not converged to
-# ORTHOGONALITY, the SVD decides.
-WELL_CONDITIONED = 1e-3
-ORTHOGONALITY = 1e-13
-NEWTON_STEPS = 12
+# The projection works on blocks of BLOCK points: its work arrays (240 bytes a point,
+# 2 MB) stay in cache across the twenty-odd elementwise operations of a Newton step, and
+# each numpy call still has thousands of points to amortise its overhead on.
+BLOCK = 8192
+# After the first step every singular value of the Newton iterate X_k is >= 1, so
+# |X_k - T| <= det X_k - 1 and the next step leaves |X_k - T|^2 / 2: below NEWTON_TOL
+# that step is the last.
+NEWTON_TOL = 1e-8
+# Newton takes the points with det b > SINGULAR |b|_F^3 (below, det b is round-off of a
+# singular b, or b is a reflection) and det b in DET_RANGE (cofactors neither over- nor
+# underflow); of those, det X_1 - 1 grows like cond(b)^(4/3) / 8, and above
+# ILL_CONDITIONED (cond b about 1e3) a point leaves Newton too. The others go to the
+# eigen-solve.
+SINGULAR = 1e-6
+ILL_CONDITIONED = 1e3
+DET_RANGE = (1e-290, 1e290)
+MAX_STEPS = 10
+# update_multipliers works on this many values at a time, through one reused buffer.
+CHUNK = 1 << 17
+
+_EYE = np.eye(3)[:, :, None]
+_BUFFERS = threading.local()
 
 
-def nearest_rotation(b):
+def nearest_rotation(b, out=None):
     """The local step (§3 step 2): tau = argmax_{T in SO(3)} sum_i T_i . b_i.
 
     b: (..., 3, 3), rows b_i = R d_i + lambda_i. With b = U S V^T (SVD), the maximiser is
     T = U diag(1, 1, det(U V^T)) V^T: the polar factor of b with the sign fixed so that
-    det T = +1 also when b is singular or a reflection. Returns (..., 3, 3).
+    det T = +1 also when b is singular or a reflection. Returns (..., 3, 3), in ``out``
+    when given (it may be b itself).
 
-    Where det b > 0 and b is well conditioned (every point of a running iteration, where
-    b is near R times a rotation) T is the polar factor, computed by the scaled Newton
-    iteration X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3), on the nine
-    components as contiguous arrays: several times faster than a batched LAPACK SVD.
-    The other points, and any that Newton leaves unconverged, go through the SVD.
-    A b with NaN or Inf gives NaN.
+    Where det b > 0 and b is not ill-conditioned (every point of a running iteration,
+    where b is near R times a rotation) T is the polar factor, by the scaled Newton
+    iteration X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3) (polar_newton), on
+    blocks of points so that its temporaries stay in cache. The other points go to the
+    eigen-solve of Horn's quaternion matrix (nearest_rotation_eigen), which handles
+    reflections and singular b. A b with NaN or Inf gives NaN.
     """
     b = np.asarray(b, dtype=float)
+    if b.shape[-2:] != (3, 3):
+        raise ValueError(f"nearest_rotation: b has shape {b.shape}, expected (..., 3, 3)")
+    if out is None:
+        out = np.empty(b.shape)
+    elif (out.shape != b.shape or out.dtype != np.float64
+          or not out.flags.c_contiguous):
+        raise ValueError(f"nearest_rotation: out is {out.dtype} {out.shape}, expected a "
+                         f"contiguous float64 array of shape {b.shape}")
     flat = b.reshape(-1, 3, 3)
-    scale = np.abs(flat).max(axis=(1, 2))
-    scale[scale == 0] = 1.0
-    x = np.ascontiguousarray((flat / scale[:, None, None]).transpose(1, 2, 0))  # (3, 3, n)
-    newton = cofactors(x)[1] > WELL_CONDITIONED
-    polar = polar_newton(x[:, :, newton])
-    gram = np.einsum("ikn,jkn->ijn", polar, polar) - np.eye(3)[:, :, None]
-    converged = np.abs(gram).max(axis=(0, 1)) < ORTHOGONALITY
-    t = np.empty_like(flat)
-    t[newton] = polar.transpose(2, 0, 1)
-    rest = ~newton
-    rest[np.flatnonzero(newton)[~converged]] = True
-    # NaN/Inf (a diverged iteration) would make the SVD raise on this rank alone: give
-    # NaN instead, which the iteration's collective norms report as a divergence.
-    finite = np.isfinite(flat).all(axis=(1, 2))
-    t[rest & ~finite] = np.nan
-    t[rest & finite] = nearest_rotation_svd(flat[rest & finite])
-    return t.reshape(b.shape)
+    t = out.reshape(-1, 3, 3)
+    hard, hard_b = [], []
+    # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for start in range(0, len(flat), BLOCK):
+            block = flat[start:start + BLOCK]
+            polar, missed = polar_newton(block)
+            if missed is not None:
+                hard.append(start + np.flatnonzero(missed))
+                hard_b.append(block[missed])        # a copy, taken before out is written
+            if polar is not None:
+                np.copyto(t[start:start + len(block)].reshape(-1, 9),
+                          polar.reshape(9, -1).T)
+    if hard:
+        t[np.concatenate(hard)] = nearest_rotation_eigen(np.concatenate(hard_b))
+    return out
 
 
-def cofactors(x):
-    """Cofactor matrices and determinants of matrices stored as (3, 3, n) components.
+def polar_newton(b):
+    """Orthogonal polar factor of the (nb, 3, 3) matrices b where Newton suits them.
 
-    Row i of the cofactor matrix is x_{i+1} x x_{i+2} (rows of x), so x^-T = C / det.
+    Scaled Newton X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3), carried as the
+    multiple M = 2 X / zeta_prev: M <- M + zeta C(M), C the cofactor matrix (so that
+    X^-T = C / det), two operations per component instead of three; zeta is scale free.
+    The nine components are contiguous rows of length nb, each row of M extended by its
+    first two columns, so that the cross products C_i = M_(i+1) x M_(i+2) are three
+    products of contiguous slices. Returns (polar factor (3, 3, nb) in the work arrays,
+    or None when no point suits Newton; mask of the points it does not suit, or None).
     """
-    (a, b, c), (d, e, f), (g, h, i) = x
-    cofactor = np.array([[e * i - f * h, f * g - d * i, d * h - e * g],
-                         [h * c - i * b, i * a - g * c, g * b - h * a],
-                         [b * f - c * e, c * d - a * f, a * e - b * d]])
-    det = a * cofactor[0, 0] + b * cofactor[0, 1] + c * cofactor[0, 2]
-    return cofactor, det
-
-
-def polar_newton(x):
-    """Orthogonal polar factor of (3, 3, n) matrices with positive determinant."""
-    for _ in range(NEWTON_STEPS):
-        cofactor, det = cofactors(x)
-        zeta = np.cbrt(1.0 / det)
-        x_next = 0.5 * (zeta * x + cofactor / (zeta * det))
-        step = np.abs(x_next - x).max() if x.size else 0.0
-        x = x_next
-        if step < ORTHOGONALITY:
+    nb = len(b)
+    s = _buffer("rows", 15 * nb).reshape(3, 5, nb)
+    cof = _buffer("cofactors", 9 * nb).reshape(3, 3, nb)
+    tmp = _buffer("product", 3 * nb).reshape(3, nb)
+    det, ratio, zeta = (_buffer(name, nb) for name in ("det", "ratio", "zeta"))
+    m = s[:, :3]
+    np.copyto(m, b.transpose(1, 2, 0))
+    np.multiply(m, m, out=cof)
+    frobenius = np.sum(cof.reshape(9, nb), axis=0, out=zeta)    # |b|_F^2
+    missed = None
+    converged = False
+    for step in range(MAX_STEPS):
+        np.copyto(s[:, 3:], s[:, :2])
+        for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(s[j, 1:4], s[k, 2:5], out=cof[i])
+            np.multiply(s[j, 2:5], s[k, 1:4], out=tmp)
+            np.subtract(cof[i], tmp, out=cof[i])
+        np.multiply(m[0], cof[0], out=tmp)
+        np.add(tmp[0], tmp[1], out=det)
+        np.add(det, tmp[2], out=det)
+        if step == 0:
+            np.multiply(frobenius, frobenius, out=ratio)
+            ratio *= frobenius
+            ratio *= SINGULAR**2
+            missed = ~((det > DET_RANGE[0]) & (det < DET_RANGE[1]) & (det * det > ratio))
+            if missed.all():
+                return None, missed
+            _set_identity(missed, m, cof, det)
+        else:
+            np.divide(det, ratio, out=ratio)        # det M_k / det M_(k-1) = 8 det X_k
+            if step == 1:       # det X_1 >= 1 in exact arithmetic: below 1/2 a breakdown
+                ill = ~((ratio > 4.0) & (ratio < 8.0 * (1.0 + ILL_CONDITIONED)))
+                missed |= ill
+                _set_identity(ill, m, cof, det)
+                ratio[ill] = 8.0
+            converged = ratio.max() < 8.0 * (1.0 + NEWTON_TOL)
+        np.cbrt(det, out=zeta)
+        np.divide(1.0, zeta, out=zeta)
+        np.multiply(cof, zeta, out=cof)
+        if converged or step == MAX_STEPS - 1:
             break
-    return x
+        np.add(m, cof, out=m)
+        det, ratio = ratio, det
+    if not converged:
+        missed |= ~(ratio < 8.0 * (1.0 + NEWTON_TOL))
+    np.add(m, cof, out=cof)
+    zeta *= 0.5
+    np.multiply(cof, zeta, out=cof)
+    return cof, (missed if missed.any() else None)
+
+
+def _set_identity(mask, m, cof, det):
+    """Points left to the eigen-solve become X = I (converged at once), if any."""
+    if mask.any():
+        m[:, :, mask] = _EYE
+        cof[:, :, mask] = _EYE
+        det[mask] = 1.0
+
+
+def _buffer(name, size):
+    """This thread's work array ``name``, its first ``size`` values: allocated once (and
+    when a larger one is asked for), not at every call."""
+    buffers = _BUFFERS.__dict__.setdefault("arrays", {})
+    array = buffers.get(name)
+    if array is None or array.size < size:
+        array = buffers[name] = np.empty(size)
+    return array[:size]
+
+
+def nearest_rotation_eigen(b):
+    """The maximiser for any (n, 3, 3) b, by Horn's quaternion method.
+
+    With T = T(q) for a unit quaternion q, sum_i T_i . b_i = q^T K q, K the symmetric
+    traceless 4 x 4 matrix of b (horn_matrix): q is the eigenvector of the largest
+    eigenvalue of K (LAPACK), which is s1 + s2 + sign(det b) s3, and T(q) is a proper
+    rotation whatever b (singular, reflected). One symmetric eigen-solve per point
+    instead of an SVD. A b with NaN or Inf gives NaN.
+    """
+    b = np.asarray(b, dtype=float).reshape(-1, 3, 3)
+    finite = np.isfinite(b).all(axis=(1, 2))
+    if finite.all():
+        return quaternion_rotation(np.linalg.eigh(horn_matrix(b))[1][:, :, 3])
+    t = np.full(b.shape, np.nan)
+    t[finite] = nearest_rotation_eigen(b[finite])
+    return t
+
+
+def horn_matrix(b):
+    """K (n, 4, 4) with q^T K q = sum_ij T(q)_ij b_ij (quaternion_rotation), q = (w, x, y, z)."""
+    (b00, b01, b02), (b10, b11, b12), (b20, b21, b22) = b.transpose(1, 2, 0)
+    k = np.empty((len(b), 4, 4))
+    k[:, 0, 0] = b00 + b11 + b22
+    k[:, 1, 1] = b00 - b11 - b22
+    k[:, 2, 2] = b11 - b00 - b22
+    k[:, 3, 3] = b22 - b00 - b11
+    for (i, j), value in {(0, 1): b21 - b12, (0, 2): b02 - b20, (0, 3): b10 - b01,
+                          (1, 2): b01 + b10, (1, 3): b02 + b20, (2, 3): b12 + b21}.items():
+        k[:, i, j] = k[:, j, i] = value
+    return k
+
+
+def quaternion_rotation(q):
+    """Rotation matrices (n, 3, 3) of unit quaternions q = (w, x, y, z), (n, 4)."""
+    w, x, y, z = q.T
+    return np.stack([w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y),
+                     2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x),
+                     2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z],
+                    axis=1).reshape(-1, 3, 3)
 
 
 def nearest_rotation_svd(b):
@@ -84,8 +205,22 @@ def nearest_rotation_svd(b):
 
 
 def update_multipliers(lam, directors, tau, penalty):
-    """Multiplier update (§3 step 3): lambda_i <- lambda_i + R (d_i - tau_i), in place."""
-    lam += penalty * (directors - tau)
+    """Multiplier update (§3 step 3): lambda_i <- lambda_i + R (d_i - tau_i), in place.
+
+    In chunks through one small buffer: no temporaries of the size of lambda (arrays of
+    other shapes are broadcast the plain way).
+    """
+    if not (lam.flags.c_contiguous and lam.shape == np.shape(directors) == np.shape(tau)):
+        lam += penalty * (directors - tau)
+        return lam
+    flat_lam, flat_d, flat_tau = (np.asarray(a).reshape(-1) for a in (lam, directors, tau))
+    buffer = _buffer("chunk", min(CHUNK, flat_lam.size))
+    for start in range(0, flat_lam.size, CHUNK):
+        part = slice(start, start + CHUNK)
+        tmp = buffer[:len(flat_lam[part])]
+        np.subtract(flat_d[part], flat_tau[part], out=tmp)
+        tmp *= penalty
+        flat_lam[part] += tmp
     return lam
 
 
