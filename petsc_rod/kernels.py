@@ -58,20 +58,17 @@ def nearest_rotation(b, out=None):
                          f"contiguous float64 array of shape {b.shape}")
     flat = b.reshape(-1, 3, 3)
     t = out.reshape(-1, 3, 3)
-    hard, hard_b = [], []
-    # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for start in range(0, len(flat), BLOCK):
-            block = flat[start:start + BLOCK]
+    for start in range(0, len(flat), BLOCK):
+        block = flat[start:start + BLOCK]
+        # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             polar, missed = polar_newton(block)
-            if missed is not None:
-                hard.append(start + np.flatnonzero(missed))
-                hard_b.append(block[missed])        # a copy, taken before out is written
-            if polar is not None:
-                np.copyto(t[start:start + len(block)].reshape(-1, 9),
-                          polar.reshape(9, -1).T)
-    if hard:
-        t[np.concatenate(hard)] = nearest_rotation_eigen(np.concatenate(hard_b))
+        if missed is not None:
+            hard = nearest_rotation_eigen(block[missed])    # before out (maybe b) is written
+        if polar is not None:
+            np.copyto(t[start:start + len(block)].reshape(-1, 9), polar.reshape(9, -1).T)
+        if missed is not None:
+            t[start:start + len(block)][missed] = hard
     return out
 
 
