@@ -8,7 +8,7 @@ import threading
 import numpy as np
 
 
-# The projection works on blocks of BLOCK points: its work arrays (240 bytes a point,
+# The projection works on blocks of BLOCK points: its work arrays (250 bytes a point,
 # 2 MB) stay in cache across the twenty-odd elementwise operations of a Newton step, and
 # each numpy call still has thousands of points to amortise its overhead on.
 BLOCK = 8192
@@ -25,6 +25,8 @@ SINGULAR = 1e-6
 ILL_CONDITIONED = 1e3
 DET_RANGE = (1e-290, 1e290)
 MAX_STEPS = 10
+# From this step on, once 7/8 of a block has converged the rest goes on as a smaller block.
+COMPACT_AFTER = 3
 # update_multipliers works on this many values at a time, through one reused buffer.
 CHUNK = 1 << 17
 
@@ -58,43 +60,50 @@ def nearest_rotation(b, out=None):
                          f"contiguous float64 array of shape {b.shape}")
     flat = b.reshape(-1, 3, 3)
     t = out.reshape(-1, 3, 3)
+    # the hard points of a block are read after its out is written: if out may be b, from
+    # a copy of the block
+    aliased = np.may_share_memory(out, b)
     for start in range(0, len(flat), BLOCK):
         block = flat[start:start + BLOCK]
+        if aliased:
+            copy = _buffer("block", block.size).reshape(block.shape)
+            np.copyto(copy, block)
+            block = copy
+        result = t[start:start + BLOCK]
         # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            polar, missed = polar_newton(block)
+            missed = polar_newton(block, result)
         if missed is not None:
-            hard = nearest_rotation_eigen(block[missed])    # before out (maybe b) is written
-        if polar is not None:
-            np.copyto(t[start:start + len(block)].reshape(-1, 9), polar.reshape(9, -1).T)
-        if missed is not None:
-            t[start:start + len(block)][missed] = hard
+            result[missed] = nearest_rotation_eigen(block[missed])
     return out
 
 
-def polar_newton(b):
-    """Orthogonal polar factor of the (nb, 3, 3) matrices b where Newton suits them.
+def polar_newton(b, out, steps=None, iterate=False):
+    """Orthogonal polar factors of the (nb, 3, 3) matrices b into out, where Newton suits.
 
     Scaled Newton X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3), carried as the
     multiple M = 2 X / zeta_prev: M <- M + zeta C(M), C the cofactor matrix (so that
     X^-T = C / det), two operations per component instead of three; zeta is scale free.
     The nine components are contiguous rows of length nb, each row of M extended by its
     first two columns, so that the cross products C_i = M_(i+1) x M_(i+2) are three
-    products of contiguous slices. Returns (polar factor (3, 3, nb) in the work arrays,
-    or None when no point suits Newton; mask of the points it does not suit, or None).
+    products of contiguous slices. Once 7/8 of the points have converged the others go on
+    as a smaller block (their X, with ``iterate``: its singular values are >= 1), so that a
+    few slow points do not hold the whole block. Returns the mask of the points left out
+    (their out is meaningless), or None.
     """
     nb = len(b)
+    steps = MAX_STEPS if steps is None else steps
     s = _buffer("rows", 15 * nb).reshape(3, 5, nb)
     cof = _buffer("cofactors", 9 * nb).reshape(3, 3, nb)
     tmp = _buffer("product", 3 * nb).reshape(3, nb)
-    det, ratio, zeta = (_buffer(name, nb) for name in ("det", "ratio", "zeta"))
+    det, previous, ratio, zeta = (_buffer(name, nb)
+                                  for name in ("det", "previous", "ratio", "zeta"))
     m = s[:, :3]
     np.copyto(m, b.transpose(1, 2, 0))
     np.multiply(m, m, out=cof)
-    frobenius = np.sum(cof.reshape(9, nb), axis=0, out=zeta)    # |b|_F^2
-    missed = None
-    converged = False
-    for step in range(MAX_STEPS):
+    frobenius = np.sum(cof.reshape(9, nb), axis=0, out=ratio)   # |b|_F^2
+    done = converged = False
+    for step in range(steps):
         np.copyto(s[:, 3:], s[:, :2])
         for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
             np.multiply(s[j, 1:4], s[k, 2:5], out=cof[i])
@@ -104,34 +113,50 @@ def polar_newton(b):
         np.add(tmp[0], tmp[1], out=det)
         np.add(det, tmp[2], out=det)
         if step == 0:
-            np.multiply(frobenius, frobenius, out=ratio)
-            ratio *= frobenius
-            ratio *= SINGULAR**2
-            missed = ~((det > DET_RANGE[0]) & (det < DET_RANGE[1]) & (det * det > ratio))
+            np.multiply(frobenius, frobenius, out=zeta)
+            zeta *= frobenius
+            zeta *= SINGULAR**2
+            missed = ~((det > DET_RANGE[0]) & (det < DET_RANGE[1]) & (det * det > zeta))
             if missed.all():
-                return None, missed
+                return missed
             _set_identity(missed, m, cof, det)
+            if iterate:
+                np.multiply(det, 8.0, out=ratio)
         else:
-            np.divide(det, ratio, out=ratio)        # det M_k / det M_(k-1) = 8 det X_k
-            if step == 1:       # det X_1 >= 1 in exact arithmetic: below 1/2 a breakdown
-                ill = ~((ratio > 4.0) & (ratio < 8.0 * (1.0 + ILL_CONDITIONED)))
-                missed |= ill
-                _set_identity(ill, m, cof, det)
-                ratio[ill] = 8.0
-            converged = ratio.max() < 8.0 * (1.0 + NEWTON_TOL)
+            np.divide(det, previous, out=ratio)     # det M_k / det M_(k-1) = 8 det X_k
+        if step == 1 and not iterate:   # det X_1 >= 1 in exact arithmetic: below 1/2 a breakdown
+            ill = ~((ratio > 4.0) & (ratio < 8.0 * (1.0 + ILL_CONDITIONED)))
+            missed |= ill
+            _set_identity(ill, m, cof, det)
+            ratio[ill] = 8.0
         np.cbrt(det, out=zeta)
         np.divide(1.0, zeta, out=zeta)
         np.multiply(cof, zeta, out=cof)
-        if converged or step == MAX_STEPS - 1:
-            break
+        if step > 0 or iterate:
+            converged = ratio.max() < 8.0 * (1.0 + NEWTON_TOL)
+            done = converged or step == steps - 1
+            if not done and step >= COMPACT_AFTER:
+                slow = ~(ratio < 8.0 * (1.0 + NEWTON_TOL))
+                done = np.count_nonzero(slow) <= nb // 8
         np.add(m, cof, out=m)
-        det, ratio = ratio, det
-    if not converged:
-        missed |= ~(ratio < 8.0 * (1.0 + NEWTON_TOL))
-    np.add(m, cof, out=cof)
+        if done:
+            break
+        det, previous = previous, det
     zeta *= 0.5
-    np.multiply(cof, zeta, out=cof)
-    return cof, (missed if missed.any() else None)
+    np.multiply(m, zeta, out=cof)
+    np.copyto(out.reshape(nb, 9), cof.reshape(9, nb).T)
+    if not converged:
+        slow = (~(ratio < 8.0 * (1.0 + NEWTON_TOL)) if step > 0 or iterate
+                else np.ones(nb, dtype=bool))
+        if step < steps - 1 and slow.any():
+            # X_(k+1) of the slow points is in out: continue from it as a block of its own
+            sub = np.flatnonzero(slow)
+            x = out[sub]
+            slow_missed = polar_newton(x, x, steps - step - 1, iterate=True)
+            out[sub] = x
+            slow[sub] = False if slow_missed is None else slow_missed
+        missed |= slow
+    return missed if missed.any() else None
 
 
 def _set_identity(mask, m, cof, det):

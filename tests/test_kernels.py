@@ -230,17 +230,17 @@ def test_newton_takes_the_points_of_a_running_iteration(name, share):
     """Only hard points go to the eigen-solve: none of a running iteration's, and of
     random matrices with det > 0 only the ill-conditioned ones (cond above about 1e3)."""
     b = input_class(name, 2000, np.random.default_rng(22))
-    polar, missed = polar_newton(b)
+    polar = np.empty_like(b)
+    missed = polar_newton(b, polar)
     missed = np.zeros(len(b), dtype=bool) if missed is None else missed
     assert missed.mean() <= share
-    assert np.abs(polar.transpose(2, 0, 1)[~missed]
-                  - nearest_rotation_svd(b[~missed])).max() < ROUND_OFF
+    assert np.abs(polar[~missed] - nearest_rotation_svd(b[~missed])).max() < ROUND_OFF
 
 
 @pytest.mark.parametrize("name", ["rank 2", "reflected", "ill-conditioned"])
 def test_newton_leaves_hard_points_to_the_eigen_solve(name):
     b = input_class(name, 300, np.random.default_rng(23))
-    polar, missed = polar_newton(b)
+    missed = polar_newton(b, np.empty_like(b))
     assert missed is not None and missed.all()
     assert np.abs(nearest_rotation_eigen(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
 
@@ -293,8 +293,28 @@ def test_points_newton_has_not_converged_go_to_the_eigen_solve(monkeypatch):
     """With too few steps allowed, the points not converged are caught, not returned."""
     monkeypatch.setattr(kernels, "MAX_STEPS", 3)
     b = input_class("far", 300, np.random.default_rng(31))
-    assert polar_newton(b)[1].mean() > 0.5
+    assert polar_newton(b, np.empty_like(b)).mean() > 0.5
     assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("far", [1, 30, 300])
+def test_slow_points_go_on_as_a_smaller_block(monkeypatch, far):
+    """A few points far from a rotation among near ones: once the near ones have
+    converged, the far ones continue from their iterate alone, with the same result."""
+    rng = np.random.default_rng(32)
+    b = input_class("near", 1000, rng)
+    b[rng.choice(1000, far, replace=False)] = input_class("far", far, rng)
+    calls = []
+    newton = kernels.polar_newton
+
+    def spy(b, out, steps=None, iterate=False):
+        calls.append((len(b), iterate))
+        return newton(b, out, steps, iterate)
+
+    monkeypatch.setattr(kernels, "polar_newton", spy)
+    assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+    assert calls[0] == (1000, False)
+    assert 1 < len(calls) and all(n <= far and iterate for n, iterate in calls[1:])
 
 
 def test_nearest_rotation_at_the_block_size():
