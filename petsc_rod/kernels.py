@@ -45,9 +45,11 @@ def nearest_rotation(b, out=None):
     Where det b > 0 and b is not ill-conditioned (every point of a running iteration,
     where b is near R times a rotation) T is the polar factor, by the scaled Newton
     iteration X <- (zeta X + (zeta X)^-T) / 2, zeta = det(X)^(-1/3) (polar_newton), on
-    blocks of points so that its temporaries stay in cache. The other points go to the
-    eigen-solve of Horn's quaternion matrix (nearest_rotation_eigen), which handles
-    reflections and singular b. A b with NaN or Inf gives NaN.
+    blocks of points so that its temporaries stay in cache. The other points (singular,
+    reflected, ill-conditioned) are shifted to a matrix whose polar factor is T (shifted)
+    and go through Newton again; what is left (rank 1, reflections with s2 = s3: several
+    maximisers) goes to the eigen-solve of Horn's quaternion matrix
+    (nearest_rotation_eigen). A b with NaN or Inf gives NaN.
     """
     b = np.asarray(b, dtype=float)
     if b.shape[-2:] != (3, 3):
@@ -73,9 +75,36 @@ def nearest_rotation(b, out=None):
         # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             missed = polar_newton(block, result)
-        if missed is not None:
-            result[missed] = nearest_rotation_eigen(block[missed])
+            if missed is not None:
+                hard = block[missed]
+                rotation = np.empty_like(hard)
+                left = polar_newton(shifted(hard), rotation)
+                if left is not None:
+                    rotation[left] = nearest_rotation_eigen(hard[left])
+                result[missed] = rotation
     return out
+
+
+def shifted(b):
+    """b + cof(b) / s1 for (m, 3, 3) b: where its det is > 0, its polar factor is T(b).
+
+    With b = U diag(s1, s2, s3) V^T, U and V rotations (s3 < 0 for a reflection), the
+    cofactor matrix is U diag(s2 s3, s1 s3, s1 s2) V^T, so b + a cof(b) = U diag(s1 + a s2
+    s3, s2 + a s1 s3, s3 + a s1 s2) V^T. For 0 < a <= 1/s1 the first entry is positive,
+    and where the shifted matrix has det > 0 so are the others (for a reflection when
+    s3 < s2, a unique maximiser): its polar factor is U V^T, the maximiser of b, with
+    condition s1 / (s2 + s3) like the maximiser's own. Reflections and singular b thus
+    go through Newton as well. s1^2 <= mu: Newton on det(mu I - b^T b) from mu = |b|_F^2.
+    """
+    cof = np.cross(b[:, [1, 2, 0]], b[:, [2, 0, 1]])
+    frobenius = np.einsum("nij,nij->n", b, b)
+    minors = np.einsum("nij,nij->n", cof, cof)
+    det = np.einsum("nj,nj->n", b[:, 0], cof[:, 0])
+    mu = frobenius.copy()
+    for _ in range(3):
+        mu -= (((mu - frobenius) * mu + minors) * mu - det * det) / (
+            (3.0 * mu - 2.0 * frobenius) * mu + minors)
+    return b + cof / np.sqrt(mu)[:, None, None]
 
 
 def polar_newton(b, out, steps=None, iterate=False):

@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from petsc_rod import kernels
 from petsc_rod.kernels import (nearest_rotation, nearest_rotation_eigen, nearest_rotation_svd,
-                               polar_newton, rotation_about, rotation_log,
+                               polar_newton, rotation_about, rotation_log, shifted,
                                split_coefficients, strains, update_multipliers)
 
 ROUND_OFF = 1e-12
@@ -219,6 +219,8 @@ def test_nearest_rotation_rank_one_is_a_proper_maximiser():
     rng = np.random.default_rng(21)
     x, y = rng.normal(size=(2, 500, 3))
     b = x[:, :, None] * y[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):     # left to the eigen-solve
+        assert polar_newton(shifted(b), np.empty_like(b)).all()
     t = nearest_rotation(b)
     assert_proper_rotation(t)
     optimum = np.linalg.norm(x, axis=1) * np.linalg.norm(y, axis=1)
@@ -238,10 +240,21 @@ def test_newton_takes_the_points_of_a_running_iteration(name, share):
 
 
 @pytest.mark.parametrize("name", ["rank 2", "reflected", "ill-conditioned"])
-def test_newton_leaves_hard_points_to_the_eigen_solve(name):
+def test_hard_points_go_through_newton_shifted(name):
+    """Newton leaves singular, reflected and ill-conditioned b out; b + cof(b) / s1 has
+    the maximiser of b as its polar factor, and Newton takes it."""
     b = input_class(name, 300, np.random.default_rng(23))
     missed = polar_newton(b, np.empty_like(b))
     assert missed is not None and missed.all()
+    t = np.empty_like(b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        assert polar_newton(shifted(b), t) is None
+    assert np.abs(t - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("name", ["rank 2", "reflected", "ill-conditioned", "far"])
+def test_nearest_rotation_eigen_equals_the_svd(name):
+    b = input_class(name, 300, np.random.default_rng(33))
     assert np.abs(nearest_rotation_eigen(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
 
 
