@@ -62,26 +62,30 @@ def nearest_rotation(b, out=None):
                          f"contiguous float64 array of shape {b.shape}")
     flat = b.reshape(-1, 3, 3)
     t = out.reshape(-1, 3, 3)
-    # the hard points of a block are read after its out is written: if out may be b, from
-    # a copy of the block
-    aliased = np.may_share_memory(out, b)
-    for start in range(0, len(flat), BLOCK):
-        block = flat[start:start + BLOCK]
-        if aliased:
-            copy = _buffer("block", block.size).reshape(block.shape)
-            np.copyto(copy, block)
-            block = copy
-        result = t[start:start + BLOCK]
-        # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            missed = polar_newton(block, result)
+    pending = []        # (indices, copies of b) of points Newton left out, up to a block
+    aliased = np.may_share_memory(out, b)   # then b is read from a copy of each block
+    # a point where Newton breaks down (overflow, 0/0) fails its tests and is set aside
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for start in range(0, len(flat), BLOCK):
+            block = flat[start:start + BLOCK]
+            if aliased:
+                copy = _buffer("block", block.size).reshape(block.shape)
+                np.copyto(copy, block)
+                block = copy
+            missed = polar_newton(block, t[start:start + BLOCK])
             if missed is not None:
-                hard = block[missed]
+                pending.append((start + np.flatnonzero(missed), block[missed]))
+            # together, a block at a time: a few per block would each cost a block's calls
+            if pending and (sum(len(w) for w, _ in pending) >= BLOCK
+                            or start + BLOCK >= len(flat)):
+                where = np.concatenate([w for w, _ in pending])
+                hard = np.concatenate([h for _, h in pending])
                 rotation = np.empty_like(hard)
                 left = polar_newton(shifted(hard), rotation)
                 if left is not None:
                     rotation[left] = nearest_rotation_eigen(hard[left])
-                result[missed] = rotation
+                t[where] = rotation
+                pending = []
     return out
 
 
