@@ -16,8 +16,9 @@ gets them):
 "dev" is max |T - T_svd| over the points whose maximiser is unique (all but rank 1);
 "objective" is the largest shortfall (f(T_svd) - f(T)) / |b|, f(T) = sum_i T_i . b_i,
 over all points, rank 1 included; "eigen" the share of points that Newton leaves to the
-eigen-solve (neither b nor kernels.shifted(b) suited it). --kernel times another function with the same signature (e.g. an older
-kernels.py copied outside the repository, on PYTHONPATH).
+eigen-solve (neither b nor kernels.shifted(b) suited it). --kernel times another
+function with the same signature (e.g. an older kernels.py copied outside the
+repository, on PYTHONPATH).
 """
 
 import argparse

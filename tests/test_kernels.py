@@ -362,6 +362,27 @@ def test_nearest_rotation_of_scaled_points():
         assert np.abs(nearest_rotation(scale * b) - expected).max() < ROUND_OFF
 
 
+def test_benchmark_projection_script(monkeypatch, capsys):
+    """scripts/benchmark_projection.py on small counts: a row per class and size, the
+    kernel within round-off of the SVD."""
+    import importlib.util
+    import os
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                        "scripts", "benchmark_projection.py")
+    spec = importlib.util.spec_from_file_location("benchmark_projection", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.setattr(script, "BUDGET", 0.0)
+    monkeypatch.setattr("sys.argv", ["benchmark_projection.py", "--sizes", "50,300"])
+    script.main()
+    rows = [line.split("|")[1:-1] for line in capsys.readouterr().out.splitlines()
+            if line.startswith("| ") and not line.startswith("| input")]
+    assert [(row[0].strip(), int(float(row[1]))) for row in rows] == [
+        (name, n) for name in script.CLASSES for n in (50, 300)]
+    assert max(float(row[5]) for row in rows) < ROUND_OFF        # dev
+    assert max(float(row[6]) for row in rows) < ROUND_OFF        # objective shortfall
+
+
 # --- multipliers -----------------------------------------------------------------------
 
 def test_update_multipliers_in_place():
