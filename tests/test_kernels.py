@@ -2,8 +2,9 @@
 
 nearest_rotation(b) is the local step: the T in SO(3) maximising sum_i T_i . b_i =
 trace(T b^T). It is checked against a brute force (local perturbations along every
-direction of so(3), and 20000 uniformly random rotations), not against the SVD formula
-it is built on.
+direction of so(3), and 20000 uniformly random rotations), and against the SVD formula
+(nearest_rotation_svd) on each class of input of scripts/benchmark_projection.py, across
+the blocks it works on.
 """
 
 import numpy as np
@@ -11,7 +12,9 @@ import pytest
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
-from petsc_rod.kernels import (nearest_rotation, rotation_about, rotation_log,
+from petsc_rod import kernels
+from petsc_rod.kernels import (nearest_rotation, nearest_rotation_eigen, nearest_rotation_svd,
+                               polar_newton, rotation_about, rotation_log, shifted,
                                split_coefficients, strains, update_multipliers)
 
 ROUND_OFF = 1e-12
@@ -166,6 +169,220 @@ def test_nearest_rotation_does_not_modify_its_input():
     assert np.array_equal(b, copy)
 
 
+def with_singular_values(rng, s):
+    """Q diag(s) P^T for random rotations Q, P; s (n, 3)."""
+    q, p = random_rotations(rng, len(s)), random_rotations(rng, len(s))
+    return np.einsum("nij,nj,nkj->nik", q, s, p)
+
+
+def input_class(name, n, rng):
+    """The input classes of scripts/benchmark_projection.py, and two more."""
+    if name == "near":          # a running iteration: R (rotation + perturbation)
+        return 400.0 * (random_rotations(rng, n) + 0.05 * rng.normal(size=(n, 3, 3)))
+    if name == "far":           # a start far from any rotation, det > 0
+        b = rng.normal(size=(n, 3, 3))
+        b[np.linalg.det(b) < 0] *= -1.0
+        return b
+    if name == "rank 2":
+        return with_singular_values(rng, np.stack(
+            [rng.uniform(1.5, 2.0, n), rng.uniform(0.5, 1.2, n), np.zeros(n)], axis=1))
+    if name == "reflected":     # det < 0 with s2 - s3 not small: a unique maximiser
+        return with_singular_values(rng, np.stack(
+            [rng.uniform(1.5, 2.0, n), rng.uniform(0.9, 1.4, n), -rng.uniform(0.1, 0.8, n)],
+            axis=1))
+    if name == "ill-conditioned":   # det > 0, cond 1e4..1e8: left to the eigen-solve
+        return with_singular_values(rng, np.stack(
+            [np.ones(n), rng.uniform(0.3, 1.0, n), 10.0 ** rng.uniform(-8, -4, n)], axis=1))
+    if name == "mixed":         # every class, shuffled, with scales 1e-3..1e3
+        parts = [input_class(other, n // 5 + 1, rng) for other in
+                 ("near", "far", "rank 2", "reflected", "ill-conditioned")]
+        b = rng.permutation(np.concatenate(parts))[:n]
+        return b * 10.0 ** rng.uniform(-3, 3, size=(n, 1, 1))
+    raise ValueError(name)
+
+
+CLASSES = ["near", "far", "rank 2", "reflected", "ill-conditioned", "mixed"]
+
+
+@pytest.mark.parametrize("name", CLASSES)
+def test_nearest_rotation_equals_the_svd_on_each_input_class(name):
+    rng = np.random.default_rng(20)
+    b = input_class(name, 3000, rng)
+    t = nearest_rotation(b)
+    assert np.abs(t - nearest_rotation_svd(b)).max() < ROUND_OFF
+    assert_proper_rotation(t)
+
+
+def test_nearest_rotation_rank_one_is_a_proper_maximiser():
+    """b = x y^T: the maximiser is not unique (any rotation taking y/|y| to x/|x|); the
+    value is |x| |y|."""
+    rng = np.random.default_rng(21)
+    x, y = rng.normal(size=(2, 500, 3))
+    b = x[:, :, None] * y[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):     # left to the eigen-solve
+        assert polar_newton(shifted(b), np.empty_like(b)).all()
+    t = nearest_rotation(b)
+    assert_proper_rotation(t)
+    optimum = np.linalg.norm(x, axis=1) * np.linalg.norm(y, axis=1)
+    assert np.abs(objective(t, b) - optimum).max() < ROUND_OFF * optimum.max()
+
+
+@pytest.mark.parametrize("name, share", [("near", 0.0), ("far", 0.01)])
+def test_newton_takes_the_points_of_a_running_iteration(name, share):
+    """Only hard points go to the eigen-solve: none of a running iteration's, and of
+    random matrices with det > 0 only the ill-conditioned ones (cond above about 1e3)."""
+    b = input_class(name, 2000, np.random.default_rng(22))
+    polar = np.empty_like(b)
+    missed = polar_newton(b, polar)
+    missed = np.zeros(len(b), dtype=bool) if missed is None else missed
+    assert missed.mean() <= share
+    assert np.abs(polar[~missed] - nearest_rotation_svd(b[~missed])).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("name", ["rank 2", "reflected", "ill-conditioned"])
+def test_hard_points_go_through_newton_shifted(name):
+    """Newton leaves singular, reflected and ill-conditioned b out; b + cof(b) / s1 has
+    the maximiser of b as its polar factor, and Newton takes it."""
+    b = input_class(name, 300, np.random.default_rng(23))
+    missed = polar_newton(b, np.empty_like(b))
+    assert missed is not None and missed.all()
+    t = np.empty_like(b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        assert polar_newton(shifted(b), t) is None
+    assert np.abs(t - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("name", ["rank 2", "reflected", "ill-conditioned", "far"])
+def test_nearest_rotation_eigen_equals_the_svd(name):
+    b = input_class(name, 300, np.random.default_rng(33))
+    assert np.abs(nearest_rotation_eigen(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+def test_nearest_rotation_nan_or_inf_anywhere_in_a_block():
+    """Non-finite points give NaN, at any position and however many; the others are
+    unaffected."""
+    rng = np.random.default_rng(24)
+    b = input_class("mixed", 1000, rng)
+    expected = nearest_rotation_svd(b)
+    bad = rng.choice(1000, size=50, replace=False)
+    b[bad[:25], rng.integers(0, 3, 25), rng.integers(0, 3, 25)] = np.nan
+    b[bad[25:], rng.integers(0, 3, 25), rng.integers(0, 3, 25)] = -np.inf
+    t = nearest_rotation(b)
+    assert np.isnan(t[bad]).all()
+    good = np.setdiff1d(np.arange(1000), bad)
+    assert np.abs(t[good] - expected[good]).max() < ROUND_OFF
+    assert np.isnan(nearest_rotation(np.full((4, 3, 3), np.inf))).all()
+
+
+@pytest.mark.parametrize("shape", [(40, 3, 3, 3), (60, 2, 3, 3), (2, 3, 4, 3, 3)])
+def test_nearest_rotation_leading_dimensions(shape):
+    rng = np.random.default_rng(25)
+    n = int(np.prod(shape[:-2]))
+    b = input_class("mixed", n, rng).reshape(shape)
+    t = nearest_rotation(b)
+    assert t.shape == shape
+    assert np.abs(t.reshape(-1, 3, 3) - nearest_rotation_svd(b.reshape(-1, 3, 3))).max() \
+        < ROUND_OFF
+
+
+@pytest.mark.parametrize("block", [1, 7, 64])
+@pytest.mark.parametrize("n", [0, 1, 2, 6, 7, 8, 63, 64, 65, 200])
+def test_nearest_rotation_block_boundaries(monkeypatch, block, n):
+    """Any n against any block size: whole blocks, a partial last one, n < block, n = 0;
+    hard points at the blocks' ends."""
+    monkeypatch.setattr(kernels, "BLOCK", block)
+    rng = np.random.default_rng(26)
+    b = input_class("near", max(n, 1), rng)[:n]
+    ends = np.arange(n)[(np.arange(n) % block == 0) | (np.arange(n) % block == block - 1)]
+    if len(ends[::2]):
+        b[ends[::2]] = input_class("reflected", len(ends[::2]), rng)
+    t = nearest_rotation(b)
+    assert t.shape == (n, 3, 3)
+    if n:
+        assert np.abs(t - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+def test_points_newton_has_not_converged_go_to_the_eigen_solve(monkeypatch):
+    """With too few steps allowed, the points not converged are caught, not returned."""
+    monkeypatch.setattr(kernels, "MAX_STEPS", 3)
+    b = input_class("far", 300, np.random.default_rng(31))
+    assert polar_newton(b, np.empty_like(b)).mean() > 0.5
+    assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+@pytest.mark.parametrize("far", [1, 30, 300])
+def test_slow_points_go_on_as_a_smaller_block(monkeypatch, far):
+    """A few points far from a rotation among near ones: once the near ones have
+    converged, the far ones continue from their iterate alone, with the same result."""
+    rng = np.random.default_rng(32)
+    b = input_class("near", 1000, rng)
+    b[rng.choice(1000, far, replace=False)] = input_class("far", far, rng)
+    calls = []
+    newton = kernels.polar_newton
+
+    def spy(b, out, steps=None, iterate=False):
+        calls.append((len(b), iterate))
+        return newton(b, out, steps, iterate)
+
+    monkeypatch.setattr(kernels, "polar_newton", spy)
+    assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+    assert calls[0] == (1000, False)
+    assert 1 < len(calls) and all(n <= far and iterate for n, iterate in calls[1:])
+
+
+def test_nearest_rotation_at_the_block_size():
+    """The block size itself, once over: a full block, then a partial one."""
+    rng = np.random.default_rng(27)
+    b = input_class("mixed", kernels.BLOCK + 3, rng)
+    assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
+
+
+def test_nearest_rotation_into_out_and_in_place():
+    rng = np.random.default_rng(28)
+    b = input_class("mixed", 500, rng).reshape(50, 10, 3, 3)
+    expected = nearest_rotation_svd(b.reshape(-1, 3, 3)).reshape(b.shape)
+    out = np.empty_like(b)
+    assert nearest_rotation(b, out=out) is out
+    assert np.abs(out - expected).max() < ROUND_OFF
+    assert nearest_rotation(b, out=b) is b           # out may be b itself
+    assert np.abs(b - expected).max() < ROUND_OFF
+    with pytest.raises(ValueError):
+        nearest_rotation(b, out=np.empty((500, 3, 3)))
+    with pytest.raises(ValueError):
+        nearest_rotation(np.ones((4, 9)))
+
+
+def test_nearest_rotation_of_scaled_points():
+    """Newton is scale free and the eigen-solve takes what it cannot: the same rotation
+    from 1e-120 to 1e120."""
+    rng = np.random.default_rng(29)
+    b = input_class("far", 100, rng)
+    expected = nearest_rotation_svd(b)
+    for scale in (1e-120, 1e-95, 1e-30, 1e30, 1e95, 1e120):
+        assert np.abs(nearest_rotation(scale * b) - expected).max() < ROUND_OFF
+
+
+def test_benchmark_projection_script(monkeypatch, capsys):
+    """scripts/benchmark_projection.py on small counts: a row per class and size, the
+    kernel within round-off of the SVD."""
+    import importlib.util
+    import os
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                        "scripts", "benchmark_projection.py")
+    spec = importlib.util.spec_from_file_location("benchmark_projection", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.setattr(script, "BUDGET", 0.0)
+    monkeypatch.setattr("sys.argv", ["benchmark_projection.py", "--sizes", "50,300"])
+    script.main()
+    rows = [line.split("|")[1:-1] for line in capsys.readouterr().out.splitlines()
+            if line.startswith("| ") and not line.startswith("| input")]
+    assert [(row[0].strip(), int(float(row[1]))) for row in rows] == [
+        (name, n) for name in script.CLASSES for n in (50, 300)]
+    assert max(float(row[5]) for row in rows) < ROUND_OFF        # dev
+    assert max(float(row[6]) for row in rows) < ROUND_OFF        # objective shortfall
+
+
 # --- multipliers -----------------------------------------------------------------------
 
 def test_update_multipliers_in_place():
@@ -181,6 +398,19 @@ def test_update_multipliers_in_place():
     before = lam.copy()
     update_multipliers(lam, tau, tau, 400.0)
     assert np.array_equal(lam, before)
+
+
+@pytest.mark.parametrize("size", [1, 1000, kernels.CHUNK, 2 * kernels.CHUNK + 5])
+def test_update_multipliers_in_chunks(size):
+    """Across the chunks it works in, and broadcast when the shapes differ."""
+    rng = np.random.default_rng(30)
+    lam, d, tau = rng.normal(size=(3, size, 3))
+    expected = lam + 400.0 * (d - tau)
+    update_multipliers(lam, d, tau, 400.0)
+    assert np.abs(lam - expected).max() < 1e-12
+    expected = lam + 2.0 * (d[:1] - tau)
+    update_multipliers(lam, d[:1], tau, 2.0)
+    assert np.abs(lam - expected).max() < 1e-12
 
 
 # --- strains ---------------------------------------------------------------------------
