@@ -643,7 +643,7 @@ class UzawaSolver:
         EVENTS["solve"].end()
         EVENTS["projection"].begin()
         self._directors = directors = self.node_directors()
-        self.tau[:] = nearest_rotation(R * directors + self.lam)
+        nearest_rotation(R * directors + self.lam, out=self.tau)
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(self.lam, directors, self.tau, R)
