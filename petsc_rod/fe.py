@@ -96,11 +96,6 @@ def gram(weights, a, b):
 # Simpson's weights of the P2 nodes (left vertex, midpoint, right vertex) on [0, 1].
 NODE_WEIGHTS = np.array([1.0, 4.0, 1.0]) / 6.0
 
-# Largest generalised eigenvalue of (stiffness, lumped mass) = (int g'.g',
-# sum_n w_n g_n^2) on one P2 element of length h, times h^2: 24 (computed in
-# tests/test_nonconvex.py). The global eigenvalue is bounded by the largest element one.
-STIFFNESS_TO_MASS_MAX = 24.0
-
 
 def p2_element_matrices(h, stiffness, penalty):
     """Element matrices of one field of the global step (docs/method.md §3):

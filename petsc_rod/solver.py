@@ -188,7 +188,7 @@ def penalty_too_low(history, penalty, scale):
 
 
 def matrix_split(split):
-    """The coefficients c_i of the global step's matrices 2 c_i K + R W (docs/method.md §3).
+    """The coefficients c_i of the global step's matrices 2 c_i K + R W (docs/method.md §2).
 
     Where every a_i > 0, c = a. A stiffness above the sum of the other two makes one
     a_j < 0 (a flat section; K3 > K1 + K2 in torsion): its matrix would be indefinite
@@ -474,7 +474,7 @@ class UzawaSolver:
 
     def solve_step(self, t, label="", observer=None):
         """The iteration at load factor t, driven by the SNES ``-rod_snes_*`` (anderson by
-        default, nrichardson for the plain iteration; docs/method.md §5), until both
+        default, nrichardson for the plain iteration; docs/method.md §6), until both
         stopping tests hold: change <= change_tolerance (rtol) and RMS constraint residual
         <= ctol. A step whose change and residual are within STALL_FACTOR of their
         tolerances but, at their rate, would not meet them within max_it stops early as
@@ -700,7 +700,7 @@ class UzawaSolver:
 
     def norms(self):
         """Relative change of (r, r', d1, d2) and RMS constraint residual
-        sqrt(sum_n w_n |d_n - tau_n|^2 / L) at the nodes (docs/method.md §5)."""
+        sqrt(sum_n w_n |d_n - tau_n|^2 / L) at the nodes (docs/method.md §6)."""
         EVENTS["norms"].begin()
         self._positions = self.node_positions()
         current = self._stacked()

@@ -1,5 +1,5 @@
 """Which equilibrium a step reached: the second variation of the discrete energy on the
-constraint set, and a direction that leaves a saddle (docs/method.md §6).
+constraint set, and a direction that leaves a saddle (docs/method.md §10).
 
 At a converged state the nodal frames are rotations, d_n = tau_n, and a variation turns
 each by a small rotation vector omega_n: delta d_i = omega x d_i, to second order
