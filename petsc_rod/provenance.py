@@ -20,11 +20,14 @@ def version():
 @functools.lru_cache(maxsize=None)
 def commit():
     """The commit of the checkout the package runs from, with '+modified' when tracked
-    files differ from it; 'unknown' outside a git checkout or without git."""
+    files differ from it; 'unknown' outside a git checkout of its own (e.g. installed
+    into another repository's tree) or without git."""
     def git(*args):
         return subprocess.run(["git", "-C", REPOSITORY, *args], capture_output=True,
                               text=True, timeout=20, check=True).stdout.strip()
     try:
+        if os.path.realpath(git("rev-parse", "--show-toplevel")) != os.path.realpath(REPOSITORY):
+            return "unknown"
         head = git("rev-parse", "HEAD")
         modified = git("status", "--porcelain", "--untracked-files=no")
     except (OSError, subprocess.SubprocessError):

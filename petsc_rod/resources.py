@@ -52,13 +52,18 @@ def size_text(nbytes):
 
 
 def check_elements_fit(comm, elements):
-    """Refuse an element count PETSc cannot index, or whose estimated memory exceeds what
-    a machine has available (the share of the ranks it runs). Collective."""
+    """Refuse an element count PETSc cannot index or distribute (every rank owns a
+    vertex), or whose estimated memory exceeds what a machine has available (the share
+    of the ranks it runs). Collective."""
     if elements > MAX_ELEMENTS:
         raise RodInputError(f"-rod_elements {elements}: at most {MAX_ELEMENTS} elements fit "
                             "in PETSc's integers (2 dofs per vertex)")
     from mpi4py import MPI
     mpi = comm.tompi4py()
+    if elements + 1 < mpi.Get_size():
+        raise RodInputError(f"-rod_elements {elements} on {mpi.Get_size()} ranks: every rank "
+                            f"needs a vertex; use at least {mpi.Get_size() - 1} elements or "
+                            "fewer ranks")
     node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
     here = node.Get_size()
     node.Free()

@@ -31,7 +31,8 @@ class Interrupts:
 
     def __exit__(self, *exc):
         for stop, handler in self._previous.items():
-            signal.signal(stop, handler)
+            if handler is not None:         # None: a handler not set from Python
+                signal.signal(stop, handler)
         return False
 
     def received(self):

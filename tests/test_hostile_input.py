@@ -130,6 +130,15 @@ def test_a_mesh_too_large_for_the_memory_is_refused_with_the_numbers(comm):
     check_elements_fit(comm, 1000)
 
 
+def test_fewer_vertices_than_ranks_are_refused(comm):
+    size = comm.getSize()
+    if size == 1:
+        pytest.skip("one rank always owns a vertex")
+    with pytest.raises(RodInputError, match=f"on {size} ranks"):
+        check_elements_fit(comm, size - 2)
+    check_elements_fit(comm, size - 1)
+
+
 def test_a_grading_double_precision_cannot_resolve_is_refused(comm):
     values = {"rod_elements": 1000000, "rod_length": 1.0, "rod_mesh_grading": 1e30}
     with pytest.raises(RodInputError, match="-rod_mesh_grading") as error:
