@@ -1,31 +1,97 @@
 """``python -m petsc_rod -options_file options/<scene>.opts``."""
 
+import ctypes
 import os
 import sys
 
 
-def missing_options_files(argv):
-    """Files named after -options_file that do not exist (PETSc would stop with a trace)."""
-    return [path for flag, path in zip(argv, argv[1:])
-            if flag == "-options_file" and not os.path.isfile(path)]
+def options_files(argv):
+    """The paths given after -options_file."""
+    return [path for flag, path in zip(argv, argv[1:]) if flag == "-options_file"]
+
+
+def options_file_error(path):
+    """Why an options file cannot be a scene ('' when it can): missing, unreadable, or
+    with no option in it (PETSc would read it as empty and run the default scene)."""
+    if not os.path.isfile(path):
+        return (f"-options_file {path}: no such scene file; the scenes are in options/ (e.g. "
+                "options/paper.opts)")
+    try:
+        with open(path, "rb") as scene:
+            text = scene.read().decode("utf-8", errors="replace")
+    except OSError as error:
+        return f"-options_file {path}: cannot be read ({error.strerror})"
+    if not any(line.split("#", 1)[0].strip() for line in text.splitlines()):
+        return (f"-options_file {path}: holds no option (empty, or only comments); a scene "
+                "file has one '-name value' per line (options/paper.opts)")
+    return ""
+
+
+def petsc_error(report):
+    """The message of a PETSc error report (the line after the error class), or ''."""
+    lines = [line.split("PETSC ERROR: ", 1)[1].strip() for line in report.splitlines()
+             if "PETSC ERROR: " in line]
+    headers = [k for k, line in enumerate(lines) if "Error Message" in line]
+    if not headers:
+        return ""
+    message = [line for line in lines[headers[0] + 1:headers[0] + 4]
+               if line and not line.startswith("See ")]
+    return message[-1] if message else ""
+
+
+def start_petsc(argv):
+    """Initialise PETSc with ``argv``; returns '' or, when PETSc refuses the options (a
+    line of an options file it cannot parse), its message, instead of PETSc's own
+    report and a traceback."""
+    import petsc4py
+
+    from .capture import stderr_captured
+    with stderr_captured() as report:
+        try:
+            petsc4py.init(argv)         # PETSc starts and reads the options here
+        except Exception:               # petsc4py.PETSc.Error, not importable before
+            return petsc_error(report()) or "PETSc could not start with these options"
+        printed = report()
+    sys.stderr.write(printed)
+    return ""
+
+
+def end(code):
+    """Exit with ``code``. After a failed HDF5 write the process ends at once, without
+    the shutdown of HDF5 (and of MPI-IO, PETSc and MPI, which would close the file
+    too), which would crash flushing the file it could not write (io.hdf5_failed)."""
+    from . import io
+    if not io.hdf5_failed():
+        return code
+    sys.stdout.flush()
+    sys.stderr.flush()
+    ctypes.CDLL(None).fflush(None)      # C stdio (PETSc's output), which os._exit skips
+    os._exit(code)
 
 
 def main():
-    for path in missing_options_files(sys.argv):
-        sys.stderr.write(f"petsc_rod: error: -options_file {path}: no such scene file; the "
-                         "scenes are in options/ (e.g. options/paper.opts)\n")
-        return 2
+    for path in options_files(sys.argv):
+        error = options_file_error(path)
+        if error:
+            sys.stderr.write(f"petsc_rod: error: {error}\n")
+            return 2
     try:
-        import petsc4py
+        import petsc4py  # noqa: F401
     except ImportError:
         sys.stderr.write(
             "petsc_rod: error: petsc4py is not importable by this python "
             f"({sys.executable}); run scripts/setup.sh once, then `source .venv/bin/activate`"
             "\n")
         return 2
-    petsc4py.init(sys.argv)
+    from .provenance import commit
+    commit()                          # git runs before MPI starts (provenance)
+    error = start_petsc(sys.argv)
+    if error:
+        sys.stderr.write(f"petsc_rod: error: {error}; an options file has one '-name value' "
+                         "per line, '#' starts a comment\n")
+        return 2
     from .cli import run
-    return run()
+    return end(run())
 
 
 if __name__ == "__main__":

@@ -7,9 +7,9 @@ import time
 import numpy as np
 
 from . import outputs
-from .errors import RodDivergedError, RodNotConvergedError
+from .errors import RodDivergedError, RodInterrupted, RodNotConvergedError
 from .link import changed_class
-from .solver import ADAPT_WINDOW, STOP_LINK, STOP_SADDLE
+from .solver import ADAPT_WINDOW, STOP_LINK, STOP_OBSERVER, STOP_SADDLE
 
 
 def not_converged_reason(report, solver):
@@ -44,7 +44,8 @@ def not_converged_reason(report, solver):
 
 class LoadPath:
     """The load factors of the continuation: ``steps`` regular steps t_k = k/K, and the
-    sub-steps by which a step that failed is retried.
+    sub-steps by which a step that failed is retried. A path that goes on from a load
+    factor t_0 > 0 (a restart) has t_k = t_0 + (1 - t_0) k/K; from t_0 = 1, one step at 1.
 
     A failed attempt halves the increment (a smaller step starts nearer its solution,
     §7), at most ``max_halvings`` times on the way to one t_k; an accepted sub-step keeps
@@ -53,16 +54,21 @@ class LoadPath:
     reached exactly and is k/K to the last bit, as without halving.
     """
 
-    def __init__(self, steps, max_halvings):
-        self.steps = steps
+    def __init__(self, steps, max_halvings, start=0.0):
+        self.start = start
+        self.steps = steps if start < 1 else 1
         self.units_per_step = 2**max_halvings
         self.reached = 0                          # units: the last accepted load factor
         self.increment = self.units_per_step      # units
         self.halvings = 0                         # in the whole run
+        self.step_halvings = 0                    # on the way to the next t_k
 
     def factor(self, units):
-        """The load factor of a number of units."""
-        return units / (self.steps * self.units_per_step)
+        """The load factor of a number of units (1 exactly at the end of the path)."""
+        total = self.steps * self.units_per_step
+        if units == total:
+            return 1.0
+        return self.start + (1.0 - self.start) * (units / total)
 
     @property
     def step(self):
@@ -85,6 +91,7 @@ class LoadPath:
     def halve(self):
         self.increment //= 2
         self.halvings += 1
+        self.step_halvings += 1
 
     def given_up(self):
         """What a run's failure message adds once halvings were tried ('' before)."""
@@ -98,6 +105,7 @@ class LoadPath:
         self.reached += self.increment
         if self.reached % self.units_per_step == 0:
             self.increment = self.units_per_step
+            self.step_halvings = 0
 
 
 class Predictor:
@@ -123,17 +131,22 @@ class Predictor:
         solver.lam[:] = lam1 + ratio * (lam1 - lam0)
 
 
-def attempt(solver, t, imperfection, label, expected_link=None):
+def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     """One try at load factor t from the current state, its cross-sections rolled first:
     (report, failure), ``failure`` None when the step converged, the RodDivergedError
     when it diverged (report None), else a sentence saying how far it got (short: the
     run goes on; not_converged_reason is the final one, with its advice). A converged
-    state whose linking number is not ``expected_link`` (turns, link.py) is a failure."""
+    state whose linking number is not ``expected_link`` (turns, link.py) is a failure.
+    ``stop()`` (collective), if given, is asked after every iteration whether to stop
+    (the report's reason is then STOP_OBSERVER)."""
     solver.roll_cross_sections(imperfection)
+    observer = None if stop is None else (lambda iteration, change, residual: stop())
     try:
-        report = solver.solve_step(t, label=label)
+        report = solver.solve_step(t, label=label, observer=observer)
     except RodDivergedError as error:
         return None, error
+    if report.reason == STOP_OBSERVER:
+        return report, "interrupted"
     if report.converged:
         report.link, report.link_expected = solver.link(), expected_link
         if not changed_class(report.link, expected_link):
@@ -147,63 +160,84 @@ def attempt(solver, t, imperfection, label, expected_link=None):
 
 
 def continuation(solver, steps, imperfection, writer, say, options, max_halvings,
-                 track_link=True):
-    """Reach the scene in ``steps`` equal load increments, each warm-started (§7) from the
-    last state with its cross-sections rolled by ``imperfection`` (see
-    UzawaSolver.roll_cross_sections). A step that does not converge or diverges is undone
-    (UzawaSolver.snapshot/restore) and retried with half the increment, at most
-    ``max_halvings`` times on the way to each t_k (LoadPath); so is a step that converged
-    to another linking number (link.py) when ``track_link``. The file has one group
-    ``steps/<n>`` per accepted step, and the failed one that ends a run."""
+                 track_link=True, start=0.0, interrupts=None):
+    """Reach the scene in ``steps`` equal load increments from load factor ``start`` (0,
+    or a restart's), each warm-started (§7) from the last state with its cross-sections
+    rolled by ``imperfection`` (see UzawaSolver.roll_cross_sections). A step that does
+    not converge or diverges is undone (UzawaSolver.snapshot/restore) and retried with
+    half the increment, at most ``max_halvings`` times on the way to each t_k (LoadPath);
+    so is a step that converged to another linking number (link.py) when ``track_link``.
+    The file has one group ``steps/<n>`` per accepted step, and the failed one that ends
+    a run. ``interrupts`` (signals.Interrupts), if given, are asked after every iteration
+    and before the file is finished: a signal ends the run with RodInterrupted."""
     mesh = solver.mesh
     clock = time.perf_counter()
+    path = LoadPath(steps, max_halvings, start)
+    stop = None if interrupts is None else interrupts.received
+    origin = f" from load factor {start:.6g}" if start > 0 else ""
     say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
-        f"R = {solver.settings.penalty:g}, {steps} step(s)")
-    path = LoadPath(steps, max_halvings)
+        f"R = {solver.settings.penalty:g}, {path.steps} step(s){origin}")
     predictor = Predictor()
-    predictor.accept(0.0, solver)
-    total_iterations = undone_iterations = written = 0
+    predictor.accept(start, solver)
+    totals = {"total_iterations": 0, "undone_iterations": 0}
+    written = 0
     # (Tw, Wr) of the last accepted state (of the start, then of each step), or None
     link = solver.link() if track_link else None
     while not path.finished:
-        t, label = path.next_factor, f"step {path.step}/{steps}"
+        t, label = path.next_factor, f"step {path.step}/{path.steps}"
         saved = solver.snapshot()
         predictor.predict(solver, t)
         report, failure = attempt(solver, t, imperfection, f"{label} ",
-                                  expected_link(solver.scene, link, path.factor(path.reached), t))
+                                  expected_link(solver.scene, link, path.factor(path.reached), t),
+                                  stop)
+        if failure == "interrupted":
+            raise interrupted(interrupts, f"in {label} at load factor {t:.6g}, iteration "
+                              f"{report.iterations}", path)
         iterations = (failure.iterations or 0) if report is None else report.iterations
-        total_iterations += iterations
+        totals["total_iterations"] += iterations
         # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
         stalled = report is not None and report.stalled
         if failure is not None and path.can_halve and not stalled:
             solver.restore(saved)
             path.halve()
-            undone_iterations += iterations
+            totals["undone_iterations"] += iterations
             reason = str(failure).removeprefix(f"{label} ")   # a divergence names the step
             say(f"petsc_rod: {label} at load factor {t:.6g}: {reason}; halving "
                 f"{path.halvings}: retrying from load factor {path.factor(path.reached):.6g} "
-                f"with increment {path.factor(path.increment):.6g}")
+                f"with increment {path.factor(path.increment) - path.factor(0):.6g}")
             continue
         if report is None:
             raise RodDivergedError(f"{failure}{path.given_up()}", failure.iterations) from None
         written += 1
         attributes = record_step(solver, report, t, label, say, writer, f"steps/{written}",
-                                 wall_time=time.perf_counter() - clock, options=options)
+                                 wall_time=time.perf_counter() - clock, options=options,
+                                 halvings=path.step_halvings, total_halvings=path.halvings,
+                                 **totals)
         if not report.converged:
             break
         path.accept()
         predictor.accept(t, solver)
         link = report.link if track_link else None
+    if stop is not None and stop():
+        raise interrupted(interrupts, "after the last step", path)
     if writer is not None:
         writer.finish(f"steps/{written}", attributes)
     if not report.converged:
         say(f"petsc_rod: error: {label} {not_converged_reason(report, solver)}"
             f"{path.given_up()}; the result file says converged = 0")
         return RodNotConvergedError.exit_code
-    say(f"petsc_rod: converged, {total_iterations} iterations in "
+    say(f"petsc_rod: converged, {totals['total_iterations']} iterations in "
         f"{time.perf_counter() - clock:.3g} s, {path.halvings} halving(s) of the step "
-        f"({undone_iterations} iterations undone)")
+        f"({totals['undone_iterations']} iterations undone)")
     return 0
+
+
+def interrupted(interrupts, where, path):
+    """The RodInterrupted that ends a run stopped by a signal ``where``."""
+    number = interrupts.received()
+    return RodInterrupted(f"interrupted by {interrupts.name(number)} {where}; the last "
+                          f"converged load factor is {path.factor(path.reached):.6g}; no "
+                          "result file is written", number)
 
 
 def expected_link(scene, link, t_from, t):
@@ -240,12 +274,14 @@ def link_text(link):
 
 def record_step(solver, report, t, label, say, writer, group, **common):
     """Say the state after a step at load factor t and write it as ``group`` (with the
-    attributes ``common`` to the run: wall_time, options); returns the group's attributes."""
+    attributes ``common`` to the run so far: wall_time, options, halvings and the
+    totals); returns the group's attributes."""
     mesh = solver.mesh
     vertex = outputs.vertex_fields(solver, t)
     energy = solver.energy()
     u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
-    attributes = {"converged": int(report.converged), "iterations": report.iterations,
+    attributes = {"converged": int(report.converged),
+                  "stop_reason": report.reason or "converged", "iterations": report.iterations,
                   "constraint_residual": report.constraint_residual,
                   "change": report.change, "stable": stability_code(report),
                   "energy": energy, "ranks": mesh.comm.getSize(),

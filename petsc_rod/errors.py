@@ -1,4 +1,5 @@
-"""Exceptions that end a run with a one-line message and a non-zero exit code."""
+"""Exceptions that end a run with a one-line message and a non-zero exit code, and the
+agreement of all ranks on whether one was raised."""
 
 
 class RodError(Exception):
@@ -30,3 +31,38 @@ class RodDivergedError(RodError):
     def __init__(self, message, iterations=None):
         super().__init__(message)
         self.iterations = iterations
+
+
+class RodIOError(RodError):
+    """The result file could not be written during the run (a full disk, a file system
+    error); the partial file is removed."""
+
+    exit_code = 5
+
+
+class RodInterrupted(RodError):
+    """SIGINT, SIGTERM or SIGHUP ended the run; the exit code is the shell's 128 + the
+    signal number (130, 143, 129), and the partial file is removed."""
+
+    def __init__(self, message, signal_number):
+        super().__init__(message)
+        self.signal_number = signal_number
+        self.exit_code = 128 + signal_number
+
+    def __reduce__(self):
+        return type(self), (str(self), self.signal_number)
+
+
+def on_every_rank(comm, action, *args):
+    """``action(*args)`` on every rank of ``comm`` (PETSc or mpi4py); if it raised a
+    RodError on any rank, the lowest such rank's error is raised on every rank, so that
+    no rank goes on into a collective call that the others have left. Collective."""
+    mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
+    try:
+        result, failure = action(*args), None
+    except RodError as error:
+        result, failure = None, error
+    first = next((error for error in mpi.allgather(failure) if error is not None), None)
+    if first is None:
+        return result
+    raise first from None

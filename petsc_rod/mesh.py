@@ -21,6 +21,19 @@ def graded_coordinates(t, grading):
     return t - beta / (2 * np.pi) * np.sin(2 * np.pi * t)
 
 
+def vertex_coordinates(vertex_index, n_elements, length, grading):
+    """S of the given global vertex indices of a mesh (Mesh.coordinates)."""
+    t = np.asarray(vertex_index, dtype=float) / n_elements
+    return length * graded_coordinates(t, grading)
+
+
+def end_element_lengths(n_elements, length, grading):
+    """The lengths (m) of the first and last elements, the smallest of a graded mesh, as
+    the mesh will compute them: known before the mesh is allocated."""
+    ends = vertex_coordinates([0, 1, n_elements - 1, n_elements], n_elements, length, grading)
+    return np.diff(ends)[[0, 2]]
+
+
 class Mesh:
     """A distributed mesh of ``n_elements`` elements on [0, length].
 
@@ -82,8 +95,7 @@ class Mesh:
 
     def coordinates(self, vertex_index):
         """S of the given global vertex indices."""
-        t = np.asarray(vertex_index, dtype=float) / self.n_elements
-        return self.length * graded_coordinates(t, self.grading)
+        return vertex_coordinates(vertex_index, self.n_elements, self.length, self.grading)
 
     def point_S(self, xi):
         """S at reference points xi (nq,) of the owned elements, (ne, nq)."""

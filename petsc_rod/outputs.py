@@ -56,7 +56,7 @@ def restart_state(solver):
             "tau": solver.tau, "lambda": solver.lam}
 
 
-def set_state(solver, vertex, element, node):
+def set_state(solver, vertex, state):
     """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
     holds r and d3 = r' at the vertices: theta's midpoints are those of the Hermite cubic
     they define (UzawaSolver.set_centreline)."""
@@ -66,9 +66,9 @@ def set_state(solver, vertex, element, node):
     for field, name in ((solver.d1, "d1"), (solver.d2, "d2")):
         values = np.zeros((n_owned, 2, 3))
         values[:, 0] = vertex[name]
-        values[:n_local, 1] = element[f"{name}_mid"]
+        values[:n_local, 1] = state[f"{name}_mid"]
         field.set_owned(values)
-    solver.tau[:] = node["tau"]
-    solver.lam[:] = node["lambda"]
+    solver.tau[:] = state["tau"]
+    solver.lam[:] = state["lambda"]
     solver.remember_state()
 

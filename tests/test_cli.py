@@ -5,6 +5,8 @@ tests themselves run under mpiexec: mpiexec cannot nest). Exit codes: 0 converge
 2 bad input, 3 not converged (method.md §6; petsc_rod/errors.py).
 """
 
+import datetime
+import json
 import os
 import shutil
 import subprocess
@@ -14,6 +16,7 @@ import h5py
 import numpy as np
 import pytest
 
+import petsc_rod
 from helpers import child_env
 from petsc_rod.options import OPTIONS
 
@@ -121,18 +124,75 @@ def test_restart_converges_at_once_to_the_same_state(cantilever, folder):
     path, first = cantilever
     assert first.returncode == 0, describe(first)
     second_path = folder / "c2.h5"
-    # one step: the restart starts from the final state of the first run (with the
-    # file's continuation steps it would begin again at the first load factor)
-    process = run(cantilever_args() + ["-rod_steps", "1", "-rod_initial", str(path),
+    # the file reached load factor 1: the restart solves one step there, from its state
+    process = run(cantilever_args() + ["-rod_steps", "3", "-rod_initial", str(path),
                                        "-rod_output", str(second_path)])
     assert process.returncode == 0, describe(process)
     with h5py.File(path, "r") as f, h5py.File(second_path, "r") as g:
         first_iterations = int(f.attrs["iterations"])
         assert first_iterations >= 20
         assert int(g.attrs["converged"]) == 1
+        assert sorted(g["steps"]) == ["1"] and float(g.attrs["load_factor"]) == 1.0
         assert int(g.attrs["iterations"]) < 0.1 * first_iterations
         assert np.abs(f["r"][:] - g["r"][:]).max() < 1e-8
         assert np.abs(f["d1"][:] - g["d1"][:]).max() < 1e-8
+
+
+def visit_objects(f):
+    """Every group and dataset of an open file, the root included, by name."""
+    found = {"/": f}
+    f.visititems(lambda name, item: found.setdefault(name, item))
+    return found
+
+
+def test_result_file_says_what_wrote_it_with_units_and_parameters(cantilever):
+    path, process = cantilever
+    assert process.returncode == 0, describe(process)
+    with h5py.File(path, "r") as f:
+        for name, item in visit_objects(f).items():
+            if isinstance(item, h5py.Dataset):
+                assert str(item.attrs["units"]), name
+                continue
+            units = json.loads(item.attrs.get("attribute_units", "{}"))
+            attributes = set(item.attrs) - {"attribute_units"}
+            assert attributes == set(units), name
+        attrs = f.attrs
+        assert f["r"].attrs["units"] == "m" and f["state/lambda"].attrs["units"] == "N"
+        assert json.loads(attrs["attribute_units"])["energy"] == "J"
+        assert attrs["version"] == petsc_rod.__version__
+        commit = str(attrs["commit"])
+        assert commit == "unknown" or len(commit.split("+")[0]) == 40, commit
+        written = datetime.datetime.fromisoformat(str(attrs["written"]))
+        age = datetime.datetime.now(datetime.timezone.utc) - written
+        assert datetime.timedelta(0) <= age < datetime.timedelta(hours=1)
+        steps = [f[f"steps/{k}"] for k in sorted(f["steps"], key=int)]
+        assert int(attrs["total_iterations"]) == sum(int(s.attrs["iterations"]) for s in steps)
+        assert int(attrs["total_iterations"]) > int(attrs["iterations"]) or len(steps) == 1
+        assert int(attrs["total_halvings"]) == 0 and int(attrs["halvings"]) == 0
+        assert attrs["stop_reason"] == "converged"
+        in_effect = str(attrs["options_in_effect"]).splitlines()
+        assert "-rod_elements 32" in in_effect
+        assert "-rod_al_max_it 2000" in in_effect         # a default, not given
+        assert any(line.startswith("-rod_r_ksp_type ") for line in in_effect)
+        given = parse_options_text(str(attrs["options"]))
+        parameters = f["parameters"].attrs
+        assert int(parameters["elements"]) == 32
+        assert float(parameters["length"]) == float(given.get("rod_length", 1.0))
+        assert np.array_equal(parameters["stiffness"], given_reals(given, "rod_stiffness"))
+        assert np.array_equal(parameters["end_force"], given_reals(given, "rod_end_force"))
+        assert parameters["load"].shape == (1, 3)
+        assert float(parameters["al_penalty"]) == float(attrs["penalty"])
+        assert json.loads(parameters["attribute_units"])["stiffness"] == "N m^2"
+
+
+def parse_options_text(text):
+    """'-name value' lines -> {name: value}."""
+    pairs = (line.lstrip("-").split(" ", 1) for line in text.splitlines() if line)
+    return {pair[0]: (pair[1] if len(pair) > 1 else "") for pair in pairs}
+
+
+def given_reals(given, name):
+    return np.array([float(v) for v in given[name].split(",")])
 
 
 def test_unknown_option_suggests_the_closest(folder):
