@@ -43,7 +43,8 @@ def settings_from_options(values, scene):
     return Settings(penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
-                    adapt_penalty=values["rod_al_adapt_penalty"])
+                    adapt_penalty=values["rod_al_adapt_penalty"],
+                    check_stability=values["rod_al_stability"])
 
 
 def options_record():

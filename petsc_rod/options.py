@@ -154,14 +154,16 @@ OPTIONS = [
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
            "min(K1, K2) with M = K3 a / L for a clamped end turned by a", SCALE, "N"),
-    Option("rod_al_max_it", _int, 2000, "n", "Uzawa iteration cap per step", POSITIVE),
-    Option("rod_al_rtol", _real, 1e-5, "tol",
-           "stop when the relative L2 change of (r, r', d1, d2) per iteration is below tol "
-           "(a step that stops while its estimated distance to the limit, change x rho / "
-           "(1 - rho), is above 10 tol says so)", TOLERANCE),
-    Option("rod_al_ctol", _real, 1e-3, "tol",
+    Option("rod_al_max_it", _int, 2000, "n", "iteration cap per step", POSITIVE),
+    Option("rod_al_rtol", _real, 1e-9, "tol",
+           "stop when the relative L2 change of (r, r', d1, d2) at the nodes per iteration "
+           "is below tol", TOLERANCE),
+    Option("rod_al_ctol", _real, 1e-9, "tol",
            "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
            "below tol", TOLERANCE),
+    Option("rod_al_stability", _bool, True, "bool",
+           "at each converged step, test the second variation of the energy (Sylvester "
+           "inertia); at a saddle turn the frames along its negative curvature and go on"),
     Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, True, "bool",
            "raise R tenfold, refactoring the matrices, while it is below a tenth of the "

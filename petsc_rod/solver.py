@@ -97,7 +97,7 @@ CONVERGED = (True, "")
 STOP_SADDLE = "saddle"      # converged, to a saddle, MAX_ESCAPES times
 # A step that converged to a saddle goes on from its frames turned along the negative
 # curvature by this angle at most (rad), at most MAX_ESCAPES times.
-ESCAPE_ANGLE = 0.1
+ESCAPE_ANGLE = 0.3
 MAX_ESCAPES = 5
 ESCAPE_GROWTH = 2.0
 
