@@ -1,7 +1,7 @@
 """PETSc glue of the global step: matrices assembled and factored once, right-hand sides.
 
 Each of d1, d2 and the slope theta = r' is one scalar SPD problem A x = b (P2) solved for
-the x, y and z components with one factorisation (method.md §3 step 1). Essential
+the x, y and z components with one factorisation (docs/method.md §3 step 1). Essential
 conditions keep A symmetric: rows and columns of prescribed dofs are zeroed with a unit
 diagonal, and the right-hand side is lifted by the unconstrained matrix times the
 prescribed values. The theta problem of a rod held at both ends is bordered by the

@@ -385,7 +385,7 @@ def catenary(length, chord, load, s):
         r'(S) = (e_h + sinh(x / a) e_v) / cosh(x / a),
         n(S) = H (e_h + sinh(x / a) e_v)        (n' + f = 0, tension H cosh(x / a)).
 
-    ``n`` is the force the part beyond S exerts on the part before it (method.md §6).
+    ``n`` is the force the part beyond S exerts on the part before it (docs/method.md §6).
     Returns ``(r, tangent, force)`` at the arc lengths ``s``, each ``s.shape + (3,)``.
     """
     up, along = catenary_axes(length, chord, load)

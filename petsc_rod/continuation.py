@@ -1,4 +1,4 @@
-"""The continuation (method.md §7): the load path from the start to the scene in
+"""The continuation (docs/method.md §7): the load path from the start to the scene in
 ``-rod_steps`` steps, each warm-started from the last converged state, halved when a step
 fails, reported one line per step and written one group per step."""
 

@@ -1,6 +1,6 @@
 """The P2 reference element on [0, 1] and its element matrices (numpy only).
 
-Every field of the global step lives in the same P2 Lagrange space (method.md §4,
+Every field of the global step lives in the same P2 Lagrange space (docs/method.md §4,
 with the centreline recast): d1, d2, and the slope theta = r' of the centreline. The
 paper's C^1 Hermite cubic r has a C^0 piecewise-quadratic derivative, so theta in P2
 together with r(0) is the same discrete space; r itself is recovered by integrating

@@ -1,7 +1,7 @@
 """Distributed vector fields (r, d1, d2): three scalar DMDA Vecs, one per component.
 
 The global step solves one scalar problem per Cartesian component with the same
-factorisation (method.md §3), so each component is its own Vec on the mesh's DMDA.
+factorisation (docs/method.md §3), so each component is its own Vec on the mesh's DMDA.
 Local views are numpy arrays of shape (n_local_vertices, 2 slots, 3 components).
 """
 

@@ -1,6 +1,6 @@
 """Pointwise kernels of the Uzawa iteration (numpy only, vectorised over points).
 
-Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (method.md §3).
+Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (docs/method.md §3).
 """
 
 import threading

@@ -34,7 +34,7 @@ def vertex_strains(solver):
 
 
 def vertex_fields(solver, t):
-    """All vertex datasets of the result file (method.md §6, issue format)."""
+    """All vertex datasets of the result file (docs/method.md §6, issue format)."""
     mesh, scene = solver.mesh, solver.scene
     r = solver.r.owned()
     d1 = solver.d1.owned()[:, 0]

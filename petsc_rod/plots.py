@@ -3,7 +3,7 @@
     python -m petsc_rod.plots paper.h5 paper.png
 
 draws the centreline projected on the xy, xz and yz planes, and the strains u1, u2,
-u3 against S: the paper's Figures 1 and 3 for one solution (method.md §8).
+u3 against S: the paper's Figures 1 and 3 for one solution (docs/method.md §8).
 """
 
 import sys

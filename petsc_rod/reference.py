@@ -1,7 +1,7 @@
 r"""Independent reference solutions of the static Kirchhoff rod by collocation.
 
 This module solves the same continuum problem as the augmented-Lagrangian solver
-(``shared/method.md`` §1) by a different method: the strong form of the equilibrium
+(``docs/method.md`` §1) by a different method: the strong form of the equilibrium
 equations, written as a first-order two-point boundary-value problem and solved by
 ``scipy.integrate.solve_bvp`` (4th-order Lobatto IIIA collocation with residual-based
 mesh adaptation). It uses numpy, scipy and h5py only, never PETSc, and nothing of the
@@ -17,7 +17,7 @@ Arc length ``S`` in ``[0, L]``. Thirteen unknown functions of ``S``:
     m  (3)  internal moment,
 
 ``n(S)``, ``m(S)`` being the force and moment (about r(S)) that the part beyond ``S``
-exerts on the part before it (method.md §9). With no distributed load (f = g = 0):
+exerts on the part before it (docs/method.md §9). With no distributed load (f = g = 0):
 
     r' = d3                                  (inextensible, unshearable)
     q' = 1/2 q (x) (0, u),   u_i = (m . d_i) / K_i        (i = 1, 2, 3)
@@ -61,7 +61,7 @@ and it is reported as ``quaternion_norm_error``.
 
 Branches
 --------
-The planar (untwisted) configuration of the paper's scene (method.md §8: clamp with
+The planar (untwisted) configuration of the paper's scene (docs/method.md §8: clamp with
 d1 = e_y, d2 = e_z, d3 = e_x, pinned end at (X_F, 20 - X_F, 0)) satisfies these equations
 too: the plane z = 0 with d2 = e_z is invariant under the ODE and the boundary
 conditions, so Newton's method started in it stays in it (:func:`planar_guess`). It
@@ -72,7 +72,7 @@ reactions. Followed in X_F (:func:`solve_paper_scene`) it is, near X_F = 20, the
 buckling of the clamped-pinned rod about the weak axis d1 (|n| -> 20.19 K1/L^2 = 11.86)
 and, for K = (235, 360, 200), it joins the planar branch in a pitchfork near X_F = 5.15;
 below that, continuation along y = 20 - x yields the planar state. Mirror images
-(z -> -z, u1 and u3 change sign) are equally valid solutions (method.md §9).
+(z -> -z, u1 and u3 change sign) are equally valid solutions (docs/method.md §9).
 
 Accuracy
 --------
@@ -108,7 +108,7 @@ __all__ = [
 PAPER_CLAMP_FRAME = np.array([[0.0, 1.0, 0.0],    # d1 = e_y
                               [0.0, 0.0, 1.0],    # d2 = e_z
                               [1.0, 0.0, 0.0]])   # d3 = e_x
-"""The clamp frame of the paper's scene (method.md §8); row i is d_{i+1}."""
+"""The clamp frame of the paper's scene (docs/method.md §8); row i is d_{i+1}."""
 
 _N_STATE = 13
 _R, _Q, _N, _M = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
@@ -526,7 +526,7 @@ def planar_guess(end_x, length=20.0, nodes=81):
 
 def solve_paper_scene(end_x, guess, stiffness=(235.0, 360.0, 200.0), length=20.0,
                       tol=1e-10, steps=1, nodes=201):
-    r"""The paper's scene (method.md §8) at X_F = ``end_x``, by continuation in X_F.
+    r"""The paper's scene (docs/method.md §8) at X_F = ``end_x``, by continuation in X_F.
 
     Clamp at S = 0 (r = 0, d1 = e_y, d2 = e_z, d3 = e_x), pinned end
     r(L) = (X_F, L - X_F, 0), m(L) = 0. ``guess`` is (S, r, frames, n, m) (e.g. from

@@ -8,11 +8,19 @@ from petsc4py import PETSc
 
 from .errors import RodInputError
 
-# Memory of a run: per element (fields, matrices and their factors, the Uzawa state at
-# the quadrature points; about 6.5 KiB on one rank and more on two, README Performance,
-# rounded up) and per rank (the interpreter, PETSc, MPI).
-BYTES_PER_ELEMENT = 8 * 2**10
+# Memory of a run: per element (fields, matrices and their factors, the node state,
+# Anderson's history, the stability test's factorisation: 10^6 elements on 2 ranks
+# peaked at 9.6 GiB per rank, docs/stability.md; rounded up) and per rank (the
+# interpreter, PETSc, MPI).
+BYTES_PER_ELEMENT = 20 * 2**10
 BYTES_PER_RANK = 80 * 2**20
+# Anderson mixing keeps 2 m vectors of the node state (18 numbers at 2 nodes per
+# element): 576 bytes per element and unit of depth. Its default depth is the largest
+# up to DEFAULT_DEPTH whose history takes at most ANDERSON_SHARE of the memory available.
+ANDERSON_BYTES = 2 * 18 * 2 * 8
+DEFAULT_DEPTH = 30
+MIN_DEPTH = 5
+ANDERSON_SHARE = 0.25
 # The DMDA has 2 dofs per vertex, indexed by PETSc integers.
 MAX_ELEMENTS = int(np.iinfo(PETSc.IntType).max) // 2 - 1
 
@@ -20,6 +28,25 @@ MAX_ELEMENTS = int(np.iinfo(PETSc.IntType).max) // 2 - 1
 def needed_memory(elements, ranks):
     """Bytes a run of ``elements`` elements on ``ranks`` ranks needs, estimated."""
     return ranks * BYTES_PER_RANK + elements * BYTES_PER_ELEMENT
+
+
+def anderson_depth(local_elements, ranks_here):
+    """The default depth m of Anderson mixing for a rank with ``local_elements``
+    elements on a machine shared by ``ranks_here`` ranks (see ANDERSON_SHARE)."""
+    available = available_memory()
+    if available is None or local_elements == 0:
+        return DEFAULT_DEPTH
+    budget = ANDERSON_SHARE * available / ranks_here
+    return int(min(DEFAULT_DEPTH, max(MIN_DEPTH, budget // (ANDERSON_BYTES * local_elements))))
+
+
+def ranks_on_this_machine(comm):
+    """How many ranks of ``comm`` (petsc4py) share this machine's memory. Collective."""
+    from mpi4py import MPI
+    node = comm.tompi4py().Split_type(MPI.COMM_TYPE_SHARED)
+    here = node.Get_size()
+    node.Free()
+    return here
 
 
 def available_memory():
@@ -58,15 +85,12 @@ def check_elements_fit(comm, elements):
     if elements > MAX_ELEMENTS:
         raise RodInputError(f"-rod_elements {elements}: at most {MAX_ELEMENTS} elements fit "
                             "in PETSc's integers (2 dofs per vertex)")
-    from mpi4py import MPI
     mpi = comm.tompi4py()
     if elements + 1 < mpi.Get_size():
         raise RodInputError(f"-rod_elements {elements} on {mpi.Get_size()} ranks: every rank "
                             f"needs a vertex; use at least {mpi.Get_size() - 1} elements or "
                             "fewer ranks")
-    node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
-    here = node.Get_size()
-    node.Free()
+    here = ranks_on_this_machine(comm)
     needed = needed_memory(elements * here / mpi.Get_size(), here)
     known = [value for value in mpi.allgather(available_memory()) if value is not None]
     available = min(known) if known else None

@@ -1,4 +1,4 @@
-"""The augmented-Lagrangian (Uzawa, ALG2) driver of method.md §3.
+"""The augmented-Lagrangian (Uzawa, ALG2) driver of docs/method.md §3.
 
 State: d1, d2 and the slope theta = r' = d3 (P2 VectorFields on the DMDA), the
 centreline r at the vertices (a VectorField holding the Hermite pair (r, r') of each
@@ -26,6 +26,7 @@ from .fields import VectorField, at_points, element_dofs
 from .kernels import (nearest_rotation, rotations, split_coefficients, strains,
                       update_multipliers)
 from .link import FULLER_MARGIN, link_integrands
+from .resources import anderson_depth, ranks_on_this_machine
 from .stability import SecondVariation
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
@@ -95,8 +96,11 @@ STALL_CHECK_EVERY = STALL_WINDOW // 10
 RAISE_PENALTY = "raise_penalty"     # the step goes on with a larger R (raise_penalty)
 CONVERGED = (True, "")
 STOP_SADDLE = "saddle"      # converged, to a saddle, MAX_ESCAPES times
-# A step that converged to a saddle goes on from its frames turned along the negative
-# curvature by this angle at most (rad), at most MAX_ESCAPES times.
+# A step that converged to a saddle goes on from its frames turned along the direction
+# of negative curvature, the largest node turned by ESCAPE_ANGLE rad, the angle times
+# ESCAPE_GROWTH and of the other sign at each further saddle, at most MAX_ESCAPES times
+# (large enough to leave the saddle's basin of the accelerated iteration: 0.1 rad did not
+# on the paper scene, docs/stability.md).
 ESCAPE_ANGLE = 0.3
 MAX_ESCAPES = 5
 ESCAPE_GROWTH = 2.0
@@ -300,11 +304,21 @@ class UzawaSolver:
         snes.setTolerances(max_it=2**30)
         snes.setMaxFunctionEvaluations(2**30)
         database = PETSc.Options()
-        if database.getString("rod_snes_type", DEFAULT_SNES) == PETSc.SNES.Type.NRICHARDSON \
-                and not database.hasName("rod_snes_linesearch_type"):
+        defaults = {}
+        kind = database.getString("rod_snes_type", DEFAULT_SNES)
+        if kind == PETSc.SNES.Type.NRICHARDSON:
             # nrichardson's default line search (secant) is not the plain iteration
-            database.setValue("rod_snes_linesearch_type", "basic")
+            defaults["rod_snes_linesearch_type"] = "basic"
+        if kind == PETSc.SNES.Type.ANDERSON:
+            here = ranks_on_this_machine(self.mesh.comm)
+            defaults["rod_snes_anderson_m"] = str(int(self.mesh.global_min(
+                anderson_depth(self.mesh.n_local_elements, here))))
+        defaults = {k: v for k, v in defaults.items() if not database.hasName(k)}
+        for name, value in defaults.items():
+            database.setValue(name, value)
         snes.setFromOptions()
+        for name in defaults:
+            database.delValue(name)
 
     def _set_prescribed(self):
         """The end states' frame rows as the prescribed values of the three problems."""
@@ -400,7 +414,7 @@ class UzawaSolver:
         self.theta.set_owned(theta)
 
     def snapshot(self):
-        """Copies of this rank's share of the state a warm start needs (method.md §3: r,
+        """Copies of this rank's share of the state a warm start needs (docs/method.md §3: r,
         d, tau, lambda; theta = r' with r), so that a failed continuation step can be
         undone (``restore``). Owned arrays only: nothing is gathered or communicated."""
         state = {name: field.owned() for name, field in self._state_fields().items()}

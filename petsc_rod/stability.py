@@ -85,10 +85,11 @@ class SecondVariation:
     def _assemble(self):
         solver, mesh = self.solver, self.solver.mesh
         ne = mesh.n_local_elements
+        # directors at the 3 nodes of each owned element, (ne, 3 nodes, 3 dirs, 3); the
+        # ghost exchange is collective, also on a rank that owns no element
+        d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
+                      for f in solver.frame_fields], axis=2)
         if ne:
-            # directors at the 3 nodes of each owned element, (ne, 3 nodes, 3 dirs, 3)
-            d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
-                          for f in solver.frame_fields], axis=2)
             stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
             x = skew(d)                                      # (ne, node, dir, 3, 3)
             # block (a, b) = sum_i 2 a_i K_ab [d_a,i]x^T [d_b,i]x

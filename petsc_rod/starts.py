@@ -1,4 +1,4 @@
-"""Initial states of the iteration (method.md §3, "Start"), as smooth curves of S.
+"""Initial states of the iteration (docs/method.md §3, "Start"), as smooth curves of S.
 
 A curve maps arc lengths S (any shape) to (r, frame, force): the centreline, the director
 frame (rows d1, d2, d3 = r') and the internal force n(S). The solver samples it at its

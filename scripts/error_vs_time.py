@@ -15,7 +15,7 @@ Scenes and references:
 - cantilever: P L^2/EI = 3, dead tip force; elliptic-integral elastica (closed_forms)
   for r and d, the collocation reference (reference.py) for the energy;
 - twist: both ends clamped on the axis, end rolled by 1 rad; u3 = 1 / L exactly;
-- paper: method.md §8 at X_F = 16, K3 = 200; the collocation reference of the
+- paper: docs/method.md §8 at X_F = 16, K3 = 200; the collocation reference of the
   out-of-plane branch, compared with the nearer of the mirror pair (z -> -z).
 
 What one run is: a mesh of N elements and a penalty R, solved as the CLI solves it (the

@@ -1,4 +1,4 @@
-"""Essential and natural end conditions (method.md §5) on 1 or several ranks.
+"""Essential and natural end conditions (docs/method.md §5) on 1 or several ranks.
 
 For each combination of end kinds a small scene is solved from the straight state in one
 step, and the prescribed values are checked to round-off at the vertex that carries them
@@ -6,7 +6,7 @@ step, and the prescribed values are checked to round-off at the vertex that carr
 The recovered forces and moments are checked where the continuum says what they are:
 n = the dead force at a free end (n(0) = -F at a free start, read from the FE reaction at
 the other end), m = 0 at a pinned or free end, and the moment balance about the origin
-(method.md §9) m(0) = m(L) + r(L) x n(L) with no distributed load.
+(docs/method.md §9) m(0) = m(L) + r(L) x n(L) with no distributed load.
 
 Constraint tolerance: on 24 elements the RMS constraint residual of a scene with both
 ends held does not go below ~2e-5 (clamp-pin 1.9e-5, clamp-clamp 3.0e-5, measured to
@@ -181,7 +181,7 @@ def test_moment_vanishes_at_a_pinned_or_free_end(solved, name, at_start):
 
 @pytest.mark.parametrize("name", list(CASES))
 def test_moment_balance_about_the_origin(solved, name):
-    """m(0) = m(L) + (r(L) - r(0)) x n(L) without distributed load (method.md §9).
+    """m(0) = m(L) + (r(L) - r(0)) x n(L) without distributed load (docs/method.md §9).
 
     Measured |error| / max|m|: 1e-4 (free end) to 2.3e-3 (clamp-pin) on 24 elements; a
     sign error in the reaction or in the moment would give O(1).

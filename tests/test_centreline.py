@@ -41,6 +41,8 @@ CASES = {
                      end_position=(1.0, 0.1, 0.3)),
 }
 ROUND_OFF = 1e-12
+SIMPSON_POINTS = np.array([0.0, 0.5, 1.0])
+SIMPSON_WEIGHTS = np.array([1.0, 4.0, 1.0]) / 6
 
 
 def hermite(x, h):
@@ -75,13 +77,17 @@ def hermite_step(S, scene, t, target):
     """The Hermite r step solved densely: vertex dofs (N + 1, 2, 3) (r, r'), the reaction
     at S = L ((A r - b) at the r(L) row; the dead force at a free end), the load work
     (load vector . dofs) and max |b|, the size of the terms the reaction cancels.
-    ``target`` = R tau3 - lambda3 at the Gauss points (N, 3, 3)."""
+    ``target`` = R tau3 - lambda3 at the P2 nodes (2N + 1, 3): the penalty term and the
+    right-hand side by Simpson's rule on each element (the nodal quadrature)."""
     n, h = S.size - 1, np.diff(S)
-    _, dphi, ddphi = hermite(np.broadcast_to(GAUSS_POINTS, (n, 3)), h)
+    _, _, ddphi = hermite(np.broadcast_to(GAUSS_POINTS, (n, 3)), h)
     w = h[:, None] * GAUSS_WEIGHTS
+    _, dphi, _ = hermite(np.broadcast_to(SIMPSON_POINTS, (n, 3)), h)
+    simpson = h[:, None] * SIMPSON_WEIGHTS
     bending = 2 * split_coefficients(scene.stiffness)[2]
     matrices = (bending * np.einsum("eq,eqk,eql->ekl", w, ddphi, ddphi)
-                + PENALTY * np.einsum("eq,eqk,eql->ekl", w, dphi, dphi))
+                + PENALTY * np.einsum("eq,eqk,eql->ekl", simpson, dphi, dphi))
+    target = np.stack([target[0:-1:2], target[1::2], target[2::2]], axis=1)   # (n, 3, 3)
     dofs = 2 * np.arange(n)[:, None] + np.arange(4)
     a = np.zeros((2 * n + 2, 2 * n + 2))
     np.add.at(a, (dofs[:, :, None], dofs[:, None, :]), matrices)
@@ -97,7 +103,7 @@ def hermite_step(S, scene, t, target):
         if state.kind == "clamp":
             fixed[row + 1] = state.frame[2]
     b = load.copy()
-    np.add.at(b, dofs, np.einsum("eq,eqk,eqc->ekc", w, dphi, target))
+    np.add.at(b, dofs, np.einsum("eq,eqk,eqc->ekc", simpson, dphi, target))
     x = np.zeros_like(b)
     rows = np.array(list(fixed))
     x[rows] = np.array(list(fixed.values()))
@@ -119,8 +125,8 @@ def one_step(request):
         solver.set_straight()
         solver.prepare_step(1.0)
         rng = np.random.default_rng(7)
-        tau, lam = rng.standard_normal((2, mesh.n_elements, 3, 3, 3))
-        owned = slice(mesh.element_start, mesh.element_end)
+        tau, lam = rng.standard_normal((2, 2 * mesh.n_elements + 1, 3, 3))
+        owned = slice(2 * mesh.vertex_start, 2 * mesh.vertex_start + mesh.n_local_nodes)
         solver.tau[:], solver.lam[:] = tau[owned], lam[owned]
         solver.iterate()
         points = {key: gather(comm, value) for key, value in solver.point_values().items()}
@@ -130,7 +136,7 @@ def one_step(request):
     finally:
         solver.destroy()
         mesh.destroy()
-    result["hermite"] = hermite_step(S, scene, 1.0, PENALTY * tau[:, :, 2] - lam[:, :, 2])
+    result["hermite"] = hermite_step(S, scene, 1.0, PENALTY * tau[:, 2] - lam[:, 2])
     result["S"], result["scene"] = S, scene
     return result
 

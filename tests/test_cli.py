@@ -2,7 +2,7 @@
 
 Every test here spawns processes, so the module is marked ``serial`` (skipped when the
 tests themselves run under mpiexec: mpiexec cannot nest). Exit codes: 0 converged,
-2 bad input, 3 not converged (method.md §6; petsc_rod/errors.py).
+2 bad input, 3 not converged (docs/method.md §6; petsc_rod/errors.py).
 """
 
 import datetime
@@ -100,8 +100,8 @@ def test_cantilever_run_writes_the_result_file(cantilever):
         last = f["steps"][str(len(f["steps"]))]
         assert np.array_equal(last["r"][:], f["r"][:])
         assert float(last.attrs["load_factor"]) == 1.0
-        assert f["state/tau"].shape == (32, 3, 3, 3)
-        assert f["state/lambda"].shape == (32, 3, 3, 3)
+        assert f["state/tau"].shape == (65, 3, 3)          # the 2 N + 1 P2 nodes
+        assert f["state/lambda"].shape == (65, 3, 3)
         S = f["S"][:]
         r, d1, d2, d3 = (f[name][:] for name in ("r", "d1", "d2", "d3"))
     assert S[0] == 0.0 and S[-1] == pytest.approx(1.0, abs=1e-14)

@@ -1,4 +1,4 @@
-"""The pointwise kernels of the Uzawa iteration (method.md §1-§3), numpy only.
+"""The pointwise kernels of the Uzawa iteration (docs/method.md §1-§3), numpy only.
 
 nearest_rotation(b) is the local step: the T in SO(3) maximising sum_i T_i . b_i =
 trace(T b^T). It is checked against a brute force (local perturbations along every

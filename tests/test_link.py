@@ -120,6 +120,7 @@ def test_a_whole_turn_in_one_step_is_refused(solver_factory, comm):
     lines = []
     assert continuation(solver, 4, 0.0, None, lines.append, "", 0) == 0, "\n".join(lines)
     twist, writhe = solver.link()
-    assert twist == pytest.approx(1.0, abs=1e-6) and abs(writhe) < 1e-9
+    # the twist integral of the P2 frames, O(h^4) from its limit: 3.1e-6 on 32 elements
+    assert twist == pytest.approx(1.0, abs=1e-5) and abs(writhe) < 1e-9
     assert "link 1.0000 turns = twist 1.0000 + writhe" in [
         line for line in lines if line.startswith("step 4/4")][0]

@@ -46,7 +46,7 @@ def cantilever():
 
 
 def _moment_balance_error(result):
-    """|m(0) - m(L) - r(L) x n(L)| / |m(0)| (method.md §9, no distributed load)."""
+    """|m(0) - m(L) - r(L) x n(L)| / |m(0)| (docs/method.md §9, no distributed load)."""
     balance = result.m[-1] + np.cross(result.r[-1], result.n[-1])
     return np.linalg.norm(result.m[0] - balance) / np.linalg.norm(result.m[0])
 
