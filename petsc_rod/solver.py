@@ -1,12 +1,12 @@
-"""The augmented-Lagrangian (Uzawa, ALG2) driver of docs/method.md §3.
+"""The augmented-Lagrangian (Uzawa, ALG2) iteration of docs/method.md §3, driven by a
+PETSc SNES (§6), with the stability test of §10 at each converged step.
 
 State: d1, d2 and the slope theta = r' = d3 (P2 VectorFields on the DMDA), the
 centreline r at the vertices (a VectorField holding the Hermite pair (r, r') of each
-vertex, recovered from theta by integration, centreline.py) and, at the 3 Gauss points
-of each owned element, tau and lambda, arrays (ne, 3 points, 3 directors, 3 components)
-with director rows d1, d2, d3 = r'. One iteration: global step (three scalar SPD solves
-per field, factorisations reused), local step (nearest rotation at every point),
-multiplier update.
+vertex, recovered from theta by integration, centreline.py) and, at the owned P2 nodes,
+tau and lambda, arrays (n_nodes, 3 directors, 3 components) with director rows d1, d2,
+d3 = r'. One iteration: global step (three scalar SPD solves per field, factorisations
+reused), local step (nearest rotation at every node), multiplier update.
 """
 
 import time
@@ -42,8 +42,8 @@ DIVERGED_RESIDUAL = 1e3
 class Settings:
     penalty: float
     max_it: int = 2000
-    rtol: float = 1e-5
-    ctol: float = 1e-3
+    rtol: float = 1e-9
+    ctol: float = 1e-9
     monitor: bool = False
     adapt_penalty: bool = True      # raise a penalty far below the scale (raise_penalty)
     check_stability: bool = True    # test the second variation at convergence (stability.py)

@@ -3,8 +3,12 @@
 The same scene (clamp at 0, pin at L at (0.7, 0.5, 0.2), two continuation steps) is
 solved on PETSc.COMM_SELF (every rank its own full serial solve) and on
 PETSc.COMM_WORLD (the mesh split over the ranks). Under a serial run both are one rank;
-under ``mpiexec -n 2`` this is the 1-versus-2-ranks check: the fields, the Uzawa state,
-the iteration counts and the energy must agree to round-off.
+under ``mpiexec -n 2`` this is the 1-versus-2-ranks check. The plain iteration
+(``nrichardson``) is a map that does not depend on the partition: the iteration counts,
+the histories, the fields, the Uzawa state and the energy agree to round-off. The
+default (Anderson mixing) solves a small least-squares problem per iteration whose
+round-off steers its path: the same state to the iteration's tolerance (1e-11 here),
+the iteration counts within 10%.
 """
 
 import numpy as np
@@ -17,16 +21,22 @@ SCENE = dict(length=1.0, stiffness=(1.0, 1.3, 0.9), start="clamp", end="pin",
              end_position=(0.7, 0.5, 0.2))
 N_ELEMENTS = 40
 PENALTY = 100.0
-RTOL = 1e-7
-CTOL = 1e-4
+TOLERANCES = {"nrichardson": (1e-7, 1e-4), "anderson": (1e-11, 1e-11)}
 MAX_IT = 3000
 STEPS = (0.5, 1.0)
-FIELD_TOL = 1e-10
+# agreement of the fields (relative for lambda) for each iteration
+FIELD_TOL = {"nrichardson": 1e-10, "anderson": 1e-9}
 
 
-def solve_on(comm):
-    """Solve SCENE on ``comm`` in STEPS; every result gathered on every rank of comm."""
-    mesh, solver = make_solver(comm, N_ELEMENTS, SCENE, PENALTY, RTOL, CTOL, MAX_IT)
+def solve_on(comm, kind):
+    """Solve SCENE on ``comm`` in STEPS with the SNES ``kind``; every result gathered on
+    every rank of comm."""
+    database = PETSc.Options()
+    database.setValue("rod_snes_type", kind)
+    try:
+        mesh, solver = make_solver(comm, N_ELEMENTS, SCENE, PENALTY, *TOLERANCES[kind], MAX_IT)
+    finally:
+        database.delValue("rod_snes_type")
     try:
         solver.set_straight()
         reports = [solver.solve_step(t) for t in STEPS]
@@ -46,26 +56,29 @@ def solve_on(comm):
         mesh.destroy()
 
 
-@pytest.fixture(scope="module")
-def both():
-    serial = solve_on(PETSc.COMM_SELF)
-    parallel = solve_on(PETSc.COMM_WORLD)
-    return serial, parallel
+@pytest.fixture(scope="module", params=["nrichardson", "anderson"])
+def both(request):
+    serial = solve_on(PETSc.COMM_SELF, request.param)
+    parallel = solve_on(PETSc.COMM_WORLD, request.param)
+    return serial, parallel, request.param
 
 
 def test_the_world_run_is_distributed(both):
-    serial, parallel = both
+    serial, parallel, _ = both
     assert serial["ranks"] == 1 and not serial["split"]
     assert parallel["ranks"] == PETSc.COMM_WORLD.getSize()
     assert parallel["split"] == (parallel["ranks"] > 1)
 
 
 def test_both_converge_in_the_same_iterations(both):
-    serial, parallel = both
+    serial, parallel, kind = both
     for one, many in zip(serial["reports"], parallel["reports"]):
         assert one.converged and many.converged
-        assert one.iterations == many.iterations
         assert one.iterations > 10
+        if kind == "anderson":
+            assert abs(one.iterations - many.iterations) <= 0.1 * one.iterations
+            continue
+        assert one.iterations == many.iterations
         history_one = np.array(one.history)[:, :2]
         history_many = np.array(many.history)[:, :2]
         assert np.allclose(history_one, history_many, rtol=1e-6, atol=1e-12)
@@ -73,10 +86,10 @@ def test_both_converge_in_the_same_iterations(both):
 
 @pytest.mark.parametrize("name", ["r", "d1", "d2"])
 def test_fields_agree(both, name):
-    serial, parallel = both
+    serial, parallel, kind = both
     one, many = serial[name], parallel[name]
     assert one.shape == many.shape == (N_ELEMENTS + 1, 2, 3)
-    assert np.abs(one - many).max() < FIELD_TOL
+    assert np.abs(one - many).max() < FIELD_TOL[kind]
     # the scene is not trivial: the end moved out of the plane and the frame turned
     if name == "r":
         assert np.abs(one[-1, 0] - SCENE["end_position"]).max() < 1e-12
@@ -84,15 +97,15 @@ def test_fields_agree(both, name):
 
 
 def test_uzawa_state_agrees(both):
-    serial, parallel = both
+    serial, parallel, kind = both
     assert serial["tau"].shape == (2 * N_ELEMENTS + 1, 3, 3)
-    assert np.abs(serial["tau"] - parallel["tau"]).max() < FIELD_TOL
+    assert np.abs(serial["tau"] - parallel["tau"]).max() < FIELD_TOL[kind]
     scale = np.abs(serial["lam"]).max()
     assert scale > 1.0
-    assert np.abs(serial["lam"] - parallel["lam"]).max() < FIELD_TOL * scale
+    assert np.abs(serial["lam"] - parallel["lam"]).max() < FIELD_TOL[kind] * scale
 
 
 def test_energy_agrees(both):
-    serial, parallel = both
+    serial, parallel, _ = both
     assert serial["energy"] > 0.1
     assert serial["energy"] == pytest.approx(parallel["energy"], rel=1e-10, abs=0)
