@@ -489,8 +489,10 @@ class UzawaSolver:
     def solve_step(self, t, label="", observer=None):
         """The iteration at load factor t, driven by the SNES ``-rod_snes_*`` (anderson by
         default, nrichardson for the plain iteration; docs/method.md §6), until both
-        stopping tests hold: change <= change_tolerance (rtol) and RMS constraint residual
-        <= ctol. A step whose change and residual are within STALL_FACTOR of their
+        stopping tests hold: change <= rtol and RMS constraint residual <= ctol; then,
+        with check_stability, the state is tested (§10) and a saddle is left along its
+        negative curvature, up to MAX_ESCAPES times (the report says stable, or the step
+        ends not converged with STOP_SADDLE). A step whose change and residual are within STALL_FACTOR of their
         tolerances but, at their rate, would not meet them within max_it stops early as
         stalled (stalled_projection). A penalty far below the problem's scale whose
         residual hardly falls is raised on the way (penalty_too_low, raise_penalty; the
@@ -517,7 +519,7 @@ class UzawaSolver:
                 self.turn_frames(angle * direction / self.mesh.global_max(
                     float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
                 step.escapes += 1
-                step.outcome = None
+                step.outcome = step.stable = None
                 self._iterate(step)
         finally:
             self._step = None
