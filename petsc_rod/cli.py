@@ -126,7 +126,7 @@ def build_solver(mesh, scene, settings):
     except PETSc.Error as error:
         detail = str(error).strip().splitlines()[-1].split("] ", 1)[-1]
         raise RodInputError(f"PETSc refused the solver options: {detail}; check the "
-                            "-rod_r_*, -rod_d1_* and -rod_d2_* options") from None
+                            "-rod_r_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
 
 
 def start_from(solver, values, given, say):

@@ -19,7 +19,7 @@ from . import boundary, starts
 from .assembly import ScalarProblem, assemble_matrix, load_ghosted
 from .centreline import (anchor_work, load_offset, midpoint_slopes, positions_at_points,
                          vertex_positions)
-from .errors import RodDivergedError
+from .errors import RodDivergedError, RodInputError
 from .fe import (GAUSS_POINTS, P2, element_integrals, p2_basis,
                  p2_element_matrices, p2_integrals, quadrature_weights)
 from .fields import VectorField, at_points, element_dofs
@@ -233,10 +233,22 @@ def default_penalty(scene):
     return max(bending, 0.5 * scene.applied_force(), twist)
 
 
+def check_anderson_depth():
+    """Refuse a -rod_snes_anderson_m that is not a whole number of at least 1 (PETSc
+    itself fails on it with a stack of messages)."""
+    database = PETSc.Options()
+    if database.hasName("rod_snes_anderson_m"):
+        depth = database.getString("rod_snes_anderson_m", "")
+        if not depth.isdigit() or int(depth) < 1:
+            raise RodInputError(f"-rod_snes_anderson_m {depth}: the depth of Anderson "
+                                "mixing is a whole number of at least 1")
+
+
 class UzawaSolver:
     """Owns every PETSc object of the solve; ``destroy()`` releases them all."""
 
     def __init__(self, mesh, scene, settings):
+        check_anderson_depth()          # before any PETSc object is made
         self.mesh, self.scene, self.settings = mesh, scene, settings
         self.split = split_coefficients(scene.stiffness)
         self.matrix_split = matrix_split(self.split)

@@ -228,6 +228,9 @@ BAD_INPUTS = {
     "catenary on one vertical": (["-rod_initial_shape", "catenary", "-rod_end", "pin",
                                   "-rod_end_position", "0,0,-0.5", "-rod_load", "0,0,-1"],
                                  "-rod_initial_shape"),
+    "unknown iteration": (["-rod_snes_type", "bogus"], "-rod_snes_*"),
+    "negative Anderson depth": (["-rod_snes_anderson_m", "-3"], "-rod_snes_anderson_m"),
+    "malformed stability switch": (["-rod_al_stability", "maybe"], "-rod_al_stability"),
 }
 
 
