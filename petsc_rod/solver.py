@@ -296,7 +296,9 @@ class UzawaSolver:
             self.r_problem.add_integral_constraint(element_integrals(h))
         self._set_prescribed()
         if self._lagged is None and np.any(self.matrix_split != self.split):
+            # the stiffness K of the lagged part, and two work vectors for K tau_i
             self._lagged = assemble_matrix(mesh, p2_element_matrices(h, 1.0, 0.0))
+            self._lagged_work = self._lagged.createVecs()
         EVENTS["assembly"].end()
 
     def _create_snes(self):
@@ -681,8 +683,7 @@ class UzawaSolver:
         """2 (c_i - a_i) K tau_i on each field's right-hand side, where the matrix uses c_i
         instead of a_i: at a fixed point (d = tau) the equations are those of a_i."""
         n = self.mesh.n_local_nodes
-        work = self._lagged.createVecLeft()
-        product = self._lagged.createVecLeft()
+        work, product = self._lagged_work
         for i, rhs in enumerate(self.rhs):
             factor = 2 * (self.matrix_split[i] - self.split[i])
             if factor == 0:
@@ -693,8 +694,6 @@ class UzawaSolver:
                 values[n:] = 0.0
                 self._lagged.mult(work, product)
                 vec.axpy(factor, product)
-        work.destroy()
-        product.destroy()
 
     def solve_centreline(self):
         """theta from its right-hand side ``rhs[2]``, bordered by r(L) - r(0) = int theta
@@ -781,6 +780,9 @@ class UzawaSolver:
         self._destroy_problems()
         for obj in (self.snes, self._x, self._f):
             obj.destroy()
+        if self._lagged is not None:
+            for obj in (self._lagged, *self._lagged_work):
+                obj.destroy()
         for obj in [*self.frame_fields, self.r, self.load, *self.rhs]:
             obj.destroy()
 

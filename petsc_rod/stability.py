@@ -76,8 +76,6 @@ class SecondVariation:
         self.mass = self._mass()
         self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
         self._mass_or_one.getArray()[self._clamped - self.first_row] = 1.0
-        self._ones = self.mass.duplicate()
-        self._ones.set(1.0)
         self._work = self.mass.duplicate()
         self._create_solver()
 
@@ -184,7 +182,7 @@ class SecondVariation:
     def _factor(self, shift):
         """Factor H - shift M."""
         self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self._work.pointwiseMult(self.mass, self._ones)
+        self.mass.copy(self._work)
         self._work.scale(-shift)
         self.shifted.setDiagonal(self._work, addv=PETSc.InsertMode.ADD_VALUES)
         self.ksp.setOperators(self.shifted)
@@ -262,5 +260,5 @@ class SecondVariation:
 
     def destroy(self):
         for obj in [self.ksp, self.shifted, self.matrix, self.mass, self._mass_or_one,
-                    self._ones, self._work, self._diagonal, *self.constraint]:
+                    self._work, self._diagonal, *self.constraint]:
             obj.destroy()
