@@ -11,7 +11,7 @@ n' + f = 0); lambda1 = lambda2 = 0.
 import numpy as np
 
 from .boundary import is_held
-from .closed_forms import catenary, catenary_axes
+from .catenary import catenary, catenary_axes
 from .errors import RodInputError
 from .scene import REFERENCE_FRAME
 
@@ -26,7 +26,7 @@ def straight(S):
 
 
 def catenary_start(scene, t):
-    """The inextensible catenary (closed_forms.catenary) of the scene at load factor t:
+    """The inextensible catenary (catenary.catenary) of the scene at load factor t:
     through both held ends, under the uniform load, with the tension as its force. The
     frame keeps d1 normal to the plane of the catenary (e_v x e_h, which is e_y for a
     cable in the x-z plane, as in the reference frame), d2 = d3 x d1.

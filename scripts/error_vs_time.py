@@ -83,13 +83,13 @@ def scene_definitions():
 
 class CantileverReference:
     def __init__(self):
-        from petsc_rod import reference
+        from petsc_rod.validation import reference
         bvp = reference.solve_cantilever_bvp(1.0, 1.0, 3.0, tol=1e-10)
         self.energy = reference.energy(bvp) + 3.0 * bvp.r[-1, 1]     # - F.r(L)
         self.u3 = 0.0
 
     def fields(self, S):
-        from petsc_rod.closed_forms import cantilever_shape
+        from petsc_rod.validation.closed_forms import cantilever_shape
         theta, x, y = cantilever_shape(1.0, 1.0, 3.0, S)
         zero = 0 * S
         r = np.stack([x, y, zero], axis=1)
@@ -114,7 +114,7 @@ class PaperReference:
     """The out-of-plane branch at X_F = 16 and its mirror image (z -> -z)."""
 
     def __init__(self):
-        from petsc_rod import reference
+        from petsc_rod.validation import reference
         guess = reference.shooting_guess(20.0, (235.0, 360.0, 200.0), (-11.6, -4.03, 2.30),
                                          (9.21, -36.8, -18.0))
         self.bvp = reference.solve_paper_scene(16.0, guess, tol=1e-10)

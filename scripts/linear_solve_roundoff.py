@@ -9,7 +9,7 @@ prints two relative errors:
 * r solve: the centreline solve of the run (the P2 slope matrix int 2 a3 theta'.g' +
   R theta.g, the constraint int theta = r(L) - r(0) when both ends are held, and the
   integration of theta into r) for a right-hand side whose exact discrete solution is a
-  known cubic centreline (petsc_rod.roundoff): max |r - r*| / max |r*|;
+  known cubic centreline (petsc_rod.validation.roundoff): max |r - r*| / max |r*|;
 * d1 solve: the d1 matrix (P2, int 2 a1 d'.g' + R d.g) times a known smooth vector x,
   solved again with the run's KSP: max |x_solved - x| / max |x|.
 
@@ -27,7 +27,7 @@ petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
 from petsc_rod.mesh import Mesh  # noqa: E402
-from petsc_rod.roundoff import centreline_solve_error  # noqa: E402
+from petsc_rod.validation.roundoff import centreline_solve_error  # noqa: E402
 from petsc_rod.scene import Scene  # noqa: E402
 from petsc_rod.solver import Settings, UzawaSolver  # noqa: E402
 

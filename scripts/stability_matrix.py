@@ -46,8 +46,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from petsc_rod import closed_forms  # noqa: E402
-from petsc_rod.link import gauss_writhe  # noqa: E402
+from petsc_rod.validation import closed_forms  # noqa: E402
+from petsc_rod.validation.writhe import gauss_writhe  # noqa: E402
 
 TIMEOUT = 1800.0          # s per case; beyond it the case is "failed (timeout)"
 COLUMNS = ("group", "case", "ranks", "elements", "outcome", "reason", "iterations",
@@ -165,8 +165,8 @@ def transported_twist(d1, d3):
 def check_link(turns, bound):
     """Calugareanu-White: Tw + Wr, with Tw from the file's vertex frames
     (transported_twist) and Wr the Gauss double integral of its centreline, the cubic
-    through its vertices (link.gauss_writhe): both independent of the solver's own
-    Tw + Wr (Gauss points, Fuller's formula). Against the end roll in turns."""
+    through its vertices (validation.writhe.gauss_writhe): both independent of the
+    solver's own Tw + Wr (Gauss points, Fuller's formula). Against the end roll in turns."""
     def check(result):
         twist = transported_twist(result["d1"], result["d3"])
         writhe = gauss_writhe(hermite_points(result["S"], result["r"], result["d3"]),
@@ -213,9 +213,9 @@ PAPER = {"length": 20, "stiffness": "235,360,200", "start": "clamp", "end": "pin
 
 
 def check_paper_reference(bound, stiffness):
-    """Against petsc_rod.reference (collocation, solve_bvp) started from the result."""
+    """Against petsc_rod.validation.reference (collocation, solve_bvp) started from the result."""
     def check(result):
-        from petsc_rod import reference
+        from petsc_rod.validation import reference
         guess = reference.initial_guess_from_result(result["path"])
         S, r, frames, n, m = (guess[k] for k in ("S", "r", "frames", "n", "m"))
         bvp = reference.solve_rod_bvp(20.0, stiffness, r[-1], S, r, frames, n, m, tol=1e-10)

@@ -6,7 +6,7 @@
   unknowns, so vertex positions and slopes, r, r', r'' at the Gauss points, the reaction
   at S = L and the energy agree to round-off, for every kind of end, a graded mesh and a
   piecewise load broken inside elements.
-* The round-off of one centreline solve at N = 3200 (petsc_rod.roundoff) stays below
+* The round-off of one centreline solve at N = 3200 (petsc_rod.validation.roundoff) stays below
   1e-10; the Hermite r solve gave 5.7e-5 there (scripts/linear_solve_roundoff.py).
 
 Serial and under mpiexec -n 2 (fields gathered, the prefix sum crosses ranks).
@@ -20,7 +20,7 @@ from helpers import gather
 from petsc_rod.fe import GAUSS_POINTS, GAUSS_WEIGHTS
 from petsc_rod.kernels import rotation_about, split_coefficients, strains
 from petsc_rod.mesh import Mesh
-from petsc_rod.roundoff import MULTIPLIER, centreline_solve_error
+from petsc_rod.validation.roundoff import MULTIPLIER, centreline_solve_error
 from petsc_rod.scene import REFERENCE_FRAME, Scene
 from petsc_rod.solver import Settings, UzawaSolver
 

@@ -1,4 +1,4 @@
-"""Tests of petsc_rod.closed_forms against independent numerical solutions.
+"""Tests of petsc_rod.validation.closed_forms against independent numerical solutions.
 
 The cantilever elastica (length L, bending stiffness EI, dead tip force
 (0, -P, 0), clamped at s = 0) satisfies, with theta the tangent angle below
@@ -17,7 +17,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from petsc_rod.closed_forms import cantilever_shape, cantilever_tip, twisted_rod
+from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip, twisted_rod
 
 LENGTH = 2.0
 BENDING_STIFFNESS = 3.0

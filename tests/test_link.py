@@ -17,7 +17,8 @@ from helpers import continuation as reach_load, gather
 from petsc_rod.continuation import continuation
 from petsc_rod.errors import RodNotConvergedError
 from petsc_rod.kernels import rotation_about
-from petsc_rod.link import LINK_TOLERANCE, changed_class, gauss_writhe, link_integrands
+from petsc_rod.link import LINK_TOLERANCE, changed_class, link_integrands
+from petsc_rod.validation.writhe import gauss_writhe
 from petsc_rod.scene import REFERENCE_FRAME, Scene
 
 AXIS = np.array([1.0, 0.0, 0.0])

@@ -4,7 +4,7 @@ import numpy as np
 
 from helpers import gather
 from petsc_rod.assembly import load_ghosted
-from petsc_rod.closed_forms import cantilever_tip
+from petsc_rod.validation.closed_forms import cantilever_tip
 from petsc_rod.fields import VectorField
 from petsc_rod.mesh import Mesh, graded_coordinates
 from petsc_rod.outputs import vertex_fields

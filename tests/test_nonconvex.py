@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from helpers import continuation, gather
-from petsc_rod.closed_forms import cantilever_tip
+from petsc_rod.validation.closed_forms import cantilever_tip
 from petsc_rod.fe import p2_element_matrices
 from petsc_rod.kernels import split_coefficients
 from petsc_rod.outputs import vertex_fields

@@ -1,4 +1,5 @@
-"""The collocation reference (petsc_rod/reference.py): numpy/scipy only, no PETSc, no MPI.
+"""The collocation reference (petsc_rod/validation/reference.py): numpy/scipy only, no
+PETSc, no MPI.
 
 Under ``mpiexec -n 2`` every rank runs the same serial computations (nothing here is
 collective). The paper scene's twisted branch is started from a shooting guess built from
@@ -12,8 +13,8 @@ import tempfile
 import numpy as np
 import pytest
 
-from petsc_rod import reference as ref
-from petsc_rod.closed_forms import cantilever_shape, cantilever_tip
+from petsc_rod.validation import reference as ref
+from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
 
 PAPER_STIFFNESS = (235.0, 360.0, 200.0)
 PAPER_LENGTH = 20.0

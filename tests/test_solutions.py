@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from helpers import continuation as solve, gather
-from petsc_rod.closed_forms import cantilever_shape, cantilever_tip
+from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
 from petsc_rod.outputs import vertex_fields
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from helpers import continuation, gather
-from petsc_rod.closed_forms import cantilever_tip, catenary
+from petsc_rod.validation.closed_forms import cantilever_tip, catenary
 from petsc_rod.errors import RodInputError
 from petsc_rod.scene import Scene
 from petsc_rod.solver import (ADAPT_WINDOW, STALL_MARGIN, STALL_WINDOW, default_penalty,

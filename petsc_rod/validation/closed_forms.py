@@ -113,7 +113,9 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import elliprd, elliprf, ellipj, expit
 
-__all__ = ["cantilever_tip", "cantilever_shape", "twisted_rod"]
+from ..catenary import catenary, catenary_axes  # noqa: F401  (the runtime's, re-exported)
+
+__all__ = ["cantilever_tip", "cantilever_shape", "twisted_rod", "catenary", "catenary_axes"]
 
 _EPS = np.finfo(float).eps
 _SMALLEST_RESOLVED_SINE = 1e-290
@@ -346,60 +348,3 @@ def twisted_rod(length, torsion_stiffness, angle):
     _require_positive("torsion_stiffness", torsion_stiffness)
     twist = float(angle) / float(length)
     return {"u3": twist, "torque": float(torsion_stiffness) * twist}
-
-
-def catenary_axes(length, chord, load):
-    """The unit vectors (e_v, e_h) of a catenary's plane: up (against the load) and along
-    the horizontal part of the chord. ValueError when there is no catenary: a length or
-    load that is not positive, a chord not shorter than the cable, or a chord along the
-    load."""
-    _require_positive("length", length)
-    chord, load = np.asarray(chord, dtype=float), np.asarray(load, dtype=float)
-    weight = np.linalg.norm(load)
-    _require_positive("load", weight)
-    up = -load / weight
-    horizontal = chord - (chord @ up) * up
-    span = np.linalg.norm(horizontal)
-    if not (np.linalg.norm(chord) < length and span > 1e-9 * length):
-        raise ValueError("catenary: the chord must be shorter than the cable and not "
-                         "parallel to the load")
-    return up, horizontal / span
-
-
-def catenary(length, chord, load, s):
-    r"""The inextensible catenary through two held ends under a uniform dead load.
-
-    A perfectly flexible cable of length ``L`` hangs from ``r(0) = 0`` to
-    ``r(L) = chord`` under the load ``f`` per unit length (vector, N/m).  With
-    ``w = |f|``, ``e_v = -f / w`` (up), the rise ``v = chord . e_v``, the span
-    ``s_h = |chord - v e_v|`` along ``e_h``, and ``x`` the horizontal coordinate from
-    the lowest point (the vertex) of ``z = a cosh(x / a)``:
-
-        L^2 - v^2 = (2 a sinh(s_h / 2a))^2      (the parameter a = H / w),
-        v / L = tanh(x_c / a)                   (x_c: the mid-span abscissa),
-        S(x) = a (sinh(x / a) - sinh(x_0 / a)),  x_0 = x_c - s_h / 2,
-
-    so that ``x(S) = a asinh(S / a + sinh(x_0 / a))`` and
-
-        r(S) = (x - x_0) e_h + a (cosh(x / a) - cosh(x_0 / a)) e_v,
-        r'(S) = (e_h + sinh(x / a) e_v) / cosh(x / a),
-        n(S) = H (e_h + sinh(x / a) e_v)        (n' + f = 0, tension H cosh(x / a)).
-
-    ``n`` is the force the part beyond S exerts on the part before it (docs/method.md §6).
-    Returns ``(r, tangent, force)`` at the arc lengths ``s``, each ``s.shape + (3,)``.
-    """
-    up, along = catenary_axes(length, chord, load)
-    chord = np.asarray(chord, dtype=float)
-    weight = np.linalg.norm(load)
-    rise, span = float(chord @ up), float(chord @ along)
-    target = np.sqrt(length**2 - rise**2) / span     # 2a sinh(span/2a) / span, > 1
-    # q = span / 2a solves sinh(q) / q = target; sinh(q)/q is increasing on q > 0.
-    q = brentq(lambda q: np.sinh(q) / q - target, 1e-12, np.arcsinh(target) + 50.0,
-               xtol=1e-15, rtol=4 * np.finfo(float).eps)
-    a = span / (2 * q)
-    x0 = a * np.arctanh(rise / length) - span / 2
-    x = a * np.arcsinh(np.asarray(s, dtype=float) / a + np.sinh(x0 / a))
-    sh, ch = np.sinh(x / a)[..., None], np.cosh(x / a)[..., None]
-    r = (x - x0)[..., None] * along + a * (ch - np.cosh(x0 / a)) * up
-    direction = along + sh * up
-    return r, direction / ch, weight * a * direction
