@@ -37,12 +37,21 @@ def assemble_matrix(mesh, element_matrices):
     return matrix
 
 
+# The global step on several ranks, unless the options say otherwise: CG preconditioned
+# by block Jacobi with an exact Cholesky factorisation of each rank's block. The
+# matrices are second-order P2 chains, so a few CG iterations reach round-off; it beats
+# MUMPS, whose solve phase is slow on such chains (docs/performance.md).
+PARALLEL_DEFAULTS = {"ksp_type": "cg", "pc_type": "bjacobi", "sub_pc_type": "cholesky",
+                     "ksp_rtol": "1e-14", "ksp_atol": "1e-300"}
+
+
 class ScalarProblem:
     """One scalar SPD operator of the global step with its KSP.
 
     ``element_matrices`` (ne, 3, 3) are summed into the DMDA matrix; ``prescribed`` is a
     list of (vertex, slot, value) whose rows are constrained. KSP options are read with
-    ``prefix``; the default is a direct Cholesky factorisation (MUMPS on several ranks).
+    ``prefix``; the default is a direct Cholesky factorisation on one rank and
+    PARALLEL_DEFAULTS on several.
     """
 
     def __init__(self, mesh, element_matrices, prescribed, prefix):
@@ -69,10 +78,16 @@ class ScalarProblem:
         self.ksp.setType(PETSc.KSP.Type.PREONLY)
         pc = self.ksp.getPC()
         pc.setType(PETSc.PC.Type.CHOLESKY)
-        if mesh.comm.getSize() > 1:
-            pc.setFactorSolverType("mumps")
         self.ksp.setOptionsPrefix(prefix)
+        database = PETSc.Options()
+        defaults = {f"{prefix}{key}": value for key, value in (
+            PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}).items()
+            if not database.hasName(f"{prefix}{key}")}
+        for name, value in defaults.items():
+            database.setValue(name, value)
         self.ksp.setFromOptions()
+        for name in defaults:
+            database.delValue(name)
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY

@@ -24,8 +24,11 @@ PENALTY = 100.0
 TOLERANCES = {"nrichardson": (1e-7, 1e-4), "anderson": (1e-11, 1e-11)}
 MAX_IT = 3000
 STEPS = (0.5, 1.0)
-# agreement of the fields (relative for lambda) for each iteration
+# agreement of the fields for each iteration, and of lambda relative to its size: the
+# multipliers carry R times the constraint gap, and on several ranks the global step is
+# CG to 1e-14 (assembly.PARALLEL_DEFAULTS) rather than a factorisation
 FIELD_TOL = {"nrichardson": 1e-10, "anderson": 1e-9}
+MULTIPLIER_TOL = {"nrichardson": 1e-10, "anderson": 1e-8}
 
 
 def solve_on(comm, kind):
@@ -102,7 +105,7 @@ def test_uzawa_state_agrees(both):
     assert np.abs(serial["tau"] - parallel["tau"]).max() < FIELD_TOL[kind]
     scale = np.abs(serial["lam"]).max()
     assert scale > 1.0
-    assert np.abs(serial["lam"] - parallel["lam"]).max() < FIELD_TOL[kind] * scale
+    assert np.abs(serial["lam"] - parallel["lam"]).max() < MULTIPLIER_TOL[kind] * scale
 
 
 def test_energy_agrees(both):
