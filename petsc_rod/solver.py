@@ -95,11 +95,6 @@ STALL_CHECK_EVERY = STALL_WINDOW // 10
 
 RAISE_PENALTY = "raise_penalty"     # the step goes on with a larger R (raise_penalty)
 CONVERGED = (True, "")
-LEAVE_SADDLE = "leave_saddle"   # a test on the way found a saddle: turn the frames now
-# On the way to the tolerances, the state is tested once both the change and the
-# residual are below EARLY_CHECK: a step heading for a saddle leaves it at once instead
-# of converging to it first (a test that finds a minimiser does not stop the SNES).
-EARLY_CHECK = 1e-3
 STOP_SADDLE = "saddle"      # converged, to a saddle, MAX_ESCAPES times
 # A step that converged to a saddle goes on from its frames turned along the direction
 # of negative curvature, the largest node turned by ESCAPE_ANGLE rad, the angle times
@@ -126,8 +121,6 @@ class StepProgress:
     error: Exception = None
     stable: bool = None         # a local minimiser (stability.py); None: not checked
     escapes: int = 0            # saddles left on the way
-    early_checked: bool = False     # the state was tested on the way (EARLY_CHECK)
-    direction: object = None        # the negative curvature an early test found
 
     @property
     def finished(self):
@@ -513,9 +506,7 @@ class UzawaSolver:
         stopping tests hold: change <= rtol and RMS constraint residual <= ctol; then,
         with check_stability, the state is tested (§10) and a saddle is left along its
         negative curvature, up to MAX_ESCAPES times (the report says stable, or the step
-        ends not converged with STOP_SADDLE); it is also tested once on the way, at
-        EARLY_CHECK, so that a saddle is left before the iteration converges to it. A
-        step whose change and residual are within STALL_FACTOR of their
+        ends not converged with STOP_SADDLE). A step whose change and residual are within STALL_FACTOR of their
         tolerances but, at their rate, would not meet them within max_it stops early as
         stalled (stalled_projection). A penalty far below the problem's scale whose
         residual hardly falls is raised on the way (penalty_too_low, raise_penalty; the
@@ -530,11 +521,8 @@ class UzawaSolver:
         step = self._step = StepProgress(label, observer)
         try:
             self._iterate(step)
-            while step.outcome in (CONVERGED, LEAVE_SADDLE) and self.settings.check_stability:
-                if step.outcome == LEAVE_SADDLE:
-                    step.stable, direction = False, step.direction
-                else:
-                    step.stable, direction = self.check_stability()
+            while step.outcome == CONVERGED and self.settings.check_stability:
+                step.stable, direction = self.check_stability()
                 if step.stable is not False:
                     break
                 if step.escapes == MAX_ESCAPES:
@@ -545,8 +533,7 @@ class UzawaSolver:
                 self.turn_frames(angle * direction / self.mesh.global_max(
                     float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
                 step.escapes += 1
-                step.outcome = step.stable = step.direction = None
-                step.early_checked = False
+                step.outcome = step.stable = None
                 self._iterate(step)
         finally:
             self._step = None
@@ -634,12 +621,6 @@ class UzawaSolver:
             return (False, STOP_OBSERVER)
         if change <= settings.rtol and residual <= settings.ctol:
             return CONVERGED
-        if (settings.check_stability and not step.early_checked
-                and change <= EARLY_CHECK and residual <= EARLY_CHECK):
-            step.early_checked = True
-            stable, step.direction = self.check_stability()
-            if stable is False:
-                return LEAVE_SADDLE
         if iteration >= settings.max_it:
             return (False, STOP_MAX_IT)
         if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
