@@ -14,6 +14,7 @@ from petsc4py import PETSc
 from .errors import RodDivergedError
 from .fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
 from .fields import scatter_element_vectors
+from .options import set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
                for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
@@ -79,15 +80,9 @@ class ScalarProblem:
         pc = self.ksp.getPC()
         pc.setType(PETSc.PC.Type.CHOLESKY)
         self.ksp.setOptionsPrefix(prefix)
-        database = PETSc.Options()
-        defaults = {f"{prefix}{key}": value for key, value in (
-            PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}).items()
-            if not database.hasName(f"{prefix}{key}")}
-        for name, value in defaults.items():
-            database.setValue(name, value)
-        self.ksp.setFromOptions()
-        for name in defaults:
-            database.delValue(name)
+        parallel = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}
+        set_from_options_with_defaults(
+            self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY

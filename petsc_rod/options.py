@@ -172,6 +172,22 @@ OPTIONS = [
 BY_NAME = {option.name: option for option in OPTIONS}
 
 
+def set_from_options_with_defaults(obj, defaults):
+    """``obj.setFromOptions()`` with ``defaults`` ({option name: value}) in effect for
+    the options the user did not give: the default of a PETSc object's option that only
+    the options database can set (a sub-PC type, a line search) without making it a
+    user's option afterwards."""
+    database = PETSc.Options()
+    added = [name for name in defaults if not database.hasName(name)]
+    for name in added:
+        database.setValue(name, defaults[name])
+    try:
+        obj.setFromOptions()
+    finally:
+        for name in added:
+            database.delValue(name)
+
+
 def read_options():
     """Parse every ``-rod_*`` option; returns (values by name, set of names the user gave).
 

@@ -26,6 +26,7 @@ from .fields import VectorField, at_points, element_dofs
 from .kernels import (nearest_rotation, rotations, split_coefficients, strains,
                       update_multipliers)
 from .link import FULLER_MARGIN, link_integrands
+from .options import set_from_options_with_defaults
 from .resources import anderson_depth, ranks_on_this_machine
 from .stability import SecondVariation
 
@@ -317,9 +318,8 @@ class UzawaSolver:
         # the step's own tests end it (_outcome): SNES's counts must not come first
         snes.setTolerances(max_it=2**30)
         snes.setMaxFunctionEvaluations(2**30)
-        database = PETSc.Options()
         defaults = {}
-        kind = database.getString("rod_snes_type", DEFAULT_SNES)
+        kind = PETSc.Options().getString("rod_snes_type", DEFAULT_SNES)
         if kind == PETSc.SNES.Type.NRICHARDSON:
             # nrichardson's default line search (secant) is not the plain iteration
             defaults["rod_snes_linesearch_type"] = "basic"
@@ -327,12 +327,7 @@ class UzawaSolver:
             here = ranks_on_this_machine(self.mesh.comm)
             defaults["rod_snes_anderson_m"] = str(int(self.mesh.global_min(
                 anderson_depth(self.mesh.n_local_elements, here))))
-        defaults = {k: v for k, v in defaults.items() if not database.hasName(k)}
-        for name, value in defaults.items():
-            database.setValue(name, value)
-        snes.setFromOptions()
-        for name in defaults:
-            database.delValue(name)
+        set_from_options_with_defaults(snes, defaults)
 
     def _set_prescribed(self):
         """The end states' frame rows as the prescribed values of the three problems."""
