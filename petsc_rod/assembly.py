@@ -14,6 +14,7 @@ from petsc4py import PETSc
 from .errors import RodDivergedError
 from .fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
 from .fields import scatter_element_vectors
+from . import substructuring
 from .options import set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
@@ -38,12 +39,14 @@ def assemble_matrix(mesh, element_matrices):
     return matrix
 
 
-# The global step on several ranks, unless the options say otherwise: CG preconditioned
-# by block Jacobi with an exact Cholesky factorisation of each rank's block. The
-# matrices are second-order P2 chains, so a few CG iterations reach round-off; it beats
-# MUMPS, whose solve phase is slow on such chains (docs/performance.md).
-PARALLEL_DEFAULTS = {"ksp_type": "cg", "pc_type": "bjacobi", "sub_pc_type": "cholesky",
-                     "ksp_rtol": "1e-14", "ksp_atol": "1e-300"}
+# The global step on several ranks, unless the options say otherwise: the exact
+# substructuring solve of substructuring.py as a python PC (each rank a local Cholesky
+# solve of its half of the chain, and a tridiagonal interface system of one unknown per
+# rank boundary). It does the serial Cholesky's work divided by the ranks; CG with block
+# Jacobi (a few iterations, each a product, a local solve and reductions) and MUMPS (a
+# slow solve phase on chains) are slower (docs/performance.md).
+PARALLEL_DEFAULTS = {"ksp_type": "preonly", "pc_type": "python",
+                     "pc_python_type": substructuring.PYTHON_TYPE}
 
 
 class ScalarProblem:
@@ -85,10 +88,32 @@ class ScalarProblem:
             self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
         self.ksp.setUp()
         self._report_failed_factorisation()
-        self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY
-                        and pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU)
-                        else None)
+        self._factor, self._columns = self._direct_solver()
         self._border = []            # c and w = A^-1 c of the integral constraint, if any
+
+    def _direct_solver(self):
+        """How solve() reaches an exact solver past KSPSolve: (factor, None) for a
+        factorisation with a multiple right-hand-side solve of its own (MatMatSolve:
+        MUMPS, ...); (None, solve) with solve(b, x) on lists of component Vecs for PETSc's
+        own factorisation (column by column, as its MatMatSolve would, without copying
+        into a dense block) and for the substructuring PC (its three right-hand sides
+        share one interface reduction); (None, None) for any other KSP (one KSPSolve per
+        component)."""
+        pc = self.ksp.getPC()
+        if self.ksp.getType() != PETSc.KSP.Type.PREONLY:
+            return None, None
+        if pc.getType() == PETSc.PC.Type.PYTHON:
+            context = pc.getPythonContext()
+            if isinstance(context, substructuring.InterfacePC):
+                return None, lambda b, x: context.solver.solve(
+                    [v.getArray(readonly=True) for v in b], [v.getArray() for v in x])
+            return None, None
+        if pc.getType() not in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU):
+            return None, None
+        factor = pc.getFactorMatrix()
+        if pc.getFactorSolverType() != PETSc.Mat.SolverType.PETSC:
+            return factor, None
+        return None, lambda b, x: [factor.solve(*pair) for pair in zip(b, x)]
 
     def add_integral_constraint(self, element_integrals):
         """Border A with the row c, c_k = int phi_k dS, for the constraint c.x = target
@@ -115,7 +140,8 @@ class ScalarProblem:
         self._c_dot_w = c.dot(w)
 
     def set_prescribed(self, prescribed):
-        """New prescribed values (same rows); computes the lifting A_full x_bc once."""
+        """New prescribed values (same rows); computes the lifting A_full x_bc once, kept
+        sparse: it is nonzero only on the rows coupled to a prescribed one."""
         self._fixed_values = np.array([value for _, _, value in prescribed]).reshape(-1, 3)[
             self._owned]
         for c, lift in enumerate(self._lift):
@@ -123,30 +149,40 @@ class ScalarProblem:
             self._work.getArray()[self._local_rows] = self._fixed_values[:, c]
             self.full.mult(self._work, lift)
             lift.getArray()[self._local_rows] = 0.0
+        lifts = np.stack([lift.getArray(readonly=True) for lift in self._lift], axis=1)
+        self._lift_rows = np.flatnonzero(np.any(lifts != 0.0, axis=1))
+        self._lift_values = lifts[self._lift_rows]
 
     def solve(self, rhs, solution):
-        """Solve for the three components: rhs, solution are VectorFields.
+        """Solve for the three components: rhs, solution are VectorFields. ``rhs`` is
+        overwritten: its prescribed rows take the prescribed values, and the lifting is
+        subtracted from the rows next to them.
 
-        With a direct solver (preonly + Cholesky or LU) the three right-hand sides go to
-        the factorisation together (MatMatSolve): MUMPS then makes one pass instead of
-        three, half the solve time on 2 ranks (README, "Performance"). Any other KSP solves
-        them one by one.
+        A direct solver is called past KSPSolve (_direct_solver): PETSc's factorisation
+        and the substructuring PC column by column on the Vecs, a factorisation with a
+        multiple right-hand-side solve (MUMPS) with the three right-hand sides together
+        (MatMatSolve: one pass instead of three, half the solve time on 2 ranks). Any
+        other KSP solves them one by one.
         """
-        block = self._rhs_block.getDenseArray()
-        for c in range(3):
-            block[:, c] = rhs.components[c].getArray(readonly=True)
-            block[:, c] -= self._lift[c].getArray(readonly=True)
-            block[self._local_rows, c] = self._fixed_values[:, c]
-        self._rhs_block.assemble()
+        for c, vec in enumerate(rhs.components):
+            values = vec.getArray()
+            values[self._lift_rows] -= self._lift_values[:, c]
+            values[self._local_rows] = self._fixed_values[:, c]
+        if self._columns is not None:
+            self._columns(rhs.components, solution.components)
+            return
         if self._factor is not None:
+            block = self._rhs_block.getDenseArray()
+            for c, vec in enumerate(rhs.components):
+                block[:, c] = vec.getArray(readonly=True)
+            self._rhs_block.assemble()
             self._factor.matSolve(self._rhs_block, self._solution_block)
             result = self._solution_block.getDenseArray()
             for c in range(3):
                 solution.components[c].getArray()[:] = result[:, c]
             return
-        for c in range(3):
-            self._work.getArray()[:] = block[:, c]
-            self._solve_one(self._work, solution.components[c])
+        for vec, x in zip(rhs.components, solution.components):
+            self._solve_one(vec, x)
 
     def solve_constrained(self, rhs, solution, target):
         """Solve the bordered system of add_integral_constraint for the three components.
