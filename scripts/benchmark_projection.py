@@ -27,8 +27,8 @@ import time
 
 import numpy as np
 
-from petsc_rod import kernels
-from petsc_rod.kernels import nearest_rotation, nearest_rotation_svd
+from petsc_rod.local_step import projection as kernels
+from petsc_rod.local_step.projection import nearest_rotation, nearest_rotation_svd
 
 PENALTY = 400.0
 CLASSES = ("near", "far", "singular", "reflected")

@@ -136,7 +136,7 @@ REFERENCES = {"cantilever": CantileverReference, "twist": TwistReference,
 
 def snapshot(solver):
     """What the errors need, on this rank's vertices: S, r, d1, d2; u3(0); energy."""
-    from petsc_rod.outputs import vertex_strains
+    from petsc_rod.io.outputs import vertex_strains
     mesh = solver.mesh
     u = vertex_strains(solver)                 # collective (ghost update): every rank
     u3 = u[0, 2] if mesh.on_lower_boundary else 0.0
@@ -164,9 +164,9 @@ def distance(mesh, state, final):
 
 def run_one(comm, name, n_elements, penalty, reference):
     """One mesh and penalty: a row for each tolerance pair the last step reached."""
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import Settings, UzawaSolver
 
     kwargs, steps, imperfection = scene_definitions()[name]
     scene = Scene(**kwargs)

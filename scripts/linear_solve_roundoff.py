@@ -26,10 +26,10 @@ import petsc4py
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
-from petsc_rod.mesh import Mesh  # noqa: E402
+from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.validation.roundoff import centreline_solve_error  # noqa: E402
-from petsc_rod.scene import Scene  # noqa: E402
-from petsc_rod.solver import Settings, UzawaSolver  # noqa: E402
+from petsc_rod.scenes.scene import Scene  # noqa: E402
+from petsc_rod.iteration.driver import Settings, UzawaSolver  # noqa: E402
 
 SCENES = {
     "cantilever": dict(length=1.0, stiffness=[1.0, 1.0, 1.0], start="clamp", end="free",

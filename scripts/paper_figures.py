@@ -67,10 +67,10 @@ def gather(comm, owned):
 
 def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
     """One continuation from X_F = 20 to ``end_x``: (step rows, profiles by X_F)."""
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.outputs import set_state, vertex_fields
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.io.outputs import set_state, vertex_fields
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import Settings, UzawaSolver
 
     from petsc4py import PETSc
 
@@ -138,7 +138,7 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
 
 def saved_state(solver, t):
     """Copies of this rank's state, for outputs.set_state."""
-    from petsc_rod.outputs import restart_state, vertex_fields
+    from petsc_rod.io.outputs import restart_state, vertex_fields
     return ({key: np.copy(value) for key, value in vertex_fields(solver, t).items()},
             {key: np.copy(value) for key, value in restart_state(solver).items()})
 

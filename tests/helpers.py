@@ -12,9 +12,9 @@ def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
     The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
     ``solver_factory`` fixture which does it.
     """
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import Settings, UzawaSolver
 
     scene = Scene(**scene_kwargs)
     mesh = Mesh(comm, n_elements, scene.length)

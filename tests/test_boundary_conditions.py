@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from helpers import gather, global_max
-from petsc_rod import outputs
-from petsc_rod.kernels import rotation_about
-from petsc_rod.scene import REFERENCE_FRAME
+from petsc_rod.io import outputs
+from petsc_rod.local_step.projection import rotation_about
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 ROUND_OFF = 1e-12
 LENGTH = 1.0

@@ -17,12 +17,12 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather
-from petsc_rod.fe import GAUSS_POINTS, GAUSS_WEIGHTS
-from petsc_rod.kernels import rotation_about, split_coefficients, strains
-from petsc_rod.mesh import Mesh
+from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS
+from petsc_rod.local_step.projection import rotation_about, split_coefficients, strains
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.validation.roundoff import MULTIPLIER, centreline_solve_error
-from petsc_rod.scene import REFERENCE_FRAME, Scene
-from petsc_rod.solver import Settings, UzawaSolver
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+from petsc_rod.iteration.driver import Settings, UzawaSolver
 
 LENGTH = 1.3
 STIFFNESS = (1.0, 1.5, 0.8)

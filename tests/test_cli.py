@@ -18,7 +18,7 @@ import pytest
 
 import petsc_rod
 from helpers import child_env
-from petsc_rod.options import OPTIONS
+from petsc_rod.cli.options import OPTIONS
 
 pytestmark = pytest.mark.serial
 

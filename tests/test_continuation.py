@@ -29,7 +29,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import child_env, gather
-from petsc_rod.continuation import LoadPath, continuation
+from petsc_rod.iteration.continuation import LoadPath, continuation
 from petsc_rod.errors import RodDivergedError, RodNotConvergedError
 
 N_ELEMENTS = 16

@@ -12,11 +12,12 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_rod import io, outputs
-from petsc_rod.cli import MIN_RELATIVE_ELEMENT, check_mesh
-from petsc_rod.continuation import LoadPath, record_step
+from petsc_rod.io import outputs
+from petsc_rod.io import results as io
+from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
+from petsc_rod.iteration.continuation import LoadPath, record_step
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
-from petsc_rod.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
+from petsc_rod.cli.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
 from petsc_rod.resources import BYTES_PER_ELEMENT, MAX_ELEMENTS, check_elements_fit
 

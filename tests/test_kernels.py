@@ -12,8 +12,8 @@ import pytest
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
-from petsc_rod import kernels
-from petsc_rod.kernels import (nearest_rotation, nearest_rotation_eigen, nearest_rotation_svd,
+from petsc_rod.local_step import projection as kernels
+from petsc_rod.local_step.projection import (nearest_rotation, nearest_rotation_eigen, nearest_rotation_svd,
                                polar_newton, rotation_about, rotation_log, shifted,
                                split_coefficients, strains, update_multipliers)
 

@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 
 from helpers import continuation as reach_load, gather
-from petsc_rod.continuation import continuation
+from petsc_rod.iteration.continuation import continuation
 from petsc_rod.errors import RodNotConvergedError
-from petsc_rod.kernels import rotation_about
-from petsc_rod.link import LINK_TOLERANCE, changed_class, link_integrands
+from petsc_rod.local_step.projection import rotation_about
+from petsc_rod.analysis.link import LINK_TOLERANCE, changed_class, link_integrands
 from petsc_rod.validation.writhe import gauss_writhe
-from petsc_rod.scene import REFERENCE_FRAME, Scene
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
 
 AXIS = np.array([1.0, 0.0, 0.0])
 

@@ -11,10 +11,10 @@ import pytest
 
 from helpers import continuation, gather
 from petsc_rod.validation.closed_forms import cantilever_tip
-from petsc_rod.fe import p2_element_matrices
-from petsc_rod.kernels import split_coefficients
-from petsc_rod.outputs import vertex_fields
-from petsc_rod.solver import matrix_split
+from petsc_rod.mesh.elements import p2_element_matrices
+from petsc_rod.local_step.projection import split_coefficients
+from petsc_rod.io.outputs import vertex_fields
+from petsc_rod.iteration.driver import matrix_split
 
 
 def assembled(element_matrices):

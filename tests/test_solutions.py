@@ -10,7 +10,7 @@ import pytest
 
 from helpers import continuation as solve, gather
 from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
-from petsc_rod.outputs import vertex_fields
+from petsc_rod.io.outputs import vertex_fields
 
 
 def fitted_order(n_elements, errors):
@@ -118,7 +118,7 @@ def paper_branches():
     Returns {name: (converged, u3(0), energy, negative directions of the final state)}."""
     from petsc4py import PETSc
     from helpers import make_solver
-    from petsc_rod.stability import SecondVariation
+    from petsc_rod.analysis.stability import SecondVariation
     results = {}
 
     def record(name, solver, report):

@@ -9,10 +9,10 @@ import pytest
 from helpers import continuation, gather
 from petsc_rod.validation.closed_forms import cantilever_tip, catenary
 from petsc_rod.errors import RodInputError
-from petsc_rod.scene import Scene
-from petsc_rod.solver import (ADAPT_WINDOW, STALL_MARGIN, STALL_WINDOW, default_penalty,
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.iteration.driver import (ADAPT_WINDOW, STALL_MARGIN, STALL_WINDOW, default_penalty,
                               penalty_too_low, stalled_projection)
-from petsc_rod.starts import catenary_start
+from petsc_rod.scenes.starts import catenary_start
 
 LENGTH, CHORD, LOAD = 3000.0, np.array([2500.0, 0.0, 400.0]), np.array([0.0, 0.0, -1000.0])
 

@@ -11,9 +11,9 @@ scripts/linear_solve_roundoff.py and tests/test_centreline.py.
 
 import numpy as np
 
-from ..boundary import is_held
-from ..fe import P2, element_integrals, p2_basis, p2_integrals
-from ..fields import scatter_element_vectors
+from petsc_rod.scenes.boundary import is_held
+from petsc_rod.mesh.elements import P2, element_integrals, p2_basis, p2_integrals
+from petsc_rod.mesh.fields import scatter_element_vectors
 
 # Slopes at S = 0, S = L and at the middle where no condition fixes them.
 FREE_SLOPES = np.array([[1.0, 0.3, -0.2], [0.5, -0.4, 0.6], [0.2, 0.9, 0.3]])

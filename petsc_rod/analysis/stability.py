@@ -25,8 +25,8 @@ accelerated one may converge to it, hence this check.
 import numpy as np
 from petsc4py import PETSc
 
-from .fe import P2, p2_element_matrices
-from .fields import element_dofs
+from petsc_rod.mesh.elements import P2, p2_element_matrices
+from petsc_rod.mesh.fields import element_dofs
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.

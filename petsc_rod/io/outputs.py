@@ -8,8 +8,8 @@ either side (u is discontinuous across elements for P2 directors).
 
 import numpy as np
 
-from .fe import p2_basis, p2_integrals
-from .kernels import strains
+from petsc_rod.mesh.elements import p2_basis, p2_integrals
+from petsc_rod.local_step.projection import strains
 
 
 def vertex_strains(solver):

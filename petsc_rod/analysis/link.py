@@ -21,7 +21,7 @@ points of each rank, so nothing is gathered.
 
 import numpy as np
 
-from .kernels import strains
+from petsc_rod.local_step.projection import strains
 
 # Fuller's formula is used where 1 + e.t stays above this at every point; a tangent that
 # comes nearer to -e (a loop) leaves the link untracked for that state.

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import RodInputError
+from petsc_rod.errors import RodInputError
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
 SOLVER_PREFIXES = ("rod_r_", "rod_d1_", "rod_d2_", "rod_snes_")

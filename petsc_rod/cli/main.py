@@ -6,15 +6,18 @@ code (README, "Exit codes and bad input": 0 converged, 2 bad input, 3 not conver
 import numpy as np
 from petsc4py import PETSc
 
-from . import io, outputs, provenance, resources, starts
-from .errors import RodError, RodInputError
-from .mesh import Mesh, end_element_lengths
-from .options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
+from petsc_rod import resources
+from petsc_rod.io import outputs, provenance
+from petsc_rod.io import results as io
+from petsc_rod.scenes import starts
+from petsc_rod.errors import RodError, RodInputError
+from petsc_rod.mesh.mesh import Mesh, end_element_lengths
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
                       read_options, unused_options)
-from .scene import Scene
-from .signals import Interrupts
-from .continuation import continuation
-from .solver import Settings, UzawaSolver, default_penalty
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.cli.signals import Interrupts
+from petsc_rod.iteration.continuation import continuation
+from petsc_rod.iteration.driver import Settings, UzawaSolver, default_penalty
 
 # The smallest element, relative to the length, whose end coordinates double precision
 # still tells apart to many digits.

@@ -11,10 +11,10 @@ constraint int theta dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import RodDivergedError
-from .fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
-from .fields import scatter_element_vectors
-from .options import set_from_options_with_defaults
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
+from petsc_rod.mesh.fields import scatter_element_vectors
+from petsc_rod.cli.options import set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
                for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}

@@ -6,10 +6,10 @@ import time
 
 import numpy as np
 
-from . import outputs
-from .errors import RodDivergedError, RodInterrupted, RodNotConvergedError
-from .link import changed_class
-from .solver import ADAPT_WINDOW, STOP_LINK, STOP_OBSERVER, STOP_SADDLE
+from petsc_rod.io import outputs
+from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
+from petsc_rod.analysis.link import changed_class
+from petsc_rod.iteration.driver import ADAPT_WINDOW, STOP_LINK, STOP_OBSERVER, STOP_SADDLE
 
 
 def not_converged_reason(report, solver):

@@ -15,20 +15,20 @@ from dataclasses import dataclass, field
 import numpy as np
 from petsc4py import PETSc
 
-from . import boundary, starts
-from .assembly import ScalarProblem, assemble_matrix, load_ghosted
-from .centreline import (anchor_work, load_offset, midpoint_slopes, positions_at_points,
+from petsc_rod.scenes import boundary, starts
+from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix, load_ghosted
+from petsc_rod.global_step.centreline import (anchor_work, load_offset, midpoint_slopes, positions_at_points,
                          vertex_positions)
-from .errors import RodDivergedError, RodInputError
-from .fe import (GAUSS_POINTS, P2, element_integrals, p2_basis,
+from petsc_rod.errors import RodDivergedError, RodInputError
+from petsc_rod.mesh.elements import (GAUSS_POINTS, P2, element_integrals, p2_basis,
                  p2_element_matrices, p2_integrals, quadrature_weights)
-from .fields import VectorField, at_points, element_dofs
-from .kernels import (nearest_rotation, rotations, split_coefficients, strains,
+from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
+from petsc_rod.local_step.projection import (nearest_rotation, rotations, split_coefficients, strains,
                       update_multipliers)
-from .link import FULLER_MARGIN, link_integrands
-from .options import set_from_options_with_defaults
-from .resources import anderson_depth, ranks_on_this_machine
-from .stability import SecondVariation
+from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
+from petsc_rod.cli.options import set_from_options_with_defaults
+from petsc_rod.resources import anderson_depth, ranks_on_this_machine
+from petsc_rod.analysis.stability import SecondVariation
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
           for name in ("assembly", "rhs", "solve", "projection", "multiplier", "norms")}

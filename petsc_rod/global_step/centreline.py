@@ -19,8 +19,8 @@ Both ends held: r(L) - r(0) = int_0^L theta dS is a constraint with multiplier m
 
 import numpy as np
 
-from .boundary import is_held
-from .fe import element_integrals
+from petsc_rod.scenes.boundary import is_held
+from petsc_rod.mesh.elements import element_integrals
 
 
 def load_offset(start, end, total_load):
