@@ -138,14 +138,14 @@ def paper_branches():
             record("twisted" if check else "unguarded", solver, solve(solver, steps=8))
             if check:
                 mirror = np.diag([1.0, 1.0, -1.0])
-                state = solver.snapshot()
-                for name in ("r", "theta", "d1"):
+                state = solver.state.snapshot()
+                for name in ("r", "slope", "d1"):
                     state[name] = state[name] @ mirror
                 state["d2"] = -state["d2"] @ mirror
                 for name in ("tau", "lam"):
                     state[name] = state[name] @ mirror
                     state[name][:, 1] *= -1
-                solver.restore(state)
+                solver.state.restore(state)
                 record("mirrored", solver, solver.solve_step(1.0))
         finally:
             solver.destroy()
