@@ -67,10 +67,11 @@ def gather(comm, owned):
 
 def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
     """One continuation from X_F = 20 to ``end_x``: (step rows, profiles by X_F)."""
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.outputs import set_state, vertex_fields
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.io.outputs import set_state, vertex_fields
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
 
     from petsc4py import PETSc
 
@@ -83,7 +84,7 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
         database.setValue("rod_snes_type", "nrichardson")
     try:
         solver = UzawaSolver(mesh, scene, Settings(
-            penalty=PENALTY, max_it=MAX_ITERATIONS, rtol=RTOL, ctol=CTOL,
+            asked_penalty=PENALTY, max_it=MAX_ITERATIONS, rtol=RTOL, ctol=CTOL,
             check_stability=not planar))
     finally:
         if planar:
@@ -91,11 +92,11 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
     rows, profiles = [], {}
     converged_state, failures_in_a_row = None, 0
     try:
-        solver.set_straight()
+        solver.state.set_straight()
         clock = time.perf_counter()
         for k in range(1, steps + 1):
             t = k / steps
-            solver.roll_cross_sections(imperfection)
+            solver.state.roll_cross_sections(imperfection)
             report = solver.solve_step(t)
             fields = {key: gather(comm, value)
                       for key, value in vertex_fields(solver, t).items()}
@@ -138,7 +139,7 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
 
 def saved_state(solver, t):
     """Copies of this rank's state, for outputs.set_state."""
-    from petsc_rod.outputs import restart_state, vertex_fields
+    from petsc_rod.io.outputs import restart_state, vertex_fields
     return ({key: np.copy(value) for key, value in vertex_fields(solver, t).items()},
             {key: np.copy(value) for key, value in restart_state(solver).items()})
 

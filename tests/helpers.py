@@ -12,13 +12,14 @@ def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
     The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
     ``solver_factory`` fixture which does it.
     """
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
 
     scene = Scene(**scene_kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
-    settings = Settings(penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
+    settings = Settings(asked_penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
     solver = UzawaSolver(mesh, scene, settings)
     return mesh, solver
 
@@ -42,9 +43,9 @@ def global_max(comm, value):
 
 def continuation(solver, steps=1, imperfection=0.0):
     """From the straight state to load factor 1 as the CLI does it; the last StepReport."""
-    solver.set_straight()
+    solver.state.set_straight()
     for k in range(1, steps + 1):
-        solver.roll_cross_sections(imperfection)
+        solver.state.roll_cross_sections(imperfection)
         report = solver.solve_step(k / steps)
     return report
 

@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from helpers import gather, global_max
-from petsc_rod import outputs
-from petsc_rod.kernels import rotation_about
-from petsc_rod.scene import REFERENCE_FRAME
+from petsc_rod.io import outputs
+from petsc_rod.frames import rotation_about
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 ROUND_OFF = 1e-12
 LENGTH = 1.0
@@ -62,11 +62,11 @@ def solved():
         mesh, solver = make_solver(comm, N_ELEMENTS, scene_kwargs, PENALTY, RTOL,
                                    ctol_for(kwargs), MAX_IT)
         try:
-            solver.set_straight()
+            solver.state.set_straight()
             report = solver.solve_step(1.0)
             fields = outputs.vertex_fields(solver, 1.0)
-            owned = {"r": solver.r.owned(), "d1": solver.d1.owned()[:, 0],
-                     "d2": solver.d2.owned()[:, 0]}
+            owned = {"r": solver.state.r.owned(), "d1": solver.state.d1.owned()[:, 0],
+                     "d2": solver.state.d2.owned()[:, 0]}
             results[name] = dict(
                 report=report, scene=solver.scene, comm=comm,
                 lower=mesh.on_lower_boundary, upper=mesh.on_upper_boundary,

@@ -17,12 +17,13 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather
-from petsc_rod.fe import GAUSS_POINTS, GAUSS_WEIGHTS
-from petsc_rod.kernels import rotation_about, split_coefficients, strains
-from petsc_rod.mesh import Mesh
+from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS
+from petsc_rod.frames import rotation_about, split_coefficients, strains
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.validation.roundoff import MULTIPLIER, centreline_solve_error
-from petsc_rod.scene import REFERENCE_FRAME, Scene
-from petsc_rod.solver import Settings, UzawaSolver
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+from petsc_rod.iteration.driver import UzawaSolver
+from petsc_rod.iteration.stopping import Settings
 
 LENGTH = 1.3
 STIFFNESS = (1.0, 1.5, 0.8)
@@ -120,17 +121,17 @@ def one_step(request):
     comm = PETSc.COMM_WORLD
     scene = Scene(length=LENGTH, stiffness=STIFFNESS, **CASES[request.param], **LOADS)
     mesh = Mesh(comm, 6, LENGTH, grading=2.0)
-    solver = UzawaSolver(mesh, scene, Settings(penalty=PENALTY))
+    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=PENALTY))
     try:
-        solver.set_straight()
+        solver.state.set_straight()
         solver.prepare_step(1.0)
         rng = np.random.default_rng(7)
         tau, lam = rng.standard_normal((2, 2 * mesh.n_elements + 1, 3, 3))
         owned = slice(2 * mesh.vertex_start, 2 * mesh.vertex_start + mesh.n_local_nodes)
-        solver.tau[:], solver.lam[:] = tau[owned], lam[owned]
+        solver.state.tau[:], solver.state.lam[:] = tau[owned], lam[owned]
         solver.iterate()
-        points = {key: gather(comm, value) for key, value in solver.point_values().items()}
-        result = dict(r=gather(comm, solver.r.owned()), points=points,
+        points = {key: gather(comm, value) for key, value in solver.state.point_values().items()}
+        result = dict(r=gather(comm, solver.state.r.owned()), points=points,
                       reaction=solver.end_reaction(), energy=solver.energy())
         S = mesh.coordinates(np.arange(mesh.n_vertices))
     finally:
@@ -197,10 +198,10 @@ def test_centreline_solve_round_off_at_3200_elements(comm, scene):
     small difference c.theta0 - (r(L) - r(0)) of terms of size 16 m, over c.w)."""
     scene = Scene(**scene)
     mesh = Mesh(comm, 3200, scene.length)
-    solver = UzawaSolver(mesh, scene, Settings(penalty=400.0))
+    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=400.0))
     try:
         assert centreline_solve_error(solver) < 1e-10
-        if solver.bordered:
+        if solver.global_step.bordered:
             assert np.abs(solver.end_reaction() + MULTIPLIER).max() < 1e-8
     finally:
         solver.destroy()

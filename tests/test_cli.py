@@ -18,7 +18,7 @@ import pytest
 
 import petsc_rod
 from helpers import child_env
-from petsc_rod.options import OPTIONS
+from petsc_rod.cli.options import OPTIONS
 
 pytestmark = pytest.mark.serial
 
@@ -173,7 +173,7 @@ def test_result_file_says_what_wrote_it_with_units_and_parameters(cantilever):
         in_effect = str(attrs["options_in_effect"]).splitlines()
         assert "-rod_elements 32" in in_effect
         assert "-rod_al_max_it 2000" in in_effect         # a default, not given
-        assert any(line.startswith("-rod_r_ksp_type ") for line in in_effect)
+        assert any(line.startswith("-rod_slope_ksp_type ") for line in in_effect)
         given = parse_options_text(str(attrs["options"]))
         parameters = f["parameters"].attrs
         assert int(parameters["elements"]) == 32

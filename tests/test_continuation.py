@@ -29,7 +29,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import child_env, gather
-from petsc_rod.continuation import LoadPath, continuation
+from petsc_rod.iteration.continuation import LoadPath, continuation
 from petsc_rod.errors import RodDivergedError, RodNotConvergedError
 
 N_ELEMENTS = 16
@@ -52,7 +52,7 @@ def build(solver_factory, comm, case):
                                       CTOL, case["max_it"])
     finally:
         database.delValue("rod_snes_type")
-    solver.set_straight()
+    solver.state.set_straight()
     return mesh, solver
 
 
@@ -69,8 +69,8 @@ def run_continuation(solver_factory, comm, case, steps, max_halvings):
 
 def owned_state(solver):
     """Copies of this rank's share of every field of the Uzawa state."""
-    return {"r": solver.r.owned(), "theta": solver.theta.owned(), "d1": solver.d1.owned(),
-            "d2": solver.d2.owned(), "tau": solver.tau.copy(), "lam": solver.lam.copy()}
+    return {"r": solver.state.r.owned(), "slope": solver.state.slope.owned(), "d1": solver.state.d1.owned(),
+            "d2": solver.state.d2.owned(), "tau": solver.state.tau.copy(), "lam": solver.state.lam.copy()}
 
 
 def step_results(lines):
@@ -80,7 +80,7 @@ def step_results(lines):
 
 
 def assert_same_state(first, second):
-    for name in ("r", "theta", "d1", "d2", "tau", "lam"):
+    for name in ("r", "slope", "d1", "d2", "tau", "lam"):
         scale = np.abs(second[name]).max()
         assert np.abs(first[name] - second[name]).max() <= 1e-9 * scale, name
     assert first["energy"] == pytest.approx(second["energy"], rel=1e-9)
@@ -123,11 +123,11 @@ def test_snapshot_restore_is_exact_and_the_next_step_repeats_itself(solver_facto
     mesh, solver = build(solver_factory, comm, BENT)
     assert solver.solve_step(0.5).converged
     before = owned_state(solver)
-    saved = solver.snapshot()
+    saved = solver.state.snapshot()
     first = solver.solve_step(1.0)
     moved = owned_state(solver)
     assert mesh.global_sum(float(np.abs(moved["r"] - before["r"]).max())) > 0.01
-    solver.restore(saved)
+    solver.state.restore(saved)
     for name, values in owned_state(solver).items():
         assert np.array_equal(values, before[name]), name
     second = solver.solve_step(1.0)               # the change test starts from the restore
@@ -139,15 +139,15 @@ def test_snapshot_restore_is_exact_and_the_next_step_repeats_itself(solver_facto
 
 def test_restore_after_a_diverged_attempt_leaves_no_nan(solver_factory, comm):
     mesh, solver = build(solver_factory, comm, BENT)
-    saved = solver.snapshot()
+    saved = solver.state.snapshot()
     before = owned_state(solver)
-    solver.lam[0, 0, 0] = np.nan                   # a state gone bad on every rank
+    solver.state.lam[0, 0, 0] = np.nan                   # a state gone bad on every rank
     with pytest.raises(RodDivergedError) as error:
         solver.solve_step(1.0)
     assert error.value.iterations == 1
     poisoned = [np.isnan(values).any() for values in owned_state(solver).values()]
     assert mesh.global_sum(float(sum(poisoned))) >= comm.getSize()
-    solver.restore(saved)
+    solver.state.restore(saved)
     for name, values in owned_state(solver).items():
         assert np.isfinite(values).all(), name
         assert np.array_equal(values, before[name]), name

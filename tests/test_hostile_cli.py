@@ -143,7 +143,7 @@ def test_an_options_file_without_options_exits_2(tmp_path):
 
 def test_an_unknown_solver_type_exits_2(tmp_path):
     path = tmp_path / "out.h5"
-    done = run(SMALL + ["-rod_r_ksp_type", "nonsense", "-rod_output", str(path)])
+    done = run(SMALL + ["-rod_slope_ksp_type", "nonsense", "-rod_output", str(path)])
     assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
                                      ["KSP type nonsense"], path)
 

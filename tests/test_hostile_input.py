@@ -12,11 +12,12 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_rod import io, outputs
-from petsc_rod.cli import MIN_RELATIVE_ELEMENT, check_mesh
-from petsc_rod.continuation import LoadPath, record_step
+from petsc_rod.io import outputs
+from petsc_rod.io import results as io
+from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
+from petsc_rod.iteration.continuation import LoadPath, record_step
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
-from petsc_rod.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
+from petsc_rod.cli.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
 from petsc_rod.resources import BYTES_PER_ELEMENT, MAX_ELEMENTS, check_elements_fit
 
@@ -188,7 +189,7 @@ def write_result(solver, path, attributes=None):
 def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
         solver_factory, comm, shared_tmp, monkeypatch):
     mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 500)
-    solver.set_straight()
+    solver.state.set_straight()
     path = os.path.join(shared_tmp, "full.h5")
     monkeypatch.setattr(io, "free_disk", lambda folder: 1000)
     with pytest.raises(RodInputError, match="free"):
@@ -210,7 +211,7 @@ def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
 def result(solver_factory, comm, shared_tmp):
     """(solver, path of a converged result file of it)."""
     mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 2000)
-    solver.set_straight()
+    solver.state.set_straight()
     path = os.path.join(shared_tmp, "result.h5")
     assert write_result(solver, path).converged
     return solver, path
@@ -275,7 +276,7 @@ def test_a_good_restart_file_gives_back_the_state(result, comm):
     assert restart.load_factor == 1.0 and restart.converged
     for key, value in saved.items():
         assert np.array_equal(restart.state[key], value), key
-    assert np.array_equal(restart.vertex["r"], solver.r.owned()[:, 0])
+    assert np.array_equal(restart.vertex["r"], solver.state.r.owned()[:, 0])
 
 
 # --- the load path of a restart --------------------------------------------------------

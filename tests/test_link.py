@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 
 from helpers import continuation as reach_load, gather
-from petsc_rod.continuation import continuation
+from petsc_rod.iteration.continuation import continuation
 from petsc_rod.errors import RodNotConvergedError
-from petsc_rod.kernels import rotation_about
-from petsc_rod.link import LINK_TOLERANCE, changed_class, link_integrands
+from petsc_rod.frames import rotation_about
+from petsc_rod.analysis.link import LINK_TOLERANCE, changed_class, link_integrands
 from petsc_rod.validation.writhe import gauss_writhe
-from petsc_rod.scene import REFERENCE_FRAME, Scene
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
 
 AXIS = np.array([1.0, 0.0, 0.0])
 
@@ -94,7 +94,7 @@ def test_a_twisted_rod_with_slack_writhes_and_keeps_its_link(solver_factory, com
     twist, writhe = solver.link()
     assert twist + writhe == pytest.approx(1.0, abs=2e-3)
     assert 0.03 < writhe < 0.1
-    points = gather(comm, solver.r.owned()[:, 0])
+    points = gather(comm, solver.state.r.owned()[:, 0])
     assert gauss_writhe(points, AXIS) == pytest.approx(writhe, abs=2e-3)
 
 
@@ -107,17 +107,17 @@ def test_a_whole_turn_in_one_step_is_refused(solver_factory, comm):
     the untwisted rod, which the link check refuses (exit 3); in 4 steps the rod keeps
     its turn, all of it twist (u3 = 2 pi / L)."""
     mesh, solver = solver_factory(comm, 32, PURE_TWIST, 100.0, 1e-8, 1e-5, 5000)
-    solver.set_straight()
+    solver.state.set_straight()
     lines = []
     code = continuation(solver, 1, 0.0, None, lines.append, "", 0)
     assert code == RodNotConvergedError.exit_code, "\n".join(lines)
     found = re.search(r"linking number is (-?[0-9.]+) turns .* not the 1.000 turns", lines[-1])
     assert found and abs(float(found.group(1))) < 1e-3, lines[-1]
-    solver.set_straight()                           # -rod_track_link 0: accepted
+    solver.state.set_straight()                           # -rod_track_link 0: accepted
     lines = []
     assert continuation(solver, 1, 0.0, None, lines.append, "", 0, track_link=False) == 0
     assert abs(sum(solver.link())) < 1e-3
-    solver.set_straight()
+    solver.state.set_straight()
     lines = []
     assert continuation(solver, 4, 0.0, None, lines.append, "", 0) == 0, "\n".join(lines)
     twist, writhe = solver.link()

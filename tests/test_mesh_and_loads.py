@@ -3,12 +3,12 @@
 import numpy as np
 
 from helpers import gather
-from petsc_rod.assembly import load_ghosted
+from petsc_rod.global_step.matrices import load_ghosted
 from petsc_rod.validation.closed_forms import cantilever_tip
-from petsc_rod.fields import VectorField
-from petsc_rod.mesh import Mesh, graded_coordinates
-from petsc_rod.outputs import vertex_fields
-from petsc_rod.scene import Scene
+from petsc_rod.mesh.fields import VectorField
+from petsc_rod.mesh.mesh import Mesh, graded_coordinates
+from petsc_rod.io.outputs import vertex_fields
+from petsc_rod.scenes.scene import Scene
 
 
 def test_grading_ratio_and_ends():
@@ -54,13 +54,14 @@ def test_piecewise_load_is_integrated_exactly(comm):
 
 def test_cantilever_on_graded_mesh(comm):
     """The closed-form tip also on a mesh graded 4:1 towards both ends."""
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
     scene = Scene(length=1.0, stiffness=[1.0, 1.0, 1.0], end="free", end_force=[0, -3.0, 0])
     mesh = Mesh(comm, 64, 1.0, grading=4.0)
-    solver = UzawaSolver(mesh, scene, Settings(penalty=100.0, max_it=5000, rtol=1e-9,
+    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=100.0, max_it=5000, rtol=1e-9,
                                                ctol=1e-5))
     try:
-        solver.set_straight()
+        solver.state.set_straight()
         assert solver.solve_step(1.0).converged
         r = gather(comm, vertex_fields(solver, 1.0)["r"])
         assert np.abs(r[-1, :2] - cantilever_tip(1.0, 1.0, 3.0)).max() < 1e-6

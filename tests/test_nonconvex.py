@@ -1,7 +1,7 @@
 """The non-convex split (a stiffness above the sum of the other two, docs/method.md §2).
 
 The matrices use c_j = max_i a_i for the negative a_j and move 2 (c_j - a_j) K tau_j to
-the right-hand side (solver.matrix_split): the matrices are positive definite for any
+the right-hand side (penalty.matrix_split): the matrices are positive definite for any
 R > 0 on any mesh, and the fixed points are those of the true split. These tests check
 both, and that anisotropic sections reach the right equilibrium at the default penalty.
 """
@@ -11,10 +11,10 @@ import pytest
 
 from helpers import continuation, gather
 from petsc_rod.validation.closed_forms import cantilever_tip
-from petsc_rod.fe import p2_element_matrices
-from petsc_rod.kernels import split_coefficients
-from petsc_rod.outputs import vertex_fields
-from petsc_rod.solver import matrix_split
+from petsc_rod.mesh.elements import p2_element_matrices
+from petsc_rod.frames import split_coefficients
+from petsc_rod.io.outputs import vertex_fields
+from petsc_rod.iteration.penalty import matrix_split
 
 
 def assembled(element_matrices):

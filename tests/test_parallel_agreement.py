@@ -41,16 +41,16 @@ def solve_on(comm, kind):
     finally:
         database.delValue("rod_snes_type")
     try:
-        solver.set_straight()
+        solver.state.set_straight()
         reports = [solver.solve_step(t) for t in STEPS]
         owned_vertices = mesh.vertex_end - mesh.vertex_start
         return dict(
             reports=reports,
-            r=gather(comm, solver.r.owned()),
-            d1=gather(comm, solver.d1.owned()),
-            d2=gather(comm, solver.d2.owned()),
-            tau=gather(comm, solver.tau),
-            lam=gather(comm, solver.lam),
+            r=gather(comm, solver.state.r.owned()),
+            d1=gather(comm, solver.state.d1.owned()),
+            d2=gather(comm, solver.state.d2.owned()),
+            tau=gather(comm, solver.state.tau),
+            lam=gather(comm, solver.state.lam),
             energy=solver.energy(),
             split=owned_vertices < mesh.n_vertices,
             ranks=comm.getSize())

@@ -178,7 +178,7 @@ def test_petsc_rod_paper_scene_agrees_with_the_reference(twisted):
     from petsc4py import PETSc
 
     from helpers import continuation, gather, make_solver
-    from petsc_rod.outputs import vertex_fields
+    from petsc_rod.io.outputs import vertex_fields
 
     scene = dict(length=PAPER_LENGTH, stiffness=PAPER_STIFFNESS, start="clamp", end="pin",
                  end_position=END)

@@ -10,7 +10,7 @@ import pytest
 
 from helpers import continuation as solve, gather
 from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
-from petsc_rod.outputs import vertex_fields
+from petsc_rod.io.outputs import vertex_fields
 
 
 def fitted_order(n_elements, errors):
@@ -118,7 +118,7 @@ def paper_branches():
     Returns {name: (converged, u3(0), energy, negative directions of the final state)}."""
     from petsc4py import PETSc
     from helpers import make_solver
-    from petsc_rod.stability import SecondVariation
+    from petsc_rod.analysis.stability import SecondVariation
     results = {}
 
     def record(name, solver, report):
@@ -138,14 +138,14 @@ def paper_branches():
             record("twisted" if check else "unguarded", solver, solve(solver, steps=8))
             if check:
                 mirror = np.diag([1.0, 1.0, -1.0])
-                state = solver.snapshot()
-                for name in ("r", "theta", "d1"):
+                state = solver.state.snapshot()
+                for name in ("r", "slope", "d1"):
                     state[name] = state[name] @ mirror
                 state["d2"] = -state["d2"] @ mirror
                 for name in ("tau", "lam"):
                     state[name] = state[name] @ mirror
                     state[name][:, 1] *= -1
-                solver.restore(state)
+                solver.state.restore(state)
                 record("mirrored", solver, solver.solve_step(1.0))
         finally:
             solver.destroy()

@@ -9,10 +9,10 @@ import pytest
 from helpers import continuation, gather
 from petsc_rod.validation.closed_forms import cantilever_tip, catenary
 from petsc_rod.errors import RodInputError
-from petsc_rod.scene import Scene
-from petsc_rod.solver import (ADAPT_WINDOW, STALL_MARGIN, STALL_WINDOW, default_penalty,
-                              penalty_too_low, stalled_projection)
-from petsc_rod.starts import catenary_start
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.iteration.penalty import ADAPT_WINDOW, default_penalty, penalty_too_low
+from petsc_rod.iteration.stopping import STALL_MARGIN, STALL_WINDOW, stalled_projection
+from petsc_rod.scenes.starts import catenary_start
 
 LENGTH, CHORD, LOAD = 3000.0, np.array([2500.0, 0.0, 400.0]), np.array([0.0, 0.0, -1000.0])
 
@@ -141,6 +141,6 @@ def test_a_penalty_far_below_the_scale_is_raised_and_the_elastica_reached(
         return
     assert report.converged
     assert solver.penalty == pytest.approx(10.0)
-    tip = gather(comm, solver.r.owned()[:, 0])[-1]
+    tip = gather(comm, solver.state.r.owned()[:, 0])[-1]
     x, y = cantilever_tip(1.0, 1.0, 3.0)
     assert np.abs(tip - [x, y, 0.0]).max() < 1e-5

@@ -11,7 +11,7 @@ at R = 100: a whole turn of twist lost in one step at 9.75 rad; one step of a wh
 which the clamps do not see at all: the untwisted rod; docs/stability.md, fix 9). The
 continuation checks Lk after each step (continuation.py).
 
-Tw = (1/2 pi) int u3 dS with u3 = d1'.d2 (kernels.strains). Wr, for a rod whose end
+Tw = (1/2 pi) int u3 dS with u3 = d1'.d2 (frames.strains). Wr, for a rod whose end
 tangents both equal the axis e, is given by Fuller's formula relative to the straight rod
 along e: Wr = (1/2 pi) int (e x t).t' / (1 + e.t) dS, t = r'; it is the writhe of the
 rod closed by rays along -e and +e from its ends, exact as long as t never points along
@@ -21,7 +21,7 @@ points of each rank, so nothing is gathered.
 
 import numpy as np
 
-from .kernels import strains
+from petsc_rod.frames import strains
 
 # Fuller's formula is used where 1 + e.t stays above this at every point; a tangent that
 # comes nearer to -e (a loop) leaves the link untracked for that state.

@@ -1,4 +1,4 @@
-"""The pointwise kernels of the Uzawa iteration (docs/method.md §1-§3), numpy only.
+"""The pointwise projection of the Uzawa iteration (docs/method.md §1-§3), numpy only.
 
 nearest_rotation(b) is the local step: the T in SO(3) maximising sum_i T_i . b_i =
 trace(T b^T). It is checked against a brute force (local perturbations along every
@@ -12,10 +12,11 @@ import pytest
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
-from petsc_rod import kernels
-from petsc_rod.kernels import (nearest_rotation, nearest_rotation_eigen, nearest_rotation_svd,
-                               polar_newton, rotation_about, rotation_log, shifted,
-                               split_coefficients, strains, update_multipliers)
+from petsc_rod.frames import rotation_about, rotation_log, split_coefficients, strains
+from petsc_rod.local_step import projection
+from petsc_rod.local_step.projection import (nearest_rotation, nearest_rotation_eigen,
+                                             nearest_rotation_svd, polar_newton, shifted,
+                                             update_multipliers)
 
 ROUND_OFF = 1e-12
 
@@ -290,7 +291,7 @@ def test_nearest_rotation_leading_dimensions(shape):
 def test_nearest_rotation_block_boundaries(monkeypatch, block, n):
     """Any n against any block size: whole blocks, a partial last one, n < block, n = 0;
     hard points at the blocks' ends."""
-    monkeypatch.setattr(kernels, "BLOCK", block)
+    monkeypatch.setattr(projection, "BLOCK", block)
     rng = np.random.default_rng(26)
     b = input_class("near", max(n, 1), rng)[:n]
     ends = np.arange(n)[(np.arange(n) % block == 0) | (np.arange(n) % block == block - 1)]
@@ -304,7 +305,7 @@ def test_nearest_rotation_block_boundaries(monkeypatch, block, n):
 
 def test_points_newton_has_not_converged_go_to_the_eigen_solve(monkeypatch):
     """With too few steps allowed, the points not converged are caught, not returned."""
-    monkeypatch.setattr(kernels, "MAX_STEPS", 3)
+    monkeypatch.setattr(projection, "MAX_STEPS", 3)
     b = input_class("far", 300, np.random.default_rng(31))
     assert polar_newton(b, np.empty_like(b)).mean() > 0.5
     assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
@@ -318,13 +319,13 @@ def test_slow_points_go_on_as_a_smaller_block(monkeypatch, far):
     b = input_class("near", 1000, rng)
     b[rng.choice(1000, far, replace=False)] = input_class("far", far, rng)
     calls = []
-    newton = kernels.polar_newton
+    newton = projection.polar_newton
 
     def spy(b, out, steps=None, iterate=False):
         calls.append((len(b), iterate))
         return newton(b, out, steps, iterate)
 
-    monkeypatch.setattr(kernels, "polar_newton", spy)
+    monkeypatch.setattr(projection, "polar_newton", spy)
     assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
     assert calls[0] == (1000, False)
     assert 1 < len(calls) and all(n <= far and iterate for n, iterate in calls[1:])
@@ -333,7 +334,7 @@ def test_slow_points_go_on_as_a_smaller_block(monkeypatch, far):
 def test_nearest_rotation_at_the_block_size():
     """The block size itself, once over: a full block, then a partial one."""
     rng = np.random.default_rng(27)
-    b = input_class("mixed", kernels.BLOCK + 3, rng)
+    b = input_class("mixed", projection.BLOCK + 3, rng)
     assert np.abs(nearest_rotation(b) - nearest_rotation_svd(b)).max() < ROUND_OFF
 
 
@@ -400,7 +401,7 @@ def test_update_multipliers_in_place():
     assert np.array_equal(lam, before)
 
 
-@pytest.mark.parametrize("size", [1, 1000, kernels.CHUNK, 2 * kernels.CHUNK + 5])
+@pytest.mark.parametrize("size", [1, 1000, projection.CHUNK, 2 * projection.CHUNK + 5])
 def test_update_multipliers_in_chunks(size):
     """Across the chunks it works in, and broadcast when the shapes differ."""
     rng = np.random.default_rng(30)

@@ -22,7 +22,7 @@ solves and reductions per right-hand side (docs/performance.md).
 
 ``ChainSolver`` does the algebra on numpy views of the local rows; ``InterfacePC`` is
 the same solve as a PETSc python preconditioner (``-rod_d1_pc_type python
--rod_d1_pc_python_type petsc_rod.substructuring.InterfacePC``), exact, so that KSP
+-rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so that KSP
 preonly with it is a direct solver. The PETSc objects (the interior matrix, its factor,
 two work vectors) are created in ChainSolver.__init__ and destroyed in destroy().
 """
@@ -31,7 +31,7 @@ import numpy as np
 from petsc4py import PETSc
 from scipy.linalg import cho_solve_banded, cholesky_banded
 
-PYTHON_TYPE = "petsc_rod.substructuring.InterfacePC"
+PYTHON_TYPE = "petsc_rod.global_step.substructuring.InterfacePC"
 
 
 class NotAChainError(ValueError):

@@ -1,21 +1,21 @@
 """PETSc glue of the global step: matrices assembled and factored once, right-hand sides.
 
-Each of d1, d2 and the slope theta = r' is one scalar SPD problem A x = b (P2) solved for
+Each of d1, d2 and the slope r' is one scalar SPD problem A x = b (P2) solved for
 the x, y and z components with one factorisation (docs/method.md §3 step 1). Essential
 conditions keep A symmetric: rows and columns of prescribed dofs are zeroed with a unit
 diagonal, and the right-hand side is lifted by the unconstrained matrix times the
-prescribed values. The theta problem of a rod held at both ends is bordered by the
-constraint int theta dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
+prescribed values. The slope problem of a rod held at both ends is bordered by the
+constraint int slope dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
 """
 
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import RodDivergedError
-from .fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
-from .fields import scatter_element_vectors
-from . import substructuring
-from .options import set_from_options_with_defaults
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.global_step import substructuring
+from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
+from petsc_rod.mesh.fields import scatter_element_vectors
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
                for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
@@ -243,7 +243,7 @@ def load_element_vectors(mesh, load, breaks):
 
 
 def load_ghosted(mesh, load, breaks):
-    """The load part int F.g of the theta right-hand side on the ghosted vertices,
+    """The load part int F.g of the slope right-hand side on the ghosted vertices,
     (n_ghosted, 2, 3) (load_element_vectors summed into the vertex slots)."""
     return scatter_element_vectors(mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
                                    load_element_vectors(mesh, load, breaks))

@@ -8,8 +8,8 @@ either side (u is discontinuous across elements for P2 directors).
 
 import numpy as np
 
-from .fe import p2_basis, p2_integrals
-from .kernels import strains
+from petsc_rod.mesh.elements import p2_basis, p2_integrals
+from petsc_rod.frames import strains
 
 
 def vertex_strains(solver):
@@ -19,7 +19,7 @@ def vertex_strains(solver):
     elements = np.arange(first, end)
     h = mesh.coordinates(elements + 1) - mesh.coordinates(elements)
     ends = np.array([0.0, 1.0])
-    values = solver.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
+    values = solver.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
                              p2_integrals(ends, h))
     u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
     n_owned = mesh.vertex_end - mesh.vertex_start
@@ -36,9 +36,9 @@ def vertex_strains(solver):
 def vertex_fields(solver, t):
     """All vertex datasets of the result file (docs/method.md §6, issue format)."""
     mesh, scene = solver.mesh, solver.scene
-    r = solver.r.owned()
-    d1 = solver.d1.owned()[:, 0]
-    d2 = solver.d2.owned()[:, 0]
+    r = solver.state.r.owned()
+    d1 = solver.state.d1.owned()[:, 0]
+    d2 = solver.state.d2.owned()[:, 0]
     d3 = r[:, 1]
     u = vertex_strains(solver)
     k = scene.stiffness
@@ -52,23 +52,23 @@ def restart_state(solver):
     """Dofs not in the vertex datasets: the P2 midpoints of d1, d2 per owned element, and
     tau, lambda at the owned P2 nodes."""
     n_local = solver.mesh.n_local_elements
-    return {"d1_mid": solver.d1.owned()[:n_local, 1], "d2_mid": solver.d2.owned()[:n_local, 1],
-            "tau": solver.tau, "lambda": solver.lam}
+    return {"d1_mid": solver.state.d1.owned()[:n_local, 1], "d2_mid": solver.state.d2.owned()[:n_local, 1],
+            "tau": solver.state.tau, "lambda": solver.state.lam}
 
 
 def set_state(solver, vertex, state):
     """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
-    holds r and d3 = r' at the vertices: theta's midpoints are those of the Hermite cubic
+    holds r and d3 = r' at the vertices: slope's midpoints are those of the Hermite cubic
     they define (UzawaSolver.set_centreline)."""
     n_local = solver.mesh.n_local_elements
     n_owned = vertex["r"].shape[0]
-    solver.set_centreline(vertex["r"], vertex["d3"])
-    for field, name in ((solver.d1, "d1"), (solver.d2, "d2")):
+    solver.state.set_centreline(vertex["r"], vertex["d3"])
+    for field, name in ((solver.state.d1, "d1"), (solver.state.d2, "d2")):
         values = np.zeros((n_owned, 2, 3))
         values[:, 0] = vertex[name]
         values[:n_local, 1] = state[f"{name}_mid"]
         field.set_owned(values)
-    solver.tau[:] = state["tau"]
-    solver.lam[:] = state["lambda"]
-    solver.remember_state()
+    solver.state.tau[:] = state["tau"]
+    solver.state.lam[:] = state["lambda"]
+    solver.state.remember()
 

@@ -1,7 +1,7 @@
 """The application's PETSc options: one table drives parsing, defaults and ``-help``.
 
 Every option has the root prefix ``rod_``. The KSPs of the global step have their own
-prefixes (``rod_r_``, ``rod_d1_``, ``rod_d2_``), the SNES of the iteration ``rod_snes_``;
+prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``), the SNES of the iteration ``rod_snes_``;
 they read the usual PETSc options. A
 ``-rod_*`` name that is not in the table is an error (with the closest known name); any
 other option nobody read is reported at the end of the run.
@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import RodInputError
+from petsc_rod.errors import RodInputError
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
-SOLVER_PREFIXES = ("rod_r_", "rod_d1_", "rod_d2_", "rod_snes_")
+SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_")
 
 # Every number must be finite and at most this large in magnitude (and a positive scale,
 # such as a length or a tolerance, at least its inverse): the solver forms products of
@@ -113,7 +113,7 @@ OPTIONS = [
            "position of the end S = L (clamp, pin); default (L,0,0)", unit="m"),
     Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
            "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
-    Option("rod_end_twist", _real, 0.0, "theta",
+    Option("rod_end_twist", _real, 0.0, "angle",
            "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
            "continuation", unit="rad"),
     Option("rod_end_force", _reals(3), np.zeros(3), "fx,fy,fz", "dead force at a free end S = L, N",
@@ -170,22 +170,6 @@ OPTIONS = [
            "default and the constraint residual falls by less than half in 200 iterations"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
-
-
-def set_from_options_with_defaults(obj, defaults):
-    """``obj.setFromOptions()`` with ``defaults`` ({option name: value}) in effect for
-    the options the user did not give: the default of a PETSc object's option that only
-    the options database can set (a sub-PC type, a line search) without making it a
-    user's option afterwards."""
-    database = PETSc.Options()
-    added = [name for name in defaults if not database.hasName(name)]
-    for name in added:
-        database.setValue(name, defaults[name])
-    try:
-        obj.setFromOptions()
-    finally:
-        for name in added:
-            database.delValue(name)
 
 
 def read_options():
@@ -257,7 +241,7 @@ def help_text():
             default = ",".join(f"{v:g}" for v in default) or "none"
         lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
                      f"(default {default})")
-    lines.append("  Global-step solvers: -rod_r_ksp_*, -rod_r_pc_* (r), -rod_d1_*, -rod_d2_* "
+    lines.append("  Global-step solvers: -rod_slope_ksp_*, -rod_slope_pc_* (the slope r'), -rod_d1_*, -rod_d2_* "
                  "(directors); default preonly + Cholesky on one rank, CG with block Jacobi and "
                  "Cholesky blocks (rtol 1e-14) on several.")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "

@@ -1,10 +1,10 @@
 """The P2 reference element on [0, 1] and its element matrices (numpy only).
 
 Every field of the global step lives in the same P2 Lagrange space (docs/method.md §4,
-with the centreline recast): d1, d2, and the slope theta = r' of the centreline. The
-paper's C^1 Hermite cubic r has a C^0 piecewise-quadratic derivative, so theta in P2
+with the centreline recast): d1, d2, and the slope r' of the centreline. The
+paper's C^1 Hermite cubic r has a C^0 piecewise-quadratic derivative, so a P2 slope
 together with r(0) is the same discrete space; r itself is recovered by integrating
-theta (centreline.py), which keeps the r matrix second order (condition ~N^2) instead
+the slope (centreline.py), which keeps the r matrix second order (condition ~N^2) instead
 of the fourth-order Hermite one (~N^4). Element dofs ``[g(S_e), g(midpoint of e),
 g(S_e+1)]``.
 
@@ -101,8 +101,8 @@ def p2_element_matrices(h, stiffness, penalty):
     """Element matrices of one field of the global step (docs/method.md §3):
     int s g'.k' dS + R sum_n w_n g_n k_n, the penalty mass lumped at the nodes.
 
-    For d_a (a = 1, 2) s = 2 a_a; for the slope theta = r' = d3, s = 2 a3 (the r equation
-    int 2 a3 r''.p'' with theta = r', g = p'). ``penalty`` is R (N). Returns (ne, 3, 3).
+    For d_a (a = 1, 2) s = 2 a_a; for the slope r' = d3, s = 2 a3 (the r equation
+    int 2 a3 r''.p'' with slope = r', g = p'). ``penalty`` is R (N). Returns (ne, 3, 3).
     """
     _, dphi = p2_basis(GAUSS_POINTS, h)
     w = quadrature_weights(h)

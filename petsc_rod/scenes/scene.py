@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import RodInputError
-from .kernels import rotation_about, rotation_log
+from petsc_rod.errors import RodInputError
+from petsc_rod.frames import rotation_about, rotation_log
 
 REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 END_KINDS = ("clamp", "pin", "free")

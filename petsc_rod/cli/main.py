@@ -6,15 +6,20 @@ code (README, "Exit codes and bad input": 0 converged, 2 bad input, 3 not conver
 import numpy as np
 from petsc4py import PETSc
 
-from . import io, outputs, provenance, resources, starts
-from .errors import RodError, RodInputError
-from .mesh import Mesh, end_element_lengths
-from .options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
+from petsc_rod import resources
+from petsc_rod.io import outputs, provenance
+from petsc_rod.io import results as io
+from petsc_rod.scenes import starts
+from petsc_rod.errors import RodError, RodInputError
+from petsc_rod.mesh.mesh import Mesh, end_element_lengths
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
                       read_options, unused_options)
-from .scene import Scene
-from .signals import Interrupts
-from .continuation import continuation
-from .solver import Settings, UzawaSolver, default_penalty
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.cli.signals import Interrupts
+from petsc_rod.iteration.continuation import continuation
+from petsc_rod.iteration.driver import UzawaSolver
+from petsc_rod.iteration.penalty import default_penalty
+from petsc_rod.iteration.stopping import Settings
 
 # The smallest element, relative to the length, whose end coordinates double precision
 # still tells apart to many digits.
@@ -40,7 +45,7 @@ def settings_from_options(values, scene):
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = default_penalty(scene)
-    return Settings(penalty=penalty, max_it=values["rod_al_max_it"],
+    return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
                     adapt_penalty=values["rod_al_adapt_penalty"],
@@ -120,13 +125,13 @@ def check_mesh(comm, values):
 
 def build_solver(mesh, scene, settings):
     """The UzawaSolver; a PETSc error while it sets up its solvers (an unknown
-    -rod_r_ksp_type, say) is bad input."""
+    -rod_slope_ksp_type, say) is bad input."""
     try:
         return UzawaSolver(mesh, scene, settings)
     except PETSc.Error as error:
         detail = str(error).strip().splitlines()[-1].split("] ", 1)[-1]
         raise RodInputError(f"PETSc refused the solver options: {detail}; check the "
-                            "-rod_r_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
+                            "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
 
 
 def start_from(solver, values, given, say):
@@ -146,9 +151,9 @@ def start_from(solver, values, given, say):
         raise RodInputError("-rod_initial_load_factor needs -rod_initial (the state it is "
                             "the load factor of); drop it or give the file")
     if shape == "catenary":
-        solver.set_from_curve(starts.catenary_start(solver.scene, 1.0 / values["rod_steps"]))
+        solver.state.set_from_curve(starts.catenary_start(solver.scene, 1.0 / values["rod_steps"]))
     else:
-        solver.set_straight()
+        solver.state.set_straight()
     return 0.0
 
 
@@ -187,7 +192,7 @@ def options_in_effect(values, solver, start):
     then each global-step solver's KSP, PC and factorisation package."""
     scene = solver.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
-                "rod_al_penalty": solver.settings.penalty, "rod_initial_load_factor": start}
+                "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     parameters, units = {}, {}
     for option in OPTIONS:
         value = resolved.get(option.name, values[option.name])
@@ -207,7 +212,7 @@ def solver_types(solver):
     """{'<prefix>ksp_type': ..., '<prefix>pc_type': ..., '<prefix>pc_factor_mat_solver_type':
     ...} of the global step's solvers, prefixes without ``rod_``."""
     types = {}
-    for problem in solver.problems:
+    for problem in solver.global_step.problems:
         ksp = problem.ksp
         prefix = (ksp.getOptionsPrefix() or "").removeprefix("rod_")
         pc = ksp.getPC()

@@ -6,10 +6,11 @@ import time
 
 import numpy as np
 
-from . import outputs
-from .errors import RodDivergedError, RodInterrupted, RodNotConvergedError
-from .link import changed_class
-from .solver import ADAPT_WINDOW, STOP_LINK, STOP_OBSERVER, STOP_SADDLE
+from petsc_rod.io import outputs
+from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
+from petsc_rod.analysis.link import changed_class
+from petsc_rod.iteration.penalty import ADAPT_WINDOW
+from petsc_rod.iteration.stopping import STOP_LINK, STOP_OBSERVER, STOP_SADDLE
 
 
 def not_converged_reason(report, solver):
@@ -36,8 +37,8 @@ def not_converged_reason(report, solver):
                 "symmetry holds the iterate (a straight rod shortened along its axis: move "
                 "the end off the axis)")
     hint = ""
-    if settings.penalty < 0.1 * solver.scale:
-        hint = (f"; -rod_al_penalty {settings.penalty:g} is far below the problem's scale "
+    if settings.asked_penalty < 0.1 * solver.scale:
+        hint = (f"; -rod_al_penalty {settings.asked_penalty:g} is far below the problem's scale "
                 f"{solver.scale:.3g} (the default): raise it")
     return f"did not converge in {report.iterations} iterations ({numbers}){hint}"
 
@@ -118,7 +119,7 @@ class Predictor:
         self.accepted = []          # (t, tau, lambda) of the last two accepted states
 
     def accept(self, t, solver):
-        self.accepted = self.accepted[-1:] + [(t, solver.tau.copy(), solver.lam.copy())]
+        self.accepted = self.accepted[-1:] + [(t, solver.state.tau.copy(), solver.state.lam.copy())]
 
     def predict(self, solver, t):
         """Set the solver's tau and lambda for load factor t (its current state must be
@@ -127,8 +128,8 @@ class Predictor:
             return
         (t0, tau0, lam0), (t1, tau1, lam1) = self.accepted
         ratio = (t - t1) / (t1 - t0)
-        solver.tau[:] = tau1 + ratio * (tau1 - tau0)
-        solver.lam[:] = lam1 + ratio * (lam1 - lam0)
+        solver.state.tau[:] = tau1 + ratio * (tau1 - tau0)
+        solver.state.lam[:] = lam1 + ratio * (lam1 - lam0)
 
 
 def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
@@ -139,7 +140,7 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     state whose linking number is not ``expected_link`` (turns, link.py) is a failure.
     ``stop()`` (collective), if given, is asked after every iteration whether to stop
     (the report's reason is then STOP_OBSERVER)."""
-    solver.roll_cross_sections(imperfection)
+    solver.state.roll_cross_sections(imperfection)
     observer = None if stop is None else (lambda iteration, change, residual: stop())
     try:
         report = solver.solve_step(t, label=label, observer=observer)
@@ -176,7 +177,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     stop = None if interrupts is None else interrupts.received
     origin = f" from load factor {start:.6g}" if start > 0 else ""
     say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
-        f"R = {solver.settings.penalty:g}, {path.steps} step(s){origin}")
+        f"R = {solver.settings.asked_penalty:g}, {path.steps} step(s){origin}")
     predictor = Predictor()
     predictor.accept(start, solver)
     totals = {"total_iterations": 0, "undone_iterations": 0}
@@ -185,7 +186,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     link = solver.link() if track_link else None
     while not path.finished:
         t, label = path.next_factor, f"step {path.step}/{path.steps}"
-        saved = solver.snapshot()
+        saved = solver.state.snapshot()
         predictor.predict(solver, t)
         report, failure = attempt(solver, t, imperfection, f"{label} ",
                                   expected_link(solver.scene, link, path.factor(path.reached), t),
@@ -198,7 +199,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
         stalled = report is not None and report.stalled
         if failure is not None and path.can_halve and not stalled:
-            solver.restore(saved)
+            solver.state.restore(saved)
             path.halve()
             totals["undone_iterations"] += iterations
             reason = str(failure).removeprefix(f"{label} ")   # a divergence names the step

@@ -10,10 +10,10 @@ n' + f = 0); lambda1 = lambda2 = 0.
 
 import numpy as np
 
-from .boundary import is_held
-from .catenary import catenary, catenary_axes
-from .errors import RodInputError
-from .scene import REFERENCE_FRAME
+from petsc_rod.scenes.boundary import is_held
+from petsc_rod.scenes.catenary import catenary, catenary_axes
+from petsc_rod.errors import RodInputError
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 SHAPES = ("straight", "catenary")
 

@@ -8,7 +8,7 @@ import functools
 import os
 import subprocess
 
-from . import __version__
+from petsc_rod import __version__
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

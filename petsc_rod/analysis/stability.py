@@ -12,7 +12,7 @@ variation is
                       - sum_n w_n sum_i lambda_{n,i} . (omega_n x (omega_n x d_{n,i}))
 
 on the omega with omega_n = 0 at a clamp and, when both ends are held,
-sum_n w_n (omega_n x theta_n) = 0 (the chord int theta dS stays fixed). The state is a
+sum_n w_n (omega_n x tau3_n) = 0 (the chord int r' dS stays fixed). The state is a
 local minimiser when H is positive semi-definite there, a saddle when H has a negative
 eigenvalue. Sylvester's law of inertia counts those without an eigen-solve: the
 symmetric-indefinite factorisation of H (MUMPS) gives the number of negative pivots,
@@ -25,8 +25,8 @@ accelerated one may converge to it, hence this check.
 import numpy as np
 from petsc4py import PETSc
 
-from .fe import P2, p2_element_matrices
-from .fields import element_dofs
+from petsc_rod.mesh.elements import P2, p2_element_matrices
+from petsc_rod.mesh.fields import element_dofs
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
@@ -68,11 +68,11 @@ class SecondVariation:
         self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self._diagonal = self.matrix.getDiagonal()
-        self.constraint = self._chord_columns() if solver.bordered else []
+        self.constraint = self._chord_columns() if solver.global_step.bordered else []
         # a taut, straight rod: the chord fixes the whole state and its forms are
         # dependent; the second variation says nothing there (no constraint
         # qualification), and the state is the only one the ends allow
-        self.decidable = len(self.constraint) == 3 or not solver.bordered
+        self.decidable = len(self.constraint) == 3 or not solver.global_step.bordered
         self.mass = self._mass()
         self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
         self._mass_or_one.getArray()[self._clamped - self.first_row] = 1.0
@@ -86,7 +86,7 @@ class SecondVariation:
         # directors at the 3 nodes of each owned element, (ne, 3 nodes, 3 dirs, 3); the
         # ghost exchange is collective, also on a rank that owns no element
         d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
-                      for f in solver.frame_fields], axis=2)
+                      for f in solver.state.frame_fields], axis=2)
         if ne:
             stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
             x = skew(d)                                      # (ne, node, dir, 3, 3)
@@ -97,7 +97,7 @@ class SecondVariation:
             self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
-        tau, lam, w = solver.tau, solver.lam, solver.node_weights
+        tau, lam, w = solver.state.tau, solver.state.lam, solver.state.node_weights
         outer = np.einsum("nik,nil->nkl", lam, tau)
         dots = np.einsum("nik,nik->n", lam, tau)
         local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
@@ -111,19 +111,19 @@ class SecondVariation:
     def _clamped_rows(self):
         solver, mesh = self.solver, self.solver.mesh
         rows = []
-        if solver.start_state.kind == "clamp" and mesh.on_lower_boundary:
+        if solver.global_step.start_state.kind == "clamp" and mesh.on_lower_boundary:
             rows += [0, 1, 2]
-        if solver.end_state.kind == "clamp" and mesh.on_upper_boundary:
+        if solver.global_step.end_state.kind == "clamp" and mesh.on_upper_boundary:
             last = 3 * 2 * mesh.n_elements
             rows += [last, last + 1, last + 2]
         return np.array(rows, dtype=PETSc.IntType)
 
     def _chord_columns(self):
-        """The 3 linear forms omega -> sum_n w_n (omega_n x theta_n)_k, as Vecs (zero at
+        """The 3 linear forms omega -> sum_n w_n (omega_n x tau3_n)_k, as Vecs (zero at
         clamped rows)."""
         solver = self.solver
-        theta = solver.tau[:, 2]
-        forms = -solver.node_weights[:, None, None] * skew(theta)    # (n, k, 3)
+        tangent = solver.state.tau[:, 2]
+        forms = -solver.state.node_weights[:, None, None] * skew(tangent)    # (n, k, 3)
         columns = []
         for k in range(3):
             vec = self.matrix.createVecLeft()
@@ -154,7 +154,7 @@ class SecondVariation:
         """The lumped mass diag(w_n) on each rotation component (0 at the clamped rows,
         whose unit diagonal no shift moves), as a Vec."""
         vec = self.matrix.createVecLeft()
-        vec.getArray()[:] = np.repeat(self.solver.node_weights, 3)
+        vec.getArray()[:] = np.repeat(self.solver.state.node_weights, 3)
         self._zero_clamped(vec)
         return vec
 

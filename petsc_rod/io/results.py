@@ -30,9 +30,9 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from .capture import stderr_captured
-from .errors import RodInputError, RodIOError, on_every_rank
-from .resources import free_disk, size_text
+from petsc_rod.io.capture import stderr_captured
+from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
+from petsc_rod.resources import free_disk, size_text
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
