@@ -20,7 +20,6 @@ Both ends held: r(L) - r(0) = int_0^L slope dS is a constraint with multiplier m
 import numpy as np
 
 from petsc_rod.scenes.boundary import is_held
-from petsc_rod.mesh.elements import element_integrals
 
 
 def load_offset(start, end, total_load):
@@ -40,15 +39,12 @@ def anchor_work(start, end, total_load):
     return float(anchor.position @ applied)
 
 
-def vertex_positions(mesh, slope, start, end):
-    """r at the owned vertices from the slope's element dofs slope (ne, 3, 3).
-
-    Each element adds int_e slope dS = h (r'_0 + 4 r'_mid + r'_1) / 6; across
+def positions_from_increments(mesh, increments, start, end):
+    """r at the owned vertices from int_e slope dS of the owned elements (ne, 3): across
     ranks the running sum is a prefix sum (Mesh.prefix_sum). From a held start,
     r_i = r(0) + sum_{e < i} int_e slope; from a held end (free start),
     r_i = r(L) - sum_{e >= i} int_e slope. Returns (n_owned, 3).
     """
-    increments = np.einsum("ek,ekc->ec", element_integrals(mesh.element_h), slope)
     before = mesh.prefix_sum(increments)
     if is_held(start):
         return start.position + before

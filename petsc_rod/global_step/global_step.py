@@ -14,10 +14,11 @@ matrices are assembled and factored once per penalty R.
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.centreline import anchor_work, load_offset, vertex_positions
+from petsc_rod.global_step.centreline import (anchor_work, load_offset,
+                                              positions_from_increments)
 from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix, load_ghosted
-from petsc_rod.mesh.elements import P2, element_integrals, p2_element_matrices
-from petsc_rod.mesh.fields import VectorField, element_dofs
+from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
+from petsc_rod.mesh.fields import VectorField, element_slices
 from petsc_rod.scenes import boundary
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("assembly", "rhs", "solve")}
@@ -45,6 +46,11 @@ class GlobalStep:
             self.lagged = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 1.0, 0.0))
             self._lagged_work = self.lagged.createVecs()
         self.problems = []
+        # int_e phi_k dS, (3, ne), and work arrays of the slope's integration
+        self._integrals = np.ascontiguousarray(element_integrals(mesh.element_h).T)
+        self._increments = np.zeros((3, mesh.n_local_elements))
+        self._element_work = np.zeros(mesh.n_local_elements)
+        self._target = np.zeros((mesh.n_local_nodes, 3, 3))      # w (R tau - lambda)
         self.build(penalty)
 
     def build(self, penalty):
@@ -102,16 +108,22 @@ class GlobalStep:
 
     def _assemble_rhs(self, tau, lam, weights):
         """Field i: sum_n w_n (R tau_i - lambda_i) g_n, the lagged part, and for r' the
-        load."""
+        load; w (R tau - lambda) is formed in one work array (n_nodes, 3, 3), and the
+        load added as it is copied into the r' Vecs."""
         n = self.mesh.n_local_nodes
-        target = weights[:, None, None] * (self.penalty * tau - lam)
+        target = np.multiply(tau, self.penalty, out=self._target)
+        target -= lam
+        target *= weights[:, None, None]
         for i, rhs in enumerate(self.rhs):
             for c, vec in enumerate(rhs.components):
                 values = vec.getArray()
-                values[:n] = target[:, i, c]
-                values[n:] = 0.0
-        for vec, load in zip(self.rhs[2].components, self.load.components):
-            vec.axpy(1.0, load)
+                if i == 2:
+                    load = self.load.components[c].getArray(readonly=True)
+                    np.add(target[:, i, c], load[:n], out=values[:n])
+                    values[n:] = load[n:]
+                else:
+                    values[:n] = target[:, i, c]
+                    values[n:] = 0.0
         if self.lagged is not None:
             self._add_lagged_part(tau)
 
@@ -140,9 +152,27 @@ class GlobalStep:
                 self.rhs[2], state.slope, chord)
         else:
             self.slope_problem.solve(self.rhs[2], state.slope)
-        slope = element_dofs(state.slope.ghosted(), self.mesh.element_local, P2)
-        positions = vertex_positions(self.mesh, slope, self.start_state, self.end_state)
-        state.r.set_owned(np.stack([positions, state.slope.owned()[:, 0]], axis=1))
+        self._integrate_slope(state)
+
+    def _integrate_slope(self, state):
+        """r at the vertices from the slope (centreline.positions_from_increments), into
+        the r field with the slope's vertex values: the element dofs are stride-2 views
+        of the slope's ghosted arrays (fields.element_slices), no gather."""
+        mesh = self.mesh
+        ne = mesh.n_local_elements
+        first = int(mesh.element_local[0]) if ne else 0
+        increments, work = self._increments, self._element_work
+        for c, ghosted in enumerate(state.slope.ghosted_components()):
+            left, middle, right = element_slices(ghosted, first, ne)
+            column = np.multiply(self._integrals[0], left, out=increments[c])
+            column += np.multiply(self._integrals[1], middle, out=work)
+            column += np.multiply(self._integrals[2], right, out=work)
+        positions = positions_from_increments(mesh, increments.T, self.start_state,
+                                              self.end_state)
+        for c, (r, slope) in enumerate(zip(state.r.components, state.slope.components)):
+            values = r.getArray()
+            values[0::2] = positions[:, c]
+            values[1::2] = slope.getArray(readonly=True)[0::2]
 
     def load_work(self, state):
         """The work of the loads on the state, J: r(a).(applied forces) + int F.r' dS

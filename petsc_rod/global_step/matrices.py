@@ -193,7 +193,9 @@ class ScalarProblem:
         """
         c, w = self._border
         self.solve(rhs, solution)
-        local = [c.getArray(readonly=True) @ x.getArray(readonly=True)
+        # einsum, not a BLAS dot: a threaded OpenBLAS ddot waits for its threads on a
+        # busy machine (docs/performance.md)
+        local = [np.einsum("i,i->", c.getArray(readonly=True), x.getArray(readonly=True))
                  for x in solution.components]
         mu = (self.mesh.global_sum(np.array(local)) - target) / self._c_dot_w
         for x, value in zip(solution.components, mu):

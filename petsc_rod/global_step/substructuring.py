@@ -14,7 +14,7 @@ interior rows ordered first, A = [A_II A_IG; A_GI A_GG] and
 
 W has two columns per rank (g_p, g_{p+1}) and S is (P-1) x (P-1) and tridiagonal; both
 are formed once per matrix (set-up: two local solves and one allgather), and S is
-factored on every rank (banded LAPACK Cholesky). A solve is then one local half-chain Cholesky
+factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A solve is then one local half-chain Cholesky
 solve per right-hand side, an allgather of 2 k numbers per rank (k right-hand sides),
 the small tridiagonal solve, and x_I -= W x_G: it does the work of the serial Cholesky
 divided by the ranks, where CG with block Jacobi needs several matrix products, local
@@ -24,14 +24,50 @@ solves and reductions per right-hand side (docs/performance.md).
 the same solve as a PETSc python preconditioner (``-rod_d1_pc_type python
 -rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so that KSP
 preonly with it is a direct solver. The PETSc objects (the interior matrix, its factor,
-two work vectors) are created in ChainSolver.__init__ and destroyed in destroy().
+two work vectors, the same for S: SeqCholesky) are created in ChainSolver.__init__ and
+destroyed in ChainSolver.destroy().
 """
 
 import numpy as np
 from petsc4py import PETSc
-from scipy.linalg import cho_solve_banded, cholesky_banded
 
 PYTHON_TYPE = "petsc_rod.global_step.substructuring.InterfacePC"
+
+
+class SeqCholesky:
+    """A sequential sparse SPD matrix given in CSR (indptr, indices, values) with its
+    PETSc Cholesky factor in the natural order (a band matrix: no fill), and
+    solve(b, x) on numpy arrays without copies (the arrays are placed in two Vecs)."""
+
+    def __init__(self, n, indptr, indices, values):
+        self.matrix = PETSc.Mat().createAIJ(
+            (n, n), comm=PETSc.COMM_SELF,
+            csr=(np.asarray(indptr, dtype=PETSc.IntType),
+                 np.asarray(indices, dtype=PETSc.IntType), np.asarray(values, dtype=float)))
+        self.matrix.assemble()
+        self.matrix.setOption(PETSc.Mat.Option.SPD, True)
+        self._pc = PETSc.PC().create(comm=PETSc.COMM_SELF)
+        self._pc.setOperators(self.matrix)
+        self._pc.setType(PETSc.PC.Type.CHOLESKY)
+        self._pc.setFactorOrdering(PETSc.Mat.OrderingType.NATURAL)
+        self._pc.setUp()
+        self.factor = self._pc.getFactorMatrix()
+        self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
+        self._x = self._b.duplicate()
+
+    def solve(self, b, x):
+        """x = A^-1 b, contiguous float arrays (n,)."""
+        self._b.placeArray(b)
+        self._x.placeArray(x)
+        try:
+            self.factor.solve(self._b, self._x)
+        finally:
+            self._b.resetArray()
+            self._x.resetArray()
+
+    def destroy(self):
+        for obj in (self._pc, self.matrix, self._b, self._x):
+            obj.destroy()
 
 
 class NotAChainError(ValueError):
@@ -65,25 +101,16 @@ class ChainSolver:
         left = interior_row & nonzero & (cols == start) & (self.offset == 1)
         right = interior_row & nonzero & (cols == end) & (not self.last)
         stray = interior_row & nonzero & ~inside & ~left & ~right
-        if stray.any():
-            raise NotAChainError(
-                f"row {row_of[stray][0]} couples to row {cols[stray][0]} of another rank")
+        where = (int(row_of[stray][0]), int(cols[stray][0])) if stray.any() else None
+        refused = [pair for pair in self._mpi.allgather(where) if pair is not None]
+        if refused:             # on every rank: the others would wait in the allgather
+            row, col = refused[0]
+            raise NotAChainError(f"row {row} couples to row {col} of another rank: not a "
+                                 "chain split at the ranks' first rows")
         keep = interior_row & inside & (nonzero | (cols == row_of))
         counts = np.bincount(row_of[keep] - first, minlength=n_interior)
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
-        self.interior = PETSc.Mat().createAIJ(
-            (n_interior, n_interior), comm=PETSc.COMM_SELF,
-            csr=(indptr, (cols[keep] - first).astype(PETSc.IntType), values[keep]))
-        self.interior.assemble()
-        self.interior.setOption(PETSc.Mat.Option.SPD, True)
-        self._pc = PETSc.PC().create(comm=PETSc.COMM_SELF)
-        self._pc.setOperators(self.interior)
-        self._pc.setType(PETSc.PC.Type.CHOLESKY)
-        self._pc.setFactorOrdering(PETSc.Mat.OrderingType.NATURAL)   # banded: no fill
-        self._pc.setUp()
-        self.factor = self._pc.getFactorMatrix()
-        self._b = PETSc.Vec().createSeq(n_interior, comm=PETSc.COMM_SELF)
-        self._x = self._b.duplicate()
+        self.interior = SeqCholesky(n_interior, indptr, cols[keep] - first, values[keep])
         # A_IG as two sparse columns (interior indices, values); W = A_II^-1 A_IG
         self._coupling = [(row_of[mask] - first, values[mask]) for mask in (left, right)]
         self.W = np.zeros((2, n_interior))     # rows: columns of W, contiguous
@@ -91,7 +118,7 @@ class ChainSolver:
             if index.size:
                 b = np.zeros(n_interior)
                 b[index] = value
-                self._interior_solve(b, self.W[column])
+                self.interior.solve(b, self.W[column])
         self._factor_interface(matrix, row_of, cols, values, start, end)
 
     def _factor_interface(self, matrix, row_of, cols, values, start, end):
@@ -112,20 +139,16 @@ class ChainSolver:
         n = self.size - 1
         self.diagonal = parts[1:, 0] - parts[1:, 2] - parts[:-1, 4]
         self.off_diagonal = parts[1:-1, 1] - 0.5 * parts[1:-1, 3]
-        banded = np.zeros((2, n))          # upper storage: row 0 the superdiagonal
-        banded[0, 1:] = self.off_diagonal
-        banded[1] = self.diagonal
-        self._schur = cholesky_banded(banded, check_finite=False) if n else None
-
-    def _interior_solve(self, b, x):
-        """x = A_II^-1 b on numpy arrays (n_I,), without copies (placed arrays)."""
-        self._b.placeArray(b)
-        self._x.placeArray(x)
-        try:
-            self.factor.solve(self._b, self._x)
-        finally:
-            self._b.resetArray()
-            self._x.resetArray()
+        self.schur = None
+        if n:
+            rows = np.arange(n)
+            indices = np.stack([rows - 1, rows, rows + 1], axis=1)
+            entries = np.stack([np.r_[0.0, self.off_diagonal], self.diagonal,
+                                np.r_[self.off_diagonal, 0.0]], axis=1)
+            inside = (indices >= 0) & (indices < n)
+            self.schur = SeqCholesky(n, np.r_[0, np.cumsum(inside.sum(axis=1))],
+                                     indices[inside], entries[inside])
+            self._interface = np.zeros(n)
 
     def solve(self, rhs, solution):
         """solution = A^-1 rhs for k right-hand sides: lists of k local arrays (n,) of
@@ -134,7 +157,7 @@ class ChainSolver:
         off = self.offset
         sent = np.zeros((2, k))
         for c, (b, x) in enumerate(zip(rhs, solution)):
-            self._interior_solve(b[off:], x[off:])
+            self.interior.solve(b[off:], x[off:])
             (left_index, left_value), (right_index, right_value) = self._coupling
             if off:
                 sent[0, c] = b[0] - left_value @ x[off:][left_index]
@@ -144,11 +167,13 @@ class ChainSolver:
             return
         parts = np.empty((self.size, 2, k))
         self._mpi.Allgather(sent, parts)
-        interface = cho_solve_banded((self._schur, False), parts[1:, 0] + parts[:-1, 1],
-                                     check_finite=False)
+        rhs_interface = parts[1:, 0] + parts[:-1, 1]          # (P-1, k)
         rank = self._mpi.Get_rank()
-        own = interface[rank - 1] if off else np.zeros(k)
-        following = interface[rank] if not self.last else np.zeros(k)
+        own, following = np.zeros(k), np.zeros(k)
+        for c in range(k):
+            self.schur.solve(np.ascontiguousarray(rhs_interface[:, c]), self._interface)
+            own[c] = self._interface[rank - 1] if off else 0.0
+            following[c] = self._interface[rank] if not self.last else 0.0
         for c, x in enumerate(solution):
             interior = x[off:]
             interior -= own[c] * self.W[0]
@@ -157,8 +182,9 @@ class ChainSolver:
                 x[0] = own[c]
 
     def destroy(self):
-        for obj in (self._pc, self.interior, self._b, self._x):
-            obj.destroy()
+        for obj in (self.interior, self.schur):
+            if obj is not None:
+                obj.destroy()
 
 
 class InterfacePC:

@@ -220,13 +220,14 @@ class UzawaSolver:
     def _pack(self, x):
         """x = sqrt(w) (tau, lambda / R), (n_nodes, 2, 3, 3) in the SNES vector."""
         values = x.getArray().reshape(-1, 2, 3, 3)
-        values[:, 0] = self._root_weights * self.state.tau
-        values[:, 1] = self._root_weights * self.state.lam / self.penalty
+        np.multiply(self._root_weights, self.state.tau, out=values[:, 0])
+        np.multiply(self._root_weights, self.state.lam, out=values[:, 1])
+        values[:, 1] /= self.penalty
 
     def _unpack(self, x):
         values = x.getArray(readonly=True).reshape(-1, 2, 3, 3)
-        self.state.tau[:] = values[:, 0] / self._root_weights
-        self.state.lam[:] = values[:, 1] * (self.penalty / self._root_weights)
+        np.divide(values[:, 0], self._root_weights, out=self.state.tau)
+        np.multiply(values[:, 1], self.penalty / self._root_weights, out=self.state.lam)
 
     def iterate(self):
         """One iteration (docs/method.md §3): global step, local step (nearest rotation of
@@ -235,7 +236,9 @@ class UzawaSolver:
         self.global_step.solve(state)
         EVENTS["projection"].begin()
         directors = state.take_directors()
-        nearest_rotation(R * directors + state.lam, out=state.tau)
+        b = np.multiply(directors, R, out=state.tau)       # b = R d + lambda, in place
+        b += state.lam
+        nearest_rotation(b, out=state.tau)
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)

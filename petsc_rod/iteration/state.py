@@ -15,6 +15,7 @@ from petsc_rod.global_step.centreline import midpoint_slopes, positions_at_point
 from petsc_rod.mesh.elements import GAUSS_POINTS, P2, p2_basis, p2_integrals
 from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
 from petsc_rod.frames import rotations
+from petsc_rod.iteration.node_values import NodeValues
 from petsc_rod.scenes import starts
 
 
@@ -32,9 +33,7 @@ class RodState:
         self.node_weights = mesh.node_weights()
         h = mesh.element_h
         self._gauss = p2_basis(GAUSS_POINTS, h), p2_integrals(GAUSS_POINTS, h)
-        self._directors = np.zeros(shape)
-        self._positions = np.zeros((mesh.n_local_nodes, 3))
-        self._previous = None
+        self._nodes = NodeValues(mesh)
 
     @property
     def frame_fields(self):
@@ -139,23 +138,15 @@ class RodState:
     # --- values at nodes and points ---------------------------------------------------
     def node_directors(self):
         """d1, d2 and r' = d3 at the owned P2 nodes, rows, (n_nodes, 3, 3): the dofs of
-        the fields themselves (the phantom slot of the last vertex left out)."""
-        n = self.mesh.n_local_nodes
-        return np.stack([np.stack([c.getArray(readonly=True)[:n] for c in f.components],
-                                  axis=-1) for f in self.frame_fields], axis=1)
+        the fields themselves (the phantom slot of the last vertex left out). The array
+        is the state's own, overwritten by the next call (node_values.py)."""
+        return self._nodes.take_directors(self.frame_fields)
 
     def node_positions(self):
         """r at the owned P2 nodes, (n_nodes, 3): the vertex values, and at each midpoint
         r(S_e) + int r' over the element's first half, h (5 r'_0 + 8 r'_m - r'_1) / 24
-        (exact for the P2 slope)."""
-        mesh = self.mesh
-        slope = element_dofs(self.slope.ghosted(), mesh.element_local, P2)
-        vertices = self.r.owned()[:, 0]
-        r = np.empty((mesh.n_local_nodes, 3))
-        r[0::2] = vertices
-        r[1::2] = vertices[:mesh.n_local_elements] + np.einsum(
-            "ek,ekc->ec", p2_integrals(np.array([0.5]), mesh.element_h)[:, 0], slope)
-        return r
+        (exact for the P2 slope). The state's own array, overwritten by the next call."""
+        return self._nodes.take_positions(self.r, self.slope)
 
     def point_values(self):
         """r, directors and their derivatives at the Gauss points of the owned elements."""
@@ -178,35 +169,27 @@ class RodState:
     # --- the stopping quantities ------------------------------------------------------
     def remember(self):
         """Take the current fields as the reference of the next change."""
-        self._directors = self.node_directors()
-        self._positions = self.node_positions()
-        self._previous = self._stacked()
-
-    def _stacked(self):
-        """(r, d1, d2, r') at the owned nodes, (n_nodes, 4, 3)."""
-        return np.concatenate([self._positions[:, None, :], self._directors], axis=1)
+        self.node_directors()
+        self.node_positions()
+        self._nodes.remember()
 
     def take_directors(self):
         """The node directors of the fields the global step just solved for, kept for
         the residual of ``norms`` (n_nodes, 3, 3)."""
-        self._directors = self.node_directors()
-        return self._directors
+        return self.node_directors()
 
     def norms(self):
         """Relative change of X = (r, d1, d2, r') since the last call and RMS constraint
         residual at the nodes (docs/method.md §6):
 
             change = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2),
-            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L)   (one allreduce).
+            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L)   (one allreduce),
+
+        d_n the directors of the last take_directors (or remember).
         """
-        self._positions = self.node_positions()
-        current = self._stacked()
-        w = self.node_weights
-        gap = w @ np.sum((self._directors - self.tau) ** 2, axis=(1, 2))
-        size = w @ np.sum(current**2, axis=(1, 2))
-        step = w @ np.sum((current - self._previous) ** 2, axis=(1, 2))
-        gap, size, step = self.mesh.global_sum(np.array([gap, size, step]))
-        self._previous = current
+        self.node_positions()
+        gap, size, step = self.mesh.global_sum(
+            self._nodes.stopping_sums(self.tau, self.node_weights))
         change = np.sqrt(step / size) if size > 0 else np.inf
         return change, np.sqrt(gap / self.mesh.length)
 

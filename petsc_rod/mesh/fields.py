@@ -27,6 +27,13 @@ class VectorField:
         return np.stack([loc.getArray(readonly=True).reshape(-1, 2) for loc in self._local],
                         axis=-1)
 
+    def ghosted_components(self):
+        """Ghosted local values as the three components' arrays (2 n_ghosted,), slots
+        interleaved: views of the local Vecs, valid until the next ghost update."""
+        for glob, loc in zip(self.components, self._local):
+            self.mesh.da.globalToLocal(glob, loc)
+        return [loc.getArray(readonly=True) for loc in self._local]
+
     def owned(self):
         """Owned values, (n_owned_vertices, 2, 3) (a copy)."""
         return np.stack([vec.getArray(readonly=True).reshape(-1, 2) for vec in self.components],
@@ -47,6 +54,17 @@ class VectorField:
     def destroy(self):
         for vec in self.components + self._local:
             vec.destroy()
+
+
+def element_slices(ghosted, first, n_elements):
+    """The P2 element dofs (left vertex, midpoint, right vertex) of ``n_elements``
+    consecutive elements, the first with its left vertex at ghosted vertex ``first``, as
+    three stride-2 views of one component's ghosted array (2 n_ghosted,): what
+    element_dofs gathers, without a copy."""
+    base = 2 * first
+    return (ghosted[base:base + 2 * n_elements:2],
+            ghosted[base + 1:base + 2 * n_elements:2],
+            ghosted[base + 2:base + 2 * n_elements + 1:2])
 
 
 def element_dofs(ghosted, element_local, element):

@@ -1,0 +1,218 @@
+"""The substructuring solve of the global step (global_step/substructuring.py).
+
+On COMM_WORLD the chain matrices are split over the ranks; the solve must agree with
+PETSc's serial Cholesky factorisation of the same matrix on one rank to round-off, for
+the plain and the bordered (chord-constrained) problem, for partitions where a rank owns
+a single vertex, and through the KSP (python PC) as well as through ScalarProblem's
+multiple right-hand-side path. Under a serial run COMM_WORLD is one rank: the solve is
+then the interior Cholesky alone.
+"""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import gather
+from petsc_rod.global_step import substructuring
+from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix
+from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
+from petsc_rod.mesh.fields import VectorField
+from petsc_rod.mesh.mesh import Mesh
+
+# round-off of a direct solve of these matrices (condition ~ 1e4 to 1e6 here), relative
+# to the size of the solution
+ROUND_OFF = 1e-12
+
+
+def chain_matrix(comm, n_elements, prescribed_rows=()):
+    """A graded mesh's P2 matrix 2 K + 50 W with the given rows made identity rows."""
+    mesh = Mesh(comm, n_elements, 2.0, grading=3.0)
+    matrix = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 2.0, 50.0))
+    rows = np.array(prescribed_rows, dtype=PETSc.IntType)
+    start, end = matrix.getOwnershipRange()
+    matrix.zeroRowsColumns(rows[(rows >= start) & (rows < end)], diag=1.0)
+    return mesh, matrix
+
+
+def right_hand_sides(mesh, k):
+    """k smooth-and-rough right-hand sides on the owned rows, the same on any partition."""
+    start, end = 2 * mesh.vertex_start, 2 * mesh.vertex_end
+    rows = np.arange(start, end)
+    return [np.sin(0.37 * (j + 1) * rows) + (j + 1) * np.cos(0.011 * rows) for j in range(k)]
+
+
+def serial_cholesky(n_elements, prescribed_rows, rhs):
+    """The reference: PETSc's Cholesky of the whole matrix on one rank."""
+    mesh, matrix = chain_matrix(PETSc.COMM_SELF, n_elements, prescribed_rows)
+    ksp = PETSc.KSP().create(comm=PETSc.COMM_SELF)
+    try:
+        ksp.setOperators(matrix)
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        ksp.getPC().setType(PETSc.PC.Type.CHOLESKY)
+        b, x = matrix.createVecs()
+        out = []
+        for column in rhs:
+            b.getArray()[:] = column
+            ksp.solve(b, x)
+            out.append(x.getArray().copy())
+        b.destroy()
+        x.destroy()
+        return out
+    finally:
+        ksp.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("n_elements", [1, 3, 7, 40])
+def test_chain_solver_agrees_with_serial_cholesky(n_elements):
+    comm = PETSc.COMM_WORLD
+    if comm.getSize() > n_elements + 1:
+        pytest.skip("fewer vertices than ranks")
+    fixed = (0, 1, 2 * n_elements, 2 * n_elements + 1)      # clamp, clamp, phantom
+    mesh, matrix = chain_matrix(comm, n_elements, fixed)
+    solver = substructuring.ChainSolver(matrix)
+    try:
+        rhs = right_hand_sides(mesh, 3)
+        solution = [np.zeros_like(column) for column in rhs]
+        solver.solve(rhs, solution)
+        whole = [gather(comm, x) for x in solution]
+        reference = serial_cholesky(n_elements, fixed, [gather(comm, b) for b in rhs])
+        for x, y in zip(whole, reference):
+            assert np.abs(x - y).max() <= ROUND_OFF * np.abs(y).max()
+        # and it solves the system: A x = b on the owned rows
+        b, x = matrix.createVecs()
+        x.getArray()[:] = solution[1]
+        matrix.mult(x, b)
+        assert np.abs(b.getArray() - rhs[1]).max() <= ROUND_OFF * np.abs(rhs[1]).max()
+        b.destroy()
+        x.destroy()
+    finally:
+        solver.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_every_rank_owns_interior_rows_and_the_interface_is_one_row_per_boundary():
+    comm = PETSc.COMM_WORLD
+    mesh, matrix = chain_matrix(comm, 20, (41,))      # the phantom slot pinned
+    solver = substructuring.ChainSolver(matrix)
+    try:
+        start, end = matrix.getOwnershipRange()
+        assert solver.interior.matrix.getSize()[0] == end - start - (comm.getRank() > 0)
+        assert solver.diagonal.shape == (comm.getSize() - 1,)
+        assert solver.off_diagonal.shape == (max(comm.getSize() - 2, 0),)
+        assert np.all(solver.diagonal > 0)
+    finally:
+        solver.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_a_matrix_that_is_no_chain_is_refused():
+    comm = PETSc.COMM_WORLD
+    if comm.getSize() == 1:
+        pytest.skip("one rank: every matrix is its own interior block")
+    mesh, matrix = chain_matrix(comm, 20)
+    try:
+        # couple the first row with the last: an interior row of the first rank with an
+        # interior row of the last
+        big = matrix.getSize()[0] - 2
+        coupled = PETSc.Mat().createAIJ(matrix.getSizes(), nnz=(8, 8), comm=comm)
+        coupled.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        rows, cols, values = matrix.getValuesCSR()
+        start, _ = matrix.getOwnershipRange()
+        for i in range(len(rows) - 1):
+            coupled.setValues(start + i, cols[rows[i]:rows[i + 1]], values[rows[i]:rows[i + 1]])
+        if comm.getRank() == 0:
+            coupled.setValue(1, big, 0.01)
+            coupled.setValue(big, 1, 0.01)
+        coupled.assemble()
+        with pytest.raises(substructuring.NotAChainError):
+            substructuring.ChainSolver(coupled)
+        coupled.destroy()
+    finally:
+        matrix.destroy()
+        mesh.destroy()
+
+
+def problem_on(comm, prefix, bordered):
+    """A ScalarProblem of a clamped start and a pinned end (phantom pinned), and its
+    solution for three right-hand sides; with ``bordered`` the chord constraint too."""
+    n_elements = 30
+    mesh = Mesh(comm, n_elements, 2.0, grading=2.0)
+    prescribed = [(0, 0, np.array([0.0, 0.6, 0.8])), (n_elements, 1, np.zeros(3))]
+    problem = ScalarProblem(mesh, p2_element_matrices(mesh.element_h, 3.0, 20.0),
+                            prescribed, prefix)
+    rhs, solution = VectorField(mesh, "rhs"), VectorField(mesh, "x")
+    try:
+        problem.set_prescribed(prescribed)
+        for c, vec in enumerate(rhs.components):
+            vec.getArray()[:] = right_hand_sides(mesh, 3)[c]
+        multiplier = None
+        if bordered:
+            problem.add_integral_constraint(element_integrals(mesh.element_h))
+            multiplier = problem.solve_constrained(rhs, solution, np.array([1.2, 0.3, -0.4]))
+        else:
+            problem.solve(rhs, solution)
+        kind = problem.ksp.getPC().getType()
+        return gather(comm, solution.owned()), multiplier, kind
+    finally:
+        problem.destroy()
+        rhs.destroy()
+        solution.destroy()
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("bordered", [False, True])
+def test_scalar_problem_on_all_ranks_agrees_with_one_rank(bordered):
+    """The default solver on COMM_WORLD (the substructuring PC on several ranks) against
+    the serial default (Cholesky) on COMM_SELF: the fields and the chord multiplier."""
+    many, mu_many, kind = problem_on(PETSc.COMM_WORLD, "test_sub_", bordered)
+    one, mu_one, _ = problem_on(PETSc.COMM_SELF, "test_sub_", bordered)
+    if PETSc.COMM_WORLD.getSize() > 1:
+        assert kind == PETSc.PC.Type.PYTHON
+    assert np.abs(many - one).max() <= ROUND_OFF * np.abs(one).max()
+    assert np.abs(many[0, 0] - [0.0, 0.6, 0.8]).max() == 0.0      # the clamp, exactly
+    if bordered:
+        assert np.abs(mu_many - mu_one).max() <= ROUND_OFF * np.abs(mu_one).max()
+
+
+def test_the_python_pc_is_selected_by_options_and_solves_through_ksp():
+    """-<prefix>pc_type python with the PC's class: exact through KSPSolve (the path of
+    any caller that is not ScalarProblem.solve), on one rank too."""
+    comm = PETSc.COMM_WORLD
+    fixed = (0, 81)
+    mesh, matrix = chain_matrix(comm, 40, fixed)
+    database = PETSc.Options()
+    names = {"test_pc_pc_type": "python",
+             "test_pc_pc_python_type": substructuring.PYTHON_TYPE}
+    for name, value in names.items():
+        database.setValue(name, value)
+    ksp = PETSc.KSP().create(comm=comm)
+    try:
+        ksp.setOperators(matrix)
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        ksp.setOptionsPrefix("test_pc_")
+        ksp.setFromOptions()
+        assert ksp.getPC().getType() == PETSc.PC.Type.PYTHON
+        b, x = matrix.createVecs()
+        b.getArray()[:] = right_hand_sides(mesh, 1)[0]
+        ksp.solve(b, x)
+        assert ksp.getConvergedReason() > 0
+        reference, = serial_cholesky(40, fixed, [gather(comm, b.getArray())])
+        whole = gather(comm, x.getArray())
+        assert np.abs(whole - reference).max() <= ROUND_OFF * np.abs(reference).max()
+        b.destroy()
+        x.destroy()
+    finally:
+        for name in names:
+            database.delValue(name)
+        ksp.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_one_rank_keeps_the_cholesky_factorisation():
+    _, _, kind = problem_on(PETSc.COMM_SELF, "test_sub_", False)
+    assert kind == PETSc.PC.Type.CHOLESKY
