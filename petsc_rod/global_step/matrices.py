@@ -47,6 +47,10 @@ def assemble_matrix(mesh, element_matrices):
 # slow solve phase on chains) are slower (docs/performance.md).
 PARALLEL_DEFAULTS = {"ksp_type": "preonly", "pc_type": "python",
                      "pc_python_type": substructuring.PYTHON_TYPE}
+# On one rank: PETSc's Cholesky in the natural order, in which the chain is a band
+# matrix: no fill (the default nested dissection order of PCCHOLESKY fills in and is
+# slower here, docs/performance.md).
+SERIAL_DEFAULTS = {"pc_factor_mat_ordering_type": "natural"}
 
 
 class ScalarProblem:
@@ -54,8 +58,8 @@ class ScalarProblem:
 
     ``element_matrices`` (ne, 3, 3) are summed into the DMDA matrix; ``prescribed`` is a
     list of (vertex, slot, value) whose rows are constrained. KSP options are read with
-    ``prefix``; the default is a direct Cholesky factorisation on one rank and
-    PARALLEL_DEFAULTS on several.
+    ``prefix``; the default is SERIAL_DEFAULTS (a direct Cholesky factorisation) on one
+    rank and PARALLEL_DEFAULTS on several.
     """
 
     def __init__(self, mesh, element_matrices, prescribed, prefix):
@@ -83,9 +87,9 @@ class ScalarProblem:
         pc = self.ksp.getPC()
         pc.setType(PETSc.PC.Type.CHOLESKY)
         self.ksp.setOptionsPrefix(prefix)
-        parallel = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}
+        defaults = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else SERIAL_DEFAULTS
         set_from_options_with_defaults(
-            self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
+            self.ksp, {f"{prefix}{key}": value for key, value in defaults.items()})
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor, self._columns = self._direct_solver()

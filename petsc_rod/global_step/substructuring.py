@@ -114,6 +114,7 @@ class ChainSolver:
         # A_IG as two sparse columns (interior indices, values); W = A_II^-1 A_IG
         self._coupling = [(row_of[mask] - first, values[mask]) for mask in (left, right)]
         self.W = np.zeros((2, n_interior))     # rows: columns of W, contiguous
+        self._work = np.zeros(n_interior)
         for column, (index, value) in enumerate(self._coupling):
             if index.size:
                 b = np.zeros(n_interior)
@@ -174,10 +175,12 @@ class ChainSolver:
             self.schur.solve(np.ascontiguousarray(rhs_interface[:, c]), self._interface)
             own[c] = self._interface[rank - 1] if off else 0.0
             following[c] = self._interface[rank] if not self.last else 0.0
+        work = self._work
         for c, x in enumerate(solution):
             interior = x[off:]
-            interior -= own[c] * self.W[0]
-            interior -= following[c] * self.W[1]
+            for column, value in ((0, own[c]), (1, following[c])):
+                if self._coupling[column][0].size:      # W's column is zero otherwise
+                    interior -= np.multiply(self.W[column], value, out=work)
             if off:
                 x[0] = own[c]
 

@@ -6,7 +6,7 @@ the midpoint value of the element to its right), so its first n_nodes entries ar
 owned node values in node order (the last vertex's midpoint slot is a phantom). Hence:
 
 * node directors D (n_nodes, 3 rows d1 d2 r', 3 components): 9 strided copies of Vec
-  prefixes, into the same array every iteration;
+  prefixes, block by block (``blocks``), into the same array every iteration;
 * r at the nodes: the vertex values of r, and at the midpoint of element e
   r(S_e) + h (5 r'_0 + 8 r'_m - r'_1) / 24 (exact for the P2 slope), the element dofs
   r'_0, r'_m, r'_1 being stride-2 slices of the slope's ghosted arrays
@@ -18,11 +18,8 @@ owned node values in node order (the last vertex's midpoint slot is a phantom). 
 
 import numpy as np
 
-from petsc_rod.mesh.fields import element_slices
+from petsc_rod.mesh.fields import CHUNK, blocks, element_slices
 
-# nodes per block of the stopping sums: the block's differences (CHUNK x 9 doubles, 288
-# KiB) stay in a core's 1 MiB L2 cache
-CHUNK = 4096
 # r(S_e + h/2) - r(S_e) = h (5 r'_0 + 8 r'_m - r'_1) / 24 for the P2 slope
 HALF_ELEMENT = np.array([5.0, 8.0, -1.0]) / 24.0
 
@@ -44,10 +41,14 @@ class NodeValues:
         self._element_work = np.zeros(ne)
 
     def take_directors(self, fields):
-        """D[:, i, c] = component c of field i at the nodes (fields d1, d2, r')."""
-        for i, field in enumerate(fields):
-            for c, vec in enumerate(field.components):
-                self.directors[:, i, c] = vec.getArray(readonly=True)[:self.n]
+        """D[:, i, c] = component c of field i at the nodes (fields d1, d2, r'), block by
+        block: the block of D a column is scattered into stays in cache."""
+        sources = [(i, c, vec.getArray(readonly=True)) for i, field in enumerate(fields)
+                   for c, vec in enumerate(field.components)]
+        for block in blocks(self.n):
+            rows = self.directors[block]
+            for i, c, values in sources:
+                rows[:, i, c] = values[block]
         return self.directors
 
     def take_positions(self, r, slope):
@@ -85,9 +86,9 @@ class NodeValues:
         tau = tau.reshape(n, 9)
         positions, previous_positions = self.positions, self.previous_positions
         sums = np.zeros(3)          # gap, size, step
-        for lo in range(0, n, CHUNK):
-            hi = min(lo + CHUNK, n)
-            w, rows, work = weights[lo:hi], self._rows[:hi - lo], self._scratch[:hi - lo]
+        for block in blocks(n):
+            size = block.stop - block.start
+            w, rows, work = weights[block], self._rows[:size], self._scratch[:size]
 
             def weighted(a, b=None):
                 """sum_n w_n |a_n - b_n|^2 over the block's rows."""
@@ -95,10 +96,10 @@ class NodeValues:
                     a = np.subtract(a, b, out=work[:, :a.shape[1]])
                 return w @ np.einsum("nk,nk->n", a, a, out=rows)
 
-            d, p = directors[lo:hi], positions[lo:hi]
-            sums[0] += weighted(d, tau[lo:hi])
+            d, p = directors[block], positions[block]
+            sums[0] += weighted(d, tau[block])
             sums[1] += weighted(d) + weighted(p)
-            sums[2] += weighted(d, previous[lo:hi]) + weighted(p, previous_positions[lo:hi])
+            sums[2] += weighted(d, previous[block]) + weighted(p, previous_positions[block])
         self.directors, self.previous_directors = self.previous_directors, self.directors
         self.positions, self.previous_positions = self.previous_positions, self.positions
         return sums
