@@ -41,13 +41,14 @@ def global_max(comm, value):
     return mpi.allreduce(float(value), op=MPI.MAX)
 
 
-def continuation(solver, steps=1, imperfection=0.0):
-    """From the straight state to load factor 1 as the CLI does it; the last StepReport."""
+def continuation(solver, steps=1, imperfection=0.0, **options):
+    """From the straight state to load factor 1 by the CLI's continuation loop (halving
+    and link check included; ``options`` as iteration.continuation.continuation takes
+    them); the last StepReport."""
+    from petsc_rod.iteration.continuation import continuation as run
+
     solver.state.set_straight()
-    for k in range(1, steps + 1):
-        solver.state.roll_cross_sections(imperfection)
-        report = solver.solve_step(k / steps)
-    return report
+    return run(solver, steps, imperfection, **options).report
 
 
 # Variables an enclosing mpiexec sets for its own processes: a child must not inherit

@@ -61,7 +61,7 @@ def run_continuation(solver_factory, comm, case, steps, max_halvings):
     final state gathered on every rank)."""
     mesh, solver = build(solver_factory, comm, case)
     lines = []
-    code = continuation(solver, steps, 0.0, None, lines.append, "", max_halvings)
+    code = continuation(solver, steps, say=lines.append, max_halvings=max_halvings).code
     state = {name: gather(comm, array) for name, array in owned_state(solver).items()}
     state["energy"] = solver.energy()
     return code, lines, state
