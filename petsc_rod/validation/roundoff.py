@@ -49,7 +49,7 @@ def centreline_solve_error(solver, t=1.0):
     discrete solution is slope* (and mu = MULTIPLIER when both ends are held).
 
     The right-hand side is A slope* (+ mu int g), with A the full slope matrix; the
-    solve is the run's (UzawaSolver.solve_centreline). Overwrites the solver's state.
+    solve is the run's (GlobalStep.solve_centreline). Overwrites the solver's state.
     """
     mesh, problem = solver.mesh, solver.global_step.slope_problem
     solver.prepare_step(t)
