@@ -1,4 +1,4 @@
-"""Error against wall time over elements, penalty and stopping tolerances (issue 3).
+"""Error against wall time over elements, penalty and stopping tolerances (docs/error_vs_time.md).
 
 One command:
     python scripts/error_vs_time.py [--quick] [--out docs/error_vs_time]
