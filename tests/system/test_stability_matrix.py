@@ -12,11 +12,11 @@ import os
 import numpy as np
 import pytest
 
-from helpers import child_env
+from helpers import REPO_ROOT, child_env
 
 pytestmark = pytest.mark.serial
 
-SCRIPT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+SCRIPT = os.path.join(REPO_ROOT,
                       "scripts", "stability_matrix.py")
 
 
