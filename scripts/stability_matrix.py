@@ -23,7 +23,7 @@ first measures of docs/stability.md switched off (the old default penalty
 400 max(K)/L^2, the straight start, no step halving, no link check, no raise of a low
 penalty): the "before" table of docs/stability.md (History B). ``--only`` reruns the cases whose names contain one of the words
 and merges them into the CSV and the table of the last full run. ``--ci`` runs the
-small subset the tests run on 1 and 2 ranks (tests/test_stability_matrix.py), printed,
+small subset the tests run on 1 and 2 ranks (tests/system/test_stability_matrix.py), printed,
 not written. The full
 matrix takes about half an hour on two cores, most of it the 10^6-element catenary.
 """

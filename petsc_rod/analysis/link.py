@@ -45,7 +45,7 @@ def link_integrands(directors, derivatives, axis):
 
 # A step whose Lk differs from the expected one by more than this (turns) changed its
 # class: whole turns are lost or gained, the discretisation error is far smaller
-# (tests/test_link.py).
+# (tests/unit/test_link_formulas.py).
 LINK_TOLERANCE = 0.25
 
 

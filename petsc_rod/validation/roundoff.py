@@ -6,7 +6,7 @@ slope*(S) = A N0(s) + M N1(s) + B N2(s) (s = S/L, N_k the P2 shape functions on
 is a cubic known in closed form: the recovered r has no discretisation error, only
 round-off. slope* takes the prescribed slope at a clamped end, and when both ends are
 held M makes int_0^L slope* dS the prescribed chord. Used by
-scripts/linear_solve_roundoff.py and tests/test_centreline.py.
+scripts/linear_solve_roundoff.py and tests/solver/test_centreline.py.
 """
 
 import numpy as np
