@@ -1,4 +1,4 @@
-"""The centreline solved through its slope theta = r' (petsc_rod/centreline.py).
+"""The centreline solved through its slope r' (petsc_rod/global_step/centreline.py).
 
 * One global step equals the paper's Hermite-cubic step for r (a dense numpy solve of
   int 2 a3 r''.p'' + R r'.p' = int (R tau3 - lambda3).p' + int f.p + end forces, with

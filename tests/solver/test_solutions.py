@@ -1,7 +1,7 @@
 """Solutions against closed forms, observed convergence orders, and the paper's branch.
 
 Serial and under mpiexec -n 2 (global quantities only). Bounds come from measured runs
-(README, "Accuracy"); none is looser than needed to hold the measured value with a margin
+(docs/accuracy.md); none is looser than needed to hold the measured value with a margin
 for the 1-rank / 2-rank round-off difference.
 """
 
