@@ -33,10 +33,9 @@ def not_converged_reason(report, solver):
                 "curvature each time: take more -rod_steps, or -rod_imperfection")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
-                "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
-                "h^3) lies above them (use more -rod_elements or looser tolerances), or a "
-                "symmetry holds the iterate (a straight rod shortened along its axis: move "
-                "the end off the axis)")
+                "would not meet the tolerances within -rod_al_max_it: tolerances near round-off "
+                "for this mesh and these forces (loosen them), or a slowly contracting "
+                "iteration (take more -rod_steps or a larger -rod_al_max_it)")
     hint = ""
     if settings.asked_penalty < 0.1 * solver.scale:
         hint = (f"; -rod_al_penalty {settings.asked_penalty:g} is far below the problem's scale "
@@ -226,7 +225,7 @@ def continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, opti
                               f"{report.iterations}", path)
         iterations = (failure.iterations or 0) if report is None else report.iterations
         totals["total_iterations"] += iterations
-        # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
+        # a stalled step is not halved: a smaller step does not move what stops it
         stalled = report is not None and report.stalled
         if failure is not None and path.can_halve and not stalled:
             solver.state.restore(saved)
