@@ -14,12 +14,13 @@ def strains(d, dd):
     rate of rotation omega (§1, §6). d, dd: (..., 3, 3), rows d1, d2, d3 and d1', d2',
     d3'; returns (..., 3).
 
-    For an orthonormal frame, d_i' = omega x d_i, i.e. [omega]x = D'^T D (D the matrix of
+    For a field of rotations, d_i' = omega x d_i, i.e. [omega]x = D'^T D (D the matrix of
     rows d_i), and u_i = d_i . omega gives u1 = d2'.d3, u2 = d3'.d1, u3 = d1'.d2. The
     discrete directors are orthonormal at the nodes only; in general [omega]x is taken as
     the skew part of D'^T D^-T: what rotates counts, the small stretch and shear of the
-    interpolated directors between the nodes (a discretisation artefact) does not. It
-    makes the energy's discretisation error several times smaller (docs/accuracy.md).
+    interpolated directors between the nodes (a discretisation artefact) does not (at a
+    node this is u1 = (d2'.d3 - d3'.d2) / 2 and the like). It makes the energy's
+    discretisation error several times smaller (docs/accuracy.md).
     A singular D (a frame with a zero director) takes the pseudo-inverse.
     """
     shape = np.shape(d)
