@@ -14,9 +14,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+DPI = 110
+
 
 def plot_result(path, output):
     """Write the figure of result file ``path`` to ``output`` (PNG)."""
+    figure = result_figure(path)
+    figure.savefig(output, dpi=DPI)
+    plt.close(figure)
+
+
+def result_figure(path):
+    """The figure of result file ``path``: three projections of r, and u against S."""
     with h5py.File(path, "r") as f:
         S, r, u = f["S"][:], f["r"][:], f["u"][:]
         converged = int(f.attrs["converged"])
@@ -37,8 +46,7 @@ def plot_result(path, output):
     axes[3].set_title("bending u1, u2 and twist u3")
     status = "converged" if converged else "NOT converged"
     figure.suptitle(f"{path}: {status}, energy {energy:.6g} J")
-    figure.savefig(output, dpi=110)
-    plt.close(figure)
+    return figure
 
 
 def main(argv):

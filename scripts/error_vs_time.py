@@ -1,4 +1,4 @@
-"""Error against wall time over elements, penalty and stopping tolerances (issue 3).
+"""Error against wall time over elements, penalty and stopping tolerances (docs/error_vs_time.md).
 
 One command:
     python scripts/error_vs_time.py [--quick] [--out docs/error_vs_time]
@@ -99,7 +99,7 @@ class CantileverReference:
 
 
 class TwistReference:
-    energy = 0.25          # K3 theta^2 / (2 L)
+    energy = 0.25          # K3 a^2 / (2 L), a = 1 rad the end roll
     u3 = 1.0
 
     def fields(self, S):
@@ -166,6 +166,7 @@ def run_one(comm, name, n_elements, penalty, reference):
     """One mesh and penalty: a row for each tolerance pair the last step reached."""
     from petsc_rod.mesh.mesh import Mesh
     from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.continuation import continuation
     from petsc_rod.iteration.driver import UzawaSolver
     from petsc_rod.iteration.stopping import Settings
 
@@ -178,12 +179,12 @@ def run_one(comm, name, n_elements, penalty, reference):
         clock = time.perf_counter()
         solver.state.set_straight()
         earlier = 0                 # iterations of the continuation steps before the last
-        for k in range(1, steps):
-            solver.state.roll_cross_sections(imperfection)
-            report = solver.solve_step(k / steps)
-            if not report.converged:
-                raise RuntimeError(f"{name}: continuation step {k} did not converge")
-            earlier += report.iterations
+        if steps > 1:
+            before = continuation(solver, steps - 1, imperfection, end=(steps - 1) / steps)
+            if not before.converged:
+                raise RuntimeError(f"{name}: the continuation to the last step did not "
+                                   "converge")
+            earlier = before.iterations
         solver.state.roll_cross_sections(imperfection)
         solver.settings.rtol, solver.settings.ctol = TOLERANCES[-1], 100 * TOLERANCES[-1]
         pending = list(TOLERANCES)

@@ -1,6 +1,6 @@
 """Command line: read the -rod_* options, check them and what the run needs before any
 work, build the scene, run the continuation, write, report. Returns the process exit
-code (README, "Exit codes and bad input": 0 converged, 2 bad input, 3 not converged,
+code (docs/errors.md: 0 converged, 2 bad input, 3 not converged,
 4 diverged, 5 the result could not be written, 128 + n stopped by signal n)."""
 
 import numpy as np
@@ -90,8 +90,10 @@ def run(comm=None):
                     io.minimum_bytes(mesh, outputs.restart_state(solver), values["rod_steps"]),
                     run_record(values, solver, start))
             code = continuation(solver, values["rod_steps"], values["rod_imperfection"],
-                                writer, say, options_record(), values["rod_max_halvings"],
-                                values["rod_track_link"], start, interrupts)
+                                writer=writer, say=say, options=options_record(),
+                                max_halvings=values["rod_max_halvings"],
+                                track_link=values["rod_track_link"], start=start,
+                                interrupts=interrupts).code
             writer = None
             for name in unused_options():
                 say(f"petsc_rod: warning: option -{name} was set but not used")

@@ -242,8 +242,8 @@ def help_text():
         lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
                      f"(default {default})")
     lines.append("  Global-step solvers: -rod_slope_ksp_*, -rod_slope_pc_* (the slope r'), -rod_d1_*, -rod_d2_* "
-                 "(directors); default preonly + Cholesky on one rank, CG with block Jacobi and "
-                 "Cholesky blocks (rtol 1e-14) on several.")
+                 "(directors); default preonly + Cholesky on one rank, preonly + the exact "
+                 "substructuring PC (-pc_type python) on several.")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres, and the SNES "
                  "options under the same prefix (-rod_snes_anderson_m, -rod_snes_monitor).")

@@ -165,7 +165,7 @@ class ScalarProblem:
         A direct solver is called past KSPSolve (_direct_solver): PETSc's factorisation
         and the substructuring PC column by column on the Vecs, a factorisation with a
         multiple right-hand-side solve (MUMPS) with the three right-hand sides together
-        (MatMatSolve: one pass instead of three, half the solve time on 2 ranks). Any
+        (MatMatSolve: one pass instead of three, half the solve time on 2 ranks, docs/performance.md). Any
         other KSP solves them one by one.
         """
         for c, vec in enumerate(rhs.components):

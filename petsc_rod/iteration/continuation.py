@@ -3,6 +3,7 @@
 fails, reported one line per step and written one group per step."""
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,10 +33,9 @@ def not_converged_reason(report, solver):
                 "curvature each time: take more -rod_steps, or -rod_imperfection")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
-                "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
-                "h^3) lies above them (use more -rod_elements or looser tolerances), or a "
-                "symmetry holds the iterate (a straight rod shortened along its axis: move "
-                "the end off the axis)")
+                "would not meet the tolerances within -rod_al_max_it: tolerances near round-off "
+                "for this mesh and these forces (loosen them), or a slowly contracting "
+                "iteration (take more -rod_steps or a larger -rod_al_max_it)")
     hint = ""
     if settings.asked_penalty < 0.1 * solver.scale:
         hint = (f"; -rod_al_penalty {settings.asked_penalty:g} is far below the problem's scale "
@@ -44,9 +44,10 @@ def not_converged_reason(report, solver):
 
 
 class LoadPath:
-    """The load factors of the continuation: ``steps`` regular steps t_k = k/K, and the
-    sub-steps by which a step that failed is retried. A path that goes on from a load
-    factor t_0 > 0 (a restart) has t_k = t_0 + (1 - t_0) k/K; from t_0 = 1, one step at 1.
+    """The load factors of the continuation: ``steps`` regular steps
+    t_k = t_0 + (t_end - t_0) k/K (t_0 = 0 and t_end = 1 for a whole run; t_0 > 0 for a
+    restart; from t_0 = t_end, one step at t_end), and the sub-steps by which a step that
+    failed is retried.
 
     A failed attempt halves the increment (a smaller step starts nearer its solution,
     §7), at most ``max_halvings`` times on the way to one t_k; an accepted sub-step keeps
@@ -55,9 +56,9 @@ class LoadPath:
     reached exactly and is k/K to the last bit, as without halving.
     """
 
-    def __init__(self, steps, max_halvings, start=0.0):
-        self.start = start
-        self.steps = steps if start < 1 else 1
+    def __init__(self, steps, max_halvings, start=0.0, end=1.0):
+        self.start, self.end = start, end
+        self.steps = steps if start < end else 1
         self.units_per_step = 2**max_halvings
         self.reached = 0                          # units: the last accepted load factor
         self.increment = self.units_per_step      # units
@@ -65,11 +66,11 @@ class LoadPath:
         self.step_halvings = 0                    # on the way to the next t_k
 
     def factor(self, units):
-        """The load factor of a number of units (1 exactly at the end of the path)."""
+        """The load factor of a number of units (``end`` exactly at the end of the path)."""
         total = self.steps * self.units_per_step
         if units == total:
-            return 1.0
-        return self.start + (1.0 - self.start) * (units / total)
+            return self.end
+        return self.start + (self.end - self.start) * (units / total)
 
     @property
     def step(self):
@@ -160,24 +161,52 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
                     f"{report.constraint_residual:.2e})")
 
 
-def continuation(solver, steps, imperfection, writer, say, options, max_halvings,
-                 track_link=True, start=0.0, interrupts=None):
-    """Reach the scene in ``steps`` equal load increments from load factor ``start`` (0,
-    or a restart's), each warm-started (§7) from the last state with its cross-sections
-    rolled by ``imperfection`` (see UzawaSolver.roll_cross_sections). A step that does
-    not converge or diverges is undone (UzawaSolver.snapshot/restore) and retried with
-    half the increment, at most ``max_halvings`` times on the way to each t_k (LoadPath);
-    so is a step that converged to another linking number (link.py) when ``track_link``.
-    The file has one group ``steps/<n>`` per accepted step, and the failed one that ends
-    a run. ``interrupts`` (signals.Interrupts), if given, are asked after every iteration
-    and before the file is finished: a signal ends the run with RodInterrupted."""
+# The default of -rod_max_halvings: halvings of the step on the way to each t_k.
+MAX_HALVINGS = 4
+
+
+@dataclass
+class ContinuationResult:
+    """How a continuation ended: the process exit code (0, or RodNotConvergedError's),
+    the last step's report, and the iterations of the whole run."""
+
+    code: int
+    report: object
+    iterations: int
+
+    @property
+    def converged(self):
+        return self.code == 0
+
+
+def continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, options="",
+                 max_halvings=MAX_HALVINGS, track_link=True, start=0.0, end=1.0,
+                 interrupts=None, on_step=None):
+    """Reach load factor ``end`` in ``steps`` equal increments from ``start`` (0, or a
+    restart's), each warm-started (§7) from the last state with its cross-sections
+    rolled by ``imperfection`` (RodState.roll_cross_sections) and tau, lambda
+    extrapolated (Predictor). A step that does not converge or diverges is undone
+    (RodState.snapshot/restore) and retried with half the increment, at most
+    ``max_halvings`` times on the way to each t_k (LoadPath); so is a step that converged
+    to another linking number (link.py) when ``track_link``.
+
+    The one loop of the project: the command line, the scripts and the tests all call
+    it. ``writer`` (io.results.ResultWriter or None) gets a group ``steps/<n>`` per
+    accepted step and the failed one that ends a run; ``say(line)`` gets the step lines
+    (None: silent); ``on_step(t, report)``, if given, is called after each accepted step
+    and the failed last one. ``interrupts`` (signals.Interrupts), if given, are asked
+    after every iteration and before the file is finished: a signal ends the run with
+    RodInterrupted. Returns a ContinuationResult.
+    """
+    say = say or (lambda line: None)
     mesh = solver.mesh
     clock = time.perf_counter()
-    path = LoadPath(steps, max_halvings, start)
+    path = LoadPath(steps, max_halvings, start, end)
     stop = None if interrupts is None else interrupts.received
     origin = f" from load factor {start:.6g}" if start > 0 else ""
+    penalty = solver.settings.asked_penalty
     say(f"petsc_rod: {mesh.n_elements} elements on {mesh.comm.getSize()} rank(s), "
-        f"R = {solver.settings.asked_penalty:g}, {path.steps} step(s){origin}")
+        f"R = {penalty:g}, {path.steps} step(s){origin}")
     predictor = Predictor()
     predictor.accept(start, solver)
     totals = {"total_iterations": 0, "undone_iterations": 0}
@@ -196,7 +225,7 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
                               f"{report.iterations}", path)
         iterations = (failure.iterations or 0) if report is None else report.iterations
         totals["total_iterations"] += iterations
-        # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
+        # a stalled step is not halved: a smaller step does not move what stops it
         stalled = report is not None and report.stalled
         if failure is not None and path.can_halve and not stalled:
             solver.state.restore(saved)
@@ -213,7 +242,9 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
         attributes = record_step(solver, report, t, label, say, writer, f"steps/{written}",
                                  wall_time=time.perf_counter() - clock, options=options,
                                  halvings=path.step_halvings, total_halvings=path.halvings,
-                                 **totals)
+                                 asked_penalty=penalty, **totals)
+        if on_step is not None:
+            on_step(t, report)
         if not report.converged:
             break
         path.accept()
@@ -226,11 +257,12 @@ def continuation(solver, steps, imperfection, writer, say, options, max_halvings
     if not report.converged:
         say(f"petsc_rod: error: {label} {not_converged_reason(report, solver)}"
             f"{path.given_up()}; the result file says converged = 0")
-        return RodNotConvergedError.exit_code
+        return ContinuationResult(RodNotConvergedError.exit_code, report,
+                                  totals["total_iterations"])
     say(f"petsc_rod: converged, {totals['total_iterations']} iterations in "
         f"{time.perf_counter() - clock:.3g} s, {path.halvings} halving(s) of the step "
         f"({totals['undone_iterations']} iterations undone)")
-    return 0
+    return ContinuationResult(0, report, totals["total_iterations"])
 
 
 def interrupted(interrupts, where, path):

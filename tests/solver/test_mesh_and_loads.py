@@ -6,18 +6,9 @@ from helpers import gather
 from petsc_rod.global_step.matrices import load_ghosted
 from petsc_rod.validation.closed_forms import cantilever_tip
 from petsc_rod.mesh.fields import VectorField
-from petsc_rod.mesh.mesh import Mesh, graded_coordinates
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.scenes.scene import Scene
-
-
-def test_grading_ratio_and_ends():
-    t = np.linspace(0.0, 1.0, 1001)
-    for q in (1.0, 4.0, 100.0):
-        S = graded_coordinates(t, q)
-        h = np.diff(S)
-        assert abs(S[0]) < 1e-15 and abs(S[-1] - 1.0) < 1e-15 and np.all(h > 0)
-        assert abs(h.max() / h.min() - q) < 1e-3 * q
 
 
 def test_piecewise_load_is_integrated_exactly(comm):

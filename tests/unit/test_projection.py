@@ -12,6 +12,7 @@ import pytest
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
+from helpers import REPO_ROOT
 from petsc_rod.frames import rotation_about, rotation_log, split_coefficients, strains
 from petsc_rod.local_step import projection
 from petsc_rod.local_step.projection import (nearest_rotation, nearest_rotation_eigen,
@@ -368,7 +369,7 @@ def test_benchmark_projection_script(monkeypatch, capsys):
     kernel within round-off of the SVD."""
     import importlib.util
     import os
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+    path = os.path.join(REPO_ROOT,
                         "scripts", "benchmark_projection.py")
     spec = importlib.util.spec_from_file_location("benchmark_projection", path)
     script = importlib.util.module_from_spec(spec)

@@ -5,17 +5,15 @@ The test spawns processes, so it is marked ``serial`` (skipped inside an MPI run
 """
 
 import json
-import os
 import subprocess
 import sys
 
 import pytest
 
-from helpers import child_env
+from helpers import REPO_ROOT, child_env
 
 pytestmark = pytest.mark.serial
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # What ``python -m petsc_rod ARGS`` does (petsc_rod/__main__.py), then the modules loaded.
 CHILD = """

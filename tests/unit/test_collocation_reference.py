@@ -3,7 +3,7 @@ PETSc, no MPI.
 
 Under ``mpiexec -n 2`` every rank runs the same serial computations (nothing here is
 collective). The paper scene's twisted branch is started from a shooting guess built from
-six rounded clamp reactions (see ``TWISTED_CLAMP_FORCE``), so the tests need no data file;
+six rounded clamp reactions (``TWISTED_CLAMP_FORCE`` in tests/helpers.py), so the tests need no data file;
 the comparison with a petsc_rod result file runs only where that file exists.
 """
 
@@ -13,26 +13,16 @@ import tempfile
 import numpy as np
 import pytest
 
+from helpers import PAPER_END as END, PAPER_END_X, PAPER_LENGTH, PAPER_STIFFNESS, twisted_paper_reference
 from petsc_rod.validation import reference as ref
 from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
 
-PAPER_STIFFNESS = (235.0, 360.0, 200.0)
-PAPER_LENGTH = 20.0
-END_X = 16.0
-END = np.array([END_X, PAPER_LENGTH - END_X, 0.0])
-# Clamp reactions n(0), m(0) of petsc_rod's paper-scene solution at X_F = 16, K3 = 200
-# (a result file of options/paper.opts with 80 elements: n = (-11.640, -4.0328, 2.3025), m(0) = (9.2094, -36.859,
-# -17.970)), rounded to three digits. Integrated from the clamp they give a complete
-# guess close to the twisted branch (perturbing them by 6 % still converges to it).
-TWISTED_CLAMP_FORCE = (-11.6, -4.03, 2.30)
-TWISTED_CLAMP_MOMENT = (9.21, -36.8, -18.0)
+END_X = PAPER_END_X
 
 
 @pytest.fixture(scope="module")
 def twisted():
-    guess = ref.shooting_guess(PAPER_LENGTH, PAPER_STIFFNESS, TWISTED_CLAMP_FORCE,
-                               TWISTED_CLAMP_MOMENT)
-    return ref.solve_paper_scene(END_X, guess, stiffness=PAPER_STIFFNESS, tol=1e-10)
+    return twisted_paper_reference()
 
 
 @pytest.fixture(scope="module")
@@ -170,31 +160,4 @@ def test_initial_guess_from_result_reads_a_result_file(twisted):
     # trapezoidal energy of the vertex samples: second order in h = 0.5
     assert abs(ref.energy(guess) - ref.energy(twisted)) < 0.1
 
-
-def test_petsc_rod_paper_scene_agrees_with_the_reference(twisted):
-    """petsc_rod (40 elements, R = 400, 8 steps rolled by 0.01, rtol 1e-6) against the
-    collocation solution, on 1 or 2 ranks. Measured: u3(0) 2.1e-4 and W 1.5e-4 J apart,
-    positions 6.6e-3 m (20 m cable; 8.4e-4 m with 80 elements and rtol 1e-7)."""
-    from petsc4py import PETSc
-
-    from helpers import continuation, gather, make_solver
-    from petsc_rod.io.outputs import vertex_fields
-
-    scene = dict(length=PAPER_LENGTH, stiffness=PAPER_STIFFNESS, start="clamp", end="pin",
-                 end_position=END)
-    mesh, solver = make_solver(PETSc.COMM_WORLD, 40, scene, penalty=400.0, rtol=1e-6,
-                               ctol=1e-5, max_it=20000)
-    try:
-        assert continuation(solver, steps=8, imperfection=0.01).converged
-        fields = {k: gather(mesh.comm, v) for k, v in vertex_fields(solver, 1.0).items()}
-        energy = solver.energy()
-    finally:
-        solver.destroy()
-        mesh.destroy()
-    exact = twisted.sample(fields["S"])
-    mirror = np.sign(fields["u"][0, 2] * exact["u"][0, 2])      # z -> -z flips u1, u3
-    exact["r"][:, 2] *= mirror
-    assert abs(fields["u"][0, 2] - mirror * exact["u"][0, 2]) < 5e-4
-    assert abs(energy - ref.energy(twisted)) < 5e-4
-    assert np.abs(fields["r"] - exact["r"]).max() < 1e-2                 # measured 6.6e-3 m
 

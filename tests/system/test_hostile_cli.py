@@ -1,6 +1,6 @@
 """Hostile input and faults, end to end (``python -m petsc_rod``, 1 and 2 ranks): each
-class ends with one petsc_rod line, its documented exit code (README, "Exit codes and bad
-input"), no traceback, no hang, and no result or ``.partial`` file left behind.
+class ends with one petsc_rod line, its documented exit code (docs/errors.md), no
+traceback, no hang, and no result or ``.partial`` file left behind.
 
 Every test spawns processes, so the module is marked ``serial``.
 """
@@ -17,11 +17,10 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import child_env
+from helpers import REPO_ROOT, child_env
 
 pytestmark = pytest.mark.serial
 
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TIMEOUT = 120
 SMALL = ["-rod_elements", "16", "-rod_end_force", "0,-3,0", "-rod_al_penalty", "100",
          "-rod_al_rtol", "1e-7", "-rod_al_ctol", "1e-4"]

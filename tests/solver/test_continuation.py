@@ -9,7 +9,7 @@ two can, measured when these tests were written:
   half steps converge in 194 and 89.
 - PULLED, pulled along its axis by 1.5e5 N, R = 100: the first global step of one step
   gives |r'| about 1 + P/R, an RMS constraint residual of 1.4e3 above the divergence
-  bound (solver.DIVERGED_RESIDUAL = 1e3); the half steps (7.5e2) converge in 648 each.
+  bound (stopping.DIVERGED_RESIDUAL = 1e3); the half steps (7.5e2) converge in 648 each.
 
 With halvings the run undoes the failed step and gets there in two half steps; since the
 undo is exact, it then does what ``-rod_steps 2`` does, iteration for iteration.
@@ -18,31 +18,16 @@ The in-process tests run on any number of ranks; those that spawn ``python -m pe
 are marked ``serial`` (tests/conftest.py).
 """
 
-import os
-import subprocess
-import sys
 
-import h5py
 import numpy as np
 import pytest
 
 from petsc4py import PETSc
 
-from helpers import child_env, gather
-from petsc_rod.iteration.continuation import LoadPath, continuation
+from helpers import BENT, PULLED, gather
+from helpers import HALVING_CTOL as CTOL, HALVING_ELEMENTS as N_ELEMENTS, HALVING_RTOL as RTOL
+from petsc_rod.iteration.continuation import continuation
 from petsc_rod.errors import RodDivergedError, RodNotConvergedError
-
-N_ELEMENTS = 16
-RTOL, CTOL = 1e-7, 1e-4
-BENT = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
-                       end_force=(0.0, -10.0, 0.0)),
-            penalty=25.0, max_it=220, snes_type="nrichardson")
-PULLED = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
-                         end_force=(1.5e5, 0.0, 0.0)),
-              penalty=100.0, max_it=2000, snes_type="anderson")
-REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TIMEOUT = 120
-
 
 def build(solver_factory, comm, case):
     database = PETSc.Options()
@@ -61,7 +46,7 @@ def run_continuation(solver_factory, comm, case, steps, max_halvings):
     final state gathered on every rank)."""
     mesh, solver = build(solver_factory, comm, case)
     lines = []
-    code = continuation(solver, steps, 0.0, None, lines.append, "", max_halvings)
+    code = continuation(solver, steps, say=lines.append, max_halvings=max_halvings).code
     state = {name: gather(comm, array) for name, array in owned_state(solver).items()}
     state["energy"] = solver.energy()
     return code, lines, state
@@ -84,38 +69,6 @@ def assert_same_state(first, second):
         scale = np.abs(second[name]).max()
         assert np.abs(first[name] - second[name]).max() <= 1e-9 * scale, name
     assert first["energy"] == pytest.approx(second["energy"], rel=1e-9)
-
-
-# --- the sequence of load factors ------------------------------------------------------
-def test_without_halvings_the_load_factors_are_k_over_K():
-    path = LoadPath(7, 0)
-    factors = []
-    while not path.finished:
-        assert not path.can_halve
-        factors.append(path.next_factor)
-        path.accept()
-    assert factors == [k / 7 for k in range(1, 8)]
-
-
-def test_a_halved_step_goes_on_halved_to_t_k_then_regular():
-    path = LoadPath(3, 2)
-    assert (path.step, path.next_factor) == (1, 1 / 3)
-    path.halve()                                   # step 1 failed at 1/3
-    assert path.next_factor == 1 / 6
-    path.accept()
-    assert (path.step, path.next_factor) == (1, 1 / 3)      # still the halved increment
-    path.accept()
-    assert path.factor(path.reached) == 1 / 3      # t_1 exactly, the regular size again
-    assert (path.step, path.next_factor) == (2, 2 / 3)
-    path.halve()
-    path.halve()
-    assert not path.can_halve and path.halvings == 3
-    assert path.next_factor == pytest.approx(1 / 3 + 1 / 12, rel=1e-15)
-    for _ in range(4):
-        path.accept()
-    assert path.factor(path.reached) == 2 / 3 and path.next_factor == 1.0
-    path.accept()
-    assert path.finished
 
 
 # --- snapshot and restore ---------------------------------------------------------------
@@ -180,54 +133,3 @@ def test_a_failed_step_is_halved_and_ends_where_two_steps_do(solver_factory, com
     assert_same_state(halved, regular)
 
 
-# --- the command line (spawns processes) -------------------------------------------------
-def cli_args(case):
-    scene = case["scene"]
-    return ["-rod_length", "1", "-rod_stiffness", "1,1,1", "-rod_end", "free",
-            "-rod_end_force", ",".join(f"{v:g}" for v in scene["end_force"]),
-            "-rod_elements", str(N_ELEMENTS), "-rod_al_penalty", f"{case['penalty']:g}",
-            "-rod_al_rtol", f"{RTOL:g}", "-rod_al_ctol", f"{CTOL:g}",
-            "-rod_al_max_it", str(case["max_it"]), "-rod_snes_type", case["snes_type"]]
-
-
-def run_cli(args):
-    return subprocess.run([sys.executable, "-m", "petsc_rod"] + args, cwd=REPO_ROOT,
-                          env=child_env(), capture_output=True, text=True, timeout=TIMEOUT,
-                          check=False)
-
-
-def describe(process):
-    return f"exit {process.returncode}\nstdout:\n{process.stdout}\nstderr:\n{process.stderr}"
-
-
-@pytest.mark.serial
-@pytest.mark.parametrize("case, exit_code", [(BENT, 3), (PULLED, 4)],
-                         ids=["max_it", "diverged"])
-def test_no_halvings_keeps_the_failure_exit_code(tmp_path, case, exit_code):
-    path = tmp_path / "failed.h5"
-    process = run_cli(cli_args(case) + ["-rod_max_halvings", "0", "-rod_output", str(path)])
-    assert process.returncode == exit_code, describe(process)
-    assert "halving" not in process.stdout, describe(process)
-    assert not os.path.exists(f"{path}.partial")
-    if exit_code == 4:
-        assert not path.exists()
-        return
-    with h5py.File(path, "r") as f:
-        assert int(f.attrs["converged"]) == 0
-        assert list(f["steps"]) == ["1"]
-
-
-@pytest.mark.serial
-def test_halved_run_writes_one_group_per_accepted_step(tmp_path):
-    path = tmp_path / "halved.h5"
-    process = run_cli(cli_args(BENT) + ["-rod_output", str(path)])
-    assert process.returncode == 0, describe(process)
-    assert process.stdout.count("halving 1: retrying from load factor 0 with increment 0.5") == 1
-    with h5py.File(path, "r") as f:
-        assert int(f.attrs["converged"]) == 1
-        assert sorted(f["steps"]) == ["1", "2"]
-        assert [float(f[f"steps/{k}"].attrs["load_factor"]) for k in "12"] == [0.5, 1.0]
-        assert all(0 < int(f[f"steps/{k}"].attrs["iterations"]) < BENT["max_it"]
-                   for k in "12")
-        assert float(f.attrs["load_factor"]) == 1.0
-        assert np.array_equal(f["r"][:], f["steps/2/r"][:])
