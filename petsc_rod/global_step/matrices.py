@@ -77,10 +77,6 @@ class ScalarProblem:
         self._fixed_values = np.zeros((int(self._owned.sum()), 3))
         self._lift = [self.full.createVecLeft() for _ in range(3)]
         self._work = self.full.createVecLeft()
-        sizes = [(end - start, self.full.getSize()[0]), (3, 3)]
-        self._rhs_block = PETSc.Mat().createDense(sizes, comm=mesh.comm)
-        self._rhs_block.setUp()
-        self._solution_block = self._rhs_block.duplicate()
         self.ksp = PETSc.KSP().create(comm=mesh.comm)
         self.ksp.setOperators(self.constrained)
         self.ksp.setType(PETSc.KSP.Type.PREONLY)
@@ -93,6 +89,12 @@ class ScalarProblem:
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor, self._columns = self._direct_solver()
+        self._blocks = []           # dense right-hand sides and solutions for MatMatSolve
+        if self._factor is not None:
+            sizes = [(end - start, self.full.getSize()[0]), (3, 3)]
+            self._blocks = [PETSc.Mat().createDense(sizes, comm=mesh.comm) for _ in range(2)]
+            for block in self._blocks:
+                block.setUp()
         self._border = []            # c and w = A^-1 c of the integral constraint, if any
 
     def _direct_solver(self):
@@ -176,12 +178,13 @@ class ScalarProblem:
             self._columns(rhs.components, solution.components)
             return
         if self._factor is not None:
-            block = self._rhs_block.getDenseArray()
+            rhs_block, solution_block = self._blocks
+            block = rhs_block.getDenseArray()
             for c, vec in enumerate(rhs.components):
                 block[:, c] = vec.getArray(readonly=True)
-            self._rhs_block.assemble()
-            self._factor.matSolve(self._rhs_block, self._solution_block)
-            result = self._solution_block.getDenseArray()
+            rhs_block.assemble()
+            self._factor.matSolve(rhs_block, solution_block)
+            result = solution_block.getDenseArray()
             for c in range(3):
                 solution.components[c].getArray()[:] = result[:, c]
             return
@@ -225,8 +228,8 @@ class ScalarProblem:
                                    f"{KSP_REASONS.get(reason, reason)}")
 
     def destroy(self):
-        for obj in [self.ksp, self.full, self.constrained, self._work, self._rhs_block,
-                    self._solution_block] + self._lift + self._border:
+        for obj in [self.ksp, self.full, self.constrained, self._work] + self._blocks \
+                + self._lift + self._border:
             obj.destroy()
 
 
