@@ -1,6 +1,6 @@
 """Exact parallel solve of the global step's chain matrices by substructuring.
 
-The matrices of the global step (assembly.ScalarProblem) are P2 chains on a 1-D DMDA:
+The matrices of the global step (matrices.ScalarProblem) are P2 chains on a 1-D DMDA:
 row i couples only to rows within two of it, and every rank owns a contiguous range of
 rows [start_p, end_p). Take as the interface G the first row g_p = start_p of every rank
 but the first (a vertex dof: the P2 elements on either side meet there). Removing G
@@ -14,16 +14,17 @@ interior rows ordered first, A = [A_II A_IG; A_GI A_GG] and
 
 W has two columns per rank (g_p, g_{p+1}) and S is (P-1) x (P-1) and tridiagonal; both
 are formed once per matrix (set-up: two local solves and one allgather), and S is
-factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A solve is then one local half-chain Cholesky
-solve per right-hand side, an allgather of 2 k numbers per rank (k right-hand sides),
+factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A solve
+is then one local half-chain Cholesky solve per right-hand side, an allgather of 2 k
+numbers per rank (k right-hand sides),
 the small tridiagonal solve, and x_I -= W x_G: it does the work of the serial Cholesky
 divided by the ranks, where CG with block Jacobi needs several matrix products, local
 solves and reductions per right-hand side (docs/performance.md).
 
 ``ChainSolver`` does the algebra on numpy views of the local rows; ``InterfacePC`` is
 the same solve as a PETSc python preconditioner (``-rod_d1_pc_type python
--rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so that KSP
-preonly with it is a direct solver. The PETSc objects (the interior matrix, its factor,
+-rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so
+that KSP preonly with it is a direct solver. The PETSc objects (the interior matrix, its factor,
 two work vectors, the same for S: SeqCholesky) are created in ChainSolver.__init__ and
 destroyed in ChainSolver.destroy().
 """
@@ -77,7 +78,8 @@ class NotAChainError(ValueError):
 
 class ChainSolver:
     """Exact solve with an assembled, symmetric positive definite AIJ ``matrix``
-    distributed by contiguous rows, coupled across ranks as a chain (module docstring).
+    distributed by contiguous rows, coupled across ranks as a chain (module docstring);
+    A_GI is taken as A_IG^T (the symmetry), every rank must own two rows or more.
 
     Shapes (local): n = owned rows, n_I = n - offset interior rows (offset = 1 on every
     rank but the first), W stored transposed (2, n_I), the interface system (P-1, P-1).
@@ -101,12 +103,15 @@ class ChainSolver:
         left = interior_row & nonzero & (cols == start) & (self.offset == 1)
         right = interior_row & nonzero & (cols == end) & (not self.last)
         stray = interior_row & nonzero & ~inside & ~left & ~right
-        where = (int(row_of[stray][0]), int(cols[stray][0])) if stray.any() else None
-        refused = [pair for pair in self._mpi.allgather(where) if pair is not None]
+        why = None
+        if stray.any():
+            why = (f"row {row_of[stray][0]} couples to row {cols[stray][0]} of another "
+                   "rank: not a chain split at the ranks' first rows")
+        elif n_interior <= 0:
+            why = f"rows {start} to {end - 1}: a rank with no interior row"
+        refused = [text for text in self._mpi.allgather(why) if text is not None]
         if refused:             # on every rank: the others would wait in the allgather
-            row, col = refused[0]
-            raise NotAChainError(f"row {row} couples to row {col} of another rank: not a "
-                                 "chain split at the ranks' first rows")
+            raise NotAChainError(refused[0])
         keep = interior_row & inside & (nonzero | (cols == row_of))
         counts = np.bincount(row_of[keep] - first, minlength=n_interior)
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
@@ -120,9 +125,9 @@ class ChainSolver:
                 b = np.zeros(n_interior)
                 b[index] = value
                 self.interior.solve(b, self.W[column])
-        self._factor_interface(matrix, row_of, cols, values, start, end)
+        self._factor_interface(row_of, cols, values, start, end)
 
-    def _factor_interface(self, matrix, row_of, cols, values, start, end):
+    def _factor_interface(self, row_of, cols, values, start, end):
         """S = A_GG - A_GI W, tridiagonal: each rank sends (A_{g_p g_p}, A_{g_p g_p+1},
         and its 2x2 A_GI W on (g_p, g_p+1)); every rank assembles and factors S."""
         local = np.zeros(5)
