@@ -26,9 +26,10 @@ def element_rows(mesh):
     return (2 * (first + P2.offsets[None, :]) + P2.slots[None, :]).astype(PETSc.IntType)
 
 
-def assemble_matrix(mesh, element_matrices):
-    """The DMDA matrix sum_e of element matrices (ne, 3, 3) on the P2 dofs."""
-    rows = element_rows(mesh)
+def assemble_matrix(mesh, element_matrices, rows=None):
+    """The DMDA matrix sum_e of element matrices (ne, k, k) on the element rows ``rows``
+    (ne, k), by default the P2 dofs (element_rows)."""
+    rows = element_rows(mesh) if rows is None else rows
     matrix = mesh.da.createMatrix()
     if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
         # petsc4py's setValuesRCV divides by the number of rows

@@ -14,6 +14,7 @@ from .options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, 
 from .scene import Scene
 from .signals import Interrupts
 from .continuation import continuation
+from .riser.environment import environment_from_options
 from .solver import Settings, UzawaSolver, default_penalty
 
 # The smallest element, relative to the length, whose end coordinates double precision
@@ -33,6 +34,7 @@ def scene_from_options(values, given):
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
+    scene.seabed, scene.current = environment_from_options(values, given, scene)
     return scene
 
 
@@ -44,7 +46,8 @@ def settings_from_options(values, scene):
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
                     adapt_penalty=values["rod_al_adapt_penalty"],
-                    check_stability=values["rod_al_stability"])
+                    # a current's drag is not conservative: no energy to test (docs/riser.md)
+                    check_stability=values["rod_al_stability"] and scene.current is None)
 
 
 def options_record():

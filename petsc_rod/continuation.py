@@ -9,6 +9,7 @@ import numpy as np
 from . import outputs
 from .errors import RodDivergedError, RodInterrupted, RodNotConvergedError
 from .link import changed_class
+from .riser.quantities import riser_report
 from .solver import ADAPT_WINDOW, STOP_LINK, STOP_OBSERVER, STOP_SADDLE
 
 
@@ -288,11 +289,16 @@ def record_step(solver, report, t, label, say, writer, group, **common):
                   "load_factor": t, "penalty": solver.penalty, **common}
     if report.link is not None:
         attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
+    riser = riser_report(solver, vertex) if solver.riser is not None else None
+    if riser is not None:           # petsc_rod/riser/quantities.py
+        vertex.update(riser.datasets)
+        attributes.update(riser.attributes)
     say(f"{label}: load factor {t:.4g}, "
         f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
         f"iterations, change {report.change:.2e}, constraint residual (RMS) "
         f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
-        + link_text(report.link) + stability_text(report))
+        + link_text(report.link) + stability_text(report)
+        + (f"; {riser.text}" if riser is not None else ""))
     if report.penalty_raises:
         raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in report.penalty_raises)
         say(f"petsc_rod: {label}: the constraint residual fell by less than half in "

@@ -44,6 +44,8 @@ def vertex_fields(solver, t):
     k = scene.stiffness
     moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
     force = solver.end_reaction()[None, :] + scene.load_beyond(mesh.vertex_S, t)
+    if solver.riser is not None:            # the drag and the seabed (petsc_rod/riser)
+        force += solver.riser.force_beyond(solver)
     return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
             "m": moment, "n": force}
 

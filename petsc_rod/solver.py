@@ -28,6 +28,7 @@ from .kernels import (nearest_rotation, rotations, split_coefficients, strains,
 from .link import FULLER_MARGIN, link_integrands
 from .options import set_from_options_with_defaults
 from .resources import anderson_depth, ranks_on_this_machine
+from .riser.terms import RiserTerms
 from .stability import SecondVariation
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}")
@@ -279,6 +280,8 @@ class UzawaSolver:
         self._step = None
         self._create_snes()
         self._previous = None
+        # the seabed and the current (petsc_rod/riser), built only when the scene has them
+        self.riser = RiserTerms(self) if scene.seabed or scene.current else None
 
     def _build_problems(self):
         """The three scalar problems of the global step at the current R, with the
@@ -494,6 +497,8 @@ class UzawaSolver:
         self.load.add_ghosted(load_ghosted(
             self.mesh, lambda S: scene.load_beyond(S, t) + self._load_offset,
             scene.load_piece_ends))
+        if self.riser is not None:
+            self.riser.prepare_step(self, t)
 
     def solve_step(self, t, label="", observer=None):
         """The iteration at load factor t, driven by the SNES ``-rod_snes_*`` (anderson by
@@ -658,6 +663,8 @@ class UzawaSolver:
                 values[n:] = 0.0
         for vec, load in zip(self.rhs[2].components, self.load.components):
             vec.axpy(1.0, load)
+        if self.riser is not None:
+            self.riser.add_loads(self)
         if self._lagged is not None:
             self._add_lagged_part()
         EVENTS["rhs"].end()
@@ -698,6 +705,8 @@ class UzawaSolver:
             self._multiplier = self.r_problem.solve_constrained(self.rhs[2], self.theta, chord)
         else:
             self.r_problem.solve(self.rhs[2], self.theta)
+        if self.riser is not None:
+            self.riser.solve_vertical(self)
         theta = element_dofs(self.theta.ghosted(), self.mesh.element_local, P2)
         positions = vertex_positions(self.mesh, theta, self.start_state, self.end_state)
         self.r.set_owned(np.stack([positions, self.theta.owned()[:, 0]], axis=1))
@@ -747,7 +756,8 @@ class UzawaSolver:
         stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
         work = self._anchor_work + sum(load.dot(theta) for load, theta
                                        in zip(self.load.components, self.theta.components))
-        return self.mesh.global_sum(stored) - work
+        riser = self.riser.energy() if self.riser is not None else 0.0
+        return self.mesh.global_sum(stored) - work + riser
 
     def link(self):
         """Twist and writhe of the current state, (Tw, Wr) in turns, Lk = Tw + Wr
@@ -780,6 +790,8 @@ class UzawaSolver:
                 obj.destroy()
         for obj in [*self.frame_fields, self.r, self.load, *self.rhs]:
             obj.destroy()
+        if self.riser is not None:
+            self.riser.destroy()
 
 
 def rolled(first, second, angle):
