@@ -45,7 +45,7 @@ def start_petsc(argv):
     report and a traceback."""
     import petsc4py
 
-    from .capture import stderr_captured
+    from petsc_rod.io.capture import stderr_captured
     with stderr_captured() as report:
         try:
             petsc4py.init(argv)         # PETSc starts and reads the options here
@@ -60,7 +60,7 @@ def end(code):
     """Exit with ``code``. After a failed HDF5 write the process ends at once, without
     the shutdown of HDF5 (and of MPI-IO, PETSc and MPI, which would close the file
     too), which would crash flushing the file it could not write (io.hdf5_failed)."""
-    from . import io
+    from petsc_rod.io import results as io
     if not io.hdf5_failed():
         return code
     sys.stdout.flush()
@@ -83,14 +83,14 @@ def main():
             f"({sys.executable}); run scripts/setup.sh once, then `source .venv/bin/activate`"
             "\n")
         return 2
-    from .provenance import commit
+    from petsc_rod.io.provenance import commit
     commit()                          # git runs before MPI starts (provenance)
     error = start_petsc(sys.argv)
     if error:
         sys.stderr.write(f"petsc_rod: error: {error}; an options file has one '-name value' "
                          "per line, '#' starts a comment\n")
         return 2
-    from .cli import run
+    from petsc_rod.cli.main import run
     return end(run())
 
 

@@ -16,11 +16,20 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from .riser.figure import draw_riser  # noqa: E402
+from petsc_rod.riser.figure import draw_riser  # noqa: E402
+
+DPI = 110
 
 
 def plot_result(path, output):
     """Write the figure of result file ``path`` to ``output`` (PNG)."""
+    figure = result_figure(path)
+    figure.savefig(output, dpi=DPI)
+    plt.close(figure)
+
+
+def result_figure(path):
+    """The figure of result file ``path``: three projections of r, and u against S."""
     with h5py.File(path, "r") as f:
         S, r, u = f["S"][:], f["r"][:], f["u"][:]
         converged = int(f.attrs["converged"])
@@ -29,7 +38,7 @@ def plot_result(path, output):
     if riser is not None:               # a riser scene (petsc_rod/riser/figure.py)
         figure = plt.figure(figsize=(16, 4.5), layout="constrained")
         draw_riser(figure, {"S": S, "r": r, "u": u, **riser})
-        return finish(figure, path, output, converged, energy)
+        return titled(figure, path, converged, energy)
     figure, axes = plt.subplots(1, 4, figsize=(16, 4), layout="constrained")
     for axis, (i, j), names in zip(axes, ((0, 1), (0, 2), (1, 2)), ("xy", "xz", "yz")):
         axis.plot(r[:, i], r[:, j], "-", lw=1.5)
@@ -44,15 +53,14 @@ def plot_result(path, output):
     axes[3].set_ylabel("strain (1/m)")
     axes[3].legend()
     axes[3].set_title("bending u1, u2 and twist u3")
-    finish(figure, path, output, converged, energy)
+    return titled(figure, path, converged, energy)
 
 
-def finish(figure, path, output, converged, energy):
-    """Title ``figure`` with the file's outcome, write it to ``output`` and close it."""
+def titled(figure, path, converged, energy):
+    """``figure`` titled with the file's outcome."""
     status = "converged" if converged else "NOT converged"
     figure.suptitle(f"{path}: {status}, energy {energy:.6g} J")
-    figure.savefig(output, dpi=110)
-    plt.close(figure)
+    return figure
 
 
 def riser_data(f):

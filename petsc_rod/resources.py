@@ -6,7 +6,7 @@ import os
 import numpy as np
 from petsc4py import PETSc
 
-from .errors import RodInputError
+from petsc_rod.errors import RodInputError
 
 # Memory of a run: per element (fields, matrices and their factors, the node state,
 # Anderson's history, the stability test's factorisation: 10^6 elements on 2 ranks

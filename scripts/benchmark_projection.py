@@ -1,10 +1,10 @@
-"""Micro-benchmark of the local step's projection onto SO(3) (kernels.nearest_rotation).
+"""Micro-benchmark of the local step's projection onto SO(3) (projection.nearest_rotation).
 
     python scripts/benchmark_projection.py [--sizes 1e4,1e5,1e6] [--repeat N]
                                            [--kernel MODULE.FUNCTION]
 
 For each input class and point count: points per second of the kernel and of the batched
-SVD (kernels.nearest_rotation_svd), best of a few runs on one core (--repeat N: of N
+SVD (projection.nearest_rotation_svd), best of a few runs on one core (--repeat N: of N
 rounds over all the cases, against a machine shared with other jobs), and how far the
 kernel's rotations are from the SVD's. Input classes (b = rows b_i, as the local step
 gets them):
@@ -16,8 +16,8 @@ gets them):
 "dev" is max |T - T_svd| over the points whose maximiser is unique (all but rank 1);
 "objective" is the largest shortfall (f(T_svd) - f(T)) / |b|, f(T) = sum_i T_i . b_i,
 over all points, rank 1 included; "eigen" the share of points that Newton leaves to the
-eigen-solve (neither b nor kernels.shifted(b) suited it). --kernel times another
-function with the same signature (e.g. an older kernels.py copied outside the
+eigen-solve (neither b nor projection.shifted(b) suited it). --kernel times another
+function with the same signature (e.g. an older projection.py copied outside the
 repository, on PYTHONPATH).
 """
 
@@ -27,8 +27,8 @@ import time
 
 import numpy as np
 
-from petsc_rod import kernels
-from petsc_rod.kernels import nearest_rotation, nearest_rotation_svd
+from petsc_rod.local_step import projection
+from petsc_rod.local_step.projection import nearest_rotation, nearest_rotation_svd
 
 PENALTY = 400.0
 CLASSES = ("near", "far", "singular", "reflected")
@@ -90,18 +90,18 @@ def best_time(function, b):
 
 
 def eigen_share(b):
-    """Share of the points of b that kernels.nearest_rotation leaves to the eigen-solve:
+    """Share of the points of b that projection.nearest_rotation leaves to the eigen-solve:
     those Newton takes neither as they are nor shifted."""
     flat = b.reshape(-1, 3, 3)
     out = np.empty_like(flat)
     left = 0
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for start in range(0, len(flat), kernels.BLOCK):
-            block = flat[start:start + kernels.BLOCK]
-            missed = kernels.polar_newton(block, out[start:start + kernels.BLOCK])
+        for start in range(0, len(flat), projection.BLOCK):
+            block = flat[start:start + projection.BLOCK]
+            missed = projection.polar_newton(block, out[start:start + projection.BLOCK])
             if missed is not None:
                 hard = block[missed]
-                mask = kernels.polar_newton(kernels.shifted(hard), np.empty_like(hard))
+                mask = projection.polar_newton(projection.shifted(hard), np.empty_like(hard))
                 left += 0 if mask is None else np.count_nonzero(mask)
     return left / max(len(flat), 1)
 
@@ -129,7 +129,7 @@ def main():
     parser.add_argument("--repeat", type=int, default=1,
                         help="rounds over all the cases, the best of each kept (1)")
     parser.add_argument("--kernel", default=None,
-                        help="MODULE.FUNCTION to time instead of kernels.nearest_rotation")
+                        help="MODULE.FUNCTION to time instead of projection.nearest_rotation")
     args = parser.parse_args()
     kernel = nearest_rotation
     if args.kernel:

@@ -19,9 +19,10 @@ import petsc4py
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
-from petsc_rod.mesh import Mesh  # noqa: E402
-from petsc_rod.scene import Scene  # noqa: E402
-from petsc_rod.solver import Settings, UzawaSolver  # noqa: E402
+from petsc_rod.mesh.mesh import Mesh  # noqa: E402
+from petsc_rod.scenes.scene import Scene  # noqa: E402
+from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
+from petsc_rod.iteration.stopping import Settings  # noqa: E402
 
 ITERATIONS = 20
 
@@ -33,16 +34,16 @@ def measure(n_elements):
                   end="pin", end_position=[16.0 * scale, 4.0 * scale, 0.0])
     clock = time.perf_counter()
     mesh = Mesh(comm, n_elements, scene.length)
-    solver = UzawaSolver(mesh, scene, Settings(penalty=400.0 / scale**2, max_it=ITERATIONS,
+    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=400.0 / scale**2, max_it=ITERATIONS,
                                                rtol=0.0, ctol=0.0))
-    solver.set_straight()
+    solver.state.set_straight()
     solver.prepare_step(0.125)
     setup = time.perf_counter() - clock
     solver.iterate()                      # first solve includes the numeric factorisation
     clock = time.perf_counter()
     for _ in range(ITERATIONS):
         solver.iterate()
-        solver.norms()
+        solver.state.norms()
     per_iteration = (time.perf_counter() - clock) / ITERATIONS
     solver.destroy()
     mesh.destroy()

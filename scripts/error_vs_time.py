@@ -136,12 +136,12 @@ REFERENCES = {"cantilever": CantileverReference, "twist": TwistReference,
 
 def snapshot(solver):
     """What the errors need, on this rank's vertices: S, r, d1, d2; u3(0); energy."""
-    from petsc_rod.outputs import vertex_strains
+    from petsc_rod.io.outputs import vertex_strains
     mesh = solver.mesh
     u = vertex_strains(solver)                 # collective (ghost update): every rank
     u3 = u[0, 2] if mesh.on_lower_boundary else 0.0
-    return {"S": mesh.vertex_S.copy(), "r": solver.r.owned()[:, 0].copy(),
-            "d1": solver.d1.owned()[:, 0].copy(), "d2": solver.d2.owned()[:, 0].copy(),
+    return {"S": mesh.vertex_S.copy(), "r": solver.state.r.owned()[:, 0].copy(),
+            "d1": solver.state.d1.owned()[:, 0].copy(), "d2": solver.state.d2.owned()[:, 0].copy(),
             "u3": mesh.global_sum(u3), "energy": solver.energy()}
 
 
@@ -164,26 +164,28 @@ def distance(mesh, state, final):
 
 def run_one(comm, name, n_elements, penalty, reference):
     """One mesh and penalty: a row for each tolerance pair the last step reached."""
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.continuation import continuation
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
 
     kwargs, steps, imperfection = scene_definitions()[name]
     scene = Scene(**kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
-    solver = UzawaSolver(mesh, scene, Settings(penalty=penalty, max_it=MAX_ITERATIONS,
+    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=penalty, max_it=MAX_ITERATIONS,
                                                rtol=1e-5, ctol=1e-3))
     try:
         clock = time.perf_counter()
-        solver.set_straight()
+        solver.state.set_straight()
         earlier = 0                 # iterations of the continuation steps before the last
-        for k in range(1, steps):
-            solver.roll_cross_sections(imperfection)
-            report = solver.solve_step(k / steps)
-            if not report.converged:
-                raise RuntimeError(f"{name}: continuation step {k} did not converge")
-            earlier += report.iterations
-        solver.roll_cross_sections(imperfection)
+        if steps > 1:
+            before = continuation(solver, steps - 1, imperfection, end=(steps - 1) / steps)
+            if not before.converged:
+                raise RuntimeError(f"{name}: the continuation to the last step did not "
+                                   "converge")
+            earlier = before.iterations
+        solver.state.roll_cross_sections(imperfection)
         solver.settings.rtol, solver.settings.ctol = TOLERANCES[-1], 100 * TOLERANCES[-1]
         pending = list(TOLERANCES)
         recorded = []

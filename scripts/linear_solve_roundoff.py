@@ -26,10 +26,11 @@ import petsc4py
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
-from petsc_rod.mesh import Mesh  # noqa: E402
+from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.validation.roundoff import centreline_solve_error  # noqa: E402
-from petsc_rod.scene import Scene  # noqa: E402
-from petsc_rod.solver import Settings, UzawaSolver  # noqa: E402
+from petsc_rod.scenes.scene import Scene  # noqa: E402
+from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
+from petsc_rod.iteration.stopping import Settings  # noqa: E402
 
 SCENES = {
     "cantilever": dict(length=1.0, stiffness=[1.0, 1.0, 1.0], start="clamp", end="free",
@@ -63,10 +64,10 @@ def main():
         scene = Scene(**kwargs)
         for n in sizes:
             mesh = Mesh(comm, n, scene.length)
-            solver = UzawaSolver(mesh, scene, Settings(penalty=400.0))
+            solver = UzawaSolver(mesh, scene, Settings(asked_penalty=400.0))
             owned = np.arange(mesh.vertex_start, mesh.vertex_end)
             S = np.repeat(mesh.coordinates(owned), 2) / scene.length
-            d_error = relative_solve_error(solver.d_problems[0], S)
+            d_error = relative_solve_error(solver.global_step.problems[0], S)
             r_error = centreline_solve_error(solver)
             PETSc.Sys.Print(f"{name:10s} {n:9d}  {r_error:13.2e}  {d_error:14.2e}", comm=comm)
             solver.destroy()

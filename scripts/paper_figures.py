@@ -18,9 +18,9 @@ the cable at X_F = 19, 16 and 2) and three PNGs:
 - twist_along_cable.png: u3(S) at X_F = 16 and 2.
 `--replot` redraws the PNGs from those two files.
 
-A step that does not converge (next to a pitchfork the iteration slows down sharply) is
-reported, kept in steps.csv as converged = 0 and left out of the figures, and the next
-X_F starts from the last converged state. Progress: one line per step. The whole run
+The runs use the command line's continuation loop: a step that does not converge is
+retried with half the increment (the sub-steps are rows of steps.csv too), and a run
+that still fails ends there. Progress: one line per step. The whole run
 takes about half an hour on one core; `--quick` (X_F = 20 to 19 in 2 steps, coarse
 meshes) takes seconds and is what the tests run.
 """
@@ -42,7 +42,6 @@ LENGTH = 20.0
 RTOL, CTOL, PENALTY = 1e-7, 1e-5, 400.0
 MAX_ITERATIONS = 200000
 PROFILE_X = (19.0, 16.0, 2.0)
-MAX_SKIPPED = 2            # steps in a row that may fail before a run stops
 # |z| above this (0.05% of L) on a rolled run means the cable has left the plane z = 0.
 # On the planar side of the pitchfork the roll of 0.01 rad put in at each step has not
 # quite died out when the step stops (|z| ~ 3e-4 m, u3(0) ~ 2e-4 /m, the energy equal to
@@ -66,11 +65,14 @@ def gather(comm, owned):
 
 
 def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
-    """One continuation from X_F = 20 to ``end_x``: (step rows, profiles by X_F)."""
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.outputs import set_state, vertex_fields
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    """One continuation from X_F = 20 to ``end_x`` by the CLI's loop (a step that fails is
+    halved, as on the command line): (step rows, profiles by X_F)."""
+    from petsc_rod.iteration.continuation import continuation
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
+    from petsc_rod.io.outputs import vertex_fields
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
 
     from petsc4py import PETSc
 
@@ -83,64 +85,42 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
         database.setValue("rod_snes_type", "nrichardson")
     try:
         solver = UzawaSolver(mesh, scene, Settings(
-            penalty=PENALTY, max_it=MAX_ITERATIONS, rtol=RTOL, ctol=CTOL,
+            asked_penalty=PENALTY, max_it=MAX_ITERATIONS, rtol=RTOL, ctol=CTOL,
             check_stability=not planar))
     finally:
         if planar:
             database.delValue("rod_snes_type")
     rows, profiles = [], {}
-    converged_state, failures_in_a_row = None, 0
+    clock = time.perf_counter()
+
+    def record(t, report):
+        fields = {key: gather(comm, value) for key, value in vertex_fields(solver, t).items()}
+        x_f = LENGTH + t * (end_x - LENGTH)
+        rows.append(dict(run=label, K3=k3, elements=n_elements,
+                         penalty=solver.penalty, X_F=round(x_f, 6),
+                         converged=int(report.converged), iterations=report.iterations,
+                         wall_time=time.perf_counter() - clock,
+                         u3_clamp=fields["u"][0, 2], energy=solver.energy(),
+                         max_abs_z=np.abs(fields["r"][:, 2]).max(),
+                         constraint_residual=report.constraint_residual))
+        outcome = "converged" if report.converged else "NOT converged"
+        say(f"{label:9s} X_F = {x_f:5.2f}: {outcome}"
+            f" in {report.iterations:6d} its, u3(0) = {fields['u'][0, 2]:+.5f} /m, "
+            f"W = {rows[-1]['energy']:.4f} J, max|z| = {rows[-1]['max_abs_z']:.3g} m "
+            f"({rows[-1]['wall_time']:.1f} s)")
+        for x in PROFILE_X:
+            if report.converged and abs(x_f - x) < 1e-9:
+                profiles[x] = {"S": fields["S"], "r": fields["r"], "u3": fields["u"][:, 2]}
+
     try:
-        solver.set_straight()
-        clock = time.perf_counter()
-        for k in range(1, steps + 1):
-            t = k / steps
-            solver.roll_cross_sections(imperfection)
-            report = solver.solve_step(t)
-            fields = {key: gather(comm, value)
-                      for key, value in vertex_fields(solver, t).items()}
-            x_f = LENGTH + t * (end_x - LENGTH)
-            rows.append(dict(run=label, K3=k3, elements=n_elements,
-                             penalty=solver.penalty, X_F=round(x_f, 6),
-                             converged=int(report.converged), iterations=report.iterations,
-                             wall_time=time.perf_counter() - clock,
-                             u3_clamp=fields["u"][0, 2], energy=solver.energy(),
-                             max_abs_z=np.abs(fields["r"][:, 2]).max(),
-                             constraint_residual=report.constraint_residual))
-            outcome = "converged" if report.converged else "NOT converged"
-            say(f"{label:9s} X_F = {x_f:5.2f}: {outcome}"
-                f" in {report.iterations:6d} its, u3(0) = {fields['u'][0, 2]:+.5f} /m, "
-                f"W = {rows[-1]['energy']:.4f} J, max|z| = {rows[-1]['max_abs_z']:.3g} m "
-                f"({rows[-1]['wall_time']:.1f} s)")
-            if report.converged:
-                failures_in_a_row = 0
-                converged_state = saved_state(solver, t)
-                for x in PROFILE_X:
-                    if abs(x_f - x) < 1e-9:
-                        profiles[x] = {"S": fields["S"], "r": fields["r"],
-                                       "u3": fields["u"][:, 2]}
-                continue
-            # Next to a pitchfork the iteration slows down sharply (a mode of almost
-            # no stiffness): skip this X_F, reported as not converged, and take the next
-            # one from the last converged state.
-            failures_in_a_row += 1
-            if converged_state is None or failures_in_a_row > MAX_SKIPPED:
-                say(f"{label}: stopped, step {k} did not converge")
-                break
-            say(f"{label}: X_F = {x_f:g} skipped; the next step starts from the last "
-                "converged state")
-            set_state(solver, *converged_state)
+        solver.state.set_straight()
+        result = continuation(solver, steps, imperfection, on_step=record)
+        if not result.converged:
+            say(f"{label}: stopped, a step did not converge")
     finally:
         solver.destroy()
         mesh.destroy()
     return rows, profiles
-
-
-def saved_state(solver, t):
-    """Copies of this rank's state, for outputs.set_state."""
-    from petsc_rod.outputs import restart_state, vertex_fields
-    return ({key: np.copy(value) for key, value in vertex_fields(solver, t).items()},
-            {key: np.copy(value) for key, value in restart_state(solver).items()})
 
 
 def out_of_plane_range(rows):

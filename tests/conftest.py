@@ -1,5 +1,11 @@
 """Shared pytest set-up for petsc_rod: PETSc initialisation, communicators, MPI-safe
-temporary folders, the ``serial`` marker and helpers to build a solver.
+temporary folders, the markers and helpers to build a solver.
+
+Tiers, one folder each, marked by it: ``unit`` (numpy only, no PETSc object), ``solver``
+(solver runs in this process, on the ranks pytest runs on) and ``system`` (spawn
+``python -m petsc_rod`` or a script; also marked ``serial`` and ``slow``). ``slow``
+also marks the few solver runs that take seconds: ``pytest -m "not slow"`` is the quick
+tier.
 
 Every test file must pass both serially and under ``mpiexec -n 2``: collective calls are
 made in the same order on every rank, and skip decisions are identical on all ranks.
@@ -27,13 +33,26 @@ for path in (TESTS_DIR, REPO_ROOT):
 from helpers import gather, make_solver  # noqa: E402,F401  (re-exported for tests)
 
 
+TIERS = ("unit", "solver", "system")
+
+
 def pytest_configure(config):
     config.addinivalue_line(
         "markers", "serial: spawns processes (or needs the whole machine); skipped when "
         "the tests themselves run on several MPI ranks")
+    config.addinivalue_line("markers", "slow: takes seconds; left out by -m 'not slow'")
+    for tier in TIERS:
+        config.addinivalue_line("markers", f"{tier}: a test of the tests/{tier} folder")
 
 
 def pytest_collection_modifyitems(config, items):
+    for item in items:
+        tier = os.path.basename(os.path.dirname(str(item.fspath)))
+        if tier in TIERS:
+            item.add_marker(getattr(pytest.mark, tier))
+        if tier == "system":
+            item.add_marker(pytest.mark.serial)
+            item.add_marker(pytest.mark.slow)
     if MPI.COMM_WORLD.size == 1:
         return
     skip = pytest.mark.skip(reason="serial test (spawns processes; mpiexec cannot nest): "

@@ -4,6 +4,8 @@ import os
 
 import numpy as np
 
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
 
 def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
                 max_it=5000):
@@ -12,15 +14,49 @@ def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
     The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
     ``solver_factory`` fixture which does it.
     """
-    from petsc_rod.mesh import Mesh
-    from petsc_rod.scene import Scene
-    from petsc_rod.solver import Settings, UzawaSolver
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.stopping import Settings
 
     scene = Scene(**scene_kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
-    settings = Settings(penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
+    settings = Settings(asked_penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
     solver = UzawaSolver(mesh, scene, settings)
     return mesh, solver
+
+
+# The paper scene at X_F = 16 (docs/method.md §8), and clamp reactions n(0), m(0) of
+# petsc_rod's solution of it (80 elements, K3 = 200), rounded to three digits: integrated
+# from the clamp they give a shooting guess close to the twisted branch of the collocation
+# reference.
+PAPER_STIFFNESS = (235.0, 360.0, 200.0)
+PAPER_LENGTH = 20.0
+PAPER_END_X = 16.0
+PAPER_END = np.array([PAPER_END_X, PAPER_LENGTH - PAPER_END_X, 0.0])
+TWISTED_CLAMP_FORCE = (-11.6, -4.03, 2.30)
+TWISTED_CLAMP_MOMENT = (9.21, -36.8, -18.0)
+
+# The cantilevers of the halving tests (tests/solver/test_continuation.py,
+# tests/system/test_continuation_cli.py): 16 elements, one load step too many for
+# -rod_al_max_it (BENT) or for the divergence bound (PULLED), two steps fine.
+HALVING_ELEMENTS = 16
+HALVING_RTOL, HALVING_CTOL = 1e-7, 1e-4
+BENT = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                       end_force=(0.0, -10.0, 0.0)),
+            penalty=25.0, max_it=220, snes_type="nrichardson")
+PULLED = dict(scene=dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                         end_force=(1.5e5, 0.0, 0.0)),
+              penalty=100.0, max_it=2000, snes_type="anderson")
+
+
+def twisted_paper_reference(tol=1e-10):
+    """The collocation solution of the paper scene's twisted branch (validation/reference.py)."""
+    from petsc_rod.validation import reference
+
+    guess = reference.shooting_guess(PAPER_LENGTH, PAPER_STIFFNESS, TWISTED_CLAMP_FORCE,
+                                     TWISTED_CLAMP_MOMENT)
+    return reference.solve_paper_scene(PAPER_END_X, guess, stiffness=PAPER_STIFFNESS, tol=tol)
 
 
 def gather(comm, owned):
@@ -40,13 +76,14 @@ def global_max(comm, value):
     return mpi.allreduce(float(value), op=MPI.MAX)
 
 
-def continuation(solver, steps=1, imperfection=0.0):
-    """From the straight state to load factor 1 as the CLI does it; the last StepReport."""
-    solver.set_straight()
-    for k in range(1, steps + 1):
-        solver.roll_cross_sections(imperfection)
-        report = solver.solve_step(k / steps)
-    return report
+def continuation(solver, steps=1, imperfection=0.0, **options):
+    """From the straight state to load factor 1 by the CLI's continuation loop (halving
+    and link check included; ``options`` as iteration.continuation.continuation takes
+    them); the last StepReport."""
+    from petsc_rod.iteration.continuation import continuation as run
+
+    solver.state.set_straight()
+    return run(solver, steps, imperfection, **options).report
 
 
 # Variables an enclosing mpiexec sets for its own processes: a child must not inherit
@@ -61,3 +98,12 @@ LAUNCHER_PREFIXES = ("PMIX_", "OMPI_COMM_WORLD", "OMPI_UNIVERSE_SIZE", "OMPI_FIR
 def child_env():
     """This environment without the variables of an enclosing mpiexec."""
     return {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_PREFIXES)}
+
+
+def png_summary(path):
+    """(height, width, share of pixels that are not white) of a PNG file: a figure that
+    was drawn, not only written."""
+    import matplotlib.image
+
+    pixels = matplotlib.image.imread(str(path))[..., :3]
+    return pixels.shape[0], pixels.shape[1], float(np.mean(np.any(pixels < 0.95, axis=-1)))

@@ -22,8 +22,8 @@ sqrt(a^2 + sigma^2) - a, the horizontal distance a asinh(sigma / a), the tangent
 
 import numpy as np
 
-from ..catenary import _increasing_root
-from ..errors import RodInputError
+from petsc_rod.scenes.catenary import _increasing_root
+from petsc_rod.errors import RodInputError
 
 
 def touchdown_parameter(length, span, h0, h1):

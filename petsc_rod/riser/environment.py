@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import RodInputError
+from petsc_rod.errors import RodInputError
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3

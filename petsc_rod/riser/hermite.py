@@ -20,9 +20,9 @@ of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of theta does.
 import numpy as np
 from petsc4py import PETSc
 
-from ..assembly import KSP_REASONS, PARALLEL_DEFAULTS, assemble_matrix
-from ..errors import RodDivergedError
-from ..options import set_from_options_with_defaults
+from petsc_rod.global_step.matrices import KSP_REASONS, PARALLEL_DEFAULTS, assemble_matrix
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
 
 
 def hermite_rows(mesh):

@@ -14,8 +14,9 @@ elements of later ranks: one prefix sum (Mesh.prefix_sum), nothing gathered.
 
 import numpy as np
 
-from ..fe import GAUSS_POINTS, GAUSS_WEIGHTS, P2, element_integrals, p2_basis, p2_integrals
-from ..fields import element_dofs
+from petsc_rod.mesh.elements import (GAUSS_POINTS, GAUSS_WEIGHTS, P2, element_integrals,
+                                     p2_basis, p2_integrals)
+from petsc_rod.mesh.fields import element_dofs
 
 
 def node_slots(mesh, values):

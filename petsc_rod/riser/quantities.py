@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..boundary import is_held
+from petsc_rod.scenes.boundary import is_held
 
 # Units of the datasets and attributes this module adds to the result file.
 DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m"}
@@ -37,7 +37,7 @@ class RiserReport:
 def top_end(solver):
     """0 or 1: which end is the top (the higher held end; the end S = L on a tie or when
     only that one is held)."""
-    start, end = solver.start_state, solver.end_state
+    start, end = solver.global_step.start_state, solver.global_step.end_state
     if is_held(start) and (not is_held(end) or start.position[2] > end.position[2]):
         return 0
     return 1
@@ -65,7 +65,7 @@ def touchdown(solver, seabed, top):
     """(S, position (3,), grounded length) of the touchdown point (module docstring);
     S and position NaN when the line does not reach the seabed. Collective."""
     mesh = solver.mesh
-    ghosted = solver.r.ghosted()[:, 0]
+    ghosted = solver.state.r.ghosted()[:, 0]
     left = mesh.element_local
     r0, r1 = ghosted[left], ghosted[left + 1]
     gap0, gap1 = r0[:, 2] - seabed.height, r1[:, 2] - seabed.height
@@ -90,9 +90,9 @@ def touchdown(solver, seabed, top):
         pick = np.argmin(S) if top == 0 else np.argmax(S)
         local = (S[pick], position[pick])
     found = _extreme(mesh, local[0], local, largest=top == 1)
-    end_z = _at_vertex(mesh, solver.r.owned()[:, 0, 2], top * mesh.n_elements)
+    end_z = _at_vertex(mesh, solver.state.r.owned()[:, 0, 2], top * mesh.n_elements)
     if end_z < seabed.height:          # the line lies on the seabed up to the top
-        found = (top * mesh.length, _at_vertex(mesh, solver.r.owned()[:, 0], top * mesh.n_elements))
+        found = (top * mesh.length, _at_vertex(mesh, solver.state.r.owned()[:, 0], top * mesh.n_elements))
     if found is None:
         return np.nan, np.full(3, np.nan), grounded
     return float(found[0]), np.asarray(found[1], dtype=float), grounded
@@ -101,7 +101,7 @@ def touchdown(solver, seabed, top):
 def riser_report(solver, vertex):
     """The datasets, attributes and step-line text of a riser scene from the vertex
     fields ``vertex`` (outputs.vertex_fields). Collective."""
-    mesh, riser = solver.mesh, solver.riser
+    mesh, riser = solver.mesh, solver.global_step.riser
     z = vertex["r"][:, 2]
     tension = np.einsum("nc,nc->n", vertex["n"], vertex["d3"])
     datasets = {"effective_tension": tension, "seabed_reaction": riser.seabed_pressure(z)}

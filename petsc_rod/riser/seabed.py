@@ -19,8 +19,8 @@ within a millimetre (measured in docs/riser.md).
 
 import numpy as np
 
-from ..fe import NODE_WEIGHTS
-from .hermite import midpoint_values, node_heights
+from petsc_rod.mesh.elements import NODE_WEIGHTS
+from petsc_rod.riser.hermite import midpoint_values, node_heights
 
 # The active-set loop of one global step ends after this many solves even if the set
 # still changes; the next iteration starts from the last set (a cycle between two sets

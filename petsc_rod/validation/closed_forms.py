@@ -113,7 +113,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import elliprd, elliprf, ellipj, expit
 
-from ..catenary import catenary, catenary_axes  # noqa: F401  (the runtime's, re-exported)
+from petsc_rod.scenes.catenary import catenary, catenary_axes  # noqa: F401  (the runtime's, re-exported)
 
 __all__ = ["cantilever_tip", "cantilever_shape", "twisted_rod", "catenary", "catenary_axes"]
 

@@ -1,0 +1,264 @@
+"""Which equilibrium a step reached: the second variation of the discrete energy on the
+constraint set, and a direction that leaves a saddle (docs/method.md §10).
+
+At a converged state the nodal frames are rotations, d_n = tau_n, and a variation turns
+each by a small rotation vector omega_n: delta d_i = omega x d_i, to second order
+omega x (omega x d_i) / 2. With the discrete energy E = sum_i a_i d_i^T K d_i - work and
+its gradient at the solution, grad_{d_i} E = -w lambda_i (the global step's optimality
+at d = tau; the reaction mu of a chord constraint is linear and drops out), the second
+variation is
+
+    H[omega, omega] = sum_i 2 a_i (omega x d_i)^T K (omega x d_i)
+                      - sum_n w_n sum_i lambda_{n,i} . (omega_n x (omega_n x d_{n,i}))
+
+on the omega with omega_n = 0 at a clamp and, when both ends are held,
+sum_n w_n (omega_n x tau3_n) = 0 (the chord int r' dS stays fixed). The state is a
+local minimiser when H is positive semi-definite there, a saddle when H has a negative
+eigenvalue. Sylvester's law of inertia counts those without an eigen-solve: the
+symmetric-indefinite factorisation of H (MUMPS) gives the number of negative pivots,
+and the chord constraint is taken into account by the Schur complement,
+n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - 3 (C: its 3 columns).
+The plain iteration is a descent method and leaves a saddle by itself, slowly; an
+accelerated one may converge to it, hence this check.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.mesh.elements import P2, p2_element_matrices
+from petsc_rod.mesh.fields import element_dofs
+
+# A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
+# (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
+TOLERANCE = 1e-9
+# Inverse-iteration steps for the direction of negative curvature.
+INVERSE_STEPS = 8
+# Start of the inverse iteration: sin(GOLDEN i^1.5) at row i (no pattern a mode could
+# be orthogonal to).
+GOLDEN = 0.5 * (1 + 5**0.5)
+# Chord forms whose Gram eigenvalue is below this fraction of the largest are dependent.
+RANK_TOLERANCE = 1e-12
+
+
+def skew(v):
+    """Cross-product matrices [v]x with [v]x w = v x w: (..., 3) -> (..., 3, 3)."""
+    out = np.zeros(v.shape + (3,))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+class SecondVariation:
+    """H of the module docstring at the solver's current state, as a PETSc matrix on the
+    rotation vectors of the P2 nodes (3 per node, node n = 2 vertex + slot), with what
+    the inertia test needs. Collective; ``destroy()`` frees every PETSc object."""
+
+    def __init__(self, solver):
+        self.solver = solver
+        mesh = solver.mesh
+        self.comm = mesh.comm
+        n_local = 3 * mesh.n_local_nodes
+        self.first_row = 6 * mesh.vertex_start
+        self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
+                                            nnz=(15, 6), comm=self.comm)
+        self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        self._assemble()
+        self._clamped = self._clamped_rows()
+        self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
+        self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self._diagonal = self.matrix.getDiagonal()
+        self.constraint = self._chord_columns() if solver.global_step.bordered else []
+        # a taut, straight rod: the chord fixes the whole state and its forms are
+        # dependent; the second variation says nothing there (no constraint
+        # qualification), and the state is the only one the ends allow
+        self.decidable = len(self.constraint) == 3 or not solver.global_step.bordered
+        self.mass = self._mass()
+        self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
+        self._mass_or_one.getArray()[self._clamped - self.first_row] = 1.0
+        self._work = self.mass.duplicate()
+        self._create_solver()
+
+    # --- assembly -------------------------------------------------------------------
+    def _assemble(self):
+        solver, mesh = self.solver, self.solver.mesh
+        ne = mesh.n_local_elements
+        # directors at the 3 nodes of each owned element, (ne, 3 nodes, 3 dirs, 3); the
+        # ghost exchange is collective, also on a rank that owns no element
+        d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
+                      for f in solver.state.frame_fields], axis=2)
+        if ne:
+            stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
+            x = skew(d)                                      # (ne, node, dir, 3, 3)
+            # block (a, b) = sum_i 2 a_i K_ab [d_a,i]x^T [d_b,i]x
+            blocks = np.einsum("i,eab,eaiks,ebikt->easbt", 2 * solver.split, stiffness, x, x)
+            rows = (self.first_row + 3 * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
+            rows = (rows[:, :, None] + np.arange(3)).reshape(ne, 9).astype(PETSc.IntType)
+            self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
+                                     addv=PETSc.InsertMode.ADD_VALUES)
+        # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
+        tau, lam, w = solver.state.tau, solver.state.lam, solver.state.node_weights
+        outer = np.einsum("nik,nil->nkl", lam, tau)
+        dots = np.einsum("nik,nik->n", lam, tau)
+        local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
+                                     - dots[:, None, None] * np.eye(3))
+        rows = (self.first_row + 3 * np.arange(mesh.n_local_nodes)[:, None]
+                + np.arange(3)).astype(PETSc.IntType)
+        if rows.size:
+            self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
+        self.matrix.assemble()
+
+    def _clamped_rows(self):
+        solver, mesh = self.solver, self.solver.mesh
+        rows = []
+        if solver.global_step.start_state.kind == "clamp" and mesh.on_lower_boundary:
+            rows += [0, 1, 2]
+        if solver.global_step.end_state.kind == "clamp" and mesh.on_upper_boundary:
+            last = 3 * 2 * mesh.n_elements
+            rows += [last, last + 1, last + 2]
+        return np.array(rows, dtype=PETSc.IntType)
+
+    def _chord_columns(self):
+        """The 3 linear forms omega -> sum_n w_n (omega_n x tau3_n)_k, as Vecs (zero at
+        clamped rows)."""
+        solver = self.solver
+        tangent = solver.state.tau[:, 2]
+        forms = -solver.state.node_weights[:, None, None] * skew(tangent)    # (n, k, 3)
+        columns = []
+        for k in range(3):
+            vec = self.matrix.createVecLeft()
+            vec.getArray()[:] = forms[:, k, :].ravel()
+            self._zero_clamped(vec)
+            columns.append(vec)
+        return self._independent(columns)
+
+    @staticmethod
+    def _independent(columns):
+        """An orthonormal basis of the span of ``columns`` (Vecs): a straight rod's chord
+        form along its own axis vanishes, and the inertia formula needs independent
+        constraints."""
+        gram = np.array([[a.dot(b) for b in columns] for a in columns])
+        values, vectors = np.linalg.eigh(gram)
+        keep = values > RANK_TOLERANCE * max(values.max(), np.finfo(float).tiny)
+        basis = []
+        for value, coefficients in zip(values[keep], vectors.T[keep]):
+            vec = columns[0].duplicate()
+            vec.zeroEntries()
+            vec.maxpy(coefficients / np.sqrt(value), columns)
+            basis.append(vec)
+        for vec in columns:
+            vec.destroy()
+        return basis
+
+    def _mass(self):
+        """The lumped mass diag(w_n) on each rotation component (0 at the clamped rows,
+        whose unit diagonal no shift moves), as a Vec."""
+        vec = self.matrix.createVecLeft()
+        vec.getArray()[:] = np.repeat(self.solver.state.node_weights, 3)
+        self._zero_clamped(vec)
+        return vec
+
+    def _zero_clamped(self, vec):
+        local = self._clamped - self.first_row
+        vec.getArray()[local] = 0.0
+
+    # --- inertia --------------------------------------------------------------------
+    def _create_solver(self):
+        """One KSP (preonly, MUMPS LDL^T) for H - shift M at every shift: the symbolic
+        factorisation is made once, the numeric one per shift."""
+        self.shifted = self.matrix.duplicate(copy=True)
+        self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        ksp = self.ksp = PETSc.KSP().create(comm=self.comm)
+        ksp.setOperators(self.shifted)
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        pc = ksp.getPC()
+        pc.setType(PETSc.PC.Type.CHOLESKY)
+        pc.setFactorSolverType("mumps")
+        pc.setFactorSetUpSolverType()
+        self.factor = pc.getFactorMatrix()
+        self.factor.setMumpsIcntl(13, 1)     # the inertia of the whole matrix on every rank
+        self.factor.setMumpsIcntl(24, 1)     # null pivots detected, not failed on
+
+    def _factor(self, shift):
+        """Factor H - shift M."""
+        self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.mass.copy(self._work)
+        self._work.scale(-shift)
+        self.shifted.setDiagonal(self._work, addv=PETSc.InsertMode.ADD_VALUES)
+        self.ksp.setOperators(self.shifted)
+        self.ksp.setUp()
+
+    def negative_directions(self, shift):
+        """Eigenvalues of H below ``shift`` (times the mass M) on the constraint set."""
+        self._factor(shift)
+        negative, _, _ = self.factor.getInertia()
+        if not self.constraint:
+            return int(negative)
+        solves = []
+        for column in self.constraint:
+            y = column.duplicate()
+            self.ksp.solve(column, y)
+            solves.append(y)
+        schur = np.array([[c.dot(y) for y in solves] for c in self.constraint])
+        for y in solves:
+            y.destroy()
+        return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
+
+    def tolerance(self):
+        """TOLERANCE times max_i |H_ii| / M_ii: an eigenvalue of H / M above -tolerance
+        is zero to round-off (the free roll of a section with K1 = K2 between pins)."""
+        self._work.pointwiseDivide(self._diagonal, self._mass_or_one)
+        return TOLERANCE * self._work.norm(PETSc.NormType.INFINITY)
+
+    def lower_bound(self):
+        """Gershgorin: every eigenvalue of H / M is at least min_i (H_ii - sum_j |H_ij|)
+        / M_ii (M diagonal)."""
+        indptr, _, values = self.matrix.getValuesCSR()
+        absolute = np.add.reduceat(np.abs(values), indptr[:-1]) if values.size else np.zeros(0)
+        diagonal = self._diagonal.getArray(readonly=True)
+        bound = (diagonal + np.abs(diagonal) - absolute) / self._mass_or_one.getArray(readonly=True)
+        return self.solver.mesh.global_min(float(bound.min(initial=0.0)))
+
+    def descent_direction(self):
+        """A unit rotation-vector field of negative curvature, (n_nodes, 3), or None when
+        H has no eigenvalue below -tolerance() on the constraint set. The lowest
+        eigenvalue is bracketed by bisection on the inertia between the Gershgorin bound
+        and -tolerance to within a factor 2, and inverse iteration at the lower end
+        converges to its eigenvector at a rate of at most 1/2 per step."""
+        upper = -self.tolerance()
+        if self.negative_directions(upper) == 0:
+            return None
+        lower = min(self.lower_bound(), 2 * upper)
+        while lower < 2 * upper:
+            middle = -np.sqrt(lower * upper)
+            if self.negative_directions(middle) > 0:
+                upper = middle
+            else:
+                lower = middle
+        self._factor(lower)
+        vector = self.matrix.createVecLeft()
+        # a start with a component along every eigenvector, the same on any number of ranks
+        start, end = vector.getOwnershipRange()
+        vector.getArray()[:] = np.sin(GOLDEN * np.arange(start, end) ** 1.5)
+        self._zero_clamped(vector)
+        work = vector.duplicate()
+        for _ in range(INVERSE_STEPS):
+            self._project(vector)
+            self.ksp.solve(vector, work)
+            work.copy(vector)
+            vector.scale(1.0 / vector.norm())
+        self._project(vector)
+        direction = vector.getArray().reshape(-1, 3).copy()
+        vector.destroy()
+        work.destroy()
+        return direction
+
+    def _project(self, vector):
+        """Remove the components along the (orthonormal) chord forms."""
+        for c in self.constraint:
+            vector.axpy(-c.dot(vector), c)
+
+    def destroy(self):
+        for obj in [self.ksp, self.shifted, self.matrix, self.mass, self._mass_or_one,
+                    self._work, self._diagonal, *self.constraint]:
+            obj.destroy()

@@ -1,0 +1,228 @@
+"""Command line: read the -rod_* options, check them and what the run needs before any
+work, build the scene, run the continuation, write, report. Returns the process exit
+code (README, "Exit codes and bad input": 0 converged, 2 bad input, 3 not converged,
+4 diverged, 5 the result could not be written, 128 + n stopped by signal n)."""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod import resources
+from petsc_rod.io import outputs, provenance
+from petsc_rod.io import results as io
+from petsc_rod.scenes import starts
+from petsc_rod.errors import RodError, RodInputError
+from petsc_rod.mesh.mesh import Mesh, end_element_lengths
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
+                      read_options, unused_options)
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.cli.signals import Interrupts
+from petsc_rod.iteration.continuation import continuation
+from petsc_rod.iteration.driver import UzawaSolver
+from petsc_rod.iteration.penalty import default_penalty
+from petsc_rod.iteration.stopping import Settings
+from petsc_rod.riser.environment import environment_from_options
+
+# The smallest element, relative to the length, whose end coordinates double precision
+# still tells apart to many digits.
+MIN_RELATIVE_ELEMENT = 1e-12
+
+
+def scene_from_options(values, given):
+    """A validated Scene from parsed option values."""
+    load = np.asarray(values["rod_load"])
+    if load.size % 3:
+        raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
+    scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
+                  start=values["rod_start"], end=values["rod_end"],
+                  end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
+                  end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
+                  end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
+                  load_breaks=values["rod_load_breaks"])
+    scene.validate(given)
+    scene.seabed, scene.current = environment_from_options(values, given, scene)
+    return scene
+
+
+def settings_from_options(values, scene):
+    penalty = values["rod_al_penalty"]
+    if penalty is None:
+        penalty = default_penalty(scene)
+    return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
+                    rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
+                    monitor=values["rod_al_monitor"],
+                    adapt_penalty=values["rod_al_adapt_penalty"],
+                    # a current's drag is not conservative: no energy to test (docs/riser.md)
+                    check_stability=values["rod_al_stability"] and scene.current is None)
+
+
+def options_record():
+    """The whole options database as '-name value' lines (the file's ``options``)."""
+    return "\n".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items()))
+
+
+def run(comm=None):
+    """The whole program on ``comm``; returns the exit code. Only this function opens,
+    finishes or aborts the result file, and destroys the PETSc objects."""
+    comm = comm or PETSc.COMM_WORLD
+    database = PETSc.Options()
+    mesh = solver = writer = None
+
+    def say(text):
+        PETSc.Sys.Print(text, comm=comm)
+
+    with Interrupts(comm) as interrupts:
+        try:
+            check_same_on_every_rank(comm)
+            values, given = read_options()
+            if database.hasName("help"):
+                for line in help_text():
+                    say(line)
+            scene = scene_from_options(values, given)
+            settings = settings_from_options(values, scene)
+            check_mesh(comm, values)
+            if values["rod_output"]:
+                io.check_output_path(values["rod_output"], comm)
+            mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
+            solver = build_solver(mesh, scene, settings)
+            if database.hasName("help"):
+                return 0
+            start = start_from(solver, values, given, say)
+            if values["rod_output"]:
+                writer = io.ResultWriter(
+                    values["rod_output"], mesh,
+                    io.minimum_bytes(mesh, outputs.restart_state(solver), values["rod_steps"]),
+                    run_record(values, solver, start))
+            code = continuation(solver, values["rod_steps"], values["rod_imperfection"],
+                                writer=writer, say=say, options=options_record(),
+                                max_halvings=values["rod_max_halvings"],
+                                track_link=values["rod_track_link"], start=start,
+                                interrupts=interrupts).code
+            writer = None
+            for name in unused_options():
+                say(f"petsc_rod: warning: option -{name} was set but not used")
+            return code
+        except RodError as error:
+            say(f"petsc_rod: error: {error}")
+            database.setValue("options_left", "0")
+            return error.exit_code
+        finally:
+            if writer is not None:          # any failure before the file was finished
+                writer.abort()
+            if solver is not None:
+                solver.destroy()
+            if mesh is not None:
+                mesh.destroy()
+
+
+def check_mesh(comm, values):
+    """Refuse, before it is allocated, a mesh the machine cannot hold or whose smallest
+    elements double precision cannot resolve (a large -rod_mesh_grading)."""
+    elements, length = values["rod_elements"], values["rod_length"]
+    resources.check_elements_fit(comm, elements)
+    smallest = end_element_lengths(elements, length, values["rod_mesh_grading"]).min()
+    if not smallest >= MIN_RELATIVE_ELEMENT * length:
+        raise RodInputError(
+            f"-rod_mesh_grading {values['rod_mesh_grading']:g} with {elements} elements: the "
+            f"end elements would be {smallest / length:.2g} of the length, below what double "
+            f"precision resolves ({MIN_RELATIVE_ELEMENT:g}); use a smaller grading or fewer "
+            "elements")
+
+
+def build_solver(mesh, scene, settings):
+    """The UzawaSolver; a PETSc error while it sets up its solvers (an unknown
+    -rod_slope_ksp_type, say) is bad input."""
+    try:
+        return UzawaSolver(mesh, scene, settings)
+    except PETSc.Error as error:
+        detail = str(error).strip().splitlines()[-1].split("] ", 1)[-1]
+        raise RodInputError(f"PETSc refused the solver options: {detail}; check the "
+                            "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
+
+
+def start_from(solver, values, given, say):
+    """Set the state the first step starts from, a restart file or -rod_initial_shape;
+    returns the load factor the load path goes on from (0 but for a restart)."""
+    shape = values["rod_initial_shape"]
+    if shape not in starts.SHAPES:
+        raise RodInputError(f"-rod_initial_shape {shape}: unknown shape; use one of "
+                            + "|".join(starts.SHAPES))
+    if values["rod_initial"]:
+        if shape != "straight":
+            raise RodInputError("-rod_initial and -rod_initial_shape both set the start; "
+                                "give one of them")
+        return restart_from(solver, values["rod_initial"], values["rod_initial_load_factor"],
+                            say)
+    if "rod_initial_load_factor" in given:
+        raise RodInputError("-rod_initial_load_factor needs -rod_initial (the state it is "
+                            "the load factor of); drop it or give the file")
+    if shape == "catenary":
+        solver.state.set_from_curve(starts.catenary_start(solver.scene, 1.0 / values["rod_steps"]))
+    else:
+        solver.state.set_straight()
+    return 0.0
+
+
+def restart_from(solver, path, load_factor, say):
+    """Set the state of result file ``path`` (validated by io.read_restart against this
+    run's arrays); returns ``load_factor``, or the file's when it is None."""
+    restart = io.read_restart(path, solver.mesh, outputs.restart_state(solver))
+    outputs.set_state(solver, restart.vertex, restart.state)
+    if not restart.converged:
+        say(f"petsc_rod: warning: -rod_initial {path} says converged = 0: the run starts "
+            f"from a state that did not converge (at load factor {restart.load_factor:.6g})")
+    start = restart.load_factor if load_factor is None else load_factor
+    say(f"petsc_rod: restart from {path}, load factor {start:.6g}"
+        + (" (-rod_initial_load_factor)" if load_factor is not None else
+           " (the file's; -rod_initial_load_factor 0 walks the load path again)"))
+    return start
+
+
+def run_record(values, solver, start):
+    """What the result file's root says about the run: version, commit and the options in
+    effect as text, and the group ``parameters`` (every option in effect, defaults and
+    the solvers' included, as numbers with their units)."""
+    parameters, units = options_in_effect(values, solver, start)
+    text = "\n".join(f"-rod_{name} {format_value(value)}" for name, value in parameters.items()
+                     if not (isinstance(value, str) and value == ""))
+    attributes = {"version": provenance.version(), "commit": provenance.commit(),
+                  "options_in_effect": text}
+    shaped = {**parameters, "load": np.asarray(parameters["load"]).reshape(-1, 3),
+              "end_frame": np.asarray(parameters["end_frame"]).reshape(3, 3)}
+    return io.RunRecord(attributes, shaped, units)
+
+
+def options_in_effect(values, solver, start):
+    """Every -rod_* option's value in effect, by name without ``rod_`` (the defaults that
+    depend on the scene resolved, text options that were not given as ''), and its unit;
+    then each global-step solver's KSP, PC and factorisation package."""
+    scene = solver.scene
+    resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
+                "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
+    parameters, units = {}, {}
+    for option in OPTIONS:
+        value = resolved.get(option.name, values[option.name])
+        if value is None:
+            value = ""
+        if isinstance(value, bool):
+            value = int(value)
+        parameters[option.name.removeprefix("rod_")] = value
+        units[option.name.removeprefix("rod_")] = BY_NAME[option.name].unit
+    for name, value in solver_types(solver).items():
+        parameters[name] = value
+        units[name] = "text"
+    return parameters, units
+
+
+def solver_types(solver):
+    """{'<prefix>ksp_type': ..., '<prefix>pc_type': ..., '<prefix>pc_factor_mat_solver_type':
+    ...} of the global step's solvers, prefixes without ``rod_``."""
+    types = {}
+    for problem in solver.global_step.problems:
+        ksp = problem.ksp
+        prefix = (ksp.getOptionsPrefix() or "").removeprefix("rod_")
+        pc = ksp.getPC()
+        types[f"{prefix}ksp_type"] = ksp.getType()
+        types[f"{prefix}pc_type"] = pc.getType()
+        if pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU):
+            types[f"{prefix}pc_factor_mat_solver_type"] = pc.getFactorSolverType()
+    return types

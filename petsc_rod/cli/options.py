@@ -1,0 +1,288 @@
+"""The application's PETSc options: one table drives parsing, defaults and ``-help``.
+
+Every option has the root prefix ``rod_``. The KSPs of the global step have their own
+prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``; ``rod_z_`` the seabed's vertical
+problem), the SNES of the iteration ``rod_snes_``;
+they read the usual PETSc options. A
+``-rod_*`` name that is not in the table is an error (with the closest known name); any
+other option nobody read is reported at the end of the run.
+"""
+
+import ctypes
+import difflib
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.errors import RodInputError
+
+# Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
+SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_")
+
+# Every number must be finite and at most this large in magnitude (and a positive scale,
+# such as a length or a tolerance, at least its inverse): the solver forms products of
+# a few of them (K / L^2, (K3 a / L)^2 / K, R h), which must stay within double
+# precision.
+MAX_MAGNITUDE = 1e30
+# The largest whole number an integer option may hold: a PETSc integer.
+MAX_INT = int(np.iinfo(PETSc.IntType).max)
+
+
+def _checked_reals(values):
+    """``values`` (an array), refused when not finite or too large (MAX_MAGNITUDE)."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError("expected finite numbers, not nan or inf")
+    if np.any(np.abs(values) > MAX_MAGNITUDE):
+        raise ValueError(f"out of range: magnitudes above {MAX_MAGNITUDE:g} are refused")
+    return values
+
+
+def _real(text):
+    return float(_checked_reals(np.array([float(text)]))[0])
+
+
+def _reals(count=None):
+    def parse(text):
+        values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+        if count is not None and len(values) != count:
+            raise ValueError(f"expected {count} comma-separated numbers")
+        return _checked_reals(np.array(values))
+    return parse
+
+
+def _int(text):
+    value = float(text)
+    if not np.isfinite(value) or abs(value) > MAX_INT:
+        raise ValueError(f"expected a whole number of magnitude at most {MAX_INT} (a PETSc "
+                         "integer)")
+    if value != int(value):
+        raise ValueError("expected a whole number")
+    return int(value)
+
+
+def _bool(text):
+    lowered = text.strip().lower()
+    if lowered in ("", "1", "true", "yes", "on"):
+        return True
+    if lowered in ("0", "false", "no", "off"):
+        return False
+    raise ValueError("expected true or false")
+
+
+def _string(text):
+    if not text:
+        raise ValueError("expected a value")
+    return text
+
+
+@dataclass(frozen=True)
+class Option:
+    name: str
+    parse: object
+    default: object
+    metavar: str
+    help: str
+    check: object = None     # (predicate, what is required)
+    unit: str = "1"          # of the value in the result file's ``parameters`` ("text")
+
+
+POSITIVE = (lambda v: np.all(np.asarray(v) > 0), "must be positive")
+# a positive scale (length, stiffness, penalty): also not below 1 / MAX_MAGNITUDE
+SCALE = (lambda v: np.all(np.asarray(v) >= 1 / MAX_MAGNITUDE),
+         f"must be positive (at least {1 / MAX_MAGNITUDE:g})")
+NON_NEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
+# a stopping tolerance: a change or residual of 1 or more would accept any iterate
+TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
+             f"must be positive (at least {1 / MAX_MAGNITUDE:g}) and below 1: a tolerance of "
+             "1 or more accepts any iterate")
+# halvings beyond this make increments below the resolution of a load factor in [0, 1]
+MAX_HALVINGS = 50
+
+OPTIONS = [
+    Option("rod_length", _real, 1.0, "L", "length of the cable, m", SCALE, "m"),
+    Option("rod_elements", _int, 64, "N", "number of elements", POSITIVE),
+    Option("rod_mesh_grading", _real, 1.0, "q",
+           "ratio of the largest to the smallest element; > 1 refines both ends",
+           (lambda v: v >= 1, "must be >= 1")),
+    Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
+           "bending (about d1, d2) and torsion stiffness, N m^2", SCALE, "N m^2"),
+    Option("rod_start", _string, "clamp", "clamp|pin|free", "condition at S = 0 (at the origin)",
+           unit="text"),
+    Option("rod_end", _string, "free", "clamp|pin|free", "condition at S = L", unit="text"),
+    Option("rod_end_position", _reals(3), None, "x,y,z",
+           "position of the end S = L (clamp, pin); default (L,0,0)", unit="m"),
+    Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
+           "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
+    Option("rod_end_twist", _real, 0.0, "angle",
+           "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
+           "continuation", unit="rad"),
+    Option("rod_end_force", _reals(3), np.zeros(3), "fx,fy,fz", "dead force at a free end S = L, N",
+           unit="N"),
+    Option("rod_start_force", _reals(3), np.zeros(3), "fx,fy,fz",
+           "dead force at a free start S = 0, N", unit="N"),
+    Option("rod_load", _reals(), np.zeros(3), "fx,fy,fz[,...]",
+           "distributed dead load, N/m: 3 values, or 3 per piece with -rod_load_breaks",
+           unit="N/m"),
+    Option("rod_load_breaks", _reals(), np.zeros(0), "s1,...",
+           "arc lengths where the piecewise-constant load changes, m", unit="m"),
+    # riser terms (petsc_rod/riser, docs/riser.md)
+    Option("rod_seabed", _real, None, "z",
+           "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",
+           unit="m"),
+    Option("rod_seabed_stiffness", _real, None, "k",
+           "seabed stiffness, N/m per m of line per m of penetration; default w / 1 mm, w the "
+           "largest downward -rod_load (N/m)", SCALE, "N/m^2"),
+    Option("rod_current", _reals(3), None, "ux,uy,uz",
+           "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),
+    Option("rod_current_profile", _string, None, "FILE",
+           "current profile: rows 'depth ux uy uz' (m, m/s), depths increasing, linear in "
+           "between, constant beyond", unit="text"),
+    Option("rod_sea_surface", _real, None, "z",
+           "height of the sea surface the profile's depths are measured from, m; default "
+           "the highest held end", unit="m"),
+    Option("rod_drag", _reals(3), None, "rho,Cd,D",
+           "water density kg/m^3, normal drag coefficient, hydrodynamic diameter m: drag "
+           "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE),
+    Option("rod_steps", _int, 1, "K", "continuation steps from the straight state", POSITIVE),
+    Option("rod_imperfection", _real, 0.0, "eps",
+           "at the start of each step, roll the cross-sections about the tangent by "
+           "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left", unit="rad"),
+    Option("rod_max_halvings", _int, 4, "n",
+           "a step that does not converge or diverges is retried from the last converged "
+           "state with half the increment, at most n times per step (smallest increment "
+           "1/(K 2^n)); 0: stop at the first failure",
+           (lambda v: 0 <= v <= MAX_HALVINGS, f"must be between 0 and {MAX_HALVINGS}")),
+    Option("rod_track_link", _bool, True, "bool",
+           "ends clamped on a common axis: refuse a step whose linking number Tw + Wr is "
+           "not the last one plus the end roll over 2 pi (the rod passed around an end or "
+           "through itself); 0 for a rod free to pass around its ends"),
+    Option("rod_initial", _string, None, "FILE", "start from (restart) a result file",
+           unit="text"),
+    Option("rod_initial_load_factor", _real, None, "t",
+           "the load factor of the -rod_initial state: the load path goes on from it to 1 "
+           "in -rod_steps steps; default the file's load_factor (0: walk the whole path "
+           "again, e.g. from a file of another scene)",
+           (lambda v: 0 <= v <= 1, "must be between 0 and 1")),
+    Option("rod_initial_shape", _string, "straight", "straight|catenary",
+           "start of the first step: the straight reference, or the inextensible catenary "
+           "of that step with its tension as multiplier (both ends held, uniform load)",
+           unit="text"),
+    Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE", unit="text"),
+    Option("rod_al_penalty", _real, None, "R",
+           "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
+           "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
+           "min(K1, K2) with M = K3 a / L for a clamped end turned by a", SCALE, "N"),
+    Option("rod_al_max_it", _int, 2000, "n", "iteration cap per step", POSITIVE),
+    Option("rod_al_rtol", _real, 1e-9, "tol",
+           "stop when the relative L2 change of (r, r', d1, d2) at the nodes per iteration "
+           "is below tol", TOLERANCE),
+    Option("rod_al_ctol", _real, 1e-9, "tol",
+           "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
+           "below tol", TOLERANCE),
+    Option("rod_al_stability", _bool, True, "bool",
+           "at each converged step, test the second variation of the energy (Sylvester "
+           "inertia); at a saddle turn the frames along its negative curvature and go on; "
+           "not with a current (its drag has no energy)"),
+    Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
+    Option("rod_al_adapt_penalty", _bool, True, "bool",
+           "raise R tenfold, refactoring the matrices, while it is below a tenth of the "
+           "default and the constraint residual falls by less than half in 200 iterations"),
+]
+BY_NAME = {option.name: option for option in OPTIONS}
+
+
+def read_options():
+    """Parse every ``-rod_*`` option; returns (values by name, set of names the user gave).
+
+    Raises RodInputError for an unknown ``-rod_`` name or a malformed value.
+    """
+    database = PETSc.Options()
+    given = {name for name in database.getAll() if name.startswith("rod_")}
+    for name in sorted(given):
+        if name not in BY_NAME and not name.startswith(SOLVER_PREFIXES):
+            close = difflib.get_close_matches(name, list(BY_NAME), n=1)
+            hint = f"; did you mean -{close[0]}?" if close else "; see -help"
+            raise RodInputError(f"unknown option -{name}{hint}")
+    values = {}
+    for option in OPTIONS:
+        if option.name not in given:
+            values[option.name] = option.default
+            continue
+        text = database.getString(option.name, "")
+        try:
+            value = option.parse(text)
+        except ValueError as error:
+            expected = "" if "expected" in str(error) else f"; expected {option.metavar}"
+            raise RodInputError(f"-{option.name} {text!r}: {error}{expected}") from None
+        if option.check is not None and not option.check[0](value):
+            raise RodInputError(f"-{option.name} {text}: {option.check[1]}")
+        values[option.name] = value
+    return values, given
+
+
+def check_same_on_every_rank(comm):
+    """Refuse a run whose ranks were given different options (e.g. an option on one rank
+    only), which would otherwise crash or deadlock in the first collective call: the
+    digests of the whole options database are compared, and a mismatch is reported with
+    the options that differ. Collective; raises the same RodInputError on every rank."""
+    mpi = comm.tompi4py()
+    database = PETSc.Options().getAll()
+    digest = hashlib.sha256(repr(sorted(database.items())).encode()).hexdigest()
+    digests = mpi.allgather(digest)
+    if len(set(digests)) == 1:
+        return
+    rank = next(k for k, other in enumerate(digests) if other != digests[0])
+    first, other = mpi.bcast(database, root=0), mpi.bcast(database, root=rank)
+    names = sorted(name for name in set(first) | set(other)
+                   if name not in first or name not in other or first[name] != other[name])
+    shown = " ".join(f"-{name}" for name in names[:5]) + (" ..." if len(names) > 5 else "")
+    raise RodInputError(f"rank {rank} was given other options than rank 0 ({shown}); give every "
+                        "rank the same options (one mpiexec command, one options file)")
+
+
+def format_value(value):
+    """An option's value as text that its parser reads back."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, np.ndarray):
+        return ",".join(f"{v:.17g}" for v in value.ravel())
+    if isinstance(value, float):
+        return f"{value:.17g}"
+    return str(value)
+
+
+def help_text():
+    """The lines -help prints for the application's options."""
+    lines = ["petsc_rod options (prefix rod_):"]
+    for option in OPTIONS:
+        default = option.default
+        if isinstance(default, np.ndarray):
+            default = ",".join(f"{v:g}" for v in default) or "none"
+        lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
+                     f"(default {default})")
+    lines.append("  Global-step solvers: -rod_slope_ksp_*, -rod_slope_pc_* (the slope r'), -rod_d1_*, -rod_d2_* "
+                 "(directors), -rod_z_* (the height, with -rod_seabed); default preonly + Cholesky on one rank, CG with block Jacobi and "
+                 "Cholesky blocks (rtol 1e-14) on several.")
+    lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
+                 "iterates) | nrichardson (the plain iteration) | ngmres, and the SNES "
+                 "options under the same prefix (-rod_snes_anderson_m, -rod_snes_monitor).")
+    return lines
+
+
+def unused_options():
+    """Names of options in the database that no PETSc object or this program read."""
+    try:
+        library = ctypes.CDLL(PETSc.__file__)
+        used = library.PetscOptionsUsed
+    except (OSError, AttributeError):
+        return []
+    unused = []
+    for name in PETSc.Options().getAll():
+        if name in ("help", "options_left", "options_file"):
+            continue
+        flag = ctypes.c_int(0)
+        if used(None, name.encode(), ctypes.byref(flag)) == 0 and not flag.value:
+            unused.append(name)
+    return unused

@@ -1,0 +1,68 @@
+"""Director frames and their strains (numpy only, vectorised over points).
+
+Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (docs/method.md §1, §2).
+"""
+
+import numpy as np
+
+
+def strains(d, dd):
+    """Strains u_i in the director basis from directors and their S-derivatives (§1).
+
+    d, dd: (..., 3, 3) rows d1, d2, d3 and d1', d2', d3'.
+    u1 = d2'.d3, u2 = d3'.d1, u3 = d1'.d2.  Returns (..., 3).
+    """
+    return np.stack([np.einsum("...c,...c->...", dd[..., 1, :], d[..., 2, :]),
+                     np.einsum("...c,...c->...", dd[..., 2, :], d[..., 0, :]),
+                     np.einsum("...c,...c->...", dd[..., 0, :], d[..., 1, :])], axis=-1)
+
+
+def split_coefficients(stiffness):
+    """a_i of the quadratic form w = a1|d1'|^2 + a2|d2'|^2 + a3|r''|^2 (§2).
+
+    a1 = (K2 + K3 - K1)/4, a2 = (K3 + K1 - K2)/4, a3 = (K1 + K2 - K3)/4.
+    """
+    k1, k2, k3 = stiffness
+    return np.array([k2 + k3 - k1, k3 + k1 - k2, k1 + k2 - k3]) / 4.0
+
+
+def rotation_about(axis, angle):
+    """Rotation matrix (3, 3) of ``angle`` rad about the unit vector ``axis`` (Rodrigues)."""
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def rotations(omega):
+    """Rotation matrices exp([omega]x) of rotation vectors omega (..., 3) (Rodrigues):
+    I + sin(a) [k]x + (1 - cos a) [k]x^2 with a = |omega|, k = omega / a. (..., 3, 3)."""
+    omega = np.asarray(omega, dtype=float)
+    angle = np.linalg.norm(omega, axis=-1)[..., None, None]
+    k = np.zeros(omega.shape + (3,))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -omega[..., 2], omega[..., 1], -omega[..., 0]
+    k = k - np.swapaxes(k, -1, -2)
+    # sin(a)/a and (1 - cos a)/a^2, well defined at a = 0
+    first = np.sinc(angle / np.pi)
+    second = 0.5 * np.sinc(angle / (2 * np.pi)) ** 2
+    return np.eye(3) + first * k + second * (k @ k)
+
+
+def rotation_log(q):
+    """Axis-angle vector w (3,) with rotation_about(w/|w|, |w|) = q, |w| in [0, pi].
+
+    With s = (q - q^T)^vee = 2 sin(a) axis, the angle a = atan2(|s|, tr q - 1) is accurate
+    over the whole range; w = s a / (2 sin a) below a half-turn's neighbourhood, and near
+    a = pi the axis comes from the symmetric part (q + q^T)/2 - cos(a) I = (1 - cos a)
+    axis axis^T, its sign from s.
+    """
+    skew = np.array([q[2, 1] - q[1, 2], q[0, 2] - q[2, 0], q[1, 0] - q[0, 1]])
+    angle = np.arctan2(np.linalg.norm(skew), np.trace(q) - 1.0)
+    if angle < np.pi / 2:
+        return skew / (2.0 * np.sinc(angle / np.pi))
+    outer = (q + q.T) / 2.0 - np.cos(angle) * np.eye(3)
+    column = outer[:, np.argmax(np.diag(outer))]
+    axis = column / np.linalg.norm(column)
+    if axis @ skew < 0:
+        axis = -axis
+    return angle * axis

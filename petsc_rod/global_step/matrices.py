@@ -1,0 +1,214 @@
+"""PETSc glue of the global step: matrices assembled and factored once, right-hand sides.
+
+Each of d1, d2 and the slope r' is one scalar SPD problem A x = b (P2) solved for
+the x, y and z components with one factorisation (docs/method.md §3 step 1). Essential
+conditions keep A symmetric: rows and columns of prescribed dofs are zeroed with a unit
+diagonal, and the right-hand side is lifted by the unconstrained matrix times the
+prescribed values. The slope problem of a rod held at both ends is bordered by the
+constraint int slope dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
+from petsc_rod.mesh.fields import scatter_element_vectors
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
+
+KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
+               for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
+
+
+def element_rows(mesh):
+    """Global row of each owned element's P2 dofs, (ne, 3). DMDA order is natural in 1-D."""
+    first = np.arange(mesh.element_start, mesh.element_end)[:, None]
+    return (2 * (first + P2.offsets[None, :]) + P2.slots[None, :]).astype(PETSc.IntType)
+
+
+def assemble_matrix(mesh, element_matrices, rows=None):
+    """The DMDA matrix sum_e of element matrices (ne, k, k) on the element rows ``rows``
+    (ne, k), by default the P2 dofs (element_rows)."""
+    rows = element_rows(mesh) if rows is None else rows
+    matrix = mesh.da.createMatrix()
+    if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
+        # petsc4py's setValuesRCV divides by the number of rows
+        matrix.setValuesRCV(rows, rows, element_matrices, addv=PETSc.InsertMode.ADD_VALUES)
+    matrix.assemble()
+    matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    return matrix
+
+
+# The global step on several ranks, unless the options say otherwise: CG preconditioned
+# by block Jacobi with an exact Cholesky factorisation of each rank's block. The
+# matrices are second-order P2 chains, so a few CG iterations reach round-off; it beats
+# MUMPS, whose solve phase is slow on such chains (docs/performance.md).
+PARALLEL_DEFAULTS = {"ksp_type": "cg", "pc_type": "bjacobi", "sub_pc_type": "cholesky",
+                     "ksp_rtol": "1e-14", "ksp_atol": "1e-300"}
+
+
+class ScalarProblem:
+    """One scalar SPD operator of the global step with its KSP.
+
+    ``element_matrices`` (ne, 3, 3) are summed into the DMDA matrix; ``prescribed`` is a
+    list of (vertex, slot, value) whose rows are constrained. KSP options are read with
+    ``prefix``; the default is a direct Cholesky factorisation on one rank and
+    PARALLEL_DEFAULTS on several.
+    """
+
+    def __init__(self, mesh, element_matrices, prescribed, prefix):
+        self.mesh = mesh
+        self.name = prefix
+        self._rows = element_rows(mesh)
+        self.full = assemble_matrix(mesh, element_matrices)
+        self.constrained = self.full.duplicate(copy=True)
+        start, end = self.full.getOwnershipRange()
+        self.fixed_rows = np.array([2 * v + s for v, s, _ in prescribed], dtype=PETSc.IntType)
+        self._owned = (self.fixed_rows >= start) & (self.fixed_rows < end)
+        self.constrained.zeroRowsColumns(self.fixed_rows[self._owned], diag=1.0)
+        self.constrained.setOption(PETSc.Mat.Option.SPD, True)
+        self._local_rows = self.fixed_rows[self._owned] - start
+        self._fixed_values = np.zeros((int(self._owned.sum()), 3))
+        self._lift = [self.full.createVecLeft() for _ in range(3)]
+        self._work = self.full.createVecLeft()
+        sizes = [(end - start, self.full.getSize()[0]), (3, 3)]
+        self._rhs_block = PETSc.Mat().createDense(sizes, comm=mesh.comm)
+        self._rhs_block.setUp()
+        self._solution_block = self._rhs_block.duplicate()
+        self.ksp = PETSc.KSP().create(comm=mesh.comm)
+        self.ksp.setOperators(self.constrained)
+        self.ksp.setType(PETSc.KSP.Type.PREONLY)
+        pc = self.ksp.getPC()
+        pc.setType(PETSc.PC.Type.CHOLESKY)
+        self.ksp.setOptionsPrefix(prefix)
+        parallel = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}
+        set_from_options_with_defaults(
+            self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
+        self.ksp.setUp()
+        self._report_failed_factorisation()
+        self._factor = (pc.getFactorMatrix() if self.ksp.getType() == PETSc.KSP.Type.PREONLY
+                        and pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU)
+                        else None)
+        self._border = []            # c and w = A^-1 c of the integral constraint, if any
+
+    def add_integral_constraint(self, element_integrals):
+        """Border A with the row c, c_k = int phi_k dS, for the constraint c.x = target
+        (one per component, the same row for x, y and z): the system becomes
+        [A c; c^T 0] [x; mu] = [b; target].
+
+        It is solved by the Schur complement (solve_constrained); here, once, w = A^-1 c0
+        with c0 = c with the prescribed rows zeroed (so w vanishes there and the
+        correction x - mu w keeps the prescribed values), and c.w = c0^T A^-1 c0 > 0.
+        ``element_integrals`` (ne, 3) are the element contributions int_e phi_k dS.
+        """
+        c = self.full.createVecLeft()
+        c.setValues(self._rows.ravel(), np.ravel(element_integrals),
+                    addv=PETSc.InsertMode.ADD_VALUES)
+        c.assemble()
+        free = c.copy()
+        free.getArray()[self._local_rows] = 0.0
+        w = free.duplicate()
+        try:
+            self._solve_one(free, w)
+        finally:
+            free.destroy()
+        self._border = [c, w]
+        self._c_dot_w = c.dot(w)
+
+    def set_prescribed(self, prescribed):
+        """New prescribed values (same rows); computes the lifting A_full x_bc once."""
+        self._fixed_values = np.array([value for _, _, value in prescribed]).reshape(-1, 3)[
+            self._owned]
+        for c, lift in enumerate(self._lift):
+            self._work.zeroEntries()
+            self._work.getArray()[self._local_rows] = self._fixed_values[:, c]
+            self.full.mult(self._work, lift)
+            lift.getArray()[self._local_rows] = 0.0
+
+    def solve(self, rhs, solution):
+        """Solve for the three components: rhs, solution are VectorFields.
+
+        With a direct solver (preonly + Cholesky or LU) the three right-hand sides go to
+        the factorisation together (MatMatSolve): MUMPS then makes one pass instead of
+        three, half the solve time on 2 ranks (README, "Performance"). Any other KSP solves
+        them one by one.
+        """
+        block = self._rhs_block.getDenseArray()
+        for c in range(3):
+            block[:, c] = rhs.components[c].getArray(readonly=True)
+            block[:, c] -= self._lift[c].getArray(readonly=True)
+            block[self._local_rows, c] = self._fixed_values[:, c]
+        self._rhs_block.assemble()
+        if self._factor is not None:
+            self._factor.matSolve(self._rhs_block, self._solution_block)
+            result = self._solution_block.getDenseArray()
+            for c in range(3):
+                solution.components[c].getArray()[:] = result[:, c]
+            return
+        for c in range(3):
+            self._work.getArray()[:] = block[:, c]
+            self._solve_one(self._work, solution.components[c])
+
+    def solve_constrained(self, rhs, solution, target):
+        """Solve the bordered system of add_integral_constraint for the three components.
+
+        x0 = A^-1 b (solve), then mu = (c.x0 - target) / (c.w) and x = x0 - mu w, so that
+        c.x = target. ``target`` (3,); returns mu (3,), the multiplier of the constraint
+        (one allreduce for the three components).
+        """
+        c, w = self._border
+        self.solve(rhs, solution)
+        local = [c.getArray(readonly=True) @ x.getArray(readonly=True)
+                 for x in solution.components]
+        mu = (self.mesh.global_sum(np.array(local)) - target) / self._c_dot_w
+        for x, value in zip(solution.components, mu):
+            x.axpy(-value, w)
+        return mu
+
+    def _report_failed_factorisation(self):
+        """One solve with a zero right-hand side: KSPSolve is what reports a failed set-up
+        (this petsc4py has no PCGetFailedReason), and the MatMatSolve path skips it."""
+        zero = self.full.createVecLeft()
+        solution = zero.duplicate()
+        try:
+            self._solve_one(zero, solution)
+        finally:
+            zero.destroy()
+            solution.destroy()
+
+    def _solve_one(self, rhs, solution):
+        self.ksp.solve(rhs, solution)
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            raise RodDivergedError(f"linear solver -{self.name} failed: "
+                                   f"{KSP_REASONS.get(reason, reason)}")
+
+    def destroy(self):
+        for obj in [self.ksp, self.full, self.constrained, self._work, self._rhs_block,
+                    self._solution_block] + self._lift + self._border:
+            obj.destroy()
+
+
+def load_element_vectors(mesh, load, breaks):
+    """Exact int_e F(S) g_k dS over the owned elements, (ne, 3, 3), for a load function
+    F: S (...) -> (..., 3) that is linear between consecutive ``breaks`` (sorted).
+
+    Each element is cut at the breaks inside it; on each piece F g_k is a cubic, which
+    3-point Gauss integrates exactly. The loop runs over the breaks, not the elements.
+    """
+    a, h = mesh.element_S[:, None], mesh.element_h[:, None]
+    cuts = np.clip((np.asarray(breaks, dtype=float)[None, :] - a) / h, 0.0, 1.0)
+    cuts = np.concatenate([np.zeros_like(a), cuts, np.ones_like(a)], axis=1)
+    out = np.zeros((mesh.n_local_elements, P2.ndofs, 3))
+    for lo, hi in zip(cuts.T[:-1, :, None], cuts.T[1:, :, None]):
+        x = lo + (hi - lo) * GAUSS_POINTS[None, :]
+        phi, _ = p2_basis(x, mesh.element_h)
+        out += np.einsum("eq,eqk,eqc->ekc", h * (hi - lo) * GAUSS_WEIGHTS, phi, load(a + h * x))
+    return out
+
+
+def load_ghosted(mesh, load, breaks):
+    """The load part int F.g of the slope right-hand side on the ghosted vertices,
+    (n_ghosted, 2, 3) (load_element_vectors summed into the vertex slots)."""
+    return scatter_element_vectors(mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+                                   load_element_vectors(mesh, load, breaks))

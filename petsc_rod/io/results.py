@@ -1,0 +1,424 @@
+"""HDF5 results, written collectively and atomically, and read back for a restart.
+
+Layout (documented in README.md): vertex datasets S (n,), r, d1, d2, d3, u, m, n (n, 3);
+attributes converged, stop_reason, iterations, halvings, total_iterations,
+total_halvings, undone_iterations, constraint_residual, change, stable,
+energy, wall_time, written, ranks, load_factor, penalty (in use), asked_penalty (and twist_turns, writhe_turns
+where the link is tracked); a group ``history``; a group ``state`` with what a restart
+needs beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>``
+per accepted continuation step (halved sub-steps included) and the failed one that ends
+a run, with the same content. The root links to the last step and also holds the run's
+version, commit, options and options_in_effect, and a group ``parameters`` with every
+option in effect as numbers. Every dataset has a ``units`` attribute, every group an
+``attribute_units`` (JSON). The file is written as ``<name>.partial`` and renamed only
+when complete, so a crash or an interrupt never leaves a half-written result under the
+requested name; a failure or an interrupt removes the partial file.
+
+A write that fails inside HDF5 leaves the library unable to close the file (it crashes
+at exit trying to flush it): such a file is removed without being closed, and
+``hdf5_failed()`` tells the program to end without HDF5's shutdown (__main__).
+"""
+
+import contextlib
+import datetime
+import json
+import os
+import stat
+import sys
+from dataclasses import dataclass
+
+import h5py
+import numpy as np
+
+from petsc_rod.io.capture import stderr_captured
+from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
+from petsc_rod.resources import free_disk, size_text
+from petsc_rod.riser import quantities as riser_quantities
+
+VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
+RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
+HISTORY_COLUMNS = ("change", "constraint_residual", "wall_time")
+
+# Units of every dataset ("1": dimensionless) ...
+DATASET_UNITS = {
+    "S": "m", "r": "m", "d1": "1", "d2": "1", "d3": "1", "u": "rad/m", "m": "N m", "n": "N",
+    "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
+    "change": "1", "constraint_residual": "1", "wall_time": "s",
+    **riser_quantities.DATASET_UNITS,
+}
+# ... and of every attribute of a step group and of the root ("text": a string).
+ATTRIBUTE_UNITS = {
+    "converged": "1", "stop_reason": "text", "iterations": "1", "halvings": "1",
+    "total_iterations": "1", "total_halvings": "1", "undone_iterations": "1",
+    "constraint_residual": "1", "change": "1", "stable": "1", "energy": "J",
+    "wall_time": "s", "written": "text", "ranks": "1", "load_factor": "1", "penalty": "N",
+    "asked_penalty": "N",
+    "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
+    "options_in_effect": "text", "version": "text", "commit": "text",
+    **riser_quantities.ATTRIBUTE_UNITS,
+}
+# A step is written only while the disk has this many times its size free, plus
+# SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.
+SPACE_FACTOR = 2
+SPACE_RESERVE = 2**20
+# Exceptions through which h5py and the OS report a failed write.
+WRITE_FAILURES = (OSError, RuntimeError, ValueError, KeyError, TypeError)
+
+_hdf5_failed = False
+_unclosable = []            # h5py files whose writes failed, kept until the process ends
+
+
+def hdf5_failed():
+    """Whether a write failed inside HDF5 in this process (see the module docstring)."""
+    return _hdf5_failed
+
+
+def now():
+    """The current UTC time, ISO 8601 to the second."""
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def distributed_layout(comm, arrays):
+    """{name: (global shape, this rank's first row, its number of rows)} of arrays split
+    by rows over the ranks in rank order (each rank's owned slice). Collective (mpi4py
+    ``comm``)."""
+    counts = comm.allgather({name: np.shape(array)[0] for name, array in arrays.items()})
+    rank = comm.Get_rank()
+    return {name: ((sum(c[name] for c in counts),) + np.shape(array)[1:],
+                   sum(c[name] for c in counts[:rank]), counts[rank][name])
+            for name, array in arrays.items()}
+
+
+# --------------------------------------------------------------------- the output path
+def check_output_path(path, comm):
+    """Refuse, before any work, an output that could not be written: a folder, a missing
+    folder, a device or other non-regular file, a folder where a file cannot be created
+    (permissions, a read-only or special file system). A stale ``<path>.partial`` is
+    removed. Collective: rank 0 checks, every rank raises."""
+    on_every_rank(comm, _check_output_path if comm.getRank() == 0 else _nothing, path)
+
+
+def _nothing(*args):
+    return None
+
+
+def _check_output_path(path):
+    folder = os.path.dirname(os.path.abspath(path))
+    partial = f"{path}.partial"
+    if path.endswith(os.sep) or os.path.isdir(path):
+        raise RodInputError(f"-rod_output {path}: is a folder; name a file, e.g. "
+                            f"{os.path.join(path, 'result.h5')}")
+    if not os.path.isdir(folder):
+        raise RodInputError(f"-rod_output {path}: the folder {folder} does not exist")
+    for name in (path, partial):
+        if os.path.lexists(name) and not _regular_file(name):
+            raise RodInputError(f"-rod_output {path}: {name} exists and is not a regular "
+                                "file (a folder, a device, a socket); name another file")
+    try:
+        with open(partial, "wb"):
+            pass
+        os.remove(partial)
+    except OSError as error:
+        raise RodInputError(f"-rod_output {path}: cannot create a file in {folder} "
+                            f"({error.strerror}); choose a writable folder") from None
+
+
+def _regular_file(name):
+    try:
+        return stat.S_ISREG(os.stat(name).st_mode)
+    except OSError:
+        return False           # a broken link: replaced by the rename, like a file
+
+
+# --------------------------------------------------------------------------- writing
+@dataclass
+class RunRecord:
+    """What the root of a result file says about the run beyond its last step: root
+    attributes (version, commit, options_in_effect) and the group ``parameters`` (every
+    option in effect, with its unit)."""
+
+    attributes: dict
+    parameters: dict
+    units: dict
+
+
+def minimum_bytes(mesh, state, steps):
+    """Bytes a file of ``steps`` steps needs at least: each step's vertex datasets and
+    restart state (this rank's arrays ``state``); the histories come on top. Collective."""
+    local = sum(np.asarray(array).nbytes for array in state.values())
+    vertex = 8 * mesh.n_vertices * (1 + 3 * (len(VERTEX_DATASETS) - 1))
+    return steps * (vertex + int(mesh.global_sum(local)))
+
+
+def _open(path, mode, comm):
+    if h5py.get_config().mpi and comm.size > 1:
+        return h5py.File(path, mode, driver="mpio", comm=comm)
+    if comm.size > 1:
+        raise RodInputError("h5py has no MPI support here: run the set-up script (scripts/"
+                            "setup.sh) so that Debian's python3-h5py-mpi is used")
+    return h5py.File(path, mode)
+
+
+@contextlib.contextmanager
+def _failures_collected(found):
+    """The exceptions of a failed write, into ``found``: those raised, and those h5py
+    reports only when a handle is freed (a traceback, then 'Exception ignored'). What
+    HDF5, MPI-IO and h5py print meanwhile is kept off the terminal, unless nothing
+    failed."""
+    previous = sys.unraisablehook
+    sys.unraisablehook = lambda report: found.append(report.exc_value)
+    try:
+        with stderr_captured() as printed:
+            try:
+                yield
+            except WRITE_FAILURES as error:
+                found.append(error)
+            text = printed()
+    finally:
+        sys.unraisablehook = previous
+    if not found:
+        sys.stderr.write(text)
+
+
+def _failure_text(error):
+    """The reason of a failed write: the system's message where HDF5 quotes it."""
+    text = str(error)
+    if "error message = '" in text:
+        return text.split("error message = '", 1)[1].split("'", 1)[0]
+    return (text.strip().splitlines() or [type(error).__name__])[0]
+
+
+class ResultWriter:
+    """One result file being written by all ranks of ``mesh.comm``. Every method is
+    collective; a failure on any rank raises the same RodIOError on every rank."""
+
+    def __init__(self, path, mesh, minimum_bytes=0, run=None):
+        """Open ``<path>.partial``; ``minimum_bytes``: what the whole file will need at
+        least (RodInputError when the disk has less); ``run``: the RunRecord the root
+        gets when the file is finished."""
+        self.path = path
+        self.run = run or RunRecord({}, {}, {})
+        self.partial = f"{path}.partial"
+        self.mesh = mesh
+        self.comm = mesh.comm.tompi4py()
+        self.folder = os.path.dirname(os.path.abspath(path))
+        self.file = None
+        self.broken = False           # a write failed inside HDF5
+        on_every_rank(self.comm, self._check_room_for_file, minimum_bytes)
+        self.file = self._collective(_open, self.partial, "w", self.comm)
+
+    def _free_disk_below(self, nbytes):
+        """The free bytes of the file's disk when fewer than ``nbytes`` (rank 0; other
+        ranks: None), else None."""
+        if self.comm.Get_rank() != 0:
+            return None
+        free = free_disk(self.folder)
+        return free if free < nbytes else None
+
+    def _check_room_for_file(self, nbytes):
+        free = self._free_disk_below(nbytes)
+        if free is not None:
+            raise RodInputError(
+                f"-rod_output {self.path}: the result needs at least {size_text(nbytes)}, the "
+                f"disk of {self.folder} has {size_text(free)} free; free some space or "
+                "choose another folder")
+
+    def _check_room_for_step(self, nbytes):
+        free = self._free_disk_below(nbytes)
+        if free is not None:
+            raise RodIOError(
+                f"-rod_output {self.path}: the disk of {self.folder} is full ({size_text(free)} "
+                f"free, the next step needs {size_text(nbytes)} with HDF5's reserve); the "
+                "partial file is removed")
+
+    def _collective(self, action, *args):
+        """``action(*args)`` (HDF5 and file operations only, no MPI call of ours) on every
+        rank; a failure on any rank becomes the same RodIOError on every rank."""
+        def guarded():
+            found, result = [], None
+            with _failures_collected(found):
+                result = action(*args)
+            if found:
+                failure = RodIOError(f"writing {self.partial} failed ({_failure_text(found[0])})"
+                                     "; the partial file is removed")
+                failure.hdf5 = self.file is not None
+                raise failure
+            return result
+        try:
+            return on_every_rank(self.comm, guarded)
+        except RodIOError as error:
+            self.broken = self.broken or getattr(error, "hdf5", False)
+            raise
+
+    def write_step(self, name, vertex, state, history, attributes):
+        """Write one solution as group ``name``, after checking that the disk has room."""
+        table = np.asarray(history, dtype=float).reshape(-1, len(HISTORY_COLUMNS))
+        # the vertex datasets, and those a riser scene adds (riser/quantities.py)
+        arrays = {key: np.asarray(value) for key, value in vertex.items()}
+        arrays.update({key: np.asarray(value) for key, value in state.items()})
+        layout = distributed_layout(self.comm, arrays)
+        nbytes = 8 * sum(int(np.prod(shape)) for shape, _, _ in layout.values()) + table.nbytes
+        on_every_rank(self.comm, self._check_room_for_step,
+                      SPACE_FACTOR * nbytes + SPACE_RESERVE)
+        attributes = self._shared(attributes)
+        self._collective(self._write_step, name, arrays, list(state), layout, table,
+                         attributes)
+
+    def _shared(self, attributes):
+        """Rank 0's attributes with the time written: HDF5 needs the same value on every
+        rank."""
+        return self.comm.bcast({**attributes, "written": now()}, root=0)
+
+    def _write_step(self, name, arrays, state_keys, layout, table, attributes):
+        group = self.file.require_group(name)
+        state_group = group.create_group("state")
+        for key, local in arrays.items():
+            shape, start, rows = layout[key]
+            target = state_group if key in state_keys else group
+            data = target.create_dataset(key, shape=shape, dtype="f8")
+            data.attrs["units"] = DATASET_UNITS[key]
+            if rows:
+                data[start:start + rows] = local
+        history_group = group.create_group("history")
+        for column, key in enumerate(HISTORY_COLUMNS):
+            data = history_group.create_dataset(key, shape=(table.shape[0],), dtype="f8")
+            data.attrs["units"] = DATASET_UNITS[key]
+            if self.comm.Get_rank() == 0:
+                data[:] = table[:, column]
+        _set_attributes(group, attributes, ATTRIBUTE_UNITS)
+        self.file.flush()
+
+    def finish(self, last_group, attributes):
+        """Link the root to ``last_group``, set the root attributes (the last step's and
+        the run record's) and the group ``parameters``, close and rename."""
+        attributes = self._shared({**attributes, **self.run.attributes})
+        self._collective(self._finish, last_group, attributes)
+        self._collective(self._rename)
+
+    def _finish(self, last_group, attributes):
+        source = self.file[last_group]
+        for key in list(source.keys()):
+            self.file[key] = source[key]
+        _set_attributes(self.file, attributes, ATTRIBUTE_UNITS)
+        _set_attributes(self.file.create_group("parameters"), self.run.parameters,
+                        self.run.units)
+        self.file.close()
+        self.file = None
+
+    def _rename(self):
+        if self.comm.Get_rank() == 0:
+            os.replace(self.partial, self.path)
+
+    def abort(self):
+        """Remove the partial file: nothing is left under the result name or beside it. A
+        file whose writes failed is not closed (HDF5 cannot; hdf5_failed)."""
+        global _hdf5_failed
+        if self.file is not None and not self.broken:
+            found = []
+            with _failures_collected(found):
+                self.file.close()
+            self.broken = bool(found)
+        if self.broken:
+            _unclosable.append(self.file)   # freeing the handle would try to close it
+        self.file = None
+        _hdf5_failed = _hdf5_failed or self.broken
+        self.comm.Barrier()
+        if self.comm.Get_rank() == 0:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(self.partial)
+
+
+def _set_attributes(group, attributes, units):
+    """Attributes and their ``attribute_units`` (JSON); a unit is needed for each."""
+    for key, value in attributes.items():
+        group.attrs[key] = value
+    group.attrs["attribute_units"] = json.dumps({key: units[key] for key in attributes})
+
+
+# --------------------------------------------------------------------------- restart
+@dataclass
+class Restart:
+    """This rank's slices of a result file, and what the run reached."""
+
+    vertex: dict
+    state: dict
+    load_factor: float
+    converged: bool
+
+
+def read_restart(path, mesh, state_templates):
+    """Owned slices of result file ``path`` for a restart on ``mesh``, validated: every
+    dataset present, of the shape this run's arrays need (``state_templates``: this
+    rank's arrays of outputs.restart_state, so that the check follows the solver),
+    finite, on this run's mesh, with a load factor in [0, 1]. Collective: a file any rank
+    finds wrong is refused (RodInputError) on every rank."""
+    comm = mesh.comm.tompi4py()
+    vertex_templates = {key: np.zeros((len(mesh.vertex_S), 3)) for key in
+                        RESTART_VERTEX_DATASETS}
+    vertex_templates["S"] = mesh.vertex_S
+    layout = distributed_layout(comm, {**vertex_templates,
+                                       **{f"state/{k}": v for k, v in state_templates.items()}})
+    return on_every_rank(comm, _read_restart, path, mesh, layout)
+
+
+def _read_restart(path, mesh, layout):
+    def refuse(what):
+        raise RodInputError(f"-rod_initial {path}: {what}")
+
+    if os.path.isdir(path) or not os.path.isfile(path):
+        refuse("is a folder" if os.path.isdir(path) else "no such file")
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as error:
+        refuse(f"not an HDF5 result file ({_failure_text(error)})")
+    with handle as f:
+        if "S" not in f or not isinstance(f["S"], h5py.Dataset):
+            refuse("not a petsc_rod result file (no dataset S)")
+        if f["S"].shape != layout["S"][0]:
+            elements = f["S"].shape[0] - 1 if f["S"].ndim == 1 else "?"
+            refuse(f"the file has {elements} elements, this run {mesh.n_elements}; use "
+                   f"-rod_elements {elements}")
+        data = {key: _read_slice(f, key, *layout[key], refuse) for key in layout}
+        if not np.allclose(data["S"], mesh.vertex_S, rtol=1e-12, atol=1e-12 * mesh.length):
+            refuse("the file's mesh (length or grading) is not this run's; use the same "
+                   "-rod_length and -rod_mesh_grading")
+        load_factor = _attribute(f, "load_factor", refuse)
+        if not 0 <= load_factor <= 1:
+            refuse(f"its load_factor {load_factor:g} is not in [0, 1]")
+        converged = bool(_attribute(f, "converged", refuse))
+    vertex = {key: data[key] for key in RESTART_VERTEX_DATASETS}
+    state = {key.removeprefix("state/"): value for key, value in data.items()
+             if key.startswith("state/")}
+    return Restart(vertex, state, load_factor, converged)
+
+
+def _read_slice(f, key, shape, start, rows, refuse):
+    """Rows [start, start + rows) of dataset ``key``, checked: present, of global
+    ``shape``, numbers, finite."""
+    try:
+        dataset = f.get(key)
+    except (KeyError, TypeError, ValueError, OSError):     # e.g. 'state' not a group
+        dataset = None
+    if not isinstance(dataset, h5py.Dataset):
+        refuse(f"the dataset {key} is missing: not a complete petsc_rod result file")
+    if dataset.shape != shape:
+        refuse(f"the dataset {key} has shape {dataset.shape}, this run needs {shape} (a "
+               "file of another version of petsc_rod, or damaged)")
+    try:
+        values = np.asarray(dataset[start:start + rows], dtype=float)
+    except (OSError, TypeError, ValueError) as error:
+        refuse(f"the dataset {key} cannot be read as numbers ({_failure_text(error)})")
+    if not np.all(np.isfinite(values)):
+        refuse(f"the dataset {key} holds NaN or Inf (a diverged or damaged result)")
+    return values
+
+
+def _attribute(f, name, refuse):
+    """A finite number attribute of the root."""
+    try:
+        value = float(np.asarray(f.attrs[name]).ravel()[0])
+    except (KeyError, IndexError, TypeError, ValueError, OSError):
+        refuse(f"its attribute {name} is missing or not a number")
+    if not np.isfinite(value):
+        refuse(f"its attribute {name} is {value}")
+    return value

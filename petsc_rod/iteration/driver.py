@@ -1,0 +1,275 @@
+"""The augmented-Lagrangian (Uzawa, ALG2) iteration of docs/method.md §3, driven by a
+PETSc SNES (§6), with the stability test of §10 at each converged step.
+
+One iteration: the global step (global_step/), the local step at every node
+(local_step/projection.py), the multiplier update. The SNES sees the iteration as the
+fixed-point problem F(x) = x - G(x) on x = sqrt(w) (tau, lambda / R) at the nodes; the
+step's own tests (stopping.py) decide when it ends.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
+from petsc_rod.analysis.stability import SecondVariation
+from petsc_rod.errors import RodDivergedError, RodInputError
+from petsc_rod.frames import split_coefficients, strains
+from petsc_rod.global_step.global_step import GlobalStep
+from petsc_rod.iteration import penalty as penalty_policy
+from petsc_rod.iteration import stopping
+from petsc_rod.iteration.state import RodState
+from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
+from petsc_rod.mesh.elements import quadrature_weights
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
+from petsc_rod.resources import anderson_depth, ranks_on_this_machine
+
+EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("projection", "multiplier", "norms")}
+
+# The SNES type of the iteration unless -rod_snes_type says otherwise.
+DEFAULT_SNES = "anderson"
+SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
+                for name in dir(PETSc.SNES.ConvergedReason) if not name.startswith("_")}
+
+# A step that converged to a saddle goes on from its frames turned along the direction
+# of negative curvature, the largest node turned by ESCAPE_ANGLE rad, the angle times
+# ESCAPE_GROWTH and of the other sign at each further saddle, at most MAX_ESCAPES times
+# (the turn must leave the saddle's basin of the accelerated iteration, §10).
+ESCAPE_ANGLE = 0.3
+MAX_ESCAPES = 5
+ESCAPE_GROWTH = 2.0
+
+
+def check_anderson_depth():
+    """Refuse a -rod_snes_anderson_m that is not a whole number of at least 1 (PETSc
+    itself fails on it with a stack of messages)."""
+    database = PETSc.Options()
+    if database.hasName("rod_snes_anderson_m"):
+        depth = database.getString("rod_snes_anderson_m", "")
+        if not depth.isdigit() or int(depth) < 1:
+            raise RodInputError(f"-rod_snes_anderson_m {depth}: the depth of Anderson "
+                                "mixing is a whole number of at least 1")
+
+
+class UzawaSolver:
+    """The iteration on one mesh and scene: a RodState, a GlobalStep and the SNES that
+    drives them. Owns every PETSc object of the solve; ``destroy()`` releases them."""
+
+    def __init__(self, mesh, scene, settings):
+        check_anderson_depth()          # before any PETSc object is made
+        self.mesh, self.scene, self.settings = mesh, scene, settings
+        self.split = split_coefficients(scene.stiffness)
+        self.penalty = float(settings.asked_penalty)    # in use: may be raised on the way
+        self.scale = penalty_policy.default_penalty(scene)
+        self.state = RodState(mesh)
+        self.global_step = GlobalStep(mesh, scene, self.split,
+                                      penalty_policy.matrix_split(self.split), self.penalty)
+        self.weights = quadrature_weights(mesh.element_h)
+        self._root_weights = np.sqrt(self.state.node_weights)[:, None, None]
+        self._step = None
+        self._create_snes()
+
+    def _create_snes(self):
+        """The SNES of the fixed-point problem, options -rod_snes_*: Anderson mixing by
+        default (the combination of recent iterates of least residual), nrichardson with
+        the basic line search for the plain iteration."""
+        size = 18 * self.mesh.n_local_nodes
+        self._x = PETSc.Vec().createMPI((size, PETSc.DECIDE), comm=self.mesh.comm)
+        self._f = self._x.duplicate()
+        snes = self.snes = PETSc.SNES().create(comm=self.mesh.comm)
+        snes.setOptionsPrefix("rod_")
+        snes.setType(DEFAULT_SNES)
+        snes.setFunction(self._fixed_point_residual, self._f)
+        snes.setConvergenceTest(self._converged)
+        # the step's own tests end it (_outcome): SNES's counts must not come first
+        snes.setTolerances(max_it=2**30)
+        snes.setMaxFunctionEvaluations(2**30)
+        defaults = {}
+        kind = PETSc.Options().getString("rod_snes_type", DEFAULT_SNES)
+        if kind == PETSc.SNES.Type.NRICHARDSON:
+            # nrichardson's default line search (secant) is not the plain iteration
+            defaults["rod_snes_linesearch_type"] = "basic"
+        if kind == PETSc.SNES.Type.ANDERSON:
+            here = ranks_on_this_machine(self.mesh.comm)
+            defaults["rod_snes_anderson_m"] = str(int(self.mesh.global_min(
+                anderson_depth(self.mesh.n_local_elements, here))))
+        set_from_options_with_defaults(snes, defaults)
+
+    # --- one continuation step ------------------------------------------------------
+    def prepare_step(self, t):
+        """End conditions and loads at load factor t (GlobalStep.prepare)."""
+        self.global_step.prepare(t)
+
+    def solve_step(self, t, label="", observer=None):
+        """The iteration at load factor t until both stopping tests hold (stopping.py);
+        then, with check_stability, the state is tested (§10) and a saddle is left along
+        its negative curvature, up to MAX_ESCAPES times (the report says stable, or the
+        step ends not converged with STOP_SADDLE).
+
+        ``observer(iteration, change, residual)``, if given, is called (collectively)
+        after each iteration's norms, e.g. to record the state at looser tolerances on
+        the way (scripts/error_vs_time.py); if it returns True the step stops there,
+        reported as not converged.
+        """
+        self.prepare_step(t)
+        step = self._step = stopping.StepProgress(label, observer)
+        try:
+            self._iterate(step)
+            while step.outcome == stopping.CONVERGED and self.settings.check_stability:
+                step.stable, direction = self.check_stability()
+                if step.stable is not False:
+                    break
+                if step.escapes == MAX_ESCAPES:
+                    step.outcome = (False, stopping.STOP_SADDLE)
+                    break
+                angle = ESCAPE_ANGLE * ESCAPE_GROWTH**step.escapes * (-1) ** step.escapes
+                self.state.turn_frames(angle * direction / self.mesh.global_max(
+                    float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
+                step.escapes += 1
+                step.outcome = step.stable = None
+                self._iterate(step)
+        finally:
+            self._step = None
+        if step.error is not None:
+            raise step.error
+        return stopping.StepReport.of(step)
+
+    def _iterate(self, step):
+        """Run the SNES from the current state until ``step`` has an outcome (a penalty
+        raise starts it again from where it is)."""
+        while True:
+            self._pack(self._x)
+            self.snes.solve(None, self._x)
+            if step.outcome != stopping.RAISE_PENALTY:
+                break
+            self.penalty = penalty_policy.raised_penalty(self.penalty, self.scale)
+            self.global_step.build(self.penalty)
+            step.raises.append((len(step.history), self.penalty))
+            step.outcome = None
+        if step.outcome is None and step.error is None:   # the SNES stopped on its own test
+            reason = self.snes.getConvergedReason()
+            step.outcome = (False, f"snes_{SNES_REASONS.get(reason, reason)}")
+
+    def check_stability(self):
+        """(stable, direction) of the current (converged) state (analysis/stability.py):
+        True and None for a local minimiser; False and a rotation-vector field
+        (n_nodes, 3) along which the energy decreases to second order for a saddle;
+        None, None where the test cannot decide (a taut, straight rod)."""
+        hessian = SecondVariation(self)
+        try:
+            if not hessian.decidable:
+                return None, None
+            direction = hessian.descent_direction()
+            return direction is None, direction
+        finally:
+            hessian.destroy()
+
+    # --- the SNES's view of the iteration -----------------------------------------------
+    def _fixed_point_residual(self, snes, x, f):
+        """F(x) = x - G(x), G one iteration (``iterate``) of x = sqrt(w) (tau, lambda / R)
+        (sqrt(w): the Euclidean norm of x is the L2 norm of the fields). Records the
+        iteration's norms and decides, for _converged, whether the step is over."""
+        step = self._step
+        if step.finished:
+            f.set(0.0)
+            return
+        self._unpack(x)
+        iteration = len(step.history) + 1
+        try:
+            self.iterate()
+        except RodDivergedError as error:
+            step.error = RodDivergedError(f"{step.label}iteration {iteration}: {error}",
+                                          iteration)
+            f.set(0.0)
+            return
+        EVENTS["norms"].begin()
+        change, residual = self.state.norms()
+        EVENTS["norms"].end()
+        step.record(change, residual)
+        step.outcome = self._outcome(step, change, residual)
+        if self.settings.monitor:
+            PETSc.Sys.Print(f"  {step.label}it {iteration:5d}  change {change:.3e}  "
+                            f"constraint {residual:.3e}", comm=self.mesh.comm)
+        self._pack(f)
+        f.aypx(-1.0, x)
+
+    def _outcome(self, step, change, residual):
+        """What the step does after an iteration: None (go on), RAISE_PENALTY, or
+        (converged, reason); sets step.error when the iteration diverged."""
+        settings, iteration = self.settings, len(step.history)
+        if stopping.diverged(change, residual):
+            step.error = RodDivergedError(
+                f"{step.label}iteration {iteration}: the iteration diverged (change "
+                f"{change:.3g}, constraint residual {residual:.3g}); try a larger "
+                "-rod_al_penalty or more -rod_steps", iteration)
+            return None
+        if step.observer is not None and step.observer(iteration, change, residual):
+            return (False, stopping.STOP_OBSERVER)
+        if stopping.converged(settings, change, residual):
+            return stopping.CONVERGED
+        if (settings.adapt_penalty and iteration % penalty_policy.ADAPT_WINDOW == 0
+                and penalty_policy.penalty_too_low(step.history, self.penalty, self.scale)):
+            return stopping.RAISE_PENALTY
+        return stopping.stall_outcome(settings, step.history)
+
+    def _converged(self, snes, its, norms):
+        """The SNES convergence test: the decision _fixed_point_residual took."""
+        if self._step.finished:
+            return PETSc.SNES.ConvergedReason.CONVERGED_ITS
+        return PETSc.SNES.ConvergedReason.ITERATING
+
+    def _pack(self, x):
+        """x = sqrt(w) (tau, lambda / R), (n_nodes, 2, 3, 3) in the SNES vector."""
+        values = x.getArray().reshape(-1, 2, 3, 3)
+        values[:, 0] = self._root_weights * self.state.tau
+        values[:, 1] = self._root_weights * self.state.lam / self.penalty
+
+    def _unpack(self, x):
+        values = x.getArray(readonly=True).reshape(-1, 2, 3, 3)
+        self.state.tau[:] = values[:, 0] / self._root_weights
+        self.state.lam[:] = values[:, 1] * (self.penalty / self._root_weights)
+
+    def iterate(self):
+        """One iteration (docs/method.md §3): global step, local step (nearest rotation of
+        R d + lambda at every node), multiplier update lambda += R (d - tau)."""
+        state, R = self.state, self.penalty
+        self.global_step.solve(state)
+        EVENTS["projection"].begin()
+        directors = state.take_directors()
+        nearest_rotation(R * directors + state.lam, out=state.tau)
+        EVENTS["projection"].end()
+        EVENTS["multiplier"].begin()
+        update_multipliers(state.lam, directors, state.tau, R)
+        EVENTS["multiplier"].end()
+
+    # --- outputs --------------------------------------------------------------------
+    def energy(self):
+        """W = int w dS - int f.r dS - end forces . r (§6), J, with the strains u of the
+        FE fields at the Gauss points."""
+        p = self.state.point_values()
+        u = strains(p["directors"], p["derivatives"])
+        stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
+        return self.mesh.global_sum(stored) - self.global_step.load_work(self.state)
+
+    def link(self):
+        """Twist and writhe of the current state, (Tw, Wr) in turns, Lk = Tw + Wr
+        (analysis/link.py); None when the scene has no common end axis or a tangent comes
+        within FULLER_MARGIN of pointing back along it."""
+        axis = self.scene.link_axis
+        if axis is None:
+            return None
+        p = self.state.point_values()
+        twist, writhe, margin = link_integrands(p["directors"], p["derivatives"], axis)
+        tw, wr, backward = self.mesh.global_sum(np.array([
+            np.sum(self.weights * twist), np.sum(self.weights * writhe),
+            np.sum(margin < FULLER_MARGIN)]))
+        return None if backward else (float(tw), float(wr))
+
+    def end_reaction(self):
+        """External force N on the rod at S = L, N (GlobalStep.end_reaction)."""
+        return self.global_step.end_reaction(self.state)
+
+    def destroy(self):
+        self.global_step.destroy()
+        self.state.destroy()
+        for obj in (self.snes, self._x, self._f):
+            obj.destroy()

@@ -1,0 +1,65 @@
+"""The penalty R of the augmented Lagrangian (docs/method.md §2, §3): its default, the
+splitting of the stiffness into the matrices' coefficients, and when to raise it.
+
+Two penalties are named apart: the one asked for (``Settings.asked_penalty``:
+-rod_al_penalty or ``default_penalty``) and the one in use (``UzawaSolver.penalty``),
+which ``penalty_too_low`` may have raised on the way.
+"""
+
+import numpy as np
+
+# A penalty below ADAPT_BELOW times the problem's scale (default_penalty) is multiplied
+# by ADAPT_FACTOR, up to the scale, whenever the constraint residual has fallen by less
+# than the factor ADAPT_PROGRESS over the last ADAPT_WINDOW iterations.
+ADAPT_BELOW = 0.1
+ADAPT_FACTOR = 10.0
+ADAPT_PROGRESS = 0.5
+ADAPT_WINDOW = 200
+
+
+def default_penalty(scene):
+    """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2)), N.
+
+    Three scales, each a lower bound below which the iteration crawls or leaves the
+    branch (docs/method.md §3, measurements in docs/stability.md):
+    * bending and torsion, 100 sqrt(min K max K) / L^2: the count grows with R over the
+      softest stiffness and the iteration fails when R is far below the stiffest one;
+    * tension, F / 2 with F = int |f| dS + |P_0| + |P_L| (Scene.applied_force): the
+      multiplier lambda3 reaches the tension by steps of at most 2R per iteration;
+    * twisting moment M = K3 a / L of an end turned by a: M^2 / K_b is four times the
+      axial compression it stands for in Greenhill's condition
+      (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2).
+    """
+    stiffness = scene.stiffness
+    bending = 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2
+    moment = stiffness[2] * scene.end_rotation() / scene.length
+    twist = 2.0 * moment**2 / stiffness[:2].min()
+    return max(bending, 0.5 * scene.applied_force(), twist)
+
+
+def matrix_split(split):
+    """The coefficients c_i of the global step's matrices 2 c_i K + R W (§2), from the
+    split a_i of the stiffness (frames.split_coefficients).
+
+    Where every a_i > 0, c = a. A stiffness above the sum of the other two makes one
+    a_j < 0 (a flat section; K3 > K1 + K2 in torsion), and its matrix would be indefinite
+    unless R grew like 1/h^2. Instead c_j = max_i a_i and the difference
+    2 (c_j - a_j) K tau_j goes to the right-hand side (GlobalStep): the fixed points are
+    those of the a_i, and the matrix of d_j keeps a stiffness of the size of the others.
+    """
+    return np.where(split < 0, split.max(), split)
+
+
+def penalty_too_low(history, penalty, scale):
+    """Whether a step's (change, residual, time) rows call for a larger penalty: R below
+    ADAPT_BELOW times ``scale`` and the residual of the last row more than
+    ADAPT_PROGRESS times that of ADAPT_WINDOW rows before (the multiplier creeps
+    towards the internal forces by at most 2R per iteration)."""
+    if penalty >= ADAPT_BELOW * scale or len(history) <= ADAPT_WINDOW:
+        return False
+    return history[-1][1] > ADAPT_PROGRESS * history[-1 - ADAPT_WINDOW][1]
+
+
+def raised_penalty(penalty, scale):
+    """The next penalty after penalty_too_low: min(ADAPT_FACTOR R, scale), N."""
+    return min(ADAPT_FACTOR * penalty, scale)

@@ -1,0 +1,221 @@
+"""The state of the iteration (docs/method.md §3, §4): the fields of the global step and
+the node values of the local step, how a state is started, saved and measured.
+
+* d1, d2 and the slope r' = d3: P2 VectorFields on the DMDA (slots: vertex, midpoint);
+* r: a VectorField holding the Hermite pair (r, r') at each vertex, recovered from the
+  slope by integration (global_step/centreline.py);
+* tau and lambda at the owned P2 nodes, arrays (n_nodes, 3 directors, 3 components)
+  with director rows d1, d2, d3;
+* mu, the multiplier of the chord constraint r(L) - r(0) = int r' dS (both ends held).
+"""
+
+import numpy as np
+
+from petsc_rod.global_step.centreline import midpoint_slopes, positions_at_points
+from petsc_rod.mesh.elements import GAUSS_POINTS, P2, p2_basis, p2_integrals
+from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
+from petsc_rod.frames import rotations
+from petsc_rod.scenes import starts
+
+
+class RodState:
+    """Owns the state's Vecs; ``destroy()`` releases them."""
+
+    def __init__(self, mesh):
+        self.mesh = mesh
+        self.d1, self.d2, self.slope, self.r = (VectorField(mesh, n)
+                                                for n in ("d1", "d2", "slope", "r"))
+        shape = (mesh.n_local_nodes, 3, 3)
+        self.tau = np.zeros(shape)
+        self.lam = np.zeros(shape)
+        self.chord_multiplier = np.zeros(3)
+        self.node_weights = mesh.node_weights()
+        h = mesh.element_h
+        self._gauss = p2_basis(GAUSS_POINTS, h), p2_integrals(GAUSS_POINTS, h)
+        self._directors = np.zeros(shape)
+        self._positions = np.zeros((mesh.n_local_nodes, 3))
+        self._previous = None
+
+    @property
+    def frame_fields(self):
+        """The P2 fields of the global step in frame order: d1, d2, r' = d3."""
+        return self.d1, self.d2, self.slope
+
+    # --- starts ---------------------------------------------------------------------
+    def set_straight(self):
+        """The straight reference state: r = S e_x, frame (e_y, e_z, e_x), lambda = 0."""
+        self.set_from_curve(starts.straight)
+
+    def set_from_curve(self, curve):
+        """Start from a smooth curve S -> (r, frame, force) (scenes/starts.py): r and
+        r' = d3 at the vertices (the slope's midpoints from the Hermite cubic they
+        define), d1, d2 at the vertices and midpoints, tau = frame at the nodes,
+        lambda3 = force there and lambda1 = lambda2 = 0."""
+        mesh = self.mesh
+        vertex_S, midpoint_S = self._owned_vertex_and_midpoint_S()
+        positions, vertex_frame, _ = curve(vertex_S)
+        self.set_centreline(positions, vertex_frame[:, 2])
+        _, midpoint_frame, _ = curve(midpoint_S)
+        for index, director in enumerate(self.frame_fields[:2]):
+            director.set_owned(np.stack([vertex_frame[:, index], midpoint_frame[:, index]],
+                                        axis=1))
+        _, node_frame, node_force = curve(mesh.node_S())
+        self.tau[:] = node_frame
+        self.lam[:] = 0.0
+        self.lam[:, 2] = node_force
+        self.remember()
+
+    def roll_cross_sections(self, amplitude):
+        """Roll the cross-sections about their tangent by phi(S) = amplitude sin(pi S / 2L)
+        rad (zero at S = 0): (d1, d2) -> (cos phi d1 + sin phi d2, -sin phi d1 +
+        cos phi d2), likewise (tau1, tau2) and (lambda1, lambda2). It changes the start,
+        not the problem, so that a symmetric start (e.g. a planar one) can leave a
+        symmetric equilibrium that is not a minimiser (docs/method.md §7)."""
+        if amplitude == 0.0:
+            return
+        mesh = self.mesh
+        slot_S = np.stack(self._owned_vertex_and_midpoint_S(), axis=1)
+        slot_angle = amplitude * np.sin(np.pi * slot_S / (2 * mesh.length))
+        node_angle = amplitude * np.sin(np.pi * mesh.node_S() / (2 * mesh.length))
+        d1, d2 = rolled(self.d1.owned(), self.d2.owned(), slot_angle[..., None])
+        self.d1.set_owned(d1)
+        self.d2.set_owned(d2)
+        for frames in (self.tau, self.lam):
+            frames[:, 0], frames[:, 1] = rolled(frames[:, 0], frames[:, 1],
+                                                node_angle[..., None])
+        self.remember()
+
+    def turn_frames(self, omega):
+        """Turn tau and lambda at each node by exp([omega_n]x), omega (n_nodes, 3):
+        rows t_i -> Q t_i (leaving a saddle, docs/method.md §10)."""
+        turn = rotations(omega)
+        self.tau[:] = np.einsum("nkl,nil->nik", turn, self.tau)
+        self.lam[:] = np.einsum("nkl,nil->nik", turn, self.lam)
+
+    def set_centreline(self, positions, slopes):
+        """r and r' from Hermite vertex data (n_owned, 3) each, e.g. a restart: the slope
+        field takes r' at the vertices and the cubic's derivative at the midpoints."""
+        mesh = self.mesh
+        self.r.set_owned(np.stack([positions, slopes], axis=1))
+        ghosted, left = self.r.ghosted(), mesh.element_local
+        slope = np.zeros((positions.shape[0], 2, 3))
+        slope[:, 0] = slopes
+        slope[:mesh.n_local_elements, 1] = midpoint_slopes(
+            ghosted[left, 0], ghosted[left, 1], ghosted[left + 1, 0], ghosted[left + 1, 1],
+            mesh.element_h)
+        self.slope.set_owned(slope)
+
+    def _owned_vertex_and_midpoint_S(self):
+        """S at the owned vertices and at the P2 midpoints after them, (n_owned,) each
+        (the last vertex's midpoint slot is a phantom past the end)."""
+        mesh = self.mesh
+        owned = np.arange(mesh.vertex_start, mesh.vertex_end)
+        vertex_S = mesh.coordinates(owned)
+        return vertex_S, (vertex_S + mesh.coordinates(owned + 1)) / 2
+
+    # --- save and restore -------------------------------------------------------------
+    def snapshot(self):
+        """Copies of this rank's share of the state a warm start needs (r, d, tau,
+        lambda, mu), so that a failed continuation step can be undone (``restore``).
+        Owned arrays only: nothing is gathered or communicated."""
+        state = {name: field.owned() for name, field in self._fields().items()}
+        state.update(tau=self.tau.copy(), lam=self.lam.copy(),
+                     chord_multiplier=self.chord_multiplier.copy())
+        return state
+
+    def restore(self, snapshot):
+        """Put back a ``snapshot`` bit for bit, e.g. after a step that diverged and left
+        NaN in the fields."""
+        for name, field in self._fields().items():
+            field.set_owned(snapshot[name])
+        self.tau[:] = snapshot["tau"]
+        self.lam[:] = snapshot["lam"]
+        self.chord_multiplier = snapshot["chord_multiplier"].copy()
+        self.remember()
+
+    def _fields(self):
+        return {"r": self.r, "slope": self.slope, "d1": self.d1, "d2": self.d2}
+
+    # --- values at nodes and points ---------------------------------------------------
+    def node_directors(self):
+        """d1, d2 and r' = d3 at the owned P2 nodes, rows, (n_nodes, 3, 3): the dofs of
+        the fields themselves (the phantom slot of the last vertex left out)."""
+        n = self.mesh.n_local_nodes
+        return np.stack([np.stack([c.getArray(readonly=True)[:n] for c in f.components],
+                                  axis=-1) for f in self.frame_fields], axis=1)
+
+    def node_positions(self):
+        """r at the owned P2 nodes, (n_nodes, 3): the vertex values, and at each midpoint
+        r(S_e) + int r' over the element's first half, h (5 r'_0 + 8 r'_m - r'_1) / 24
+        (exact for the P2 slope)."""
+        mesh = self.mesh
+        slope = element_dofs(self.slope.ghosted(), mesh.element_local, P2)
+        vertices = self.r.owned()[:, 0]
+        r = np.empty((mesh.n_local_nodes, 3))
+        r[0::2] = vertices
+        r[1::2] = vertices[:mesh.n_local_elements] + np.einsum(
+            "ek,ekc->ec", p2_integrals(np.array([0.5]), mesh.element_h)[:, 0], slope)
+        return r
+
+    def point_values(self):
+        """r, directors and their derivatives at the Gauss points of the owned elements."""
+        return self.evaluate(self.mesh.element_local, *self._gauss)
+
+    def evaluate(self, element_local, p2, integrals):
+        """Fields at points of the given elements (ghosted local indices, (ne,)).
+
+        p2 = (phi, dphi) and integrals (elements.p2_integrals) tabulated at the points,
+        (ne, nq, 3). Returns r (ne, nq, 3), directors and derivatives (ne, nq, 3, 3), rows
+        d1, d2, r' and d1', d2', r''; r = r(S_e) + int_{S_e}^S r'.
+        """
+        dofs = [element_dofs(f.ghosted(), element_local, P2) for f in self.frame_fields]
+        left = self.r.ghosted()[element_local, 0]
+        directors = np.stack([at_points(p2[0], d) for d in dofs], axis=2)
+        derivatives = np.stack([at_points(p2[1], d) for d in dofs], axis=2)
+        return {"r": positions_at_points(left, dofs[2], integrals), "directors": directors,
+                "derivatives": derivatives}
+
+    # --- the stopping quantities ------------------------------------------------------
+    def remember(self):
+        """Take the current fields as the reference of the next change."""
+        self._directors = self.node_directors()
+        self._positions = self.node_positions()
+        self._previous = self._stacked()
+
+    def _stacked(self):
+        """(r, d1, d2, r') at the owned nodes, (n_nodes, 4, 3)."""
+        return np.concatenate([self._positions[:, None, :], self._directors], axis=1)
+
+    def take_directors(self):
+        """The node directors of the fields the global step just solved for, kept for
+        the residual of ``norms`` (n_nodes, 3, 3)."""
+        self._directors = self.node_directors()
+        return self._directors
+
+    def norms(self):
+        """Relative change of X = (r, d1, d2, r') since the last call and RMS constraint
+        residual at the nodes (docs/method.md §6):
+
+            change = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2),
+            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L)   (one allreduce).
+        """
+        self._positions = self.node_positions()
+        current = self._stacked()
+        w = self.node_weights
+        gap = w @ np.sum((self._directors - self.tau) ** 2, axis=(1, 2))
+        size = w @ np.sum(current**2, axis=(1, 2))
+        step = w @ np.sum((current - self._previous) ** 2, axis=(1, 2))
+        gap, size, step = self.mesh.global_sum(np.array([gap, size, step]))
+        self._previous = current
+        change = np.sqrt(step / size) if size > 0 else np.inf
+        return change, np.sqrt(gap / self.mesh.length)
+
+    def destroy(self):
+        for obj in [*self.frame_fields, self.r]:
+            obj.destroy()
+
+
+def rolled(first, second, angle):
+    """(cos a first + sin a second, -sin a first + cos a second), broadcasting ``angle``."""
+    c, s = np.cos(angle), np.sin(angle)
+    return c * first + s * second, -s * first + c * second

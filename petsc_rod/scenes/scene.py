@@ -1,0 +1,166 @@
+"""Boundary conditions and loads of a scene, and the continuation path to them (§5, §7).
+
+The reference state is straight along e_x from the origin, with d1 = e_y, d2 = e_z,
+d3 = e_x. The end S = 0 stays at the origin in the reference frame (if it is held);
+the end S = L and the loads are reached along the path t in [0, 1]:
+position (1 - t) L e_x + t r_L, frame exp(t log Q) then a roll t * twist about the
+current tangent, and forces scaled by t. Every quantity is in SI units.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError
+from petsc_rod.frames import rotation_about, rotation_log
+
+REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+END_KINDS = ("clamp", "pin", "free")
+
+
+@dataclass
+class EndState:
+    """What is prescribed at one end for one load factor."""
+
+    kind: str
+    position: np.ndarray
+    frame: np.ndarray
+    force: np.ndarray
+
+
+@dataclass
+class Scene:
+    length: float
+    stiffness: np.ndarray
+    start: str = "clamp"
+    end: str = "free"
+    end_position: np.ndarray = None
+    end_frame: np.ndarray = None
+    end_twist: float = 0.0
+    start_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    end_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    load_values: np.ndarray = field(default_factory=lambda: np.zeros((1, 3)))
+    load_breaks: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # riser terms (petsc_rod/riser/environment.py): a Seabed and a Current, or None
+    seabed: object = None
+    current: object = None
+
+    def __post_init__(self):
+        self.stiffness = np.asarray(self.stiffness, dtype=float)
+        if self.end_position is None:
+            self.end_position = np.array([self.length, 0.0, 0.0])
+        if self.end_frame is None:
+            self.end_frame = REFERENCE_FRAME.copy()
+        self.end_position = np.asarray(self.end_position, dtype=float)
+        self.start_force = np.asarray(self.start_force, dtype=float)
+        self.end_force = np.asarray(self.end_force, dtype=float)
+        self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
+        self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
+        self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
+        self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
+
+    @property
+    def load_piece_ends(self):
+        """S at the ends of the load pieces, (m + 1,)."""
+        return np.concatenate([[0.0], self.load_breaks, [self.length]])
+
+    def load_beyond(self, S, t):
+        """int_S^L f dS of the piecewise-constant load at factor t: S (...) -> (..., 3).
+
+        Piecewise linear in S, with kinks at the load breaks.
+        """
+        ends = self.load_piece_ends
+        S = np.asarray(S, dtype=float)[..., None]
+        overlap = np.clip(ends[1:] - np.maximum(ends[:-1], S), 0.0, None)
+        return t * overlap @ self.load_values
+
+    def applied_force(self):
+        """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
+        (and of the multiplier lambda3 that converges to it)."""
+        pieces = np.diff(self.load_piece_ends) @ np.linalg.norm(self.load_values, axis=1)
+        if self.current is not None:            # the largest drag the current can exert
+            pieces += self.length * self.current.largest_drag()
+        return float(pieces + np.linalg.norm(self.start_force) + np.linalg.norm(self.end_force))
+
+    def end_rotation(self):
+        """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
+        plus |-rod_end_twist|; 0 at a pinned or free end."""
+        if self.end != "clamp":
+            return 0.0
+        return float(np.linalg.norm(self._end_rotation) + abs(self.end_twist))
+
+    def start_state(self, t):
+        return EndState(self.start, np.zeros(3), REFERENCE_FRAME.copy(), t * self.start_force)
+
+    def end_state(self, t):
+        position = (1 - t) * np.array([self.length, 0.0, 0.0]) + t * self.end_position
+        angle = np.linalg.norm(self._end_rotation)
+        q = (rotation_about(self._end_rotation, t * angle) if angle > 0 else np.eye(3))
+        frame = REFERENCE_FRAME @ q.T
+        frame = frame @ rotation_about(frame[2], t * self.end_twist).T
+        return EndState(self.end, position, frame, t * self.end_force)
+
+    @property
+    def link_axis(self):
+        """The common end tangent e of a rod clamped at both ends whose end frame only
+        rolls about it on the whole load path (its d3 stays e), else None: the scenes
+        whose linking number is defined and tracked (link.py)."""
+        axis = REFERENCE_FRAME[2]
+        tilt = self._end_rotation - (self._end_rotation @ axis) * axis
+        if self.start != "clamp" or self.end != "clamp" or np.linalg.norm(tilt) > 1e-12:
+            return None
+        return axis.copy()
+
+    def end_roll(self, t):
+        """The angle (rad) by which the end frame has rolled about link_axis at load
+        factor t, counted continuously from t = 0 (end_state: the rotation of -rod_end_frame
+        about e_x, then -rod_end_twist)."""
+        return t * (self._end_rotation @ REFERENCE_FRAME[2] + self.end_twist)
+
+    def validate(self, used):
+        """Raise RodInputError on a scene no inextensible cable can realise.
+
+        ``used`` is the set of option names the user set, so that an option the scene
+        would ignore is an error, not a silent no-op.
+        """
+        if self.length <= 0:
+            raise RodInputError(f"-rod_length {self.length:g}: the length must be positive")
+        if np.any(self.stiffness <= 0):
+            raise RodInputError("-rod_stiffness: K1, K2, K3 must all be positive (N m^2)")
+        for name, kind in (("-rod_start", self.start), ("-rod_end", self.end)):
+            if kind not in END_KINDS:
+                raise RodInputError(f"{name} {kind}: unknown end condition; use one of "
+                                    + "|".join(END_KINDS))
+        if self.start == "free" and self.end == "free":
+            raise RodInputError("-rod_start free and -rod_end free: nothing holds the cable "
+                                "(a rigid motion is free); hold one end with clamp or pin")
+        held = self.start != "free" and self.end != "free"
+        chord = np.linalg.norm(self.end_position)
+        if held and chord > self.length * (1 + 1e-12):
+            raise RodInputError(
+                f"-rod_end_position: the ends are {chord:.6g} m apart but the cable is only "
+                f"{self.length:.6g} m long (inextensible); bring the end within -rod_length")
+        frame = self.end_frame
+        if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
+                or np.linalg.det(frame) < 0):
+            raise RodInputError("-rod_end_frame: the rows d1, d2, d3 must be orthonormal and "
+                                "right-handed (d3 = d1 x d2)")
+        requires = {"rod_end_frame": ("clamp",), "rod_end_twist": ("clamp",),
+                    "rod_end_position": ("clamp", "pin"), "rod_end_force": ("free",)}
+        for name, kinds in requires.items():
+            if name in used and self.end not in kinds:
+                raise RodInputError(f"-{name} needs -rod_end {'|'.join(kinds)} "
+                                    f"(the end is {self.end}); drop it or change -rod_end")
+        if "rod_start_force" in used and self.start != "free":
+            raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
+                                f"{self.start}); drop it or change -rod_start")
+        breaks = self.load_breaks
+        if len(self.load_values) != len(breaks) + 1:
+            raise RodInputError(
+                f"-rod_load has {len(self.load_values)} pieces of 3 values but "
+                f"-rod_load_breaks gives {len(breaks)} breaks; give 3 (m) values for m pieces "
+                "and m - 1 breaks")
+        if np.any(np.diff(self.load_piece_ends) <= 0):
+            raise RodInputError("-rod_load_breaks: the breaks must increase strictly inside "
+                                "(0, -rod_length)")
+

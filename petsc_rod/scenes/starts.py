@@ -1,0 +1,67 @@
+"""Initial states of the iteration (docs/method.md §3, "Start"), as smooth curves of S.
+
+A curve maps arc lengths S (any shape) to (r, frame, force): the centreline, the director
+frame (rows d1, d2, d3 = r') and the internal force n(S). The solver samples it at its
+dofs and quadrature points (UzawaSolver.set_from_curve) and starts the multiplier of the
+constraint r' = tau3 at lambda3 = n, which is what it converges to when the bending terms
+are small (at convergence int 2 a3 r''.p'' + lambda3.p' = int f.p, the weak form of
+n' + f = 0); lambda1 = lambda2 = 0.
+"""
+
+import numpy as np
+
+from petsc_rod.scenes.boundary import is_held
+from petsc_rod.scenes.catenary import catenary, catenary_axes
+from petsc_rod.errors import RodInputError
+from petsc_rod.scenes.scene import REFERENCE_FRAME
+from petsc_rod.riser.catenary import seabed_shape
+
+SHAPES = ("straight", "catenary")
+
+
+def straight(S):
+    """The reference state: r = S e_x, frame (e_y, e_z, e_x), no force."""
+    S = np.asarray(S, dtype=float)
+    r = S[..., None] * REFERENCE_FRAME[2]
+    return r, np.broadcast_to(REFERENCE_FRAME, S.shape + (3, 3)), np.zeros(S.shape + (3,))
+
+
+def catenary_start(scene, t):
+    """The inextensible catenary (catenary.catenary) of the scene at load factor t:
+    through both held ends, under the uniform load, with the tension as its force. The
+    frame keeps d1 normal to the plane of the catenary (e_v x e_h, which is e_y for a
+    cable in the x-z plane, as in the reference frame), d2 = d3 x d1.
+
+    Raises RodInputError for scenes that have no catenary: an end not held, a load that
+    is zero or not uniform, the ends L or more apart, or a chord along the load.
+    """
+    start, end = scene.start_state(t), scene.end_state(t)
+    if not (is_held(start) and is_held(end)):
+        raise RodInputError("-rod_initial_shape catenary needs both ends held "
+                            "(-rod_start and -rod_end clamp or pin)")
+    if len(scene.load_values) != 1 or not np.any(scene.load_values[0]):
+        raise RodInputError("-rod_initial_shape catenary needs one uniform, non-zero "
+                            "-rod_load (no -rod_load_breaks)")
+    load = t * scene.load_values[0]
+    chord = end.position - start.position
+    try:
+        up, along = catenary_axes(scene.length, chord, load)
+    except ValueError:
+        raise RodInputError("-rod_initial_shape catenary: the ends must be less than "
+                            "-rod_length apart and not on one vertical (along the load)"
+                            ) from None
+    normal = np.cross(up, along)
+
+    def shape(S):
+        return catenary(scene.length, chord, load, S)
+
+    if scene.seabed is not None:        # resting on the seabed where it reaches it
+        shape = seabed_shape(scene, chord, load, shape)
+
+    def curve(S):
+        r, tangent, force = shape(S)
+        d1 = np.broadcast_to(normal, tangent.shape)
+        frame = np.stack([d1, np.cross(tangent, d1), tangent], axis=-2)
+        return start.position + r, frame, force
+
+    return curve

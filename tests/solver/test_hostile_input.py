@@ -1,0 +1,293 @@
+"""Hostile input, in process (serially and on 2 ranks): option values that are not
+finite or out of range, ranks that disagree, meshes too large, output paths that cannot
+be written, a disk that fills up, restart files that are damaged, and the load path of a
+restart. Every refusal must reach every rank (errors.on_every_rank), or a rank would go
+on into a collective call alone. The same classes end to end: test_hostile_cli.py.
+"""
+
+import os
+
+import h5py
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.io import outputs
+from petsc_rod.io import results as io
+from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
+from petsc_rod.iteration.continuation import LoadPath, record_step
+from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
+from petsc_rod.cli.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
+                               read_options)
+from petsc_rod.resources import BYTES_PER_ELEMENT, MAX_ELEMENTS, check_elements_fit
+
+CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                  end_force=(0.0, -1.0, 0.0))
+
+
+@pytest.fixture
+def options():
+    """Set PETSc options for one test (on every rank); removed afterwards."""
+    database = PETSc.Options()
+    names = []
+
+    def set_options(**values):
+        for name, value in values.items():
+            database.setValue(name, value)
+            names.append(name)
+        return read_options
+
+    yield set_options
+    for name in names:
+        database.delValue(name)
+
+
+# --- option values ---------------------------------------------------------------------
+REFUSED = {
+    "nan load": ("rod_load", "nan,0,0", "finite"),
+    "inf end force": ("rod_end_force", "0,inf,0", "finite"),
+    "nan end position": ("rod_end_position", "nan,0,0", "finite"),
+    "nan in the end frame": ("rod_end_frame", "0,1,0,0,0,1,1,0,nan", "finite"),
+    "inf twist": ("rod_end_twist", "inf", "finite"),
+    "nan grading": ("rod_mesh_grading", "nan", "finite"),
+    "inf penalty": ("rod_al_penalty", "inf", "finite"),
+    "nan imperfection": ("rod_imperfection", "nan", "finite"),
+    "inf load break": ("rod_load_breaks", "0.5,inf", "finite"),
+    "inf rtol": ("rod_al_rtol", "inf", "finite"),
+    "rtol of 1": ("rod_al_rtol", "1", "below 1"),
+    "zero ctol": ("rod_al_ctol", "0", "positive"),
+    "inf elements": ("rod_elements", "inf", "whole number"),
+    "elements beyond a PETSc integer": ("rod_elements", "1e12", "PETSc integer"),
+    "inf steps": ("rod_steps", "inf", "whole number"),
+    "nan steps": ("rod_steps", "nan", "whole number"),
+    "huge length": ("rod_length", "1e200", "out of range"),
+    "tiny length": ("rod_length", "1e-40", "positive"),
+    "huge stiffness": ("rod_stiffness", "1,1e31,1", "out of range"),
+    "too many halvings": ("rod_max_halvings", str(MAX_HALVINGS + 1), "between"),
+    "load factor above 1": ("rod_initial_load_factor", "1.5", "between 0 and 1"),
+}
+
+
+@pytest.mark.parametrize("case", list(REFUSED))
+def test_a_value_out_of_its_range_is_refused(options, case):
+    name, text, words = REFUSED[case]
+    read = options(**{name: text})
+    with pytest.raises(RodInputError) as error:
+        read()
+    message = str(error.value)
+    assert message.startswith(f"-{name} ") and text in message and words in message, message
+
+
+def test_the_limits_themselves_are_accepted(options):
+    read = options(rod_length=f"{MAX_MAGNITUDE:g}", rod_al_rtol=f"{1 / MAX_MAGNITUDE:g}",
+                   rod_max_halvings=str(MAX_HALVINGS), rod_elements="2147483647",
+                   rod_load="-1e30,0,0")
+    values, _ = read()
+    assert values["rod_length"] == MAX_MAGNITUDE
+    assert values["rod_max_halvings"] == MAX_HALVINGS
+    assert values["rod_elements"] == 2147483647
+
+
+# --- ranks -----------------------------------------------------------------------------
+def test_an_error_on_one_rank_is_raised_on_every_rank(comm):
+    mpi = comm.tompi4py()
+    last = mpi.Get_size() - 1
+
+    def action(rank):
+        if rank == last:
+            raise RodIOError(f"failed on rank {rank}")
+        return rank
+
+    with pytest.raises(RodIOError, match=f"failed on rank {last}"):
+        on_every_rank(comm, action, mpi.Get_rank())
+    assert on_every_rank(comm, lambda: "fine") == "fine"
+
+
+def test_options_given_to_one_rank_only_are_refused_on_every_rank(comm):
+    mpi = comm.tompi4py()
+    if mpi.Get_size() == 1:
+        check_same_on_every_rank(comm)          # one rank agrees with itself
+        pytest.skip("needs 2 ranks (test_hostile_cli runs the same through mpiexec)")
+    database = PETSc.Options()
+    if mpi.Get_rank() == 1:
+        database.setValue("rod_al_monitor", "")
+    try:
+        with pytest.raises(RodInputError, match="rank 1 .*-rod_al_monitor"):
+            check_same_on_every_rank(comm)
+    finally:
+        if mpi.Get_rank() == 1:
+            database.delValue("rod_al_monitor")
+    check_same_on_every_rank(comm)
+
+
+# --- what the machine can hold ---------------------------------------------------------
+def test_a_mesh_too_large_for_the_memory_is_refused_with_the_numbers(comm):
+    with pytest.raises(RodInputError, match="memory") as error:
+        check_elements_fit(comm, 10**9)         # 8 TB: more than any test machine has
+    assert "-rod_elements 1000000000" in str(error.value)
+    assert f"{BYTES_PER_ELEMENT // 1024} KiB per element" in str(error.value)
+    with pytest.raises(RodInputError, match="PETSc's integers"):
+        check_elements_fit(comm, MAX_ELEMENTS + 1)
+    check_elements_fit(comm, 1000)
+
+
+def test_fewer_vertices_than_ranks_are_refused(comm):
+    size = comm.getSize()
+    if size == 1:
+        pytest.skip("one rank always owns a vertex")
+    with pytest.raises(RodInputError, match=f"on {size} ranks"):
+        check_elements_fit(comm, size - 2)
+    check_elements_fit(comm, size - 1)
+
+
+def test_a_grading_double_precision_cannot_resolve_is_refused(comm):
+    values = {"rod_elements": 1000000, "rod_length": 1.0, "rod_mesh_grading": 1e30}
+    with pytest.raises(RodInputError, match="-rod_mesh_grading") as error:
+        check_mesh(comm, values)
+    assert f"{MIN_RELATIVE_ELEMENT:g}" in str(error.value)
+    check_mesh(comm, dict(values, rod_mesh_grading=20.0))
+
+
+# --- the output path -------------------------------------------------------------------
+def unwritable_paths(folder):
+    """Output paths that no run can write, by what is wrong with them."""
+    paths = {"a folder": folder, "a missing folder": os.path.join(folder, "no", "x.h5"),
+             "a device": os.devnull}
+    if os.path.isdir("/proc/self"):
+        paths["a special file system"] = "/proc/petsc_rod_test.h5"
+    return paths
+
+
+def test_an_output_that_cannot_be_written_is_refused_before_the_run(comm, shared_tmp):
+    for what, path in unwritable_paths(shared_tmp).items():
+        with pytest.raises(RodInputError, match="-rod_output") as error:
+            io.check_output_path(path, comm)
+        assert path in str(error.value), what
+    good = os.path.join(shared_tmp, "good.h5")
+    io.check_output_path(good, comm)
+    comm.tompi4py().Barrier()
+    assert not os.path.exists(good) and not os.path.exists(f"{good}.partial")
+
+
+# --- writing and reading a result ------------------------------------------------------
+def write_result(solver, path, attributes=None):
+    """A result file of the solver's current state (one step at load factor 1)."""
+    report = solver.solve_step(1.0)
+    writer = io.ResultWriter(path, solver.mesh)
+    try:
+        recorded = record_step(solver, report, 1.0, "step 1/1", lambda text: None, writer,
+                               "steps/1", wall_time=0.0, options="", halvings=0,
+                               total_halvings=0, total_iterations=report.iterations,
+                               undone_iterations=0)
+        writer.finish("steps/1", {**recorded, **(attributes or {})})
+    finally:
+        if writer.file is not None:
+            writer.abort()
+    return report
+
+
+def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
+        solver_factory, comm, shared_tmp, monkeypatch):
+    mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 500)
+    solver.state.set_straight()
+    path = os.path.join(shared_tmp, "full.h5")
+    monkeypatch.setattr(io, "free_disk", lambda folder: 1000)
+    with pytest.raises(RodInputError, match="free"):
+        io.ResultWriter(path, mesh, minimum_bytes=10**6)
+    writer = io.ResultWriter(path, mesh)
+    assert os.path.exists(f"{path}.partial")
+    with pytest.raises(RodIOError, match="disk .* is full"):
+        report = solver.solve_step(1.0)
+        record_step(solver, report, 1.0, "step 1/1", lambda text: None, writer, "steps/1",
+                    wall_time=0.0, options="", halvings=0, total_halvings=0,
+                    total_iterations=1, undone_iterations=0)
+    writer.abort()
+    comm.tompi4py().Barrier()
+    assert not os.path.exists(f"{path}.partial") and not os.path.exists(path)
+    assert not io.hdf5_failed()          # a refused step never reached HDF5
+
+
+@pytest.fixture
+def result(solver_factory, comm, shared_tmp):
+    """(solver, path of a converged result file of it)."""
+    mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 2000)
+    solver.state.set_straight()
+    path = os.path.join(shared_tmp, "result.h5")
+    assert write_result(solver, path).converged
+    return solver, path
+
+
+def damaged_copy(comm, path, name, damage):
+    """A copy of result file ``path`` damaged by ``damage(file)`` (on rank 0)."""
+    copy = os.path.join(os.path.dirname(path), f"{name}.h5")
+    mpi = comm.tompi4py()
+    if mpi.Get_rank() == 0:
+        with open(path, "rb") as source, open(copy, "wb") as target:
+            target.write(source.read())
+        with h5py.File(copy, "a") as f:
+            damage(f)
+    mpi.Barrier()
+    return copy
+
+
+def replace(f, name, values):
+    del f[name]
+    f.create_dataset(name, data=values)
+
+
+DAMAGES = {
+    "a dataset missing": (lambda f: f["state"].__delitem__("lambda"), "state/lambda is missing"),
+    "tau of another shape": (lambda f: replace(f, "state/tau", f["state/tau"][:, :-1]),
+                             "state/tau has shape"),
+    "NaN on the last rank's rows": (lambda f: replace(f, "r", np.where(
+        np.arange(len(f["r"]))[:, None] == len(f["r"]) - 1, np.nan, f["r"][:])), "r holds NaN"),
+    "no load factor": (lambda f: f.attrs.__delitem__("load_factor"), "load_factor is missing"),
+    "a load factor above 1": (lambda f: f.attrs.__setitem__("load_factor", 2.0), "not in [0, 1]"),
+    "another mesh": (lambda f: replace(f, "S", f["S"][:] * 1.5), "mesh"),
+    "other element count": (lambda f: replace(f, "S", np.linspace(0, 1, 5)), "4 elements"),
+}
+
+
+@pytest.mark.parametrize("case", list(DAMAGES))
+def test_a_damaged_restart_file_is_refused_on_every_rank(result, comm, case):
+    solver, path = result
+    damage, words = DAMAGES[case]
+    copy = damaged_copy(comm, path, case.replace(" ", "_"), damage)
+    with pytest.raises(RodInputError) as error:
+        io.read_restart(copy, solver.mesh, outputs.restart_state(solver))
+    message = str(error.value)
+    assert message.startswith(f"-rod_initial {copy}: ") and words in message, message
+
+
+def test_the_expected_shapes_come_from_the_solver_arrays(result, comm):
+    """The validation takes its shapes from outputs.restart_state: templates of another
+    shape make the (good) file wrong."""
+    solver, path = result
+    templates = {key: np.zeros(value.shape[:1] + (7,)) for key, value in
+                 outputs.restart_state(solver).items()}
+    with pytest.raises(RodInputError, match="has shape"):
+        io.read_restart(path, solver.mesh, templates)
+
+
+def test_a_good_restart_file_gives_back_the_state(result, comm):
+    solver, path = result
+    saved = {key: np.array(value) for key, value in outputs.restart_state(solver).items()}
+    restart = io.read_restart(path, solver.mesh, outputs.restart_state(solver))
+    assert restart.load_factor == 1.0 and restart.converged
+    for key, value in saved.items():
+        assert np.array_equal(restart.state[key], value), key
+    assert np.array_equal(restart.vertex["r"], solver.state.r.owned()[:, 0])
+
+
+# --- the load path of a restart --------------------------------------------------------
+def test_a_restart_load_path_goes_on_from_its_load_factor():
+    path = LoadPath(4, 2, start=0.5)
+    factors = []
+    while not path.finished:
+        factors.append(path.next_factor)
+        path.accept()
+    assert factors[:-1] == pytest.approx([0.625, 0.75, 0.875], rel=1e-15)
+    assert factors[-1] == 1.0 and path.factor(0) == 0.5
+    assert LoadPath(4, 2, start=1.0).steps == 1
+    plain = LoadPath(3, 1)
+    assert [plain.factor(u) for u in range(7)] == [u / 6 for u in range(7)]

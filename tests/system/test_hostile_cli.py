@@ -1,0 +1,267 @@
+"""Hostile input and faults, end to end (``python -m petsc_rod``, 1 and 2 ranks): each
+class ends with one petsc_rod line, its documented exit code (README, "Exit codes and bad
+input"), no traceback, no hang, and no result or ``.partial`` file left behind.
+
+Every test spawns processes, so the module is marked ``serial``.
+"""
+
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import REPO_ROOT, child_env
+
+pytestmark = pytest.mark.serial
+
+TIMEOUT = 120
+SMALL = ["-rod_elements", "16", "-rod_end_force", "0,-3,0", "-rod_al_penalty", "100",
+         "-rod_al_rtol", "1e-7", "-rod_al_ctol", "1e-4"]
+# A run long enough to be stopped or made to fail while it writes: 50 steps of the plain
+# iteration, several hundred iterations each.
+LONG = ["-rod_elements", "32", "-rod_end_force", "0,-3,0", "-rod_al_penalty", "100",
+        "-rod_al_rtol", "1e-9", "-rod_al_ctol", "1e-5", "-rod_steps", "50",
+        "-rod_snes_type", "nrichardson"]
+
+
+def mpiexec(ranks):
+    if ranks == 1:
+        return []
+    launcher = shutil.which("mpiexec")
+    if launcher is None:
+        pytest.skip("mpiexec is not on PATH")
+    return [launcher, "-n", str(ranks)]
+
+
+def command(args, ranks=1):
+    return mpiexec(ranks) + [sys.executable, "-m", "petsc_rod"] + list(args)
+
+
+def run(args, ranks=1):
+    return subprocess.run(command(args, ranks), cwd=REPO_ROOT, env=child_env(),
+                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
+
+
+def start(args, ranks=1):
+    return subprocess.Popen(command(args, ranks), cwd=REPO_ROOT, env=child_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def petsc_rod_lines(text):
+    return [line for line in text.splitlines() if line.startswith("petsc_rod: error")]
+
+
+def describe(code, text):
+    return f"exit {code}\noutput:\n{text}"
+
+
+def assert_one_line_and_nothing_left(code, text, expected_code, words, path=None):
+    """The run ended with ``expected_code`` and one error line containing ``words``, no
+    traceback or crash, and left neither ``path`` nor ``path.partial``."""
+    assert code == expected_code, describe(code, text)
+    errors = petsc_rod_lines(text)
+    assert len(errors) == 1 and all(w in errors[0] for w in words), describe(code, text)
+    for bad in ("Traceback", "Segmentation", "PETSC ERROR"):
+        assert bad not in text, describe(code, text)
+    if path is not None:
+        assert not os.path.exists(path) and not os.path.exists(f"{path}.partial")
+
+
+def wait_for(path, process, timeout=60):
+    """Wait until ``path`` exists (the run got that far), failing if the run ends first."""
+    deadline = time.monotonic() + timeout
+    while not os.path.exists(path):
+        assert process.poll() is None, process.stdout.read()
+        assert time.monotonic() < deadline, f"{path} never appeared"
+        time.sleep(0.05)
+
+
+def ranks_of(process, ranks):
+    """The python processes of a run: the process itself, or mpiexec's children."""
+    if ranks == 1:
+        return [process.pid]
+    children = []
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/stat") as stat:
+                parent = int(stat.read().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
+            continue
+        if parent == process.pid:
+            children.append(int(entry))
+    assert len(children) == ranks, children
+    return children
+
+
+# --- option values ---------------------------------------------------------------------
+@pytest.mark.parametrize("args, named", [
+    (["-rod_end", "clamp", "-rod_end_frame", "0,1,0,0,0,1,1,0,nan"], "-rod_end_frame"),
+    (["-rod_al_rtol", "inf", "-rod_al_ctol", "inf"], "-rod_al_rtol"),
+    (["-rod_elements", "inf"], "-rod_elements"),
+    (["-rod_length", "1e200"], "-rod_length"),
+], ids=["nan in the end frame", "infinite tolerances", "infinite elements", "huge length"])
+def test_a_value_out_of_range_exits_2_with_one_line(tmp_path, args, named):
+    path = tmp_path / "out.h5"
+    done = run(["-rod_elements", "8"] + args + ["-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, [named],
+                                     path)
+
+
+def test_a_mesh_too_large_for_the_machine_is_refused_before_allocating(tmp_path):
+    clock = time.monotonic()
+    done = run(["-rod_elements", "1000000000", "-rod_output", str(tmp_path / "big.h5")])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     ["-rod_elements", "memory", "TiB"], tmp_path / "big.h5")
+    assert time.monotonic() - clock < 30
+
+
+# --- options files and PETSc's options -------------------------------------------------
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_an_options_file_petsc_cannot_parse_exits_2(tmp_path, ranks):
+    scene = tmp_path / "bad.opts"
+    scene.write_text("-rod_elements 8\nrod_length 2\n")
+    done = run(["-options_file", str(scene)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     [str(scene), "line 2", "rod_length"])
+
+
+def test_an_options_file_without_options_exits_2(tmp_path):
+    scene = tmp_path / "empty.opts"
+    scene.write_text("# a comment, and nothing else\n\n")
+    done = run(["-options_file", str(scene)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     [str(scene), "no option"])
+
+
+def test_an_unknown_solver_type_exits_2(tmp_path):
+    path = tmp_path / "out.h5"
+    done = run(SMALL + ["-rod_slope_ksp_type", "nonsense", "-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     ["KSP type nonsense"], path)
+
+
+def test_ranks_given_different_options_exit_2_without_hanging(tmp_path):
+    launcher = mpiexec(2)[0]
+    path = tmp_path / "out.h5"
+    python = [sys.executable, "-m", "petsc_rod", "-rod_output", str(path)]
+    done = subprocess.run([launcher, "-n", "1"] + python + ["-rod_elements", "8", ":",
+                                                            "-n", "1"] + python
+                          + ["-rod_elements", "16"], cwd=REPO_ROOT, env=child_env(),
+                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     ["rank 1", "-rod_elements"], path)
+
+
+# --- the output path and failed writes -------------------------------------------------
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_an_output_path_that_is_a_folder_is_refused_before_the_solve(tmp_path, ranks):
+    folder = tmp_path / "folder.h5"
+    folder.mkdir()
+    done = run(SMALL + ["-rod_output", str(folder)], ranks)
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2, ["-rod_output", "folder"])
+    assert "step 1/" not in text and folder.is_dir()
+    assert not os.path.exists(f"{folder}.partial")
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_write_that_fails_during_the_run_exits_5_and_removes_the_partial_file(tmp_path,
+                                                                                 ranks):
+    """The file size limit (RLIMIT_FSIZE, set once the run has opened its file) makes
+    HDF5's writes fail as a full disk does, past the free-space check."""
+    path = tmp_path / "limited.h5"
+    process = start(LONG + ["-rod_output", str(path)], ranks)
+    try:
+        wait_for(f"{path}.partial", process)
+        for pid in ranks_of(process, ranks):
+            resource.prlimit(pid, resource.RLIMIT_FSIZE, (20000, 20000))
+        output, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    assert_one_line_and_nothing_left(process.returncode, output, 5, ["failed"], path)
+
+
+# --- signals ---------------------------------------------------------------------------
+@pytest.mark.parametrize("ranks, signal_number", [
+    (1, signal.SIGTERM), (1, signal.SIGHUP), (1, signal.SIGINT),
+    (2, signal.SIGINT), (2, signal.SIGTERM)],
+    ids=["SIGTERM", "SIGHUP", "SIGINT", "SIGINT to mpiexec", "SIGTERM to mpiexec"])
+def test_a_signal_ends_the_run_cleanly(tmp_path, ranks, signal_number):
+    path = tmp_path / "stopped.h5"
+    process = start(LONG + ["-rod_output", str(path)], ranks)
+    try:
+        wait_for(f"{path}.partial", process)
+        time.sleep(0.5)
+        process.send_signal(signal_number)
+        output, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    # mpiexec forwards the signal to every rank as SIGTERM and exits 1 itself
+    expected = 128 + signal_number if ranks == 1 else 1
+    name = signal.Signals(signal_number).name if ranks == 1 else "SIGTERM"
+    assert_one_line_and_nothing_left(process.returncode, output, expected,
+                                     [f"interrupted by {name}", "load factor"], path)
+
+
+# --- restarts --------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def half_way(tmp_path_factory):
+    """A result file that stopped at load factor 0.5 without converging: a converged
+    two-step run whose file is made to say so."""
+    folder = tmp_path_factory.mktemp("restart")
+    path = folder / "half.h5"
+    done = run(SMALL + ["-rod_steps", "2", "-rod_output", str(path)])
+    assert done.returncode == 0, describe(done.returncode, done.stdout + done.stderr)
+    with h5py.File(path, "a") as f:
+        f.attrs["load_factor"] = 0.5
+        f.attrs["converged"] = 0
+    return path
+
+
+def step_factors(path):
+    with h5py.File(path, "r") as f:
+        return [float(f[f"steps/{k}"].attrs["load_factor"]) for k in
+                sorted(f["steps"], key=int)]
+
+
+def test_a_restart_goes_on_from_the_file_s_load_factor_and_warns_of_converged_0(half_way,
+                                                                               tmp_path):
+    path = tmp_path / "continued.h5"
+    done = run(SMALL + ["-rod_steps", "2", "-rod_initial", str(half_way),
+                        "-rod_output", str(path)])
+    text = done.stdout + done.stderr
+    assert done.returncode == 0, describe(done.returncode, text)
+    assert "warning: -rod_initial" in text and "converged = 0" in text, text
+    assert step_factors(path) == [0.75, 1.0]
+    with h5py.File(path, "r") as f:
+        assert float(f["parameters"].attrs["initial_load_factor"]) == 0.5
+
+
+def test_a_restart_told_otherwise_walks_the_load_path_again(half_way, tmp_path):
+    path = tmp_path / "again.h5"
+    done = run(SMALL + ["-rod_steps", "2", "-rod_initial", str(half_way),
+                        "-rod_initial_load_factor", "0", "-rod_output", str(path)])
+    assert done.returncode == 0, describe(done.returncode, done.stdout + done.stderr)
+    assert step_factors(path) == [0.5, 1.0]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_restart_file_with_nan_exits_2(half_way, tmp_path, ranks):
+    bad = tmp_path / "nan.h5"
+    shutil.copy(half_way, bad)
+    with h5py.File(bad, "a") as f:
+        lam = f["state/lambda"][:]
+        lam[-1] = np.nan                   # the last rank's rows
+        del f["state/lambda"]
+        f["state"].create_dataset("lambda", data=lam)
+    path = tmp_path / "out.h5"
+    done = run(SMALL + ["-rod_initial", str(bad), "-rod_output", str(path)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     ["-rod_initial", "state/lambda", "NaN"], path)
