@@ -51,8 +51,7 @@ def settings_from_options(values, scene):
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
                     adapt_penalty=values["rod_al_adapt_penalty"],
-                    # a current's drag is not conservative: no energy to test (docs/riser.md)
-                    check_stability=values["rod_al_stability"] and scene.current is None)
+                    check_stability=values["rod_al_stability"])
 
 
 def options_record():

@@ -114,7 +114,7 @@ class UzawaSolver:
         step = self._step = stopping.StepProgress(label, observer)
         try:
             self._iterate(step)
-            while step.outcome == stopping.CONVERGED and self.settings.check_stability:
+            while step.outcome == stopping.CONVERGED and self.tests_stability:
                 step.stable, direction = self.check_stability()
                 if step.stable is not False:
                     break
@@ -132,6 +132,12 @@ class UzawaSolver:
         if step.error is not None:
             raise step.error
         return stopping.StepReport.of(step)
+
+    @property
+    def tests_stability(self):
+        """Whether converged steps are tested (§10): asked for, and the loads have an
+        energy (a current's drag has none, docs/riser.md)."""
+        return self.settings.check_stability and self.scene.current is None
 
     def _iterate(self, step):
         """Run the SNES from the current state until ``step`` has an outcome (a penalty
