@@ -61,6 +61,8 @@ def grounded_catenary(length, chord, weight, seabed, S):
     a = touchdown_parameter(length, span, h0, h1)
     s0 = np.sqrt(h0**2 + 2 * a * h0)
     s1 = np.sqrt(h1**2 + 2 * a * h1)
+    if s0 + s1 > length:
+        raise ValueError("touchdown catenary: the line hangs clear of the seabed")
     x0 = a * np.arccosh(1 + h0 / a)
     S = np.asarray(S, dtype=float)
     # signed arc length from the nearer touchdown point: < 0 before the grounded
