@@ -3,7 +3,7 @@
 fails, reported one line per step and written one group per step."""
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -150,10 +150,10 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     if report.reason == STOP_OBSERVER:
         return report, "interrupted"
     if report.converged:
-        report.link, report.link_expected = solver.link(), expected_link
+        report = replace(report, link=solver.link(), link_expected=expected_link)
         if not changed_class(report.link, expected_link):
             return report, None
-        report.converged, report.reason = False, STOP_LINK
+        report = replace(report, converged=False, reason=STOP_LINK)
         return report, (f"converged in {report.iterations} iterations to a linking number "
                         f"of {sum(report.link):.3f} turns, not {expected_link:.3f}")
     return report, (f"not converged in {report.iterations} iterations (change "
