@@ -9,9 +9,9 @@ from petsc4py import PETSc
 from petsc_rod.errors import RodInputError
 
 # Memory of a run: per element (fields, matrices and their factors, the node state,
-# Anderson's history, the stability test's factorisation: 10^6 elements on 2 ranks
-# peaked at 9.6 GiB per rank, docs/stability.md; rounded up) and per rank (the
-# interpreter, PETSc, MPI).
+# Anderson's history, the stability test's factorisation; the measured peak of the
+# largest run, rounded up: docs/stability.md, "Catenary and long lines") and per rank
+# (the interpreter, PETSc, MPI).
 BYTES_PER_ELEMENT = 20 * 2**10
 BYTES_PER_RANK = 80 * 2**20
 # Anderson mixing keeps 2 m vectors of the node state (18 numbers at 2 nodes per

@@ -31,8 +31,9 @@ sys.path.insert(0, str(ROOT))
 import stability_matrix  # noqa: E402
 
 PLAIN = ["-rod_snes_type", "nrichardson"]
-# The collocation reference of the paper scene at X_F = 16, K3 = 200 (tests/test_reference.py
-# recomputes it: petsc_rod.validation.reference.solve_paper_scene).
+# The collocation reference of the paper scene at X_F = 16, K3 = 200
+# (tests/unit/test_collocation_reference.py recomputes it:
+# petsc_rod.validation.reference.solve_paper_scene).
 PAPER_ENERGY = 40.5313519
 TIMEOUT = 1800.0
 

@@ -1,4 +1,4 @@
-"""Error against wall time over elements, penalty and stopping tolerances (issue 3).
+"""Error against wall time over elements, penalty and stopping tolerances (docs/error_vs_time.md).
 
 One command:
     python scripts/error_vs_time.py [--quick] [--out docs/error_vs_time]
@@ -99,7 +99,7 @@ class CantileverReference:
 
 
 class TwistReference:
-    energy = 0.25          # K3 theta^2 / (2 L)
+    energy = 0.25          # K3 a^2 / (2 L), a = 1 rad the end roll
     u3 = 1.0
 
     def fields(self, S):

@@ -3,12 +3,12 @@
     python scripts/linear_solve_roundoff.py [N ...]        (default 100 200 400 ... 6400)
 
 For the cantilever scene (L = 1, K = 1, R = 400, clamp and free end) and the paper scene
-(L = 20, K = 235, 360, 200, R = 400, clamp and pin: the bordered theta problem), it
+(L = 20, K = 235, 360, 200, R = 400, clamp and pin: the bordered slope problem), it
 prints two relative errors:
 
-* r solve: the centreline solve of the run (the P2 slope matrix int 2 a3 theta'.g' +
-  R theta.g, the constraint int theta = r(L) - r(0) when both ends are held, and the
-  integration of theta into r) for a right-hand side whose exact discrete solution is a
+* r solve: the centreline solve of the run (the P2 matrix of the slope r',
+  int 2 a3 r''.g' + R r'.g, the constraint int r' = r(L) - r(0) when both ends are
+  held, and the integration of r' into r) for a right-hand side whose exact discrete solution is a
   known cubic centreline (petsc_rod.validation.roundoff): max |r - r*| / max |r*|;
 * d1 solve: the d1 matrix (P2, int 2 a1 d'.g' + R d.g) times a known smooth vector x,
   solved again with the run's KSP: max |x_solved - x| / max |x|.

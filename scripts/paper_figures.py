@@ -1,4 +1,4 @@
-"""The paper's three figures, from petsc_rod solutions (docs/method.md §8, issue 3).
+"""The paper's three figures, from petsc_rod solutions (docs/method.md §8; docs/paper.md).
 
     python scripts/paper_figures.py [--quick] [--out docs/paper]
 

@@ -1,4 +1,4 @@
-"""The matrix of hard cases of issue 4: each case run as a user runs it, judged.
+"""The matrix of hard cases of docs/stability.md: each case run as a user runs it, judged.
 
     python scripts/stability_matrix.py [--before] [--only NAME,...] [--ci] [--out DIR]
 
@@ -19,11 +19,11 @@ petsc_rod (``python -m petsc_rod``, or ``mpiexec -n 2 python -m petsc_rod`` for 
 Writes DIR/cases.csv (or cases_before.csv), and the case table into docs/stability.md
 between the markers ``<!-- matrix:begin -->`` and ``<!-- matrix:end -->`` (or
 ``<!-- before:begin -->``/``<!-- before:end -->``). ``--before`` runs every case with the
-fixes of issue 4 switched off (the old default penalty 400 max(K)/L^2, the straight
-start, no step halving, no link check, no raise of a low penalty): the "before" table
-of docs/stability.md. ``--only`` reruns the cases whose names contain one of the words
+first measures of docs/stability.md switched off (the old default penalty
+400 max(K)/L^2, the straight start, no step halving, no link check, no raise of a low
+penalty): the "before" table of docs/stability.md (History B). ``--only`` reruns the cases whose names contain one of the words
 and merges them into the CSV and the table of the last full run. ``--ci`` runs the
-small subset the tests run on 1 and 2 ranks (tests/test_stability_matrix.py), printed,
+small subset the tests run on 1 and 2 ranks (tests/system/test_stability_matrix.py), printed,
 not written. The full
 matrix takes about half an hour on two cores, most of it the 10^6-element catenary.
 """
@@ -275,7 +275,7 @@ def check_paper_reference(bound, stiffness):
 
 
 def cases():
-    """The matrix (issue 4, point 1)."""
+    """The matrix (docs/stability.md, "The cases")."""
     matrix = []
     add = matrix.append
     # stiffness ratios: K2/K1 on the weak-axis cantilever, K3/K1 on pure twist
@@ -315,12 +315,12 @@ def cases():
              dict(PAPER, end_position="20,0,0", steps=1),
              check_straight(1e-6), needs="paper K3 = 200"))
     # large twist: Greenhill. The end moves to 0.9 L along the axis and 0.1 L to the side
-    # (a rod shortened exactly along its axis is held straight by its symmetry and
-    # stalls, tests/test_stability_fixes.py) while it is rolled: the rod is bent from the
-    # start and turns part of the twist into writhe. Judged by Calugareanu-White,
-    # Lk = Tw + Wr = the end roll in turns (check_link). At R = 100, below the twist term
-    # of the default penalty (2 M^2 / K = 316 N), the iteration loses a turn of link
-    # (fix 9).
+    # (a rod shortened exactly along its axis is held straight by its symmetry in exact
+    # arithmetic, docs/method.md §9) while it is rolled: the rod is bent from the start
+    # and turns part of the twist into writhe. Judged by Calugareanu-White,
+    # Lk = Tw + Wr = the end roll in turns (check_link). R = 100 is below the twist term
+    # of the default penalty (2 M^2 / K = 316 N), where the former iteration lost a turn
+    # of link (docs/stability.md, History C).
     greenhill = 2.861 * math.pi                  # clamped-clamped, K1 = K2 = K3
     for turns, steps, penalty in ((1.5, 15, None), (2.0, 20, None), (2.0, 20, 100)):
         angle = 2 * math.pi * turns
@@ -376,8 +376,9 @@ def cases():
 
 
 def before_options(case):
-    """The case as it ran before the fixes of issue 4: the old default penalty, the
-    straight start, no step halving, no link check, no raise of a low penalty."""
+    """The case as it ran before the first measures of docs/stability.md (History B):
+    the old default penalty, the straight start, no step halving, no link check, no raise
+    of a low penalty."""
     options = dict(case.options)
     if "al_penalty" not in options:
         K = max(float(v) for v in str(options["stiffness"]).split(","))
@@ -521,7 +522,7 @@ def merged(path, rows):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", action="store_true",
-                        help="switch the fixes of issue 4 off (docs/stability.md 'before')")
+                        help="switch the first measures off (docs/stability.md, History B)")
     parser.add_argument("--only", help="comma-separated substrings of case names to run")
     parser.add_argument("--ci", action="store_true", help="only the CI subset")
     parser.add_argument("--out", default=str(ROOT / "docs" / "stability"))

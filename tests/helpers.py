@@ -59,6 +59,11 @@ def twisted_paper_reference(tol=1e-10):
     return reference.solve_paper_scene(PAPER_END_X, guess, stiffness=PAPER_STIFFNESS, tol=tol)
 
 
+def fitted_order(n_elements, errors):
+    """Slope of log(error) against log(h) by least squares."""
+    return -np.polyfit(np.log(n_elements), np.log(errors), 1)[0]
+
+
 def gather(comm, owned):
     """All ranks' owned slices of an array (first axis), concatenated in rank order.
 

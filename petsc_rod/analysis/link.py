@@ -6,10 +6,10 @@ twisted rod reached by continuation keeps its linking number Lk = Tw + Wr
 unless the rod passes through itself or around one of its ends (a motion that walls at
 the clamps forbid). An iteration that takes a large step, as the Uzawa iteration may, can
 land on an equilibrium of another Lk: the end frames are met, the state converges, and
-it is not the twisted rod the load path describes (a rod clamped 0.9 L apart, twisted
-at R = 100: a whole turn of twist lost in one step at 9.75 rad; one step of a whole turn,
-which the clamps do not see at all: the untwisted rod; docs/stability.md, fix 9). The
-continuation checks Lk after each step (continuation.py).
+it is not the twisted rod the load path describes (one step of a whole turn, which the
+clamps do not see at all, gives the untwisted rod; measured cases in docs/stability.md,
+"Twist and Greenhill"). The continuation checks Lk after each step
+(iteration/continuation.py).
 
 Tw = (1/2 pi) int u3 dS with u3 = d1'.d2 (frames.strains). Wr, for a rod whose end
 tangents both equal the axis e, is given by Fuller's formula relative to the straight rod
@@ -45,7 +45,7 @@ def link_integrands(directors, derivatives, axis):
 
 # A step whose Lk differs from the expected one by more than this (turns) changed its
 # class: whole turns are lost or gained, the discretisation error is far smaller
-# (tests/test_link.py).
+# (tests/unit/test_link_formulas.py).
 LINK_TOLERANCE = 0.25
 
 

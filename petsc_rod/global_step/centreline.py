@@ -1,8 +1,8 @@
 """The centreline from its slope: r(S) = r(a) + int_a^S slope, slope = r' in P2 (numpy).
 
-The global step solves for slope instead of r (fe.py): the map (r at a held end,
-slope in P2) <-> Hermite cubic r is a bijection, so the discrete problem is the paper's,
-only better conditioned. In slope the r equation of §3 step 1 reads, for all P2 g,
+The global step solves for slope instead of r (mesh/elements.py): the map (r at a held
+end, slope in P2) <-> Hermite cubic r is a bijection, so the discrete problem is the
+paper's, only better conditioned. In slope the r equation of §3 step 1 reads, for all P2 g,
 
     int 2 a3 slope'.g' + R slope.g = int (R tau3 - lambda3).g + int F.g  (- mu . int g),
 
@@ -14,7 +14,7 @@ where the load F comes from int f.p dS + end forces with p(S) = p(a) + int_a^S g
   = int_S^L f dS - (int_0^L f dS + P_0).
 
 Both ends held: r(L) - r(0) = int_0^L slope dS is a constraint with multiplier mu
-(assembly.ScalarProblem.add_integral_constraint); mu = -N, N the reaction at S = L.
+(matrices.ScalarProblem.add_integral_constraint); mu = -N, N the reaction at S = L.
 """
 
 import numpy as np
@@ -59,7 +59,7 @@ def positions_at_points(left, slope, integrals):
     """r at points of elements: r(S_e) + int_{S_e}^S slope dS, exact for the P2 slope.
 
     left: r at each element's left vertex (ne, 3); slope: element dofs (ne, 3, 3);
-    integrals: fe.p2_integrals at the points (ne, nq, 3). Returns (ne, nq, 3).
+    integrals: elements.p2_integrals at the points (ne, nq, 3). Returns (ne, nq, 3).
     """
     return left[:, None, :] + np.einsum("eqk,ekc->eqc", integrals, slope)
 

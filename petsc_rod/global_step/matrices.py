@@ -130,7 +130,7 @@ class ScalarProblem:
 
         With a direct solver (preonly + Cholesky or LU) the three right-hand sides go to
         the factorisation together (MatMatSolve): MUMPS then makes one pass instead of
-        three, half the solve time on 2 ranks (README, "Performance"). Any other KSP solves
+        three, half the solve time on 2 ranks (docs/performance.md). Any other KSP solves
         them one by one.
         """
         block = self._rhs_block.getDenseArray()

@@ -34,7 +34,7 @@ def vertex_strains(solver):
 
 
 def vertex_fields(solver, t):
-    """All vertex datasets of the result file (docs/method.md §6, issue format)."""
+    """All vertex datasets of the result file (docs/method.md §6; docs/output.md)."""
     mesh, scene = solver.mesh, solver.scene
     r = solver.state.r.owned()
     d1 = solver.state.d1.owned()[:, 0]
@@ -62,7 +62,7 @@ def restart_state(solver):
 def set_state(solver, vertex, state):
     """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
     holds r and d3 = r' at the vertices: slope's midpoints are those of the Hermite cubic
-    they define (UzawaSolver.set_centreline)."""
+    they define (RodState.set_centreline)."""
     n_local = solver.mesh.n_local_elements
     n_owned = vertex["r"].shape[0]
     solver.state.set_centreline(vertex["r"], vertex["d3"])

@@ -1,10 +1,10 @@
 """HDF5 results, written collectively and atomically, and read back for a restart.
 
-Layout (documented in README.md): vertex datasets S (n,), r, d1, d2, d3, u, m, n (n, 3);
-attributes converged, stop_reason, iterations, halvings, total_iterations,
-total_halvings, undone_iterations, constraint_residual, change, stable,
-energy, wall_time, written, ranks, load_factor, penalty (in use), asked_penalty (and twist_turns, writhe_turns
-where the link is tracked); a group ``history``; a group ``state`` with what a restart
+Layout (documented in docs/output.md): vertex datasets S (n,), r, d1, d2, d3, u, m, n
+(n, 3); attributes converged, stop_reason, iterations, halvings, total_iterations,
+total_halvings, undone_iterations, constraint_residual, change, stable, energy,
+wall_time, written, ranks, load_factor, penalty (in use), asked_penalty (and
+twist_turns, writhe_turns where the link is tracked); a group ``history``; a group ``state`` with what a restart
 needs beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>``
 per accepted continuation step (halved sub-steps included) and the failed one that ends
 a run, with the same content. The root links to the last step and also holds the run's

@@ -3,7 +3,7 @@
 fails, reported one line per step and written one group per step."""
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,10 +34,9 @@ def not_converged_reason(report, solver):
                 "curvature each time: take more -rod_steps, or -rod_imperfection")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
-                "would not meet the tolerances within -rod_al_max_it: the mesh's floor (about "
-                "h^3) lies above them (use more -rod_elements or looser tolerances), or a "
-                "symmetry holds the iterate (a straight rod shortened along its axis: move "
-                "the end off the axis)")
+                "would not meet the tolerances within -rod_al_max_it: tolerances near round-off "
+                "for this mesh and these forces (loosen them), or a slowly contracting "
+                "iteration (take more -rod_steps or a larger -rod_al_max_it)")
     hint = ""
     if settings.asked_penalty < 0.1 * solver.scale:
         hint = (f"; -rod_al_penalty {settings.asked_penalty:g} is far below the problem's scale "
@@ -152,10 +151,10 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     if report.reason == STOP_OBSERVER:
         return report, "interrupted"
     if report.converged:
-        report.link, report.link_expected = solver.link(), expected_link
+        report = replace(report, link=solver.link(), link_expected=expected_link)
         if not changed_class(report.link, expected_link):
             return report, None
-        report.converged, report.reason = False, STOP_LINK
+        report = replace(report, converged=False, reason=STOP_LINK)
         return report, (f"converged in {report.iterations} iterations to a linking number "
                         f"of {sum(report.link):.3f} turns, not {expected_link:.3f}")
     return report, (f"not converged in {report.iterations} iterations (change "
@@ -227,7 +226,7 @@ def continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, opti
                               f"{report.iterations}", path)
         iterations = (failure.iterations or 0) if report is None else report.iterations
         totals["total_iterations"] += iterations
-        # a stalled step is not halved: the floor that stops it is the mesh's, not the step's
+        # a stalled step is not halved: a smaller step does not move what stops it
         stalled = report is not None and report.stalled
         if failure is not None and path.can_halve and not stalled:
             solver.state.restore(saved)

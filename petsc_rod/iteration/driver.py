@@ -58,15 +58,20 @@ class UzawaSolver:
         check_anderson_depth()          # before any PETSc object is made
         self.mesh, self.scene, self.settings = mesh, scene, settings
         self.split = split_coefficients(scene.stiffness)
-        self.penalty = float(settings.asked_penalty)    # in use: may be raised on the way
         self.scale = penalty_policy.default_penalty(scene)
         self.state = RodState(mesh)
         self.global_step = GlobalStep(mesh, scene, self.split,
-                                      penalty_policy.matrix_split(self.split), self.penalty)
+                                      penalty_policy.matrix_split(self.split),
+                                      float(settings.asked_penalty))
         self.weights = quadrature_weights(mesh.element_h)
         self._root_weights = np.sqrt(self.state.node_weights)[:, None, None]
         self._step = None
         self._create_snes()
+
+    @property
+    def penalty(self):
+        """The penalty R in use, N: the one asked for, or larger after a raise."""
+        return self.global_step.penalty
 
     def _create_snes(self):
         """The SNES of the fixed-point problem, options -rod_snes_*: Anderson mixing by
@@ -147,8 +152,7 @@ class UzawaSolver:
             self.snes.solve(None, self._x)
             if step.outcome != stopping.RAISE_PENALTY:
                 break
-            self.penalty = penalty_policy.raised_penalty(self.penalty, self.scale)
-            self.global_step.build(self.penalty)
+            self.global_step.build(penalty_policy.raised_penalty(self.penalty, self.scale))
             step.raises.append((len(step.history), self.penalty))
             step.outcome = None
         if step.outcome is None and step.error is None:   # the SNES stopped on its own test

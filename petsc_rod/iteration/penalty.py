@@ -21,7 +21,7 @@ def default_penalty(scene):
     """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2)), N.
 
     Three scales, each a lower bound below which the iteration crawls or leaves the
-    branch (docs/method.md §3, measurements in docs/stability.md):
+    branch (docs/method.md §3; measurements in docs/stability.md, History C):
     * bending and torsion, 100 sqrt(min K max K) / L^2: the count grows with R over the
       softest stiffness and the iteration fails when R is far below the stiffest one;
     * tension, F / 2 with F = int |f| dS + |P_0| + |P_L| (Scene.applied_force): the

@@ -1,4 +1,5 @@
-"""Distributed vector fields (r, d1, d2): three scalar DMDA Vecs, one per component.
+"""Distributed vector fields (r, d1, d2, the slope r'): three scalar DMDA Vecs, one per
+component.
 
 The global step solves one scalar problem per Cartesian component with the same
 factorisation (docs/method.md §3), so each component is its own Vec on the mesh's DMDA.

@@ -3,7 +3,8 @@
 Vertex i sits at S_i = L g(i/N). Element e = [S_e, S_e+1] belongs to the rank that owns
 its left vertex; its P2 midpoint dof is stored with that vertex (slot 1), so every
 element's dofs are in the rank's ghosted local vector (ghost width 1). The last
-vertex's slot 1 is a phantom dof, pinned to zero by the assembly.
+vertex's slot 1 is a phantom dof, pinned to zero in the matrices
+(boundary.director_prescribed).
 """
 
 import numpy as np

@@ -104,7 +104,7 @@ class Scene:
     def link_axis(self):
         """The common end tangent e of a rod clamped at both ends whose end frame only
         rolls about it on the whole load path (its d3 stays e), else None: the scenes
-        whose linking number is defined and tracked (link.py)."""
+        whose linking number is defined and tracked (analysis/link.py)."""
         axis = REFERENCE_FRAME[2]
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
         if self.start != "clamp" or self.end != "clamp" or np.linalg.norm(tilt) > 1e-12:

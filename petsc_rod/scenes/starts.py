@@ -2,7 +2,7 @@
 
 A curve maps arc lengths S (any shape) to (r, frame, force): the centreline, the director
 frame (rows d1, d2, d3 = r') and the internal force n(S). The solver samples it at its
-dofs and quadrature points (UzawaSolver.set_from_curve) and starts the multiplier of the
+dofs and quadrature points (RodState.set_from_curve) and starts the multiplier of the
 constraint r' = tau3 at lambda3 = n, which is what it converges to when the bending terms
 are small (at convergence int 2 a3 r''.p'' + lambda3.p' = int f.p, the weak form of
 n' + f = 0); lambda1 = lambda2 = 0.

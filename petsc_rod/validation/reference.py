@@ -466,7 +466,7 @@ def self_check(result, coarse_tol=1e-8, fine_tol=1e-10, coarse_nodes=81, refinem
 # --------------------------------------------------------------------- initial guesses
 
 def initial_guess_from_result(path):
-    """Initial guess from a petsc_rod HDF5 result file (format: petsc_rod/io.py).
+    """Initial guess from a petsc_rod HDF5 result file (format: docs/output.md).
 
     Reads the vertex datasets ``S`` (n,), ``r``, ``d1``, ``d2``, ``d3``, ``u``, ``n``,
     ``m`` (n, 3) of the file's last step (the root links to it), and the stiffness from

@@ -6,7 +6,7 @@ slope*(S) = A N0(s) + M N1(s) + B N2(s) (s = S/L, N_k the P2 shape functions on
 is a cubic known in closed form: the recovered r has no discretisation error, only
 round-off. slope* takes the prescribed slope at a clamped end, and when both ends are
 held M makes int_0^L slope* dS the prescribed chord. Used by
-scripts/linear_solve_roundoff.py and tests/test_centreline.py.
+scripts/linear_solve_roundoff.py and tests/solver/test_centreline.py.
 """
 
 import numpy as np
@@ -49,7 +49,7 @@ def centreline_solve_error(solver, t=1.0):
     discrete solution is slope* (and mu = MULTIPLIER when both ends are held).
 
     The right-hand side is A slope* (+ mu int g), with A the full slope matrix; the
-    solve is the run's (UzawaSolver.solve_centreline). Overwrites the solver's state.
+    solve is the run's (GlobalStep.solve_centreline). Overwrites the solver's state.
     """
     mesh, problem = solver.mesh, solver.global_step.slope_problem
     solver.prepare_step(t)

@@ -1,5 +1,6 @@
 """The writhe of a whole centreline by the Gauss double integral (numpy only), an
-independent check of Fuller's local writhe that the runtime uses (petsc_rod/link.py).
+independent check of Fuller's local writhe that the runtime uses
+(petsc_rod/analysis/link.py).
 """
 
 import numpy as np
@@ -7,8 +8,8 @@ import numpy as np
 
 def gauss_writhe(points, axis, reach=50.0):
     """Writhe (turns) of a whole centreline by the Gauss double integral, an independent
-    check of Fuller's formula (link.py; tests, scripts/stability_matrix.py; O(n^2) work and
-    memory, n = len(points)).
+    check of Fuller's formula (analysis/link.py; tests, scripts/stability_matrix.py;
+    O(n^2) work and memory, n = len(points)).
 
     points: (n, 3) along a curve whose end tangents are ``axis``. The curve is closed as
     Fuller's formula assumes: rays of length ``reach`` along -axis and +axis from its ends

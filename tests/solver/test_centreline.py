@@ -1,4 +1,4 @@
-"""The centreline solved through its slope theta = r' (petsc_rod/centreline.py).
+"""The centreline solved through its slope r' (petsc_rod/global_step/centreline.py).
 
 * One global step equals the paper's Hermite-cubic step for r (a dense numpy solve of
   int 2 a3 r''.p'' + R r'.p' = int (R tau3 - lambda3).p' + int f.p + end forces, with
@@ -182,7 +182,11 @@ def test_energy_is_the_hermite_one(one_step):
     u = strains(directors, derivatives)
     w = np.diff(S)[:, None] * GAUSS_WEIGHTS
     stored = 0.5 * np.sum(w[:, :, None] * one_step["scene"].stiffness * u**2)
-    assert abs(one_step["energy"] - (stored - work)) < ROUND_OFF * max(stored, abs(work))
+    # the strains resolve D' on D^-1: round-off in r' and r'' grows with the condition
+    # number of the frames, which random tau and lambda make large
+    condition = np.linalg.cond(directors.reshape(-1, 3, 3)).max()
+    bound = ROUND_OFF * condition * max(stored, abs(work))
+    assert abs(one_step["energy"] - (stored - work)) < bound
 
 
 @pytest.mark.parametrize("scene", [

@@ -9,7 +9,7 @@ two can, measured when these tests were written:
   half steps converge in 194 and 89.
 - PULLED, pulled along its axis by 1.5e5 N, R = 100: the first global step of one step
   gives |r'| about 1 + P/R, an RMS constraint residual of 1.4e3 above the divergence
-  bound (solver.DIVERGED_RESIDUAL = 1e3); the half steps (7.5e2) converge in 648 each.
+  bound (stopping.DIVERGED_RESIDUAL = 1e3); the half steps (7.5e2) converge in 648 each.
 
 With halvings the run undoes the failed step and gets there in two half steps; since the
 undo is exact, it then does what ``-rod_steps 2`` does, iteration for iteration.

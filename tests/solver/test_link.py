@@ -1,5 +1,6 @@
-"""The linking number Lk = Tw + Wr of rods clamped at both ends (petsc_rod/link.py) and
-the continuation's check that a step keeps it (docs/stability.md, fix 9).
+"""The linking number Lk = Tw + Wr of rods clamped at both ends
+(petsc_rod/analysis/link.py) and the continuation's check that a step keeps it
+(docs/stability.md, "Twist and Greenhill").
 
 - Fuller's writhe against the Gauss double integral, on a curve given in closed form
   and on a converged writhed rod;

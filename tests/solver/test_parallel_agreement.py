@@ -26,7 +26,7 @@ MAX_IT = 3000
 STEPS = (0.5, 1.0)
 # agreement of the fields for each iteration, and of lambda relative to its size: the
 # multipliers carry R times the constraint gap, and on several ranks the global step is
-# CG to 1e-14 (assembly.PARALLEL_DEFAULTS) rather than a factorisation
+# CG to 1e-14 (matrices.PARALLEL_DEFAULTS) rather than a factorisation
 FIELD_TOL = {"nrichardson": 1e-10, "anderson": 1e-9}
 MULTIPLIER_TOL = {"nrichardson": 1e-10, "anderson": 1e-8}
 

@@ -17,7 +17,8 @@ def test_a_penalty_far_below_the_scale_is_raised_and_the_elastica_reached(
         solver_factory, comm, adapt):
     """Cantilever P L^2/K = 3 at R = 1e-3 K/L^2 (scale 100): raised tenfold four times to
     10, the tip meets the elastica to 1e-5; kept at 1e-3 (-rod_al_adapt_penalty 0) the
-    residual is still above 0.1 after 2000 iterations (docs/stability.md, fix 10)."""
+    residual is still above 0.1 after 2000 iterations (docs/stability.md, "Planar
+    bending")."""
     mesh, solver = solver_factory(comm, 32, CANTILEVER, 1e-3, 1e-7, 1e-5, 2000)
     solver.settings.adapt_penalty = adapt
     report = continuation(solver, steps=2)

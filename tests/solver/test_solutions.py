@@ -1,21 +1,16 @@
 """Solutions against closed forms, observed convergence orders, and the paper's branch.
 
 Serial and under mpiexec -n 2 (global quantities only). Bounds come from measured runs
-(README, "Accuracy"); none is looser than needed to hold the measured value with a margin
+(docs/accuracy.md); none is looser than needed to hold the measured value with a margin
 for the 1-rank / 2-rank round-off difference.
 """
 
 import numpy as np
 import pytest
 
-from helpers import continuation as solve, gather
+from helpers import continuation as solve, fitted_order, gather
 from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
 from petsc_rod.io.outputs import vertex_fields
-
-
-def fitted_order(n_elements, errors):
-    """Slope of log(error) against log(h) by least squares."""
-    return -np.polyfit(np.log(n_elements), np.log(errors), 1)[0]
 
 
 def twist_scene(theta):

@@ -1,6 +1,6 @@
 """Hostile input and faults, end to end (``python -m petsc_rod``, 1 and 2 ranks): each
-class ends with one petsc_rod line, its documented exit code (README, "Exit codes and bad
-input"), no traceback, no hang, and no result or ``.partial`` file left behind.
+class ends with one petsc_rod line, its documented exit code (docs/errors.md), no
+traceback, no hang, and no result or ``.partial`` file left behind.
 
 Every test spawns processes, so the module is marked ``serial``.
 """

@@ -1,6 +1,7 @@
-"""The issue-3 scripts end to end on their small setting (--quick), and what their
-documents rely on: 1 and 2 ranks give the same numbers, a tighter tolerance gives a
-smaller iteration error, the paper scene leaves the plane where the docs say it does.
+"""The scripts of docs/error_vs_time.md and docs/paper.md end to end on their small
+setting (--quick), and what their documents rely on: 1 and 2 ranks give the same
+numbers, a tighter tolerance gives a smaller iteration error, the paper scene leaves the
+plane where the docs say it does.
 
 Serial: the scripts spawn mpiexec themselves.
 """

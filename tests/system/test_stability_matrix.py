@@ -1,4 +1,4 @@
-"""The CI subset of the stability matrix (scripts/stability_matrix.py, issue 4 point 5):
+"""The CI subset of the stability matrix (scripts/stability_matrix.py, docs/stability.md):
 each case run as a user runs it, on 1 rank and under mpiexec -n 2, must give the same
 outcome; a converged case must be within its bound of the closed form, with the same
 iteration count and the same centreline on both rank counts.
