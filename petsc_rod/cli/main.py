@@ -197,6 +197,10 @@ def options_in_effect(values, solver, start):
     scene = solver.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
+    if scene.seabed is not None:                # the default stiffness (riser/environment.py)
+        resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
+    if values["rod_current_profile"]:
+        resolved["rod_sea_surface"] = scene.current.surface
     parameters, units = {}, {}
     for option in OPTIONS:
         value = resolved.get(option.name, values[option.name])
