@@ -66,7 +66,7 @@ class LaggedSeabed(RiserTerms):
 
     def add_loads(self, slope_rhs, state):
         loads = np.zeros((self.mesh.n_local_nodes, 3))
-        loads[:, 2] = self.seabed_pressure(state._positions[:, 2])
+        loads[:, 2] = self.seabed_pressure(state.node_positions()[:, 2])
         self.contact_load.set(loads)
         mesh = self.mesh
         self._rhs.add_ghosted(scatter_element_vectors(

@@ -77,7 +77,8 @@ class VerticalProblem:
         self.matrix = self.base.duplicate(copy=True)
         self.constrained = self.base.duplicate(copy=True)
         self.added_rhs = self.base.createVecLeft()
-        self.rhs, self.solution, self.bc = (self.base.createVecLeft() for _ in range(3))
+        self.rhs, self.solution, self.bc, self._work, self._product = (
+            self.base.createVecLeft() for _ in range(5))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
         self.ksp = PETSc.KSP().create(comm=mesh.comm)
         self.ksp.setOperators(self.constrained)
@@ -143,16 +144,11 @@ class VerticalProblem:
         in P2 layout); sets ``theta`` (Vec) = T y and returns y (a Vec owned here)."""
         self.slope.multTranspose(theta_rhs, self.rhs)
         self.rhs.axpy(1.0, self.added_rhs)
-        work = self.rhs.copy()
-        lift = self.rhs.duplicate()
-        try:
-            self.matrix.mult(self.bc, lift)
-            work.axpy(-1.0, lift)
-            work.getArray()[self._local_fixed] = self._fixed_values
-            self.ksp.solve(work, self.solution)
-        finally:
-            work.destroy()
-            lift.destroy()
+        self.matrix.mult(self.bc, self._product)            # the lifting
+        self.rhs.copy(self._work)
+        self._work.axpy(-1.0, self._product)
+        self._work.getArray()[self._local_fixed] = self._fixed_values
+        self.ksp.solve(self._work, self.solution)
         reason = self.ksp.getConvergedReason()
         if reason < 0:
             raise RodDivergedError(f"linear solver -{self.name} failed: "
@@ -164,18 +160,16 @@ class VerticalProblem:
         """(b - M y) at the row of z(L) after a solve (summed over the ranks): the z part of
         the chord multiplier mu of the theta problem, T^T c = e_z(L) - e_z(0)
         (docs/riser.md). Collective."""
-        residual = self.rhs.duplicate()
-        try:
-            self.matrix.mult(self.solution, residual)
-            residual.aypx(-1.0, self.rhs)
-            row = 2 * self.mesh.n_elements
-            start, end = residual.getOwnershipRange()
-            local = residual.getArray(readonly=True)[row - start] if start <= row < end else 0.0
-        finally:
-            residual.destroy()
+        residual = self._product
+        self.matrix.mult(self.solution, residual)
+        residual.aypx(-1.0, self.rhs)
+        row = 2 * self.mesh.n_elements
+        start, end = residual.getOwnershipRange()
+        local = residual.getArray(readonly=True)[row - start] if start <= row < end else 0.0
         return float(self.mesh.global_sum(local))
 
     def destroy(self):
         for obj in (self.ksp, self.base, self.slope, self.matrix, self.constrained,
-                    self.added_rhs, self.rhs, self.solution, self.bc):
+                    self.added_rhs, self.rhs, self.solution, self.bc, self._work,
+                    self._product):
             obj.destroy()

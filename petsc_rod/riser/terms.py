@@ -59,10 +59,12 @@ class RiserTerms:
     # --- each iteration ------------------------------------------------------------
     def drag_at_nodes(self, state):
         """t c |v_n| v_n at the owned nodes (N/m), (n_nodes, 3), from the tangents tau3
-        and, for the current's depth, the heights of the last global step."""
+        and, for a current that varies with depth, the heights of the last global step.
+        Collective when it does (a ghost exchange)."""
         current = self.current
-        return self.t * normal_drag(state.tau[:, 2], current.velocity(state._positions[:, 2]),
-                                    current.drag)
+        z = (state.node_positions()[:, 2] if current.depths.size > 1
+             else np.zeros(self.mesh.n_local_nodes))
+        return self.t * normal_drag(state.tau[:, 2], current.velocity(z), current.drag)
 
     def add_loads(self, slope_rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side (a VectorField)."""
