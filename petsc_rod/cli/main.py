@@ -220,12 +220,13 @@ def solver_types(solver):
     """{'<prefix>ksp_type': ..., '<prefix>pc_type': ..., '<prefix>pc_factor_mat_solver_type':
     ...} of the global step's solvers, prefixes without ``rod_``."""
     types = {}
-    for problem in solver.global_step.problems:
-        ksp = problem.ksp
+    for ksp in solver.global_step.ksps():
         prefix = (ksp.getOptionsPrefix() or "").removeprefix("rod_")
         pc = ksp.getPC()
         types[f"{prefix}ksp_type"] = ksp.getType()
         types[f"{prefix}pc_type"] = pc.getType()
-        if pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU):
-            types[f"{prefix}pc_factor_mat_solver_type"] = pc.getFactorSolverType()
+        package = (pc.getFactorSolverType()
+                   if pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU) else None)
+        if package:             # known once the factorisation is set up
+            types[f"{prefix}pc_factor_mat_solver_type"] = package
     return types

@@ -69,6 +69,11 @@ class GlobalStep:
             self.riser.build(2 * self.matrix_split[2], penalty)
         EVENTS["assembly"].end()
 
+    def ksps(self):
+        """Every KSP of the global step: d1, d2, the slope, and the height's with a seabed."""
+        riser = self.riser.ksps() if self.riser is not None else []
+        return [problem.ksp for problem in self.problems] + riser
+
     @property
     def slope_problem(self):
         return self.problems[2]

@@ -50,6 +50,10 @@ class RiserTerms:
         if self.start_state is not None:
             self.vertical.set_prescribed(self.start_state, self.end_state)
 
+    def ksps(self):
+        """The KSP of the vertical problem, where there is a seabed."""
+        return [self.vertical.ksp] if self.vertical is not None else []
+
     def prepare(self, t, start_state, end_state):
         """The load factor and end states of a step (GlobalStep.prepare)."""
         self.t, self.start_state, self.end_state = t, start_state, end_state

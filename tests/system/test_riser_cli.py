@@ -49,6 +49,9 @@ def test_a_riser_scene_converges_on_two_ranks_with_the_defaults(scenes, name):
         touchdown = float(f.attrs["touchdown_S"])
         assert f["effective_tension"].attrs["units"] == "N"
         assert "touchdown_S" in f.attrs["attribute_units"]
+        in_effect = str(f.attrs["options_in_effect"]).splitlines()
+    # the height's solver is recorded with the others where there is a seabed
+    assert any(line.startswith("-rod_z_ksp_type ") for line in in_effect)
     grounded = S < touchdown
     assert grounded.sum() > 10 and np.all(tension > 0)
     # the grounded part rests on the seabed z = 0, within a few millimetres
