@@ -46,6 +46,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
+from petsc_rod.riser.catenary import grounded_catenary  # noqa: E402
 from petsc_rod.validation import closed_forms  # noqa: E402
 from petsc_rod.validation.writhe import gauss_writhe  # noqa: E402
 
@@ -84,7 +85,7 @@ def option_list(options):
     """{'length': 1, ...} -> ['-rod_length', '1', ...]."""
     words = []
     for key, value in options.items():
-        words += [f"-rod_{key}", str(value)]
+        words += ["-options_file" if key == "options_file" else f"-rod_{key}", str(value)]
     return words
 
 
@@ -207,6 +208,53 @@ def check_catenary(bound):
     return check
 
 
+# Risers (docs/riser.md): 1800 m of line of 1.2 kN/m from an anchor on the seabed z = 0
+# to a pin 1000 m up. EI = 1e4 N m^2 (a bending length sqrt(EI / H) of 0.2 m or less),
+# so that the catenary with touchdown (riser/catenary.py) is the reference 20 m away from
+# the touchdown point and the ends.
+RISER = {"length": 1800, "stiffness": "1e4,1e4,7.5e3", "start": "pin", "end": "pin",
+         "end_position": "1157,0,1000", "load": "0,0,-1200", "seabed": 0,
+         "elements": 1800, "initial_shape": "catenary"}
+RISER_ZONE = 20.0
+
+
+def riser(**overrides):
+    options = dict(RISER)
+    options.update(overrides)
+    return options
+
+
+def check_grounded(end_position, bound):
+    """r against the catenary with touchdown to ``end_position`` (text x,y,z)."""
+    chord = np.array([float(v) for v in end_position.split(",")])
+
+    def check(result):
+        S = result["S"]
+        exact, _, _, (_, touchdown) = grounded_catenary(1800.0, chord, 1200.0, 0.0, S)
+        away = ((np.abs(S - touchdown) > RISER_ZONE) & (S > RISER_ZONE)
+                & (S < 1800.0 - RISER_ZONE))
+        return (max_error(result["r"][away], exact[away]), bound,
+                "r vs catenary with touchdown, 20 m from it and the ends, m")
+    return check
+
+
+# A weightless 100 m line pinned 80 m apart in a current across it: the current catenary
+# (tests/solver/test_riser.py).
+CURRENT_LINE = {"length": 100, "stiffness": "1,1,1", "start": "pin", "end": "pin",
+                "end_position": "80,0,0", "drag": "1025,1.2,0.1", "elements": 200,
+                "al_rtol": 1e-10, "al_ctol": 1e-10}
+
+
+def check_current_catenary(speed, bound):
+    def check(result):
+        drag = 0.5 * 1025 * 1.2 * 0.1 * speed**2
+        exact, _, _ = closed_forms.catenary(100.0, np.array([80.0, 0.0, 0.0]),
+                                            np.array([0.0, drag, 0.0]), result["S"])
+        return (max_error(result["r"], exact), bound,
+                "r vs the catenary of the normal drag, m")
+    return check
+
+
 PAPER = {"length": 20, "stiffness": "235,360,200", "start": "clamp", "end": "pin",
          "end_position": "16,4,0", "elements": 80, "al_penalty": 400, "al_rtol": 1e-7,
          "al_ctol": 1e-5, "al_max_it": 200000, "steps": 8, "imperfection": 0.01}
@@ -301,6 +349,26 @@ def cases():
              ranks=2))
     add(Case("catenary", "uniform, 10^6 elements (h/L = 1e-6)", catenary(1000000),
              check_catenary(1e-4), ranks=2))
+    # risers: the seabed and the current (docs/riser.md)
+    top = RISER["end_position"]
+    add(Case("riser", "catenary riser, default seabed (w / 1 mm)", riser(),
+             check_grounded(top, 2e-3), ranks=2, notes="1 mm penetration"))
+    add(Case("riser", "catenary riser, seabed 1000 x stiffer", riser(seabed_stiffness=1.2e9),
+             check_grounded(top, 2e-4), ranks=2))
+    add(Case("riser", "catenary riser, straight start, 1 step", riser(initial_shape="straight"),
+             check_grounded(top, 2e-3), ranks=2))
+    add(Case("riser", "nearly all on the seabed (1711 of 1800 m)",
+             riser(end_position="1780,0,50"), check_grounded("1780,0,50", 2e-3), ranks=2))
+    add(Case("riser", "touchdown 23 m from the anchor", riser(end_position="1397,0,1000"),
+             check_grounded("1397,0,1000", 2e-3), ranks=2))
+    add(Case("riser", "weightless line, current 3 m/s across",
+             dict(CURRENT_LINE, current="0,3,0"), check_current_catenary(3.0, 1e-4)))
+    add(Case("riser", "catenary riser, current 2 m/s across its plane",
+             riser(current="0,2,0", drag="1025,1.2,0.324"), ranks=2,
+             notes="no closed form; drag 40% of the weight"))
+    add(Case("riser", "lazy wave (options/lazy_wave.opts)",
+             {"options_file": "options/lazy_wave.opts", "elements": 2000}, ranks=2,
+             notes="no closed form"))
     return matrix
 
 

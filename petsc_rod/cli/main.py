@@ -20,6 +20,7 @@ from petsc_rod.iteration.continuation import continuation
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.iteration.penalty import default_penalty
 from petsc_rod.iteration.stopping import Settings
+from petsc_rod.riser.environment import environment_from_options
 
 # The smallest element, relative to the length, whose end coordinates double precision
 # still tells apart to many digits.
@@ -38,6 +39,7 @@ def scene_from_options(values, given):
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
+    scene.seabed, scene.current = environment_from_options(values, given, scene)
     return scene
 
 
@@ -195,6 +197,10 @@ def options_in_effect(values, solver, start):
     scene = solver.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
+    if scene.seabed is not None:                # the default stiffness (riser/environment.py)
+        resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
+    if values["rod_current_profile"]:
+        resolved["rod_sea_surface"] = scene.current.surface
     parameters, units = {}, {}
     for option in OPTIONS:
         value = resolved.get(option.name, values[option.name])
@@ -214,12 +220,13 @@ def solver_types(solver):
     """{'<prefix>ksp_type': ..., '<prefix>pc_type': ..., '<prefix>pc_factor_mat_solver_type':
     ...} of the global step's solvers, prefixes without ``rod_``."""
     types = {}
-    for problem in solver.global_step.problems:
-        ksp = problem.ksp
+    for ksp in solver.global_step.ksps():
         prefix = (ksp.getOptionsPrefix() or "").removeprefix("rod_")
         pc = ksp.getPC()
         types[f"{prefix}ksp_type"] = ksp.getType()
         types[f"{prefix}pc_type"] = pc.getType()
-        if pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU):
-            types[f"{prefix}pc_factor_mat_solver_type"] = pc.getFactorSolverType()
+        package = (pc.getFactorSolverType()
+                   if pc.getType() in (PETSc.PC.Type.CHOLESKY, PETSc.PC.Type.LU) else None)
+        if package:             # known once the factorisation is set up
+            types[f"{prefix}pc_factor_mat_solver_type"] = package
     return types

@@ -1,7 +1,8 @@
 """The application's PETSc options: one table drives parsing, defaults and ``-help``.
 
 Every option has the root prefix ``rod_``. The KSPs of the global step have their own
-prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``), the SNES of the iteration ``rod_snes_``;
+prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``; ``rod_z_`` the seabed's vertical
+problem), the SNES of the iteration ``rod_snes_``;
 they read the usual PETSc options. A
 ``-rod_*`` name that is not in the table is an error (with the closest known name); any
 other option nobody read is reported at the end of the run.
@@ -18,7 +19,7 @@ from petsc4py import PETSc
 from petsc_rod.errors import RodInputError
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
-SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_")
+SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_")
 
 # Every number must be finite and at most this large in magnitude (and a positive scale,
 # such as a length or a tolerance, at least its inverse): the solver forms products of
@@ -91,6 +92,7 @@ POSITIVE = (lambda v: np.all(np.asarray(v) > 0), "must be positive")
 # a positive scale (length, stiffness, penalty): also not below 1 / MAX_MAGNITUDE
 SCALE = (lambda v: np.all(np.asarray(v) >= 1 / MAX_MAGNITUDE),
          f"must be positive (at least {1 / MAX_MAGNITUDE:g})")
+NON_NEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
 # a stopping tolerance: a change or residual of 1 or more would accept any iterate
 TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
              f"must be positive (at least {1 / MAX_MAGNITUDE:g}) and below 1: a tolerance of "
@@ -125,6 +127,24 @@ OPTIONS = [
            unit="N/m"),
     Option("rod_load_breaks", _reals(), np.zeros(0), "s1,...",
            "arc lengths where the piecewise-constant load changes, m", unit="m"),
+    # riser terms (petsc_rod/riser, docs/riser.md)
+    Option("rod_seabed", _real, None, "z",
+           "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",
+           unit="m"),
+    Option("rod_seabed_stiffness", _real, None, "k",
+           "seabed stiffness, N/m per m of line per m of penetration; default w / 1 mm, w the "
+           "largest downward -rod_load (N/m)", SCALE, "N/m^2"),
+    Option("rod_current", _reals(3), None, "ux,uy,uz",
+           "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),
+    Option("rod_current_profile", _string, None, "FILE",
+           "current profile: rows 'depth ux uy uz' (m, m/s), depths increasing, linear in "
+           "between, constant beyond", unit="text"),
+    Option("rod_sea_surface", _real, None, "z",
+           "height of the sea surface the profile's depths are measured from, m; default "
+           "the highest held end", unit="m"),
+    Option("rod_drag", _reals(3), None, "rho,Cd,D",
+           "water density kg/m^3, normal drag coefficient, hydrodynamic diameter m: drag "
+           "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE),
     Option("rod_steps", _int, 1, "K", "continuation steps from the straight state", POSITIVE),
     Option("rod_imperfection", _real, 0.0, "eps",
            "at the start of each step, roll the cross-sections about the tangent by "
@@ -163,7 +183,8 @@ OPTIONS = [
            "below tol", TOLERANCE),
     Option("rod_al_stability", _bool, True, "bool",
            "at each converged step, test the second variation of the energy (Sylvester "
-           "inertia); at a saddle turn the frames along its negative curvature and go on"),
+           "inertia); at a saddle turn the frames along its negative curvature and go on; "
+           "not with a current (its drag has no energy)"),
     Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, True, "bool",
            "raise R tenfold, refactoring the matrices, while it is below a tenth of the "
@@ -242,8 +263,9 @@ def help_text():
         lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
                      f"(default {default})")
     lines.append("  Global-step solvers: -rod_slope_ksp_*, -rod_slope_pc_* (the slope r'), -rod_d1_*, -rod_d2_* "
-                 "(directors); default preonly + Cholesky on one rank, preonly + the exact "
-                 "substructuring PC (-pc_type python) on several.")
+                 "(directors), -rod_z_* (the height, with -rod_seabed); default preonly + "
+                 "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
+                 "python) on several.")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres, and the SNES "
                  "options under the same prefix (-rod_snes_anderson_m, -rod_snes_monitor).")

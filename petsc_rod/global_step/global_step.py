@@ -19,6 +19,7 @@ from petsc_rod.global_step.centreline import (anchor_work, load_offset,
 from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix, load_ghosted
 from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
 from petsc_rod.mesh.fields import CHUNK, VectorField, blocks, element_slices
+from petsc_rod.riser.terms import RiserTerms
 from petsc_rod.scenes import boundary
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("assembly", "rhs", "solve")}
@@ -51,6 +52,8 @@ class GlobalStep:
         self._increments = np.zeros((3, mesh.n_local_elements))
         self._element_work = np.zeros(mesh.n_local_elements)
         self._target = np.zeros((min(mesh.n_local_nodes, CHUNK), 3, 3))   # w (R tau - lambda)
+        # the seabed and the current (petsc_rod/riser), built only when the scene has them
+        self.riser = RiserTerms(mesh, scene) if scene.seabed or scene.current else None
         self.build(penalty)
 
     def build(self, penalty):
@@ -68,7 +71,14 @@ class GlobalStep:
         if self.bordered:
             self.problems[2].add_integral_constraint(element_integrals(h))
         self._set_prescribed()
+        if self.riser is not None:
+            self.riser.build(2 * self.matrix_split[2], penalty)
         EVENTS["assembly"].end()
+
+    def ksps(self):
+        """Every KSP of the global step: d1, d2, the slope, and the height's with a seabed."""
+        riser = self.riser.ksps() if self.riser is not None else []
+        return [problem.ksp for problem in self.problems] + riser
 
     @property
     def slope_problem(self):
@@ -87,6 +97,8 @@ class GlobalStep:
         self.load.add_ghosted(load_ghosted(
             self.mesh, lambda S: scene.load_beyond(S, t) + self.load_offset,
             scene.load_piece_ends))
+        if self.riser is not None:
+            self.riser.prepare(t, start, end)
 
     def _set_prescribed(self):
         for i, problem in enumerate(self.problems):
@@ -98,6 +110,8 @@ class GlobalStep:
         lambda; with a border, the chord multiplier mu goes to state.chord_multiplier."""
         EVENTS["rhs"].begin()
         self._assemble_rhs(state.tau, state.lam, state.node_weights)
+        if self.riser is not None:
+            self.riser.add_loads(self.rhs[2], state)
         EVENTS["rhs"].end()
         EVENTS["solve"].begin()
         for problem, rhs, director in zip(self.problems[:2], self.rhs[:2],
@@ -156,6 +170,8 @@ class GlobalStep:
                 self.rhs[2], state.slope, chord)
         else:
             self.slope_problem.solve(self.rhs[2], state.slope)
+        if self.riser is not None:
+            self.riser.solve_vertical(self.rhs[2], state, self.bordered)
         self._integrate_slope(state)
 
     def _integrate_slope(self, state):
@@ -180,9 +196,10 @@ class GlobalStep:
 
     def load_work(self, state):
         """The work of the loads on the state, J: r(a).(applied forces) + int F.r' dS
-        (centreline.anchor_work)."""
-        return self.anchor_work + sum(load.dot(slope) for load, slope
+        (centreline.anchor_work), less the seabed's stored energy (riser/seabed.py)."""
+        work = self.anchor_work + sum(load.dot(slope) for load, slope
                                       in zip(self.load.components, state.slope.components))
+        return work - (self.riser.energy() if self.riser is not None else 0.0)
 
     def end_reaction(self, state):
         """External force N on the rod at S = L, N: F(L) - mu (centreline.py), i.e. the
@@ -202,3 +219,5 @@ class GlobalStep:
                 obj.destroy()
         for obj in [*self.rhs, self.load]:
             obj.destroy()
+        if self.riser is not None:
+            self.riser.destroy()

@@ -27,9 +27,10 @@ def element_rows(mesh):
     return (2 * (first + P2.offsets[None, :]) + P2.slots[None, :]).astype(PETSc.IntType)
 
 
-def assemble_matrix(mesh, element_matrices):
-    """The DMDA matrix sum_e of element matrices (ne, 3, 3) on the P2 dofs."""
-    rows = element_rows(mesh)
+def assemble_matrix(mesh, element_matrices, rows=None):
+    """The DMDA matrix sum_e of element matrices (ne, k, k) on the element rows ``rows``
+    (ne, k), by default the P2 dofs (element_rows)."""
+    rows = element_rows(mesh) if rows is None else rows
     matrix = mesh.da.createMatrix()
     if len(rows):        # a rank may own no element (e.g. 2 elements on 2 ranks), and
         # petsc4py's setValuesRCV divides by the number of rows
@@ -160,20 +161,31 @@ class ScalarProblem:
         self._lift_values = lifts[self._lift_rows]
 
     def solve(self, rhs, solution):
-        """Solve for the three components: rhs, solution are VectorFields. ``rhs`` is
-        overwritten: its prescribed rows take the prescribed values, and the lifting is
-        subtracted from the rows next to them.
+        """Solve for the three components: rhs, solution are VectorFields.
 
-        A direct solver is called past KSPSolve (_direct_solver): PETSc's factorisation
-        and the substructuring PC column by column on the Vecs, a factorisation with a
-        multiple right-hand-side solve (MUMPS) with the three right-hand sides together
-        (MatMatSolve: one pass instead of three, half the solve time on 2 ranks, docs/performance.md). Any
-        other KSP solves them one by one.
+        The prescribed rows of ``rhs`` take the prescribed values and the lifting is
+        subtracted from the rows next to them, in place, for the solve only: those few
+        entries are put back afterwards (the riser's vertical problem reads the same
+        right-hand side). A direct solver is called past KSPSolve (_direct_solver):
+        PETSc's factorisation and the substructuring PC column by column on the Vecs, a
+        factorisation with a multiple right-hand-side solve (MUMPS) with the three
+        right-hand sides together (MatMatSolve: one pass instead of three, half the solve
+        time on 2 ranks, docs/performance.md). Any other KSP solves them one by one.
         """
+        touched = np.concatenate([self._lift_rows, self._local_rows])
+        kept = []
         for c, vec in enumerate(rhs.components):
             values = vec.getArray()
+            kept.append(values[touched])
             values[self._lift_rows] -= self._lift_values[:, c]
             values[self._local_rows] = self._fixed_values[:, c]
+        try:
+            self._solve_columns(rhs, solution)
+        finally:
+            for vec, values in zip(rhs.components, kept):
+                vec.getArray()[touched] = values
+
+    def _solve_columns(self, rhs, solution):
         if self._columns is not None:
             self._columns(rhs.components, solution.components)
             return

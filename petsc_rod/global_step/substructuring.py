@@ -76,49 +76,47 @@ class NotAChainError(ValueError):
     rank's first row: the substructuring of this module does not apply."""
 
 
+# Interface widths tried, in order: 1 for the P2 chains of the global step (a vertex
+# value separates), 2 for a Hermite matrix in the same DMDA layout (the riser's vertical
+# problem: a vertex's value and slope).
+WIDTHS = (1, 2)
+
+
 class ChainSolver:
     """Exact solve with an assembled, symmetric positive definite AIJ ``matrix``
-    distributed by contiguous rows, coupled across ranks as a chain (module docstring);
-    A_GI is taken as A_IG^T (the symmetry), every rank must own two rows or more.
+    distributed by contiguous rows, coupled across ranks as a chain (module docstring):
+    the interface of a rank but the first is its first w rows, w the first of WIDTHS
+    that splits the matrix (the same on every rank); A_GI is taken as A_IG^T.
 
-    Shapes (local): n = owned rows, n_I = n - offset interior rows (offset = 1 on every
-    rank but the first), W stored transposed (2, n_I), the interface system (P-1, P-1).
+    Shapes (local): n = owned rows, n_I = n - offset interior rows (offset = w on every
+    rank but the first), W stored transposed (2w, n_I): rows for the w own interface
+    rows, then the next rank's w; the interface system ((P-1) w, (P-1) w), banded.
     """
 
     def __init__(self, matrix):
         comm = matrix.getComm()
         self._mpi = comm.tompi4py()
-        self.size, rank = comm.getSize(), comm.getRank()
+        self.size, self.rank = comm.getSize(), comm.getRank()
         start, end = matrix.getOwnershipRange()
-        self.offset = 1 if rank > 0 else 0
-        self.last = rank == self.size - 1
-        first = start + self.offset
-        n_interior = end - first
+        self.last = self.rank == self.size - 1
         rows, cols, values = matrix.getValuesCSR()
         row_of = np.repeat(np.arange(start, end), np.diff(rows))
-        nonzero = values != 0.0
-        interior_row = row_of >= first
-        inside = (cols >= first) & (cols < end)
-        # couplings of the interior rows: to I_p, to g_p (= start), to g_{p+1} (= end)
-        left = interior_row & nonzero & (cols == start) & (self.offset == 1)
-        right = interior_row & nonzero & (cols == end) & (not self.last)
-        stray = interior_row & nonzero & ~inside & ~left & ~right
-        why = None
-        if stray.any():
-            why = (f"row {row_of[stray][0]} couples to row {cols[stray][0]} of another "
-                   "rank: not a chain split at the ranks' first rows")
-        elif n_interior <= 0:
-            why = f"rows {start} to {end - 1}: a rank with no interior row"
-        refused = [text for text in self._mpi.allgather(why) if text is not None]
-        if refused:             # on every rank: the others would wait in the allgather
+        for width in WIDTHS:
+            why = self._split(row_of, cols, values, start, end, width)
+            refused = [text for text in self._mpi.allgather(why) if text is not None]
+            if not refused:     # decided on every rank: the others would wait otherwise
+                break
+        else:
             raise NotAChainError(refused[0])
-        keep = interior_row & inside & (nonzero | (cols == row_of))
+        self.width = width
+        first = start + self.offset
+        n_interior = end - first
+        keep = (row_of >= first) & (cols >= first) & (cols < end) & (
+            (values != 0.0) | (cols == row_of))
         counts = np.bincount(row_of[keep] - first, minlength=n_interior)
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
         self.interior = SeqCholesky(n_interior, indptr, cols[keep] - first, values[keep])
-        # A_IG as two sparse columns (interior indices, values); W = A_II^-1 A_IG
-        self._coupling = [(row_of[mask] - first, values[mask]) for mask in (left, right)]
-        self.W = np.zeros((2, n_interior))     # rows: columns of W, contiguous
+        self.W = np.zeros((2 * width, n_interior))     # rows: columns of W, contiguous
         self._work = np.zeros(n_interior)
         for column, (index, value) in enumerate(self._coupling):
             if index.size:
@@ -127,67 +125,104 @@ class ChainSolver:
                 self.interior.solve(b, self.W[column])
         self._factor_interface(row_of, cols, values, start, end)
 
+    def _split(self, row_of, cols, values, start, end, width):
+        """With the interface ``width`` rows wide: None if it splits the matrix (and the
+        interior rows' couplings A_IG as 2w sparse columns in self._coupling), else why
+        not."""
+        self.offset = width if self.rank > 0 else 0
+        first = start + self.offset
+        if end - first <= 0:
+            return f"rows {start} to {end - 1}: no interior row with an interface of {width}"
+        interior = (row_of >= first) & (values != 0.0)
+        inside = (cols >= first) & (cols < end)
+        own = [start + k if self.offset else -1 for k in range(width)]
+        following = [end + k if not self.last else -1 for k in range(width)]
+        masks = [interior & (cols == col) for col in own + following]
+        stray = interior & ~inside & ~np.any(masks, axis=0)
+        if stray.any():
+            return (f"row {row_of[stray][0]} couples to row {cols[stray][0]} of another "
+                    "rank: not a chain split at the ranks' first rows")
+        self._coupling = [(row_of[mask] - first, values[mask]) for mask in masks]
+        return None
+
     def _factor_interface(self, row_of, cols, values, start, end):
-        """S = A_GG - A_GI W, tridiagonal: each rank sends (A_{g_p g_p}, A_{g_p g_p+1},
-        and its 2x2 A_GI W on (g_p, g_p+1)); every rank assembles and factors S."""
-        local = np.zeros(5)
+        """S = A_GG - A_GI W, block tridiagonal with w x w blocks: each rank sends its
+        entries of S as (row, column, value) in the interface numbering, (q - 1) w + k
+        for row k of rank q's interface: its own interface rows' entries in A_GG (to its
+        own and the next rank's interface, with the symmetric one), and -A_GI W on its
+        two neighbouring interfaces; every rank assembles and factors S."""
+        w = self.width
+        n = (self.size - 1) * w
+        mine = [(self.rank - 1) * w + k for k in range(w)] if self.offset else []
+        mine += [self.rank * w + k for k in range(w)] if not self.last else []
+        slots = ([k for k in range(w)] if self.offset else []) + (
+            [w + k for k in range(w)] if not self.last else [])
+        entries = []
         if self.offset:
-            own = row_of == start
-            local[0] = values[own & (cols == start)].sum()
-            local[1] = values[own & (cols == end)].sum() if not self.last else 0.0
-        for column, (index, value) in enumerate(self._coupling):
-            for other in range(2):
+            for k in range(w):
+                row = row_of == start + k
+                for col, value in zip(cols[row], values[row]):
+                    j = col - start                 # own interface: 0..w-1, next: end..
+                    if 0 <= j < w:
+                        entries.append(((self.rank - 1) * w + k, (self.rank - 1) * w + j,
+                                        value))
+                    elif not self.last and end <= col < end + w:
+                        i, j = (self.rank - 1) * w + k, self.rank * w + col - end
+                        entries += [(i, j, value), (j, i, value)]
+        for a, i in zip(slots, mine):
+            index, value = self._coupling[a]
+            for b, j in zip(slots, mine):
                 if index.size:
-                    local[2 + column + other] += value @ self.W[other, index]
-        parts = np.empty((self.size, 5))
-        self._mpi.Allgather(local, parts)
-        # local[2:]: (L.W_L, L.W_R + R.W_L, R.W_R) summed as 2 + column + other
-        n = self.size - 1
-        self.diagonal = parts[1:, 0] - parts[1:, 2] - parts[:-1, 4]
-        self.off_diagonal = parts[1:-1, 1] - 0.5 * parts[1:-1, 3]
+                    entries.append((i, j, -(value @ self.W[b, index])))
+        everything = [e for part in self._mpi.allgather(entries) for e in part]
         self.schur = None
         if n:
-            rows = np.arange(n)
-            indices = np.stack([rows - 1, rows, rows + 1], axis=1)
-            entries = np.stack([np.r_[0.0, self.off_diagonal], self.diagonal,
-                                np.r_[self.off_diagonal, 0.0]], axis=1)
-            inside = (indices >= 0) & (indices < n)
-            self.schur = SeqCholesky(n, np.r_[0, np.cumsum(inside.sum(axis=1))],
-                                     indices[inside], entries[inside])
+            diagonal = [(r, r, 0.0) for r in range(n)]      # stored even if all zero
+            i, j, v = (np.array([e[k] for e in everything + diagonal]) for k in range(3))
+            key, where = np.unique(i.astype(np.int64) * n + j.astype(np.int64),
+                                   return_inverse=True)     # sorted by row, then column
+            summed = np.zeros(key.size)
+            np.add.at(summed, where, v.astype(float))
+            rows, columns = key // n, key % n
+            self.diagonal = summed[rows == columns]
+            self.schur = SeqCholesky(n, np.r_[0, np.cumsum(np.bincount(rows, minlength=n))],
+                                     columns, summed)
             self._interface = np.zeros(n)
+        else:
+            self.diagonal = np.zeros(0)
 
     def solve(self, rhs, solution):
         """solution = A^-1 rhs for k right-hand sides: lists of k local arrays (n,) of
-        owned rows (rhs is read only), one allgather of 2k numbers per rank."""
-        k = len(rhs)
-        off = self.offset
-        sent = np.zeros((2, k))
+        owned rows (rhs is read only), one allgather of 2 w k numbers per rank."""
+        k, w, off = len(rhs), self.width, self.offset
+        sent = np.zeros((2 * w, k))
         for c, (b, x) in enumerate(zip(rhs, solution)):
-            self.interior.solve(b[off:], x[off:])
-            (left_index, left_value), (right_index, right_value) = self._coupling
-            if off:
-                sent[0, c] = b[0] - left_value @ x[off:][left_index]
-            if right_index.size:
-                sent[1, c] = -(right_value @ x[off:][right_index])
+            interior = x[off:]
+            self.interior.solve(b[off:], interior)
+            for a, (index, value) in enumerate(self._coupling):
+                if index.size:
+                    sent[a, c] = -(value @ interior[index])
+            sent[:off, c] += b[:off]
         if self.size == 1:
             return
-        parts = np.empty((self.size, 2, k))
+        parts = np.empty((self.size, 2 * w, k))
         self._mpi.Allgather(sent, parts)
-        rhs_interface = parts[1:, 0] + parts[:-1, 1]          # (P-1, k)
-        rank = self._mpi.Get_rank()
-        own, following = np.zeros(k), np.zeros(k)
+        rhs_interface = (parts[1:, :w] + parts[:-1, w:]).reshape(-1, k)   # ((P-1) w, k)
+        values = np.zeros((2 * w, k))       # x_G on the own and the next interface
+        lo = (self.rank - 1) * w
         for c in range(k):
             self.schur.solve(np.ascontiguousarray(rhs_interface[:, c]), self._interface)
-            own[c] = self._interface[rank - 1] if off else 0.0
-            following[c] = self._interface[rank] if not self.last else 0.0
+            if off:
+                values[:w, c] = self._interface[lo:lo + w]
+            if not self.last:
+                values[w:, c] = self._interface[lo + w:lo + 2 * w]
         work = self._work
         for c, x in enumerate(solution):
             interior = x[off:]
-            for column, value in ((0, own[c]), (1, following[c])):
-                if self._coupling[column][0].size:      # W's column is zero otherwise
-                    interior -= np.multiply(self.W[column], value, out=work)
-            if off:
-                x[0] = own[c]
+            for a, (index, _) in enumerate(self._coupling):
+                if index.size:                  # W's column is zero otherwise
+                    interior -= np.multiply(self.W[a], values[a, c], out=work)
+            x[:off] = values[:off, c]
 
     def destroy(self):
         for obj in (self.interior, self.schur):

@@ -44,6 +44,9 @@ def vertex_fields(solver, t):
     k = scene.stiffness
     moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
     force = solver.end_reaction()[None, :] + scene.load_beyond(mesh.vertex_S, t)
+    riser = solver.global_step.riser
+    if riser is not None:                   # the drag and the seabed (petsc_rod/riser)
+        force += riser.force_beyond(solver.state)
     return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
             "m": moment, "n": force}
 

@@ -33,6 +33,7 @@ import numpy as np
 from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
+from petsc_rod.riser import quantities as riser_quantities
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -43,6 +44,7 @@ DATASET_UNITS = {
     "S": "m", "r": "m", "d1": "1", "d2": "1", "d3": "1", "u": "rad/m", "m": "N m", "n": "N",
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
+    **riser_quantities.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
 ATTRIBUTE_UNITS = {
@@ -53,6 +55,7 @@ ATTRIBUTE_UNITS = {
     "asked_penalty": "N",
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text",
+    **riser_quantities.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.
@@ -250,7 +253,8 @@ class ResultWriter:
     def write_step(self, name, vertex, state, history, attributes):
         """Write one solution as group ``name``, after checking that the disk has room."""
         table = np.asarray(history, dtype=float).reshape(-1, len(HISTORY_COLUMNS))
-        arrays = {key: np.asarray(vertex[key]) for key in VERTEX_DATASETS}
+        # the vertex datasets, and those a riser scene adds (riser/quantities.py)
+        arrays = {key: np.asarray(value) for key, value in vertex.items()}
         arrays.update({key: np.asarray(value) for key, value in state.items()})
         layout = distributed_layout(self.comm, arrays)
         nbytes = 8 * sum(int(np.prod(shape)) for shape, _, _ in layout.values()) + table.nbytes

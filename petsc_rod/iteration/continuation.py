@@ -3,7 +3,7 @@
 fails, reported one line per step and written one group per step."""
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -12,6 +12,7 @@ from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedEr
 from petsc_rod.analysis.link import changed_class
 from petsc_rod.iteration.penalty import ADAPT_WINDOW
 from petsc_rod.iteration.stopping import STOP_LINK, STOP_OBSERVER, STOP_SADDLE
+from petsc_rod.riser.quantities import riser_report
 
 
 def not_converged_reason(report, solver):
@@ -150,10 +151,10 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     if report.reason == STOP_OBSERVER:
         return report, "interrupted"
     if report.converged:
-        report.link, report.link_expected = solver.link(), expected_link
+        report = replace(report, link=solver.link(), link_expected=expected_link)
         if not changed_class(report.link, expected_link):
             return report, None
-        report.converged, report.reason = False, STOP_LINK
+        report = replace(report, converged=False, reason=STOP_LINK)
         return report, (f"converged in {report.iterations} iterations to a linking number "
                         f"of {sum(report.link):.3f} turns, not {expected_link:.3f}")
     return report, (f"not converged in {report.iterations} iterations (change "
@@ -321,11 +322,16 @@ def record_step(solver, report, t, label, say, writer, group, **common):
                   "load_factor": t, "penalty": solver.penalty, **common}
     if report.link is not None:
         attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
+    riser = riser_report(solver, vertex) if solver.global_step.riser is not None else None
+    if riser is not None:           # petsc_rod/riser/quantities.py
+        vertex.update(riser.datasets)
+        attributes.update(riser.attributes)
     say(f"{label}: load factor {t:.4g}, "
         f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
         f"iterations, change {report.change:.2e}, constraint residual (RMS) "
         f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
-        + link_text(report.link) + stability_text(report))
+        + link_text(report.link) + stability_text(report)
+        + (f"; {riser.text}" if riser is not None else ""))
     if report.penalty_raises:
         raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in report.penalty_raises)
         say(f"petsc_rod: {label}: the constraint residual fell by less than half in "

@@ -58,15 +58,20 @@ class UzawaSolver:
         check_anderson_depth()          # before any PETSc object is made
         self.mesh, self.scene, self.settings = mesh, scene, settings
         self.split = split_coefficients(scene.stiffness)
-        self.penalty = float(settings.asked_penalty)    # in use: may be raised on the way
         self.scale = penalty_policy.default_penalty(scene)
         self.state = RodState(mesh)
         self.global_step = GlobalStep(mesh, scene, self.split,
-                                      penalty_policy.matrix_split(self.split), self.penalty)
+                                      penalty_policy.matrix_split(self.split),
+                                      float(settings.asked_penalty))
         self.weights = quadrature_weights(mesh.element_h)
         self._root_weights = np.sqrt(self.state.node_weights)[:, None, None]
         self._step = None
         self._create_snes()
+
+    @property
+    def penalty(self):
+        """The penalty R in use, N: the one asked for, or larger after a raise."""
+        return self.global_step.penalty
 
     def _create_snes(self):
         """The SNES of the fixed-point problem, options -rod_snes_*: Anderson mixing by
@@ -114,7 +119,7 @@ class UzawaSolver:
         step = self._step = stopping.StepProgress(label, observer)
         try:
             self._iterate(step)
-            while step.outcome == stopping.CONVERGED and self.settings.check_stability:
+            while step.outcome == stopping.CONVERGED and self.tests_stability:
                 step.stable, direction = self.check_stability()
                 if step.stable is not False:
                     break
@@ -133,6 +138,12 @@ class UzawaSolver:
             raise step.error
         return stopping.StepReport.of(step)
 
+    @property
+    def tests_stability(self):
+        """Whether converged steps are tested (§10): asked for, and the loads have an
+        energy (a current's drag has none, docs/riser.md)."""
+        return self.settings.check_stability and self.scene.current is None
+
     def _iterate(self, step):
         """Run the SNES from the current state until ``step`` has an outcome (a penalty
         raise starts it again from where it is)."""
@@ -141,8 +152,7 @@ class UzawaSolver:
             self.snes.solve(None, self._x)
             if step.outcome != stopping.RAISE_PENALTY:
                 break
-            self.penalty = penalty_policy.raised_penalty(self.penalty, self.scale)
-            self.global_step.build(self.penalty)
+            self.global_step.build(penalty_policy.raised_penalty(self.penalty, self.scale))
             step.raises.append((len(step.history), self.penalty))
             step.outcome = None
         if step.outcome is None and step.error is None:   # the SNES stopped on its own test

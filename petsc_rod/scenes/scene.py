@@ -41,6 +41,9 @@ class Scene:
     end_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     load_values: np.ndarray = field(default_factory=lambda: np.zeros((1, 3)))
     load_breaks: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # riser terms (petsc_rod/riser/environment.py): a Seabed and a Current, or None
+    seabed: object = None
+    current: object = None
 
     def __post_init__(self):
         self.stiffness = np.asarray(self.stiffness, dtype=float)
@@ -75,6 +78,8 @@ class Scene:
         """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
         (and of the multiplier lambda3 that converges to it)."""
         pieces = np.diff(self.load_piece_ends) @ np.linalg.norm(self.load_values, axis=1)
+        if self.current is not None:            # the largest drag the current can exert
+            pieces += self.length * self.current.largest_drag()
         return float(pieces + np.linalg.norm(self.start_force) + np.linalg.norm(self.end_force))
 
     def end_rotation(self):

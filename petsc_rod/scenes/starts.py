@@ -14,6 +14,7 @@ from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.scene import REFERENCE_FRAME
+from petsc_rod.riser.catenary import seabed_shape
 
 SHAPES = ("straight", "catenary")
 
@@ -51,8 +52,14 @@ def catenary_start(scene, t):
                             ) from None
     normal = np.cross(up, along)
 
+    def shape(S):
+        return catenary(scene.length, chord, load, S)
+
+    if scene.seabed is not None:        # resting on the seabed where it reaches it
+        shape = seabed_shape(scene, chord, load, shape)
+
     def curve(S):
-        r, tangent, force = catenary(scene.length, chord, load, S)
+        r, tangent, force = shape(S)
         d1 = np.broadcast_to(normal, tangent.shape)
         frame = np.stack([d1, np.cross(tangent, d1), tangent], axis=-2)
         return start.position + r, frame, force

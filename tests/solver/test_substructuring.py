@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from helpers import gather
+from helpers import gather, global_max
 from petsc_rod.global_step import substructuring
 from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix
 from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
@@ -100,9 +100,49 @@ def test_every_rank_owns_interior_rows_and_the_interface_is_one_row_per_boundary
     try:
         start, end = matrix.getOwnershipRange()
         assert solver.interior.matrix.getSize()[0] == end - start - (comm.getRank() > 0)
+        assert solver.width == 1
         assert solver.diagonal.shape == (comm.getSize() - 1,)
-        assert solver.off_diagonal.shape == (max(comm.getSize() - 2, 0),)
         assert np.all(solver.diagonal > 0)
+    finally:
+        solver.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def hermite_matrix(comm, n_elements):
+    """A matrix in the Hermite layout of the riser's vertical problem: element e couples
+    both dofs of its two vertices (rows 2e to 2e + 3), SPD element matrices; the value
+    and the slope of a vertex both separate it, so the interface is 2 rows wide."""
+    mesh = Mesh(comm, n_elements, 1.0)
+    first = 2 * np.arange(mesh.element_start, mesh.element_end)[:, None]
+    rows = (first + np.arange(4)[None, :]).astype(PETSc.IntType)
+    rng = np.random.default_rng(7)
+    b = rng.standard_normal((n_elements, 4, 4))
+    elements = (b @ b.transpose(0, 2, 1) + np.eye(4))[mesh.element_start:mesh.element_end]
+    matrix = mesh.da.createMatrix()
+    if len(rows):
+        matrix.setValuesRCV(rows, rows, elements, addv=PETSc.InsertMode.ADD_VALUES)
+    matrix.assemble()
+    return mesh, matrix, elements
+
+
+def test_a_hermite_matrix_gets_an_interface_two_rows_wide():
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, _ = hermite_matrix(comm, 12)
+    solver = substructuring.ChainSolver(matrix)
+    try:
+        assert solver.width == (2 if comm.getSize() > 1 else 1)
+        rhs = right_hand_sides(mesh, 2)
+        solution = [np.zeros_like(column) for column in rhs]
+        solver.solve(rhs, solution)
+        b, x = matrix.createVecs()
+        for column, y in zip(rhs, solution):
+            x.getArray()[:] = y
+            matrix.mult(x, b)
+            scale = global_max(comm, np.abs(column).max())
+            assert global_max(comm, np.abs(b.getArray() - column).max()) <= ROUND_OFF * scale
+        b.destroy()
+        x.destroy()
     finally:
         solver.destroy()
         matrix.destroy()

@@ -1,0 +1,19 @@
+"""Morison drag of a steady current on the line, normal component only (docs/riser.md).
+
+Per metre of line with unit tangent t, in a current v (m/s):
+
+    f = c |v_n| v_n,   v_n = v - (v.t) t,   c = rho C_d D / 2  (kg/m^2; f in N/m).
+
+The tangential (skin friction) drag is not modelled. The drag follows the line: it is
+evaluated at the deformed state, lagged by one iteration (terms.py).
+"""
+
+import numpy as np
+
+
+def normal_drag(tangent, velocity, drag):
+    """f = c |v_n| v_n, (n, 3) N/m, for tangents (n, 3) (normalised here), current
+    velocities (n, 3) m/s and c = ``drag`` (kg/m^2)."""
+    t = tangent / np.linalg.norm(tangent, axis=1, keepdims=True)
+    normal = velocity - np.einsum("nc,nc->n", velocity, t)[:, None] * t
+    return drag * np.linalg.norm(normal, axis=1, keepdims=True) * normal

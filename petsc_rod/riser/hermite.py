@@ -1,0 +1,175 @@
+"""The vertical component of the slope problem in Hermite dofs, where a spring on the
+height z is banded (docs/riser.md, "The seabed in the global step").
+
+The global step solves for the slope theta = r' (P2), not for r (docs/method.md §4). A
+seabed spring acts on z = z(a) + int_a^S theta_z, a non-local function of theta: its
+matrix in theta would be dense. The pair (z(a), theta_z in P2) is the same space as the
+C^1 Hermite cubic z with dofs y = (z_i, z'_i) at the vertices, and the map y -> theta_z is
+local (element e, h its length):
+
+    theta(S_e) = z'_e,   theta(S_e+1) = z'_e+1,
+    theta(midpoint) = 3/2 (z_e+1 - z_e) / h - (z'_e + z'_e+1) / 4,
+
+theta_z = T y with T banded. The theta_z problem A theta = b becomes T^T A T y = T^T b,
+the same equations in other coordinates (banded, SPD), where a spring at a node adds a
+local term. A held end prescribes z there (the chord condition of the theta problem
+becomes z(L) = z_L), a clamp z' there. The Hermite pair (z_i, z'_i) sits in the two slots
+of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of theta does.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.global_step.matrices import KSP_REASONS, PARALLEL_DEFAULTS, assemble_matrix
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
+
+
+def hermite_rows(mesh):
+    """Global rows (z_e, z'_e, z_e+1, z'_e+1) of each owned element, (ne, 4)."""
+    first = 2 * np.arange(mesh.element_start, mesh.element_end)[:, None]
+    return (first + np.arange(4)[None, :]).astype(PETSc.IntType)
+
+
+def slope_map(h):
+    """T_e, (ne, 3, 4): the element's P2 slope dofs (left, midpoint, right) from its
+    Hermite dofs (z_e, z'_e, z_e+1, z'_e+1)."""
+    h = np.asarray(h, dtype=float)
+    T = np.zeros((h.size, 3, 4))
+    T[:, 0, 1] = T[:, 2, 3] = 1.0
+    T[:, 1, 0], T[:, 1, 2] = -1.5 / h, 1.5 / h
+    T[:, 1, 1] = T[:, 1, 3] = -0.25
+    return T
+
+
+def midpoint_values(h):
+    """e_m, (ne, 4): z at the element's midpoint from its Hermite dofs,
+    (z_e + z_e+1) / 2 + h (z'_e - z'_e+1) / 8."""
+    h = np.asarray(h, dtype=float)
+    return np.stack([np.full_like(h, 0.5), h / 8, np.full_like(h, 0.5), -h / 8], axis=1)
+
+
+def node_heights(dofs, h):
+    """z at each owned element's (left vertex, midpoint, right vertex), (ne, 3), from its
+    Hermite dofs (ne, 4)."""
+    middle = np.einsum("ek,ek->e", midpoint_values(h), dofs)
+    return np.stack([dofs[:, 0], middle, dofs[:, 2]], axis=1)
+
+
+class VerticalProblem:
+    """T^T A T y = T^T b for the z component of the slope, plus a symmetric term added
+    per element (set_added: the seabed), with essential conditions on y.
+
+    ``theta_matrices`` (ne, 3, 3) are the element matrices of the theta problem (2 c3 K +
+    R W). The KSP (prefix ``prefix``) is preonly + Cholesky on one rank and
+    assembly.PARALLEL_DEFAULTS on several, like the other global-step solvers.
+    """
+
+    def __init__(self, mesh, theta_matrices, prefix):
+        self.mesh = mesh
+        self.name = prefix
+        h = mesh.element_h
+        self.rows = hermite_rows(mesh)
+        T = slope_map(h)
+        self.base = assemble_matrix(mesh, np.einsum("eki,ekl,elj->eij", T, theta_matrices, T),
+                                    self.rows)
+        self.slope = self._slope_matrix(T)
+        self.matrix = self.base.duplicate(copy=True)
+        self.constrained = self.base.duplicate(copy=True)
+        self.added_rhs = self.base.createVecLeft()
+        self.rhs, self.solution, self.bc, self._work, self._product = (
+            self.base.createVecLeft() for _ in range(5))
+        self.fixed = np.zeros(0, dtype=PETSc.IntType)
+        self.ksp = PETSc.KSP().create(comm=mesh.comm)
+        self.ksp.setOperators(self.constrained)
+        self.ksp.setType(PETSc.KSP.Type.PREONLY)
+        self.ksp.getPC().setType(PETSc.PC.Type.CHOLESKY)
+        self.ksp.setOptionsPrefix(prefix)
+        parallel = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}
+        set_from_options_with_defaults(
+            self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
+
+    def _slope_matrix(self, T):
+        """T as a DMDA matrix: rows the P2 slope dofs, columns the Hermite dofs (the
+        phantom midpoint row of the last vertex stays empty: theta is zero there)."""
+        mesh = self.mesh
+        matrix = mesh.da.createMatrix()
+        vertices = np.arange(mesh.vertex_start, mesh.vertex_end, dtype=PETSc.IntType)
+        matrix.setValuesRCV((2 * vertices)[:, None], (2 * vertices + 1)[:, None],
+                            np.ones((vertices.size, 1, 1)))
+        if len(self.rows):
+            matrix.setValuesRCV(self.rows[:, :1] + 1, self.rows, T[:, 1:2, :])
+        matrix.assemble()
+        return matrix
+
+    def set_prescribed(self, start, end):
+        """Essential conditions from the end states: z at a held end, z' at a clamp."""
+        last = 2 * self.mesh.n_elements
+        fixed = []
+        for row, state in ((0, start), (last, end)):
+            if state.kind in ("clamp", "pin"):
+                fixed.append((row, state.position[2]))
+            if state.kind == "clamp":
+                fixed.append((row + 1, state.frame[2, 2]))
+        start_row, end_row = self.base.getOwnershipRange()
+        self.fixed = np.array([r for r, _ in fixed], dtype=PETSc.IntType)
+        owned = [(r - start_row, v) for r, v in fixed if start_row <= r < end_row]
+        self._local_fixed = np.array([r for r, _ in owned], dtype=np.int64)
+        self._fixed_values = np.array([v for _, v in owned], dtype=float)
+        self.bc.zeroEntries()
+        self.bc.getArray()[self._local_fixed] = self._fixed_values
+        self._constrain()
+
+    def set_added(self, element_matrices, element_vectors):
+        """Add sum_e element_matrices (ne, 4, 4) to the matrix and sum_e element_vectors
+        (ne, 4) to the right-hand side (replacing the last ones); refactored at the next
+        solve."""
+        self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.added_rhs.zeroEntries()
+        if len(self.rows):
+            self.matrix.setValuesRCV(self.rows, self.rows, element_matrices,
+                                     addv=PETSc.InsertMode.ADD_VALUES)
+            self.added_rhs.setValues(self.rows.ravel(), np.ravel(element_vectors),
+                                     addv=PETSc.InsertMode.ADD_VALUES)
+        self.matrix.assemble()
+        self.added_rhs.assemble()
+        self._constrain()
+
+    def _constrain(self):
+        self.matrix.copy(self.constrained, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.constrained.zeroRowsColumns(self.fixed, diag=1.0)
+
+    def solve(self, theta_rhs, theta):
+        """y from the slope problem's right-hand side ``theta_rhs`` (its z component, a Vec
+        in P2 layout); sets ``theta`` (Vec) = T y and returns y (a Vec owned here)."""
+        self.slope.multTranspose(theta_rhs, self.rhs)
+        self.rhs.axpy(1.0, self.added_rhs)
+        self.matrix.mult(self.bc, self._product)            # the lifting
+        self.rhs.copy(self._work)
+        self._work.axpy(-1.0, self._product)
+        self._work.getArray()[self._local_fixed] = self._fixed_values
+        self.ksp.solve(self._work, self.solution)
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            raise RodDivergedError(f"linear solver -{self.name} failed: "
+                                   f"{KSP_REASONS.get(reason, reason)}")
+        self.slope.mult(self.solution, theta)
+        return self.solution
+
+    def end_residual(self):
+        """(b - M y) at the row of z(L) after a solve (summed over the ranks): the z part of
+        the chord multiplier mu of the theta problem, T^T c = e_z(L) - e_z(0)
+        (docs/riser.md). Collective."""
+        residual = self._product
+        self.matrix.mult(self.solution, residual)
+        residual.aypx(-1.0, self.rhs)
+        row = 2 * self.mesh.n_elements
+        start, end = residual.getOwnershipRange()
+        local = residual.getArray(readonly=True)[row - start] if start <= row < end else 0.0
+        return float(self.mesh.global_sum(local))
+
+    def destroy(self):
+        for obj in (self.ksp, self.base, self.slope, self.matrix, self.constrained,
+                    self.added_rhs, self.rhs, self.solution, self.bc, self._work,
+                    self._product):
+            obj.destroy()

@@ -1,0 +1,65 @@
+"""Loads given by their values at the P2 nodes (the drag, the seabed's reaction): the
+slope problem's right-hand side and the force they add to n(S).
+
+Between the nodes the load is the P2 interpolant f_h of its nodal values, so that a
+uniform nodal load is exactly the uniform dead load of the same value
+(assembly.load_element_vectors). As for dead loads (docs/method.md §5) its work is
+int F.g dS with F(S) = int_S^L f_h dS + offset; in element e,
+
+    F(S) = B_e + int_S^{S_e+1} f_h dS,   B_e = int_{S_e+1}^L f_h dS,
+
+a cubic in S, so 3-point Gauss integrates F g_k exactly. B_e needs the integrals of the
+elements of later ranks: one prefix sum (Mesh.prefix_sum), nothing gathered.
+"""
+
+import numpy as np
+
+from petsc_rod.mesh.elements import (GAUSS_POINTS, GAUSS_WEIGHTS, P2, element_integrals,
+                                     p2_basis, p2_integrals)
+from petsc_rod.mesh.fields import element_dofs
+
+
+def node_slots(mesh, values):
+    """Values at the owned P2 nodes (n_nodes, ...) in the DMDA's vertex slots (n_owned,
+    2, ...): (vertex, midpoint to its right), the phantom midpoint of the last vertex 0."""
+    n_owned = mesh.vertex_end - mesh.vertex_start
+    slots = np.zeros((n_owned, 2) + values.shape[1:])
+    slots[:, 0] = values[0::2]
+    slots[:mesh.n_local_elements, 1] = values[1::2]
+    return slots
+
+
+class NodalLoad:
+    """A load per metre given at the owned P2 nodes (set), on the mesh's elements."""
+
+    def __init__(self, mesh, field):
+        self.mesh = mesh
+        self._field = field           # a VectorField, for the ghost exchange
+        h = mesh.element_h
+        self._phi, _ = p2_basis(GAUSS_POINTS, h)
+        self._after = (element_integrals(h)[:, None, :]
+                       - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_k, (ne, nq, 3)
+        self._weights = h[:, None] * GAUSS_WEIGHTS[None, :]
+        self._integrals = element_integrals(h)
+        self.set(np.zeros((mesh.n_local_nodes, 3)))
+
+    def set(self, values):
+        """The nodal values (n_nodes, 3), N/m. Collective (a ghost exchange and a prefix
+        sum)."""
+        mesh = self.mesh
+        self._field.set_owned(node_slots(mesh, values))
+        self.element_values = element_dofs(self._field.ghosted(), mesh.element_local, P2)
+        pieces = np.einsum("ek,ekc->ec", self._integrals, self.element_values)
+        self.before = mesh.prefix_sum(pieces)          # int_0^{S_i} f_h at owned vertices
+        self.total = mesh.global_sum(pieces.sum(axis=0))
+        self._beyond = self.total - self.before[:mesh.n_local_elements] - pieces
+
+    def beyond_vertices(self):
+        """int_{S_i}^L f_h dS at the owned vertices, (n_owned, 3)."""
+        return self.total - self.before
+
+    def element_vectors(self, offset):
+        """int_e F g_k dS, (ne, 3, 3), F(S) = int_S^L f_h dS + ``offset`` (3,)."""
+        F = (self._beyond + offset)[:, None, :] + np.einsum(
+            "eqk,ekc->eqc", self._after, self.element_values)
+        return np.einsum("eq,eqk,eqc->ekc", self._weights, self._phi, F)

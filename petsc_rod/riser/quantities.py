@@ -1,0 +1,131 @@
+"""The numbers a riser engineer reads, from the vertex fields of one state (outputs.py):
+vectorised on each rank's owned vertices and elements, combined by MPI reductions.
+
+* effective tension n.d3 (N) and the seabed reaction k (z_b - z)_+ (N/m) at the vertices
+  (datasets ``effective_tension``, ``seabed_reaction``). With the submerged weight as the
+  load, n.d3 is the effective tension of riser practice.
+* the top: the held end that is higher (S = L on a tie); its tension |n| (N) and the
+  angle of its tangent from the vertical (degrees);
+* the touchdown point: where the line, followed from the top, first reaches the seabed
+  (the height crosses z_b between two vertices, interpolated linearly), its arc length
+  and position; the grounded length, the length of line below z_b;
+* the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
+  and where they occur.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from petsc_rod.scenes.boundary import is_held
+
+# Units of the datasets and attributes this module adds to the result file.
+DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m"}
+ATTRIBUTE_UNITS = {
+    "top_tension": "N", "top_angle": "deg", "touchdown_S": "m", "touchdown_position": "m",
+    "grounded_length": "m", "max_curvature": "1/m", "max_curvature_S": "m",
+    "max_curvature_position": "m", "min_bend_radius": "m"}
+
+
+@dataclass
+class RiserReport:
+    datasets: dict
+    attributes: dict
+    text: str
+
+
+def top_end(solver):
+    """0 or 1: which end is the top (the higher held end; the end S = L on a tie or when
+    only that one is held)."""
+    start, end = solver.global_step.start_state, solver.global_step.end_state
+    if is_held(start) and (not is_held(end) or start.position[2] > end.position[2]):
+        return 0
+    return 1
+
+
+def _at_vertex(mesh, values, index):
+    """values[index] of the owned vertex ``index`` (global), on every rank. Collective."""
+    local = np.zeros(np.shape(values)[1:])
+    if mesh.vertex_start <= index < mesh.vertex_end:
+        local = np.asarray(values[index - mesh.vertex_start], dtype=float)
+    return mesh.global_sum(local)
+
+
+def _extreme(mesh, key, payload, largest):
+    """The payload of the rank whose ``key`` is the largest (or smallest); ``key`` None
+    where a rank has no candidate. Collective (small objects only)."""
+    candidates = [c for c in mesh.comm.tompi4py().allgather((key, payload)) if c[0] is not None]
+    if not candidates:
+        return None
+    pick = max if largest else min
+    return pick(candidates, key=lambda c: c[0])[1]
+
+
+def touchdown(solver, seabed, top):
+    """(S, position (3,), grounded length) of the touchdown point (module docstring);
+    S and position NaN when the line does not reach the seabed. Collective."""
+    mesh = solver.mesh
+    ghosted = solver.state.r.ghosted()[:, 0]
+    left = mesh.element_local
+    r0, r1 = ghosted[left], ghosted[left + 1]
+    gap0, gap1 = r0[:, 2] - seabed.height, r1[:, 2] - seabed.height
+    S0, S1 = mesh.element_S, mesh.element_S + mesh.element_h
+    # the fraction of each element below the seabed, with its heights linear in S
+    below = np.where(gap0 < 0, np.where(gap1 < 0, 1.0, gap0 / (gap0 - gap1)),
+                     np.where(gap1 < 0, gap1 / (gap1 - gap0), 0.0))
+    grounded = float(mesh.global_sum(np.sum(below * mesh.element_h)))
+    # toward the top: the element whose end nearer the top is off the seabed and the
+    # other end on it (or the top vertex itself on it)
+    near, far = (gap0, gap1) if top == 0 else (gap1, gap0)
+    crossing = np.flatnonzero((near >= 0) & (far < 0))
+    fraction = far[crossing] / (far[crossing] - near[crossing])     # from the far end
+    if top == 0:
+        S = S1[crossing] - fraction * (S1[crossing] - S0[crossing])
+        position = r1[crossing] + fraction[:, None] * (r0[crossing] - r1[crossing])
+    else:
+        S = S0[crossing] + fraction * (S1[crossing] - S0[crossing])
+        position = r0[crossing] + fraction[:, None] * (r1[crossing] - r0[crossing])
+    local = (None, None)
+    if S.size:
+        pick = np.argmin(S) if top == 0 else np.argmax(S)
+        local = (S[pick], position[pick])
+    found = _extreme(mesh, local[0], local, largest=top == 1)
+    end_z = _at_vertex(mesh, solver.state.r.owned()[:, 0, 2], top * mesh.n_elements)
+    if end_z < seabed.height:          # the line lies on the seabed up to the top
+        found = (top * mesh.length, _at_vertex(mesh, solver.state.r.owned()[:, 0], top * mesh.n_elements))
+    if found is None:
+        return np.nan, np.full(3, np.nan), grounded
+    return float(found[0]), np.asarray(found[1], dtype=float), grounded
+
+
+def riser_report(solver, vertex):
+    """The datasets, attributes and step-line text of a riser scene from the vertex
+    fields ``vertex`` (outputs.vertex_fields). Collective."""
+    mesh, riser = solver.mesh, solver.global_step.riser
+    z = vertex["r"][:, 2]
+    tension = np.einsum("nc,nc->n", vertex["n"], vertex["d3"])
+    datasets = {"effective_tension": tension, "seabed_reaction": riser.seabed_pressure(z)}
+    top = top_end(solver)
+    index = top * mesh.n_elements
+    top_force = _at_vertex(mesh, vertex["n"], index)
+    top_tangent = _at_vertex(mesh, vertex["d3"], index)
+    angle = float(np.degrees(np.arccos(min(1.0, abs(top_tangent[2])))))
+    curvature = np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
+    k = int(np.argmax(curvature)) if curvature.size else 0
+    local = ((curvature[k], vertex["S"][k], vertex["r"][k]) if curvature.size
+             else (None, None, None))
+    kappa, kappa_S, kappa_r = _extreme(mesh, local[0], local, largest=True)
+    attributes = {"top_tension": float(np.linalg.norm(top_force)), "top_angle": angle,
+                  "max_curvature": float(kappa), "max_curvature_S": float(kappa_S),
+                  "max_curvature_position": np.asarray(kappa_r, dtype=float),
+                  "min_bend_radius": float(1.0 / kappa) if kappa > 0 else np.inf}
+    text = (f"top tension {attributes['top_tension']:.6g} N at {angle:.3f} deg from the "
+            f"vertical")
+    if riser.seabed is not None:
+        S, position, grounded = touchdown(solver, riser.seabed, top)
+        attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
+        text += (f", touchdown at S = {S:.6g} m (x, y, z = "
+                 + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
+    text += (f", largest curvature {kappa:.4g} 1/m (bend radius "
+             f"{attributes['min_bend_radius']:.4g} m) at S = {kappa_S:.6g} m")
+    return RiserReport(datasets, attributes, text)

@@ -1,0 +1,91 @@
+"""The seabed as a unilateral spring in the global step, solved implicitly (docs/riser.md).
+
+Energy of the seabed z = z_b with stiffness k (N/m^2), with Simpson's rule at the P2
+nodes (the quadrature of the constraint, docs/method.md §4):
+
+    E_s = k/2 sum_n w_n (z_b - z_n)_+^2,
+
+so the line presses the seabed with k (z_b - z_n)_+ per metre at node n, upwards. E_s is
+convex and piecewise quadratic in the Hermite dofs y of the vertical problem
+(hermite.py). The global step minimises it exactly with the rest of the augmented
+Lagrangian by an active-set (semi-smooth Newton) loop: with A the nodes below z_b,
+solve (M + k sum_A w_n e_n e_n^T) y = b + k z_b sum_A w_n e_n, take the new A, and repeat
+until A no longer changes (e_n: z_n from the element's Hermite dofs). The matrix is
+refactored only when A changes. Why implicit: the iteration's compliance to a load on a
+stretch l of line is about l^2 / R, so an explicit (lagged) spring k is amplified
+k l^2 / R times per iteration, 1e5 or more for a seabed stiff enough to hold the line
+within a millimetre (measured in docs/riser.md).
+"""
+
+import numpy as np
+
+from petsc_rod.mesh.elements import NODE_WEIGHTS
+from petsc_rod.riser.hermite import midpoint_values, node_heights
+
+# The active-set loop of one global step ends after this many solves even if the set
+# still changes; the next iteration starts from the last set (a cycle between two sets
+# differs by nodes within round-off of z_b, whose force is negligible).
+MAX_SOLVES = 30
+
+
+def node_rows(h):
+    """E, (ne, 3 nodes, 4): z at the element's (left vertex, midpoint, right vertex) as
+    rows acting on its Hermite dofs (z_e, z'_e, z_e+1, z'_e+1)."""
+    rows = np.zeros((np.size(h), 3, 4))
+    rows[:, 0, 0] = rows[:, 2, 2] = 1.0
+    rows[:, 1] = midpoint_values(h)
+    return rows
+
+
+class SeabedContact:
+    """The seabed term of a VerticalProblem and its active-set solve."""
+
+    def __init__(self, mesh, seabed, problem):
+        self.mesh, self.seabed, self.problem = mesh, seabed, problem
+        h = mesh.element_h
+        self.weights = h[:, None] * NODE_WEIGHTS[None, :]          # (ne, 3), per element
+        self.rows = node_rows(h)
+        self.active = None                                          # (ne, 3) booleans
+        self.solves = 0                                             # since the last reset
+        self._local = mesh.da.createLocalVec()
+
+    def _set_active(self, active):
+        spring = self.seabed.stiffness * self.weights * active
+        self.problem.set_added(np.einsum("en,enk,enl->ekl", spring, self.rows, self.rows),
+                               self.seabed.height * np.einsum("en,enk->ek", spring, self.rows))
+        self.active = active
+
+    def heights(self, y):
+        """z at the three nodes of each owned element, (ne, 3), from the Hermite dofs y."""
+        self.mesh.da.globalToLocal(y, self._local)
+        ghosted = self._local.getArray(readonly=True).reshape(-1, 2)
+        left = self.mesh.element_local
+        dofs = np.concatenate([ghosted[left], ghosted[left + 1]], axis=1)
+        return node_heights(dofs, self.mesh.element_h)
+
+    def solve(self, theta_rhs, theta):
+        """The vertical problem with the seabed (module docstring): sets ``theta`` (the z
+        slope) and returns the Hermite dofs y. Collective."""
+        if self.active is None:
+            self._set_active(np.zeros(self.weights.shape, dtype=bool))
+        for _ in range(MAX_SOLVES):
+            y = self.problem.solve(theta_rhs, theta)
+            self.solves += 1
+            active = self.heights(y) < self.seabed.height
+            if not self.mesh.global_sum(int(np.any(active != self.active))):
+                break
+            self._set_active(active)
+        return y
+
+    def pressure(self, z):
+        """k (z_b - z)_+ (N/m), the seabed's upward force per metre of line at heights z."""
+        return self.seabed.stiffness * np.maximum(self.seabed.height - z, 0.0)
+
+    def energy(self, y):
+        """E_s of the module docstring (J). Collective."""
+        gap = np.maximum(self.seabed.height - self.heights(y), 0.0)
+        return float(self.mesh.global_sum(0.5 * self.seabed.stiffness
+                                          * np.sum(self.weights * gap**2)))
+
+    def destroy(self):
+        self._local.destroy()

@@ -1,0 +1,106 @@
+"""The riser scenes end to end (``mpiexec -n 2 python -m petsc_rod``, the default solver
+settings), their result files and figures, and the riser's bad input: one line, exit 2,
+no file. Spawns processes: marked ``serial``."""
+
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import REPO_ROOT, child_env
+from test_hostile_cli import assert_one_line_and_nothing_left, mpiexec
+
+pytestmark = pytest.mark.serial
+
+TIMEOUT = 300
+
+
+def run(args, ranks=1):
+    command = mpiexec(ranks) + [sys.executable, "-m", "petsc_rod"] + list(args)
+    return subprocess.run(command, cwd=REPO_ROOT, env=child_env(), capture_output=True,
+                          text=True, timeout=TIMEOUT, check=False)
+
+
+@pytest.fixture(scope="module")
+def scenes(tmp_path_factory):
+    """Both riser scenes solved on 2 ranks with their own options only: (process, file)."""
+    folder = tmp_path_factory.mktemp("riser")
+    done = {}
+    for name in ("riser_catenary", "lazy_wave"):
+        path = folder / f"{name}.h5"
+        done[name] = (run(["-options_file", f"options/{name}.opts", "-rod_output", str(path)],
+                          ranks=2), path)
+    return done
+
+
+@pytest.mark.parametrize("name", ["riser_catenary", "lazy_wave"])
+def test_a_riser_scene_converges_on_two_ranks_with_the_defaults(scenes, name):
+    process, path = scenes[name]
+    text = process.stdout + process.stderr
+    assert process.returncode == 0, text
+    assert "top tension" in text and "touchdown at S = " in text
+    with h5py.File(path, "r") as f:
+        assert int(f.attrs["converged"]) == 1
+        S, r = f["S"][:], f["r"][:]
+        tension, reaction = f["effective_tension"][:], f["seabed_reaction"][:]
+        touchdown = float(f.attrs["touchdown_S"])
+        assert f["effective_tension"].attrs["units"] == "N"
+        assert "touchdown_S" in f.attrs["attribute_units"]
+        in_effect = str(f.attrs["options_in_effect"]).splitlines()
+    # the height's solver is recorded with the others where there is a seabed
+    assert any(line.startswith("-rod_z_ksp_type ") for line in in_effect)
+    grounded = S < touchdown
+    assert grounded.sum() > 10 and np.all(tension > 0)
+    # the grounded part rests on the seabed z = 0, within a few millimetres
+    assert np.abs(r[grounded][5:, 2]).max() < 5e-3
+    assert np.all(reaction[~grounded] == 0) and np.median(reaction[grounded]) > 0
+
+
+def test_the_riser_figure(scenes, tmp_path):
+    _, path = scenes["riser_catenary"]
+    figure = tmp_path / "riser.png"
+    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure)],
+                          cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
+                          timeout=TIMEOUT, check=False)
+    assert done.returncode == 0, done.stderr
+    assert figure.stat().st_size > 20000
+
+
+SCENE = ["-rod_length", "10", "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position",
+         "7,0,4", "-rod_load", "0,0,-1", "-rod_elements", "16"]
+
+
+def write(folder, name, text):
+    path = folder / name
+    path.write_text(text)
+    return str(path)
+
+
+BAD = {
+    "negative stiffness": (["-rod_seabed", "0", "-rod_seabed_stiffness", "-5"],
+                           ["-rod_seabed_stiffness", "positive"]),
+    "missing profile": (["-rod_current_profile", "{folder}/nowhere.txt", "-rod_drag",
+                         "1025,1.2,0.1"], ["-rod_current_profile", "no such file"]),
+    "profile not monotone": (["-rod_current_profile", "{bad_profile}", "-rod_drag",
+                              "1025,1.2,0.1"], ["-rod_current_profile", "increase"]),
+    "negative drag entry": (["-rod_current", "0.5,0,0", "-rod_drag", "1025,-1.2,0.1"],
+                            ["-rod_drag", "negative"]),
+    "end below the seabed": (["-rod_seabed", "5"], ["-rod_start", "below the seabed"]),
+    "current without drag": (["-rod_current", "0.5,0,0"], ["-rod_drag"]),
+    "stiffness without seabed": (["-rod_seabed_stiffness", "1e3"], ["-rod_seabed"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_bad_riser_input_exits_2_with_one_line_and_no_file(tmp_path, case, ranks):
+    args, words = BAD[case]
+    bad_profile = write(tmp_path, "profile.txt", "0 1 0 0\n50 1 0 0\n40 0 0 0\n")
+    args = [a.format(folder=tmp_path, bad_profile=bad_profile) for a in args]
+    path = tmp_path / "out.h5"
+    done = run(SCENE + args + ["-rod_output", str(path)], ranks=ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
