@@ -4,6 +4,12 @@ import ctypes
 import os
 import sys
 
+# One BLAS thread per process unless the environment says otherwise, set before numpy
+# loads OpenBLAS: the ranks are the parallelism, and Debian's threaded OpenBLAS makes its
+# vector operations (PETSc's VecAXPY, numpy's dot) wait for threads whenever the cores
+# are busy (docs/performance.md, "Per-iteration overhead").
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 
 def options_files(argv):
     """The paths given after -options_file."""

@@ -26,11 +26,13 @@ the same as table rows.
 """
 
 import argparse
+import os
 import resource
 import sys
 import time
 
-import numpy as np
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")     # as python -m petsc_rod runs
+import numpy as np  # noqa: E402
 import petsc4py
 
 petsc4py.init(sys.argv[:1])
