@@ -338,3 +338,18 @@ def test_plot_of_a_result_file(cantilever, folder):
     wrong = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path)],
                            cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
     assert wrong.returncode == 2 and "usage" in wrong.stderr
+
+
+def test_the_readme_python_example_runs_and_prints_what_the_readme_says(tmp_path):
+    """The README's Python API example, run as it stands; its last line is the one the
+    README quotes."""
+    with open(os.path.join(REPO_ROOT, "README.md")) as stream:
+        readme = stream.read()
+    start = readme.index("```python\n") + len("```python\n")
+    script = tmp_path / "example.py"
+    script.write_text(readme[start:readme.index("```", start)])
+    process = subprocess.run([sys.executable, str(script)], cwd=REPO_ROOT, env=child_env(),
+                             capture_output=True, text=True, timeout=TIMEOUT)
+    assert process.returncode == 0, describe(process)
+    last = process.stdout.strip().splitlines()[-1]
+    assert last.startswith("converged: True") and f"`{last}`" in readme, last

@@ -75,7 +75,7 @@ def test_error_vs_time_same_numbers_on_one_and_two_ranks(error_vs_time):
     tightest = [runs for runs in pairs if runs[1.0]["tightest"] == "1"]
     assert len(tightest) >= 3
     for runs in tightest:
-        assert runs[2.0]["tightest"] == "1"
+        assert float(runs[2.0]["tightest"]) == 1.0
         for column in ("position_error", "director_error", "energy_error"):
             one, two = float(runs[1.0][column]), float(runs[2.0][column])
             assert abs(one - two) <= 1e-9, (column, one, two)
