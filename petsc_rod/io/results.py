@@ -207,29 +207,26 @@ class ResultWriter:
         on_every_rank(self.comm, self._check_room_for_file, minimum_bytes)
         self.file = self._collective(_open, self.partial, "w", self.comm)
 
-    def _free_disk_below(self, nbytes):
-        """The free bytes of the file's disk when fewer than ``nbytes`` (rank 0; other
-        ranks: None), else None."""
+    def _check_room(self, nbytes, refusal):
+        """Raise ``refusal(free bytes)`` when the file's disk has fewer than ``nbytes``
+        free (read on rank 0; on_every_rank makes the error every rank's)."""
         if self.comm.Get_rank() != 0:
-            return None
+            return
         free = free_disk(self.folder)
-        return free if free < nbytes else None
+        if free < nbytes:
+            raise refusal(free)
 
     def _check_room_for_file(self, nbytes):
-        free = self._free_disk_below(nbytes)
-        if free is not None:
-            raise RodInputError(
-                f"-rod_output {self.path}: the result needs at least {size_text(nbytes)}, the "
-                f"disk of {self.folder} has {size_text(free)} free; free some space or "
-                "choose another folder")
+        self._check_room(nbytes, lambda free: RodInputError(
+            f"-rod_output {self.path}: the result needs at least {size_text(nbytes)}, the "
+            f"disk of {self.folder} has {size_text(free)} free; free some space or choose "
+            "another folder"))
 
     def _check_room_for_step(self, nbytes):
-        free = self._free_disk_below(nbytes)
-        if free is not None:
-            raise RodIOError(
-                f"-rod_output {self.path}: the disk of {self.folder} is full ({size_text(free)} "
-                f"free, the next step needs {size_text(nbytes)} with HDF5's reserve); the "
-                "partial file is removed")
+        self._check_room(nbytes, lambda free: RodIOError(
+            f"-rod_output {self.path}: the disk of {self.folder} is full ({size_text(free)} "
+            f"free, the next step needs {size_text(nbytes)} with HDF5's reserve); the "
+            "partial file is removed"))
 
     def _collective(self, action, *args):
         """``action(*args)`` (HDF5 and file operations only, no MPI call of ours) on every
