@@ -22,7 +22,7 @@ sqrt(a^2 + sigma^2) - a, the horizontal distance a asinh(sigma / a), the tangent
 
 import numpy as np
 
-from petsc_rod.scenes.catenary import _increasing_root
+from petsc_rod.scenes.catenary import increasing_root
 from petsc_rod.errors import RodInputError
 
 
@@ -41,7 +41,7 @@ def touchdown_parameter(length, span, h0, h1):
     upper = length
     while excess(upper) < 0:
         upper *= 2
-    return _increasing_root(excess, 1e-12 * length, upper)
+    return increasing_root(excess, 1e-12 * length, upper)
 
 
 def grounded_catenary(length, chord, weight, seabed, S):

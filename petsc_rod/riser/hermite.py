@@ -1,20 +1,20 @@
 """The vertical component of the slope problem in Hermite dofs, where a spring on the
 height z is banded (docs/riser.md, "The seabed in the global step").
 
-The global step solves for the slope theta = r' (P2), not for r (docs/method.md §4). A
-seabed spring acts on z = z(a) + int_a^S theta_z, a non-local function of theta: its
-matrix in theta would be dense. The pair (z(a), theta_z in P2) is the same space as the
-C^1 Hermite cubic z with dofs y = (z_i, z'_i) at the vertices, and the map y -> theta_z is
+The global step solves for the slope r' (P2), not for r (docs/method.md §4). A
+seabed spring acts on z = z(a) + int_a^S r'_z, a non-local function of the slope: its
+matrix in the slope's dofs would be dense. The pair (z(a), r'_z in P2) is the same space as the
+C^1 Hermite cubic z with dofs y = (z_i, z'_i) at the vertices, and the map y -> r'_z is
 local (element e, h its length):
 
-    theta(S_e) = z'_e,   theta(S_e+1) = z'_e+1,
-    theta(midpoint) = 3/2 (z_e+1 - z_e) / h - (z'_e + z'_e+1) / 4,
+    r'_z(S_e) = z'_e,   r'_z(S_e+1) = z'_e+1,
+    r'_z(midpoint) = 3/2 (z_e+1 - z_e) / h - (z'_e + z'_e+1) / 4,
 
-theta_z = T y with T banded. The theta_z problem A theta = b becomes T^T A T y = T^T b,
+r'_z = T y with T banded. The r'_z problem A r'_z = b becomes T^T A T y = T^T b,
 the same equations in other coordinates (banded, SPD), where a spring at a node adds a
-local term. A held end prescribes z there (the chord condition of the theta problem
+local term. A held end prescribes z there (the chord condition of the slope problem
 becomes z(L) = z_L), a clamp z' there. The Hermite pair (z_i, z'_i) sits in the two slots
-of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of theta does.
+of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of the slope does.
 """
 
 import numpy as np
@@ -60,20 +60,20 @@ class VerticalProblem:
     """T^T A T y = T^T b for the z component of the slope, plus a symmetric term added
     per element (set_added: the seabed), with essential conditions on y.
 
-    ``theta_matrices`` (ne, 3, 3) are the element matrices of the theta problem (2 c3 K +
+    ``slope_matrices`` (ne, 3, 3) are the element matrices of the slope problem (2 c3 K +
     R W). The KSP (prefix ``prefix``) is preonly + Cholesky on one rank and
     assembly.PARALLEL_DEFAULTS on several, like the other global-step solvers.
     """
 
-    def __init__(self, mesh, theta_matrices, prefix):
+    def __init__(self, mesh, slope_matrices, prefix):
         self.mesh = mesh
         self.name = prefix
         h = mesh.element_h
         self.rows = hermite_rows(mesh)
         T = slope_map(h)
-        self.base = assemble_matrix(mesh, np.einsum("eki,ekl,elj->eij", T, theta_matrices, T),
+        self.base = assemble_matrix(mesh, np.einsum("eki,ekl,elj->eij", T, slope_matrices, T),
                                     self.rows)
-        self.slope = self._slope_matrix(T)
+        self.to_slope = self._slope_matrix(T)
         self.matrix = self.base.duplicate(copy=True)
         self.constrained = self.base.duplicate(copy=True)
         self.added_rhs = self.base.createVecLeft()
@@ -91,7 +91,7 @@ class VerticalProblem:
 
     def _slope_matrix(self, T):
         """T as a DMDA matrix: rows the P2 slope dofs, columns the Hermite dofs (the
-        phantom midpoint row of the last vertex stays empty: theta is zero there)."""
+        phantom midpoint row of the last vertex stays empty: slope is zero there)."""
         mesh = self.mesh
         matrix = mesh.da.createMatrix()
         vertices = np.arange(mesh.vertex_start, mesh.vertex_end, dtype=PETSc.IntType)
@@ -139,10 +139,10 @@ class VerticalProblem:
         self.matrix.copy(self.constrained, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.constrained.zeroRowsColumns(self.fixed, diag=1.0)
 
-    def solve(self, theta_rhs, theta):
-        """y from the slope problem's right-hand side ``theta_rhs`` (its z component, a Vec
-        in P2 layout); sets ``theta`` (Vec) = T y and returns y (a Vec owned here)."""
-        self.slope.multTranspose(theta_rhs, self.rhs)
+    def solve(self, slope_rhs, slope):
+        """y from the slope problem's right-hand side ``slope_rhs`` (its z component, a Vec
+        in P2 layout); sets ``slope`` (Vec) = T y and returns y (a Vec owned here)."""
+        self.to_slope.multTranspose(slope_rhs, self.rhs)
         self.rhs.axpy(1.0, self.added_rhs)
         self.matrix.mult(self.bc, self._product)            # the lifting
         self.rhs.copy(self._work)
@@ -153,12 +153,12 @@ class VerticalProblem:
         if reason < 0:
             raise RodDivergedError(f"linear solver -{self.name} failed: "
                                    f"{KSP_REASONS.get(reason, reason)}")
-        self.slope.mult(self.solution, theta)
+        self.to_slope.mult(self.solution, slope)
         return self.solution
 
     def end_residual(self):
         """(b - M y) at the row of z(L) after a solve (summed over the ranks): the z part of
-        the chord multiplier mu of the theta problem, T^T c = e_z(L) - e_z(0)
+        the chord multiplier mu of the slope problem, T^T c = e_z(L) - e_z(0)
         (docs/riser.md). Collective."""
         residual = self._product
         self.matrix.mult(self.solution, residual)
@@ -169,7 +169,7 @@ class VerticalProblem:
         return float(self.mesh.global_sum(local))
 
     def destroy(self):
-        for obj in (self.ksp, self.base, self.slope, self.matrix, self.constrained,
+        for obj in (self.ksp, self.base, self.to_slope, self.matrix, self.constrained,
                     self.added_rhs, self.rhs, self.solution, self.bc, self._work,
                     self._product):
             obj.destroy()

@@ -63,13 +63,13 @@ class SeabedContact:
         dofs = np.concatenate([ghosted[left], ghosted[left + 1]], axis=1)
         return node_heights(dofs, self.mesh.element_h)
 
-    def solve(self, theta_rhs, theta):
-        """The vertical problem with the seabed (module docstring): sets ``theta`` (the z
+    def solve(self, slope_rhs, slope):
+        """The vertical problem with the seabed (module docstring): sets ``slope`` (the z
         slope) and returns the Hermite dofs y. Collective."""
         if self.active is None:
             self._set_active(np.zeros(self.weights.shape, dtype=bool))
         for _ in range(MAX_SOLVES):
-            y = self.problem.solve(theta_rhs, theta)
+            y = self.problem.solve(slope_rhs, slope)
             self.solves += 1
             active = self.heights(y) < self.seabed.height
             if not self.mesh.global_sum(int(np.any(active != self.active))):

@@ -11,7 +11,7 @@ def _require_positive(name, value):
         raise ValueError(f"{name} must be positive and finite, got {value!r}")
 
 
-def _increasing_root(function, lower, upper):
+def increasing_root(function, lower, upper):
     """The root of an increasing ``function`` in [lower, upper] (function(lower) < 0 <
     function(upper)), bisected until the bracket is two adjacent doubles."""
     while True:
@@ -70,7 +70,7 @@ def catenary(length, chord, load, s):
     rise, span = float(chord @ up), float(chord @ along)
     target = np.sqrt(length**2 - rise**2) / span     # 2a sinh(span/2a) / span, > 1
     # q = span / 2a solves sinh(q) / q = target; sinh(q)/q is increasing on q > 0.
-    q = _increasing_root(lambda q: np.sinh(q) / q - target, 1e-12, np.arcsinh(target) + 50.0)
+    q = increasing_root(lambda q: np.sinh(q) / q - target, 1e-12, np.arcsinh(target) + 50.0)
     a = span / (2 * q)
     x0 = a * np.arctanh(rise / length) - span / 2
     x = a * np.arcsinh(np.asarray(s, dtype=float) / a + np.sinh(x0 / a))

@@ -64,6 +64,20 @@ def serial_cholesky(n_elements, prescribed_rows, rhs):
         mesh.destroy()
 
 
+def assert_solves(comm, matrix, rhs, solution):
+    """A x = b to round-off for every column, on the owned rows of every rank."""
+    b, x = matrix.createVecs()
+    try:
+        for column, y in zip(rhs, solution):
+            x.getArray()[:] = y
+            matrix.mult(x, b)
+            scale = global_max(comm, np.abs(column).max())
+            assert global_max(comm, np.abs(b.getArray() - column).max()) <= ROUND_OFF * scale
+    finally:
+        b.destroy()
+        x.destroy()
+
+
 @pytest.mark.parametrize("n_elements", [1, 3, 7, 40])
 def test_chain_solver_agrees_with_serial_cholesky(n_elements):
     comm = PETSc.COMM_WORLD
@@ -80,13 +94,7 @@ def test_chain_solver_agrees_with_serial_cholesky(n_elements):
         reference = serial_cholesky(n_elements, fixed, [gather(comm, b) for b in rhs])
         for x, y in zip(whole, reference):
             assert np.abs(x - y).max() <= ROUND_OFF * np.abs(y).max()
-        # and it solves the system: A x = b on the owned rows
-        b, x = matrix.createVecs()
-        x.getArray()[:] = solution[1]
-        matrix.mult(x, b)
-        assert np.abs(b.getArray() - rhs[1]).max() <= ROUND_OFF * np.abs(rhs[1]).max()
-        b.destroy()
-        x.destroy()
+        assert_solves(comm, matrix, rhs, solution)
     finally:
         solver.destroy()
         matrix.destroy()
@@ -135,14 +143,7 @@ def test_a_hermite_matrix_gets_an_interface_two_rows_wide():
         rhs = right_hand_sides(mesh, 2)
         solution = [np.zeros_like(column) for column in rhs]
         solver.solve(rhs, solution)
-        b, x = matrix.createVecs()
-        for column, y in zip(rhs, solution):
-            x.getArray()[:] = y
-            matrix.mult(x, b)
-            scale = global_max(comm, np.abs(column).max())
-            assert global_max(comm, np.abs(b.getArray() - column).max()) <= ROUND_OFF * scale
-        b.destroy()
-        x.destroy()
+        assert_solves(comm, matrix, rhs, solution)
     finally:
         solver.destroy()
         matrix.destroy()
