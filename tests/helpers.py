@@ -8,8 +8,9 @@ REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
-                max_it=5000):
-    """A (mesh, solver) pair for ``Scene(**scene_kwargs)`` on ``comm``.
+                max_it=5000, newton=True):
+    """A (mesh, solver) pair for ``Scene(**scene_kwargs)`` on ``comm`` (``newton``:
+    Settings.newton, off where a test is about the iteration without it).
 
     The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
     ``solver_factory`` fixture which does it.
@@ -21,7 +22,8 @@ def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
 
     scene = Scene(**scene_kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
-    settings = Settings(asked_penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol)
+    settings = Settings(asked_penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol,
+                        newton=newton)
     solver = UzawaSolver(mesh, scene, settings)
     return mesh, solver
 

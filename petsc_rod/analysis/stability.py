@@ -179,7 +179,7 @@ class SecondVariation:
         self.factor.setMumpsIcntl(13, 1)     # the inertia of the whole matrix on every rank
         self.factor.setMumpsIcntl(24, 1)     # null pivots detected, not failed on
 
-    def _factor(self, shift):
+    def factorise(self, shift):
         """Factor H - shift M."""
         self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.mass.copy(self._work)
@@ -188,9 +188,15 @@ class SecondVariation:
         self.ksp.setOperators(self.shifted)
         self.ksp.setUp()
 
+    def solve(self, rhs):
+        """(H - shift M)^-1 rhs, a new Vec, with the last ``factorise``."""
+        solution = rhs.duplicate()
+        self.ksp.solve(rhs, solution)
+        return solution
+
     def negative_directions(self, shift):
         """Eigenvalues of H below ``shift`` (times the mass M) on the constraint set."""
-        self._factor(shift)
+        self.factorise(shift)
         negative, _, _ = self.factor.getInertia()
         if not self.constraint:
             return int(negative)
@@ -235,7 +241,7 @@ class SecondVariation:
                 upper = middle
             else:
                 lower = middle
-        self._factor(lower)
+        self.factorise(lower)
         vector = self.matrix.createVecLeft()
         # a start with a component along every eigenvector, the same on any number of ranks
         start, end = vector.getOwnershipRange()

@@ -51,7 +51,8 @@ def settings_from_options(values, scene):
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
                     adapt_penalty=values["rod_al_adapt_penalty"],
-                    check_stability=values["rod_al_stability"])
+                    check_stability=values["rod_al_stability"],
+                    newton=values["rod_al_newton"])
 
 
 def options_record():

@@ -172,9 +172,9 @@ class GlobalStep:
             self.slope_problem.solve(self.rhs[2], state.slope)
         if self.riser is not None:
             self.riser.solve_vertical(self.rhs[2], state, self.bordered)
-        self._integrate_slope(state)
+        self.integrate_slope(state)
 
-    def _integrate_slope(self, state):
+    def integrate_slope(self, state):
         """r at the vertices from the slope (centreline.positions_from_increments), into
         the r field with the slope's vertex values: the element dofs are stride-2 views
         of the slope's ghosted arrays (fields.element_slices), no gather."""

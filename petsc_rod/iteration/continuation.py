@@ -298,6 +298,11 @@ def stability_text(report):
     return f", stable{left} (second variation positive)"
 
 
+def newton_text(report):
+    """The step line's count of Newton steps among the iterations (newton.py)."""
+    return f" ({report.newton_steps} Newton)" if report.newton_steps else ""
+
+
 def link_text(link):
     """The step line's account of the link, '' where it is not tracked."""
     if link is None:
@@ -328,16 +333,16 @@ def record_step(solver, report, t, label, say, writer, group, **common):
         attributes.update(riser.attributes)
     say(f"{label}: load factor {t:.4g}, "
         f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
-        f"iterations, change {report.change:.2e}, constraint residual (RMS) "
+        f"iterations{newton_text(report)}, change {report.change:.2e}, constraint residual (RMS) "
         f"{report.constraint_residual:.2e}, energy {energy:.10g} J, u3(0) {u3_start:.6g}"
         + link_text(report.link) + stability_text(report)
         + (f"; {riser.text}" if riser is not None else ""))
     if report.penalty_raises:
         raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in report.penalty_raises)
-        say(f"petsc_rod: {label}: the constraint residual fell by less than half in "
-            f"{ADAPT_WINDOW} iterations with R far below the problem's scale "
-            f"{solver.scale:.3g}: R raised to {raised} (matrices refactored; "
-            "-rod_al_adapt_penalty)")
+        say(f"petsc_rod: {label}: R raised to {raised} (matrices refactored): the "
+            f"constraint residual fell by less than half in {ADAPT_WINDOW} iterations with "
+            f"R far below the problem's scale {solver.scale:.3g} (-rod_al_adapt_penalty), "
+            "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)")
     if writer is not None:
         writer.write_step(group, vertex, outputs.restart_state(solver), report.history,
                           attributes)

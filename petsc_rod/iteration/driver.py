@@ -17,6 +17,7 @@ from petsc_rod.frames import split_coefficients, strains
 from petsc_rod.global_step.global_step import GlobalStep
 from petsc_rod.iteration import penalty as penalty_policy
 from petsc_rod.iteration import stopping
+from petsc_rod.iteration import newton
 from petsc_rod.iteration.state import RodState
 from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
 from petsc_rod.mesh.elements import quadrature_weights
@@ -37,6 +38,18 @@ SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
 ESCAPE_ANGLE = 0.3
 MAX_ESCAPES = 5
 ESCAPE_GROWTH = 2.0
+# The iteration hands over to Newton steps on the reduced problem (newton.py) once a
+# step has taken NEWTON_AFTER iterations and change and residual are both below
+# NEWTON_SWITCH: near a solution, where the accelerated iteration is slow.
+NEWTON_AFTER = 15
+NEWTON_SWITCH = 0.1
+# After each attempt that did not converge the wait doubles (an attempt restarts the
+# accelerated iteration). A Newton solution the Uzawa map cannot hold at the current
+# penalty (newton.least_penalty) raises it to NEWTON_RAISE times the least that can.
+NEWTON_RAISE = 2.0
+# A state where Newton finds negative curvature is left at once (not first converged to)
+# when change and residual are below EARLY_ESCAPE: near an equilibrium, so a saddle.
+EARLY_ESCAPE = 1e-2
 
 
 def check_anderson_depth():
@@ -67,6 +80,7 @@ class UzawaSolver:
         self._root_weights = np.sqrt(self.state.node_weights)[:, None, None]
         self._step = None
         self._create_snes()
+        self.newton = newton.NewtonPolish(self) if self.uses_newton else None
 
     @property
     def penalty(self):
@@ -123,13 +137,9 @@ class UzawaSolver:
                 step.stable, direction = self.check_stability()
                 if step.stable is not False:
                     break
-                if step.escapes == MAX_ESCAPES:
+                if not self._escape(step, direction):
                     step.outcome = (False, stopping.STOP_SADDLE)
                     break
-                angle = ESCAPE_ANGLE * ESCAPE_GROWTH**step.escapes * (-1) ** step.escapes
-                self.state.turn_frames(angle * direction / self.mesh.global_max(
-                    float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
-                step.escapes += 1
                 step.outcome = step.stable = None
                 self._iterate(step)
         finally:
@@ -137,6 +147,15 @@ class UzawaSolver:
         if step.error is not None:
             raise step.error
         return stopping.StepReport.of(step)
+
+    @property
+    def uses_newton(self):
+        """Whether the iteration hands over to Newton (newton.py): asked for, the loads
+        have an energy (no seabed or current: not part of E), and the stiffness split
+        is convex (every a_i >= 0; with a negative a_i the Newton point of E need not be
+        a fixed point of the Uzawa map, whose lagged part stands for the a_i < 0)."""
+        return (self.settings.newton and self.global_step.riser is None
+                and self.global_step.lagged is None)
 
     @property
     def tests_stability(self):
@@ -147,9 +166,15 @@ class UzawaSolver:
     def _iterate(self, step):
         """Run the SNES from the current state until ``step`` has an outcome (a penalty
         raise starts it again from where it is)."""
+        step.newton_next = len(step.history) + NEWTON_AFTER
         while True:
             self._pack(self._x)
             self.snes.solve(None, self._x)
+            if step.outcome == stopping.TRY_NEWTON:
+                step.outcome = None
+                self._polish(step)
+                step.newton_next = len(step.history) + NEWTON_AFTER * 2**step.newton_failures
+                continue
             if step.outcome != stopping.RAISE_PENALTY:
                 break
             self.global_step.build(penalty_policy.raised_penalty(self.penalty, self.scale))
@@ -158,6 +183,42 @@ class UzawaSolver:
         if step.outcome is None and step.error is None:   # the SNES stopped on its own test
             reason = self.snes.getConvergedReason()
             step.outcome = (False, f"snes_{SNES_REASONS.get(reason, reason)}")
+
+    def _escape(self, step, direction):
+        """Turn the frames along ``direction`` (n_nodes, 3), a direction of negative
+        curvature, the largest node by ESCAPE_ANGLE ESCAPE_GROWTH^k (-1)^k rad at the
+        k-th escape of the step; False, and nothing turned, after MAX_ESCAPES."""
+        if step.escapes == MAX_ESCAPES:
+            return False
+        angle = ESCAPE_ANGLE * ESCAPE_GROWTH**step.escapes * (-1) ** step.escapes
+        self.state.turn_frames(angle * direction / self.mesh.global_max(
+            float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
+        step.escapes += 1
+        return True
+
+    def _polish(self, step):
+        """Newton steps from the current state (newton.py), each recorded as an
+        iteration (change: its largest turn, rad; the frames are rotations). Where the
+        second variation has a direction of negative curvature the state is near a
+        saddle: with the stability test on, it is left now, as at convergence."""
+        def record(turn):
+            step.record(turn, 0.0)
+            step.newton_steps += 1
+        outcome = self.newton.run(record)
+        if outcome == newton.CONVERGED:
+            least = self.newton.least_penalty()
+            if least >= self.penalty:
+                self.global_step.build(NEWTON_RAISE * least)
+                step.raises.append((len(step.history), self.penalty))
+            return
+        step.newton_failures += 1
+        change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
+        if (outcome != newton.INDEFINITE or not self.tests_stability
+                or max(change, residual) > EARLY_ESCAPE):
+            return
+        stable, direction = self.check_stability()
+        if stable is False:
+            self._escape(step, direction)
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state (analysis/stability.py):
@@ -216,6 +277,9 @@ class UzawaSolver:
             return (False, stopping.STOP_OBSERVER)
         if stopping.converged(settings, change, residual):
             return stopping.CONVERGED
+        if (self.newton is not None and iteration >= step.newton_next
+                and max(change, residual) <= NEWTON_SWITCH):
+            return stopping.TRY_NEWTON
         if (settings.adapt_penalty and iteration % penalty_policy.ADAPT_WINDOW == 0
                 and penalty_policy.penalty_too_low(step.history, self.penalty, self.scale)):
             return stopping.RAISE_PENALTY
@@ -284,5 +348,7 @@ class UzawaSolver:
     def destroy(self):
         self.global_step.destroy()
         self.state.destroy()
+        if self.newton is not None:
+            self.newton.destroy()
         for obj in (self.snes, self._x, self._f):
             obj.destroy()

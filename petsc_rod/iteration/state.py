@@ -91,6 +91,15 @@ class RodState:
         self.tau[:] = np.einsum("nkl,nil->nik", turn, self.tau)
         self.lam[:] = np.einsum("nkl,nil->nik", turn, self.lam)
 
+    def set_node_directors(self, frames):
+        """d1, d2 and r' = d3 at the owned P2 nodes from frames (n_nodes, 3, 3), rows
+        d1, d2, d3 (the last vertex's phantom midpoint slot set to 0)."""
+        n_vertices = self.d1.components[0].getLocalSize() // 2
+        slots = np.zeros((2 * n_vertices, 3, 3))
+        slots[:frames.shape[0]] = frames
+        for i, field in enumerate(self.frame_fields):
+            field.set_owned(slots[:, i].reshape(n_vertices, 2, 3))
+
     def set_centreline(self, positions, slopes):
         """r and r' from Hermite vertex data (n_owned, 3) each, e.g. a restart: the slope
         field takes r' at the vertices and the cubic's derivative at the midpoints."""

@@ -23,6 +23,7 @@ STOP_OBSERVER = "observer"      # the caller's observer asked to stop
 STOP_LINK = "link"              # converged, to a state of another linking number (link.py)
 STOP_SADDLE = "saddle"          # converged to a saddle, and left it too often
 RAISE_PENALTY = "raise_penalty"     # not an end: the step goes on with a larger R
+TRY_NEWTON = "try_newton"           # not an end: Newton steps, then the iteration again
 CONVERGED = (True, "")
 
 # The stall test looks at windows of STALL_WINDOW iterations (stalled_projection), and
@@ -48,6 +49,7 @@ class Settings:
     monitor: bool = False
     adapt_penalty: bool = True      # raise a penalty far below the scale (penalty.py)
     check_stability: bool = True    # test the second variation at convergence (§10)
+    newton: bool = True             # Newton steps near a solution (newton.py)
 
 
 @dataclass
@@ -65,6 +67,9 @@ class StepProgress:
     error: Exception = None
     stable: bool = None         # a local minimiser (stability.py); None: not checked
     escapes: int = 0            # saddles left on the way
+    newton_steps: int = 0       # Newton steps taken (newton.py), counted in history
+    newton_next: int = 0        # the iteration from which Newton may be tried again
+    newton_failures: int = 0    # attempts that did not converge
 
     @property
     def finished(self):
@@ -89,13 +94,15 @@ class StepReport:
     link_expected: float = None     # the Lk the load path leads to, turns (continuation)
     stable: bool = None     # the second variation is positive (§10); None: unchecked
     escapes: int = 0        # saddles the step converged to and left
+    newton_steps: int = 0   # of the iterations, Newton steps on the reduced problem
 
     @classmethod
     def of(cls, step):
         converged, reason = step.outcome
         change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
         return cls(converged, len(step.history), change, residual, step.history, reason,
-                   step.raises, stable=step.stable, escapes=step.escapes)
+                   step.raises, stable=step.stable, escapes=step.escapes,
+                   newton_steps=step.newton_steps)
 
     @property
     def stalled(self):

@@ -1,0 +1,230 @@
+"""Newton's method on the reduced problem, near a solution (docs/method.md §11).
+
+The discrete problem the Uzawa iteration solves is: minimise
+
+    E(d) = sum_i a_i d_i^T K d_i - b . d3      (K the P2 stiffness, b the slope's load)
+
+over frames d_n in SO(3) at the P2 nodes, with the clamped frames fixed and, when both
+ends are held, the chord sum_n w_n d3_n = r(L) - r(0). Near a solution this module takes
+Newton steps on it directly. A step turns each frame by a rotation vector omega_n,
+d_n <- exp([omega_n]x) d_n, with omega from the KKT system
+
+    [ H  C^T ] [ omega ]   [ -grad L ]
+    [ C   0  ] [ dmu   ] = [ -c      ],
+
+L = E + mu . c the Lagrangian of the chord constraint c(d) = sum_n w_n d3_n - chord,
+grad_n L = sum_i d_{n,i} x g_{n,i} (g_i = dL/dd_i = 2 a_i K d_i - b delta_i3 + w mu
+delta_i3), C omega = sum_n w_n omega_n x d3_n, and H the Riemannian Hessian of L: the
+second variation of analysis/stability.py with lambda_n = -g_n / w_n (at a solution
+these are the Uzawa multipliers, and H is exactly the matrix of the stability test).
+
+A step is taken only where H is positive definite on the constraint set (the inertia of
+its factorisation, as in the stability test): Newton then heads for a local minimiser,
+never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
+Uzawa iteration goes on from where it was. On success the state is handed back as a
+fixed point of the Uzawa iteration: tau = d and lambda = -g / w, so that the next
+iteration (whose tests decide convergence, as always) moves it only by round-off.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.analysis.stability import SecondVariation, skew
+from petsc_rod.frames import rotations
+from petsc_rod.global_step.matrices import assemble_matrix
+from petsc_rod.mesh.elements import p2_element_matrices
+
+EVENT = PETSc.Log.Event("rod_newton")
+
+# At most this many Newton steps per attempt; a step whose largest turn is below
+# STEP_TOLERANCE rad is the last (the error after it is about its square).
+MAX_STEPS = 8
+STEP_TOLERANCE = 1e-10
+# A step must shrink to at most this fraction of the previous one, or the polish stops
+# (Newton contracts quadratically near a regular minimiser).
+SHRINK = 0.5
+# What an attempt ends with (NewtonPolish.run).
+CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
+
+
+class NewtonPolish:
+    """Newton steps of the module docstring on a solver's state. Owns the stiffness
+    matrix K and a work Vec pair; ``destroy()`` frees them."""
+
+    def __init__(self, solver):
+        self.solver = solver
+        mesh = solver.mesh
+        self.stiffness = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 1.0, 0.0))
+        self._x, self._y = self.stiffness.createVecs()
+
+    def run(self, record=None):
+        """Newton steps from the state's current tau (rotations near the fields). Returns
+        CONVERGED (the state is then the Uzawa fixed point of the module docstring),
+        INDEFINITE (H has a direction of negative curvature: near a saddle) or FAILED
+        (the steps did not converge); in the last two cases the state is as it was.
+        ``record(turn)`` is called after each step with its largest turn, rad."""
+        solver = self.solver
+        state = solver.state
+        EVENT.begin()
+        saved = state.snapshot()
+        frames = state.tau.copy()
+        clamped = ~self._free_nodes()
+        frames[clamped] = state.node_directors()[clamped]      # the prescribed frames
+        mu = None
+        previous = np.inf
+        outcome = FAILED
+        try:
+            for _ in range(MAX_STEPS):
+                self._set_frames(frames)
+                g = self._energy_gradient(frames)
+                mu = self._least_squares_multiplier(frames, g) if mu is None else mu
+                omega, dmu = self._newton_step(frames, g, mu)
+                if omega is None:
+                    outcome = INDEFINITE
+                    break
+                largest = solver.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
+                if not np.isfinite(largest) or largest > SHRINK * previous:
+                    break
+                frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
+                mu = mu + dmu
+                previous = largest
+                if record is not None:
+                    record(largest)
+                if largest < STEP_TOLERANCE:
+                    self._hand_over(frames, mu)
+                    return CONVERGED
+            state.restore(saved)
+            return outcome
+        finally:
+            EVENT.end()
+
+    # --- the pieces of a step ---------------------------------------------------------
+    def _set_frames(self, frames):
+        """The fields d1, d2, r' from node frames (n_nodes, 3, 3), and r by integration."""
+        self.solver.state.set_node_directors(frames)
+        self.solver.global_step.integrate_slope(self.solver.state)
+
+    def _energy_gradient(self, frames):
+        """g_i = dE/dd_i at the nodes, (n_nodes, 3, 3): 2 a_i K d_i, less b for d3."""
+        solver = self.solver
+        n = frames.shape[0]
+        g = np.empty_like(frames)
+        loads = solver.global_step.load.components
+        for i, field in enumerate(solver.state.frame_fields):
+            for c, vec in enumerate(field.components):
+                self.stiffness.mult(vec, self._y)
+                g[:, i, c] = 2 * solver.split[i] * self._y.getArray(readonly=True)[:n]
+                if i == 2:
+                    g[:, i, c] -= loads[c].getArray(readonly=True)[:n]
+        return g
+
+    def _bordered(self):
+        return self.solver.global_step.bordered
+
+    def _least_squares_multiplier(self, frames, g):
+        """The chord multiplier mu (3,) that makes grad L smallest (0 when the chord is
+        free): sum_n |a_n + w_n d3_n x mu|^2 minimal, a_n = sum_i d_i x g_i, over the
+        nodes that are not clamped."""
+        if not self._bordered():
+            return np.zeros(3)
+        w = self.solver.state.node_weights
+        a = np.cross(frames, g).sum(axis=1)
+        A = w[:, None, None] * skew(frames[:, 2])          # w d3 x mu = A mu
+        free = self._free_nodes()
+        normal = np.einsum("nki,nkj->ij", A[free], A[free])
+        right = -np.einsum("nki,nk->i", A[free], a[free])
+        total = self.solver.mesh.global_sum(np.concatenate([normal.ravel(), right]))
+        return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
+
+    def _free_nodes(self):
+        """Mask of the owned nodes whose frame is not clamped, (n_nodes,)."""
+        solver, mesh = self.solver, self.solver.mesh
+        free = np.ones(mesh.n_local_nodes, dtype=bool)
+        if solver.global_step.start_state.kind == "clamp" and mesh.on_lower_boundary:
+            free[0] = False
+        if solver.global_step.end_state.kind == "clamp" and mesh.on_upper_boundary:
+            free[-1] = False
+        return free
+
+    def _newton_step(self, frames, g, mu):
+        """(omega (n_nodes, 3), dmu (3,)) of the KKT system, or (None, None) where H is
+        not positive definite on the constraint set."""
+        solver = self.solver
+        state, w = solver.state, solver.state.node_weights
+        g = g.copy()
+        g[:, 2] += w[:, None] * mu
+        gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
+        gradient[~self._free_nodes()] = 0.0
+        state.tau[:] = frames
+        state.lam[:] = -g / w[:, None, None]
+        hessian = SecondVariation(solver)
+        try:
+            # the factorisation of the inertia test, H + tolerance M, serves the solves
+            if not hessian.decidable or hessian.negative_directions(-hessian.tolerance()):
+                return None, None
+            rhs = hessian.matrix.createVecLeft()
+            rhs.getArray()[:] = -gradient.ravel()
+            direction = hessian.solve(rhs)
+            if not self._bordered():
+                omega = direction.getArray().reshape(-1, 3).copy()
+                return omega, np.zeros(3)
+            columns = self._chord_columns(hessian, frames)
+            solved = [hessian.solve(column) for column in columns]
+            schur = np.array([[c.dot(s) for s in solved] for c in columns])
+            chord = self._chord_residual(frames)
+            dmu = np.linalg.lstsq(schur, chord + np.array([c.dot(direction) for c in columns]),
+                                  rcond=None)[0]
+            # omega = H^-1 (-grad L - C^T dmu); C omega = -c
+            direction.maxpy(-dmu, solved)
+            omega = direction.getArray().reshape(-1, 3).copy()
+            for vec in [rhs, direction, *columns, *solved]:
+                vec.destroy()
+            return omega, dmu
+        finally:
+            hessian.destroy()
+
+    def _chord_columns(self, hessian, frames):
+        """The rows of C as Vecs: omega -> sum_n w_n (omega_n x d3_n)_k, k = 0, 1, 2."""
+        forms = -self.solver.state.node_weights[:, None, None] * skew(frames[:, 2])
+        columns = []
+        for k in range(3):
+            vec = hessian.matrix.createVecLeft()
+            vec.getArray()[:] = forms[:, k, :].ravel()
+            vec.getArray()[np.repeat(~self._free_nodes(), 3)] = 0.0
+            columns.append(vec)
+        return columns
+
+    def _chord_residual(self, frames):
+        """c = sum_n w_n d3_n - (r(L) - r(0)), (3,)."""
+        step = self.solver.global_step
+        local = self.solver.state.node_weights @ frames[:, 2]
+        return (self.solver.mesh.global_sum(local)
+                - (step.end_state.position - step.start_state.position))
+
+    def _hand_over(self, frames, mu):
+        """The state as the Uzawa fixed point at ``frames``: fields, r, tau = d and
+        lambda = -g / w (with the chord's share in lambda3; 0 at a clamped node)."""
+        state = self.solver.state
+        self._set_frames(frames)
+        g = self._energy_gradient(frames)
+        g[:, 2] += state.node_weights[:, None] * mu
+        state.tau[:] = frames
+        state.lam[:] = -g / state.node_weights[:, None, None]
+        # a clamped frame is prescribed, not solved for: its multiplier is free, and 0
+        # is one the local step keeps (P(R d) = d)
+        state.lam[~self._free_nodes()] = 0.0
+        state.remember()
+
+    def least_penalty(self):
+        """The R above which the handed-over state is a fixed point of the Uzawa map:
+        the local step returns tau = P(R tau + lambda) only if R I + lambda tau^T
+        (symmetric at a solution) is positive definite at every node, i.e. R > the
+        largest -eig(sym(lambda_n tau_n^T)), N."""
+        state = self.solver.state
+        product = np.einsum("nik,nil->nkl", state.lam, state.tau)
+        lowest = np.linalg.eigvalsh(0.5 * (product + product.transpose(0, 2, 1)))[:, 0]
+        return self.solver.mesh.global_max(float(-lowest.min(initial=0.0)))
+
+    def destroy(self):
+        for obj in (self.stiffness, self._x, self._y):
+            obj.destroy()
