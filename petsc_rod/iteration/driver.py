@@ -216,9 +216,14 @@ class UzawaSolver:
         if (outcome != newton.INDEFINITE or not self.tests_stability
                 or max(change, residual) > EARLY_ESCAPE):
             return
+        if step.early_escapes == MAX_ESCAPES:
+            return
         stable, direction = self.check_stability()
         if stable is False:
+            # an early escape does not use the budget of escapes from converged saddles
+            step.early_escapes += 1
             self._escape(step, direction)
+            step.escapes -= 1
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state (analysis/stability.py):

@@ -70,6 +70,7 @@ class StepProgress:
     newton_steps: int = 0       # Newton steps taken (newton.py), counted in history
     newton_next: int = 0        # the iteration from which Newton may be tried again
     newton_failures: int = 0    # attempts that did not converge
+    early_escapes: int = 0      # saddles left before converging to them (driver._polish)
 
     @property
     def finished(self):
@@ -101,7 +102,8 @@ class StepReport:
         converged, reason = step.outcome
         change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
         return cls(converged, len(step.history), change, residual, step.history, reason,
-                   step.raises, stable=step.stable, escapes=step.escapes,
+                   step.raises, stable=step.stable,
+                   escapes=step.escapes + step.early_escapes,
                    newton_steps=step.newton_steps)
 
     @property

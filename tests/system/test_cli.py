@@ -130,7 +130,7 @@ def test_restart_converges_at_once_to_the_same_state(cantilever, folder):
     assert process.returncode == 0, describe(process)
     with h5py.File(path, "r") as f, h5py.File(second_path, "r") as g:
         first_iterations = int(f.attrs["iterations"])
-        assert first_iterations >= 20
+        assert first_iterations >= 10        # a step with work to undo (Newton: 19)
         assert int(g.attrs["converged"]) == 1
         assert sorted(g["steps"]) == ["1"] and float(g.attrs["load_factor"]) == 1.0
         assert int(g.attrs["iterations"]) < 0.1 * first_iterations
