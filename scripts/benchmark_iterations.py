@@ -4,8 +4,9 @@
 
 Every shipped scene (options/*.opts) and one case of each group of the stability matrix
 (scripts/stability_matrix.py) is run twice as a user runs it, in a child process on
-1 rank: with ``-rod_snes_type nrichardson`` (the plain iteration, x <- G(x)) and with
-the default (Anderson mixing with the stability check). Both runs use the scene's own
+1 rank: with ``-rod_snes_type nrichardson -rod_al_newton 0`` (the plain iteration,
+x <- G(x)) and with the default (Anderson mixing, Newton steps near the solution, the
+stability check). Both runs use the scene's own
 tolerances, so they stop on the same tests. Printed side by side, and written as a
 Markdown table to FILE (default docs/iterations.md): outcome, total iterations, the
 largest and the mean iterations per step, wall time, and the energy. For the paper
@@ -30,7 +31,7 @@ sys.path.insert(0, str(ROOT))
 
 import stability_matrix  # noqa: E402
 
-PLAIN = ["-rod_snes_type", "nrichardson"]
+PLAIN = ["-rod_snes_type", "nrichardson", "-rod_al_newton", "0"]
 # The collocation reference of the paper scene at X_F = 16, K3 = 200
 # (tests/unit/test_collocation_reference.py recomputes it:
 # petsc_rod.validation.reference.solve_paper_scene).
@@ -123,7 +124,7 @@ def main():
             f"# Iterations: plain against default\n\nWritten by `{command}` (1 rank; the "
             "scene's own tolerances and halvings; `iterations` counts every iteration of "
             "the accepted steps, `max / mean per step` over them; the plain iteration is "
-            "`-rod_snes_type nrichardson`).\n\n" + "\n".join(lines) + "\n")
+            "`-rod_snes_type nrichardson -rod_al_newton 0`).\n\n" + "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -191,7 +191,7 @@ OPTIONS = [
            "the energy's second variation), taken only where it is positive definite; "
            "where it is not and change and residual are below 0.01, the state is near a "
            "saddle and is left at once; after a failed attempt the wait doubles; not with "
-           "a seabed, a current or a non-convex stiffness split"),
+           "a seabed or a current"),
     Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, True, "bool",
            "raise R tenfold, refactoring the matrices, while it is below a tenth of the "

@@ -48,7 +48,8 @@ DATASET_UNITS = {
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
 ATTRIBUTE_UNITS = {
-    "converged": "1", "stop_reason": "text", "iterations": "1", "halvings": "1",
+    "converged": "1", "stop_reason": "text", "iterations": "1", "newton_steps": "1",
+    "halvings": "1",
     "total_iterations": "1", "total_halvings": "1", "undone_iterations": "1",
     "constraint_residual": "1", "change": "1", "stable": "1", "energy": "J",
     "wall_time": "s", "written": "text", "ranks": "1", "load_factor": "1", "penalty": "N",

@@ -323,6 +323,7 @@ def record_step(solver, report, t, label, say, writer, group, **common):
                   "stop_reason": report.reason or "converged", "iterations": report.iterations,
                   "constraint_residual": report.constraint_residual,
                   "change": report.change, "stable": stability_code(report),
+                  "newton_steps": report.newton_steps,
                   "energy": energy, "ranks": mesh.comm.getSize(),
                   "load_factor": t, "penalty": solver.penalty, **common}
     if report.link is not None:

@@ -1,5 +1,6 @@
 """The augmented-Lagrangian (Uzawa, ALG2) iteration of docs/method.md §3, driven by a
-PETSc SNES (§6), with the stability test of §10 at each converged step.
+PETSc SNES (§6), handing over to Newton steps near a solution (§11, newton.py), with the
+stability test of §10 at each converged step.
 
 One iteration: the global step (global_step/), the local step at every node
 (local_step/projection.py), the multiplier update. The SNES sees the iteration as the
@@ -150,12 +151,9 @@ class UzawaSolver:
 
     @property
     def uses_newton(self):
-        """Whether the iteration hands over to Newton (newton.py): asked for, the loads
-        have an energy (no seabed or current: not part of E), and the stiffness split
-        is convex (every a_i >= 0; with a negative a_i the Newton point of E need not be
-        a fixed point of the Uzawa map, whose lagged part stands for the a_i < 0)."""
-        return (self.settings.newton and self.global_step.riser is None
-                and self.global_step.lagged is None)
+        """Whether the iteration hands over to Newton (newton.py): asked for, and the
+        loads have an energy (no seabed or current: they are not part of E)."""
+        return self.settings.newton and self.global_step.riser is None
 
     @property
     def tests_stability(self):
@@ -184,16 +182,22 @@ class UzawaSolver:
             reason = self.snes.getConvergedReason()
             step.outcome = (False, f"snes_{SNES_REASONS.get(reason, reason)}")
 
-    def _escape(self, step, direction):
+    def _escape(self, step, direction, early=False):
         """Turn the frames along ``direction`` (n_nodes, 3), a direction of negative
         curvature, the largest node by ESCAPE_ANGLE ESCAPE_GROWTH^k (-1)^k rad at the
-        k-th escape of the step; False, and nothing turned, after MAX_ESCAPES."""
-        if step.escapes == MAX_ESCAPES:
+        k-th escape of the step (early or not). Escapes from converged saddles and early
+        ones (_polish) have a budget of MAX_ESCAPES each; False, and nothing turned,
+        when it is spent."""
+        if (step.early_escapes if early else step.escapes) == MAX_ESCAPES:
             return False
-        angle = ESCAPE_ANGLE * ESCAPE_GROWTH**step.escapes * (-1) ** step.escapes
+        k = step.escapes + step.early_escapes
+        angle = ESCAPE_ANGLE * ESCAPE_GROWTH**k * (-1) ** k
         self.state.turn_frames(angle * direction / self.mesh.global_max(
             float(np.linalg.norm(direction, axis=1).max(initial=0.0))))
-        step.escapes += 1
+        if early:
+            step.early_escapes += 1
+        else:
+            step.escapes += 1
         return True
 
     def _polish(self, step):
@@ -214,16 +218,11 @@ class UzawaSolver:
         step.newton_failures += 1
         change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
         if (outcome != newton.INDEFINITE or not self.tests_stability
-                or max(change, residual) > EARLY_ESCAPE):
-            return
-        if step.early_escapes == MAX_ESCAPES:
+                or max(change, residual) > EARLY_ESCAPE or step.early_escapes == MAX_ESCAPES):
             return
         stable, direction = self.check_stability()
-        if stable is False:
-            # an early escape does not use the budget of escapes from converged saddles
-            step.early_escapes += 1
-            self._escape(step, direction)
-            step.escapes -= 1
+        if stable is False and self._escape(step, direction, early=True):
+            step.newton_failures = 0        # a new start: the wait starts again
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state (analysis/stability.py):

@@ -49,13 +49,14 @@ CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 class NewtonPolish:
     """Newton steps of the module docstring on a solver's state. Owns the stiffness
-    matrix K and a work Vec pair; ``destroy()`` frees them."""
+    matrix K and a work Vec; ``destroy()`` frees them (the second variation of each step
+    is made and destroyed within the step)."""
 
     def __init__(self, solver):
         self.solver = solver
         mesh = solver.mesh
         self.stiffness = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 1.0, 0.0))
-        self._x, self._y = self.stiffness.createVecs()
+        self._product = self.stiffness.createVecLeft()
 
     def run(self, record=None):
         """Newton steps from the state's current tau (rotations near the fields). Returns
@@ -112,8 +113,8 @@ class NewtonPolish:
         loads = solver.global_step.load.components
         for i, field in enumerate(solver.state.frame_fields):
             for c, vec in enumerate(field.components):
-                self.stiffness.mult(vec, self._y)
-                g[:, i, c] = 2 * solver.split[i] * self._y.getArray(readonly=True)[:n]
+                self.stiffness.mult(vec, self._product)
+                g[:, i, c] = 2 * solver.split[i] * self._product.getArray(readonly=True)[:n]
                 if i == 2:
                     g[:, i, c] -= loads[c].getArray(readonly=True)[:n]
         return g
@@ -158,30 +159,43 @@ class NewtonPolish:
         state.tau[:] = frames
         state.lam[:] = -g / w[:, None, None]
         hessian = SecondVariation(solver)
+        vecs = []                   # every Vec made here, destroyed on the way out
         try:
-            # the factorisation of the inertia test, H + tolerance M, serves the solves
-            if not hessian.decidable or hessian.negative_directions(-hessian.tolerance()):
+            if not self._positive_definite(hessian):
                 return None, None
             rhs = hessian.matrix.createVecLeft()
+            vecs.append(rhs)
             rhs.getArray()[:] = -gradient.ravel()
             direction = hessian.solve(rhs)
-            if not self._bordered():
-                omega = direction.getArray().reshape(-1, 3).copy()
-                return omega, np.zeros(3)
-            columns = self._chord_columns(hessian, frames)
-            solved = [hessian.solve(column) for column in columns]
-            schur = np.array([[c.dot(s) for s in solved] for c in columns])
-            chord = self._chord_residual(frames)
-            dmu = np.linalg.lstsq(schur, chord + np.array([c.dot(direction) for c in columns]),
-                                  rcond=None)[0]
-            # omega = H^-1 (-grad L - C^T dmu); C omega = -c
-            direction.maxpy(-dmu, solved)
-            omega = direction.getArray().reshape(-1, 3).copy()
-            for vec in [rhs, direction, *columns, *solved]:
-                vec.destroy()
-            return omega, dmu
+            vecs.append(direction)
+            dmu = np.zeros(3)
+            if self._bordered():
+                # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
+                # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
+                columns = self._chord_columns(hessian, frames)
+                vecs.extend(columns)
+                solved = [hessian.solve(column) for column in columns]
+                vecs.extend(solved)
+                schur = np.array([[c.dot(s) for s in solved] for c in columns])
+                right = self._chord_residual(frames) + np.array([c.dot(direction)
+                                                                 for c in columns])
+                dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
+                direction.maxpy(-dmu, solved)
+            return direction.getArray().reshape(-1, 3).copy(), dmu
         finally:
+            for vec in vecs:
+                vec.destroy()
             hessian.destroy()
+
+    @staticmethod
+    def _positive_definite(hessian):
+        """Whether H is positive definite on the constraint set (its inertia, §10), with
+        H + tolerance M factored for the solves. Where the chord forms are dependent (a
+        taut, straight rod) H itself must be: a sufficient condition."""
+        if hessian.decidable:
+            return hessian.negative_directions(-hessian.tolerance()) == 0
+        hessian.factorise(-hessian.tolerance())
+        return int(hessian.factor.getInertia()[0]) == 0
 
     def _chord_columns(self, hessian, frames):
         """The rows of C as Vecs: omega -> sum_n w_n (omega_n x d3_n)_k, k = 0, 1, 2."""
@@ -226,5 +240,5 @@ class NewtonPolish:
         return self.solver.mesh.global_max(float(-lowest.min(initial=0.0)))
 
     def destroy(self):
-        for obj in (self.stiffness, self._x, self._y):
+        for obj in (self.stiffness, self._product):
             obj.destroy()
