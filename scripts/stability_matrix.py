@@ -25,7 +25,7 @@ penalty): the "before" table of docs/stability.md (History B). ``--only`` reruns
 and merges them into the CSV and the table of the last full run. ``--ci`` runs the
 small subset the tests run on 1 and 2 ranks (tests/system/test_stability_matrix.py), printed,
 not written. The full
-matrix takes about half an hour on two cores, most of it the 10^6-element catenary.
+matrix takes about two minutes on two cores, half of it the 10^6-element catenary.
 """
 
 import argparse
