@@ -222,7 +222,8 @@ class UzawaSolver:
             return
         stable, direction = self.check_stability()
         if stable is False and self._escape(step, direction, early=True):
-            step.newton_failures = 0        # a new start: the wait starts again
+            # a new start: the turned state is given the wait after one failure
+            step.newton_failures = 1
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state (analysis/stability.py):
