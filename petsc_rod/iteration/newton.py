@@ -231,9 +231,9 @@ class NewtonPolish:
 
     def least_penalty(self):
         """The R above which the handed-over state is a fixed point of the Uzawa map:
-        the local step returns tau = P(R tau + lambda) only if R I + lambda tau^T
-        (symmetric at a solution) is positive definite at every node, i.e. R > the
-        largest -eig(sym(lambda_n tau_n^T)), N."""
+        the local step returns tau = P(R tau + lambda) = P(tau (R I + tau^T lambda))
+        only if R I + tau^T lambda (symmetric at a solution) is positive definite at
+        every node, i.e. R > the largest -eig(sym(tau_n^T lambda_n)), N."""
         state = self.solver.state
         product = np.einsum("nik,nil->nkl", state.lam, state.tau)
         lowest = np.linalg.eigvalsh(0.5 * (product + product.transpose(0, 2, 1)))[:, 0]
