@@ -186,8 +186,9 @@ OPTIONS = [
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
            "not with a current (its drag has no energy)"),
     Option("rod_al_newton", _bool, True, "bool",
-           "from the 15th iteration of a step, while change and residual are below 0.1, "
-           "try Newton steps on the reduced problem (frames turned by the KKT system of "
+           "from the 15th iteration of a step, while change and residual are below 0.1 "
+           "and more than 30 iterations would remain at the recent rate, try Newton steps "
+           "on the reduced problem (frames turned by the KKT system of "
            "the energy's second variation), taken only where it is positive definite; "
            "where it is not and change and residual are below 0.01, the state is near a "
            "saddle and is left at once; after a failed attempt the wait doubles; not with "

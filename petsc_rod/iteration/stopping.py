@@ -111,6 +111,26 @@ class StepReport:
         return self.reason == STOP_STALLED
 
 
+def remaining_iterations(history, rtol, ctol, window=10):
+    """Iterations the step would still need at its recent rate, estimated from the rows
+    of ``history``: with q = max(change / rtol, residual / ctol) (above 1 until both
+    tests hold), the smallest q of the last 3 rows against that of the 3 rows ``window``
+    iterations earlier gives a rate rho per iteration, and log(q) / -log(rho) iterations
+    remain. inf when there are too few rows or q did not fall (the accelerated iteration
+    is not monotone: the minima of short runs of rows smooth it).
+    """
+    if len(history) < window + 3:
+        return np.inf
+    distance = [max(change / rtol, residual / ctol) for change, residual, _ in history]
+    now = min(distance[-3:])
+    before = min(distance[-window - 3:-window])
+    if now <= 1.0:
+        return 0.0
+    if now >= before:
+        return np.inf
+    return np.log(now) / (np.log(before / now) / window)
+
+
 def diverged(change, residual):
     """A non-finite norm, or directors far from unit vectors."""
     return not (np.isfinite(change) and np.isfinite(residual)) or residual > DIVERGED_RESIDUAL

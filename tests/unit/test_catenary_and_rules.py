@@ -7,7 +7,8 @@ import pytest
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.penalty import ADAPT_WINDOW, default_penalty, penalty_too_low
-from petsc_rod.iteration.stopping import STALL_MARGIN, STALL_WINDOW, stalled_projection
+from petsc_rod.iteration.stopping import (STALL_MARGIN, STALL_WINDOW, remaining_iterations,
+                                          stalled_projection)
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.scenes.starts import catenary_start
 from petsc_rod.validation.closed_forms import catenary
@@ -110,6 +111,21 @@ def test_stall_projection():
         STALL_WINDOW) / STALL_WINDOW))
     assert not stalled_projection(flat_then_falling, 1e-8, budget=10**6)
     assert stalled_projection([1e-6] * n, 1e-8, budget=10**6)
+
+
+def test_remaining_iterations_of_a_geometric_decay():
+    """Change and residual falling by 10 every 4 iterations from 1e-2 and 1e-3 (tests at
+    1e-9): the distance to the tests, max(change / rtol, residual / ctol), is 1e7 at
+    iteration 0, so 28 iterations are needed in all; after 16 rows, 12 remain. No fall,
+    or too short a history, gives inf; a history that already meets both, 0."""
+    rate = 10 ** (-1 / 4)
+    history = [(1e-2 * rate**k, 1e-3 * rate**k, 0.0) for k in range(17)]
+    assert remaining_iterations(history, 1e-9, 1e-9) == pytest.approx(12.0)
+    assert remaining_iterations(history[:12], 1e-9, 1e-9) == np.inf
+    flat = [(1e-3, 1e-3, 0.0)] * 20
+    assert remaining_iterations(flat, 1e-9, 1e-9) == np.inf
+    done = [(1e-10, 1e-10, 0.0)] * 20
+    assert remaining_iterations(done, 1e-9, 1e-9) == 0.0
 
 
 def test_penalty_too_low_needs_a_low_penalty_and_a_stuck_residual():
