@@ -115,8 +115,9 @@ def measure(comm, n_elements, args):
     scale, rod = scene()
     clock = time.perf_counter()
     mesh = Mesh(comm, n_elements, rod.length)
+    # the iteration alone: no Newton steps (their factorisations are not an iteration's)
     settings = Settings(asked_penalty=400.0 / scale**2, max_it=10**9, rtol=0.0, ctol=0.0,
-                        adapt_penalty=False, check_stability=False)
+                        adapt_penalty=False, check_stability=False, newton=False)
     solver = UzawaSolver(mesh, rod, settings)
     solver.state.set_straight()
     solver.prepare_step(0.125)

@@ -121,7 +121,9 @@ def remaining_iterations(history, rtol, ctol, window=10):
     """
     if len(history) < window + 3:
         return np.inf
-    distance = [max(change / rtol, residual / ctol) for change, residual, _ in history]
+    with np.errstate(divide="ignore", invalid="ignore"):      # a tolerance of 0: inf
+        distance = [max(np.float64(change) / rtol, np.float64(residual) / ctol)
+                    for change, residual, _ in history]
     now = min(distance[-3:])
     before = min(distance[-window - 3:-window])
     if now <= 1.0:
