@@ -163,13 +163,15 @@ class GlobalStep:
 
     def solve_centreline(self, state):
         """r' from its right-hand side rhs[2], bordered by r(L) - r(0) = int r' when both
-        ends are held, then r at the vertices by integration."""
+        ends are held, then r at the vertices by integration. With a seabed the z slope
+        is the vertical problem's (riser/terms.py), not solved here."""
+        components = (0, 1) if self.riser is not None and self.riser.seabed else (0, 1, 2)
         if self.bordered:
             chord = self.end_state.position - self.start_state.position
             state.chord_multiplier = self.slope_problem.solve_constrained(
-                self.rhs[2], state.slope, chord)
+                self.rhs[2], state.slope, chord, components)
         else:
-            self.slope_problem.solve(self.rhs[2], state.slope)
+            self.slope_problem.solve(self.rhs[2], state.slope, components)
         if self.riser is not None:
             self.riser.solve_vertical(self.rhs[2], state, self.bordered)
         self.integrate_slope(state)

@@ -160,8 +160,10 @@ class ScalarProblem:
         self._lift_rows = np.flatnonzero(np.any(lifts != 0.0, axis=1))
         self._lift_values = lifts[self._lift_rows]
 
-    def solve(self, rhs, solution):
-        """Solve for the three components: rhs, solution are VectorFields.
+    def solve(self, rhs, solution, components=(0, 1, 2)):
+        """Solve for the given components (x, y, z by default): rhs, solution are
+        VectorFields; the other components of ``solution`` are left as they are (the
+        seabed's vertical problem solves z its own way, riser/terms.py).
 
         The prescribed rows of ``rhs`` take the prescribed values and the lifting is
         subtracted from the rows next to them, in place, for the solve only: those few
@@ -180,16 +182,17 @@ class ScalarProblem:
             values[self._lift_rows] -= self._lift_values[:, c]
             values[self._local_rows] = self._fixed_values[:, c]
         try:
-            self._solve_columns(rhs, solution)
+            self._solve_columns(rhs, solution, components)
         finally:
             for vec, values in zip(rhs.components, kept):
                 vec.getArray()[touched] = values
 
-    def _solve_columns(self, rhs, solution):
+    def _solve_columns(self, rhs, solution, components):
         if self._columns is not None:
-            self._columns(rhs.components, solution.components)
+            self._columns([rhs.components[c] for c in components],
+                          [solution.components[c] for c in components])
             return
-        if self._factor is not None:
+        if self._factor is not None:        # the block of three (any other is left alone)
             rhs_block, solution_block = self._blocks
             block = rhs_block.getDenseArray()
             for c, vec in enumerate(rhs.components):
@@ -197,28 +200,32 @@ class ScalarProblem:
             rhs_block.assemble()
             self._factor.matSolve(rhs_block, solution_block)
             result = solution_block.getDenseArray()
-            for c in range(3):
+            for c in components:
                 solution.components[c].getArray()[:] = result[:, c]
             return
-        for vec, x in zip(rhs.components, solution.components):
-            self._solve_one(vec, x)
+        for c in components:
+            self._solve_one(rhs.components[c], solution.components[c])
 
-    def solve_constrained(self, rhs, solution, target):
-        """Solve the bordered system of add_integral_constraint for the three components.
+    def solve_constrained(self, rhs, solution, target, components=(0, 1, 2)):
+        """Solve the bordered system of add_integral_constraint for the given components.
 
         x0 = A^-1 b (solve), then mu = (c.x0 - target) / (c.w) and x = x0 - mu w, so that
         c.x = target. ``target`` (3,); returns mu (3,), the multiplier of the constraint
-        (one allreduce for the three components).
+        (one allreduce for the three components; 0 for a component not solved).
         """
         c, w = self._border
-        self.solve(rhs, solution)
+        self.solve(rhs, solution, components)
         # einsum, not a BLAS dot: a threaded OpenBLAS ddot waits for its threads on a
         # busy machine (docs/performance.md)
-        local = [np.einsum("i,i->", c.getArray(readonly=True), x.getArray(readonly=True))
-                 for x in solution.components]
-        mu = (self.mesh.global_sum(np.array(local)) - target) / self._c_dot_w
-        for x, value in zip(solution.components, mu):
-            x.axpy(-value, w)
+        local = np.zeros(3)
+        for k in components:
+            local[k] = np.einsum("i,i->", c.getArray(readonly=True),
+                                 solution.components[k].getArray(readonly=True))
+        mu = np.zeros(3)
+        solved = list(components)
+        mu[solved] = (self.mesh.global_sum(local)[solved] - target[solved]) / self._c_dot_w
+        for k in components:
+            solution.components[k].axpy(-mu[k], w)
         return mu
 
     def _report_failed_factorisation(self):

@@ -6,9 +6,9 @@ a current (docs/riser.md); it holds None instead when the scene has neither.
   mixes and at the heights of the last global step (for a current profile), times the
   load factor t: a function of the iterate, so that Anderson mixing sees it.
 * The seabed is part of the global step: the z slope is solved in Hermite dofs with the
-  contact by an active-set loop (hermite.py, seabed.py) and replaces the z component of
-  the P2 solve; when both ends are held, the z part of the chord multiplier is that
-  problem's residual at z(L).
+  contact by an active-set loop (hermite.py, seabed.py) in place of the z component of
+  the P2 solve (which then solves x and y only); when both ends are held, the z part of
+  the chord multiplier is that problem's residual at z(L).
 """
 
 import numpy as np
