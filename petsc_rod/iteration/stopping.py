@@ -123,9 +123,9 @@ def remaining_iterations(history, rtol, ctol, window=10):
         return np.inf
     with np.errstate(divide="ignore", invalid="ignore"):      # a tolerance of 0: inf
         distance = [max(np.float64(change) / rtol, np.float64(residual) / ctol)
-                    for change, residual, _ in history]
+                    for change, residual, _ in history[-window - 3:]]
     now = min(distance[-3:])
-    before = min(distance[-window - 3:-window])
+    before = min(distance[:3])
     if now <= 1.0:
         return 0.0
     if now >= before:
