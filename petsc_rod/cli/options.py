@@ -53,7 +53,10 @@ def _reals(count=None):
 
 
 def _int(text):
-    value = float(text)
+    try:
+        value = float(text)          # "1e6" is a whole number too
+    except ValueError:
+        raise ValueError("expected a whole number") from None
     if not np.isfinite(value) or abs(value) > MAX_INT:
         raise ValueError(f"expected a whole number of magnitude at most {MAX_INT} (a PETSc "
                          "integer)")

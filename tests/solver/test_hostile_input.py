@@ -58,6 +58,8 @@ REFUSED = {
     "rtol of 1": ("rod_al_rtol", "1", "below 1"),
     "zero ctol": ("rod_al_ctol", "0", "positive"),
     "inf elements": ("rod_elements", "inf", "whole number"),
+    "word elements": ("rod_elements", "abc", "whole number"),
+    "word Newton switch": ("rod_al_newton", "maybe", "true or false"),
     "elements beyond a PETSc integer": ("rod_elements", "1e12", "PETSc integer"),
     "inf steps": ("rod_steps", "inf", "whole number"),
     "nan steps": ("rod_steps", "nan", "whole number"),
