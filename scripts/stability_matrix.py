@@ -375,14 +375,26 @@ def cases():
 # --------------------------------------------------------------------- running
 
 
+def scene_option(options, key):
+    """The value of -rod_<key> for a case: its own, or that of its options file."""
+    if key in options:
+        return str(options[key])
+    with open(ROOT / options["options_file"], encoding="utf-8") as scene:
+        for line in scene:
+            words = line.split()
+            if len(words) == 2 and words[0] == f"-rod_{key}":
+                return words[1]
+    raise KeyError(f"{key} is neither a case option nor in {options['options_file']}")
+
+
 def before_options(case):
     """The case as it ran before the first measures of docs/stability.md (History B):
     the old default penalty, the straight start, no step halving, no link check, no raise
     of a low penalty."""
     options = dict(case.options)
     if "al_penalty" not in options:
-        K = max(float(v) for v in str(options["stiffness"]).split(","))
-        options["al_penalty"] = f"{400 * K / float(options['length'])**2:.6g}"
+        K = max(float(v) for v in scene_option(options, "stiffness").split(","))
+        options["al_penalty"] = f"{400 * K / float(scene_option(options, 'length'))**2:.6g}"
     options["initial_shape"] = "straight"
     options["max_halvings"] = 0
     options["al_adapt_penalty"] = 0
