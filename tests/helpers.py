@@ -1,6 +1,9 @@
 """Helpers for the tests (importable because conftest puts tests/ on sys.path)."""
 
 import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 
@@ -105,6 +108,36 @@ LAUNCHER_PREFIXES = ("PMIX_", "OMPI_COMM_WORLD", "OMPI_UNIVERSE_SIZE", "OMPI_FIR
 def child_env():
     """This environment without the variables of an enclosing mpiexec."""
     return {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_PREFIXES)}
+
+
+def mpiexec(ranks):
+    """The launcher words for ``ranks`` ranks ([] for one); skips the test when mpiexec
+    is not on PATH."""
+    import pytest
+
+    if ranks == 1:
+        return []
+    launcher = shutil.which("mpiexec")
+    if launcher is None:
+        pytest.skip("mpiexec is not on PATH")
+    return [launcher, "-n", str(ranks)]
+
+
+def petsc_rod_command(args, ranks=1):
+    """``python -m petsc_rod args``, under mpiexec for several ranks."""
+    return mpiexec(ranks) + [sys.executable, "-m", "petsc_rod"] + list(args)
+
+
+def run_petsc_rod(args, ranks=1, timeout=120):
+    """Run petsc_rod from the repository root in a clean environment; CompletedProcess
+    with stdout and stderr captured apart."""
+    return subprocess.run(petsc_rod_command(args, ranks), cwd=REPO_ROOT, env=child_env(),
+                          capture_output=True, text=True, timeout=timeout, check=False)
+
+
+def describe(process):
+    """A finished process's exit code and output, for an assertion message."""
+    return f"exit {process.returncode}\nstdout:\n{process.stdout}\nstderr:\n{process.stderr}"
 
 
 def png_summary(path):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from helpers import gather, make_solver
+from helpers import fitted_order, gather, make_solver
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration.continuation import record_step
 from petsc_rod.iteration.penalty import default_penalty
@@ -21,11 +21,6 @@ from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.scenes.catenary import catenary
-
-
-def fitted_order(n_elements, errors):
-    """Slope of log(error) against log(h) by least squares."""
-    return -np.polyfit(np.log(n_elements), np.log(errors), 1)[0]
 
 
 def solved(solver_factory, comm, n_elements, scene, start="straight", rtol=1e-12,

@@ -8,7 +8,6 @@ tests themselves run under mpiexec: mpiexec cannot nest). Exit codes: 0 converge
 import datetime
 import json
 import os
-import shutil
 import subprocess
 import sys
 
@@ -17,7 +16,7 @@ import numpy as np
 import pytest
 
 import petsc_rod
-from helpers import REPO_ROOT, child_env, png_summary
+from helpers import REPO_ROOT, child_env, describe, png_summary, run_petsc_rod
 from petsc_rod.plots import DPI, result_figure
 from petsc_rod.cli.options import OPTIONS
 
@@ -40,19 +39,13 @@ def cantilever_args():
     return base + ["-rod_elements", "32"]
 
 
-def run(args, launcher=()):
+def run(args, ranks=1):
     """Run petsc_rod with ``args`` from the repository root; returns CompletedProcess."""
-    command = list(launcher) + [sys.executable, "-m", "petsc_rod"] + list(args)
-    return subprocess.run(command, cwd=REPO_ROOT, env=child_env(), capture_output=True,
-                          text=True, timeout=TIMEOUT, check=False)
+    return run_petsc_rod(args, ranks, TIMEOUT)
 
 
 def output_lines(process):
     return [line for line in (process.stdout + process.stderr).splitlines() if line.strip()]
-
-
-def describe(process):
-    return f"exit {process.returncode}\nstdout:\n{process.stdout}\nstderr:\n{process.stderr}"
 
 
 @pytest.fixture(scope="module")
@@ -299,13 +292,10 @@ def test_help_lists_every_option():
 
 
 def test_two_ranks_write_the_same_result(cantilever, folder):
-    mpiexec = shutil.which("mpiexec")
-    if mpiexec is None:
-        pytest.skip("mpiexec is not on PATH: cannot run the 2-rank cantilever")
     path, first = cantilever
     assert first.returncode == 0, describe(first)
     out = folder / "c_np2.h5"
-    process = run(cantilever_args() + ["-rod_output", str(out)], launcher=[mpiexec, "-n", "2"])
+    process = run(cantilever_args() + ["-rod_output", str(out)], ranks=2)
     assert process.returncode == 0, describe(process)
     with h5py.File(path, "r") as f, h5py.File(out, "r") as g:
         assert int(g.attrs["ranks"]) == 2

@@ -2,14 +2,12 @@
 per accepted step with them (spawns python -m petsc_rod: marked serial)."""
 
 import os
-import subprocess
-import sys
 
 import h5py
 import numpy as np
 import pytest
 
-from helpers import BENT, PULLED, REPO_ROOT, child_env
+from helpers import BENT, PULLED, describe, run_petsc_rod
 from helpers import HALVING_CTOL as CTOL, HALVING_ELEMENTS as N_ELEMENTS, HALVING_RTOL as RTOL
 
 
@@ -28,13 +26,7 @@ def cli_args(case):
 
 
 def run_cli(args):
-    return subprocess.run([sys.executable, "-m", "petsc_rod"] + args, cwd=REPO_ROOT,
-                          env=child_env(), capture_output=True, text=True, timeout=TIMEOUT,
-                          check=False)
-
-
-def describe(process):
-    return f"exit {process.returncode}\nstdout:\n{process.stdout}\nstderr:\n{process.stderr}"
+    return run_petsc_rod(args, timeout=TIMEOUT)
 
 
 @pytest.mark.serial

@@ -17,7 +17,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, child_env
+from helpers import REPO_ROOT, child_env, mpiexec, petsc_rod_command, run_petsc_rod
 
 pytestmark = pytest.mark.serial
 
@@ -31,26 +31,12 @@ LONG = ["-rod_elements", "32", "-rod_end_force", "0,-3,0", "-rod_al_penalty", "1
         "-rod_snes_type", "nrichardson", "-rod_al_newton", "0"]
 
 
-def mpiexec(ranks):
-    if ranks == 1:
-        return []
-    launcher = shutil.which("mpiexec")
-    if launcher is None:
-        pytest.skip("mpiexec is not on PATH")
-    return [launcher, "-n", str(ranks)]
-
-
-def command(args, ranks=1):
-    return mpiexec(ranks) + [sys.executable, "-m", "petsc_rod"] + list(args)
-
-
 def run(args, ranks=1):
-    return subprocess.run(command(args, ranks), cwd=REPO_ROOT, env=child_env(),
-                          capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    return run_petsc_rod(args, ranks, TIMEOUT)
 
 
 def start(args, ranks=1):
-    return subprocess.Popen(command(args, ranks), cwd=REPO_ROOT, env=child_env(),
+    return subprocess.Popen(petsc_rod_command(args, ranks), cwd=REPO_ROOT, env=child_env(),
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 

@@ -2,7 +2,6 @@
 settings), their result files and figures, and the riser's bad input: one line, exit 2,
 no file. Spawns processes: marked ``serial``."""
 
-import os
 import subprocess
 import sys
 
@@ -10,8 +9,8 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, child_env
-from test_hostile_cli import assert_one_line_and_nothing_left, mpiexec
+from helpers import REPO_ROOT, child_env, png_summary, run_petsc_rod
+from test_hostile_cli import assert_one_line_and_nothing_left
 
 pytestmark = pytest.mark.serial
 
@@ -19,9 +18,7 @@ TIMEOUT = 300
 
 
 def run(args, ranks=1):
-    command = mpiexec(ranks) + [sys.executable, "-m", "petsc_rod"] + list(args)
-    return subprocess.run(command, cwd=REPO_ROOT, env=child_env(), capture_output=True,
-                          text=True, timeout=TIMEOUT, check=False)
+    return run_petsc_rod(args, ranks, TIMEOUT)
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +63,8 @@ def test_the_riser_figure(scenes, tmp_path):
                           cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
                           timeout=TIMEOUT, check=False)
     assert done.returncode == 0, done.stderr
-    assert figure.stat().st_size > 20000
+    height, width, drawn = png_summary(figure)
+    assert height > 300 and width > 600 and drawn > 0.02
 
 
 SCENE = ["-rod_length", "10", "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position",

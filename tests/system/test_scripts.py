@@ -58,13 +58,11 @@ def test_error_vs_time_writes_csv_and_plot(error_vs_time):
 
 
 def test_error_vs_time_same_numbers_on_one_and_two_ranks(error_vs_time):
-    """At the tightest tolerance both rank counts reach it, with errors equal to 1e-9.
-
-    The iteration counts are not compared: Anderson mixing's least-squares step amplifies
-    round-off (5e-13 grows to 1e-2 in the iterate within 44 iterations), so its path, and
-    the count to a tolerance, depend on the order of the sums. On one rank, equally exact
-    global-step solvers give 124 to 146 iterations for the quick cantilever; 1 and 2
-    ranks give 129 and 146 (docs/performance.md). The states agree to the tolerances."""
+    """At the tightest tolerance both rank counts reach it, with errors equal to 1e-9,
+    in iteration counts within 10% of each other. (Anderson mixing alone amplifies
+    round-off, so its counts depended on the order of the sums: 129 and 146 on the quick
+    cantilever, docs/performance.md; with the Newton steps near the solution the quick
+    runs take the same counts on 1 and 2 ranks, 21, 19 and 295.)"""
     _, rows, _ = error_vs_time
     by_key = defaultdict(dict)
     for row in rows:
@@ -76,6 +74,8 @@ def test_error_vs_time_same_numbers_on_one_and_two_ranks(error_vs_time):
     assert len(tightest) >= 3
     for runs in tightest:
         assert float(runs[2.0]["tightest"]) == 1.0
+        one, two = float(runs[1.0]["iterations"]), float(runs[2.0]["iterations"])
+        assert abs(one - two) <= 0.1 * one, (one, two)
         for column in ("position_error", "director_error", "energy_error"):
             one, two = float(runs[1.0][column]), float(runs[2.0][column])
             assert abs(one - two) <= 1e-9, (column, one, two)

@@ -64,6 +64,10 @@ def test_current_profile_is_linear_in_depth_and_constant_beyond():
     expected = [[1, 0, 0], [1, 0, 0], [0.5, 0.25, 0], [0, 0.5, 0], [0, 0.5, 0]]
     assert np.allclose(current.velocity(z), expected)
     assert current.largest_drag() == 1.0
+    # c max |v|^2 with c = 2 and a top speed of 3 m/s (the largest of two speeds)
+    strong = Current(np.array([0.0, 100.0]), np.array([[3.0, 0.0, 0.0], [0.0, 2.0, 0.0]]),
+                     surface=10.0, drag=2.0)
+    assert strong.largest_drag() == pytest.approx(18.0)
 
 
 @pytest.mark.parametrize("text, words", [
