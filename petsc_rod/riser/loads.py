@@ -36,10 +36,14 @@ class NodalLoad:
         self.mesh = mesh
         self._field = field           # a VectorField, for the ghost exchange
         h = mesh.element_h
-        self._phi, _ = p2_basis(GAUSS_POINTS, h)
-        self._after = (element_integrals(h)[:, None, :]
-                       - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_k, (ne, nq, 3)
-        self._weights = h[:, None] * GAUSS_WEIGHTS[None, :]
+        phi, _ = p2_basis(GAUSS_POINTS, h)
+        after = (element_integrals(h)[:, None, :]
+                 - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_l, (ne, nq, 3)
+        weighted = h[:, None, None] * GAUSS_WEIGHTS[None, :, None] * phi   # w_q N_k(S_q)
+        # the constant parts of element_vectors, made once: int_e g_k and
+        # int_e g_k(S) int_S^{S_e+1} N_l dS, (ne, 3) and (ne, 3, 3)
+        self._basis_integrals = weighted.sum(axis=1)
+        self._tail_integrals = np.einsum("eqk,eql->ekl", weighted, after)
         self._integrals = element_integrals(h)
         self.set(np.zeros((mesh.n_local_nodes, 3)))
 
@@ -59,7 +63,9 @@ class NodalLoad:
         return self.total - self.before
 
     def element_vectors(self, offset):
-        """int_e F g_k dS, (ne, 3, 3), F(S) = int_S^L f_h dS + ``offset`` (3,)."""
-        F = (self._beyond + offset)[:, None, :] + np.einsum(
-            "eqk,ekc->eqc", self._after, self.element_values)
-        return np.einsum("eq,eqk,eqc->ekc", self._weights, self._phi, F)
+        """int_e F g_k dS, (ne, 3, 3), F(S) = int_S^L f_h dS + ``offset`` (3,): with
+        F = B_e + offset + sum_l f_l int_S^{S_e+1} N_l, the integrals of g_k and of
+        g_k int_S N_l are constants of the mesh (made in __init__)."""
+        out = self._basis_integrals[:, :, None] * (self._beyond + offset)[:, None, :]
+        out += np.matmul(self._tail_integrals, self.element_values)
+        return out
