@@ -20,7 +20,8 @@ of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of the slope d
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.matrices import KSP_REASONS, PARALLEL_DEFAULTS, assemble_matrix
+from petsc_rod.global_step.matrices import (KSP_REASONS, PARALLEL_DEFAULTS, SERIAL_DEFAULTS,
+                                             assemble_matrix)
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.petsc_defaults import set_from_options_with_defaults
 
@@ -61,8 +62,9 @@ class VerticalProblem:
     per element (set_added: the seabed), with essential conditions on y.
 
     ``slope_matrices`` (ne, 3, 3) are the element matrices of the slope problem (2 c3 K +
-    R W). The KSP (prefix ``prefix``) is preonly + Cholesky on one rank and
-    assembly.PARALLEL_DEFAULTS on several, like the other global-step solvers.
+    R W). The KSP (prefix ``prefix``) is preonly + Cholesky in the natural order on one
+    rank and the parallel default on several (matrices.SERIAL_DEFAULTS and
+    PARALLEL_DEFAULTS), like the other global-step solvers.
     """
 
     def __init__(self, mesh, slope_matrices, prefix):
@@ -85,9 +87,11 @@ class VerticalProblem:
         self.ksp.setType(PETSc.KSP.Type.PREONLY)
         self.ksp.getPC().setType(PETSc.PC.Type.CHOLESKY)
         self.ksp.setOptionsPrefix(prefix)
-        parallel = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else {}
+        # the slope problem's defaults (matrices.py): the natural order on one rank, in
+        # which the chain is a band matrix without fill
+        defaults = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else SERIAL_DEFAULTS
         set_from_options_with_defaults(
-            self.ksp, {f"{prefix}{key}": value for key, value in parallel.items()})
+            self.ksp, {f"{prefix}{key}": value for key, value in defaults.items()})
 
     def _slope_matrix(self, T):
         """T as a DMDA matrix: rows the P2 slope dofs, columns the Hermite dofs (the
