@@ -50,13 +50,6 @@ def midpoint_values(h):
     return np.stack([np.full_like(h, 0.5), h / 8, np.full_like(h, 0.5), -h / 8], axis=1)
 
 
-def node_heights(dofs, h):
-    """z at each owned element's (left vertex, midpoint, right vertex), (ne, 3), from its
-    Hermite dofs (ne, 4)."""
-    middle = np.einsum("ek,ek->e", midpoint_values(h), dofs)
-    return np.stack([dofs[:, 0], middle, dofs[:, 2]], axis=1)
-
-
 class VerticalProblem:
     """T^T A T y = T^T b for the z component of the slope, plus a symmetric term added
     per element (set_added: the seabed), with essential conditions on y.

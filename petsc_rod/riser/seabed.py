@@ -20,7 +20,7 @@ within a millimetre (measured in docs/riser.md).
 import numpy as np
 
 from petsc_rod.mesh.elements import NODE_WEIGHTS
-from petsc_rod.riser.hermite import midpoint_values, node_heights
+from petsc_rod.riser.hermite import midpoint_values
 
 # The active-set loop of one global step ends after this many solves even if the set
 # still changes; the next iteration starts from the last set (a cycle between two sets
@@ -50,9 +50,12 @@ class SeabedContact:
         self._local = mesh.da.createLocalVec()
 
     def _set_active(self, active):
+        """The spring k w_n at the active nodes: element matrices E^T diag(k w) E and
+        vectors k z_b E^T (k w), (ne, 4, 4) and (ne, 4)."""
         spring = self.seabed.stiffness * self.weights * active
-        self.problem.set_added(np.einsum("en,enk,enl->ekl", spring, self.rows, self.rows),
-                               self.seabed.height * np.einsum("en,enk->ek", spring, self.rows))
+        weighted = self.rows.transpose(0, 2, 1) * spring[:, None, :]         # (ne, 4, 3)
+        self.problem.set_added(np.matmul(weighted, self.rows),
+                               self.seabed.height * weighted.sum(axis=2))
         self.active = active
 
     def heights(self, y):
@@ -61,7 +64,7 @@ class SeabedContact:
         ghosted = self._local.getArray(readonly=True).reshape(-1, 2)
         left = self.mesh.element_local
         dofs = np.concatenate([ghosted[left], ghosted[left + 1]], axis=1)
-        return node_heights(dofs, self.mesh.element_h)
+        return np.einsum("enk,ek->en", self.rows, dofs)
 
     def solve(self, slope_rhs, slope):
         """The vertical problem with the seabed (module docstring): sets ``slope`` (the z
