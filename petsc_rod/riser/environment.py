@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.scenes.boundary import is_held
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
@@ -138,7 +139,7 @@ def check_ends_above(seabed, ends, length):
         return
     for name, state in ends:
         depth = seabed.height - state.position[2]
-        if state.kind != "free" and depth > 1e-12 * length:
+        if is_held(state) and depth > 1e-12 * length:
             raise RodInputError(
                 f"{name}: the end is held at z = {state.position[2]:.6g} m, {depth:.3g} m "
                 f"below the seabed (-rod_seabed {seabed.height:g}); hold it on or above it")
@@ -150,5 +151,5 @@ def environment_from_options(values, given, scene):
     ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
     ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
     check_ends_above(seabed, ends, scene.length)
-    held = [state.position[2] for _, state in ends if state.kind != "free"]
+    held = [state.position[2] for _, state in ends if is_held(state)]
     return seabed, current_from_options(values, given, max(held))

@@ -24,6 +24,7 @@ from petsc_rod.global_step.matrices import (KSP_REASONS, PARALLEL_DEFAULTS, SERI
                                              assemble_matrix)
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.petsc_defaults import set_from_options_with_defaults
+from petsc_rod.scenes.boundary import is_held
 
 
 def hermite_rows(mesh):
@@ -104,7 +105,7 @@ class VerticalProblem:
         last = 2 * self.mesh.n_elements
         fixed = []
         for row, state in ((0, start), (last, end)):
-            if state.kind in ("clamp", "pin"):
+            if is_held(state):
                 fixed.append((row, state.position[2]))
             if state.kind == "clamp":
                 fixed.append((row + 1, state.frame[2, 2]))
