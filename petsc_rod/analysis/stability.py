@@ -27,6 +27,7 @@ from petsc4py import PETSc
 
 from petsc_rod.mesh.elements import P2, p2_element_matrices
 from petsc_rod.mesh.fields import element_dofs
+from petsc_rod.scenes.boundary import clamped_nodes
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
@@ -111,28 +112,27 @@ class SecondVariation:
         self.matrix.assemble()
 
     def _clamped_rows(self):
-        solver, mesh = self.solver, self.solver.mesh
-        rows = []
-        if solver.global_step.start_state.kind == "clamp" and mesh.on_lower_boundary:
-            rows += [0, 1, 2]
-        if solver.global_step.end_state.kind == "clamp" and mesh.on_upper_boundary:
-            last = 3 * 2 * mesh.n_elements
-            rows += [last, last + 1, last + 2]
-        return np.array(rows, dtype=PETSc.IntType)
+        """Global rows of the rotation vectors at clamped nodes."""
+        step = self.solver.global_step
+        nodes = np.flatnonzero(clamped_nodes(self.solver.mesh, step.start_state,
+                                             step.end_state))
+        return (self.first_row + 3 * nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
 
-    def _chord_columns(self):
-        """The 3 linear forms omega -> sum_n w_n (omega_n x tau3_n)_k, as Vecs (zero at
-        clamped rows)."""
-        solver = self.solver
-        tangent = solver.state.tau[:, 2]
-        forms = -solver.state.node_weights[:, None, None] * skew(tangent)    # (n, k, 3)
+    def chord_forms(self, tangents):
+        """The 3 linear forms omega -> sum_n w_n (omega_n x t_n)_k, the first variation of
+        the chord int r' dS at tangents t (n_nodes, 3), as Vecs (zero at clamped rows)."""
+        forms = -self.solver.state.node_weights[:, None, None] * skew(tangents)   # (n, k, 3)
         columns = []
         for k in range(3):
             vec = self.matrix.createVecLeft()
             vec.getArray()[:] = forms[:, k, :].ravel()
             self._zero_clamped(vec)
             columns.append(vec)
-        return self._independent(columns)
+        return columns
+
+    def _chord_columns(self):
+        """An orthonormal basis of the chord forms at tau3 (the constraint of the test)."""
+        return self._independent(self.chord_forms(self.solver.state.tau[:, 2]))
 
     @staticmethod
     def _independent(columns):

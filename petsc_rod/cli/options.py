@@ -17,6 +17,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.iteration.driver import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
 SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_")
@@ -189,13 +190,13 @@ OPTIONS = [
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
            "not with a current (its drag has no energy)"),
     Option("rod_al_newton", _bool, True, "bool",
-           "from the 15th iteration of a step, while change and residual are below 0.1 "
-           "and more than 30 iterations would remain at the recent rate, try Newton steps "
-           "on the reduced problem (frames turned by the KKT system of "
-           "the energy's second variation), taken only where it is positive definite; "
-           "where it is not and change and residual are below 0.01, the state is near a "
-           "saddle and is left at once; after a failed attempt the wait doubles; not with "
-           "a seabed or a current"),
+           f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
+           f"{NEWTON_SWITCH:g} and more than {NEWTON_WORTH} iterations would remain at the "
+           "recent rate, try Newton steps on the reduced problem (frames turned by the KKT "
+           "system of the energy's second variation), taken only where it is positive "
+           f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
+           "the state is near a saddle and is left at once; after a failed attempt the wait "
+           "doubles; not with a seabed or a current"),
     Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, True, "bool",
            "raise R tenfold, refactoring the matrices, while it is below a tenth of the "

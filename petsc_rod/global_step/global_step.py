@@ -41,11 +41,11 @@ class GlobalStep:
         self.load = VectorField(mesh, "load")
         self.load_offset = np.zeros(3)
         self.anchor_work = 0.0
-        self.lagged = None
-        if np.any(matrix_split != split):
-            # the stiffness K of the lagged part, and two work vectors for K tau_i
-            self.lagged = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 1.0, 0.0))
-            self._lagged_work = self.lagged.createVecs()
+        self.lags = bool(np.any(matrix_split != split))
+        self._stiffness = None
+        if self.lags:
+            # two work vectors for K tau_i
+            self._lagged_work = self.stiffness().createVecs()
         self.problems = []
         # int_e phi_k dS, (3, ne), and work arrays of the slope's integration
         self._integrals = np.ascontiguousarray(element_integrals(mesh.element_h).T)
@@ -142,7 +142,7 @@ class GlobalStep:
         for i, columns in enumerate(targets):        # the phantom slot of the last vertex
             for c, values in enumerate(columns):
                 values[n:] = loads[c][n:] if i == 2 else 0.0
-        if self.lagged is not None:
+        if self.lags:
             self._add_lagged_part(tau)
 
     def _add_lagged_part(self, tau):
@@ -158,8 +158,17 @@ class GlobalStep:
                 values = work.getArray()
                 values[:n] = tau[:, i, c]
                 values[n:] = 0.0
-                self.lagged.mult(work, product)
+                self._stiffness.mult(work, product)
                 vec.axpy(factor, product)
+
+    def stiffness(self):
+        """K = int g_k' g_l' dS on the P2 dofs (unit coefficient): the matrix of the
+        lagged part and of the energy's gradient (iteration/newton.py), assembled on
+        first use, once."""
+        if self._stiffness is None:
+            self._stiffness = assemble_matrix(
+                self.mesh, p2_element_matrices(self.mesh.element_h, 1.0, 0.0))
+        return self._stiffness
 
     def solve_centreline(self, state):
         """r' from its right-hand side rhs[2], bordered by r(L) - r(0) = int r' when both
@@ -216,9 +225,11 @@ class GlobalStep:
 
     def destroy(self):
         self._destroy_problems()
-        if self.lagged is not None:
-            for obj in (self.lagged, *self._lagged_work):
+        if self.lags:
+            for obj in self._lagged_work:
                 obj.destroy()
+        if self._stiffness is not None:
+            self._stiffness.destroy()
         for obj in [*self.rhs, self.load]:
             obj.destroy()
         if self.riser is not None:

@@ -139,6 +139,9 @@ class UzawaSolver:
         try:
             self._iterate(step)
             while step.outcome == stopping.CONVERGED and self.tests_stability:
+                if step.newton_verified == len(step.history) - 1:
+                    step.stable = True      # Newton's last factorisation, one iteration ago
+                    break
                 step.stable, direction = self.check_stability()
                 if step.stable is not False:
                     break
@@ -179,12 +182,16 @@ class UzawaSolver:
                 continue
             if step.outcome != stopping.RAISE_PENALTY:
                 break
-            self.global_step.build(penalty_policy.raised_penalty(self.penalty, self.scale))
-            step.raises.append((len(step.history), self.penalty))
+            self._raise_penalty(step, penalty_policy.raised_penalty(self.penalty, self.scale))
             step.outcome = None
         if step.outcome is None and step.error is None:   # the SNES stopped on its own test
             reason = self.snes.getConvergedReason()
             step.outcome = (False, f"snes_{SNES_REASONS.get(reason, reason)}")
+
+    def _raise_penalty(self, step, penalty):
+        """Refactor the global step at a larger penalty, recorded in the step's raises."""
+        self.global_step.build(penalty)
+        step.raises.append((len(step.history), penalty))
 
     def _escape(self, step, direction, early=False):
         """Turn the frames along ``direction`` (n_nodes, 3), a direction of negative
@@ -214,10 +221,11 @@ class UzawaSolver:
             step.newton_steps += 1
         outcome = self.newton.run(record)
         if outcome == newton.CONVERGED:
+            if self.newton.verified:
+                step.newton_verified = len(step.history)
             least = self.newton.least_penalty()
             if least >= self.penalty:
-                self.global_step.build(NEWTON_RAISE * least)
-                step.raises.append((len(step.history), self.penalty))
+                self._raise_penalty(step, NEWTON_RAISE * least)
             return
         step.newton_failures += 1
         change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)

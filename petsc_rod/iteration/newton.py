@@ -31,8 +31,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.stability import SecondVariation, skew
 from petsc_rod.frames import rotations
-from petsc_rod.global_step.matrices import assemble_matrix
-from petsc_rod.mesh.elements import p2_element_matrices
+from petsc_rod.scenes.boundary import clamped_nodes
 
 EVENT = PETSc.Log.Event("rod_newton")
 
@@ -48,15 +47,20 @@ CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 
 class NewtonPolish:
-    """Newton steps of the module docstring on a solver's state. Owns the stiffness
-    matrix K and a work Vec; ``destroy()`` frees them (the second variation of each step
+    """Newton steps of the module docstring on a solver's state. Owns a work Vec for K d
+    (K is the global step's); ``destroy()`` frees it (the second variation of each step
     is made and destroyed within the step)."""
 
     def __init__(self, solver):
         self.solver = solver
-        mesh = solver.mesh
-        self.stiffness = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 1.0, 0.0))
+        step = solver.global_step
+        self.stiffness = step.stiffness()
         self._product = self.stiffness.createVecLeft()
+        # the ends' kinds do not change: the clamped nodes are those of the whole run
+        self._free = ~clamped_nodes(solver.mesh, step.start_state, step.end_state)
+        # whether the last step's H was tested on the constraint set (decidable) and found
+        # positive definite: the stability test's verdict, at 1e-10 rad from the result
+        self.verified = False
 
     def run(self, record=None):
         """Newton steps from the state's current tau (rotations near the fields). Returns
@@ -69,14 +73,14 @@ class NewtonPolish:
         EVENT.begin()
         saved = state.snapshot()
         frames = state.tau.copy()
-        clamped = ~self._free_nodes()
+        clamped = ~self._free
         frames[clamped] = state.node_directors()[clamped]      # the prescribed frames
         mu = None
         previous = np.inf
         outcome = FAILED
         try:
             for _ in range(MAX_STEPS):
-                self._set_frames(frames)
+                self.solver.state.set_node_directors(frames)
                 g = self._energy_gradient(frames)
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
                 omega, dmu = self._newton_step(frames, g, mu)
@@ -100,11 +104,6 @@ class NewtonPolish:
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
-    def _set_frames(self, frames):
-        """The fields d1, d2, r' from node frames (n_nodes, 3, 3), and r by integration."""
-        self.solver.state.set_node_directors(frames)
-        self.solver.global_step.integrate_slope(self.solver.state)
-
     def _energy_gradient(self, frames):
         """g_i = dE/dd_i at the nodes, (n_nodes, 3, 3): 2 a_i K d_i, less b for d3."""
         solver = self.solver
@@ -131,38 +130,24 @@ class NewtonPolish:
         w = self.solver.state.node_weights
         a = np.cross(frames, g).sum(axis=1)
         A = w[:, None, None] * skew(frames[:, 2])          # w d3 x mu = A mu
-        free = self._free_nodes()
+        free = self._free
         normal = np.einsum("nki,nkj->ij", A[free], A[free])
         right = -np.einsum("nki,nk->i", A[free], a[free])
         total = self.solver.mesh.global_sum(np.concatenate([normal.ravel(), right]))
         return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
 
-    def _free_nodes(self):
-        """Mask of the owned nodes whose frame is not clamped, (n_nodes,)."""
-        solver, mesh = self.solver, self.solver.mesh
-        free = np.ones(mesh.n_local_nodes, dtype=bool)
-        if solver.global_step.start_state.kind == "clamp" and mesh.on_lower_boundary:
-            free[0] = False
-        if solver.global_step.end_state.kind == "clamp" and mesh.on_upper_boundary:
-            free[-1] = False
-        return free
-
     def _newton_step(self, frames, g, mu):
         """(omega (n_nodes, 3), dmu (3,)) of the KKT system, or (None, None) where H is
         not positive definite on the constraint set."""
-        solver = self.solver
-        state, w = solver.state, solver.state.node_weights
-        g = g.copy()
-        g[:, 2] += w[:, None] * mu
+        g = self._set_multipliers(frames, g, mu)
         gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
-        gradient[~self._free_nodes()] = 0.0
-        state.tau[:] = frames
-        state.lam[:] = -g / w[:, None, None]
-        hessian = SecondVariation(solver)
+        gradient[~self._free] = 0.0
+        hessian = SecondVariation(self.solver)
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
             if not self._positive_definite(hessian):
                 return None, None
+            self.verified = hessian.decidable
             rhs = hessian.matrix.createVecLeft()
             vecs.append(rhs)
             rhs.getArray()[:] = -gradient.ravel()
@@ -172,7 +157,7 @@ class NewtonPolish:
             if self._bordered():
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
                 # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
-                columns = self._chord_columns(hessian, frames)
+                columns = hessian.chord_forms(frames[:, 2])
                 vecs.extend(columns)
                 solved = [hessian.solve(column) for column in columns]
                 vecs.extend(solved)
@@ -197,17 +182,6 @@ class NewtonPolish:
         hessian.factorise(-hessian.tolerance())
         return int(hessian.factor.getInertia()[0]) == 0
 
-    def _chord_columns(self, hessian, frames):
-        """The rows of C as Vecs: omega -> sum_n w_n (omega_n x d3_n)_k, k = 0, 1, 2."""
-        forms = -self.solver.state.node_weights[:, None, None] * skew(frames[:, 2])
-        columns = []
-        for k in range(3):
-            vec = hessian.matrix.createVecLeft()
-            vec.getArray()[:] = forms[:, k, :].ravel()
-            vec.getArray()[np.repeat(~self._free_nodes(), 3)] = 0.0
-            columns.append(vec)
-        return columns
-
     def _chord_residual(self, frames):
         """c = sum_n w_n d3_n - (r(L) - r(0)), (3,)."""
         step = self.solver.global_step
@@ -219,15 +193,24 @@ class NewtonPolish:
         """The state as the Uzawa fixed point at ``frames``: fields, r, tau = d and
         lambda = -g / w (with the chord's share in lambda3; 0 at a clamped node)."""
         state = self.solver.state
-        self._set_frames(frames)
-        g = self._energy_gradient(frames)
-        g[:, 2] += state.node_weights[:, None] * mu
-        state.tau[:] = frames
-        state.lam[:] = -g / state.node_weights[:, None, None]
+        state.set_node_directors(frames)
+        self.solver.global_step.integrate_slope(state)
+        self._set_multipliers(frames, self._energy_gradient(frames), mu)
         # a clamped frame is prescribed, not solved for: its multiplier is free, and 0
         # is one the local step keeps (P(R d) = d)
-        state.lam[~self._free_nodes()] = 0.0
+        state.lam[~self._free] = 0.0
         state.remember()
+
+    def _set_multipliers(self, frames, g, mu):
+        """tau = frames and lambda = -g / w with g the gradient of L (the chord's mu w in
+        its d3 rows); returns that g, (n_nodes, 3, 3). H is assembled from these."""
+        state = self.solver.state
+        w = state.node_weights
+        g = g.copy()
+        g[:, 2] += w[:, None] * mu
+        state.tau[:] = frames
+        state.lam[:] = -g / w[:, None, None]
+        return g
 
     def least_penalty(self):
         """The R above which the handed-over state is a fixed point of the Uzawa map:
@@ -240,5 +223,4 @@ class NewtonPolish:
         return self.solver.mesh.global_max(float(-lowest.min(initial=0.0)))
 
     def destroy(self):
-        for obj in (self.stiffness, self._product):
-            obj.destroy()
+        self._product.destroy()

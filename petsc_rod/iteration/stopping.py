@@ -71,6 +71,10 @@ class StepProgress:
     newton_next: int = 0        # the iteration from which Newton may be tried again
     newton_failures: int = 0    # attempts that did not converge
     early_escapes: int = 0      # saddles left before converging to them (driver._polish)
+    # the iteration at which Newton converged with H positive definite on the constraint
+    # set (the stability test's own criterion): the state is stable if the step
+    # converges at the next one
+    newton_verified: int = None
 
     @property
     def finished(self):

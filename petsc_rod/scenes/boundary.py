@@ -28,6 +28,17 @@ def director_prescribed(index, start, end, n_elements):
     return dofs
 
 
+def clamped_nodes(mesh, start, end):
+    """Mask of the owned P2 nodes whose frame a clamp prescribes, (n_nodes,): the first
+    node at a clamped start, the last at a clamped end, on the ranks that own them."""
+    clamped = np.zeros(mesh.n_local_nodes, dtype=bool)
+    if start.kind == "clamp" and mesh.on_lower_boundary:
+        clamped[0] = True
+    if end.kind == "clamp" and mesh.on_upper_boundary:
+        clamped[-1] = True
+    return clamped
+
+
 def is_held(state):
     """Whether the end's position is prescribed (a clamp or a pin)."""
     return state.kind in HELD
