@@ -38,10 +38,9 @@ import petsc4py
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
-from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
+from petsc_rod.iteration.driver import UzawaSolver, default_anderson_depth  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
-from petsc_rod.resources import anderson_depth, ranks_on_this_machine  # noqa: E402
 from petsc_rod.scenes.scene import Scene  # noqa: E402
 
 PHASES = ("rhs", "solve", "projection", "multiplier", "norms")
@@ -73,12 +72,9 @@ def counters():
 
 def anderson_history(mesh):
     """The depth m of Anderson mixing the driver picks (-rod_snes_anderson_m, or
-    resources.anderson_depth as in UzawaSolver._create_snes)."""
+    driver.default_anderson_depth)."""
     given = PETSc.Options().getInt("rod_snes_anderson_m", 0)
-    if given:
-        return given
-    here = ranks_on_this_machine(mesh.comm)
-    return int(mesh.global_min(anderson_depth(mesh.n_local_elements, here)))
+    return given or default_anderson_depth(mesh)
 
 
 def scene():

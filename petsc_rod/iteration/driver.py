@@ -68,6 +68,13 @@ def check_anderson_depth():
                                 "mixing is a whole number of at least 1")
 
 
+def default_anderson_depth(mesh):
+    """The depth of Anderson mixing unless -rod_snes_anderson_m says otherwise: the
+    smallest over the ranks of resources.anderson_depth. Collective."""
+    here = ranks_on_this_machine(mesh.comm)
+    return int(mesh.global_min(anderson_depth(mesh.n_local_elements, here)))
+
+
 class UzawaSolver:
     """The iteration on one mesh and scene: a RodState, a GlobalStep and the SNES that
     drives them. Owns every PETSc object of the solve; ``destroy()`` releases them."""
@@ -113,9 +120,7 @@ class UzawaSolver:
             # nrichardson's default line search (secant) is not the plain iteration
             defaults["rod_snes_linesearch_type"] = "basic"
         if kind == PETSc.SNES.Type.ANDERSON:
-            here = ranks_on_this_machine(self.mesh.comm)
-            defaults["rod_snes_anderson_m"] = str(int(self.mesh.global_min(
-                anderson_depth(self.mesh.n_local_elements, here))))
+            defaults["rod_snes_anderson_m"] = str(default_anderson_depth(self.mesh))
         set_from_options_with_defaults(snes, defaults)
 
     # --- one continuation step ------------------------------------------------------
