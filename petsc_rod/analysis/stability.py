@@ -64,21 +64,36 @@ class SecondVariation:
         self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
                                             nnz=(15, 6), comm=self.comm)
         self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        self._assemble()
         self._clamped = self._clamped_rows()
-        self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
-        self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        self._diagonal = self.matrix.getDiagonal()
-        self.constraint = self._chord_columns() if solver.global_step.bordered else []
-        # a taut, straight rod: the chord fixes the whole state and its forms are
-        # dependent; the second variation says nothing there (no constraint
-        # qualification), and the state is the only one the ends allow
-        self.decidable = len(self.constraint) == 3 or not solver.global_step.bordered
+        self._diagonal = self.matrix.createVecLeft()
+        self.constraint = []
+        self._fill()
         self.mass = self._mass()
         self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
         self._mass_or_one.getArray()[self._clamped - self.first_row] = 1.0
         self._work = self.mass.duplicate()
         self._create_solver()
+
+    def update(self):
+        """H at the solver's current state, in the same matrix. Its nonzero pattern is
+        the mesh's, so the factorisations that follow reuse MUMPS's analysis (the
+        symbolic factorisation: two thirds of the first factorisation's time)."""
+        self.matrix.zeroEntries()
+        self._fill()
+
+    def _fill(self):
+        """Assemble H at the current state, with its diagonal and the chord constraint."""
+        self._assemble()
+        self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
+        self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self.matrix.getDiagonal(self._diagonal)
+        for vec in self.constraint:
+            vec.destroy()
+        self.constraint = self._chord_columns() if self.solver.global_step.bordered else []
+        # a taut, straight rod: the chord fixes the whole state and its forms are
+        # dependent; the second variation says nothing there (no constraint
+        # qualification), and the state is the only one the ends allow
+        self.decidable = len(self.constraint) == 3 or not self.solver.global_step.bordered
 
     # --- assembly -------------------------------------------------------------------
     def _assemble(self):
@@ -90,11 +105,7 @@ class SecondVariation:
                       for f in solver.state.frame_fields], axis=2)
         if ne:
             stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
-            x = skew(d)                                      # (ne, node, dir, 3, 3)
-            # block (a, b) = sum_i 2 a_i K_ab [d_a,i]x^T [d_b,i]x
-            # optimize: numpy contracts pairwise (3 times faster than the single loop)
-            blocks = np.einsum("i,eab,eaiks,ebikt->easbt", 2 * solver.split, stiffness, x, x,
-                               optimize=True)
+            blocks = self._element_blocks(d, 2 * np.asarray(solver.split), stiffness)
             rows = (self.first_row + 3 * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
             rows = (rows[:, :, None] + np.arange(3)).reshape(ne, 9).astype(PETSc.IntType)
             self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
@@ -110,6 +121,29 @@ class SecondVariation:
         if rows.size:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
         self.matrix.assemble()
+
+    @staticmethod
+    def _element_blocks(d, weights, stiffness):
+        """The element blocks of the bending and torsion part of H, (ne, 3, 3, 3, 3)
+        indexed (node a, component s, node b, component t):
+        sum_i weights_i K_ab ([d_a,i]x^T [d_b,i]x)_st with [u]x^T [v]x = (u.v) I - v u^T,
+        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3).
+        Written out in broadcast products (no einsum: 3 times faster)."""
+        ne = d.shape[0]
+        blocks = np.zeros((ne, 3, 3, 3, 3))
+        product = np.empty_like(blocks)
+        dots = np.zeros((ne, 3, 3))
+        for i, weight in enumerate(weights):
+            di = d[:, :, i, :]                                       # (ne, node, 3)
+            # product[e, a, s, b, t] = d_a,i[t] d_b,i[s]
+            np.multiply(di[:, :, None, None, :], di.transpose(0, 2, 1)[:, None, :, :, None],
+                        out=product)
+            blocks -= weight * product
+            dots += weight * np.matmul(di, di.transpose(0, 2, 1))   # (ne, a, b)
+        for s in range(3):
+            blocks[:, :, s, :, s] += dots
+        blocks *= stiffness[:, :, None, :, None]
+        return blocks
 
     def _clamped_rows(self):
         """Global rows of the rotation vectors at clamped nodes."""

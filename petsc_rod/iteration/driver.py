@@ -91,6 +91,7 @@ class UzawaSolver:
         self.weights = quadrature_weights(mesh.element_h)
         self._root_weights = np.sqrt(self.state.node_weights)[:, None, None]
         self._step = None
+        self._second_variation = None
         self._create_snes()
         self.newton = newton.NewtonPolish(self) if self.uses_newton else None
 
@@ -247,14 +248,21 @@ class UzawaSolver:
         True and None for a local minimiser; False and a rotation-vector field
         (n_nodes, 3) along which the energy decreases to second order for a saddle;
         None, None where the test cannot decide (a taut, straight rod)."""
-        hessian = SecondVariation(self)
-        try:
-            if not hessian.decidable:
-                return None, None
-            direction = hessian.descent_direction()
-            return direction is None, direction
-        finally:
-            hessian.destroy()
+        hessian = self.second_variation()
+        if not hessian.decidable:
+            return None, None
+        direction = hessian.descent_direction()
+        return direction is None, direction
+
+    def second_variation(self):
+        """The SecondVariation at the current state: one object for the solver's life,
+        made at the first call and updated at the next ones, so that its factorisations
+        share one symbolic analysis (the stability test and every Newton step)."""
+        if self._second_variation is None:
+            self._second_variation = SecondVariation(self)
+        else:
+            self._second_variation.update()
+        return self._second_variation
 
     # --- the SNES's view of the iteration -----------------------------------------------
     def _fixed_point_residual(self, snes, x, f):
@@ -374,5 +382,7 @@ class UzawaSolver:
         self.state.destroy()
         if self.newton is not None:
             self.newton.destroy()
+        if self._second_variation is not None:
+            self._second_variation.destroy()
         for obj in (self.snes, self._x, self._f):
             obj.destroy()

@@ -29,7 +29,7 @@ iteration (whose tests decide convergence, as always) moves it only by round-off
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.analysis.stability import SecondVariation, skew
+from petsc_rod.analysis.stability import skew
 from petsc_rod.frames import rotations
 from petsc_rod.scenes.boundary import clamped_nodes
 
@@ -142,7 +142,7 @@ class NewtonPolish:
         g = self._set_multipliers(frames, g, mu)
         gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
         gradient[~self._free] = 0.0
-        hessian = SecondVariation(self.solver)
+        hessian = self.solver.second_variation()
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
             if not self._positive_definite(hessian):
@@ -170,7 +170,6 @@ class NewtonPolish:
         finally:
             for vec in vecs:
                 vec.destroy()
-            hessian.destroy()
 
     @staticmethod
     def _positive_definite(hessian):
