@@ -67,6 +67,7 @@ class SecondVariation:
         self._clamped = self._clamped_rows()
         self._diagonal = self.matrix.createVecLeft()
         self.constraint = []
+        self._constraint_solves = []      # (H - shift M)^-1 of each, at the last factorisation
         self._fill()
         self.mass = self._mass()
         self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
@@ -216,7 +217,9 @@ class SecondVariation:
         self.factor.setMumpsIcntl(24, 1)     # null pivots detected, not failed on
 
     def factorise(self, shift):
-        """Factor H - shift M."""
+        """Factor H - shift M (the constraint solves of the previous factorisation are
+        dropped)."""
+        self._drop_constraint_solves()
         self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.mass.copy(self._work)
         self._work.scale(-shift)
@@ -236,15 +239,30 @@ class SecondVariation:
         negative, _, _ = self.factor.getInertia()
         if not self.constraint:
             return int(negative)
-        solves = []
-        for column in self.constraint:
-            y = column.duplicate()
-            self.ksp.solve(column, y)
-            solves.append(y)
-        schur = np.array([[c.dot(y) for y in solves] for c in self.constraint])
-        for y in solves:
-            y.destroy()
+        self._constraint_solves = [self.solve(column) for column in self.constraint]
+        schur = np.array([[c.dot(y) for y in self._constraint_solves] for c in self.constraint])
         return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
+
+    def solve_in_constraint_span(self, columns):
+        """(H - shift M)^-1 c, new Vecs, for the Vecs c of ``columns`` that lie in the span
+        of the constraint's orthonormal basis b_j (the chord forms at the state's
+        tangents), without a new solve: c = sum_j (b_j . c) b_j, so the solution is
+        sum_j (b_j . c) (H - shift M)^-1 b_j, from the solves of the last
+        ``negative_directions``."""
+        if len(self._constraint_solves) != len(self.constraint) or not self.constraint:
+            raise RuntimeError("solve_in_constraint_span needs negative_directions first")
+        solutions = []
+        for column in columns:
+            y = column.duplicate()
+            y.zeroEntries()
+            y.maxpy([b.dot(column) for b in self.constraint], self._constraint_solves)
+            solutions.append(y)
+        return solutions
+
+    def _drop_constraint_solves(self):
+        for vec in self._constraint_solves:
+            vec.destroy()
+        self._constraint_solves = []
 
     def tolerance(self):
         """TOLERANCE times max_i |H_ii| / M_ii: an eigenvalue of H / M above -tolerance
@@ -301,6 +319,7 @@ class SecondVariation:
             vector.axpy(-c.dot(vector), c)
 
     def destroy(self):
+        self._drop_constraint_solves()
         for obj in [self.ksp, self.shifted, self.matrix, self.mass, self._mass_or_one,
                     self._work, self._diagonal, *self.constraint]:
             obj.destroy()

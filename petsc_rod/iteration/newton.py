@@ -159,7 +159,9 @@ class NewtonPolish:
                 # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
                 columns = hessian.chord_forms(frames[:, 2])
                 vecs.extend(columns)
-                solved = [hessian.solve(column) for column in columns]
+                # the inertia test solved for a basis of the same forms (decidable)
+                solved = (hessian.solve_in_constraint_span(columns) if hessian.decidable
+                          else [hessian.solve(column) for column in columns])
                 vecs.extend(solved)
                 schur = np.array([[c.dot(s) for s in solved] for c in columns])
                 right = self._chord_residual(frames) + np.array([c.dot(direction)

@@ -3,6 +3,8 @@ matrix for the solver's life, updated in place at each Newton step and stability
 
 - Updated at a new state, H, its chord constraint and its inertia are those of an H
   assembled afresh there (on 1 or several ranks).
+- The chord forms solved through the inertia test's solves of their orthonormal basis
+  (what a Newton step uses) are the direct solves.
 - The element blocks, written out in broadcast products, are the cross-product form
   sum_i 2 a_i K_ab [d_a,i]x^T [d_b,i]x of the module docstring.
 """
@@ -48,6 +50,25 @@ def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory,
     finally:
         fresh.destroy()
         before.destroy()
+
+
+def test_chord_forms_solved_from_the_inertia_test_are_the_direct_solves(solver_factory,
+                                                                         comm):
+    _, solver = solver_factory(comm, 24, PAPER, 400.0, 1e-3, 1e-3, 5000, newton=False)
+    solver.settings.check_stability = False
+    assert continuation(solver, steps=2).converged
+    hessian = solver.second_variation()
+    hessian.negative_directions(-hessian.tolerance())
+    forms = hessian.chord_forms(solver.state.tau[:, 2])
+    reused = hessian.solve_in_constraint_span(forms)
+    direct = [hessian.solve(form) for form in forms]
+    try:
+        for a, b in zip(reused, direct):
+            a.axpy(-1.0, b)
+            assert a.norm() < 1e-10 * b.norm()
+    finally:
+        for vec in forms + reused + direct:
+            vec.destroy()
 
 
 def test_element_blocks_are_the_cross_product_form():
