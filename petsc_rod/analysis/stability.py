@@ -78,7 +78,8 @@ class SecondVariation:
     def update(self):
         """H at the solver's current state, in the same matrix. Its nonzero pattern is
         the mesh's, so the factorisations that follow reuse MUMPS's analysis (the
-        symbolic factorisation: two thirds of the first factorisation's time)."""
+        symbolic factorisation, most of a first factorisation's cost:
+        docs/performance.md)."""
         self.matrix.zeroEntries()
         self._fill()
 
@@ -128,8 +129,9 @@ class SecondVariation:
         """The element blocks of the bending and torsion part of H, (ne, 3, 3, 3, 3)
         indexed (node a, component s, node b, component t):
         sum_i weights_i K_ab ([d_a,i]x^T [d_b,i]x)_st with [u]x^T [v]x = (u.v) I - v u^T,
-        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3).
-        Written out in broadcast products (no einsum: 3 times faster)."""
+        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3),
+        written out in broadcast products (cheaper than an einsum over the cross-product
+        matrices: docs/performance.md)."""
         ne = d.shape[0]
         blocks = np.zeros((ne, 3, 3, 3, 3))
         product = np.empty_like(blocks)
