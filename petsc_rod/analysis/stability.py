@@ -51,7 +51,8 @@ def skew(v):
 
 
 class SecondVariation:
-    """H of the module docstring at the solver's current state, as a PETSc matrix on the
+    """H of the module docstring at the solver's state of the last construction or
+    ``update()``, as a PETSc matrix on the
     rotation vectors of the P2 nodes (3 per node, node n = 2 vertex + slot), with what
     the inertia test needs. Collective; ``destroy()`` frees every PETSc object."""
 
@@ -84,7 +85,10 @@ class SecondVariation:
         self._fill()
 
     def _fill(self):
-        """Assemble H at the current state, with its diagonal and the chord constraint."""
+        """Assemble H at the current state, with its diagonal and the chord constraint;
+        the factorisation and the constraint solves of the previous H are stale."""
+        self._factored = False
+        self._drop_constraint_solves()
         self._assemble()
         self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
@@ -228,9 +232,12 @@ class SecondVariation:
         self.shifted.setDiagonal(self._work, addv=PETSc.InsertMode.ADD_VALUES)
         self.ksp.setOperators(self.shifted)
         self.ksp.setUp()
+        self._factored = True
 
     def solve(self, rhs):
-        """(H - shift M)^-1 rhs, a new Vec, with the last ``factorise``."""
+        """(H - shift M)^-1 rhs, a new Vec, with the last ``factorise`` (of this H)."""
+        if not self._factored:
+            raise RuntimeError("SecondVariation.solve needs factorise after the last update")
         solution = rhs.duplicate()
         self.ksp.solve(rhs, solution)
         return solution

@@ -54,8 +54,8 @@ CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 class NewtonPolish:
     """Newton steps of the module docstring on a solver's state. Owns a work Vec for K d
-    (K is the global step's); ``destroy()`` frees it (the second variation of each step
-    is made and destroyed within the step)."""
+    (K is the global step's); ``destroy()`` frees it (the second variation is the
+    solver's, ``UzawaSolver.second_variation``, updated at each step)."""
 
     def __init__(self, solver):
         self.solver = solver
@@ -191,8 +191,12 @@ class NewtonPolish:
         made again at -tolerance, whose eigenvalues above are zero to round-off (a free
         roll), and then H + tolerance M is factored for the solves: a shift that would
         slow every step to the rate tolerance / (lowest eigenvalue + tolerance), and the
-        tolerance grows like the square of the element count. Where the chord forms are
-        dependent (a taut, straight rod) H itself must be: a sufficient condition."""
+        tolerance grows like the square of the element count. An eigenvalue that is zero
+        exactly (a rigid turn about the chord between pins) goes to the second test only
+        where round-off makes its pivot negative; otherwise MUMPS takes its pivot as null
+        (ICNTL(24)) and the step has no component along it, and a symmetry's component
+        would only turn the rod rigidly. Where the chord forms are dependent (a taut,
+        straight rod) H itself must be positive definite: a sufficient condition."""
         for shift in (0.0, -hessian.tolerance()):
             if hessian.decidable:
                 negative = hessian.negative_directions(shift)

@@ -30,9 +30,9 @@ def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory,
     updated = solver.second_variation()
     assert updated is kept
     fresh = SecondVariation(solver)
+    difference = updated.matrix.copy()
     try:
         scale = fresh.matrix.norm(norm_type=3)                  # NORM_INFINITY
-        difference = updated.matrix.copy()
         difference.axpy(-1.0, fresh.matrix)
         assert difference.norm(norm_type=3) < 1e-13 * scale
         before.axpy(-1.0, fresh.matrix)
@@ -44,12 +44,11 @@ def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory,
                 rest.axpy(-kept_column.dot(column), kept_column)
             assert rest.norm() < 1e-12 * column.norm()
             rest.destroy()
-        difference.destroy()
         for shift in (-fresh.tolerance(), 1.0):
             assert updated.negative_directions(shift) == fresh.negative_directions(shift)
     finally:
-        fresh.destroy()
-        before.destroy()
+        for obj in (fresh, before, difference):
+            obj.destroy()
 
 
 def test_chord_forms_solved_from_the_inertia_test_are_the_direct_solves(solver_factory,
