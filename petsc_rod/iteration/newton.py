@@ -43,10 +43,10 @@ STEP_TOLERANCE = 1e-10
 # (Newton contracts quadratically near a regular minimiser).
 SHRINK = 0.5
 # Steps stop shrinking at the round-off floor of the Newton system, about cond(H) eps
-# (cond(H) grows like the square of the element count): far below 1e-10 rad on a short
-# mesh, about 2e-10 rad at 10^4 elements. An attempt whose last step was below
-# FLOOR_TURN rad when the next one stopped shrinking has reached that floor: its state is
-# handed over, and the iteration, whose tests decide convergence, goes on from there.
+# (cond(H) grows like the square of the element count; docs/performance.md has it at
+# 10^4 elements). An attempt whose last step was below FLOOR_TURN rad when the next one
+# stopped shrinking has reached that floor: its state is handed over, and the iteration,
+# whose tests decide convergence, goes on from there.
 FLOOR_TURN = 1e-7
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
@@ -193,9 +193,9 @@ class NewtonPolish:
         slow every step to the rate tolerance / (lowest eigenvalue + tolerance), and the
         tolerance grows like the square of the element count. An eigenvalue that is zero
         exactly (a rigid turn about the chord between pins) goes to the second test only
-        where round-off makes its pivot negative; otherwise MUMPS takes its pivot as null
-        (ICNTL(24)) and the step has no component along it, and a symmetry's component
-        would only turn the rod rigidly. Where the chord forms are dependent (a taut,
+        where round-off makes its pivot negative; otherwise the unshifted H is used, the
+        step's component along that symmetry only turns the rod rigidly, and a step that
+        does not shrink ends the attempt. Where the chord forms are dependent (a taut,
         straight rod) H itself must be positive definite: a sufficient condition."""
         for shift in (0.0, -hessian.tolerance()):
             if hessian.decidable:
