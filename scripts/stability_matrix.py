@@ -381,7 +381,7 @@ def scene_option(options, key):
         return str(options[key])
     with open(ROOT / options["options_file"], encoding="utf-8") as scene:
         for line in scene:
-            words = line.split()
+            words = line.split("#", 1)[0].split()
             if len(words) == 2 and words[0] == f"-rod_{key}":
                 return words[1]
     raise KeyError(f"{key} is neither a case option nor in {options['options_file']}")

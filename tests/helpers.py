@@ -41,6 +41,12 @@ PAPER_END_X = 16.0
 PAPER_END = np.array([PAPER_END_X, PAPER_LENGTH - PAPER_END_X, 0.0])
 TWISTED_CLAMP_FORCE = (-11.6, -4.03, 2.30)
 TWISTED_CLAMP_MOMENT = (9.21, -36.8, -18.0)
+# The scene of options/paper.opts at X_F = 16 as Scene keywords, and the unit cantilever
+# under a tip force of 3 (P L^2 / EI = 3) of the solver tests.
+PAPER_SCENE = dict(length=PAPER_LENGTH, stiffness=list(PAPER_STIFFNESS), start="clamp",
+                   end="pin", end_position=[PAPER_END_X, PAPER_LENGTH - PAPER_END_X, 0.0])
+CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                  end_force=(0.0, -3.0, 0.0))
 
 # The cantilevers of the halving tests (tests/solver/test_continuation.py,
 # tests/system/test_continuation_cli.py): 16 elements, one load step too many for

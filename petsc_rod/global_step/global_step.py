@@ -54,6 +54,8 @@ class GlobalStep:
         self._target = np.zeros((min(mesh.n_local_nodes, CHUNK), 3, 3))   # w (R tau - lambda)
         # the seabed and the current (petsc_rod/riser), built only when the scene has them
         self.riser = RiserTerms(mesh, scene) if scene.seabed or scene.current else None
+        # the slope components solved here: with a seabed z is the vertical problem's
+        self._slope_components = (0, 1) if scene.seabed is not None else (0, 1, 2)
         self.build(penalty)
 
     def build(self, penalty):
@@ -174,7 +176,7 @@ class GlobalStep:
         """r' from its right-hand side rhs[2], bordered by r(L) - r(0) = int r' when both
         ends are held, then r at the vertices by integration. With a seabed the z slope
         is the vertical problem's (riser/terms.py), not solved here."""
-        components = (0, 1) if self.riser is not None and self.riser.seabed else (0, 1, 2)
+        components = self._slope_components
         if self.bordered:
             chord = self.end_state.position - self.start_state.position
             state.chord_multiplier = self.slope_problem.solve_constrained(

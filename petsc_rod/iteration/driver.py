@@ -44,9 +44,9 @@ ESCAPE_GROWTH = 2.0
 # NEWTON_SWITCH: near a solution, where the accelerated iteration is slow.
 NEWTON_AFTER = 15
 NEWTON_SWITCH = 0.1
-# An attempt costs about as much as 25 - 40 iterations (a sparse LDL^T factorisation per
-# Newton step, measured on 80 and 3000 elements): it is made only while the iteration
-# would still need more than NEWTON_WORTH iterations at its recent rate.
+# An attempt costs as much as tens of iterations (a sparse LDL^T factorisation per Newton
+# step: docs/performance.md): it is made only while the iteration would still need more
+# than NEWTON_WORTH iterations at its recent rate.
 NEWTON_WORTH = 30
 # After each attempt that did not converge the wait doubles (an attempt restarts the
 # accelerated iteration). A Newton solution the Uzawa map cannot hold at the current

@@ -14,8 +14,8 @@ elements of later ranks: one prefix sum (Mesh.prefix_sum), nothing gathered.
 
 import numpy as np
 
-from petsc_rod.mesh.elements import (GAUSS_POINTS, GAUSS_WEIGHTS, P2, element_integrals,
-                                     p2_basis, p2_integrals)
+from petsc_rod.mesh.elements import (GAUSS_POINTS, P2, element_integrals, gram,
+                                     p2_basis, p2_integrals, quadrature_weights)
 from petsc_rod.mesh.fields import element_dofs
 
 
@@ -37,14 +37,12 @@ class NodalLoad:
         self._field = field           # a VectorField, for the ghost exchange
         h = mesh.element_h
         phi, _ = p2_basis(GAUSS_POINTS, h)
-        after = (element_integrals(h)[:, None, :]
-                 - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_l, (ne, nq, 3)
-        weighted = h[:, None, None] * GAUSS_WEIGHTS[None, :, None] * phi   # w_q N_k(S_q)
         # the constant parts of element_vectors, made once: int_e g_k and
         # int_e g_k(S) int_S^{S_e+1} N_l dS, (ne, 3) and (ne, 3, 3)
-        self._basis_integrals = weighted.sum(axis=1)
-        self._tail_integrals = np.einsum("eqk,eql->ekl", weighted, after)
         self._integrals = element_integrals(h)
+        after = (self._integrals[:, None, :]
+                 - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_l, (ne, nq, 3)
+        self._tail_integrals = gram(quadrature_weights(h), phi, after)
         self.set(np.zeros((mesh.n_local_nodes, 3)))
 
     def set(self, values):
@@ -66,6 +64,6 @@ class NodalLoad:
         """int_e F g_k dS, (ne, 3, 3), F(S) = int_S^L f_h dS + ``offset`` (3,): with
         F = B_e + offset + sum_l f_l int_S^{S_e+1} N_l, the integrals of g_k and of
         g_k int_S N_l are constants of the mesh (made in __init__)."""
-        out = self._basis_integrals[:, :, None] * (self._beyond + offset)[:, None, :]
+        out = self._integrals[:, :, None] * (self._beyond + offset)[:, None, :]
         out += np.matmul(self._tail_integrals, self.element_values)
         return out

@@ -17,14 +17,10 @@ docs/method.md §11), on 1 or several ranks.
 import numpy as np
 import pytest
 
-from helpers import continuation, gather
+from helpers import CANTILEVER, PAPER_SCENE as PAPER, continuation, gather
 from petsc_rod.iteration import newton
 from petsc_rod.validation.closed_forms import cantilever_tip
 
-CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
-                  end_force=(0.0, -3.0, 0.0))
-PAPER = dict(length=20.0, stiffness=[235.0, 360.0, 200.0], start="clamp", end="pin",
-             end_position=[16.0, 4.0, 0.0])
 TIGHT = 1e-12
 
 

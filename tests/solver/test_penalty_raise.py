@@ -4,12 +4,8 @@ and the cantilever reaches the elastica; kept low, the step does not converge.""
 import numpy as np
 import pytest
 
-from helpers import continuation, gather
+from helpers import CANTILEVER, continuation, gather
 from petsc_rod.validation.closed_forms import cantilever_tip
-
-
-CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
-                  end_force=(0.0, -3.0, 0.0))
 
 
 @pytest.mark.parametrize("adapt", [True, pytest.param(False, marks=pytest.mark.slow)])

@@ -11,11 +11,8 @@ matrix for the solver's life, updated in place at each Newton step and stability
 
 import numpy as np
 
-from helpers import continuation
+from helpers import PAPER_SCENE as PAPER, continuation
 from petsc_rod.analysis.stability import SecondVariation, skew
-
-PAPER = dict(length=20.0, stiffness=[235.0, 360.0, 200.0], start="clamp", end="pin",
-             end_position=[16.0, 4.0, 0.0])
 
 
 def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory, comm):

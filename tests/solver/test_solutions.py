@@ -8,7 +8,7 @@ for the 1-rank / 2-rank round-off difference.
 import numpy as np
 import pytest
 
-from helpers import continuation as solve, fitted_order, gather
+from helpers import PAPER_SCENE as PAPER, continuation as solve, fitted_order, gather
 from petsc_rod.validation.closed_forms import cantilever_shape, cantilever_tip
 from petsc_rod.io.outputs import vertex_fields
 
@@ -98,10 +98,6 @@ def test_cantilever_convergence_orders(comm, solver_factory):
     assert 3.7 < fitted_order(sizes, position) < 4.3
     assert 3.7 < fitted_order(sizes, director) < 4.3
     assert position[-1] < 3e-8 and director[-1] < 3e-8
-
-
-PAPER = dict(length=20.0, stiffness=[235.0, 360.0, 200.0], start="clamp", end="pin",
-             end_position=[16.0, 4.0, 0.0])
 
 
 @pytest.fixture(scope="module")
