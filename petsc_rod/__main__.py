@@ -75,19 +75,48 @@ def end(code):
     os._exit(code)
 
 
+# Where Debian's python3-petsc4py puts the module: under PETSC_DIR, which its own .pth
+# file expects in the environment (or the /usr/lib/petsc link of the -dev package).
+DEBIAN_PETSC4PY = "/usr/lib/petscdir/petsc3.*/*-real/lib/python3/dist-packages"
+
+
+def find_petsc4py():
+    """Whether petsc4py imports, after adding Debian's newest real-scalar petsc4py to the
+    path when it does not on its own (a venv made by `pip install .`, no PETSC_DIR)."""
+    try:
+        import petsc4py  # noqa: F401
+        return True
+    except ImportError:
+        pass
+    import glob
+    import importlib
+    import re
+
+    def version(path):
+        return [int(part) for part in re.findall(r"\d+", path)]
+
+    found = sorted(glob.glob(DEBIAN_PETSC4PY), key=version)
+    if not found:
+        return False
+    sys.path.append(found[-1])
+    try:
+        importlib.import_module("petsc4py")
+        return True
+    except ImportError:
+        return False
+
+
 def main():
     for path in options_files(sys.argv):
         error = options_file_error(path)
         if error:
             sys.stderr.write(f"petsc_rod: error: {error}\n")
             return 2
-    try:
-        import petsc4py  # noqa: F401
-    except ImportError:
+    if not find_petsc4py():
         sys.stderr.write(
             "petsc_rod: error: petsc4py is not importable by this python "
-            f"({sys.executable}); run scripts/setup.sh once, then `source .venv/bin/activate`"
-            "\n")
+            f"({sys.executable}); install Debian's python3-petsc4py (or run scripts/setup.sh "
+            "once, then `source .venv/bin/activate`)\n")
         return 2
     from petsc_rod.io.provenance import commit
     commit()                          # git runs before MPI starts (provenance)

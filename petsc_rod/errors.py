@@ -33,6 +33,12 @@ class RodDivergedError(RodError):
         self.iterations = iterations
 
 
+class RodIterationDiverged(RodDivergedError):
+    """The iteration's own norms left every meaningful state (stopping.diverged), as
+    opposed to a linear solver that failed: a smaller step or a larger penalty helps
+    (the command line says so, cli/lines.py)."""
+
+
 class RodIOError(RodError):
     """The result file could not be written during the run (a full disk, a file system
     error); the partial file is removed."""

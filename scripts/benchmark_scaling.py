@@ -8,7 +8,7 @@ The scene is the paper's (clamp, pinned end at X_F = 16), scaled to a 20 km cabl
 the elements stay 0.02 m or longer; a fixed number of iterations is timed (convergence
 is not the point here). Two drivers (--driver):
 
-* ``map``: the map G of one iteration alone, solver.iterate() + state.norms() (the plain
+* ``map``: the map G of one iteration alone, solver.problem.iterate() + state.norms() (the plain
   iteration, -rod_snes_type nrichardson, less the SNES's own vector work);
 * ``snes``: the default driver, solve_step through the SNES (Anderson mixing with the
   depth it picks, whose history is m vectors of 18 numbers per node), timed over the
@@ -38,7 +38,7 @@ import petsc4py
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
-from petsc_rod.iteration.driver import UzawaSolver, default_anderson_depth  # noqa: E402
+from petsc_rod.iteration.driver import solver_for, default_anderson_depth  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.scenes.scene import Scene  # noqa: E402
@@ -87,10 +87,8 @@ def timed_map(solver, iterations):
     """Seconds of ``iterations`` evaluations of the map G (iterate + norms)."""
     clock = time.perf_counter()
     for _ in range(iterations):
-        solver.iterate()
-        EVENTS["norms"].begin()         # as the driver does (_fixed_point_residual)
-        solver.state.norms()
-        EVENTS["norms"].end()
+        solver.problem.iterate()
+        solver.problem.norms()
     return time.perf_counter() - clock
 
 
@@ -114,11 +112,11 @@ def measure(comm, n_elements, args):
     # the iteration alone: no Newton steps (their factorisations are not an iteration's)
     settings = Settings(asked_penalty=400.0 / scale**2, max_it=10**9, rtol=0.0, ctol=0.0,
                         adapt_penalty=False, check_stability=False, newton=False)
-    solver = UzawaSolver(mesh, rod, settings)
-    solver.state.set_straight()
-    solver.prepare_step(0.125)
+    solver = solver_for(mesh, rod, settings)
+    solver.problem.state.set_straight()
+    solver.problem.prepare(0.125)
     setup = time.perf_counter() - clock
-    solver.iterate()                      # a first iteration: caches, first touches
+    solver.problem.iterate()                      # a first iteration: caches, first touches
     best = None
     for _ in range(args.repeat):
         if args.driver == "map":
@@ -129,7 +127,7 @@ def measure(comm, n_elements, args):
             depth = anderson_history(mesh)
             window = Window(depth + 1)
             settings.max_it = depth + 1 + args.iterations
-            solver.state.set_straight()
+            solver.problem.state.set_straight()
             solver.solve_step(0.125, observer=window)
             seconds = time.perf_counter() - window.start
             before, after = window.counts, counters()
@@ -137,6 +135,7 @@ def measure(comm, n_elements, args):
             best = (seconds, {name: after[name] - before[name] for name in PHASES})
     seconds, phases = best
     solver.destroy()
+    solver.problem.destroy()
     mesh.destroy()
     mpi = comm.tompi4py()
     per_iteration = mpi.allreduce(seconds, op=_max()) / args.iterations

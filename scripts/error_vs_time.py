@@ -134,15 +134,16 @@ REFERENCES = {"cantilever": CantileverReference, "twist": TwistReference,
               "paper": PaperReference}
 
 
-def snapshot(solver):
+def snapshot(problem):
     """What the errors need, on this rank's vertices: S, r, d1, d2; u3(0); energy."""
     from petsc_rod.io.outputs import vertex_strains
-    mesh = solver.mesh
-    u = vertex_strains(solver)                 # collective (ghost update): every rank
+    mesh = problem.mesh
+    u = vertex_strains(problem)                # collective (ghost update): every rank
     u3 = u[0, 2] if mesh.on_lower_boundary else 0.0
-    return {"S": mesh.vertex_S.copy(), "r": solver.state.r.owned()[:, 0].copy(),
-            "d1": solver.state.d1.owned()[:, 0].copy(), "d2": solver.state.d2.owned()[:, 0].copy(),
-            "u3": mesh.global_sum(u3), "energy": solver.energy()}
+    state = problem.state
+    return {"S": mesh.vertex_S.copy(), "r": state.r.owned()[:, 0].copy(),
+            "d1": state.d1.owned()[:, 0].copy(), "d2": state.d2.owned()[:, 0].copy(),
+            "u3": mesh.global_sum(u3), "energy": problem.energy()}
 
 
 def errors(mesh, state, reference, expected_fields):
@@ -166,26 +167,26 @@ def run_one(comm, name, n_elements, penalty, reference):
     """One mesh and penalty: a row for each tolerance pair the last step reached."""
     from petsc_rod.mesh.mesh import Mesh
     from petsc_rod.scenes.scene import Scene
-    from petsc_rod.iteration.continuation import continuation
-    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.cli.session import run_continuation
+    from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
 
     kwargs, steps, imperfection = scene_definitions()[name]
     scene = Scene(**kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
-    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=penalty, max_it=MAX_ITERATIONS,
+    solver = solver_for(mesh, scene, Settings(asked_penalty=penalty, max_it=MAX_ITERATIONS,
                                                rtol=1e-5, ctol=1e-3))
     try:
         clock = time.perf_counter()
-        solver.state.set_straight()
+        solver.problem.state.set_straight()
         earlier = 0                 # iterations of the continuation steps before the last
         if steps > 1:
-            before = continuation(solver, steps - 1, imperfection, end=(steps - 1) / steps)
+            before = run_continuation(solver, steps - 1, imperfection, end=(steps - 1) / steps)
             if not before.converged:
                 raise RuntimeError(f"{name}: the continuation to the last step did not "
                                    "converge")
             earlier = before.iterations
-        solver.state.roll_cross_sections(imperfection)
+        solver.problem.state.roll_cross_sections(imperfection)
         solver.settings.rtol, solver.settings.ctol = TOLERANCES[-1], 100 * TOLERANCES[-1]
         pending = list(TOLERANCES)
         recorded = []
@@ -195,7 +196,7 @@ def run_one(comm, name, n_elements, penalty, reference):
             while pending and change <= pending[0] and residual <= 100 * pending[0]:
                 start = time.perf_counter()
                 recorded.append((pending.pop(0), earlier + iteration,
-                                 start - clock - spent[0], snapshot(solver)))
+                                 start - clock - spent[0], snapshot(solver.problem)))
                 spent[0] += time.perf_counter() - start
             last = recorded[-1][1] - earlier if recorded else 0
             return iteration - last > max(STALL_MINIMUM, STALL_FACTOR * last)
@@ -219,6 +220,7 @@ def run_one(comm, name, n_elements, penalty, reference):
         return rows
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
 
 

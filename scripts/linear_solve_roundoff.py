@@ -29,7 +29,7 @@ from petsc4py import PETSc  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.validation.roundoff import centreline_solve_error  # noqa: E402
 from petsc_rod.scenes.scene import Scene  # noqa: E402
-from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
+from petsc_rod.iteration.driver import solver_for  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
 
 SCENES = {
@@ -64,13 +64,14 @@ def main():
         scene = Scene(**kwargs)
         for n in sizes:
             mesh = Mesh(comm, n, scene.length)
-            solver = UzawaSolver(mesh, scene, Settings(asked_penalty=400.0))
+            solver = solver_for(mesh, scene, Settings(asked_penalty=400.0))
             owned = np.arange(mesh.vertex_start, mesh.vertex_end)
             S = np.repeat(mesh.coordinates(owned), 2) / scene.length
-            d_error = relative_solve_error(solver.global_step.problems[0], S)
-            r_error = centreline_solve_error(solver)
+            d_error = relative_solve_error(solver.problem.global_step.problems[0], S)
+            r_error = centreline_solve_error(solver.problem)
             PETSc.Sys.Print(f"{name:10s} {n:9d}  {r_error:13.2e}  {d_error:14.2e}", comm=comm)
             solver.destroy()
+            solver.problem.destroy()
             mesh.destroy()
 
 

@@ -67,8 +67,8 @@ def gather(comm, owned):
 def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
     """One continuation from X_F = 20 to ``end_x`` by the CLI's loop (a step that fails is
     halved, as on the command line): (step rows, profiles by X_F)."""
-    from petsc_rod.iteration.continuation import continuation
-    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.cli.session import run_continuation
+    from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
     from petsc_rod.io.outputs import vertex_fields
     from petsc_rod.mesh.mesh import Mesh
@@ -84,7 +84,7 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
     if planar:          # the plain iteration, which keeps a symmetric state symmetric
         database.setValue("rod_snes_type", "nrichardson")
     try:
-        solver = UzawaSolver(mesh, scene, Settings(
+        solver = solver_for(mesh, scene, Settings(
             asked_penalty=PENALTY, max_it=MAX_ITERATIONS, rtol=RTOL, ctol=CTOL,
             check_stability=not planar))
     finally:
@@ -94,13 +94,13 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
     clock = time.perf_counter()
 
     def record(t, report):
-        fields = {key: gather(comm, value) for key, value in vertex_fields(solver, t).items()}
+        fields = {key: gather(comm, value) for key, value in vertex_fields(solver.problem).items()}
         x_f = LENGTH + t * (end_x - LENGTH)
         rows.append(dict(run=label, K3=k3, elements=n_elements,
                          penalty=solver.penalty, X_F=round(x_f, 6),
                          converged=int(report.converged), iterations=report.iterations,
                          wall_time=time.perf_counter() - clock,
-                         u3_clamp=fields["u"][0, 2], energy=solver.energy(),
+                         u3_clamp=fields["u"][0, 2], energy=solver.problem.energy(),
                          max_abs_z=np.abs(fields["r"][:, 2]).max(),
                          constraint_residual=report.constraint_residual))
         outcome = "converged" if report.converged else "NOT converged"
@@ -113,12 +113,13 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
                 profiles[x] = {"S": fields["S"], "r": fields["r"], "u3": fields["u"][:, 2]}
 
     try:
-        solver.state.set_straight()
-        result = continuation(solver, steps, imperfection, on_step=record)
+        solver.problem.state.set_straight()
+        result = run_continuation(solver, steps, imperfection, on_step=record)
         if not result.converged:
             say(f"{label}: stopped, a step did not converge")
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
     return rows, profiles
 

@@ -28,14 +28,16 @@ from petsc4py import PETSc  # noqa: E402
 
 from petsc_rod.errors import RodDivergedError  # noqa: E402
 from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
-from petsc_rod.iteration.penalty import default_penalty  # noqa: E402
+from petsc_rod.problem.penalty import default_penalty  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
 from petsc_rod.mesh.elements import P2  # noqa: E402
-from petsc_rod.mesh.fields import scatter_element_vectors  # noqa: E402
+from petsc_rod.mesh.fields import VectorField, scatter_element_vectors  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.riser.environment import Seabed, default_stiffness  # noqa: E402
 from petsc_rod.riser.loads import NodalLoad  # noqa: E402
-from petsc_rod.riser.terms import RiserTerms  # noqa: E402
+from petsc_rod.physics.dead_loads import DeadLoads  # noqa: E402
+from petsc_rod.problem.problem import RodProblem  # noqa: E402
+from petsc_rod.riser.terms import NodalLoadTerm  # noqa: E402
 from petsc_rod.scenes.scene import Scene  # noqa: E402
 from petsc_rod.scenes.starts import catenary_start  # noqa: E402
 
@@ -51,35 +53,40 @@ SCENES = {
 }
 
 
-class LaggedSeabed(RiserTerms):
+class LaggedSeabed(NodalLoadTerm):
     """The seabed as a load lagged by one iteration: k (z_b - z)_+ at the nodes from the
-    heights of the last global step, added like the drag; no vertical problem."""
+    heights of the last global step, added to the slope's right-hand side like the drag
+    (a term of physics, physics/term.py, in place of riser.terms.SeabedTerm); no vertical
+    problem, no energy."""
 
-    def build(self, slope_stiffness, penalty):
-        self.contact_load = NodalLoad(self.mesh, self._nodes)
+    conservative = in_newton = False
 
-    def prepare(self, t, start_state, end_state):
-        self.t, self.start_state, self.end_state = t, start_state, end_state
+    def __init__(self, mesh, seabed):
+        super().__init__(mesh, "lagged_seabed")
+        self.seabed = seabed
+        self.contact_load = NodalLoad(mesh, self._nodes)
+        self._rhs = VectorField(mesh, "lagged_seabed_rhs")
 
-    def seabed_pressure(self, z):
+    def pressure(self, z):
         return self.seabed.stiffness * np.maximum(self.seabed.height - z, 0.0)
 
-    def add_loads(self, slope_rhs, state):
+    def node_loads(self, state):
         loads = np.zeros((self.mesh.n_local_nodes, 3))
-        loads[:, 2] = self.seabed_pressure(state.node_positions()[:, 2])
-        self.contact_load.set(loads)
+        loads[:, 2] = self.pressure(state.node_positions()[:, 2])
+        return loads
+
+    def add_iterate_load(self, rhs, state):
+        self.contact_load.set(self.node_loads(state))
         mesh = self.mesh
         self._rhs.add_ghosted(scatter_element_vectors(
             mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
             self.contact_load.element_vectors(np.zeros(3))))
-        for vec, load in zip(slope_rhs.components, self._rhs.components):
+        for vec, load in zip(rhs.components, self._rhs.components):
             vec.axpy(1.0, load)
 
-    def solve_vertical(self, slope_rhs, state, bordered):
-        pass
-
-    def energy(self):
-        return 0.0
+    def destroy(self):
+        self._rhs.destroy()
+        super().destroy()
 
 
 def run(scene_kwargs, elements, factor, scheme, snes_type, max_it):
@@ -90,17 +97,16 @@ def run(scene_kwargs, elements, factor, scheme, snes_type, max_it):
     database.setValue("rod_snes_type", snes_type)
     mesh = Mesh(PETSc.COMM_WORLD, elements, scene.length)
     penalty = default_penalty(scene)
+    terms = None            # the scene's own: the implicit seabed
+    if scheme == "lagged":
+        terms = [DeadLoads(mesh, scene), LaggedSeabed(mesh, scene.seabed)]
     try:
-        solver = UzawaSolver(mesh, scene, Settings(asked_penalty=penalty, max_it=max_it,
-                                                   rtol=1e-9, ctol=1e-9,
-                                                   check_stability=False))
+        problem = RodProblem(mesh, scene, penalty, terms)
+        solver = UzawaSolver(problem, Settings(asked_penalty=penalty, max_it=max_it,
+                                               rtol=1e-9, ctol=1e-9, check_stability=False))
     finally:
         database.delValue("rod_snes_type")
-    if scheme == "lagged":
-        solver.global_step.riser.destroy()
-        solver.global_step.riser = LaggedSeabed(mesh, scene)
-        solver.global_step.riser.build(None, None)
-    solver.state.set_from_curve(catenary_start(scene, 1.0))
+    solver.problem.state.set_from_curve(catenary_start(scene, 1.0))
     clock = time.perf_counter()
     try:
         report = solver.solve_step(1.0)
@@ -110,6 +116,7 @@ def run(scene_kwargs, elements, factor, scheme, snes_type, max_it):
         outcome, iterations = "diverged", error.iterations
     seconds = time.perf_counter() - clock
     solver.destroy()
+    solver.problem.destroy()
     mesh.destroy()
     return outcome, iterations, seconds, penalty, scene.seabed.stiffness
 

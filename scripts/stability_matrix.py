@@ -46,7 +46,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from petsc_rod.riser.catenary import grounded_catenary  # noqa: E402
+from petsc_rod.scenes.touchdown import grounded_catenary  # noqa: E402
 from petsc_rod.validation import closed_forms  # noqa: E402
 from petsc_rod.validation.writhe import gauss_writhe  # noqa: E402
 
@@ -210,7 +210,7 @@ def check_catenary(bound):
 
 # Risers (docs/riser.md): 1800 m of line of 1.2 kN/m from an anchor on the seabed z = 0
 # to a pin 1000 m up. EI = 1e4 N m^2 (a bending length sqrt(EI / H) of 0.2 m or less),
-# so that the catenary with touchdown (riser/catenary.py) is the reference 20 m away from
+# so that the catenary with touchdown (scenes/touchdown.py) is the reference 20 m away from
 # the touchdown point and the ends.
 RISER = {"length": 1800, "stiffness": "1e4,1e4,7.5e3", "start": "pin", "end": "pin",
          "end_position": "1157,0,1000", "load": "0,0,-1200", "seabed": 0,

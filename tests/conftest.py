@@ -30,7 +30,7 @@ for path in (TESTS_DIR, REPO_ROOT):
     if path not in sys.path:
         sys.path.insert(0, path)
 
-from helpers import gather, make_solver  # noqa: E402,F401  (re-exported for tests)
+from helpers import destroy, gather, make_solver  # noqa: E402,F401  (re-exported for tests)
 
 
 TIERS = ("unit", "solver", "system")
@@ -93,5 +93,4 @@ def solver_factory():
 
     yield build
     for mesh, solver in reversed(built):
-        solver.destroy()
-        mesh.destroy()
+        destroy(mesh, solver)

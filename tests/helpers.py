@@ -13,22 +13,29 @@ REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 def make_solver(comm, n_elements, scene_kwargs, penalty, rtol=1e-8, ctol=1e-5,
                 max_it=5000, newton=True):
     """A (mesh, solver) pair for ``Scene(**scene_kwargs)`` on ``comm`` (``newton``:
-    Settings.newton, off where a test is about the iteration without it).
+    Settings.newton, off where a test is about the iteration without it); the problem is
+    ``solver.problem``.
 
-    The caller must call ``solver.destroy(); mesh.destroy()`` (collectively), or use the
+    The caller must call ``destroy(mesh, solver)`` (collectively), or use the
     ``solver_factory`` fixture which does it.
     """
     from petsc_rod.mesh.mesh import Mesh
     from petsc_rod.scenes.scene import Scene
-    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
 
     scene = Scene(**scene_kwargs)
     mesh = Mesh(comm, n_elements, scene.length)
     settings = Settings(asked_penalty=penalty, max_it=max_it, rtol=rtol, ctol=ctol,
                         newton=newton)
-    solver = UzawaSolver(mesh, scene, settings)
-    return mesh, solver
+    return mesh, solver_for(mesh, scene, settings)
+
+
+def destroy(mesh, solver):
+    """Destroy what make_solver made (collective)."""
+    solver.destroy()
+    solver.problem.destroy()
+    mesh.destroy()
 
 
 # The paper scene at X_F = 16 (docs/method.md §8), and clamp reactions n(0), m(0) of
@@ -94,12 +101,12 @@ def global_max(comm, value):
 
 def continuation(solver, steps=1, imperfection=0.0, **options):
     """From the straight state to load factor 1 by the CLI's continuation loop (halving
-    and link check included; ``options`` as iteration.continuation.continuation takes
-    them); the last StepReport."""
-    from petsc_rod.iteration.continuation import continuation as run
+    and link check included; ``options`` as cli.session.run_continuation takes them);
+    the last StepReport."""
+    from petsc_rod.cli.session import run_continuation
 
-    solver.state.set_straight()
-    return run(solver, steps, imperfection, **options).report
+    solver.problem.state.set_straight()
+    return run_continuation(solver, steps, imperfection, **options).report
 
 
 # Variables an enclosing mpiexec sets for its own processes: a child must not inherit

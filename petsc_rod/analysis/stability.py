@@ -25,9 +25,9 @@ accelerated one may converge to it, hence this check.
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.mesh.elements import P2, p2_element_matrices
 from petsc_rod.mesh.fields import element_dofs
-from petsc_rod.scenes.boundary import clamped_nodes
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
@@ -51,14 +51,15 @@ def skew(v):
 
 
 class SecondVariation:
-    """H of the module docstring at the solver's state of the last construction or
-    ``update()``, as a PETSc matrix on the
-    rotation vectors of the P2 nodes (3 per node, node n = 2 vertex + slot), with what
-    the inertia test needs. Collective; ``destroy()`` frees every PETSc object."""
+    """H of the module docstring at the state of a problem (problem/problem.py) at the
+    last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
+    P2 nodes (3 per node, node n = 2 vertex + slot), with what the inertia test needs;
+    the problem's terms add their own curvature (Term.add_hessian). Collective;
+    ``destroy()`` frees every PETSc object."""
 
-    def __init__(self, solver):
-        self.solver = solver
-        mesh = solver.mesh
+    def __init__(self, problem):
+        self.problem = problem
+        mesh = problem.mesh
         self.comm = mesh.comm
         n_local = 3 * mesh.n_local_nodes
         self.first_row = 6 * mesh.vertex_start
@@ -77,7 +78,7 @@ class SecondVariation:
         self._create_solver()
 
     def update(self):
-        """H at the solver's current state, in the same matrix. Its nonzero pattern is
+        """H at the problem's current state, in the same matrix. Its nonzero pattern is
         the mesh's, so the factorisations that follow reuse MUMPS's analysis (the
         symbolic factorisation, most of a first factorisation's cost:
         docs/performance.md)."""
@@ -95,29 +96,29 @@ class SecondVariation:
         self.matrix.getDiagonal(self._diagonal)
         for vec in self.constraint:
             vec.destroy()
-        self.constraint = self._chord_columns() if self.solver.global_step.bordered else []
+        self.constraint = self._chord_columns() if self.problem.bordered else []
         # a taut, straight rod: the chord fixes the whole state and its forms are
         # dependent; the second variation says nothing there (no constraint
         # qualification), and the state is the only one the ends allow
-        self.decidable = len(self.constraint) == 3 or not self.solver.global_step.bordered
+        self.decidable = len(self.constraint) == 3 or not self.problem.bordered
 
     # --- assembly -------------------------------------------------------------------
     def _assemble(self):
-        solver, mesh = self.solver, self.solver.mesh
+        problem, mesh = self.problem, self.problem.mesh
         ne = mesh.n_local_elements
         # directors at the 3 nodes of each owned element, (ne, 3 nodes, 3 dirs, 3); the
         # ghost exchange is collective, also on a rank that owns no element
         d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
-                      for f in solver.state.frame_fields], axis=2)
+                      for f in problem.state.frame_fields], axis=2)
         if ne:
             stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
-            blocks = self._element_blocks(d, 2 * np.asarray(solver.split), stiffness)
+            blocks = self._element_blocks(d, 2 * np.asarray(problem.split), stiffness)
             rows = (self.first_row + 3 * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
             rows = (rows[:, :, None] + np.arange(3)).reshape(ne, 9).astype(PETSc.IntType)
             self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
-        tau, lam, w = solver.state.tau, solver.state.lam, solver.state.node_weights
+        tau, lam, w = problem.state.tau, problem.state.lam, problem.state.node_weights
         outer = np.einsum("nik,nil->nkl", lam, tau)
         dots = np.einsum("nik,nik->n", lam, tau)
         local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
@@ -126,6 +127,8 @@ class SecondVariation:
                 + np.arange(3)).astype(PETSc.IntType)
         if rows.size:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
+        for term in problem.terms:
+            term.add_hessian(self)
         self.matrix.assemble()
 
     @staticmethod
@@ -154,15 +157,13 @@ class SecondVariation:
 
     def _clamped_rows(self):
         """Global rows of the rotation vectors at clamped nodes."""
-        step = self.solver.global_step
-        nodes = np.flatnonzero(clamped_nodes(self.solver.mesh, step.start_state,
-                                             step.end_state))
+        nodes = np.flatnonzero(~self.problem.free_nodes)
         return (self.first_row + 3 * nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
 
     def chord_forms(self, tangents):
         """The 3 linear forms omega -> sum_n w_n (omega_n x t_n)_k, the first variation of
         the chord int r' dS at tangents t (n_nodes, 3), as Vecs (zero at clamped rows)."""
-        forms = -self.solver.state.node_weights[:, None, None] * skew(tangents)   # (n, k, 3)
+        forms = -self.problem.state.node_weights[:, None, None] * skew(tangents)   # (n, k, 3)
         columns = []
         for k in range(3):
             vec = self.matrix.createVecLeft()
@@ -173,7 +174,7 @@ class SecondVariation:
 
     def _chord_columns(self):
         """An orthonormal basis of the chord forms at tau3 (the constraint of the test)."""
-        return self._independent(self.chord_forms(self.solver.state.tau[:, 2]))
+        return self._independent(self.chord_forms(self.problem.state.tau[:, 2]))
 
     @staticmethod
     def _independent(columns):
@@ -197,7 +198,7 @@ class SecondVariation:
         """The lumped mass diag(w_n) on each rotation component (0 at the clamped rows,
         whose unit diagonal no shift moves), as a Vec."""
         vec = self.matrix.createVecLeft()
-        vec.getArray()[:] = np.repeat(self.solver.state.node_weights, 3)
+        vec.getArray()[:] = np.repeat(self.problem.state.node_weights, 3)
         self._zero_clamped(vec)
         return vec
 
@@ -211,16 +212,7 @@ class SecondVariation:
         factorisation is made once, the numeric one per shift."""
         self.shifted = self.matrix.duplicate(copy=True)
         self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        ksp = self.ksp = PETSc.KSP().create(comm=self.comm)
-        ksp.setOperators(self.shifted)
-        ksp.setType(PETSc.KSP.Type.PREONLY)
-        pc = ksp.getPC()
-        pc.setType(PETSc.PC.Type.CHOLESKY)
-        pc.setFactorSolverType("mumps")
-        pc.setFactorSetUpSolverType()
-        self.factor = pc.getFactorMatrix()
-        self.factor.setMumpsIcntl(13, 1)     # the inertia of the whole matrix on every rank
-        self.factor.setMumpsIcntl(24, 1)     # null pivots detected, not failed on
+        self.ksp, self.factor = inertia_solver(self.comm, self.shifted)
 
     def factorise(self, shift):
         """Factor H - shift M (the constraint solves of the previous factorisation are
@@ -286,7 +278,7 @@ class SecondVariation:
         absolute = np.add.reduceat(np.abs(values), indptr[:-1]) if values.size else np.zeros(0)
         diagonal = self._diagonal.getArray(readonly=True)
         bound = (diagonal + np.abs(diagonal) - absolute) / self._mass_or_one.getArray(readonly=True)
-        return self.solver.mesh.global_min(float(bound.min(initial=0.0)))
+        return self.problem.mesh.global_min(float(bound.min(initial=0.0)))
 
     def descent_direction(self):
         """A unit rotation-vector field of negative curvature, (n_nodes, 3), or None when

@@ -12,47 +12,18 @@ from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
 from petsc_rod.errors import RodError, RodInputError
 from petsc_rod.mesh.mesh import Mesh, end_element_lengths
-from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_same_on_every_rank, format_value, help_text,
-                      read_options, unused_options)
-from petsc_rod.scenes.scene import Scene
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
+                                   check_same_on_every_rank, format_value, help_text,
+                                   read_options, unused_options)
+from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
+from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
-from petsc_rod.iteration.continuation import continuation
 from petsc_rod.iteration.driver import UzawaSolver
-from petsc_rod.iteration.penalty import default_penalty
-from petsc_rod.iteration.stopping import Settings
-from petsc_rod.riser.environment import environment_from_options
+from petsc_rod.problem.problem import RodProblem
 
 # The smallest element, relative to the length, whose end coordinates double precision
 # still tells apart to many digits.
 MIN_RELATIVE_ELEMENT = 1e-12
-
-
-def scene_from_options(values, given):
-    """A validated Scene from parsed option values."""
-    load = np.asarray(values["rod_load"])
-    if load.size % 3:
-        raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
-    scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
-                  start=values["rod_start"], end=values["rod_end"],
-                  end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
-                  end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
-                  end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
-                  load_breaks=values["rod_load_breaks"])
-    scene.validate(given)
-    scene.seabed, scene.current = environment_from_options(values, given, scene)
-    return scene
-
-
-def settings_from_options(values, scene):
-    penalty = values["rod_al_penalty"]
-    if penalty is None:
-        penalty = default_penalty(scene)
-    return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
-                    rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
-                    monitor=values["rod_al_monitor"],
-                    adapt_penalty=values["rod_al_adapt_penalty"],
-                    check_stability=values["rod_al_stability"],
-                    newton=values["rod_al_newton"])
 
 
 def options_record():
@@ -65,7 +36,7 @@ def run(comm=None):
     finishes or aborts the result file, and destroys the PETSc objects."""
     comm = comm or PETSc.COMM_WORLD
     database = PETSc.Options()
-    mesh = solver = writer = None
+    mesh = problem = solver = writer = None
 
     def say(text):
         PETSc.Sys.Print(text, comm=comm)
@@ -74,6 +45,7 @@ def run(comm=None):
         try:
             check_same_on_every_rank(comm)
             values, given = read_options()
+            check_anderson_depth()          # before any PETSc object is made
             if database.hasName("help"):
                 for line in help_text():
                     say(line)
@@ -83,20 +55,20 @@ def run(comm=None):
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
-            solver = build_solver(mesh, scene, settings)
+            problem, solver = build_solver(mesh, scene, settings)
             if database.hasName("help"):
                 return 0
-            start = start_from(solver, values, given, say)
+            start = start_from(problem, values, given, say)
             if values["rod_output"]:
                 writer = io.ResultWriter(
                     values["rod_output"], mesh,
-                    io.minimum_bytes(mesh, outputs.restart_state(solver), values["rod_steps"]),
+                    io.minimum_bytes(mesh, outputs.restart_state(problem), values["rod_steps"]),
                     run_record(values, solver, start))
-            code = continuation(solver, values["rod_steps"], values["rod_imperfection"],
-                                writer=writer, say=say, options=options_record(),
-                                max_halvings=values["rod_max_halvings"],
-                                track_link=values["rod_track_link"], start=start,
-                                interrupts=interrupts).code
+            code = run_continuation(solver, values["rod_steps"], values["rod_imperfection"],
+                                    writer=writer, say=say, options=options_record(),
+                                    max_halvings=values["rod_max_halvings"],
+                                    track_link=values["rod_track_link"], start=start,
+                                    interrupts=interrupts).code
             writer = None
             for name in unused_options():
                 say(f"petsc_rod: warning: option -{name} was set but not used")
@@ -110,6 +82,8 @@ def run(comm=None):
                 writer.abort()
             if solver is not None:
                 solver.destroy()
+            if problem is not None:
+                problem.destroy()
             if mesh is not None:
                 mesh.destroy()
 
@@ -129,17 +103,21 @@ def check_mesh(comm, values):
 
 
 def build_solver(mesh, scene, settings):
-    """The UzawaSolver; a PETSc error while it sets up its solvers (an unknown
-    -rod_slope_ksp_type, say) is bad input."""
+    """(RodProblem, UzawaSolver); a PETSc error while they set up their solvers (an
+    unknown -rod_slope_ksp_type, say) is bad input (what was made is destroyed)."""
+    problem = None
     try:
-        return UzawaSolver(mesh, scene, settings)
+        problem = RodProblem(mesh, scene, settings.asked_penalty)
+        return problem, UzawaSolver(problem, settings)
     except PETSc.Error as error:
+        if problem is not None:
+            problem.destroy()
         detail = str(error).strip().splitlines()[-1].split("] ", 1)[-1]
         raise RodInputError(f"PETSc refused the solver options: {detail}; check the "
                             "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
 
 
-def start_from(solver, values, given, say):
+def start_from(problem, values, given, say):
     """Set the state the first step starts from, a restart file or -rod_initial_shape;
     returns the load factor the load path goes on from (0 but for a restart)."""
     shape = values["rod_initial_shape"]
@@ -150,23 +128,24 @@ def start_from(solver, values, given, say):
         if shape != "straight":
             raise RodInputError("-rod_initial and -rod_initial_shape both set the start; "
                                 "give one of them")
-        return restart_from(solver, values["rod_initial"], values["rod_initial_load_factor"],
+        return restart_from(problem, values["rod_initial"], values["rod_initial_load_factor"],
                             say)
     if "rod_initial_load_factor" in given:
         raise RodInputError("-rod_initial_load_factor needs -rod_initial (the state it is "
                             "the load factor of); drop it or give the file")
     if shape == "catenary":
-        solver.state.set_from_curve(starts.catenary_start(solver.scene, 1.0 / values["rod_steps"]))
+        problem.state.set_from_curve(starts.catenary_start(problem.scene,
+                                                           1.0 / values["rod_steps"]))
     else:
-        solver.state.set_straight()
+        problem.state.set_straight()
     return 0.0
 
 
-def restart_from(solver, path, load_factor, say):
+def restart_from(problem, path, load_factor, say):
     """Set the state of result file ``path`` (validated by io.read_restart against this
     run's arrays); returns ``load_factor``, or the file's when it is None."""
-    restart = io.read_restart(path, solver.mesh, outputs.restart_state(solver))
-    outputs.set_state(solver, restart.vertex, restart.state)
+    restart = io.read_restart(path, problem.mesh, outputs.restart_state(problem))
+    outputs.set_state(problem, restart.vertex, restart.state)
     if not restart.converged:
         say(f"petsc_rod: warning: -rod_initial {path} says converged = 0: the run starts "
             f"from a state that did not converge (at load factor {restart.load_factor:.6g})")
@@ -195,7 +174,7 @@ def options_in_effect(values, solver, start):
     """Every -rod_* option's value in effect, by name without ``rod_`` (the defaults that
     depend on the scene resolved, text options that were not given as ''), and its unit;
     then each global-step solver's KSP, PC and factorisation package."""
-    scene = solver.scene
+    scene = solver.problem.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     if scene.seabed is not None:                # the default stiffness (riser/environment.py)
@@ -221,7 +200,7 @@ def solver_types(solver):
     """{'<prefix>ksp_type': ..., '<prefix>pc_type': ..., '<prefix>pc_factor_mat_solver_type':
     ...} of the global step's solvers, prefixes without ``rod_``."""
     types = {}
-    for ksp in solver.global_step.ksps():
+    for ksp in solver.problem.global_step.ksps():
         prefix = (ksp.getOptionsPrefix() or "").removeprefix("rod_")
         pc = ksp.getPC()
         types[f"{prefix}ksp_type"] = ksp.getType()

@@ -9,6 +9,7 @@ other option nobody read is reported at the end of the run.
 """
 
 import ctypes
+import dataclasses
 import difflib
 import hashlib
 from dataclasses import dataclass
@@ -17,7 +18,12 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.iteration.driver import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
+from petsc_rod.iteration.continuation import MAX_HALVINGS, MAX_HALVINGS_CAP
+from petsc_rod.iteration.controller import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
+from petsc_rod.iteration.stopping import Settings
+from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
+from petsc_rod.riser.environment import DEFAULT_PENETRATION
+from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
 SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_")
@@ -101,8 +107,16 @@ NON_NEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
 TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
              f"must be positive (at least {1 / MAX_MAGNITUDE:g}) and below 1: a tolerance of "
              "1 or more accepts any iterate")
-# halvings beyond this make increments below the resolution of a load factor in [0, 1]
-MAX_HALVINGS = 50
+
+
+def default_of(owner, name):
+    """The default of field ``name`` of the dataclass ``owner`` (Scene, Settings): an
+    option's default is that of the object that uses it, read from there."""
+    field = next(f for f in dataclasses.fields(owner) if f.name == name)
+    if field.default_factory is not dataclasses.MISSING:
+        return field.default_factory()
+    return field.default
+
 
 OPTIONS = [
     Option("rod_length", _real, 1.0, "L", "length of the cable, m", SCALE, "m"),
@@ -112,32 +126,34 @@ OPTIONS = [
            (lambda v: v >= 1, "must be >= 1")),
     Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
            "bending (about d1, d2) and torsion stiffness, N m^2", SCALE, "N m^2"),
-    Option("rod_start", _string, "clamp", "clamp|pin|free", "condition at S = 0 (at the origin)",
+    Option("rod_start", _string, default_of(Scene, "start"), "clamp|pin|free",
+           "condition at S = 0 (at the origin)", unit="text"),
+    Option("rod_end", _string, default_of(Scene, "end"), "clamp|pin|free", "condition at S = L",
            unit="text"),
-    Option("rod_end", _string, "free", "clamp|pin|free", "condition at S = L", unit="text"),
     Option("rod_end_position", _reals(3), None, "x,y,z",
            "position of the end S = L (clamp, pin); default (L,0,0)", unit="m"),
     Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
            "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
-    Option("rod_end_twist", _real, 0.0, "angle",
+    Option("rod_end_twist", _real, default_of(Scene, "end_twist"), "angle",
            "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
            "continuation", unit="rad"),
-    Option("rod_end_force", _reals(3), np.zeros(3), "fx,fy,fz", "dead force at a free end S = L, N",
-           unit="N"),
-    Option("rod_start_force", _reals(3), np.zeros(3), "fx,fy,fz",
+    Option("rod_end_force", _reals(3), default_of(Scene, "end_force"), "fx,fy,fz",
+           "dead force at a free end S = L, N", unit="N"),
+    Option("rod_start_force", _reals(3), default_of(Scene, "start_force"), "fx,fy,fz",
            "dead force at a free start S = 0, N", unit="N"),
-    Option("rod_load", _reals(), np.zeros(3), "fx,fy,fz[,...]",
+    Option("rod_load", _reals(), default_of(Scene, "load_values").ravel(), "fx,fy,fz[,...]",
            "distributed dead load, N/m: 3 values, or 3 per piece with -rod_load_breaks",
            unit="N/m"),
-    Option("rod_load_breaks", _reals(), np.zeros(0), "s1,...",
+    Option("rod_load_breaks", _reals(), default_of(Scene, "load_breaks"), "s1,...",
            "arc lengths where the piecewise-constant load changes, m", unit="m"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",
            unit="m"),
     Option("rod_seabed_stiffness", _real, None, "k",
-           "seabed stiffness, N/m per m of line per m of penetration; default w / 1 mm, w the "
-           "largest downward -rod_load (N/m)", SCALE, "N/m^2"),
+           "seabed stiffness, N/m per m of line per m of penetration; default w / "
+           f"{DEFAULT_PENETRATION * 1e3:g} mm, w the largest downward -rod_load (N/m)", SCALE,
+           "N/m^2"),
     Option("rod_current", _reals(3), None, "ux,uy,uz",
            "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),
     Option("rod_current_profile", _string, None, "FILE",
@@ -153,11 +169,11 @@ OPTIONS = [
     Option("rod_imperfection", _real, 0.0, "eps",
            "at the start of each step, roll the cross-sections about the tangent by "
            "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left", unit="rad"),
-    Option("rod_max_halvings", _int, 4, "n",
+    Option("rod_max_halvings", _int, MAX_HALVINGS, "n",
            "a step that does not converge or diverges is retried from the last converged "
            "state with half the increment, at most n times per step (smallest increment "
            "1/(K 2^n)); 0: stop at the first failure",
-           (lambda v: 0 <= v <= MAX_HALVINGS, f"must be between 0 and {MAX_HALVINGS}")),
+           (lambda v: 0 <= v <= MAX_HALVINGS_CAP, f"must be between 0 and {MAX_HALVINGS_CAP}")),
     Option("rod_track_link", _bool, True, "bool",
            "ends clamped on a common axis: refuse a step whose linking number Tw + Wr is "
            "not the last one plus the end roll over 2 pi (the rod passed around an end or "
@@ -178,18 +194,19 @@ OPTIONS = [
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
            "min(K1, K2) with M = K3 a / L for a clamped end turned by a", SCALE, "N"),
-    Option("rod_al_max_it", _int, 2000, "n", "iteration cap per step", POSITIVE),
-    Option("rod_al_rtol", _real, 1e-9, "tol",
+    Option("rod_al_max_it", _int, default_of(Settings, "max_it"), "n", "iteration cap per step",
+           POSITIVE),
+    Option("rod_al_rtol", _real, default_of(Settings, "rtol"), "tol",
            "stop when the relative L2 change of (r, r', d1, d2) at the nodes per iteration "
            "is below tol", TOLERANCE),
-    Option("rod_al_ctol", _real, 1e-9, "tol",
+    Option("rod_al_ctol", _real, default_of(Settings, "ctol"), "tol",
            "and the RMS constraint residual |(r'-tau3, d1-tau1, d2-tau2)|_L2 / sqrt(L) is "
            "below tol", TOLERANCE),
-    Option("rod_al_stability", _bool, True, "bool",
+    Option("rod_al_stability", _bool, default_of(Settings, "check_stability"), "bool",
            "at each converged step, test the second variation of the energy (Sylvester "
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
            "not with a current (its drag has no energy)"),
-    Option("rod_al_newton", _bool, True, "bool",
+    Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
            f"{NEWTON_SWITCH:g} and more than {NEWTON_WORTH} iterations would remain at the "
            "recent rate, try Newton steps on the reduced problem (frames turned by the KKT "
@@ -197,10 +214,12 @@ OPTIONS = [
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once; after a failed attempt the wait "
            "doubles; not with a seabed or a current"),
-    Option("rod_al_monitor", _bool, False, "", "print change and residual at each iteration"),
-    Option("rod_al_adapt_penalty", _bool, True, "bool",
-           "raise R tenfold, refactoring the matrices, while it is below a tenth of the "
-           "default and the constraint residual falls by less than half in 200 iterations"),
+    Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
+           "print change and residual at each iteration"),
+    Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",
+           f"raise R {ADAPT_FACTOR:g}-fold, refactoring the matrices, while it is below "
+           f"{ADAPT_BELOW:g} times the default and the constraint residual falls by less "
+           f"than a factor {ADAPT_PROGRESS:g} in {ADAPT_WINDOW} iterations"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
 
@@ -232,6 +251,17 @@ def read_options():
             raise RodInputError(f"-{option.name} {text}: {option.check[1]}")
         values[option.name] = value
     return values, given
+
+
+def check_anderson_depth():
+    """Refuse a -rod_snes_anderson_m that is not a whole number of at least 1 (PETSc
+    itself fails on it with a stack of messages)."""
+    database = PETSc.Options()
+    if database.hasName("rod_snes_anderson_m"):
+        depth = database.getString("rod_snes_anderson_m", "")
+        if not depth.isdigit() or int(depth) < 1:
+            raise RodInputError(f"-rod_snes_anderson_m {depth}: the depth of Anderson "
+                                "mixing is a whole number of at least 1")
 
 
 def check_same_on_every_rank(comm):

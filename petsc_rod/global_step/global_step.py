@@ -9,17 +9,21 @@ stiffness, c_i the coefficients of the matrices (penalty.matrix_split) and b_3 t
 int F.g dS (centreline.py). The r' problem of a rod held at both ends is bordered by the
 chord constraint int r' dS = r(L) - r(0); r follows from r' by integration. The three
 matrices are assembled and factored once per penalty R.
+
+The loads and whatever else the physics adds come from the problem's terms
+(physics/term.py), called in list order: the loads fixed over a step are summed once
+per step into b_3 (add_step_load), those that depend on the iterate are added every
+iteration (add_iterate_load), and a term may solve slope components itself
+(solve_slope: the seabed's z).
 """
 
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.centreline import (anchor_work, load_offset,
-                                              positions_from_increments)
-from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix, load_ghosted
+from petsc_rod.global_step.centreline import positions_from_increments
+from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix
 from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
 from petsc_rod.mesh.fields import CHUNK, VectorField, blocks, element_slices
-from petsc_rod.riser.terms import RiserTerms
 from petsc_rod.scenes import boundary
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("assembly", "rhs", "solve")}
@@ -30,17 +34,17 @@ PREFIXES = ("rod_d1_", "rod_d2_", "rod_slope_")
 
 class GlobalStep:
     """The three scalar problems at one penalty, with the end conditions and loads of
-    the current load factor. Owns their PETSc objects; ``destroy()`` releases them."""
+    the current load factor, for the ``terms`` (physics/term.py) of the problem. Owns the
+    problems' PETSc objects and the summed load; ``destroy()`` releases them (the terms
+    are the problem's)."""
 
-    def __init__(self, mesh, scene, split, matrix_split, penalty):
-        self.mesh, self.scene = mesh, scene
+    def __init__(self, mesh, scene, split, matrix_split, penalty, terms):
+        self.mesh, self.scene, self.terms = mesh, scene, terms
         self.split, self.matrix_split = split, matrix_split
         self.start_state, self.end_state = scene.start_state(0.0), scene.end_state(0.0)
         self.bordered = boundary.is_held(self.start_state) and boundary.is_held(self.end_state)
         self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("d1", "d2", "slope")]
-        self.load = VectorField(mesh, "load")
-        self.load_offset = np.zeros(3)
-        self.anchor_work = 0.0
+        self.load = VectorField(mesh, "step_load")     # b_3: the terms' loads of the step
         self.lags = bool(np.any(matrix_split != split))
         self._stiffness = None
         if self.lags:
@@ -52,10 +56,9 @@ class GlobalStep:
         self._increments = np.zeros((3, mesh.n_local_elements))
         self._element_work = np.zeros(mesh.n_local_elements)
         self._target = np.zeros((min(mesh.n_local_nodes, CHUNK), 3, 3))   # w (R tau - lambda)
-        # the seabed and the current (petsc_rod/riser), built only when the scene has them
-        self.riser = RiserTerms(mesh, scene) if scene.seabed or scene.current else None
-        # the slope components solved here: with a seabed z is the vertical problem's
-        self._slope_components = (0, 1) if scene.seabed is not None else (0, 1, 2)
+        # the slope components solved here: those no term solves itself
+        elsewhere = {c for term in terms for c in term.slope_components}
+        self._slope_components = tuple(c for c in range(3) if c not in elsewhere)
         self.build(penalty)
 
     def build(self, penalty):
@@ -73,34 +76,32 @@ class GlobalStep:
         if self.bordered:
             self.problems[2].add_integral_constraint(element_integrals(h))
         self._set_prescribed()
-        if self.riser is not None:
-            self.riser.build(2 * self.matrix_split[2], penalty)
+        for term in self.terms:
+            term.build(2 * self.matrix_split[2], penalty)
         EVENTS["assembly"].end()
 
     def ksps(self):
-        """Every KSP of the global step: d1, d2, the slope, and the height's with a seabed."""
-        riser = self.riser.ksps() if self.riser is not None else []
-        return [problem.ksp for problem in self.problems] + riser
+        """Every KSP of the global step: d1, d2, the slope, and the terms' (the height's
+        with a seabed)."""
+        return [problem.ksp for problem in self.problems] + [
+            ksp for term in self.terms for ksp in term.ksps()]
 
     @property
     def slope_problem(self):
         return self.problems[2]
 
     def prepare(self, t):
-        """End conditions and loads at load factor t: the prescribed frame rows, and the
-        slope's load int F.g dS with F(S) = int_S^L f dS + offset (centreline.py),
-        integrated exactly between the load breaks."""
+        """End conditions and loads at load factor t: the prescribed frame rows, the
+        terms' step (Term.prepare), and b_3, the sum of their loads fixed over the step
+        (Term.add_step_load: the dead loads' int F.g dS)."""
         scene = self.scene
         self.start_state, self.end_state = start, end = scene.start_state(t), scene.end_state(t)
         self._set_prescribed()
-        total = scene.load_beyond(0.0, t)
-        self.load_offset = load_offset(start, end, total)
-        self.anchor_work = anchor_work(start, end, total)
-        self.load.add_ghosted(load_ghosted(
-            self.mesh, lambda S: scene.load_beyond(S, t) + self.load_offset,
-            scene.load_piece_ends))
-        if self.riser is not None:
-            self.riser.prepare(t, start, end)
+        for vec in self.load.components:
+            vec.zeroEntries()
+        for term in self.terms:
+            term.prepare(t, start, end)
+            term.add_step_load(self.load)
 
     def _set_prescribed(self):
         for i, problem in enumerate(self.problems):
@@ -108,12 +109,12 @@ class GlobalStep:
                 i, self.start_state, self.end_state, self.mesh.n_elements))
 
     def solve(self, state):
-        """Solve for d1, d2, r' and r of ``state`` (iteration/state.py) from its tau and
+        """Solve for d1, d2, r' and r of ``state`` (problem/state.py) from its tau and
         lambda; with a border, the chord multiplier mu goes to state.chord_multiplier."""
         EVENTS["rhs"].begin()
         self._assemble_rhs(state.tau, state.lam, state.node_weights)
-        if self.riser is not None:
-            self.riser.add_loads(self.rhs[2], state)
+        for term in self.terms:
+            term.add_iterate_load(self.rhs[2], state)
         EVENTS["rhs"].end()
         EVENTS["solve"].begin()
         for problem, rhs, director in zip(self.problems[:2], self.rhs[:2],
@@ -174,8 +175,8 @@ class GlobalStep:
 
     def solve_centreline(self, state):
         """r' from its right-hand side rhs[2], bordered by r(L) - r(0) = int r' when both
-        ends are held, then r at the vertices by integration. With a seabed the z slope
-        is the vertical problem's (riser/terms.py), not solved here."""
+        ends are held, then r at the vertices by integration. The components a term
+        solves itself (Term.solve_slope: with a seabed z) are left to it."""
         components = self._slope_components
         if self.bordered:
             chord = self.end_state.position - self.start_state.position
@@ -183,8 +184,8 @@ class GlobalStep:
                 self.rhs[2], state.slope, chord, components)
         else:
             self.slope_problem.solve(self.rhs[2], state.slope, components)
-        if self.riser is not None:
-            self.riser.solve_vertical(self.rhs[2], state, self.bordered)
+        for term in self.terms:
+            term.solve_slope(self.rhs[2], state, self.bordered)
         self.integrate_slope(state)
 
     def integrate_slope(self, state):
@@ -207,19 +208,6 @@ class GlobalStep:
             values[0::2] = positions[:, c]
             values[1::2] = slope.getArray(readonly=True)[0::2]
 
-    def load_work(self, state):
-        """The work of the loads on the state, J: r(a).(applied forces) + int F.r' dS
-        (centreline.anchor_work), less the seabed's stored energy (riser/seabed.py)."""
-        work = self.anchor_work + sum(load.dot(slope) for load, slope
-                                      in zip(self.load.components, state.slope.components))
-        return work - (self.riser.energy() if self.riser is not None else 0.0)
-
-    def end_reaction(self, state):
-        """External force N on the rod at S = L, N: F(L) - mu (centreline.py), i.e. the
-        dead force at a free end; -(int_0^L f dS + P_0) at a held end when the start is
-        free; and -mu, the chord multiplier, when both ends are held."""
-        return self.load_offset - state.chord_multiplier
-
     def _destroy_problems(self):
         for problem in self.problems:
             problem.destroy()
@@ -234,5 +222,3 @@ class GlobalStep:
             self._stiffness.destroy()
         for obj in [*self.rhs, self.load]:
             obj.destroy()
-        if self.riser is not None:
-            self.riser.destroy()

@@ -11,14 +11,10 @@ constraint int slope dS = r(L) - r(0) (ScalarProblem.add_integral_constraint).
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.errors import RodDivergedError
 from petsc_rod.global_step import substructuring
+from petsc_rod.global_step.ksp import chain_solver, check_solved
 from petsc_rod.mesh.elements import GAUSS_POINTS, GAUSS_WEIGHTS, P2, p2_basis
 from petsc_rod.mesh.fields import scatter_element_vectors
-from petsc_rod.petsc_defaults import set_from_options_with_defaults
-
-KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
-               for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
 
 
 def element_rows(mesh):
@@ -40,27 +36,12 @@ def assemble_matrix(mesh, element_matrices, rows=None):
     return matrix
 
 
-# The global step on several ranks, unless the options say otherwise: the exact
-# substructuring solve of substructuring.py as a python PC (each rank a local Cholesky
-# solve of its half of the chain, and a tridiagonal interface system of one unknown per
-# rank boundary). It does the serial Cholesky's work divided by the ranks; CG with block
-# Jacobi (a few iterations, each a product, a local solve and reductions) and MUMPS (a
-# slow solve phase on chains) are slower (docs/performance.md).
-PARALLEL_DEFAULTS = {"ksp_type": "preonly", "pc_type": "python",
-                     "pc_python_type": substructuring.PYTHON_TYPE}
-# On one rank: PETSc's Cholesky in the natural order, in which the chain is a band
-# matrix: no fill (the default nested dissection order of PCCHOLESKY fills in and is
-# slower here, docs/performance.md).
-SERIAL_DEFAULTS = {"pc_factor_mat_ordering_type": "natural"}
-
-
 class ScalarProblem:
     """One scalar SPD operator of the global step with its KSP.
 
     ``element_matrices`` (ne, 3, 3) are summed into the DMDA matrix; ``prescribed`` is a
     list of (vertex, slot, value) whose rows are constrained. KSP options are read with
-    ``prefix``; the default is SERIAL_DEFAULTS (a direct Cholesky factorisation) on one
-    rank and PARALLEL_DEFAULTS on several.
+    ``prefix`` (ksp.chain_solver: a direct Cholesky factorisation by default).
     """
 
     def __init__(self, mesh, element_matrices, prescribed, prefix):
@@ -78,15 +59,7 @@ class ScalarProblem:
         self._fixed_values = np.zeros((int(self._owned.sum()), 3))
         self._lift = [self.full.createVecLeft() for _ in range(3)]
         self._work = self.full.createVecLeft()
-        self.ksp = PETSc.KSP().create(comm=mesh.comm)
-        self.ksp.setOperators(self.constrained)
-        self.ksp.setType(PETSc.KSP.Type.PREONLY)
-        pc = self.ksp.getPC()
-        pc.setType(PETSc.PC.Type.CHOLESKY)
-        self.ksp.setOptionsPrefix(prefix)
-        defaults = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else SERIAL_DEFAULTS
-        set_from_options_with_defaults(
-            self.ksp, {f"{prefix}{key}": value for key, value in defaults.items()})
+        self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor, self._columns = self._direct_solver()
@@ -241,10 +214,7 @@ class ScalarProblem:
 
     def _solve_one(self, rhs, solution):
         self.ksp.solve(rhs, solution)
-        reason = self.ksp.getConvergedReason()
-        if reason < 0:
-            raise RodDivergedError(f"linear solver -{self.name} failed: "
-                                   f"{KSP_REASONS.get(reason, reason)}")
+        check_solved(self.ksp, self.name)
 
     def destroy(self):
         for obj in [self.ksp, self.full, self.constrained, self._work] + self._blocks \

@@ -1,10 +1,13 @@
-"""Derived outputs at the mesh vertices: positions, frames, strains, moment, force (§6).
+"""What a result file holds of a problem's state (problem/problem.py): the vertex fields
+(positions, frames, strains, moment, force, §6, and what the terms add), the restart
+state, and a step's attributes (docs/output.md).
 
 Every array is this rank's owned vertices (or owned elements and P2 nodes for the
-restart state);
-nothing is gathered. Strains at a vertex average the limits from the elements on
-either side (u is discontinuous across elements for P2 directors).
+restart state); nothing is gathered. Strains at a vertex average the limits from the
+elements on either side (u is discontinuous across elements for P2 directors).
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -12,15 +15,15 @@ from petsc_rod.mesh.elements import p2_basis, p2_integrals
 from petsc_rod.frames import strains
 
 
-def vertex_strains(solver):
+def vertex_strains(problem):
     """u = (u1, u2, u3) at the owned vertices, (n_owned, 3)."""
-    mesh = solver.mesh
+    mesh = problem.mesh
     first, end = mesh.elements_around_owned_vertices()
     elements = np.arange(first, end)
     h = mesh.coordinates(elements + 1) - mesh.coordinates(elements)
     ends = np.array([0.0, 1.0])
-    values = solver.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
-                             p2_integrals(ends, h))
+    values = problem.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
+                                    p2_integrals(ends, h))
     u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
     n_owned = mesh.vertex_end - mesh.vertex_start
     total = np.zeros((n_owned, 3))
@@ -33,45 +36,88 @@ def vertex_strains(solver):
     return total / count[:, None]
 
 
-def vertex_fields(solver, t):
-    """All vertex datasets of the result file (docs/method.md §6; docs/output.md)."""
-    mesh, scene = solver.mesh, solver.scene
-    r = solver.state.r.owned()
-    d1 = solver.state.d1.owned()[:, 0]
-    d2 = solver.state.d2.owned()[:, 0]
+def vertex_fields(problem):
+    """The vertex datasets of the result file that every problem has (docs/method.md §6;
+    docs/output.md): S, r, d1, d2, d3, u, the moment m and the internal force n
+    (RodProblem.internal_force). Collective."""
+    mesh, state = problem.mesh, problem.state
+    r = state.r.owned()
+    d1 = state.d1.owned()[:, 0]
+    d2 = state.d2.owned()[:, 0]
     d3 = r[:, 1]
-    u = vertex_strains(solver)
-    k = scene.stiffness
+    u = vertex_strains(problem)
+    k = problem.scene.stiffness
     moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
-    force = solver.end_reaction()[None, :] + scene.load_beyond(mesh.vertex_S, t)
-    riser = solver.global_step.riser
-    if riser is not None:                   # the drag and the seabed (petsc_rod/riser)
-        force += riser.force_beyond(solver.state)
     return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
-            "m": moment, "n": force}
+            "m": moment, "n": problem.internal_force()}
 
 
-def restart_state(solver):
+def restart_state(problem):
     """Dofs not in the vertex datasets: the P2 midpoints of d1, d2 per owned element, and
     tau, lambda at the owned P2 nodes."""
-    n_local = solver.mesh.n_local_elements
-    return {"d1_mid": solver.state.d1.owned()[:n_local, 1], "d2_mid": solver.state.d2.owned()[:n_local, 1],
-            "tau": solver.state.tau, "lambda": solver.state.lam}
+    n_local, state = problem.mesh.n_local_elements, problem.state
+    return {"d1_mid": state.d1.owned()[:n_local, 1], "d2_mid": state.d2.owned()[:n_local, 1],
+            "tau": state.tau, "lambda": state.lam}
 
 
-def set_state(solver, vertex, state):
+def set_state(problem, vertex, saved):
     """Inverse of vertex_fields + restart_state for owned slices (a restart). The file
     holds r and d3 = r' at the vertices: slope's midpoints are those of the Hermite cubic
     they define (RodState.set_centreline)."""
-    n_local = solver.mesh.n_local_elements
+    n_local, state = problem.mesh.n_local_elements, problem.state
     n_owned = vertex["r"].shape[0]
-    solver.state.set_centreline(vertex["r"], vertex["d3"])
-    for field, name in ((solver.state.d1, "d1"), (solver.state.d2, "d2")):
+    state.set_centreline(vertex["r"], vertex["d3"])
+    for field, name in ((state.d1, "d1"), (state.d2, "d2")):
         values = np.zeros((n_owned, 2, 3))
         values[:, 0] = vertex[name]
-        values[:n_local, 1] = state[f"{name}_mid"]
+        values[:n_local, 1] = saved[f"{name}_mid"]
         field.set_owned(values)
-    solver.state.tau[:] = state["tau"]
-    solver.state.lam[:] = state["lambda"]
-    solver.state.remember()
+    state.tau[:] = saved["tau"]
+    state.lam[:] = saved["lambda"]
+    state.remember()
+
+
+def stability_code(report):
+    """The file's ``stable``: 1 a local minimiser, 0 a saddle, -1 not checked."""
+    return -1 if report.stable is None else int(report.stable)
+
+
+@dataclass
+class StepRecord:
+    """What a step leaves (step_record): the vertex datasets (the terms' included), the
+    group's attributes, the terms' phrases for the step line, and u3(0) (1/m) for it."""
+
+    vertex: dict
+    attributes: dict
+    texts: list
+    u3_start: float
+
+    @property
+    def energy(self):
+        return self.attributes["energy"]
+
+
+def step_record(problem, report, t, **common):
+    """The StepRecord of the problem's state after a step at load factor t with its
+    stopping.StepReport, with the attributes ``common`` to the run so far (wall time,
+    options, halvings, totals). Collective."""
+    mesh = problem.mesh
+    vertex = vertex_fields(problem)
+    u3_start = mesh.global_sum(vertex["u"][0, 2] if mesh.on_lower_boundary else 0.0)
+    attributes = {"converged": int(report.converged),
+                  "stop_reason": report.reason or "converged", "iterations": report.iterations,
+                  "constraint_residual": report.constraint_residual,
+                  "change": report.change, "stable": stability_code(report),
+                  "newton_steps": report.newton_steps,
+                  "energy": problem.energy(), "ranks": mesh.comm.getSize(),
+                  "load_factor": t, "penalty": problem.penalty, **common}
+    if report.link is not None:
+        attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
+    texts = []
+    for output in problem.term_outputs(vertex):
+        vertex.update(output.datasets)
+        attributes.update(output.attributes)
+        if output.text:
+            texts.append(output.text)
+    return StepRecord(vertex, attributes, texts, u3_start)
 

@@ -31,7 +31,6 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.stability import skew
 from petsc_rod.frames import rotations
-from petsc_rod.scenes.boundary import clamped_nodes
 
 EVENT = PETSc.Log.Event("rod_newton")
 
@@ -53,17 +52,14 @@ CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 
 class NewtonPolish:
-    """Newton steps of the module docstring on a solver's state. Owns a work Vec for K d
-    (K is the global step's); ``destroy()`` frees it (the second variation is the
-    solver's, ``UzawaSolver.second_variation``, updated at each step)."""
+    """Newton steps of the module docstring on a problem's state (problem/problem.py).
+    Owns a work Vec for K d (K is the global step's); ``destroy()`` frees it (the second
+    variation is the problem's, ``RodProblem.second_variation``, updated at each step)."""
 
-    def __init__(self, solver):
-        self.solver = solver
-        step = solver.global_step
-        self.stiffness = step.stiffness()
-        self._product = self.stiffness.createVecLeft()
-        # the ends' kinds do not change: the clamped nodes are those of the whole run
-        self._free = ~clamped_nodes(solver.mesh, step.start_state, step.end_state)
+    def __init__(self, problem):
+        self.problem = problem
+        self._product = problem.stiffness().createVecLeft()
+        self._free = problem.free_nodes
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite: the stability test's verdict, at 1e-10 rad from the result
         self.verified = False
@@ -75,8 +71,8 @@ class NewtonPolish:
         INDEFINITE (H has a direction of negative curvature: near a saddle) or FAILED
         (the steps did not converge); in the last two cases the state is as it was.
         ``record(turn)`` is called after each step with its largest turn, rad."""
-        solver = self.solver
-        state = solver.state
+        problem = self.problem
+        state = problem.state
         EVENT.begin()
         saved = state.snapshot()
         frames = state.tau.copy()
@@ -87,14 +83,14 @@ class NewtonPolish:
         outcome = FAILED
         try:
             for _ in range(MAX_STEPS):
-                self.solver.state.set_node_directors(frames)
-                g = self._energy_gradient(frames)
+                state.set_node_directors(frames)
+                g = problem.energy_gradient(self._product)
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
                 omega, dmu = self._newton_step(frames, g, mu)
                 if omega is None:
                     outcome = INDEFINITE
                     break
-                largest = solver.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
+                largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
                 if not np.isfinite(largest) or largest > SHRINK * previous:
                     if np.isfinite(largest) and previous <= FLOOR_TURN:
                         self._hand_over(frames, mu)
@@ -114,22 +110,8 @@ class NewtonPolish:
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
-    def _energy_gradient(self, frames):
-        """g_i = dE/dd_i at the nodes, (n_nodes, 3, 3): 2 a_i K d_i, less b for d3."""
-        solver = self.solver
-        n = frames.shape[0]
-        g = np.empty_like(frames)
-        loads = solver.global_step.load.components
-        for i, field in enumerate(solver.state.frame_fields):
-            for c, vec in enumerate(field.components):
-                self.stiffness.mult(vec, self._product)
-                g[:, i, c] = 2 * solver.split[i] * self._product.getArray(readonly=True)[:n]
-                if i == 2:
-                    g[:, i, c] -= loads[c].getArray(readonly=True)[:n]
-        return g
-
     def _bordered(self):
-        return self.solver.global_step.bordered
+        return self.problem.bordered
 
     def _least_squares_multiplier(self, frames, g):
         """The chord multiplier mu (3,) that makes grad L smallest (0 when the chord is
@@ -137,13 +119,13 @@ class NewtonPolish:
         nodes that are not clamped."""
         if not self._bordered():
             return np.zeros(3)
-        w = self.solver.state.node_weights
+        w = self.problem.state.node_weights
         a = np.cross(frames, g).sum(axis=1)
         A = w[:, None, None] * skew(frames[:, 2])          # w d3 x mu = A mu
         free = self._free
         normal = np.einsum("nki,nkj->ij", A[free], A[free])
         right = -np.einsum("nki,nk->i", A[free], a[free])
-        total = self.solver.mesh.global_sum(np.concatenate([normal.ravel(), right]))
+        total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
         return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
 
     def _newton_step(self, frames, g, mu):
@@ -152,7 +134,7 @@ class NewtonPolish:
         g = self._set_multipliers(frames, g, mu)
         gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
         gradient[~self._free] = 0.0
-        hessian = self.solver.second_variation()
+        hessian = self.problem.second_variation()
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
             if not self._positive_definite(hessian):
@@ -209,18 +191,19 @@ class NewtonPolish:
 
     def _chord_residual(self, frames):
         """c = sum_n w_n d3_n - (r(L) - r(0)), (3,)."""
-        step = self.solver.global_step
-        local = self.solver.state.node_weights @ frames[:, 2]
-        return (self.solver.mesh.global_sum(local)
-                - (step.end_state.position - step.start_state.position))
+        problem = self.problem
+        local = problem.state.node_weights @ frames[:, 2]
+        return (problem.mesh.global_sum(local)
+                - (problem.end_state.position - problem.start_state.position))
 
     def _hand_over(self, frames, mu):
         """The state as the Uzawa fixed point at ``frames``: fields, r, tau = d and
         lambda = -g / w (with the chord's share in lambda3; 0 at a clamped node)."""
-        state = self.solver.state
+        problem = self.problem
+        state = problem.state
         state.set_node_directors(frames)
-        self.solver.global_step.integrate_slope(state)
-        self._set_multipliers(frames, self._energy_gradient(frames), mu)
+        problem.global_step.integrate_slope(state)
+        self._set_multipliers(frames, problem.energy_gradient(self._product), mu)
         # a clamped frame is prescribed, not solved for: its multiplier is free, and 0
         # is one the local step keeps (P(R d) = d)
         state.lam[~self._free] = 0.0
@@ -229,7 +212,7 @@ class NewtonPolish:
     def _set_multipliers(self, frames, g, mu):
         """tau = frames and lambda = -g / w with g the gradient of L (the chord's mu w in
         its d3 rows); returns that g, (n_nodes, 3, 3). H is assembled from these."""
-        state = self.solver.state
+        state = self.problem.state
         w = state.node_weights
         g = g.copy()
         g[:, 2] += w[:, None] * mu
@@ -242,10 +225,10 @@ class NewtonPolish:
         the local step returns tau = P(R tau + lambda) = P(tau (R I + tau^T lambda))
         only if R I + tau^T lambda (symmetric at a solution) is positive definite at
         every node, i.e. R > the largest -eig(sym(tau_n^T lambda_n)), N."""
-        state = self.solver.state
+        state = self.problem.state
         product = np.einsum("nik,nil->nkl", state.lam, state.tau)
         lowest = np.linalg.eigvalsh(0.5 * (product + product.transpose(0, 2, 1)))[:, 0]
-        return self.solver.mesh.global_max(float(-lowest.min(initial=0.0)))
+        return self.problem.mesh.global_max(float(-lowest.min(initial=0.0)))
 
     def destroy(self):
         self._product.destroy()

@@ -1,12 +1,12 @@
-"""When a step of the iteration ends (docs/method.md §6): the stopping tests, the
-divergence and stall rules, and the record of what a step did.
+"""When a step of the iteration ends (docs/method.md §6): what the user asks of the
+iteration (Settings), the stopping tests, the divergence and stall rules, and the report
+of a finished step.
 
 Every rule here reads the step's history of (change, constraint residual, wall time)
-rows, one per iteration, and returns a decision; nothing here touches the solver's
-state.
+rows, one per iteration, and returns a verdict; the step controller (controller.py)
+turns them into its decisions, and nothing here touches the solver's state.
 """
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,9 +22,6 @@ STOP_STALLED = "stalled"
 STOP_OBSERVER = "observer"      # the caller's observer asked to stop
 STOP_LINK = "link"              # converged, to a state of another linking number (link.py)
 STOP_SADDLE = "saddle"          # converged to a saddle, and left it too often
-RAISE_PENALTY = "raise_penalty"     # not an end: the step goes on with a larger R
-TRY_NEWTON = "try_newton"           # not an end: Newton steps, then the iteration again
-CONVERGED = (True, "")
 
 # The stall test looks at windows of STALL_WINDOW iterations (stalled_projection), and
 # only once both stopping quantities are within STALL_FACTOR of their tolerances: an
@@ -40,9 +37,10 @@ STALL_CHECK_EVERY = STALL_WINDOW // 10
 
 @dataclass
 class Settings:
-    """What the user asks of the iteration (-rod_al_*; docs/method.md §6)."""
+    """What the user asks of the iteration (docs/method.md §6). The defaults here are
+    the command line's (cli/options.py reads them from this class)."""
 
-    asked_penalty: float            # R asked for, N (-rod_al_penalty or default_penalty)
+    asked_penalty: float            # R asked for, N (penalty.default_penalty by default)
     max_it: int = 2000
     rtol: float = 1e-9
     ctol: float = 1e-9
@@ -53,40 +51,8 @@ class Settings:
 
 
 @dataclass
-class StepProgress:
-    """What one step has done so far: a (change, residual, wall time) row per iteration,
-    the penalty raises, and the outcome once decided: (converged, reason), or
-    RAISE_PENALTY, or the error that ended it."""
-
-    label: str
-    observer: object
-    clock: float = field(default_factory=time.perf_counter)
-    history: list = field(default_factory=list)
-    raises: list = field(default_factory=list)
-    outcome: object = None
-    error: Exception = None
-    stable: bool = None         # a local minimiser (stability.py); None: not checked
-    escapes: int = 0            # saddles left on the way
-    newton_steps: int = 0       # Newton steps taken (newton.py), counted in history
-    newton_next: int = 0        # the iteration from which Newton may be tried again
-    newton_failures: int = 0    # attempts that did not converge
-    early_escapes: int = 0      # saddles left before converging to them (driver._polish)
-    # the iteration at which Newton converged with H positive definite on the constraint
-    # set (the stability test's own criterion): the state is stable if the step
-    # converges at the next one
-    newton_verified: int = None
-
-    @property
-    def finished(self):
-        return self.outcome is not None or self.error is not None
-
-    def record(self, change, residual):
-        self.history.append((change, residual, time.perf_counter() - self.clock))
-
-
-@dataclass
 class StepReport:
-    """What a finished step reports (UzawaSolver.solve_step)."""
+    """What a finished step reports (UzawaSolver.solve_step, controller.report)."""
 
     converged: bool
     iterations: int
@@ -100,15 +66,6 @@ class StepReport:
     stable: bool = None     # the second variation is positive (§10); None: unchecked
     escapes: int = 0        # saddles the step converged to and left
     newton_steps: int = 0   # of the iterations, Newton steps on the reduced problem
-
-    @classmethod
-    def of(cls, step):
-        converged, reason = step.outcome
-        change, residual = step.history[-1][:2] if step.history else (np.inf, np.inf)
-        return cls(converged, len(step.history), change, residual, step.history, reason,
-                   step.raises, stable=step.stable,
-                   escapes=step.escapes + step.early_escapes,
-                   newton_steps=step.newton_steps)
 
     @property
     def stalled(self):
@@ -185,13 +142,13 @@ def stalled(history, rtol, ctol, budget):
                for column, tolerance in ((0, rtol), (1, ctol)))
 
 
-def stall_outcome(settings, history):
-    """(False, STOP_STALLED) every STALL_CHECK_EVERY iterations if ``stalled``, or
-    (False, STOP_MAX_IT) at the cap, else None."""
+def stall_reason(settings, history):
+    """STOP_STALLED every STALL_CHECK_EVERY iterations if ``stalled``, or STOP_MAX_IT at
+    the cap, else None."""
     iteration = len(history)
     if iteration >= settings.max_it:
-        return (False, STOP_MAX_IT)
+        return STOP_MAX_IT
     if iteration % STALL_CHECK_EVERY == 0 and stalled(
             history, settings.rtol, settings.ctol, settings.max_it - iteration):
-        return (False, STOP_STALLED)
+        return STOP_STALLED
     return None

@@ -1,4 +1,5 @@
-"""The sea around a riser as given by the options, checked: seabed, current, drag.
+"""The sea around a riser: seabed, current, drag (made from the options by
+cli/scene_options.py), the current profile file, and the checks against the scene.
 
 z is up. The seabed is the plane z = height; the current a velocity field of z only
 (uniform, or a profile of depth below the sea surface). Every quantity in SI units.
@@ -59,22 +60,6 @@ def default_stiffness(load_values):
     return downward / DEFAULT_PENETRATION if downward > 0 else None
 
 
-def seabed_from_options(values, given, load_values):
-    """The Seabed of -rod_seabed and -rod_seabed_stiffness, or None."""
-    if "rod_seabed" not in given:
-        if "rod_seabed_stiffness" in given:
-            raise RodInputError("-rod_seabed_stiffness needs -rod_seabed (the height of the "
-                                "seabed plane)")
-        return None
-    stiffness = values["rod_seabed_stiffness"]
-    if stiffness is None:
-        stiffness = default_stiffness(load_values)
-        if stiffness is None:
-            raise RodInputError("-rod_seabed: no -rod_load points down to set the default "
-                                "stiffness (weight / 1 mm); give -rod_seabed_stiffness")
-    return Seabed(float(values["rod_seabed"]), float(stiffness))
-
-
 def read_profile(path):
     """(depths (m,), velocities (m, 3)) from a text file of rows 'depth ux uy uz' (m,
     m/s; '#' starts a comment), depths strictly increasing. RodInputError otherwise."""
@@ -103,35 +88,6 @@ def read_profile(path):
     return table[:, 0], table[:, 1:]
 
 
-def current_from_options(values, given, surface_default):
-    """The Current of -rod_current or -rod_current_profile with -rod_drag, or None.
-    ``surface_default``: the sea surface height when -rod_sea_surface is not given."""
-    uniform, profile = "rod_current" in given, "rod_current_profile" in given
-    if uniform and profile:
-        raise RodInputError("-rod_current and -rod_current_profile both give the current; "
-                            "give one of them")
-    if not (uniform or profile):
-        for name in ("rod_drag", "rod_sea_surface"):
-            if name in given:
-                raise RodInputError(f"-{name} needs a current (-rod_current or "
-                                    "-rod_current_profile)")
-        return None
-    if "rod_drag" not in given:
-        raise RodInputError("a current needs -rod_drag rho,Cd,D (water density kg/m^3, drag "
-                            "coefficient, hydrodynamic diameter m)")
-    if "rod_sea_surface" in given and not profile:
-        raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
-                            "current does not depend on depth)")
-    if profile:
-        depths, velocities = read_profile(values["rod_current_profile"])
-    else:
-        depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
-    surface = values["rod_sea_surface"]
-    rho, cd, diameter = values["rod_drag"]
-    return Current(depths, velocities, float(surface_default if surface is None else surface),
-                   0.5 * rho * cd * diameter)
-
-
 def check_ends_above(seabed, ends, length):
     """Refuse a held end below the seabed (``ends``: (name, EndState) pairs at t = 1); an
     end on it (an anchor) is fine, to round-off of the length."""
@@ -143,13 +99,3 @@ def check_ends_above(seabed, ends, length):
             raise RodInputError(
                 f"{name}: the end is held at z = {state.position[2]:.6g} m, {depth:.3g} m "
                 f"below the seabed (-rod_seabed {seabed.height:g}); hold it on or above it")
-
-
-def environment_from_options(values, given, scene):
-    """(Seabed or None, Current or None) for a validated ``scene``, checked against it."""
-    seabed = seabed_from_options(values, given, scene.load_values)
-    ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
-    ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
-    check_ends_above(seabed, ends, scene.length)
-    held = [state.position[2] for _, state in ends if is_held(state)]
-    return seabed, current_from_options(values, given, max(held))

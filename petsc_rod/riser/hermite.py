@@ -20,10 +20,8 @@ of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of the slope d
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.matrices import (KSP_REASONS, PARALLEL_DEFAULTS, SERIAL_DEFAULTS,
-                                             assemble_matrix)
-from petsc_rod.errors import RodDivergedError
-from petsc_rod.petsc_defaults import set_from_options_with_defaults
+from petsc_rod.global_step.ksp import chain_solver, check_solved
+from petsc_rod.global_step.matrices import assemble_matrix
 from petsc_rod.scenes.boundary import is_held
 
 
@@ -56,9 +54,9 @@ class VerticalProblem:
     per element (set_added: the seabed), with essential conditions on y.
 
     ``slope_matrices`` (ne, 3, 3) are the element matrices of the slope problem (2 c3 K +
-    R W). The KSP (prefix ``prefix``) is preonly + Cholesky in the natural order on one
-    rank and the parallel default on several (matrices.SERIAL_DEFAULTS and
-    PARALLEL_DEFAULTS), like the other global-step solvers.
+    R W). The KSP (prefix ``prefix``) is the chain solver of the global step
+    (ksp.chain_solver: Cholesky in the natural order on one rank, the exact
+    substructuring on several).
     """
 
     def __init__(self, mesh, slope_matrices, prefix):
@@ -76,16 +74,9 @@ class VerticalProblem:
         self.rhs, self.solution, self.bc, self._work, self._product = (
             self.base.createVecLeft() for _ in range(5))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
-        self.ksp = PETSc.KSP().create(comm=mesh.comm)
-        self.ksp.setOperators(self.constrained)
-        self.ksp.setType(PETSc.KSP.Type.PREONLY)
-        self.ksp.getPC().setType(PETSc.PC.Type.CHOLESKY)
-        self.ksp.setOptionsPrefix(prefix)
-        # the slope problem's defaults (matrices.py): the natural order on one rank, in
+        # the slope problem's solver and defaults: the natural order on one rank, in
         # which the chain is a band matrix without fill
-        defaults = PARALLEL_DEFAULTS if mesh.comm.getSize() > 1 else SERIAL_DEFAULTS
-        set_from_options_with_defaults(
-            self.ksp, {f"{prefix}{key}": value for key, value in defaults.items()})
+        self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
 
     def _slope_matrix(self, T):
         """T as a DMDA matrix: rows the P2 slope dofs, columns the Hermite dofs (the
@@ -100,7 +91,7 @@ class VerticalProblem:
         matrix.assemble()
         return matrix
 
-    def set_prescribed(self, start, end):
+    def set_end_states(self, start, end):
         """Essential conditions from the end states: z at a held end, z' at a clamp."""
         last = 2 * self.mesh.n_elements
         fixed = []
@@ -147,10 +138,7 @@ class VerticalProblem:
         self._work.axpy(-1.0, self._product)
         self._work.getArray()[self._local_fixed] = self._fixed_values
         self.ksp.solve(self._work, self.solution)
-        reason = self.ksp.getConvergedReason()
-        if reason < 0:
-            raise RodDivergedError(f"linear solver -{self.name} failed: "
-                                   f"{KSP_REASONS.get(reason, reason)}")
+        check_solved(self.ksp, self.name)
         self.to_slope.mult(self.solution, slope)
         return self.solution
 

@@ -13,10 +13,9 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   and where they occur.
 """
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from petsc_rod.physics.term import Term, TermOutput
 from petsc_rod.scenes.boundary import is_held
 
 # Units of the datasets and attributes this module adds to the result file.
@@ -27,17 +26,21 @@ ATTRIBUTE_UNITS = {
     "max_curvature_position": "m", "min_bend_radius": "m"}
 
 
-@dataclass
-class RiserReport:
-    datasets: dict
-    attributes: dict
-    text: str
+class RiserNumbers(Term):
+    """The riser numbers as a term that only reports (physics/term.py): built for every
+    scene with a seabed or a current, with the SeabedTerm (riser/terms.py) or None."""
+
+    def __init__(self, seabed=None):
+        self.seabed = seabed
+
+    def outputs(self, problem, vertex):
+        return riser_report(problem, vertex, self.seabed)
 
 
-def top_end(solver):
+def top_end(problem):
     """0 or 1: which end is the top (the higher held end; the end S = L on a tie or when
     only that one is held)."""
-    start, end = solver.global_step.start_state, solver.global_step.end_state
+    start, end = problem.start_state, problem.end_state
     if is_held(start) and (not is_held(end) or start.position[2] > end.position[2]):
         return 0
     return 1
@@ -61,11 +64,12 @@ def _extreme(mesh, key, payload, largest):
     return pick(candidates, key=lambda c: c[0])[1]
 
 
-def touchdown(solver, seabed, top):
-    """(S, position (3,), grounded length) of the touchdown point (module docstring);
-    S and position NaN when the line does not reach the seabed. Collective."""
-    mesh = solver.mesh
-    ghosted = solver.state.r.ghosted()[:, 0]
+def touchdown(problem, seabed, top):
+    """(S, position (3,), grounded length) of the touchdown point (module docstring) on
+    the environment.Seabed ``seabed``; S and position NaN when the line does not reach
+    it. Collective."""
+    mesh = problem.mesh
+    ghosted = problem.state.r.ghosted()[:, 0]
     left = mesh.element_local
     r0, r1 = ghosted[left], ghosted[left + 1]
     gap0, gap1 = r0[:, 2] - seabed.height, r1[:, 2] - seabed.height
@@ -90,22 +94,25 @@ def touchdown(solver, seabed, top):
         pick = np.argmin(S) if top == 0 else np.argmax(S)
         local = (S[pick], position[pick])
     found = _extreme(mesh, local[0], local, largest=top == 1)
-    end_z = _at_vertex(mesh, solver.state.r.owned()[:, 0, 2], top * mesh.n_elements)
+    end_z = _at_vertex(mesh, problem.state.r.owned()[:, 0, 2], top * mesh.n_elements)
     if end_z < seabed.height:          # the line lies on the seabed up to the top
-        found = (top * mesh.length, _at_vertex(mesh, solver.state.r.owned()[:, 0], top * mesh.n_elements))
+        found = (top * mesh.length,
+                 _at_vertex(mesh, problem.state.r.owned()[:, 0], top * mesh.n_elements))
     if found is None:
         return np.nan, np.full(3, np.nan), grounded
     return float(found[0]), np.asarray(found[1], dtype=float), grounded
 
 
-def riser_report(solver, vertex):
-    """The datasets, attributes and step-line text of a riser scene from the vertex
-    fields ``vertex`` (outputs.vertex_fields). Collective."""
-    mesh, riser = solver.mesh, solver.global_step.riser
+def riser_report(problem, vertex, seabed=None):
+    """The datasets, attributes and step-line text (a physics.term.TermOutput) of a riser
+    scene from the vertex fields ``vertex`` (outputs.vertex_fields), with the touchdown
+    on the SeabedTerm ``seabed`` if there is one. Collective."""
+    mesh = problem.mesh
     z = vertex["r"][:, 2]
     tension = np.einsum("nc,nc->n", vertex["n"], vertex["d3"])
-    datasets = {"effective_tension": tension, "seabed_reaction": riser.seabed_pressure(z)}
-    top = top_end(solver)
+    reaction = seabed.pressure(z) if seabed is not None else np.zeros_like(z)
+    datasets = {"effective_tension": tension, "seabed_reaction": reaction}
+    top = top_end(problem)
     index = top * mesh.n_elements
     top_force = _at_vertex(mesh, vertex["n"], index)
     top_tangent = _at_vertex(mesh, vertex["d3"], index)
@@ -121,11 +128,11 @@ def riser_report(solver, vertex):
                   "min_bend_radius": float(1.0 / kappa) if kappa > 0 else np.inf}
     text = (f"top tension {attributes['top_tension']:.6g} N at {angle:.3f} deg from the "
             f"vertical")
-    if riser.seabed is not None:
-        S, position, grounded = touchdown(solver, riser.seabed, top)
+    if seabed is not None:
+        S, position, grounded = touchdown(problem, seabed.seabed, top)
         attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
     text += (f", largest curvature {kappa:.4g} 1/m (bend radius "
              f"{attributes['min_bend_radius']:.4g} m) at S = {kappa_S:.6g} m")
-    return RiserReport(datasets, attributes, text)
+    return TermOutput(datasets, attributes, text)

@@ -1,20 +1,25 @@
-"""What the global step (global_step/global_step.py) calls for a scene with a seabed or
-a current (docs/riser.md); it holds None instead when the scene has neither.
+"""The seabed and the drag as terms of physics (physics/term.py; docs/riser.md), built
+only for a scene that has them (problem/build.py).
 
-* The drag enters the slope problem's right-hand side like a dead load (loads.py),
-  evaluated at the tangents tau3 of the iterate x = (tau, lambda / R) that the SNES
-  mixes and at the heights of the last global step (for a current profile), times the
-  load factor t: a function of the iterate, so that Anderson mixing sees it.
 * The seabed is part of the global step: the z slope is solved in Hermite dofs with the
   contact by an active-set loop (hermite.py, seabed.py) in place of the z component of
   the P2 solve (which then solves x and y only); when both ends are held, the z part of
   the chord multiplier is that problem's residual at z(L).
+* The drag enters the slope problem's right-hand side like a dead load (loads.py),
+  evaluated at the tangents tau3 of the iterate x = (tau, lambda / R) that the SNES
+  mixes and at the heights of the last global step (for a current profile), times the
+  load factor t: a function of the iterate, so that Anderson mixing sees it. It has no
+  energy (a follower load).
+
+Neither is yet in the Newton steps (in_newton False): the iteration alone converges
+with them.
 """
 
 import numpy as np
 
 from petsc_rod.mesh.elements import P2, p2_element_matrices
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
+from petsc_rod.physics.term import Term
 from petsc_rod.riser.current import normal_drag
 from petsc_rod.riser.hermite import VerticalProblem
 from petsc_rod.riser.loads import NodalLoad
@@ -25,102 +30,96 @@ from petsc_rod.scenes.boundary import is_held
 VERTICAL_PREFIX = "rod_z_"
 
 
-class RiserTerms:
-    """The seabed and drag terms of one GlobalStep (see the module docstring)."""
+class NodalLoadTerm(Term):
+    """What the seabed and the drag share: a load per metre known at the P2 nodes
+    (node_loads), whose share of n(S) is int_S^L f_h dS (loads.NodalLoad), plus, when the
+    start is free, minus its whole resultant (the reaction at the held end)."""
 
-    def __init__(self, mesh, scene):
-        self.mesh, self.seabed, self.current = mesh, scene.seabed, scene.current
+    def __init__(self, mesh, name):
+        self.mesh = mesh
         self.t = 0.0
         self.start_state = self.end_state = None
-        self.y = None                   # Hermite dofs of z after the last global step
-        self.vertical = self.contact = None
-        self._nodes = VectorField(mesh, "riser_nodes")      # ghost exchange of nodal loads
-        self._rhs = VectorField(mesh, "riser_rhs")
-        self.drag = NodalLoad(mesh, self._nodes) if self.current is not None else None
+        self._nodes = VectorField(mesh, f"{name}_nodes")      # ghost exchange of nodal loads
 
-    def build(self, slope_stiffness, penalty):
-        """The vertical problem with the slope problem's coefficients 2 c3 (N m^2) and R
-        (N): at the start and after every penalty raise (GlobalStep.build)."""
-        if self.seabed is None:
-            return
-        self._destroy_vertical()
-        matrices = p2_element_matrices(self.mesh.element_h, slope_stiffness, penalty)
-        self.vertical = VerticalProblem(self.mesh, matrices, VERTICAL_PREFIX)
-        self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
-        if self.start_state is not None:
-            self.vertical.set_prescribed(self.start_state, self.end_state)
-
-    def ksps(self):
-        """The KSP of the vertical problem, where there is a seabed."""
-        return [self.vertical.ksp] if self.vertical is not None else []
-
-    def prepare(self, t, start_state, end_state):
-        """The load factor and end states of a step (GlobalStep.prepare)."""
-        self.t, self.start_state, self.end_state = t, start_state, end_state
-        if self.vertical is not None:
-            self.vertical.set_prescribed(start_state, end_state)
-
-    # --- each iteration ------------------------------------------------------------
-    def drag_at_nodes(self, state):
-        """t c |v_n| v_n at the owned nodes (N/m), (n_nodes, 3), from the tangents tau3
-        and, for a current that varies with depth, the heights of the last global step.
-        Collective when it does (a ghost exchange)."""
-        current = self.current
-        z = (state.node_positions()[:, 2] if current.depths.size > 1
-             else np.zeros(self.mesh.n_local_nodes))
-        return self.t * normal_drag(state.tau[:, 2], current.velocity(z), current.drag)
-
-    def add_loads(self, slope_rhs, state):
-        """Add the drag's int F.g to the slope problem's right-hand side (a VectorField)."""
-        if self.drag is None:
-            return
-        self.drag.set(self.drag_at_nodes(state))
-        offset = np.zeros(3) if is_held(self.start_state) else -self.drag.total
-        mesh = self.mesh
-        self._rhs.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
-            self.drag.element_vectors(offset)))
-        for vec, load in zip(slope_rhs.components, self._rhs.components):
-            vec.axpy(1.0, load)
-
-    def solve_vertical(self, slope_rhs, state, bordered):
-        """Replace the z slope of ``state`` by the solution with the seabed (after the P2
-        solve); with both ends held, the z part of state.chord_multiplier too."""
-        if self.seabed is None:
-            return
-        self.y = self.contact.solve(slope_rhs.components[2], state.slope.components[2])
-        if bordered:
-            state.chord_multiplier[2] = self.vertical.end_residual()
-
-    # --- outputs ---------------------------------------------------------------------
-    def seabed_pressure(self, z):
-        """The seabed's upward force per metre (N/m) at heights z; zero without a seabed."""
-        if self.seabed is None:
-            return np.zeros_like(z)
-        return self.contact.pressure(z)
+    def prepare(self, t, start, end):
+        self.t, self.start_state, self.end_state = t, start, end
 
     def node_loads(self, state):
-        """The state's loads per metre at the owned nodes, drag and seabed, (n_nodes, 3)."""
-        loads = np.zeros((self.mesh.n_local_nodes, 3))
-        if self.drag is not None:
-            loads += self.drag_at_nodes(state)
-        loads[:, 2] += self.seabed_pressure(state.node_positions()[:, 2])
-        return loads
+        """The load per metre at the owned P2 nodes, N/m, (n_nodes, 3)."""
+        raise NotImplementedError
 
-    def force_beyond(self, state):
-        """The part of n(S) at the owned vertices that the drag and the seabed make,
-        int_S^L f_h dS, plus, when the start is free, their share -int_0^L f_h of the
-        reaction at the held end (docs/method.md §6). (n_owned, 3). Collective."""
+    def _nodal_load(self, state):
         load = NodalLoad(self.mesh, self._nodes)
         load.set(self.node_loads(state))
+        return load
+
+    def force_beyond(self, state):
+        """(n_owned, 3), N. Collective."""
+        load = self._nodal_load(state)
         offset = np.zeros(3) if is_held(self.start_state) else -load.total
         return load.beyond_vertices() + offset
 
-    def energy(self):
-        """The seabed's stored energy (J); the drag has none (it is not conservative)."""
-        if self.seabed is None or self.y is None:
+    def end_force(self, state):
+        """0 when the start is held (the load is carried there), else -int_0^L f_h dS.
+        Collective."""
+        if is_held(self.start_state):
+            return np.zeros(3)
+        return -self._nodal_load(state).total
+
+    def destroy(self):
+        self._nodes.destroy()
+
+
+class SeabedTerm(NodalLoadTerm):
+    """A flat elastic seabed (environment.Seabed) under the line: the z slope solved with
+    the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2."""
+
+    slope_components = (2,)
+    in_newton = False           # its gradient and Hessian are not in the Newton steps yet
+
+    def __init__(self, mesh, seabed):
+        super().__init__(mesh, "seabed")
+        self.seabed = seabed
+        self.y = None                   # Hermite dofs of z after the last global step
+        self.vertical = self.contact = None
+
+    def build(self, slope_coefficient, penalty):
+        """The vertical problem with the slope problem's coefficients 2 c3 (N m^2) and R
+        (N): at the start and after every penalty raise."""
+        self._destroy_vertical()
+        matrices = p2_element_matrices(self.mesh.element_h, slope_coefficient, penalty)
+        self.vertical = VerticalProblem(self.mesh, matrices, VERTICAL_PREFIX)
+        self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
+        if self.start_state is not None:
+            self.vertical.set_end_states(self.start_state, self.end_state)
+
+    def ksps(self):
+        return [self.vertical.ksp]
+
+    def prepare(self, t, start, end):
+        super().prepare(t, start, end)
+        self.vertical.set_end_states(start, end)
+
+    def solve_slope(self, rhs, state, bordered):
+        """z' from the vertical problem with the contact (seabed.SeabedContact.solve)."""
+        self.y = self.contact.solve(rhs.components[2], state.slope.components[2])
+        if bordered:
+            state.chord_multiplier[2] = self.vertical.end_residual()
+
+    def energy(self, state):
+        """E_s at the last global step's heights, J."""
+        if self.y is None:
             return 0.0
         return self.contact.energy(self.y)
+
+    def pressure(self, z):
+        """The seabed's upward force per metre (N/m) at heights z."""
+        return self.contact.pressure(z)
+
+    def node_loads(self, state):
+        loads = np.zeros((self.mesh.n_local_nodes, 3))
+        loads[:, 2] = self.pressure(state.node_positions()[:, 2])
+        return loads
 
     def _destroy_vertical(self):
         if self.vertical is not None:
@@ -130,5 +129,42 @@ class RiserTerms:
 
     def destroy(self):
         self._destroy_vertical()
-        self._nodes.destroy()
+        super().destroy()
+
+
+class DragTerm(NodalLoadTerm):
+    """The Morison normal drag of a steady current (environment.Current) on the line, a
+    follower load of the iterate (module docstring)."""
+
+    conservative = False
+    in_newton = False
+
+    def __init__(self, mesh, current):
+        super().__init__(mesh, "drag")
+        self.current = current
+        self._rhs = VectorField(mesh, "drag_rhs")
+        self.drag = NodalLoad(mesh, self._nodes)
+
+    def node_loads(self, state):
+        """t c |v_n| v_n at the owned nodes (N/m), (n_nodes, 3), from the tangents tau3
+        and, for a current that varies with depth, the heights of the last global step.
+        Collective when it does (a ghost exchange)."""
+        current = self.current
+        z = (state.node_positions()[:, 2] if current.depths.size > 1
+             else np.zeros(self.mesh.n_local_nodes))
+        return self.t * normal_drag(state.tau[:, 2], current.velocity(z), current.drag)
+
+    def add_iterate_load(self, rhs, state):
+        """Add the drag's int F.g to the slope problem's right-hand side."""
+        self.drag.set(self.node_loads(state))
+        offset = np.zeros(3) if is_held(self.start_state) else -self.drag.total
+        mesh = self.mesh
+        self._rhs.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+            self.drag.element_vectors(offset)))
+        for vec, load in zip(rhs.components, self._rhs.components):
+            vec.axpy(1.0, load)
+
+    def destroy(self):
         self._rhs.destroy()
+        super().destroy()

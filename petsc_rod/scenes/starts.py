@@ -14,7 +14,7 @@ from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.scene import REFERENCE_FRAME
-from petsc_rod.riser.catenary import seabed_shape
+from petsc_rod.scenes.touchdown import seabed_shape
 
 SHAPES = ("straight", "catenary")
 

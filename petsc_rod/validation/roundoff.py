@@ -44,16 +44,16 @@ def exact_centreline(length, nodal, start, end, S):
     return end.position + primitive(S) - primitive(np.array([length]))
 
 
-def centreline_solve_error(solver, t=1.0):
+def centreline_solve_error(problem, t=1.0):
     """max |r - r*| / max |r*| over the vertices after one centreline solve whose exact
     discrete solution is slope* (and mu = MULTIPLIER when both ends are held).
 
     The right-hand side is A slope* (+ mu int g), with A the full slope matrix; the
-    solve is the run's (GlobalStep.solve_centreline). Overwrites the solver's state.
+    solve is the run's (GlobalStep.solve_centreline). Overwrites the problem's state.
     """
-    mesh, problem = solver.mesh, solver.global_step.slope_problem
-    solver.prepare_step(t)
-    start, end = solver.global_step.start_state, solver.global_step.end_state
+    mesh, slope_problem = problem.mesh, problem.global_step.slope_problem
+    problem.prepare(t)
+    start, end = problem.start_state, problem.end_state
     nodal = quadratic_slope(mesh.length, start, end)
     owned = np.arange(mesh.vertex_start, mesh.vertex_end)
     S = mesh.coordinates(owned)
@@ -62,14 +62,14 @@ def centreline_solve_error(solver, t=1.0):
     slope = p2_basis(slots.ravel() / mesh.length, np.ones(1))[0][0] @ nodal
     slope = slope.reshape(-1, 2, 3)
     slope[mesh.n_local_elements:, 1] = 0.0                   # the phantom slot
-    solver.state.slope.set_owned(slope)
-    bordered = MULTIPLIER if solver.global_step.bordered else np.zeros(3)
+    problem.state.slope.set_owned(slope)
+    bordered = MULTIPLIER if problem.global_step.bordered else np.zeros(3)
     contributions = element_integrals(mesh.element_h)[:, :, None] * bordered
-    solver.global_step.rhs[2].add_ghosted(scatter_element_vectors(
+    problem.global_step.rhs[2].add_ghosted(scatter_element_vectors(
         mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, contributions))
-    for x, b in zip(solver.state.slope.components, solver.global_step.rhs[2].components):
-        problem.full.multAdd(x, b, b)
-    solver.global_step.solve_centreline(solver.state)
+    for x, b in zip(problem.state.slope.components, problem.global_step.rhs[2].components):
+        slope_problem.full.multAdd(x, b, b)
+    problem.global_step.solve_centreline(problem.state)
     exact = exact_centreline(mesh.length, nodal, start, end, S)
-    error = mesh.global_max(float(np.abs(solver.state.r.owned()[:, 0] - exact).max(initial=0.0)))
+    error = mesh.global_max(float(np.abs(problem.state.r.owned()[:, 0] - exact).max(initial=0.0)))
     return error / mesh.global_max(float(np.abs(exact).max(initial=0.0)))

@@ -27,10 +27,11 @@ def test_petsc_rod_paper_scene_agrees_with_the_reference(twisted):
                                ctol=1e-5, max_it=20000)
     try:
         assert continuation(solver, steps=8, imperfection=0.01).converged
-        fields = {k: gather(mesh.comm, v) for k, v in vertex_fields(solver, 1.0).items()}
-        energy = solver.energy()
+        fields = {k: gather(mesh.comm, v) for k, v in vertex_fields(solver.problem).items()}
+        energy = solver.problem.energy()
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
     exact = twisted.sample(fields["S"])
     mirror = np.sign(fields["u"][0, 2] * exact["u"][0, 2])      # z -> -z flips u1, u3
@@ -58,9 +59,10 @@ def test_paper_scene_energy_converges_at_order_4_and_within_1e_6_at_80_elements(
         try:
             report = continuation(solver, steps=8)
             assert report.converged and report.stable
-            errors.append(abs(solver.energy() - ref.energy(twisted)))
+            errors.append(abs(solver.problem.energy() - ref.energy(twisted)))
         finally:
             solver.destroy()
+            solver.problem.destroy()
             mesh.destroy()
     assert 3.7 < fitted_order(sizes, errors) < 4.3, errors
     assert errors[-1] < 1e-6, errors

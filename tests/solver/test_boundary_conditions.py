@@ -55,18 +55,19 @@ def solved():
         mesh, solver = make_solver(comm, N_ELEMENTS, scene_kwargs, PENALTY, RTOL,
                                    CTOL, MAX_IT)
         try:
-            solver.state.set_straight()
+            solver.problem.state.set_straight()
             report = solver.solve_step(1.0)
-            fields = outputs.vertex_fields(solver, 1.0)
-            owned = {"r": solver.state.r.owned(), "d1": solver.state.d1.owned()[:, 0],
-                     "d2": solver.state.d2.owned()[:, 0]}
+            fields = outputs.vertex_fields(solver.problem)
+            owned = {"r": solver.problem.state.r.owned(), "d1": solver.problem.state.d1.owned()[:, 0],
+                     "d2": solver.problem.state.d2.owned()[:, 0]}
             results[name] = dict(
-                report=report, scene=solver.scene, comm=comm,
+                report=report, scene=solver.problem.scene, comm=comm,
                 lower=mesh.on_lower_boundary, upper=mesh.on_upper_boundary,
                 owned=owned, fields={k: gather(comm, v) for k, v in fields.items()},
-                end_frame=solver.scene.end_state(1.0).frame)
+                end_frame=solver.problem.scene.end_state(1.0).frame)
         finally:
             solver.destroy()
+            solver.problem.destroy()
             mesh.destroy()
     return results
 

@@ -22,7 +22,7 @@ from petsc_rod.frames import rotation_about, rotations, split_coefficients, stra
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.validation.roundoff import MULTIPLIER, centreline_solve_error
 from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
-from petsc_rod.iteration.driver import UzawaSolver
+from petsc_rod.iteration.driver import solver_for
 from petsc_rod.iteration.stopping import Settings
 
 LENGTH = 1.3
@@ -122,10 +122,10 @@ def one_step(request):
     comm = PETSc.COMM_WORLD
     scene = Scene(length=LENGTH, stiffness=STIFFNESS, **CASES[request.param], **LOADS)
     mesh = Mesh(comm, 6, LENGTH, grading=2.0)
-    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=PENALTY))
+    solver = solver_for(mesh, scene, Settings(asked_penalty=PENALTY))
     try:
-        solver.state.set_straight()
-        solver.prepare_step(1.0)
+        solver.problem.state.set_straight()
+        solver.problem.prepare(1.0)
         rng = np.random.default_rng(7)
         # tau: a smooth random field of rotations, so that the interpolated frames
         # stay well conditioned (the strains resolve D' on D^-1)
@@ -134,14 +134,15 @@ def one_step(request):
         tau = rotations(a + b * x + c * x**2)
         lam = rng.standard_normal((x.size, 3, 3))
         owned = slice(2 * mesh.vertex_start, 2 * mesh.vertex_start + mesh.n_local_nodes)
-        solver.state.tau[:], solver.state.lam[:] = tau[owned], lam[owned]
-        solver.iterate()
-        points = {key: gather(comm, value) for key, value in solver.state.point_values().items()}
-        result = dict(r=gather(comm, solver.state.r.owned()), points=points,
-                      reaction=solver.end_reaction(), energy=solver.energy())
+        solver.problem.state.tau[:], solver.problem.state.lam[:] = tau[owned], lam[owned]
+        solver.problem.iterate()
+        points = {key: gather(comm, value) for key, value in solver.problem.state.point_values().items()}
+        result = dict(r=gather(comm, solver.problem.state.r.owned()), points=points,
+                      reaction=solver.problem.end_reaction(), energy=solver.problem.energy())
         S = mesh.coordinates(np.arange(mesh.n_vertices))
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
     result["hermite"] = hermite_step(S, scene, 1.0, PENALTY * tau[:, 2] - lam[:, 2])
     result["S"], result["scene"] = S, scene
@@ -205,11 +206,12 @@ def test_centreline_solve_round_off_at_3200_elements(comm, scene):
     small difference c.theta0 - (r(L) - r(0)) of terms of size 16 m, over c.w)."""
     scene = Scene(**scene)
     mesh = Mesh(comm, 3200, scene.length)
-    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=400.0))
+    solver = solver_for(mesh, scene, Settings(asked_penalty=400.0))
     try:
-        assert centreline_solve_error(solver) < 1e-10
-        if solver.global_step.bordered:
-            assert np.abs(solver.end_reaction() + MULTIPLIER).max() < 1e-8
+        assert centreline_solve_error(solver.problem) < 1e-10
+        if solver.problem.global_step.bordered:
+            assert np.abs(solver.problem.end_reaction() + MULTIPLIER).max() < 1e-8
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()

@@ -26,7 +26,7 @@ from petsc4py import PETSc
 
 from helpers import BENT, PULLED, gather
 from helpers import HALVING_CTOL as CTOL, HALVING_ELEMENTS as N_ELEMENTS, HALVING_RTOL as RTOL
-from petsc_rod.iteration.continuation import continuation
+from petsc_rod.cli import session
 from petsc_rod.errors import RodDivergedError, RodNotConvergedError
 
 def build(solver_factory, comm, case):
@@ -38,25 +38,26 @@ def build(solver_factory, comm, case):
                                       CTOL, case["max_it"], newton=False)
     finally:
         database.delValue("rod_snes_type")
-    solver.state.set_straight()
+    solver.problem.state.set_straight()
     return mesh, solver
 
 
 def run_continuation(solver_factory, comm, case, steps, max_halvings):
-    """continuation.continuation from the straight state, no file: (exit code, printed lines, the
+    """session.run_continuation from the straight state, no file: (exit code, printed lines, the
     final state gathered on every rank)."""
     mesh, solver = build(solver_factory, comm, case)
     lines = []
-    code = continuation(solver, steps, say=lines.append, max_halvings=max_halvings).code
+    code = session.run_continuation(solver, steps, say=lines.append,
+                                    max_halvings=max_halvings).code
     state = {name: gather(comm, array) for name, array in owned_state(solver).items()}
-    state["energy"] = solver.energy()
+    state["energy"] = solver.problem.energy()
     return code, lines, state
 
 
 def owned_state(solver):
     """Copies of this rank's share of every field of the Uzawa state."""
-    return {"r": solver.state.r.owned(), "slope": solver.state.slope.owned(), "d1": solver.state.d1.owned(),
-            "d2": solver.state.d2.owned(), "tau": solver.state.tau.copy(), "lam": solver.state.lam.copy()}
+    return {"r": solver.problem.state.r.owned(), "slope": solver.problem.state.slope.owned(), "d1": solver.problem.state.d1.owned(),
+            "d2": solver.problem.state.d2.owned(), "tau": solver.problem.state.tau.copy(), "lam": solver.problem.state.lam.copy()}
 
 
 def step_results(lines):
@@ -77,11 +78,11 @@ def test_snapshot_restore_is_exact_and_the_next_step_repeats_itself(solver_facto
     mesh, solver = build(solver_factory, comm, BENT)
     assert solver.solve_step(0.5).converged
     before = owned_state(solver)
-    saved = solver.state.snapshot()
+    saved = solver.problem.state.snapshot()
     first = solver.solve_step(1.0)
     moved = owned_state(solver)
     assert mesh.global_sum(float(np.abs(moved["r"] - before["r"]).max())) > 0.01
-    solver.state.restore(saved)
+    solver.problem.state.restore(saved)
     for name, values in owned_state(solver).items():
         assert np.array_equal(values, before[name]), name
     second = solver.solve_step(1.0)               # the change test starts from the restore
@@ -93,15 +94,15 @@ def test_snapshot_restore_is_exact_and_the_next_step_repeats_itself(solver_facto
 
 def test_restore_after_a_diverged_attempt_leaves_no_nan(solver_factory, comm):
     mesh, solver = build(solver_factory, comm, BENT)
-    saved = solver.state.snapshot()
+    saved = solver.problem.state.snapshot()
     before = owned_state(solver)
-    solver.state.lam[0, 0, 0] = np.nan                   # a state gone bad on every rank
+    solver.problem.state.lam[0, 0, 0] = np.nan                   # a state gone bad on every rank
     with pytest.raises(RodDivergedError) as error:
         solver.solve_step(1.0)
     assert error.value.iterations == 1
     poisoned = [np.isnan(values).any() for values in owned_state(solver).values()]
     assert mesh.global_sum(float(sum(poisoned))) >= comm.getSize()
-    solver.state.restore(saved)
+    solver.problem.state.restore(saved)
     for name, values in owned_state(solver).items():
         assert np.isfinite(values).all(), name
         assert np.array_equal(values, before[name]), name

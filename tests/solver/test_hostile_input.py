@@ -16,9 +16,10 @@ from petsc_rod import resources
 from petsc_rod.io import outputs
 from petsc_rod.io import results as io
 from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
-from petsc_rod.iteration.continuation import LoadPath, record_step
+from petsc_rod.cli.session import record_step
+from petsc_rod.iteration.continuation import LoadPath
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
-from petsc_rod.cli.options import (MAX_HALVINGS, MAX_MAGNITUDE, check_same_on_every_rank,
+from petsc_rod.cli.options import (MAX_HALVINGS_CAP, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
 from petsc_rod.resources import BYTES_PER_ELEMENT, MAX_ELEMENTS, check_elements_fit
 
@@ -66,7 +67,7 @@ REFUSED = {
     "huge length": ("rod_length", "1e200", "out of range"),
     "tiny length": ("rod_length", "1e-40", "positive"),
     "huge stiffness": ("rod_stiffness", "1,1e31,1", "out of range"),
-    "too many halvings": ("rod_max_halvings", str(MAX_HALVINGS + 1), "between"),
+    "too many halvings": ("rod_max_halvings", str(MAX_HALVINGS_CAP + 1), "between"),
     "load factor above 1": ("rod_initial_load_factor", "1.5", "between 0 and 1"),
 }
 
@@ -83,11 +84,11 @@ def test_a_value_out_of_its_range_is_refused(options, case):
 
 def test_the_limits_themselves_are_accepted(options):
     read = options(rod_length=f"{MAX_MAGNITUDE:g}", rod_al_rtol=f"{1 / MAX_MAGNITUDE:g}",
-                   rod_max_halvings=str(MAX_HALVINGS), rod_elements="2147483647",
+                   rod_max_halvings=str(MAX_HALVINGS_CAP), rod_elements="2147483647",
                    rod_load="-1e30,0,0")
     values, _ = read()
     assert values["rod_length"] == MAX_MAGNITUDE
-    assert values["rod_max_halvings"] == MAX_HALVINGS
+    assert values["rod_max_halvings"] == MAX_HALVINGS_CAP
     assert values["rod_elements"] == 2147483647
 
 
@@ -179,13 +180,12 @@ def test_an_output_that_cannot_be_written_is_refused_before_the_run(comm, shared
 def write_result(solver, path, attributes=None):
     """A result file of the solver's current state (one step at load factor 1)."""
     report = solver.solve_step(1.0)
-    writer = io.ResultWriter(path, solver.mesh)
+    writer = io.ResultWriter(path, solver.problem.mesh)
     try:
-        recorded = record_step(solver, report, 1.0, "step 1/1", lambda text: None, writer,
-                               "steps/1", wall_time=0.0, options="", halvings=0,
-                               total_halvings=0, total_iterations=report.iterations,
-                               undone_iterations=0)
-        writer.finish("steps/1", {**recorded, **(attributes or {})})
+        recorded = record_step(solver.problem, report, 1.0, writer, "steps/1", wall_time=0.0,
+                               options="", halvings=0, total_halvings=0,
+                               total_iterations=report.iterations, undone_iterations=0)
+        writer.finish("steps/1", {**recorded.attributes, **(attributes or {})})
     finally:
         if writer.file is not None:
             writer.abort()
@@ -195,7 +195,7 @@ def write_result(solver, path, attributes=None):
 def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
         solver_factory, comm, shared_tmp, monkeypatch):
     mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 500)
-    solver.state.set_straight()
+    solver.problem.state.set_straight()
     path = os.path.join(shared_tmp, "full.h5")
     monkeypatch.setattr(io, "free_disk", lambda folder: 1000)
     with pytest.raises(RodInputError, match="free"):
@@ -204,9 +204,8 @@ def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
     assert os.path.exists(f"{path}.partial")
     with pytest.raises(RodIOError, match="disk .* is full"):
         report = solver.solve_step(1.0)
-        record_step(solver, report, 1.0, "step 1/1", lambda text: None, writer, "steps/1",
-                    wall_time=0.0, options="", halvings=0, total_halvings=0,
-                    total_iterations=1, undone_iterations=0)
+        record_step(solver.problem, report, 1.0, writer, "steps/1", wall_time=0.0, options="",
+                    halvings=0, total_halvings=0, total_iterations=1, undone_iterations=0)
     writer.abort()
     comm.tompi4py().Barrier()
     assert not os.path.exists(f"{path}.partial") and not os.path.exists(path)
@@ -217,7 +216,7 @@ def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
 def result(solver_factory, comm, shared_tmp):
     """(solver, path of a converged result file of it)."""
     mesh, solver = solver_factory(comm, 8, CANTILEVER, 10.0, 1e-6, 1e-4, 2000)
-    solver.state.set_straight()
+    solver.problem.state.set_straight()
     path = os.path.join(shared_tmp, "result.h5")
     assert write_result(solver, path).converged
     return solver, path
@@ -260,7 +259,7 @@ def test_a_damaged_restart_file_is_refused_on_every_rank(result, comm, case):
     damage, words = DAMAGES[case]
     copy = damaged_copy(comm, path, case.replace(" ", "_"), damage)
     with pytest.raises(RodInputError) as error:
-        io.read_restart(copy, solver.mesh, outputs.restart_state(solver))
+        io.read_restart(copy, solver.problem.mesh, outputs.restart_state(solver.problem))
     message = str(error.value)
     assert message.startswith(f"-rod_initial {copy}: ") and words in message, message
 
@@ -270,19 +269,19 @@ def test_the_expected_shapes_come_from_the_solver_arrays(result, comm):
     shape make the (good) file wrong."""
     solver, path = result
     templates = {key: np.zeros(value.shape[:1] + (7,)) for key, value in
-                 outputs.restart_state(solver).items()}
+                 outputs.restart_state(solver.problem).items()}
     with pytest.raises(RodInputError, match="has shape"):
-        io.read_restart(path, solver.mesh, templates)
+        io.read_restart(path, solver.problem.mesh, templates)
 
 
 def test_a_good_restart_file_gives_back_the_state(result, comm):
     solver, path = result
-    saved = {key: np.array(value) for key, value in outputs.restart_state(solver).items()}
-    restart = io.read_restart(path, solver.mesh, outputs.restart_state(solver))
+    saved = {key: np.array(value) for key, value in outputs.restart_state(solver.problem).items()}
+    restart = io.read_restart(path, solver.problem.mesh, outputs.restart_state(solver.problem))
     assert restart.load_factor == 1.0 and restart.converged
     for key, value in saved.items():
         assert np.array_equal(restart.state[key], value), key
-    assert np.array_equal(restart.vertex["r"], solver.state.r.owned()[:, 0])
+    assert np.array_equal(restart.vertex["r"], solver.problem.state.r.owned()[:, 0])
 
 
 # --- the load path of a restart --------------------------------------------------------

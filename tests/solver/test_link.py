@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from helpers import continuation as reach_load, gather
-from petsc_rod.iteration.continuation import continuation
+from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodNotConvergedError
 from petsc_rod.validation.writhe import gauss_writhe
 
@@ -33,10 +33,10 @@ def test_a_twisted_rod_with_slack_writhes_and_keeps_its_link(solver_factory, com
     mesh, solver = solver_factory(comm, 64, SLACK, 100.0, 1e-6, 1e-5, 20000)
     report = reach_load(solver, steps=10, imperfection=0.01)
     assert report.converged
-    twist, writhe = solver.link()
+    twist, writhe = solver.problem.link()
     assert twist + writhe == pytest.approx(1.0, abs=2e-3)
     assert 0.03 < writhe < 0.1
-    points = gather(comm, solver.state.r.owned()[:, 0])
+    points = gather(comm, solver.problem.state.r.owned()[:, 0])
     assert gauss_writhe(points, AXIS) == pytest.approx(writhe, abs=2e-3)
 
 
@@ -49,20 +49,20 @@ def test_a_whole_turn_in_one_step_is_refused(solver_factory, comm):
     the untwisted rod, which the link check refuses (exit 3); in 4 steps the rod keeps
     its turn, all of it twist (u3 = 2 pi / L)."""
     mesh, solver = solver_factory(comm, 32, PURE_TWIST, 100.0, 1e-8, 1e-5, 5000)
-    solver.state.set_straight()
+    solver.problem.state.set_straight()
     lines = []
-    code = continuation(solver, 1, say=lines.append, max_halvings=0).code
+    code = run_continuation(solver, 1, say=lines.append, max_halvings=0).code
     assert code == RodNotConvergedError.exit_code, "\n".join(lines)
     found = re.search(r"linking number is (-?[0-9.]+) turns .* not the 1.000 turns", lines[-1])
     assert found and abs(float(found.group(1))) < 1e-3, lines[-1]
-    solver.state.set_straight()                           # -rod_track_link 0: accepted
+    solver.problem.state.set_straight()                           # -rod_track_link 0: accepted
     lines = []
-    assert continuation(solver, 1, say=lines.append, max_halvings=0, track_link=False).code == 0
-    assert abs(sum(solver.link())) < 1e-3
-    solver.state.set_straight()
+    assert run_continuation(solver, 1, say=lines.append, max_halvings=0, track_link=False).code == 0
+    assert abs(sum(solver.problem.link())) < 1e-3
+    solver.problem.state.set_straight()
     lines = []
-    assert continuation(solver, 4, say=lines.append, max_halvings=0).code == 0, "\n".join(lines)
-    twist, writhe = solver.link()
+    assert run_continuation(solver, 4, say=lines.append, max_halvings=0).code == 0, "\n".join(lines)
+    twist, writhe = solver.problem.link()
     # the twist integral of the P2 frames, O(h^4) from its limit: 3.1e-6 on 32 elements
     assert twist == pytest.approx(1.0, abs=1e-5) and abs(writhe) < 1e-9
     assert "link 1.0000 turns = twist 1.0000 + writhe" in [

@@ -45,17 +45,18 @@ def test_piecewise_load_is_integrated_exactly(comm):
 
 def test_cantilever_on_graded_mesh(comm):
     """The closed-form tip also on a mesh graded 4:1 towards both ends."""
-    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
     scene = Scene(length=1.0, stiffness=[1.0, 1.0, 1.0], end="free", end_force=[0, -3.0, 0])
     mesh = Mesh(comm, 64, 1.0, grading=4.0)
-    solver = UzawaSolver(mesh, scene, Settings(asked_penalty=100.0, max_it=5000, rtol=1e-9,
+    solver = solver_for(mesh, scene, Settings(asked_penalty=100.0, max_it=5000, rtol=1e-9,
                                                ctol=1e-5))
     try:
-        solver.state.set_straight()
+        solver.problem.state.set_straight()
         assert solver.solve_step(1.0).converged
-        r = gather(comm, vertex_fields(solver, 1.0)["r"])
+        r = gather(comm, vertex_fields(solver.problem)["r"])
         assert np.abs(r[-1, :2] - cantilever_tip(1.0, 1.0, 3.0)).max() < 1e-6
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()

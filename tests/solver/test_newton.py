@@ -30,9 +30,9 @@ def newton_turns(report):
 
 
 def owned_fields(solver):
-    comm = solver.mesh.comm
+    comm = solver.problem.mesh.comm
     return {name: gather(comm, field.owned()) for name, field in
-            (("r", solver.state.r), ("d1", solver.state.d1), ("d2", solver.state.d2))}
+            (("r", solver.problem.state.r), ("d1", solver.problem.state.d1), ("d2", solver.problem.state.d2))}
 
 
 def test_newton_is_quadratic_and_ends_where_the_iteration_alone_does(solver_factory, comm):
@@ -72,14 +72,14 @@ def test_newton_stays_quadratic_on_a_fine_mesh(solver_factory, comm):
 def test_the_handed_over_state_is_a_fixed_point_of_the_uzawa_map(solver_factory, comm):
     _, solver = solver_factory(comm, 16, CANTILEVER, 100.0, 1e-3, 1e-3, 5000, newton=False)
     assert continuation(solver, steps=1).converged          # near, not at, the solution
-    polish = newton.NewtonPolish(solver)
+    polish = newton.NewtonPolish(solver.problem)
     try:
         assert polish.run() == newton.CONVERGED
         assert polish.least_penalty() < solver.penalty
     finally:
         polish.destroy()
-    solver.iterate()
-    change, residual = solver.state.norms()
+    solver.problem.iterate()
+    change, residual = solver.problem.state.norms()
     assert change < 1e-12 and residual < 1e-12
 
 
@@ -88,10 +88,10 @@ def test_newton_takes_no_step_at_a_saddle(solver_factory, comm):
     solver.settings.check_stability = False     # the accelerated iteration ends planar
     report = continuation(solver, steps=8)
     assert report.converged and report.newton_steps == 0
-    planar = gather(comm, solver.state.r.owned())
+    planar = gather(comm, solver.problem.state.r.owned())
     assert np.abs(planar[:, 0, 2]).max() < 1e-8
     assert solver.newton.run() == newton.INDEFINITE
-    assert np.array_equal(gather(comm, solver.state.r.owned()), planar)   # left as it was
+    assert np.array_equal(gather(comm, solver.problem.state.r.owned()), planar)   # left as it was
 
 
 @pytest.mark.parametrize("ratio", [100.0])
@@ -102,5 +102,5 @@ def test_an_anisotropic_cantilever_converges_in_tens_of_iterations(solver_factor
     report = continuation(solver, steps=2)
     assert report.converged and report.iterations < 60
     tip = cantilever_tip(1.0, 1.0, 3.0)
-    r = gather(comm, solver.state.r.owned())[-1, 0]
+    r = gather(comm, solver.problem.state.r.owned())[-1, 0]
     assert np.abs(r - np.array([tip[0], 0.0, tip[1]])).max() < 1e-5

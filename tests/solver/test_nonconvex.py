@@ -24,7 +24,7 @@ def test_nonconvex_cantilever_against_elastica(comm, solver_factory):
                                   ctol=1e-11, max_it=3000)
     report = continuation(solver, steps=2)
     assert report.converged
-    r = gather(comm, vertex_fields(solver, 1.0)["r"])
+    r = gather(comm, vertex_fields(solver.problem)["r"])
     assert np.abs(r[-1, :2] - cantilever_tip(1.0, 3.0, 4.5)).max() < 1e-5
     assert np.abs(r[:, 2]).max() < 1e-10
 
@@ -37,7 +37,7 @@ def oblique_cantilever(comm, solver_factory, elements):
     mesh, solver = solver_factory(comm, elements, scene, penalty=100 * np.sqrt(10.0),
                                   rtol=1e-10, ctol=1e-10, max_it=3000)
     report = continuation(solver, steps=2)
-    tip = gather(comm, vertex_fields(solver, 1.0)["r"])[-1]
+    tip = gather(comm, vertex_fields(solver.problem)["r"])[-1]
     return report, tip
 
 

@@ -26,7 +26,7 @@ MAX_IT = 3000
 STEPS = (0.5, 1.0)
 # agreement of the fields for each iteration, and of lambda relative to its size: the
 # multipliers carry R times the constraint gap, and on several ranks the global step is
-# another exact solve (substructuring, matrices.PARALLEL_DEFAULTS) with its own round-off
+# another exact solve (substructuring, ksp.PARALLEL_DEFAULTS) with its own round-off
 FIELD_TOL = {"nrichardson": 1e-10, "anderson": 1e-9}
 MULTIPLIER_TOL = {"nrichardson": 1e-10, "anderson": 1e-8}
 
@@ -41,21 +41,22 @@ def solve_on(comm, kind):
     finally:
         database.delValue("rod_snes_type")
     try:
-        solver.state.set_straight()
+        solver.problem.state.set_straight()
         reports = [solver.solve_step(t) for t in STEPS]
         owned_vertices = mesh.vertex_end - mesh.vertex_start
         return dict(
             reports=reports,
-            r=gather(comm, solver.state.r.owned()),
-            d1=gather(comm, solver.state.d1.owned()),
-            d2=gather(comm, solver.state.d2.owned()),
-            tau=gather(comm, solver.state.tau),
-            lam=gather(comm, solver.state.lam),
-            energy=solver.energy(),
+            r=gather(comm, solver.problem.state.r.owned()),
+            d1=gather(comm, solver.problem.state.d1.owned()),
+            d2=gather(comm, solver.problem.state.d2.owned()),
+            tau=gather(comm, solver.problem.state.tau),
+            lam=gather(comm, solver.problem.state.lam),
+            energy=solver.problem.energy(),
             split=owned_vertices < mesh.n_vertices,
             ranks=comm.getSize())
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
 
 

@@ -1,4 +1,4 @@
-"""A penalty far below the problem's scale is raised on the way (iteration/penalty.py)
+"""A penalty far below the problem's scale is raised on the way (problem/penalty.py)
 and the cantilever reaches the elastica; kept low, the step does not converge."""
 
 import numpy as np
@@ -25,6 +25,6 @@ def test_a_penalty_far_below_the_scale_is_raised_and_the_elastica_reached(
         return
     assert report.converged
     assert solver.penalty == pytest.approx(10.0)
-    tip = gather(comm, solver.state.r.owned()[:, 0])[-1]
+    tip = gather(comm, solver.problem.state.r.owned()[:, 0])[-1]
     x, y = cantilever_tip(1.0, 1.0, 3.0)
     assert np.abs(tip - [x, y, 0.0]).max() < 1e-5

@@ -8,12 +8,13 @@ from petsc4py import PETSc
 
 from helpers import fitted_order, gather, make_solver
 from petsc_rod.io.outputs import vertex_fields
-from petsc_rod.iteration.continuation import record_step
-from petsc_rod.iteration.penalty import default_penalty
-from petsc_rod.riser.catenary import grounded_catenary
+from petsc_rod.cli import lines as step_lines
+from petsc_rod.cli.session import record_step
+from petsc_rod.iteration.events import StepEnded
+from petsc_rod.problem.penalty import default_penalty
+from petsc_rod.scenes.touchdown import grounded_catenary
 from petsc_rod.riser.environment import Current, Seabed
 from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.riser.quantities import riser_report
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.scenes.starts import catenary_start
 from petsc_rod.global_step.matrices import load_ghosted
@@ -31,9 +32,9 @@ def solved(solver_factory, comm, n_elements, scene, start="straight", rtol=1e-12
     mesh, solver = solver_factory(comm, n_elements, scene, penalty, rtol=rtol, ctol=ctol,
                                   max_it=20000, newton=False)
     if start == "catenary":
-        solver.state.set_from_curve(catenary_start(solver.scene, 1.0))
+        solver.problem.state.set_from_curve(catenary_start(solver.problem.scene, 1.0))
     else:
-        solver.state.set_straight()
+        solver.problem.state.set_straight()
     return mesh, solver, solver.solve_step(1.0)
 
 
@@ -41,7 +42,7 @@ def solved(solver_factory, comm, n_elements, scene, start="straight", rtol=1e-12
 # 10 m of line of weight 1 N/m from an anchor on the seabed z = 0 to a pin 7 m away and
 # 4 m up: 5.5 m of it rest on the seabed. Bending and penetration are made negligible
 # (EI = 1e-6 N m^2: a bending length of 5e-4 m; k = 1e6 N/m^2: 1 micrometre), so that
-# the closed form (riser/catenary.py) is the limit of the discrete problem.
+# the closed form (scenes/touchdown.py) is the limit of the discrete problem.
 GROUNDED_CHORD = np.array([7.0, 0.0, 4.0])
 GROUNDED = dict(length=10.0, stiffness=(1e-6, 1e-6, 1e-6), start="pin", end="pin",
                 end_position=GROUNDED_CHORD, load_values=[[0.0, 0.0, -1.0]],
@@ -54,8 +55,8 @@ def grounded_errors(comm, solver_factory, n_elements):
     riser report's numbers, against the closed form."""
     mesh, solver, report = solved(solver_factory, comm, n_elements, GROUNDED)
     assert report.converged and report.stable
-    fields = vertex_fields(solver, 1.0)
-    numbers = riser_report(solver, fields).attributes
+    fields = vertex_fields(solver.problem)
+    numbers = riser_output(solver.problem, fields).attributes
     S, r, n = (gather(comm, fields[key]) for key in ("S", "r", "n"))
     exact, tangent, force, (_, touchdown) = grounded_catenary(10.0, GROUNDED_CHORD, 1.0, 0.0, S)
     away = (np.abs(S - touchdown) > 1.0) & (S > 0.5)
@@ -80,6 +81,7 @@ def grounded_runs():
     yield runs
     for mesh, solver in reversed(built):
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
 
 
@@ -121,9 +123,11 @@ def test_a_seabed_far_below_changes_nothing(comm, solver_factory):
                                     {**scene, "seabed": Seabed(-100.0, 1e6)}, start="catenary")
     assert free_report.converged and report.converged
     assert report.iterations == pytest.approx(free_report.iterations, rel=0.1)
-    for a, b in ((free.state.r, with_seabed.state.r), (free.state.d1, with_seabed.state.d1)):
+    for a, b in ((free.problem.state.r, with_seabed.problem.state.r),
+                 (free.problem.state.d1, with_seabed.problem.state.d1)):
         assert np.abs(a.owned() - b.owned()).max() < 1e-9
-    assert np.allclose(free.end_reaction(), with_seabed.end_reaction(), rtol=0, atol=1e-8)
+    assert np.allclose(free.problem.end_reaction(), with_seabed.problem.end_reaction(),
+                       rtol=0, atol=1e-8)
 
 
 @pytest.mark.parametrize("factor", [1.0, 1e3, 1e6])
@@ -134,7 +138,7 @@ def test_a_stiffer_seabed_converges_as_fast(comm, solver_factory, factor):
     scene = {**GROUNDED, "stiffness": (1e-3, 1e-3, 1e-3), "seabed": Seabed(0.0, factor * 1e3)}
     _, solver, report = solved(solver_factory, comm, 160, scene, rtol=1e-9, ctol=1e-9)
     assert report.converged and report.iterations < 150
-    lowest = solver.mesh.global_min(float(solver.state.r.owned()[:, 0, 2].min()))
+    lowest = solver.problem.mesh.global_min(float(solver.problem.state.r.owned()[:, 0, 2].min()))
     # about w / k below the seabed, 2.2 w / k at the touchdown node (measured)
     assert -3.0e-3 / factor < lowest < 0
 
@@ -162,7 +166,7 @@ def test_uniform_current_on_a_pinned_line_is_the_current_catenary(comm, solver_f
     mesh, solver, report = solved(solver_factory, comm, 200, current_scene(), rtol=1e-10,
                                   ctol=1e-10)
     assert report.converged and report.stable is None       # not tested: no energy
-    fields = vertex_fields(solver, 1.0)
+    fields = vertex_fields(solver.problem)
     S, r, n = (gather(comm, fields[key]) for key in ("S", "r", "n"))
     load = np.array([0.0, DRAG * SPEED**2, 0.0])
     exact, tangent, force = catenary(100.0, CURRENT_CHORD, load, S)
@@ -201,6 +205,12 @@ RISER = dict(length=50.0, stiffness=(20.0, 20.0, 15.0), start="pin", end="pin",
                                                               [0.1, 0.0, 0.0]]), 20.0, 1.0))
 
 
+def riser_output(problem, fields):
+    """The riser numbers (a TermOutput): the one term output of a riser scene."""
+    (output,) = problem.term_outputs(fields)
+    return output
+
+
 def riser_on(comm):
     """The RISER scene solved on ``comm`` with the default Anderson mixing (whose path
     round-off steers: the states agree to the iteration's tolerance); its vertex fields,
@@ -208,15 +218,16 @@ def riser_on(comm):
     mesh, solver = make_solver(comm, 100, RISER, default_penalty(Scene(**RISER)),
                                rtol=1e-11, ctol=1e-11, max_it=20000)
     try:
-        solver.state.set_straight()
+        solver.problem.state.set_straight()
         report = solver.solve_step(1.0)
-        fields = vertex_fields(solver, 1.0)
-        numbers = riser_report(solver, fields)
+        fields = vertex_fields(solver.problem)
+        numbers = riser_output(solver.problem, fields)
         whole = {key: gather(comm, value) for key, value in
                  {**fields, **numbers.datasets}.items()}
-        return report, whole, numbers.attributes, solver.energy()
+        return report, whole, numbers.attributes, solver.problem.energy()
     finally:
         solver.destroy()
+        solver.problem.destroy()
         mesh.destroy()
 
 
@@ -235,7 +246,7 @@ def test_one_rank_and_two_give_the_same_riser():
 
 
 def test_the_step_line_and_file_attributes_of_a_riser(comm, solver_factory):
-    """record_step says the riser numbers and hands the datasets to the writer."""
+    """The step line says the riser numbers; record_step hands the datasets to the writer."""
     mesh, solver, report = solved(solver_factory, comm, 40, GROUNDED, rtol=1e-9, ctol=1e-9)
     lines, written = [], {}
 
@@ -243,7 +254,9 @@ def test_the_step_line_and_file_attributes_of_a_riser(comm, solver_factory):
         def write_step(self, group, vertex, state, history, attributes):
             written.update(vertex=vertex, attributes=attributes)
 
-    record_step(solver, report, 1.0, "step 1/1", lines.append, Writer(), "steps/1")
+    record = record_step(solver.problem, report, 1.0, Writer(), "steps/1")
+    event = StepEnded("step 1/1", 1.0, report, 1, 0, 0, report.iterations, 0, 0.0)
+    lines.append(step_lines.step_line(event, record))
     assert "top tension" in lines[0] and "touchdown at S = " in lines[0]
     assert {"effective_tension", "seabed_reaction"} <= set(written["vertex"])
     assert {"top_tension", "top_angle", "touchdown_S", "touchdown_position", "max_curvature",

@@ -19,14 +19,14 @@ def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory,
     _, solver = solver_factory(comm, 24, PAPER, 400.0, 1e-3, 1e-3, 5000, newton=False)
     solver.settings.check_stability = False
     assert continuation(solver, steps=2).converged
-    kept = solver.second_variation()
+    kept = solver.problem.second_variation()
     assert kept.decidable and len(kept.constraint) == 3          # both ends held
     before = kept.matrix.copy()
     for _ in range(40):                                          # a different state
-        solver.iterate()
-    updated = solver.second_variation()
+        solver.problem.iterate()
+    updated = solver.problem.second_variation()
     assert updated is kept
-    fresh = SecondVariation(solver)
+    fresh = SecondVariation(solver.problem)
     difference = updated.matrix.copy()
     try:
         scale = fresh.matrix.norm(norm_type=3)                  # NORM_INFINITY
@@ -53,9 +53,9 @@ def test_chord_forms_solved_from_the_inertia_test_are_the_direct_solves(solver_f
     _, solver = solver_factory(comm, 24, PAPER, 400.0, 1e-3, 1e-3, 5000, newton=False)
     solver.settings.check_stability = False
     assert continuation(solver, steps=2).converged
-    hessian = solver.second_variation()
+    hessian = solver.problem.second_variation()
     hessian.negative_directions(-hessian.tolerance())
-    forms = hessian.chord_forms(solver.state.tau[:, 2])
+    forms = hessian.chord_forms(solver.problem.state.tau[:, 2])
     reused = hessian.solve_in_constraint_span(forms)
     direct = [hessian.solve(form) for form in forms]
     try:

@@ -19,7 +19,7 @@ def twist_scene(theta):
 
 
 def whole_vertex_fields(comm, solver):
-    return {key: gather(comm, value) for key, value in vertex_fields(solver, 1.0).items()}
+    return {key: gather(comm, value) for key, value in vertex_fields(solver.problem).items()}
 
 
 def test_pure_twist_against_closed_form(comm, solver_factory):
@@ -34,7 +34,7 @@ def test_pure_twist_against_closed_form(comm, solver_factory):
     assert np.abs(fields["u"][:, :2]).max() < 1e-10
     torque = np.einsum("ic,ic->i", fields["m"], fields["d3"])
     assert np.abs(torque - k3 * theta).max() < 1e-4
-    assert abs(solver.energy() - 0.5 * k3 * theta**2) < 1e-8
+    assert abs(solver.problem.energy() - 0.5 * k3 * theta**2) < 1e-8
     assert np.abs(fields["r"][:, 1:]).max() < 1e-12
     assert np.abs(fields["r"][:, 0] - fields["S"]).max() < 1e-12
 
@@ -55,7 +55,7 @@ def test_pure_twist_convergence_orders(comm, solver_factory):
         S = fields["S"]
         exact = np.stack([0 * S, np.cos(theta * S), np.sin(theta * S)], axis=1)
         director.append(np.abs(fields["d1"] - exact).max())
-        energy.append(abs(solver.energy() - 0.25 * theta**2))
+        energy.append(abs(solver.problem.energy() - 0.25 * theta**2))
         twist.append(np.abs(fields["u"][:, 2] - theta).max())
     assert max(director) < 1e-10
     assert 3.7 < fitted_order(sizes, energy) < 4.3
@@ -113,13 +113,13 @@ def paper_branches():
     results = {}
 
     def record(name, solver, report):
-        u = gather(solver.mesh.comm, vertex_fields(solver, 1.0)["u"])
-        hessian = SecondVariation(solver)
+        u = gather(solver.problem.mesh.comm, vertex_fields(solver.problem)["u"])
+        hessian = SecondVariation(solver.problem)
         try:
             negative = hessian.negative_directions(-hessian.tolerance())
         finally:
             hessian.destroy()
-        results[name] = (report.converged, u[0, 2], solver.energy(), negative)
+        results[name] = (report.converged, u[0, 2], solver.problem.energy(), negative)
 
     for check in (False, True):
         mesh, solver = make_solver(PETSc.COMM_WORLD, 40, PAPER, penalty=400.0, rtol=1e-10,
@@ -129,17 +129,18 @@ def paper_branches():
             record("twisted" if check else "unguarded", solver, solve(solver, steps=8))
             if check:
                 mirror = np.diag([1.0, 1.0, -1.0])
-                state = solver.state.snapshot()
+                state = solver.problem.state.snapshot()
                 for name in ("r", "slope", "d1"):
                     state[name] = state[name] @ mirror
                 state["d2"] = -state["d2"] @ mirror
                 for name in ("tau", "lam"):
                     state[name] = state[name] @ mirror
                     state[name][:, 1] *= -1
-                solver.state.restore(state)
+                solver.problem.state.restore(state)
                 record("mirrored", solver, solver.solve_step(1.0))
         finally:
             solver.destroy()
+            solver.problem.destroy()
             mesh.destroy()
     return results
 

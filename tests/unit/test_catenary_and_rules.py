@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.iteration.penalty import ADAPT_WINDOW, default_penalty, penalty_too_low
+from petsc_rod.problem.penalty import ADAPT_WINDOW, default_penalty, penalty_too_low
 from petsc_rod.iteration.stopping import (STALL_MARGIN, STALL_WINDOW, remaining_iterations,
                                           stalled_projection)
 from petsc_rod.scenes.scene import Scene

@@ -1,4 +1,4 @@
-"""The matrices' split of the stiffness (iteration/penalty.py matrix_split), numpy only:
+"""The matrices' split of the stiffness (problem/penalty.py matrix_split), numpy only:
 positive coefficients, the convex split unchanged, and positive definite matrices at a
 small penalty on any mesh."""
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from petsc_rod.frames import split_coefficients
-from petsc_rod.iteration.penalty import matrix_split
+from petsc_rod.problem.penalty import matrix_split
 from petsc_rod.mesh.elements import p2_element_matrices
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.riser.catenary import grounded_catenary, touchdown_parameter
+from petsc_rod.scenes.touchdown import grounded_catenary, touchdown_parameter
 from petsc_rod.riser.current import normal_drag
 from petsc_rod.riser.environment import Current, default_stiffness, read_profile
 from petsc_rod.riser.hermite import midpoint_values, slope_map

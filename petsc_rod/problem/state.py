@@ -15,7 +15,7 @@ from petsc_rod.global_step.centreline import midpoint_slopes, positions_at_point
 from petsc_rod.mesh.elements import GAUSS_POINTS, P2, p2_basis, p2_integrals
 from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
 from petsc_rod.frames import rotations
-from petsc_rod.iteration.node_values import NodeValues
+from petsc_rod.problem.node_values import NodeValues
 from petsc_rod.scenes import starts
 
 

@@ -1,0 +1,88 @@
+"""A run of the continuation as the command line makes it: the events of
+iteration/continuation.py said as lines (lines.py) and recorded in the result file
+(io/outputs.py, io/results.py), with the run's errors raised as RodErrors. The command
+line, the scripts and the tests call run_continuation."""
+
+from dataclasses import dataclass
+
+from petsc_rod.cli import lines
+from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
+from petsc_rod.io import outputs
+from petsc_rod.iteration import events
+from petsc_rod.iteration.continuation import MAX_HALVINGS, continuation
+
+
+@dataclass
+class ContinuationResult:
+    """How a continuation ended: the process exit code (0, or RodNotConvergedError's),
+    the last step's report, and the iterations of the whole run."""
+
+    code: int
+    report: object
+    iterations: int
+
+    @property
+    def converged(self):
+        return self.code == 0
+
+
+def run_continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, options="",
+                     max_halvings=MAX_HALVINGS, track_link=True, start=0.0, end=1.0,
+                     interrupts=None, on_step=None):
+    """Walk continuation(solver, steps, ...) (its arguments as there) to its end.
+
+    ``say(line)`` gets the lines (None: silent); ``writer`` (io.results.ResultWriter or
+    None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
+    text) among its attributes, and is finished at the end; ``on_step(t, report)``, if
+    given, is called after each StepEnded. ``interrupts`` (signals.Interrupts), if given,
+    are asked after every iteration and before the file is finished: a signal ends the
+    run with RodInterrupted. A divergence with no halving left raises RodDivergedError.
+    Returns a ContinuationResult.
+    """
+    say = say or (lambda line: None)
+    problem = solver.problem
+    stop = None if interrupts is None else interrupts.received
+    last = None                 # (group, attributes) of the last step written
+    for event in continuation(solver, steps, imperfection, max_halvings=max_halvings,
+                              track_link=track_link, start=start, end=end, stop=stop):
+        if isinstance(event, events.RunStarted):
+            say(lines.started(event))
+        elif isinstance(event, events.StepHalved):
+            say(lines.halved(event))
+        elif isinstance(event, events.StepEnded):
+            group = f"steps/{event.number}"
+            record = record_step(
+                problem, event.report, event.t, writer, group, wall_time=event.wall_time,
+                options=options, halvings=event.halvings, total_halvings=event.total_halvings,
+                asked_penalty=solver.settings.asked_penalty,
+                total_iterations=event.total_iterations,
+                undone_iterations=event.undone_iterations)
+            say(lines.step_line(event, record))
+            for line in lines.raise_lines(event, problem.scale):
+                say(line)
+            last = (group, record.attributes)
+            if on_step is not None:
+                on_step(event.t, event.report)
+        elif isinstance(event, events.RunDiverged):
+            raise RodDivergedError(lines.diverged_message(event), event.error.iterations)
+        elif isinstance(event, events.Interrupted):
+            number = interrupts.received()
+            raise RodInterrupted(lines.interrupted(interrupts.name(number), event), number)
+        elif isinstance(event, events.RunFinished):
+            if writer is not None:
+                writer.finish(*last)
+            say(lines.finished(event, solver.settings, problem.scale))
+            code = 0 if event.converged else RodNotConvergedError.exit_code
+            return ContinuationResult(code, event.report, event.iterations)
+    raise RuntimeError("the continuation ended without a final event")
+
+
+def record_step(problem, report, t, writer, group, **common):
+    """The io.outputs.StepRecord of the problem's state after a step at load factor t
+    (``common``: the run's attributes so far), written as ``group`` when ``writer`` is
+    not None. Collective."""
+    record = outputs.step_record(problem, report, t, **common)
+    if writer is not None:
+        writer.write_step(group, record.vertex, outputs.restart_state(problem), report.history,
+                          record.attributes)
+    return record

@@ -1,0 +1,74 @@
+"""The direct solvers of the project, made in one place: the chain solvers of the global
+step (the three P2 problems, and the seabed's vertical problem) and the MUMPS LDL^T of
+the second variation (analysis/stability.py).
+
+A chain solver is preonly + Cholesky under its own options prefix, with the project's
+defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
+the natural order on one rank (SERIAL_DEFAULTS) and the exact substructuring PC on
+several (PARALLEL_DEFAULTS); ``-<prefix>ksp_type``, ``-<prefix>pc_type`` and the rest
+override them as for any PETSc KSP.
+"""
+
+from petsc4py import PETSc
+
+from petsc_rod.errors import RodDivergedError
+from petsc_rod.global_step import substructuring
+from petsc_rod.petsc_defaults import set_from_options_with_defaults
+
+KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
+               for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
+
+# The global step on several ranks, unless the options say otherwise: the exact
+# substructuring solve of substructuring.py as a python PC (each rank a local Cholesky
+# solve of its half of the chain, and a tridiagonal interface system of one unknown per
+# rank boundary). It does the serial Cholesky's work divided by the ranks; CG with block
+# Jacobi (a few iterations, each a product, a local solve and reductions) and MUMPS (a
+# slow solve phase on chains) are slower (docs/performance.md).
+PARALLEL_DEFAULTS = {"ksp_type": "preonly", "pc_type": "python",
+                     "pc_python_type": substructuring.PYTHON_TYPE}
+# On one rank: PETSc's Cholesky in the natural order, in which the chain is a band
+# matrix: no fill (the default nested dissection order of PCCHOLESKY fills in and is
+# slower here, docs/performance.md).
+SERIAL_DEFAULTS = {"pc_factor_mat_ordering_type": "natural"}
+
+
+def chain_solver(comm, operator, prefix):
+    """A KSP for the SPD chain matrix ``operator`` (a DMDA matrix): preonly + Cholesky,
+    options read under ``prefix`` with SERIAL_DEFAULTS on one rank and
+    PARALLEL_DEFAULTS on several in effect. Not yet set up; the caller owns it."""
+    ksp = PETSc.KSP().create(comm=comm)
+    ksp.setOperators(operator)
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    ksp.getPC().setType(PETSc.PC.Type.CHOLESKY)
+    ksp.setOptionsPrefix(prefix)
+    defaults = PARALLEL_DEFAULTS if comm.getSize() > 1 else SERIAL_DEFAULTS
+    set_from_options_with_defaults(
+        ksp, {f"{prefix}{key}": value for key, value in defaults.items()})
+    return ksp
+
+
+def inertia_solver(comm, operator):
+    """(ksp, factor): preonly + MUMPS's symmetric-indefinite factorisation of
+    ``operator``, reporting the inertia of the whole matrix on every rank (ICNTL 13) and
+    detecting null pivots instead of failing on them (ICNTL 24). The symbolic
+    factorisation is made at the first set-up and kept while the pattern stays. The
+    caller owns the KSP (the factor is the PC's)."""
+    ksp = PETSc.KSP().create(comm=comm)
+    ksp.setOperators(operator)
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(PETSc.PC.Type.CHOLESKY)
+    pc.setFactorSolverType("mumps")
+    pc.setFactorSetUpSolverType()
+    factor = pc.getFactorMatrix()
+    factor.setMumpsIcntl(13, 1)
+    factor.setMumpsIcntl(24, 1)
+    return ksp, factor
+
+
+def check_solved(ksp, name):
+    """Raise RodDivergedError when the last solve of ``ksp`` failed; ``name`` is the
+    solver's options prefix, as the message gives it."""
+    reason = ksp.getConvergedReason()
+    if reason < 0:
+        raise RodDivergedError(f"linear solver -{name} failed: {KSP_REASONS.get(reason, reason)}")

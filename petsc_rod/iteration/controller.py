@@ -1,0 +1,226 @@
+"""The step controller: what one continuation step does next after each iteration, as a
+small state machine with a typed decision (docs/design.md, "One step").
+
+The solver (driver.py) records every iteration's (change, residual) here and asks
+``decide``; the SNES's convergence test is where it asks. A Decision is one of
+
+    ITERATE        go on with the SNES
+    CONVERGED      both stopping tests hold (§6)
+    TRY_NEWTON     near a solution and still slow: Newton steps (§11), then the SNES again
+    RAISE_PENALTY  R far below the problem's scale and the residual not falling: refactor
+    STOP           not converged, with a reason (stopping.STOP_* or "snes_<reason>")
+    DIVERGED       the iteration diverged; ``error`` holds the RodDivergedError
+
+The controller owns the step's record (its rows, penalty raises, Newton steps, escapes),
+the Newton schedule (when an attempt may be made again), and the budgets of the escapes
+from saddles (§10). It reads values and returns decisions; it touches no PETSc object
+and no state: the solver acts.
+"""
+
+import enum
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from petsc_rod.errors import RodDivergedError, RodIterationDiverged
+from petsc_rod.iteration import stopping
+from petsc_rod.problem.penalty import ADAPT_WINDOW, penalty_too_low
+
+# The iteration hands over to Newton steps on the reduced problem (newton.py) once a
+# step has taken NEWTON_AFTER iterations and change and residual are both below
+# NEWTON_SWITCH: near a solution, where the accelerated iteration is slow.
+NEWTON_AFTER = 15
+NEWTON_SWITCH = 0.1
+# An attempt costs as much as tens of iterations (a sparse LDL^T factorisation per Newton
+# step: docs/performance.md): it is made only while the iteration would still need more
+# than NEWTON_WORTH iterations at its recent rate. After each attempt that did not
+# converge the wait doubles (an attempt restarts the accelerated iteration).
+NEWTON_WORTH = 30
+# A state where Newton finds negative curvature is left at once (not first converged to)
+# when change and residual are below EARLY_ESCAPE: near an equilibrium, so a saddle.
+EARLY_ESCAPE = 1e-2
+# A step that converged to a saddle goes on from its frames turned along the direction
+# of negative curvature, the largest node turned by ESCAPE_ANGLE rad, the angle times
+# ESCAPE_GROWTH and of the other sign at each further saddle, at most MAX_ESCAPES times
+# (the turn must leave the saddle's basin of the accelerated iteration, §10); the early
+# escapes have a budget of their own of the same size.
+ESCAPE_ANGLE = 0.3
+MAX_ESCAPES = 5
+ESCAPE_GROWTH = 2.0
+
+
+class Action(enum.Enum):
+    ITERATE = "iterate"
+    CONVERGED = "converged"
+    TRY_NEWTON = "try_newton"
+    RAISE_PENALTY = "raise_penalty"
+    STOP = "stop"
+    DIVERGED = "diverged"
+
+
+@dataclass(frozen=True)
+class Decision:
+    action: Action
+    reason: str = ""            # why a STOP stopped
+
+    @property
+    def ends_solve(self):
+        """Whether the SNES solve ends here (every action but ITERATE)."""
+        return self.action is not Action.ITERATE
+
+
+ITERATE = Decision(Action.ITERATE)
+
+
+class StepController:
+    """One step's state machine (module docstring). ``settings`` (stopping.Settings),
+    ``scale`` the problem's scale of R (N), ``newton`` whether Newton steps may be tried,
+    ``label`` the step's name in messages, ``observer(iteration, change, residual)``
+    asked after every iteration (True: stop, STOP_OBSERVER)."""
+
+    def __init__(self, settings, scale, newton, label="", observer=None):
+        self.settings, self.scale, self.newton = settings, scale, newton
+        self.label, self.observer = label, observer
+        self.clock = time.perf_counter()
+        self.history = []           # (change, residual, wall time) rows, one per iteration
+        self.raises = []            # (iteration, new R)
+        self.decision = None        # the last one, None before any and after resume()
+        self.error = None           # the RodDivergedError that ended the step
+        self.stable = None          # a local minimiser (stability.py); None: not checked
+        self.escapes = 0            # saddles converged to and left
+        self.early_escapes = 0      # saddles left before converging to them
+        self.newton_steps = 0       # Newton steps taken, counted in history
+        self.newton_failures = 0    # attempts that did not converge
+        self.newton_next = NEWTON_AFTER     # the iteration from which Newton may be tried
+        # the iteration at which Newton converged with H positive definite on the
+        # constraint set (the stability test's own criterion)
+        self.newton_verified = None
+        self._undecided = False     # a row (or a failure) the decision has not seen yet
+
+    # --- what happened --------------------------------------------------------------
+    def record(self, change, residual):
+        """An iteration's norms (a Uzawa iteration, or a Newton step's largest turn with
+        residual 0)."""
+        self.history.append((change, residual, time.perf_counter() - self.clock))
+        self._undecided = True
+
+    def record_newton_step(self, turn):
+        self.record(turn, 0.0)
+        self.newton_steps += 1
+
+    def fail(self, error):
+        """The iteration itself failed (a RodDivergedError: a linear solver failed)."""
+        iteration = len(self.history) + 1
+        self.error = RodDivergedError(f"{self.label}iteration {iteration}: {error}", iteration)
+        self.decision = Decision(Action.DIVERGED)
+        self._undecided = False
+
+    def raised(self, penalty):
+        """The solver refactored at penalty R (N)."""
+        self.raises.append((len(self.history), penalty))
+
+    # --- the decision ---------------------------------------------------------------
+    def decide(self, penalty):
+        """The Decision after the last recorded iteration at penalty R (N); the same one
+        again when nothing was recorded since."""
+        if self._undecided:
+            self._undecided = False
+            self.decision = self._decide(penalty)
+        return self.decision if self.decision is not None else ITERATE
+
+    def _decide(self, penalty):
+        settings, iteration = self.settings, len(self.history)
+        change, residual = self.history[-1][:2]
+        if stopping.diverged(change, residual):
+            self.error = RodIterationDiverged(
+                f"{self.label}iteration {iteration}: the iteration diverged (change "
+                f"{change:.3g}, constraint residual {residual:.3g})", iteration)
+            return Decision(Action.DIVERGED)
+        if self.observer is not None and self.observer(iteration, change, residual):
+            return Decision(Action.STOP, stopping.STOP_OBSERVER)
+        if stopping.converged(settings, change, residual):
+            return Decision(Action.CONVERGED)
+        if (self.newton and iteration >= self.newton_next
+                and max(change, residual) <= NEWTON_SWITCH
+                and stopping.remaining_iterations(self.history, settings.rtol,
+                                                  settings.ctol) > NEWTON_WORTH):
+            return Decision(Action.TRY_NEWTON)
+        if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
+                and penalty_too_low(self.history, penalty, self.scale)):
+            return Decision(Action.RAISE_PENALTY)
+        stop = stopping.stall_reason(settings, self.history)
+        return ITERATE if stop is None else Decision(Action.STOP, stop)
+
+    def stop(self, reason):
+        """End the step not converged, for ``reason``."""
+        self.decision = Decision(Action.STOP, reason)
+
+    def resume(self):
+        """The solver acted on the last decision (a Newton attempt, a raise, an escape):
+        the step goes on."""
+        self.decision = None
+
+    @property
+    def finished(self):
+        """A decision that ends the SNES solve has been taken."""
+        return self.decision is not None and self.decision.ends_solve
+
+    @property
+    def converged(self):
+        return self.decision is not None and self.decision.action is Action.CONVERGED
+
+    # --- the Newton schedule ----------------------------------------------------------
+    def start_iterating(self):
+        """The SNES starts (again, after an escape): Newton waits NEWTON_AFTER iterations."""
+        self.newton_next = len(self.history) + NEWTON_AFTER
+
+    def wait_for_newton(self):
+        """Newton may be tried again NEWTON_AFTER 2^failures iterations from now."""
+        self.newton_next = len(self.history) + NEWTON_AFTER * 2**self.newton_failures
+
+    def newton_converged(self, verified):
+        """An attempt converged; ``verified``: with H positive definite on the constraint
+        set at its last step."""
+        if verified:
+            self.newton_verified = len(self.history)
+
+    @property
+    def verified_by_newton(self):
+        """Newton's last factorisation, one iteration ago, showed the state stable."""
+        return self.newton_verified == len(self.history) - 1
+
+    def wants_early_escape(self):
+        """After an attempt that found negative curvature: whether the state is near
+        enough an equilibrium (EARLY_ESCAPE) to be taken for a saddle and left now, with
+        the early escapes' budget not spent."""
+        change, residual = self.history[-1][:2] if self.history else (np.inf, np.inf)
+        return max(change, residual) <= EARLY_ESCAPE and self.early_escapes < MAX_ESCAPES
+
+    # --- escapes from saddles ---------------------------------------------------------
+    def escape_angle(self, early=False):
+        """The angle (rad) of the next escape, ESCAPE_ANGLE ESCAPE_GROWTH^k (-1)^k at the
+        k-th escape of the step (early or not), counted as taken; None when its budget
+        (MAX_ESCAPES each) is spent."""
+        if (self.early_escapes if early else self.escapes) == MAX_ESCAPES:
+            return None
+        k = self.escapes + self.early_escapes
+        if early:
+            self.early_escapes += 1
+            # a new start: the turned state is given the wait after one failure
+            self.newton_failures = 1
+        else:
+            self.escapes += 1
+        return ESCAPE_ANGLE * ESCAPE_GROWTH**k * (-1) ** k
+
+    # --- the end ----------------------------------------------------------------------
+    def report(self):
+        """The StepReport of the finished step."""
+        decision = self.decision
+        converged = decision.action is Action.CONVERGED
+        change, residual = self.history[-1][:2] if self.history else (np.inf, np.inf)
+        return stopping.StepReport(converged, len(self.history), change, residual,
+                                   self.history, "" if converged else decision.reason,
+                                   self.raises, stable=self.stable,
+                                   escapes=self.escapes + self.early_escapes,
+                                   newton_steps=self.newton_steps)

@@ -1,0 +1,115 @@
+"""The protocol of a term of physics: what a piece of the problem beside the rod's
+elastic energy and its constraint contributes to each part of the method
+(docs/design.md, "Terms of physics").
+
+The problem (problem/problem.py) holds a list of terms, built for its scene
+(problem/build.py): the dead loads (physics/dead_loads.py) always; the seabed, the drag
+and the riser numbers (riser/terms.py, riser/quantities.py) where the scene has them.
+The core walks the list and calls the methods below; it never asks which terms exist.
+Every default does nothing, so a term overrides only what it contributes. Every method
+is called on every rank, in the same order (collective where a term needs it).
+
+When each is called:
+
+* the global step (global_step/global_step.py, docs/method.md §3 step 1):
+  ``build`` at every factorisation, ``prepare`` at every load step, then
+  ``add_step_load`` once into the load that stays fixed over the step;
+  ``add_iterate_load`` at every iteration; ``solve_slope`` after the P2 solve of the
+  slope, for the components of ``slope_components``;
+* the energy and its derivatives (problem.energy, problem.energy_gradient, the Newton
+  steps of §11 and the second variation of §10): ``energy``, ``add_gradient``,
+  ``add_hessian``; ``conservative`` and ``in_newton`` say whether they are the term's
+  whole contribution;
+* the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
+  force n(S), ``outputs`` for datasets, attributes and the step line.
+"""
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class TermOutput:
+    """What a term adds to a step's record: vertex datasets {name: (n_owned, ...)},
+    attributes {name: value} (units in io/results.py) and a phrase for the step line."""
+
+    datasets: dict = field(default_factory=dict)
+    attributes: dict = field(default_factory=dict)
+    text: str = ""
+
+
+class Term:
+    """A term of physics (module docstring). Subclasses set the class attributes that
+    differ and override the methods they contribute to."""
+
+    # the term has an energy: its loads are conservative, and the stability test (§10)
+    # says which equilibrium a step reached (a drag has none: docs/riser.md)
+    conservative = True
+    # energy, add_gradient and add_hessian are the term's whole contribution to E, so
+    # that Newton steps on the reduced problem (§11) may be taken with it
+    in_newton = True
+    # components of the slope r' (0, 1, 2 for x, y, z) that the term solves itself in
+    # the global step (solve_slope) in place of the P2 solve (the seabed: z)
+    slope_components = ()
+
+    # --- the global step --------------------------------------------------------------
+    def build(self, slope_coefficient, penalty):
+        """At every factorisation of the global step: the slope problem's 2 c3 (N m^2)
+        and its penalty R (N) (global_step.GlobalStep.build)."""
+
+    def prepare(self, t, start, end):
+        """At each load step: the load factor t and the end states (scenes.EndState)."""
+
+    def add_step_load(self, load):
+        """Add the term's int F.g dS of a load fixed over the step (F the resultant
+        beyond S, docs/method.md §5) into ``load`` (a VectorField on the slope's P2 dofs,
+        N), which the global step adds to the slope's right-hand side every iteration.
+        Called once per ``prepare``."""
+
+    def add_iterate_load(self, rhs, state):
+        """Add, every iteration, a load that depends on the iterate (RodState ``state``:
+        its tau, lambda and the last fields) to the slope's right-hand side ``rhs``
+        (VectorField)."""
+
+    def solve_slope(self, rhs, state, bordered):
+        """After the P2 solve of the slope's other components: set the components of
+        ``slope_components`` of state.slope from the right-hand side ``rhs``; with both
+        ends held (``bordered``) also their part of state.chord_multiplier."""
+
+    def ksps(self):
+        """The KSPs the term made (their types go to the result file)."""
+        return []
+
+    # --- the energy, Newton and the stability test -----------------------------------------
+    def energy(self, state):
+        """The term's part of the discrete energy E (§6) at ``state``, J: stored energy
+        less the work of its loads. Collective."""
+        return 0.0
+
+    def add_gradient(self, g, state):
+        """Add dE_term / dd_i at the owned P2 nodes into g (n_nodes, 3 directors, 3), the
+        fields of ``state`` being the frames (iteration/newton.py)."""
+
+    def add_hessian(self, hessian):
+        """Add the second derivative of E_term in the directors, beyond what its gradient
+        gives through the multipliers (§10), to the SecondVariation ``hessian`` before it
+        is assembled (a term linear in the directors adds nothing)."""
+
+    # --- outputs --------------------------------------------------------------------
+    def force_beyond(self, state):
+        """The term's share of the internal force n(S) at the owned vertices, N,
+        (n_owned, 3): the resultant of its loads beyond S, with, when the start is free,
+        its share of the reaction at the held end; None: nothing."""
+        return None
+
+    def end_force(self, state):
+        """The term's share of the external force on the rod at S = L, N, (3,) (that is,
+        of n(L)); None: nothing. Collective."""
+        return None
+
+    def outputs(self, problem, vertex):
+        """A TermOutput for the step's record from the vertex fields ``vertex``
+        (io/outputs.vertex_fields), or None. Collective."""
+        return None
+
+    def destroy(self):
+        """Free the term's PETSc objects (collective)."""

@@ -1,0 +1,193 @@
+"""What is solved: the discrete rod problem on one mesh and scene (docs/method.md §2-§6),
+apart from how it is solved (iteration/driver.py: the SNES and the step controller).
+
+A RodProblem holds the mesh, the scene, the state (problem/state.py), the global step
+(global_step/) and the list of terms of physics (physics/term.py) that the scene needs
+(problem/build.py). It answers what the method and its users ask of the problem: one
+Uzawa iteration G (the map the SNES mixes), the energy E and its gradient, the second
+variation (analysis/stability.py), the link, the end reaction and the internal force,
+and the terms' outputs. The Newton steps, the stability test, the outputs and the
+riser numbers take a RodProblem, never the solver.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
+from petsc_rod.analysis.stability import SecondVariation
+from petsc_rod.frames import split_coefficients, strains
+from petsc_rod.global_step.global_step import GlobalStep
+from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
+from petsc_rod.mesh.elements import quadrature_weights
+from petsc_rod.problem import penalty as penalty_policy
+from petsc_rod.problem.build import scene_terms
+from petsc_rod.problem.state import RodState
+from petsc_rod.scenes.boundary import clamped_nodes
+
+EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("projection", "multiplier", "norms")}
+
+
+class RodProblem:
+    """The problem of a Scene on a Mesh at an asked penalty R (N), with the ``terms``
+    (physics/term.py; default: those the scene needs, problem/build.py). Owns the state,
+    the global step, the terms and the second variation; ``destroy()`` releases them."""
+
+    def __init__(self, mesh, scene, penalty, terms=None):
+        self.mesh, self.scene = mesh, scene
+        self.terms = list(scene_terms(mesh, scene) if terms is None else terms)
+        self.split = split_coefficients(scene.stiffness)
+        # the problem's scale of R, N (penalty.default_penalty): what "far below" means
+        self.scale = penalty_policy.default_penalty(scene)
+        self.state = RodState(mesh)
+        self.global_step = GlobalStep(mesh, scene, self.split,
+                                      penalty_policy.matrix_split(self.split), float(penalty),
+                                      self.terms)
+        self.weights = quadrature_weights(mesh.element_h)
+        # the ends' kinds do not change: the clamped nodes are those of the whole run
+        self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
+        self._second_variation = None
+
+    # --- what the terms allow ---------------------------------------------------------
+    @property
+    def conservative(self):
+        """Every term has an energy: the stability test (§10) applies."""
+        return all(term.conservative for term in self.terms)
+
+    @property
+    def in_newton(self):
+        """Every term's energy, gradient and Hessian are exact: Newton steps (§11) apply."""
+        return all(term.in_newton for term in self.terms)
+
+    # --- the global step and the map --------------------------------------------------------
+    @property
+    def penalty(self):
+        """The penalty R of the global step's factorisation, N."""
+        return self.global_step.penalty
+
+    def rebuild(self, penalty):
+        """Refactor the global step at penalty R, N (GlobalStep.build)."""
+        self.global_step.build(penalty)
+
+    @property
+    def start_state(self):
+        """The end conditions at S = 0 of the last ``prepare`` (scenes.EndState)."""
+        return self.global_step.start_state
+
+    @property
+    def end_state(self):
+        return self.global_step.end_state
+
+    @property
+    def bordered(self):
+        """Both ends held: the chord int r' dS = r(L) - r(0) is a constraint."""
+        return self.global_step.bordered
+
+    def prepare(self, t):
+        """End conditions and loads at load factor t (GlobalStep.prepare)."""
+        self.global_step.prepare(t)
+
+    def iterate(self):
+        """One iteration G (docs/method.md §3): global step, local step (nearest rotation
+        of R d + lambda at every node), multiplier update lambda += R (d - tau)."""
+        state, R = self.state, self.penalty
+        self.global_step.solve(state)
+        EVENTS["projection"].begin()
+        directors = state.take_directors()
+        b = np.multiply(directors, R, out=state.tau)       # b = R d + lambda, in place
+        b += state.lam
+        nearest_rotation(b, out=state.tau)
+        EVENTS["projection"].end()
+        EVENTS["multiplier"].begin()
+        update_multipliers(state.lam, directors, state.tau, R)
+        EVENTS["multiplier"].end()
+
+    def norms(self):
+        """(relative change, RMS constraint residual) of the last iteration (§6,
+        RodState.norms; one allreduce)."""
+        EVENTS["norms"].begin()
+        try:
+            return self.state.norms()
+        finally:
+            EVENTS["norms"].end()
+
+    # --- the energy and its derivatives ------------------------------------------------
+    def energy(self):
+        """E = int w dS (the strains u of the FE fields at the Gauss points) plus every
+        term's part (the work of the loads with its sign, the seabed's stored energy), J
+        (§6). Collective."""
+        p = self.state.point_values()
+        u = strains(p["directors"], p["derivatives"])
+        stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
+        return self.mesh.global_sum(stored) + sum(term.energy(self.state)
+                                                  for term in self.terms)
+
+    def stiffness(self):
+        """K, the P2 stiffness matrix of unit coefficient (GlobalStep.stiffness)."""
+        return self.global_step.stiffness()
+
+    def energy_gradient(self, work):
+        """g_i = dE/dd_i at the owned P2 nodes, (n_nodes, 3, 3), with the fields of the
+        state as the frames: 2 a_i K d_i and the terms' (Term.add_gradient: -b on d3 for
+        the loads). ``work``: a Vec of K's layout for the products."""
+        n = self.mesh.n_local_nodes
+        g = np.empty((n, 3, 3))
+        stiffness = self.stiffness()
+        for i, field in enumerate(self.state.frame_fields):
+            for c, vec in enumerate(field.components):
+                stiffness.mult(vec, work)
+                g[:, i, c] = 2 * self.split[i] * work.getArray(readonly=True)[:n]
+        for term in self.terms:
+            term.add_gradient(g, self.state)
+        return g
+
+    def second_variation(self):
+        """The SecondVariation at the current state: one object for the problem's life,
+        made at the first call and updated at the next ones, so that its factorisations
+        share one symbolic analysis (the stability test and every Newton step)."""
+        if self._second_variation is None:
+            self._second_variation = SecondVariation(self)
+        else:
+            self._second_variation.update()
+        return self._second_variation
+
+    # --- what the outputs read ----------------------------------------------------------
+    def link(self):
+        """Twist and writhe of the current state, (Tw, Wr) in turns, Lk = Tw + Wr
+        (analysis/link.py); None when the scene has no common end axis or a tangent comes
+        within FULLER_MARGIN of pointing back along it."""
+        axis = self.scene.link_axis
+        if axis is None:
+            return None
+        p = self.state.point_values()
+        twist, writhe, margin = link_integrands(p["directors"], p["derivatives"], axis)
+        tw, wr, backward = self.mesh.global_sum(np.array([
+            np.sum(self.weights * twist), np.sum(self.weights * writhe),
+            np.sum(margin < FULLER_MARGIN)]))
+        return None if backward else (float(tw), float(wr))
+
+    def end_reaction(self):
+        """External force on the rod at S = L, N: the terms' shares (Term.end_force: the
+        dead force at a free end; -(the whole load and P_0) at a held end when the start
+        is free) less the chord multiplier mu when both ends are held. Collective."""
+        shares = [term.end_force(self.state) for term in self.terms]
+        return sum(share for share in shares if share is not None) - self.state.chord_multiplier
+
+    def internal_force(self):
+        """n(S) at the owned vertices, (n_owned, 3), N: the terms' shares
+        (Term.force_beyond) less mu. Collective."""
+        shares = [term.force_beyond(self.state) for term in self.terms]
+        return sum(share for share in shares if share is not None) - self.state.chord_multiplier
+
+    def term_outputs(self, vertex):
+        """The terms' TermOutputs for the vertex fields ``vertex``, in list order (None
+        left out). Collective."""
+        outputs = [term.outputs(self, vertex) for term in self.terms]
+        return [output for output in outputs if output is not None]
+
+    def destroy(self):
+        if self._second_variation is not None:
+            self._second_variation.destroy()
+        self.global_step.destroy()
+        for term in self.terms:
+            term.destroy()
+        self.state.destroy()

@@ -1,0 +1,107 @@
+"""The shape of the package (docs/design.md), read from the code's own imports and
+strings with ``ast``: no loop between folders, the core never imports the riser (its
+terms come in a list, problem/build.py), and the algorithm layer never names a
+command-line option (cli/ says what to change)."""
+
+import ast
+import os
+from collections import defaultdict
+
+from helpers import REPO_ROOT
+
+PACKAGE = os.path.join(REPO_ROOT, "petsc_rod")
+# Folders and modules that make up the core of the method, which must work with any
+# list of terms and so never import the riser's.
+CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics",
+        "problem/problem.py", "problem/state.py", "io/outputs.py")
+# The algorithm layer, whose messages must not name -rod_* options.
+ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step")
+
+
+def modules():
+    """{path relative to petsc_rod/: ast.Module} of every module of the package."""
+    found = {}
+    for folder, _, files in os.walk(PACKAGE):
+        for name in files:
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                with open(path, encoding="utf-8") as source:
+                    found[os.path.relpath(path, PACKAGE)] = ast.parse(source.read())
+    return found
+
+
+def imported(tree):
+    """The petsc_rod modules a module imports, dotted below petsc_rod."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module.startswith("petsc_rod."):
+                base = node.module.removeprefix("petsc_rod.")
+                names.add(base)
+                names.update(f"{base}.{alias.name}" for alias in node.names)
+        elif isinstance(node, ast.Import):
+            names.update(alias.name.removeprefix("petsc_rod.") for alias in node.names
+                         if alias.name.startswith("petsc_rod."))
+    return names
+
+
+def folder_of(path):
+    """The top-level folder of a module (or the module itself at the top)."""
+    return path.split(os.sep)[0].removesuffix(".py")
+
+
+def test_no_loop_between_folders():
+    graph = defaultdict(set)
+    for path, tree in modules().items():
+        here = folder_of(path)
+        for name in imported(tree):
+            there = name.split(".")[0]
+            known = (os.path.isdir(os.path.join(PACKAGE, there))
+                     or os.path.isfile(os.path.join(PACKAGE, f"{there}.py")))
+            if known and there != here:
+                graph[here].add(there)
+    visiting, done = set(), set()
+
+    def visit(node, trail):
+        assert node not in visiting, f"a loop between folders: {' -> '.join(trail + [node])}"
+        if node in done:
+            return
+        visiting.add(node)
+        for child in sorted(graph[node]):
+            visit(child, trail + [node])
+        visiting.discard(node)
+        done.add(node)
+
+    for node in sorted(graph):
+        visit(node, [])
+    assert graph["problem"] and graph["iteration"]       # the graph was read
+
+
+def test_the_core_never_imports_the_riser():
+    for path, tree in modules().items():
+        if path.startswith(CORE):
+            riser = sorted(name for name in imported(tree) if name.startswith("riser"))
+            assert not riser, f"{path} imports {riser}: a term belongs in problem/build.py"
+
+
+def docstrings(tree):
+    """The ids of the string nodes that are docstrings."""
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                found.add(id(first.value))
+    return found
+
+
+def test_the_algorithm_layer_names_no_command_line_option():
+    for path, tree in modules().items():
+        if not path.startswith(ALGORITHM):
+            continue
+        skip = docstrings(tree)
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                    and id(node) not in skip):
+                assert "-rod_" not in node.value, (f"{path}:{node.lineno} names an option: "
+                                                   f"{node.value!r}")
