@@ -168,6 +168,7 @@ def run_one(comm, name, n_elements, penalty, reference):
     from petsc_rod.mesh.mesh import Mesh
     from petsc_rod.scenes.scene import Scene
     from petsc_rod.cli.session import run_continuation
+    from petsc_rod.iteration.continuation import PathSettings
     from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
 
@@ -181,7 +182,8 @@ def run_one(comm, name, n_elements, penalty, reference):
         solver.problem.state.set_straight()
         earlier = 0                 # iterations of the continuation steps before the last
         if steps > 1:
-            before = run_continuation(solver, steps - 1, imperfection, end=(steps - 1) / steps)
+            before = run_continuation(solver, PathSettings(steps - 1, imperfection,
+                                                           end=(steps - 1) / steps))
             if not before.converged:
                 raise RuntimeError(f"{name}: the continuation to the last step did not "
                                    "converge")

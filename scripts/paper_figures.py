@@ -66,8 +66,10 @@ def gather(comm, owned):
 
 def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, say):
     """One continuation from X_F = 20 to ``end_x`` by the CLI's loop (a step that fails is
-    halved, as on the command line): (step rows, profiles by X_F)."""
-    from petsc_rod.cli.session import run_continuation
+    halved, as on the command line), each step recorded from its event: (step rows,
+    profiles by X_F)."""
+    from petsc_rod.iteration import events
+    from petsc_rod.iteration.continuation import PathSettings, continuation
     from petsc_rod.iteration.driver import solver_for
     from petsc_rod.iteration.stopping import Settings
     from petsc_rod.io.outputs import vertex_fields
@@ -114,9 +116,12 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
 
     try:
         solver.problem.state.set_straight()
-        result = run_continuation(solver, steps, imperfection, on_step=record)
-        if not result.converged:
-            say(f"{label}: stopped, a step did not converge")
+        for event in continuation(solver, PathSettings(steps, imperfection)):
+            if isinstance(event, events.StepEnded):
+                record(event.t, event.report)
+            elif isinstance(event, events.RunDiverged) or (
+                    isinstance(event, events.RunFinished) and not event.converged):
+                say(f"{label}: stopped, a step did not converge")
     finally:
         solver.destroy()
         solver.problem.destroy()

@@ -99,14 +99,15 @@ def global_max(comm, value):
     return mpi.allreduce(float(value), op=MPI.MAX)
 
 
-def continuation(solver, steps=1, imperfection=0.0, **options):
+def continuation(solver, steps=1, imperfection=0.0, **path):
     """From the straight state to load factor 1 by the CLI's continuation loop (halving
-    and link check included; ``options`` as cli.session.run_continuation takes them);
-    the last StepReport."""
+    and link check included; ``path``: the other fields of
+    iteration.continuation.PathSettings); the last StepReport."""
     from petsc_rod.cli.session import run_continuation
+    from petsc_rod.iteration.continuation import PathSettings
 
     solver.problem.state.set_straight()
-    return run_continuation(solver, steps, imperfection, **options).report
+    return run_continuation(solver, PathSettings(steps, imperfection, **path)).report
 
 
 # Variables an enclosing mpiexec sets for its own processes: a child must not inherit

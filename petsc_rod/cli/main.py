@@ -18,6 +18,7 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
 from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
+from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.problem.problem import RodProblem
 
@@ -64,11 +65,12 @@ def run(comm=None):
                     values["rod_output"], mesh,
                     io.minimum_bytes(mesh, outputs.restart_state(problem), values["rod_steps"]),
                     run_record(values, solver, start))
-            code = run_continuation(solver, values["rod_steps"], values["rod_imperfection"],
-                                    writer=writer, say=say, options=options_record(),
-                                    max_halvings=values["rod_max_halvings"],
-                                    track_link=values["rod_track_link"], start=start,
-                                    interrupts=interrupts).code
+            path = PathSettings(steps=values["rod_steps"], start=start,
+                                imperfection=values["rod_imperfection"],
+                                max_halvings=values["rod_max_halvings"],
+                                track_link=values["rod_track_link"])
+            code = run_continuation(solver, path, say=say, writer=writer,
+                                    options=options_record(), interrupts=interrupts).code
             writer = None
             for name in unused_options():
                 say(f"petsc_rod: warning: option -{name} was set but not used")

@@ -18,7 +18,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.iteration.continuation import MAX_HALVINGS, MAX_HALVINGS_CAP
+from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.controller import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
@@ -110,8 +110,9 @@ TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
 
 
 def default_of(owner, name):
-    """The default of field ``name`` of the dataclass ``owner`` (Scene, Settings): an
-    option's default is that of the object that uses it, read from there."""
+    """The default of field ``name`` of the dataclass ``owner`` (Scene, Settings,
+    PathSettings): an option's default is that of the object that uses it, read from
+    there."""
     field = next(f for f in dataclasses.fields(owner) if f.name == name)
     if field.default_factory is not dataclasses.MISSING:
         return field.default_factory()
@@ -165,16 +166,17 @@ OPTIONS = [
     Option("rod_drag", _reals(3), None, "rho,Cd,D",
            "water density kg/m^3, normal drag coefficient, hydrodynamic diameter m: drag "
            "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE),
-    Option("rod_steps", _int, 1, "K", "continuation steps from the straight state", POSITIVE),
-    Option("rod_imperfection", _real, 0.0, "eps",
+    Option("rod_steps", _int, default_of(PathSettings, "steps"), "K",
+           "continuation steps from the straight state", POSITIVE),
+    Option("rod_imperfection", _real, default_of(PathSettings, "imperfection"), "eps",
            "at the start of each step, roll the cross-sections about the tangent by "
            "eps sin(pi S / 2L) rad, so that an unstable symmetric branch is left", unit="rad"),
-    Option("rod_max_halvings", _int, MAX_HALVINGS, "n",
+    Option("rod_max_halvings", _int, default_of(PathSettings, "max_halvings"), "n",
            "a step that does not converge or diverges is retried from the last converged "
            "state with half the increment, at most n times per step (smallest increment "
            "1/(K 2^n)); 0: stop at the first failure",
            (lambda v: 0 <= v <= MAX_HALVINGS_CAP, f"must be between 0 and {MAX_HALVINGS_CAP}")),
-    Option("rod_track_link", _bool, True, "bool",
+    Option("rod_track_link", _bool, default_of(PathSettings, "track_link"), "bool",
            "ends clamped on a common axis: refuse a step whose linking number Tw + Wr is "
            "not the last one plus the end roll over 2 pi (the rod passed around an end or "
            "through itself); 0 for a rod free to pass around its ends"),

@@ -9,7 +9,7 @@ from petsc_rod.cli import lines
 from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
 from petsc_rod.io import outputs
 from petsc_rod.iteration import events
-from petsc_rod.iteration.continuation import MAX_HALVINGS, continuation
+from petsc_rod.iteration.continuation import PathSettings, continuation
 
 
 @dataclass
@@ -26,25 +26,22 @@ class ContinuationResult:
         return self.code == 0
 
 
-def run_continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, options="",
-                     max_halvings=MAX_HALVINGS, track_link=True, start=0.0, end=1.0,
-                     interrupts=None, on_step=None):
-    """Walk continuation(solver, steps, ...) (its arguments as there) to its end.
+def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, options="",
+                     interrupts=None):
+    """Walk continuation(solver, path) (iteration/continuation.py) to its end.
 
     ``say(line)`` gets the lines (None: silent); ``writer`` (io.results.ResultWriter or
     None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
-    text) among its attributes, and is finished at the end; ``on_step(t, report)``, if
-    given, is called after each StepEnded. ``interrupts`` (signals.Interrupts), if given,
-    are asked after every iteration and before the file is finished: a signal ends the
-    run with RodInterrupted. A divergence with no halving left raises RodDivergedError.
-    Returns a ContinuationResult.
+    text) among its attributes, and is finished at the end. ``interrupts``
+    (signals.Interrupts), if given, are asked after every iteration and before the file
+    is finished: a signal ends the run with RodInterrupted. A divergence with no halving
+    left raises RodDivergedError. Returns a ContinuationResult.
     """
     say = say or (lambda line: None)
     problem = solver.problem
     stop = None if interrupts is None else interrupts.received
     last = None                 # (group, attributes) of the last step written
-    for event in continuation(solver, steps, imperfection, max_halvings=max_halvings,
-                              track_link=track_link, start=start, end=end, stop=stop):
+    for event in continuation(solver, path, stop):
         if isinstance(event, events.RunStarted):
             say(lines.started(event))
         elif isinstance(event, events.StepHalved):
@@ -61,8 +58,6 @@ def run_continuation(solver, steps, imperfection=0.0, *, writer=None, say=None, 
             for line in lines.raise_lines(event, problem.scale):
                 say(line)
             last = (group, record.attributes)
-            if on_step is not None:
-                on_step(event.t, event.report)
         elif isinstance(event, events.RunDiverged):
             raise RodDivergedError(lines.diverged_message(event), event.error.iterations)
         elif isinstance(event, events.Interrupted):

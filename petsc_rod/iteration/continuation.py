@@ -4,7 +4,7 @@ fails. The run is a generator of events (events.py): it says what happened and l
 the lines and the file to its caller (cli/session.py)."""
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -13,11 +13,22 @@ from petsc_rod.errors import RodDivergedError
 from petsc_rod.iteration import events
 from petsc_rod.iteration.stopping import STOP_LINK, STOP_OBSERVER
 
-# The default number of halvings of the step on the way to each t_k.
-MAX_HALVINGS = 4
 # The most halvings a path may be asked for: the load factors are counted in whole
 # units of 1/(K 2^n) (LoadPath), which must stay exact integers.
 MAX_HALVINGS_CAP = 50
+
+
+@dataclass(frozen=True)
+class PathSettings:
+    """What the user asks of the load path (docs/method.md §7; the command line's
+    defaults are these, cli/options.py reads them from here)."""
+
+    steps: int = 1                  # regular steps t_k = t_0 + (t_end - t_0) k / steps
+    imperfection: float = 0.0       # roll of the sections at each step's start, rad
+    max_halvings: int = 4           # halvings of the step on the way to each t_k
+    track_link: bool = True         # refuse a step of another linking number (link.py)
+    start: float = 0.0              # the load factor the path starts from (a restart's)
+    end: float = 1.0                # and ends at
 
 
 class LoadPath:
@@ -131,16 +142,16 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
                     f"{report.constraint_residual:.2e})")
 
 
-def continuation(solver, steps, imperfection=0.0, *, max_halvings=MAX_HALVINGS,
-                 track_link=True, start=0.0, end=1.0, stop=None):
-    """Reach load factor ``end`` in ``steps`` equal increments from ``start`` (0, or a
-    restart's), each warm-started (§7) from the last state with its cross-sections
-    rolled by ``imperfection`` (RodState.roll_cross_sections) and tau, lambda
-    extrapolated (Predictor). A step that does not converge or diverges is undone
-    (RodState.snapshot/restore) and retried with half the increment, at most
-    ``max_halvings`` times on the way to each t_k (LoadPath); so is a step that converged
-    to another linking number (link.py) when ``track_link``. ``stop()`` (collective), if
-    given, is asked after every iteration and after the last step: True ends the run.
+def continuation(solver, path=PathSettings(), stop=None):
+    """Reach load factor ``path.end`` in ``path.steps`` equal increments from
+    ``path.start`` (0, or a restart's), each warm-started (§7) from the last state with
+    its cross-sections rolled by ``path.imperfection`` (RodState.roll_cross_sections)
+    and tau, lambda extrapolated (Predictor). A step that does not converge or diverges
+    is undone (RodState.snapshot/restore) and retried with half the increment, at most
+    ``path.max_halvings`` times on the way to each t_k (LoadPath); so is a step that
+    converged to another linking number (link.py) when ``path.track_link``. ``stop()``
+    (collective), if given, is asked after every iteration and after the last step:
+    True ends the run.
 
     The one loop of the project: the command line, the scripts and the tests all walk
     it (cli/session.py). Yields the events of events.py: RunStarted; per attempt
@@ -150,11 +161,12 @@ def continuation(solver, steps, imperfection=0.0, *, max_halvings=MAX_HALVINGS,
     problem = solver.problem
     state, mesh = problem.state, problem.mesh
     clock = time.perf_counter()
-    path = LoadPath(steps, max_halvings, start, end)
+    settings, track_link = path, path.track_link
+    path = LoadPath(settings.steps, settings.max_halvings, settings.start, settings.end)
     yield events.RunStarted(mesh.n_elements, mesh.comm.getSize(), solver.settings.asked_penalty,
-                            path.steps, start)
+                            path.steps, settings.start)
     predictor = Predictor()
-    predictor.accept(start, state)
+    predictor.accept(settings.start, state)
     total, undone, written = 0, 0, 0
     # (Tw, Wr) of the last accepted state (of the start, then of each step), or None
     link = problem.link() if track_link else None
@@ -162,7 +174,7 @@ def continuation(solver, steps, imperfection=0.0, *, max_halvings=MAX_HALVINGS,
         t, label = path.next_factor, f"step {path.step}/{path.steps}"
         saved = state.snapshot()
         predictor.predict(state, t)
-        report, failure = attempt(solver, t, imperfection, f"{label} ",
+        report, failure = attempt(solver, t, settings.imperfection, f"{label} ",
                                   expected_link(problem.scene, link, path.factor(path.reached), t),
                                   stop)
         if failure == "interrupted":

@@ -27,6 +27,7 @@ from petsc4py import PETSc
 from helpers import BENT, PULLED, gather
 from helpers import HALVING_CTOL as CTOL, HALVING_ELEMENTS as N_ELEMENTS, HALVING_RTOL as RTOL
 from petsc_rod.cli import session
+from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.errors import RodDivergedError, RodNotConvergedError
 
 def build(solver_factory, comm, case):
@@ -47,8 +48,8 @@ def run_continuation(solver_factory, comm, case, steps, max_halvings):
     final state gathered on every rank)."""
     mesh, solver = build(solver_factory, comm, case)
     lines = []
-    code = session.run_continuation(solver, steps, say=lines.append,
-                                    max_halvings=max_halvings).code
+    code = session.run_continuation(solver, PathSettings(steps, max_halvings=max_halvings),
+                                    say=lines.append).code
     state = {name: gather(comm, array) for name, array in owned_state(solver).items()}
     state["energy"] = solver.problem.energy()
     return code, lines, state

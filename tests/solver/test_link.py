@@ -16,6 +16,7 @@ import pytest
 
 from helpers import continuation as reach_load, gather
 from petsc_rod.cli.session import run_continuation
+from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.errors import RodNotConvergedError
 from petsc_rod.validation.writhe import gauss_writhe
 
@@ -51,17 +52,19 @@ def test_a_whole_turn_in_one_step_is_refused(solver_factory, comm):
     mesh, solver = solver_factory(comm, 32, PURE_TWIST, 100.0, 1e-8, 1e-5, 5000)
     solver.problem.state.set_straight()
     lines = []
-    code = run_continuation(solver, 1, say=lines.append, max_halvings=0).code
+    code = run_continuation(solver, PathSettings(1, max_halvings=0), say=lines.append).code
     assert code == RodNotConvergedError.exit_code, "\n".join(lines)
     found = re.search(r"linking number is (-?[0-9.]+) turns .* not the 1.000 turns", lines[-1])
     assert found and abs(float(found.group(1))) < 1e-3, lines[-1]
     solver.problem.state.set_straight()                           # -rod_track_link 0: accepted
     lines = []
-    assert run_continuation(solver, 1, say=lines.append, max_halvings=0, track_link=False).code == 0
+    assert run_continuation(solver, PathSettings(1, max_halvings=0, track_link=False),
+                            say=lines.append).code == 0
     assert abs(sum(solver.problem.link())) < 1e-3
     solver.problem.state.set_straight()
     lines = []
-    assert run_continuation(solver, 4, say=lines.append, max_halvings=0).code == 0, "\n".join(lines)
+    assert run_continuation(solver, PathSettings(4, max_halvings=0),
+                            say=lines.append).code == 0, "\n".join(lines)
     twist, writhe = solver.problem.link()
     # the twist integral of the P2 frames, O(h^4) from its limit: 3.1e-6 on 32 elements
     assert twist == pytest.approx(1.0, abs=1e-5) and abs(writhe) < 1e-9
