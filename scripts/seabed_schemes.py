@@ -30,8 +30,6 @@ from petsc_rod.errors import RodDivergedError  # noqa: E402
 from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
 from petsc_rod.problem.penalty import default_penalty  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
-from petsc_rod.mesh.elements import P2  # noqa: E402
-from petsc_rod.mesh.fields import VectorField, scatter_element_vectors  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
 from petsc_rod.riser.environment import Seabed, default_stiffness  # noqa: E402
 from petsc_rod.riser.loads import NodalLoad  # noqa: E402
@@ -65,7 +63,6 @@ class LaggedSeabed(NodalLoadTerm):
         super().__init__(mesh, "lagged_seabed")
         self.seabed = seabed
         self.contact_load = NodalLoad(mesh, self._nodes)
-        self._rhs = VectorField(mesh, "lagged_seabed_rhs")
 
     def pressure(self, z):
         return self.seabed.stiffness * np.maximum(self.seabed.height - z, 0.0)
@@ -77,16 +74,7 @@ class LaggedSeabed(NodalLoadTerm):
 
     def add_iterate_load(self, rhs, state):
         self.contact_load.set(self.node_loads(state))
-        mesh = self.mesh
-        self._rhs.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
-            self.contact_load.element_vectors(np.zeros(3))))
-        for vec, load in zip(rhs.components, self._rhs.components):
-            vec.axpy(1.0, load)
-
-    def destroy(self):
-        self._rhs.destroy()
-        super().destroy()
+        self.add_to_rhs(rhs, self.contact_load)
 
 
 def run(scene_kwargs, elements, factor, scheme, snes_type, max_it):

@@ -10,6 +10,11 @@ from petsc_rod.problem.penalty import ADAPT_WINDOW
 DIVERGED_ADVICE = "try a larger -rod_al_penalty or more -rod_steps"
 
 
+def monitor(label, iteration, change, residual):
+    """The -rod_al_monitor line of one iteration (UzawaSolver's monitor)."""
+    return f"  {label}it {iteration:5d}  change {change:.3e}  constraint {residual:.3e}"
+
+
 def started(event):
     origin = f" from load factor {event.start:.6g}" if event.start > 0 else ""
     return (f"petsc_rod: {event.elements} elements on {event.ranks} rank(s), "
@@ -66,17 +71,14 @@ def step_line(event, record):
             + "".join(f"; {text}" for text in record.texts))
 
 
-def raise_lines(event, scale):
-    """The line that says the penalty was raised in a step, if it was; ``scale`` the
-    problem's scale of R (N)."""
-    raises = event.report.penalty_raises
-    if not raises:
-        return []
-    raised = ", ".join(f"{R:.3g} at iteration {i}" for i, R in raises)
-    return [f"petsc_rod: {event.label}: R raised to {raised} (matrices refactored): the "
+def raised(label, raises, scale):
+    """The line that says the penalty was raised in a step: its events.PenaltyRaised
+    ``raises``; ``scale`` the problem's scale of R (N)."""
+    listed = ", ".join(f"{event.penalty:.3g} at iteration {event.iteration}" for event in raises)
+    return (f"petsc_rod: {label}: R raised to {listed} (matrices refactored): the "
             f"constraint residual fell by less than half in {ADAPT_WINDOW} iterations with "
             f"R far below the problem's scale {scale:.3g} (-rod_al_adapt_penalty), "
-            "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)"]
+            "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)")
 
 
 def given_up(halvings, load_factor):

@@ -15,6 +15,7 @@ from petsc_rod.mesh.mesh import Mesh, end_element_lengths
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, format_value, help_text,
                                    read_options, unused_options)
+from petsc_rod.cli import lines
 from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
@@ -56,7 +57,7 @@ def run(comm=None):
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
-            problem, solver = build_solver(mesh, scene, settings)
+            problem, solver = build_solver(mesh, scene, settings, say)
             if database.hasName("help"):
                 return 0
             start = start_from(problem, values, given, say)
@@ -104,13 +105,18 @@ def check_mesh(comm, values):
             "elements")
 
 
-def build_solver(mesh, scene, settings):
-    """(RodProblem, UzawaSolver); a PETSc error while they set up their solvers (an
-    unknown -rod_slope_ksp_type, say) is bad input (what was made is destroyed)."""
+def build_solver(mesh, scene, settings, say):
+    """(RodProblem, UzawaSolver), the solver saying a monitor line per iteration with
+    -rod_al_monitor; a PETSc error while they set up their solvers (an unknown
+    -rod_slope_ksp_type, say) is bad input (what was made is destroyed)."""
+    def say_monitor(*row):
+        say(lines.monitor(*row))
+
+    monitor = say_monitor if settings.monitor else None
     problem = None
     try:
         problem = RodProblem(mesh, scene, settings.asked_penalty)
-        return problem, UzawaSolver(problem, settings)
+        return problem, UzawaSolver(problem, settings, monitor)
     except PETSc.Error as error:
         if problem is not None:
             problem.destroy()

@@ -12,6 +12,7 @@ import ctypes
 import dataclasses
 import difflib
 import hashlib
+import inspect
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,7 @@ from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.controller import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
 from petsc_rod.iteration.stopping import Settings
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
 from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
@@ -107,6 +109,8 @@ NON_NEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
 TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
              f"must be positive (at least {1 / MAX_MAGNITUDE:g}) and below 1: a tolerance of "
              "1 or more accepts any iterate")
+# The mesh's own default grading (Mesh's keyword).
+MESH_GRADING = inspect.signature(Mesh).parameters["grading"].default
 
 
 def default_of(owner, name):
@@ -122,7 +126,7 @@ def default_of(owner, name):
 OPTIONS = [
     Option("rod_length", _real, 1.0, "L", "length of the cable, m", SCALE, "m"),
     Option("rod_elements", _int, 64, "N", "number of elements", POSITIVE),
-    Option("rod_mesh_grading", _real, 1.0, "q",
+    Option("rod_mesh_grading", _real, MESH_GRADING, "q",
            "ratio of the largest to the smallest element; > 1 refines both ends",
            (lambda v: v >= 1, "must be >= 1")),
     Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
@@ -219,9 +223,9 @@ OPTIONS = [
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",
-           f"raise R {ADAPT_FACTOR:g}-fold, refactoring the matrices, while it is below "
-           f"{ADAPT_BELOW:g} times the default and the constraint residual falls by less "
-           f"than a factor {ADAPT_PROGRESS:g} in {ADAPT_WINDOW} iterations"),
+           f"raise R {ADAPT_FACTOR:g} times, refactoring the matrices, while it is below "
+           f"{ADAPT_BELOW:g} of the default and the constraint residual stays above "
+           f"{ADAPT_PROGRESS:g} of its value {ADAPT_WINDOW} iterations before"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
 

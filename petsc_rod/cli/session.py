@@ -41,11 +41,15 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     problem = solver.problem
     stop = None if interrupts is None else interrupts.received
     last = None                 # (group, attributes) of the last step written
+    raises = []                 # the PenaltyRaised events of the attempt so far
     for event in continuation(solver, path, stop):
         if isinstance(event, events.RunStarted):
             say(lines.started(event))
+        elif isinstance(event, events.PenaltyRaised):
+            raises.append(event)
         elif isinstance(event, events.StepHalved):
             say(lines.halved(event))
+            raises = []
         elif isinstance(event, events.StepEnded):
             group = f"steps/{event.number}"
             record = record_step(
@@ -55,8 +59,9 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 total_iterations=event.total_iterations,
                 undone_iterations=event.undone_iterations)
             say(lines.step_line(event, record))
-            for line in lines.raise_lines(event, problem.scale):
-                say(line)
+            if raises:
+                say(lines.raised(event.label, raises, problem.scale))
+            raises = []
             last = (group, record.attributes)
         elif isinstance(event, events.RunDiverged):
             raise RodDivergedError(lines.diverged_message(event), event.error.iterations)

@@ -59,7 +59,11 @@ class GlobalStep:
         # the slope components solved here: those no term solves itself
         elsewhere = {c for term in terms for c in term.slope_components}
         self._slope_components = tuple(c for c in range(3) if c not in elsewhere)
-        self.build(penalty)
+        try:
+            self.build(penalty)
+        except Exception:           # a solver the options refuse: free what was made
+            self.destroy()
+            raise
 
     def build(self, penalty):
         """(Re)assemble and factor the three problems at penalty R, N (the only place

@@ -154,9 +154,10 @@ def continuation(solver, path=PathSettings(), stop=None):
     True ends the run.
 
     The one loop of the project: the command line, the scripts and the tests all walk
-    it (cli/session.py). Yields the events of events.py: RunStarted; per attempt
-    StepHalved or StepEnded (the problem's state is the step's while it is handled);
-    then one of RunFinished, RunDiverged or Interrupted.
+    it (cli/session.py). Yields the events of events.py: RunStarted; per attempt the
+    step's own (SaddleLeft, PenaltyRaised, NewtonAttempt), then StepHalved or StepEnded
+    (the problem's state is the step's while it is handled); then one of RunFinished,
+    RunDiverged or Interrupted.
     """
     problem = solver.problem
     state, mesh = problem.state, problem.mesh
@@ -181,6 +182,8 @@ def continuation(solver, path=PathSettings(), stop=None):
             yield events.Interrupted(f"in {label} at load factor {t:.6g}, iteration "
                                      f"{report.iterations}", path.factor(path.reached))
             return
+        if report is not None:
+            yield from report.events         # what happened within the attempt
         iterations = (failure.iterations or 0) if report is None else report.iterations
         total += iterations
         # a stalled step is not halved: a smaller step does not move what stops it

@@ -1,8 +1,10 @@
 """The step controller: what one continuation step does next after each iteration, as a
 small state machine with a typed decision (docs/design.md, "One step").
 
-The solver (driver.py) records every iteration's (change, residual) here and asks
-``decide``; the SNES's convergence test is where it asks. A Decision is one of
+The solver (driver.py) hands every iteration's (change, residual) to ``observe``, which
+decides at once (a SNES may evaluate the map more than once per convergence test:
+ngmres, qn); the SNES's convergence test only reads whether the decision ends the solve.
+A Decision is one of
 
     ITERATE        go on with the SNES
     CONVERGED      both stopping tests hold (§6)
@@ -11,10 +13,11 @@ The solver (driver.py) records every iteration's (change, residual) here and ask
     STOP           not converged, with a reason (stopping.STOP_* or "snes_<reason>")
     DIVERGED       the iteration diverged; ``error`` holds the RodDivergedError
 
-The controller owns the step's record (its rows, penalty raises, Newton steps, escapes),
-the Newton schedule (when an attempt may be made again), and the budgets of the escapes
-from saddles (§10). It reads values and returns decisions; it touches no PETSc object
-and no state: the solver acts.
+The controller owns the step's record (its rows, penalty raises, Newton steps, escapes,
+and the events of events.py that say them), the Newton schedule (when an attempt may be
+made again, whether a Newton solution needs a larger penalty), and the budgets of the
+escapes from saddles (§10). It reads values and returns decisions; it touches no PETSc
+object and no state: the solver acts.
 """
 
 import enum
@@ -24,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from petsc_rod.errors import RodDivergedError, RodIterationDiverged
-from petsc_rod.iteration import stopping
+from petsc_rod.iteration import events, stopping
 from petsc_rod.problem.penalty import ADAPT_WINDOW, penalty_too_low
 
 # The iteration hands over to Newton steps on the reduced problem (newton.py) once a
@@ -48,6 +51,9 @@ EARLY_ESCAPE = 1e-2
 ESCAPE_ANGLE = 0.3
 MAX_ESCAPES = 5
 ESCAPE_GROWTH = 2.0
+# A Newton solution the Uzawa map cannot hold at the current penalty
+# (newton.least_penalty) raises it to NEWTON_RAISE times the least that can.
+NEWTON_RAISE = 2.0
 
 
 class Action(enum.Enum):
@@ -96,17 +102,22 @@ class StepController:
         # the iteration at which Newton converged with H positive definite on the
         # constraint set (the stability test's own criterion)
         self.newton_verified = None
-        self._undecided = False     # a row (or a failure) the decision has not seen yet
+        self.events = []            # what happened in the step (events.py), in order
 
     # --- what happened --------------------------------------------------------------
-    def record(self, change, residual):
-        """An iteration's norms (a Uzawa iteration, or a Newton step's largest turn with
-        residual 0)."""
+    def _record(self, change, residual):
         self.history.append((change, residual, time.perf_counter() - self.clock))
-        self._undecided = True
+
+    def observe(self, change, residual, penalty):
+        """A Uzawa iteration's norms at penalty R (N): recorded, and the Decision after
+        it taken (and returned)."""
+        self._record(change, residual)
+        self.decision = self._decide(penalty)
+        return self.decision
 
     def record_newton_step(self, turn):
-        self.record(turn, 0.0)
+        """A Newton step, recorded as an iteration (change: its largest turn, rad)."""
+        self._record(turn, 0.0)
         self.newton_steps += 1
 
     def fail(self, error):
@@ -114,19 +125,16 @@ class StepController:
         iteration = len(self.history) + 1
         self.error = RodDivergedError(f"{self.label}iteration {iteration}: {error}", iteration)
         self.decision = Decision(Action.DIVERGED)
-        self._undecided = False
 
-    def raised(self, penalty):
-        """The solver refactored at penalty R (N)."""
+    def raised(self, penalty, reason):
+        """The solver refactored at penalty R (N), for ``reason`` (events.PenaltyRaised)."""
         self.raises.append((len(self.history), penalty))
+        self.events.append(events.PenaltyRaised(self.label, len(self.history), penalty, reason))
 
     # --- the decision ---------------------------------------------------------------
-    def decide(self, penalty):
-        """The Decision after the last recorded iteration at penalty R (N); the same one
-        again when nothing was recorded since."""
-        if self._undecided:
-            self._undecided = False
-            self.decision = self._decide(penalty)
+    @property
+    def current(self):
+        """The last decision, ITERATE before any and after ``resume``."""
         return self.decision if self.decision is not None else ITERATE
 
     def _decide(self, penalty):
@@ -179,11 +187,23 @@ class StepController:
         """Newton may be tried again NEWTON_AFTER 2^failures iterations from now."""
         self.newton_next = len(self.history) + NEWTON_AFTER * 2**self.newton_failures
 
-    def newton_converged(self, verified):
+    def newton_converged(self, verified, least_penalty, penalty):
         """An attempt converged; ``verified``: with H positive definite on the constraint
-        set at its last step."""
+        set at its last step. Returns the penalty to raise R (N) to when the handed-over
+        state needs at least ``least_penalty`` to stay a fixed point, else None."""
+        self.events.append(events.NewtonAttempt(self.label, len(self.history), "converged"))
         if verified:
             self.newton_verified = len(self.history)
+        return NEWTON_RAISE * least_penalty if least_penalty >= penalty else None
+
+    def newton_failed(self, outcome):
+        """An attempt did not converge (``outcome``: newton.INDEFINITE or FAILED)."""
+        self.events.append(events.NewtonAttempt(self.label, len(self.history), outcome))
+        self.newton_failures += 1
+
+    def stability_tested(self, stable):
+        """The stability test's verdict on the converged state (True, False, None)."""
+        self.stable = stable
 
     @property
     def verified_by_newton(self):
@@ -211,7 +231,9 @@ class StepController:
             self.newton_failures = 1
         else:
             self.escapes += 1
-        return ESCAPE_ANGLE * ESCAPE_GROWTH**k * (-1) ** k
+        angle = ESCAPE_ANGLE * ESCAPE_GROWTH**k * (-1) ** k
+        self.events.append(events.SaddleLeft(self.label, len(self.history), angle, early))
+        return angle
 
     # --- the end ----------------------------------------------------------------------
     def report(self):
@@ -223,4 +245,4 @@ class StepController:
                                    self.history, "" if converged else decision.reason,
                                    self.raises, stable=self.stable,
                                    escapes=self.escapes + self.early_escapes,
-                                   newton_steps=self.newton_steps)
+                                   newton_steps=self.newton_steps, events=tuple(self.events))

@@ -4,9 +4,9 @@ solution (§11, newton.py), with the stability test of §10 at each converged st
 
 The problem (problem/problem.py) is the map G, one Uzawa iteration; the SNES sees it as
 the fixed-point problem F(x) = x - G(x) on x = sqrt(w) (tau, lambda / R) at the nodes.
-The step controller (controller.py) decides, at the SNES's convergence test, whether the
-step goes on, has converged, tries Newton, raises the penalty or stops; the solver acts
-on its decisions.
+The step controller (controller.py) decides after each iteration whether the step goes
+on, has converged, tries Newton, raises the penalty or stops; the SNES's convergence
+test ends the solve on a decision that says so, and the solver acts on it.
 """
 
 import numpy as np
@@ -14,7 +14,7 @@ from petsc4py import PETSc
 
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.iteration import controller as control
-from petsc_rod.iteration import newton, stopping
+from petsc_rod.iteration import events, newton, stopping
 from petsc_rod.petsc_defaults import set_from_options_with_defaults
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.problem import RodProblem
@@ -24,9 +24,6 @@ from petsc_rod.resources import anderson_depth, ranks_on_this_machine
 DEFAULT_SNES = "anderson"
 SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
                 for name in dir(PETSc.SNES.ConvergedReason) if not name.startswith("_")}
-# A Newton solution the Uzawa map cannot hold at the current penalty
-# (newton.least_penalty) raises it to NEWTON_RAISE times the least that can.
-NEWTON_RAISE = 2.0
 
 
 def default_anderson_depth(mesh):
@@ -39,11 +36,13 @@ def default_anderson_depth(mesh):
 class UzawaSolver:
     """The iteration on a RodProblem with the user's stopping.Settings: the SNES that
     drives the problem's map, the Newton steps and the stability test of each step.
-    Owns the SNES, its vectors and the Newton steps' work; ``destroy()`` releases them
-    (the problem is its creator's to destroy)."""
+    ``monitor(label, iteration, change, residual)``, if given, is called after every
+    iteration (the command line's -rod_al_monitor prints with it). Owns the SNES, its
+    vectors and the Newton steps' work; ``destroy()`` releases them (the problem is its
+    creator's to destroy)."""
 
-    def __init__(self, problem, settings):
-        self.problem, self.settings = problem, settings
+    def __init__(self, problem, settings, monitor=None):
+        self.problem, self.settings, self.monitor = problem, settings, monitor
         self._root_weights = np.sqrt(problem.state.node_weights)[:, None, None]
         self._controller = None
         self._create_snes()
@@ -111,17 +110,19 @@ class UzawaSolver:
             self._iterate(step)
             while step.converged and self.tests_stability:
                 if step.verified_by_newton:
-                    step.stable = True      # Newton's last factorisation, one iteration ago
+                    # Newton's last factorisation, one iteration ago, showed it stable
+                    step.stability_tested(True)
                     break
-                step.stable, direction = self.check_stability()
-                if step.stable is not False:
+                stable, direction = self.check_stability()
+                step.stability_tested(stable)
+                if stable is not False:
                     break
                 angle = step.escape_angle()
                 if angle is None:
                     step.stop(stopping.STOP_SADDLE)
                     break
                 self._turn(angle, direction)
-                step.stable = None
+                step.stability_tested(None)
                 step.resume()
                 self._iterate(step)
         finally:
@@ -137,9 +138,7 @@ class UzawaSolver:
         while True:
             self._pack(self._x)
             self.snes.solve(None, self._x)
-            # the last iteration's decision also where the SNES stopped before its
-            # convergence test (a residual of NaN norm)
-            decision = step.decide(self.penalty)
+            decision = step.current
             if not decision.ends_solve:         # the SNES's own stop
                 reason = self.snes.getConvergedReason()
                 step.stop(f"snes_{SNES_REASONS.get(reason, reason)}")
@@ -151,14 +150,14 @@ class UzawaSolver:
             elif decision.action is control.Action.RAISE_PENALTY:
                 step.resume()
                 self._raise_penalty(step, penalty_policy.raised_penalty(
-                    self.penalty, self.problem.scale))
+                    self.penalty, self.problem.scale), events.RAISED_STALLING)
             else:
                 return
 
-    def _raise_penalty(self, step, penalty):
+    def _raise_penalty(self, step, penalty, reason):
         """Refactor the global step at a larger penalty, recorded by the controller."""
         self.problem.rebuild(penalty)
-        step.raised(penalty)
+        step.raised(penalty, reason)
 
     def _turn(self, angle, direction):
         """Turn the frames along ``direction`` (n_nodes, 3), a direction of negative
@@ -174,13 +173,14 @@ class UzawaSolver:
         saddle: with the stability test on, it is left now, as at convergence."""
         outcome = self.newton.run(step.record_newton_step)
         if outcome == newton.CONVERGED:
-            step.newton_converged(self.newton.verified)
-            least = self.newton.least_penalty()
-            if least >= self.penalty:
-                self._raise_penalty(step, NEWTON_RAISE * least)
+            raised = step.newton_converged(self.newton.verified, self.newton.least_penalty(),
+                                           self.penalty)
+            if raised is not None:
+                self._raise_penalty(step, raised, events.RAISED_NEWTON)
             return
-        step.newton_failures += 1
-        if outcome != newton.INDEFINITE or not self.tests_stability or not step.wants_early_escape():
+        step.newton_failed(outcome)
+        if (outcome != newton.INDEFINITE or not self.tests_stability
+                or not step.wants_early_escape()):
             return
         stable, direction = self.check_stability()
         if stable is False:
@@ -217,16 +217,16 @@ class UzawaSolver:
             f.set(0.0)
             return
         change, residual = self.problem.norms()
-        step.record(change, residual)
-        if self.settings.monitor:
-            PETSc.Sys.Print(f"  {step.label}it {len(step.history):5d}  change {change:.3e}  "
-                            f"constraint {residual:.3e}", comm=self.problem.mesh.comm)
+        step.observe(change, residual, self.penalty)
+        if self.monitor is not None:
+            self.monitor(step.label, len(step.history), change, residual)
         self._pack(f)
         f.aypx(-1.0, x)
 
     def _converged(self, snes, its, norms):
-        """The SNES convergence test: the controller's decision on the last iteration."""
-        if self._controller.decide(self.penalty).ends_solve:
+        """The SNES convergence test: whether the controller's last decision ends the
+        solve."""
+        if self._controller.finished:
             return PETSc.SNES.ConvergedReason.CONVERGED_ITS
         return PETSc.SNES.ConvergedReason.ITERATING
 
@@ -255,4 +255,9 @@ def solver_for(mesh, scene, settings):
     """The UzawaSolver of a new RodProblem of ``scene`` on ``mesh`` at the asked penalty
     of ``settings`` (what a script or a test makes). The caller destroys both:
     ``solver.destroy(); solver.problem.destroy()``."""
-    return UzawaSolver(RodProblem(mesh, scene, settings.asked_penalty), settings)
+    problem = RodProblem(mesh, scene, settings.asked_penalty)
+    try:
+        return UzawaSolver(problem, settings)
+    except Exception:
+        problem.destroy()
+        raise

@@ -1,10 +1,50 @@
 """What a run of the continuation (continuation.py) tells as it goes: one event per thing
-that happened, in order. The continuation yields them and never formats or writes;
+that happened, in order: within an attempt (SaddleLeft, PenaltyRaised, NewtonAttempt,
+recorded by the step controller), then the attempt's end (StepHalved or StepEnded), and
+the run's. The continuation yields them and never formats or writes;
 cli/session.py walks them, with cli/lines.py for the lines a user reads and io/ for the
 result file.
 """
 
 from dataclasses import dataclass
+
+
+# Why the penalty was raised (PenaltyRaised.reason).
+RAISED_STALLING = "stalling"    # far below the scale, the residual not falling (penalty.py)
+RAISED_NEWTON = "newton"        # a Newton solution needs a larger R to stay a fixed point
+
+
+@dataclass(frozen=True)
+class SaddleLeft:
+    """In a step, at iteration ``iteration``: the frames were turned by ``angle`` rad
+    along a direction of negative curvature (§10); ``early``: before the iteration had
+    converged to the saddle (a Newton attempt found the negative curvature)."""
+
+    label: str
+    iteration: int
+    angle: float
+    early: bool
+
+
+@dataclass(frozen=True)
+class PenaltyRaised:
+    """In a step, at iteration ``iteration``: R raised to ``penalty`` (N), the matrices
+    refactored, for ``reason`` (RAISED_STALLING or RAISED_NEWTON)."""
+
+    label: str
+    iteration: int
+    penalty: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class NewtonAttempt:
+    """In a step, after iteration ``iteration``: an attempt of Newton steps ended with
+    ``outcome`` (newton.CONVERGED, INDEFINITE or FAILED)."""
+
+    label: str
+    iteration: int
+    outcome: str
 
 
 @dataclass(frozen=True)

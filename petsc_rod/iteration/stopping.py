@@ -66,6 +66,7 @@ class StepReport:
     stable: bool = None     # the second variation is positive (§10); None: unchecked
     escapes: int = 0        # saddles the step converged to and left
     newton_steps: int = 0   # of the iterations, Newton steps on the reduced problem
+    events: tuple = ()      # what happened in the step (events.py: SaddleLeft, ...)
 
     @property
     def stalled(self):

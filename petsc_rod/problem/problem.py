@@ -39,9 +39,15 @@ class RodProblem:
         # the problem's scale of R, N (penalty.default_penalty): what "far below" means
         self.scale = penalty_policy.default_penalty(scene)
         self.state = RodState(mesh)
-        self.global_step = GlobalStep(mesh, scene, self.split,
-                                      penalty_policy.matrix_split(self.split), float(penalty),
-                                      self.terms)
+        try:
+            self.global_step = GlobalStep(mesh, scene, self.split,
+                                          penalty_policy.matrix_split(self.split),
+                                          float(penalty), self.terms)
+        except Exception:           # a solver the options refuse: free what was made
+            for term in self.terms:
+                term.destroy()
+            self.state.destroy()
+            raise
         self.weights = quadrature_weights(mesh.element_h)
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)

@@ -40,6 +40,7 @@ class NodalLoadTerm(Term):
         self.t = 0.0
         self.start_state = self.end_state = None
         self._nodes = VectorField(mesh, f"{name}_nodes")      # ghost exchange of nodal loads
+        self._rhs = None                                      # made at the first add_to_rhs
 
     def prepare(self, t, start, end):
         self.t, self.start_state, self.end_state = t, start, end
@@ -47,6 +48,20 @@ class NodalLoadTerm(Term):
     def node_loads(self, state):
         """The load per metre at the owned P2 nodes, N/m, (n_nodes, 3)."""
         raise NotImplementedError
+
+    def add_to_rhs(self, rhs, load):
+        """Add int F.g dS of the loads.NodalLoad ``load`` to the slope's right-hand side
+        ``rhs`` (VectorField), F(S) = int_S^L f_h dS + offset, the offset -int_0^L f_h when
+        the start is free (docs/method.md §5)."""
+        if self._rhs is None:
+            self._rhs = VectorField(self.mesh, "nodal_load_rhs")
+        offset = np.zeros(3) if is_held(self.start_state) else -load.total
+        mesh = self.mesh
+        self._rhs.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+            load.element_vectors(offset)))
+        for vec, part in zip(rhs.components, self._rhs.components):
+            vec.axpy(1.0, part)
 
     def _nodal_load(self, state):
         load = NodalLoad(self.mesh, self._nodes)
@@ -68,6 +83,8 @@ class NodalLoadTerm(Term):
 
     def destroy(self):
         self._nodes.destroy()
+        if self._rhs is not None:
+            self._rhs.destroy()
 
 
 class SeabedTerm(NodalLoadTerm):
@@ -142,7 +159,6 @@ class DragTerm(NodalLoadTerm):
     def __init__(self, mesh, current):
         super().__init__(mesh, "drag")
         self.current = current
-        self._rhs = VectorField(mesh, "drag_rhs")
         self.drag = NodalLoad(mesh, self._nodes)
 
     def node_loads(self, state):
@@ -157,14 +173,4 @@ class DragTerm(NodalLoadTerm):
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""
         self.drag.set(self.node_loads(state))
-        offset = np.zeros(3) if is_held(self.start_state) else -self.drag.total
-        mesh = self.mesh
-        self._rhs.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
-            self.drag.element_vectors(offset)))
-        for vec, load in zip(rhs.components, self._rhs.components):
-            vec.axpy(1.0, load)
-
-    def destroy(self):
-        self._rhs.destroy()
-        super().destroy()
+        self.add_to_rhs(rhs, self.drag)

@@ -8,8 +8,6 @@ import pytest
 from helpers import gather
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.iteration.stopping import Settings
-from petsc_rod.mesh.elements import P2
-from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.term import Term
@@ -18,7 +16,7 @@ from petsc_rod.problem.problem import RodProblem
 from petsc_rod.riser.environment import Current, Seabed
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.quantities import RiserNumbers
-from petsc_rod.riser.terms import DragTerm, SeabedTerm
+from petsc_rod.riser.terms import DragTerm, NodalLoadTerm, SeabedTerm
 from petsc_rod.scenes.scene import Scene
 
 FORCE = np.array([0.0, -2.0, 1.0])          # N/m
@@ -28,7 +26,7 @@ PENALTY = 50.0
 ELEMENTS = 24
 
 
-class NodalUniformLoad(Term):
+class NodalUniformLoad(NodalLoadTerm):
     """A uniform load f (N/m) given by its values at the P2 nodes and added to the
     slope's right-hand side every iteration, as a follower load would be: the core knows
     it only through the protocol. Its P2 interpolant is f itself, so it is the dead load
@@ -37,27 +35,16 @@ class NodalUniformLoad(Term):
     conservative = in_newton = False        # no energy given
 
     def __init__(self, mesh, force):
-        self.mesh, self.force = mesh, np.asarray(force, dtype=float)
-        self._nodes, self._rhs = VectorField(mesh, "nodes"), VectorField(mesh, "rhs")
+        super().__init__(mesh, "uniform")
+        self.force = np.asarray(force, dtype=float)
         self.load = NodalLoad(mesh, self._nodes)
 
-    def prepare(self, t, start, end):
-        self.load.set(np.tile(t * self.force, (self.mesh.n_local_nodes, 1)))
+    def node_loads(self, state):
+        return np.tile(self.t * self.force, (self.mesh.n_local_nodes, 1))
 
     def add_iterate_load(self, rhs, state):
-        mesh = self.mesh
-        self._rhs.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
-            self.load.element_vectors(np.zeros(3))))          # the start is held
-        for vec, load in zip(rhs.components, self._rhs.components):
-            vec.axpy(1.0, load)
-
-    def force_beyond(self, state):
-        return self.load.beyond_vertices()
-
-    def destroy(self):
-        self._nodes.destroy()
-        self._rhs.destroy()
+        self.load.set(self.node_loads(state))
+        self.add_to_rhs(rhs, self.load)
 
 
 def solve(comm, scene_kwargs, extra_terms=()):

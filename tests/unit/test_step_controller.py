@@ -6,6 +6,7 @@ import pytest
 
 from petsc_rod.errors import RodIterationDiverged
 from petsc_rod.iteration import controller as control
+from petsc_rod.iteration import events
 from petsc_rod.iteration.stopping import STOP_MAX_IT, STOP_OBSERVER, Settings
 
 SETTINGS = Settings(asked_penalty=1.0, max_it=100, rtol=1e-9, ctol=1e-9)
@@ -16,10 +17,7 @@ def fed(rows, newton=False, settings=SETTINGS, observer=None):
     decisions."""
     step = control.StepController(settings, scale=1.0, newton=newton, label="step 1/1 ",
                                   observer=observer)
-    decisions = []
-    for change, residual in rows:
-        step.record(change, residual)
-        decisions.append(step.decide(penalty=1.0))
+    decisions = [step.observe(change, residual, penalty=1.0) for change, residual in rows]
     return step, decisions
 
 
@@ -31,11 +29,14 @@ def test_it_iterates_until_both_tests_hold():
     assert report.converged and report.iterations == 3 and report.reason == ""
 
 
-def test_a_decision_is_taken_once_per_row():
+def test_a_decision_is_taken_at_every_row_and_kept_until_the_next():
     calls = []
-    step, _ = fed([(1e-3, 1e-3)], observer=lambda *row: calls.append(row) and False)
-    assert step.decide(1.0).action is control.Action.ITERATE     # asked again, no new row
-    assert calls == [(1, 1e-3, 1e-3)]
+    step, _ = fed([(1e-3, 1e-3), (1e-10, 1e-10)],
+                  observer=lambda *row: calls.append(row) and False)
+    assert calls == [(1, 1e-3, 1e-3), (2, 1e-10, 1e-10)]
+    assert step.current.action is control.Action.CONVERGED and step.finished
+    step.resume()
+    assert step.current.action is control.Action.ITERATE and not step.finished
 
 
 def test_a_diverged_row_ends_the_step_with_an_error_that_names_no_option():
@@ -91,3 +92,17 @@ def test_escapes_alternate_grow_and_run_out():
     early = step.escape_angle(early=True)           # a budget of its own, counted on
     assert early == pytest.approx(control.ESCAPE_ANGLE * control.ESCAPE_GROWTH**5 * -1)
     assert step.newton_failures == 1 and step.early_escapes == 1
+    left = [event for event in step.events if isinstance(event, events.SaddleLeft)]
+    assert [event.angle for event in left] == pytest.approx(expected + [early])
+    assert [event.early for event in left] == [False] * control.MAX_ESCAPES + [True]
+
+
+def test_a_newton_solution_that_needs_a_larger_penalty_raises_it():
+    step = control.StepController(SETTINGS, 1.0, True)
+    assert step.newton_converged(True, least_penalty=0.5, penalty=1.0) is None
+    assert step.newton_converged(True, least_penalty=3.0, penalty=1.0) == pytest.approx(
+        control.NEWTON_RAISE * 3.0)
+    step.newton_failed("indefinite")
+    assert step.newton_failures == 1
+    outcomes = [event.outcome for event in step.events if isinstance(event, events.NewtonAttempt)]
+    assert outcomes == ["converged", "converged", "indefinite"]
