@@ -11,7 +11,7 @@ from petsc_rod.io import outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
 from petsc_rod.errors import RodError, RodInputError
-from petsc_rod.mesh.mesh import Mesh, end_element_lengths
+from petsc_rod.mesh.mesh import Mesh, end_element_lengths, fewest_elements, largest_grading
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, format_value, help_text,
                                    read_options, unused_options)
@@ -92,17 +92,39 @@ def run(comm=None):
 
 
 def check_mesh(comm, values):
-    """Refuse, before it is allocated, a mesh the machine cannot hold or whose smallest
-    elements double precision cannot resolve (a large -rod_mesh_grading)."""
+    """Refuse, before it is allocated, a mesh the machine cannot hold, a grading the
+    mesh's smooth map cannot build on that many elements (mesh.largest_grading: 1 for 1
+    or 2 elements, about 3 N^2 / pi^2 for N), or one whose smallest elements double
+    precision cannot resolve. Any mesh of N elements whose largest element is q times its
+    smallest has a smallest element of at most L / (N - 1 + q): that bound is checked
+    first, so a grading no mesh could resolve is said as such."""
     elements, length = values["rod_elements"], values["rod_length"]
+    grading = values["rod_mesh_grading"]
     resources.check_elements_fit(comm, elements)
-    smallest = end_element_lengths(elements, length, values["rod_mesh_grading"]).min()
-    if not smallest >= MIN_RELATIVE_ELEMENT * length:
+
+    def unresolved(smallest):
+        return RodInputError(
+            f"-rod_mesh_grading {grading:g} with {elements} elements: the end elements "
+            f"would be {smallest / length:.2g} of the length, below what double precision "
+            f"resolves ({MIN_RELATIVE_ELEMENT:g}); use a smaller grading or fewer elements")
+
+    if not length / (elements - 1 + grading) >= MIN_RELATIVE_ELEMENT * length:
+        raise unresolved(length / (elements - 1 + grading))
+    largest = largest_grading(elements)
+    if grading > largest:
+        fix = f"-rod_elements {fewest_elements(grading)} or more"
+        if largest > 1:                 # the limit rounded down to 6 digits
+            digits = 10.0 ** (np.floor(np.log10(largest)) - 5)
+            fix = f"-rod_mesh_grading {np.floor(largest / digits) * digits:.6g} or less, or " + fix
+        else:
+            fix = "-rod_mesh_grading 1 (uniform), or " + fix
         raise RodInputError(
-            f"-rod_mesh_grading {values['rod_mesh_grading']:g} with {elements} elements: the "
-            f"end elements would be {smallest / length:.2g} of the length, below what double "
-            f"precision resolves ({MIN_RELATIVE_ELEMENT:g}); use a smaller grading or fewer "
-            "elements")
+            f"-rod_mesh_grading {grading:g} with {elements} elements: the graded mesh "
+            f"S = L(t - beta sin(2 pi t)/2 pi) reaches a largest / smallest element of at "
+            f"most {largest:.6g} on {elements} element(s); use {fix}")
+    smallest = end_element_lengths(elements, length, grading).min()
+    if not smallest >= MIN_RELATIVE_ELEMENT * length:
+        raise unresolved(smallest)
 
 
 def build_solver(mesh, scene, settings, say):

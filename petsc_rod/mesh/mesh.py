@@ -1,6 +1,8 @@
 """The 1-D mesh: a DMDA over the vertices, the elements this rank owns, the grading.
 
-Vertex i sits at S_i = L g(i/N). Element e = [S_e, S_e+1] belongs to the rank that owns
+Vertex i sits at S_i = L g(i/N), g the sine map whose beta makes the largest element
+exactly ``grading`` times the smallest (mesh_beta; grading 1 is uniform). Element
+e = [S_e, S_e+1] belongs to the rank that owns
 its left vertex; its P2 midpoint dof is stored with that vertex (slot 1), so every
 element's dofs are in the rank's ghosted local vector (ghost width 1). The last
 vertex's slot 1 is a phantom dof, pinned to zero in the matrices
@@ -11,28 +13,133 @@ import numpy as np
 from petsc4py import PETSc
 
 
-def graded_coordinates(t, grading):
-    """Map g(t) = t - beta/(2 pi) sin(2 pi t) of [0, 1] onto itself.
+def _x_minus_sin(x):
+    """x - sin x for 0 <= x <= pi, to round-off relative to the result: the Taylor series
+    x^3/3! - x^5/5! + ... for x <= 1 (where the difference would cancel), else directly."""
+    x = np.asarray(x, dtype=float)
+    small = np.minimum(x, 1.0)
+    term, series = small**3 / 6.0, np.zeros_like(small)
+    for k in range(1, 12):                  # 23! > 1e22: the next term is below eps
+        series += term
+        term = -term * small**2 / ((2 * k + 2) * (2 * k + 3))
+    return np.where(x <= 1.0, series, x - np.sin(x))
 
-    g'(t) = 1 - beta cos(2 pi t): elements are smallest at both ends and largest in the
-    middle, their size ratio being ``grading`` = (1 + beta)/(1 - beta) >= 1. The map is
-    smooth, so the graded mesh keeps the convergence orders of the uniform one.
+
+def sine_map(t, beta, complement=None):
+    """g(t) = t - beta/(2 pi) sin(2 pi t), t in [0, 1], 0 <= beta <= 1; ``complement``
+    is 1 - beta when the caller knows it more precisely than 1 - beta rounds.
+
+    g'(t) = 1 - beta cos(2 pi t) >= 0: smallest at both ends, largest in the middle, and
+    smooth, so a mesh S_i = L g(i/N) keeps the convergence orders of the uniform one.
+    Evaluated as (1 - beta) t + beta (x - sin x)/(2 pi), x = 2 pi t, on t <= 1/2 and as
+    1 - g(1 - t) beyond: no cancellation near the ends, and exactly symmetric.
     """
-    beta = (grading - 1.0) / (grading + 1.0)
-    return t - beta / (2 * np.pi) * np.sin(2 * np.pi * t)
+    t = np.asarray(t, dtype=float)
+    if beta == 0.0:
+        return t.copy()
+    near = np.minimum(t, 1.0 - t)
+    complement = 1.0 - beta if complement is None else complement
+    g = complement * near + beta * _x_minus_sin(2 * np.pi * near) / (2 * np.pi)
+    return np.where(t <= 0.5, g, 1.0 - g)
+
+
+def graded_coordinates(t, grading):
+    """The sine map g(t) (sine_map) whose density g' has the ratio ``grading`` >= 1
+    between the middle and the ends: beta = (grading - 1)/(grading + 1). The element
+    ratio of a mesh of N elements differs by O(1/N^2); a mesh uses mesh_beta."""
+    return sine_map(t, (grading - 1.0) / (grading + 1.0))
+
+
+def _element_coefficients(n_elements):
+    """(N a, N b) with the end elements of the sine map of N elements
+    (1/N)(1 - beta N a) L and the largest (1/N)(1 + beta N b) L: element i is
+    L (1/N - beta/pi sin(pi/N) cos(pi (2i+1)/N)), smallest at i = 0 and N - 1, largest
+    at 2i + 1 = N (N odd) or N +- 1 (N even). Also 1 - N a = (x - sin x)/x, x = 2 pi/N,
+    without cancellation."""
+    n = int(n_elements)
+    x = 2 * np.pi / n
+    one_minus_na = float(_x_minus_sin(x)) / x
+    nb = 1.0 - one_minus_na if n % 2 == 0 else n * np.sin(np.pi / n) / np.pi
+    return 1.0 - one_minus_na, nb, one_minus_na
+
+
+def largest_grading(n_elements):
+    """The largest ratio of the largest to the smallest element the sine map can give N
+    elements, (1 + N b)/(1 - N a) at beta = 1 (g'(0) = 0); 1 for N <= 2, whose elements
+    it keeps equal (one element; two mirror images)."""
+    if n_elements <= 2:
+        return 1.0
+    _, nb, one_minus_na = _element_coefficients(n_elements)
+    return (1.0 + nb) / one_minus_na
+
+
+def fewest_elements(grading):
+    """The fewest elements whose sine-map mesh reaches the ratio ``grading`` (the limit
+    largest_grading(N) grows like 3 N^2 / pi^2)."""
+    n = max(3, int(np.sqrt(3.0 * grading) / np.pi) - 2)
+    while largest_grading(n) < grading:
+        n += 1
+    return n
+
+
+def mesh_beta(n_elements, grading):
+    """(beta, 1 - beta) of the sine map for which a mesh of N elements has largest /
+    smallest element exactly ``grading`` = q (to round-off): 1 + beta N b =
+    q (1 - beta N a), so beta = (q - 1) / (N b + q N a) and
+    1 - beta = (1 + N b - q (1 - N a)) / (N b + q N a), each without cancellation but
+    the one q near largest_grading(N) asks for. None when no beta in [0, 1] does."""
+    grading = float(grading)
+    if grading == 1.0:
+        return 0.0, 1.0
+    if not grading >= 1.0 or grading > largest_grading(n_elements):
+        return None
+    na, nb, one_minus_na = _element_coefficients(n_elements)
+    denominator = nb + grading * na
+    complement = max(0.0, (1.0 + nb - grading * one_minus_na) / denominator)
+    return min(1.0, (grading - 1.0) / denominator), complement
 
 
 def vertex_coordinates(vertex_index, n_elements, length, grading):
-    """S of the given global vertex indices of a mesh (Mesh.coordinates)."""
-    t = np.asarray(vertex_index, dtype=float) / n_elements
-    return length * graded_coordinates(t, grading)
+    """S of the given global vertex indices of a mesh (Mesh.coordinates): L g(i/N) with
+    g the sine map of mesh_beta; ValueError when the grading cannot be built (refused
+    before, with the option's name: cli.main.check_mesh)."""
+    beta = mesh_beta(n_elements, grading)
+    if beta is None:
+        raise ValueError(f"a grading of {grading:g} cannot be built on {n_elements} "
+                         f"elements (at most {largest_grading(n_elements):.6g})")
+    index = np.asarray(vertex_index)
+    t = index / n_elements
+    # t beyond 1/2 from the mirror index, so that the mesh is exactly symmetric
+    mirrored = 1.0 - sine_map((n_elements - index) / n_elements, *beta)
+    return length * np.where(2 * index <= n_elements, sine_map(t, *beta), mirrored)
+
+
+def element_lengths(element_index, n_elements, length, grading):
+    """The lengths (m) of the given global elements (Mesh.element_h). An element in one
+    half of the mesh is the difference of g at its vertices counted from the nearer end
+    (sine_map), so that the small end elements keep their own relative precision rather
+    than that of S ~ L; an element across the middle (N odd) is S_e+1 - S_e; a uniform
+    mesh's are L / N."""
+    beta = mesh_beta(n_elements, grading)
+    e = np.asarray(element_index)
+    if beta is not None and beta[0] == 0.0:
+        return np.full(e.shape, length / n_elements)
+    if beta is None:
+        return np.diff(vertex_coordinates(np.stack([e, e + 1]), n_elements, length,
+                                          grading), axis=0)[0]
+    left = sine_map((e + 1) / n_elements, *beta) - sine_map(e / n_elements, *beta)
+    right = (sine_map((n_elements - e) / n_elements, *beta)
+             - sine_map((n_elements - e - 1) / n_elements, *beta))
+    across = np.diff(vertex_coordinates(np.stack([e, e + 1]), n_elements, length, grading),
+                     axis=0)[0]
+    return np.where(2 * (e + 1) <= n_elements, length * left,
+                    np.where(2 * e >= n_elements, length * right, across))
 
 
 def end_element_lengths(n_elements, length, grading):
     """The lengths (m) of the first and last elements, the smallest of a graded mesh, as
     the mesh will compute them: known before the mesh is allocated."""
-    ends = vertex_coordinates([0, 1, n_elements - 1, n_elements], n_elements, length, grading)
-    return np.diff(ends)[[0, 2]]
+    return element_lengths([0, n_elements - 1], n_elements, length, grading)
 
 
 class Mesh:
@@ -60,7 +167,8 @@ class Mesh:
         self.vertex_S = self.coordinates(np.arange(self.vertex_start, self.vertex_end))
         ends = self.coordinates(np.arange(self.element_start, self.element_end + 1))
         self.element_S = ends[:-1]
-        self.element_h = np.diff(ends)
+        self.element_h = element_lengths(np.arange(self.element_start, self.element_end),
+                                         self.n_elements, self.length, self.grading)
         # Local (ghosted) index of each owned element's left vertex.
         self.element_local = np.arange(self.element_start, self.element_end) - self.ghost_start
 
@@ -86,9 +194,10 @@ class Mesh:
         element, summed at the vertices, so that sum_n w_n g(S_n) = int g dS exactly for
         a piecewise cubic g (the quadrature of the constraint, docs/method.md §4)."""
         vertices = np.arange(self.vertex_start, self.vertex_end)
-        left = self.coordinates(vertices) - self.coordinates(np.maximum(vertices - 1, 0))
-        right = self.coordinates(np.minimum(vertices + 1, self.n_elements)) \
-            - self.coordinates(vertices)
+        lengths = lambda e: element_lengths(e, self.n_elements, self.length, self.grading)
+        left = np.where(vertices > 0, lengths(np.maximum(vertices - 1, 0)), 0.0)
+        right = np.where(vertices < self.n_elements,
+                         lengths(np.minimum(vertices, self.n_elements - 1)), 0.0)
         w = np.empty(self.n_local_nodes)
         w[0::2] = (left + right) / 6
         w[1::2] = 4 * self.element_h / 6

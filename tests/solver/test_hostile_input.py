@@ -6,6 +6,7 @@ on into a collective call alone. The same classes end to end: test_hostile_cli.p
 """
 
 import os
+import re
 
 import h5py
 import numpy as np
@@ -153,6 +154,36 @@ def test_a_grading_double_precision_cannot_resolve_is_refused(comm, monkeypatch)
         check_mesh(comm, values)
     assert f"{MIN_RELATIVE_ELEMENT:g}" in str(error.value)
     check_mesh(comm, dict(values, rod_mesh_grading=20.0))
+
+
+@pytest.mark.parametrize("elements, grading", [(1, 1.5), (2, 2.0), (3, 3.2), (16, 1e9)])
+def test_a_grading_the_mesh_cannot_build_is_refused(comm, elements, grading):
+    """Issue 25: -rod_mesh_grading 1e9 on 16 elements built a ratio of 77.4, and 2 elements
+    stayed uniform, while the file said 1e9: refused, naming the option, the element
+    count and what can be built."""
+    from petsc_rod.mesh.mesh import largest_grading
+    values = {"rod_elements": elements, "rod_length": 1.0, "rod_mesh_grading": grading}
+    with pytest.raises(RodInputError, match=re.escape(f"-rod_mesh_grading {grading:g} with "
+                                                      f"{elements} elements")) as error:
+        check_mesh(comm, values)
+    assert "-rod_elements" in str(error.value)
+    if elements > 2:
+        check_mesh(comm, dict(values, rod_mesh_grading=largest_grading(elements)))
+    check_mesh(comm, dict(values, rod_mesh_grading=1.0))
+
+
+def test_the_built_mesh_has_the_asked_grading(comm):
+    """The distributed mesh's elements (each rank its own) have largest / smallest equal
+    to -rod_mesh_grading to round-off, and the node weights add up to the length."""
+    from petsc_rod.mesh.mesh import Mesh
+    for elements, grading in ((3, 3.0), (16, 77.0), (17, 20.0), (64, 4.0), (301, 1e4)):
+        mesh = Mesh(comm, elements, 2.0, grading)
+        try:
+            largest = mesh.global_max(float(mesh.element_h.max(initial=0.0)))
+            assert abs(largest / mesh.smallest_element - grading) < 1e-12 * grading
+            assert abs(mesh.global_sum(float(mesh.node_weights().sum())) - 2.0) < 1e-13
+        finally:
+            mesh.destroy()
 
 
 # --- the output path -------------------------------------------------------------------
