@@ -16,7 +16,8 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, format_value, help_text,
                                    read_options, unused_options)
 from petsc_rod.cli import lines
-from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
+from petsc_rod.cli.scene_options import (rounded_down, scene_from_options,
+                                         settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.iteration.continuation import PathSettings
@@ -113,9 +114,8 @@ def check_mesh(comm, values):
     largest = largest_grading(elements)
     if grading > largest:
         fix = f"-rod_elements {fewest_elements(grading)} or more"
-        if largest > 1:                 # the limit rounded down to 6 digits
-            digits = 10.0 ** (np.floor(np.log10(largest)) - 5)
-            fix = f"-rod_mesh_grading {np.floor(largest / digits) * digits:.6g} or less, or " + fix
+        if largest > 1:
+            fix = f"-rod_mesh_grading {rounded_down(largest, 6):.6g} or less, or " + fix
         else:
             fix = "-rod_mesh_grading 1 (uniform), or " + fix
         raise RodInputError(

@@ -4,11 +4,13 @@ takes (Scene, Seabed, Current, Settings), with the checks that need several opti
 
 import numpy as np
 
+from petsc_rod.cli.options import MAX_MAGNITUDE
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
-from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.environment import (Current, Seabed, check_ends_above, default_stiffness,
-                                         read_profile)
+from petsc_rod.problem.penalty import penalty_scales
+from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
+                                         check_ends_above, default_stiffness,
+                                         largest_stiffness, read_profile)
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.scene import Scene
 
@@ -26,19 +28,101 @@ def scene_from_options(values, given):
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene)
+    check_applied_forces(scene, given)
+    check_seabed_stiffness(scene, given)
     return scene
+
+
+def check_seabed_stiffness(scene, given):
+    """Refuse a seabed stiffer than environment.largest_stiffness (given, or the default
+    w / 1 mm of a long line), naming the option and the largest stiffness accepted."""
+    if scene.seabed is None:
+        return
+    force = scene.applied_force()
+    largest = min(largest_stiffness(force, scene.length), MAX_MAGNITUDE)
+    k = scene.seabed.stiffness
+    if k <= largest:
+        return
+    largest = rounded_down(largest)
+    why = (f"the largest accepted is {largest:.3g} N/m^2, under which the line's mean load "
+           f"{force / scene.length:.3g} N/m sinks {MIN_RELATIVE_PENETRATION:g} of the length "
+           "(near the round-off of a height: a stiffer seabed changes nothing but the "
+           "conditioning of the vertical problem)")
+    if "rod_seabed_stiffness" in given:
+        raise RodInputError(f"-rod_seabed_stiffness {k:g}: {why}; use "
+                            f"-rod_seabed_stiffness {largest:.3g} or less")
+    raise RodInputError(f"-rod_load: the default -rod_seabed_stiffness (weight / 1 mm) is "
+                        f"{k:.3g} N/m^2, above what this line accepts: {why}; give "
+                        f"-rod_seabed_stiffness {largest:.3g} or less")
+
+
+def rounded_down(value, digits=3):
+    """``value`` > 0 rounded down to ``digits`` significant digits, so that the largest
+    accepted value a message quotes is itself accepted."""
+    unit = 10.0 ** (np.floor(np.log10(value)) - digits + 1)
+    return float(np.floor(value / unit) * unit)
+
+
+def _current_option(given):
+    return "-rod_current_profile" if "rod_current_profile" in given else "-rod_current"
+
+
+def check_applied_forces(scene, given):
+    """Refuse a force the accepted options derive beyond MAX_MAGNITUDE (the bound of the
+    options themselves): the drag coefficient c = rho C_d D / 2, the largest drag
+    c max |v|^2 (N/m) and the total applied force F = int |f| dS + |P_0| + |P_L| + L c
+    max |v|^2 (N, Scene.applied_forces), naming the option behind the largest part."""
+    if scene.current is not None:
+        if scene.current.drag > MAX_MAGNITUDE:
+            raise RodInputError(
+                f"-rod_drag: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is above "
+                f"{MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
+        drag = scene.current.largest_drag()
+        if drag > MAX_MAGNITUDE:
+            raise RodInputError(
+                f"{_current_option(given)} with -rod_drag: the largest drag c max |v|^2 = "
+                f"{drag:.3g} N/m is above {MAX_MAGNITUDE:g}; give the current in m/s")
+    parts = scene.applied_forces()
+    total = sum(parts.values())
+    if total > MAX_MAGNITUDE:
+        name = max(parts, key=parts.get)
+        option = {"load": "-rod_load (with -rod_length)", "start_force": "-rod_start_force",
+                  "end_force": "-rod_end_force",
+                  "drag": f"{_current_option(given)} with -rod_drag and -rod_length"}[name]
+        raise RodInputError(
+            f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
+            f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
+            "lengths in m")
 
 
 def settings_from_options(values, scene):
     penalty = values["rod_al_penalty"]
     if penalty is None:
-        penalty = default_penalty(scene)
+        penalty = checked_default_penalty(scene)
     return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
                     adapt_penalty=values["rod_al_adapt_penalty"],
                     check_stability=values["rod_al_stability"],
                     newton=values["rod_al_newton"])
+
+
+def checked_default_penalty(scene):
+    """default_penalty(scene), refused above MAX_MAGNITUDE (the bound of -rod_al_penalty)
+    with the options behind the scale that sets it (problem/penalty.penalty_scales)."""
+    scales = penalty_scales(scene)
+    name = max(scales, key=scales.get)
+    if scales[name] > MAX_MAGNITUDE:
+        option, formula = {
+            "bending": ("-rod_stiffness with -rod_length", "100 sqrt(min K max K) / L^2"),
+            "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
+            "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness",
+                      "2 (K3 alpha / L)^2 / min(K1, K2)")}[name]
+        raise RodInputError(
+            f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
+            f"above {MAX_MAGNITUDE:g}, beyond what double precision carries through the "
+            "solver; check the units (N m^2, m, rad)")
+    return scales[name]
 
 
 def seabed_from_options(values, given, load_values):
@@ -77,7 +161,7 @@ def current_from_options(values, given, surface_default):
         raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
                             "current does not depend on depth)")
     if profile:
-        depths, velocities = read_profile(values["rod_current_profile"])
+        depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
     else:
         depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
     surface = values["rod_sea_surface"]

@@ -30,11 +30,18 @@ def default_penalty(scene):
       axial compression it stands for in Greenhill's condition
       (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2).
     """
+    return max(penalty_scales(scene).values())
+
+
+def penalty_scales(scene):
+    """The three scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
+    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2)}; the command line names the options
+    behind the one that makes a default penalty out of range."""
     stiffness = scene.stiffness
-    bending = 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2
     moment = stiffness[2] * scene.end_rotation() / scene.length
-    twist = 2.0 * moment**2 / stiffness[:2].min()
-    return max(bending, 0.5 * scene.applied_force(), twist)
+    return {"bending": 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2,
+            "tension": 0.5 * scene.applied_force(),
+            "twist": 2.0 * moment**2 / stiffness[:2].min()}
 
 
 def matrix_split(split):

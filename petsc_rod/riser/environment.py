@@ -14,6 +14,11 @@ from petsc_rod.scenes.boundary import is_held
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
+# The stiffest seabed accepted lets the line's mean load press it in by this fraction of
+# the length: 50 times the round-off of a height (2.2e-16 L), below which the contact is
+# decided by round-off and a stiffer seabed changes nothing but the conditioning of the
+# vertical problem (largest_stiffness).
+MIN_RELATIVE_PENETRATION = 1e-14
 
 
 @dataclass(frozen=True)
@@ -60,9 +65,24 @@ def default_stiffness(load_values):
     return downward / DEFAULT_PENETRATION if downward > 0 else None
 
 
-def read_profile(path):
+def largest_stiffness(applied_force, length):
+    """k_max = (F / L) / (MIN_RELATIVE_PENETRATION L), N/m^2: the seabed under which the
+    mean load per metre F / L (F = Scene.applied_force, N) sinks 1e-14 L.
+
+    Why this bound: the vertical problem's matrix adds k w_n (w_n ~ h, the Simpson
+    weights) to the elastic and penalty terms, whose diagonal is at least about R / h
+    with R >= F / 2 (the default penalty's tension scale); the ratio k h^2 / R then stays
+    below 2 (h / L)^2 / MIN_RELATIVE_PENETRATION <= 2e14, within double precision's
+    1 / eps = 4.5e15, on any mesh. A stiffer seabed would hold the line to within
+    round-off of its height anyway, so nothing physical is refused.
+    """
+    return applied_force / length / (MIN_RELATIVE_PENETRATION * length)
+
+
+def read_profile(path, largest=np.inf):
     """(depths (m,), velocities (m, 3)) from a text file of rows 'depth ux uy uz' (m,
-    m/s; '#' starts a comment), depths strictly increasing. RodInputError otherwise."""
+    m/s; '#' starts a comment), depths strictly increasing, every magnitude at most
+    ``largest`` (the bound of the options' numbers). RodInputError otherwise."""
     def refuse(what):
         raise RodInputError(f"-rod_current_profile {path}: {what}")
 
@@ -83,6 +103,11 @@ def read_profile(path):
         refuse("expected rows of 4 numbers: depth (m), ux, uy, uz (m/s)")
     if not np.all(np.isfinite(table)):
         refuse("holds a number that is not finite")
+    if np.any(np.abs(table) > largest):
+        row = int(np.flatnonzero(np.any(np.abs(table) > largest, axis=1))[0])
+        refuse(f"row {row + 1} holds a magnitude above {largest:g}, which the solver cannot "
+               "carry through products such as the drag c |v|^2; give depths in m and "
+               "velocities in m/s")
     if np.any(np.diff(table[:, 0]) <= 0):
         refuse("the depths must increase strictly from row to row")
     return table[:, 0], table[:, 1:]

@@ -77,10 +77,19 @@ class Scene:
     def applied_force(self):
         """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
         (and of the multiplier lambda3 that converges to it)."""
-        pieces = np.diff(self.load_piece_ends) @ np.linalg.norm(self.load_values, axis=1)
+        return float(sum(self.applied_forces().values()))
+
+    def applied_forces(self):
+        """The parts of applied_force by where they come from, N: {'load': int |f| dS of
+        the dead load, 'drag': L c max |v|^2 of the current (0 without one), 'start_force':
+        |P_0|, 'end_force': |P_L|}."""
+        drag = 0.0
         if self.current is not None:            # the largest drag the current can exert
-            pieces += self.length * self.current.largest_drag()
-        return float(pieces + np.linalg.norm(self.start_force) + np.linalg.norm(self.end_force))
+            drag = self.length * self.current.largest_drag()
+        return {"load": float(np.diff(self.load_piece_ends)
+                              @ np.linalg.norm(self.load_values, axis=1)),
+                "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
+                "end_force": float(np.linalg.norm(self.end_force))}
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame

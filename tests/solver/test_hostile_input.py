@@ -327,3 +327,64 @@ def test_a_restart_load_path_goes_on_from_its_load_factor():
     assert LoadPath(4, 2, start=1.0).steps == 1
     plain = LoadPath(3, 1)
     assert [plain.factor(u) for u in range(7)] == [u / 6 for u in range(7)]
+
+
+# --- values derived from accepted input (issue 25) -------------------------------------
+DERIVED = {
+    "a current of 1e20 m/s": (dict(rod_current="1e20,0,0", rod_drag="1025,1.2,0.3"),
+                              "-rod_current with -rod_drag"),
+    "a drag coefficient of 1e60": (dict(rod_current="1,0,0", rod_drag="1e30,1,1e30"),
+                                   "-rod_drag"),
+    "an end force of 1e30 with a load of 1e30 N/m": (dict(rod_end_force="0,1e30,0",
+                                                          rod_load="0,1e30,0"),
+                                                     "-rod_load (with -rod_length)"),
+    "a default penalty of 1e38 N": (dict(rod_stiffness="1e30,1e30,1e30", rod_length="1e-3"),
+                                    "-rod_stiffness with -rod_length: the default "
+                                    "-rod_al_penalty"),
+    "a default penalty from the twist": (dict(rod_end="clamp", rod_end_twist="1e20",
+                                              rod_stiffness="1,1,1e10"),
+                                         "-rod_end_twist"),
+    "a seabed of 1e25 N/m^2": (dict(rod_end="pin", rod_end_position="0.5,0,0.5",
+                                    rod_load="0,0,-1", rod_seabed="0",
+                                    rod_seabed_stiffness="1e25"), "-rod_seabed_stiffness 1e+25"),
+    "a default seabed stiffness above the bound": (dict(rod_end="pin", rod_length="1e20",
+                                                        rod_end_position="1e19,0,1e18",
+                                                        rod_load="0,0,-1", rod_seabed="0"),
+                                                   "-rod_load: the default "
+                                                   "-rod_seabed_stiffness"),
+}
+
+
+@pytest.mark.parametrize("case", list(DERIVED))
+def test_a_derived_value_out_of_range_is_refused_naming_its_option(options, case):
+    """A current of 1e20 m/s derived a default penalty of 3.1e40 N, above the 1e30 that
+    -rod_al_penalty accepts, and ran 10 000 iterations: every derived force, drag,
+    penalty and seabed stiffness is held to the options' bound, before any work."""
+    from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
+    given, named = DERIVED[case]
+    values, names = options(**given)()
+    with pytest.raises(RodInputError) as error:
+        settings_from_options(values, scene_from_options(values, names))
+    assert str(error.value).startswith(named), str(error.value)
+
+
+def test_the_derived_bounds_accept_what_is_within_them(options):
+    """Just inside: 1e14 m/s would be refused, 1e10 m/s derives a drag of 1.8e22 N/m."""
+    from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
+    values, names = options(rod_current="1e10,0,0", rod_drag="1025,1.2,0.3")()
+    settings = settings_from_options(values, scene_from_options(values, names))
+    assert 1e21 < settings.asked_penalty <= MAX_MAGNITUDE
+
+
+def test_a_profile_above_the_bound_is_refused_when_read(tmp_path_factory, comm):
+    from petsc_rod.riser.environment import read_profile
+    folder = tmp_path_factory.mktemp("profile") if comm.getRank() == 0 else None
+    folder = comm.tompi4py().bcast(folder)
+    path = folder / "huge.txt"
+    if comm.getRank() == 0:
+        path.write_text("0 0 0 0\n10 1e300 0 0\n")
+    comm.tompi4py().barrier()
+    with pytest.raises(RodInputError, match="row 2 holds a magnitude above 1e"):
+        read_profile(str(path), MAX_MAGNITUDE)
+    depths, velocities = read_profile(str(path))            # no bound: read as it is
+    assert velocities[1, 0] == 1e300

@@ -89,6 +89,17 @@ BAD = {
     "end below the seabed": (["-rod_seabed", "5"], ["-rod_start", "below the seabed"]),
     "current without drag": (["-rod_current", "0.5,0,0"], ["-rod_drag"]),
     "stiffness without seabed": (["-rod_seabed_stiffness", "1e3"], ["-rod_seabed"]),
+    # issue 25: numbers derived from accepted input, checked against the options' bound
+    "current of 1e20 m/s": (["-rod_current", "1e20,0,0", "-rod_drag", "1025,1.2,0.3"],
+                            ["-rod_current with -rod_drag", "largest drag", "1e+30"]),
+    "profile with 1e300": (["-rod_current_profile", "{huge_profile}", "-rod_drag",
+                            "1025,1.2,0.1"], ["-rod_current_profile", "row 2", "1e+30"]),
+    "profile with 1e20 m/s": (["-rod_current_profile", "{fast_profile}", "-rod_drag",
+                               "1025,1.2,0.1"], ["-rod_current_profile", "largest drag"]),
+    "load of 1e30 N/m on 10 m": (["-rod_load", "0,0,-1e30"], ["-rod_load", "applied force"]),
+    # issue 25: a seabed above the stated bound (1e13 N/m^2 for this 10 m line of 1 N/m)
+    "seabed of 1e25 N/m^2": (["-rod_seabed", "0", "-rod_seabed_stiffness", "1e25"],
+                             ["-rod_seabed_stiffness 1e+25", "largest accepted is 1e+13"]),
 }
 
 
@@ -97,8 +108,30 @@ BAD = {
 def test_bad_riser_input_exits_2_with_one_line_and_no_file(tmp_path, case, ranks):
     args, words = BAD[case]
     bad_profile = write(tmp_path, "profile.txt", "0 1 0 0\n50 1 0 0\n40 0 0 0\n")
-    args = [a.format(folder=tmp_path, bad_profile=bad_profile) for a in args]
+    huge_profile = write(tmp_path, "huge.txt", "0 1 0 0\n50 1e300 0 0\n")
+    fast_profile = write(tmp_path, "fast.txt", "0 1e20 0 0\n50 1 0 0\n")
+    args = [a.format(folder=tmp_path, bad_profile=bad_profile, huge_profile=huge_profile,
+                     fast_profile=fast_profile) for a in args]
     path = tmp_path / "out.h5"
     done = run(SCENE + args + ["-rod_output", str(path)], ranks=ranks)
     assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
                                      path)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_stiffest_seabed_accepted_converges(tmp_path, ranks):
+    """Issue 25: 1e25 N/m^2 ended in DIVERGED_PCSETUP_FAILED; the largest stiffness
+    accepted (environment.largest_stiffness, quoted by the refusal) converges, on the
+    direct solver of one rank and the CG of two."""
+    from petsc_rod.cli.scene_options import rounded_down
+    from petsc_rod.riser.environment import largest_stiffness
+    largest = rounded_down(largest_stiffness(10.0, 10.0))
+    path = tmp_path / "out.h5"
+    done = run(SCENE + ["-rod_seabed", "0", "-rod_seabed_stiffness", f"{largest:.3g}",
+                        "-rod_output", str(path)], ranks=ranks)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        assert int(f.attrs["converged"]) == 1
+        assert float(f["parameters"].attrs["seabed_stiffness"]) == largest
+        # the line rests on the seabed, sunk by about w / k = 1e-13 m
+        assert np.abs(f["r"][:][f["S"][:] < 2.0, 2]).max() < 1e-9
