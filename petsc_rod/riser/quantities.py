@@ -74,9 +74,15 @@ def touchdown(problem, seabed, top):
     r0, r1 = ghosted[left], ghosted[left + 1]
     gap0, gap1 = r0[:, 2] - seabed.height, r1[:, 2] - seabed.height
     S0, S1 = mesh.element_S, mesh.element_S + mesh.element_h
-    # the fraction of each element below the seabed, with its heights linear in S
-    below = np.where(gap0 < 0, np.where(gap1 < 0, 1.0, gap0 / (gap0 - gap1)),
-                     np.where(gap1 < 0, gap1 / (gap1 - gap0), 0.0))
+    # the fraction of each element below the seabed, with its heights linear in S: 1 or 0
+    # when both ends are on one side, else the crossing's gap0 / (gap0 - gap1) from the
+    # lower end; divided only where the ends straddle z_b (np.where would divide by the
+    # zero gap0 - gap1 of an element lying flat, and warn)
+    straddles = (gap0 < 0) != (gap1 < 0)
+    lower_gap = np.where(gap0 < 0, gap0, gap1)
+    crossing_fraction = np.divide(lower_gap, lower_gap - np.where(gap0 < 0, gap1, gap0),
+                                  out=np.zeros_like(gap0), where=straddles)
+    below = np.where(straddles, crossing_fraction, (gap0 < 0) & (gap1 < 0)).astype(float)
     grounded = float(mesh.global_sum(np.sum(below * mesh.element_h)))
     # toward the top: the element whose end nearer the top is off the seabed and the
     # other end on it (or the top vertex itself on it)
