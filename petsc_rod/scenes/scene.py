@@ -147,8 +147,9 @@ class Scene:
         chord = np.linalg.norm(self.end_position)
         if held and chord > self.length * (1 + 1e-12):
             raise RodInputError(
-                f"-rod_end_position: the ends are {chord:.6g} m apart but the cable is only "
-                f"{self.length:.6g} m long (inextensible); bring the end within -rod_length")
+                f"-rod_end_position: the ends are {chord:.15g} m apart, "
+                f"{chord - self.length:.3g} m more than the cable's length {self.length:.15g} m "
+                "(inextensible); bring the end within -rod_length")
         frame = self.end_frame
         if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
                 or np.linalg.det(frame) < 0):

@@ -388,3 +388,14 @@ def test_a_profile_above_the_bound_is_refused_when_read(tmp_path_factory, comm):
         read_profile(str(path), MAX_MAGNITUDE)
     depths, velocities = read_profile(str(path))            # no bound: read as it is
     assert velocities[1, 0] == 1e300
+
+
+def test_ends_a_little_too_far_apart_say_by_how_much():
+    """Issue 25: ends 1.0000001 m apart on a 1 m line said "1 m apart but only 1 m long"."""
+    from petsc_rod.scenes.scene import Scene
+    scene = Scene(length=1.0, stiffness=[1.0, 1.0, 1.0], start="clamp", end="pin",
+                  end_position=[1.0000001, 0.0, 0.0])
+    with pytest.raises(RodInputError) as error:
+        scene.validate({"rod_end_position"})
+    message = str(error.value)
+    assert "1.0000001 m apart" in message and "1e-07 m more than" in message, message
