@@ -25,8 +25,9 @@ ROUND_OFF = 1e-12
 
 
 def chain_matrix(comm, n_elements, prescribed_rows=()):
-    """A graded mesh's P2 matrix 2 K + 50 W with the given rows made identity rows."""
-    mesh = Mesh(comm, n_elements, 2.0, grading=3.0)
+    """A graded mesh's P2 matrix 2 K + 50 W with the given rows made identity rows (1
+    and 2 elements cannot be graded: uniform, as they always were built)."""
+    mesh = Mesh(comm, n_elements, 2.0, grading=3.0 if n_elements > 2 else 1.0)
     matrix = assemble_matrix(mesh, p2_element_matrices(mesh.element_h, 2.0, 50.0))
     rows = np.array(prescribed_rows, dtype=PETSc.IntType)
     start, end = matrix.getOwnershipRange()
