@@ -126,6 +126,93 @@ def test_an_options_file_without_options_exits_2(tmp_path):
                                      [str(scene), "no option"])
 
 
+def options_file_loops(folder):
+    """Scene files that include themselves: directly, and through a second file named
+    by a relative path in other case (PETSc opens it from the working folder and
+    compares option names without case)."""
+    itself = folder / "itself.opts"
+    itself.write_text(f"-rod_elements 8\n-options_file {itself}\n")
+    first, second = folder / "first.opts", folder / "second.opts"
+    first.write_text(f"-rod_elements 8\n-options_file {second}  # the rest\n")
+    second.write_text(f"-rod_steps 1\n-OPTIONS_FILE {os.path.relpath(first, REPO_ROOT)}\n")
+    return {"itself": itself, "through another": first}
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("loop", ["itself", "through another"])
+def test_an_options_file_that_includes_itself_exits_2(tmp_path, loop, ranks):
+    """PETSc follows -options_file lines without end and overflows its stack (a
+    segmentation fault, no message): the loop is refused before PETSc starts."""
+    scene = options_file_loops(tmp_path)[loop]
+    path = tmp_path / "out.h5"
+    done = run(["-options_file", str(scene), "-rod_output", str(path)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     [str(scene), "include themselves", "line 2"], path)
+
+
+def test_a_loop_of_options_files_through_petsc_options_exits_2(tmp_path):
+    scene = options_file_loops(tmp_path)["itself"]
+    env = {**child_env(), "PETSC_OPTIONS": f"-options_file {scene}"}
+    done = subprocess.run(petsc_rod_command(["-rod_output", str(tmp_path / "out.h5")]),
+                          cwd=REPO_ROOT, env=env, capture_output=True, text=True,
+                          timeout=TIMEOUT, check=False)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     ["PETSC_OPTIONS", "include themselves"],
+                                     tmp_path / "out.h5")
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_missing_nested_options_file_is_named(tmp_path, ranks):
+    scene = tmp_path / "outer.opts"
+    scene.write_text(f"-rod_elements 8\n-options_file {tmp_path / 'absent.opts'}\n")
+    done = run(["-options_file", str(scene)], ranks)
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2,
+                                     ["absent.opts", f"{scene} line 2", "no such file"])
+    assert "Petsc Release" not in text and "Option left" not in text, text
+
+
+@pytest.mark.parametrize("args", [["-rod_elements", "8", "-options_file"],
+                                  ["-options_file", "-rod_elements", "8"]],
+                         ids=["at the end", "before an option"])
+def test_options_file_without_a_path_exits_2(tmp_path, args):
+    done = run(args)
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2, ["-options_file", "path"])
+    assert "Option left" not in text, text
+
+
+def test_a_nested_options_file_line_without_a_path_exits_2(tmp_path):
+    scene = tmp_path / "nopath.opts"
+    scene.write_text("-rod_elements 8\n-options_file   # which one?\n")
+    done = run(["-options_file", str(scene)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     [f"{scene} line 2", "-options_file", "path"])
+
+
+def test_an_options_file_with_a_byte_order_mark_is_refused_saying_so(tmp_path):
+    """A UTF-8 byte-order mark is invisible in an editor; PETSc reads it as part of the
+    first option's name (docs/errors.md says why it is refused, not stripped)."""
+    scene = tmp_path / "bom.opts"
+    scene.write_bytes(b"\xef\xbb\xbf-rod_elements 8\n")
+    path = tmp_path / "out.h5"
+    done = run(["-options_file", str(scene), "-rod_output", str(path)])
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2,
+                                     [str(scene), "UTF-8 byte-order mark"], path)
+    assert "\ufeff" not in text, text
+
+
+def test_an_options_file_that_is_a_pipe_is_refused_saying_so(tmp_path):
+    """A FIFO stands for ``-options_file <(cmd)`` (/dev/fd/N, a pipe): it can be read
+    only once, and petsc_rod reads the file before PETSc does."""
+    fifo = tmp_path / "scene.fifo"
+    os.mkfifo(fifo)
+    done = run(["-options_file", str(fifo)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
+                                     [str(fifo), "not a regular file"])
+
+
 def test_an_unknown_solver_type_exits_2(tmp_path):
     path = tmp_path / "out.h5"
     done = run(SMALL + ["-rod_slope_ksp_type", "nonsense", "-rod_output", str(path)])
