@@ -295,7 +295,10 @@ def main():
                          "per line, '#' starts a comment\n")
         return 2
     from petsc_rod.cli.main import run
-    return end(run())
+    from petsc_rod.cli.signals import ignore_stop_signals
+    code = run()
+    ignore_stop_signals()
+    return end(code)
 
 
 if __name__ == "__main__":

@@ -3,6 +3,9 @@ work, build the scene, run the continuation, write, report. Returns the process 
 code (docs/errors.md: 0 converged, 2 bad input, 3 not converged,
 4 diverged, 5 the result could not be written, 128 + n stopped by signal n)."""
 
+import signal
+import sys
+
 import numpy as np
 from petsc4py import PETSc
 
@@ -78,7 +81,12 @@ def run(comm=None):
                 say(f"petsc_rod: warning: option -{name} was set but not used")
             return code
         except RodError as error:
-            say(f"petsc_rod: error: {error}")
+            if getattr(error, "signal_number", 0) == signal.SIGPIPE:
+                # the output is a pipe nobody reads any more: the line goes to stderr
+                if comm.getRank() == 0:
+                    sys.stderr.write(f"petsc_rod: error: {error}\n")
+            else:
+                say(f"petsc_rod: error: {error}")
             database.setValue("options_left", "0")
             return error.exit_code
         finally:

@@ -264,8 +264,10 @@ def test_a_write_that_fails_during_the_run_exits_5_and_removes_the_partial_file(
 # --- signals ---------------------------------------------------------------------------
 @pytest.mark.parametrize("ranks, signal_number", [
     (1, signal.SIGTERM), (1, signal.SIGHUP), (1, signal.SIGINT),
-    (2, signal.SIGINT), (2, signal.SIGTERM)],
-    ids=["SIGTERM", "SIGHUP", "SIGINT", "SIGINT to mpiexec", "SIGTERM to mpiexec"])
+    (2, signal.SIGINT), (2, signal.SIGTERM),
+    (1, signal.SIGQUIT), (1, signal.SIGUSR1), (1, signal.SIGUSR2)],
+    ids=["SIGTERM", "SIGHUP", "SIGINT", "SIGINT to mpiexec", "SIGTERM to mpiexec",
+         "SIGQUIT", "SIGUSR1", "SIGUSR2"])
 def test_a_signal_ends_the_run_cleanly(tmp_path, ranks, signal_number):
     path = tmp_path / "stopped.h5"
     process = start(LONG + ["-rod_output", str(path)], ranks)
@@ -281,6 +283,62 @@ def test_a_signal_ends_the_run_cleanly(tmp_path, ranks, signal_number):
     name = signal.Signals(signal_number).name if ranks == 1 else "SIGTERM"
     assert_one_line_and_nothing_left(process.returncode, output, expected,
                                      [f"interrupted by {name}", "load factor"], path)
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGUSR1, signal.SIGUSR2])
+def test_a_user_signal_to_mpiexec_ends_the_run_cleanly(tmp_path, signal_number):
+    """mpiexec (Open MPI) forwards SIGUSR1 and SIGUSR2 to every rank as they are."""
+    path = tmp_path / "stopped.h5"
+    process = start(LONG + ["-rod_output", str(path)], 2)
+    try:
+        wait_for(f"{path}.partial", process)
+        time.sleep(0.5)
+        process.send_signal(signal_number)
+        output, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    assert_one_line_and_nothing_left(process.returncode, output, 128 + signal_number,
+                                     [f"interrupted by {signal.Signals(signal_number).name}",
+                                      "load factor"], path)
+
+
+def test_a_second_signal_while_the_run_stops_changes_nothing(tmp_path):
+    """Ctrl-C twice: the second SIGINT, while the run stops after the first, neither
+    cuts the stop short nor changes its line."""
+    path = tmp_path / "stopped.h5"
+    process = start(LONG + ["-rod_output", str(path)])
+    try:
+        wait_for(f"{path}.partial", process)
+        time.sleep(0.5)
+        process.send_signal(signal.SIGINT)
+        time.sleep(0.02)
+        process.send_signal(signal.SIGINT)
+        output, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    assert_one_line_and_nothing_left(process.returncode, output, 130,
+                                     ["interrupted by SIGINT", "load factor"], path)
+    assert "KeyboardInterrupt" not in output, output
+
+
+def test_output_piped_into_a_reader_that_ends_stops_the_run_cleanly(tmp_path):
+    """``python -m petsc_rod ... | head -1``: the next line written gets SIGPIPE, which
+    is recorded like the other stop signals (not PETSc's report, exit 59): exit 141,
+    the line on stderr (stdout is gone), no file left."""
+    path = tmp_path / "piped.h5"
+    process = subprocess.Popen(petsc_rod_command(LONG + ["-rod_output", str(path)]),
+                               cwd=REPO_ROOT, env=child_env(), stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        first = process.stdout.readline()
+        process.stdout.close()              # the reader ends, as head does
+        errors = process.stderr.read()
+        process.wait(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    assert first.startswith("petsc_rod: "), first
+    assert_one_line_and_nothing_left(process.returncode, errors, 141,
+                                     ["interrupted by SIGPIPE", "load factor"], path)
 
 
 # --- restarts --------------------------------------------------------------------------
