@@ -3,8 +3,11 @@ work, build the scene, run the continuation, write, report. Returns the process 
 code (docs/errors.md: 0 converged, 2 bad input, 3 not converged,
 4 diverged, 5 the result could not be written, 128 + n stopped by signal n)."""
 
+import contextlib
+import os
 import signal
 import sys
+import time
 
 import numpy as np
 from petsc4py import PETSc
@@ -13,11 +16,11 @@ from petsc_rod import resources
 from petsc_rod.io import outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
-from petsc_rod.errors import RodError, RodInputError
+from petsc_rod.errors import RodDivergedError, RodError, RodInputError
 from petsc_rod.mesh.mesh import Mesh, end_element_lengths, fewest_elements, largest_grading
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
-                                   check_same_on_every_rank, format_value, help_text,
-                                   read_options, unused_options)
+                                   check_same_on_every_rank, check_snes_type, format_value,
+                                   help_text, read_options, unused_options)
 from petsc_rod.cli import lines
 from petsc_rod.cli.scene_options import (rounded_down, scene_from_options,
                                          settings_from_options)
@@ -27,6 +30,9 @@ from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.problem.problem import RodProblem
 
+# How long the ranks wait for each other after a PETSc error before taking it for one
+# rank's alone, s.
+FAILURE_WAIT = 10.0
 # The smallest element, relative to the length, whose end coordinates double precision
 # still tells apart to many digits.
 MIN_RELATIVE_ELEMENT = 1e-12
@@ -47,11 +53,15 @@ def run(comm=None):
     def say(text):
         PETSc.Sys.Print(text, comm=comm)
 
+    # where the ranks agree on a PETSc error (made now: creating it is collective)
+    failures = comm.tompi4py().Dup()
+
     with Interrupts(comm) as interrupts:
         try:
             check_same_on_every_rank(comm)
             values, given = read_options()
             check_anderson_depth()          # before any PETSc object is made
+            check_snes_type()
             if database.hasName("help"):
                 for line in help_text():
                     say(line)
@@ -89,6 +99,12 @@ def run(comm=None):
                 say(f"petsc_rod: error: {error}")
             database.setValue("options_left", "0")
             return error.exit_code
+        except PETSc.Error as error:        # inside a solve: the SNES's own options, say
+            if not every_rank_failed(failures):
+                abort_alone(comm, petsc_failure(error), getattr(writer, "partial", None))
+            say(f"petsc_rod: error: {petsc_failure(error)}")
+            database.setValue("options_left", "0")
+            return RodDivergedError.exit_code
         finally:
             if writer is not None:          # any failure before the file was finished
                 writer.abort()
@@ -98,6 +114,44 @@ def run(comm=None):
                 problem.destroy()
             if mesh is not None:
                 mesh.destroy()
+            failures.Free()
+
+
+def petsc_message(error):
+    """The last line of a PETSc.Error's report (PETSc's own message), without its rank."""
+    return str(error).strip().splitlines()[-1].split("] ", 1)[-1]
+
+
+def petsc_failure(error):
+    """The one line of a PETSc error raised during the run (exit 4, no result file)."""
+    return (f"PETSc failed during the solve: {petsc_message(error)}; check the "
+            "-rod_snes_* options (the iteration has no Jacobian) and the solvers' "
+            "-rod_slope_*, -rod_d1_*, -rod_d2_* options")
+
+
+def every_rank_failed(failures, wait=FAILURE_WAIT):
+    """Whether every rank of communicator ``failures`` (used for nothing else) reaches
+    this call within ``wait`` seconds, as all do after a PETSc error that every rank
+    raised; a rank-local error leaves the others inside a collective call of PETSc's."""
+    request = failures.Ibarrier()
+    deadline = time.monotonic() + wait
+    while not request.Test():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def abort_alone(comm, message, partial=None):
+    """End every rank after an error that only this one raised (the others wait in a
+    collective call and cannot be told): the line, the partial file ``partial`` removed
+    by its name (the collective close cannot be made), then MPI_Abort with exit 4."""
+    sys.stdout.write(f"petsc_rod: error: {message}\n")
+    sys.stdout.flush()
+    if partial is not None:
+        with contextlib.suppress(OSError):
+            os.remove(partial)
+    comm.tompi4py().Abort(RodDivergedError.exit_code)
 
 
 def check_mesh(comm, values):
@@ -150,8 +204,8 @@ def build_solver(mesh, scene, settings, say):
     except PETSc.Error as error:
         if problem is not None:
             problem.destroy()
-        detail = str(error).strip().splitlines()[-1].split("] ", 1)[-1]
-        raise RodInputError(f"PETSc refused the solver options: {detail}; check the "
+        raise RodInputError(f"PETSc refused the solver options: {petsc_message(error)}; "
+                            "check the "
                             "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
 
 

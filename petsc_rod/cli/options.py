@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
+from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.controller import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
@@ -270,6 +271,18 @@ def check_anderson_depth():
                                 "mixing is a whole number of at least 1")
 
 
+def check_snes_type():
+    """Refuse a -rod_snes_type that cannot drive the fixed-point map, before any work:
+    only the types that need no Jacobian can (driver.FUNCTION_ONLY_SNES); the others
+    would fail inside their first solve."""
+    kind = PETSc.Options().getString("rod_snes_type", DEFAULT_SNES)
+    if kind not in FUNCTION_ONLY_SNES:
+        raise RodInputError(
+            f"-rod_snes_type {kind}: the iteration is a fixed point x = G(x) with no "
+            "Jacobian, which only a SNES that needs the residual alone can drive; use one "
+            f"of {'|'.join(FUNCTION_ONLY_SNES)} (and their -rod_snes_* options)")
+
+
 def check_same_on_every_rank(comm):
     """Refuse a run whose ranks were given different options (e.g. an option on one rank
     only), which would otherwise crash or deadlock in the first collective call: the
@@ -315,8 +328,9 @@ def help_text():
                  "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
                  "python) on several.")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
-                 "iterates) | nrichardson (the plain iteration) | ngmres, and the SNES "
-                 "options under the same prefix (-rod_snes_anderson_m, -rod_snes_monitor).")
+                 "iterates) | nrichardson (the plain iteration) | ngmres | qn | ncg (the SNES "
+                 "types that need no Jacobian), and the SNES options under the same prefix "
+                 "(-rod_snes_anderson_m, -rod_snes_monitor).")
     return lines
 
 

@@ -22,6 +22,10 @@ from petsc_rod.resources import anderson_depth, ranks_on_this_machine
 
 # The SNES type of the iteration unless -rod_snes_type says otherwise.
 DEFAULT_SNES = "anderson"
+# The SNES types that can drive the map: they need only the residual F(x) = x - G(x),
+# which has no Jacobian; the others (newtonls, ngs, fas, nasm, ...) fail in their first
+# solve.
+FUNCTION_ONLY_SNES = ("anderson", "nrichardson", "ngmres", "qn", "ncg")
 SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
                 for name in dir(PETSc.SNES.ConvergedReason) if not name.startswith("_")}
 

@@ -220,6 +220,47 @@ def test_an_unknown_solver_type_exits_2(tmp_path):
                                      ["KSP type nonsense"], path)
 
 
+CANTILEVER = ["-options_file", "options/cantilever.opts", "-rod_elements", "8"]
+JACOBIAN_SNES = ["newtonls", "newtontr", "ngs", "ksponly", "fas", "nasm", "composite",
+                 "shell", "vinewtonrsls"]
+
+
+@pytest.mark.parametrize("kind, ranks", [(kind, 1) for kind in JACOBIAN_SNES]
+                         + [("newtonls", 2), ("ngs", 2)])
+def test_a_snes_type_that_cannot_drive_the_map_is_refused_before_any_work(tmp_path, kind,
+                                                                         ranks):
+    """These SNES types need a Jacobian, or set-up the map has not (a decomposition, a
+    shell solve): they failed with a traceback at the first solve."""
+    path = tmp_path / "out.h5"
+    done = run(CANTILEVER + ["-rod_snes_type", kind, "-rod_output", str(path)], ranks)
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2,
+                                     [f"-rod_snes_type {kind}", "anderson|nrichardson"], path)
+    assert "elements on" not in text, text          # refused before the run started
+
+
+@pytest.mark.parametrize("kind", ["qn", "ncg", "ngmres"])
+def test_the_other_snes_types_that_need_only_the_residual_drive_the_map(tmp_path, kind):
+    done = run(CANTILEVER + ["-rod_snes_type", kind, "-rod_output", str(tmp_path / "out.h5")])
+    assert done.returncode == 0, describe(done.returncode, done.stdout + done.stderr)
+    assert os.path.exists(tmp_path / "out.h5")
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("options", [
+    ["-rod_snes_type", "qn", "-rod_snes_qn_scale_type", "jacobian"],
+    ["-rod_snes_type", "ngmres", "-rod_snes_ngmres_select_type", "linesearch",
+     "-rod_snes_linesearch_type", "nleqerr"]], ids=["qn Jacobian scaling", "nleqerr"])
+def test_a_petsc_error_inside_a_solve_exits_4_with_one_line(tmp_path, options, ranks):
+    """SNES options that need what the map has not (a Jacobian, a preconditioner) fail
+    inside PETSc during the first solve, on one rank (the other waits in a collective
+    call: the run is aborted with the same code) or on all."""
+    path = tmp_path / "out.h5"
+    done = run(CANTILEVER + options + ["-rod_output", str(path)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 4,
+                                     ["PETSc failed during the solve", "-rod_snes_*"], path)
+
+
 def test_ranks_given_different_options_exit_2_without_hanging(tmp_path):
     launcher = mpiexec(2)[0]
     path = tmp_path / "out.h5"
