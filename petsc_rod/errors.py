@@ -47,8 +47,9 @@ class RodIOError(RodError):
 
 
 class RodInterrupted(RodError):
-    """SIGINT, SIGTERM or SIGHUP ended the run; the exit code is the shell's 128 + the
-    signal number (130, 143, 129), and the partial file is removed."""
+    """A stop signal (cli/signals.py: SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2,
+    SIGPIPE) ended the run; the exit code is the shell's 128 + the signal number (130,
+    143, 129, 131, 138, 140, 141), and the partial file is removed."""
 
     def __init__(self, message, signal_number):
         super().__init__(message)

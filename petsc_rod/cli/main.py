@@ -1,7 +1,8 @@
 """Command line: read the -rod_* options, check them and what the run needs before any
 work, build the scene, run the continuation, write, report. Returns the process exit
 code (docs/errors.md: 0 converged, 2 bad input, 3 not converged,
-4 diverged, 5 the result could not be written, 128 + n stopped by signal n)."""
+4 diverged or a PETSc error during the solve, 5 the result could not be written,
+128 + n stopped by signal n)."""
 
 import contextlib
 import os
