@@ -113,7 +113,8 @@ def nested_files(path, text):
 
 def read_options_file(path, reference, nested):
     """The text of options file ``path`` (``reference``: how it was named, for the
-    message; ``nested``: named in another options file), after the checks PETSc would otherwise fail on without a clear message."""
+    message; ``nested``: named in another options file), after the checks PETSc would
+    otherwise fail on without a clear message."""
     if os.path.isdir(path):
         raise OptionsFileError(f"{reference}: is a folder, not a scene file")
     if os.path.exists(path) and not os.path.isfile(path):
