@@ -119,6 +119,12 @@ LAUNCHER_PREFIXES = ("PMIX_", "OMPI_COMM_WORLD", "OMPI_UNIVERSE_SIZE", "OMPI_FIR
                      "OMPI_MCA_mpi_oversubscribe")
 
 
+def partial_files(path):
+    """Every run's partial file of the result ``path`` (io.results.partial_name)."""
+    import glob
+    return glob.glob(f"{glob.escape(str(path))}.*.partial")
+
+
 def child_env():
     """This environment without the variables of an enclosing mpiexec."""
     return {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_PREFIXES)}

@@ -10,7 +10,8 @@ per accepted continuation step (halved sub-steps included) and the failed one th
 a run, with the same content. The root links to the last step and also holds the run's
 version, commit, options and options_in_effect, and a group ``parameters`` with every
 option in effect as numbers. Every dataset has a ``units`` attribute, every group an
-``attribute_units`` (JSON). The file is written as ``<name>.partial`` and renamed only
+``attribute_units`` (JSON). The file is written as the run's own partial file
+``<name>.<pid>-<tag>.partial`` (partial_name) and renamed only
 when complete, so a crash or an interrupt never leaves a half-written result under the
 requested name; a failure or an interrupt removes the partial file.
 
@@ -19,10 +20,14 @@ at exit trying to flush it): such a file is removed without being closed, and
 ``hdf5_failed()`` tells the program to end without HDF5's shutdown (__main__).
 """
 
+import array
 import contextlib
 import datetime
+import errno
+import fcntl
 import json
 import os
+import secrets
 import stat
 import sys
 from dataclasses import dataclass
@@ -91,44 +96,93 @@ def distributed_layout(comm, arrays):
 
 
 # --------------------------------------------------------------------- the output path
+def partial_name(path, comm):
+    """The run's own partial file, ``<path>.<pid>-<6 hex>.partial`` (rank 0's pid and a
+    random tag, the same on every rank): two runs with the same output never write, check
+    or remove each other's partial file. Collective."""
+    tag = f"{os.getpid()}-{secrets.token_hex(3)}" if comm.getRank() == 0 else None
+    return f"{path}.{comm.tompi4py().bcast(tag, root=0)}.partial"
+
+
 def check_output_path(path, comm):
     """Refuse, before any work, an output that could not be written: a folder, a missing
-    folder, a device or other non-regular file, a folder where a file cannot be created
-    (permissions, a read-only or special file system). A stale ``<path>.partial`` is
-    removed. Collective: rank 0 checks, every rank raises."""
-    on_every_rank(comm, _check_output_path if comm.getRank() == 0 else _nothing, path)
+    folder, a device or other non-regular file, a link to nothing, a folder where a file
+    cannot be created (permissions, a read-only or special file system), a name too long
+    for the partial file's suffix. Nothing but the run's own probe is created or removed
+    (another run's partial file is left alone). Collective: rank 0 checks, every rank
+    raises."""
+    probe = partial_name(path, comm)
+    on_every_rank(comm, _check_output_path if comm.getRank() == 0 else _nothing, path, probe)
 
 
 def _nothing(*args):
     return None
 
 
-def _check_output_path(path):
+def _check_output_path(path, probe):
     folder = os.path.dirname(os.path.abspath(path))
-    partial = f"{path}.partial"
     if path.endswith(os.sep) or os.path.isdir(path):
         raise RodInputError(f"-rod_output {path}: is a folder; name a file, e.g. "
                             f"{os.path.join(path, 'result.h5')}")
     if not os.path.isdir(folder):
         raise RodInputError(f"-rod_output {path}: the folder {folder} does not exist")
-    for name in (path, partial):
-        if os.path.lexists(name) and not _regular_file(name):
-            raise RodInputError(f"-rod_output {path}: {name} exists and is not a regular "
-                                "file (a folder, a device, a socket); name another file")
+    if os.path.islink(path) and not os.path.exists(path):
+        raise RodInputError(f"-rod_output {path}: is a symbolic link to {os.readlink(path)}, "
+                            "which does not exist; remove the link or name another file")
+    if os.path.lexists(path) and not _regular_file(path):
+        raise RodInputError(f"-rod_output {path}: exists and is not a regular file (a "
+                            "folder, a device, a socket); name another file")
+    if _append_only(folder):
+        raise RodInputError(f"-rod_output {path}: the folder {folder} is append-only (a "
+                            "file made there can never be renamed or removed); choose "
+                            "another folder")
     try:
-        with open(partial, "wb"):
-            pass
-        os.remove(partial)
+        descriptor = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
     except OSError as error:
+        if error.errno == errno.ENAMETOOLONG:
+            suffix = probe[len(path):]
+            raise RodInputError(
+                f"-rod_output {path}: the name is too long for this file system once the "
+                f"run's partial suffix ({len(suffix)} characters, e.g. {suffix}) is added; "
+                "choose a shorter name") from None
         raise RodInputError(f"-rod_output {path}: cannot create a file in {folder} "
                             f"({error.strerror}); choose a writable folder") from None
+    os.close(descriptor)
+    try:
+        os.remove(probe)
+    except OSError as error:        # an append-only folder: a file is made, never removed
+        raise RodInputError(f"-rod_output {path}: a file created in {folder} cannot be "
+                            f"removed ({error.strerror}: an append-only or sticky folder); "
+                            f"remove {probe} by hand and choose another folder") from None
+
+
+# The Linux ioctl that reads a file's attribute flags, and the append-only flag.
+FS_IOC_GETFLAGS = 0x80086601
+FS_APPEND_FL = 0x20
+
+
+def _append_only(folder):
+    """Whether the folder has the append-only attribute (chattr +a); False where the file
+    system keeps no such flags."""
+    try:
+        descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError:
+        return False
+    try:
+        flags = array.array("l", [0])
+        fcntl.ioctl(descriptor, FS_IOC_GETFLAGS, flags, True)
+        return bool(flags[0] & FS_APPEND_FL)
+    except OSError:
+        return False
+    finally:
+        os.close(descriptor)
 
 
 def _regular_file(name):
     try:
         return stat.S_ISREG(os.stat(name).st_mode)
     except OSError:
-        return False           # a broken link: replaced by the rename, like a file
+        return False
 
 
 # --------------------------------------------------------------------------- writing
@@ -194,12 +248,12 @@ class ResultWriter:
     collective; a failure on any rank raises the same RodIOError on every rank."""
 
     def __init__(self, path, mesh, minimum_bytes=0, run=None):
-        """Open ``<path>.partial``; ``minimum_bytes``: what the whole file will need at
-        least (RodInputError when the disk has less); ``run``: the RunRecord the root
-        gets when the file is finished."""
+        """Open the run's own partial file (partial_name); ``minimum_bytes``: what the
+        whole file will need at least (RodInputError when the disk has less); ``run``:
+        the RunRecord the root gets when the file is finished."""
         self.path = path
         self.run = run or RunRecord({}, {}, {})
-        self.partial = f"{path}.partial"
+        self.partial = partial_name(path, mesh.comm)
         self.mesh = mesh
         self.comm = mesh.comm.tompi4py()
         self.folder = os.path.dirname(os.path.abspath(path))

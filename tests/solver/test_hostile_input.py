@@ -13,12 +13,14 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from helpers import partial_files
 from petsc_rod import resources
 from petsc_rod.io import outputs
 from petsc_rod.io import results as io
 from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
 from petsc_rod.cli.session import record_step
 from petsc_rod.iteration.continuation import LoadPath
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.cli.options import (MAX_HALVINGS_CAP, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
@@ -204,7 +206,7 @@ def test_an_output_that_cannot_be_written_is_refused_before_the_run(comm, shared
     good = os.path.join(shared_tmp, "good.h5")
     io.check_output_path(good, comm)
     comm.tompi4py().Barrier()
-    assert not os.path.exists(good) and not os.path.exists(f"{good}.partial")
+    assert not os.path.exists(good) and not partial_files(good)
 
 
 # --- writing and reading a result ------------------------------------------------------
@@ -232,14 +234,14 @@ def test_a_full_disk_ends_the_run_on_every_rank_and_removes_the_partial_file(
     with pytest.raises(RodInputError, match="free"):
         io.ResultWriter(path, mesh, minimum_bytes=10**6)
     writer = io.ResultWriter(path, mesh)
-    assert os.path.exists(f"{path}.partial")
+    assert os.path.exists(writer.partial)
     with pytest.raises(RodIOError, match="disk .* is full"):
         report = solver.solve_step(1.0)
         record_step(solver.problem, report, 1.0, writer, "steps/1", wall_time=0.0, options="",
                     halvings=0, total_halvings=0, total_iterations=1, undone_iterations=0)
     writer.abort()
     comm.tompi4py().Barrier()
-    assert not os.path.exists(f"{path}.partial") and not os.path.exists(path)
+    assert not partial_files(path) and not os.path.exists(path)
     assert not io.hdf5_failed()          # a refused step never reached HDF5
 
 
@@ -399,3 +401,73 @@ def test_ends_a_little_too_far_apart_say_by_how_much():
         scene.validate({"rod_end_position"})
     message = str(error.value)
     assert "1.0000001 m apart" in message and "1e-07 m more than" in message, message
+
+
+# --- runs that share an output, and output paths that cannot work -----------------------
+def test_each_run_has_a_partial_file_of_its_own_and_leaves_others_alone(comm, shared_tmp):
+    """Issue 25: two runs with the same -rod_output both wrote FILE.partial, and the
+    second one's start-up check truncated and removed the first one's live file."""
+    mesh = Mesh(comm, 4, 1.0)
+    path = os.path.join(shared_tmp, "shared.h5")
+    others = [f"{path}.partial", f"{path}.99-abcdef.partial"]      # another run's, live
+    if comm.getRank() == 0:
+        for other in others:
+            with open(other, "wb") as handle:
+                handle.write(b"another run's data")
+    comm.tompi4py().Barrier()
+    first = second = None
+    try:
+        io.check_output_path(path, comm)
+        first, second = io.ResultWriter(path, mesh), io.ResultWriter(path, mesh)
+        assert first.partial != second.partial
+        assert first.partial == comm.tompi4py().bcast(first.partial, root=0)   # one name
+        assert first.partial.startswith(f"{path}.") and first.partial.endswith(".partial")
+        assert os.path.exists(first.partial) and os.path.exists(second.partial)
+    finally:
+        for writer in (first, second):
+            if writer is not None:
+                writer.abort()
+        mesh.destroy()
+    comm.tompi4py().Barrier()
+    for other in others:
+        with open(other, "rb") as handle:
+            assert handle.read() == b"another run's data", other
+    assert sorted(partial_files(path)) == sorted(others[1:])
+
+
+def test_output_paths_that_cannot_work_are_refused_in_one_line(comm, shared_tmp):
+    """Issue 25: a dangling symlink said 'not a regular file'; a 250-character name said
+    'choose a writable folder' (the partial suffix made it too long)."""
+    link = os.path.join(shared_tmp, "link.h5")
+    long_name = os.path.join(shared_tmp, "r" * 250 + ".h5")
+    if comm.getRank() == 0:
+        os.symlink(os.path.join(shared_tmp, "missing", "target.h5"), link)
+    comm.tompi4py().Barrier()
+    with pytest.raises(RodInputError, match="symbolic link to .*does not exist"):
+        io.check_output_path(link, comm)
+    with pytest.raises(RodInputError, match="too long for this file system once the run's "
+                                            "partial suffix"):
+        io.check_output_path(long_name, comm)
+    comm.tompi4py().Barrier()
+    assert sorted(os.listdir(shared_tmp)) == ["link.h5"]            # nothing made
+
+
+def test_an_append_only_folder_is_refused_and_left_empty(comm, shared_tmp):
+    """Issue 25: an append-only folder gave exit 2 but left a 0-byte partial file."""
+    import subprocess
+    folder = os.path.join(shared_tmp, "append_only")
+    made = 0
+    if comm.getRank() == 0:
+        os.mkdir(folder)
+        made = subprocess.run(["chattr", "+a", folder], capture_output=True).returncode == 0
+    if not comm.tompi4py().bcast(made, root=0):
+        pytest.skip("chattr +a is not available here")
+    try:
+        with pytest.raises(RodInputError, match="append-only"):
+            io.check_output_path(os.path.join(folder, "result.h5"), comm)
+        comm.tompi4py().Barrier()
+        assert os.listdir(folder) == []
+    finally:
+        comm.tompi4py().Barrier()
+        if comm.getRank() == 0:
+            subprocess.run(["chattr", "-a", folder], check=True)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import petsc_rod
-from helpers import REPO_ROOT, child_env, describe, png_summary, run_petsc_rod
+from helpers import REPO_ROOT, child_env, describe, partial_files, png_summary, run_petsc_rod
 from petsc_rod.plots import DPI, result_figure
 from petsc_rod.cli.options import OPTIONS
 
@@ -65,7 +65,7 @@ def test_cantilever_run_writes_the_result_file(cantilever):
     path, process = cantilever
     assert process.returncode == 0, describe(process)
     assert path.is_file()
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
     with h5py.File(path, "r") as f:
         assert f["S"].shape == (33,)
         for name in ("r", "d1", "d2", "d3", "u", "m", "n"):
@@ -201,7 +201,7 @@ def test_unknown_option_suggests_the_closest(folder):
     assert len(lines) == 1, describe(process)
     assert "did you mean -rod_length" in lines[0]
     assert not os.path.exists(path)
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
 
 
 BAD_INPUTS = {
@@ -242,7 +242,7 @@ def test_bad_input_exits_2_with_one_line(case, folder):
     assert len(lines) == 1, describe(process)
     assert named in lines[0], describe(process)
     assert not os.path.exists(path)
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
 
 
 def test_restart_from_a_different_mesh_is_refused(cantilever, folder):
@@ -257,7 +257,7 @@ def test_restart_from_a_different_mesh_is_refused(cantilever, folder):
     assert len(lines) == 1, describe(process)
     assert "-rod_initial" in lines[0] and "32" in lines[0]
     assert not os.path.exists(out)
-    assert not os.path.exists(f"{out}.partial")
+    assert not partial_files(out)
 
 
 def test_missing_options_file_fails_without_output(folder):
@@ -268,7 +268,7 @@ def test_missing_options_file_fails_without_output(folder):
     lines = (process.stdout + process.stderr).strip().splitlines()
     assert len(lines) == 1 and "nonexistent.opts" in lines[0], describe(process)
     assert not os.path.exists(path)
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
 
 
 def test_not_converged_exits_3_and_says_so_in_the_file(folder):
@@ -276,7 +276,7 @@ def test_not_converged_exits_3_and_says_so_in_the_file(folder):
     process = run(cantilever_args() + ["-rod_al_max_it", "3", "-rod_output", str(path)])
     assert process.returncode == 3, describe(process)
     assert path.is_file()
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
     with h5py.File(path, "r") as f:
         assert int(f.attrs["converged"]) == 0
         assert int(f.attrs["iterations"]) == 3

@@ -7,7 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import BENT, PULLED, describe, run_petsc_rod
+from helpers import BENT, PULLED, describe, partial_files, run_petsc_rod
 from helpers import HALVING_CTOL as CTOL, HALVING_ELEMENTS as N_ELEMENTS, HALVING_RTOL as RTOL
 
 
@@ -37,7 +37,7 @@ def test_no_halvings_keeps_the_failure_exit_code(tmp_path, case, exit_code):
     process = run_cli(cli_args(case) + ["-rod_max_halvings", "0", "-rod_output", str(path)])
     assert process.returncode == exit_code, describe(process)
     assert "halving" not in process.stdout, describe(process)
-    assert not os.path.exists(f"{path}.partial")
+    assert not partial_files(path)
     if exit_code == 4:
         assert not path.exists()
         return

@@ -17,7 +17,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, child_env, mpiexec, petsc_rod_command, run_petsc_rod
+from helpers import REPO_ROOT, child_env, mpiexec, partial_files, petsc_rod_command, run_petsc_rod
 
 pytestmark = pytest.mark.serial
 
@@ -57,13 +57,19 @@ def assert_one_line_and_nothing_left(code, text, expected_code, words, path=None
     for bad in ("Traceback", "Segmentation", "PETSC ERROR"):
         assert bad not in text, describe(code, text)
     if path is not None:
-        assert not os.path.exists(path) and not os.path.exists(f"{path}.partial")
+        assert not os.path.exists(path) and not partial_files(path)
 
 
 def wait_for(path, process, timeout=60):
-    """Wait until ``path`` exists (the run got that far), failing if the run ends first."""
+    """Wait until ``path`` exists, or for a path ending in .partial until the run's own
+    partial file of it exists (the run got that far), failing if the run ends first."""
     deadline = time.monotonic() + timeout
-    while not os.path.exists(path):
+    partial = path.endswith(".partial")
+
+    def found():
+        return partial_files(path.removesuffix(".partial")) if partial else os.path.exists(path)
+
+    while not found():
         assert process.poll() is None, process.stdout.read()
         assert time.monotonic() < deadline, f"{path} never appeared"
         time.sleep(0.05)
@@ -282,7 +288,7 @@ def test_an_output_path_that_is_a_folder_is_refused_before_the_solve(tmp_path, r
     text = done.stdout + done.stderr
     assert_one_line_and_nothing_left(done.returncode, text, 2, ["-rod_output", "folder"])
     assert "step 1/" not in text and folder.is_dir()
-    assert not os.path.exists(f"{folder}.partial")
+    assert not partial_files(folder)
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
@@ -437,3 +443,20 @@ def test_a_restart_file_with_nan_exits_2(half_way, tmp_path, ranks):
     done = run(SMALL + ["-rod_initial", str(bad), "-rod_output", str(path)], ranks)
     assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2,
                                      ["-rod_initial", "state/lambda", "NaN"], path)
+
+
+def test_two_runs_with_the_same_output_both_finish_and_leave_a_whole_file(tmp_path):
+    """Issue 25: two runs with the same -rod_output shared FILE.partial; the second's
+    start-up check removed the first one's live file (one ended 0 with its result lost,
+    the other with exit 5). Each now writes a partial file of its own."""
+    path = tmp_path / "shared.h5"
+    args = SMALL + ["-rod_steps", "4", "-rod_output", str(path)]
+    runs = [subprocess.Popen(petsc_rod_command(args), cwd=REPO_ROOT, env=child_env(),
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            for _ in range(2)]
+    outputs = [process.communicate(timeout=TIMEOUT)[0] for process in runs]
+    for process, output in zip(runs, outputs):
+        assert process.returncode == 0, output
+    with h5py.File(path, "r") as result:
+        assert result.attrs["converged"] == 1 and "r" in result
+    assert not partial_files(path)
