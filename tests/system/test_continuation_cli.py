@@ -1,8 +1,6 @@
 """Halving seen from the command line: the exit code without halvings, and one file group
 per accepted step with them (spawns python -m petsc_rod: marked serial)."""
 
-import os
-
 import h5py
 import numpy as np
 import pytest
