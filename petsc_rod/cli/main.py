@@ -266,6 +266,7 @@ def run_record(values, solver, start):
 def options_in_effect(values, solver, start):
     """Every -rod_* option's value in effect, by name without ``rod_`` (the defaults that
     depend on the scene resolved, text options that were not given as ''), and its unit;
+    the current profile's rows (``current_profile_table``), not only its file's name;
     then each global-step solver's KSP, PC and factorisation package."""
     scene = solver.problem.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
@@ -283,6 +284,11 @@ def options_in_effect(values, solver, start):
             value = int(value)
         parameters[option.name.removeprefix("rod_")] = value
         units[option.name.removeprefix("rod_")] = BY_NAME[option.name].unit
+    if values["rod_current_profile"]:           # the profile itself, to repeat the run
+        current = scene.current
+        parameters["current_profile_table"] = np.column_stack([current.depths,
+                                                               current.velocities])
+        units["current_profile_table"] = "m, m/s, m/s, m/s (depth, ux, uy, uz)"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

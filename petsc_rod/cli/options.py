@@ -170,7 +170,7 @@ OPTIONS = [
            "the highest held end", unit="m"),
     Option("rod_drag", _reals(3), None, "rho,Cd,D",
            "water density kg/m^3, normal drag coefficient, hydrodynamic diameter m: drag "
-           "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE),
+           "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE, "kg/m^3, 1, m"),
     Option("rod_steps", _int, default_of(PathSettings, "steps"), "K",
            "continuation steps from the straight state", POSITIVE),
     Option("rod_imperfection", _real, default_of(PathSettings, "imperfection"), "eps",

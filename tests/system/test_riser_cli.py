@@ -2,6 +2,7 @@
 settings), their result files and figures, and the riser's bad input: one line, exit 2,
 no file. Spawns processes: marked ``serial``."""
 
+import json
 import subprocess
 import sys
 
@@ -135,3 +136,26 @@ def test_the_stiffest_seabed_accepted_converges(tmp_path, ranks):
         assert float(f["parameters"].attrs["seabed_stiffness"]) == largest
         # the line rests on the seabed, sunk by about w / k = 1e-13 m
         assert np.abs(f["r"][:][f["S"][:] < 2.0, 2]).max() < 1e-9
+
+
+def test_the_file_holds_the_current_profile_and_the_drag_with_its_units(tmp_path):
+    """Issue 25: the file held only the profile's name, and parameters/drag said "1"."""
+    rows = np.array([[0.0, 0.5, 0.2, 0.0], [500.0, 0.2, 0.0, 0.0], [1000.0, 0.0, 0.0, 0.0]])
+    profile = write(tmp_path, "profile.txt",
+                    "# depth ux uy uz\n" + "\n".join(" ".join(f"{v:g}" for v in row)
+                                                     for row in rows) + "\n")
+    path = tmp_path / "profile.h5"
+    # options/riser_catenary.opts, coarser, with the profile in place of its current
+    done = run(["-rod_length", "1800", "-rod_stiffness", "5.6e7,5.6e7,4.3e7", "-rod_start",
+                "pin", "-rod_end", "pin", "-rod_end_position", "1157,0,1000", "-rod_load",
+                "0,0,-1200", "-rod_seabed", "0", "-rod_elements", "200",
+                "-rod_initial_shape", "catenary", "-rod_current_profile", profile,
+                "-rod_drag", "1025,1.2,0.324", "-rod_output", str(path)])
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as result:
+        parameters = result["parameters"]
+        units = json.loads(parameters.attrs["attribute_units"])
+        assert np.array_equal(parameters.attrs["current_profile_table"], rows)
+        assert units["current_profile_table"].startswith("m, m/s")
+        assert np.array_equal(parameters.attrs["drag"], [1025.0, 1.2, 0.324])
+        assert units["drag"] == "kg/m^3, 1, m"
