@@ -422,7 +422,12 @@ def _read_restart(path, mesh, layout):
     try:
         handle = h5py.File(path, "r")
     except OSError as error:
-        refuse(f"not an HDF5 result file ({_failure_text(error)})")
+        text = _failure_text(error)
+        if "lock" in text.lower() or getattr(error, "errno", None) in (errno.EAGAIN,
+                                                                        errno.EWOULDBLOCK):
+            refuse("is locked by another process (a run still writing or reading it); wait "
+                   "for it to end, or restart from a copy of the file")
+        refuse(f"not an HDF5 result file ({text})")
     with handle as f:
         if "S" not in f or not isinstance(f["S"], h5py.Dataset):
             refuse("not a petsc_rod result file (no dataset S)")
@@ -456,6 +461,9 @@ def _read_slice(f, key, shape, start, rows, refuse):
     if dataset.shape != shape:
         refuse(f"the dataset {key} has shape {dataset.shape}, this run needs {shape} (a "
                "file of another version of petsc_rod, or damaged)")
+    if dataset.dtype.kind not in "fiu":
+        refuse(f"the dataset {key} holds {dataset.dtype} values, not real numbers (a file "
+               "not written by petsc_rod)")
     try:
         values = np.asarray(dataset[start:start + rows], dtype=float)
     except (OSError, TypeError, ValueError) as error:

@@ -283,6 +283,9 @@ DAMAGES = {
     "a load factor above 1": (lambda f: f.attrs.__setitem__("load_factor", 2.0), "not in [0, 1]"),
     "another mesh": (lambda f: replace(f, "S", f["S"][:] * 1.5), "mesh"),
     "other element count": (lambda f: replace(f, "S", np.linspace(0, 1, 5)), "4 elements"),
+    # issue 25: numpy's ComplexWarning, and the imaginary part dropped
+    "a complex tau": (lambda f: replace(f, "state/tau", f["state/tau"][:] * (1 + 1e-3j)),
+                      "state/tau holds complex128 values, not real numbers"),
 }
 
 
@@ -295,6 +298,29 @@ def test_a_damaged_restart_file_is_refused_on_every_rank(result, comm, case):
         io.read_restart(copy, solver.problem.mesh, outputs.restart_state(solver.problem))
     message = str(error.value)
     assert message.startswith(f"-rod_initial {copy}: ") and words in message, message
+
+
+def test_a_restart_file_locked_by_another_process_is_refused_saying_so(result, comm):
+    """Issue 25: a restart file another process holds open for writing said 'not an
+    HDF5 result file'."""
+    import subprocess
+    import sys
+    solver, path = result
+    holder = None
+    if comm.getRank() == 0:          # HDF5's file lock, held by another process
+        holder = subprocess.Popen([sys.executable, "-c", "import h5py, sys; "
+                                   "f = h5py.File(sys.argv[1], 'a'); print('open', flush=True); "
+                                   "sys.stdin.read()", path],
+                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        assert holder.stdout.readline().strip() == "open"
+    comm.tompi4py().Barrier()
+    try:
+        with pytest.raises(RodInputError, match="locked by another process"):
+            io.read_restart(path, solver.problem.mesh, outputs.restart_state(solver.problem))
+    finally:
+        comm.tompi4py().Barrier()
+        if holder is not None:
+            holder.communicate("", timeout=30)
 
 
 def test_the_expected_shapes_come_from_the_solver_arrays(result, comm):
