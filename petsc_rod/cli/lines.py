@@ -134,7 +134,10 @@ def finished(event, settings, scale):
             f"{event.halvings} halving(s) of the step ({event.undone} iterations undone)")
 
 
-def interrupted(name, event):
-    """The one-line error of a run stopped by the signal called ``name``."""
+def interrupted(name, event, kept=None):
+    """The one-line error of a run stopped by the signal called ``name``, whose
+    converged steps were kept in the file ``kept`` (None: there were none, or no file)."""
+    where = (f"the converged steps are kept in {kept} (converged = 0; -rod_initial {kept} "
+             "goes on from there)" if kept else "no result file is written")
     return (f"interrupted by {name} {event.where}; the last converged load factor is "
-            f"{event.last_factor:.6g}; no result file is written")
+            f"{event.last_factor:.6g}; {where}")

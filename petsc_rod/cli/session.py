@@ -34,8 +34,10 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
     text) among its attributes, and is finished at the end. ``interrupts``
     (signals.Interrupts), if given, are asked after every iteration and before the file
-    is finished: a signal ends the run with RodInterrupted. A divergence with no halving
-    left raises RodDivergedError. Returns a ContinuationResult.
+    is finished: a signal ends the run with RodInterrupted, the steps written so far kept
+    as a finished file of their own (ResultWriter.kept_name: converged = 0,
+    stop_reason "interrupted", a restart file). A divergence with no halving left raises
+    RodDivergedError. Returns a ContinuationResult.
     """
     say = say or (lambda line: None)
     problem = solver.problem
@@ -67,7 +69,13 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
             raise RodDivergedError(lines.diverged_message(event), event.error.iterations)
         elif isinstance(event, events.Interrupted):
             number = interrupts.received()
-            raise RodInterrupted(lines.interrupted(interrupts.name(number), event), number)
+            kept = None
+            if writer is not None and last is not None:     # keep what converged
+                kept = writer.kept_name()
+                writer.finish(last[0], {**last[1], "converged": 0,
+                                        "stop_reason": "interrupted"}, kept)
+            raise RodInterrupted(lines.interrupted(interrupts.name(number), event, kept),
+                                 number)
         elif isinstance(event, events.RunFinished):
             if writer is not None:
                 writer.finish(*last)

@@ -340,12 +340,20 @@ class ResultWriter:
         _set_attributes(group, attributes, ATTRIBUTE_UNITS)
         self.file.flush()
 
-    def finish(self, last_group, attributes):
+    def finish(self, last_group, attributes, name=None):
         """Link the root to ``last_group``, set the root attributes (the last step's and
-        the run record's) and the group ``parameters``, close and rename."""
+        the run record's) and the group ``parameters``, close and rename to the result's
+        path (or to ``name``: kept_name for the steps of an interrupted run)."""
         attributes = self._shared({**attributes, **self.run.attributes})
         self._collective(self._finish, last_group, attributes)
-        self._collective(self._rename)
+        self._collective(self._rename, name or self.path)
+
+    def kept_name(self):
+        """Where an interrupted run keeps its converged steps: ``<stem>.interrupted<ext>``
+        beside the result (``run.h5`` -> ``run.interrupted.h5``), never the result's own
+        name."""
+        stem, extension = os.path.splitext(self.path)
+        return f"{stem}.interrupted{extension or '.h5'}"
 
     def _finish(self, last_group, attributes):
         source = self.file[last_group]
@@ -357,9 +365,9 @@ class ResultWriter:
         self.file.close()
         self.file = None
 
-    def _rename(self):
+    def _rename(self, name):
         if self.comm.Get_rank() == 0:
-            os.replace(self.partial, self.path)
+            os.replace(self.partial, name)
 
     def abort(self):
         """Remove the partial file: nothing is left under the result name or beside it. A

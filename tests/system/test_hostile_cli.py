@@ -460,3 +460,37 @@ def test_two_runs_with_the_same_output_both_finish_and_leave_a_whole_file(tmp_pa
     with h5py.File(path, "r") as result:
         assert result.attrs["converged"] == 1 and "r" in result
     assert not partial_files(path)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_run_stopped_by_a_signal_keeps_its_converged_steps_as_a_restart_file(tmp_path,
+                                                                              ranks):
+    """Issue 25: a run stopped by a signal after some converged steps lost them all. They
+    are kept in FILE's .interrupted file (never FILE itself), converged = 0, stop_reason
+    interrupted, and a restart goes on from its load factor."""
+    path = tmp_path / "long.h5"
+    kept = tmp_path / "long.interrupted.h5"
+    process = start(LONG + ["-rod_output", str(path)], ranks)
+    try:
+        seen = []
+        for line in process.stdout:           # the second step converged: stop
+            seen.append(line)
+            if line.startswith("step 2/50:"):
+                break
+        assert seen and seen[-1].startswith("step 2/50:"), "".join(seen)
+        process.send_signal(signal.SIGTERM)
+        output, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    output = "".join(seen) + output
+    expected = 128 + signal.SIGTERM if ranks == 1 else 1        # mpiexec exits 1 itself
+    assert process.returncode == expected, output
+    assert not os.path.exists(path) and not partial_files(path), output
+    assert f"the converged steps are kept in {kept}" in output, output
+    with h5py.File(kept, "r") as f:
+        assert f.attrs["converged"] == 0 and f.attrs["stop_reason"] == "interrupted"
+        factor = float(f.attrs["load_factor"])
+        assert factor >= 2 / 50 - 1e-12 and len(f["steps"]) >= 2
+    again = run(LONG[:-6] + ["-rod_steps", "2", "-rod_initial", str(kept)])
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert f"restart from {kept}, load factor {factor:.6g}" in again.stdout
