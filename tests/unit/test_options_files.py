@@ -1,11 +1,11 @@
-"""The options files as PETSc reads them (petsc_rod/__main__.py), checked before PETSc
+"""The options files as PETSc reads them (petsc_rod/cli/options_files.py), checked before PETSc
 starts: the -options_file paths of a command line and of the files' own lines, loops
 and missing nested files refused, an include of the same file twice (no loop) kept.
 Pure Python: no PETSc, no MPI."""
 
 import pytest
 
-from petsc_rod.__main__ import (OptionsFileError, is_key, nested_files, options_file_error,
+from petsc_rod.cli.options_files import (OptionsFileError, is_key, nested_files, options_file_error,
                                 options_files)
 
 NO_PETSCRC = {"PETSC_OPTIONS": "-skip_petscrc"}
