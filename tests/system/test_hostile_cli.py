@@ -316,6 +316,17 @@ def test_a_write_that_fails_during_the_run_exits_5_and_removes_the_partial_file(
     ids=["SIGTERM", "SIGHUP", "SIGINT", "SIGINT to mpiexec", "SIGTERM to mpiexec",
          "SIGQUIT", "SIGUSR1", "SIGUSR2"])
 def test_a_signal_ends_the_run_cleanly(tmp_path, ranks, signal_number):
+    returncode, output, path = signalled_run(tmp_path, ranks, signal_number)
+    # mpiexec forwards the signal to every rank as SIGTERM and exits 1 itself
+    expected = 128 + signal_number if ranks == 1 else 1
+    name = signal.Signals(signal_number).name if ranks == 1 else "SIGTERM"
+    assert_one_line_and_nothing_left(returncode, output, expected,
+                                     [f"interrupted by {name}", "load factor"], path)
+
+
+def signalled_run(tmp_path, ranks, signal_number):
+    """(exit code, output, result path) of the LONG run sent ``signal_number`` half a
+    second after its partial file appeared."""
     path = tmp_path / "stopped.h5"
     process = start(LONG + ["-rod_output", str(path)], ranks)
     try:
@@ -325,26 +336,14 @@ def test_a_signal_ends_the_run_cleanly(tmp_path, ranks, signal_number):
         output, _ = process.communicate(timeout=TIMEOUT)
     finally:
         process.kill()
-    # mpiexec forwards the signal to every rank as SIGTERM and exits 1 itself
-    expected = 128 + signal_number if ranks == 1 else 1
-    name = signal.Signals(signal_number).name if ranks == 1 else "SIGTERM"
-    assert_one_line_and_nothing_left(process.returncode, output, expected,
-                                     [f"interrupted by {name}", "load factor"], path)
+    return process.returncode, output, path
 
 
 @pytest.mark.parametrize("signal_number", [signal.SIGUSR1, signal.SIGUSR2])
 def test_a_user_signal_to_mpiexec_ends_the_run_cleanly(tmp_path, signal_number):
     """mpiexec (Open MPI) forwards SIGUSR1 and SIGUSR2 to every rank as they are."""
-    path = tmp_path / "stopped.h5"
-    process = start(LONG + ["-rod_output", str(path)], 2)
-    try:
-        wait_for(f"{path}.partial", process)
-        time.sleep(0.5)
-        process.send_signal(signal_number)
-        output, _ = process.communicate(timeout=TIMEOUT)
-    finally:
-        process.kill()
-    assert_one_line_and_nothing_left(process.returncode, output, 128 + signal_number,
+    returncode, output, path = signalled_run(tmp_path, 2, signal_number)
+    assert_one_line_and_nothing_left(returncode, output, 128 + signal_number,
                                      [f"interrupted by {signal.Signals(signal_number).name}",
                                       "load factor"], path)
 
