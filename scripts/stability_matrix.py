@@ -184,6 +184,33 @@ def check_straight(bound):
     return check
 
 
+# Small deformations (docs/method.md §6: the stopping test measures the change and the
+# residual against the size of the deformation): the default tolerances, a cantilever
+# with a tip force along -y and a clamped-clamped rod twisted by a tiny angle, judged
+# against linear theory, exact to O((P L^2 / EI)^2) and O(angle^2) here (the elastica's
+# closed form loses ~1e-8 to cancellation at such loads).
+def small_cantilever(length, stiffness, force):
+    return {"length": length, "stiffness": f"{stiffness:g},{stiffness:g},{stiffness:g}",
+            "start": "clamp", "end": "free", "end_force": f"0,{-force:g},0",
+            "elements": 16, "steps": 2}
+
+
+def check_small_cantilever(length, stiffness, force, bound):
+    def check(result):
+        exact = force * length**3 / (3 * stiffness)         # P L^3 / 3 EI
+        error = abs(-float(result["r"][-1][1]) - exact) / exact
+        return error, bound, f"|deflection - P L^3/3EI| / (P L^3/3EI), P L^3/3EI = {exact:.3g} m"
+    return check
+
+
+def check_small_twist(angle, bound):
+    def check(result):
+        u3 = np.asarray(result["u"])[:, 2]              # u3 = angle / L, L = 1
+        return (float(np.max(np.abs(u3 - angle))) / angle, bound,
+                f"max |u3 - angle/L| / (angle/L), angle = {angle:g} rad")
+    return check
+
+
 CATENARY = {"length": 3000, "stiffness": "1e5,1e5,7.5e4", "start": "pin", "end": "pin",
             "end_position": "2500,0,0", "load": "0,0,-1000", "al_rtol": 1e-10,
             "al_ctol": 1e-7, "al_max_it": 20000}
@@ -332,6 +359,17 @@ def cases():
             name += f", R = {penalty}"
         add(Case("twist", name, options, check_link(turns, 2e-3),
                  notes=f"beyond the Greenhill angle {greenhill:.3g} rad"))
+    # small deformations at the default tolerances
+    for name, (length, stiffness, force) in {
+            "stiff cantilever, K = 1e8 N m^2, P = 3 N": (1.0, 1e8, 3.0),
+            "short cantilever, L = 1 mm, P = 0.03 N": (1e-3, 1.0, 0.03),
+            "tiny load, P = 1e-8 N": (1.0, 1.0, 1e-8)}.items():
+        add(Case("small", name, small_cantilever(length, stiffness, force),
+                 check_small_cantilever(length, stiffness, force, 1e-6),
+                 notes="P L^2/EI = " f"{force * length**2 / stiffness:.0e}"))
+    add(Case("small", "tiny twist, 1e-8 rad", twist(angle=1e-8, elements=16, al_rtol=1e-9,
+                                                       al_ctol=1e-9, al_max_it=2000),
+             check_small_twist(1e-8, 1e-6)))
     # mesh extremes
     coarse = {"al_rtol": 1e-5, "al_ctol": 1e-3}             # the paper's tolerances
     add(Case("mesh", "cantilever, 2 elements", cantilever(elements=2, **coarse),

@@ -108,11 +108,12 @@ class StepController:
     def _record(self, change, residual):
         self.history.append((change, residual, time.perf_counter() - self.clock))
 
-    def observe(self, change, residual, penalty):
-        """A Uzawa iteration's norms at penalty R (N): recorded, and the Decision after
-        it taken (and returned)."""
+    def observe(self, change, residual, penalty, scale=1.0):
+        """A Uzawa iteration's norms at penalty R (N), relative to the size of the
+        deformation ``scale`` (RodState.norms: they were divided by it): recorded, and
+        the Decision after it taken (and returned)."""
         self._record(change, residual)
-        self.decision = self._decide(penalty)
+        self.decision = self._decide(penalty, residual * scale)
         return self.decision
 
     def record_newton_step(self, turn):
@@ -137,10 +138,10 @@ class StepController:
         """The last decision, ITERATE before any and after ``resume``."""
         return self.decision if self.decision is not None else ITERATE
 
-    def _decide(self, penalty):
+    def _decide(self, penalty, absolute_residual):
         settings, iteration = self.settings, len(self.history)
         change, residual = self.history[-1][:2]
-        if stopping.diverged(change, residual):
+        if stopping.diverged(change, absolute_residual):
             self.error = RodIterationDiverged(
                 f"{self.label}iteration {iteration}: the iteration diverged (change "
                 f"{change:.3g}, constraint residual {residual:.3g})", iteration)

@@ -220,10 +220,10 @@ class UzawaSolver:
             step.fail(error)
             f.set(0.0)
             return
-        change, residual = self.problem.norms()
-        step.observe(change, residual, self.penalty)
+        norms = self.problem.norms()
+        step.observe(norms.change, norms.residual, self.penalty, norms.scale)
         if self.monitor is not None:
-            self.monitor(step.label, len(step.history), change, residual)
+            self.monitor(step.label, len(step.history), norms.change, norms.residual)
         self._pack(f)
         f.aypx(-1.0, x)
 

@@ -12,7 +12,7 @@ owned node values in node order (the last vertex's midpoint slot is a phantom). 
   r'_0, r'_m, r'_1 being stride-2 slices of the slope's ghosted arrays
   (fields.element_slices), not a gather through an index array;
 * the sums of the stopping tests (RodState.norms): weighted row sums of squares of
-  differences, block by block through a scratch array that stays in cache; the previous
+  differences (to tau, to the previous values, to the unstressed reference), block by block through a scratch array that stays in cache; the previous
   values are kept by swapping two arrays, not by a copy.
 """
 
@@ -71,11 +71,14 @@ class NodeValues:
         np.copyto(self.previous_directors, self.directors)
         np.copyto(self.previous_positions, self.positions)
 
-    def stopping_sums(self, tau, weights):
-        """Local sums (gap, size, step) of the stopping tests, with X = (r, D):
+    def stopping_sums(self, tau, weights, reference_directors, reference_positions):
+        """Local sums (gap, size, step, deformation) of the stopping tests, with
+        X = (r, D) and X^ref the unstressed reference state at the nodes (the reference
+        directors (n, 3, 3) and positions (n, 3)):
 
             gap = sum_n w_n |D_n - tau_n|^2,   size = sum_n w_n |X_n|^2,
             step = sum_n w_n |X_n - X_n^prev|^2,
+            deformation = sum_n w_n |X_n - X_n^ref|^2,
 
         over blocks of CHUNK nodes, so that the differences stay in cache and each array
         is read once; then the current values become the previous ones (the arrays are
@@ -84,8 +87,9 @@ class NodeValues:
         n = self.n
         directors, previous = self.directors.reshape(n, 9), self.previous_directors.reshape(n, 9)
         tau = tau.reshape(n, 9)
+        reference = reference_directors.reshape(n, 9)
         positions, previous_positions = self.positions, self.previous_positions
-        sums = np.zeros(3)          # gap, size, step
+        sums = np.zeros(4)          # gap, size, step, deformation
         for block in blocks(n):
             size = block.stop - block.start
             w, rows, work = weights[block], self._rows[:size], self._scratch[:size]
@@ -100,6 +104,7 @@ class NodeValues:
             sums[0] += weighted(d, tau[block])
             sums[1] += weighted(d) + weighted(p)
             sums[2] += weighted(d, previous[block]) + weighted(p, previous_positions[block])
+            sums[3] += weighted(d, reference[block]) + weighted(p, reference_positions[block])
         self.directors, self.previous_directors = self.previous_directors, self.directors
         self.positions, self.previous_positions = self.previous_positions, self.positions
         return sums

@@ -108,8 +108,8 @@ class RodProblem:
         EVENTS["multiplier"].end()
 
     def norms(self):
-        """(relative change, RMS constraint residual) of the last iteration (§6,
-        RodState.norms; one allreduce)."""
+        """The change and RMS constraint residual of the last iteration, relative to the
+        size of the deformation (§6, RodState.norms: a state.Norms; one allreduce)."""
         EVENTS["norms"].begin()
         try:
             return self.state.norms()

@@ -9,6 +9,8 @@ the node values of the local step, how a state is started, saved and measured.
 * mu, the multiplier of the chord constraint r(L) - r(0) = int r' dS (both ends held).
 """
 
+from typing import NamedTuple
+
 import numpy as np
 
 from petsc_rod.global_step.centreline import midpoint_slopes, positions_at_points
@@ -17,6 +19,21 @@ from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
 from petsc_rod.frames import rotations
 from petsc_rod.problem.node_values import NodeValues
 from petsc_rod.scenes import starts
+
+# Deformations smaller than this, relative to |X|, are resolved to rtol times it of |X|
+# (1e-14 at the default rtol: near round-off, which the iteration reaches: docs/method.md
+# §6), not relative to themselves.
+DEFORMATION_FLOOR = 1e-5
+
+
+class Norms(NamedTuple):
+    """The stopping quantities of one iteration (RodState.norms): change and RMS
+    constraint residual, both divided by ``scale``, the relative size of the deformation
+    in [DEFORMATION_FLOOR, 1]."""
+
+    change: float
+    residual: float
+    scale: float
 
 
 class RodState:
@@ -34,6 +51,10 @@ class RodState:
         h = mesh.element_h
         self._gauss = p2_basis(GAUSS_POINTS, h), p2_integrals(GAUSS_POINTS, h)
         self._nodes = NodeValues(mesh)
+        # the unstressed reference state at the nodes: what the deformation is measured
+        # from (norms)
+        self._reference_positions, reference_frames, _ = starts.straight(mesh.node_S())
+        self._reference_directors = np.ascontiguousarray(reference_frames)
 
     @property
     def frame_fields(self):
@@ -188,19 +209,30 @@ class RodState:
         return self.node_directors()
 
     def norms(self):
-        """Relative change of X = (r, d1, d2, r') since the last call and RMS constraint
-        residual at the nodes (docs/method.md §6):
+        """The stopping quantities of the last iteration (docs/method.md §6), measured
+        against the size of the deformation, so that they mean the distance to the
+        solution whatever that size (one allreduce). With X = (r, d1, d2, r') at the
+        nodes, X^ref the unstressed reference state and d_n the directors of the last
+        take_directors (or remember):
 
-            change = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2),
-            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L)   (one allreduce),
+            deformation = sqrt(sum_n w_n |X_n - X_n^ref|^2 / sum_n w_n |X_n|^2),
+            s = min(1, max(deformation, DEFORMATION_FLOOR)),
+            change   = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2) / s,
+            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L) / s.
 
-        d_n the directors of the last take_directors (or remember).
+        A deformation of the order of the state (s = 1) gives the change relative to
+        |X| and the plain RMS residual; a small one is resolved relative to itself,
+        down to DEFORMATION_FLOOR (below it, to rtol DEFORMATION_FLOOR of |X|, near
+        round-off). Returns Norms(change, residual, scale = s).
         """
         self.node_positions()
-        gap, size, step = self.mesh.global_sum(
-            self._nodes.stopping_sums(self.tau, self.node_weights))
-        change = np.sqrt(step / size) if size > 0 else np.inf
-        return change, np.sqrt(gap / self.mesh.length)
+        gap, size, step, deformation = self.mesh.global_sum(self._nodes.stopping_sums(
+            self.tau, self.node_weights, self._reference_directors, self._reference_positions))
+        if size <= 0:
+            return Norms(np.inf, np.inf, 1.0)
+        scale = min(1.0, max(np.sqrt(deformation / size), DEFORMATION_FLOOR))
+        return Norms(np.sqrt(step / size) / scale, np.sqrt(gap / self.mesh.length) / scale,
+                     scale)
 
     def destroy(self):
         for obj in [*self.frame_fields, self.r]:
