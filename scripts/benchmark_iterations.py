@@ -57,22 +57,31 @@ def matrix_representatives():
     return chosen
 
 
-def run(arguments, max_it, folder):
-    """One child run; (outcome, per-step iterations, wall time, energy)."""
+def run_child(arguments, folder, ranks=1, timeout=TIMEOUT):
+    """One child run of petsc_rod as a user runs it (``mpiexec -n ranks`` for ranks > 1)
+    with its result written into ``folder``: (outcome, wall time of the process in s,
+    the result file's path or None when there is none)."""
     output = os.path.join(folder, "result.h5")
-    command = [sys.executable, "-m", "petsc_rod", *arguments, "-rod_output", output]
-    if max_it:
-        command += ["-rod_al_max_it", str(max_it)]
+    if os.path.exists(output):
+        os.remove(output)
+    command = [*stability_matrix.python_command(ranks), *arguments, "-rod_output", output]
     clock = time.perf_counter()
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT,
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout,
                               cwd=ROOT)
     except subprocess.TimeoutExpired:
-        return "timeout", [], TIMEOUT, np.nan
+        return "timeout", timeout, None
     wall = time.perf_counter() - clock
     outcome = {0: "converged", 3: "stopped", 4: "diverged"}.get(done.returncode,
                                                                f"exit {done.returncode}")
-    if not os.path.exists(output):
+    return outcome, wall, output if os.path.exists(output) else None
+
+
+def run(arguments, max_it, folder):
+    """One child run; (outcome, per-step iterations, wall time, energy)."""
+    outcome, wall, output = run_child(
+        arguments + (["-rod_al_max_it", str(max_it)] if max_it else []), folder)
+    if output is None:
         return outcome, [], wall, np.nan
     with h5py.File(output, "r") as f:
         steps = sorted(f["steps"], key=int)

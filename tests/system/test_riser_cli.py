@@ -159,3 +159,22 @@ def test_the_file_holds_the_current_profile_and_the_drag_with_its_units(tmp_path
         assert units["current_profile_table"].startswith("m, m/s")
         assert np.array_equal(parameters.attrs["drag"], [1025.0, 1.2, 0.324])
         assert units["drag"] == "kg/m^3, 1, m"
+
+
+def test_the_80_m_lazy_wave_cable_on_one_and_two_ranks(tmp_path):
+    """options/cable_80m.opts (Lozon et al. 2025, the 80 m site) converges with the
+    defaults, to the same state on 1 and 2 ranks (the iteration's tolerance; the 2-rank
+    global step is another exact solve, with its own round-off)."""
+    results = {}
+    for ranks in (1, 2):
+        path = tmp_path / f"cable_{ranks}.h5"
+        process = run(["-options_file", "options/cable_80m.opts", "-rod_output", str(path)],
+                      ranks=ranks)
+        assert process.returncode == 0, process.stdout + process.stderr
+        with h5py.File(path, "r") as f:
+            results[ranks] = {key: f.attrs[key] for key in ("top_tension", "touchdown_S")}
+            results[ranks]["r"] = f["r"][:]
+    one, two = results[1], results[2]
+    assert abs(one["top_tension"] - two["top_tension"]) < 1e-6 * one["top_tension"]
+    assert abs(one["touchdown_S"] - two["touchdown_S"]) < 1e-3
+    assert np.abs(one["r"] - two["r"]).max() < 1e-5
