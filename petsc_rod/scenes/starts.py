@@ -10,6 +10,7 @@ n' + f = 0); lambda1 = lambda2 = 0.
 
 import numpy as np
 
+from petsc_rod.scenes import section_catenary
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
 from petsc_rod.errors import RodInputError
@@ -32,16 +33,21 @@ def catenary_start(scene, t):
     frame keeps d1 normal to the plane of the catenary (e_v x e_h, which is e_y for a
     cable in the x-z plane, as in the reference frame), d2 = d3 x d1.
 
+    A load of several pieces (-rod_load_breaks: a line of sections, a lazy wave's
+    buoyancy) gives the catenary of those weights, section_start.
+
     Raises RodInputError for scenes that have no catenary: an end not held, a load that
-    is zero or not uniform, the ends L or more apart, or a chord along the load.
+    is zero (or, in pieces, not vertical), the ends L or more apart, or a chord along
+    the load.
     """
     start, end = scene.start_state(t), scene.end_state(t)
     if not (is_held(start) and is_held(end)):
         raise RodInputError("-rod_initial_shape catenary needs both ends held "
                             "(-rod_start and -rod_end clamp or pin)")
-    if len(scene.load_values) != 1 or not np.any(scene.load_values[0]):
-        raise RodInputError("-rod_initial_shape catenary needs one uniform, non-zero "
-                            "-rod_load (no -rod_load_breaks)")
+    if len(scene.load_values) > 1:
+        return section_start(scene, t, start, end)
+    if not np.any(scene.load_values[0]):
+        raise RodInputError("-rod_initial_shape catenary needs a non-zero -rod_load")
     load = t * scene.load_values[0]
     chord = end.position - start.position
     try:
@@ -58,10 +64,55 @@ def catenary_start(scene, t):
     if scene.seabed is not None:        # resting on the seabed where it reaches it
         shape = seabed_shape(scene, chord, load, shape)
 
+    return planar_curve(shape, normal, start.position)
+
+
+def planar_curve(shape, normal, origin):
+    """The curve S -> (r, frame, force) of a planar ``shape`` S -> (r, tangent, force)
+    (r from ``origin``): d1 = ``normal`` to the plane, d2 = d3 x d1, d3 the tangent."""
     def curve(S):
         r, tangent, force = shape(S)
         d1 = np.broadcast_to(normal, tangent.shape)
         frame = np.stack([d1, np.cross(tangent, d1), tangent], axis=-2)
-        return start.position + r, frame, force
+        return origin + r, frame, force
 
     return curve
+
+
+def section_start(scene, t, start, end):
+    """The catenary of a line of sections (section_catenary.py) at load factor t: the
+    weights of the load's pieces, which must all be vertical; resting on the seabed
+    from S = 0 where the start lies on it. RodInputError where there is none, or where
+    the line would pass below the seabed."""
+    loads = t * scene.load_values
+    if np.any(loads[:, :2]) or not np.any(loads[:, 2]):
+        raise RodInputError("-rod_initial_shape catenary with -rod_load_breaks needs "
+                            "vertical loads (0,0,fz per piece), not all zero")
+    chord = end.position - start.position
+    span = float(np.hypot(chord[0], chord[1]))
+    seabed = scene.seabed
+    on_seabed = seabed is not None and abs(start.position[2] - seabed.height) <= (
+        1e-9 * scene.length)
+    try:
+        line = section_catenary.solve(scene.load_piece_ends, -loads[:, 2], span,
+                                      float(chord[2]), on_seabed)
+    except ValueError as error:
+        raise RodInputError(f"-rod_initial_shape catenary: no catenary of the load's pieces "
+                            f"({str(error).removeprefix('section catenary: ')}); use the "
+                            "straight start") from None
+    along = np.array([chord[0], chord[1], 0.0]) / span
+    up = np.array([0.0, 0.0, 1.0])
+    if seabed is not None and not on_seabed:
+        lowest = line.at(np.linspace(0.0, scene.length, 4097))[1].min() + start.position[2]
+        if lowest < seabed.height:
+            raise RodInputError("-rod_initial_shape catenary: the catenary of the load's "
+                                "pieces passes below the seabed and its start is not on "
+                                "it; use the straight start")
+
+    def shape(S):
+        x, z, V = line.at(S)
+        force = line.H * along + V[..., None] * up
+        tangent = force / np.linalg.norm(force, axis=-1, keepdims=True)
+        return x[..., None] * along + z[..., None] * up, tangent, force
+
+    return planar_curve(shape, np.cross(up, along), start.position)

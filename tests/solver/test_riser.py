@@ -261,3 +261,40 @@ def test_the_step_line_and_file_attributes_of_a_riser(comm, solver_factory):
     assert {"effective_tension", "seabed_reaction"} <= set(written["vertex"])
     assert {"top_tension", "top_angle", "touchdown_S", "touchdown_position", "max_curvature",
             "min_bend_radius", "grounded_length"} <= set(written["attributes"])
+
+
+# --- a lazy wave in the small-EI limit --------------------------------------------------
+# The 80 m cable of options/cable_80m.opts (bare / buoyancy / bare, an uplift on the
+# buoyancy section), on a seabed stiff enough that it sinks by 1 micrometre: as EI -> 0
+# the line tends to the catenary of its sections (scenes/section_catenary.py), with
+# boundary layers of width sqrt(EI / T) at the touchdown and the ends.
+CABLE_ENDS = [0.0, 52.101, 102.101, 170.215]
+CABLE_WEIGHTS = [157.8003, -80.1525, 157.8003]
+
+
+def cable(stiffness):
+    return dict(length=170.215, stiffness=(stiffness,) * 3, start="pin", end="pin",
+                end_position=(120.0, 0.0, 66.0), load_breaks=CABLE_ENDS[1:-1],
+                load_values=[[0.0, 0.0, -w] for w in CABLE_WEIGHTS],
+                seabed=Seabed(0.0, 157.8003e6))
+
+
+def test_a_lazy_wave_tends_to_the_catenary_of_its_sections(comm, solver_factory):
+    """Measured: the largest distance to the section catenary is 4.0e-3 m at EI = 100
+    and 3.7e-4 m at EI = 1 N m^2, falling like sqrt(EI); the hang-off tension within
+    1.5e-6 of it at EI = 1. Started from that catenary (starts.section_start)."""
+    from petsc_rod.scenes.section_catenary import solve
+    line = solve(CABLE_ENDS, CABLE_WEIGHTS, 120.0, 66.0, on_seabed=True)
+    errors = []
+    for stiffness in (100.0, 1.0):
+        _, solver, report = solved(solver_factory, comm, 340, cable(stiffness),
+                                   start="catenary", rtol=1e-9, ctol=1e-9)
+        assert report.converged
+        fields = vertex_fields(solver.problem)
+        S, r, n = (gather(comm, fields[key]) for key in ("S", "r", "n"))
+        x, z, V = line.at(S)
+        errors.append(np.hypot(r[:, 0] - x, r[:, 2] - z).max())
+        assert np.abs(r[:, 1]).max() == 0.0
+    tension = np.hypot(line.H, line.at(170.215)[2])
+    assert errors[1] < 1e-3 and errors[0] / errors[1] > 5.0        # sqrt(100) = 10
+    assert abs(np.linalg.norm(n[-1]) - tension) < 1e-5 * tension

@@ -65,14 +65,19 @@ def test_catenary_start_frame_is_a_right_handed_rotation_with_d3_the_tangent():
     assert np.allclose(force, exact_force)
 
 
-def test_catenary_start_needs_held_ends_and_one_uniform_load():
+def test_catenary_start_needs_held_ends_and_a_load_it_can_hang_under():
     held = dict(length=10.0, stiffness=[1, 1, 1], start="pin", end="pin",
                 end_position=[8.0, 0.0, 0.0])
     for scene in (Scene(**dict(held, end="free")),
                   Scene(**held),
-                  Scene(**held, load_values=[[0, 0, -1], [0, 0, -2]], load_breaks=[5.0])):
+                  Scene(**held, load_values=[[0, -1, 0], [0, 0, -2]], load_breaks=[5.0])):
         with pytest.raises(RodInputError):
             catenary_start(scene, 1.0)
+    # vertical pieces: the catenary of the sections (section_catenary.py), through both ends
+    pieces = Scene(**held, load_values=[[0, 0, -1], [0, 0, -2]], load_breaks=[5.0])
+    r, frames, force = catenary_start(pieces, 1.0)(np.array([0.0, 10.0]))
+    assert np.allclose(r, [[0.0, 0.0, 0.0], [8.0, 0.0, 0.0]], atol=1e-9)
+    assert np.allclose(np.cross(frames[:, 2], force), 0.0, atol=1e-9)    # force along d3
 
 
 def test_default_penalty_is_the_largest_of_bending_load_and_twist_scales():
