@@ -156,6 +156,18 @@ class RodProblem:
             self._second_variation.update()
         return self._second_variation
 
+    def turn_to_canonical(self):
+        """In an axially symmetric scene (Scene.axially_symmetric) turn the state about
+        the axis to the canonical member of its family of equilibria
+        (RodState.canonical_angle, docs/method.md §10); elsewhere nothing. Which member
+        an iteration reaches depends on round-off that an accelerated iteration
+        amplifies, so on the partition; the canonical one does not. Collective."""
+        if not self.scene.axially_symmetric:
+            return
+        angle = self.state.canonical_angle()
+        if angle is not None:
+            self.state.turn_about_axis(angle)
+
     # --- what the outputs read ----------------------------------------------------------
     def link(self):
         """Twist and writhe of the current state, (Tw, Wr) in turns, Lk = Tw + Wr
