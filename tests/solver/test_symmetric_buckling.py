@@ -48,8 +48,10 @@ def solve_on(comm, scene_kwargs, steps):
         solver.problem.state.set_straight()
         reports = [event.report for event in continuation(solver, PathSettings(steps=steps))
                    if isinstance(event, StepEnded)]
-        return dict(reports=reports, r=gather(comm, solver.problem.state.r.owned()[:, 0]),
-                    energy=solver.problem.energy())
+        r, energy = gather(comm, solver.problem.state.r.owned()[:, 0]), solver.problem.energy()
+        # one more iteration from the turned state: (change, residual) of a fixed point
+        solver.problem.iterate()
+        return dict(reports=reports, r=r, energy=energy, next_norms=solver.problem.norms())
     finally:
         solver.destroy()
         solver.problem.destroy()
@@ -90,6 +92,15 @@ def test_the_canonical_member(both):
         assert np.abs(run["r"][:, 2]).max() < R_TOL
         S = np.linspace(0.0, 1.0, N_ELEMENTS + 1)
         assert np.mean((1 + S) * run["r"][:, 1]) > 0.05
+
+
+def test_the_turned_state_is_still_a_fixed_point(both):
+    """The turn to the canonical member moves a converged state along its family: the
+    next iteration changes it no more than the last one before the turn did (rtol, ctol
+    1e-9)."""
+    for run in both:
+        change, residual = run["next_norms"]
+        assert change < 1e-8 and residual < 1e-8
 
 
 def test_same_energy(both):
