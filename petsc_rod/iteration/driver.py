@@ -133,6 +133,9 @@ class UzawaSolver:
             self._controller = None
         if step.error is not None:
             raise step.error
+        if step.converged:
+            # the member of a symmetric scene's family that no partition chooses (§10)
+            self.problem.turn_to_canonical()
         return step.report()
 
     def _iterate(self, step):

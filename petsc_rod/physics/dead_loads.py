@@ -19,6 +19,9 @@ from petsc_rod.physics.term import Term
 class DeadLoads(Term):
     """The dead loads of a Scene on a Mesh. Owns the VectorField of b; ``destroy()``."""
 
+    # the scene's own loads, which Scene.axially_symmetric checks
+    axially_symmetric = True
+
     def __init__(self, mesh, scene):
         self.mesh, self.scene = mesh, scene
         self.t = 0.0

@@ -47,6 +47,11 @@ class Term:
     # energy, add_gradient and add_hessian are the term's whole contribution to E, so
     # that Newton steps on the reduced problem (§11) may be taken with it
     in_newton = True
+    # the term is unchanged by a turn of the rod about the x axis when the scene is
+    # (Scene.axially_symmetric): the solver may then report the canonical member of a
+    # family of equilibria (§10). False unless the term says so: a term the core does
+    # not know may load the rod off the axis
+    axially_symmetric = False
     # components of the slope r' (0, 1, 2 for x, y, z) that the term solves itself in
     # the global step (solve_slope) in place of the P2 solve (the seabed: z)
     slope_components = ()

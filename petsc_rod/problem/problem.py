@@ -64,6 +64,13 @@ class RodProblem:
         """Every term's energy, gradient and Hessian are exact: Newton steps (§11) apply."""
         return all(term.in_newton for term in self.terms)
 
+    @property
+    def axially_symmetric(self):
+        """The scene and every term are unchanged by a turn about the x axis (with the
+        sections' roll): equilibria come in families (§10, ``turn_to_canonical``)."""
+        return self.scene.axially_symmetric and all(term.axially_symmetric
+                                                    for term in self.terms)
+
     # --- the global step and the map --------------------------------------------------------
     @property
     def penalty(self):
@@ -155,6 +162,18 @@ class RodProblem:
         else:
             self._second_variation.update()
         return self._second_variation
+
+    def turn_to_canonical(self):
+        """In an axially symmetric problem (``axially_symmetric``) turn the state about
+        the axis to the canonical member of its family of equilibria
+        (RodState.canonical_angle, docs/method.md §10); elsewhere nothing. Which member
+        an iteration reaches depends on round-off that an accelerated iteration
+        amplifies, so on the partition; the canonical one does not. Collective."""
+        if not self.axially_symmetric:
+            return
+        angle = self.state.canonical_angle()
+        if angle is not None:
+            self.state.turn_about_axis(angle)
 
     # --- what the outputs read ----------------------------------------------------------
     def link(self):

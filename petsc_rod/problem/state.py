@@ -16,7 +16,7 @@ import numpy as np
 from petsc_rod.global_step.centreline import midpoint_slopes, positions_at_points
 from petsc_rod.mesh.elements import GAUSS_POINTS, P2, p2_basis, p2_integrals
 from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
-from petsc_rod.frames import rotations
+from petsc_rod.frames import rotation_about, rotations
 from petsc_rod.problem.node_values import NodeValues
 from petsc_rod.scenes import starts
 
@@ -24,6 +24,12 @@ from petsc_rod.scenes import starts
 # (1e-14 at the default rtol: near round-off, which the iteration reaches: docs/method.md
 # §6), not relative to themselves.
 DEFORMATION_FLOOR = 1e-5
+
+# The axis of the turns of an axially symmetric scene (Scene.axially_symmetric).
+REFERENCE_AXIS = np.array([1.0, 0.0, 0.0])
+# A state whose weighted off-axis moment |v| (RodState.canonical_angle) is below this
+# times L^2 is not turned: straight to round-off.
+CANONICAL_FLOOR = 1e-8
 
 
 class Norms(NamedTuple):
@@ -111,6 +117,40 @@ class RodState:
         turn = rotations(omega)
         self.tau[:] = np.einsum("nkl,nil->nik", turn, self.tau)
         self.lam[:] = np.einsum("nkl,nil->nik", turn, self.lam)
+
+    def canonical_angle(self):
+        """The angle (rad) of the turn about e_x that takes this state to the canonical
+        member of its family in an axially symmetric scene (docs/method.md §10): the
+        turn that points v = int (1 + S/L) (r_y, r_z) dS along +y. None where |v| is
+        below CANONICAL_FLOOR L^2 (a straight rod: no family to choose from). The weight
+        has an even and an odd part in S, so that neither a symmetric nor an
+        antisymmetric bow gives v = 0. v is a sum over the nodes (one allreduce): the
+        same on any number of ranks to round-off."""
+        mesh = self.mesh
+        weight = self.node_weights * (1 + mesh.node_S() / mesh.length)
+        v = mesh.global_sum(weight @ self.node_positions()[:, 1:])
+        if np.hypot(*v) <= CANONICAL_FLOOR * mesh.length**2:
+            return None
+        return -float(np.arctan2(v[1], v[0]))
+
+    def turn_about_axis(self, angle):
+        """Turn the whole state by ``angle`` rad about the x axis through the origin and
+        roll every section back by -angle about its own d3: r, r', d_i, tau_i, lambda_i
+        and mu -> Q (.) with Q the rotation about e_x, then (d1, d2) and their tau,
+        lambda rolled (``rolled``). Where d3 = e_x (a clamp in an axially symmetric
+        scene) the two cancel; with K1 = K2 the roll costs nothing: an equilibrium goes
+        to an equilibrium, a fixed point of the iteration to a fixed point."""
+        q = rotation_about(REFERENCE_AXIS, angle)
+        for field in (self.r, self.slope):
+            field.set_owned(field.owned() @ q.T)
+        d1, d2 = rolled(self.d1.owned() @ q.T, self.d2.owned() @ q.T, -angle)
+        self.d1.set_owned(d1)
+        self.d2.set_owned(d2)
+        for frames in (self.tau, self.lam):
+            frames[:] = frames @ q.T
+            frames[:, 0], frames[:, 1] = rolled(frames[:, 0], frames[:, 1], -angle)
+        self.chord_multiplier = q @ self.chord_multiplier
+        self.remember()
 
     def set_node_directors(self, frames):
         """d1, d2 and r' = d3 at the owned P2 nodes from frames (n_nodes, 3, 3), rows

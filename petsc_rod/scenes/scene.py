@@ -120,6 +120,22 @@ class Scene:
             return None
         return axis.copy()
 
+    @property
+    def axially_symmetric(self):
+        """Whether every rotation about the x axis through the origin, together with a
+        uniform roll of the sections, maps an equilibrium to an equilibrium: K1 = K2 (the
+        roll costs nothing), every load along e_x, a held end S = L on the axis and a
+        clamped one only rolled about e_x, no seabed, no current. Such a scene buckles
+        into a family of equilibria (docs/method.md §10, which the solver reports)."""
+        axis = REFERENCE_FRAME[2]
+        off_axis = np.concatenate([self.start_force[1:], self.end_force[1:],
+                                   self.load_values[:, 1:].ravel()])
+        tilt = self._end_rotation - (self._end_rotation @ axis) * axis
+        return bool(self.stiffness[0] == self.stiffness[1] and not np.any(off_axis)
+                    and (self.end == "free" or not np.any(self.end_position[1:]))
+                    and (self.end != "clamp" or np.linalg.norm(tilt) <= 1e-12)
+                    and self.seabed is None and self.current is None)
+
     def end_roll(self, t):
         """The angle (rad) by which the end frame has rolled about link_axis at load
         factor t, counted continuously from t = 0 (end_state: the rotation of -rod_end_frame
