@@ -94,3 +94,24 @@ def test_a_restart_of_the_same_scene_goes_on_from_the_files_load_factor(shared_t
     assert run_cli({**force, "rod_initial": old, "rod_initial_load_factor": "0.5",
                     "rod_steps": "2", "rod_output": new}) == 0
     assert step_factors(new) == [0.75, 1.0]
+
+
+def test_a_restart_adding_a_current_reaches_the_direct_run_with_it(shared_tmp):
+    """A hanging line (HANGING) converged without a current, restarted with one: the
+    drag is walked in, (1 - s) t_f f_A + s f_B with f_A = 0, and the end is the direct
+    run's with the current (both in STEPS steps; the drag, about 0.5 N/m across, bends
+    the line out of its plane)."""
+    current = {"rod_current": "0,1,0", "rod_drag": "1000,1,0.001"}
+    line = {**HANGING, "rod_end_position": "0.8,0,0.3"}
+    files = {name: f"{shared_tmp}/{name}.h5" for name in ("still", "walk", "direct")}
+    assert run_cli({**line, "rod_initial_shape": "catenary", "rod_output": files["still"]}) == 0
+    assert run_cli({**line, **current, "rod_initial": files["still"], "rod_steps": str(STEPS),
+                    "rod_output": files["walk"]}) == 0
+    assert run_cli({**line, **current, "rod_initial_shape": "catenary",
+                    "rod_steps": str(STEPS), "rod_output": files["direct"]}) == 0
+    assert step_factors(files["walk"]) == [k / STEPS for k in range(1, STEPS + 1)]
+    walked, _ = positions(files["walk"])
+    direct, _ = positions(files["direct"])
+    still, _ = positions(files["still"])
+    assert np.abs(walked - still).max() > 1e-2           # the current moved it
+    assert np.abs(walked - direct).max() <= AGREEMENT
