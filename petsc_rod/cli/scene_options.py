@@ -232,12 +232,13 @@ def scene_from_parameters(parameters):
 def restart_path(scene, parameters, t_file):
     """The scene a restart's load path walks: ``scene`` itself (the path goes on from the
     file's load factor t_file) when the file's scene, rebuilt from its ``parameters``,
-    carries the same load path; else the BlendedPath from the file's scene at t_file to
-    ``scene`` at 1 (scenes/blend.py). Returns (that scene, the options whose load-path
+    carries the same load path, or t_file = 0 (both paths start from the same unloaded
+    reference: this scene's own path is the walk); else the BlendedPath from the file's
+    scene at t_file to ``scene`` at 1 (scenes/blend.py). Returns (that scene, the options whose load-path
     values differ, the options taken from ``scene`` from the first step)."""
     old = scene_from_parameters(parameters)
     walked = [FIELD_OPTIONS[name] for name in differences(old, scene, PATH_FIELDS)]
     fixed = [FIELD_OPTIONS[name] for name in differences(old, scene, FIXED_FIELDS)]
-    if not walked:
-        return scene, walked, fixed
+    if not walked or t_file == 0:       # at t = 0 every scene is the unloaded reference
+        return scene, [], fixed
     return BlendedPath(old, t_file, scene), walked, fixed
