@@ -17,6 +17,8 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.cli import main
+from petsc_rod.frames import rotation_about, rotation_log
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 STEPS = 2
 # positions agree to this fraction of the length (the iteration's tolerances are 1e-10)
@@ -24,6 +26,31 @@ AGREEMENT = 1e-7
 COMMON = {"rod_elements": "16", "rod_al_rtol": "1e-10", "rod_al_ctol": "1e-10"}
 # pinned at both ends under its weight: it hangs below its ends, one stable equilibrium
 HANGING = {"rod_start": "pin", "rod_end": "pin", "rod_load": "0,0,-5"}
+
+# clamped at both ends on e_x with a little slack: the link is tracked through the walk
+TWISTED = {"rod_end": "clamp", "rod_end_position": "0.97,0,0", "rod_load": "0,0,-2"}
+# clamped at both ends, the end turned: its frame walks along the geodesic
+CANTILEVER_DOWN = {"rod_end": "clamp", "rod_end_position": "0.8,0.3,0.2"}
+
+
+def tilted(axis, angle):
+    """The reference frame (rows e_y, e_z, e_x) turned by ``angle`` about ``axis``."""
+    return REFERENCE_FRAME @ rotation_about(axis, angle).T
+
+
+def frame_option(axis, angle):
+    return ",".join(f"{v:.17g}" for v in tilted(axis, angle).ravel())
+
+
+def mean_frame_option(first, second):
+    """The frame halfway along the geodesic between two tilted frames a and b: a turned
+    by half the angle of the rotation P = b^T a that takes a's rows to b's, about its
+    axis."""
+    a, b = tilted(*first), tilted(*second)
+    w = rotation_log(b.T @ a)
+    return ",".join(f"{v:.17g}" for v in
+                    (a @ rotation_about(w, 0.5 * np.linalg.norm(w)).T).ravel())
+
 
 # (file's scene A, new scene B, the mean scene, the start of a run from no file)
 CASES = {
@@ -35,6 +62,12 @@ CASES = {
                      {**HANGING, "rod_end_position": "0.7,0.2,0.3"},
                      {**HANGING, "rod_end_position": "0.75,0.25,0.15"},
                      {"rod_initial_shape": "catenary"}),
+    "end twist": ({**TWISTED, "rod_end_twist": "1"}, {**TWISTED, "rod_end_twist": "2.5"},
+                  {**TWISTED, "rod_end_twist": "1.75"}, {}),
+    "end frame": ({**CANTILEVER_DOWN, "rod_end_frame": frame_option([0, 0, 1], 0.3)},
+                  {**CANTILEVER_DOWN, "rod_end_frame": frame_option([0, 1, 0], -0.5)},
+                  {**CANTILEVER_DOWN, "rod_end_frame": mean_frame_option(
+                      ([0, 0, 1], 0.3), ([0, 1, 0], -0.5))}, {}),
 }
 
 
