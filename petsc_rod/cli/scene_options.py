@@ -20,7 +20,8 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "start_force": "-rod_start_force", "end_force": "-rod_end_force",
                  "end_position": "-rod_end_position", "end_frame": "-rod_end_frame",
                  "end_twist": "-rod_end_twist",
-                 "current": "the current (-rod_current|-rod_current_profile, -rod_drag)",
+                 "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
+                             "-rod_drag)"),
                  "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
                  "seabed": "-rod_seabed"}
 

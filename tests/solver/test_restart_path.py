@@ -148,3 +148,23 @@ def test_a_restart_adding_a_current_reaches_the_direct_run_with_it(shared_tmp):
     still, _ = positions(files["still"])
     assert np.abs(walked - still).max() > 1e-2           # the current moved it
     assert np.abs(walked - direct).max() <= AGREEMENT
+
+
+def test_a_restart_of_the_files_own_scene_is_not_a_walk(shared_tmp):
+    """The file's scene rebuilt from its parameters (a current profile from the file's
+    table, pinned ends, the default end frame) is this run's: the restart goes on from the
+    file's load factor 1, one step, no walk; with another profile it walks."""
+    profile = f"{shared_tmp}/profile.txt"
+    if PETSc.COMM_WORLD.getRank() == 0:
+        with open(profile, "w", encoding="utf-8") as handle:
+            handle.write("0 0 1 0\n2 0 0.5 0\n")
+    PETSc.COMM_WORLD.tompi4py().Barrier()
+    line = {**HANGING, "rod_end_position": "0.8,0,0.3", "rod_current_profile": profile,
+            "rod_drag": "1000,1,0.001"}
+    old, again, other = (f"{shared_tmp}/{name}.h5" for name in ("old", "again", "other"))
+    assert run_cli({**line, "rod_initial_shape": "catenary", "rod_output": old}) == 0
+    assert run_cli({**line, "rod_initial": old, "rod_steps": "2", "rod_output": again}) == 0
+    assert step_factors(again) == [1.0]
+    assert run_cli({**line, "rod_sea_surface": "0.5", "rod_initial": old, "rod_steps": "2",
+                    "rod_output": other}) == 0
+    assert step_factors(other) == [0.5, 1.0]
