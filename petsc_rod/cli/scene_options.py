@@ -240,6 +240,8 @@ def restart_path(scene, parameters, t_file):
     old = scene_from_parameters(parameters)
     walked = [FIELD_OPTIONS[name] for name in differences(old, scene, PATH_FIELDS)]
     fixed = [FIELD_OPTIONS[name] for name in differences(old, scene, FIXED_FIELDS)]
-    if not walked or t_file == 0:       # at t = 0 every scene is the unloaded reference
+    # at t = 0 every scene is the unloaded reference; another length is another mesh,
+    # which read_restart refuses
+    if not walked or t_file == 0 or old.length != scene.length:
         return scene, [], fixed
     return BlendedPath(old, t_file, scene), walked, fixed
