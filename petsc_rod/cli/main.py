@@ -72,11 +72,13 @@ def run(comm=None):
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
-            path_scene = walked_scene(scene, values, say)
+            path_scene, notes = walked_scene(scene, values)
             problem, solver = build_solver(mesh, path_scene, settings, say)
             if database.hasName("help"):
                 return 0
             start = start_from(problem, values, given, say)
+            for note in notes:              # once the file is known to fit this run
+                say(note)
             if values["rod_output"]:
                 writer = io.ResultWriter(
                     values["rod_output"], mesh,
@@ -237,16 +239,16 @@ def start_from(problem, values, given, say):
     return 0.0
 
 
-def walked_scene(scene, values, say):
-    """The scene this run's load path walks: ``scene``, or for a restart whose file's
-    scene (rebuilt from its ``parameters`` group) differs in what the load path carries,
-    the walk from the file's scene at its load factor to ``scene`` in -rod_steps steps
-    (scene_options.restart_path, docs/method.md §7), said in one line; what else differs
-    is ``scene``'s from the first step, said in another."""
+def walked_scene(scene, values):
+    """(the scene this run's load path walks, the lines that say so): ``scene``, or for
+    a restart whose file's scene (rebuilt from its ``parameters`` group) differs in what
+    the load path carries, the walk from the file's scene at its load factor to ``scene``
+    in -rod_steps steps (scene_options.restart_path, docs/method.md §7), said in one line;
+    what else differs is ``scene``'s from the first step, said in another."""
     path = values["rod_initial"]
     record = io.read_parameters(path) if path else None
     if record is None:
-        return scene
+        return scene, []
     parameters, t_file = record
     if values["rod_initial_load_factor"] is not None:
         t_file = values["rod_initial_load_factor"]
@@ -255,14 +257,16 @@ def walked_scene(scene, values, say):
     except RodInputError as error:
         raise RodInputError(f"-rod_initial {path}: its parameters do not make a scene "
                             f"({error})") from None
-    if fixed:
-        say(f"petsc_rod: restart: {', '.join(fixed)} differ(s) from the file's; this run's "
-            "value(s) hold from the first step")
+    notes = []
     if walked is not scene:
-        say(f"petsc_rod: restart: walks from the file's scene at load factor {t_file:.6g} to "
-            f"this one in {values['rod_steps']} step(s) (load factor s of the walk, 0 the "
-            f"file's state, 1 this scene); they differ in {', '.join(differ)}")
-    return walked
+        notes.append(f"petsc_rod: restart: walks from the file's scene at load factor "
+                     f"{t_file:.6g} to this one in {values['rod_steps']} step(s) (load factor "
+                     f"s of the walk, 0 the file's state, 1 this scene); they differ in "
+                     f"{', '.join(differ)}")
+    if fixed:
+        notes.append(f"petsc_rod: restart: {', '.join(fixed)} differ(s) from the file's; "
+                     "this run's value(s) hold from the first step")
+    return walked, notes
 
 
 def restart_from(problem, path, load_factor, say):
