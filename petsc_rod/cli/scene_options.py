@@ -235,8 +235,9 @@ def restart_path(scene, parameters, t_file):
     file's load factor t_file) when the file's scene, rebuilt from its ``parameters``,
     carries the same load path, or t_file = 0 (both paths start from the same unloaded
     reference: this scene's own path is the walk); else the BlendedPath from the file's
-    scene at t_file to ``scene`` at 1 (scenes/blend.py). Returns (that scene, the options whose load-path
-    values differ, the options taken from ``scene`` from the first step)."""
+    scene at t_file to ``scene`` at 1 (scenes/blend.py). Returns (that scene, the options
+    whose load-path values differ, the options taken from ``scene`` from the first
+    step)."""
     old = scene_from_parameters(parameters)
     walked = [FIELD_OPTIONS[name] for name in differences(old, scene, PATH_FIELDS)]
     fixed = [FIELD_OPTIONS[name] for name in differences(old, scene, FIXED_FIELDS)]
