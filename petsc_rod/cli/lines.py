@@ -81,8 +81,15 @@ def raised(label, raises, scale):
             "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)")
 
 
-def given_up(halvings, load_factor):
-    """What a run's failure message adds once halvings were tried ('' before)."""
+def given_up(halvings, load_factor, nothing_to_halve=False):
+    """What a run's failure message adds once halvings were tried ('' before), or why
+    none was: a step that moves no load (a restart at its own load factor) cannot be
+    made easier by halving it (continuation.LoadPath.nothing_to_halve)."""
+    if nothing_to_halve:
+        return (f"; the step to load factor {load_factor:.6g} starts there and moves no "
+                "load, so halving it cannot help: the run ends (restart with "
+                "-rod_initial_load_factor below it, more -rod_al_max_it, or looser "
+                "-rod_al_rtol/-rod_al_ctol)")
     if not halvings:
         return ""
     return (f"; load factor {load_factor:.6g} after {halvings} halving(s) of the step "
@@ -91,7 +98,8 @@ def given_up(halvings, load_factor):
 
 def diverged_message(event):
     """The one-line error of a RunDiverged event."""
-    return f"{failure_text(event.error)}{given_up(event.halvings, event.load_factor)}"
+    return (f"{failure_text(event.error)}"
+            f"{given_up(event.halvings, event.load_factor, event.nothing_to_halve)}")
 
 
 def not_converged_reason(report, settings, scale):
@@ -128,7 +136,8 @@ def finished(event, settings, scale):
     if not event.converged:
         return (f"petsc_rod: error: {event.label} "
                 f"{not_converged_reason(event.report, settings, scale)}"
-                f"{given_up(event.halvings, event.load_factor)}; the result file says "
+                f"{given_up(event.halvings, event.load_factor, event.nothing_to_halve)}"
+                "; the result file says "
                 "converged = 0")
     return (f"petsc_rod: converged, {event.iterations} iterations in {event.wall_time:.3g} s, "
             f"{event.halvings} halving(s) of the step ({event.undone} iterations undone)")

@@ -23,7 +23,7 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
-from petsc_rod.cli.scene_options import (rounded_down, scene_from_options,
+from petsc_rod.cli.scene_options import (restart_path, rounded_down, scene_from_options,
                                          settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
@@ -72,16 +72,21 @@ def run(comm=None):
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
-            problem, solver = build_solver(mesh, scene, settings, say)
+            path_scene, notes = walked_scene(scene, values)
+            problem, solver = build_solver(mesh, path_scene, settings, say)
             if database.hasName("help"):
                 return 0
             start = start_from(problem, values, given, say)
+            for note in notes:              # once the file is known to fit this run
+                say(note)
             if values["rod_output"]:
                 writer = io.ResultWriter(
                     values["rod_output"], mesh,
                     io.minimum_bytes(mesh, outputs.restart_state(problem), values["rod_steps"]),
                     run_record(values, solver, start))
-            path = PathSettings(steps=values["rod_steps"], start=start,
+            # a walk from the file's scene starts at its own s = 0, the file's state
+            path = PathSettings(steps=values["rod_steps"],
+                                start=start if path_scene is scene else 0.0,
                                 imperfection=values["rod_imperfection"],
                                 max_halvings=values["rod_max_halvings"],
                                 track_link=values["rod_track_link"])
@@ -232,6 +237,36 @@ def start_from(problem, values, given, say):
     else:
         problem.state.set_straight()
     return 0.0
+
+
+def walked_scene(scene, values):
+    """(the scene this run's load path walks, the lines that say so): ``scene``, or for
+    a restart whose file's scene (rebuilt from its ``parameters`` group) differs in what
+    the load path carries, the walk from the file's scene at its load factor to ``scene``
+    in -rod_steps steps (scene_options.restart_path, docs/method.md §7), said in one line;
+    what else differs is ``scene``'s from the first step, said in another."""
+    path = values["rod_initial"]
+    record = io.read_parameters(path) if path else None
+    if record is None:
+        return scene, []
+    parameters, t_file = record
+    if values["rod_initial_load_factor"] is not None:
+        t_file = values["rod_initial_load_factor"]
+    try:
+        walked, differ, fixed = restart_path(scene, parameters, t_file)
+    except RodInputError as error:
+        raise RodInputError(f"-rod_initial {path}: its parameters do not make a scene "
+                            f"({error})") from None
+    notes = []
+    if walked is not scene:
+        notes.append(f"petsc_rod: restart: walks from the file's scene at load factor "
+                     f"{t_file:.6g} to this one in {values['rod_steps']} step(s) (load factor "
+                     f"s of the walk, 0 the file's state, 1 this scene); they differ in "
+                     f"{', '.join(differ)}")
+    if fixed:
+        notes.append(f"petsc_rod: restart: {', '.join(fixed)} differ(s) from the file's; "
+                     "this run's value(s) hold from the first step")
+    return walked, notes
 
 
 def restart_from(problem, path, load_factor, say):

@@ -185,8 +185,10 @@ OPTIONS = [
            "ends clamped on a common axis: refuse a step whose linking number Tw + Wr is "
            "not the last one plus the end roll over 2 pi (the rod passed around an end or "
            "through itself); 0 for a rod free to pass around its ends"),
-    Option("rod_initial", _string, None, "FILE", "start from (restart) a result file",
-           unit="text"),
+    Option("rod_initial", _string, None, "FILE",
+           "start from (restart) a result file; where this run's loads, end forces, end "
+           "position or frame, or current differ from the file's, walk from the file's "
+           "scene to this one in -rod_steps steps", unit="text"),
     Option("rod_initial_load_factor", _real, None, "t",
            "the load factor of the -rod_initial state: the load path goes on from it to 1 "
            "in -rod_steps steps; default the file's load_factor (0: walk the whole path "

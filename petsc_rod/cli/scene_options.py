@@ -4,19 +4,32 @@ takes (Scene, Seabed, Current, Settings), with the checks that need several opti
 
 import numpy as np
 
-from petsc_rod.cli.options import MAX_MAGNITUDE
+from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.problem.penalty import penalty_scales
 from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
                                          check_ends_above, default_stiffness,
                                          largest_stiffness, read_profile)
+from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
-from petsc_rod.scenes.scene import Scene
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+
+# The options behind each Scene field a restart compares (scenes/blend.py).
+FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
+                 "start_force": "-rod_start_force", "end_force": "-rod_end_force",
+                 "end_position": "-rod_end_position", "end_frame": "-rod_end_frame",
+                 "end_twist": "-rod_end_twist",
+                 "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
+                             "-rod_drag)"),
+                 "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
+                 "seabed": "-rod_seabed"}
 
 
-def scene_from_options(values, given):
-    """A validated Scene from parsed option values."""
+def scene_from_options(values, given, profile=None):
+    """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
+    rows of -rod_current_profile when already read (a result file's
+    current_profile_table), else they are read from its file."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
@@ -27,7 +40,7 @@ def scene_from_options(values, given):
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
-    scene.seabed, scene.current = environment_from_options(values, given, scene)
+    scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
     return scene
@@ -141,9 +154,11 @@ def seabed_from_options(values, given, load_values):
     return Seabed(float(values["rod_seabed"]), float(stiffness))
 
 
-def current_from_options(values, given, surface_default):
+def current_from_options(values, given, surface_default, profile=None):
     """The Current of -rod_current or -rod_current_profile with -rod_drag, or None.
-    ``surface_default``: the sea surface height when -rod_sea_surface is not given."""
+    ``surface_default``: the sea surface height when -rod_sea_surface is not given;
+    ``profile``: the profile's (depths, velocities) when already read."""
+    table = profile
     uniform, profile = "rod_current" in given, "rod_current_profile" in given
     if uniform and profile:
         raise RodInputError("-rod_current and -rod_current_profile both give the current; "
@@ -160,7 +175,9 @@ def current_from_options(values, given, surface_default):
     if "rod_sea_surface" in given and not profile:
         raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
                             "current does not depend on depth)")
-    if profile:
+    if profile and table is not None:
+        depths, velocities = table
+    elif profile:
         depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
     else:
         depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
@@ -170,11 +187,62 @@ def current_from_options(values, given, surface_default):
                    0.5 * rho * cd * diameter)
 
 
-def environment_from_options(values, given, scene):
-    """(Seabed or None, Current or None) for a validated ``scene``, checked against it."""
+def environment_from_options(values, given, scene, profile=None):
+    """(Seabed or None, Current or None) for a validated ``scene``, checked against it
+    (``profile``: as in current_from_options)."""
     seabed = seabed_from_options(values, given, scene.load_values)
     ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
     ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
     check_ends_above(seabed, ends, scene.length)
     held = [state.position[2] for _, state in ends if is_held(state)]
-    return seabed, current_from_options(values, given, max(held))
+    return seabed, current_from_options(values, given, max(held), profile)
+
+
+def options_from_parameters(parameters):
+    """(values, given) as read_options would return them for the run that wrote a result
+    file's ``parameters`` group (io.results.read_parameters): '' is an option not given;
+    an option counts as given where its value differs from its default (the end position
+    and frame from the ones Scene puts in their place), so that Scene.validate and the
+    riser options see the run as it was asked."""
+    length = float(parameters.get("length", 1.0))
+    defaults = {"rod_end_position": np.array([length, 0.0, 0.0]),
+                "rod_end_frame": REFERENCE_FRAME}
+    values, given = {}, set()
+    for option in OPTIONS:
+        value = parameters.get(option.name.removeprefix("rod_"), "")
+        if isinstance(value, str) and value == "":
+            values[option.name] = option.default
+            continue
+        values[option.name] = value
+        default = defaults.get(option.name, option.default)
+        if default is None or np.shape(value) != np.shape(default) or np.any(value != default):
+            given.add(option.name)
+    return values, given
+
+
+def scene_from_parameters(parameters):
+    """The Scene of the run that wrote a result file's ``parameters`` group, built by
+    scene_from_options (its current profile from the file's current_profile_table, not
+    from a profile file that may have changed since)."""
+    values, given = options_from_parameters(parameters)
+    table = parameters.get("current_profile_table")
+    profile = None if table is None else (table[:, 0], table[:, 1:])
+    return scene_from_options(values, given, profile)
+
+
+def restart_path(scene, parameters, t_file):
+    """The scene a restart's load path walks: ``scene`` itself (the path goes on from the
+    file's load factor t_file) when the file's scene, rebuilt from its ``parameters``,
+    carries the same load path, or t_file = 0 (both paths start from the same unloaded
+    reference: this scene's own path is the walk); else the BlendedPath from the file's
+    scene at t_file to ``scene`` at 1 (scenes/blend.py). Returns (that scene, the options
+    whose load-path values differ, the options taken from ``scene`` from the first
+    step)."""
+    old = scene_from_parameters(parameters)
+    walked = [FIELD_OPTIONS[name] for name in differences(old, scene, PATH_FIELDS)]
+    fixed = [FIELD_OPTIONS[name] for name in differences(old, scene, FIXED_FIELDS)]
+    # at t = 0 every scene is the unloaded reference; another length is another mesh,
+    # which read_restart refuses
+    if not walked or t_file == 0 or old.length != scene.length:
+        return scene, [], fixed
+    return BlendedPath(old, t_file, scene), walked, fixed

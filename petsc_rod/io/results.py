@@ -457,6 +457,24 @@ def _read_restart(path, mesh, layout):
     return Restart(vertex, state, load_factor, converged)
 
 
+def read_parameters(path):
+    """(the group ``parameters`` of result file ``path`` as {name: value}, its root's
+    load_factor): what a restart needs to rebuild the file's scene (cli/scene_options.py).
+    None when the file cannot be read or has no such group (read_restart then says
+    what is wrong with it, or the restart keeps the file's path as it is). Read on every
+    rank alike, like read_restart."""
+    try:
+        with h5py.File(path, "r") as f:
+            group = f.get("parameters")
+            if not isinstance(group, h5py.Group) or "load_factor" not in f.attrs:
+                return None
+            values = {key: value.decode() if isinstance(value, bytes) else value
+                      for key, value in group.attrs.items() if key != "attribute_units"}
+            return values, float(np.asarray(f.attrs["load_factor"]).ravel()[0])
+    except (OSError, KeyError, TypeError, ValueError, IndexError):
+        return None
+
+
 def _read_slice(f, key, shape, start, rows, refuse):
     """Rows [start, start + rows) of dataset ``key``, checked: present, of global
     ``shape``, numbers, finite."""

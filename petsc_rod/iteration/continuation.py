@@ -75,8 +75,20 @@ class LoadPath:
         return self.reached == self.steps * self.units_per_step
 
     @property
+    def nothing_to_halve(self):
+        """Whether half the increment would not move the load factor at all:
+        factor(reached + increment / 2) == factor(reached) in floating point. So it is on
+        a path from t_0 = t_end (a restart at its end load factor: every step is the same
+        load) and below the round-off of t; a retry there would repeat the failed attempt
+        exactly, so the run must end instead."""
+        half = max(self.increment // 2, 1)
+        return self.factor(self.reached + half) == self.factor(self.reached)
+
+    @property
     def can_halve(self):
-        return self.increment > 1
+        """A failed attempt may be retried with half the increment: halvings are left
+        (increment > 1 unit) and the half increment still moves the load factor."""
+        return self.increment > 1 and not self.nothing_to_halve
 
     def halve(self):
         self.increment //= 2
@@ -196,7 +208,8 @@ def continuation(solver, path=PathSettings(), stop=None):
                                     path.factor(path.increment) - path.factor(0))
             continue
         if report is None:
-            yield events.RunDiverged(failure, path.next_factor, path.halvings)
+            yield events.RunDiverged(failure, path.next_factor, path.halvings,
+                                     path.nothing_to_halve)
             return
         written += 1
         yield events.StepEnded(label, t, report, written, path.step_halvings, path.halvings,
@@ -210,7 +223,8 @@ def continuation(solver, path=PathSettings(), stop=None):
         yield events.Interrupted("after the last step", path.factor(path.reached))
         return
     yield events.RunFinished(report.converged, label, report, total, undone, path.halvings,
-                             time.perf_counter() - clock, path.next_factor)
+                             time.perf_counter() - clock, path.next_factor,
+                             not report.converged and path.nothing_to_halve)
 
 
 def expected_link(scene, link, t_from, t):

@@ -101,6 +101,7 @@ class RunDiverged:
     error: Exception
     load_factor: float
     halvings: int
+    nothing_to_halve: bool = False      # the step could not be halved: it moves no load
 
 
 @dataclass(frozen=True)
@@ -126,3 +127,4 @@ class RunFinished:
     halvings: int
     wall_time: float
     load_factor: float
+    nothing_to_halve: bool = False      # the last step failed and moves no load to halve

@@ -13,8 +13,9 @@ def scene_terms(mesh, scene):
     seabed = SeabedTerm(mesh, scene.seabed) if scene.seabed is not None else None
     if seabed is not None:
         terms.append(seabed)
-    if scene.current is not None:
-        terms.append(DragTerm(mesh, scene.current))
-    if seabed is not None or scene.current is not None:
+    drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
+    if drag:
+        terms.append(DragTerm(mesh, scene))
+    if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
     return terms

@@ -8,8 +8,9 @@ only for a scene that has them (problem/build.py).
 * The drag enters the slope problem's right-hand side like a dead load (loads.py),
   evaluated at the tangents tau3 of the iterate x = (tau, lambda / R) that the SNES
   mixes and at the heights of the last global step (for a current profile), times the
-  load factor t: a function of the iterate, so that Anderson mixing sees it. It has no
-  energy (a follower load).
+  weight the scene's path gives its current at the load factor t (Scene.drag_loads: t
+  itself; on a restart's blended path two currents, scenes/blend.py): a function of the
+  iterate, so that Anderson mixing sees it. It has no energy (a follower load).
 
 Neither is yet in the Newton steps (in_newton False): the iteration alone converges
 with them.
@@ -156,19 +157,21 @@ class DragTerm(NodalLoadTerm):
     conservative = False
     in_newton = False
 
-    def __init__(self, mesh, current):
+    def __init__(self, mesh, scene):
         super().__init__(mesh, "drag")
-        self.current = current
+        self.scene = scene
         self.drag = NodalLoad(mesh, self._nodes)
 
     def node_loads(self, state):
-        """t c |v_n| v_n at the owned nodes (N/m), (n_nodes, 3), from the tangents tau3
-        and, for a current that varies with depth, the heights of the last global step.
-        Collective when it does (a ghost exchange)."""
-        current = self.current
-        z = (state.node_positions()[:, 2] if current.depths.size > 1
+        """sum_k w_k c_k |v_n,k| v_n,k at the owned nodes (N/m), (n_nodes, 3), over the
+        (weight, current) pairs of scene.drag_loads(t) (w = t for one current), from the
+        tangents tau3 and, for a current that varies with depth, the heights of the last
+        global step. Collective when one does (a ghost exchange)."""
+        currents = self.scene.drag_loads(self.t)
+        z = (state.node_positions()[:, 2] if any(c.depths.size > 1 for _, c in currents)
              else np.zeros(self.mesh.n_local_nodes))
-        return self.t * normal_drag(state.tau[:, 2], current.velocity(z), current.drag)
+        return sum(w * normal_drag(state.tau[:, 2], c.velocity(z), c.drag)
+                   for w, c in currents)
 
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""

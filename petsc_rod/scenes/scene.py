@@ -109,6 +109,12 @@ class Scene:
         frame = frame @ rotation_about(frame[2], t * self.end_twist).T
         return EndState(self.end, position, frame, t * self.end_force)
 
+    def drag_loads(self, t):
+        """[(weight, Current)]: the drag at load factor t is the sum of each current's
+        Morison drag times its weight, here t times the scene's current ([] without one;
+        a restart's blended path has two, scenes/blend.py)."""
+        return [] if self.current is None else [(t, self.current)]
+
     @property
     def link_axis(self):
         """The common end tangent e of a rod clamped at both ends whose end frame only

@@ -1,0 +1,130 @@
+"""The load path of a restart whose scene differs from its file's (docs/method.md §7).
+
+The file's state is an equilibrium of its scene A at load factor t_f; this run's scene
+B is to be reached at t = 1. The path parameter s in [0, 1] walks from one to the other:
+every quantity the load path carries is
+
+    q(s) = (1 - s) q_A(t_f) + s q_B(1),
+
+so that s = 0 is the file's equilibrium itself (the first step is a warm start, not a
+jump) and s = 1 is this run's scene. The loads and forces are linear in their values,
+so the blend of the loads is the load of the blended values, exactly; the end frame
+turns along the geodesic from A's to B's, except for a rod clamped at both ends on one
+axis, whose end roll is blended linearly so that the linking number's bookkeeping
+(Scene.end_roll) stays continuous. Everything the load path does not carry (length,
+stiffness, end kinds, seabed) is B's from the first step.
+"""
+
+import numpy as np
+
+from petsc_rod.frames import rotation_about, rotation_log, rotations
+from petsc_rod.scenes.scene import EndState
+
+# The Scene fields the load path carries, compared to tell whether a restart walks.
+PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
+               "end_frame", "end_twist", "current")
+# The Scene fields a restart takes from this run's scene at once.
+FIXED_FIELDS = ("stiffness", "start", "end", "seabed")
+
+
+def _same(a, b):
+    """Whether two field values are equal: arrays exactly (shape and bits), a Current
+    by its depths, velocities, surface and drag, anything else by ==."""
+    if a is None or b is None:
+        return a is b
+    if hasattr(a, "velocities"):
+        return all(_same(getattr(a, key), getattr(b, key))
+                   for key in ("depths", "velocities", "surface", "drag"))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return np.array_equal(np.asarray(a), np.asarray(b))
+    return a == b
+
+
+def differences(old, new, fields=PATH_FIELDS):
+    """The names of ``fields`` in which Scene ``old`` and Scene ``new`` differ."""
+    return [name for name in fields if not _same(getattr(old, name), getattr(new, name))]
+
+
+def blended_frame(a, b, s, axis=None):
+    """The end frame (rows d1, d2, d3) a fraction s of the way from frame ``a`` to frame
+    ``b``: a @ exp(s log P)^T with P = b^T a the rotation that takes the rows of a to
+    those of b (the geodesic, |log P| <= pi). With ``axis`` (the common tangent of a rod
+    tracked for its link), a turned about it by s times ``axis`` (a rotation vector
+    whose length is the roll to add, any size), so that a roll of a whole turn is walked,
+    not skipped."""
+    if axis is not None:
+        angle = float(np.linalg.norm(axis))
+        turn = rotation_about(axis, s * angle) if angle > 0 else np.eye(3)
+        return a @ turn.T
+    return a @ rotations(s * rotation_log(b.T @ a)).T
+
+
+class BlendedPath:
+    """The scene of a restart's walk from Scene ``old`` at load factor ``t_old`` (the
+    file's) to Scene ``new`` at 1 (module docstring), with the interface the terms, the
+    global step and the continuation ask of a scene's path: start_state(s), end_state(s),
+    load_beyond(S, s), load_piece_ends, end_roll(s), link_axis, drag_loads(s). Any other
+    attribute (length, stiffness, seabed, applied_force, ...) is ``new``'s."""
+
+    def __init__(self, old, t_old, new):
+        self.old, self.t_old, self.new = old, float(t_old), new
+        # a rod tracked for its link in both scenes: the roll walked about the axis
+        self._axis = new.link_axis if old.link_axis is not None else None
+
+    def __getattr__(self, name):
+        """What the load path does not carry is the new scene's."""
+        if name in ("old", "new", "t_old", "_axis"):
+            raise AttributeError(name)
+        return getattr(self.new, name)
+
+    @property
+    def link_axis(self):
+        return self._axis
+
+    @property
+    def axially_symmetric(self):
+        """The walk is symmetric about the x axis only where both scenes are (an
+        intermediate scene of a walk from an asymmetric one is not: its states must not
+        be turned, RodProblem.turn_to_canonical)."""
+        return self.old.axially_symmetric and self.new.axially_symmetric
+
+    @property
+    def load_piece_ends(self):
+        """S at the ends of the pieces of either load, (m + 1,): the blend is piecewise
+        constant between them (their union)."""
+        return np.union1d(self.old.load_piece_ends, self.new.load_piece_ends)
+
+    def load_beyond(self, S, s):
+        """int_S^L f dS of the blended load, (1 - s) F_A(S, t_f) + s F_B(S, 1), N:
+        S (...) -> (..., 3); exact, the load being linear in its values."""
+        return ((1 - s) * self.old.load_beyond(S, self.t_old)
+                + s * self.new.load_beyond(S, 1.0))
+
+    def end_roll(self, s):
+        """(1 - s) roll_A(t_f) + s roll_B(1), rad: continuous along the walk."""
+        return (1 - s) * self.old.end_roll(self.t_old) + s * self.new.end_roll(1.0)
+
+    def _blended_end(self, a, b, s, axis=None):
+        """The EndState of kind b.kind with position and force blended linearly and the
+        frame by blended_frame. Where the kinds differ, b's values from the first step
+        (what a held end means in one scene, it does not in the other)."""
+        if a.kind != b.kind:
+            return b
+        return EndState(b.kind, (1 - s) * a.position + s * b.position,
+                        blended_frame(a.frame, b.frame, s, axis), (1 - s) * a.force + s * b.force)
+
+    def start_state(self, s):
+        return self._blended_end(self.old.start_state(self.t_old), self.new.start_state(1.0), s)
+
+    def end_state(self, s):
+        axis = None
+        if self._axis is not None:
+            axis = self._axis * (self.new.end_roll(1.0) - self.old.end_roll(self.t_old))
+        return self._blended_end(self.old.end_state(self.t_old), self.new.end_state(1.0), s,
+                                 axis)
+
+    def drag_loads(self, s):
+        """[(weight, Current)]: the drag is (1 - s) t_f f_A + s f_B, the sum of each
+        current's drag c |v_n| v_n times its weight (riser/terms.py DragTerm)."""
+        return ([((1 - s) * w, c) for w, c in self.old.drag_loads(self.t_old)]
+                + [(s * w, c) for w, c in self.new.drag_loads(1.0)])

@@ -1,0 +1,82 @@
+"""The blended load path of a restart from another scene (scenes/blend.py), numpy only:
+its ends are the file's scene at t_f and the new scene at 1, it is linear in between,
+and the end frame turns along the geodesic, or rolls whole turns for a rod tracked for
+its link."""
+
+import numpy as np
+import pytest
+
+from petsc_rod.frames import rotation_about
+from petsc_rod.scenes.blend import BlendedPath, blended_frame, differences
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+
+
+def tilted(axis, angle):
+    """The reference frame turned by ``angle`` about ``axis`` (rows d1, d2, d3)."""
+    return REFERENCE_FRAME @ rotation_about(axis, angle).T
+
+
+OLD = Scene(length=2.0, stiffness=(1, 1, 1), end="clamp", end_position=[1.5, 0.3, 0.2],
+            end_frame=tilted([0, 0, 1], 0.4), load_values=[[0, 0, -1]])
+NEW = Scene(length=2.0, stiffness=(1, 1, 1), end="clamp", end_position=[1.2, -0.4, 0.5],
+            end_frame=tilted([1, 1, 0], 1.1), end_twist=0.5,
+            load_values=[[0, 1, 0], [0, 0, -3]], load_breaks=[0.7])
+
+
+def test_the_walk_starts_at_the_files_scene_and_ends_at_the_new_one():
+    path = BlendedPath(OLD, 0.6, NEW)
+    for s, (scene, t) in ((0.0, (OLD, 0.6)), (1.0, (NEW, 1.0))):
+        got, want = path.end_state(s), scene.end_state(t)
+        assert np.allclose(got.position, want.position, atol=1e-15)
+        assert np.allclose(got.frame, want.frame, atol=1e-14)
+        S = np.linspace(0, 2, 9)
+        assert np.allclose(path.load_beyond(S, s), scene.load_beyond(S, t), atol=1e-15)
+    assert list(path.load_piece_ends) == [0.0, 0.7, 2.0]
+    assert path.length == NEW.length and path.link_axis is None
+    assert differences(OLD, NEW) == ["load_values", "load_breaks", "end_position",
+                                     "end_frame", "end_twist"]
+
+
+def test_the_walk_is_linear_and_the_frame_turns_along_the_geodesic():
+    path = BlendedPath(OLD, 0.6, NEW)
+    a, b = OLD.end_state(0.6), NEW.end_state(1.0)
+    mid = path.end_state(0.5)
+    assert np.allclose(mid.position, (a.position + b.position) / 2, atol=1e-15)
+    S = np.array([0.3, 1.0])
+    assert np.allclose(path.load_beyond(S, 0.5),
+                       (OLD.load_beyond(S, 0.6) + NEW.load_beyond(S, 1.0)) / 2, atol=1e-15)
+    # halfway along the geodesic: the same rotation takes a to mid and mid to b
+    first, second = mid.frame.T @ a.frame, b.frame.T @ mid.frame
+    assert np.allclose(first, second, atol=1e-13)
+    assert np.allclose(mid.frame @ mid.frame.T, np.eye(3), atol=1e-14)
+
+
+def test_a_rod_tracked_for_its_link_rolls_whole_turns_continuously():
+    """Both ends clamped on e_x: the roll walks from 2 turns to 3 turns and a quarter, all
+    of it (the geodesic would skip the whole turn)."""
+    old = Scene(length=1.0, stiffness=(1, 1, 1), end="clamp", end_position=[0.9, 0, 0],
+                end_twist=4 * np.pi)
+    new = Scene(length=1.0, stiffness=(1, 1, 1), end="clamp", end_position=[0.9, 0, 0],
+                end_twist=6.5 * np.pi)
+    path = BlendedPath(old, 1.0, new)
+    assert np.array_equal(path.link_axis, [1.0, 0.0, 0.0])
+    assert path.end_roll(0.0) == pytest.approx(4 * np.pi)
+    assert path.end_roll(1.0) == pytest.approx(6.5 * np.pi)
+    for s in (0.0, 0.4, 1.0):
+        roll = path.end_roll(s)
+        assert np.allclose(path.end_state(s).frame, tilted([1, 0, 0], roll), atol=1e-12)
+
+
+def test_the_drag_is_walked_in_by_weights():
+    """f = (1 - s) t_f f_A + s f_B: the file's current (none here) and the new one."""
+    current = object()
+    new = Scene(length=1.0, stiffness=(1, 1, 1), current=current)
+    path = BlendedPath(Scene(length=1.0, stiffness=(1, 1, 1)), 0.5, new)
+    assert path.drag_loads(0.25) == [(0.25, current)]
+    both = BlendedPath(new, 0.5, new)
+    assert both.drag_loads(0.25) == [(0.75 * 0.5, current), (0.25, current)]
+
+
+def test_blended_frame_of_a_frame_with_itself_is_that_frame():
+    a = tilted([0.2, -1, 0.5], 2.0)
+    assert np.allclose(blended_frame(a, a, 0.3), a, atol=1e-15)
