@@ -223,9 +223,9 @@ def start_from(problem, values, given, say):
         raise RodInputError(f"-rod_initial_shape {shape}: unknown shape; use one of "
                             + "|".join(starts.SHAPES))
     if values["rod_initial"]:
-        if shape != "straight":
-            raise RodInputError("-rod_initial and -rod_initial_shape both set the start; "
-                                "give one of them")
+        if shape != "straight":         # e.g. a scene file's: the restart file starts it
+            say(f"petsc_rod: -rod_initial_shape {shape} is not used: the restart file "
+                f"{values['rod_initial']} is the start")
         return restart_from(problem, values["rod_initial"], values["rod_initial_load_factor"],
                             say)
     if "rod_initial_load_factor" in given:

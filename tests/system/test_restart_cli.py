@@ -35,6 +35,8 @@ def test_a_current_added_on_restart_is_walked_in(lazy_wave, tmp_path):
     assert "increment 0" not in process.stdout, describe(process)
     walks = [line for line in process.stdout.splitlines() if "walks from the file's scene" in line]
     assert len(walks) == 1 and "-rod_current" in walks[0], describe(process)
+    # the scene file's catenary start gives way to the restart file, said in one line
+    assert "-rod_initial_shape catenary is not used" in process.stdout, describe(process)
     with h5py.File(path, "r") as f:
         assert [f["steps"][k].attrs["load_factor"] for k in sorted(f["steps"], key=int)] \
             == [0.5, 1.0]
