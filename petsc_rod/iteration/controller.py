@@ -90,6 +90,9 @@ class StepController:
         self.label, self.observer = label, observer
         self.clock = time.perf_counter()
         self.history = []           # (change, residual, wall time) rows, one per iteration
+        # the relative size of the deformation at the last Uzawa iteration (state.Norms):
+        # the stopping test divides change and residual by it
+        self.deformation = 1.0
         self.raises = []            # (iteration, new R)
         self.decision = None        # the last one, None before any and after resume()
         self.error = None           # the RodDivergedError that ended the step
@@ -108,12 +111,15 @@ class StepController:
     def _record(self, change, residual):
         self.history.append((change, residual, time.perf_counter() - self.clock))
 
-    def observe(self, change, residual, penalty, scale=1.0):
-        """A Uzawa iteration's norms at penalty R (N), relative to the size of the
-        deformation ``scale`` (RodState.norms: they were divided by it): recorded, and
-        the Decision after it taken (and returned)."""
+    def observe(self, change, residual, penalty, deformation=1.0):
+        """A Uzawa iteration's norms at penalty R (N) and the relative size of the
+        deformation (RodState.norms): recorded, and the Decision after it taken (and
+        returned). Only the stopping test (and the report) divides change and residual
+        by the deformation; the rules that steer the iteration read them as they are,
+        so that a deformation of order one is iterated as without it."""
         self._record(change, residual)
-        self.decision = self._decide(penalty, residual * scale)
+        self.deformation = deformation
+        self.decision = self._decide(penalty)
         return self.decision
 
     def record_newton_step(self, turn):
@@ -138,17 +144,18 @@ class StepController:
         """The last decision, ITERATE before any and after ``resume``."""
         return self.decision if self.decision is not None else ITERATE
 
-    def _decide(self, penalty, absolute_residual):
+    def _decide(self, penalty):
         settings, iteration = self.settings, len(self.history)
         change, residual = self.history[-1][:2]
-        if stopping.diverged(change, absolute_residual):
+        if stopping.diverged(change, residual):
             self.error = RodIterationDiverged(
                 f"{self.label}iteration {iteration}: the iteration diverged (change "
                 f"{change:.3g}, constraint residual {residual:.3g})", iteration)
             return Decision(Action.DIVERGED)
         if self.observer is not None and self.observer(iteration, change, residual):
             return Decision(Action.STOP, stopping.STOP_OBSERVER)
-        if stopping.converged(settings, change, residual):
+        if stopping.converged(settings, change / self.deformation,
+                              residual / self.deformation):
             return Decision(Action.CONVERGED)
         if (self.newton and iteration >= self.newton_next
                 and max(change, residual) <= NEWTON_SWITCH
@@ -242,6 +249,8 @@ class StepController:
         decision = self.decision
         converged = decision.action is Action.CONVERGED
         change, residual = self.history[-1][:2] if self.history else (np.inf, np.inf)
+        # as the stopping test reads them
+        change, residual = change / self.deformation, residual / self.deformation
         return stopping.StepReport(converged, len(self.history), change, residual,
                                    self.history, "" if converged else decision.reason,
                                    self.raises, stable=self.stable,

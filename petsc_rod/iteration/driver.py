@@ -226,7 +226,8 @@ class UzawaSolver:
         norms = self.problem.norms()
         step.observe(norms.change, norms.residual, self.penalty, norms.scale)
         if self.monitor is not None:
-            self.monitor(step.label, len(step.history), norms.change, norms.residual)
+            self.monitor(step.label, len(step.history), norms.change / norms.scale,
+                         norms.residual / norms.scale)
         self._pack(f)
         f.aypx(-1.0, x)
 

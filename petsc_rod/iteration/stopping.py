@@ -56,7 +56,7 @@ class StepReport:
 
     converged: bool
     iterations: int
-    change: float           # the last iteration's relative change
+    change: float           # the last iteration's change, over the deformation (state.Norms)
     constraint_residual: float
     history: list = field(default_factory=list)   # (change, residual, wall time) rows
     reason: str = ""        # why a step that did not converge stopped (STOP_* above)

@@ -33,9 +33,9 @@ CANONICAL_FLOOR = 1e-8
 
 
 class Norms(NamedTuple):
-    """The stopping quantities of one iteration (RodState.norms): change and RMS
-    constraint residual, both divided by ``scale``, the relative size of the deformation
-    in [DEFORMATION_FLOOR, 1]."""
+    """The stopping quantities of one iteration (RodState.norms): the change relative to
+    |X|, the RMS constraint residual, and ``scale``, the relative size of the deformation
+    in [DEFORMATION_FLOOR, 1] that the stopping test divides both by."""
 
     change: float
     residual: float
@@ -255,13 +255,13 @@ class RodState:
         nodes, X^ref the unstressed reference state and d_n the directors of the last
         take_directors (or remember):
 
+            change   = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2),
+            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L),
             deformation = sqrt(sum_n w_n |X_n - X_n^ref|^2 / sum_n w_n |X_n|^2),
-            s = min(1, max(deformation, DEFORMATION_FLOOR)),
-            change   = sqrt(sum_n w_n |X_n - X_n^prev|^2 / sum_n w_n |X_n|^2) / s,
-            residual = sqrt(sum_n w_n |d_n - tau_n|^2 / L) / s.
+            s = min(1, max(deformation, DEFORMATION_FLOOR)).
 
-        A deformation of the order of the state (s = 1) gives the change relative to
-        |X| and the plain RMS residual; a small one is resolved relative to itself,
+        The stopping test reads change / s and residual / s: a deformation of the order
+        of the state (s = 1) is tested relative to |X|, a small one relative to itself,
         down to DEFORMATION_FLOOR (below it, to rtol DEFORMATION_FLOOR of |X|, near
         round-off). Returns Norms(change, residual, scale = s).
         """
@@ -271,8 +271,7 @@ class RodState:
         if size <= 0:
             return Norms(np.inf, np.inf, 1.0)
         scale = min(1.0, max(np.sqrt(deformation / size), DEFORMATION_FLOOR))
-        return Norms(np.sqrt(step / size) / scale, np.sqrt(gap / self.mesh.length) / scale,
-                     scale)
+        return Norms(np.sqrt(step / size), np.sqrt(gap / self.mesh.length), scale)
 
     def destroy(self):
         for obj in [*self.frame_fields, self.r]:
