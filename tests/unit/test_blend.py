@@ -80,3 +80,14 @@ def test_the_drag_is_walked_in_by_weights():
 def test_blended_frame_of_a_frame_with_itself_is_that_frame():
     a = tilted([0.2, -1, 0.5], 2.0)
     assert np.allclose(blended_frame(a, a, 0.3), a, atol=1e-15)
+
+
+def test_a_walk_is_axially_symmetric_only_where_both_scenes_are():
+    """An intermediate scene of a walk from an off-axis load to an on-axis one is not
+    symmetric about e_x, so its states must not be turned (RodProblem.turn_to_canonical)."""
+    on_axis = Scene(length=1.0, stiffness=(1, 1, 1), end_force=[-2.6, 0.0, 0.0])
+    off_axis = Scene(length=1.0, stiffness=(1, 1, 1), end_force=[-2.6, 0.1, 0.0])
+    assert on_axis.axially_symmetric and not off_axis.axially_symmetric
+    assert BlendedPath(on_axis, 1.0, on_axis).axially_symmetric
+    assert not BlendedPath(off_axis, 1.0, on_axis).axially_symmetric
+    assert not BlendedPath(on_axis, 1.0, off_axis).axially_symmetric
