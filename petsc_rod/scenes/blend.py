@@ -18,7 +18,7 @@ stiffness, end kinds, seabed) is B's from the first step.
 import numpy as np
 
 from petsc_rod.frames import rotation_about, rotation_log, rotations
-from petsc_rod.scenes.scene import EndState
+from petsc_rod.scenes.scene import EndState, rolled_frame
 
 # The Scene fields the load path carries, compared to tell whether a restart walks.
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
@@ -104,24 +104,34 @@ class BlendedPath:
         """(1 - s) roll_A(t_f) + s roll_B(1), rad: continuous along the walk."""
         return (1 - s) * self.old.end_roll(self.t_old) + s * self.new.end_roll(1.0)
 
-    def _blended_end(self, a, b, s, axis=None):
+    def _blended_end(self, a, b, s, frame):
         """The EndState of kind b.kind with position and force blended linearly and the
-        frame by blended_frame. Where the kinds differ, b's values from the first step
-        (what a held end means in one scene, it does not in the other)."""
+        given ``frame``. Where the kinds differ, b's values from the first step (what a
+        held end means in one scene, it does not in the other)."""
         if a.kind != b.kind:
             return b
-        return EndState(b.kind, (1 - s) * a.position + s * b.position,
-                        blended_frame(a.frame, b.frame, s, axis), (1 - s) * a.force + s * b.force)
+        return EndState(b.kind, (1 - s) * a.position + s * b.position, frame,
+                        (1 - s) * a.force + s * b.force)
 
     def start_state(self, s):
-        return self._blended_end(self.old.start_state(self.t_old), self.new.start_state(1.0), s)
+        a, b = self.old.start_state(self.t_old), self.new.start_state(1.0)
+        return self._blended_end(a, b, s, blended_frame(a.frame, b.frame, s))
 
     def end_state(self, s):
-        axis = None
+        """The end frame as Scene.end_state builds it, in its two parts: the geodesic
+        between the two scenes' frames before their -rod_end_twist, then the blended
+        roll (1 - s) t_f twist_A + s twist_B about its d3, of any size (a geodesic
+        between the rolled frames would walk a roll above pi the short way round). For a
+        rod tracked for its link, the whole roll about the axis (blended_frame)."""
+        a, b = self.old.end_state(self.t_old), self.new.end_state(1.0)
         if self._axis is not None:
-            axis = self._axis * (self.new.end_roll(1.0) - self.old.end_roll(self.t_old))
-        return self._blended_end(self.old.end_state(self.t_old), self.new.end_state(1.0), s,
-                                 axis)
+            roll = self.new.end_roll(1.0) - self.old.end_roll(self.t_old)
+            frame = blended_frame(a.frame, b.frame, s, self._axis * roll)
+        else:
+            (tilt_a, roll_a), (tilt_b, roll_b) = (self.old.end_frame_parts(self.t_old),
+                                                  self.new.end_frame_parts(1.0))
+            frame = rolled_frame(blended_frame(tilt_a, tilt_b, s), (1 - s) * roll_a + s * roll_b)
+        return self._blended_end(a, b, s, frame)
 
     def drag_loads(self, s):
         """[(weight, Current)]: the drag is (1 - s) t_f f_A + s f_B, the sum of each

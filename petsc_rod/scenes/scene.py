@@ -18,6 +18,11 @@ REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 END_KINDS = ("clamp", "pin", "free")
 
 
+def rolled_frame(frame, angle):
+    """``frame`` (rows d1, d2, d3) rolled by ``angle`` rad about its own d3."""
+    return frame @ rotation_about(frame[2], angle).T
+
+
 @dataclass
 class EndState:
     """What is prescribed at one end for one load factor."""
@@ -103,11 +108,16 @@ class Scene:
 
     def end_state(self, t):
         position = (1 - t) * np.array([self.length, 0.0, 0.0]) + t * self.end_position
+        tilted, roll = self.end_frame_parts(t)
+        return EndState(self.end, position, rolled_frame(tilted, roll), t * self.end_force)
+
+    def end_frame_parts(self, t):
+        """The end frame at load factor t in its two parts: the reference frame turned by
+        exp(t log Q) (rows d1, d2, d3), and the roll about its d3 that -rod_end_twist
+        adds, t * twist rad (any size; rolled_frame puts them together)."""
         angle = np.linalg.norm(self._end_rotation)
         q = (rotation_about(self._end_rotation, t * angle) if angle > 0 else np.eye(3))
-        frame = REFERENCE_FRAME @ q.T
-        frame = frame @ rotation_about(frame[2], t * self.end_twist).T
-        return EndState(self.end, position, frame, t * self.end_force)
+        return REFERENCE_FRAME @ q.T, t * self.end_twist
 
     def drag_loads(self, t):
         """[(weight, Current)]: the drag at load factor t is the sum of each current's

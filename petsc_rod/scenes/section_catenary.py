@@ -15,9 +15,14 @@ Two unknowns fix the shape: H, and either V(0) (the line hangs from the start) o
 grounded length a (the start lies on a flat, frictionless seabed: the line rests on it,
 straight and under the tension H, up to the touchdown point S = a, where it lifts off
 with V(a) = 0). H makes the span X for a given V(0) or a (x(L) grows with H), and the
-rise Z fixes the other: z(L) grows with V(0) and falls as a grows. Both are bracketed
-and bisected to adjacent doubles (catenary.increasing_root). A uniform weight gives
-the catenary and the catenary with touchdown of catenary.py and touchdown.py.
+rise Z fixes the other: z(L) grows with V(0), and falls as a grows where the weight at
+the touchdown w(a) is positive (dz(L)/da = -w(a) det / (dx(L)/dH), det >= 0 by
+Cauchy-Schwarz). Both are bracketed and bisected to adjacent doubles
+(catenary.increasing_root). A line that rests on the seabed must leave it going up and
+stay above it: a touchdown on a buoyant or weightless piece, or a suspended part that
+dips below the seabed (a sag bend after a buoyant arch in shallow water), is refused. A
+uniform weight gives the catenary and the catenary with touchdown of catenary.py and
+touchdown.py.
 """
 
 from dataclasses import dataclass
@@ -87,6 +92,14 @@ def advance(H, V0, w, dS):
     return np.where(straight, H * dS / middle, curved), dz
 
 
+def _root(function, lower, upper):
+    """catenary.increasing_root, with its precondition function(lower) < 0 <
+    function(upper) checked (ValueError: no catenary)."""
+    if not function(lower) < 0.0 < function(upper):
+        raise ValueError("section catenary: no catenary of these weights between the ends")
+    return increasing_root(function, lower, upper)
+
+
 def _bracket_above(function, start):
     """The first of start, 2 start, 4 start, ... where ``function`` > 0; ValueError when
     none is within MAX_DOUBLINGS."""
@@ -120,7 +133,7 @@ def solve(ends, weights, span, rise, on_seabed):
         def excess(H):
             return line(H, grounded, V0).end_point()[0] - span
         upper = _bracket_above(excess, scale)
-        return line(increasing_root(excess, 1e-300, upper), grounded, V0)
+        return line(_root(excess, 1e-300, upper), grounded, V0)
 
     def climb(V0):                                  # z(L) - Z, increasing in V(0)
         return spanned(0.0, V0).end_point()[1] - rise
@@ -132,7 +145,24 @@ def solve(ends, weights, span, rise, on_seabed):
         if sink(span * (1 - 1e-12)) <= 0.0:
             raise ValueError("section catenary: the line is too long to lie taut on the "
                              "seabed between its ends")
-        return spanned(increasing_root(sink, 0.0, span * (1 - 1e-12)), 0.0)
-    upper = _bracket_above(climb, scale)
-    lower = 0.0 if on_seabed else -_bracket_above(lambda v: -climb(-v), scale)
-    return spanned(0.0, increasing_root(climb, lower, upper))
+        solved = spanned(_root(sink, 0.0, span * (1 - 1e-12)), 0.0)
+    else:
+        upper = _bracket_above(climb, scale)
+        lower = 0.0 if on_seabed else -_bracket_above(lambda v: -climb(-v), scale)
+        solved = spanned(0.0, _root(climb, lower, upper))
+    if on_seabed:
+        _check_above_seabed(solved, length)
+    return solved
+
+
+def _check_above_seabed(line, length):
+    """ValueError unless the suspended part of a line resting on the seabed z = 0 leaves
+    it going up (a positive weight at the touchdown) and stays above it (sampled at 4096
+    points, to 1e-9 L)."""
+    piece = np.searchsorted(line.ends, line.grounded, side="right") - 1
+    if line.grounded > 0.0 and line.weights[min(piece, len(line.weights) - 1)] <= 0.0:
+        raise ValueError("section catenary: the touchdown falls on a buoyant or weightless "
+                         "piece")
+    S = np.linspace(line.grounded, length, 4097)
+    if line.at(S)[1].min() < -1e-9 * length:
+        raise ValueError("section catenary: the line would pass below the seabed")

@@ -102,7 +102,7 @@ def section_start(scene, t, start, end):
                             "straight start") from None
     along = np.array([chord[0], chord[1], 0.0]) / span
     up = np.array([0.0, 0.0, 1.0])
-    if seabed is not None and not on_seabed:
+    if seabed is not None and not on_seabed:        # on it: section_catenary checks
         lowest = line.at(np.linspace(0.0, scene.length, 4097))[1].min() + start.position[2]
         if lowest < seabed.height:
             raise RodInputError("-rod_initial_shape catenary: the catenary of the load's "

@@ -68,6 +68,11 @@ CASES = {
                   {**CANTILEVER_DOWN, "rod_end_frame": frame_option([0, 1, 0], -0.5)},
                   {**CANTILEVER_DOWN, "rod_end_frame": mean_frame_option(
                       ([0, 0, 1], 0.3), ([0, 1, 0], -0.5))}, {}),
+    # a roll above pi at an end that is not on the axis (no link tracked): walked whole,
+    # not the short way round (Scene.end_frame_parts)
+    "twist at a tilted end": tuple(
+        {**CANTILEVER_DOWN, "rod_end_frame": frame_option([0, 0, 1], 0.3), **twist}
+        for twist in ({}, {"rod_end_twist": "5"}, {"rod_end_twist": "2.5"})) + ({},),
 }
 
 

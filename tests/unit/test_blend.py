@@ -8,7 +8,7 @@ import pytest
 
 from petsc_rod.frames import rotation_about
 from petsc_rod.scenes.blend import BlendedPath, blended_frame, differences
-from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene, rolled_frame
 
 
 def tilted(axis, angle):
@@ -45,10 +45,29 @@ def test_the_walk_is_linear_and_the_frame_turns_along_the_geodesic():
     S = np.array([0.3, 1.0])
     assert np.allclose(path.load_beyond(S, 0.5),
                        (OLD.load_beyond(S, 0.6) + NEW.load_beyond(S, 1.0)) / 2, atol=1e-15)
-    # halfway along the geodesic: the same rotation takes a to mid and mid to b
-    first, second = mid.frame.T @ a.frame, b.frame.T @ mid.frame
-    assert np.allclose(first, second, atol=1e-13)
+    # the frame before the twist halfway along the geodesic (the same rotation takes a's
+    # to it and it to b's), then rolled by the mean of the two twists about its d3
+    (tilt_a, roll_a), (tilt_b, roll_b) = OLD.end_frame_parts(0.6), NEW.end_frame_parts(1.0)
+    tilt = rolled_frame(mid.frame, -(roll_a + roll_b) / 2)
+    assert np.allclose(tilt.T @ tilt_a, tilt_b.T @ tilt, atol=1e-13)
     assert np.allclose(mid.frame @ mid.frame.T, np.eye(3), atol=1e-14)
+
+
+def test_a_twist_above_pi_is_walked_whole_at_a_tilted_end():
+    """A clamped end off the axis (no link tracked) whose -rod_end_twist goes from 0 to
+    5 rad: the frame turns continuously through the whole 5 rad of roll. The geodesic
+    between the twisted frames walked it the short way round (1.28 rad the other way),
+    to another equilibrium."""
+    old = Scene(length=1.0, stiffness=(1, 1, 1), end="clamp", end_position=[0.8, 0.3, 0],
+                end_frame=tilted([0, 0, 1], 0.3))
+    new = Scene(length=1.0, stiffness=(1, 1, 1), end="clamp", end_position=[0.8, 0.3, 0],
+                end_frame=tilted([0, 0, 1], 0.3), end_twist=5.0)
+    path = BlendedPath(old, 1.0, new)
+    assert path.link_axis is None
+    frames = [path.end_state(s).frame for s in np.linspace(0.0, 1.0, 1001)]
+    turns = [np.arccos(np.clip((np.trace(b.T @ a) - 1) / 2, -1.0, 1.0))
+             for a, b in zip(frames, frames[1:])]
+    assert max(turns) < 1e-2 and abs(sum(turns) - 5.0) < 1e-6
 
 
 def test_a_rod_tracked_for_its_link_rolls_whole_turns_continuously():

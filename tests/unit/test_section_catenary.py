@@ -1,8 +1,8 @@
 """The catenary of a line of sections (petsc_rod/scenes/section_catenary.py) against the
 closed forms of a uniform line: a uniform weight cut into pieces is the catenary
 (scenes/catenary.py) hanging from the start, and the catenary with touchdown
-(scenes/touchdown.py) resting on the seabed; a lazy wave meets its ends and its force
-balance; lines with no catenary are refused."""
+(scenes/touchdown.py) resting on the seabed, to 1e-12 of L; a lazy wave meets its ends
+and its force balance; lines with no catenary, or none above the seabed, are refused."""
 
 import numpy as np
 import pytest
@@ -23,10 +23,10 @@ def test_a_uniform_line_in_pieces_is_the_catenary():
     S = np.linspace(0.0, length, 101)
     x, z, V = line.at(S)
     r, _, force = catenary(length, chord, [0.0, 0.0, -weight], S)
-    assert np.abs(x - r[:, 0]).max() < 1e-9 * length
-    assert np.abs(z - r[:, 2]).max() < 1e-9 * length
-    assert abs(line.H - force[0, 0]) < 1e-9 * line.H
-    assert np.abs(V - force[:, 2]).max() < 1e-9 * weight * length
+    assert np.abs(x - r[:, 0]).max() < 1e-12 * length
+    assert np.abs(z - r[:, 2]).max() < 1e-12 * length
+    assert abs(line.H - force[0, 0]) < 1e-12 * line.H
+    assert np.abs(V - force[:, 2]).max() < 1e-12 * weight * length
 
 
 def test_a_uniform_line_in_pieces_on_the_seabed_is_the_catenary_with_touchdown():
@@ -36,11 +36,11 @@ def test_a_uniform_line_in_pieces_on_the_seabed_is_the_catenary_with_touchdown()
     S = np.linspace(0.0, length, 101)
     x, z, V = line.at(S)
     r, _, force, (_, touchdown) = grounded_catenary(length, chord, weight, 0.0, S)
-    assert abs(line.grounded - touchdown) < 1e-9 * length
-    assert np.abs(x - r[:, 0]).max() < 1e-9 * length
-    assert np.abs(z - r[:, 2]).max() < 1e-9 * length
-    assert abs(line.H - force[0, 0]) < 1e-9 * line.H
-    assert np.abs(V - force[:, 2]).max() < 1e-9 * weight * length
+    assert abs(line.grounded - touchdown) < 1e-12 * length
+    assert np.abs(x - r[:, 0]).max() < 1e-12 * length
+    assert np.abs(z - r[:, 2]).max() < 1e-12 * length
+    assert abs(line.H - force[0, 0]) < 1e-12 * line.H
+    assert np.abs(V - force[:, 2]).max() < 1e-12 * weight * length
 
 
 def test_a_lazy_wave_meets_its_ends_and_its_force_balance():
@@ -75,7 +75,19 @@ def test_a_lazy_wave_meets_its_ends_and_its_force_balance():
     (120.0, 170.0, True, "less than L apart"),          # the ends beyond the length
     (0.0, 66.0, False, "one vertical"),
     (20.0, 10.0, True, "too long to lie taut"),          # 170 m of line, 30 m of path
+    (150.0, 30.0, True, "below the seabed"),             # the sag after the arch, 5 m under
 ])
 def test_lines_without_a_catenary_are_refused(span, rise, on_seabed, words):
     with pytest.raises(ValueError, match=words):
         section_catenary.solve(CABLE_ENDS, CABLE_WEIGHTS, span, rise, on_seabed)
+
+
+def test_a_buoyant_first_section_that_would_dip_under_the_seabed_is_refused():
+    """50 m of buoyant line (-50 N/m) from the anchor, then 90 m of 200 N/m, to 100 m
+    away and 60 m up: its catenary rises from the anchor and then hangs below the
+    seabed, which a line resting on it cannot do. 10 m shorter it stays above."""
+    with pytest.raises(ValueError, match="below the seabed"):
+        section_catenary.solve([0.0, 50.0, 140.0], [-50.0, 200.0], 100.0, 60.0, True)
+    line = section_catenary.solve([0.0, 50.0, 130.0], [-50.0, 200.0], 100.0, 60.0, True)
+    assert line.grounded == 0.0 and line.V0 > 0.0
+    assert line.at(np.linspace(0.0, 130.0, 4097))[1].min() >= 0.0
