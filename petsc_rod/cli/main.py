@@ -72,7 +72,7 @@ def run(comm=None):
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
-            path_scene, notes = walked_scene(scene, values)
+            path_scene, notes = walked_scene(scene, values, comm)
             problem, solver = build_solver(mesh, path_scene, settings, say)
             if database.hasName("help"):
                 return 0
@@ -239,17 +239,26 @@ def start_from(problem, values, given, say):
     return 0.0
 
 
-def walked_scene(scene, values):
+def walked_scene(scene, values, comm):
     """(the scene this run's load path walks, the lines that say so): ``scene``, or for
     a restart whose file's scene (rebuilt from its ``parameters`` group) differs in what
     the load path carries, the walk from the file's scene at its load factor to ``scene``
     in -rod_steps steps (scene_options.restart_path, docs/method.md §7), said in one line;
-    what else differs is ``scene``'s from the first step, said in another."""
+    what else differs is ``scene``'s from the first step, said in another. A file whose
+    parameters lack an option (an older version's, or one written through the Python API)
+    is taken as a file of ``scene``, as a file without them: its scene is not rebuilt
+    from defaults. Collective."""
     path = values["rod_initial"]
-    record = io.read_parameters(path) if path else None
+    record = io.read_parameters(path, comm) if path else None
     if record is None:
         return scene, []
     parameters, t_file = record
+    missing = [option.name for option in OPTIONS
+               if option.name.removeprefix("rod_") not in parameters]
+    if missing:
+        return scene, [f"petsc_rod: restart: the file's parameters lack -{missing[0]}"
+                       f"{' and more' if len(missing) > 1 else ''}; its scene is taken as "
+                       "this run's"]
     if values["rod_initial_load_factor"] is not None:
         t_file = values["rod_initial_load_factor"]
     try:

@@ -457,12 +457,18 @@ def _read_restart(path, mesh, layout):
     return Restart(vertex, state, load_factor, converged)
 
 
-def read_parameters(path):
+def read_parameters(path, comm):
     """(the group ``parameters`` of result file ``path`` as {name: value}, its root's
     load_factor): what a restart needs to rebuild the file's scene (cli/scene_options.py).
     None when the file cannot be read or has no such group (read_restart then says
-    what is wrong with it, or the restart keeps the file's path as it is). Read on every
-    rank alike, like read_restart."""
+    what is wrong with it, or the restart keeps the file's path as it is). Read on rank
+    0 and broadcast, so that every rank of ``comm`` (petsc4py) builds the same scene even
+    where one rank could not open the file. Collective."""
+    return comm.tompi4py().bcast(_parameters(path) if comm.getRank() == 0 else None, root=0)
+
+
+def _parameters(path):
+    """read_parameters on one process."""
     try:
         with h5py.File(path, "r") as f:
             group = f.get("parameters")

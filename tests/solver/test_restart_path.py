@@ -172,3 +172,20 @@ def test_a_restart_of_the_files_own_scene_is_not_a_walk(shared_tmp):
     assert run_cli({**line, "rod_sea_surface": "0.5", "rod_initial": old, "rod_steps": "2",
                     "rod_output": other}) == 0
     assert step_factors(other) == [0.5, 1.0]
+
+
+def test_a_file_whose_parameters_lack_an_option_is_taken_as_this_runs_scene(shared_tmp):
+    """Its scene is not rebuilt from defaults (an empty group would make it an unloaded
+    rod of 1 m and walk from there): the restart goes on from the file's load factor
+    with this run's scene, as for a file without parameters."""
+    old, new, _, _ = CASES["end force"]
+    files = {name: f"{shared_tmp}/{name}.h5" for name in ("old", "new")}
+    assert run_cli({**old, "rod_output": files["old"]}) == 0
+    comm = PETSc.COMM_WORLD.tompi4py()
+    if comm.rank == 0:
+        with h5py.File(files["old"], "r+") as f:
+            del f["parameters"].attrs["end_force"]
+    comm.Barrier()
+    assert run_cli({**new, "rod_initial": files["old"], "rod_steps": str(STEPS),
+                    "rod_output": files["new"]}) == 0
+    assert step_factors(files["new"]) == [1.0]
