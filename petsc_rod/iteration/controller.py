@@ -83,7 +83,8 @@ class StepController:
     """One step's state machine (module docstring). ``settings`` (stopping.Settings),
     ``scale`` the problem's scale of R (N), ``newton`` whether Newton steps may be tried,
     ``label`` the step's name in messages, ``observer(iteration, change, residual)``
-    asked after every iteration (True: stop, STOP_OBSERVER)."""
+    asked after every iteration (True: stop, STOP_OBSERVER), with change and residual
+    divided by the deformation's size, as the stopping test reads them."""
 
     def __init__(self, settings, scale, newton, label="", observer=None):
         self.settings, self.scale, self.newton = settings, scale, newton
@@ -152,7 +153,8 @@ class StepController:
                 f"{self.label}iteration {iteration}: the iteration diverged (change "
                 f"{change:.3g}, constraint residual {residual:.3g})", iteration)
             return Decision(Action.DIVERGED)
-        if self.observer is not None and self.observer(iteration, change, residual):
+        if self.observer is not None and self.observer(iteration, change / self.deformation,
+                                                       residual / self.deformation):
             return Decision(Action.STOP, stopping.STOP_OBSERVER)
         if stopping.converged(settings, change / self.deformation,
                               residual / self.deformation):
@@ -165,7 +167,7 @@ class StepController:
         if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
                 and penalty_too_low(self.history, penalty, self.scale)):
             return Decision(Action.RAISE_PENALTY)
-        stop = stopping.stall_reason(settings, self.history)
+        stop = stopping.stall_reason(settings, self.history, self.deformation)
         return ITERATE if stop is None else Decision(Action.STOP, stop)
 
     def stop(self, reason):

@@ -143,13 +143,16 @@ def stalled(history, rtol, ctol, budget):
                for column, tolerance in ((0, rtol), (1, ctol)))
 
 
-def stall_reason(settings, history):
+def stall_reason(settings, history, deformation=1.0):
     """STOP_STALLED every STALL_CHECK_EVERY iterations if ``stalled``, or STOP_MAX_IT at
-    the cap, else None."""
+    the cap, else None. ``history`` holds the undivided change and residual, so the
+    targets are the stopping test's tolerances times the deformation's relative size
+    (state.Norms): a step stuck above them, below rtol and ctol, is a stall too."""
     iteration = len(history)
     if iteration >= settings.max_it:
         return STOP_MAX_IT
     if iteration % STALL_CHECK_EVERY == 0 and stalled(
-            history, settings.rtol, settings.ctol, settings.max_it - iteration):
+            history, settings.rtol * deformation, settings.ctol * deformation,
+            settings.max_it - iteration):
         return STOP_STALLED
     return None

@@ -19,6 +19,7 @@ owned node values in node order (the last vertex's midpoint slot is a phantom). 
 import numpy as np
 
 from petsc_rod.mesh.fields import CHUNK, blocks, element_slices
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 # r(S_e + h/2) - r(S_e) = h (5 r'_0 + 8 r'_m - r'_1) / 24 for the P2 slope
 HALF_ELEMENT = np.array([5.0, 8.0, -1.0]) / 24.0
@@ -71,10 +72,11 @@ class NodeValues:
         np.copyto(self.previous_directors, self.directors)
         np.copyto(self.previous_positions, self.positions)
 
-    def stopping_sums(self, tau, weights, reference_directors, reference_positions):
+    def stopping_sums(self, tau, weights, node_S):
         """Local sums (gap, size, step, deformation) of the stopping tests, with
-        X = (r, D) and X^ref the unstressed reference state at the nodes (the reference
-        directors (n, 3, 3) and positions (n, 3)):
+        X = (r, D) and X^ref the unstressed reference state at the nodes, S_n e_x and the
+        reference frame (scenes.scene.REFERENCE_FRAME; node_S (n,), m: nothing stored
+        per node but S):
 
             gap = sum_n w_n |D_n - tau_n|^2,   size = sum_n w_n |X_n|^2,
             step = sum_n w_n |X_n - X_n^prev|^2,
@@ -87,7 +89,7 @@ class NodeValues:
         n = self.n
         directors, previous = self.directors.reshape(n, 9), self.previous_directors.reshape(n, 9)
         tau = tau.reshape(n, 9)
-        reference = reference_directors.reshape(n, 9)
+        reference, axis = REFERENCE_FRAME.reshape(9), REFERENCE_FRAME[2]
         positions, previous_positions = self.positions, self.previous_positions
         sums = np.zeros(4)          # gap, size, step, deformation
         for block in blocks(n):
@@ -104,7 +106,9 @@ class NodeValues:
             sums[0] += weighted(d, tau[block])
             sums[1] += weighted(d) + weighted(p)
             sums[2] += weighted(d, previous[block]) + weighted(p, previous_positions[block])
-            sums[3] += weighted(d, reference[block]) + weighted(p, reference_positions[block])
+            sums[3] += weighted(d, reference)
+            away = np.subtract(p, node_S[block, None] * axis, out=work[:, :3])
+            sums[3] += weighted(away)
         self.directors, self.previous_directors = self.previous_directors, self.directors
         self.positions, self.previous_positions = self.previous_positions, self.positions
         return sums

@@ -19,14 +19,13 @@ from petsc_rod.mesh.fields import VectorField, at_points, element_dofs
 from petsc_rod.frames import rotation_about, rotations
 from petsc_rod.problem.node_values import NodeValues
 from petsc_rod.scenes import starts
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 
 # Deformations smaller than this, relative to |X|, are resolved to rtol times it of |X|
 # (1e-14 at the default rtol: near round-off, which the iteration reaches: docs/method.md
 # §6), not relative to themselves.
 DEFORMATION_FLOOR = 1e-5
 
-# The axis of the turns of an axially symmetric scene (Scene.axially_symmetric).
-REFERENCE_AXIS = np.array([1.0, 0.0, 0.0])
 # A state whose weighted off-axis moment |v| (RodState.canonical_angle) is below this
 # times L^2 is not turned: straight to round-off.
 CANONICAL_FLOOR = 1e-8
@@ -57,10 +56,9 @@ class RodState:
         h = mesh.element_h
         self._gauss = p2_basis(GAUSS_POINTS, h), p2_integrals(GAUSS_POINTS, h)
         self._nodes = NodeValues(mesh)
-        # the unstressed reference state at the nodes: what the deformation is measured
-        # from (norms)
-        self._reference_positions, reference_frames, _ = starts.straight(mesh.node_S())
-        self._reference_directors = np.ascontiguousarray(reference_frames)
+        # S at the nodes: the unstressed reference state there, S e_x and the reference
+        # frame (starts.straight), is what the deformation is measured from (norms)
+        self._node_S = mesh.node_S()
 
     @property
     def frame_fields(self):
@@ -140,7 +138,7 @@ class RodState:
         lambda rolled (``rolled``). Where d3 = e_x (a clamp in an axially symmetric
         scene) the two cancel; with K1 = K2 the roll costs nothing: an equilibrium goes
         to an equilibrium, a fixed point of the iteration to a fixed point."""
-        q = rotation_about(REFERENCE_AXIS, angle)
+        q = rotation_about(REFERENCE_FRAME[2], angle)   # e_x, the axis of the scene
         for field in (self.r, self.slope):
             field.set_owned(field.owned() @ q.T)
         d1, d2 = rolled(self.d1.owned() @ q.T, self.d2.owned() @ q.T, -angle)
@@ -267,7 +265,7 @@ class RodState:
         """
         self.node_positions()
         gap, size, step, deformation = self.mesh.global_sum(self._nodes.stopping_sums(
-            self.tau, self.node_weights, self._reference_directors, self._reference_positions))
+            self.tau, self.node_weights, self._node_S))
         if size <= 0:
             return Norms(np.inf, np.inf, 1.0)
         scale = min(1.0, max(np.sqrt(deformation / size), DEFORMATION_FLOOR))
