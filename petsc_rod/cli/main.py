@@ -23,6 +23,7 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
+from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (restart_path, rounded_down, scene_from_options,
                                          settings_from_options)
 from petsc_rod.cli.session import run_continuation
@@ -252,7 +253,12 @@ def walked_scene(scene, values, comm):
     record = io.read_parameters(path, comm) if path else None
     if record is None:
         return scene, []
-    parameters, t_file = record
+    parameters, t_file, walked_file = record
+    if walked_file and t_file < 1.0:
+        raise RodInputError(
+            f"-rod_initial {path}: written part way along a restart's walk from another "
+            f"scene (s = {t_file:.6g}), its state is the equilibrium of a scene between the "
+            "two; restart from the file that walk started from")
     missing = [option.name for option in OPTIONS
                if option.name.removeprefix("rod_") not in parameters]
     if missing:
@@ -301,7 +307,9 @@ def run_record(values, solver, start):
     text = "\n".join(f"-rod_{name} {format_value(value)}" for name, value in parameters.items()
                      if not (isinstance(value, str) and value == ""))
     attributes = {"version": provenance.version(), "commit": provenance.commit(),
-                  "options_in_effect": text}
+                  "options_in_effect": text,
+                  # the load factors are a walk's s (scenes/blend.py): read_parameters
+                  "restart_walk": int(isinstance(solver.problem.scene, BlendedPath))}
     shaped = {**parameters, "load": np.asarray(parameters["load"]).reshape(-1, 3),
               "end_frame": np.asarray(parameters["end_frame"]).reshape(3, 3)}
     return io.RunRecord(attributes, shaped, units)

@@ -60,7 +60,7 @@ ATTRIBUTE_UNITS = {
     "wall_time": "s", "written": "text", "ranks": "1", "load_factor": "1", "penalty": "N",
     "asked_penalty": "N",
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
-    "options_in_effect": "text", "version": "text", "commit": "text",
+    "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
@@ -459,7 +459,9 @@ def _read_restart(path, mesh, layout):
 
 def read_parameters(path, comm):
     """(the group ``parameters`` of result file ``path`` as {name: value}, its root's
-    load_factor): what a restart needs to rebuild the file's scene (cli/scene_options.py).
+    load_factor, whether the run that wrote it walked from another scene's file (its
+    ``restart_walk``, 0 in files of older versions)): what a restart needs to rebuild
+    the file's scene (cli/scene_options.py).
     None when the file cannot be read or has no such group (read_restart then says
     what is wrong with it, or the restart keeps the file's path as it is). Read on rank
     0 and broadcast, so that every rank of ``comm`` (petsc4py) builds the same scene even
@@ -476,7 +478,8 @@ def _parameters(path):
                 return None
             values = {key: value.decode() if isinstance(value, bytes) else value
                       for key, value in group.attrs.items() if key != "attribute_units"}
-            return values, float(np.asarray(f.attrs["load_factor"]).ravel()[0])
+            return (values, float(np.asarray(f.attrs["load_factor"]).ravel()[0]),
+                    bool(np.asarray(f.attrs.get("restart_walk", 0)).ravel()[0]))
     except (OSError, KeyError, TypeError, ValueError, IndexError):
         return None
 

@@ -189,3 +189,19 @@ def test_a_file_whose_parameters_lack_an_option_is_taken_as_this_runs_scene(shar
     assert run_cli({**new, "rod_initial": files["old"], "rod_steps": str(STEPS),
                     "rod_output": files["new"]}) == 0
     assert step_factors(files["new"]) == [1.0]
+
+
+def test_a_file_written_part_way_along_a_walk_is_refused(shared_tmp):
+    """A walk that stopped at s = 1/2 (here at its iteration cap, exit 3) keeps the
+    state of a scene between the two, which neither scene's path gives: a restart from
+    it is refused in one line (exit 2), a finished walk's file (s = 1) is not."""
+    old, new, _, _ = CASES["end force"]
+    files = {name: f"{shared_tmp}/{name}.h5" for name in ("old", "part", "whole", "again")}
+    assert run_cli({**old, "rod_output": files["old"]}) == 0
+    walk = {**new, "rod_initial": files["old"], "rod_steps": str(STEPS)}
+    assert run_cli({**walk, "rod_al_max_it": "5", "rod_max_halvings": "0",
+                    "rod_output": files["part"]}) == 3
+    assert step_factors(files["part"]) == [0.5]
+    assert run_cli({**new, "rod_initial": files["part"], "rod_output": files["again"]}) == 2
+    assert run_cli({**walk, "rod_output": files["whole"]}) == 0
+    assert run_cli({**new, "rod_initial": files["whole"], "rod_output": files["again"]}) == 0
