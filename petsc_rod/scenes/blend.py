@@ -9,9 +9,10 @@ every quantity the load path carries is
 so that s = 0 is the file's equilibrium itself (the first step is a warm start, not a
 jump) and s = 1 is this run's scene. The loads and forces are linear in their values,
 so the blend of the loads is the load of the blended values, exactly; the end frame
-turns along the geodesic from A's to B's, except for a rod clamped at both ends on one
-axis, whose end roll is blended linearly so that the linking number's bookkeeping
-(Scene.end_roll) stays continuous. Everything the load path does not carry (length,
+before its -rod_end_twist turns along the geodesic from A's to B's and the twist is
+blended linearly (of any size, Scene.end_frame_parts), except for a rod clamped at both
+ends on one axis, whose whole end roll is blended linearly so that the linking number's
+bookkeeping (Scene.end_roll) stays continuous. Everything the load path does not carry (length,
 stiffness, end kinds, seabed) is B's from the first step.
 """
 
