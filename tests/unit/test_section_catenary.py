@@ -16,17 +16,23 @@ CABLE_ENDS = [0.0, 52.101, 102.101, 170.215]
 CABLE_WEIGHTS = [157.8003, -80.1525, 157.8003]
 
 
+def assert_the_same_line(line, S, r, force, length, weight):
+    """x, z, H and V of the SectionCatenary ``line`` at S against a closed form's r and
+    n, to 1e-12 of the length, of H and of the whole weight."""
+    x, z, V = line.at(S)
+    assert np.abs(x - r[:, 0]).max() < 1e-12 * length
+    assert np.abs(z - r[:, 2]).max() < 1e-12 * length
+    assert abs(line.H - force[0, 0]) < 1e-12 * line.H
+    assert np.abs(V - force[:, 2]).max() < 1e-12 * weight * length
+
+
 def test_a_uniform_line_in_pieces_is_the_catenary():
     length, weight, chord = 3000.0, 1000.0, np.array([2500.0, 0.0, 300.0])
     line = section_catenary.solve([0.0, 700.0, 1900.0, length], [weight] * 3, chord[0],
                                   chord[2], on_seabed=False)
     S = np.linspace(0.0, length, 101)
-    x, z, V = line.at(S)
     r, _, force = catenary(length, chord, [0.0, 0.0, -weight], S)
-    assert np.abs(x - r[:, 0]).max() < 1e-12 * length
-    assert np.abs(z - r[:, 2]).max() < 1e-12 * length
-    assert abs(line.H - force[0, 0]) < 1e-12 * line.H
-    assert np.abs(V - force[:, 2]).max() < 1e-12 * weight * length
+    assert_the_same_line(line, S, r, force, length, weight)
 
 
 def test_a_uniform_line_in_pieces_on_the_seabed_is_the_catenary_with_touchdown():
@@ -34,13 +40,9 @@ def test_a_uniform_line_in_pieces_on_the_seabed_is_the_catenary_with_touchdown()
     line = section_catenary.solve([0.0, 500.0, 1200.0, length], [weight] * 3, chord[0],
                                   chord[2], on_seabed=True)
     S = np.linspace(0.0, length, 101)
-    x, z, V = line.at(S)
     r, _, force, (_, touchdown) = grounded_catenary(length, chord, weight, 0.0, S)
     assert abs(line.grounded - touchdown) < 1e-12 * length
-    assert np.abs(x - r[:, 0]).max() < 1e-12 * length
-    assert np.abs(z - r[:, 2]).max() < 1e-12 * length
-    assert abs(line.H - force[0, 0]) < 1e-12 * line.H
-    assert np.abs(V - force[:, 2]).max() < 1e-12 * weight * length
+    assert_the_same_line(line, S, r, force, length, weight)
 
 
 def test_a_lazy_wave_meets_its_ends_and_its_force_balance():
