@@ -154,11 +154,10 @@ def seabed_from_options(values, given, load_values):
     return Seabed(float(values["rod_seabed"]), float(stiffness))
 
 
-def current_from_options(values, given, surface_default, profile=None):
+def current_from_options(values, given, surface_default, profile_rows=None):
     """The Current of -rod_current or -rod_current_profile with -rod_drag, or None.
     ``surface_default``: the sea surface height when -rod_sea_surface is not given;
-    ``profile``: the profile's (depths, velocities) when already read."""
-    table = profile
+    ``profile_rows``: the profile's (depths, velocities) when already read."""
     uniform, profile = "rod_current" in given, "rod_current_profile" in given
     if uniform and profile:
         raise RodInputError("-rod_current and -rod_current_profile both give the current; "
@@ -175,8 +174,8 @@ def current_from_options(values, given, surface_default, profile=None):
     if "rod_sea_surface" in given and not profile:
         raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
                             "current does not depend on depth)")
-    if profile and table is not None:
-        depths, velocities = table
+    if profile and profile_rows is not None:
+        depths, velocities = profile_rows
     elif profile:
         depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
     else:
