@@ -49,6 +49,11 @@ class Scene:
     # riser terms (petsc_rod/riser/environment.py): a Seabed and a Current, or None
     seabed: object = None
     current: object = None
+    # the line as sections of line types (scenes/line.py), from S = 0; () for a uniform
+    # line of -rod_stiffness (and -rod_axial_stiffness)
+    sections: tuple = ()
+    # EA, N: the uniform line's axial stiffness (inf: inextensible)
+    axial_stiffness: float = np.inf
 
     def __post_init__(self):
         self.stiffness = np.asarray(self.stiffness, dtype=float)
@@ -63,6 +68,38 @@ class Scene:
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
+
+    @property
+    def uniform_stiffness(self):
+        """Whether K1, K2, K3 are the same along the whole line (no section changes them):
+        the global step then keeps its constant-coefficient matrices."""
+        return all(section.stiffness_is(self.stiffness) for section in self.sections)
+
+    def stiffness_at(self, S):
+        """(K1, K2, K3) at arc lengths S (...), N m^2 -> (..., 3): the section's, linear
+        along a tapered one; -rod_stiffness on a uniform line."""
+        S = np.asarray(S, dtype=float)
+        if not self.sections:
+            return np.broadcast_to(self.stiffness, S.shape + (3,)).copy()
+        from petsc_rod.scenes.line import piecewise_linear
+        return piecewise_linear(self.sections, S, "stiffness_start", "stiffness_end")
+
+    def axial_stiffness_at(self, S):
+        """EA at arc lengths S (...), N -> (...): the section's (inf: inextensible);
+        -rod_axial_stiffness on a uniform line."""
+        S = np.asarray(S, dtype=float)
+        if not self.sections:
+            return np.full(S.shape, float(self.axial_stiffness))
+        from petsc_rod.scenes.line import piecewise_constant
+        return piecewise_constant(self.sections, S, "axial_stiffness")
+
+    @property
+    def extensible(self):
+        """Whether some part of the line has a finite EA (nothing is built for stretch
+        otherwise)."""
+        values = ([s.axial_stiffness for s in self.sections] if self.sections
+                  else [self.axial_stiffness])
+        return bool(np.any(np.isfinite(values)))
 
     @property
     def load_piece_ends(self):
