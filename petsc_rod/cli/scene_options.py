@@ -41,9 +41,26 @@ def scene_from_options(values, given, profile=None):
                   load_breaks=values["rod_load_breaks"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
+    check_taut(scene)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
     return scene
+
+
+def check_taut(scene):
+    """Refuse a loaded inextensible line held at both ends its length apart (Scene.taut):
+    it can only be straight, and any tension balances its loads along it, so that the
+    tension the iteration would stop at is arbitrary (docs/method.md §5). An unloaded one
+    (a straight rod twisted between clamps) is kept: its tension is zero, the limit of a
+    stiff extensible rod."""
+    if not scene.taut or not scene.loaded:
+        return
+    chord = np.linalg.norm(scene.end_position - scene.start_state(1.0).position)
+    raise RodInputError(
+        f"-rod_end_position: the held ends are {chord:.15g} m apart, the line's length "
+        f"{scene.length:.15g} m: an inextensible line held taut is straight and any "
+        "tension balances its loads, so its tension is undetermined; give "
+        "-rod_axial_stiffness EA to model the stretch, or bring the ends closer")
 
 
 def check_seabed_stiffness(scene, given):

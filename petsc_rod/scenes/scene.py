@@ -16,6 +16,10 @@ from petsc_rod.frames import rotation_about, rotation_log
 
 REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 END_KINDS = ("clamp", "pin", "free")
+# Held ends closer to the length than this fraction of it make a taut line (Scene.taut):
+# a catenary of sag f has (8/3) f^2 / L of slack, so at 1e-9 L of slack its tension is
+# above 2000 times its weight, beyond what the constraint tolerance determines.
+TAUT_GAP = 1e-9
 
 
 def rolled_frame(frame, angle):
@@ -100,6 +104,23 @@ class Scene:
         values = ([s.axial_stiffness for s in self.sections] if self.sections
                   else [self.axial_stiffness])
         return bool(np.any(np.isfinite(values)))
+
+    @property
+    def taut(self):
+        """Whether an inextensible line is held at both ends at least its length less
+        TAUT_GAP (relative) apart: straight, with an axial force its inextensibility
+        leaves undetermined (cli.scene_options.check_taut)."""
+        held = self.start != "free" and self.end != "free"
+        chord = np.linalg.norm(self.end_position - self.start_state(1.0).position)
+        return held and not self.extensible and chord >= self.length * (1 - TAUT_GAP)
+
+    @property
+    def loaded(self):
+        """Whether anything but the held ends loads the line: a distributed load, a
+        seabed, a current or an end force."""
+        return bool(np.any(self.load_values) or np.any(self.start_force)
+                    or np.any(self.end_force) or self.seabed is not None
+                    or self.current is not None)
 
     @property
     def load_piece_ends(self):

@@ -497,3 +497,39 @@ def test_an_append_only_folder_is_refused_and_left_empty(comm, shared_tmp):
         comm.tompi4py().Barrier()
         if comm.getRank() == 0:
             subprocess.run(["chattr", "-a", folder], check=True)
+
+
+# --- taut inextensible lines (issue 22) -----------------------------------------------------
+TAUT_TETHER = dict(rod_length="100", rod_stiffness="1e3,1e3,1e3", rod_start="pin",
+                   rod_end="pin", rod_load="0,0,-100")
+
+
+@pytest.mark.parametrize("gap", [0.0, 1e-10])
+def test_a_loaded_line_held_taut_is_refused(options, gap):
+    """Issue 22: a vertical tether pinned exactly its length apart ended "converged" with
+    a bottom tension of 1.2 kN, 30.8 kN with another penalty and 2.5 kN in 3 steps: an
+    inextensible line held taut carries any tension. It is refused, naming the remedy."""
+    from petsc_rod.cli.scene_options import scene_from_options
+    values, names = options(**TAUT_TETHER, rod_end_position=f"0,0,{100 * (1 - gap)!r}")()
+    with pytest.raises(RodInputError) as error:
+        scene_from_options(values, names)
+    message = str(error.value)
+    assert "tension is undetermined" in message and "-rod_axial_stiffness" in message
+
+
+def test_a_line_with_slack_held_almost_taut_is_accepted(options):
+    """Just beyond the gap (1e-8 L of slack) the tension is determined."""
+    from petsc_rod.cli.scene_options import scene_from_options
+    from petsc_rod.scenes.scene import TAUT_GAP
+    slack = 10 * TAUT_GAP
+    values, names = options(**TAUT_TETHER, rod_end_position=f"0,0,{100 * (1 - slack)!r}")()
+    assert not scene_from_options(values, names).taut
+
+
+def test_an_unloaded_rod_held_taut_is_accepted(options):
+    """An unloaded rod twisted between clamps its length apart is straight with zero
+    tension, the limit of a stiff extensible rod (docs/method.md §5)."""
+    from petsc_rod.cli.scene_options import scene_from_options
+    values, names = options(rod_start="clamp", rod_end="clamp", rod_end_twist="1")()
+    scene = scene_from_options(values, names)
+    assert scene.taut and not scene.loaded
