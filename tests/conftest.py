@@ -81,6 +81,25 @@ def shared_tmp():
 
 
 @pytest.fixture
+def options():
+    """``set(**values)`` sets PETSc options for one test (on every rank) and returns
+    cli.options.read_options, to call for (values, given); removed afterwards."""
+    from petsc_rod.cli.options import read_options
+    database = PETSc.Options()
+    names = []
+
+    def set_options(**values):
+        for name, value in values.items():
+            database.setValue(name, value)
+            names.append(name)
+        return read_options
+
+    yield set_options
+    for name in names:
+        database.delValue(name)
+
+
+@pytest.fixture
 def solver_factory():
     """``build(comm, n_elements, scene_kwargs, penalty, rtol, ctol, max_it)`` -> (mesh,
     solver); every solver built is destroyed (collectively, in reverse order) at the end."""

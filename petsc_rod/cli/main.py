@@ -24,8 +24,8 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
 from petsc_rod.scenes.blend import BlendedPath
-from petsc_rod.cli.scene_options import (restart_path, rounded_down, scene_from_options,
-                                         settings_from_options)
+from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
+                                         scene_from_options, settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.iteration.continuation import PathSettings
@@ -69,10 +69,14 @@ def run(comm=None):
                     say(line)
             scene = scene_from_options(values, given)
             settings = settings_from_options(values, scene)
+            pieces = mesh_pieces(values, scene)
+            if pieces is not None:          # the sections' elements, every section end a vertex
+                values["rod_elements"] = int(pieces.counts.sum())
             check_mesh(comm, values)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
-            mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"])
+            mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
+                        pieces)
             path_scene, notes = walked_scene(scene, values, comm)
             problem, solver = build_solver(mesh, path_scene, settings, say)
             if database.hasName("help"):

@@ -152,6 +152,19 @@ OPTIONS = [
            unit="N/m"),
     Option("rod_load_breaks", _reals(), default_of(Scene, "load_breaks"), "s1,...",
            "arc lengths where the piecewise-constant load changes, m", unit="m"),
+    # the line as line types and sections (scenes/line.py, docs/riser.md)
+    Option("rod_line_types", _string, None, "FILE",
+           "line types: a header row naming the columns name od mass gj and ei (or ei1 "
+           "ei2, or ei_start ei_end), optionally ea cd drag_d; one row per type (m, kg/m, "
+           "N m^2, N)", unit="text"),
+    Option("rod_sections", _string, None, "TYPE:LENGTH[:ELEMENTS],...",
+           "the line from S = 0 as sections of -rod_line_types (m); they set the length, "
+           "stiffness, weight and drag; elements shared out by length where not given",
+           unit="text"),
+    Option("rod_water_density", _real, 1025.0, "rho",
+           "sea water density, kg/m^3 (the line types' buoyancy and drag)", SCALE, "kg/m^3"),
+    Option("rod_gravity", _real, 9.80665, "g",
+           "gravity, m/s^2, along -z (the line types' weight)", SCALE, "m/s^2"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",

@@ -23,7 +23,8 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
                              "-rod_drag)"),
                  "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
-                 "seabed": "-rod_seabed"}
+                 "seabed": "-rod_seabed", "sections": "-rod_line_types/-rod_sections",
+                 "axial_stiffness": "-rod_axial_stiffness"}
 
 
 def scene_from_options(values, given, profile=None):
@@ -33,18 +34,89 @@ def scene_from_options(values, given, profile=None):
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
-    scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
-                  start=values["rod_start"], end=values["rod_end"],
+    line = dict(length=values["rod_length"], stiffness=values["rod_stiffness"],
+                load_values=load.reshape(-1, 3), load_breaks=values["rod_load_breaks"])
+    sections = sections_from_options(values, given)
+    if sections:
+        line = dict(length=sections[-1].end, stiffness=sections[0].stiffness_start,
+                    load_values=[s.weight for s in sections],
+                    load_breaks=[s.start for s in sections[1:]], sections=tuple(sections))
+    scene = Scene(**line, start=values["rod_start"], end=values["rod_end"],
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
-                  end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
-                  load_breaks=values["rod_load_breaks"])
+                  end_force=values["rod_end_force"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_taut(scene)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
     return scene
+
+
+# Options the sections replace, and what gives the value instead.
+SECTION_REPLACES = {"rod_stiffness": "the line types' ei and gj",
+                    "rod_load": "the line types' mass and od (the submerged weight)",
+                    "rod_load_breaks": "the section ends",
+                    "rod_drag": "the line types' cd and drag_d",
+                    "rod_mesh_grading": "the element counts of -rod_sections (each "
+                                        "section is meshed uniformly)"}
+
+
+def sections_from_options(values, given):
+    """The line's Sections (scenes/line.py) from -rod_line_types and -rod_sections, or
+    [] when neither is given; RodInputError for one without the other, an unknown type,
+    a length that disagrees with -rod_length, or an option the sections replace."""
+    from petsc_rod.io.tables import read_table
+    from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
+                                       line_types_from_table, parse_sections)
+    if "rod_sections" not in given:
+        if "rod_line_types" in given:
+            raise RodInputError("-rod_line_types needs -rod_sections TYPE:LENGTH[:ELEMENTS],"
+                                "... (the line from S = 0 as sections of those types)")
+        for name in ("rod_water_density", "rod_gravity"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_sections (the weight and drag "
+                                    "of line types); the uniform line takes -rod_load")
+        return []
+    if "rod_line_types" not in given:
+        raise RodInputError("-rod_sections needs -rod_line_types FILE (the table of the "
+                            "line types it names)")
+    for name, instead in SECTION_REPLACES.items():
+        if name in given:
+            raise RodInputError(f"-{name} with -rod_sections: {instead} give it; drop -{name}")
+    path = values["rod_line_types"]
+    types = line_types_from_table(
+        read_table(path, "-rod_line_types", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL),
+        f"-rod_line_types {path}")
+    entries = parse_sections(values["rod_sections"], "-rod_sections")
+    for name, _, _ in entries:
+        if name not in types:
+            raise RodInputError(f"-rod_sections: unknown line type '{name}'; "
+                                f"-rod_line_types {path} has {', '.join(types)}")
+    ends = np.concatenate([[0.0], np.cumsum([length for _, length, _ in entries])])
+    if "rod_length" in given and abs(ends[-1] - values["rod_length"]) > 1e-9 * ends[-1]:
+        raise RodInputError(
+            f"-rod_sections add up to {ends[-1]:.15g} m, -rod_length is "
+            f"{values['rod_length']:.15g} m; the sections set the length: drop -rod_length "
+            "or correct a section")
+    rho, g = values["rod_water_density"], values["rod_gravity"]
+    return [types[name].section(ends[k], ends[k + 1], rho, g)
+            for k, (name, _, _) in enumerate(entries)]
+
+
+def mesh_pieces(values, scene):
+    """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
+    vertex, with the element counts -rod_sections gives and the rest of -rod_elements
+    shared out by length; None for a line without sections."""
+    from petsc_rod.mesh.mesh import Pieces
+    from petsc_rod.scenes.line import parse_sections, section_elements
+    if not scene.sections:
+        return None
+    entries = parse_sections(values["rod_sections"], "-rod_sections")
+    counts = section_elements([length for _, length, _ in entries],
+                              [count for _, _, count in entries], values["rod_elements"])
+    ends = [scene.sections[0].start] + [section.end for section in scene.sections]
+    return Pieces(ends, counts)
 
 
 def check_taut(scene):
@@ -171,10 +243,14 @@ def seabed_from_options(values, given, load_values):
     return Seabed(float(values["rod_seabed"]), float(stiffness))
 
 
-def current_from_options(values, given, surface_default, profile_rows=None):
+def current_from_options(values, given, surface_default, profile_rows=None,
+                         section_drag=None):
     """The Current of -rod_current or -rod_current_profile with -rod_drag, or None.
     ``surface_default``: the sea surface height when -rod_sea_surface is not given;
-    ``profile_rows``: the profile's (depths, velocities) when already read."""
+    ``profile_rows``: the profile's (depths, velocities) when already read;
+    ``section_drag``: for a line of sections, the largest of their drag coefficients
+    c (kg/m^2), which the current carries in place of -rod_drag's (the drag term takes
+    each section's own, Scene.drag_at)."""
     uniform, profile = "rod_current" in given, "rod_current_profile" in given
     if uniform and profile:
         raise RodInputError("-rod_current and -rod_current_profile both give the current; "
@@ -185,7 +261,7 @@ def current_from_options(values, given, surface_default, profile_rows=None):
                 raise RodInputError(f"-{name} needs a current (-rod_current or "
                                     "-rod_current_profile)")
         return None
-    if "rod_drag" not in given:
+    if section_drag is None and "rod_drag" not in given:
         raise RodInputError("a current needs -rod_drag rho,Cd,D (water density kg/m^3, drag "
                             "coefficient, hydrodynamic diameter m)")
     if "rod_sea_surface" in given and not profile:
@@ -198,9 +274,16 @@ def current_from_options(values, given, surface_default, profile_rows=None):
     else:
         depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
     surface = values["rod_sea_surface"]
-    rho, cd, diameter = values["rod_drag"]
+    if section_drag is not None:
+        if section_drag == 0:
+            raise RodInputError("a current on -rod_sections whose line types have no drag: "
+                                "give the line types a cd column")
+        drag = section_drag
+    else:
+        rho, cd, diameter = values["rod_drag"]
+        drag = 0.5 * rho * cd * diameter
     return Current(depths, velocities, float(surface_default if surface is None else surface),
-                   0.5 * rho * cd * diameter)
+                   drag)
 
 
 def environment_from_options(values, given, scene, profile=None):
@@ -211,7 +294,8 @@ def environment_from_options(values, given, scene, profile=None):
     ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
     check_ends_above(seabed, ends, scene.length)
     held = [state.position[2] for _, state in ends if is_held(state)]
-    return seabed, current_from_options(values, given, max(held), profile)
+    section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
+    return seabed, current_from_options(values, given, max(held), profile, section_drag)
 
 
 def options_from_parameters(parameters):

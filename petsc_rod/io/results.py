@@ -39,6 +39,7 @@ from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
 from petsc_rod.riser import quantities as riser_quantities
+from petsc_rod.riser import section_numbers
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -49,7 +50,7 @@ DATASET_UNITS = {
     "S": "m", "r": "m", "d1": "1", "d2": "1", "d3": "1", "u": "rad/m", "m": "N m", "n": "N",
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
-    **riser_quantities.DATASET_UNITS,
+    **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
 ATTRIBUTE_UNITS = {
@@ -61,7 +62,7 @@ ATTRIBUTE_UNITS = {
     "asked_penalty": "N",
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
-    **riser_quantities.ATTRIBUTE_UNITS,
+    **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

@@ -142,19 +142,48 @@ def end_element_lengths(n_elements, length, grading):
     return element_lengths([0, n_elements - 1], n_elements, length, grading)
 
 
+class Pieces:
+    """A mesh made of pieces, each uniform: piece k spans [S_k, S_k+1] (``ends``, (m+1,),
+    m) with ``counts[k]`` elements, so that every S_k is a vertex (the ends of a line's
+    sections, scenes/line.py)."""
+
+    def __init__(self, ends, counts):
+        self.ends = np.asarray(ends, dtype=float)
+        self.counts = np.asarray(counts, dtype=int)
+        self.first = np.concatenate([[0], np.cumsum(self.counts)])   # first vertex of each
+
+    def coordinates(self, vertex_index):
+        """S of global vertices: S_k + (i - first_k) (S_k+1 - S_k) / n_k, the piece ends
+        exactly."""
+        i = np.asarray(vertex_index)
+        k = np.clip(np.searchsorted(self.first, i, side="right") - 1, 0,
+                    len(self.counts) - 1)
+        fraction = (i - self.first[k]) / self.counts[k]
+        return np.where(fraction >= 1.0, self.ends[k + 1],
+                        self.ends[k] + fraction * (self.ends[k + 1] - self.ends[k]))
+
+    def element_lengths(self, element_index):
+        """(S_k+1 - S_k) / n_k of the piece holding each global element."""
+        e = np.asarray(element_index)
+        k = np.searchsorted(self.first[1:], e, side="right")
+        return (np.diff(self.ends) / self.counts)[k]
+
+
 class Mesh:
-    """A distributed mesh of ``n_elements`` elements on [0, length].
+    """A distributed mesh of ``n_elements`` elements on [0, length]: the sine map of
+    ``grading``, or uniform ``pieces`` (Pieces) when given.
 
     Attributes a kernel needs are plain numpy arrays of this rank's part; the rank
     itself never appears outside this class (``on_lower_boundary`` and
     ``on_upper_boundary`` say whether the rank holds S = 0 and S = L).
     """
 
-    def __init__(self, comm, n_elements, length, grading=1.0):
+    def __init__(self, comm, n_elements, length, grading=1.0, pieces=None):
         self.n_elements = int(n_elements)
         self.n_vertices = self.n_elements + 1
         self.length = float(length)
         self.grading = float(grading)
+        self.pieces = pieces
         self.comm = comm
         self.da = PETSc.DMDA().create(dim=1, sizes=(self.n_vertices,), dof=2,
                                       stencil_width=1, comm=comm)
@@ -167,8 +196,8 @@ class Mesh:
         self.vertex_S = self.coordinates(np.arange(self.vertex_start, self.vertex_end))
         ends = self.coordinates(np.arange(self.element_start, self.element_end + 1))
         self.element_S = ends[:-1]
-        self.element_h = element_lengths(np.arange(self.element_start, self.element_end),
-                                         self.n_elements, self.length, self.grading)
+        self.element_h = self.element_lengths(np.arange(self.element_start,
+                                                        self.element_end))
         # Local (ghosted) index of each owned element's left vertex.
         self.element_local = np.arange(self.element_start, self.element_end) - self.ghost_start
 
@@ -194,7 +223,7 @@ class Mesh:
         element, summed at the vertices, so that sum_n w_n g(S_n) = int g dS exactly for
         a piecewise cubic g (the quadrature of the constraint, docs/method.md §4)."""
         vertices = np.arange(self.vertex_start, self.vertex_end)
-        lengths = lambda e: element_lengths(e, self.n_elements, self.length, self.grading)
+        lengths = self.element_lengths
         left = np.where(vertices > 0, lengths(np.maximum(vertices - 1, 0)), 0.0)
         right = np.where(vertices < self.n_elements,
                          lengths(np.minimum(vertices, self.n_elements - 1)), 0.0)
@@ -205,7 +234,15 @@ class Mesh:
 
     def coordinates(self, vertex_index):
         """S of the given global vertex indices."""
+        if self.pieces is not None:
+            return self.pieces.coordinates(vertex_index)
         return vertex_coordinates(vertex_index, self.n_elements, self.length, self.grading)
+
+    def element_lengths(self, element_index):
+        """The lengths (m) of the given global elements."""
+        if self.pieces is not None:
+            return self.pieces.element_lengths(element_index)
+        return element_lengths(element_index, self.n_elements, self.length, self.grading)
 
     def point_S(self, xi):
         """S at reference points xi (nq,) of the owned elements, (ne, nq)."""

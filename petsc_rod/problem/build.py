@@ -4,6 +4,7 @@ seabed or a current (docs/riser.md)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.riser.quantities import RiserNumbers
+from petsc_rod.riser.section_numbers import SectionNumbers
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
 
 
@@ -18,4 +19,6 @@ def scene_terms(mesh, scene):
         terms.append(DragTerm(mesh, scene))
     if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
+    if scene.sections:
+        terms.append(SectionNumbers(scene.sections))
     return terms

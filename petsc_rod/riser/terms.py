@@ -170,7 +170,9 @@ class DragTerm(NodalLoadTerm):
         currents = self.scene.drag_loads(self.t)
         z = (state.node_positions()[:, 2] if any(c.depths.size > 1 for _, c in currents)
              else np.zeros(self.mesh.n_local_nodes))
-        return sum(w * normal_drag(state.tau[:, 2], c.velocity(z), c.drag)
+        S = self.mesh.node_S()
+        return sum(w * normal_drag(state.tau[:, 2], c.velocity(z),
+                                   self.scene.drag_at(S, c)[:, None])
                    for w, c in currents)
 
     def add_iterate_load(self, rhs, state):

@@ -16,6 +16,8 @@ bookkeeping (Scene.end_roll) stays continuous. Everything the load path does not
 stiffness, end kinds, seabed) is B's from the first step.
 """
 
+import dataclasses
+
 import numpy as np
 
 from petsc_rod.frames import rotation_about, rotation_log, rotations
@@ -25,7 +27,7 @@ from petsc_rod.scenes.scene import EndState, rolled_frame
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
                "end_frame", "end_twist", "current")
 # The Scene fields a restart takes from this run's scene at once.
-FIXED_FIELDS = ("stiffness", "start", "end", "seabed")
+FIXED_FIELDS = ("stiffness", "start", "end", "seabed", "sections", "axial_stiffness")
 
 
 def _same(a, b):
@@ -33,6 +35,12 @@ def _same(a, b):
     by its depths, velocities, surface and drag, anything else by ==."""
     if a is None or b is None:
         return a is b
+    if isinstance(a, tuple) or isinstance(b, tuple):        # sections
+        return (isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b)
+                and all(_same(x, y) for x, y in zip(a, b)))
+    if dataclasses.is_dataclass(a) and type(a) is type(b):
+        return all(_same(getattr(a, f.name), getattr(b, f.name))
+                   for f in dataclasses.fields(a))
     if hasattr(a, "velocities"):
         return all(_same(getattr(a, key), getattr(b, key))
                    for key in ("depths", "velocities", "surface", "drag"))

@@ -69,3 +69,138 @@ def piecewise_constant(sections, S, name):
     """Each S (...) mapped to the value ``name`` of its section."""
     values = np.array([getattr(s, name) for s in sections], dtype=float)
     return values[section_index(sections, S)]
+
+
+# The columns of a line-type table (-rod_line_types): required, and optional.
+LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
+LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d")
+# The ways of giving the bending stiffness, one per table: isotropic, anisotropic
+# (about d1 and d2), and a linear taper along each section of the type.
+BENDING_FORMS = (("ei",), ("ei1", "ei2"), ("ei_start", "ei_end"))
+
+
+@dataclass
+class LineType:
+    """A line type as a data sheet gives it: outer diameter ``od`` (m), ``mass`` in air
+    with contents (kg/m), bending stiffnesses about d1 and d2 at the start and end of
+    each section of the type (``bending_start``, ``bending_end``, N m^2, equal unless
+    tapered), torsional ``gj`` (N m^2), axial ``ea`` (N, inf: inextensible), normal drag
+    coefficient ``cd`` and hydrodynamic diameter ``drag_d`` (m)."""
+
+    name: str
+    od: float
+    mass: float
+    bending_start: np.ndarray
+    bending_end: np.ndarray
+    gj: float
+    ea: float = np.inf
+    cd: float = 0.0
+    drag_d: float = np.nan
+
+    def submerged_weight(self, water_density, gravity):
+        """(mass - rho_w pi od^2 / 4) g, N/m: positive sinks, negative floats."""
+        return (self.mass - water_density * np.pi * self.od**2 / 4) * gravity
+
+    def section(self, start, end, water_density, gravity):
+        """The Section [start, end] (m) of this type in water of ``water_density``
+        (kg/m^3) under ``gravity`` (m/s^2, along -z)."""
+        return Section(self.name, start, end,
+                       np.append(self.bending_start, self.gj),
+                       np.append(self.bending_end, self.gj), self.ea,
+                       np.array([0.0, 0.0, -self.submerged_weight(water_density, gravity)]),
+                       0.5 * water_density * self.cd * self.drag_d, self.od, self.mass)
+
+
+def line_types_from_table(table, option):
+    """{name: LineType} from the columns of a -rod_line_types table (io/tables.py
+    read_table with LINE_TYPE_COLUMNS and LINE_TYPE_OPTIONAL); RodInputError naming
+    ``option`` for a table that does not give one bending form or gives a value out of
+    range."""
+    from petsc_rod.errors import RodInputError
+
+    forms = [form for form in BENDING_FORMS if any(name in table for name in form)]
+    if len(forms) != 1 or not all(name in table for name in forms[0]):
+        raise RodInputError(
+            f"{option}: give the bending stiffness (N m^2) in one of the forms: a column ei; "
+            "columns ei1 and ei2 (about d1 and d2); columns ei_start and ei_end (tapered "
+            "along each section)")
+    names = table["name"]
+    if len(set(names)) != len(names):
+        raise RodInputError(f"{option}: a line type is named twice")
+    rows = len(names)
+    column = lambda name, default: table.get(name, np.full(rows, default))
+    positive = {"od": table["od"], "mass": table["mass"], "gj": table["gj"],
+                "ea": column("ea", np.inf), "drag_d": column("drag_d", 1.0)}
+    positive.update({name: table[name] for name in forms[0]})
+    for name, values in positive.items():
+        bad = ~(values > 0)
+        if np.any(bad):
+            row = int(np.flatnonzero(bad)[0])
+            raise RodInputError(f"{option}: line type {names[row]}: {name} "
+                                f"{values[row]:g} must be positive")
+    finite = {name: values for name, values in positive.items() if name != "ea"}
+    for name, values in finite.items():
+        if not np.all(np.isfinite(values)):
+            row = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise RodInputError(f"{option}: line type {names[row]}: {name} must be finite "
+                                "(only ea may be inf: inextensible)")
+    cd = column("cd", 0.0)
+    if not np.all((cd >= 0) & np.isfinite(cd)):
+        row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
+        raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
+                            "finite number, 0 or more")
+    if forms[0] == ("ei",):
+        start = end = np.stack([table["ei"], table["ei"]], axis=1)
+    elif forms[0] == ("ei1", "ei2"):
+        start = end = np.stack([table["ei1"], table["ei2"]], axis=1)
+    else:
+        start = np.stack([table["ei_start"]] * 2, axis=1)
+        end = np.stack([table["ei_end"]] * 2, axis=1)
+    drag_d = table.get("drag_d", table["od"])
+    return {name: LineType(name, table["od"][i], table["mass"][i], start[i], end[i],
+                           table["gj"][i], column("ea", np.inf)[i], cd[i], drag_d[i])
+            for i, name in enumerate(names)}
+
+
+def parse_sections(text, option):
+    """[(type name, length m, elements or None)] from 'TYPE:LENGTH[:ELEMENTS],...';
+    RodInputError naming ``option`` for an entry of another form, a length that is not
+    positive or a count that is not a whole number of at least 1."""
+    from petsc_rod.errors import RodInputError
+
+    entries = []
+    for entry in text.split(","):
+        parts = entry.strip().split(":")
+        if len(parts) not in (2, 3) or not parts[0]:
+            raise RodInputError(f"{option}: '{entry}' is not TYPE:LENGTH[:ELEMENTS]")
+        try:
+            length = float(parts[1])
+        except ValueError:
+            raise RodInputError(f"{option}: '{entry}': the length '{parts[1]}' is not a "
+                                "number (m)") from None
+        if not (np.isfinite(length) and length > 0):
+            raise RodInputError(f"{option}: '{entry}': the length must be positive (m)")
+        count = None
+        if len(parts) == 3:
+            try:
+                count = int(parts[2])
+            except ValueError:
+                count = 0
+            if count < 1:
+                raise RodInputError(f"{option}: '{entry}': the element count '{parts[2]}' "
+                                    "must be a whole number of at least 1")
+        entries.append((parts[0], length, count))
+    return entries
+
+
+def section_elements(lengths, counts, total):
+    """The element count of each section: its own where given, else the share of the
+    ``total`` left over in proportion to its length (at least 1 each)."""
+    lengths = np.asarray(lengths, dtype=float)
+    given = np.array([c is not None for c in counts])
+    result = np.array([c or 0 for c in counts])
+    if np.any(~given):
+        left = max(total - result[given].sum(), int((~given).sum()))
+        share = lengths[~given] / lengths[~given].sum() * left
+        result[~given] = np.maximum(1, np.round(share)).astype(int)
+    return result

@@ -97,6 +97,15 @@ class Scene:
         from petsc_rod.scenes.line import piecewise_constant
         return piecewise_constant(self.sections, S, "axial_stiffness")
 
+    def drag_at(self, S, current):
+        """The drag coefficient c = rho Cd D / 2 (kg/m^2) at arc lengths S (...): each
+        section's own on a line of sections, else the current's (-rod_drag)."""
+        S = np.asarray(S, dtype=float)
+        if not self.sections:
+            return np.full(S.shape, float(current.drag))
+        from petsc_rod.scenes.line import piecewise_constant
+        return piecewise_constant(self.sections, S, "drag")
+
     @property
     def extensible(self):
         """Whether some part of the line has a finite EA (nothing is built for stretch

@@ -30,23 +30,6 @@ CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="fre
                   end_force=(0.0, -1.0, 0.0))
 
 
-@pytest.fixture
-def options():
-    """Set PETSc options for one test (on every rank); removed afterwards."""
-    database = PETSc.Options()
-    names = []
-
-    def set_options(**values):
-        for name, value in values.items():
-            database.setValue(name, value)
-            names.append(name)
-        return read_options
-
-    yield set_options
-    for name in names:
-        database.delValue(name)
-
-
 # --- option values ---------------------------------------------------------------------
 REFUSED = {
     "nan load": ("rod_load", "nan,0,0", "finite"),

@@ -1,0 +1,172 @@
+"""Line types and sections (-rod_line_types, -rod_sections; scenes/line.py, docs/riser.md):
+the weight, drag and mesh they make, one bad input a case, and a line given by line
+types against the same line given by load pieces. Serial and under mpiexec -n 2."""
+
+import numpy as np
+import pytest
+
+from helpers import gather
+from petsc_rod.errors import RodInputError
+
+# The 80 m lazy-wave cable of issue 21 (Lozon et al. 2025) as its data sheet gives it:
+# bare cable od 0.160 m, 36.70 kg/m; buoyancy section od 0.290 m, 59.53 kg/m.
+CABLE_TYPES = """# name od mass ei gj ea cd
+name   od     mass   ei      gj      ea      cd    drag_d
+bare   0.160  36.70  1.99e4  1.99e4  inf     1.2   0.160
+float  0.290  59.53  1.99e4  1.99e4  inf     1.0   0.300
+"""
+CABLE_SECTIONS = "bare:52.101:104,float:50:100,bare:68.114:136"
+CABLE_ENDS = dict(rod_start="pin", rod_end="pin", rod_end_position="120,0,66",
+                  rod_seabed="0")
+# The same line given by hand as three load pieces (options/cable_80m.opts), N/m.
+CABLE_LOADS = dict(rod_length="170.215", rod_stiffness="1.99e4,1.99e4,1.99e4",
+                   rod_load="0,0,-157.8003,0,0,80.1525,0,0,-157.8003",
+                   rod_load_breaks="52.101,102.101")
+
+
+@pytest.fixture
+def table(shared_tmp):
+    """write(text) -> the path of a table holding ``text`` (on every rank)."""
+    from mpi4py import MPI
+    count = [0]
+
+    def write(text):
+        count[0] += 1
+        path = f"{shared_tmp}/types{count[0]}.txt"
+        if MPI.COMM_WORLD.rank == 0:
+            with open(path, "w") as handle:
+                handle.write(text)
+        MPI.COMM_WORLD.Barrier()
+        return path
+    return write
+
+
+def scene_of(options, **given):
+    from petsc_rod.cli.scene_options import scene_from_options
+    values, names = options(**given)()
+    return scene_from_options(values, names), values
+
+
+def test_the_sections_give_the_submerged_weight_drag_and_length(options, table):
+    """(mass - rho pi od^2 / 4) g: 157.80 N/m bare (the issue's figure), -80.15 N/m with
+    the buoyancy; c = rho Cd D / 2 per section; the length is the sections' sum."""
+    scene, _ = scene_of(options, rod_line_types=table(CABLE_TYPES),
+                        rod_sections=CABLE_SECTIONS, **CABLE_ENDS)
+    assert scene.length == pytest.approx(170.215, abs=1e-12)
+    weight = lambda mass, od: (mass - 1025 * np.pi * od**2 / 4) * 9.80665
+    np.testing.assert_allclose(-scene.load_values[:, 2], [weight(36.70, 0.16),
+                               weight(59.53, 0.29), weight(36.70, 0.16)], rtol=1e-15)
+    assert abs(-scene.load_values[0, 2] - 157.80) < 0.005
+    np.testing.assert_allclose(scene.load_breaks, [52.101, 102.101], rtol=1e-15)
+    assert scene.uniform_stiffness and not scene.extensible
+    drag = scene.drag_at(np.array([10.0, 60.0, 150.0]), current=None)
+    np.testing.assert_allclose(drag, [0.5 * 1025 * 1.2 * 0.16, 0.5 * 1025 * 1.0 * 0.3,
+                                      0.5 * 1025 * 1.2 * 0.16], rtol=1e-15)
+
+
+def test_every_section_end_is_a_vertex(options, table, comm):
+    from petsc_rod.cli.scene_options import mesh_pieces
+    from petsc_rod.mesh.mesh import Mesh
+    scene, values = scene_of(options, rod_line_types=table(CABLE_TYPES),
+                             rod_sections="bare:52.101:7,float:50,bare:68.114",
+                             rod_elements="100", **CABLE_ENDS)
+    pieces = mesh_pieces(values, scene)
+    assert pieces.counts[0] == 7 and pieces.counts.sum() == 100
+    mesh = Mesh(comm, int(pieces.counts.sum()), scene.length, pieces=pieces)
+    try:
+        S = gather(comm, mesh.vertex_S)
+        for end in (0.0, 52.101, 102.101, 170.215):
+            assert np.min(np.abs(S - end)) == 0.0
+        assert mesh.global_sum(mesh.element_h.sum()) == pytest.approx(scene.length, rel=1e-14)
+    finally:
+        mesh.destroy()
+
+
+BAD = {
+    "an unknown line type": (dict(rod_sections="bare:52.101,pipe:118.114"),
+                             "unknown line type 'pipe'"),
+    "sections that do not add up to -rod_length": (
+        dict(rod_sections=CABLE_SECTIONS, rod_length="170"), "add up to 170.215 m"),
+    "a zero ea": ("name od mass ei gj ea\nbare 0.16 36.7 1.99e4 1.99e4 0\n", "ea 0 must be"),
+    "a negative od": ("name od mass ei gj\nbare -0.16 36.7 1.99e4 1.99e4\n", "od -0.16 must"),
+    "a zero ei": ("name od mass ei gj\nbare 0.16 36.7 0 1.99e4\n", "ei 0 must be positive"),
+    "a missing column": ("name od ei gj\nbare 0.16 1.99e4 1.99e4\n", "no column mass"),
+    "an unknown column": ("name od mass ei gj colour\nbare 0.16 36.7 1 1 red\n",
+                          "unknown column 'colour'"),
+    "no bending stiffness": ("name od mass gj\nbare 0.16 36.7 1\n", "bending stiffness"),
+    "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "row 2 has 4 values"),
+    "a word for a number": ("name od mass ei gj\nbare 0.16 heavy 1 1\n", "'heavy' is not"),
+    "-rod_stiffness with sections": (dict(rod_sections="bare:10", rod_stiffness="1,1,1"),
+                                     "-rod_stiffness with -rod_sections"),
+    "-rod_load with sections": (dict(rod_sections="bare:10", rod_load="0,0,-1"),
+                                "-rod_load with -rod_sections"),
+    "a section of no length": (dict(rod_sections="bare:0"), "must be positive"),
+    "a section of half an element": (dict(rod_sections="bare:10:0.5"), "whole number"),
+    "sections without types": (dict(rod_sections="bare:10", rod_line_types=None),
+                               "-rod_sections needs -rod_line_types"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_line_types_and_sections_are_refused_in_one_line(options, table, case):
+    from petsc_rod.cli.scene_options import scene_from_options
+    change, words = BAD[case]
+    given = {**CABLE_ENDS, "rod_line_types": table(CABLE_TYPES), "rod_sections": "bare:10",
+             "rod_end_position": "5,0,5"}
+    if isinstance(change, str):
+        given["rod_line_types"] = table(change)
+    else:
+        given.update(change)
+    given = {key: value for key, value in given.items() if value is not None}
+    values, names = options(**given)()
+    with pytest.raises(RodInputError) as error:
+        scene_from_options(values, names)
+    message = str(error.value)
+    assert words in message and "\n" not in message, message
+
+
+def solved_cable(options, given, comm):
+    """r and the effective tension of the 80 m cable from its catenary start, and the
+    step's iterations."""
+    from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
+    from petsc_rod.io.outputs import vertex_fields
+    from petsc_rod.iteration.driver import solver_for
+    from petsc_rod.iteration.stopping import Settings
+    from petsc_rod.mesh.mesh import Mesh, Pieces
+    from petsc_rod.problem.penalty import default_penalty
+    from petsc_rod.scenes.starts import catenary_start
+    values, names = options(**given)()
+    scene = scene_from_options(values, names)
+    pieces = mesh_pieces(values, scene) or Pieces(np.cumsum([0, 52.101, 50, 68.114]),
+                                                  [104, 100, 136])
+    mesh = Mesh(comm, 340, scene.length, pieces=pieces)
+    solver = solver_for(mesh, scene, Settings(asked_penalty=default_penalty(scene),
+                                              rtol=1e-10, ctol=1e-10))
+    try:
+        solver.problem.state.set_from_curve(catenary_start(scene, 1.0))
+        report = solver.solve_step(1.0)
+        fields = vertex_fields(solver.problem)
+        tension = np.einsum("nc,nc->n", fields["n"], fields["d3"])
+        return gather(comm, fields["r"]), gather(comm, tension), report
+    finally:
+        solver.destroy()
+        solver.problem.destroy()
+        mesh.destroy()
+
+
+def test_a_line_of_line_types_is_the_line_of_its_load_pieces(options, table, comm):
+    """The cable by line types and by the load pieces computed by hand (7 digits): the
+    same shape and tension to the loads' rounding (2e-7), on a mesh of the same vertices
+    (uniform per section in both: 104, 100 and 136 elements)."""
+    r_types, tension_types, report = solved_cable(
+        options, dict(rod_line_types=table(CABLE_TYPES), rod_sections=CABLE_SECTIONS,
+                      **CABLE_ENDS), comm)
+    assert report.converged
+    from petsc4py import PETSc
+    for key in ("rod_line_types", "rod_sections"):
+        PETSc.Options().delValue(key)
+    r_loads, tension_loads, report = solved_cable(
+        options, dict(**CABLE_LOADS, **CABLE_ENDS), comm)
+    assert report.converged
+    assert np.abs(r_types - r_loads).max() < 2e-7 * 170.215
+    assert np.abs(tension_types - tension_loads).max() < 2e-7 * np.abs(tension_loads).max()
