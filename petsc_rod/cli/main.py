@@ -27,6 +27,7 @@ from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
                                          scene_from_options, settings_from_options)
 from petsc_rod.cli.session import run_continuation
+from petsc_rod.io.tables import read_text
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
@@ -322,7 +323,8 @@ def run_record(values, solver, start):
 def options_in_effect(values, solver, start):
     """Every -rod_* option's value in effect, by name without ``rod_`` (the defaults that
     depend on the scene resolved, text options that were not given as ''), and its unit;
-    the current profile's rows (``current_profile_table``), not only its file's name;
+    the current profile's rows (``current_profile_table``) and the line types' table
+    (``line_types_table``), not only their files' names;
     then each global-step solver's KSP, PC and factorisation package."""
     scene = solver.problem.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
@@ -331,6 +333,8 @@ def options_in_effect(values, solver, start):
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
     if values["rod_current_profile"]:
         resolved["rod_sea_surface"] = scene.current.surface
+    if scene.sections:                          # the length the sections add up to
+        resolved["rod_length"] = scene.length
     parameters, units = {}, {}
     for option in OPTIONS:
         value = resolved.get(option.name, values[option.name])
@@ -345,6 +349,10 @@ def options_in_effect(values, solver, start):
         parameters["current_profile_table"] = np.column_stack([current.depths,
                                                                current.velocities])
         units["current_profile_table"] = "m, m/s, m/s, m/s (depth, ux, uy, uz)"
+    if values["rod_line_types"]:                # the line types' table, to repeat the run
+        parameters["line_types_table"] = read_text(values["rod_line_types"],
+                                                   "-rod_line_types")
+        units["line_types_table"] = "text"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

@@ -27,16 +27,17 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "axial_stiffness": "-rod_axial_stiffness"}
 
 
-def scene_from_options(values, given, profile=None):
+def scene_from_options(values, given, profile=None, line_types=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
-    current_profile_table), else they are read from its file."""
+    current_profile_table), else they are read from its file; ``line_types`` the text of
+    the -rod_line_types table when already read (a result file's line_types_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
     line = dict(length=values["rod_length"], stiffness=values["rod_stiffness"],
                 load_values=load.reshape(-1, 3), load_breaks=values["rod_load_breaks"])
-    sections = sections_from_options(values, given)
+    sections = sections_from_options(values, given, line_types)
     if sections:
         line = dict(length=sections[-1].end, stiffness=sections[0].stiffness_start,
                     load_values=[s.weight for s in sections],
@@ -62,10 +63,11 @@ SECTION_REPLACES = {"rod_stiffness": "the line types' ei and gj",
                                         "section is meshed uniformly)"}
 
 
-def sections_from_options(values, given):
-    """The line's Sections (scenes/line.py) from -rod_line_types and -rod_sections, or
-    [] when neither is given; RodInputError for one without the other, an unknown type,
-    a length that disagrees with -rod_length, or an option the sections replace."""
+def sections_from_options(values, given, content=None):
+    """The line's Sections (scenes/line.py) from -rod_line_types (its table's text
+    ``content`` when already read) and -rod_sections, or [] when neither is given;
+    RodInputError for one without the other, an unknown type, a length that disagrees
+    with -rod_length, or an option the sections replace."""
     from petsc_rod.io.tables import read_table
     from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
                                        line_types_from_table, parse_sections)
@@ -86,7 +88,8 @@ def sections_from_options(values, given):
             raise RodInputError(f"-{name} with -rod_sections: {instead} give it; drop -{name}")
     path = values["rod_line_types"]
     types = line_types_from_table(
-        read_table(path, "-rod_line_types", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL),
+        read_table(path, "-rod_line_types", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
+                   content=content),
         f"-rod_line_types {path}")
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     for name, _, _ in entries:
@@ -315,19 +318,20 @@ def options_from_parameters(parameters):
             continue
         values[option.name] = value
         default = defaults.get(option.name, option.default)
-        if default is None or np.shape(value) != np.shape(default) or np.any(value != default):
+        if (default is None or np.size(value) != np.size(default)
+                or np.any(np.ravel(value) != np.ravel(default))):
             given.add(option.name)
     return values, given
 
 
 def scene_from_parameters(parameters):
     """The Scene of the run that wrote a result file's ``parameters`` group, built by
-    scene_from_options (its current profile from the file's current_profile_table, not
-    from a profile file that may have changed since)."""
+    scene_from_options (its current profile from the file's current_profile_table and
+    its line types from line_types_table, not from files that may have changed since)."""
     values, given = options_from_parameters(parameters)
     table = parameters.get("current_profile_table")
     profile = None if table is None else (table[:, 0], table[:, 1:])
-    return scene_from_options(values, given, profile)
+    return scene_from_options(values, given, profile, parameters.get("line_types_table"))
 
 
 def restart_path(scene, parameters, t_file):

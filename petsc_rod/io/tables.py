@@ -8,22 +8,29 @@ import numpy as np
 from petsc_rod.errors import RodInputError
 
 
-def read_table(path, option, required, optional=(), text=("name",)):
-    """{column: values} from the file ``path`` given to ``option``: float arrays (m,),
-    or lists of str for the columns in ``text``. Every column of ``required`` must be in
-    the header; a column outside ``required`` and ``optional`` is refused (a misspelt
-    name would otherwise be ignored), as are a repeated column, a row of another length,
-    a value that is not a number, and a table without rows."""
+def read_text(path, option):
+    """The text of the file ``path`` given to ``option`` (RodInputError if it cannot be
+    read)."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            return handle.read()
+    except FileNotFoundError:
+        raise RodInputError(f"{option} {path}: no such file") from None
+    except OSError as error:
+        raise RodInputError(f"{option} {path}: cannot be read ({error.strerror})") from None
+
+
+def read_table(path, option, required, optional=(), text=("name",), content=None):
+    """{column: values} from the file ``path`` given to ``option`` (or its ``content``,
+    already read: a result file's copy): float arrays (m,), or lists of str for the
+    columns in ``text``. Every column of ``required`` must be in the header; a column
+    outside ``required`` and ``optional`` is refused (a misspelt name would otherwise be
+    ignored), as are a repeated column, a row of another length, a value that is not a
+    number, and a table without rows."""
     def refuse(what):
         raise RodInputError(f"{option} {path}: {what}")
 
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            lines = handle.read().splitlines()
-    except FileNotFoundError:
-        refuse("no such file")
-    except OSError as error:
-        refuse(f"cannot be read ({error.strerror})")
+    lines = (read_text(path, option) if content is None else content).splitlines()
     rows = [line.split("#", 1)[0].replace(",", " ").split() for line in lines]
     rows = [row for row in rows if row]
     if not rows:

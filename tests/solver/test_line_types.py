@@ -170,3 +170,20 @@ def test_a_line_of_line_types_is_the_line_of_its_load_pieces(options, table, com
     assert report.converged
     assert np.abs(r_types - r_loads).max() < 2e-7 * 170.215
     assert np.abs(tension_types - tension_loads).max() < 2e-7 * np.abs(tension_loads).max()
+
+
+def test_a_result_file_rebuilds_its_sections_from_its_own_copy_of_the_table(options, table):
+    """A restart rebuilds the file's scene from the table the file holds
+    (line_types_table), not from a file that may have changed or gone since."""
+    from petsc_rod.cli.scene_options import scene_from_parameters
+    path = table(CABLE_TYPES)
+    scene, values = scene_of(options, rod_line_types=path, rod_sections=CABLE_SECTIONS,
+                             **CABLE_ENDS)
+    parameters = {key.removeprefix("rod_"): ("" if value is None else value)
+                  for key, value in values.items()}
+    parameters.update(line_types=path + ".gone", length=scene.length, end_position=[120, 0, 66],
+                      line_types_table=CABLE_TYPES)
+    rebuilt = scene_from_parameters(parameters)
+    assert [s.name for s in rebuilt.sections] == ["bare", "float", "bare"]
+    np.testing.assert_array_equal(rebuilt.load_values, scene.load_values)
+    assert rebuilt.length == scene.length
