@@ -68,8 +68,14 @@ def riser_data(f):
     seabed = f["parameters"].attrs.get("seabed", "") if "parameters" in f else ""
     touchdown = ((float(f.attrs["touchdown_S"]), f.attrs["touchdown_position"][:])
                  if "touchdown_S" in f.attrs else None)
+    sections = None
+    if "section_names" in f.attrs:          # a line of sections (riser/section_numbers.py)
+        names = [n.decode() if isinstance(n, bytes) else str(n)
+                 for n in f.attrs["section_names"]]
+        sections = (names, f.attrs["section_bounds"][:])
     return {"tension": f["effective_tension"][:], "touchdown": touchdown,
-            "seabed": None if isinstance(seabed, (str, bytes)) else float(seabed)}
+            "seabed": None if isinstance(seabed, (str, bytes)) else float(seabed),
+            "sections": sections}
 
 
 def main(argv):

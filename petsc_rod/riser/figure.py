@@ -14,14 +14,41 @@ def profile_plane(r):
     return (r - r[0]) @ along, r[:, 2]
 
 
+def section_colours(names):
+    """A colour per line type name, in order of first appearance (tab10)."""
+    import matplotlib
+    palette = matplotlib.colormaps["tab10"].colors
+    kinds = list(dict.fromkeys(names))
+    return {name: palette[kinds.index(name) % len(palette)] for name in kinds}
+
+
+def draw_sections(profile, S_axes, S, x, z, sections):
+    """Each section of ``sections`` (names, bounds (k, 2)) drawn in its line type's
+    colour on the profile (x, z at the vertices S) and shaded along S on ``S_axes``."""
+    names, bounds = sections
+    colours = section_colours(names)
+    labelled = set()
+    for name, (lo, hi) in zip(names, bounds):
+        inside = (S >= lo) & (S <= hi)
+        label = None if name in labelled else name
+        labelled.add(name)
+        profile.plot(x[inside], z[inside], "-", lw=2.5, color=colours[name], label=label)
+        for axis in S_axes:
+            axis.axvspan(lo, hi, color=colours[name], alpha=0.12, lw=0)
+
+
 def draw_riser(figure, data):
     """Three panels on ``figure`` from ``data``: S, r, u (vertex datasets), tension
-    (effective_tension), seabed (height or None), touchdown (S, position) or None."""
+    (effective_tension), seabed (height or None), touchdown (S, position) or None,
+    sections (names, bounds) or None."""
     axes = figure.subplots(1, 3)
     S, r = data["S"], data["r"]
     x, z = profile_plane(r)
     profile, tension_axis, curvature_axis = axes
-    profile.plot(x, z, "-", lw=1.5, label="line")
+    if data.get("sections") is not None:
+        draw_sections(profile, (tension_axis, curvature_axis), S, x, z, data["sections"])
+    else:
+        profile.plot(x, z, "-", lw=1.5, label="line")
     profile.plot(x[[0, -1]], z[[0, -1]], "o", ms=4)
     if data["seabed"] is not None:
         profile.axhline(data["seabed"], color="saddlebrown", lw=2, label="seabed")

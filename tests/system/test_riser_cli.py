@@ -27,14 +27,14 @@ def scenes(tmp_path_factory):
     """Both riser scenes solved on 2 ranks with their own options only: (process, file)."""
     folder = tmp_path_factory.mktemp("riser")
     done = {}
-    for name in ("riser_catenary", "lazy_wave"):
+    for name in ("riser_catenary", "lazy_wave", "lazy_wave_types"):
         path = folder / f"{name}.h5"
         done[name] = (run(["-options_file", f"options/{name}.opts", "-rod_output", str(path)],
                           ranks=2), path)
     return done
 
 
-@pytest.mark.parametrize("name", ["riser_catenary", "lazy_wave"])
+@pytest.mark.parametrize("name", ["riser_catenary", "lazy_wave", "lazy_wave_types"])
 def test_a_riser_scene_converges_on_two_ranks_with_the_defaults(scenes, name):
     process, path = scenes[name]
     text = process.stdout + process.stderr
@@ -66,6 +66,35 @@ def test_the_riser_figure(scenes, tmp_path):
     assert done.returncode == 0, done.stderr
     height, width, drawn = png_summary(figure)
     assert height > 300 and width > 600 and drawn > 0.02
+
+
+def test_the_lazy_wave_by_line_types_is_the_lazy_wave_by_loads(scenes, tmp_path):
+    """options/lazy_wave_types.opts is options/lazy_wave.opts given by line types (their
+    masses to 4 decimals: the loads agree to 2e-6): the same top tension and touchdown,
+    the sections' numbers in the file, and the sections drawn in their colours."""
+    numbers = {}
+    for name in ("lazy_wave", "lazy_wave_types"):
+        with h5py.File(scenes[name][1], "r") as f:
+            numbers[name] = {key: f.attrs[key] for key in f.attrs}
+    plain, typed = numbers["lazy_wave"], numbers["lazy_wave_types"]
+    assert abs(typed["top_tension"] / plain["top_tension"] - 1) < 1e-5
+    assert abs(typed["touchdown_S"] - plain["touchdown_S"]) < 0.01
+    assert list(typed["section_names"]) == ["umbilical", "buoyancy", "umbilical"]
+    np.testing.assert_array_equal(typed["section_bounds"], [[0, 600], [600, 1000], [1000, 2000]])
+    # the hog bend (the buoyancy) is the most curved; the top tension the largest
+    assert np.argmax(typed["section_max_curvature"]) == 1
+    assert typed["section_max_tension"][2] == pytest.approx(typed["top_tension"], rel=1e-3)
+    figure = tmp_path / "lazy_wave_types.png"
+    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(scenes["lazy_wave_types"][1]),
+                           str(figure)], cwd=REPO_ROOT, env=child_env(), capture_output=True,
+                          text=True, timeout=TIMEOUT, check=False)
+    assert done.returncode == 0, done.stderr
+    import matplotlib
+    import matplotlib.image
+    pixels = matplotlib.image.imread(str(figure))[..., :3]
+    # the two line types' colours, drawn (the buoyancy's 400 m: 6e-4 of the pixels)
+    for colour in matplotlib.colormaps["tab10"].colors[:2]:
+        assert np.mean(np.all(np.abs(pixels - colour) < 0.02, axis=-1)) > 1e-4
 
 
 SCENE = ["-rod_length", "10", "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position",
