@@ -1,11 +1,14 @@
 """Tables of named columns read from text files (line types, attachments): a header row
 naming the columns, then one row per entry; whitespace or commas separate the values,
-'#' starts a comment. Every failure is one RodInputError naming the option and the file.
+'#' starts a comment; '-' leaves an optional column's value blank. Every failure is one RodInputError naming the option and the file.
 """
 
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+
+# A value left blank in an optional column (NaN in the table): a row that does not use it.
+BLANK = "-"
 
 
 def read_text(path, option):
@@ -59,12 +62,16 @@ def read_table(path, option, required, optional=(), text=("name",), content=None
         if name in text:
             table[name] = values
             continue
+        blank = np.array([v == BLANK for v in values])
+        if np.any(blank) and name in required:
+            refuse(f"column {name} is required in every row; row "
+                   f"{int(np.flatnonzero(blank)[0]) + 2} leaves it blank ('{BLANK}')")
         try:
-            table[name] = np.array([float(v) for v in values])
+            table[name] = np.array([np.nan if v == BLANK else float(v) for v in values])
         except ValueError:
-            bad = next(v for v in values if not _is_number(v))
+            bad = next(v for v in values if v != BLANK and not _is_number(v))
             refuse(f"column {name}: '{bad}' is not a number")
-        if np.any(np.isnan(table[name])):
+        if np.any(np.isnan(table[name]) & ~blank):
             refuse(f"column {name} holds a value that is not a number")
     return table
 

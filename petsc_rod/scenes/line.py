@@ -74,8 +74,9 @@ def piecewise_constant(sections, S, name):
 # The columns of a line-type table (-rod_line_types): required, and optional.
 LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
 LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d")
-# The ways of giving the bending stiffness, one per table: isotropic, anisotropic
-# (about d1 and d2), and a linear taper along each section of the type.
+# The ways of giving the bending stiffness, one per line type (the others' columns left
+# blank, '-'): isotropic, anisotropic (about d1 and d2), and a linear taper along each
+# section of the type.
 BENDING_FORMS = (("ei",), ("ei1", "ei2"), ("ei_start", "ei_end"))
 
 
@@ -114,51 +115,57 @@ class LineType:
 def line_types_from_table(table, option):
     """{name: LineType} from the columns of a -rod_line_types table (io/tables.py
     read_table with LINE_TYPE_COLUMNS and LINE_TYPE_OPTIONAL); RodInputError naming
-    ``option`` for a table that does not give one bending form or gives a value out of
-    range."""
+    ``option`` for a row that does not give exactly one bending form (the other forms'
+    columns left blank, '-') or gives a value out of range."""
     from petsc_rod.errors import RodInputError
 
-    forms = [form for form in BENDING_FORMS if any(name in table for name in form)]
-    if len(forms) != 1 or not all(name in table for name in forms[0]):
-        raise RodInputError(
-            f"{option}: give the bending stiffness (N m^2) in one of the forms: a column ei; "
-            "columns ei1 and ei2 (about d1 and d2); columns ei_start and ei_end (tapered "
-            "along each section)")
     names = table["name"]
-    if len(set(names)) != len(names):
-        raise RodInputError(f"{option}: a line type is named twice")
     rows = len(names)
+    if len(set(names)) != rows:
+        raise RodInputError(f"{option}: a line type is named twice")
     column = lambda name, default: table.get(name, np.full(rows, default))
-    positive = {"od": table["od"], "mass": table["mass"], "gj": table["gj"],
-                "ea": column("ea", np.inf), "drag_d": column("drag_d", 1.0)}
-    positive.update({name: table[name] for name in forms[0]})
+    given = np.stack([np.all([np.isfinite(column(name, np.nan)) for name in form], axis=0)
+                      for form in BENDING_FORMS])                  # (forms, rows)
+    partly = np.stack([np.any([np.isfinite(column(name, np.nan)) for name in form], axis=0)
+                       for form in BENDING_FORMS])
+    bad = (given.sum(axis=0) != 1) | (partly.sum(axis=0) != 1)
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise RodInputError(
+            f"{option}: line type {names[row]}: give its bending stiffness (N m^2) in one "
+            "of the forms ei; ei1 and ei2 (about d1 and d2); ei_start and ei_end (tapered "
+            "along each of its sections), the other columns left blank ('-')")
+    form = np.argmax(given, axis=0)                                  # (rows,)
+    ei, ei1, ei2, ei_start, ei_end = (column(name, np.nan) for name in
+                                      ("ei", "ei1", "ei2", "ei_start", "ei_end"))
+    # each form's (K1, K2) at a section's start and end
+    forms = ((ei, ei, ei, ei), (ei1, ei2, ei1, ei2), (ei_start, ei_start, ei_end, ei_end))
+    start, end = np.empty((rows, 2)), np.empty((rows, 2))
+    for k, (k1_start, k2_start, k1_end, k2_end) in enumerate(forms):
+        start[form == k] = np.stack([k1_start, k2_start], axis=1)[form == k]
+        end[form == k] = np.stack([k1_end, k2_end], axis=1)[form == k]
+    drag_d = np.where(np.isfinite(column("drag_d", np.nan)), column("drag_d", np.nan),
+                      table["od"])
+    ea = np.where(np.isnan(column("ea", np.inf)), np.inf, column("ea", np.inf))
+    cd = np.where(np.isnan(column("cd", 0.0)), 0.0, column("cd", 0.0))
+    positive = {"od": table["od"], "mass": table["mass"], "gj": table["gj"], "ea": ea,
+                "drag_d": drag_d, "ei": np.minimum(start, end).min(axis=1)}
     for name, values in positive.items():
         bad = ~(values > 0)
         if np.any(bad):
             row = int(np.flatnonzero(bad)[0])
             raise RodInputError(f"{option}: line type {names[row]}: {name} "
                                 f"{values[row]:g} must be positive")
-    finite = {name: values for name, values in positive.items() if name != "ea"}
-    for name, values in finite.items():
-        if not np.all(np.isfinite(values)):
+        if name != "ea" and not np.all(np.isfinite(values)):
             row = int(np.flatnonzero(~np.isfinite(values))[0])
             raise RodInputError(f"{option}: line type {names[row]}: {name} must be finite "
                                 "(only ea may be inf: inextensible)")
-    cd = column("cd", 0.0)
     if not np.all((cd >= 0) & np.isfinite(cd)):
         row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
         raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
                             "finite number, 0 or more")
-    if forms[0] == ("ei",):
-        start = end = np.stack([table["ei"], table["ei"]], axis=1)
-    elif forms[0] == ("ei1", "ei2"):
-        start = end = np.stack([table["ei1"], table["ei2"]], axis=1)
-    else:
-        start = np.stack([table["ei_start"]] * 2, axis=1)
-        end = np.stack([table["ei_end"]] * 2, axis=1)
-    drag_d = table.get("drag_d", table["od"])
     return {name: LineType(name, table["od"][i], table["mass"][i], start[i], end[i],
-                           table["gj"][i], column("ea", np.inf)[i], cd[i], drag_d[i])
+                           table["gj"][i], ea[i], cd[i], drag_d[i])
             for i, name in enumerate(names)}
 
 

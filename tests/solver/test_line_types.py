@@ -64,6 +64,22 @@ def test_the_sections_give_the_submerged_weight_drag_and_length(options, table):
                                       0.5 * 1025 * 1.2 * 0.16], rtol=1e-15)
 
 
+def test_a_table_mixes_bending_forms_row_by_row(options, table):
+    """A bend stiffener (tapered) beside a bare cable (isotropic) and an anisotropic
+    section: each row gives one form, the others left blank ('-'); the stiffness along S
+    is each section's, linear along the taper."""
+    types = ("name      od   mass  gj    ei   ei1  ei2  ei_start  ei_end\n"
+             "stiffener 0.5  80    1e4   -    -    -    1e6       2e4\n"
+             "bare      0.16 36.7  1e4   2e4  -    -    -         -\n"
+             "flat      0.16 36.7  1e4   -    1e4  4e4  -         -\n")
+    scene, _ = scene_of(options, rod_line_types=table(types),
+                        rod_sections="stiffener:10,bare:100,flat:10", **CABLE_ENDS)
+    K = scene.stiffness_at(np.array([0.0, 5.0, 10.0, 50.0, 115.0]))
+    np.testing.assert_allclose(K[:, 0], [1e6, 0.5 * (1e6 + 2e4), 2e4, 2e4, 1e4], rtol=1e-15)
+    np.testing.assert_allclose(K[:, 1], [1e6, 0.5 * (1e6 + 2e4), 2e4, 2e4, 4e4], rtol=1e-15)
+    assert np.all(K[:, 2] == 1e4) and not scene.uniform_stiffness
+
+
 def test_every_section_end_is_a_vertex(options, table, comm):
     from petsc_rod.cli.scene_options import mesh_pieces
     from petsc_rod.mesh.mesh import Mesh
@@ -94,6 +110,11 @@ BAD = {
     "an unknown column": ("name od mass ei gj colour\nbare 0.16 36.7 1 1 red\n",
                           "unknown column 'colour'"),
     "no bending stiffness": ("name od mass gj\nbare 0.16 36.7 1\n", "bending stiffness"),
+    "two bending forms in a row": ("name od mass gj ei ei_start ei_end\nbare 0.16 36.7 1 1 2 1\n",
+                                   "line type bare: give its bending stiffness"),
+    "half a taper": ("name od mass gj ei_start ei_end\nbare 0.16 36.7 1 2 -\n",
+                     "line type bare: give its bending stiffness"),
+    "a blank od": ("name od mass gj ei\nbare - 36.7 1 1\n", "column od is required"),
     "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "row 2 has 4 values"),
     "a word for a number": ("name od mass ei gj\nbare 0.16 heavy 1 1\n", "'heavy' is not"),
     "-rod_stiffness with sections": (dict(rod_sections="bare:10", rod_stiffness="1,1,1"),
