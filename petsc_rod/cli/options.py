@@ -132,6 +132,10 @@ OPTIONS = [
            (lambda v: v >= 1, "must be >= 1")),
     Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
            "bending (about d1, d2) and torsion stiffness, N m^2", SCALE, "N m^2"),
+    Option("rod_axial_stiffness", _real, default_of(Scene, "axial_stiffness"), "EA",
+           "axial stiffness EA, N: the centreline stretches, r' = (1 + eps) d3, with energy "
+           "EA eps^2 / 2 per metre of unstretched line (docs/method.md §12); default inf, "
+           "inextensible", SCALE, "N"),
     Option("rod_start", _string, default_of(Scene, "start"), "clamp|pin|free",
            "condition at S = 0 (at the origin)", unit="text"),
     Option("rod_end", _string, default_of(Scene, "end"), "clamp|pin|free", "condition at S = L",

@@ -22,7 +22,8 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "end_twist": "-rod_end_twist",
                  "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
                              "-rod_drag)"),
-                 "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
+                 "stiffness": "-rod_stiffness", "axial_stiffness": "-rod_axial_stiffness",
+                 "start": "-rod_start", "end": "-rod_end",
                  "seabed": "-rod_seabed"}
 
 
@@ -38,7 +39,8 @@ def scene_from_options(values, given, profile=None):
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
-                  load_breaks=values["rod_load_breaks"])
+                  load_breaks=values["rod_load_breaks"],
+                  axial_stiffness=values["rod_axial_stiffness"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_applied_forces(scene, given)
@@ -130,7 +132,9 @@ def checked_default_penalty(scene):
             "bending": ("-rod_stiffness with -rod_length", "100 sqrt(min K max K) / L^2"),
             "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
             "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness",
-                      "2 (K3 alpha / L)^2 / min(K1, K2)")}[name]
+                      "2 (K3 alpha / L)^2 / min(K1, K2)"),
+            "stretch": ("-rod_axial_stiffness with -rod_end_position",
+                        "EA (|r_L| - L) / 2L")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
             f"above {MAX_MAGNITUDE:g}, beyond what double precision carries through the "

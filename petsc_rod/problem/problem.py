@@ -17,7 +17,8 @@ from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import SecondVariation
 from petsc_rod.frames import split_coefficients, strains
 from petsc_rod.global_step.global_step import GlobalStep
-from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
+from petsc_rod.local_step.projection import (nearest_rotation, stretched_rotation,
+                                             update_multipliers)
 from petsc_rod.mesh.elements import quadrature_weights
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.build import scene_terms
@@ -52,6 +53,9 @@ class RodProblem:
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
         self._second_variation = None
+        # EA at the owned nodes, N, for the stretched local step (§12); None, and nothing
+        # built for stretch, on an inextensible line
+        self.axial = scene.axial_stiffness_at(mesh.node_S()) if scene.extensible else None
 
     # --- what the terms allow ---------------------------------------------------------
     @property
@@ -101,14 +105,23 @@ class RodProblem:
 
     def iterate(self):
         """One iteration G (docs/method.md §3): global step, local step (nearest rotation
-        of R d + lambda at every node), multiplier update lambda += R (d - tau)."""
+        of R d + lambda at every node), multiplier update lambda += R (d - tau).
+
+        On an extensible line (§12) the local step also finds the strain eps at each
+        node (projection.stretched_rotation, from the last one) and tau holds the
+        targets (tau1, tau2, (1 + eps) tau3): the global step, the multiplier update
+        and the residual read the stretched tangent where they read tau3."""
         state, R = self.state, self.penalty
         self.global_step.solve(state)
         EVENTS["projection"].begin()
         directors = state.take_directors()
+        stretch = None if self.axial is None else 1.0 + state.strain()
         b = np.multiply(directors, R, out=state.tau)       # b = R d + lambda, in place
         b += state.lam
-        nearest_rotation(b, out=state.tau)
+        if stretch is None:
+            nearest_rotation(b, out=state.tau)
+        else:
+            stretched_rotation(b, self.axial, R, start=stretch, out=state.tau)
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)

@@ -348,3 +348,45 @@ def twisted_rod(length, torsion_stiffness, angle):
     _require_positive("torsion_stiffness", torsion_stiffness)
     twist = float(angle) / float(length)
     return {"u3": twist, "torque": float(torsion_stiffness) * twist}
+
+
+def elastic_catenary(length, axial_stiffness, weight, span, rise):
+    """Irvine's elastic catenary (H. M. Irvine, Cable Structures, 1981, §2.2): a cable of
+    unstretched length L and axial stiffness EA (N) under a uniform weight w per metre of
+    unstretched line (N/m, along -z), from a pin at the origin to a pin at (span, rise)
+    (m, span > 0, z up). With H the horizontal tension and V the upward reaction at the
+    origin, the force in the line at s is (H, w s - V), its tension T(s) = |.|, the
+    stretch 1 + T/EA, r' = (1 + T/EA) (H, w s - V) / T and
+
+        x(s) = H s / EA + (H / w) [asinh(V / H) - asinh((V - w s) / H)],
+        z(s) = (w s^2 / 2 - V s) / EA + (H / w) [sqrt(1 + ((w s - V) / H)^2)
+                                                  - sqrt(1 + (V / H)^2)].
+
+    H, V solve x(L) = span, z(L) = rise (Newton from the inextensible catenary's
+    shape-free guess, scipy's fsolve). Returns (H, V, positions) with positions(s) the
+    (..., 2) array (x, z) of the centreline at unstretched arc lengths s.
+    """
+    from scipy.optimize import fsolve
+
+    for name, value in (("length", length), ("axial_stiffness", axial_stiffness),
+                        ("weight", weight), ("span", span)):
+        _require_positive(name, value)
+    L, EA, w = float(length), float(axial_stiffness), float(weight)
+
+    def positions(s, H, V):
+        s = np.asarray(s, dtype=float)
+        x = H * s / EA + H / w * (np.arcsinh(V / H) - np.arcsinh((V - w * s) / H))
+        z = ((w * s**2 / 2 - V * s) / EA
+             + H / w * (np.hypot(1.0, (w * s - V) / H) - np.hypot(1.0, V / H)))
+        return np.stack([x, z], axis=-1)
+
+    def residual(unknowns):
+        H, V = np.exp(unknowns[0]), unknowns[1]
+        return positions(L, H, V) - np.array([span, rise])
+
+    guess = [np.log(w * L), w * L / 2]
+    solution, _, _, message = fsolve(residual, guess, xtol=1e-14, full_output=True)
+    if np.abs(residual(solution)).max() > 1e-12 * L:
+        raise ValueError(f"elastic_catenary: no solution ({message})")
+    H, V = float(np.exp(solution[0])), float(solution[1])
+    return H, V, lambda s: positions(s, H, V)
