@@ -69,4 +69,5 @@ class AxialStretch(Term):
             datasets={"axial_strain": vertex_eps, "axial_tension": tension},
             attributes={"stretched_length": float(stretched),
                         "axial_tension_gap": float(gap / size) if size > 0 else 0.0},
-            text=f"stretch max |eps| {largest:.3g}, length {stretched:.10g} m")
+            text=f"stretch max |eps| {largest:.3g}, length {stretched:.10g} m, stability not "
+                 "tested")
