@@ -284,12 +284,15 @@ def update_multipliers(lam, directors, tau, penalty):
 # no point's 1 + eps moves by more than STRETCH_TOL in a pass, after at most
 # STRETCH_PASSES; what is left is carried to the next iteration in the state (the
 # passes start from the last 1 + eps), so a fixed point of the iteration is one of the
-# passes too, whatever their number.
+# passes too, whatever their number. The iteration takes ITERATION_PASSES: one pass
+# an iteration, the pass joining the fixed-point iteration, took as few iterations as
+# converged passes at half the cost (docs/method.md §12).
 STRETCH_TOL = 1e-14
 STRETCH_PASSES = 8
+ITERATION_PASSES = 1
 
 
-def stretched_rotation(b, axial, penalty, start=None, out=None):
+def stretched_rotation(b, axial, penalty, start=None, out=None, passes=STRETCH_PASSES):
     """The local step with axial stretch (docs/method.md §12): at each node maximise over
     T in SO(3) and k = 1 + eps
 
@@ -304,8 +307,9 @@ def stretched_rotation(b, axial, penalty, start=None, out=None):
     rows of b, a few passes at EA >> R.
 
     b: (n, 3, 3) rows b_i, N; axial: EA (n,), N (inf: k = 1, the plain projection);
-    penalty: R, N; start: k of the first pass (n,) (default 1). k is kept >= 0 (a line
-    is not turned inside out). Returns the targets (n, 3, 3), rows (T1, T2, k T3), in
+    penalty: R, N; start: k of the first pass (n,) (default 1); passes: at most that
+    many (each one polar factor per point). k is kept >= 0 (a line is not turned inside
+    out). Returns the targets (n, 3, 3), rows (T1, T2, k T3), in
     ``out`` when given (it may be b itself): |row 3| - 1 is the strain eps.
     """
     b = np.array(b, dtype=float)            # a copy: out may be b
@@ -315,7 +319,7 @@ def stretched_rotation(b, axial, penalty, start=None, out=None):
     k = np.ones(n) if start is None else np.where(finite, start, 1.0)
     scaled = np.empty_like(b)
     rotation = np.empty_like(b)
-    for _ in range(STRETCH_PASSES):
+    for _ in range(passes):
         np.copyto(scaled, b)
         scaled[:, 2] *= k[:, None]
         nearest_rotation(scaled, out=rotation)

@@ -17,8 +17,8 @@ from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import SecondVariation
 from petsc_rod.frames import split_coefficients, strains
 from petsc_rod.global_step.global_step import GlobalStep
-from petsc_rod.local_step.projection import (nearest_rotation, stretched_rotation,
-                                             update_multipliers)
+from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
+                                             stretched_rotation, update_multipliers)
 from petsc_rod.mesh.elements import quadrature_weights
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.build import scene_terms
@@ -108,7 +108,8 @@ class RodProblem:
         of R d + lambda at every node), multiplier update lambda += R (d - tau).
 
         On an extensible line (§12) the local step also finds the strain eps at each
-        node (projection.stretched_rotation, from the last one) and tau holds the
+        node (projection.stretched_rotation: one majorise-minimise pass from the last
+        eps, the passes being carried by the iteration itself) and tau holds the
         targets (tau1, tau2, (1 + eps) tau3): the global step, the multiplier update
         and the residual read the stretched tangent where they read tau3."""
         state, R = self.state, self.penalty
@@ -121,7 +122,8 @@ class RodProblem:
         if stretch is None:
             nearest_rotation(b, out=state.tau)
         else:
-            stretched_rotation(b, self.axial, R, start=stretch, out=state.tau)
+            stretched_rotation(b, self.axial, R, start=stretch, out=state.tau,
+                               passes=ITERATION_PASSES)
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)
