@@ -56,6 +56,10 @@ class RodProblem:
         # EA at the owned nodes, N, for the stretched local step (§12); None, and nothing
         # built for stretch, on an inextensible line
         self.axial = scene.axial_stiffness_at(mesh.node_S()) if scene.extensible else None
+        # a clamp prescribes the slope, so its stretch comes from the force balance
+        # (_stretch_clamps)
+        self._stretched_clamps = self.axial is not None and "clamp" in (scene.start,
+                                                                         scene.end)
 
     # --- what the terms allow ---------------------------------------------------------
     @property
@@ -124,10 +128,33 @@ class RodProblem:
         else:
             stretched_rotation(b, self.axial, R, start=stretch, out=state.tau,
                                passes=ITERATION_PASSES)
+            if self._stretched_clamps:
+                self._stretch_clamps()
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)
         EVENTS["multiplier"].end()
+
+    def _stretch_clamps(self):
+        """At a clamped end the slope is prescribed, r' = (1 + eps) d3, and the local
+        step's multiplier there meets no equation: eps is taken from the force balance,
+        EA eps = n.d3 with n the internal force of the last global step at that end
+        (one iteration behind; docs/method.md §12). Sets the clamped nodes' targets
+        (1 + eps) tau3 and the prescribed slope of the next global step. Collective."""
+        mesh, state = self.mesh, self.state
+        force = self.internal_force()
+        ends = ((self.start_state, 0, mesh.on_lower_boundary),
+                (self.end_state, -1, mesh.on_upper_boundary))
+        strain = np.zeros(2)
+        for j, (end, index, owner) in enumerate(ends):
+            if end.kind == "clamp" and owner and np.isfinite(self.axial[index]):
+                strain[j] = force[index] @ end.frame[2] / self.axial[index]
+        stretch = 1.0 + mesh.global_sum(strain)
+        for j, (end, index, owner) in enumerate(ends):
+            if end.kind == "clamp" and owner:
+                tangent = state.tau[index, 2]
+                tangent *= stretch[j] / np.linalg.norm(tangent)
+        self.global_step.set_clamp_stretch(*stretch)
 
     def norms(self):
         """The change and RMS constraint residual of the last iteration, relative to the
