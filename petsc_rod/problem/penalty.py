@@ -38,8 +38,8 @@ def default_penalty(scene):
 
 def penalty_scales(scene):
     """The scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
-    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2}; the command line names the options
-    behind the one that makes a default penalty out of range."""
+    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2}; the command
+    line names the options behind the one that makes a default penalty out of range."""
     stiffness = scene.stiffness
     moment = stiffness[2] * scene.end_rotation() / scene.length
     return {"bending": 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2,
