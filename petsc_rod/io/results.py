@@ -6,9 +6,10 @@ total_halvings, undone_iterations, constraint_residual, change, stable, energy,
 wall_time, written, ranks, load_factor, penalty (in use), asked_penalty (and
 twist_turns, writhe_turns where the link is tracked; the datasets axial_strain,
 axial_tension and attributes stretched_length, axial_tension_gap on an extensible line,
-physics/stretch.py); a group ``history``; a group ``state`` with what a restart needs beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>``
-per accepted continuation step (halved sub-steps included) and the failed one that ends
-a run, with the same content. The root links to the last step and also holds the run's
+physics/stretch.py); a group ``history``; a group ``state`` with what a restart needs
+beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>`` per
+accepted continuation step (halved sub-steps included) and the failed one that ends a
+run, with the same content. The root links to the last step and also holds the run's
 version, commit, options and options_in_effect, and a group ``parameters`` with every
 option in effect as numbers. Every dataset has a ``units`` attribute, every group an
 ``attribute_units`` (JSON). The file is written as the run's own partial file
