@@ -329,6 +329,8 @@ def options_in_effect(values, solver, start):
     scene = solver.problem.scene
     resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
+    if not np.isfinite(scene.axial_stiffness):  # inextensible: written as not given
+        resolved["rod_axial_stiffness"] = None
     if scene.seabed is not None:                # the default stiffness (riser/environment.py)
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
     if values["rod_current_profile"]:

@@ -132,6 +132,10 @@ OPTIONS = [
            (lambda v: v >= 1, "must be >= 1")),
     Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
            "bending (about d1, d2) and torsion stiffness, N m^2", SCALE, "N m^2"),
+    Option("rod_axial_stiffness", _real, default_of(Scene, "axial_stiffness"), "EA",
+           "axial stiffness EA, N: the centreline stretches, r' = (1 + eps) d3, with energy "
+           "EA eps^2 / 2 per metre of unstretched line (docs/method.md §12); default inf, "
+           "inextensible", SCALE, "N"),
     Option("rod_start", _string, default_of(Scene, "start"), "clamp|pin|free",
            "condition at S = 0 (at the origin)", unit="text"),
     Option("rod_end", _string, default_of(Scene, "end"), "clamp|pin|free", "condition at S = L",
@@ -227,7 +231,7 @@ OPTIONS = [
     Option("rod_al_stability", _bool, default_of(Settings, "check_stability"), "bool",
            "at each converged step, test the second variation of the energy (Sylvester "
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
-           "not with a current (its drag has no energy)"),
+           "not with a current (its drag has no energy), nor on an extensible line"),
     Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
            f"{NEWTON_SWITCH:g} and more than {NEWTON_WORTH} iterations would remain at the "
@@ -235,7 +239,7 @@ OPTIONS = [
            "system of the energy's second variation), taken only where it is positive "
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once; after a failed attempt the wait "
-           "doubles; not with a seabed or a current"),
+           "doubles; not with a seabed or a current, nor on an extensible line"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",

@@ -45,7 +45,8 @@ def scene_from_options(values, given, profile=None, line_types=None):
     scene = Scene(**line, start=values["rod_start"], end=values["rod_end"],
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
-                  end_force=values["rod_end_force"])
+                  end_force=values["rod_end_force"],
+                  axial_stiffness=values["rod_axial_stiffness"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_taut(scene)
@@ -59,6 +60,7 @@ SECTION_REPLACES = {"rod_stiffness": "the line types' ei and gj",
                     "rod_load": "the line types' mass and od (the submerged weight)",
                     "rod_load_breaks": "the section ends",
                     "rod_drag": "the line types' cd and drag_d",
+                    "rod_axial_stiffness": "the line types' ea",
                     "rod_mesh_grading": "the element counts of -rod_sections (each "
                                         "section is meshed uniformly)"}
 
@@ -222,7 +224,9 @@ def checked_default_penalty(scene):
             "bending": ("-rod_stiffness with -rod_length", "100 sqrt(min K max K) / L^2"),
             "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
             "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness",
-                      "2 (K3 alpha / L)^2 / min(K1, K2)")}[name]
+                      "2 (K3 alpha / L)^2 / min(K1, K2)"),
+            "stretch": ("-rod_axial_stiffness with -rod_end_position",
+                        "EA (|r_L| - L) / 2L")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
             f"above {MAX_MAGNITUDE:g}, beyond what double precision carries through the "

@@ -42,6 +42,9 @@ class GlobalStep:
         self.mesh, self.scene, self.terms = mesh, scene, terms
         self.split, self.matrix_split = split, matrix_split
         self.start_state, self.end_state = scene.start_state(0.0), scene.end_state(0.0)
+        # 1 + eps at a clamped start and end: the prescribed slope is (1 + eps) d3 there
+        # on an extensible line (set_clamp_stretch, docs/method.md §12); 1 otherwise
+        self.clamp_stretch = (1.0, 1.0)
         self.bordered = boundary.is_held(self.start_state) and boundary.is_held(self.end_state)
         self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("d1", "d2", "slope")]
         self.load = VectorField(mesh, "step_load")     # b_3: the terms' loads of the step
@@ -109,8 +112,28 @@ class GlobalStep:
 
     def _set_prescribed(self):
         for i, problem in enumerate(self.problems):
-            problem.set_prescribed(boundary.director_prescribed(
-                i, self.start_state, self.end_state, self.mesh.n_elements))
+            problem.set_prescribed(self._prescribed(i))
+
+    def _prescribed(self, i):
+        """The prescribed dofs of field i (boundary.director_prescribed), the slope's
+        clamped vertex values scaled by clamp_stretch."""
+        prescribed = boundary.director_prescribed(i, self.start_state, self.end_state,
+                                                  self.mesh.n_elements)
+        if i != 2 or self.clamp_stretch == (1.0, 1.0):
+            return prescribed
+        stretch = {0: self.clamp_stretch[0], self.mesh.n_elements: self.clamp_stretch[1]}
+        return [(vertex, slot, value * stretch[vertex] if slot == boundary.VERTEX else value)
+                for vertex, slot, value in prescribed]
+
+    def set_clamp_stretch(self, start, end):
+        """1 + eps at a clamped start and end (1 at an end that is not clamped): the
+        slope prescribed there becomes (1 + eps) d3 (docs/method.md §12). The same values
+        on every rank; the slope's lifting is recomputed where they changed."""
+        stretch = (float(start), float(end))
+        if stretch != self.clamp_stretch:
+            self.clamp_stretch = stretch
+            if self.problems:
+                self.problems[2].set_prescribed(self._prescribed(2))
 
     def solve(self, state):
         """Solve for d1, d2, r' and r of ``state`` (problem/state.py) from its tau and

@@ -4,10 +4,12 @@ Layout (documented in docs/output.md): vertex datasets S (n,), r, d1, d2, d3, u,
 (n, 3); attributes converged, stop_reason, iterations, halvings, total_iterations,
 total_halvings, undone_iterations, constraint_residual, change, stable, energy,
 wall_time, written, ranks, load_factor, penalty (in use), asked_penalty (and
-twist_turns, writhe_turns where the link is tracked); a group ``history``; a group ``state`` with what a restart
-needs beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>``
-per accepted continuation step (halved sub-steps included) and the failed one that ends
-a run, with the same content. The root links to the last step and also holds the run's
+twist_turns, writhe_turns where the link is tracked; the datasets axial_strain,
+axial_tension and attributes stretched_length, axial_tension_gap on an extensible line,
+physics/stretch.py); a group ``history``; a group ``state`` with what a restart needs
+beyond the vertex datasets (outputs.restart_state); and one group ``steps/<k>`` per
+accepted continuation step (halved sub-steps included) and the failed one that ends a
+run, with the same content. The root links to the last step and also holds the run's
 version, commit, options and options_in_effect, and a group ``parameters`` with every
 option in effect as numbers. Every dataset has a ``units`` attribute, every group an
 ``attribute_units`` (JSON). The file is written as the run's own partial file
@@ -38,6 +40,7 @@ import numpy as np
 from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
+from petsc_rod.physics import stretch
 from petsc_rod.riser import quantities as riser_quantities
 from petsc_rod.riser import section_numbers
 
@@ -51,6 +54,7 @@ DATASET_UNITS = {
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
     **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
+    **stretch.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
 ATTRIBUTE_UNITS = {
@@ -63,6 +67,7 @@ ATTRIBUTE_UNITS = {
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
+    **stretch.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

@@ -278,3 +278,59 @@ def update_multipliers(lam, directors, tau, penalty):
         tmp *= penalty
         flat_lam[part] += tmp
     return lam
+
+
+# The stretched local step (stretched_rotation) stops its majorise-minimise passes once
+# no point's 1 + eps moves by more than STRETCH_TOL in a pass, after at most
+# STRETCH_PASSES; what is left is carried to the next iteration in the state (the
+# passes start from the last 1 + eps), so a fixed point of the iteration is one of the
+# passes too, whatever their number. The iteration takes ITERATION_PASSES: one pass
+# an iteration, the pass joining the fixed-point iteration, took as few iterations as
+# converged passes at half the cost (docs/method.md §12).
+STRETCH_TOL = 1e-14
+STRETCH_PASSES = 8
+ITERATION_PASSES = 1
+
+
+def stretched_rotation(b, axial, penalty, start=None, out=None, passes=STRETCH_PASSES):
+    """The local step with axial stretch (docs/method.md §12): at each node maximise over
+    T in SO(3) and k = 1 + eps
+
+        b1.T1 + b2.T2 + k b3.T3 - R k^2 / 2 - EA (k - 1)^2 / 2,
+
+    i.e. minimise sum_i [R/2 |g_i - t_i|^2 - lambda_i.t_i] + EA eps^2 / 2 over the targets
+    t = (T1, T2, k T3), b_i = R g_i + lambda_i. For fixed T, k = (b3.T3 + EA)/(R + EA); T
+    then maximises b1.T1 + b2.T2 + (b3.T3 + EA)^2 / (2 (R + EA)), a convex function of
+    T: its tangent at T_j is a minorant, whose maximiser is the polar factor of b with
+    the row b3 scaled by k_j (nearest_rotation). Each pass thus increases the objective
+    (majorise-minimise); it contracts by about R/(R + EA) times the misalignment of the
+    rows of b, a few passes at EA >> R.
+
+    b: (n, 3, 3) rows b_i, N; axial: EA (n,), N (inf: k = 1, the plain projection);
+    penalty: R, N; start: k of the first pass (n,) (default 1); passes: at most that
+    many (each one polar factor per point). k is kept >= 0 (a line is not turned inside
+    out). Returns the targets (n, 3, 3), rows (T1, T2, k T3), in
+    ``out`` when given (it may be b itself): |row 3| - 1 is the strain eps.
+    """
+    b = np.array(b, dtype=float)            # a copy: out may be b
+    n = b.shape[0]
+    finite = np.isfinite(axial)
+    ea = np.where(finite, axial, 0.0)
+    k = np.ones(n) if start is None else np.where(finite, start, 1.0)
+    scaled = np.empty_like(b)
+    rotation = np.empty_like(b)
+    for _ in range(passes):
+        np.copyto(scaled, b)
+        scaled[:, 2] *= k[:, None]
+        nearest_rotation(scaled, out=rotation)
+        s = np.einsum("nc,nc->n", b[:, 2], rotation[:, 2])
+        new = np.where(finite, np.maximum((s + ea) / (penalty + ea), 0.0), 1.0)
+        moved = np.abs(new - k).max(initial=0.0)
+        k = new
+        if moved <= STRETCH_TOL:
+            break
+    if out is None:
+        out = np.empty_like(b)
+    np.copyto(out, rotation)
+    out[:, 2] *= k[:, None]
+    return out

@@ -1,8 +1,10 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
 dead loads always; the seabed, the drag and the riser numbers only where the scene has a
-seabed or a current (docs/riser.md)."""
+seabed or a current (docs/riser.md); the axial stretch only where some EA is finite
+(docs/method.md §12)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.stretch import AxialStretch
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.section_numbers import SectionNumbers
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
@@ -19,6 +21,8 @@ def scene_terms(mesh, scene):
         terms.append(DragTerm(mesh, scene))
     if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
+    if scene.extensible:
+        terms.append(AxialStretch(mesh, scene))
     if scene.sections:
         terms.append(SectionNumbers(scene.sections))
     return terms

@@ -18,7 +18,7 @@ ADAPT_WINDOW = 200
 
 
 def default_penalty(scene):
-    """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2)), N.
+    """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2), T / 2), N.
 
     Three scales, each a lower bound below which the iteration crawls or leaves the
     branch (docs/method.md §3; measurements in docs/stability.md, History C):
@@ -28,20 +28,38 @@ def default_penalty(scene):
       multiplier lambda3 reaches the tension by steps of at most 2R per iteration;
     * twisting moment M = K3 a / L of an end turned by a: M^2 / K_b is four times the
       axial compression it stands for in Greenhill's condition
-      (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2).
+      (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2);
+    * on an extensible line held taut (ends d > L apart, docs/method.md §12), its
+      tension T / 2 with T = (d - L) / int dS / EA, which lambda3 must reach as it must
+      reach the loads' (0 on an inextensible or slack line).
     """
     return max(penalty_scales(scene).values())
 
 
 def penalty_scales(scene):
-    """The three scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
-    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2)}; the command line names the options
-    behind the one that makes a default penalty out of range."""
+    """The scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
+    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2}; the command
+    line names the options behind the one that makes a default penalty out of range."""
     stiffness = scene.stiffness
     moment = stiffness[2] * scene.end_rotation() / scene.length
     return {"bending": 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2,
             "tension": 0.5 * scene.applied_force(),
-            "twist": 2.0 * moment**2 / stiffness[:2].min()}
+            "twist": 2.0 * moment**2 / stiffness[:2].min(),
+            "stretch": 0.5 * taut_tension(scene)}
+
+
+def taut_tension(scene):
+    """The tension of an extensible line whose held ends are d > L apart at t = 1,
+    (d - L) / int dS / EA, N (the sections' compliances in series); 0 when the line is
+    inextensible, slack or not held at both ends."""
+    if not scene.extensible or "free" in (scene.start, scene.end):
+        return 0.0
+    excess = np.linalg.norm(scene.end_position) - scene.length
+    if excess <= 0:
+        return 0.0
+    pieces = ([(s.end - s.start, s.axial_stiffness) for s in scene.sections]
+              if scene.sections else [(scene.length, scene.axial_stiffness)])
+    return float(excess / sum(length / ea for length, ea in pieces))
 
 
 def matrix_split(split):

@@ -17,7 +17,8 @@ from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import SecondVariation
 from petsc_rod.frames import split_coefficients, strains
 from petsc_rod.global_step.global_step import GlobalStep
-from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
+from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
+                                             stretched_rotation, update_multipliers)
 from petsc_rod.mesh.elements import quadrature_weights
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.build import scene_terms
@@ -52,6 +53,13 @@ class RodProblem:
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
         self._second_variation = None
+        # EA at the owned nodes, N, for the stretched local step (§12); None, and nothing
+        # built for stretch, on an inextensible line
+        self.axial = scene.axial_stiffness_at(mesh.node_S()) if scene.extensible else None
+        # a clamp prescribes the slope, so its stretch comes from the force balance
+        # (_stretch_clamps)
+        self._stretched_clamps = self.axial is not None and "clamp" in (scene.start,
+                                                                         scene.end)
 
     # --- what the terms allow ---------------------------------------------------------
     @property
@@ -101,18 +109,52 @@ class RodProblem:
 
     def iterate(self):
         """One iteration G (docs/method.md §3): global step, local step (nearest rotation
-        of R d + lambda at every node), multiplier update lambda += R (d - tau)."""
+        of R d + lambda at every node), multiplier update lambda += R (d - tau).
+
+        On an extensible line (§12) the local step also finds the strain eps at each
+        node (projection.stretched_rotation: one majorise-minimise pass from the last
+        eps, the passes being carried by the iteration itself) and tau holds the
+        targets (tau1, tau2, (1 + eps) tau3): the global step, the multiplier update
+        and the residual read the stretched tangent where they read tau3."""
         state, R = self.state, self.penalty
         self.global_step.solve(state)
         EVENTS["projection"].begin()
         directors = state.take_directors()
+        stretch = None if self.axial is None else 1.0 + state.strain()
         b = np.multiply(directors, R, out=state.tau)       # b = R d + lambda, in place
         b += state.lam
-        nearest_rotation(b, out=state.tau)
+        if stretch is None:
+            nearest_rotation(b, out=state.tau)
+        else:
+            stretched_rotation(b, self.axial, R, start=stretch, out=state.tau,
+                               passes=ITERATION_PASSES)
+            if self._stretched_clamps:
+                self._stretch_clamps()
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)
         EVENTS["multiplier"].end()
+
+    def _stretch_clamps(self):
+        """At a clamped end the slope is prescribed, r' = (1 + eps) d3, and the local
+        step's multiplier there meets no equation: eps is taken from the force balance,
+        EA eps = n.d3 with n the internal force of the last global step at that end
+        (one iteration behind; docs/method.md §12). Sets the clamped nodes' targets
+        (1 + eps) tau3 and the prescribed slope of the next global step. Collective."""
+        mesh, state = self.mesh, self.state
+        force = self.internal_force()
+        ends = ((self.start_state, 0, mesh.on_lower_boundary),
+                (self.end_state, -1, mesh.on_upper_boundary))
+        strain = np.zeros(2)
+        for j, (end, index, owner) in enumerate(ends):
+            if end.kind == "clamp" and owner and np.isfinite(self.axial[index]):
+                strain[j] = force[index] @ end.frame[2] / self.axial[index]
+        stretch = 1.0 + mesh.global_sum(strain)
+        for j, (end, index, owner) in enumerate(ends):
+            if end.kind == "clamp" and owner:
+                tangent = state.tau[index, 2]
+                tangent *= stretch[j] / np.linalg.norm(tangent)
+        self.global_step.set_clamp_stretch(*stretch)
 
     def norms(self):
         """The change and RMS constraint residual of the last iteration, relative to the

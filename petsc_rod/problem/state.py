@@ -5,7 +5,9 @@ the node values of the local step, how a state is started, saved and measured.
 * r: a VectorField holding the Hermite pair (r, r') at each vertex, recovered from the
   slope by integration (global_step/centreline.py);
 * tau and lambda at the owned P2 nodes, arrays (n_nodes, 3 directors, 3 components)
-  with director rows d1, d2, d3;
+  with director rows d1, d2, d3; on an extensible line (docs/method.md §12) tau's third
+  row is the stretched tangent (1 + eps) tau3, so that the strain eps is carried with
+  tau wherever tau goes (steps, snapshots, the predictor, turns, restart files);
 * mu, the multiplier of the chord constraint r(L) - r(0) = int r' dS (both ends held).
 """
 
@@ -245,6 +247,12 @@ class RodState:
         """The node directors of the fields the global step just solved for, kept for
         the residual of ``norms`` (n_nodes, 3, 3)."""
         return self.node_directors()
+
+    def strain(self):
+        """The axial strain eps at the owned P2 nodes, (n_nodes,): |tau3| - 1, tau3 being
+        the stretched target (1 + eps) tau3 of the local step (docs/method.md §12); 0 to
+        round-off on an inextensible line."""
+        return np.sqrt(np.einsum("nc,nc->n", self.tau[:, 2], self.tau[:, 2])) - 1.0
 
     def norms(self):
         """The stopping quantities of the last iteration (docs/method.md §6), measured

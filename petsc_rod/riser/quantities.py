@@ -1,7 +1,7 @@
 """The numbers a riser engineer reads, from the vertex fields of one state (outputs.py):
 vectorised on each rank's owned vertices and elements, combined by MPI reductions.
 
-* effective tension n.d3 (N) and the seabed reaction k (z_b - z)_+ (N/m) at the vertices
+* effective tension n.t (N), t = d3 / |d3| the unit tangent, and the seabed reaction k (z_b - z)_+ (N/m) at the vertices
   (datasets ``effective_tension``, ``seabed_reaction``). With the submerged weight as the
   load, n.d3 is the effective tension of riser practice.
 * the top: the held end that is higher (S = L on a tie); its tension |n| (N) and the
@@ -35,6 +35,17 @@ class RiserNumbers(Term):
 
     def outputs(self, problem, vertex):
         return riser_report(problem, vertex, self.seabed)
+
+
+def unit_tangent(vertex):
+    """t = d3 / |d3| at the vertices, (n, 3): d3 = r' = (1 + eps) t on an extensible
+    line (docs/method.md §12)."""
+    return vertex["d3"] / np.linalg.norm(vertex["d3"], axis=1, keepdims=True)
+
+
+def effective_tension(vertex):
+    """n.t at the vertices, N, (n,)."""
+    return np.einsum("nc,nc->n", vertex["n"], unit_tangent(vertex))
 
 
 def top_end(problem):
@@ -115,13 +126,13 @@ def riser_report(problem, vertex, seabed=None):
     on the SeabedTerm ``seabed`` if there is one. Collective."""
     mesh = problem.mesh
     z = vertex["r"][:, 2]
-    tension = np.einsum("nc,nc->n", vertex["n"], vertex["d3"])
+    tension = effective_tension(vertex)
     reaction = seabed.pressure(z) if seabed is not None else np.zeros_like(z)
     datasets = {"effective_tension": tension, "seabed_reaction": reaction}
     top = top_end(problem)
     index = top * mesh.n_elements
     top_force = _at_vertex(mesh, vertex["n"], index)
-    top_tangent = _at_vertex(mesh, vertex["d3"], index)
+    top_tangent = _at_vertex(mesh, unit_tangent(vertex), index)
     angle = float(np.degrees(np.arccos(min(1.0, abs(top_tangent[2])))))
     curvature = np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
     k = int(np.argmax(curvature)) if curvature.size else 0

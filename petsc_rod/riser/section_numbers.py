@@ -1,6 +1,6 @@
 """The numbers of each section of a line of line types (scenes/line.py), for the step
 line and the result file (docs/output.md): the section's name and bounds, its largest
-effective tension n.d3 (N) and curvature |(u1, u2)| (1/m), the smallest bend radius
+effective tension n.t (N) and curvature |(u1, u2)| (1/m), the smallest bend radius
 1 / max curvature (m), and where they occur. A vertex at a section end counts in both
 sections. Vectorised on each rank's owned vertices, combined by one allgather of
 (sections x 4) numbers.
@@ -9,6 +9,7 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 import numpy as np
 
 from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.riser.quantities import effective_tension
 from petsc_rod.scenes.line import section_index
 
 DATASET_UNITS = {"section": "1"}
@@ -59,7 +60,7 @@ def section_report(mesh, sections, vertex):
     later one at an end), the attributes of ATTRIBUTE_UNITS and a phrase per section for
     the step line. Collective."""
     S = vertex["S"]
-    tension = np.einsum("nc,nc->n", vertex["n"], vertex["d3"])
+    tension = effective_tension(vertex)
     curvature = np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
     most_tension = _combine(mesh.comm, _largest_per_section(tension, S, sections))
     most_curved = _combine(mesh.comm, _largest_per_section(curvature, S, sections))

@@ -226,7 +226,9 @@ class Scene:
         return t * (self._end_rotation @ REFERENCE_FRAME[2] + self.end_twist)
 
     def validate(self, used):
-        """Raise RodInputError on a scene no inextensible cable can realise.
+        """Raise RodInputError on a scene no cable can realise (an inextensible one: ends
+        held farther apart than its length; an extensible one is then taut, with a
+        tension set by its stretch, docs/method.md §12).
 
         ``used`` is the set of option names the user set, so that an option the scene
         would ignore is an error, not a silent no-op.
@@ -235,6 +237,9 @@ class Scene:
             raise RodInputError(f"-rod_length {self.length:g}: the length must be positive")
         if np.any(self.stiffness <= 0):
             raise RodInputError("-rod_stiffness: K1, K2, K3 must all be positive (N m^2)")
+        if not self.axial_stiffness > 0:
+            raise RodInputError(f"-rod_axial_stiffness {self.axial_stiffness:g}: EA must be "
+                                "positive (N; default inf, inextensible)")
         for name, kind in (("-rod_start", self.start), ("-rod_end", self.end)):
             if kind not in END_KINDS:
                 raise RodInputError(f"{name} {kind}: unknown end condition; use one of "
@@ -244,11 +249,11 @@ class Scene:
                                 "(a rigid motion is free); hold one end with clamp or pin")
         held = self.start != "free" and self.end != "free"
         chord = np.linalg.norm(self.end_position)
-        if held and chord > self.length * (1 + 1e-12):
+        if held and chord > self.length * (1 + 1e-12) and not self.extensible:
             raise RodInputError(
                 f"-rod_end_position: the ends are {chord:.15g} m apart, "
                 f"{chord - self.length:.3g} m more than the cable's length {self.length:.15g} m "
-                "(inextensible); bring the end within -rod_length")
+                "(inextensible); bring the end within -rod_length, or give -rod_axial_stiffness")
         frame = self.end_frame
         if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
                 or np.linalg.det(frame) < 0):
