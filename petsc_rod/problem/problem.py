@@ -19,7 +19,8 @@ from petsc_rod.frames import strains
 from petsc_rod.global_step.coefficients import FieldCoefficients
 from petsc_rod.global_step.global_step import GlobalStep
 from petsc_rod.local_step.projection import nearest_rotation, update_multipliers
-from petsc_rod.mesh.elements import GAUSS_POINTS, quadrature_weights
+from petsc_rod.mesh.elements import (cut_gauss_rule, p2_basis, p2_integrals,
+                                     quadrature_weights)
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.state import RodState
@@ -51,10 +52,7 @@ class RodProblem:
             self.state.destroy()
             raise
         self.weights = quadrature_weights(mesh.element_h)
-        # K at the Gauss points of the energy, (ne, 3, 3) (the constant triple, (3,), on
-        # a line of uniform stiffness)
-        self.point_stiffness = (scene.stiffness if scene.uniform_stiffness
-                                else scene.stiffness_at(mesh.point_S(GAUSS_POINTS)))
+        self._energy_rule = self._stored_energy_rule()
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
         self._second_variation = None
@@ -132,13 +130,30 @@ class RodProblem:
     # --- the energy and its derivatives ------------------------------------------------
     def energy(self):
         """E = int w dS (the strains u of the FE fields and the stiffness K at the Gauss
-        points) plus every term's part (the work of the loads with its sign, the seabed's
+        points; those of the pieces between section ends where K varies) plus every
+        term's part (the work of the loads with its sign, the seabed's
         stored energy), J (§6). Collective."""
-        p = self.state.point_values()
+        tables, weights, stiffness = self._energy_rule
+        p = (self.state.point_values() if tables is None
+             else self.state.evaluate(self.mesh.element_local, *tables))
         u = strains(p["directors"], p["derivatives"])
-        stored = 0.5 * np.sum(self.weights[:, :, None] * self.point_stiffness * u**2)
+        stored = 0.5 * np.sum(weights[:, :, None] * stiffness * u**2)
         return self.mesh.global_sum(stored) + sum(term.energy(self.state)
                                                   for term in self.terms)
+
+    def _stored_energy_rule(self):
+        """The quadrature of the stored energy int 1/2 K_i u_i^2 dS: (tables, weights,
+        K). On a uniform line the state's Gauss points (tables None), self.weights and
+        the constant triple (3,); otherwise the Gauss points of the pieces of each element
+        between the section ends (elements.cut_gauss_rule, the pieces of the matrices),
+        as (p2_basis, p2_integrals) tables at them, their weights and K there, (ne, nq, 3)."""
+        mesh, scene = self.mesh, self.scene
+        if scene.uniform_stiffness:
+            return None, self.weights, scene.stiffness
+        h = mesh.element_h
+        xi, weights = cut_gauss_rule(mesh.element_S, h, scene.stiffness_breaks)
+        tables = (p2_basis(xi, h), p2_integrals(xi, h))
+        return tables, weights, scene.stiffness_at(mesh.element_S[:, None] + xi * h[:, None])
 
     def field_stiffness(self, i):
         """Field i's 2 a_i K as (factor, Mat) (GlobalStep.field_stiffness): on a uniform
