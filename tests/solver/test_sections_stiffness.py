@@ -1,6 +1,7 @@
 """A line whose bending and torsion stiffness vary along S (Scene.sections, docs/method.md
 §1, §2, §4) against closed forms, with the observed orders; a uniform line given as
-sections; the same answer on 1 and 2 ranks.
+sections; the same answer on 1 and 2 ranks; the stability test (§10) at a stepped
+column's buckling load.
 
 Every scene holds both ends clamped, the end S = L where the closed form puts it: the
 end moment M of a cantilever is then the clamp's reaction and the reaction force is
@@ -245,3 +246,38 @@ def test_the_same_answer_on_one_and_all_ranks():
     for key in ("r", "d1", "d2", "m", "n"):
         assert np.abs(serial[1][key] - parallel[1][key]).max() < 1e-9, key
     assert abs(serial[2] - parallel[2]) < 1e-11 * abs(serial[2])
+
+
+def stepped_column_load(a, stiff, soft):
+    """The buckling load of a cantilever of bending stiffness ``stiff`` on [0, a] and
+    ``soft`` on [a, 1] under a dead compressive tip force: the smallest root of
+    tan(k1 a) tan(k2 (1 - a)) = k2 / k1, k_i = sqrt(P / EI_i) (w = delta (1 - cos k1 S)
+    on the first part, delta - A sin(k2 (1 - S)) on the second, w and w' continuous at
+    a), below the first pole."""
+    from scipy.optimize import brentq
+
+    k = lambda P, EI: np.sqrt(P / EI)
+    f = lambda P: np.tan(k(P, stiff) * a) * np.tan(k(P, soft) * (1 - a)) - np.sqrt(stiff / soft)
+    pole = min(stiff * (np.pi / (2 * a)) ** 2, soft * (np.pi / (2 * (1 - a))) ** 2)
+    return brentq(f, 1e-9, pole * (1 - 1e-9), xtol=1e-14)
+
+
+@pytest.mark.parametrize("ratio", [0.95, 1.05])
+def test_a_stepped_column_buckles_at_its_load(comm, solver_factory, ratio):
+    """The second variation with each field's own stiffness matrix (§10): the cantilever
+    of (a) (EI 2 then 0.5) under a compressive tip force of 0.95 and 1.05 times its
+    buckling load 2.4806 (between 1.2337 and 4.9348, those of the soft and the stiff
+    line). Below, the straight state is a minimiser: no escape, no lateral deflection;
+    above, the stability test finds it a saddle, the step leaves it (one escape,
+    measured) and ends buckled (lateral 0.29 m, measured) and stable."""
+    load = stepped_column_load(0.4, 2.0, 0.5)
+    assert 2.48 < load < 2.481
+    scene = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
+                 end_force=(-ratio * load, 0.0, 0.0), sections=STEPPED)
+    report, fields, _ = solved(comm, solver_factory, 20, scene, steps=1, rtol=1e-10, ctol=1e-10)
+    assert report.converged and report.stable
+    lateral = np.abs(fields["r"][:, 1:]).max()
+    if ratio < 1:
+        assert report.escapes == 0 and lateral < 1e-12
+    else:
+        assert report.escapes >= 1 and 0.2 < lateral < 0.4

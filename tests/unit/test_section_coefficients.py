@@ -160,3 +160,18 @@ def test_one_sided_stiffness_at_a_section_end():
     assert np.array_equal(scene.stiffness_at(0.4), [0.5, 0.5, 1.5])
     assert np.array_equal(scene.stiffness_at(0.4, inside=0.35), [1.0, 1.0, 0.75])
     assert np.array_equal(scene.stiffness_values()[:, 0], [4.0, 1.0, 0.5, 0.5])
+
+
+def test_the_collocation_reference_refuses_a_line_of_sections(tmp_path):
+    """validation/reference.py solves a line of one stiffness: a result file of a line
+    of sections is refused in one line, not read with -rod_stiffness."""
+    h5py = pytest.importorskip("h5py")
+    from petsc_rod.validation.reference import initial_guess_from_result
+
+    path = str(tmp_path / "sections.h5")
+    with h5py.File(path, "w") as f:
+        for key in ("S", "r", "d1", "d2", "d3", "u", "n", "m"):
+            f[key] = np.zeros((2, 3)) if key != "S" else np.zeros(2)
+        f.attrs["options"] = "-rod_stiffness 1,1,1\n-rod_sections a:0:0.4,b:0.4:1\n"
+    with pytest.raises(ValueError, match="line of sections"):
+        initial_guess_from_result(path)
