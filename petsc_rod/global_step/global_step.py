@@ -8,9 +8,10 @@ K the P2 stiffness matrix, W the lumped (Simpson) node mass, a_i the split of th
 stiffness, c_i the coefficients of the matrices (penalty.matrix_split) and b_3 the loads
 int F.g dS (centreline.py). Where the stiffness varies along the line, a_i and c_i are
 functions of S inside the integrals of K (coefficients.FieldCoefficients: 2 c_i K stands
-for int 2 c_i(S) g_k' g_l' dS, and the lagged part is per element too). The r' problem of a rod held at both ends is bordered by the
-chord constraint int r' dS = r(L) - r(0); r follows from r' by integration. The three
-matrices are assembled and factored once per penalty R.
+for int 2 c_i(S) g_k' g_l' dS, and the lagged part is per element too). The r' problem
+of a rod held at both ends is bordered by the chord constraint int r' dS = r(L) - r(0);
+r follows from r' by integration. The three matrices are assembled and factored once per
+penalty R.
 
 The loads and whatever else the physics adds come from the problem's terms
 (physics/term.py), called in list order: the loads fixed over a step are summed once

@@ -131,8 +131,8 @@ class RodProblem:
     def energy(self):
         """E = int w dS (the strains u of the FE fields and the stiffness K at the Gauss
         points; those of the pieces between section ends where K varies) plus every
-        term's part (the work of the loads with its sign, the seabed's
-        stored energy), J (§6). Collective."""
+        term's part (the work of the loads with its sign, the seabed's stored energy), J
+        (§6). Collective."""
         tables, weights, stiffness = self._energy_rule
         p = (self.state.point_values() if tables is None
              else self.state.evaluate(self.mesh.element_local, *tables))

@@ -197,9 +197,10 @@ class Scene:
     def axially_symmetric(self):
         """Whether every rotation about the x axis through the origin, together with a
         uniform roll of the sections, maps an equilibrium to an equilibrium: K1 = K2 all
-        along the line (the roll costs nothing), every load along e_x, a held end S = L on the axis and a
-        clamped one only rolled about e_x, no seabed, no current. Such a scene buckles
-        into a family of equilibria (docs/method.md §10, which the solver reports)."""
+        along the line (the roll costs nothing), every load along e_x, a held end S = L on
+        the axis and a clamped one only rolled about e_x, no seabed, no current. Such a
+        scene buckles into a family of equilibria (docs/method.md §10, which the solver
+        reports)."""
         axis = REFERENCE_FRAME[2]
         off_axis = np.concatenate([self.start_force[1:], self.end_force[1:],
                                    self.load_values[:, 1:].ravel()])

@@ -79,7 +79,8 @@ def exact_bending(sections, S):
     for k, x in enumerate(S):
         points = [b for b in breaks if b < x] or None
         for c, f in enumerate((np.cos, np.sin)):
-            r[k, c] = quad(lambda s: f(theta(s)), 0.0, x, points=points, **options)[0] if x > 0 else 0.0
+            if x > 0:
+                r[k, c] = quad(lambda s: f(theta(s)), 0.0, x, points=points, **options)[0]
     return moment, np.array([theta(x) for x in S]), r
 
 
@@ -87,9 +88,9 @@ def bent_scene(sections):
     """Both ends clamped, the end S = L at the closed form's position and turned by BEND
     about e_z."""
     _, _, end = exact_bending(sections, np.array([1.0]))
+    frame = REFERENCE_FRAME @ rotation_about([0, 0, 1], BEND).T
     return dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="clamp",
-                end_position=end[0], end_frame=REFERENCE_FRAME @ rotation_about([0, 0, 1], BEND).T,
-                sections=sections)
+                end_position=end[0], end_frame=frame, sections=sections)
 
 
 def solved(comm, solver_factory, n, scene, steps=2, **settings):
@@ -213,8 +214,8 @@ def test_a_torsion_section_beside_an_ordinary_one(comm, solver_factory, newton):
     assert 3.8 < fitted_order(sizes, director) < 4.2
     assert 1.8 < fitted_order(sizes, torque) < 2.2
     assert director[-1] < 4e-7 and energy[-1] < 1e-6
-    bent = bending_errors(comm, solver_factory, (STEPPED[0], section("soft", 0.4, 1.0, (0.5, 0.5, 1.5))),
-                          sizes[-1:], newton=newton)
+    torsion_soft = (STEPPED[0], section("soft", 0.4, 1.0, (0.5, 0.5, 1.5)))
+    bent = bending_errors(comm, solver_factory, torsion_soft, sizes[-1:], newton=newton)
     assert bent["r"][0] < 4e-8 and bent["energy"][0] < 2e-7
 
 
