@@ -38,12 +38,15 @@ def strains(d, dd):
 
 
 def split_coefficients(stiffness):
-    """a_i of the quadratic form w = a1|d1'|^2 + a2|d2'|^2 + a3|r''|^2 (§2).
+    """a_i of the quadratic form w = a1|d1'|^2 + a2|d2'|^2 + a3|r''|^2 (§2), N m^2.
 
-    a1 = (K2 + K3 - K1)/4, a2 = (K3 + K1 - K2)/4, a3 = (K1 + K2 - K3)/4.
+    a1 = (K2 + K3 - K1)/4, a2 = (K3 + K1 - K2)/4, a3 = (K1 + K2 - K3)/4, pointwise:
+    stiffness (..., 3) -> (..., 3), one triple per point of a line whose stiffness varies
+    along S (Scene.stiffness_at), or (3,) -> (3,) for a uniform one.
     """
-    k1, k2, k3 = stiffness
-    return np.array([k2 + k3 - k1, k3 + k1 - k2, k1 + k2 - k3]) / 4.0
+    k = np.asarray(stiffness, dtype=float)
+    k1, k2, k3 = k[..., 0], k[..., 1], k[..., 2]
+    return np.stack([k2 + k3 - k1, k3 + k1 - k2, k1 + k2 - k3], axis=-1) / 4.0
 
 
 def rotation_about(axis, angle):

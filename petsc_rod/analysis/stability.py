@@ -3,13 +3,16 @@ constraint set, and a direction that leaves a saddle (docs/method.md §10).
 
 At a converged state the nodal frames are rotations, d_n = tau_n, and a variation turns
 each by a small rotation vector omega_n: delta d_i = omega x d_i, to second order
-omega x (omega x d_i) / 2. With the discrete energy E = sum_i a_i d_i^T K d_i - work and
+omega x (omega x d_i) / 2. With the discrete energy E = sum_i d_i^T K_{a_i} d_i - work and
 its gradient at the solution, grad_{d_i} E = -w lambda_i (the global step's optimality
 at d = tau; the reaction mu of a chord constraint is linear and drops out), the second
 variation is
 
-    H[omega, omega] = sum_i 2 a_i (omega x d_i)^T K (omega x d_i)
+    H[omega, omega] = sum_i 2 (omega x d_i)^T K_{a_i} (omega x d_i)
                       - sum_n w_n sum_i lambda_{n,i} . (omega_n x (omega_n x d_{n,i}))
+
+(K_{a_i} = a_i K, K the unit P2 stiffness, on a line of uniform stiffness; the matrix of
+the coefficient a_i(S) where it varies, coefficients.FieldCoefficients)
 
 on the omega with omega_n = 0 at a clamp and, when both ends are held,
 sum_n w_n (omega_n x tau3_n) = 0 (the chord int r' dS stays fixed). The state is a
@@ -26,7 +29,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.global_step.ksp import inertia_solver
-from petsc_rod.mesh.elements import P2, p2_element_matrices
+from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
@@ -111,8 +114,9 @@ class SecondVariation:
         d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
                       for f in problem.state.frame_fields], axis=2)
         if ne:
-            stiffness = p2_element_matrices(mesh.element_h, 1.0, 0.0)      # (ne, 3, 3)
-            blocks = self._element_blocks(d, 2 * np.asarray(problem.split), stiffness)
+            # 2 a_i times the unit K, or each field's K_{2 a_i} along a line of sections
+            weights, stiffness = problem.coefficients.hessian_stiffness()
+            blocks = self._element_blocks(d, weights, stiffness)
             rows = (self.first_row + 3 * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
             rows = (rows[:, :, None] + np.arange(3)).reshape(ne, 9).astype(PETSc.IntType)
             self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
@@ -138,7 +142,11 @@ class SecondVariation:
         sum_i weights_i K_ab ([d_a,i]x^T [d_b,i]x)_st with [u]x^T [v]x = (u.v) I - v u^T,
         for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3),
         written out in broadcast products (cheaper than an einsum over the cross-product
-        matrices: docs/performance.md)."""
+        matrices: docs/performance.md). Element matrices (3, ne, 3, 3), one K_i per field
+        (a stiffness varying along the line): sum_i weights_i K_i,ab (...)_st."""
+        if np.ndim(stiffness) == 4:
+            return sum(SecondVariation._element_blocks(d[:, :, i:i + 1], weights[i:i + 1],
+                                                       stiffness[i]) for i in range(3))
         ne = d.shape[0]
         blocks = np.zeros((ne, 3, 3, 3, 3))
         product = np.empty_like(blocks)

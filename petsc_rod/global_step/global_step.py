@@ -6,9 +6,12 @@ For each field g_i of (d1, d2, r' = d3), with tau and lambda fixed,
 
 K the P2 stiffness matrix, W the lumped (Simpson) node mass, a_i the split of the
 stiffness, c_i the coefficients of the matrices (penalty.matrix_split) and b_3 the loads
-int F.g dS (centreline.py). The r' problem of a rod held at both ends is bordered by the
-chord constraint int r' dS = r(L) - r(0); r follows from r' by integration. The three
-matrices are assembled and factored once per penalty R.
+int F.g dS (centreline.py). Where the stiffness varies along the line, a_i and c_i are
+functions of S inside the integrals of K (coefficients.FieldCoefficients: 2 c_i K stands
+for int 2 c_i(S) g_k' g_l' dS, and the lagged part is per element too). The r' problem
+of a rod held at both ends is bordered by the chord constraint int r' dS = r(L) - r(0);
+r follows from r' by integration. The three matrices are assembled and factored once per
+penalty R.
 
 The loads and whatever else the physics adds come from the problem's terms
 (physics/term.py), called in list order: the loads fixed over a step are summed once
@@ -21,8 +24,9 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.global_step.centreline import positions_from_increments
+from petsc_rod.global_step.coefficients import ENERGY, LAGGED
 from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix
-from petsc_rod.mesh.elements import element_integrals, p2_element_matrices
+from petsc_rod.mesh.elements import element_integrals
 from petsc_rod.mesh.fields import CHUNK, VectorField, blocks, element_slices
 from petsc_rod.scenes import boundary
 
@@ -38,9 +42,10 @@ class GlobalStep:
     problems' PETSc objects and the summed load; ``destroy()`` releases them (the terms
     are the problem's)."""
 
-    def __init__(self, mesh, scene, split, matrix_split, penalty, terms):
+    def __init__(self, mesh, scene, coefficients, penalty, terms):
         self.mesh, self.scene, self.terms = mesh, scene, terms
-        self.split, self.matrix_split = split, matrix_split
+        # the fields' stiffness along the line (coefficients.FieldCoefficients)
+        self.coefficients = coefficients
         self.start_state, self.end_state = scene.start_state(0.0), scene.end_state(0.0)
         # 1 + eps at a clamped start and end: the prescribed slope is (1 + eps) d3 there
         # on an extensible line (set_clamp_stretch, docs/method.md §12); 1 otherwise
@@ -48,11 +53,12 @@ class GlobalStep:
         self.bordered = boundary.is_held(self.start_state) and boundary.is_held(self.end_state)
         self.rhs = [VectorField(mesh, f"rhs_{n}") for n in ("d1", "d2", "slope")]
         self.load = VectorField(mesh, "step_load")     # b_3: the terms' loads of the step
-        self.lags = bool(np.any(matrix_split != split))
-        self._stiffness = None
+        self.lags = bool(coefficients.lagged_fields)
+        self._stiffness = {}            # the assembled stiffness matrices, by key
         if self.lags:
             # two work vectors for K tau_i
-            self._lagged_work = self.stiffness().createVecs()
+            self._lagged_work = self.field_stiffness(
+                coefficients.lagged_fields[0], LAGGED)[1].createVecs()
         self.problems = []
         # int_e phi_k dS, (3, ne), and work arrays of the slope's integration
         self._integrals = np.ascontiguousarray(element_integrals(mesh.element_h).T)
@@ -75,8 +81,9 @@ class GlobalStep:
         mesh, h = self.mesh, self.mesh.element_h
         EVENTS["assembly"].begin()
         self.penalty = penalty
+        matrices = [self.coefficients.global_step_matrices(i, penalty) for i in range(3)]
         self.problems = [ScalarProblem(
-            mesh, p2_element_matrices(h, 2 * self.matrix_split[i], penalty),
+            mesh, matrices[i],
             boundary.director_prescribed(i, self.start_state, self.end_state,
                                          mesh.n_elements), prefix)
             for i, prefix in enumerate(PREFIXES)]
@@ -84,7 +91,7 @@ class GlobalStep:
             self.problems[2].add_integral_constraint(element_integrals(h))
         self._set_prescribed()
         for term in self.terms:
-            term.build(2 * self.matrix_split[2], penalty)
+            term.build(matrices[2], penalty)
         EVENTS["assembly"].end()
 
     def ksps(self):
@@ -176,29 +183,32 @@ class GlobalStep:
             self._add_lagged_part(tau)
 
     def _add_lagged_part(self, tau):
-        """2 (c_i - a_i) K tau_i on each field's right-hand side, where the matrix uses c_i
-        instead of a_i: at a fixed point (d = tau) the equations are those of a_i."""
+        """2 (c_i - a_i) K tau_i on the right-hand side of each field i whose matrix uses
+        c_i instead of a_i somewhere (coefficients.FieldCoefficients.lagged_fields; with
+        a varying stiffness, int 2 (c_i - a_i)(S) g_k' g_l' dS, element by element): at a
+        fixed point (d = tau) the equations are those of a_i."""
         n = self.mesh.n_local_nodes
         work, product = self._lagged_work
-        for i, rhs in enumerate(self.rhs):
-            factor = 2 * (self.matrix_split[i] - self.split[i])
-            if factor == 0:
-                continue
-            for c, vec in enumerate(rhs.components):
+        for i in self.coefficients.lagged_fields:
+            factor, matrix = self.field_stiffness(i, LAGGED)
+            for c, vec in enumerate(self.rhs[i].components):
                 values = work.getArray()
                 values[:n] = tau[:, i, c]
                 values[n:] = 0.0
-                self._stiffness.mult(work, product)
+                matrix.mult(work, product)
                 vec.axpy(factor, product)
 
-    def stiffness(self):
-        """K = int g_k' g_l' dS on the P2 dofs (unit coefficient): the matrix of the
-        lagged part and of the energy's gradient (iteration/newton.py), assembled on
-        first use, once."""
-        if self._stiffness is None:
-            self._stiffness = assemble_matrix(
-                self.mesh, p2_element_matrices(self.mesh.element_h, 1.0, 0.0))
-        return self._stiffness
+    def field_stiffness(self, i, part=ENERGY):
+        """Field i's stiffness as (factor, Mat) on the P2 dofs: factor times the Mat is
+        2 a_i K, the energy's (ENERGY: the energy's gradient in iteration/newton.py), or
+        2 (c_i - a_i) K, the lagged part's (LAGGED). On a uniform line the Mat is the one
+        unit-coefficient K = int g_k' g_l' dS and the factor the constant; otherwise the
+        matrix of the coefficient along the line and 1 (coefficients.FieldCoefficients).
+        Each is assembled on first use, once (collective)."""
+        factor, key, element_matrices = self.coefficients.part(i, part)
+        if key not in self._stiffness:
+            self._stiffness[key] = assemble_matrix(self.mesh, element_matrices())
+        return factor, self._stiffness[key]
 
     def solve_centreline(self, state):
         """r' from its right-hand side rhs[2], bordered by r(L) - r(0) = int r' when both
@@ -245,7 +255,8 @@ class GlobalStep:
         if self.lags:
             for obj in self._lagged_work:
                 obj.destroy()
-        if self._stiffness is not None:
-            self._stiffness.destroy()
+        for matrix in self._stiffness.values():
+            matrix.destroy()
+        self._stiffness = {}
         for obj in [*self.rhs, self.load]:
             obj.destroy()

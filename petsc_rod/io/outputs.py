@@ -15,25 +15,37 @@ from petsc_rod.mesh.elements import p2_basis, p2_integrals
 from petsc_rod.frames import strains
 
 
-def vertex_strains(problem):
-    """u = (u1, u2, u3) at the owned vertices, (n_owned, 3)."""
-    mesh = problem.mesh
+def vertex_strains(problem, moments=False):
+    """u = (u1, u2, u3) at the owned vertices, (n_owned, 3): the mean of the limits
+    from the elements on either side. With ``moments``, also the moment's components
+    K_i u_i (n_owned, 3), the mean of the one-sided K u, each with the stiffness of its
+    own side (Scene.stiffness_at from the element): where the stiffness jumps at a
+    section end the moment is continuous and the strain is not."""
+    mesh, scene = problem.mesh, problem.scene
     first, end = mesh.elements_around_owned_vertices()
     elements = np.arange(first, end)
-    h = mesh.coordinates(elements + 1) - mesh.coordinates(elements)
+    left = mesh.coordinates(elements)
+    h = mesh.coordinates(elements + 1) - left
     ends = np.array([0.0, 1.0])
     values = problem.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
                                     p2_integrals(ends, h))
     u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
+    sided = [u]
+    if moments:
+        S = left[:, None] + ends[None, :] * h[:, None]
+        middle = np.broadcast_to((left + h / 2)[:, None], S.shape)
+        sided.append(scene.stiffness_at(S, inside=middle) * u)
     n_owned = mesh.vertex_end - mesh.vertex_start
-    total = np.zeros((n_owned, 3))
+    totals = [np.zeros((n_owned, 3)) for _ in sided]
     count = np.zeros(n_owned)
     for side in (0, 1):
         vertex = elements + side - mesh.vertex_start
         inside = (vertex >= 0) & (vertex < n_owned)
-        total[vertex[inside]] += u[inside, side]
+        for total, value in zip(totals, sided):
+            total[vertex[inside]] += value[inside, side]
         count[vertex[inside]] += 1
-    return total / count[:, None]
+    means = [total / count[:, None] for total in totals]
+    return tuple(means) if moments else means[0]
 
 
 def vertex_fields(problem):
@@ -45,9 +57,13 @@ def vertex_fields(problem):
     d1 = state.d1.owned()[:, 0]
     d2 = state.d2.owned()[:, 0]
     d3 = r[:, 1]
-    u = vertex_strains(problem)
-    k = problem.scene.stiffness
-    moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
+    if problem.scene.uniform_stiffness:
+        u = vertex_strains(problem)
+        k = problem.scene.stiffness
+        moment = (k[0] * u[:, :1] * d1 + k[1] * u[:, 1:2] * d2 + k[2] * u[:, 2:] * d3)
+    else:                   # the stiffness of each side (vertex_strains)
+        u, ku = vertex_strains(problem, moments=True)
+        moment = ku[:, :1] * d1 + ku[:, 1:2] * d2 + ku[:, 2:] * d3
     return {"S": mesh.vertex_S, "r": r[:, 0], "d1": d1, "d2": d2, "d3": d3, "u": u,
             "m": moment, "n": problem.internal_force()}
 

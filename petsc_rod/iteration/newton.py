@@ -2,7 +2,10 @@
 
 The discrete problem the Uzawa iteration solves is: minimise
 
-    E(d) = sum_i a_i d_i^T K d_i - b . d3      (K the P2 stiffness, b the slope's load)
+    E(d) = sum_i d_i^T K_{a_i} d_i - b . d3    (b the slope's load)
+
+(K_{a_i} = int a_i(S) g_k' g_l' dS, the P2 stiffness of field i's coefficient: a_i K on a
+line of uniform stiffness, K the unit one)
 
 over frames d_n in SO(3) at the P2 nodes, with the clamped frames fixed and, when both
 ends are held, the chord sum_n w_n d3_n = r(L) - r(0). Near a solution this module takes
@@ -13,7 +16,7 @@ d_n <- exp([omega_n]x) d_n, with omega from the KKT system
     [ C   0  ] [ dmu   ] = [ -c      ],
 
 L = E + mu . c the Lagrangian of the chord constraint c(d) = sum_n w_n d3_n - chord,
-grad_n L = sum_i d_{n,i} x g_{n,i} (g_i = dL/dd_i = 2 a_i K d_i - b delta_i3 + w mu
+grad_n L = sum_i d_{n,i} x g_{n,i} (g_i = dL/dd_i = 2 K_{a_i} d_i - b delta_i3 + w mu
 delta_i3), C omega = sum_n w_n omega_n x d3_n, and H the Riemannian Hessian of L: the
 second variation of analysis/stability.py with lambda_n = -g_n / w_n (at a solution
 these are the Uzawa multipliers, and H is exactly the matrix of the stability test).
@@ -53,12 +56,12 @@ CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 class NewtonPolish:
     """Newton steps of the module docstring on a problem's state (problem/problem.py).
-    Owns a work Vec for K d (K is the global step's); ``destroy()`` frees it (the second
+    Owns a work Vec for K d (the K are the global step's); ``destroy()`` frees it (the second
     variation is the problem's, ``RodProblem.second_variation``, updated at each step)."""
 
     def __init__(self, problem):
         self.problem = problem
-        self._product = problem.stiffness().createVecLeft()
+        self._product = problem.field_stiffness(0)[1].createVecLeft()
         self._free = problem.free_nodes
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite: the stability test's verdict, at 1e-10 rad from the result

@@ -97,14 +97,62 @@ def gram(weights, a, b):
 NODE_WEIGHTS = np.array([1.0, 4.0, 1.0]) / 6.0
 
 
+def lumped_mass(h):
+    """The Simpson node mass of each element, h diag(1, 4, 1)/6, (ne, 3, 3): the
+    penalty's W (docs/method.md §4)."""
+    return np.asarray(h, dtype=float)[:, None, None] * np.diag(NODE_WEIGHTS)[None]
+
+
 def p2_element_matrices(h, stiffness, penalty):
     """Element matrices of one field of the global step (docs/method.md §3):
     int s g'.k' dS + R sum_n w_n g_n k_n, the penalty mass lumped at the nodes.
 
     For d_a (a = 1, 2) s = 2 a_a; for the slope r' = d3, s = 2 a3 (the r equation
     int 2 a3 r''.p'' with slope = r', g = p'). ``penalty`` is R (N). Returns (ne, 3, 3).
+    A coefficient that varies along the element: p2_stiffness_matrices.
     """
     _, dphi = p2_basis(GAUSS_POINTS, h)
     w = quadrature_weights(h)
-    lumped = np.asarray(h, dtype=float)[:, None, None] * np.diag(NODE_WEIGHTS)[None]
-    return stiffness * gram(w, dphi, dphi) + penalty * lumped
+    return stiffness * gram(w, dphi, dphi) + penalty * lumped_mass(h)
+
+
+# Cut fractions this close to an element's end are its end: a break at a vertex (a
+# section end on a mesh built to have it there) cuts nothing, whatever the round-off
+# of S at the vertex.
+CUT_SNAP = 1e-12
+
+
+def cut_gauss_rule(element_S, h, breaks):
+    """The 3-point Gauss rule on the pieces of each element between the ``breaks`` (S,
+    sorted) inside it: reference points xi (ne, 3 P) and physical weights (ne, 3 P), P the
+    largest number of pieces of an element (1 where no break falls inside an element;
+    shorter elements pad with pieces of zero weight).
+
+    A coefficient linear on each piece (a stiffness constant or tapered along each
+    section of a line, the breaks its section ends) times a product of two P2
+    derivatives is a cubic on each piece, which this rule integrates exactly. Vectorised:
+    the pieces of positive length of each element are moved to the first columns.
+    """
+    a = np.asarray(element_S, dtype=float)[:, None]
+    h = np.asarray(h, dtype=float)[:, None]
+    cuts = np.clip((np.asarray(breaks, dtype=float)[None, :] - a) / h, 0.0, 1.0)
+    cuts = np.where(cuts < CUT_SNAP, 0.0, np.where(cuts > 1.0 - CUT_SNAP, 1.0, cuts))
+    cuts = np.concatenate([np.zeros_like(a), cuts, np.ones_like(a)], axis=1)
+    lo, hi = cuts[:, :-1], cuts[:, 1:]
+    order = np.argsort(hi <= lo, axis=1, kind="stable")       # positive pieces first
+    pieces = max(int(np.max(np.sum(hi > lo, axis=1), initial=1)), 1)
+    lo = np.take_along_axis(lo, order, axis=1)[:, :pieces, None]
+    hi = np.take_along_axis(hi, order, axis=1)[:, :pieces, None]
+    shape = (len(a), pieces * GAUSS_POINTS.size)
+    xi = (lo + (hi - lo) * GAUSS_POINTS).reshape(shape)
+    weights = (h[:, :, None] * (hi - lo) * GAUSS_WEIGHTS).reshape(shape)
+    return xi, weights
+
+
+def p2_stiffness_matrices(h, xi, weights, coefficients):
+    """int s_f(S) g_k' g_l' dS of each element for coefficients s_f varying along it,
+    by the quadrature (xi, weights) of cut_gauss_rule: coefficients (ne, nq, m) at its
+    points -> (m, ne, 3, 3), one set of element matrices per coefficient (the three
+    fields' 2 a_i, N m^2, docs/method.md §2, §4)."""
+    _, dphi = p2_basis(xi, h)
+    return np.einsum("eq,eqf,eqk,eql->fekl", weights, coefficients, dphi, dphi)

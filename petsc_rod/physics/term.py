@@ -57,9 +57,10 @@ class Term:
     slope_components = ()
 
     # --- the global step --------------------------------------------------------------
-    def build(self, slope_coefficient, penalty):
-        """At every factorisation of the global step: the slope problem's 2 c3 (N m^2)
-        and its penalty R (N) (global_step.GlobalStep.build)."""
+    def build(self, slope_matrices, penalty):
+        """At every factorisation of the global step: the slope problem's element
+        matrices 2 c3 K + R W, (ne, 3, 3) (c3 varying along a line of sections), and its
+        penalty R (N) (global_step.GlobalStep.build)."""
 
     def prepare(self, t, start, end):
         """At each load step: the load factor t and the end states (scenes.EndState)."""

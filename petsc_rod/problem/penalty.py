@@ -39,13 +39,39 @@ def default_penalty(scene):
 def penalty_scales(scene):
     """The scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
     'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2}; the command
-    line names the options behind the one that makes a default penalty out of range."""
-    stiffness = scene.stiffness
-    moment = stiffness[2] * scene.end_rotation() / scene.length
+    line names the options behind the one that makes a default penalty out of range.
+
+    Where the stiffness varies along the line (sections), min K and max K are taken over
+    the three stiffnesses and the whole line (Scene.stiffness_values: the softest and the
+    stiffest part, the two bounds of the bending scale), min(K1, K2) is the softest
+    bending stiffness anywhere (the part that buckles first: the larger, safer scale),
+    and M is the moment of the end's turn a through the line's torsional springs in
+    series, a / int_0^L dS / K3 (torsional_compliance), which is K3 a / L on a uniform
+    line.
+    """
+    if scene.uniform_stiffness:
+        stiffness = scene.stiffness
+        moment = stiffness[2] * scene.end_rotation() / scene.length
+        bending = stiffness[:2].min()
+    else:
+        stiffness = scene.stiffness_values()
+        moment = scene.end_rotation() / torsional_compliance(scene.sections)
+        bending = stiffness[:, :2].min()
     return {"bending": 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2,
             "tension": 0.5 * scene.applied_force(),
-            "twist": 2.0 * moment**2 / stiffness[:2].min(),
+            "twist": 2.0 * moment**2 / bending,
             "stretch": 0.5 * taut_tension(scene)}
+
+
+def torsional_compliance(sections):
+    """int dS / K3 over the sections (scenes/line.py), 1/N m: l / K3 along a uniform
+    section, l ln(K3_end / K3_start) / (K3_end - K3_start) along a tapered one."""
+    total = 0.0
+    for section in sections:
+        length = section.end - section.start
+        k0, k1 = section.stiffness_start[2], section.stiffness_end[2]
+        total += length / k0 if k0 == k1 else length * np.log(k1 / k0) / (k1 - k0)
+    return float(total)
 
 
 def taut_tension(scene):
@@ -71,8 +97,11 @@ def matrix_split(split):
     unless R grew like 1/h^2. Instead c_j = max_i a_i and the difference
     2 (c_j - a_j) K tau_j goes to the right-hand side (GlobalStep): the fixed points are
     those of the a_i, and the matrix of d_j keeps a stiffness of the size of the others.
+    Pointwise along a line whose stiffness varies: split (..., 3) -> (..., 3), the
+    maximum taken over the three coefficients at each point.
     """
-    return np.where(split < 0, split.max(), split)
+    split = np.asarray(split, dtype=float)
+    return np.where(split < 0, split.max(axis=-1, keepdims=True), split)
 
 
 def penalty_too_low(history, penalty, scale):

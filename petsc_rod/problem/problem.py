@@ -15,11 +15,13 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import SecondVariation
-from petsc_rod.frames import split_coefficients, strains
+from petsc_rod.frames import strains
+from petsc_rod.global_step.coefficients import FieldCoefficients
 from petsc_rod.global_step.global_step import GlobalStep
 from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
                                              stretched_rotation, update_multipliers)
-from petsc_rod.mesh.elements import quadrature_weights
+from petsc_rod.mesh.elements import (cut_gauss_rule, p2_basis, p2_integrals,
+                                     quadrature_weights)
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.state import RodState
@@ -36,20 +38,22 @@ class RodProblem:
     def __init__(self, mesh, scene, penalty, terms=None):
         self.mesh, self.scene = mesh, scene
         self.terms = list(scene_terms(mesh, scene) if terms is None else terms)
-        self.split = split_coefficients(scene.stiffness)
+        # the fields' stiffness along the line: a_i, c_i and their matrices (§2)
+        self.coefficients = FieldCoefficients(scene, mesh.element_S, mesh.element_h,
+                                              penalty_policy.matrix_split)
         # the problem's scale of R, N (penalty.default_penalty): what "far below" means
         self.scale = penalty_policy.default_penalty(scene)
         self.state = RodState(mesh)
         try:
-            self.global_step = GlobalStep(mesh, scene, self.split,
-                                          penalty_policy.matrix_split(self.split),
-                                          float(penalty), self.terms)
+            self.global_step = GlobalStep(mesh, scene, self.coefficients, float(penalty),
+                                          self.terms)
         except Exception:           # a solver the options refuse: free what was made
             for term in self.terms:
                 term.destroy()
             self.state.destroy()
             raise
         self.weights = quadrature_weights(mesh.element_h)
+        self._energy_rule = self._stored_energy_rule()
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
         self._second_variation = None
@@ -167,30 +171,49 @@ class RodProblem:
 
     # --- the energy and its derivatives ------------------------------------------------
     def energy(self):
-        """E = int w dS (the strains u of the FE fields at the Gauss points) plus every
+        """E = int w dS (the strains u of the FE fields and the stiffness K at the Gauss
+        points; those of the pieces between section ends where K varies) plus every
         term's part (the work of the loads with its sign, the seabed's stored energy), J
         (§6). Collective."""
-        p = self.state.point_values()
+        tables, weights, stiffness = self._energy_rule
+        p = (self.state.point_values() if tables is None
+             else self.state.evaluate(self.mesh.element_local, *tables))
         u = strains(p["directors"], p["derivatives"])
-        stored = 0.5 * np.sum(self.weights[:, :, None] * self.scene.stiffness * u**2)
+        stored = 0.5 * np.sum(weights[:, :, None] * stiffness * u**2)
         return self.mesh.global_sum(stored) + sum(term.energy(self.state)
                                                   for term in self.terms)
 
-    def stiffness(self):
-        """K, the P2 stiffness matrix of unit coefficient (GlobalStep.stiffness)."""
-        return self.global_step.stiffness()
+    def _stored_energy_rule(self):
+        """The quadrature of the stored energy int 1/2 K_i u_i^2 dS: (tables, weights,
+        K). On a uniform line the state's Gauss points (tables None), self.weights and
+        the constant triple (3,); otherwise the Gauss points of the pieces of each element
+        between the section ends (elements.cut_gauss_rule, the pieces of the matrices),
+        as (p2_basis, p2_integrals) tables at them, their weights and K there, (ne, nq, 3)."""
+        mesh, scene = self.mesh, self.scene
+        if scene.uniform_stiffness:
+            return None, self.weights, scene.stiffness
+        h = mesh.element_h
+        xi, weights = cut_gauss_rule(mesh.element_S, h, scene.stiffness_breaks)
+        tables = (p2_basis(xi, h), p2_integrals(xi, h))
+        return tables, weights, scene.stiffness_at(mesh.element_S[:, None] + xi * h[:, None])
+
+    def field_stiffness(self, i):
+        """Field i's 2 a_i K as (factor, Mat) (GlobalStep.field_stiffness): on a uniform
+        line the unit-coefficient K and 2 a_i, otherwise int 2 a_i(S) g_k' g_l' dS and 1."""
+        return self.global_step.field_stiffness(i)
 
     def energy_gradient(self, work):
         """g_i = dE/dd_i at the owned P2 nodes, (n_nodes, 3, 3), with the fields of the
-        state as the frames: 2 a_i K d_i and the terms' (Term.add_gradient: -b on d3 for
-        the loads). ``work``: a Vec of K's layout for the products."""
+        state as the frames: 2 a_i K d_i (a_i varying along a line of sections) and the
+        terms' (Term.add_gradient: -b on d3 for the loads). ``work``: a Vec of K's layout
+        for the products."""
         n = self.mesh.n_local_nodes
         g = np.empty((n, 3, 3))
-        stiffness = self.stiffness()
         for i, field in enumerate(self.state.frame_fields):
+            factor, stiffness = self.field_stiffness(i)
             for c, vec in enumerate(field.components):
                 stiffness.mult(vec, work)
-                g[:, i, c] = 2 * self.split[i] * work.getArray(readonly=True)[:n]
+                g[:, i, c] = factor * work.getArray(readonly=True)[:n]
         for term in self.terms:
             term.add_gradient(g, self.state)
         return g

@@ -18,7 +18,7 @@ with them.
 
 import numpy as np
 
-from petsc_rod.mesh.elements import P2, p2_element_matrices
+from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.physics.term import Term
 from petsc_rod.riser.current import normal_drag
@@ -101,12 +101,11 @@ class SeabedTerm(NodalLoadTerm):
         self.y = None                   # Hermite dofs of z after the last global step
         self.vertical = self.contact = None
 
-    def build(self, slope_coefficient, penalty):
-        """The vertical problem with the slope problem's coefficients 2 c3 (N m^2) and R
-        (N): at the start and after every penalty raise."""
+    def build(self, slope_matrices, penalty):
+        """The vertical problem with the slope problem's element matrices 2 c3 K + R W
+        (ne, 3, 3): at the start and after every penalty raise."""
         self._destroy_vertical()
-        matrices = p2_element_matrices(self.mesh.element_h, slope_coefficient, penalty)
-        self.vertical = VerticalProblem(self.mesh, matrices, VERTICAL_PREFIX)
+        self.vertical = VerticalProblem(self.mesh, slope_matrices, VERTICAL_PREFIX)
         self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
         if self.start_state is not None:
             self.vertical.set_end_states(self.start_state, self.end_state)

@@ -52,10 +52,12 @@ def section_index(sections, S):
     return np.searchsorted(ends, np.asarray(S, dtype=float), side="right")
 
 
-def piecewise_linear(sections, S, start_name, end_name):
+def piecewise_linear(sections, S, start_name, end_name, inside=None):
     """The (...)-shaped S mapped to (..., k): each section's value ``start_name`` at its
-    start varying linearly to ``end_name`` at its end."""
-    index = section_index(sections, S)
+    start varying linearly to ``end_name`` at its end. ``inside`` (S's shape; default S)
+    picks the section: at a section end, the value of the section that holds ``inside``
+    (a one-sided limit)."""
+    index = section_index(sections, S if inside is None else inside)
     starts = np.array([getattr(s, start_name) for s in sections], dtype=float)
     ends = np.array([getattr(s, end_name) for s in sections], dtype=float)
     lo = np.array([s.start for s in sections])

@@ -79,14 +79,34 @@ class Scene:
         the global step then keeps its constant-coefficient matrices."""
         return all(section.stiffness_is(self.stiffness) for section in self.sections)
 
-    def stiffness_at(self, S):
+    def stiffness_at(self, S, inside=None):
         """(K1, K2, K3) at arc lengths S (...), N m^2 -> (..., 3): the section's, linear
-        along a tapered one; -rod_stiffness on a uniform line."""
+        along a tapered one; -rod_stiffness on a uniform line. At a section end, the
+        section after it, or the one holding ``inside`` (S's shape) where given: the
+        one-sided limit from an element (``inside`` its midpoint)."""
         S = np.asarray(S, dtype=float)
         if not self.sections:
             return np.broadcast_to(self.stiffness, S.shape + (3,)).copy()
         from petsc_rod.scenes.line import piecewise_linear
-        return piecewise_linear(self.sections, S, "stiffness_start", "stiffness_end")
+        return piecewise_linear(self.sections, S, "stiffness_start", "stiffness_end",
+                                inside)
+
+    def stiffness_values(self):
+        """(K1, K2, K3) at both ends of every section, (2 m, 3), N m^2 ((1, 3): the
+        uniform line's): the stiffness is linear along each section, so its extremes over
+        the line, and the sign of any linear combination such as the split a_i
+        (frames.split_coefficients) anywhere on it, are those of these values."""
+        if not self.sections:
+            return self.stiffness[None, :].copy()
+        return np.array([k for section in self.sections
+                         for k in (section.stiffness_start, section.stiffness_end)])
+
+    @property
+    def stiffness_breaks(self):
+        """S where the stiffness may change its slope or jump: the ends of the sections
+        inside the line, (m - 1,) (none on a uniform line). The element matrices are
+        integrated piece by piece between them (elements.cut_gauss_rule)."""
+        return np.array([section.start for section in self.sections[1:]], dtype=float)
 
     def axial_stiffness_at(self, S):
         """EA at arc lengths S (...), N -> (...): the section's (inf: inextensible);
@@ -206,15 +226,17 @@ class Scene:
     @property
     def axially_symmetric(self):
         """Whether every rotation about the x axis through the origin, together with a
-        uniform roll of the sections, maps an equilibrium to an equilibrium: K1 = K2 (the
-        roll costs nothing), every load along e_x, a held end S = L on the axis and a
-        clamped one only rolled about e_x, no seabed, no current. Such a scene buckles
-        into a family of equilibria (docs/method.md §10, which the solver reports)."""
+        uniform roll of the sections, maps an equilibrium to an equilibrium: K1 = K2 all
+        along the line (the roll costs nothing), every load along e_x, a held end S = L on
+        the axis and a clamped one only rolled about e_x, no seabed, no current. Such a
+        scene buckles into a family of equilibria (docs/method.md §10, which the solver
+        reports)."""
         axis = REFERENCE_FRAME[2]
         off_axis = np.concatenate([self.start_force[1:], self.end_force[1:],
                                    self.load_values[:, 1:].ravel()])
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
-        return bool(self.stiffness[0] == self.stiffness[1] and not np.any(off_axis)
+        values = self.stiffness_values()
+        return bool(np.all(values[:, 0] == values[:, 1]) and not np.any(off_axis)
                     and (self.end == "free" or not np.any(self.end_position[1:]))
                     and (self.end != "clamp" or np.linalg.norm(tilt) <= 1e-12)
                     and self.seabed is None and self.current is None)

@@ -28,7 +28,9 @@ exerts on the part before it (docs/method.md §9). With no distributed load (f =
 and ``u = (u1, u2, u3)`` the strains in the director basis: the Darboux vector is
 ``sum_i u_i d_i``, so that d_i' = (sum_j u_j d_j) x d_i, equivalently R' = R [u]_x, which
 is the quaternion equation above. The constitutive law m = sum_i K_i u_i d_i is inverted
-in the second line: u_i = m . d_i / K_i.
+in the second line: u_i = m . d_i / K_i, with one stiffness triple for the whole line
+(a line of sections, Scene.sections, is not covered: initial_guess_from_result refuses
+its result file).
 
 The rotation is evaluated in homogeneous form,
 
@@ -465,6 +467,10 @@ def self_check(result, coarse_tol=1e-8, fine_tol=1e-10, coarse_nodes=81, refinem
 
 # --------------------------------------------------------------------- initial guesses
 
+# The options of a line whose stiffness varies along S (Scene.sections): the reference
+# takes one stiffness triple (K_i constant in u_i = m . d_i / K_i) and refuses them.
+SECTION_OPTIONS = ("-rod_sections", "-rod_line_types")
+
 def initial_guess_from_result(path):
     """Initial guess from a petsc_rod HDF5 result file (format: docs/output.md).
 
@@ -491,6 +497,9 @@ def initial_guess_from_result(path):
     stiffness = None
     for line in str(options).splitlines():
         words = line.split()
+        if words and words[0] in SECTION_OPTIONS:
+            raise ValueError(f"{path}: a line of sections ({words[0]}); the collocation "
+                             "reference solves a line of one stiffness only")
         if len(words) == 2 and words[0] == "-rod_stiffness":
             stiffness = np.array([float(v) for v in words[1].split(",")])
     frames = np.stack([data["d1"], data["d2"], data["d3"]], axis=1)
