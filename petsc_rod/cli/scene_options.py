@@ -221,9 +221,11 @@ def checked_default_penalty(scene):
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
         option, formula = {
-            "bending": ("-rod_stiffness with -rod_length", "100 sqrt(min K max K) / L^2"),
+            "bending": ("-rod_stiffness (or the line types' ei, gj) with -rod_length",
+                        "100 sqrt(min K max K) / L^2"),
             "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
-            "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness",
+            "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness (or the "
+                      "line types' ei, gj)",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
             "stretch": ("-rod_axial_stiffness with -rod_end_position",
                         "EA (|r_L| - L) / 2L")}[name]

@@ -247,6 +247,21 @@ class Scene:
         about e_x, then -rod_end_twist)."""
         return t * (self._end_rotation @ REFERENCE_FRAME[2] + self.end_twist)
 
+    def _validate_sections(self):
+        """The sections follow each other from S = 0 to L, each of positive length, with
+        positive stiffnesses and EA (a Python caller's; the command line's are checked as
+        they are read, scenes/line.py)."""
+        starts = np.array([s.start for s in self.sections])
+        ends = np.array([s.end for s in self.sections])
+        if (starts[0] != 0.0 or ends[-1] != self.length or np.any(ends <= starts)
+                or np.any(starts[1:] != ends[:-1])):
+            raise RodInputError("the sections must follow each other from S = 0 to the "
+                                "length, each of positive length")
+        values = np.concatenate([[s.stiffness_start, s.stiffness_end] for s in self.sections])
+        if not (np.all(values > 0) and np.all(np.isfinite(values))
+                and all(s.axial_stiffness > 0 for s in self.sections)):
+            raise RodInputError("the sections' K1, K2, K3 and EA must be positive (N m^2, N)")
+
     def validate(self, used):
         """Raise RodInputError on a scene no cable can realise (an inextensible one: ends
         held farther apart than its length; an extensible one is then taut, with a
@@ -257,6 +272,8 @@ class Scene:
         """
         if self.length <= 0:
             raise RodInputError(f"-rod_length {self.length:g}: the length must be positive")
+        if self.sections:
+            self._validate_sections()
         if np.any(self.stiffness <= 0):
             raise RodInputError("-rod_stiffness: K1, K2, K3 must all be positive (N m^2)")
         if not self.axial_stiffness > 0:

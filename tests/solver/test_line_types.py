@@ -208,3 +208,18 @@ def test_a_result_file_rebuilds_its_sections_from_its_own_copy_of_the_table(opti
     assert [s.name for s in rebuilt.sections] == ["bare", "float", "bare"]
     np.testing.assert_array_equal(rebuilt.load_values, scene.load_values)
     assert rebuilt.length == scene.length
+
+
+@pytest.mark.parametrize("sections, words", [
+    ((("a", 0.0, 4.0, 1.0), ("b", 5.0, 10.0, 1.0)), "follow each other"),
+    ((("a", 0.0, 4.0, 1.0), ("b", 4.0, 9.0, 1.0)), "follow each other"),
+    ((("a", 0.0, 4.0, 1.0), ("b", 4.0, 10.0, -1.0)), "must be positive")])
+def test_sections_given_in_python_are_checked(sections, words):
+    """A Python caller's sections must tile [0, L] with positive stiffnesses."""
+    from petsc_rod.scenes.line import Section
+    from petsc_rod.scenes.scene import Scene
+    scene = Scene(length=10.0, stiffness=[1.0, 1.0, 1.0],
+                  sections=tuple(Section(name, lo, hi, [k, k, k], [k, k, k])
+                                 for name, lo, hi, k in sections))
+    with pytest.raises(RodInputError, match=words):
+        scene.validate(set())
