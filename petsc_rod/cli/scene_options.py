@@ -23,7 +23,9 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
                              "-rod_drag)"),
                  "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
-                 "seabed": "-rod_seabed"}
+                 "seabed": "-rod_seabed",
+                 **{f"{which}_{name}": f"-rod_{which}_{name}" for which in ("start", "end")
+                    for name in ("rotational_stiffness", "joint_axis")}}
 
 
 def scene_from_options(values, given, profile=None):
@@ -38,11 +40,20 @@ def scene_from_options(values, given, profile=None):
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
-                  load_breaks=values["rod_load_breaks"])
+                  load_breaks=values["rod_load_breaks"],
+                  start_rotational_stiffness=values["rod_start_rotational_stiffness"],
+                  end_rotational_stiffness=values["rod_end_rotational_stiffness"],
+                  start_joint_axis=values["rod_start_joint_axis"],
+                  end_joint_axis=values["rod_end_joint_axis"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
+    if scene.seabed is not None and scene.joints():
+        which = scene.joints()[0][0]
+        raise RodInputError(f"-rod_{which}_rotational_stiffness with -rod_seabed: a flex joint "
+                            "is not yet solved with the seabed's vertical problem "
+                            "(docs/riser.md); drop one of them")
     return scene
 
 

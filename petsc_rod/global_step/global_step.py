@@ -11,7 +11,8 @@ chord constraint int r' dS = r(L) - r(0); r follows from r' by integration. The 
 matrices are assembled and factored once per penalty R.
 
 The loads and whatever else the physics adds come from the problem's terms
-(physics/term.py), called in list order: the loads fixed over a step are summed once
+(physics/term.py), called in list order: a term may add to the slope's matrix before
+it is factored (add_slope_matrices: a flex joint's spring), the loads fixed over a step are summed once
 per step into b_3 (add_step_load), those that depend on the iterate are added every
 iteration (add_iterate_load), and a term may solve slope components itself
 (solve_slope: the seabed's z).
@@ -72,8 +73,12 @@ class GlobalStep:
         mesh, h = self.mesh, self.mesh.element_h
         EVENTS["assembly"].begin()
         self.penalty = penalty
+        matrices = [p2_element_matrices(h, 2 * self.matrix_split[i], penalty)
+                    for i in range(3)]
+        for term in self.terms:                 # springs on the slope (the flex joints)
+            term.add_slope_matrices(matrices[2])
         self.problems = [ScalarProblem(
-            mesh, p2_element_matrices(h, 2 * self.matrix_split[i], penalty),
+            mesh, matrices[i],
             boundary.director_prescribed(i, self.start_state, self.end_state,
                                          mesh.n_elements), prefix)
             for i, prefix in enumerate(PREFIXES)]
