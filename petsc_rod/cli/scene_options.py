@@ -49,11 +49,6 @@ def scene_from_options(values, given, profile=None):
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
-    if scene.seabed is not None and scene.joints():
-        which = scene.joints()[0][0]
-        raise RodInputError(f"-rod_{which}_rotational_stiffness with -rod_seabed: a flex joint "
-                            "is not yet solved with the seabed's vertical problem "
-                            "(docs/riser.md); drop one of them")
     return scene
 
 

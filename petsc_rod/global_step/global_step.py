@@ -86,7 +86,7 @@ class GlobalStep:
             self.problems[2].add_integral_constraint(element_integrals(h))
         self._set_prescribed()
         for term in self.terms:
-            term.build(2 * self.matrix_split[2], penalty)
+            term.build(2 * self.matrix_split[2], penalty, matrices[2])
         EVENTS["assembly"].end()
 
     def ksps(self):

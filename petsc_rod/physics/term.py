@@ -65,9 +65,11 @@ class Term:
         spring on the slope at a node: the flex joint). It is factored with the rest, so
         a term that adds here keeps the matrix SPD and fixed over the penalty."""
 
-    def build(self, slope_coefficient, penalty):
-        """At every factorisation of the global step: the slope problem's 2 c3 (N m^2)
-        and its penalty R (N) (global_step.GlobalStep.build)."""
+    def build(self, slope_coefficient, penalty, slope_matrices=None):
+        """At every factorisation of the global step: the slope problem's 2 c3 (N m^2),
+        its penalty R (N) and its element matrices (n_local_elements, 3, 3), N m, as
+        factored, every term's add_slope_matrices included (global_step.GlobalStep.build;
+        the seabed's vertical problem is made from them)."""
 
     def prepare(self, t, start, end):
         """At each load step: the load factor t and the end states (scenes.EndState)."""

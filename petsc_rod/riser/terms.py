@@ -101,11 +101,13 @@ class SeabedTerm(NodalLoadTerm):
         self.y = None                   # Hermite dofs of z after the last global step
         self.vertical = self.contact = None
 
-    def build(self, slope_coefficient, penalty):
-        """The vertical problem with the slope problem's coefficients 2 c3 (N m^2) and R
-        (N): at the start and after every penalty raise."""
+    def build(self, slope_coefficient, penalty, slope_matrices=None):
+        """The vertical problem with the slope problem's element matrices (2 c3 K + R W
+        and the other terms' springs on the slope, a flex joint's), made from 2 c3
+        (N m^2) and R (N) where not given: at the start and after every penalty raise."""
         self._destroy_vertical()
-        matrices = p2_element_matrices(self.mesh.element_h, slope_coefficient, penalty)
+        matrices = (p2_element_matrices(self.mesh.element_h, slope_coefficient, penalty)
+                    if slope_matrices is None else slope_matrices)
         self.vertical = VerticalProblem(self.mesh, matrices, VERTICAL_PREFIX)
         self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
         if self.start_state is not None:

@@ -268,8 +268,9 @@ class Scene:
 
     def _validate_joints(self, used):
         """A flex joint (-rod_*_rotational_stiffness, -rod_*_joint_axis) is a spring at a
-        pinned end: k finite and not negative, the axis not zero, and the end a pin (a
-        clamp holds the frame already, a free end has nothing to turn against)."""
+        pinned end: k finite and not negative, the axis not zero and given only with
+        k > 0, and the end a pin (a clamp holds the frame already, a free end has nothing
+        to turn against)."""
         for which, kind in (("start", self.start), ("end", self.end)):
             k = float(getattr(self, f"{which}_rotational_stiffness"))
             axis = getattr(self, f"{which}_joint_axis")
@@ -282,6 +283,10 @@ class Scene:
                     or np.linalg.norm(axis) == 0:
                 raise RodInputError(f"-rod_{which}_joint_axis: give a nonzero vector x,y,z "
                                     "(the joint's neutral axis; it is normalised)")
+            if f"rod_{which}_joint_axis" in used and k == 0:
+                raise RodInputError(
+                    f"-rod_{which}_joint_axis needs -rod_{which}_rotational_stiffness k > 0 "
+                    "(the axis of a flex joint; without one the end is a plain pin)")
             for name in (f"rod_{which}_rotational_stiffness", f"rod_{which}_joint_axis"):
                 if (name in used or k > 0) and kind != "pin":
                     raise RodInputError(

@@ -174,3 +174,29 @@ def test_the_joint_carries_k_theta_at_large_turns(comm, k, force, steps):
     assert moment == pytest.approx(k * np.radians(angle), rel=1e-12)
     assert moment == pytest.approx(abs(np.cross(r[-1], force)[2]), rel=1e-8)
     assert report.stable is True
+
+
+@pytest.mark.parametrize("seabed_height, touches", [(-10.0, False), (-0.08, True)])
+def test_the_joint_acts_through_the_seabeds_vertical_problem(comm, seabed_height, touches):
+    """With a seabed the z slope is solved in Hermite dofs from the slope's element
+    matrices (riser/terms.py), which carry the joint's k. Far below the line (no
+    contact) the seabed changes nothing: the same shape as without it, the joint at
+    S = L loaded in the vertical plane by a neutral axis e_z; touched, the line differs
+    and the joint still carries k theta."""
+    from petsc_rod.riser.environment import Seabed
+
+    k = 0.05
+    scene = dict(start="pin", end="pin", end_position=(0.7, 0.0, 0.3),
+                 load_values=[(0.0, 0.0, -1.0)], end_rotational_stiffness=k,
+                 end_joint_axis=(0.0, 0.0, 1.0))
+    bare = solve(comm, scene, steps=2)
+    with_seabed = solve(comm, dict(scene, seabed=Seabed(seabed_height, 1e3)), steps=2)
+    angle, moment = with_seabed[2][0]
+    assert bare[2][0][0] > 5                                    # the joint is turned
+    assert moment == pytest.approx(k * np.radians(angle), rel=1e-12)
+    difference = np.abs(with_seabed[1] - bare[1]).max()
+    if touches:
+        assert difference > 1e-3 and with_seabed[1][:, 2].min() < seabed_height + 1e-2
+    else:
+        assert difference < 1e-8
+        assert angle == pytest.approx(bare[2][0][0], rel=1e-7)
