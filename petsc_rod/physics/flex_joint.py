@@ -19,8 +19,11 @@ so that at a fixed point (g3 = tau3) the end node feels the moment of the true l
 k theta along p / |p|. The lagged part is of order k theta^3 / 6, small beside the k the
 matrix carries. Only the tangential part is lagged: the radial force stays Q's,
 k (1 - c), so the multiplier at the end node carries no force of order k (a lagged
-k theta/sin theta a would: lambda3 ~ k / w_n there, far above R, and the iteration
-took 1056 iterations instead of 40 for k = 100 EI / L).
+k theta/sin theta a would: lambda3 ~ k / w_n there, far above R; the cantilever of
+tests/solver/test_flex_joint.py (b) at k = 100 EI / L took 1056 iterations instead of
+18). The end node's multipliers still carry the boundary fluxes of d1 and d2 that the
+moment calls for, about k theta / h: a very stiff joint may need a larger R where no
+Newton step raises it (docs/method.md §5).
 
 **Energy, gradient, Hessian** (Newton §11, stability §10). The extension off the sphere
 E_j(d) = 1/2 k theta(d)^2 + k (|d| - 1)(1 - cos theta(d)) (theta of the direction of d)
