@@ -200,3 +200,18 @@ def test_the_joint_acts_through_the_seabeds_vertical_problem(comm, seabed_height
     else:
         assert difference < 1e-8
         assert angle == pytest.approx(bare[2][0][0], rel=1e-7)
+
+
+def test_one_rank_and_all_ranks_agree(comm):
+    """(d) The joint at a large turn (112 degrees, both joints' code paths: the start's
+    matrix entry and node on the first rank, a free end on the last) on the ranks
+    pytest runs on and, on each rank, alone (PETSc.COMM_SELF): the same shape and joint
+    to the iteration's tolerance."""
+    from petsc4py import PETSc
+
+    scene = dict(start="pin", end="free", end_force=(-1.0, -1.0, 0.0),
+                 start_rotational_stiffness=0.2)
+    together = solve(comm, scene, steps=8)
+    alone = solve(PETSc.COMM_SELF, scene, steps=8)
+    assert np.abs(together[1] - alone[1]).max() < 1e-9
+    assert together[2][0][0] == pytest.approx(alone[2][0][0], rel=1e-9)
