@@ -12,10 +12,10 @@ matrices are assembled and factored once per penalty R.
 
 The loads and whatever else the physics adds come from the problem's terms
 (physics/term.py), called in list order: a term may add to the slope's matrix before
-it is factored (add_slope_matrices: a flex joint's spring), the loads fixed over a step are summed once
-per step into b_3 (add_step_load), those that depend on the iterate are added every
-iteration (add_iterate_load), and a term may solve slope components itself
-(solve_slope: the seabed's z).
+it is factored (add_slope_matrices: a flex joint's spring), the loads fixed over a
+step are summed once per step into b_3 (add_step_load), those that depend on the
+iterate are added every iteration (add_iterate_load), and a term may solve slope
+components itself (solve_slope: the seabed's z).
 """
 
 import numpy as np
