@@ -24,7 +24,9 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                              "-rod_drag)"),
                  "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
                  "seabed": "-rod_seabed", "sections": "-rod_line_types/-rod_sections",
-                 "axial_stiffness": "-rod_axial_stiffness"}
+                 "axial_stiffness": "-rod_axial_stiffness",
+                 **{f"{which}_{name}": f"-rod_{which}_{name}" for which in ("start", "end")
+                    for name in ("rotational_stiffness", "joint_axis")}}
 
 
 def scene_from_options(values, given, profile=None, line_types=None):
@@ -46,7 +48,11 @@ def scene_from_options(values, given, profile=None, line_types=None):
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"],
-                  axial_stiffness=values["rod_axial_stiffness"])
+                  axial_stiffness=values["rod_axial_stiffness"],
+                  start_rotational_stiffness=values["rod_start_rotational_stiffness"],
+                  end_rotational_stiffness=values["rod_end_rotational_stiffness"],
+                  start_joint_axis=values["rod_start_joint_axis"],
+                  end_joint_axis=values["rod_end_joint_axis"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_taut(scene)

@@ -14,10 +14,11 @@ r follows from r' by integration. The three matrices are assembled and factored 
 penalty R.
 
 The loads and whatever else the physics adds come from the problem's terms
-(physics/term.py), called in list order: the loads fixed over a step are summed once
-per step into b_3 (add_step_load), those that depend on the iterate are added every
-iteration (add_iterate_load), and a term may solve slope components itself
-(solve_slope: the seabed's z).
+(physics/term.py), called in list order: a term may add to the slope's matrix before
+it is factored (add_slope_matrices: a flex joint's spring), the loads fixed over a
+step are summed once per step into b_3 (add_step_load), those that depend on the
+iterate are added every iteration (add_iterate_load), and a term may solve slope
+components itself (solve_slope: the seabed's z).
 """
 
 import numpy as np
@@ -82,6 +83,8 @@ class GlobalStep:
         EVENTS["assembly"].begin()
         self.penalty = penalty
         matrices = [self.coefficients.global_step_matrices(i, penalty) for i in range(3)]
+        for term in self.terms:                 # springs on the slope (the flex joints)
+            term.add_slope_matrices(matrices[2])
         self.problems = [ScalarProblem(
             mesh, matrices[i],
             boundary.director_prescribed(i, self.start_state, self.end_state,

@@ -41,6 +41,7 @@ from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
 from petsc_rod.physics import stretch
+from petsc_rod.physics import flex_joint
 from petsc_rod.riser import quantities as riser_quantities
 from petsc_rod.riser import section_numbers
 
@@ -67,7 +68,7 @@ ATTRIBUTE_UNITS = {
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
-    **stretch.ATTRIBUTE_UNITS,
+    **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

@@ -12,7 +12,8 @@ is called on every rank, in the same order (collective where a term needs it).
 When each is called:
 
 * the global step (global_step/global_step.py, docs/method.md §3 step 1):
-  ``build`` at every factorisation, ``prepare`` at every load step, then
+  ``add_slope_matrices`` at every factorisation, before the slope matrix is assembled
+  and factored; ``build`` at every factorisation, ``prepare`` at every load step, then
   ``add_step_load`` once into the load that stays fixed over the step;
   ``add_iterate_load`` at every iteration; ``solve_slope`` after the P2 solve of the
   slope, for the components of ``slope_components``;
@@ -57,10 +58,18 @@ class Term:
     slope_components = ()
 
     # --- the global step --------------------------------------------------------------
+    def add_slope_matrices(self, matrices):
+        """At every factorisation, before assembly: add the term's part of the slope
+        problem's matrix into its element matrices ``matrices`` (n_local_elements, 3, 3),
+        N m, the P2 dofs (left vertex, midpoint, right vertex) of each owned element (a
+        spring on the slope at a node: the flex joint). It is factored with the rest, so
+        a term that adds here keeps the matrix SPD and fixed over the penalty."""
+
     def build(self, slope_matrices, penalty):
         """At every factorisation of the global step: the slope problem's element
-        matrices 2 c3 K + R W, (ne, 3, 3) (c3 varying along a line of sections), and its
-        penalty R (N) (global_step.GlobalStep.build)."""
+        matrices 2 c3 K + R W, (ne, 3, 3) (c3 varying along a line of sections), every
+        term's add_slope_matrices included, and its penalty R (N)
+        (global_step.GlobalStep.build)."""
 
     def prepare(self, t, start, end):
         """At each load step: the load factor t and the end states (scenes.EndState)."""

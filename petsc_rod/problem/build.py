@@ -1,9 +1,11 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
-dead loads always; the seabed, the drag and the riser numbers only where the scene has a
-seabed or a current (docs/riser.md); the axial stretch only where some EA is finite
+dead loads always; a flex joint at each pinned end given a rotational stiffness
+(physics/flex_joint.py); the seabed, the drag and the riser numbers only where the scene
+has a seabed or a current (docs/riser.md); the axial stretch only where some EA is finite
 (docs/method.md §12)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.flex_joint import FlexJoint
 from petsc_rod.physics.stretch import AxialStretch
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.section_numbers import SectionNumbers
@@ -13,6 +15,7 @@ from petsc_rod.riser.terms import DragTerm, SeabedTerm
 def scene_terms(mesh, scene):
     """The list of terms of ``scene`` on ``mesh``, in the order the core calls them."""
     terms = [DeadLoads(mesh, scene)]
+    terms += [FlexJoint(mesh, which, k, axis) for which, k, axis in scene.joints()]
     seabed = SeabedTerm(mesh, scene.seabed) if scene.seabed is not None else None
     if seabed is not None:
         terms.append(seabed)

@@ -27,7 +27,9 @@ from petsc_rod.scenes.scene import EndState, rolled_frame
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
                "end_frame", "end_twist", "current")
 # The Scene fields a restart takes from this run's scene at once.
-FIXED_FIELDS = ("stiffness", "axial_stiffness", "start", "end", "seabed", "sections")
+FIXED_FIELDS = ("stiffness", "axial_stiffness", "start", "end", "seabed", "sections",
+                "start_rotational_stiffness", "end_rotational_stiffness", "start_joint_axis",
+                "end_joint_axis")
 
 
 def _same(a, b):

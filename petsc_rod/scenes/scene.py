@@ -58,6 +58,13 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
+    # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
+    # pinned end, 0 for none, and the neutral axis a its d3 is held to (unit; default e_x,
+    # the reference tangent); fixed, not on the load path
+    start_rotational_stiffness: float = 0.0
+    end_rotational_stiffness: float = 0.0
+    start_joint_axis: np.ndarray = None
+    end_joint_axis: np.ndarray = None
 
     def __post_init__(self):
         self.stiffness = np.asarray(self.stiffness, dtype=float)
@@ -69,6 +76,10 @@ class Scene:
         self.start_force = np.asarray(self.start_force, dtype=float)
         self.end_force = np.asarray(self.end_force, dtype=float)
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
+        for name in ("start_joint_axis", "end_joint_axis"):
+            axis = getattr(self, name)
+            setattr(self, name, REFERENCE_FRAME[2].copy() if axis is None
+                    else np.asarray(axis, dtype=float).ravel())
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
@@ -206,6 +217,17 @@ class Scene:
         q = (rotation_about(self._end_rotation, t * angle) if angle > 0 else np.eye(3))
         return REFERENCE_FRAME @ q.T, t * self.end_twist
 
+    def joints(self):
+        """The flex joints, [(which, k, a)]: which 'start' or 'end', k > 0 the rotational
+        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py)."""
+        joints = []
+        for which in ("start", "end"):
+            k = float(getattr(self, f"{which}_rotational_stiffness"))
+            if k > 0:
+                axis = getattr(self, f"{which}_joint_axis")
+                joints.append((which, k, axis / np.linalg.norm(axis)))
+        return joints
+
     def drag_loads(self, t):
         """[(weight, Current)]: the drag at load factor t is the sum of each current's
         Morison drag times its weight, here t times the scene's current ([] without one;
@@ -307,6 +329,7 @@ class Scene:
         if "rod_start_force" in used and self.start != "free":
             raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
                                 f"{self.start}); drop it or change -rod_start")
+        self._validate_joints(used)
         breaks = self.load_breaks
         if len(self.load_values) != len(breaks) + 1:
             raise RodInputError(
@@ -317,3 +340,30 @@ class Scene:
             raise RodInputError("-rod_load_breaks: the breaks must increase strictly inside "
                                 "(0, -rod_length)")
 
+    def _validate_joints(self, used):
+        """A flex joint (-rod_*_rotational_stiffness, -rod_*_joint_axis) is a spring at a
+        pinned end: k finite and not negative, the axis not zero and given only with
+        k > 0, and the end a pin (a clamp holds the frame already, a free end has nothing
+        to turn against)."""
+        for which, kind in (("start", self.start), ("end", self.end)):
+            k = float(getattr(self, f"{which}_rotational_stiffness"))
+            axis = getattr(self, f"{which}_joint_axis")
+            if not np.isfinite(k) or k < 0:
+                raise RodInputError(
+                    f"-rod_{which}_rotational_stiffness {k:g}: must be finite and not "
+                    "negative (N m/rad; 0 is a pin; for an end held in full use "
+                    f"-rod_{which} clamp)")
+            if axis.shape != (3,) or not np.all(np.isfinite(axis)) \
+                    or np.linalg.norm(axis) == 0:
+                raise RodInputError(f"-rod_{which}_joint_axis: give a nonzero vector x,y,z "
+                                    "(the joint's neutral axis; it is normalised)")
+            if f"rod_{which}_joint_axis" in used and k == 0:
+                raise RodInputError(
+                    f"-rod_{which}_joint_axis needs -rod_{which}_rotational_stiffness k > 0 "
+                    "(the axis of a flex joint; without one the end is a plain pin)")
+            for name in (f"rod_{which}_rotational_stiffness", f"rod_{which}_joint_axis"):
+                if (name in used or k > 0) and kind != "pin":
+                    raise RodInputError(
+                        f"-{name} needs -rod_{which} pin (the {which} is {kind}): a flex "
+                        "joint is a rotational spring at a pinned end; drop it or set "
+                        f"-rod_{which} pin")

@@ -106,6 +106,25 @@ def test_a_value_out_of_range_exits_2_with_one_line(tmp_path, args, named):
                                      path)
 
 
+@pytest.mark.parametrize("args, words", [
+    (["-rod_start", "pin", "-rod_start_rotational_stiffness", "-2"],
+     ["-rod_start_rotational_stiffness", "negative"]),
+    (["-rod_end", "pin", "-rod_end_rotational_stiffness", "3", "-rod_end_joint_axis", "0,0,0"],
+     ["-rod_end_joint_axis", "nonzero"]),
+    (["-rod_end_rotational_stiffness", "3"],
+     ["-rod_end_rotational_stiffness", "needs -rod_end pin", "free"]),
+    (["-rod_start_rotational_stiffness", "3"],
+     ["-rod_start_rotational_stiffness", "needs -rod_start pin", "clamp"]),
+    (["-rod_start", "pin", "-rod_start_joint_axis", "0,1,0"],
+     ["-rod_start_joint_axis", "needs -rod_start_rotational_stiffness"]),
+], ids=["negative k", "zero axis", "k at a free end", "k at a clamp", "axis without k"])
+def test_a_flex_joint_that_cannot_be_exits_2_with_one_line(tmp_path, args, words):
+    path = tmp_path / "out.h5"
+    done = run(["-rod_elements", "8"] + args + ["-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
 def test_a_mesh_too_large_for_the_machine_is_refused_before_allocating(tmp_path):
     clock = time.monotonic()
     done = run(["-rod_elements", "1000000000", "-rod_output", str(tmp_path / "big.h5")])
