@@ -282,6 +282,46 @@ def check_current_catenary(speed, bound):
     return check
 
 
+# Lines of line types and stretch (issue 22): the riser above, extensible, with EA / EI
+# from 1e2 to 1e6 per m^2 (EA 1e7 N, 15 % stretch at the top, to 1e9 N, 0.15 %; EI at
+# most 1e5 N m^2, a bending length of 0.4 m), against the elastic catenary with
+# touchdown; a line whose middle section is ten times lighter; a bend stiffener 1000
+# times stiffer than the cable at a stiff flex joint.
+LINE_TYPES = "scripts/matrix_line_types.txt"
+
+
+def check_elastic_grounded(axial_stiffness, bound):
+    from petsc_rod.validation.elastic_catenary import elastic_catenary
+    line = elastic_catenary(1800.0, 1200.0, axial_stiffness, 1157.0, 1000.0)
+
+    def check(result):
+        S = result["S"]
+        x, z, _ = line.at(S)
+        away = ((np.abs(S - line.grounded) > RISER_ZONE) & (S > RISER_ZONE)
+                & (S < 1800.0 - RISER_ZONE))
+        exact = np.stack([x, np.zeros_like(x), z], axis=-1)
+        return (max_error(result["r"][away], exact[away]), bound,
+                "r vs elastic catenary with touchdown, 20 m from it and the ends, m")
+    return check
+
+
+LIGHT_MIDDLE = {"line_types": LINE_TYPES, "sections": "heavy:400:400,light:200:200,heavy:400:400",
+                "start": "pin", "end": "pin", "end_position": "700,0,300",
+                "initial_shape": "catenary", "al_rtol": 1e-10, "al_ctol": 1e-10}
+
+
+def check_section_catenary(bound):
+    from petsc_rod.scenes.section_catenary import solve
+    line = solve([0.0, 400.0, 600.0, 1000.0], [1000.0, 100.0, 1000.0], 700.0, 300.0,
+                 on_seabed=False)
+
+    def check(result):
+        x, z, _ = line.at(result["S"])
+        exact = np.stack([x, np.zeros_like(x), z], axis=-1)
+        return (max_error(result["r"], exact), bound, "r vs the catenary of the sections, m")
+    return check
+
+
 PAPER = {"length": 20, "stiffness": "235,360,200", "start": "clamp", "end": "pin",
          "end_position": "16,4,0", "elements": 80, "al_penalty": 400, "al_rtol": 1e-7,
          "al_ctol": 1e-5, "al_max_it": 200000, "steps": 8, "imperfection": 0.01}
@@ -407,6 +447,21 @@ def cases():
     add(Case("riser", "lazy wave (options/lazy_wave.opts)",
              {"options_file": "options/lazy_wave.opts", "elements": 2000}, ranks=2,
              notes="no closed form"))
+    # lines of line types and stretch (issue 22)
+    for stiffness, axial in ((1e5, 1e7), (1e5, 1e9), (1e3, 1e9)):
+        add(Case("lines", f"riser, EA / EI = {axial / stiffness:.0e} per m^2",
+                 riser(stiffness=f"{stiffness:g},{stiffness:g},{0.75 * stiffness:g}",
+                       axial_stiffness=f"{axial:g}"),
+                 check_elastic_grounded(axial, 2e-3), ranks=2,
+                 notes=f"EA {axial:.0e} N: {1.5e8 / axial:.2g} % stretch at the top"))
+    add(Case("lines", "a middle section ten times lighter", LIGHT_MIDDLE,
+             check_section_catenary(1e-3), notes="EI 1 N m^2"))
+    add(Case("lines", "80 m cable, bend stiffener 1000 x EI at a stiff flex joint",
+             {"line_types": LINE_TYPES, "sections": "bare:52.101,float:50,bare:63.114,"
+              "stiffener:5", "elements": 340, "start": "pin", "end": "pin",
+              "end_position": "120,0,66", "seabed": 0, "initial_shape": "catenary",
+              "end_rotational_stiffness": "1e6", "end_joint_axis": "0,0,1"},
+             notes="no closed form; EI 2e4 to 2e7 N m^2 over the top 5 m"))
     return matrix
 
 
