@@ -152,6 +152,18 @@ OPTIONS = [
            unit="N/m"),
     Option("rod_load_breaks", _reals(), default_of(Scene, "load_breaks"), "s1,...",
            "arc lengths where the piecewise-constant load changes, m", unit="m"),
+    # attachments (scenes/point_loads.py, physics/point_loads.py; docs/riser.md)
+    Option("rod_point_loads", _string, None, "FILE",
+           "attachments: a table with a header row naming its columns, s (arc length, m; "
+           "required) and any of mass (kg in air), volume (displaced volume, m^3), fx, fy, "
+           "fz (a point force, N), name; each adds the dead force (fx, fy, fz) + "
+           "(rho_w volume - mass) g e_z at s", unit="text"),
+    Option("rod_point_load", _reals(), None, "S,fx,fy,fz[,...]",
+           "point dead forces, N, at arc lengths S, m: 4 numbers per point", unit="m, N"),
+    Option("rod_water_density", _real, default_of(Scene, "water_density"), "rho",
+           "water density rho_w, kg/m^3 (buoyancy of attachments)", SCALE, "kg/m^3"),
+    Option("rod_gravity", _real, default_of(Scene, "gravity"), "g",
+           "gravity, m/s^2 (weight and buoyancy of attachments)", SCALE, "m/s^2"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",

@@ -13,6 +13,7 @@ from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seab
                                          largest_stiffness, read_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
+from petsc_rod.scenes.point_loads import quick_point_loads, read_point_loads
 from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
 
 # The options behind each Scene field a restart compares (scenes/blend.py).
@@ -23,22 +24,48 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
                              "-rod_drag)"),
                  "stiffness": "-rod_stiffness", "start": "-rod_start", "end": "-rod_end",
-                 "seabed": "-rod_seabed"}
+                 "seabed": "-rod_seabed",
+                 "point_load_S": "the point loads (-rod_point_loads|-rod_point_load)",
+                 "point_load_forces": ("the point loads (-rod_point_loads|-rod_point_load, "
+                                       "-rod_water_density, -rod_gravity)")}
 
 
-def scene_from_options(values, given, profile=None):
+def point_loads_from_options(values, points=None):
+    """(S (n_p,), forces (n_p, 3), names) of -rod_point_loads FILE and -rod_point_load
+    (scenes/point_loads.py), the file's first, each on the line [0, L];
+    ``points`` (S, forces) when already resolved (a result file's point_loads_table)."""
+    if points is not None:
+        S, forces = points
+        return S, forces, tuple(f"point {k + 1}" for k in range(len(S)))
+    parts, length = [], values["rod_length"]
+    if values["rod_point_loads"]:
+        parts.append(read_point_loads(values["rod_point_loads"], values["rod_water_density"],
+                                      values["rod_gravity"], length, MAX_MAGNITUDE))
+    if values["rod_point_load"] is not None:
+        parts.append(quick_point_loads(values["rod_point_load"], length))
+    if not parts:
+        return np.zeros(0), np.zeros((0, 3)), ()
+    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+            sum((tuple(p[2]) for p in parts), ()))
+
+
+def scene_from_options(values, given, profile=None, points=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
-    current_profile_table), else they are read from its file."""
+    current_profile_table), else they are read from its file; ``points`` (S, forces) the
+    point loads when already resolved (a result file's point_loads_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
+    point_S, point_forces, point_names = point_loads_from_options(values, points)
     scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
                   start=values["rod_start"], end=values["rod_end"],
                   end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
-                  load_breaks=values["rod_load_breaks"])
+                  load_breaks=values["rod_load_breaks"], point_load_S=point_S,
+                  point_load_forces=point_forces, point_load_names=point_names,
+                  water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_applied_forces(scene, given)
@@ -100,6 +127,7 @@ def check_applied_forces(scene, given):
     if total > MAX_MAGNITUDE:
         name = max(parts, key=parts.get)
         option = {"load": "-rod_load (with -rod_length)", "start_force": "-rod_start_force",
+                  "point_loads": "-rod_point_loads|-rod_point_load",
                   "end_force": "-rod_end_force",
                   "drag": f"{_current_option(given)} with -rod_drag and -rod_length"}[name]
         raise RodInputError(
@@ -226,7 +254,11 @@ def scene_from_parameters(parameters):
     values, given = options_from_parameters(parameters)
     table = parameters.get("current_profile_table")
     profile = None if table is None else (table[:, 0], table[:, 1:])
-    return scene_from_options(values, given, profile)
+    points = parameters.get("point_loads_table")
+    if points is not None:
+        points = np.asarray(points, dtype=float).reshape(-1, 4)
+        points = (points[:, 0], points[:, 1:])
+    return scene_from_options(values, given, profile, points)
 
 
 def restart_path(scene, parameters, t_file):

@@ -38,6 +38,7 @@ import numpy as np
 from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
+from petsc_rod.physics import point_loads as point_load_term
 from petsc_rod.riser import quantities as riser_quantities
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
@@ -61,7 +62,7 @@ ATTRIBUTE_UNITS = {
     "asked_penalty": "N",
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
-    **riser_quantities.ATTRIBUTE_UNITS,
+    **riser_quantities.ATTRIBUTE_UNITS, **point_load_term.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

@@ -1,8 +1,9 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
-dead loads always; the seabed, the drag and the riser numbers only where the scene has a
-seabed or a current (docs/riser.md)."""
+dead loads always; the point loads (attachments) where it has some; the seabed, the drag
+and the riser numbers only where the scene has a seabed or a current (docs/riser.md)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
 
@@ -10,6 +11,8 @@ from petsc_rod.riser.terms import DragTerm, SeabedTerm
 def scene_terms(mesh, scene):
     """The list of terms of ``scene`` on ``mesh``, in the order the core calls them."""
     terms = [DeadLoads(mesh, scene)]
+    if scene.point_loads(1.0)[0].size:          # attachments (scenes/point_loads.py)
+        terms.append(PointLoads(mesh, scene))
     seabed = SeabedTerm(mesh, scene.seabed) if scene.seabed is not None else None
     if seabed is not None:
         terms.append(seabed)

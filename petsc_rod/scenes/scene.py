@@ -54,6 +54,14 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
+    # point loads (attachments, scenes/point_loads.py): arc lengths S_p (n_p,), m, dead
+    # forces P_p (n_p, 3), N, and labels
+    point_load_S: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_load_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    point_load_names: tuple = ()
+    # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
+    water_density: float = 1025.0
+    gravity: float = 9.80665
 
     def __post_init__(self):
         self.stiffness = np.asarray(self.stiffness, dtype=float)
@@ -67,6 +75,11 @@ class Scene:
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
+        self.point_load_S = np.asarray(self.point_load_S, dtype=float).ravel()
+        self.point_load_forces = np.asarray(self.point_load_forces, dtype=float).reshape(-1, 3)
+        if len(self.point_load_names) != self.point_load_S.size:
+            self.point_load_names = tuple(f"point {k + 1}"
+                                          for k in range(self.point_load_S.size))
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
 
     @property
@@ -116,6 +129,11 @@ class Scene:
         overlap = np.clip(ends[1:] - np.maximum(ends[:-1], S), 0.0, None)
         return t * overlap @ self.load_values
 
+    def point_loads(self, t):
+        """(S_p (n_p,), t P_p (n_p, 3)): the point loads at load factor t, m and N
+        (physics/point_loads.py)."""
+        return self.point_load_S.copy(), t * self.point_load_forces
+
     def applied_force(self):
         """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
         (and of the multiplier lambda3 that converges to it)."""
@@ -124,14 +142,15 @@ class Scene:
     def applied_forces(self):
         """The parts of applied_force by where they come from, N: {'load': int |f| dS of
         the dead load, 'drag': L c max |v|^2 of the current (0 without one), 'start_force':
-        |P_0|, 'end_force': |P_L|}."""
+        |P_0|, 'end_force': |P_L|, 'point_loads': sum_p |P_p|}."""
         drag = 0.0
         if self.current is not None:            # the largest drag the current can exert
             drag = self.length * self.current.largest_drag()
         return {"load": float(np.diff(self.load_piece_ends)
                               @ np.linalg.norm(self.load_values, axis=1)),
                 "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
-                "end_force": float(np.linalg.norm(self.end_force))}
+                "end_force": float(np.linalg.norm(self.end_force)),
+                "point_loads": float(np.linalg.norm(self.point_load_forces, axis=1).sum())}
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
@@ -182,7 +201,8 @@ class Scene:
         into a family of equilibria (docs/method.md §10, which the solver reports)."""
         axis = REFERENCE_FRAME[2]
         off_axis = np.concatenate([self.start_force[1:], self.end_force[1:],
-                                   self.load_values[:, 1:].ravel()])
+                                   self.load_values[:, 1:].ravel(),
+                                   self.point_load_forces[:, 1:].ravel()])
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
         return bool(self.stiffness[0] == self.stiffness[1] and not np.any(off_axis)
                     and (self.end == "free" or not np.any(self.end_position[1:]))
@@ -233,6 +253,17 @@ class Scene:
         if "rod_start_force" in used and self.start != "free":
             raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
                                 f"{self.start}); drop it or change -rod_start")
+        S = self.point_load_S
+        if S.size != len(self.point_load_forces):
+            raise RodInputError(f"point loads: {S.size} arc lengths for "
+                                f"{len(self.point_load_forces)} forces")
+        outside = np.flatnonzero((S < 0) | (S > self.length))
+        if outside.size:
+            k = int(outside[0])
+            raise RodInputError(
+                f"point loads: {self.point_load_names[k]} at s = {S[k]:.6g} m is beyond "
+                f"the line (0 <= s <= -rod_length {self.length:.6g} m); give an arc length "
+                "on the line")
         breaks = self.load_breaks
         if len(self.load_values) != len(breaks) + 1:
             raise RodInputError(
