@@ -288,6 +288,11 @@ def restart_from(problem, path, load_factor, say):
     """Set the state of result file ``path`` (validated by io.read_restart against this
     run's arrays); returns ``load_factor``, or the file's when it is None."""
     restart = io.read_restart(path, problem.mesh, outputs.restart_state(problem))
+    # the file's r is absolute: its shape is taken from its own start (docs/method.md §5)
+    record = io.read_parameters(path, problem.mesh.comm)
+    origin = "" if record is None else record[0].get("start_position", "")
+    if not isinstance(origin, str):
+        restart.vertex["r"] = restart.vertex["r"] - np.asarray(origin, dtype=float)
     outputs.set_state(problem, restart.vertex, restart.state)
     if not restart.converged:
         say(f"petsc_rod: warning: -rod_initial {path} says converged = 0: the run starts "
@@ -321,12 +326,14 @@ def options_in_effect(values, solver, start):
     the current profile's rows (``current_profile_table``), not only its file's name;
     then each global-step solver's KSP, PC and factorisation package."""
     scene = solver.problem.scene
-    resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
+    origin = scene.start_position               # the scene's positions are from the start
+    resolved = {"rod_end_position": scene.end_position + origin,
+                "rod_start_position": origin, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     if scene.seabed is not None:                # the default stiffness (riser/environment.py)
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
     if values["rod_current_profile"]:
-        resolved["rod_sea_surface"] = scene.current.surface
+        resolved["rod_sea_surface"] = scene.current.surface + origin[2]
     parameters, units = {}, {}
     for option in OPTIONS:
         value = resolved.get(option.name, values[option.name])

@@ -58,9 +58,12 @@ def scene_from_options(values, given, profile=None, points=None):
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
     point_S, point_forces, point_names = point_loads_from_options(values, points)
+    origin = np.asarray(values["rod_start_position"], dtype=float)
+    end = values["rod_end_position"]
     scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
-                  start=values["rod_start"], end=values["rod_end"],
-                  end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
+                  start=values["rod_start"], end=values["rod_end"], start_position=origin,
+                  end_position=None if end is None else np.asarray(end) - origin,
+                  end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
                   load_breaks=values["rod_load_breaks"], point_load_S=point_S,
@@ -216,11 +219,17 @@ def current_from_options(values, given, surface_default, profile_rows=None):
 
 def environment_from_options(values, given, scene, profile=None):
     """(Seabed or None, Current or None) for a validated ``scene``, checked against it
-    (``profile``: as in current_from_options)."""
+    (``profile``: as in current_from_options), their heights in the scene's frame (the
+    options' less the start's z, docs/method.md §5)."""
+    z0 = float(scene.start_position[2])
+    values = dict(values)
+    for name in ("rod_seabed", "rod_sea_surface"):
+        if values[name] is not None:
+            values[name] = values[name] - z0
     seabed = seabed_from_options(values, given, scene.load_values)
     ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
     ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
-    check_ends_above(seabed, ends, scene.length)
+    check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
     return seabed, current_from_options(values, given, max(held), profile)
 
@@ -232,7 +241,9 @@ def options_from_parameters(parameters):
     and frame from the ones Scene puts in their place), so that Scene.validate and the
     riser options see the run as it was asked."""
     length = float(parameters.get("length", 1.0))
-    defaults = {"rod_end_position": np.array([length, 0.0, 0.0]),
+    origin = parameters.get("start_position", "")
+    origin = np.zeros(3) if isinstance(origin, str) else np.asarray(origin, dtype=float)
+    defaults = {"rod_end_position": origin + np.array([length, 0.0, 0.0]),
                 "rod_end_frame": REFERENCE_FRAME}
     values, given = {}, set()
     for option in OPTIONS:

@@ -112,12 +112,13 @@ class PointLoads(DeadLoads):
         return mesh.global_sum(local)
 
     def outputs(self, problem, vertex):
-        """The points' S, forces at the step's load factor and positions (attributes
-        point_load_S (n_p,), point_load_force and point_load_position (n_p, 3)).
+        """The points' S, forces at the step's load factor and absolute positions (the
+        start position added, docs/method.md §5) (attributes point_load_S (n_p,),
+        point_load_force and point_load_position (n_p, 3)).
         Collective."""
         if not self.S.size:
             return None
-        positions = self.positions(problem.state)
+        positions = self.positions(problem.state) + problem.scene.start_position
         return TermOutput(attributes={"point_load_S": self.S.copy(),
                                       "point_load_force": self.force.copy(),
                                       "point_load_position": positions})

@@ -1,7 +1,11 @@
 """Boundary conditions and loads of a scene, and the continuation path to them (§5, §7).
 
 The reference state is straight along e_x from the origin, with d1 = e_y, d2 = e_z,
-d3 = e_x. The end S = 0 stays at the origin in the reference frame (if it is held);
+d3 = e_x. The end S = 0 stays at the origin in the reference frame (if it is held).
+Every position a Scene holds (the end position, the seabed's and the sea surface's
+heights) is in the solver's frame, whose origin is the start; ``start_position`` is
+where that origin is (-rod_start_position: an anchor anywhere), added to every position
+the run reports and subtracted from every one it reads (docs/method.md §5);
 the end S = L and the loads are reached along the path t in [0, 1]:
 position (1 - t) L e_x + t r_L, frame exp(t log Q) then a roll t * twist about the
 current tangent, and forces scaled by t. Every quantity is in SI units.
@@ -59,6 +63,8 @@ class Scene:
     point_load_S: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_load_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     point_load_names: tuple = ()
+    # where S = 0 is, m: the solver's frame has its origin there (module docstring)
+    start_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
     water_density: float = 1025.0
     gravity: float = 9.80665
@@ -70,6 +76,7 @@ class Scene:
         if self.end_frame is None:
             self.end_frame = REFERENCE_FRAME.copy()
         self.end_position = np.asarray(self.end_position, dtype=float)
+        self.start_position = np.asarray(self.start_position, dtype=float).reshape(3)
         self.start_force = np.asarray(self.start_force, dtype=float)
         self.end_force = np.asarray(self.end_force, dtype=float)
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
@@ -250,6 +257,10 @@ class Scene:
             if name in used and self.end not in kinds:
                 raise RodInputError(f"-{name} needs -rod_end {'|'.join(kinds)} "
                                     f"(the end is {self.end}); drop it or change -rod_end")
+        if "rod_start_position" in used and self.start == "free":
+            raise RodInputError("-rod_start_position needs a held start (-rod_start clamp|"
+                                "pin): a free start goes where the loads take it; drop it, or "
+                                "give -rod_end_position for the held end")
         if "rod_start_force" in used and self.start != "free":
             raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
                                 f"{self.start}); drop it or change -rod_start")
