@@ -142,7 +142,7 @@ class Scene:
         return self.point_load_S.copy(), t * self.point_load_forces
 
     def applied_force(self):
-        """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
+        """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| at t = 1, N: the scale of the internal force n
         (and of the multiplier lambda3 that converges to it)."""
         return float(sum(self.applied_forces().values()))
 
