@@ -349,9 +349,9 @@ def options_in_effect(values, solver, start):
                                                                current.velocities])
         units["current_profile_table"] = "m, m/s, m/s, m/s (depth, ux, uy, uz)"
     if scene.point_load_S.size:                 # the attachments' forces, to repeat the run
-        parameters["point_loads_table"] = np.column_stack([scene.point_load_S,
-                                                           scene.point_load_forces])
-        units["point_loads_table"] = "m, N, N, N (S, fx, fy, fz)"
+        parameters["point_loads_table"] = np.column_stack([
+            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas])
+        units["point_loads_table"] = "m, N, N, N, m^2 (S, fx, fy, fz, CdA)"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

@@ -31,12 +31,13 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
 
 
 def point_loads_from_options(values, points=None):
-    """(S (n_p,), forces (n_p, 3), names) of -rod_point_loads FILE and -rod_point_load
-    (scenes/point_loads.py), the file's first, each on the line [0, L];
-    ``points`` (S, forces) when already resolved (a result file's point_loads_table)."""
+    """(S (n_p,), forces (n_p, 3), names, drag areas (n_p,)) of -rod_point_loads FILE
+    and -rod_point_load (scenes/point_loads.py), the file's first, each on the line
+    [0, L]; ``points`` (S, forces, drag areas) when already resolved (a result file's
+    point_loads_table)."""
     if points is not None:
-        S, forces = points
-        return S, forces, tuple(f"point {k + 1}" for k in range(len(S)))
+        S, forces, areas = points
+        return S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas
     parts, length = [], values["rod_length"]
     if values["rod_point_loads"]:
         parts.append(read_point_loads(values["rod_point_loads"], values["rod_water_density"],
@@ -44,20 +45,21 @@ def point_loads_from_options(values, points=None):
     if values["rod_point_load"] is not None:
         parts.append(quick_point_loads(values["rod_point_load"], length))
     if not parts:
-        return np.zeros(0), np.zeros((0, 3)), ()
+        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0)
     return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-            sum((tuple(p[2]) for p in parts), ()))
+            sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
 
 
 def scene_from_options(values, given, profile=None, points=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
-    current_profile_table), else they are read from its file; ``points`` (S, forces) the
-    point loads when already resolved (a result file's point_loads_table)."""
+    current_profile_table), else they are read from its file; ``points`` (S, forces,
+    drag areas) the point loads when already resolved (a result file's
+    point_loads_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
-    point_S, point_forces, point_names = point_loads_from_options(values, points)
+    point_S, point_forces, point_names, point_areas = point_loads_from_options(values, points)
     origin = np.asarray(values["rod_start_position"], dtype=float)
     end = values["rod_end_position"]
     scene = Scene(length=values["rod_length"], stiffness=values["rod_stiffness"],
@@ -68,6 +70,7 @@ def scene_from_options(values, given, profile=None, points=None):
                   end_force=values["rod_end_force"], load_values=load.reshape(-1, 3),
                   load_breaks=values["rod_load_breaks"], point_load_S=point_S,
                   point_load_forces=point_forces, point_load_names=point_names,
+                  point_load_drag_areas=point_areas,
                   water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
@@ -267,8 +270,10 @@ def scene_from_parameters(parameters):
     profile = None if table is None else (table[:, 0], table[:, 1:])
     points = parameters.get("point_loads_table")
     if points is not None:
-        points = np.asarray(points, dtype=float).reshape(-1, 4)
-        points = (points[:, 0], points[:, 1:])
+        points = np.asarray(points, dtype=float)
+        points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
+        areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
+        points = (points[:, 0], points[:, 1:4], areas)
     return scene_from_options(values, given, profile, points)
 
 

@@ -19,6 +19,14 @@ int_e N_k, those after it nothing.
 n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
 (the point counted as before S). A point at S = L acts as an end force there (it is in
 n(L), Term.end_force).
+
+An attachment with a drag area C_d A (m^2) in a current also feels the drag
+D_p = 1/2 rho_w C_d A |v| v, v the current at r(S_p) (Scene.point_drags: times the
+path's weight of each current), a point force of the iterate added to the slope's
+right-hand side every iteration (add_iterate_load) the same way, at the heights of the
+last global step, as the line's drag (riser/terms.py). It has no energy: the term is then
+neither conservative nor in the Newton steps (a current makes the line's drag term
+neither anyway).
 """
 
 import numpy as np
@@ -31,7 +39,7 @@ from petsc_rod.scenes.boundary import is_held
 
 # Units of the attributes this term adds to each step of the result file.
 ATTRIBUTE_UNITS = {"point_load_S": "m", "point_load_force": "N",
-                   "point_load_position": "m"}
+                   "point_load_position": "m", "point_load_drag": "N"}
 
 
 def point_load_element_vectors(mesh, S, force, offset):
@@ -56,6 +64,10 @@ class PointLoads(DeadLoads):
         self.load = VectorField(mesh, "point_loads")      # b = int F.g dS on the P2 dofs
         self.S, self.force = scene.point_loads(0.0)
         self.held_start = True
+        # the drag of attachments in a current (module docstring): no energy
+        self.dragged = bool(scene.point_drags(0.5))
+        self.conservative = self.in_newton = not self.dragged
+        self._drag_rhs = VectorField(mesh, "point_drag_rhs") if self.dragged else None
 
     @property
     def axially_symmetric(self):
@@ -77,6 +89,40 @@ class PointLoads(DeadLoads):
             mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
             point_load_element_vectors(mesh, self.S, self.force, self.offset)))
 
+    def drag_forces(self, state):
+        """D_p = sum_k w_k 1/2 rho_w C_d A_p |v_k| v_k, N, (n_p, 3), v_k the current k at
+        the points' heights (of the last global step; none needed for currents uniform in
+        depth). Zero without a drag area. Collective."""
+        drags = self.scene.point_drags(self.t) if self.dragged else []
+        if not drags:
+            return np.zeros_like(self.force)
+        z = (self.positions(state)[:, 2] if any(c.depths.size > 1 for _, c, _ in drags)
+             else np.zeros(self.S.size))
+        total = np.zeros_like(self.force)
+        for weight, current, area in drags:
+            v = current.velocity(z)
+            total += (weight * 0.5 * self.scene.water_density * area
+                      * np.linalg.norm(v, axis=1))[:, None] * v
+        return total
+
+    def add_iterate_load(self, rhs, state):
+        """Add the attachments' drag's int F.g to the slope's right-hand side (F its steps,
+        offset as for the dead forces). Collective."""
+        if not self.dragged:
+            return
+        drag = self.drag_forces(state)
+        offset = np.zeros(3) if self.held_start else -drag.sum(axis=0)
+        mesh = self.mesh
+        self._drag_rhs.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+            point_load_element_vectors(mesh, self.S, drag, offset)))
+        for vec, part in zip(rhs.components, self._drag_rhs.components):
+            vec.axpy(1.0, part)
+
+    def _total_force(self, state):
+        """The dead forces and, in a current, the drag, (n_p, 3), N. Collective."""
+        return self.force + self.drag_forces(state) if self.dragged else self.force
+
     def _at_end(self):
         """The points at S = L (they act as a force at the end), (n_p,) bool."""
         return self.S >= self.mesh.length
@@ -84,11 +130,15 @@ class PointLoads(DeadLoads):
     def force_beyond(self, state):
         """sum_p P_p [S_i < S_p or S_p = L] + offset at the owned vertices, N,
         (n_owned, 3)."""
+        force = self._total_force(state)
+        offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
         beyond = (self.S[None, :] > self.mesh.vertex_S[:, None]) | self._at_end()[None, :]
-        return beyond.astype(float) @ self.force + self.offset
+        return beyond.astype(float) @ force + offset
 
     def end_force(self, state):
-        return self.force[self._at_end()].sum(axis=0) + self.offset
+        force = self._total_force(state)
+        offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
+        return force[self._at_end()].sum(axis=0) + offset
 
     def positions(self, state):
         """r(S_p) of every point, (n_p, 3), m, on every rank: the rank that owns the
@@ -119,6 +169,13 @@ class PointLoads(DeadLoads):
         if not self.S.size:
             return None
         positions = self.positions(problem.state) + problem.scene.start_position
-        return TermOutput(attributes={"point_load_S": self.S.copy(),
-                                      "point_load_force": self.force.copy(),
-                                      "point_load_position": positions})
+        attributes = {"point_load_S": self.S.copy(), "point_load_force": self.force.copy(),
+                      "point_load_position": positions}
+        if self.dragged:
+            attributes["point_load_drag"] = self.drag_forces(problem.state)
+        return TermOutput(attributes=attributes)
+
+    def destroy(self):
+        super().destroy()
+        if self._drag_rhs is not None:
+            self._drag_rhs.destroy()

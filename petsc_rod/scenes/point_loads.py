@@ -4,7 +4,8 @@ loads (S_p, P_p): arc lengths (n_p,) in m and dead forces (n_p, 3) in N.
 
 A row of ``-rod_point_loads FILE`` gives the arc length ``s`` (m) and any of ``mass``
 (kg in air), ``volume`` (displaced volume, m^3), ``fx``, ``fy``, ``fz`` (a point force,
-N) and ``name`` (a label); its force is
+N), ``cda`` (a drag area C_d A, m^2: the drag 1/2 rho_w C_d A |v| v in a current) and
+``name`` (a label); its force is
 
     P = (fx, fy, fz) + (rho_w volume - mass) g e_z,
 
@@ -19,8 +20,9 @@ import numpy as np
 from petsc_rod.errors import RodInputError
 
 # The columns a table may name; ``s`` is required. Every column but ``name`` is a number.
-COLUMNS = ("s", "mass", "volume", "fx", "fy", "fz", "name")
-COLUMN_UNITS = {"s": "m", "mass": "kg", "volume": "m^3", "fx": "N", "fy": "N", "fz": "N"}
+COLUMNS = ("s", "mass", "volume", "fx", "fy", "fz", "cda", "name")
+COLUMN_UNITS = {"s": "m", "mass": "kg", "volume": "m^3", "fx": "N", "fy": "N", "fz": "N",
+                "cda": "m^2"}
 
 
 def attachment_forces(columns, density, gravity):
@@ -40,12 +42,13 @@ def beyond_the_line(S, length):
 
 
 def read_point_loads(path, density, gravity, length, largest=np.inf):
-    """(S (n_p,), forces (n_p, 3), names (n_p,)) from the table ``path`` (module
+    """(S (n_p,), forces (n_p, 3), names (n_p,), drag areas (n_p,)) from the table
+    ``path`` (module
     docstring): whitespace or comma separated, a header row naming the columns, '#'
     starts a comment. Every problem is one RodInputError that says what to fix: no
     file, no ``s`` column, an unknown or repeated column, a row of another length, a
-    value that is not a finite number of magnitude at most ``largest``, a negative mass
-    or volume, an arc length beyond the line [0, ``length``]."""
+    value that is not a finite number of magnitude at most ``largest``, a negative mass,
+    volume or drag area, an arc length beyond the line [0, ``length``]."""
     option = f"-rod_point_loads {path}"
 
     def refuse(what):
@@ -97,7 +100,7 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
             if not np.isfinite(numbers[k]) or abs(numbers[k]) > largest:
                 refuse(f"line {body[k][0]}, column {name}: {text} is not a finite number "
                        f"of magnitude at most {largest:g} ({COLUMN_UNITS[name]})")
-        if name in ("mass", "volume") and np.any(numbers < 0):
+        if name in ("mass", "volume", "cda") and np.any(numbers < 0):
             k = int(np.flatnonzero(numbers < 0)[0])
             refuse(f"line {body[k][0]}, column {name}: a {name} must not be negative")
         columns[name] = numbers
@@ -106,12 +109,13 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
         refuse(f"line {body[k][0]}: s = {columns['s'][k]:.6g} m is beyond the line (0 <= s "
                f"<= -rod_length {length:.6g} m); give an arc length on the line")
     names = columns.pop("name", [f"point {k + 1}" for k in range(len(body))])
-    return columns["s"], attachment_forces(columns, density, gravity), tuple(names)
+    areas = columns.get("cda", np.zeros(len(body)))
+    return columns["s"], attachment_forces(columns, density, gravity), tuple(names), areas
 
 
 def quick_point_loads(values, length):
-    """(S, forces, names) of -rod_point_load S,fx,fy,fz[,...] (a flat array of 4 numbers
-    per point), each S on the line [0, ``length``]."""
+    """(S, forces, names, drag areas (zero)) of -rod_point_load S,fx,fy,fz[,...] (a flat
+    array of 4 numbers per point), each S on the line [0, ``length``]."""
     values = np.asarray(values, dtype=float)
     if values.size % 4:
         raise RodInputError(f"-rod_point_load: {values.size} numbers; give 4 (S,fx,fy,fz: "
@@ -122,4 +126,5 @@ def quick_point_loads(values, length):
         raise RodInputError(
             f"-rod_point_load: point {k + 1} at S = {table[k, 0]:.6g} m is beyond the line "
             f"(0 <= S <= -rod_length {length:.6g} m); give an arc length on the line")
-    return table[:, 0], table[:, 1:], tuple(f"point {k + 1}" for k in range(len(table)))
+    return (table[:, 0], table[:, 1:], tuple(f"point {k + 1}" for k in range(len(table))),
+            np.zeros(len(table)))

@@ -63,6 +63,8 @@ class Scene:
     point_load_S: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_load_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     point_load_names: tuple = ()
+    # their drag areas C_d A (n_p,), m^2: drag 1/2 rho_w C_d A |v| v in the current
+    point_load_drag_areas: np.ndarray = field(default_factory=lambda: np.zeros(0))
     # where S = 0 is, m: the solver's frame has its origin there (module docstring)
     start_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
@@ -84,6 +86,9 @@ class Scene:
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
         self.point_load_S = np.asarray(self.point_load_S, dtype=float).ravel()
         self.point_load_forces = np.asarray(self.point_load_forces, dtype=float).reshape(-1, 3)
+        self.point_load_drag_areas = np.asarray(self.point_load_drag_areas, dtype=float).ravel()
+        if self.point_load_drag_areas.size == 0:
+            self.point_load_drag_areas = np.zeros(self.point_load_S.size)
         if len(self.point_load_names) != self.point_load_S.size:
             self.point_load_names = tuple(f"point {k + 1}"
                                           for k in range(self.point_load_S.size))
@@ -141,6 +146,15 @@ class Scene:
         (physics/point_loads.py)."""
         return self.point_load_S.copy(), t * self.point_load_forces
 
+    def point_drags(self, t):
+        """[(weight, Current, C_d A (n_p,))]: the attachments' drag at load factor t is
+        sum weight 1/2 rho_w C_d A |v| v with v the current at each point
+        (physics/point_loads.py), here t times the scene's current; [] without a current
+        or a drag area (a restart's blended path: scenes/blend.py)."""
+        if self.current is None or not np.any(self.point_load_drag_areas > 0):
+            return []
+        return [(t, self.current, self.point_load_drag_areas)]
+
     def applied_force(self):
         """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| at t = 1, N: the scale of the internal force n
         (and of the multiplier lambda3 that converges to it)."""
@@ -148,11 +162,15 @@ class Scene:
 
     def applied_forces(self):
         """The parts of applied_force by where they come from, N: {'load': int |f| dS of
-        the dead load, 'drag': L c max |v|^2 of the current (0 without one), 'start_force':
+        the dead load, 'drag': L c max |v|^2 of the current and the attachments'
+        1/2 rho_w C_d A max |v|^2 (0 without a current), 'start_force':
         |P_0|, 'end_force': |P_L|, 'point_loads': sum_p |P_p|}."""
         drag = 0.0
         if self.current is not None:            # the largest drag the current can exert
             drag = self.length * self.current.largest_drag()
+            # and the attachments', 1/2 rho_w C_d A max |v|^2 each
+            drag += (0.5 * self.water_density * self.point_load_drag_areas.sum()
+                     * float(np.max(np.sum(self.current.velocities**2, axis=1))))
         return {"load": float(np.diff(self.load_piece_ends)
                               @ np.linalg.norm(self.load_values, axis=1)),
                 "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
@@ -265,7 +283,7 @@ class Scene:
             raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
                                 f"{self.start}); drop it or change -rod_start")
         S = self.point_load_S
-        if S.size != len(self.point_load_forces):
+        if S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size:
             raise RodInputError(f"point loads: {S.size} arc lengths for "
                                 f"{len(self.point_load_forces)} forces")
         outside = np.flatnonzero((S < 0) | (S > self.length))

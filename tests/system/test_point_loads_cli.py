@@ -45,6 +45,26 @@ def test_a_table_of_attachments_reaches_the_file(tmp_path, ranks):
         assert np.array_equal(table_back[:, 0], [4.0, 7.0, 9.0])
 
 
+def test_an_attachment_with_a_drag_area_feels_the_current(tmp_path):
+    """A small buoy (0.1 l, C_d A = 2e-3 m^2) on the unit cantilever in a 1 m/s current
+    along y (the line itself of no drag, D = 0): its drag 1/2 rho_w C_d A |v| v (the
+    current uniform: a dead force) in the file as point_load_drag, the buoy pushed along
+    the current and lifted."""
+    table = tmp_path / "points.txt"
+    table.write_text("s volume cda\n0.6 1e-4 2e-3\n")
+    path = tmp_path / "out.h5"
+    done = run_petsc_rod(["-rod_elements", "16", "-rod_point_loads", str(table),
+                          "-rod_current", "0,1,0", "-rod_drag", "1025,1.2,0",
+                          "-rod_output", str(path)], 1, TIMEOUT)
+    assert done.returncode == 0, describe(done)
+    with h5py.File(path, "r") as result:
+        assert np.allclose(result.attrs["point_load_drag"], [[0.0, 0.5 * 1025 * 2e-3, 0.0]],
+                           rtol=1e-14, atol=0)
+        position = result.attrs["point_load_position"][0]
+        assert position[1] > 0.01 and position[2] > 0.01
+        assert np.array_equal(result["parameters"].attrs["point_loads_table"][:, 4], [2e-3])
+
+
 @pytest.mark.parametrize("table, args, words", [
     ("mass fz\n1 2\n", [], ["no 's' column"]),
     ("s mass colour\n0.5 1 red\n", [], ["unknown column 'colour'"]),
@@ -52,13 +72,14 @@ def test_a_table_of_attachments_reaches_the_file(tmp_path, ranks):
     ("s fz\n1.5 2\n", [], ["line 2", "beyond the line"]),
     ("s fz\n0.5\n", [], ["line 2", "1 values for the 2 columns"]),
     ("s mass\n0.5 -1\n", [], ["mass must not be negative"]),
+    ("s cda\n0.5 -1\n", [], ["cda must not be negative"]),
     (None, ["-rod_point_loads", "absent.txt"], ["absent.txt", "no such file"]),
     (None, ["-rod_point_load", "2,0,0,1"], ["-rod_point_load", "beyond the line"]),
     (None, ["-rod_point_load", "-0.1,0,0,1"], ["-rod_point_load", "beyond the line"]),
     (None, ["-rod_point_load", "0.5,0,1"], ["-rod_point_load", "give 4"]),
     (None, ["-rod_point_load", "0.5,x,0,1"], ["-rod_point_load"]),
 ], ids=["no s", "unknown column", "not a number", "beyond the end", "short row",
-        "negative mass", "no file", "quick beyond the end", "quick before the start",
+        "negative mass", "negative drag area", "no file", "quick beyond the end", "quick before the start",
         "quick short", "quick not a number"])
 def test_bad_attachments_exit_2_with_one_line(tmp_path, table, args, words):
     path = tmp_path / "out.h5"
