@@ -65,8 +65,9 @@ class BlendedPath:
     """The scene of a restart's walk from Scene ``old`` at load factor ``t_old`` (the
     file's) to Scene ``new`` at 1 (module docstring), with the interface the terms, the
     global step and the continuation ask of a scene's path: start_state(s), end_state(s),
-    load_beyond(S, s), load_piece_ends, point_loads(s), point_drags(s), end_roll(s), link_axis, drag_loads(s). Any other
-    attribute (length, stiffness, seabed, applied_force, ...) is ``new``'s."""
+    load_beyond(S, s), load_piece_ends, point_loads(s), point_drags(s), end_roll(s),
+    link_axis, drag_loads(s). Any other attribute (length, stiffness, seabed,
+    applied_force, ...) is ``new``'s."""
 
     def __init__(self, old, t_old, new):
         self.old, self.t_old, self.new = old, float(t_old), new

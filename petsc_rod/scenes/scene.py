@@ -156,8 +156,9 @@ class Scene:
         return [(t, self.current, self.point_load_drag_areas)]
 
     def applied_force(self):
-        """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| at t = 1, N: the scale of the internal force n
-        (and of the multiplier lambda3 that converges to it)."""
+        """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| (and the drag) at t = 1, N: the
+        scale of the internal force n (and of the multiplier lambda3 that converges to
+        it)."""
         return float(sum(self.applied_forces().values()))
 
     def applied_forces(self):

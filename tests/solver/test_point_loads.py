@@ -234,8 +234,9 @@ def with_drag(comm, current, forces):
         term = next(t for t in solver.problem.terms if isinstance(t, PointLoads))
         assert not term.conservative and not term.in_newton
         fields = vertex_fields(solver.problem)
-        return ({k: gather(comm, fields[k]) for k in ("r", "n")}, term.positions(solver.problem.state),
-                term.drag_forces(solver.problem.state))
+        state = solver.problem.state
+        return ({k: gather(comm, fields[k]) for k in ("r", "n")}, term.positions(state),
+                term.drag_forces(state))
     finally:
         destroy(mesh, solver)
 

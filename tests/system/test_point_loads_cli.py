@@ -79,7 +79,8 @@ def test_an_attachment_with_a_drag_area_feels_the_current(tmp_path):
     (None, ["-rod_point_load", "0.5,0,1"], ["-rod_point_load", "give 4"]),
     (None, ["-rod_point_load", "0.5,x,0,1"], ["-rod_point_load"]),
 ], ids=["no s", "unknown column", "not a number", "beyond the end", "short row",
-        "negative mass", "negative drag area", "no file", "quick beyond the end", "quick before the start",
+        "negative mass", "negative drag area", "no file", "quick beyond the end",
+        "quick before the start",
         "quick short", "quick not a number"])
 def test_bad_attachments_exit_2_with_one_line(tmp_path, table, args, words):
     path = tmp_path / "out.h5"
