@@ -39,7 +39,8 @@ from petsc_rod.scenes.boundary import is_held
 
 # Units of the attributes this term adds to each step of the result file.
 ATTRIBUTE_UNITS = {"point_load_S": "m", "point_load_force": "N",
-                   "point_load_position": "m", "point_load_drag": "N"}
+                   "point_load_position": "m", "point_load_drag": "N",
+                   "point_load_names": "text"}
 
 
 def point_load_element_vectors(mesh, S, force, offset):
@@ -164,7 +165,8 @@ class PointLoads(DeadLoads):
     def outputs(self, problem, vertex):
         """The points' S, forces at the step's load factor and absolute positions (the
         start position added, docs/method.md §5) (attributes point_load_S (n_p,),
-        point_load_force and point_load_position (n_p, 3)).
+        point_load_force and point_load_position (n_p, 3), point_load_names their labels
+        joined by commas, and in a current point_load_drag (n_p, 3)).
         Collective."""
         if not self.S.size:
             return None
@@ -173,6 +175,9 @@ class PointLoads(DeadLoads):
                       "point_load_position": positions}
         if self.dragged:
             attributes["point_load_drag"] = self.drag_forces(problem.state)
+        names = self.scene.point_load_names          # a table's labels (no comma in them)
+        if len(names) == self.S.size:                # (a restart's walk has both scenes')
+            attributes["point_load_names"] = ",".join(names)
         return TermOutput(attributes=attributes)
 
     def destroy(self):

@@ -41,6 +41,7 @@ def test_a_table_of_attachments_reaches_the_file(tmp_path, ranks):
         for s, position in zip((4.0, 7.0, 9.0), positions):   # next to the vertex values
             k = int(np.argmin(np.abs(S - s)))
             assert np.linalg.norm(position - r[k]) <= abs(S[k] - s) + 1e-12
+        assert result.attrs["point_load_names"] == "clump,buoy,point 1"
         table_back = result["parameters"].attrs["point_loads_table"]
         assert np.array_equal(table_back[:, 0], [4.0, 7.0, 9.0])
 
