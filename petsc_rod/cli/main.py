@@ -293,6 +293,11 @@ def restart_from(problem, path, load_factor, say):
     """Set the state of result file ``path`` (validated by io.read_restart against this
     run's arrays); returns ``load_factor``, or the file's when it is None."""
     restart = io.read_restart(path, problem.mesh, outputs.restart_state(problem))
+    # the file's r is absolute: its shape is taken from its own start (docs/method.md §5)
+    record = io.read_parameters(path, problem.mesh.comm)
+    origin = "" if record is None else record[0].get("start_position", "")
+    if not isinstance(origin, str):
+        restart.vertex["r"] = restart.vertex["r"] - np.asarray(origin, dtype=float)
     outputs.set_state(problem, restart.vertex, restart.state)
     if not restart.converged:
         say(f"petsc_rod: warning: -rod_initial {path} says converged = 0: the run starts "
@@ -327,14 +332,16 @@ def options_in_effect(values, solver, start):
     (``line_types_table``), not only their files' names;
     then each global-step solver's KSP, PC and factorisation package."""
     scene = solver.problem.scene
-    resolved = {"rod_end_position": scene.end_position, "rod_end_frame": scene.end_frame.ravel(),
+    origin = scene.start_position               # the scene's positions are from the start
+    resolved = {"rod_end_position": scene.end_position + origin,
+                "rod_start_position": origin, "rod_end_frame": scene.end_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     if not np.isfinite(scene.axial_stiffness):  # inextensible: written as not given
         resolved["rod_axial_stiffness"] = None
     if scene.seabed is not None:                # the default stiffness (riser/environment.py)
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
     if values["rod_current_profile"]:
-        resolved["rod_sea_surface"] = scene.current.surface
+        resolved["rod_sea_surface"] = scene.current.surface + origin[2]
     if scene.sections:                          # the length the sections add up to
         resolved["rod_length"] = scene.length
     parameters, units = {}, {}
@@ -355,6 +362,10 @@ def options_in_effect(values, solver, start):
         parameters["line_types_table"] = read_text(values["rod_line_types"],
                                                    "-rod_line_types")
         units["line_types_table"] = "text"
+    if scene.point_load_S.size:                 # the attachments' forces, to repeat the run
+        parameters["point_loads_table"] = np.column_stack([
+            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas])
+        units["point_loads_table"] = "m, N, N, N, m^2 (S, fx, fy, fz, CdA)"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

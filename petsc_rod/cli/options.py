@@ -137,11 +137,14 @@ OPTIONS = [
            "EA eps^2 / 2 per metre of unstretched line (docs/method.md §12); default inf, "
            "inextensible", SCALE, "N"),
     Option("rod_start", _string, default_of(Scene, "start"), "clamp|pin|free",
-           "condition at S = 0 (at the origin)", unit="text"),
+           "condition at S = 0 (at -rod_start_position)", unit="text"),
+    Option("rod_start_position", _reals(3), default_of(Scene, "start_position"), "x,y,z",
+           "position of the start S = 0 (clamp, pin), m: every position (end, seabed, sea "
+           "surface, outputs) is absolute, z up", unit="m"),
     Option("rod_end", _string, default_of(Scene, "end"), "clamp|pin|free", "condition at S = L",
            unit="text"),
     Option("rod_end_position", _reals(3), None, "x,y,z",
-           "position of the end S = L (clamp, pin); default (L,0,0)", unit="m"),
+           "position of the end S = L (clamp, pin); default the start + (L,0,0)", unit="m"),
     Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
            "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
     Option("rod_end_twist", _real, default_of(Scene, "end_twist"), "angle",
@@ -179,10 +182,20 @@ OPTIONS = [
            "the line from S = 0 as sections of -rod_line_types (m); they set the length, "
            "stiffness, weight and drag; elements shared out by length where not given",
            unit="text"),
-    Option("rod_water_density", _real, 1025.0, "rho",
-           "sea water density, kg/m^3 (the line types' buoyancy and drag)", SCALE, "kg/m^3"),
-    Option("rod_gravity", _real, 9.80665, "g",
-           "gravity, m/s^2, along -z (the line types' weight)", SCALE, "m/s^2"),
+    # attachments (scenes/point_loads.py, physics/point_loads.py; docs/riser.md)
+    Option("rod_point_loads", _string, None, "FILE",
+           "attachments: a table with a header row naming its columns, s (arc length, m; "
+           "required) and any of mass (kg in air), volume (displaced volume, m^3), fx, fy, "
+           "fz (a point force, N), cda (drag area, m^2), name; each adds the dead force "
+           "(fx, fy, fz) + (rho_w volume - mass) g e_z at s", unit="text"),
+    Option("rod_point_load", _reals(), None, "S,fx,fy,fz[,...]",
+           "point dead forces, N, at arc lengths S, m: 4 numbers per point", unit="m, N"),
+    Option("rod_water_density", _real, default_of(Scene, "water_density"), "rho",
+           "sea water density rho_w, kg/m^3 (the buoyancy and drag of line types and "
+           "attachments)", SCALE, "kg/m^3"),
+    Option("rod_gravity", _real, default_of(Scene, "gravity"), "g",
+           "gravity, m/s^2, along -z (the weight of line types and attachments)", SCALE,
+           "m/s^2"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",

@@ -13,6 +13,7 @@ from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seab
                                          largest_stiffness, read_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
+from petsc_rod.scenes.point_loads import quick_point_loads, read_point_loads
 from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
 
 # The options behind each Scene field a restart compares (scenes/blend.py).
@@ -26,14 +27,39 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "seabed": "-rod_seabed", "sections": "-rod_line_types/-rod_sections",
                  "axial_stiffness": "-rod_axial_stiffness",
                  **{f"{which}_{name}": f"-rod_{which}_{name}" for which in ("start", "end")
-                    for name in ("rotational_stiffness", "joint_axis")}}
+                    for name in ("rotational_stiffness", "joint_axis")},
+                 "point_load_S": "the point loads (-rod_point_loads|-rod_point_load)",
+                 "point_load_forces": ("the point loads (-rod_point_loads|-rod_point_load, "
+                                       "-rod_water_density, -rod_gravity)")}
 
 
-def scene_from_options(values, given, profile=None, line_types=None):
+def point_loads_from_options(values, length, points=None):
+    """(S (n_p,), forces (n_p, 3), names, drag areas (n_p,)) of -rod_point_loads FILE
+    and -rod_point_load (scenes/point_loads.py), the file's first, each on the line
+    [0, ``length``]; ``points`` (S, forces, drag areas) when already resolved (a result
+    file's point_loads_table)."""
+    if points is not None:
+        S, forces, areas = points
+        return S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas
+    parts = []
+    if values["rod_point_loads"]:
+        parts.append(read_point_loads(values["rod_point_loads"], values["rod_water_density"],
+                                      values["rod_gravity"], length, MAX_MAGNITUDE))
+    if values["rod_point_load"] is not None:
+        parts.append(quick_point_loads(values["rod_point_load"], length))
+    if not parts:
+        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0)
+    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+            sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
+
+
+def scene_from_options(values, given, profile=None, line_types=None, points=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
-    the -rod_line_types table when already read (a result file's line_types_table)."""
+    the -rod_line_types table when already read (a result file's line_types_table);
+    ``points`` (S, forces, drag areas) the point loads when already resolved (a result
+    file's point_loads_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
@@ -44,15 +70,29 @@ def scene_from_options(values, given, profile=None, line_types=None):
         line = dict(length=sections[-1].end, stiffness=sections[0].stiffness_start,
                     load_values=[s.weight for s in sections],
                     load_breaks=[s.start for s in sections[1:]], sections=tuple(sections))
+    point_S, point_forces, point_names, point_areas = point_loads_from_options(
+        values, line["length"], points)
+    if not (sections or point_S.size):
+        for name in ("rod_water_density", "rod_gravity"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_sections or attachments "
+                                    "(-rod_point_loads): the uniform line takes -rod_load")
+    origin = np.asarray(values["rod_start_position"], dtype=float)
+    end = values["rod_end_position"]
     scene = Scene(**line, start=values["rod_start"], end=values["rod_end"],
-                  end_position=values["rod_end_position"], end_frame=values["rod_end_frame"],
+                  start_position=origin,
+                  end_position=None if end is None else np.asarray(end) - origin,
+                  end_frame=values["rod_end_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"],
                   axial_stiffness=values["rod_axial_stiffness"],
                   start_rotational_stiffness=values["rod_start_rotational_stiffness"],
                   end_rotational_stiffness=values["rod_end_rotational_stiffness"],
                   start_joint_axis=values["rod_start_joint_axis"],
-                  end_joint_axis=values["rod_end_joint_axis"])
+                  end_joint_axis=values["rod_end_joint_axis"], point_load_S=point_S,
+                  point_load_forces=point_forces, point_load_names=point_names,
+                  point_load_drag_areas=point_areas,
+                  water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
     check_taut(scene)
@@ -83,10 +123,6 @@ def sections_from_options(values, given, content=None):
         if "rod_line_types" in given:
             raise RodInputError("-rod_line_types needs -rod_sections TYPE:LENGTH[:ELEMENTS],"
                                 "... (the line from S = 0 as sections of those types)")
-        for name in ("rod_water_density", "rod_gravity"):
-            if name in given:
-                raise RodInputError(f"-{name} needs -rod_sections (the weight and drag "
-                                    "of line types); the uniform line takes -rod_load")
         return []
     if "rod_line_types" not in given:
         raise RodInputError("-rod_sections needs -rod_line_types FILE (the table of the "
@@ -200,6 +236,7 @@ def check_applied_forces(scene, given):
     if total > MAX_MAGNITUDE:
         name = max(parts, key=parts.get)
         option = {"load": "-rod_load (with -rod_length)", "start_force": "-rod_start_force",
+                  "point_loads": "-rod_point_loads|-rod_point_load",
                   "end_force": "-rod_end_force",
                   "drag": f"{_current_option(given)} with -rod_drag and -rod_length"}[name]
         raise RodInputError(
@@ -226,12 +263,12 @@ def checked_default_penalty(scene):
     scales = penalty_scales(scene)
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
+        stiffness = ("-rod_stiffness" if not scene.sections
+                     else "the line types' ei and gj (-rod_line_types)")
         option, formula = {
-            "bending": ("-rod_stiffness (or the line types' ei, gj) with -rod_length",
-                        "100 sqrt(min K max K) / L^2"),
+            "bending": (f"{stiffness} with -rod_length", "100 sqrt(min K max K) / L^2"),
             "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
-            "twist": ("-rod_end_twist (or -rod_end_frame) with -rod_stiffness (or the "
-                      "line types' ei, gj)",
+            "twist": (f"-rod_end_twist (or -rod_end_frame) with {stiffness}",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
             "stretch": ("-rod_axial_stiffness with -rod_end_position",
                         "EA (|r_L| - L) / 2L")}[name]
@@ -303,11 +340,17 @@ def current_from_options(values, given, surface_default, profile_rows=None,
 
 def environment_from_options(values, given, scene, profile=None):
     """(Seabed or None, Current or None) for a validated ``scene``, checked against it
-    (``profile``: as in current_from_options)."""
+    (``profile``: as in current_from_options), their heights in the scene's frame (the
+    options' less the start's z, docs/method.md §5)."""
+    z0 = float(scene.start_position[2])
+    values = dict(values)
+    for name in ("rod_seabed", "rod_sea_surface"):
+        if values[name] is not None:
+            values[name] = values[name] - z0
     seabed = seabed_from_options(values, given, scene.load_values)
     ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
     ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
-    check_ends_above(seabed, ends, scene.length)
+    check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
     return seabed, current_from_options(values, given, max(held), profile, section_drag)
@@ -320,7 +363,9 @@ def options_from_parameters(parameters):
     and frame from the ones Scene puts in their place), so that Scene.validate and the
     riser options see the run as it was asked."""
     length = float(parameters.get("length", 1.0))
-    defaults = {"rod_end_position": np.array([length, 0.0, 0.0]),
+    origin = parameters.get("start_position", "")
+    origin = np.zeros(3) if isinstance(origin, str) else np.asarray(origin, dtype=float)
+    defaults = {"rod_end_position": origin + np.array([length, 0.0, 0.0]),
                 "rod_end_frame": REFERENCE_FRAME}
     values, given = {}, set()
     for option in OPTIONS:
@@ -343,7 +388,14 @@ def scene_from_parameters(parameters):
     values, given = options_from_parameters(parameters)
     table = parameters.get("current_profile_table")
     profile = None if table is None else (table[:, 0], table[:, 1:])
-    return scene_from_options(values, given, profile, parameters.get("line_types_table"))
+    points = parameters.get("point_loads_table")
+    if points is not None:
+        points = np.asarray(points, dtype=float)
+        points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
+        areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
+        points = (points[:, 0], points[:, 1:4], areas)
+    return scene_from_options(values, given, profile, parameters.get("line_types_table"),
+                              points)
 
 
 def restart_path(scene, parameters, t_file):

@@ -135,5 +135,8 @@ def step_record(problem, report, t, **common):
         attributes.update(output.attributes)
         if output.text:
             texts.append(output.text)
+    # the file's positions are absolute: the solver's frame has its origin at the start
+    # (Scene.start_position, docs/method.md §5); the terms translate their own
+    vertex["r"] = vertex["r"] + problem.scene.start_position
     return StepRecord(vertex, attributes, texts, u3_start)
 

@@ -42,6 +42,7 @@ from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
 from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
+from petsc_rod.physics import point_loads as point_load_term
 from petsc_rod.riser import quantities as riser_quantities
 from petsc_rod.riser import section_numbers
 
@@ -69,6 +70,7 @@ ATTRIBUTE_UNITS = {
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
     **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
+    **point_load_term.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

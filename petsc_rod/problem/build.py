@@ -1,11 +1,12 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
-dead loads always; a flex joint at each pinned end given a rotational stiffness
-(physics/flex_joint.py); the seabed, the drag and the riser numbers only where the scene
-has a seabed or a current (docs/riser.md); the axial stretch only where some EA is finite
-(docs/method.md §12)."""
+dead loads always; the point loads (attachments) where it has some; a flex joint at each
+pinned end given a rotational stiffness (physics/flex_joint.py); the seabed, the drag and
+the riser numbers only where the scene has a seabed or a current (docs/riser.md); the
+axial stretch only where some EA is finite (docs/method.md §12)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
+from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.stretch import AxialStretch
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.section_numbers import SectionNumbers
@@ -15,6 +16,8 @@ from petsc_rod.riser.terms import DragTerm, SeabedTerm
 def scene_terms(mesh, scene):
     """The list of terms of ``scene`` on ``mesh``, in the order the core calls them."""
     terms = [DeadLoads(mesh, scene)]
+    if scene.point_loads(1.0)[0].size:          # attachments (scenes/point_loads.py)
+        terms.append(PointLoads(mesh, scene))
     terms += [FlexJoint(mesh, which, k, axis) for which, k, axis in scene.joints()]
     seabed = SeabedTerm(mesh, scene.seabed) if scene.seabed is not None else None
     if seabed is not None:

@@ -24,8 +24,9 @@ def default_penalty(scene):
     branch (docs/method.md §3; measurements in docs/stability.md, History C):
     * bending and torsion, 100 sqrt(min K max K) / L^2: the count grows with R over the
       softest stiffness and the iteration fails when R is far below the stiffest one;
-    * tension, F / 2 with F = int |f| dS + |P_0| + |P_L| (Scene.applied_force): the
-      multiplier lambda3 reaches the tension by steps of at most 2R per iteration;
+    * tension, F / 2 with F = int |f| dS + |P_0| + |P_L| + sum |P_p| (the point loads;
+      Scene.applied_force): the multiplier lambda3 reaches the tension by steps of at
+      most 2R per iteration;
     * twisting moment M = K3 a / L of an end turned by a: M^2 / K_b is four times the
       axial compression it stands for in Greenhill's condition
       (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2);

@@ -113,14 +113,16 @@ def read_profile(path, largest=np.inf):
     return table[:, 0], table[:, 1:]
 
 
-def check_ends_above(seabed, ends, length):
+def check_ends_above(seabed, ends, length, origin_z=0.0):
     """Refuse a held end below the seabed (``ends``: (name, EndState) pairs at t = 1); an
-    end on it (an anchor) is fine, to round-off of the length."""
+    end on it (an anchor) is fine, to round-off of the length. Heights in the scene's
+    frame; the message adds ``origin_z`` (the start's z, m) to show the options' own."""
     if seabed is None:
         return
     for name, state in ends:
         depth = seabed.height - state.position[2]
         if is_held(state) and depth > 1e-12 * length:
             raise RodInputError(
-                f"{name}: the end is held at z = {state.position[2]:.6g} m, {depth:.3g} m "
-                f"below the seabed (-rod_seabed {seabed.height:g}); hold it on or above it")
+                f"{name}: the end is held at z = {state.position[2] + origin_z:.6g} m, "
+                f"{depth:.3g} m below the seabed (-rod_seabed {seabed.height + origin_z:g}); "
+                "hold it on or above it")

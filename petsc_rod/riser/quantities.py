@@ -11,6 +11,9 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   and position; the grounded length, the length of line below z_b;
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
   and where they occur.
+
+Heights are compared in the solver's frame (origin at the start, docs/method.md §5); the
+positions reported (touchdown, largest curvature) are absolute: the start position added.
 """
 
 import numpy as np
@@ -139,14 +142,17 @@ def riser_report(problem, vertex, seabed=None):
     local = ((curvature[k], vertex["S"][k], vertex["r"][k]) if curvature.size
              else (None, None, None))
     kappa, kappa_S, kappa_r = _extreme(mesh, local[0], local, largest=True)
+    origin = problem.scene.start_position       # positions reported absolute (§5)
+    kappa_r = np.asarray(kappa_r, dtype=float) + origin
     attributes = {"top_tension": float(np.linalg.norm(top_force)), "top_angle": angle,
                   "max_curvature": float(kappa), "max_curvature_S": float(kappa_S),
-                  "max_curvature_position": np.asarray(kappa_r, dtype=float),
+                  "max_curvature_position": kappa_r,
                   "min_bend_radius": float(1.0 / kappa) if kappa > 0 else np.inf}
     text = (f"top tension {attributes['top_tension']:.6g} N at {angle:.3f} deg from the "
             f"vertical")
     if seabed is not None:
         S, position, grounded = touchdown(problem, seabed.seabed, top)
+        position = position + origin
         attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")

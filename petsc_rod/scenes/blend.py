@@ -25,7 +25,8 @@ from petsc_rod.scenes.scene import EndState, rolled_frame
 
 # The Scene fields the load path carries, compared to tell whether a restart walks.
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
-               "end_frame", "end_twist", "current")
+               "end_frame", "end_twist", "current", "point_load_S", "point_load_forces",
+               "point_load_drag_areas")
 # The Scene fields a restart takes from this run's scene at once.
 FIXED_FIELDS = ("stiffness", "axial_stiffness", "start", "end", "seabed", "sections",
                 "start_rotational_stiffness", "end_rotational_stiffness", "start_joint_axis",
@@ -74,8 +75,9 @@ class BlendedPath:
     """The scene of a restart's walk from Scene ``old`` at load factor ``t_old`` (the
     file's) to Scene ``new`` at 1 (module docstring), with the interface the terms, the
     global step and the continuation ask of a scene's path: start_state(s), end_state(s),
-    load_beyond(S, s), load_piece_ends, end_roll(s), link_axis, drag_loads(s). Any other
-    attribute (length, stiffness, seabed, applied_force, ...) is ``new``'s."""
+    load_beyond(S, s), load_piece_ends, point_loads(s), point_drags(s), end_roll(s),
+    link_axis, drag_loads(s). Any other attribute (length, stiffness, seabed,
+    applied_force, ...) is ``new``'s."""
 
     def __init__(self, old, t_old, new):
         self.old, self.t_old, self.new = old, float(t_old), new
@@ -110,6 +112,21 @@ class BlendedPath:
         S (...) -> (..., 3); exact, the load being linear in its values."""
         return ((1 - s) * self.old.load_beyond(S, self.t_old)
                 + s * self.new.load_beyond(S, 1.0))
+
+    def point_loads(self, s):
+        """(S_p, P_p) of the blend: A's points with their forces at t_f times (1 - s) and
+        B's at 1 times s (each a dead load, linear in its value: physics/point_loads.py)."""
+        (S_a, P_a), (S_b, P_b) = self.old.point_loads(self.t_old), self.new.point_loads(1.0)
+        return np.concatenate([S_a, S_b]), np.concatenate([(1 - s) * P_a, s * P_b])
+
+    def point_drags(self, s):
+        """[(weight, Current, C_d A)] of the blend, aligned with point_loads(s): A's
+        attachments in A's current times (1 - s), B's in B's times s (as drag_loads)."""
+        n_old, n_new = (scene.point_loads(1.0)[0].size for scene in (self.old, self.new))
+        return ([((1 - s) * w, c, np.concatenate([a, np.zeros(n_new)]))
+                 for w, c, a in self.old.point_drags(self.t_old)]
+                + [(s * w, c, np.concatenate([np.zeros(n_old), a]))
+                   for w, c, a in self.new.point_drags(1.0)])
 
     def end_roll(self, s):
         """(1 - s) roll_A(t_f) + s roll_B(1), rad: continuous along the walk."""

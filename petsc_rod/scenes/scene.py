@@ -1,7 +1,11 @@
 """Boundary conditions and loads of a scene, and the continuation path to them (§5, §7).
 
 The reference state is straight along e_x from the origin, with d1 = e_y, d2 = e_z,
-d3 = e_x. The end S = 0 stays at the origin in the reference frame (if it is held);
+d3 = e_x. The end S = 0 stays at the origin in the reference frame (if it is held).
+Every position a Scene holds (the end position, the seabed's and the sea surface's
+heights) is in the solver's frame, whose origin is the start; ``start_position`` is
+where that origin is (-rod_start_position: an anchor anywhere), added to every position
+the run reports and subtracted from every one it reads (docs/method.md §5);
 the end S = L and the loads are reached along the path t in [0, 1]:
 position (1 - t) L e_x + t r_L, frame exp(t log Q) then a roll t * twist about the
 current tangent, and forces scaled by t. Every quantity is in SI units.
@@ -65,6 +69,18 @@ class Scene:
     end_rotational_stiffness: float = 0.0
     start_joint_axis: np.ndarray = None
     end_joint_axis: np.ndarray = None
+    # point loads (attachments, scenes/point_loads.py): arc lengths S_p (n_p,), m, dead
+    # forces P_p (n_p, 3), N, and labels
+    point_load_S: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_load_forces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    point_load_names: tuple = ()
+    # their drag areas C_d A (n_p,), m^2: drag 1/2 rho_w C_d A |v| v in the current
+    point_load_drag_areas: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # where S = 0 is, m: the solver's frame has its origin there (module docstring)
+    start_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
+    water_density: float = 1025.0
+    gravity: float = 9.80665
 
     def __post_init__(self):
         self.stiffness = np.asarray(self.stiffness, dtype=float)
@@ -73,6 +89,7 @@ class Scene:
         if self.end_frame is None:
             self.end_frame = REFERENCE_FRAME.copy()
         self.end_position = np.asarray(self.end_position, dtype=float)
+        self.start_position = np.asarray(self.start_position, dtype=float).reshape(3)
         self.start_force = np.asarray(self.start_force, dtype=float)
         self.end_force = np.asarray(self.end_force, dtype=float)
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
@@ -82,6 +99,14 @@ class Scene:
                     else np.asarray(axis, dtype=float).ravel())
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
+        self.point_load_S = np.asarray(self.point_load_S, dtype=float).ravel()
+        self.point_load_forces = np.asarray(self.point_load_forces, dtype=float).reshape(-1, 3)
+        self.point_load_drag_areas = np.asarray(self.point_load_drag_areas, dtype=float).ravel()
+        if self.point_load_drag_areas.size == 0:
+            self.point_load_drag_areas = np.zeros(self.point_load_S.size)
+        if len(self.point_load_names) != self.point_load_S.size:
+            self.point_load_names = tuple(f"point {k + 1}"
+                                          for k in range(self.point_load_S.size))
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
 
     @property
@@ -177,22 +202,42 @@ class Scene:
         overlap = np.clip(ends[1:] - np.maximum(ends[:-1], S), 0.0, None)
         return t * overlap @ self.load_values
 
+    def point_loads(self, t):
+        """(S_p (n_p,), t P_p (n_p, 3)): the point loads at load factor t, m and N
+        (physics/point_loads.py)."""
+        return self.point_load_S.copy(), t * self.point_load_forces
+
+    def point_drags(self, t):
+        """[(weight, Current, C_d A (n_p,))]: the attachments' drag at load factor t is
+        sum weight 1/2 rho_w C_d A |v| v with v the current at each point
+        (physics/point_loads.py), here t times the scene's current; [] without a current
+        or a drag area (a restart's blended path: scenes/blend.py)."""
+        if self.current is None or not np.any(self.point_load_drag_areas > 0):
+            return []
+        return [(t, self.current, self.point_load_drag_areas)]
+
     def applied_force(self):
-        """int_0^L |f| dS + |P_0| + |P_L| at t = 1, N: the scale of the internal force n
-        (and of the multiplier lambda3 that converges to it)."""
+        """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| (and the drag) at t = 1, N: the
+        scale of the internal force n (and of the multiplier lambda3 that converges to
+        it)."""
         return float(sum(self.applied_forces().values()))
 
     def applied_forces(self):
         """The parts of applied_force by where they come from, N: {'load': int |f| dS of
-        the dead load, 'drag': L c max |v|^2 of the current (0 without one), 'start_force':
-        |P_0|, 'end_force': |P_L|}."""
+        the dead load, 'drag': L c max |v|^2 of the current and the attachments'
+        1/2 rho_w C_d A max |v|^2 (0 without a current), 'start_force':
+        |P_0|, 'end_force': |P_L|, 'point_loads': sum_p |P_p|}."""
         drag = 0.0
         if self.current is not None:            # the largest drag the current can exert
             drag = self.length * self.current.largest_drag()
+            # and the attachments', 1/2 rho_w C_d A max |v|^2 each
+            drag += (0.5 * self.water_density * self.point_load_drag_areas.sum()
+                     * float(np.max(np.sum(self.current.velocities**2, axis=1))))
         return {"load": float(np.diff(self.load_piece_ends)
                               @ np.linalg.norm(self.load_values, axis=1)),
                 "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
-                "end_force": float(np.linalg.norm(self.end_force))}
+                "end_force": float(np.linalg.norm(self.end_force)),
+                "point_loads": float(np.linalg.norm(self.point_load_forces, axis=1).sum())}
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
@@ -255,7 +300,8 @@ class Scene:
         reports)."""
         axis = REFERENCE_FRAME[2]
         off_axis = np.concatenate([self.start_force[1:], self.end_force[1:],
-                                   self.load_values[:, 1:].ravel()])
+                                   self.load_values[:, 1:].ravel(),
+                                   self.point_load_forces[:, 1:].ravel()])
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
         values = self.stiffness_values()
         return bool(np.all(values[:, 0] == values[:, 1]) and not np.any(off_axis)
@@ -326,10 +372,25 @@ class Scene:
             if name in used and self.end not in kinds:
                 raise RodInputError(f"-{name} needs -rod_end {'|'.join(kinds)} "
                                     f"(the end is {self.end}); drop it or change -rod_end")
+        if "rod_start_position" in used and self.start == "free":
+            raise RodInputError("-rod_start_position needs a held start (-rod_start clamp|"
+                                "pin): a free start goes where the loads take it; drop it, or "
+                                "give -rod_end_position for the held end")
         if "rod_start_force" in used and self.start != "free":
             raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
                                 f"{self.start}); drop it or change -rod_start")
         self._validate_joints(used)
+        S = self.point_load_S
+        if S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size:
+            raise RodInputError(f"point loads: {S.size} arc lengths for "
+                                f"{len(self.point_load_forces)} forces")
+        outside = np.flatnonzero((S < 0) | (S > self.length))
+        if outside.size:
+            k = int(outside[0])
+            raise RodInputError(
+                f"point loads: {self.point_load_names[k]} at s = {S[k]:.6g} m is beyond "
+                f"the line (0 <= s <= -rod_length {self.length:.6g} m); give an arc length "
+                "on the line")
         breaks = self.load_breaks
         if len(self.load_values) != len(breaks) + 1:
             raise RodInputError(

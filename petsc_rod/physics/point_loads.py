@@ -1,0 +1,186 @@
+"""The scene's point loads (attachments, scenes/point_loads.py) as a term of physics
+(physics/term.py): dead forces P_p at arc lengths S_p, scaled by the load factor t
+(on a restart's walk, the blend of two scenes' sets: Scene.point_loads).
+
+Their work is sum_p P_p.r(S_p). With r(S) = r(a) + int_a^S r' from the held end a
+(docs/method.md §5) it is r(a).sum_p P_p + int F.r' dS, each point adding a step to F:
+
+    start held:            F_p(S) = P_p [S < S_p]
+    start free, end held:  F_p(S) = P_p [S < S_p] - P_p = -P_p [S > S_p].
+
+So, as for the distributed dead load (physics/dead_loads.py), the term is a fixed
+right-hand side b = int F.g dS of the slope problem, its energy -(r(a).sum P + b.r'),
+its gradient -b on d3 = r' and no curvature of its own (Newton and the stability test
+keep working). b is exact wherever S_p falls: in the element e that holds it,
+int_{S_e}^{S_p} N_k dS is the P2 basis integrated over the part of the element
+(elements.p2_integrals at xi = (S_p - S_e) / h), whole elements before it give
+int_e N_k, those after it nothing.
+
+n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
+(the point counted as before S). A point at S = L acts as an end force there (it is in
+n(L), Term.end_force).
+
+An attachment with a drag area C_d A (m^2) in a current also feels the drag
+D_p = 1/2 rho_w C_d A |v| v, v the current at r(S_p) (Scene.point_drags: times the
+path's weight of each current), a point force of the iterate added to the slope's
+right-hand side every iteration (add_iterate_load) the same way, at the heights of the
+last global step, as the line's drag (riser/terms.py). It has no energy: the term is then
+neither conservative nor in the Newton steps (a current makes the line's drag term
+neither anyway).
+"""
+
+import numpy as np
+
+from petsc_rod.mesh.elements import P2, element_integrals, p2_basis, p2_integrals
+from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
+from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.scenes.boundary import is_held
+
+# Units of the attributes this term adds to each step of the result file.
+ATTRIBUTE_UNITS = {"point_load_S": "m", "point_load_force": "N",
+                   "point_load_position": "m", "point_load_drag": "N",
+                   "point_load_names": "text"}
+
+
+def point_load_element_vectors(mesh, S, force, offset):
+    """int_e F.g_k dS on the owned elements, (ne, 3 dofs, 3 components), N m, with
+    F(S) = sum_p force_p [S < S_p] + offset: S (n_p,) m, force (n_p, 3) N, offset (3,) N.
+    Exact: the steps are integrated over the part of each element before S_p."""
+    h = mesh.element_h
+    xi = np.clip((np.asarray(S)[None, :] - mesh.element_S[:, None]) / h[:, None], 0.0, 1.0)
+    before = p2_integrals(xi, h)                          # int_{S_e}^{min(S_p, S_e+1)} N_k
+    return (np.einsum("epk,pc->ekc", before, force)
+            + element_integrals(h)[:, :, None] * np.asarray(offset)[None, None, :])
+
+
+class PointLoads(DeadLoads):
+    """The point loads of a Scene (or of a restart's BlendedPath) on a Mesh: a dead load
+    (DeadLoads: energy, gradient and step load from b) with its own b, anchor work and
+    share of n(S). Owns the VectorField of b; ``destroy()``."""
+
+    def __init__(self, mesh, scene):
+        super().__init__(mesh, scene)
+        self.load.destroy()
+        self.load = VectorField(mesh, "point_loads")      # b = int F.g dS on the P2 dofs
+        self.S, self.force = scene.point_loads(0.0)
+        self.held_start = True
+        # the drag of attachments in a current (module docstring): no energy
+        self.dragged = bool(scene.point_drags(0.5))
+        self.conservative = self.in_newton = not self.dragged
+        self._drag_rhs = VectorField(mesh, "point_drag_rhs") if self.dragged else None
+
+    @property
+    def axially_symmetric(self):
+        """Every point force along e_x (at t = 1): a turn about the x axis maps the loads
+        to themselves."""
+        return not np.any(self.scene.point_loads(1.0)[1][:, 1:])
+
+    def prepare(self, t, start, end):
+        """b, the offset and the anchor's work at load factor t (module docstring)."""
+        self.t = t
+        self.S, self.force = self.scene.point_loads(t)
+        total = self.force.sum(axis=0)
+        self.held_start = is_held(start)
+        self.offset = np.zeros(3) if self.held_start else -total
+        anchor = start if self.held_start else end
+        self.anchor_work = float(anchor.position @ total)
+        mesh = self.mesh
+        self.load.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+            point_load_element_vectors(mesh, self.S, self.force, self.offset)))
+
+    def drag_forces(self, state):
+        """D_p = sum_k w_k 1/2 rho_w C_d A_p |v_k| v_k, N, (n_p, 3), v_k the current k at
+        the points' heights (of the last global step; none needed for currents uniform in
+        depth). Zero without a drag area. Collective."""
+        drags = self.scene.point_drags(self.t) if self.dragged else []
+        if not drags:
+            return np.zeros_like(self.force)
+        z = (self.positions(state)[:, 2] if any(c.depths.size > 1 for _, c, _ in drags)
+             else np.zeros(self.S.size))
+        total = np.zeros_like(self.force)
+        for weight, current, area in drags:
+            v = current.velocity(z)
+            total += (weight * 0.5 * self.scene.water_density * area
+                      * np.linalg.norm(v, axis=1))[:, None] * v
+        return total
+
+    def add_iterate_load(self, rhs, state):
+        """Add the attachments' drag's int F.g to the slope's right-hand side (F its steps,
+        offset as for the dead forces). Collective."""
+        if not self.dragged:
+            return
+        drag = self.drag_forces(state)
+        offset = np.zeros(3) if self.held_start else -drag.sum(axis=0)
+        mesh = self.mesh
+        self._drag_rhs.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
+            point_load_element_vectors(mesh, self.S, drag, offset)))
+        for vec, part in zip(rhs.components, self._drag_rhs.components):
+            vec.axpy(1.0, part)
+
+    def _total_force(self, state):
+        """The dead forces and, in a current, the drag, (n_p, 3), N. Collective."""
+        return self.force + self.drag_forces(state) if self.dragged else self.force
+
+    def _at_end(self):
+        """The points at S = L (they act as a force at the end), (n_p,) bool."""
+        return self.S >= self.mesh.length
+
+    def force_beyond(self, state):
+        """sum_p P_p [S_i < S_p or S_p = L] + offset at the owned vertices, N,
+        (n_owned, 3)."""
+        force = self._total_force(state)
+        offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
+        beyond = (self.S[None, :] > self.mesh.vertex_S[:, None]) | self._at_end()[None, :]
+        return beyond.astype(float) @ force + offset
+
+    def end_force(self, state):
+        force = self._total_force(state)
+        offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
+        return force[self._at_end()].sum(axis=0) + offset
+
+    def positions(self, state):
+        """r(S_p) of every point, (n_p, 3), m, on every rank: the rank that owns the
+        element holding S_p (the last element for S_p = L) evaluates r(S_e) +
+        int_{S_e}^{S_p} r'. Collective."""
+        mesh = self.mesh
+        local = np.zeros((self.S.size, 3))
+        mine = np.zeros(self.S.size, dtype=bool)
+        e = np.zeros(0, dtype=int)
+        if mesh.n_local_elements:
+            ends = np.append(mesh.element_S, mesh.coordinates(mesh.element_end))
+            last = mesh.element_end == mesh.n_elements
+            mine = (self.S >= ends[0]) & ((self.S < ends[-1]) | (last & (self.S <= ends[-1])))
+            e = np.clip(np.searchsorted(ends, self.S[mine], side="right") - 1,
+                        0, mesh.n_local_elements - 1)
+        h = mesh.element_h[e]
+        xi = np.clip((self.S[mine] - mesh.element_S[e]) / h, 0.0, 1.0)[:, None]
+        # on every rank, with or without a point: the ghost updates are collective
+        values = state.evaluate(mesh.element_local[e], p2_basis(xi, h), p2_integrals(xi, h))
+        local[mine] = values["r"][:, 0]
+        return mesh.global_sum(local)
+
+    def outputs(self, problem, vertex):
+        """The points' S, forces at the step's load factor and absolute positions (the
+        start position added, docs/method.md §5) (attributes point_load_S (n_p,),
+        point_load_force and point_load_position (n_p, 3), point_load_names their labels
+        joined by commas, and in a current point_load_drag (n_p, 3)).
+        Collective."""
+        if not self.S.size:
+            return None
+        positions = self.positions(problem.state) + problem.scene.start_position
+        attributes = {"point_load_S": self.S.copy(), "point_load_force": self.force.copy(),
+                      "point_load_position": positions}
+        if self.dragged:
+            attributes["point_load_drag"] = self.drag_forces(problem.state)
+        names = self.scene.point_load_names          # a table's labels (no comma in them)
+        if len(names) == self.S.size:                # (a restart's walk has both scenes')
+            attributes["point_load_names"] = ",".join(names)
+        return TermOutput(attributes=attributes)
+
+    def destroy(self):
+        super().destroy()
+        if self._drag_rhs is not None:
+            self._drag_rhs.destroy()
