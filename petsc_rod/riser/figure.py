@@ -62,7 +62,7 @@ def draw_riser(figure, data):
     profile.legend()
     tension_axis.plot(S, data["tension"] / 1e3)
     tension_axis.set_xlabel("S (m)")
-    tension_axis.set_ylabel("effective tension n.d3 (kN)")
+    tension_axis.set_ylabel("effective tension n.t (kN)")
     tension_axis.set_title("effective tension")
     curvature = np.hypot(data["u"][:, 0], data["u"][:, 1])
     curvature_axis.plot(S, curvature)
