@@ -53,3 +53,23 @@ def test_the_mooring_line_balances_its_weight_clumps_and_seabed(tmp_path):
     vertical = w * 850.0 - forces[:, 2].sum() - np.trapz(reaction, S)
     assert abs((n[-1, 2] - n[0, 2]) - vertical) < 1e-4 * abs(n[-1, 2])
     assert abs(n[-1, 0] - n[0, 0]) < 1e-9 * abs(n[0, 0])       # no horizontal load
+
+
+def test_the_steel_riser_is_near_its_elastic_catenary(tmp_path):
+    """options/steel_catenary_riser.opts against the elastic catenary with touchdown of
+    its data (validation/elastic_catenary.py, no bending stiffness): the top tension to
+    2.4e-5 (measured), the shape to 2.2 cm (measured) 20 m away from the touchdown and
+    the ends: the pipe's EI = 2.7e7 N m^2 (a bending length of 6 m) is all that differs."""
+    from petsc_rod.validation.elastic_catenary import elastic_catenary
+    path = tmp_path / "scr.h5"
+    done = run_petsc_rod(["-options_file", "options/steel_catenary_riser.opts",
+                          "-rod_output", str(path)], 1, 600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        S, r, top = f["S"][:], f["r"][:], float(f.attrs["top_tension"])
+    weight = (162.07 - 1025 * np.pi * 0.2731**2 / 4) * 9.80665
+    line = elastic_catenary(2400.0, weight, 3.3826e9, 1600.0, 1500.0)
+    x, z, tension = line.at(S)
+    away = (np.abs(S - line.grounded) > 20.0) & (S > 20.0) & (S < 2380.0)
+    assert abs(top / tension[-1] - 1) < 5e-5
+    assert np.abs(r[away, 0] - x[away]).max() < 0.03 and np.abs(r[away, 2] - z[away]).max() < 0.03
