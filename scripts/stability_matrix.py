@@ -462,6 +462,15 @@ def cases():
               "end_position": "120,0,66", "seabed": 0, "initial_shape": "catenary",
               "end_rotational_stiffness": "1e6", "end_joint_axis": "0,0,1"},
              notes="no closed form; EI 2e4 to 2e7 N m^2 over the top 5 m"))
+    add(Case("lines", "80 m cable, 20 discrete buoyancy modules for its section",
+             {"line_types": LINE_TYPES, "sections": "bare:170.215", "elements": 340,
+              "point_loads": "scripts/matrix_buoyancy_modules.txt", "start": "pin",
+              "end": "pin", "end_position": "120,0,66", "seabed": 0,
+              "initial_shape": "catenary"},
+             notes="top tension 9320.97 N, 9320.02 N smeared (options/cable_80m.opts)"))
+    add(Case("lines", "mooring chain with three clump weights (options/mooring_chain.opts)",
+             {"options_file": "options/mooring_chain.opts"}, ranks=2,
+             notes="no closed form; EA 1.23e9 N, EI 1e3 N m^2"))
     return matrix
 
 
