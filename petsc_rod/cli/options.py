@@ -182,6 +182,11 @@ OPTIONS = [
            "the line from S = 0 as sections of -rod_line_types (m); they set the length, "
            "stiffness, weight and drag; elements shared out by length where not given",
            unit="text"),
+    Option("rod_contents_density", _real, 0.0, "rho_c",
+           "density of the pipe's contents, kg/m^3 (the internal pressure's head; the "
+           "contents' weight is in the line types' mass)", NON_NEGATIVE, "kg/m^3"),
+    Option("rod_internal_pressure", _real, 0.0, "p",
+           "internal pressure at the top (the higher held end), Pa", NON_NEGATIVE, "Pa"),
     # attachments (scenes/point_loads.py, physics/point_loads.py; docs/riser.md)
     Option("rod_point_loads", _string, None, "FILE",
            "attachments: a table with a header row naming its columns, s (arc length, m; "
@@ -210,8 +215,9 @@ OPTIONS = [
            "current profile: rows 'depth ux uy uz' (m, m/s), depths increasing, linear in "
            "between, constant beyond", unit="text"),
     Option("rod_sea_surface", _real, None, "z",
-           "height of the sea surface the profile's depths are measured from, m; default "
-           "the highest held end", unit="m"),
+           "height of the sea surface, m: the current profile's depths and the external "
+           "pressure of line types are measured from it; default the highest held end",
+           unit="m"),
     Option("rod_drag", _reals(3), None, "rho,Cd,D",
            "water density kg/m^3, normal drag coefficient, hydrodynamic diameter m: drag "
            "rho Cd D |v_n| v_n / 2 per metre", NON_NEGATIVE, "kg/m^3, 1, m"),

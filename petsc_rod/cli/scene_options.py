@@ -95,6 +95,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
                   water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
+    pressures_from_options(values, given, scene)
     check_taut(scene)
     check_applied_forces(scene, given)
     check_seabed_stiffness(scene, given)
@@ -164,6 +165,23 @@ def mesh_pieces(values, scene):
                               [count for _, _, count in entries], values["rod_elements"])
     ends = [scene.sections[0].start] + [section.end for section in scene.sections]
     return Pieces(ends, counts)
+
+
+def pressures_from_options(values, given, scene):
+    """Set the scene's sea surface (in its frame), contents density and internal
+    pressure (riser/pressures.py) for a line of sections; refuse them on a line without
+    line types (no diameters to press on)."""
+    if not scene.sections:
+        for name in ("rod_contents_density", "rod_internal_pressure"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
+                                    "id give the areas it presses on)")
+        return
+    surface = values["rod_sea_surface"]
+    if surface is not None:
+        scene.sea_surface = float(surface - scene.start_position[2])
+    scene.contents_density = float(values["rod_contents_density"])
+    scene.internal_pressure = float(values["rod_internal_pressure"])
 
 
 def check_taut(scene):
@@ -308,7 +326,8 @@ def current_from_options(values, given, surface_default, profile_rows=None,
         raise RodInputError("-rod_current and -rod_current_profile both give the current; "
                             "give one of them")
     if not (uniform or profile):
-        for name in ("rod_drag", "rod_sea_surface"):
+        names = ("rod_drag",) if section_drag is not None else ("rod_drag", "rod_sea_surface")
+        for name in names:
             if name in given:
                 raise RodInputError(f"-{name} needs a current (-rod_current or "
                                     "-rod_current_profile)")
@@ -316,9 +335,10 @@ def current_from_options(values, given, surface_default, profile_rows=None,
     if section_drag is None and "rod_drag" not in given:
         raise RodInputError("a current needs -rod_drag rho,Cd,D (water density kg/m^3, drag "
                             "coefficient, hydrodynamic diameter m)")
-    if "rod_sea_surface" in given and not profile:
+    if "rod_sea_surface" in given and not profile and section_drag is None:
         raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
-                            "current does not depend on depth)")
+                            "current does not depend on depth) or -rod_sections (the "
+                            "external pressure)")
     if profile and profile_rows is not None:
         depths, velocities = profile_rows
     elif profile:

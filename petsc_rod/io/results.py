@@ -44,7 +44,7 @@ from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
 from petsc_rod.physics import point_loads as point_load_term
 from petsc_rod.riser import quantities as riser_quantities
-from petsc_rod.riser import section_numbers
+from petsc_rod.riser import pressures, section_numbers
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -56,6 +56,7 @@ DATASET_UNITS = {
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
     **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
+    **pressures.DATASET_UNITS,
     **stretch.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
@@ -69,6 +70,7 @@ ATTRIBUTE_UNITS = {
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
+    **pressures.ATTRIBUTE_UNITS,
     **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
     **point_load_term.ATTRIBUTE_UNITS,
 }

@@ -8,6 +8,7 @@ from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
 from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.stretch import AxialStretch
+from petsc_rod.riser.pressures import PipePressures
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.section_numbers import SectionNumbers
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
@@ -31,4 +32,5 @@ def scene_terms(mesh, scene):
         terms.append(AxialStretch(mesh, scene))
     if scene.sections:
         terms.append(SectionNumbers(scene.sections))
+        terms.append(PipePressures(scene))
     return terms

@@ -20,7 +20,8 @@ class Section:
     stiffness_start, stiffness_end: (K1, K2, K3) at its two ends, N m^2 (equal unless
     tapered); axial_stiffness: EA, N (inf: inextensible); weight: the load per metre,
     N/m, (3,) (the submerged weight along -z); drag: c = rho Cd D / 2, kg/m^2, of the
-    normal Morison drag (0: none); od: outer diameter, m; mass: kg/m in air.
+    normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
+    mass: kg/m in air.
     """
 
     name: str
@@ -33,6 +34,7 @@ class Section:
     drag: float = 0.0
     od: float = np.nan
     mass: float = np.nan
+    id: float = 0.0
 
     def __post_init__(self):
         self.stiffness_start = np.asarray(self.stiffness_start, dtype=float)
@@ -75,7 +77,7 @@ def piecewise_constant(sections, S, name):
 
 # The columns of a line-type table (-rod_line_types): required, and optional.
 LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
-LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d")
+LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d", "id")
 # The ways of giving the bending stiffness, one per line type (the others' columns left
 # blank, '-'): isotropic, anisotropic (about d1 and d2), and a linear taper along each
 # section of the type.
@@ -88,7 +90,8 @@ class LineType:
     with contents (kg/m), bending stiffnesses about d1 and d2 at the start and end of
     each section of the type (``bending_start``, ``bending_end``, N m^2, equal unless
     tapered), torsional ``gj`` (N m^2), axial ``ea`` (N, inf: inextensible), normal drag
-    coefficient ``cd`` and hydrodynamic diameter ``drag_d`` (m)."""
+    coefficient ``cd``, hydrodynamic diameter ``drag_d`` (m) and inner diameter ``id``
+    (m, 0: no bore; the internal pressure's area, riser/pressures.py)."""
 
     name: str
     od: float
@@ -99,6 +102,7 @@ class LineType:
     ea: float = np.inf
     cd: float = 0.0
     drag_d: float = np.nan
+    id: float = 0.0
 
     def submerged_weight(self, water_density, gravity):
         """(mass - rho_w pi od^2 / 4) g, N/m: positive sinks, negative floats."""
@@ -111,7 +115,8 @@ class LineType:
                        np.append(self.bending_start, self.gj),
                        np.append(self.bending_end, self.gj), self.ea,
                        np.array([0.0, 0.0, -self.submerged_weight(water_density, gravity)]),
-                       0.5 * water_density * self.cd * self.drag_d, self.od, self.mass)
+                       0.5 * water_density * self.cd * self.drag_d, self.od, self.mass,
+                       self.id)
 
 
 def line_types_from_table(table, option):
@@ -150,6 +155,7 @@ def line_types_from_table(table, option):
                       table["od"])
     ea = np.where(np.isnan(column("ea", np.inf)), np.inf, column("ea", np.inf))
     cd = np.where(np.isnan(column("cd", 0.0)), 0.0, column("cd", 0.0))
+    inner = np.where(np.isnan(column("id", 0.0)), 0.0, column("id", 0.0))
     positive = {"od": table["od"], "mass": table["mass"], "gj": table["gj"], "ea": ea,
                 "drag_d": drag_d, "ei": np.minimum(start, end).min(axis=1)}
     for name, values in positive.items():
@@ -162,12 +168,17 @@ def line_types_from_table(table, option):
             row = int(np.flatnonzero(~np.isfinite(values))[0])
             raise RodInputError(f"{option}: line type {names[row]}: {name} must be finite "
                                 "(only ea may be inf: inextensible)")
+    bad = ~((inner >= 0) & (inner < table["od"]))
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise RodInputError(f"{option}: line type {names[row]}: id {inner[row]:g} must be "
+                            f"0 or more and below od {table['od'][row]:g} (m)")
     if not np.all((cd >= 0) & np.isfinite(cd)):
         row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
         raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
                             "finite number, 0 or more")
     return {name: LineType(name, table["od"][i], table["mass"][i], start[i], end[i],
-                           table["gj"][i], ea[i], cd[i], drag_d[i])
+                           table["gj"][i], ea[i], cd[i], drag_d[i], inner[i])
             for i, name in enumerate(names)}
 
 

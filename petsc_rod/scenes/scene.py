@@ -62,6 +62,12 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
+    # the pipe's pressures (riser/pressures.py; a line of sections): the sea surface's
+    # height in the solver's frame (m; None: the higher held end), the contents'
+    # density (kg/m^3) and the internal pressure at the top (Pa)
+    sea_surface: float = None
+    contents_density: float = 0.0
+    internal_pressure: float = 0.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
     # pinned end, 0 for none, and the neutral axis a its d3 is held to (unit; default e_x,
     # the reference tangent); fixed, not on the load path

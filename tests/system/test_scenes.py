@@ -73,3 +73,27 @@ def test_the_steel_riser_is_near_its_elastic_catenary(tmp_path):
     away = (np.abs(S - line.grounded) > 20.0) & (S > 20.0) & (S < 2380.0)
     assert abs(top / tension[-1] - 1) < 5e-5
     assert np.abs(r[away, 0] - x[away]).max() < 0.03 and np.abs(r[away, 2] - z[away]).max() < 0.03
+
+
+def test_the_steel_riser_s_wall_tension_against_a_hand_calculation(tmp_path):
+    """T_w = T_e + p_i A_i - p_e A_e (riser/pressures.py) on the steel riser with oil of
+    800 kg/m^3 at 10 MPa at the hang-off, at its two ends, by hand: at the anchor
+    (z = 0, 1500 m below the surface and the top) p_e = 1025 g 1500 = 15.08 MPa,
+    p_i = 10 MPa + 800 g 1500 = 21.77 MPa; at the top p_e = 0, p_i = 10 MPa."""
+    path = tmp_path / "scr.h5"
+    done = run_petsc_rod(["-options_file", "options/steel_catenary_riser.opts",
+                          "-rod_contents_density", "800", "-rod_internal_pressure", "1e7",
+                          "-rod_output", str(path)], 1, 600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        effective, wall = f["effective_tension"][:], f["wall_tension"][:]
+        external, internal = f["external_pressure"][:], f["internal_pressure"][:]
+        assert f["wall_tension"].attrs["units"] == "N"
+    g, outer, inner = 9.80665, 0.2731**2 * np.pi / 4, 0.2319**2 * np.pi / 4
+    assert external[0] == pytest.approx(1025 * g * 1500, rel=1e-12)
+    assert internal[0] == pytest.approx(1e7 + 800 * g * 1500, rel=1e-12)
+    assert external[-1] < 1e-6 and internal[-1] == pytest.approx(1e7, rel=1e-12)
+    by_hand = [effective[0] + (1e7 + 800 * g * 1500) * inner - 1025 * g * 1500 * outer,
+               effective[-1] + 1e7 * inner]
+    np.testing.assert_allclose([wall[0], wall[-1]], by_hand, rtol=1e-12)
+    assert 1.15 < wall[-1] / effective[-1] < 1.25          # 2.67 against 2.25 MN
