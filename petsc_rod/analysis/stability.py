@@ -71,7 +71,8 @@ def skew(v):
 class SecondVariation:
     """H of the module docstring at the state of a problem (problem/problem.py) at the
     last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
-    P2 nodes (3 per node, node n = 2 vertex + slot), with what the inertia test needs;
+    P2 nodes (3 per node, node n = 2 vertex + slot; 4 on an extensible line, the fourth
+    the stretch k), with what the inertia test needs;
     the problem's terms add their own curvature (Term.add_hessian). Collective;
     ``destroy()`` frees every PETSc object."""
 

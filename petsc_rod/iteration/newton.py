@@ -115,8 +115,9 @@ class NewtonPolish:
                 largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
                 if (self.stretch and not regularised and np.isfinite(previous)
                         and not largest <= SHRINK * previous):
-                    # a zero mode whose pivot round-off left positive: the step again
-                    # with H + tolerance M, and so on to the end of the attempt
+                    # a zero mode whose pivot round-off left positive (the roll of
+                    # K1 = K2 between pins): the step again with H + tolerance M, and so
+                    # on to the end of the attempt (_positive_definite)
                     regularised = True
                     omega, dmu = self._newton_step(frames, g, mu, regularised)
                     if omega is None:
@@ -266,7 +267,9 @@ class NewtonPolish:
         where round-off makes its pivot negative; otherwise the unshifted H is used, the
         step's component along that symmetry only turns the rod rigidly, and a step that
         does not shrink ends the attempt. Where the chord forms are dependent (a taut,
-        straight rod) H itself must be positive definite: a sufficient condition."""
+        straight rod) H itself must be positive definite: a sufficient condition.
+        ``regularised``: only the second test, and H + tolerance M for the solves (an
+        extensible line's attempt whose step did not shrink, ``run``)."""
         shifts = (-hessian.tolerance(),) if regularised else (0.0, -hessian.tolerance())
         for shift in shifts:
             if hessian.decidable:
