@@ -23,6 +23,19 @@ and the chord constraint is taken into account by the Schur complement,
 n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - 3 (C: its 3 columns).
 The plain iteration is a descent method and leaves a saddle by itself, slowly; an
 accelerated one may converge to it, hence this check.
+
+On an extensible line (docs/method.md §12) the unknowns of a node are (omega_n, k_n),
+k = 1 + eps its stretch, 4 per node: the fields are g = (d1, d2, k d3), the energy is
+E(g) + sum_n w_n EA_n eps_n^2 / 2, and a variation is delta g_i = omega x g_i +
+delta_k d3 delta_i3, to second order omega x (omega x g_i) / 2 + delta_k omega x d3
+delta_i3. So H gains the rows of k:
+
+    H[omega_a, k_b] = 2 a3 K_ab (g3_a x d3_b) - w_a (d3_a x lambda3_a) delta_ab,
+    H[k_a, k_b]     = 2 a3 K_ab d3_a.d3_b + w_a EA_a delta_ab   (AxialStretch.add_hessian),
+
+and the chord forms the columns w_n d3_n of delta int r' dS. The stretch of a clamped
+node (from the force balance, §12) and of a node with EA infinite is held: its row is
+replaced by the identity, as a clamped rotation is.
 """
 
 import numpy as np
@@ -44,6 +57,11 @@ GOLDEN = 0.5 * (1 + 5**0.5)
 RANK_TOLERANCE = 1e-12
 
 
+def unit(v):
+    """v / |v| along the last axis (the unit tangent d3 of a stretched one k d3)."""
+    return v / np.sqrt(np.einsum("...c,...c->...", v, v))[..., None]
+
+
 def skew(v):
     """Cross-product matrices [v]x with [v]x w = v x w: (..., 3) -> (..., 3, 3)."""
     out = np.zeros(v.shape + (3,))
@@ -56,7 +74,8 @@ def skew(v):
 class SecondVariation:
     """H of the module docstring at the state of a problem (problem/problem.py) at the
     last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
-    P2 nodes (3 per node, node n = 2 vertex + slot), with what the inertia test needs;
+    P2 nodes (3 per node, node n = 2 vertex + slot; 4 on an extensible line, the fourth
+    the stretch k), with what the inertia test needs;
     the problem's terms add their own curvature (Term.add_hessian). Collective;
     ``destroy()`` frees every PETSc object."""
 
@@ -64,10 +83,13 @@ class SecondVariation:
         self.problem = problem
         mesh = problem.mesh
         self.comm = mesh.comm
-        n_local = 3 * mesh.n_local_nodes
-        self.first_row = 6 * mesh.vertex_start
+        # unknowns per node: the rotation vector, and on an extensible line its stretch
+        self.stretch = getattr(problem, "axial", None) is not None
+        self.block = block = 4 if self.stretch else 3
+        n_local = block * mesh.n_local_nodes
+        self.first_row = 2 * block * mesh.vertex_start
         self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
-                                            nnz=(15, 6), comm=self.comm)
+                                            nnz=(5 * block, 2 * block), comm=self.comm)
         self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         self._clamped = self._clamped_rows()
         self._diagonal = self.matrix.createVecLeft()
@@ -113,13 +135,17 @@ class SecondVariation:
         # ghost exchange is collective, also on a rank that owns no element
         d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
                       for f in problem.state.frame_fields], axis=2)
+        B = self.block
         if ne:
             # 2 a_i times the unit K, or each field's K_{2 a_i} along a line of sections
             weights, stiffness = problem.coefficients.hessian_stiffness()
             blocks = self._element_blocks(d, weights, stiffness)
-            rows = (self.first_row + 3 * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
-            rows = (rows[:, :, None] + np.arange(3)).reshape(ne, 9).astype(PETSc.IntType)
-            self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 9, 9),
+            if self.stretch:                    # the slope's 2 a3 K, field 3's own
+                third = stiffness[2] if np.ndim(stiffness) == 4 else stiffness
+                blocks = self._stretch_blocks(d, weights[2], third, blocks)
+            rows = (self.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
+            rows = (rows[:, :, None] + np.arange(B)).reshape(ne, 3 * B).astype(PETSc.IntType)
+            self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 3 * B, 3 * B),
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
         tau, lam, w = problem.state.tau, problem.state.lam, problem.state.node_weights
@@ -127,8 +153,15 @@ class SecondVariation:
         dots = np.einsum("nik,nik->n", lam, tau)
         local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
                                      - dots[:, None, None] * np.eye(3))
-        rows = (self.first_row + 3 * np.arange(mesh.n_local_nodes)[:, None]
-                + np.arange(3)).astype(PETSc.IntType)
+        if self.stretch:
+            # (omega_n, k_n): -w_n d3_n x lambda3_n, d3 the unit tangent
+            coupling = -w[:, None] * np.cross(unit(tau[:, 2]), lam[:, 2])
+            local = np.concatenate([np.concatenate([local, coupling[:, :, None]], axis=2),
+                                    np.concatenate([coupling[:, None, :],
+                                                    np.zeros((len(w), 1, 1))], axis=2)],
+                                   axis=1)
+        rows = (self.first_row + B * np.arange(mesh.n_local_nodes)[:, None]
+                + np.arange(B)).astype(PETSc.IntType)
         if rows.size:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
         for term in problem.terms:
@@ -163,15 +196,54 @@ class SecondVariation:
         blocks *= stiffness[:, :, None, :, None]
         return blocks
 
+    @staticmethod
+    def _stretch_blocks(d, weight, stiffness, blocks):
+        """The element blocks with the stretch rows, (ne, 3, 4, 3, 4), from those of the
+        rotations ``blocks`` (ne, 3, 3, 3, 3): weight K_ab (g3_a x d3_b) in (omega_a, k_b),
+        its transpose, and weight K_ab d3_a.d3_b in (k_a, k_b), weight = 2 a3, for the
+        fields d (ne, node, director i, 3) whose third row is g3 = k d3."""
+        ne = d.shape[0]
+        g3 = d[:, :, 2, :]                                            # (ne, node, 3)
+        d3 = unit(g3)
+        out = np.zeros((ne, 3, 4, 3, 4))
+        out[:, :, :3, :, :3] = blocks
+        cross = np.cross(g3[:, :, None, :], d3[:, None, :, :])        # (ne, a, b, 3)
+        coupling = weight * stiffness[:, :, :, None] * cross
+        out[:, :, :3, :, 3] = coupling.transpose(0, 1, 3, 2)
+        out[:, :, 3, :, :3] = coupling.transpose(0, 2, 1, 3)
+        out[:, :, 3, :, 3] = weight * stiffness * np.matmul(d3, d3.transpose(0, 2, 1))
+        return out
+
+    def add_strain_diagonal(self, values):
+        """Add values (n_nodes,) to the diagonal of the stretch rows (a term's curvature
+        in k, AxialStretch.add_hessian), before assembly."""
+        rows = (self.first_row + self.block * np.arange(len(values)) + 3)[:, None]
+        if rows.size:
+            rows = rows.astype(PETSc.IntType)
+            self.matrix.setValuesRCV(rows, rows, np.asarray(values, float)[:, None, None],
+                                     addv=PETSc.InsertMode.ADD_VALUES)
+
     def _clamped_rows(self):
-        """Global rows of the rotation vectors at clamped nodes."""
+        """Global rows of the rotation vectors at clamped nodes (and, on an extensible
+        line, of the stretch held there and where EA is infinite)."""
         nodes = np.flatnonzero(~self.problem.free_nodes)
-        return (self.first_row + 3 * nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+        B = self.block
+        rows = (self.first_row + B * nodes[:, None] + np.arange(B)).ravel()
+        if self.stretch:
+            held = np.flatnonzero(~np.isfinite(self.problem.axial) & self.problem.free_nodes)
+            rows = np.sort(np.concatenate([rows, self.first_row + B * held + 3]))
+        return rows.astype(PETSc.IntType)
 
     def chord_forms(self, tangents):
         """The 3 linear forms omega -> sum_n w_n (omega_n x t_n)_k, the first variation of
-        the chord int r' dS at tangents t (n_nodes, 3), as Vecs (zero at clamped rows)."""
-        forms = -self.problem.state.node_weights[:, None, None] * skew(tangents)   # (n, k, 3)
+        the chord int r' dS at tangents t (n_nodes, 3), as Vecs (zero at clamped rows);
+        on an extensible line t = k d3 and the forms have the stretch columns
+        delta_k -> sum_n w_n delta_k_n d3_n."""
+        w = self.problem.state.node_weights
+        forms = -w[:, None, None] * skew(tangents)                     # (n, k, 3)
+        if self.stretch:
+            forms = np.concatenate([forms, (w[:, None] * unit(tangents))[:, :, None]],
+                                   axis=2)                              # (n, k, 4)
         columns = []
         for k in range(3):
             vec = self.matrix.createVecLeft()
@@ -206,7 +278,7 @@ class SecondVariation:
         """The lumped mass diag(w_n) on each rotation component (0 at the clamped rows,
         whose unit diagonal no shift moves), as a Vec."""
         vec = self.matrix.createVecLeft()
-        vec.getArray()[:] = np.repeat(self.problem.state.node_weights, 3)
+        vec.getArray()[:] = np.repeat(self.problem.state.node_weights, self.block)
         self._zero_clamped(vec)
         return vec
 
@@ -277,6 +349,10 @@ class SecondVariation:
         """TOLERANCE times max_i |H_ii| / M_ii: an eigenvalue of H / M above -tolerance
         is zero to round-off (the free roll of a section with K1 = K2 between pins)."""
         self._work.pointwiseDivide(self._diagonal, self._mass_or_one)
+        if self.stretch:
+            # the rotations' rows: EA w on the stretch rows is no scale of a buckling mode
+            ratios = np.abs(self._work.getArray(readonly=True).reshape(-1, self.block)[:, :3])
+            return TOLERANCE * self.problem.mesh.global_max(float(ratios.max(initial=0.0)))
         return TOLERANCE * self._work.norm(PETSc.NormType.INFINITY)
 
     def lower_bound(self):
@@ -289,7 +365,8 @@ class SecondVariation:
         return self.problem.mesh.global_min(float(bound.min(initial=0.0)))
 
     def descent_direction(self):
-        """A unit rotation-vector field of negative curvature, (n_nodes, 3), or None when
+        """A unit rotation-vector field of negative curvature, (n_nodes, 3) (on an
+        extensible line (n_nodes, 4): the rotation vector and the stretch k), or None when
         H has no eigenvalue below -tolerance() on the constraint set. The lowest
         eigenvalue is bracketed by bisection on the inertia between the Gershgorin bound
         and -tolerance to within a factor 2, and inverse iteration at the lower end
@@ -317,7 +394,7 @@ class SecondVariation:
             work.copy(vector)
             vector.scale(1.0 / vector.norm())
         self._project(vector)
-        direction = vector.getArray().reshape(-1, 3).copy()
+        direction = vector.getArray().reshape(-1, self.block).copy()
         vector.destroy()
         work.destroy()
         return direction

@@ -264,7 +264,8 @@ OPTIONS = [
     Option("rod_al_stability", _bool, default_of(Settings, "check_stability"), "bool",
            "at each converged step, test the second variation of the energy (Sylvester "
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
-           "not with a current (its drag has no energy), nor on an extensible line"),
+           "not with a current (its drag has no energy); on an extensible line the strains "
+           "are unknowns of it too"),
     Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
            f"{NEWTON_SWITCH:g} and more than {NEWTON_WORTH} iterations would remain at the "
@@ -272,7 +273,8 @@ OPTIONS = [
            "system of the energy's second variation), taken only where it is positive "
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once; after a failed attempt the wait "
-           "doubles; not with a seabed or a current, nor on an extensible line"),
+           "doubles; not with a seabed or a current (on an extensible line the strains are "
+           "Newton unknowns too)"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",

@@ -168,9 +168,12 @@ class UzawaSolver:
 
     def _turn(self, angle, direction):
         """Turn the frames along ``direction`` (n_nodes, 3), a direction of negative
-        curvature, the largest node by ``angle`` rad (RodState.turn_frames)."""
+        curvature, the largest node by ``angle`` rad (RodState.turn_frames); on an
+        extensible line (n_nodes, 4), the stretch moved along its fourth column in
+        proportion."""
         problem = self.problem
-        largest = problem.mesh.global_max(float(np.linalg.norm(direction, axis=1).max(initial=0.0)))
+        largest = problem.mesh.global_max(float(np.linalg.norm(direction[:, :3], axis=1)
+                                                .max(initial=0.0)))
         problem.state.turn_frames(angle * direction / largest)
 
     def _polish(self, step):

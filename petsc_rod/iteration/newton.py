@@ -27,12 +27,28 @@ never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up
 Uzawa iteration goes on from where it was. On success the state is handed back as a
 fixed point of the Uzawa iteration: tau = d and lambda = -g / w, so that the next
 iteration (whose tests decide convergence, as always) moves it only by round-off.
+
+On an extensible line (docs/method.md §12) the fields are g = (d1, d2, k d3), k = 1 + eps
+the stretch of each node, and what the Uzawa fixed point is stationary for is
+
+    F(d, k) = sum_i a_i g_i^T K g_i - b . g3 + sum_n w_n EA_n eps_n^2 / 2,
+
+on sum_n w_n k_n d3_n = r(L) - r(0) when both ends are held: the global step gives
+dE/dg = -w lambda, the local step's stationarity in k gives lambda3.d3 = EA eps, in the
+rotation sum_i g_i x lambda_i = 0. So each node has 4 unknowns, (omega_n, delta k_n),
+the frames turn as above and k <- k + delta k; the gradient in k is
+d3 . g3-gradient of L + w EA eps (Term.add_strain_gradient), H that of
+analysis/stability.py with its stretch rows, and the chord forms gain the columns
+w_n d3_n. The hand-over is the same with tau = g (the stretched targets (tau1, tau2,
+k tau3) the state keeps) and lambda = -g-gradient / w (without the axial term: the
+tension is lambda3.d3 = EA eps at the solution). The stretch of a clamped node (the
+force balance's, §12) and of a node with EA infinite is held.
 """
 
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.analysis.stability import skew
+from petsc_rod.analysis.stability import skew, unit
 from petsc_rod.frames import rotations
 
 EVENT = PETSc.Log.Event("rod_newton")
@@ -63,6 +79,11 @@ class NewtonPolish:
         self.problem = problem
         self._product = problem.field_stiffness(0)[1].createVecLeft()
         self._free = problem.free_nodes
+        # an extensible line: the stretch k is an unknown of each node but where it is
+        # held (a clamp's, from the force balance; EA infinite)
+        self.stretch = getattr(problem, "axial", None) is not None
+        self._held_stretch = (~self._free | ~np.isfinite(problem.axial)) if self.stretch \
+            else None
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite: the stability test's verdict, at 1e-10 rad from the result
         self.verified = False
@@ -84,22 +105,39 @@ class NewtonPolish:
         mu = None
         previous = np.inf
         outcome = FAILED
+        regularised = False
         try:
             for _ in range(MAX_STEPS):
                 state.set_node_directors(frames)
                 g = problem.energy_gradient(self._product)
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
-                omega, dmu = self._newton_step(frames, g, mu)
+                omega, dmu = self._newton_step(frames, g, mu, regularised)
                 if omega is None:
                     outcome = INDEFINITE
                     break
                 largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
+                if (self.stretch and not regularised and np.isfinite(previous)
+                        and not largest <= SHRINK * previous):
+                    # a zero mode whose pivot round-off left positive (the roll of
+                    # K1 = K2 between pins): the step again with H + tolerance M, and so
+                    # on to the end of the attempt (_positive_definite)
+                    regularised = True
+                    omega, dmu = self._newton_step(frames, g, mu, regularised)
+                    if omega is None:
+                        outcome = INDEFINITE
+                        break
+                    largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
                 if not np.isfinite(largest) or largest > SHRINK * previous:
                     if np.isfinite(largest) and previous <= FLOOR_TURN:
                         self._hand_over(frames, mu)
                         return CONVERGED
                     break
-                frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
+                if self.stretch:
+                    frames = self._stretched(frames, omega)
+                    if frames is None:
+                        break
+                else:
+                    frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
                 mu = mu + dmu
                 previous = largest
                 if record is not None:
@@ -113,6 +151,29 @@ class NewtonPolish:
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
+    @staticmethod
+    def _stretched(frames, step):
+        """Frames (rows d1, d2, k d3) turned by step[:, :3] and stretched by k += step[:, 3];
+        None where a stretch would not stay positive (the attempt fails)."""
+        turned = np.einsum("nkl,nil->nik", rotations(step[:, :3]), frames)
+        k = np.sqrt(np.einsum("nc,nc->n", turned[:, 2], turned[:, 2]))
+        new = k + step[:, 3]
+        if not np.all(new > 0):
+            return None
+        turned[:, 2] *= (new / k)[:, None]
+        return turned
+
+    def _strain_gradient(self, frames, g):
+        """dL/dk at the nodes, (n_nodes,): d3 . g3-gradient (its chord share included) and
+        the terms' (w EA eps), 0 where the stretch is held."""
+        tangent = frames[:, 2]
+        k = np.sqrt(np.einsum("nc,nc->n", tangent, tangent))
+        gradient = np.einsum("nc,nc->n", tangent / k[:, None], g[:, 2])
+        for term in self.problem.terms:
+            term.add_strain_gradient(gradient, self.problem.state.node_weights, k - 1.0)
+        gradient[self._held_stretch] = 0.0
+        return gradient
+
     def _bordered(self):
         return self.problem.bordered
 
@@ -126,21 +187,26 @@ class NewtonPolish:
         a = np.cross(frames, g).sum(axis=1)
         A = w[:, None, None] * skew(frames[:, 2])          # w d3 x mu = A mu
         free = self._free
+        if self.stretch:
+            # the stretch's equations d3.(g3 + w mu) + w EA eps = 0 as well: they fix the
+            # tangential part of mu that the rotations' leave free (a straight taut line)
+            a = np.concatenate([a, self._strain_gradient(frames, g)[:, None]], axis=1)
+            row = w[:, None] * unit(frames[:, 2])
+            row[self._held_stretch] = 0.0
+            A = np.concatenate([A, row[:, None, :]], axis=1)
         normal = np.einsum("nki,nkj->ij", A[free], A[free])
         right = -np.einsum("nki,nk->i", A[free], a[free])
         total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
         return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
 
-    def _newton_step(self, frames, g, mu):
+    def _newton_step(self, frames, g, mu, regularised=False):
         """(omega (n_nodes, 3), dmu (3,)) of the KKT system, or (None, None) where H is
         not positive definite on the constraint set."""
-        g = self._set_multipliers(frames, g, mu)
-        gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
-        gradient[~self._free] = 0.0
+        gradient = self._gradient(frames, g, mu)
         hessian = self.problem.second_variation()
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
-            if not self._positive_definite(hessian):
+            if not self._positive_definite(hessian, regularised):
                 return None, None
             self.verified = hessian.decidable
             rhs = hessian.matrix.createVecLeft()
@@ -163,13 +229,36 @@ class NewtonPolish:
                                                                  for c in columns])
                 dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
                 direction.maxpy(-dmu, solved)
-            return direction.getArray().reshape(-1, 3).copy(), dmu
+            return direction.getArray().reshape(-1, hessian.block).copy(), dmu
         finally:
             for vec in vecs:
                 vec.destroy()
 
+    def _gradient(self, frames, g, mu):
+        """grad L at ``frames`` (n_nodes, 3), or (n_nodes, 4) with d/dk on an extensible
+        line, 0 where held, from the fields' gradient g (without the chord's share) and
+        the chord multiplier mu; tau and lambda are set to the frames and -g / w, the
+        state H is assembled at (_set_multipliers)."""
+        g = self._set_multipliers(frames, g, mu)
+        gradient = np.cross(frames, g).sum(axis=1)           # grad_n L, (n, 3)
+        if self.stretch:                                     # (n, 4) with d/dk
+            gradient = np.concatenate([gradient, self._strain_gradient(frames, g)[:, None]],
+                                      axis=1)
+        gradient[~self._free] = 0.0
+        return gradient
+
+    def lagrangian_gradient(self, frames, mu):
+        """grad L of the module docstring at ``frames`` (rows d1, d2, k d3 at the owned
+        nodes) and chord multiplier mu (3,) (ignored when the chord is free), as the
+        Newton steps see it, with the state set there (fields, tau = frames, lambda =
+        -g / w): ``problem.second_variation()`` then assembles H at the same point (the
+        tests compare both with finite differences of the energy)."""
+        self.problem.state.set_node_directors(frames)
+        g = self.problem.energy_gradient(self._product)
+        return self._gradient(frames, g, mu if self._bordered() else np.zeros(3))
+
     @staticmethod
-    def _positive_definite(hessian):
+    def _positive_definite(hessian, regularised=False):
         """Whether H is positive definite on the constraint set (its inertia, §10), with
         the matrix the solves use factored: H itself where its inertia shows no negative
         eigenvalue, so that the steps are exact Newton steps. Where it does, the test is
@@ -181,8 +270,11 @@ class NewtonPolish:
         where round-off makes its pivot negative; otherwise the unshifted H is used, the
         step's component along that symmetry only turns the rod rigidly, and a step that
         does not shrink ends the attempt. Where the chord forms are dependent (a taut,
-        straight rod) H itself must be positive definite: a sufficient condition."""
-        for shift in (0.0, -hessian.tolerance()):
+        straight rod) H itself must be positive definite: a sufficient condition.
+        ``regularised``: only the second test, and H + tolerance M for the solves (an
+        extensible line's attempt whose step did not shrink, ``run``)."""
+        shifts = (-hessian.tolerance(),) if regularised else (0.0, -hessian.tolerance())
+        for shift in shifts:
             if hessian.decidable:
                 negative = hessian.negative_directions(shift)
             else:
@@ -227,9 +319,23 @@ class NewtonPolish:
         """The R above which the handed-over state is a fixed point of the Uzawa map:
         the local step returns tau = P(R tau + lambda) = P(tau (R I + tau^T lambda))
         only if R I + tau^T lambda (symmetric at a solution) is positive definite at
-        every node, i.e. R > the largest -eig(sym(tau_n^T lambda_n)), N."""
+        every node, i.e. R > the largest -eig(sym(tau_n^T lambda_n)), N.
+
+        On an extensible line (tau rows d1, d2, k d3) the stretched local step's polar
+        factor of (b1, b2, k b3) = (R diag(1, 1, k^2) + diag(1, 1, k) P) D, P_ij =
+        lambda_i.d_j, is D if R diag(1, 1, k^2) + sym(diag(1, 1, k) P) is positive
+        definite: R > -eig of that symmetric part scaled by diag(1, 1, 1/k) on both
+        sides; its k is then the same (lambda3.d3 = EA eps)."""
         state = self.problem.state
         product = np.einsum("nik,nil->nkl", state.lam, state.tau)
+        if self.stretch:
+            k = np.sqrt(np.einsum("nc,nc->n", state.tau[:, 2], state.tau[:, 2]))
+            frames = state.tau.copy()
+            frames[:, 2] /= k[:, None]
+            scale = np.ones((len(k), 3))
+            scale[:, 2] = 1.0 / k
+            product = np.einsum("nak,nkl,nbl->nab", frames, product, frames) \
+                * scale[:, :, None] * scale[:, None, :]
         lowest = np.linalg.eigvalsh(0.5 * (product + product.transpose(0, 2, 1)))[:, 0]
         return self.problem.mesh.global_max(float(-lowest.min(initial=0.0)))
 

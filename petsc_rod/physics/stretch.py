@@ -12,9 +12,12 @@ Outputs: the strain eps and the tension EA eps at the vertices (datasets
 largest gap between EA eps and n.t of the force balance, t = r'/|r'| (attributes
 ``stretched_length``, ``axial_tension_gap``, relative to the largest |n|).
 
-Not in the Newton steps (in_newton False: their unknowns are the frames alone), nor
-in the stability test (conservative False: the second variation of §10 has no strain
-unknowns), so an extensible step's stability is not tested (file ``stable`` = -1).
+In the Newton steps (§11) and the stability test (§10) the strain is an unknown of each
+node beside its rotation (analysis/stability.py, iteration/newton.py): this term adds
+its curvature w EA to the stretch rows of H (``add_hessian``). Its gradient is not one in
+the fields g (the Uzawa multiplier lambda = -dE/dg / w leaves it out: the local step,
+not the global one, carries EA eps): the Newton steps add w EA eps to the gradient in k
+through ``add_strain_gradient``.
 """
 
 import numpy as np
@@ -30,8 +33,6 @@ class AxialStretch(Term):
     """EA eps^2 / 2 per metre of unstretched line, for a Scene with a finite EA on a
     Mesh. EA at the owned nodes, N, (n_nodes,); inf (inextensible parts): eps = 0."""
 
-    conservative = False        # its energy is not in the second variation (§10) yet
-    in_newton = False           # eps is not a Newton unknown (§11) yet
     axially_symmetric = True    # a turn about the x axis leaves |tau3| unchanged
 
     def __init__(self, mesh, scene):
@@ -42,6 +43,17 @@ class AxialStretch(Term):
     def node_strain(self, state):
         """eps at the owned nodes (n_nodes,), 0 where EA is infinite."""
         return np.where(self.finite, state.strain(), 0.0)
+
+    def add_strain_gradient(self, gradient, weights, eps):
+        """Add d/dk of sum_n w_n EA_n eps_n^2 / 2, w EA eps (N m; 0 where EA is infinite),
+        at the strains eps (n_nodes,), k = 1 + eps, into ``gradient`` (n_nodes,)."""
+        gradient += np.where(self.finite, weights * np.where(self.finite, self.axial, 0.0)
+                             * eps, 0.0)
+
+    def add_hessian(self, hessian):
+        """w_n EA_n on the stretch rows of H (0 where EA is infinite: those rows are held)."""
+        hessian.add_strain_diagonal(np.where(self.finite, hessian.problem.state.node_weights
+                                             * np.where(self.finite, self.axial, 0.0), 0.0))
 
     def energy(self, state):
         """sum_n w_n EA_n eps_n^2 / 2, J. Collective."""
@@ -69,5 +81,4 @@ class AxialStretch(Term):
             datasets={"axial_strain": vertex_eps, "axial_tension": tension},
             attributes={"stretched_length": float(stretched),
                         "axial_tension_gap": float(gap / size) if size > 0 else 0.0},
-            text=f"stretch max |eps| {largest:.3g}, length {stretched:.10g} m, stability not "
-                 "tested")
+            text=f"stretch max |eps| {largest:.3g}, length {stretched:.10g} m")

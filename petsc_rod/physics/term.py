@@ -19,7 +19,7 @@ When each is called:
   slope, for the components of ``slope_components``;
 * the energy and its derivatives (problem.energy, problem.energy_gradient, the Newton
   steps of §11 and the second variation of §10): ``energy``, ``add_gradient``,
-  ``add_hessian``; ``conservative`` and ``in_newton`` say whether they are the term's
+  ``add_strain_gradient``, ``add_hessian``; ``conservative`` and ``in_newton`` say whether they are the term's
   whole contribution;
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
   force n(S), ``outputs`` for datasets, attributes and the step line.
@@ -103,6 +103,12 @@ class Term:
     def add_gradient(self, g, state):
         """Add dE_term / dd_i at the owned P2 nodes into g (n_nodes, 3 directors, 3), the
         fields of ``state`` being the frames (iteration/newton.py)."""
+
+    def add_strain_gradient(self, gradient, weights, eps):
+        """On an extensible line (docs/method.md §12): add the derivative of E_term in the
+        stretch k = 1 + eps of each owned P2 node, beyond what it gives through the fields
+        g3 = k d3, into ``gradient`` (n_nodes,), N m; ``weights`` the node weights w_n, m,
+        and eps the strains (n_nodes,) (the axial energy, physics/stretch.py)."""
 
     def add_hessian(self, hessian):
         """Add the second derivative of E_term in the directors, beyond what its gradient

@@ -113,10 +113,15 @@ class RodState:
 
     def turn_frames(self, omega):
         """Turn tau and lambda at each node by exp([omega_n]x), omega (n_nodes, 3):
-        rows t_i -> Q t_i (leaving a saddle, docs/method.md §10)."""
-        turn = rotations(omega)
+        rows t_i -> Q t_i (leaving a saddle, docs/method.md §10). On an extensible line
+        omega may be (n_nodes, 4): its last column moves the stretch, k -> k + omega_n3
+        (kept above k / 2: the line is not turned inside out), i.e. tau3 scaled."""
+        turn = rotations(omega[:, :3])
         self.tau[:] = np.einsum("nkl,nil->nik", turn, self.tau)
         self.lam[:] = np.einsum("nkl,nil->nik", turn, self.lam)
+        if omega.shape[1] == 4:
+            k = 1.0 + self.strain()
+            self.tau[:, 2] *= (np.maximum(k + omega[:, 3], 0.5 * k) / k)[:, None]
 
     def canonical_angle(self):
         """The angle (rad) of the turn about e_x that takes this state to the canonical

@@ -79,7 +79,11 @@ TAUT = dict(length=1.0, stiffness=(1e-3, 1e-3, 1e-3), start="pin", end="pin",
 
 @pytest.fixture(scope="module")
 def taut(comm):
-    return solve(comm, TAUT, 16, steps=(0.5, 1.0))
+    # two steps, both taut (ends 1.009 and 1.0488 m apart). At load factor 0.5 the pins
+    # are 0.987 m apart: the straight bar in compression is a saddle, which the stability
+    # test leaves, and the buckled bar (K = 1e-3 N m^2 against the taut line's default
+    # R = 244 N) is not reached in 20000 iterations (test_stretch_newton.py (e))
+    return solve(comm, TAUT, 16, steps=(0.75, 1.0))
 
 
 def test_taut_bar_has_the_tension_of_its_stretch(taut):
