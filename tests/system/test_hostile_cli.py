@@ -125,6 +125,28 @@ def test_a_flex_joint_that_cannot_be_exits_2_with_one_line(tmp_path, args, words
                                      path)
 
 
+LINE_TYPES = "name od mass ei gj ea\nbare 0.16 36.7 1.99e4 1.99e4 4.69e8\n"
+
+
+@pytest.mark.parametrize("table, args, words", [
+    (LINE_TYPES, ["-rod_sections", "bare:100,pipe:20"], ["unknown line type 'pipe'"]),
+    (LINE_TYPES, ["-rod_sections", "bare:100", "-rod_length", "90"],
+     ["-rod_sections add up to 100 m"]),
+    (LINE_TYPES.replace("4.69e8", "0"), ["-rod_sections", "bare:100"], ["ea 0 must be"]),
+    ("name od ei gj\nbare 0.16 1 1\n", ["-rod_sections", "bare:100"], ["no column mass"]),
+    (LINE_TYPES, ["-rod_sections", "bare:100", "-rod_point_load", "120,0,0,-5"],
+     ["beyond the line"]),
+], ids=["unknown type", "lengths disagree", "zero ea", "missing column", "point beyond"])
+def test_bad_line_types_exit_2_with_one_line(tmp_path, table, args, words):
+    """Issue 22: each bad line-type input ends in one line, exit 2, no file."""
+    types, path = tmp_path / "types.txt", tmp_path / "out.h5"
+    types.write_text(table)
+    done = run(["-rod_line_types", str(types), "-rod_start", "pin", "-rod_end", "pin",
+                "-rod_end_position", "60,0,60"] + args + ["-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
 def test_a_mesh_too_large_for_the_machine_is_refused_before_allocating(tmp_path):
     clock = time.monotonic()
     done = run(["-rod_elements", "1000000000", "-rod_output", str(tmp_path / "big.h5")])
