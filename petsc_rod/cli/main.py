@@ -18,7 +18,8 @@ from petsc_rod.io import outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
-from petsc_rod.mesh.mesh import Mesh, end_element_lengths, fewest_elements, largest_grading
+from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
+                                 fewest_elements, largest_grading)
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type, format_value,
                                    help_text, read_options, unused_options)
@@ -36,9 +37,6 @@ from petsc_rod.problem.problem import RodProblem
 # How long the ranks wait for each other after a PETSc error before taking it for one
 # rank's alone, s.
 FAILURE_WAIT = 10.0
-# The smallest element, relative to the length, whose end coordinates double precision
-# still tells apart to many digits.
-MIN_RELATIVE_ELEMENT = 1e-12
 
 
 def options_record():
@@ -70,7 +68,7 @@ def run(comm=None):
                     say(line)
             scene = scene_from_options(values, given)
             settings = settings_from_options(values, scene)
-            pieces = mesh_pieces(values, scene)
+            pieces = mesh_pieces(values, scene, given)
             if pieces is not None:          # the sections' elements, every section end a vertex
                 values["rod_elements"] = int(pieces.counts.sum())
             check_mesh(comm, values)

@@ -53,6 +53,12 @@ def _real(text):
     return float(_checked_reals(np.array([float(text)]))[0])
 
 
+def _real_or_inf(text):
+    """A real number as _real, or +inf (a stiffness "infinite": the rigid limit)."""
+    value = float(text)
+    return value if value == np.inf else _real(text)
+
+
 def _reals(count=None):
     def parse(text):
         values = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
@@ -132,7 +138,7 @@ OPTIONS = [
            (lambda v: v >= 1, "must be >= 1")),
     Option("rod_stiffness", _reals(3), np.ones(3), "K1,K2,K3",
            "bending (about d1, d2) and torsion stiffness, N m^2", SCALE, "N m^2"),
-    Option("rod_axial_stiffness", _real, default_of(Scene, "axial_stiffness"), "EA",
+    Option("rod_axial_stiffness", _real_or_inf, default_of(Scene, "axial_stiffness"), "EA",
            "axial stiffness EA, N: the centreline stretches, r' = (1 + eps) d3, with energy "
            "EA eps^2 / 2 per metre of unstretched line (docs/method.md §12); default inf, "
            "inextensible", SCALE, "N"),

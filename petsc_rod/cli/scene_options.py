@@ -152,18 +152,32 @@ def sections_from_options(values, given, content=None):
             for k, (name, _, _) in enumerate(entries)]
 
 
-def mesh_pieces(values, scene):
+def mesh_pieces(values, scene, given=()):
     """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
     vertex, with the element counts -rod_sections gives and the rest of -rod_elements
-    shared out by length; None for a line without sections."""
-    from petsc_rod.mesh.mesh import Pieces
+    shared out by length; None for a line without sections. A -rod_elements (in
+    ``given``) that disagrees with counts given for every section is refused, and so is
+    an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
+    from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
     from petsc_rod.scenes.line import parse_sections, section_elements
     if not scene.sections:
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")
-    counts = section_elements([length for _, length, _ in entries],
-                              [count for _, _, count in entries], values["rod_elements"])
+    counts = [count for _, _, count in entries]
+    if "rod_elements" in given and all(c is not None for c in counts) \
+            and sum(counts) != values["rod_elements"]:
+        raise RodInputError(
+            f"-rod_elements {values['rod_elements']}: -rod_sections gives every section "
+            f"its elements, {sum(counts)} in all; drop -rod_elements or a section's count")
+    counts = section_elements([length for _, length, _ in entries], counts,
+                              values["rod_elements"])
     ends = [scene.sections[0].start] + [section.end for section in scene.sections]
+    smallest = float(np.min(np.diff(ends) / counts))
+    if not smallest >= MIN_RELATIVE_ELEMENT * scene.length:
+        raise RodInputError(
+            f"-rod_sections: an element of {smallest:.3g} m is {smallest / scene.length:.2g} "
+            f"of the length, below what double precision resolves ({MIN_RELATIVE_ELEMENT:g}); "
+            "lengthen the shortest section or give it fewer elements")
     return Pieces(ends, counts)
 
 

@@ -11,9 +11,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from petsc_rod.mesh.elements import p2_basis, p2_integrals
-from petsc_rod.frames import strains
-
 
 def vertex_strains(problem, moments=False):
     """u = (u1, u2, u3) at the owned vertices, (n_owned, 3): the mean of the limits
@@ -24,16 +21,10 @@ def vertex_strains(problem, moments=False):
     mesh, scene = problem.mesh, problem.scene
     first, end = mesh.elements_around_owned_vertices()
     elements = np.arange(first, end)
-    left = mesh.coordinates(elements)
-    h = mesh.coordinates(elements + 1) - left
-    ends = np.array([0.0, 1.0])
-    values = problem.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
-                                    p2_integrals(ends, h))
-    u = strains(values["directors"], values["derivatives"])       # (ne, 2 ends, 3)
+    S, u = problem.end_strains(elements)                            # (ne, 2 ends, 3)
     sided = [u]
     if moments:
-        S = left[:, None] + ends[None, :] * h[:, None]
-        middle = np.broadcast_to((left + h / 2)[:, None], S.shape)
+        middle = np.broadcast_to(S.mean(axis=1)[:, None], S.shape)
         sided.append(scene.stiffness_at(S, inside=middle) * u)
     n_owned = mesh.vertex_end - mesh.vertex_start
     totals = [np.zeros((n_owned, 3)) for _ in sided]

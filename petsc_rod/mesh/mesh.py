@@ -12,6 +12,10 @@ vertex's slot 1 is a phantom dof, pinned to zero in the matrices
 import numpy as np
 from petsc4py import PETSc
 
+# The smallest element, relative to the length, whose end coordinates double precision
+# still tells apart to many digits.
+MIN_RELATIVE_ELEMENT = 1e-12
+
 
 def _x_minus_sin(x):
     """x - sin x for 0 <= x <= pi, to round-off relative to the result: the Taylor series

@@ -160,6 +160,20 @@ class RodProblem:
                 tangent *= stretch[j] / np.linalg.norm(tangent)
         self.global_step.set_clamp_stretch(*stretch)
 
+    def end_strains(self, elements):
+        """The one-sided strains at both ends of the given global ``elements`` (their
+        dofs in this rank's ghosted vectors): (S (ne, 2), m, u (ne, 2, 3), 1/m), each
+        element's own limit (u jumps across elements where the stiffness jumps at a
+        section end, and by the discretisation elsewhere)."""
+        mesh = self.mesh
+        left = mesh.coordinates(elements)
+        h = mesh.coordinates(elements + 1) - left
+        ends = np.array([0.0, 1.0])
+        values = self.state.evaluate(elements - mesh.ghost_start, p2_basis(ends, h),
+                                     p2_integrals(ends, h))
+        S = left[:, None] + ends[None, :] * h[:, None]
+        return S, strains(values["directors"], values["derivatives"])
+
     def norms(self):
         """The change and RMS constraint residual of the last iteration, relative to the
         size of the deformation (§6, RodState.norms: a state.Norms; one allreduce)."""

@@ -13,8 +13,10 @@ and the internal pressure p_i = p_top + rho_c g (z_top - z) of contents of densi
 (-rod_contents_density) at p_top at the top, the higher held end (-rod_internal_pressure).
 Sources: C. P. Sparks, "The influence of tension, pressure and weight on pipe and riser
 deformations and stresses", J. Energy Resour. Technol. 106 (1984) 46-54; API RP 2RD
-(1998) §4.3; DNV-OS-F201 (2010) Sec. 4 B 300. Output only: the equilibrium (and the axial
-strain, EA eps = T_e, docs/method.md §12) is not changed by it.
+(1998) §4.3; DNV-OS-F201 (2010) Sec. 4 B 300. Output only: the equilibrium is not
+changed by it, and the axial strain stays EA eps = T_e (docs/method.md §12), exact for
+a Poisson's ratio of 1/2 only (the pipe's strain is T_e + (1 - 2 nu)(p_i A_i - p_e A_e)
+over EA; docs/riser.md §2b).
 """
 
 import numpy as np

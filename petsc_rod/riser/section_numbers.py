@@ -27,7 +27,9 @@ class SectionNumbers(Term):
         self.sections = tuple(sections)
 
     def outputs(self, problem, vertex):
-        return section_report(problem.mesh, self.sections, vertex)
+        mesh = problem.mesh
+        owned = np.arange(mesh.element_start, mesh.element_end)
+        return section_report(mesh, self.sections, vertex, problem.end_strains(owned))
 
 
 def _largest_per_section(values, S, sections):
@@ -55,15 +57,32 @@ def _combine(comm, local):
     return every[pick, np.arange(every.shape[1])]
 
 
-def section_report(mesh, sections, vertex):
+def section_report(mesh, sections, vertex, element_ends=None):
     """A TermOutput: the dataset ``section`` (the index of each vertex's section, the
     later one at an end), the attributes of ATTRIBUTE_UNITS and a phrase per section for
-    the step line. Collective."""
+    the step line. The curvature of a section is taken from its own elements' one-sided
+    strains ``element_ends`` (RodProblem.end_strains: S (ne, 2), u (ne, 2, 3)),
+    so that a stiff section next to a soft one is not charged with the soft one's
+    curvature at their common vertex (the vertex strain is the mean of both sides); from
+    the vertex strains where they are not given. Collective."""
     S = vertex["S"]
     tension = effective_tension(vertex)
-    curvature = np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
     most_tension = _combine(mesh.comm, _largest_per_section(tension, S, sections))
-    most_curved = _combine(mesh.comm, _largest_per_section(curvature, S, sections))
+    if element_ends is None:
+        curvature_S, curvature = S, np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
+        most_curved = _combine(mesh.comm, _largest_per_section(curvature, S, sections))
+    else:
+        ends_S, u = element_ends
+        curvature = np.hypot(u[..., 0], u[..., 1])                   # (ne, 2)
+        middle = ends_S.mean(axis=1)
+        index = section_index(sections, middle)                      # each element's own
+        local = np.full((len(sections), 2), np.nan)
+        for k in np.unique(index):               # the sections (a handful), not elements
+            mine = index == k
+            values, where = curvature[mine].ravel(), ends_S[mine].ravel()
+            best = int(np.argmax(values))
+            local[k] = values[best], where[best]
+        most_curved = _combine(mesh.comm, local)
     with np.errstate(divide="ignore"):
         radius = np.where(most_curved[:, 0] > 0, 1.0 / most_curved[:, 0], np.inf)
     attributes = {

@@ -215,12 +215,20 @@ def parse_sections(text, option):
 
 def section_elements(lengths, counts, total):
     """The element count of each section: its own where given, else the share of the
-    ``total`` left over in proportion to its length (at least 1 each)."""
+    ``total`` left over in proportion to its length, at least 1 each, the shares rounded
+    down and the elements left given to the largest remainders (so that the counts add
+    up to ``total`` whenever that leaves each section one)."""
     lengths = np.asarray(lengths, dtype=float)
     given = np.array([c is not None for c in counts])
     result = np.array([c or 0 for c in counts])
-    if np.any(~given):
-        left = max(total - result[given].sum(), int((~given).sum()))
-        share = lengths[~given] / lengths[~given].sum() * left
-        result[~given] = np.maximum(1, np.round(share)).astype(int)
+    free = ~given
+    if np.any(free):
+        left = max(total - result[given].sum(), int(free.sum()))
+        share = lengths[free] / lengths[free].sum() * left
+        whole = np.maximum(1, np.floor(share)).astype(int)
+        spare = left - int(whole.sum())
+        if spare > 0:
+            order = np.argsort(-(share - np.floor(share)), kind="stable")[:spare]
+            whole[order] += 1
+        result[free] = whole
     return result

@@ -229,3 +229,59 @@ def test_sections_given_in_python_are_checked(sections, words):
                                  for name, lo, hi, k in sections))
     with pytest.raises(RodInputError, match=words):
         scene.validate(set())
+
+
+def test_a_stiff_section_beside_a_soft_one_keeps_its_own_curvature(options, table, comm):
+    """Review of issue 22: the vertex strain is the mean of both sides, so the stiff
+    section was charged with half the soft one's curvature at their common vertex (bend
+    radius 396 m for the true 1e4 m). A cantilever of two sections (EI 1e4, then 1e2
+    N m^2) under a small tip force P = 0.1 N: the largest curvature of each is its
+    largest M / EI, P L / EI at its clamped end for the stiff one (1e-4 1/m at S = 0), and
+    P (L - 5) / EI at the section end for the soft one (5e-3 1/m at S = 5)."""
+    from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
+    from petsc_rod.io.outputs import vertex_fields
+    from petsc_rod.iteration.driver import solver_for
+    from petsc_rod.iteration.stopping import Settings
+    from petsc_rod.mesh.mesh import Mesh
+    from petsc_rod.problem.penalty import default_penalty
+    from petsc_rod.riser.section_numbers import SectionNumbers
+    types = "name od mass ei gj\nstiff 0.1 10 1e4 1e4\nsoft 0.1 10 1e2 1e2\n"
+    values, names = options(rod_line_types=table(types), rod_sections="stiff:5:50,soft:5:50",
+                            rod_gravity="1e-12", rod_start="clamp", rod_end="free",
+                            rod_end_force="0,0,-0.1")()
+    scene = scene_from_options(values, names)
+    mesh = Mesh(comm, 100, scene.length, pieces=mesh_pieces(values, scene))
+    solver = solver_for(mesh, scene, Settings(asked_penalty=default_penalty(scene)))
+    try:
+        solver.problem.state.set_straight()
+        assert solver.solve_step(1.0).converged
+        term = [t for t in solver.problem.terms if isinstance(t, SectionNumbers)][0]
+        numbers = term.outputs(solver.problem, vertex_fields(solver.problem)).attributes
+    finally:
+        solver.destroy()
+        solver.problem.destroy()
+        mesh.destroy()
+    np.testing.assert_allclose(numbers["section_max_curvature"], [1e-4, 5e-3], rtol=1e-4)
+    np.testing.assert_array_equal(numbers["section_max_curvature_S"], [0.0, 5.0])
+
+
+@pytest.mark.parametrize("sections, elements, words", [
+    ("bare:52.101:104,float:50:100,bare:68.114:136", "1000", "gives every section its"),
+    ("bare:170.215,float:1e-12", "100", "below what double precision resolves")])
+def test_element_counts_that_cannot_be_are_refused(options, table, sections, elements, words):
+    """Review of issue 22: -rod_elements was silently ignored when every section gave
+    its count, and a 1e-14 m section built a 1e-14 m element."""
+    from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
+    values, names = options(rod_line_types=table(CABLE_TYPES), rod_sections=sections,
+                            rod_elements=elements, **CABLE_ENDS)()
+    scene = scene_from_options(values, names)
+    with pytest.raises(RodInputError, match=words):
+        mesh_pieces(values, scene, names)
+
+
+def test_the_shares_of_the_elements_add_up():
+    """-rod_elements 200 on sections of 300, 200, 290 and 10 m gave 199 elements."""
+    from petsc_rod.scenes.line import section_elements
+    counts = section_elements([300, 200, 290, 10], [None] * 4, 200)
+    assert counts.sum() == 200 and counts.min() >= 1
+    assert list(section_elements([1.0, 2.0], [5, None], 11)) == [5, 6]
