@@ -58,14 +58,30 @@ def test_a_riser_scene_converges_on_two_ranks_with_the_defaults(scenes, name):
 
 
 def test_the_riser_figure(scenes, tmp_path):
+    """The riser's figure (docs/output.md, "Figures"): drawn, with the sea surface's and
+    the seabed's colours and the allowable bend radius; the title says the engineer's
+    numbers, not the energy."""
+    from petsc_rod.figures import style
+    from petsc_rod.plots import result_figure
     _, path = scenes["riser_catenary"]
     figure = tmp_path / "riser.png"
-    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure)],
+    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure),
+                           "--min-bend-radius", "200"],
                           cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
                           timeout=TIMEOUT, check=False)
     assert done.returncode == 0, done.stderr
     height, width, drawn = png_summary(figure)
     assert height > 300 and width > 600 and drawn > 0.02
+    import matplotlib.image
+    pixels = matplotlib.image.imread(str(figure))[..., :3]
+    for colour in (style.SEA, style.SEABED, style.ALLOWABLE):
+        assert np.mean(np.all(np.abs(pixels - colour) < 0.02, axis=-1)) > 1e-4, colour
+    drawn_figure = result_figure(path)
+    title = drawn_figure._suptitle.get_text()
+    with h5py.File(path, "r") as f:
+        top, touchdown = f.attrs["top_tension"], f.attrs["touchdown_S"]
+    assert "riser_catenary: converged" in title and "energy" not in title
+    assert f"top tension {top / 1e3:.4g} kN" in title and f"S = {touchdown:.1f} m" in title
 
 
 def test_the_lazy_wave_by_line_types_is_the_lazy_wave_by_loads(scenes, tmp_path):
