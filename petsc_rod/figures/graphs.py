@@ -83,16 +83,19 @@ def graphs_for(results):
             or any(r.seabed_reaction is not None for r in results)]
 
 
-def mark_along(axis, result, colour=None):
+def mark_along(axis, result, colour=None, named=False):
     """The sections shaded (one result), the touchdown (dashed) and the attachments
-    (dotted) as vertical lines, in ``colour`` for a case of a sweep."""
+    (dotted) as vertical lines, in ``colour`` for a case of a sweep; ``named``: with
+    legend labels (on one graph of a figure)."""
     if colour is None and result.sections:
         colours = style.section_colours([name for name, _, _ in result.sections])
         for name, lo, hi in result.sections:
             axis.axvspan(lo, hi, color=colours[name], alpha=0.12, lw=0)
     if result.touchdown_S is not None:
-        axis.axvline(result.touchdown_S, color=colour or style.TOUCHDOWN, lw=0.8, ls="--")
-    for _, S_p, _ in result.attachments:
-        axis.axvline(S_p, color=colour or style.ATTACHMENT, lw=0.8, ls=":")
+        axis.axvline(result.touchdown_S, color=colour or style.TOUCHDOWN, lw=0.8, ls="--",
+                     label="touchdown" if named else None)
+    for k, (_, S_p, _) in enumerate(result.attachments):
+        axis.axvline(S_p, color=colour or style.ATTACHMENT, lw=0.8, ls=":",
+                     label="attachments" if named and k == 0 else None)
     axis.set_xlabel("S (m)")
     axis.set_xlim(result.S[0], result.S[-1])

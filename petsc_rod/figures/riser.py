@@ -30,7 +30,7 @@ def riser_figure(result, min_bend_radius=None):
     elevation.legend(loc="upper left", fontsize=8, framealpha=0.9)
     scene.draw_plan(plan, result)
     for draw, axis in zip(drawn, axes):
-        graphs.mark_along(axis, result)
+        graphs.mark_along(axis, result, named=draw is graphs.draw_tension)
         if draw is graphs.draw_curvature:
             draw(axis, result, allowable=min_bend_radius)
         else:
@@ -54,7 +54,7 @@ def sweep_overlay(results, labels, min_bend_radius=None):
         for draw, axis in zip(drawn, axes):
             graphs.mark_along(axis, result, colour)
             if draw is graphs.draw_curvature:
-                draw(axis, result, colour, text, allowable=min_bend_radius if k == 0 else None)
+                draw(axis, result, colour, text, allowable=min_bend_radius)
             else:
                 draw(axis, result, colour, text)
     scene.draw_water(elevation, results[0])

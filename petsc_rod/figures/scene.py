@@ -4,6 +4,7 @@ with the sea surface, the seabed, the anchor, the hang-off, the touchdown point,
 sections in their line types' colours and the attachments."""
 
 import numpy as np
+from matplotlib.transforms import offset_copy
 
 from petsc_rod.figures import along, style
 
@@ -142,7 +143,9 @@ def draw_current(axis, current):
     if speed == 0:
         return
     direction = horizontal / speed
-    axis.annotate("", xy=(0.08, 0.84), xycoords="axes fraction",
+    head = offset_copy(axis.transAxes, axis.figure, x=16 * direction[0], y=16 * direction[1],
+                       units="points")     # the arrow's middle at (0.1, 0.84) of the panel
+    axis.annotate("", xy=(0.1, 0.84), xycoords=head,
                   xytext=(-32 * direction[0], -32 * direction[1]), textcoords="offset points",
                   arrowprops=dict(arrowstyle="-|>", color=style.SEA, lw=2))
     axis.text(0.02, 0.95, f"current {speed:.3g} m/s", transform=axis.transAxes,

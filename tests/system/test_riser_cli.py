@@ -223,3 +223,26 @@ def test_the_80_m_lazy_wave_cable_on_one_and_two_ranks(tmp_path):
     assert abs(one["top_tension"] - two["top_tension"]) < 1e-6 * one["top_tension"]
     assert abs(one["touchdown_S"] - two["touchdown_S"]) < 1e-3
     assert np.abs(one["r"] - two["r"]).max() < 1e-5
+
+
+def test_the_plan_shows_a_riser_pushed_sideways(tmp_path):
+    """Issue 24: projected on the vertical plane of its ends, a riser pushed sideways by
+    a current looked like the one in that plane. options/riser_catenary.opts, coarser,
+    with 1 m/s across: the plan draws the line about 120 m off that plane, and the
+    elevation keeps the true horizontal distance from the anchor."""
+    from petsc_rod.plots import result_figure
+    path = tmp_path / "sideways.h5"
+    done = run(["-options_file", "options/riser_catenary.opts", "-rod_elements", "300",
+                "-rod_current", "0,1,0", "-rod_output", str(path)])
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        r = f["r"][:]
+    figure = result_figure(path)
+    plan = [a for a in figure.axes if a.get_xlabel() == "x (m)"][0]
+    line = [ln for ln in plan.lines if len(ln.get_ydata()) == len(r)][0]
+    assert 80 < line.get_ydata().max() < 200                    # the bow across, in plan
+    assert "largest offset from the plane of the ends" in plan.get_title()
+    elevation = [a for a in figure.axes if a.get_ylabel() == "z (m)"][0]
+    drawn = [ln for ln in elevation.lines if len(ln.get_xdata()) == len(r)]
+    np.testing.assert_allclose(drawn[-1].get_xdata(), np.hypot(r[:, 0], r[:, 1]))
+    assert "projected on the vertical plane of the ends" in [ln.get_label() for ln in drawn]
