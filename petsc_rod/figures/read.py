@@ -102,6 +102,8 @@ def read_result(path):
             names = [text(name) for name in a["section_names"]]
             result.sections = [(name, float(lo), float(hi))
                                for name, (lo, hi) in zip(names, a["section_bounds"][:])]
+        elif "load_breaks" in p:
+            result.sections = load_pieces(p, float(S[-1]))
         if "point_load_S" in a:
             points = np.atleast_1d(a["point_load_S"][:])
             labels = text(a.get("point_load_names", "")).split(",")
@@ -122,3 +124,18 @@ def surface_current(parameters):
         if table.ndim == 2 and table.shape[1] >= 4:
             return table[np.argmin(table[:, 0]), 1:4]
     return None
+
+
+def load_pieces(parameters, length):
+    """A line given by load pieces (-rod_load, -rod_load_breaks) rather than line types:
+    [(name, lo, hi)] a piece, named by its load, so that pieces of one load share a
+    colour; [] for one piece."""
+    breaks = parameters["load_breaks"]
+    if isinstance(breaks, (str, bytes)) or np.size(breaks) == 0:
+        return []
+    loads = np.reshape(np.asarray(parameters["load"], dtype=float), (-1, 3))
+    bounds = np.concatenate([[0.0], np.ravel(breaks), [length]])
+    if len(loads) != len(bounds) - 1:
+        return []
+    return [(f"load fz = {fz:.4g} N/m", float(lo), float(hi))
+            for (_, _, fz), lo, hi in zip(loads, bounds[:-1], bounds[1:])]

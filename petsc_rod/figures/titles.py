@@ -30,7 +30,8 @@ def engineer_numbers(result):
     tension, angle = top_numbers(result)
     words = [f"top tension {tension / 1e3:.4g} kN at {angle:.1f}° from the vertical"]
     for end, joint_angle, moment in result.joints:
-        words.append(f"{end} flex joint {joint_angle:.2f}°, {moment / 1e3:.3g} kN m")
+        where = "hang-off" if (end == "end") == (result.top != 0) else "anchor"
+        words.append(f"{where} flex joint {joint_angle:.2f}°, {moment / 1e3:.3g} kN m")
     if result.touchdown_S is not None:
         from_anchor = float(along.horizontal_distance(
             result.touchdown_position[None, :], result.r[result.anchor])[0])
@@ -42,7 +43,18 @@ def engineer_numbers(result):
     k = int(np.argmax(curvature))
     if curvature[k] > 0:
         words.append(f"smallest bend radius {1 / curvature[k]:.3g} m at S = {result.S[k]:.0f} m")
-    return " · ".join(words)
+    return wrapped(words)
+
+
+def wrapped(words, width=120):
+    """``words`` joined by ' · ', a new line before one that would pass ``width``."""
+    lines = [words[0]]
+    for word in words[1:]:
+        if len(lines[-1]) + 3 + len(word) > width:
+            lines.append(word)
+        else:
+            lines[-1] += " · " + word
+    return "\n".join(lines)
 
 
 def result_title(result):

@@ -201,3 +201,22 @@ def test_the_curvature_in_the_vertical_plane_is_positive_in_a_sag_bend():
     u = np.column_stack([0 * s, -np.ones_like(s) / R, 0 * s])
     np.testing.assert_allclose(np.abs(along.curvature_components(u, d1, d2, d3)),
                                np.column_stack([0 * s, np.ones_like(s) / R]), atol=1e-15)
+
+
+def test_a_line_of_load_pieces_is_drawn_in_pieces(folder):
+    """A line given by -rod_load and -rod_load_breaks (options/cable_80m.opts) has no
+    line types: its pieces are coloured and shaded by their load, one colour a load."""
+    path = write_line(f"{folder}/pieces.h5")
+    with h5py.File(path, "a") as f:
+        for name in ("section_names", "section_bounds"):
+            del f.attrs[name]
+        f["parameters"].attrs.update(load=[[0, 0, -157.8], [0, 0, 80.15], [0, 0, -157.8]],
+                                     load_breaks=[50.0, 100.0])
+    figure = plots.result_figure(path)
+    elevation = axis_by_labels(figure, "horizontal distance from the anchor (m)", "z (m)")
+    pieces = [line for line in elevation.lines if line.get_label().startswith(("load", "_"))
+              and len(line.get_xdata()) > 5]
+    assert [line.get_label() for line in pieces][:2] == ["load fz = -157.8 N/m",
+                                                        "load fz = 80.15 N/m"]
+    assert pieces[0].get_color() == pieces[2].get_color() != pieces[1].get_color()
+    matplotlib.pyplot.close(figure)
