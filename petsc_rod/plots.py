@@ -62,8 +62,11 @@ def save(figure, output):
 def main(argv):
     parser = argparse.ArgumentParser(
         prog="python -m petsc_rod.plots",
-        description="Draw a result file, or several overlaid, as a PNG.")
-    parser.add_argument("files", nargs="+", metavar="RESULT.h5 ... FIGURE.png")
+        usage="python -m petsc_rod.plots RESULT.h5 [MORE.h5 ...] FIGURE.png "
+              "[--min-bend-radius R]",
+        description="Draw a result file, or several overlaid (a sweep), as a PNG.")
+    parser.add_argument("files", nargs="+", metavar="FILE",
+                        help="the result files, then the figure to write")
     parser.add_argument("--min-bend-radius", type=float, default=None, metavar="R",
                         help="allowable bend radius (m), drawn against the curvature")
     args = parser.parse_args(argv[1:])
@@ -72,6 +75,10 @@ def main(argv):
         sys.stderr.write("give a result file and the figure to write\n")
         return 2
     *inputs, output = args.files
+    if output.lower().endswith((".h5", ".hdf5")):     # never write a figure over a result
+        parser.print_usage(sys.stderr)
+        sys.stderr.write(f"the last file is the figure to write, not a result: {output}\n")
+        return 2
     if len(inputs) == 1:
         plot_result(inputs[0], output, args.min_bend_radius)
     else:

@@ -174,6 +174,9 @@ def test_the_command_line_draws_one_file_or_several(folder):
         pixels = matplotlib.image.imread(f"{folder}/{name}.png")
         assert pixels.shape[:2] == (int(9.5 * plots.DPI), 16 * plots.DPI)
     assert plots.main(["plots", one]) == 2
+    before = open(two, "rb").read()
+    assert plots.main(["plots", one, two]) == 2          # the last file is the figure:
+    assert open(two, "rb").read() == before              # a result file is never overwritten
 
 
 def test_the_plain_rod_keeps_its_four_panels_without_the_energy(folder):
