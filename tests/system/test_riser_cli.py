@@ -58,14 +58,30 @@ def test_a_riser_scene_converges_on_two_ranks_with_the_defaults(scenes, name):
 
 
 def test_the_riser_figure(scenes, tmp_path):
+    """The riser's figure (docs/output.md, "Figures"): drawn, with the sea surface's and
+    the seabed's colours and the allowable bend radius; the title says the engineer's
+    numbers, not the energy."""
+    from petsc_rod.figures import style
+    from petsc_rod.plots import result_figure
     _, path = scenes["riser_catenary"]
     figure = tmp_path / "riser.png"
-    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure)],
+    done = subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(figure),
+                           "--min-bend-radius", "200"],
                           cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
                           timeout=TIMEOUT, check=False)
     assert done.returncode == 0, done.stderr
     height, width, drawn = png_summary(figure)
     assert height > 300 and width > 600 and drawn > 0.02
+    import matplotlib.image
+    pixels = matplotlib.image.imread(str(figure))[..., :3]
+    for colour in (style.SEA, style.SEABED, style.ALLOWABLE):
+        assert np.mean(np.all(np.abs(pixels - colour) < 0.02, axis=-1)) > 1e-4, colour
+    drawn_figure = result_figure(path)
+    title = drawn_figure._suptitle.get_text()
+    with h5py.File(path, "r") as f:
+        top, touchdown = f.attrs["top_tension"], f.attrs["touchdown_S"]
+    assert "riser_catenary: converged" in title and "energy" not in title
+    assert f"top tension {top / 1e3:.4g} kN" in title and f"S = {touchdown:.1f} m" in title
 
 
 def test_the_lazy_wave_by_line_types_is_the_lazy_wave_by_loads(scenes, tmp_path):
@@ -207,3 +223,26 @@ def test_the_80_m_lazy_wave_cable_on_one_and_two_ranks(tmp_path):
     assert abs(one["top_tension"] - two["top_tension"]) < 1e-6 * one["top_tension"]
     assert abs(one["touchdown_S"] - two["touchdown_S"]) < 1e-3
     assert np.abs(one["r"] - two["r"]).max() < 1e-5
+
+
+def test_the_plan_shows_a_riser_pushed_sideways(tmp_path):
+    """Issue 24: projected on the vertical plane of its ends, a riser pushed sideways by
+    a current looked like the one in that plane. options/riser_catenary.opts, coarser,
+    with 1 m/s across: the plan draws the line about 120 m off that plane, and the
+    elevation keeps the true horizontal distance from the anchor."""
+    from petsc_rod.plots import result_figure
+    path = tmp_path / "sideways.h5"
+    done = run(["-options_file", "options/riser_catenary.opts", "-rod_elements", "300",
+                "-rod_current", "0,1,0", "-rod_output", str(path)])
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        r = f["r"][:]
+    figure = result_figure(path)
+    plan = [a for a in figure.axes if a.get_xlabel() == "x (m)"][0]
+    line = [ln for ln in plan.lines if len(ln.get_ydata()) == len(r)][0]
+    assert 80 < line.get_ydata().max() < 200                    # the bow across, in plan
+    assert "largest offset from the plane of the ends" in plan.get_title()
+    elevation = [a for a in figure.axes if a.get_ylabel() == "z (m)"][0]
+    drawn = [ln for ln in elevation.lines if len(ln.get_xdata()) == len(r)]
+    np.testing.assert_allclose(drawn[-1].get_xdata(), np.hypot(r[:, 0], r[:, 1]))
+    assert "projected on the vertical plane of the ends" in [ln.get_label() for ln in drawn]
