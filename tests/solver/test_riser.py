@@ -157,7 +157,7 @@ SPEED = 1.0
 def current_scene(bending=1.0):
     return dict(length=100.0, stiffness=(bending, bending, bending), start="pin", end="pin",
                 end_position=CURRENT_CHORD,
-                current=Current(np.zeros(1), np.array([[0.0, SPEED, 0.0]]), 0.0, DRAG))
+                current=Current.uniform([0.0, SPEED, 0.0], 1025.0, 1.2, 0.1))
 
 
 def test_uniform_current_on_a_pinned_line_is_the_current_catenary(comm, solver_factory):
