@@ -330,16 +330,25 @@ def test_plot_of_a_result_file(cantilever, folder):
     assert wrong.returncode == 2 and "usage" in wrong.stderr
 
 
-def test_the_readme_python_example_runs_and_prints_what_the_readme_says(tmp_path):
-    """The README's Python API example, run as it stands; its last line is the one the
-    README quotes."""
+def readme_python_blocks():
+    """The README's Python examples, in order: the api study, then the classes'."""
     with open(os.path.join(REPO_ROOT, "README.md")) as stream:
         readme = stream.read()
-    start = readme.index("```python\n") + len("```python\n")
+    blocks = readme.split("```python\n")[1:]
+    return readme, [block[:block.index("```")] for block in blocks]
+
+
+@pytest.mark.parametrize("index, starts", [(0, "buoyancy 500 m: top tension"),
+                                           (1, "converged: True")])
+def test_the_readme_python_examples_run_and_print_what_the_readme_says(tmp_path, index,
+                                                                       starts):
+    """The README's Python API examples, run as they stand; the last line of each is
+    the one the README quotes."""
+    readme, blocks = readme_python_blocks()
     script = tmp_path / "example.py"
-    script.write_text(readme[start:readme.index("```", start)])
+    script.write_text(blocks[index])
     process = subprocess.run([sys.executable, str(script)], cwd=REPO_ROOT, env=child_env(),
                              capture_output=True, text=True, timeout=TIMEOUT)
     assert process.returncode == 0, describe(process)
     last = process.stdout.strip().splitlines()[-1]
-    assert last.startswith("converged: True") and f"`{last}`" in readme, last
+    assert last.startswith(starts) and f"`{last}`" in readme, last
