@@ -2,10 +2,11 @@
 attachments (docs/riser.md), as plain values in SI units, and the -rod_* options they
 stand for.
 
-A Model is read exactly as the command line reads its options: ``Model.options()``
-gives their text, which cli/options.parse_values parses and cli/scene_options makes into
-the Scene (with every check and message of the command line), so that a model and the
-options file it writes (``Model.options_file``) solve the same problem to round-off.
+A Model is read exactly as the command line reads its options:
+``Model.option_texts()`` gives their text, which cli/options.parse_values parses and
+cli/scene_options makes into the Scene (with every check and message of the command
+line), so that a model and the options file it writes (``Model.write_options``) solve
+the same problem to round-off.
 Nothing here knows PETSc; the run is api/run.py.
 """
 
@@ -103,7 +104,7 @@ class Line:
         found = {}
         for entry in self.sections:
             kind = entry[0]
-            if found.setdefault(kind.name, kind) != kind:
+            if found.setdefault(kind.name, kind).row() != kind.row():
                 raise RodInputError(f"two different line types are named {kind.name}")
         return list(found.values())
 
@@ -246,6 +247,29 @@ class Model:
                                     str(int(value)) if isinstance(value, (bool, int)) else
                                     _numbers(value))
         return texts
+
+    def write_options(self, path):
+        """Write the model as an options file ``path`` (``python -m petsc_rod
+        -options_file path`` solves it) and the tables it names beside it: ``path`` with
+        '.line_types.txt', '.point_loads.txt', '.current.txt' for '.opts'. Call it on
+        one rank."""
+        stem = str(path).removesuffix(".opts")
+        files = {"rod_line_types": (f"{stem}.line_types.txt", self.line_types_text())}
+        if self.attachments:
+            files["rod_point_loads"] = (f"{stem}.point_loads.txt", self.attachment_table())
+        profile = self.environment.profile()
+        if profile is not None:
+            rows = np.column_stack(profile)
+            files["rod_current_profile"] = (f"{stem}.current.txt", "".join(
+                " ".join(_number(v) for v in row) + "\n" for row in rows))
+        texts = self.option_texts()
+        for name, (file, content) in files.items():
+            with open(file, "w", encoding="utf-8") as out:
+                out.write(content)
+            texts[name] = file
+        with open(path, "w", encoding="utf-8") as out:
+            out.write("# written by petsc_rod.api.Model.write_options\n"
+                      + "".join(f"-{name} {text}\n" for name, text in texts.items()))
 
     def line_types_text(self):
         """The -rod_line_types table of the line's types."""

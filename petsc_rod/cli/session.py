@@ -32,8 +32,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
 
     ``say(line)`` gets the lines (None: silent): a short line per step (lines.step_line),
     its details too (lines.step_details) when the solver's settings ask for the monitor,
-    and the final summary (lines.summary) before the last line; ``writer`` (io.results.ResultWriter or
-    None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
+    and the final summary (lines.summary) before the last line; ``writer``
+    (io.results.ResultWriter or None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
     text) among its attributes, and is finished at the end. ``interrupts``
     (signals.Interrupts), if given, are asked after every iteration and before the file
     is finished: a signal ends the run with RodInterrupted, the steps written so far kept

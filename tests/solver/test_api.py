@@ -71,3 +71,29 @@ def test_a_bad_model_is_refused_as_the_command_line_refuses_it():
     bad = LineType("bad", od=0.2, mass=60.0, ei=-1.0, gj=8e4)
     with pytest.raises(RodInputError, match="must be positive"):
         solve(model(line=Line([(bad, 100.0)])))
+
+
+def test_a_model_written_as_options_reads_back_as_the_same_scene(tmp_path):
+    """Model.write_options: the options file and its tables make, through the command
+    line's own reading, the scene the model makes."""
+    from petsc_rod.api import scene_of
+    from petsc_rod.cli.options import parse_values
+    from petsc_rod.cli.scene_options import scene_from_options
+
+    path = tmp_path / "model.opts"
+    model().write_options(path)
+    texts = {}
+    for line in path.read_text().splitlines():
+        if line.startswith("-"):
+            name, text = line[1:].split(" ", 1)
+            texts[name] = text
+    from_file = scene_from_options(parse_values(texts), set(texts))
+    scene, _, _ = scene_of(model())
+    assert from_file.length == scene.length and len(from_file.sections) == 3
+    for a, b in zip(from_file.sections, scene.sections):
+        assert (a.name, a.start, a.end, a.drag, a.od) == (b.name, b.start, b.end, b.drag, b.od)
+        assert np.array_equal(a.weight, b.weight)
+        assert np.array_equal(a.stiffness_start, b.stiffness_start)
+    assert np.array_equal(from_file.point_load_forces, scene.point_load_forces)
+    assert np.array_equal(from_file.current.velocities, scene.current.velocities)
+    assert from_file.current.drag == scene.current.drag

@@ -352,3 +352,23 @@ def test_the_readme_python_examples_run_and_print_what_the_readme_says(tmp_path,
     assert process.returncode == 0, describe(process)
     last = process.stdout.strip().splitlines()[-1]
     assert last.startswith(starts) and f"`{last}`" in readme, last
+
+
+def test_the_step_line_is_short_and_the_monitor_adds_its_details(tmp_path):
+    """Issue 24, point 6: the step line says the load factor, iterations (Newton),
+    converged and stable; -rod_al_monitor adds after it the change, residual, energy and
+    u3(0), which are the file's."""
+    path = tmp_path / "cantilever.h5"
+    plain = run(["-options_file", "options/cantilever.opts"]).stdout.splitlines()
+    steps = [line for line in plain if line.startswith("step ")]
+    assert steps[-1].startswith("step 2/2: load factor 1, converged in ") and \
+        steps[-1].endswith(" Newton), stable"), steps
+    assert not any("energy" in line or "u3(0)" in line for line in plain), plain
+    verbose = run(["-options_file", "options/cantilever.opts", "-rod_al_monitor",
+                   "-rod_output", str(path)]).stdout.splitlines()
+    details = [line for line in verbose if line.startswith("  step 2/2 details: ")]
+    with h5py.File(path, "r") as f:
+        energy, change = float(f.attrs["energy"]), float(f.attrs["change"])
+        u3 = float(f["u"][0, 2])
+    assert len(details) == 1 and f"energy {energy:.10g} J" in details[0], verbose
+    assert f"change {change:.2e}" in details[0] and f"u3(0) {u3:.6g}" in details[0]
