@@ -18,6 +18,12 @@ import numpy as np
 from petsc_rod.errors import RodInputError
 
 KINDS = ("pin", "clamp", "free")
+# Options a Model's fields give (Line, End, Environment, Attachment), or solve's output=;
+# a restart (initial) walks a file's scene, which the API leaves to the command line.
+MODEL_OPTIONS = ("line_types", "sections", "length", "stiffness", "load", "load_breaks",
+                 "axial_stiffness", "drag", "elements", "mesh_grading", "output", "initial",
+                 "initial_load_factor", "point_loads", "point_load", "current",
+                 "current_profile")
 
 
 def _number(value):
@@ -243,6 +249,10 @@ class Model:
         if self.attachments:
             texts["rod_point_loads"] = "<attachments>"
         for name, value in self.options.items():
+            if name in MODEL_OPTIONS or f"rod_{name}" in texts:
+                raise RodInputError(f"Model.options {name!r}: the model's own fields give "
+                                    "it (or solve's output=); restarts are the command "
+                                    "line's (Model.write_options)")
             texts[f"rod_{name}"] = (value if isinstance(value, str) else
                                     str(int(value)) if isinstance(value, (bool, int)) else
                                     _numbers(value))

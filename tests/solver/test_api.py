@@ -97,3 +97,12 @@ def test_a_model_written_as_options_reads_back_as_the_same_scene(tmp_path):
     assert np.array_equal(from_file.point_load_forces, scene.point_load_forces)
     assert np.array_equal(from_file.current.velocities, scene.current.velocities)
     assert from_file.current.drag == scene.current.drag
+
+
+def test_an_option_the_model_gives_is_refused_in_its_options():
+    with pytest.raises(RodInputError, match="Model.options 'initial'"):
+        model(options={"initial": "run.h5"}).option_texts()
+    with pytest.raises(RodInputError, match="Model.options 'seabed'"):
+        model(options={"seabed": 1.0}).option_texts()
+    texts = model(options={"al_rtol": 1e-10, "al_stability": False}).option_texts()
+    assert texts["rod_al_rtol"] == "1e-10" and texts["rod_al_stability"] == "0"
