@@ -60,15 +60,99 @@ def link_text(link):
     return f", link {tw + wr:.4f} turns = twist {tw:.4f} + writhe {wr:.4f}"
 
 
+def short_stability(report):
+    """The step line's word on which equilibrium was reached: 'stable', 'stable after
+    leaving n saddle(s)', 'a saddle', or '' where it was not tested (stability.py)."""
+    if report.stable is None:
+        return ""
+    if not report.stable:
+        return ", a saddle"
+    return ", stable" + (f" after leaving {report.escapes} saddle(s)" if report.escapes else "")
+
+
+def riser_text(attributes):
+    """The engineer's numbers of a riser step (riser/quantities.py, in ``attributes``):
+    top tension (kN) and its angle from the vertical, the touchdown's S and the smallest
+    bend radius; '' for a scene without them."""
+    if "top_tension" not in attributes:
+        return ""
+    text = (f"; top tension {attributes['top_tension'] / 1e3:.6g} kN at "
+            f"{attributes['top_angle']:.2f} deg")
+    if "touchdown_S" in attributes:
+        S = attributes["touchdown_S"]
+        text += (f", touchdown S = {S:.6g} m" if S == S else ", no touchdown")
+    return text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
+
+
 def step_line(event, record):
-    """The line of a StepEnded event with its io.outputs.StepRecord."""
+    """The line of a StepEnded event with its io.outputs.StepRecord: load factor,
+    iterations (Newton steps), converged, stable or a saddle, the linking number where
+    it is tracked, and a riser's numbers at load factor 1 only (an intermediate step's
+    touchdown may lie anywhere on the way; the file has every step's). The rest is
+    step_details'."""
     report = event.report
+    link = "" if report.link is None else f", link {sum(report.link):.4f} turns"
     return (f"{event.label}: load factor {event.t:.4g}, "
             f"{'converged' if report.converged else 'NOT converged'} in {report.iterations} "
-            f"iterations{newton_text(report)}, change {report.change:.2e}, constraint "
+            f"iterations{newton_text(report)}" + short_stability(report) + link
+            + (riser_text(record.attributes) if event.t >= 1.0 else ""))
+
+
+def step_details(event, record):
+    """The -rod_al_monitor line after a step line: the stopping quantities, energy,
+    u3(0), the link's parts and every term's phrase (the riser numbers, sections,
+    stretch, joints, pressures)."""
+    report = event.report
+    return (f"  {event.label} details: change {report.change:.2e}, constraint "
             f"residual (RMS) {report.constraint_residual:.2e}, energy {record.energy:.10g} J, "
             f"u3(0) {record.u3_start:.6g}" + link_text(report.link) + stability_text(report)
             + "".join(f"; {text}" for text in record.texts))
+
+
+def _table(header, rows):
+    """Rows of text cells as lines with right-aligned columns."""
+    widths = [max(len(row[k]) for row in [header, *rows]) for k in range(len(header))]
+    return ["  " + "  ".join(cell.rjust(w) if k else cell.ljust(w)
+                             for k, (cell, w) in enumerate(zip(row, widths)))
+            for row in [header, *rows]]
+
+
+def summary(attributes):
+    """The lines of the run's final summary from the last step's attributes (at load
+    factor 1): the riser's numbers, the flex joints' angles, and per section its
+    largest tension and smallest bend radius and where; [] for a scene with none of
+    them (a rod of the paper's kind: its energy and strains are in the file)."""
+    a = attributes
+    out = []
+    if "top_tension" in a:
+        text = (f"  top tension {a['top_tension'] / 1e3:.6g} kN at {a['top_angle']:.3f} deg "
+                "from the vertical")
+        if "touchdown_S" in a:
+            S = a["touchdown_S"]
+            text += (f"; touchdown at S = {S:.6g} m, grounded {a['grounded_length']:.6g} m"
+                     if S == S else "; no touchdown")
+        text += (f"; smallest bend radius {a['min_bend_radius']:.4g} m at S = "
+                 f"{a['max_curvature_S']:.6g} m")
+        out.append(text)
+    joints = [f"{which} joint {a[f'{which}_joint_angle']:.4g} deg, "
+              f"{a[f'{which}_joint_moment'] / 1e3:.4g} kN m"
+              for which in ("start", "end") if f"{which}_joint_angle" in a]
+    if joints:
+        out.append("  " + "; ".join(joints))
+    if "max_wall_tension" in a:
+        out.append(f"  largest wall tension {a['max_wall_tension'] / 1e3:.6g} kN at S = "
+                   f"{a['max_wall_tension_S']:.6g} m")
+    if "section_names" in a:
+        header = ["section", "S from (m)", "S to (m)", "max tension (kN)", "at S (m)",
+                  "min bend radius (m)", "at S (m)"]
+        rows = [[name, f"{bounds[0]:.6g}", f"{bounds[1]:.6g}", f"{tension / 1e3:.6g}",
+                 f"{tension_S:.6g}", f"{radius:.4g}", f"{curved_S:.6g}"]
+                for name, bounds, tension, tension_S, radius, curved_S in zip(
+                    a["section_names"], a["section_bounds"], a["section_max_tension"],
+                    a["section_max_tension_S"], a["section_min_bend_radius"],
+                    a["section_max_curvature_S"])]
+        out += _table(header, rows)
+    return ["petsc_rod: at load factor 1:"] + out if out else []
 
 
 def raised(label, raises, scale):

@@ -303,12 +303,20 @@ def read_options():
             close = difflib.get_close_matches(name, list(BY_NAME), n=1)
             hint = f"; did you mean -{close[0]}?" if close else "; see -help"
             raise RodInputError(f"unknown option -{name}{hint}")
+    return parse_values({name: database.getString(name, "") for name in given
+                         if name in BY_NAME}), given
+
+
+def parse_values(texts):
+    """{name: value} of every -rod_* option from {name: text} of those given (the rest
+    take their defaults), parsed and checked as on the command line (the Python API's
+    models, petsc_rod/api, are read this way too). RodInputError for a malformed value."""
     values = {}
     for option in OPTIONS:
-        if option.name not in given:
+        if option.name not in texts:
             values[option.name] = option.default
             continue
-        text = database.getString(option.name, "")
+        text = texts[option.name]
         try:
             value = option.parse(text)
         except ValueError as error:
@@ -317,7 +325,7 @@ def read_options():
         if option.check is not None and not option.check[0](value):
             raise RodInputError(f"-{option.name} {text}: {option.check[1]}")
         values[option.name] = value
-    return values, given
+    return values
 
 
 def check_anderson_depth():

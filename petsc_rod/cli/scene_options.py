@@ -360,16 +360,14 @@ def current_from_options(values, given, surface_default, profile_rows=None,
     else:
         depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
     surface = values["rod_sea_surface"]
+    surface = float(surface_default if surface is None else surface)
     if section_drag is not None:
         if section_drag == 0:
             raise RodInputError("a current on -rod_sections whose line types have no drag: "
                                 "give the line types a cd column")
-        drag = section_drag
-    else:
-        rho, cd, diameter = values["rod_drag"]
-        drag = 0.5 * rho * cd * diameter
-    return Current(depths, velocities, float(surface_default if surface is None else surface),
-                   drag)
+        # each section's own c (Scene.drag_at); the current carries the largest
+        return Current(depths, velocities, surface, section_drag)
+    return Current.morison(depths, velocities, surface, *values["rod_drag"])
 
 
 def environment_from_options(values, given, scene, profile=None):

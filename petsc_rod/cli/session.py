@@ -30,8 +30,10 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                      interrupts=None):
     """Walk continuation(solver, path) (iteration/continuation.py) to its end.
 
-    ``say(line)`` gets the lines (None: silent); ``writer`` (io.results.ResultWriter or
-    None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
+    ``say(line)`` gets the lines (None: silent): a short line per step (lines.step_line),
+    its details too (lines.step_details) when the solver's settings ask for the monitor,
+    and the final summary (lines.summary) before the last line; ``writer``
+    (io.results.ResultWriter or None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
     text) among its attributes, and is finished at the end. ``interrupts``
     (signals.Interrupts), if given, are asked after every iteration and before the file
     is finished: a signal ends the run with RodInterrupted, the steps written so far kept
@@ -40,6 +42,7 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     RodDivergedError. Returns a ContinuationResult.
     """
     say = say or (lambda line: None)
+    verbose = solver.settings.monitor       # -rod_al_monitor: each step's details too
     problem = solver.problem
     stop = None if interrupts is None else interrupts.received
     last = None                 # (group, attributes) of the last step written
@@ -61,6 +64,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 total_iterations=event.total_iterations,
                 undone_iterations=event.undone_iterations)
             say(lines.step_line(event, record))
+            if verbose:
+                say(lines.step_details(event, record))
             if raises:
                 say(lines.raised(event.label, raises, problem.scale))
             raises = []
@@ -79,6 +84,9 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
         elif isinstance(event, events.RunFinished):
             if writer is not None:
                 writer.finish(*last)
+            if event.converged and last is not None:
+                for line in lines.summary(last[1]):
+                    say(line)
             say(lines.finished(event, solver.settings, problem.scale))
             code = 0 if event.converged else RodNotConvergedError.exit_code
             return ContinuationResult(code, event.report, event.iterations)

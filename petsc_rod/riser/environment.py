@@ -38,13 +38,31 @@ class Current:
     ``depths`` (m,) increasing depths below the sea surface z = ``surface`` and
     ``velocities`` (m, 3) the current there (m/s), linear in between and constant
     beyond the first and last rows; a uniform current is one row. ``drag`` is
-    c = rho C_d D / 2 (kg/m^2), so that the normal drag c |v_n| v_n is in N/m.
+    c = rho C_d D / 2 (kg/m^2), so that the normal drag c |v_n| v_n is in N/m: made
+    from the command line's inputs rho, C_d, D by ``Current.morison`` (``uniform`` for
+    one velocity), as -rod_drag gives them.
     """
 
     depths: np.ndarray
     velocities: np.ndarray
     surface: float
     drag: float
+
+    @classmethod
+    def morison(cls, depths, velocities, surface, water_density, cd, diameter):
+        """The current of ``depths`` (m,), m, ``velocities`` (m, 3), m/s, below the sea
+        surface z = ``surface`` (m) on a line of Morison normal drag coefficient ``cd``
+        (1) and hydrodynamic diameter ``diameter`` (m) in water of ``water_density``
+        (kg/m^3): drag c = rho C_d D / 2 (kg/m^2), as -rod_drag rho,Cd,D."""
+        return cls(np.asarray(depths, dtype=float).reshape(-1),
+                   np.asarray(velocities, dtype=float).reshape(-1, 3), float(surface),
+                   0.5 * float(water_density) * float(cd) * float(diameter))
+
+    @classmethod
+    def uniform(cls, velocity, water_density, cd, diameter, surface=0.0):
+        """A uniform current ``velocity`` (3,), m/s, with the drag of ``morison``; the
+        surface (m) only matters to a profile, kept for the record."""
+        return cls.morison([0.0], [velocity], surface, water_density, cd, diameter)
 
     def velocity(self, z):
         """The current at heights z (n,), (n, 3)."""

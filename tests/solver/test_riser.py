@@ -157,7 +157,7 @@ SPEED = 1.0
 def current_scene(bending=1.0):
     return dict(length=100.0, stiffness=(bending, bending, bending), start="pin", end="pin",
                 end_position=CURRENT_CHORD,
-                current=Current(np.zeros(1), np.array([[0.0, SPEED, 0.0]]), 0.0, DRAG))
+                current=Current.uniform([0.0, SPEED, 0.0], 1025.0, 1.2, 0.1))
 
 
 def test_uniform_current_on_a_pinned_line_is_the_current_catenary(comm, solver_factory):
@@ -257,7 +257,22 @@ def test_the_step_line_and_file_attributes_of_a_riser(comm, solver_factory):
     record = record_step(solver.problem, report, 1.0, Writer(), "steps/1")
     event = StepEnded("step 1/1", 1.0, report, 1, 0, 0, report.iterations, 0, 0.0)
     lines.append(step_lines.step_line(event, record))
-    assert "top tension" in lines[0] and "touchdown at S = " in lines[0]
+    lines.append(step_lines.step_details(event, record))
+    attributes = record.attributes
+    # the short line: the engineer's numbers as the file has them, and nothing else
+    assert (f"top tension {attributes['top_tension'] / 1e3:.6g} kN at "
+            f"{attributes['top_angle']:.2f} deg" in lines[0])
+    assert f"touchdown S = {attributes['touchdown_S']:.6g} m" in lines[0]
+    assert f"smallest bend radius {attributes['min_bend_radius']:.4g} m" in lines[0]
+    assert "energy" not in lines[0] and "u3(0)" not in lines[0] and len(lines[0]) < 200
+    # the details (-rod_al_monitor): the energy and the riser term's long text
+    assert f"energy {record.energy:.10g} J" in lines[1] and "touchdown at S = " in lines[1]
+    # an intermediate step says no riser numbers
+    halfway = StepEnded("step 1/2", 0.5, report, 1, 0, 0, report.iterations, 0, 0.0)
+    assert "top tension" not in step_lines.step_line(halfway, record)
+    summary = step_lines.summary(attributes)
+    assert summary[0] == "petsc_rod: at load factor 1:"
+    assert f"grounded {attributes['grounded_length']:.6g} m" in summary[1]
     assert {"effective_tension", "seabed_reaction"} <= set(written["vertex"])
     assert {"top_tension", "top_angle", "touchdown_S", "touchdown_position", "max_curvature",
             "min_bend_radius", "grounded_length"} <= set(written["attributes"])

@@ -330,16 +330,45 @@ def test_plot_of_a_result_file(cantilever, folder):
     assert wrong.returncode == 2 and "usage" in wrong.stderr
 
 
-def test_the_readme_python_example_runs_and_prints_what_the_readme_says(tmp_path):
-    """The README's Python API example, run as it stands; its last line is the one the
-    README quotes."""
+def readme_python_blocks():
+    """The README's Python examples, in order: the api study, then the classes'."""
     with open(os.path.join(REPO_ROOT, "README.md")) as stream:
         readme = stream.read()
-    start = readme.index("```python\n") + len("```python\n")
+    blocks = readme.split("```python\n")[1:]
+    return readme, [block[:block.index("```")] for block in blocks]
+
+
+@pytest.mark.parametrize("index, starts", [(0, "buoyancy 500 m: top tension"),
+                                           (1, "converged: True")])
+def test_the_readme_python_examples_run_and_print_what_the_readme_says(tmp_path, index,
+                                                                       starts):
+    """The README's Python API examples, run as they stand; the last line of each is
+    the one the README quotes."""
+    readme, blocks = readme_python_blocks()
     script = tmp_path / "example.py"
-    script.write_text(readme[start:readme.index("```", start)])
+    script.write_text(blocks[index])
     process = subprocess.run([sys.executable, str(script)], cwd=REPO_ROOT, env=child_env(),
                              capture_output=True, text=True, timeout=TIMEOUT)
     assert process.returncode == 0, describe(process)
     last = process.stdout.strip().splitlines()[-1]
-    assert last.startswith("converged: True") and f"`{last}`" in readme, last
+    assert last.startswith(starts) and f"`{last}`" in readme, last
+
+
+def test_the_step_line_is_short_and_the_monitor_adds_its_details(tmp_path):
+    """Issue 24, point 6: the step line says the load factor, iterations (Newton),
+    converged and stable; -rod_al_monitor adds after it the change, residual, energy and
+    u3(0), which are the file's."""
+    path = tmp_path / "cantilever.h5"
+    plain = run(["-options_file", "options/cantilever.opts"]).stdout.splitlines()
+    steps = [line for line in plain if line.startswith("step ")]
+    assert steps[-1].startswith("step 2/2: load factor 1, converged in ") and \
+        steps[-1].endswith(" Newton), stable"), steps
+    assert not any("energy" in line or "u3(0)" in line for line in plain), plain
+    verbose = run(["-options_file", "options/cantilever.opts", "-rod_al_monitor",
+                   "-rod_output", str(path)]).stdout.splitlines()
+    details = [line for line in verbose if line.startswith("  step 2/2 details: ")]
+    with h5py.File(path, "r") as f:
+        energy, change = float(f.attrs["energy"]), float(f.attrs["change"])
+        u3 = float(f["u"][0, 2])
+    assert len(details) == 1 and f"energy {energy:.10g} J" in details[0], verbose
+    assert f"change {change:.2e}" in details[0] and f"u3(0) {u3:.6g}" in details[0]

@@ -1,0 +1,296 @@
+"""What a study scripts: line types, a line of sections, its two ends, the sea, the
+attachments (docs/riser.md), as plain values in SI units, and the -rod_* options they
+stand for.
+
+A Model is read exactly as the command line reads its options:
+``Model.option_texts()`` gives their text, which cli/options.parse_values parses and
+cli/scene_options makes into the Scene (with every check and message of the command
+line), so that a model and the options file it writes (``Model.write_options``) solve
+the same problem to round-off.
+Nothing here knows PETSc; the run is api/run.py.
+"""
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError
+
+KINDS = ("pin", "clamp", "free")
+# Options a Model's fields give (Line, End, Environment, Attachment), or solve's output=;
+# a restart (initial) walks a file's scene, which the API leaves to the command line.
+MODEL_OPTIONS = ("line_types", "sections", "length", "stiffness", "load", "load_breaks",
+                 "axial_stiffness", "drag", "elements", "mesh_grading", "output", "initial",
+                 "initial_load_factor", "point_loads", "point_load", "current",
+                 "current_profile")
+
+
+def _number(value):
+    """A float as text that parses back to the same float (repr)."""
+    return repr(float(value))
+
+
+def _numbers(values):
+    return ",".join(_number(v) for v in np.ravel(values))
+
+
+@dataclass(frozen=True)
+class LineType:
+    """A line type as a data sheet gives it (scenes/line.LineType):
+
+    ``od`` outer diameter (m), ``mass`` in air with contents (kg/m), ``ei`` bending
+    stiffness (N m^2; a pair (EI1, EI2) about d1 and d2 for an anisotropic line),
+    ``gj`` torsional stiffness (N m^2), ``ea`` axial stiffness (N; inf: inextensible),
+    ``cd`` normal drag coefficient (1), ``drag_d`` hydrodynamic diameter (m; None: the
+    od), ``id`` inner diameter (m; 0: no bore), ``ei_end`` (N m^2) the bending
+    stiffness at the end of each section of the type where it tapers linearly from
+    ``ei`` (a bend stiffener). The submerged weight is (mass - rho_w pi od^2 / 4) g.
+    """
+
+    name: str
+    od: float
+    mass: float
+    ei: object
+    gj: float
+    ea: float = math.inf
+    cd: float = 0.0
+    drag_d: float = None
+    id: float = 0.0
+    ei_end: float = None
+
+    def row(self):
+        """The type's row of a -rod_line_types table, in COLUMNS order ('-' blank)."""
+        blank = "-"
+        ei = np.ravel(self.ei).astype(float)
+        if self.ei_end is not None:
+            if ei.size != 1:
+                raise RodInputError(f"line type {self.name}: a taper (ei_end) takes one ei")
+            bending = [blank, blank, blank, _number(ei[0]), _number(self.ei_end)]
+        elif ei.size == 1:
+            bending = [_number(ei[0]), blank, blank, blank, blank]
+        elif ei.size == 2:
+            bending = [blank, _number(ei[0]), _number(ei[1]), blank, blank]
+        else:
+            raise RodInputError(f"line type {self.name}: ei is one number or a pair (EI1, EI2)")
+        return ([self.name, _number(self.od), _number(self.mass), _number(self.gj)] + bending
+                + [_number(self.ea), _number(self.cd),
+                   blank if self.drag_d is None else _number(self.drag_d), _number(self.id)])
+
+
+# The columns LineType.row fills (scenes/line.py: LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL).
+COLUMNS = ("name", "od", "mass", "gj", "ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd",
+           "drag_d", "id")
+
+
+def line_types_table(types):
+    """The text of a -rod_line_types table of the LineTypes ``types``."""
+    rows = [list(COLUMNS)] + [t.row() for t in types]
+    widths = [max(len(row[k]) for row in rows) for k in range(len(COLUMNS))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip()
+                     for row in rows) + "\n"
+
+
+@dataclass(frozen=True)
+class Line:
+    """The line from S = 0: ``sections`` a sequence of (LineType, length m) or
+    (LineType, length m, elements), with ``element_length`` (m) the elements of those
+    without a count (each at least 1). ``contents_density`` (kg/m^3) and
+    ``internal_pressure`` at the top (Pa) give the reported pressures and wall tension
+    (riser/pressures.py)."""
+
+    sections: tuple
+    element_length: float = 1.0
+    contents_density: float = 0.0
+    internal_pressure: float = 0.0
+
+    def types(self):
+        """The distinct LineTypes, in the order met; RodInputError for two types of one
+        name that differ."""
+        found = {}
+        for entry in self.sections:
+            kind = entry[0]
+            if found.setdefault(kind.name, kind).row() != kind.row():
+                raise RodInputError(f"two different line types are named {kind.name}")
+        return list(found.values())
+
+    def sections_text(self):
+        """-rod_sections TYPE:LENGTH:ELEMENTS,..."""
+        parts = []
+        for entry in self.sections:
+            kind, length = entry[0], float(entry[1])
+            count = entry[2] if len(entry) > 2 else max(1, round(length / self.element_length))
+            parts.append(f"{kind.name}:{_number(length)}:{int(count)}")
+        return ",".join(parts)
+
+    @property
+    def length(self):
+        """m."""
+        return float(sum(entry[1] for entry in self.sections))
+
+
+@dataclass(frozen=True)
+class End:
+    """One end of the line: ``kind`` 'pin' (held in position: an anchor, a hang-off),
+    'clamp' (position and frame) or 'free'; ``position`` (3,), m, absolute, z up (a
+    held end's); a flex joint at a pin of rotational stiffness ``stiffness`` (N m/rad)
+    about ``axis`` (3,) (None: e_x; docs/riser.md §8); ``force`` (3,), N, a dead force
+    at a free end."""
+
+    kind: str = "pin"
+    position: tuple = None
+    stiffness: float = 0.0
+    axis: tuple = None
+    force: tuple = None
+
+    @classmethod
+    def anchor(cls, position):
+        """A pinned end at ``position`` (m), on the seabed or above it."""
+        return cls("pin", tuple(position))
+
+    @classmethod
+    def hang_off(cls, position, flex_joint=0.0, axis=None):
+        """The vessel's end at ``position`` (m): a pin, or a flex joint of stiffness
+        ``flex_joint`` (N m/rad) about ``axis`` (default e_x)."""
+        return cls("pin", tuple(position), flex_joint, None if axis is None else tuple(axis))
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """A clump weight, a buoyancy module or a point force at arc length ``S`` (m):
+    ``mass`` in air (kg), displaced ``volume`` (m^3), ``force`` (3,), N, drag area
+    ``cda`` = C_d A (m^2) in a current (scenes/point_loads.py)."""
+
+    S: float
+    mass: float = 0.0
+    volume: float = 0.0
+    force: tuple = (0.0, 0.0, 0.0)
+    cda: float = 0.0
+    name: str = None
+
+
+@dataclass(frozen=True)
+class Environment:
+    """The sea: a flat seabed at height ``seabed`` (m; None: none) of stiffness
+    ``seabed_stiffness`` (N/m^2; None: weight / 1 mm), the sea surface at height
+    ``surface`` (m; None: the higher held end), a ``current``: None, a velocity (3,) in
+    m/s (uniform), or a profile of rows (depth m, ux, uy, uz m/s) below the surface;
+    ``water_density`` (kg/m^3) and ``gravity`` (m/s^2)."""
+
+    seabed: float = None
+    seabed_stiffness: float = None
+    surface: float = None
+    current: object = None
+    water_density: float = 1025.0
+    gravity: float = 9.80665
+
+    def profile(self):
+        """(depths (m,), velocities (m, 3)) of a current profile, None for a uniform
+        current or none."""
+        rows = None if self.current is None else np.asarray(self.current, dtype=float)
+        if rows is None or rows.ndim == 1:
+            return None
+        if rows.ndim != 2 or rows.shape[1] != 4:
+            raise RodInputError("Environment.current: a velocity (3,) or rows (depth, ux, "
+                                "uy, uz)")
+        return rows[:, 0].copy(), rows[:, 1:].copy()
+
+
+@dataclass(frozen=True)
+class Model:
+    """A line between two ends in the sea, with attachments, solved in ``steps``
+    continuation steps from ``initial_shape`` ('catenary': the catenary of the sections;
+    'straight'); ``options`` {name: value} any other -rod_* option, without 'rod_'
+    (e.g. {'al_rtol': 1e-10}). Solve it with api.run.solve."""
+
+    line: Line
+    start: End
+    end: End
+    environment: Environment = field(default_factory=Environment)
+    attachments: tuple = ()
+    steps: int = 1
+    initial_shape: str = "catenary"
+    options: dict = field(default_factory=dict)
+
+    def option_texts(self, line_types="<line types>"):
+        """{'rod_<name>': text} of the options this model stands for; ``line_types`` the
+        name said for the line types' table (the table itself: ``line_types_text``)."""
+        texts = {"rod_line_types": line_types, "rod_sections": self.line.sections_text(),
+                 "rod_steps": str(int(self.steps)), "rod_initial_shape": self.initial_shape}
+        if self.line.contents_density:
+            texts["rod_contents_density"] = _number(self.line.contents_density)
+        if self.line.internal_pressure:
+            texts["rod_internal_pressure"] = _number(self.line.internal_pressure)
+        for which, end in (("start", self.start), ("end", self.end)):
+            if end.kind not in KINDS:
+                raise RodInputError(f"Model.{which}: kind {end.kind!r}; use one of {KINDS}")
+            texts[f"rod_{which}"] = end.kind
+            if end.position is not None:
+                texts[f"rod_{which}_position"] = _numbers(end.position)
+            if end.stiffness:
+                texts[f"rod_{which}_rotational_stiffness"] = _number(end.stiffness)
+            if end.axis is not None:
+                texts[f"rod_{which}_joint_axis"] = _numbers(end.axis)
+            if end.force is not None:
+                texts[f"rod_{which}_force"] = _numbers(end.force)
+        sea = self.environment
+        for name, value in (("seabed", sea.seabed), ("seabed_stiffness", sea.seabed_stiffness),
+                            ("sea_surface", sea.surface)):
+            if value is not None:
+                texts[f"rod_{name}"] = _number(value)
+        if sea.current is not None:
+            if sea.profile() is None:
+                texts["rod_current"] = _numbers(sea.current)
+            else:
+                texts["rod_current_profile"] = "<current profile>"
+        if sea.water_density != 1025.0 or sea.gravity != 9.80665:
+            texts["rod_water_density"] = _number(sea.water_density)
+            texts["rod_gravity"] = _number(sea.gravity)
+        if self.attachments:
+            texts["rod_point_loads"] = "<attachments>"
+        for name, value in self.options.items():
+            if name in MODEL_OPTIONS or f"rod_{name}" in texts:
+                raise RodInputError(f"Model.options {name!r}: the model's own fields give "
+                                    "it (or solve's output=); restarts are the command "
+                                    "line's (Model.write_options)")
+            texts[f"rod_{name}"] = (value if isinstance(value, str) else
+                                    str(int(value)) if isinstance(value, (bool, int)) else
+                                    _numbers(value))
+        return texts
+
+    def write_options(self, path):
+        """Write the model as an options file ``path`` (``python -m petsc_rod
+        -options_file path`` solves it) and the tables it names beside it: ``path`` with
+        '.line_types.txt', '.point_loads.txt', '.current.txt' for '.opts'. Call it on
+        one rank."""
+        stem = str(path).removesuffix(".opts")
+        files = {"rod_line_types": (f"{stem}.line_types.txt", self.line_types_text())}
+        if self.attachments:
+            files["rod_point_loads"] = (f"{stem}.point_loads.txt", self.attachment_table())
+        profile = self.environment.profile()
+        if profile is not None:
+            rows = np.column_stack(profile)
+            files["rod_current_profile"] = (f"{stem}.current.txt", "".join(
+                " ".join(_number(v) for v in row) + "\n" for row in rows))
+        texts = self.option_texts()
+        for name, (file, content) in files.items():
+            with open(file, "w", encoding="utf-8") as out:
+                out.write(content)
+            texts[name] = file
+        with open(path, "w", encoding="utf-8") as out:
+            out.write("# written by petsc_rod.api.Model.write_options\n"
+                      + "".join(f"-{name} {text}\n" for name, text in texts.items()))
+
+    def line_types_text(self):
+        """The -rod_line_types table of the line's types."""
+        return line_types_table(self.line.types())
+
+    def attachment_table(self):
+        """The attachments as a -rod_point_loads table's text (s, mass, volume, fx, fy,
+        fz, cda, name)."""
+        rows = ["s mass volume fx fy fz cda name"]
+        for k, a in enumerate(self.attachments):
+            name = (a.name or f"point_{k + 1}").replace(" ", "_")
+            rows.append(" ".join([_number(a.S), _number(a.mass), _number(a.volume),
+                                  _numbers(a.force).replace(",", " "), _number(a.cda), name]))
+        return "\n".join(rows) + "\n"

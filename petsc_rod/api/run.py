@@ -1,0 +1,143 @@
+"""solve(model): a Model (api/model.py) solved as the command line solves its options
+(cli/main.py): the same Scene (cli/scene_options.py), checks, mesh, solver, start and
+continuation (cli/session.run_continuation), on the ranks of ``comm``. The one place of
+the API that creates and destroys PETSc objects; what it returns holds numpy arrays
+only (api/results.py)."""
+
+import numpy as np
+
+from petsc_rod.api.model import Model
+from petsc_rod.api.results import Results
+from petsc_rod.cli.main import build_solver, check_mesh, run_record, start_from
+from petsc_rod.cli.options import parse_values
+from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
+from petsc_rod.cli.session import run_continuation
+from petsc_rod.errors import RodInputError
+from petsc_rod.io import outputs
+from petsc_rod.io import results as io
+from petsc_rod.iteration.continuation import PathSettings
+from petsc_rod.mesh.mesh import Mesh
+from petsc_rod.scenes.point_loads import attachment_forces, beyond_the_line
+
+
+class _LastStep:
+    """A writer for run_continuation that keeps the last step's vertex datasets and
+    attributes (copies of this rank's owned arrays), passing everything on to a
+    io.results.ResultWriter ``inner`` when there is one."""
+
+    def __init__(self, inner=None):
+        self.inner, self.vertex, self.attributes = inner, None, None
+
+    def write_step(self, group, vertex, state, history, attributes):
+        self.vertex = {name: np.array(value, copy=True) for name, value in vertex.items()}
+        self.attributes = dict(attributes)
+        if self.inner is not None:
+            self.inner.write_step(group, vertex, state, history, attributes)
+
+    def finish(self, *args):
+        if self.inner is not None:
+            self.inner.finish(*args)
+
+    def kept_name(self):
+        return self.inner.kept_name() if self.inner is not None else None
+
+    def abort(self):
+        if self.inner is not None:
+            self.inner.abort()
+
+
+def _points(model, length):
+    """(S, forces (n, 3), drag areas) of the model's attachments, or None."""
+    if not model.attachments:
+        return None
+    sea = model.environment
+    S = np.array([a.S for a in model.attachments], dtype=float)
+    k = beyond_the_line(S, length)
+    if k is not None:
+        raise RodInputError(f"attachment {k + 1}: S = {S[k]:.6g} m is beyond the line "
+                            f"[0, {length:.6g}] m")
+    columns = {"s": S, "mass": [a.mass for a in model.attachments],
+               "volume": [a.volume for a in model.attachments],
+               **{f"f{c}": [a.force[i] for a in model.attachments]
+                  for i, c in enumerate("xyz")}}
+    areas = np.array([a.cda for a in model.attachments], dtype=float)
+    if np.any(np.asarray(columns["mass"]) < 0) or np.any(np.asarray(columns["volume"]) < 0) \
+            or np.any(areas < 0):
+        raise RodInputError("an attachment's mass, volume and cda must not be negative")
+    return S, attachment_forces(columns, sea.water_density, sea.gravity), areas
+
+
+def _run_record(model, values, solver, start, output):
+    """cli.main.run_record of the model's run, with its line types' table (which the
+    command line reads from its file) and the model's option texts."""
+    record = run_record({**values, "rod_output": output, "rod_line_types": None}, solver,
+                        start)
+    record.parameters["line_types"] = "(Python API)"
+    record.parameters["line_types_table"] = model.line_types_text()
+    record.units["line_types_table"] = "text"
+    return record
+
+
+def scene_of(model):
+    """(Scene, option values, given names) of ``model``: its options parsed and made into
+    a validated Scene by the command line's own functions."""
+    if not isinstance(model, Model):
+        raise TypeError("solve takes an api.Model")
+    texts = model.option_texts()
+    values = parse_values(texts)
+    given = set(texts)
+    scene = scene_from_options(values, given, model.environment.profile(),
+                               model.line_types_text(), _points(model, model.line.length))
+    if model.attachments:
+        scene.point_load_names = tuple(a.name or f"point {k + 1}"
+                                       for k, a in enumerate(model.attachments))
+    return scene, values, given
+
+
+def solve(model, comm=None, output=None, say=None):
+    """Solve ``model`` (api.Model) on the ranks of ``comm`` (a PETSc communicator;
+    default PETSc.COMM_WORLD); collective. ``output``: a result file to write as well
+    (HDF5, docs/output.md), as -rod_output; ``say(line)`` gets the command line's
+    lines (None: silent). Returns an api.Results at the last load factor (its
+    ``converged`` says whether it is 1); RodInputError for a model the command line
+    would refuse, RodDivergedError for a run that diverged."""
+    from petsc4py import PETSc
+
+    comm = comm or PETSc.COMM_WORLD
+    scene, values, given = scene_of(model)
+    settings = settings_from_options(values, scene)
+    pieces = mesh_pieces(values, scene)
+    values["rod_elements"] = int(pieces.counts.sum())
+    check_mesh(comm, values)
+    if output:
+        io.check_output_path(output, comm)
+    mesh = problem = solver = keeper = None
+    say = say or (lambda line: None)
+    try:
+        mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
+                    pieces)
+        problem, solver = build_solver(mesh, scene, settings, say)
+        start = start_from(problem, values, given, say)
+        inner = None
+        if output:
+            inner = io.ResultWriter(
+                output, mesh,
+                io.minimum_bytes(mesh, outputs.restart_state(problem), values["rod_steps"]),
+                _run_record(model, values, solver, start, output))
+        keeper = _LastStep(inner)
+        path = PathSettings(steps=values["rod_steps"], imperfection=values["rod_imperfection"],
+                            max_halvings=values["rod_max_halvings"],
+                            track_link=values["rod_track_link"])
+        result = run_continuation(solver, path, say=say, writer=keeper)
+        keeper.inner = None                     # finished
+        return Results(keeper.vertex, keeper.attributes, result.converged,
+                       comm.tompi4py(), mesh.n_elements)
+    finally:
+        if keeper is not None:
+            keeper.abort()
+        if solver is not None:
+            solver.destroy()
+        if problem is not None:
+            problem.destroy()
+        if mesh is not None:
+            mesh.destroy()

@@ -1,0 +1,108 @@
+"""petsc_rod/api in the process, on the ranks pytest runs on: a small riser of two line
+types with a flex joint, an attachment, a current profile and a seabed; the numbers the
+same on one rank and on all, the arrays gathered in order, the units, the result file
+written alongside with the same numbers, and a bad model refused as the command line
+refuses it."""
+
+import h5py
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import Attachment, End, Environment, Line, LineType, Model, solve
+from petsc_rod.errors import RodInputError
+
+pytestmark = pytest.mark.solver
+
+PIPE = LineType("pipe", od=0.2, mass=60.0, ei=1e5, gj=8e4, cd=1.0)
+FLOATY = LineType("floaty", od=0.5, mass=170.0, ei=1e5, gj=8e4, cd=1.0, drag_d=0.45)
+
+
+def model(**change):
+    line = Line([(PIPE, 60.0), (FLOATY, 30.0), (PIPE, 70.0)], element_length=2.0)
+    sea = Environment(seabed=0.0, surface=60.0,
+                      current=[[0.0, 0.4, 0.1, 0.0], [60.0, 0.1, 0.0, 0.0]])
+    fields = dict(line=line, start=End.anchor((0.0, 0.0, 0.0)),
+                  end=End.hang_off((100.0, 0.0, 55.0), flex_joint=1e4, axis=(0, 0, 1)),
+                  environment=sea, attachments=(Attachment(100.0, mass=200.0, name="clump"),),
+                  steps=2, initial_shape="straight")
+    fields.update(change)
+    return Model(**fields)
+
+
+def test_one_rank_and_all_give_the_same_numbers():
+    comm = PETSc.COMM_WORLD
+    alone = solve(model(), comm=PETSc.COMM_SELF)
+    together = solve(model(), comm=comm)
+    assert alone.converged and together.converged
+    for name in ("top_tension", "top_angle", "touchdown_S", "min_bend_radius",
+                 "end_joint_angle"):
+        assert together.scalars[name] == pytest.approx(alone.scalars[name], rel=1e-8), name
+    assert alone.units["top_tension"] == "N" and alone.units["touchdown_S"] == "m"
+    assert alone.units["effective_tension"] == "N" and alone.units["r"] == "m"
+    line = together.along_line(["S", "r", "effective_tension"])
+    assert line["S"].shape == (81,) and np.all(np.diff(line["S"]) > 0)
+    assert line["r"][-1] == pytest.approx([100.0, 0.0, 55.0], abs=1e-6)
+    # the current pushes the line along +y, the clump weighs on it
+    assert line["r"][:, 1].max() > 0.1
+    assert together.scalars["point_load_force"][0][2] == pytest.approx(
+        -200.0 * 9.80665, rel=1e-12)
+    local = alone.along_line()
+    assert set(local) == set(alone.owned)
+    assert "top tension" in alone.summary()[1]
+
+
+def test_the_result_file_holds_the_same_numbers(tmp_path):
+    comm = PETSc.COMM_WORLD
+    folder = comm.tompi4py().bcast(str(tmp_path))
+    path = f"{folder}/api.h5"
+    results = solve(model(steps=1), comm=comm, output=path)
+    with h5py.File(path, "r") as f:
+        assert int(f.attrs["converged"]) == 1
+        assert float(f.attrs["top_tension"]) == results.top_tension
+        assert "floaty" in f["parameters"].attrs["line_types_table"]
+        S = f["S"][:]
+    assert S.shape == (81,)
+
+
+def test_a_bad_model_is_refused_as_the_command_line_refuses_it():
+    with pytest.raises(RodInputError, match="beyond the line"):
+        solve(model(attachments=(Attachment(500.0, mass=1.0),)))
+    bad = LineType("bad", od=0.2, mass=60.0, ei=-1.0, gj=8e4)
+    with pytest.raises(RodInputError, match="must be positive"):
+        solve(model(line=Line([(bad, 100.0)])))
+
+
+def test_a_model_written_as_options_reads_back_as_the_same_scene(tmp_path):
+    """Model.write_options: the options file and its tables make, through the command
+    line's own reading, the scene the model makes."""
+    from petsc_rod.api import scene_of
+    from petsc_rod.cli.options import parse_values
+    from petsc_rod.cli.scene_options import scene_from_options
+
+    path = tmp_path / "model.opts"
+    model().write_options(path)
+    texts = {}
+    for line in path.read_text().splitlines():
+        if line.startswith("-"):
+            name, text = line[1:].split(" ", 1)
+            texts[name] = text
+    from_file = scene_from_options(parse_values(texts), set(texts))
+    scene, _, _ = scene_of(model())
+    assert from_file.length == scene.length and len(from_file.sections) == 3
+    for a, b in zip(from_file.sections, scene.sections):
+        assert (a.name, a.start, a.end, a.drag, a.od) == (b.name, b.start, b.end, b.drag, b.od)
+        assert np.array_equal(a.weight, b.weight)
+        assert np.array_equal(a.stiffness_start, b.stiffness_start)
+    assert np.array_equal(from_file.point_load_forces, scene.point_load_forces)
+    assert np.array_equal(from_file.current.velocities, scene.current.velocities)
+    assert from_file.current.drag == scene.current.drag
+
+
+def test_an_option_the_model_gives_is_refused_in_its_options():
+    with pytest.raises(RodInputError, match="Model.options 'initial'"):
+        model(options={"initial": "run.h5"}).option_texts()
+    with pytest.raises(RodInputError, match="Model.options 'seabed'"):
+        model(options={"seabed": 1.0}).option_texts()
+    texts = model(options={"al_rtol": 1e-10, "al_stability": False}).option_texts()
+    assert texts["rod_al_rtol"] == "1e-10" and texts["rod_al_stability"] == "0"

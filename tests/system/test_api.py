@@ -1,0 +1,53 @@
+"""The README's api study (petsc_rod/api, issue 24 point 7) against the command line:
+the study run as the README has it on 2 ranks, and options/lazy_wave_types.opts on the
+same 2 m elements through ``python -m petsc_rod`` on 2 ranks; at 400 m of buoyancy they
+are the same scene, and their numbers agree to 1e-9. Spawns processes: marked
+``serial``."""
+
+import json
+import subprocess
+import sys
+
+import h5py
+import pytest
+
+from helpers import REPO_ROOT, child_env, describe, mpiexec, run_petsc_rod
+from test_cli import readme_python_blocks
+
+pytestmark = pytest.mark.serial
+
+TIMEOUT = 300
+# options/lazy_wave_types.opts on the README study's mesh (element_length 2 m)
+CLI_SECTIONS = "umbilical:600:300,buoyancy:400:200,umbilical:1000:500"
+NUMBERS = ("top_tension", "top_angle", "touchdown_S", "min_bend_radius", "max_curvature_S",
+           "energy")
+
+
+def test_the_readme_study_agrees_with_the_command_line(tmp_path):
+    _, blocks = readme_python_blocks()
+    script = tmp_path / "study.py"
+    dump = tmp_path / "study.json"
+    script.write_text(blocks[0] + f"""
+import json
+if PETSc.COMM_WORLD.getRank() == 0:
+    with open({str(dump)!r}, "w") as out:
+        json.dump({{str(k): {{n: float(getattr(v, n)) for n in {NUMBERS!r}}}
+                   for k, v in study.items()}}, out)
+along = study[400.0].along_line(["S", "effective_tension"])
+assert along["S"].shape == (1001,) and study[400.0].units["effective_tension"] == "N"
+""")
+    process = subprocess.run(mpiexec(2) + [sys.executable, str(script)], cwd=REPO_ROOT,
+                             env=child_env(), capture_output=True, text=True, timeout=TIMEOUT)
+    assert process.returncode == 0, describe(process)
+    with open(dump) as stream:
+        study = json.load(stream)
+    assert study["300.0"]["top_tension"] > study["400.0"]["top_tension"] \
+        > study["500.0"]["top_tension"]             # more buoyancy, less to hold up
+    path = tmp_path / "cli.h5"
+    done = run_petsc_rod(["-options_file", "options/lazy_wave_types.opts", "-rod_sections",
+                          CLI_SECTIONS, "-rod_output", str(path)], 2, TIMEOUT)
+    assert done.returncode == 0, describe(done)
+    with h5py.File(path, "r") as f:
+        cli = {name: float(f.attrs[name]) for name in NUMBERS}
+    for name in NUMBERS:
+        assert study["400.0"][name] == pytest.approx(cli[name], rel=1e-9, abs=1e-9), name
