@@ -81,7 +81,8 @@ def azimuth(tangent):
     +y in (-180, 180]; NaN for a vertical tangent."""
     if np.hypot(tangent[0], tangent[1]) < VERTICAL:
         return np.nan
-    return float(np.degrees(np.arctan2(tangent[1], tangent[0])))
+    angle = float(np.degrees(np.arctan2(tangent[1], tangent[0])))
+    return angle + 360.0 if angle <= -180.0 else angle     # -0 in y: 180, not -180
 
 
 def line_fields(vertex, tension=True):
