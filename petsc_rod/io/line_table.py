@@ -25,6 +25,7 @@ from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
 from petsc_rod.riser import regions
+from petsc_rod.riser.quantities import effective_tension
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
 # them.
@@ -60,14 +61,16 @@ def check_table_path(path, output, comm):
 
 
 def final_record(problem):
-    """(vertex datasets with the terms' and r absolute, attributes of the terms) of the
-    problem's state. Collective."""
+    """(vertex datasets with the terms' and r absolute, and the effective tension n.t
+    where no term wrote it; the terms' attributes) of the problem's state. Collective."""
     vertex = outputs.vertex_fields(problem)
     attributes = {}
     for output in problem.term_outputs(vertex):
         vertex.update(output.datasets)
         attributes.update(output.attributes)
     vertex["r"] = vertex["r"] + problem.scene.start_position
+    if "effective_tension" not in vertex:       # a plain rod's (riser/line_results.py)
+        vertex["effective_tension"] = effective_tension(vertex)
     return vertex, attributes
 
 

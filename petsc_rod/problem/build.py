@@ -41,8 +41,7 @@ def scene_terms(mesh, scene):
         terms.append(PipePressures(scene))
         if any(section.id > 0 for section in scene.sections):
             terms.append(PipeStresses(scene))
-    riser = seabed is not None or drag
-    terms.append(LineResults(tension=not riser))
-    if riser or scene.sections:
+    terms.append(LineResults())
+    if seabed is not None or drag or scene.sections:
         terms.append(LineRegions(seabed))
     return terms

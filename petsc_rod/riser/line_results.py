@@ -10,7 +10,10 @@ At the vertices, (n,) each, with t = d3 / |d3| the unit tangent:
 * ``shear`` |n - (n.t) t| (N), the force across the line;
 * ``declination``: the angle of t (toward increasing S) from the upward vertical,
   acos(t_z), 0 to 180 deg (OrcaFlex's declination);
-* ``effective_tension`` n.t (N), where no riser term (riser/quantities.py) writes it.
+
+The effective tension n.t is not among them: the riser term (riser/quantities.py) writes
+it for a scene with a seabed or a current, and a file with it is drawn as a riser's
+(plots.py); the CSV table has it for every scene (io/line_table.py).
 
 Attributes: ``start_force``, ``start_moment``, ``end_force``, ``end_moment`` (3,), the
 force (N) and moment (N m) the line exerts on its support at S = 0 and S = L, in the
@@ -85,16 +88,12 @@ def azimuth(tangent):
     return angle + 360.0 if angle <= -180.0 else angle     # -0 in y: 180, not -180
 
 
-def line_fields(vertex, tension=True):
-    """The datasets of DATASET_UNITS at the vertices, with ``effective_tension`` when
-    ``tension``."""
+def line_fields(vertex):
+    """The datasets of DATASET_UNITS at the vertices."""
     kappa = curvature(vertex)
-    fields = {"curvature": kappa, "bend_radius": bend_radius(kappa),
-              "bending_moment": bending_moment(vertex), "torque": torque(vertex),
-              "shear": shear(vertex), "declination": declination(unit_tangent(vertex))}
-    if tension:
-        fields["effective_tension"] = effective_tension(vertex)
-    return fields
+    return {"curvature": kappa, "bend_radius": bend_radius(kappa),
+            "bending_moment": bending_moment(vertex), "torque": torque(vertex),
+            "shear": shear(vertex), "declination": declination(unit_tangent(vertex))}
 
 
 def end_numbers(problem, vertex):
@@ -114,11 +113,7 @@ def end_numbers(problem, vertex):
 
 class LineResults(Term):
     """Reports the results along the line and at its ends (module docstring); built for
-    every scene (problem/build.py), with ``tension`` where no riser term writes the
-    effective tension."""
-
-    def __init__(self, tension=True):
-        self.tension = tension
+    every scene (problem/build.py)."""
 
     def outputs(self, problem, vertex):
-        return TermOutput(line_fields(vertex, self.tension), end_numbers(problem, vertex))
+        return TermOutput(line_fields(vertex), end_numbers(problem, vertex))
