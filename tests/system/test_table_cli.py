@@ -133,3 +133,45 @@ def test_a_plain_rod_s_table(tmp_path):
     assert "effective_tension (N)" in header and "bending_moment (N m)" in header
     assert values.shape[0] == int(done.stdout.split(" elements")[0].split()[-1]) + 1
     assert os.listdir(tmp_path) == ["c.csv"]
+
+
+def test_two_ranks_write_the_same_table(riser):
+    """The steel riser on 2 ranks: the same header, rows in the same order, the same
+    numbers to the iteration's tolerance (1e-9 of the state: 1e-6 of each column's
+    largest value for the curvatures, derivatives of it; the bend radius, 1 / curvature,
+    is left out); the same regions."""
+    _, _, table, folder = riser
+    types, two = folder / "x65.txt", folder / "scr2.csv"
+    done = run_petsc_rod(SCR + ["-rod_line_types", str(types), "-rod_table", str(two)], 2,
+                         600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    header, values = read_csv(table)
+    header2, values2 = read_csv(two)
+    assert header2 == header and values2.shape == values.shape
+    finite = np.isfinite(values)
+    np.testing.assert_array_equal(finite, np.isfinite(values2))
+    scale = np.nanmax(np.abs(np.where(finite, values, np.nan)), axis=0)
+    for j, name in enumerate(header):
+        if name == "bend_radius (m)":
+            continue
+        rows = finite[:, j]
+        np.testing.assert_allclose(values2[rows, j], values[rows, j], rtol=1e-6,
+                                   atol=1e-6 * scale[j], err_msg=name)
+    with open(folder / "scr_regions.csv") as one, open(folder / "scr2_regions.csv") as other:
+        rows, rows2 = list(csv.reader(one)), list(csv.reader(other))
+    assert [row[0] for row in rows] == [row[0] for row in rows2]
+    np.testing.assert_allclose(np.array([row[1:] for row in rows2[1:]], dtype=float),
+                               np.array([row[1:] for row in rows[1:]], dtype=float),
+                               rtol=1e-6, atol=1e-6)
+
+
+def test_a_bad_yield_stress_is_refused(tmp_path):
+    """smys must be positive: one line naming it, exit 2, no table."""
+    types = tmp_path / "bad.txt"
+    types.write_text(STEEL_X65.replace("448e6", "-448e6"))
+    done = run_petsc_rod(SCR + ["-rod_line_types", str(types), "-rod_table",
+                                str(tmp_path / "t.csv")], 1, 120)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stdout.strip().splitlines()
+    assert len(lines) == 1 and "smys" in lines[0], lines
+    assert os.listdir(tmp_path) == ["bad.txt"]
