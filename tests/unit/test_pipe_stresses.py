@@ -54,6 +54,8 @@ def test_von_mises_by_hand():
     bore = np.sqrt(axial**2 + hoop**2 + radial**2 - axial * hoop - hoop * radial
                    - radial * axial)
     assert bore == pytest.approx(150.8e6, rel=1e-3)
+    hoop, radial = lame_stresses(p_i, 0.0, R_I, R_O, R_O)
+    assert von_mises(axial, hoop, radial, 0.0) == pytest.approx(144.5e6, rel=1e-3)
     got = pipe_von_mises(np.array([wall]), np.array([0.0]), np.array([0.0]),
                          np.array([p_i]), np.array([0.0]), np.array([2 * R_O]),
                          np.array([2 * R_I]))
