@@ -14,7 +14,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod import resources
-from petsc_rod.io import outputs, provenance
+from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
@@ -74,6 +74,8 @@ def run(comm=None):
             check_mesh(comm, values)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
+            if values["rod_table"]:
+                line_table.check_table_path(values["rod_table"], values["rod_output"], comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                         pieces)
             path_scene, notes = walked_scene(scene, values, comm)
@@ -97,6 +99,8 @@ def run(comm=None):
             code = run_continuation(solver, path, say=say, writer=writer,
                                     options=options_record(), interrupts=interrupts).code
             writer = None
+            if code == 0:                   # the regions' summary, the CSV table
+                line_table.finish_run(problem, values["rod_table"], say)
             for name in unused_options():
                 say(f"petsc_rod: warning: option -{name} was set but not used")
             return code

@@ -193,6 +193,10 @@ OPTIONS = [
            "contents' weight is in the line types' mass)", NON_NEGATIVE, "kg/m^3"),
     Option("rod_internal_pressure", _real, 0.0, "p",
            "internal pressure at the top (the higher held end), Pa", NON_NEGATIVE, "Pa"),
+    Option("rod_design_factor", _real, default_of(Scene, "design_factor"), "f",
+           "the allowable von Mises stress of a line type with id and smys is f smys "
+           "(utilisation = von Mises / (f smys); default the API RP 2RD operating basic "
+           "allowable 0.67)", (lambda v: 0 < v <= 1, "must be in (0, 1]")),
     # attachments (scenes/point_loads.py, physics/point_loads.py; docs/riser.md)
     Option("rod_point_loads", _string, None, "FILE",
            "attachments: a table with a header row naming its columns, s (arc length, m; "
@@ -255,6 +259,10 @@ OPTIONS = [
            "of that step with its tension as multiplier (both ends held, uniform load)",
            unit="text"),
     Option("rod_output", _string, None, "FILE", "write the result (HDF5) to FILE", unit="text"),
+    Option("rod_table", _string, None, "FILE.csv",
+           "write the converged result along the line as CSV to FILE (one row per vertex: "
+           "S, x, y, z and the results along the line, units in the header) and the "
+           "regions' summary beside it, FILE's stem + _regions.csv", unit="text"),
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "

@@ -182,20 +182,23 @@ def mesh_pieces(values, scene, given=()):
 
 
 def pressures_from_options(values, given, scene):
-    """Set the scene's sea surface (in its frame), contents density and internal
-    pressure (riser/pressures.py) for a line of sections; refuse them on a line without
+    """Set the scene's sea surface (in its frame), contents density, internal
+    pressure (riser/pressures.py) and design factor (riser/stresses.py) for a line of
+    sections; refuse them on a line without
     line types (no diameters to press on)."""
     if not scene.sections:
-        for name in ("rod_contents_density", "rod_internal_pressure"):
+        for name in ("rod_contents_density", "rod_internal_pressure",
+                     "rod_design_factor"):
             if name in given:
                 raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
-                                    "id give the areas it presses on)")
+                                    "id give the pipe it applies to)")
         return
     surface = values["rod_sea_surface"]
     if surface is not None:
         scene.sea_surface = float(surface - scene.start_position[2])
     scene.contents_density = float(values["rod_contents_density"])
     scene.internal_pressure = float(values["rod_internal_pressure"])
+    scene.design_factor = float(values["rod_design_factor"])
 
 
 def check_taut(scene):

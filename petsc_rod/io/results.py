@@ -44,7 +44,8 @@ from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
 from petsc_rod.physics import point_loads as point_load_term
 from petsc_rod.riser import quantities as riser_quantities
-from petsc_rod.riser import pressures, section_numbers
+from petsc_rod.riser import (line_results, pressures, regions, section_numbers,
+                             stresses)
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -56,7 +57,7 @@ DATASET_UNITS = {
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
     **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
-    **pressures.DATASET_UNITS,
+    **pressures.DATASET_UNITS, **line_results.DATASET_UNITS, **stresses.DATASET_UNITS,
     **stretch.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
@@ -70,7 +71,8 @@ ATTRIBUTE_UNITS = {
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
     **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
-    **pressures.ATTRIBUTE_UNITS,
+    **pressures.ATTRIBUTE_UNITS, **line_results.ATTRIBUTE_UNITS,
+    **regions.ATTRIBUTE_UNITS, **stresses.ATTRIBUTE_UNITS,
     **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
     **point_load_term.ATTRIBUTE_UNITS,
 }
@@ -115,36 +117,37 @@ def partial_name(path, comm):
     return f"{path}.{comm.tompi4py().bcast(tag, root=0)}.partial"
 
 
-def check_output_path(path, comm):
+def check_output_path(path, comm, option="-rod_output"):
     """Refuse, before any work, an output that could not be written: a folder, a missing
     folder, a device or other non-regular file, a link to nothing, a folder where a file
     cannot be created (permissions, a read-only or special file system), a name too long
     for the partial file's suffix. Nothing but the run's own probe is created or removed
-    (another run's partial file is left alone). Collective: rank 0 checks, every rank
-    raises."""
+    (another run's partial file is left alone). The message names ``option``.
+    Collective: rank 0 checks, every rank raises."""
     probe = partial_name(path, comm)
-    on_every_rank(comm, _check_output_path if comm.getRank() == 0 else _nothing, path, probe)
+    on_every_rank(comm, _check_output_path if comm.getRank() == 0 else _nothing, path, probe,
+                  option)
 
 
 def _nothing(*args):
     return None
 
 
-def _check_output_path(path, probe):
+def _check_output_path(path, probe, option):
     folder = os.path.dirname(os.path.abspath(path))
     if path.endswith(os.sep) or os.path.isdir(path):
-        raise RodInputError(f"-rod_output {path}: is a folder; name a file, e.g. "
+        raise RodInputError(f"{option} {path}: is a folder; name a file, e.g. "
                             f"{os.path.join(path, 'result.h5')}")
     if not os.path.isdir(folder):
-        raise RodInputError(f"-rod_output {path}: the folder {folder} does not exist")
+        raise RodInputError(f"{option} {path}: the folder {folder} does not exist")
     if os.path.islink(path) and not os.path.exists(path):
-        raise RodInputError(f"-rod_output {path}: is a symbolic link to {os.readlink(path)}, "
+        raise RodInputError(f"{option} {path}: is a symbolic link to {os.readlink(path)}, "
                             "which does not exist; remove the link or name another file")
     if os.path.lexists(path) and not _regular_file(path):
-        raise RodInputError(f"-rod_output {path}: exists and is not a regular file (a "
+        raise RodInputError(f"{option} {path}: exists and is not a regular file (a "
                             "folder, a device, a socket); name another file")
     if _append_only(folder):
-        raise RodInputError(f"-rod_output {path}: the folder {folder} is append-only (a "
+        raise RodInputError(f"{option} {path}: the folder {folder} is append-only (a "
                             "file made there can never be renamed or removed); choose "
                             "another folder")
     try:
@@ -153,16 +156,16 @@ def _check_output_path(path, probe):
         if error.errno == errno.ENAMETOOLONG:
             suffix = probe[len(path):]
             raise RodInputError(
-                f"-rod_output {path}: the name is too long for this file system once the "
+                f"{option} {path}: the name is too long for this file system once the "
                 f"run's partial suffix ({len(suffix)} characters, e.g. {suffix}) is added; "
                 "choose a shorter name") from None
-        raise RodInputError(f"-rod_output {path}: cannot create a file in {folder} "
+        raise RodInputError(f"{option} {path}: cannot create a file in {folder} "
                             f"({error.strerror}); choose a writable folder") from None
     os.close(descriptor)
     try:
         os.remove(probe)
     except OSError as error:        # an append-only folder: a file is made, never removed
-        raise RodInputError(f"-rod_output {path}: a file created in {folder} cannot be "
+        raise RodInputError(f"{option} {path}: a file created in {folder} cannot be "
                             f"removed ({error.strerror}: an append-only or sticky folder); "
                             f"remove {probe} by hand and choose another folder") from None
 

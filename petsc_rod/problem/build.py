@@ -2,15 +2,21 @@
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
 pinned end given a rotational stiffness (physics/flex_joint.py); the seabed, the drag and
 the riser numbers only where the scene has a seabed or a current (docs/riser.md); the
-axial stretch only where some EA is finite (docs/method.md §12)."""
+axial stretch only where some EA is finite (docs/method.md §12); the results along the
+line (riser/line_results.py) always, its regions (riser/regions.py) on a riser-like
+scene (a seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a
+line of line types with an inner diameter."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
 from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.stretch import AxialStretch
+from petsc_rod.riser.line_results import LineResults
 from petsc_rod.riser.pressures import PipePressures
 from petsc_rod.riser.quantities import RiserNumbers
+from petsc_rod.riser.regions import LineRegions
 from petsc_rod.riser.section_numbers import SectionNumbers
+from petsc_rod.riser.stresses import PipeStresses
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
 
 
@@ -33,4 +39,9 @@ def scene_terms(mesh, scene):
     if scene.sections:
         terms.append(SectionNumbers(scene.sections))
         terms.append(PipePressures(scene))
+        if any(section.id > 0 for section in scene.sections):
+            terms.append(PipeStresses(scene))
+    terms.append(LineResults())
+    if seabed is not None or drag or scene.sections:
+        terms.append(LineRegions(seabed))
     return terms

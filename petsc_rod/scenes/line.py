@@ -21,7 +21,8 @@ class Section:
     tapered); axial_stiffness: EA, N (inf: inextensible); weight: the load per metre,
     N/m, (3,) (the submerged weight along -z); drag: c = rho Cd D / 2, kg/m^2, of the
     normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
-    mass: kg/m in air.
+    mass: kg/m in air; smys: the specified minimum yield stress of the pipe's wall, Pa
+    (NaN: not given; riser/stresses.py).
     """
 
     name: str
@@ -35,6 +36,7 @@ class Section:
     od: float = np.nan
     mass: float = np.nan
     id: float = 0.0
+    smys: float = np.nan
 
     def __post_init__(self):
         self.stiffness_start = np.asarray(self.stiffness_start, dtype=float)
@@ -77,7 +79,8 @@ def piecewise_constant(sections, S, name):
 
 # The columns of a line-type table (-rod_line_types): required, and optional.
 LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
-LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d", "id")
+LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d", "id",
+                      "smys")
 # The ways of giving the bending stiffness, one per line type (the others' columns left
 # blank, '-'): isotropic, anisotropic (about d1 and d2), and a linear taper along each
 # section of the type.
@@ -91,7 +94,8 @@ class LineType:
     each section of the type (``bending_start``, ``bending_end``, N m^2, equal unless
     tapered), torsional ``gj`` (N m^2), axial ``ea`` (N, inf: inextensible), normal drag
     coefficient ``cd``, hydrodynamic diameter ``drag_d`` (m) and inner diameter ``id``
-    (m, 0: no bore; the internal pressure's area, riser/pressures.py)."""
+    (m, 0: no bore; the internal pressure's area, riser/pressures.py), and the wall's
+    specified minimum yield stress ``smys`` (Pa, NaN: not given; riser/stresses.py)."""
 
     name: str
     od: float
@@ -103,6 +107,7 @@ class LineType:
     cd: float = 0.0
     drag_d: float = np.nan
     id: float = 0.0
+    smys: float = np.nan
 
     def submerged_weight(self, water_density, gravity):
         """(mass - rho_w pi od^2 / 4) g, N/m: positive sinks, negative floats."""
@@ -116,7 +121,7 @@ class LineType:
                        np.append(self.bending_end, self.gj), self.ea,
                        np.array([0.0, 0.0, -self.submerged_weight(water_density, gravity)]),
                        0.5 * water_density * self.cd * self.drag_d, self.od, self.mass,
-                       self.id)
+                       self.id, self.smys)
 
 
 def line_types_from_table(table, option):
@@ -173,12 +178,18 @@ def line_types_from_table(table, option):
         row = int(np.flatnonzero(bad)[0])
         raise RodInputError(f"{option}: line type {names[row]}: id {inner[row]:g} must be "
                             f"0 or more and below od {table['od'][row]:g} (m)")
+    smys = column("smys", np.nan)
+    bad = ~np.isnan(smys) & ~((smys > 0) & np.isfinite(smys))
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise RodInputError(f"{option}: line type {names[row]}: smys {smys[row]:g} must be "
+                            "a positive, finite yield stress (Pa), or blank ('-')")
     if not np.all((cd >= 0) & np.isfinite(cd)):
         row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
         raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
                             "finite number, 0 or more")
     return {name: LineType(name, table["od"][i], table["mass"][i], start[i], end[i],
-                           table["gj"][i], ea[i], cd[i], drag_d[i], inner[i])
+                           table["gj"][i], ea[i], cd[i], drag_d[i], inner[i], smys[i])
             for i, name in enumerate(names)}
 
 

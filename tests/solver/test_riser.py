@@ -206,8 +206,9 @@ RISER = dict(length=50.0, stiffness=(20.0, 20.0, 15.0), start="pin", end="pin",
 
 
 def riser_output(problem, fields):
-    """The riser numbers (a TermOutput): the one term output of a riser scene."""
-    (output,) = problem.term_outputs(fields)
+    """The riser numbers (a TermOutput): the first term output of a riser scene (the
+    line's results and regions follow)."""
+    output, *_ = problem.term_outputs(fields)
     return output
 
 

@@ -15,7 +15,9 @@ from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.problem import RodProblem
 from petsc_rod.riser.environment import Current, Seabed
 from petsc_rod.riser.loads import NodalLoad
+from petsc_rod.riser.line_results import LineResults
 from petsc_rod.riser.quantities import RiserNumbers
+from petsc_rod.riser.regions import LineRegions
 from petsc_rod.riser.terms import DragTerm, NodalLoadTerm, SeabedTerm
 from petsc_rod.scenes.scene import Scene
 
@@ -90,10 +92,11 @@ def test_a_term_that_contributes_nothing_changes_nothing(comm):
 
 
 @pytest.mark.parametrize("sea, expected", [
-    ({}, [DeadLoads]),
-    ({"seabed": Seabed(-0.5, 1e3)}, [DeadLoads, SeabedTerm, RiserNumbers]),
+    ({}, [DeadLoads, LineResults]),
+    ({"seabed": Seabed(-0.5, 1e3)}, [DeadLoads, SeabedTerm, RiserNumbers, LineResults,
+                                      LineRegions]),
     ({"current": Current(np.zeros(1), np.array([[0.0, 1.0, 0.0]]), 0.0, 1.0)},
-     [DeadLoads, DragTerm, RiserNumbers]),
+     [DeadLoads, DragTerm, RiserNumbers, LineResults, LineRegions]),
 ])
 def test_a_scene_builds_only_the_terms_it_needs(comm, sea, expected):
     scene = Scene(**dict(BARE, start="pin", end="pin", end_position=[0.8, 0.0, 0.0]), **sea)

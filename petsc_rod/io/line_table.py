@@ -1,0 +1,148 @@
+"""The converged result along the line as a CSV table (-rod_table FILE.csv), the regions'
+summary beside it (FILE's stem + ``_regions.csv``) and printed at the end of the run
+(docs/output.md, docs/riser.md §5).
+
+One row per vertex: S, x, y, z (absolute), u1, u2 (the signed curvatures about d1 and
+d2) and every result along the line the run has (TABLE_DATASETS, those of its terms),
+a header row naming each column with its unit, e.g. ``effective_tension (N)``.
+
+The table is written by rank 0: each rank formats its own vertices' rows and rank 0
+gathers the text, in rank order, into one file (a CSV is one sequential text file, of
+the size of the vertex datasets, a fraction of the HDF5 result; a collective MPI-IO
+write of text rows of varying length would need their byte offsets for no gain at this
+size). It is written only after the run converged, to the run's own partial name and
+renamed when complete, like the HDF5 result (io/results.py): a run that did not
+converge, diverged or was stopped leaves no table. Collective.
+"""
+
+import contextlib
+import io as text_io
+import os
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
+from petsc_rod.io import outputs
+from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
+from petsc_rod.riser import regions
+from petsc_rod.riser.quantities import effective_tension
+
+# The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
+# them.
+TABLE_DATASETS = ("curvature", "bend_radius", "bending_moment", "torque", "shear",
+                  "effective_tension", "wall_tension", "external_pressure",
+                  "internal_pressure", "von_mises", "utilisation", "declination",
+                  "seabed_reaction", "axial_strain", "axial_tension", "section")
+# The regions' table: its columns and the attributes they come from.
+REGION_COLUMNS = (("S_from (m)", None), ("S_to (m)", None),
+                  ("max_effective_tension (N)", "region_max_tension"),
+                  ("max_effective_tension_S (m)", "region_max_tension_S"),
+                  ("min_bend_radius (m)", "region_min_bend_radius"),
+                  ("min_bend_radius_S (m)", "region_min_bend_radius_S"),
+                  ("max_bending_moment (N m)", "region_max_bending_moment"),
+                  ("max_bending_moment_S (m)", "region_max_bending_moment_S"))
+
+
+def regions_path(path):
+    """The regions' table beside the table ``path``: ``run.csv`` -> ``run_regions.csv``."""
+    stem, extension = os.path.splitext(path)
+    return f"{stem}_regions{extension or '.csv'}"
+
+
+def check_table_path(path, output, comm):
+    """Refuse, before any work, a -rod_table (and its regions' file) that could not be
+    written (io.results.check_output_path), or one that names the -rod_output file.
+    Collective."""
+    for name in (path, regions_path(path)):
+        if output and os.path.abspath(name) == os.path.abspath(output):
+            raise RodInputError(f"-rod_table {path}: it (or its regions' table {name}) is "
+                                f"the -rod_output file; name another file")
+        check_output_path(name, comm, "-rod_table")
+
+
+def final_record(problem):
+    """(vertex datasets with the terms' and r absolute, and the effective tension n.t
+    where no term wrote it; the terms' attributes) of the problem's state. Collective."""
+    vertex = outputs.vertex_fields(problem)
+    attributes = {}
+    for output in problem.term_outputs(vertex):
+        vertex.update(output.datasets)
+        attributes.update(output.attributes)
+    vertex["r"] = vertex["r"] + problem.scene.start_position
+    if "effective_tension" not in vertex:       # a plain rod's (riser/line_results.py)
+        vertex["effective_tension"] = effective_tension(vertex)
+    return vertex, attributes
+
+
+def table_columns(vertex):
+    """(header names with units, (n, columns) values) of this rank's vertices."""
+    names = ["S (m)", "x (m)", "y (m)", "z (m)", "u1 (rad/m)", "u2 (rad/m)"]
+    columns = [vertex["S"], *vertex["r"].T, vertex["u"][:, 0], vertex["u"][:, 1]]
+    for key in TABLE_DATASETS:
+        if key in vertex:
+            names.append(f"{key} ({DATASET_UNITS[key]})")
+            columns.append(np.asarray(vertex[key], dtype=float))
+    return names, np.column_stack(columns)
+
+
+def _rows(values):
+    """CSV text of the rows ``values`` (n, columns), 12 significant digits."""
+    buffer = text_io.StringIO()
+    np.savetxt(buffer, values, fmt="%.12g", delimiter=",")
+    return buffer.getvalue()
+
+
+def region_rows(attributes):
+    """(header, rows text) of the regions' table; None without regions."""
+    if "region_names" not in attributes:
+        return None
+    header = ",".join(["region"] + [name for name, _ in REGION_COLUMNS])
+    lines = []
+    for i, name in enumerate(attributes["region_names"]):
+        values = list(attributes["region_bounds"][i]) + [attributes[key][i] for _, key in
+                                                          REGION_COLUMNS[2:]]
+        lines.append(",".join([name] + [f"{v:.12g}" for v in values]))
+    return header, "\n".join(lines) + "\n"
+
+
+def _write(path, partial, text):
+    """``text`` into ``partial``, renamed to ``path`` (rank 0)."""
+    try:
+        with open(partial, "w") as handle:
+            handle.write(text)
+        os.replace(partial, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            os.remove(partial)
+        raise RodIOError(f"-rod_table {path}: writing failed ({error.strerror}); no table "
+                         "is left") from None
+
+
+def write_tables(path, comm, vertex, attributes):
+    """The CSV table at ``path`` and the regions' beside it (module docstring).
+    Collective."""
+    names, values = table_columns(vertex)
+    pieces = comm.tompi4py().gather(_rows(values), root=0)
+    files = [(path, ",".join(names) + "\n" + "".join(pieces or []))]
+    rows = region_rows(attributes)
+    if rows is not None:
+        files.append((regions_path(path), rows[0] + "\n" + rows[1]))
+    partials = [partial_name(name, comm) for name, _ in files]
+
+    def write_all():
+        if comm.getRank() == 0:
+            for (name, text), partial in zip(files, partials):
+                _write(name, partial, text)
+    on_every_rank(comm, write_all)
+
+
+def finish_run(problem, path, say):
+    """After a converged run: the regions' summary said, the table written when ``path``
+    (-rod_table) is given. Collective."""
+    vertex, attributes = final_record(problem)
+    for line in regions.summary_lines(attributes):
+        say(line)
+    if path:
+        write_tables(path, problem.mesh.comm, vertex, attributes)
+        say(f"petsc_rod: table {path}" + (f", regions {regions_path(path)}"
+                                          if "region_names" in attributes else ""))

@@ -1,0 +1,132 @@
+"""The results along the line and at its ends (riser/line_results.py) and the regions
+(riser/regions.py) of solved lines: against EI times the curvature, the balance of the
+end forces with the loads, hand angles, and one rank against all (each scene solved on
+PETSc.COMM_SELF and on PETSc.COMM_WORLD: under mpiexec -n 2 the 1-versus-2-ranks
+check). Serial and under mpiexec -n 2."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import gather, make_solver, destroy
+from petsc_rod.io.line_table import final_record
+from petsc_rod.problem.penalty import default_penalty
+from petsc_rod.riser.environment import Seabed
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.scenes.starts import catenary_start
+
+# A catenary in the x-z plane: 10 m of line of 2 N/m, EI = 0.5 N m^2, pinned at the
+# origin and at (7, 0, 3) (the top, S = L) or (7, 0, -3) (the top the start).
+CATENARY = dict(length=10.0, stiffness=(0.5, 0.5, 0.4), start="pin", end="pin",
+                end_position=(7.0, 0.0, 3.0), load_values=[[0.0, 0.0, -2.0]])
+# The same resting partly on a seabed at z = -1 (a touchdown, a grounded part).
+GROUNDED = dict(CATENARY, end_position=(6.0, 0.0, 3.0), seabed=Seabed(-1.0, 1e5))
+LINE_DATASETS = ("curvature", "bend_radius", "bending_moment", "torque", "shear",
+                 "declination", "effective_tension")
+
+
+def solve(comm, scene, elements=80):
+    """(vertex datasets gathered on every rank, attributes) of ``scene`` solved from its
+    catenary start on ``comm``."""
+    mesh, solver = make_solver(comm, elements, scene, default_penalty(Scene(**scene)),
+                               rtol=1e-12, ctol=1e-12, max_it=20000, newton=False)
+    try:
+        solver.problem.state.set_from_curve(catenary_start(solver.problem.scene, 1.0))
+        assert solver.solve_step(1.0).converged
+        vertex, attributes = final_record(solver.problem)
+        return {key: gather(comm, value) for key, value in vertex.items()}, attributes
+    finally:
+        destroy(mesh, solver)
+
+
+@pytest.fixture(scope="module")
+def catenary():
+    return solve(PETSc.COMM_WORLD, CATENARY)
+
+
+def test_bend_radius_and_moment_are_ei_times_the_curvature(catenary):
+    """bending_moment = EI |(u1, u2)| (K1 = K2 = EI), bend_radius = 1 / curvature, the
+    curvature |(u1, u2)|; the line bends in its plane: no torque; shear =
+    |n - (n.t) t|."""
+    vertex, _ = catenary
+    kappa = np.hypot(vertex["u"][:, 0], vertex["u"][:, 1])
+    np.testing.assert_allclose(vertex["curvature"], kappa, rtol=1e-15)
+    assert kappa.max() > 0.05
+    np.testing.assert_allclose(vertex["bending_moment"], 0.5 * kappa, rtol=1e-12,
+                               atol=1e-14)
+    np.testing.assert_allclose(vertex["bend_radius"], 1 / kappa, rtol=1e-14)
+    assert np.abs(vertex["torque"]).max() < 1e-9
+    t = vertex["d3"] / np.linalg.norm(vertex["d3"], axis=1, keepdims=True)
+    tension = np.einsum("nc,nc->n", vertex["n"], t)
+    np.testing.assert_allclose(vertex["effective_tension"], tension, rtol=1e-15)
+    across = np.linalg.norm(vertex["n"] - tension[:, None] * t, axis=1)
+    np.testing.assert_allclose(vertex["shear"], across, rtol=1e-12, atol=1e-12)
+    assert vertex["shear"].max() > 1e-3        # bending carries some of the load
+
+
+def test_end_forces_balance_the_weight_and_the_hang_off_angles(catenary):
+    """What the line exerts on its supports carries its weight: start_force + end_force
+    = (0, 0, -w L) = (0, 0, -20) N; the horizontal parts are equal and opposite (the
+    line pulls the two pins toward each other). The top is the end S = L at (7, 0, 3):
+    the tangent out of the line there points up and toward +x: azimuth 0, declination
+    the angle of d3(L) from the vertical, the dataset's at that vertex."""
+    vertex, attributes = catenary
+    total = attributes["start_force"] + attributes["end_force"]
+    np.testing.assert_allclose(total, [0.0, 0.0, -20.0], atol=1e-9)
+    assert attributes["start_force"][0] > 1.0          # the anchor is pulled toward +x
+    np.testing.assert_allclose(attributes["start_force"], vertex["n"][0], rtol=1e-15)
+    np.testing.assert_allclose(attributes["end_force"], -vertex["n"][-1], rtol=1e-15)
+    np.testing.assert_allclose(attributes["end_moment"], -vertex["m"][-1], rtol=1e-15)
+    assert attributes["hang_off_S"] == 10.0
+    assert attributes["hang_off_azimuth"] == 0.0
+    t = vertex["d3"][-1] / np.linalg.norm(vertex["d3"][-1])
+    assert attributes["hang_off_declination"] == pytest.approx(
+        np.degrees(np.arccos(t[2])), rel=1e-13)
+    assert attributes["hang_off_declination"] == pytest.approx(vertex["declination"][-1],
+                                                               rel=1e-13)
+    assert 0 < attributes["hang_off_declination"] < 90
+
+
+def test_a_top_at_the_start_has_azimuth_180():
+    """Top at S = 0 (the end at (7, 0, -3) is lower): the tangent out of the line there
+    is -d3(0), pointing up and toward -x: azimuth 180, declination below 90."""
+    _, attributes = solve(PETSc.COMM_WORLD, dict(CATENARY, end_position=(7.0, 0.0, -3.0)))
+    assert attributes["hang_off_S"] == 0.0
+    assert attributes["hang_off_azimuth"] == 180.0
+    assert 0 < attributes["hang_off_declination"] < 90
+    total = attributes["start_force"] + attributes["end_force"]
+    np.testing.assert_allclose(total, [0.0, 0.0, -20.0], atol=1e-9)
+
+
+def test_one_rank_and_all_give_the_same_results_and_regions():
+    """The line's datasets and the regions' numbers of a line resting on a seabed, solved
+    on one rank and on all, to the iteration's tolerance; the regions of a catenary
+    riser: hang-off, sag bend, touchdown zone, grounded part."""
+    one, one_attributes = solve(PETSc.COMM_SELF, GROUNDED)
+    every, attributes = solve(PETSc.COMM_WORLD, GROUNDED)
+    for key in LINE_DATASETS + ("seabed_reaction",):
+        if key == "bend_radius":        # 1 / round-off where the grounded line is flat
+            continue
+        scale = np.abs(one[key]).max()
+        np.testing.assert_allclose(every[key], one[key], rtol=1e-6, atol=1e-8 * scale,
+                                   err_msg=key)
+    curved = one["curvature"] > 1e-3 * one["curvature"].max()
+    np.testing.assert_allclose(every["bend_radius"][curved], one["bend_radius"][curved],
+                               rtol=1e-6)
+    assert list(attributes["region_names"]) == ["hang_off", "sag_bend", "touchdown_zone",
+                                                "grounded"]
+    assert list(one_attributes["region_names"]) == list(attributes["region_names"])
+    np.testing.assert_allclose(attributes["region_bounds"], one_attributes["region_bounds"],
+                               rtol=1e-8, atol=1e-8)
+    for key in ("region_max_tension", "region_min_bend_radius", "region_max_bending_moment"):
+        np.testing.assert_allclose(attributes[key], one_attributes[key], rtol=1e-6,
+                                   err_msg=key)
+    for key in ("region_max_tension_S", "region_min_bend_radius_S",
+                "region_max_bending_moment_S"):
+        np.testing.assert_allclose(attributes[key], one_attributes[key], atol=1e-9,
+                                   err_msg=key)
+    # the largest tension is at the top, in the hang-off; the grounded part ends at S = 0
+    bounds = dict(zip(attributes["region_names"], attributes["region_bounds"]))
+    assert attributes["region_max_tension_S"][0] == 10.0
+    assert bounds["grounded"][0] == 0.0
+    assert bounds["grounded"][1] == pytest.approx(bounds["sag_bend"][0], abs=1e-12)

@@ -1,0 +1,177 @@
+"""-rod_table (io/line_table.py), the results along the line and the pipe's stresses
+(riser/stresses.py) from the command line: the CSV's header and rows, the regions'
+table, no table after a failed run, a bad path refused, and the steel riser's von Mises
+stress and utilisation against a hand calculation."""
+
+import csv
+import os
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import partial_files, run_petsc_rod
+
+# options/line_types/steel_riser.txt with an API 5L X65 yield stress, 448 MPa.
+STEEL_X65 = """name   od      id      mass    ei         gj         ea         cd    smys
+scr10  0.2731  0.2319  162.07  2.7135e7   2.0873e7   3.3826e9   1.0   448e6
+"""
+SCR = ["-options_file", "options/steel_catenary_riser.opts", "-rod_contents_density",
+       "800", "-rod_internal_pressure", "1e7"]
+
+
+def read_csv(path):
+    with open(path, newline="") as handle:
+        rows = list(csv.reader(handle))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.fixture(scope="module")
+def riser(tmp_path_factory):
+    """The steel riser with oil at 10 MPa and an X65 yield stress: (the run, its result
+    file, its table, the folder)."""
+    folder = tmp_path_factory.mktemp("table")
+    types = folder / "x65.txt"
+    types.write_text(STEEL_X65)
+    output, table = folder / "scr.h5", folder / "scr.csv"
+    done = run_petsc_rod(SCR + ["-rod_line_types", str(types), "-rod_output", str(output),
+                                "-rod_table", str(table)], 1, 600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done, output, table, folder
+
+
+def test_the_table_has_a_row_per_vertex_and_units_in_its_header(riser):
+    """2401 rows (2400 elements), a header naming each column with its unit, the same
+    numbers as the result file's datasets; the regions' table beside it, and the
+    regions' summary at the end of the run."""
+    done, output, table, folder = riser
+    header, values = read_csv(table)
+    assert values.shape[0] == 2401
+    assert header[:6] == ["S (m)", "x (m)", "y (m)", "z (m)", "u1 (rad/m)", "u2 (rad/m)"]
+    for name in ("curvature (1/m)", "bend_radius (m)", "bending_moment (N m)",
+                 "torque (N m)", "shear (N)", "effective_tension (N)", "wall_tension (N)",
+                 "declination (deg)", "seabed_reaction (N/m)", "von_mises (Pa)",
+                 "utilisation (1)"):
+        assert name in header, name
+    column = {name.split(" (")[0]: values[:, i] for i, name in enumerate(header)}
+    with h5py.File(output, "r") as f:
+        np.testing.assert_allclose(column["S"], f["S"][:], rtol=1e-11)
+        np.testing.assert_allclose(column["z"], f["r"][:, 2], rtol=1e-11, atol=1e-9)
+        for key in ("effective_tension", "wall_tension", "von_mises", "bending_moment"):
+            np.testing.assert_allclose(column[key], f[key][:], rtol=1e-11, err_msg=key)
+            assert f[key].attrs["units"] == header[[h.split(" (")[0] for h in
+                                                    header].index(key)].split("(")[1][:-1]
+    with open(folder / "scr_regions.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0][:4] == ["region", "S_from (m)", "S_to (m)", "max_effective_tension (N)"]
+    assert [row[0] for row in rows[1:]] == ["hang_off", "sag_bend", "touchdown_zone",
+                                            "grounded"]
+    with h5py.File(output, "r") as f:
+        np.testing.assert_allclose(np.array([row[1:3] for row in rows[1:]], dtype=float),
+                                   f.attrs["region_bounds"], rtol=1e-11)
+    assert "sag_bend" in done.stdout and f"table {table}" in done.stdout
+    assert not partial_files(table)
+
+
+def test_the_riser_s_von_mises_stress_and_utilisation_by_hand(riser):
+    """At the hang-off (z = 1500 m, the sea surface: p_e = 0, p_i = 10 MPa; a pin: the
+    moment M only that of the vertex strain, 26 N m): s_a = T_w / A + M r_i / I with
+    A = pi/4 (0.2731^2 - 0.2319^2) = 0.016341 m^2, I = pi/4 (r_o^4 - r_i^4); at the bore
+    s_h = p_i (r_o^2 + r_i^2) / (r_o^2 - r_i^2), s_r = -p_i; s_vm = sqrt(s_a^2 + s_h^2
+    + s_r^2 - s_a s_h - s_h s_r - s_r s_a); the utilisation s_vm / (0.67 448 MPa)."""
+    _, output, _, _ = riser
+    with h5py.File(output, "r") as f:
+        wall, stress = f["wall_tension"][-1], f["von_mises"][-1]
+        moment = f["bending_moment"][-1]
+        utilisation = f["utilisation"][:]
+        largest, design = f.attrs["max_utilisation"], f.attrs["design_factor"]
+    r_o, r_i, p_i = 0.2731 / 2, 0.2319 / 2, 1e7
+    axial = wall / (np.pi * (r_o**2 - r_i**2)) + moment * r_i / (np.pi * (r_o**4 - r_i**4) / 4)
+    assert 10 < moment < 50
+    hoop = p_i * (r_o**2 + r_i**2) / (r_o**2 - r_i**2)
+    radial = -p_i
+    by_hand = np.sqrt(axial**2 + hoop**2 + radial**2 - axial * hoop - hoop * radial
+                      - radial * axial)
+    assert 140e6 < by_hand < 170e6
+    assert stress == pytest.approx(by_hand, rel=1e-12)
+    assert design == 0.67
+    assert utilisation[-1] == pytest.approx(stress / (0.67 * 448e6), rel=1e-12)
+    assert largest == pytest.approx(np.nanmax(utilisation), rel=1e-15)
+    assert 0.4 < largest < 0.7
+
+
+def test_no_table_after_a_run_that_did_not_converge(tmp_path):
+    """-rod_al_max_it 2: exit 3 (the result file says converged = 0), and no table, no
+    regions' table, no partial file."""
+    table = tmp_path / "scr.csv"
+    done = run_petsc_rod(SCR + ["-rod_al_max_it", "2", "-rod_max_halvings", "0",
+                                "-rod_table", str(table)], 1, 300)
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_table_that_cannot_be_written_is_refused_before_the_run(tmp_path):
+    """A folder that does not exist, a folder, the -rod_output file: one line, exit 2."""
+    for table, more in ((tmp_path / "missing" / "t.csv", []), (tmp_path, []),
+                        (tmp_path / "r.h5", ["-rod_output", str(tmp_path / "r.h5")])):
+        done = run_petsc_rod(["-options_file", "options/cantilever.opts", "-rod_table",
+                              str(table)] + more, 1, 120)
+        assert done.returncode == 2, done.stdout + done.stderr
+        lines = done.stdout.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("petsc_rod: error: -rod_table")
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_plain_rod_s_table(tmp_path):
+    """A cantilever (no riser terms): the line's results, with its effective tension,
+    no regions' table."""
+    table = tmp_path / "c.csv"
+    done = run_petsc_rod(["-options_file", "options/cantilever.opts", "-rod_table",
+                          str(table)], 1, 120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    header, values = read_csv(table)
+    assert "effective_tension (N)" in header and "bending_moment (N m)" in header
+    assert values.shape[0] == int(done.stdout.split(" elements")[0].split()[-1]) + 1
+    assert os.listdir(tmp_path) == ["c.csv"]
+
+
+def test_two_ranks_write_the_same_table(riser):
+    """The steel riser on 2 ranks: the same header, rows in the same order, the same
+    numbers to the iteration's tolerance (1e-9 of the state: 1e-6 of each column's
+    largest value for the curvatures, derivatives of it; the bend radius, 1 / curvature,
+    is left out); the same regions."""
+    _, _, table, folder = riser
+    types, two = folder / "x65.txt", folder / "scr2.csv"
+    done = run_petsc_rod(SCR + ["-rod_line_types", str(types), "-rod_table", str(two)], 2,
+                         600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    header, values = read_csv(table)
+    header2, values2 = read_csv(two)
+    assert header2 == header and values2.shape == values.shape
+    finite = np.isfinite(values)
+    np.testing.assert_array_equal(finite, np.isfinite(values2))
+    scale = np.nanmax(np.abs(np.where(finite, values, np.nan)), axis=0)
+    for j, name in enumerate(header):
+        if name == "bend_radius (m)":
+            continue
+        rows = finite[:, j]
+        np.testing.assert_allclose(values2[rows, j], values[rows, j], rtol=1e-6,
+                                   atol=1e-6 * scale[j], err_msg=name)
+    with open(folder / "scr_regions.csv") as one, open(folder / "scr2_regions.csv") as other:
+        rows, rows2 = list(csv.reader(one)), list(csv.reader(other))
+    assert [row[0] for row in rows] == [row[0] for row in rows2]
+    np.testing.assert_allclose(np.array([row[1:] for row in rows2[1:]], dtype=float),
+                               np.array([row[1:] for row in rows[1:]], dtype=float),
+                               rtol=1e-6, atol=1e-6)
+
+
+def test_a_bad_yield_stress_is_refused(tmp_path):
+    """smys must be positive: one line naming it, exit 2, no table."""
+    types = tmp_path / "bad.txt"
+    types.write_text(STEEL_X65.replace("448e6", "-448e6"))
+    done = run_petsc_rod(SCR + ["-rod_line_types", str(types), "-rod_table",
+                                str(tmp_path / "t.csv")], 1, 120)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stdout.strip().splitlines()
+    assert len(lines) == 1 and "smys" in lines[0], lines
+    assert os.listdir(tmp_path) == ["bad.txt"]
