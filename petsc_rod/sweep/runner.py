@@ -233,6 +233,8 @@ class Sweep:
             code = with_options(self.comm, options, lambda: run(self.comm))
         if code == 0:
             self.converged.append((case, self.file(case)))
+        if code == 2:                   # refused before it started
+            start = ""
         written = code in (0, 3) and os.path.exists(self.file(case))
         return {"name": case.name, "options": self.swept(case), "set": case.options,
                 "code": code, "start": start,
