@@ -5,7 +5,8 @@ mesh, the problem and the solver), with the case's options set in PETSc's option
 database before it and the database put back as it was after it (options added removed,
 options changed restored), so that nothing of one case reaches the next. A case starts
 from the nearest converged case's result file (-rod_initial, walked in
--sweep_warm_steps steps from that case's scene to its own: docs/method.md §7), and
+-sweep_warm_steps steps from that case's scene to its own: docs/method.md §7; by
+default not a case that starts from its catenary, which no neighbour beats), and
 again from its own start when that fails; a case that fails all the same is recorded
 and the sweep goes on. After each case the summary (DIR/summary.csv, DIR/summary.md) and
 the record DIR/sweep.json are rewritten on rank 0, so a sweep stopped part way keeps
@@ -31,7 +32,10 @@ from petsc_rod.sweep import summary
 # The options that decide the mesh: a case warm-starts only from a case with the same.
 MESH_OPTIONS = ("rod_elements", "rod_length", "rod_mesh_grading", "rod_sections",
                 "rod_line_types")
-STARTS = ("nearest", "scene")
+STARTS = ("auto", "nearest", "scene")
+# With -sweep_start auto, the own starts that a neighbour's state does not beat
+# (docs/sweeps.md, measured): the catenary of the case's own scene.
+GOOD_OWN_STARTS = ("catenary",)
 
 
 @dataclass(frozen=True)
@@ -44,7 +48,7 @@ class SweepSettings:
     headings: tuple = sweep_cases.HEADINGS   # -sweep_headings near,far,cross
     current_headings: tuple = ()  # -sweep_current_headings deg,...
     current_speed: float = None  # -sweep_current_speed m/s
-    start: str = "nearest"       # -sweep_start nearest|scene
+    start: str = "auto"          # -sweep_start auto|nearest|scene
     warm_steps: int = 1          # -sweep_warm_steps K
     retry: bool = True           # -sweep_retry: a failed warm start again from the scene
 
@@ -58,8 +62,9 @@ SWEEP_OPTIONS = {
                       "cross: 90 deg anticlockwise from far seen from above)",
     "sweep_current_headings": "deg,...: headings of a uniform current, anticlockwise from +x",
     "sweep_current_speed": "m/s: their speed (default the base -rod_current's)",
-    "sweep_start": "nearest|scene: warm start from the nearest converged case, or each "
-                   "case's own start",
+    "sweep_start": "auto|nearest|scene: warm start from the nearest converged case, or "
+                   "each case's own start; auto: nearest but for a case that starts from "
+                   "its catenary (-rod_initial_shape catenary)",
     "sweep_warm_steps": "K: steps of the walk from the nearest case's scene (1)",
     "sweep_retry": "bool: a warm start that fails is run again from the case's own start "
                    "(true)",
@@ -86,9 +91,9 @@ def read_settings():
     if not output:
         raise RodInputError("-sweep_output DIR is needed: the folder of the cases' result "
                             "files and the summary")
-    start = text("sweep_start") or "nearest"
+    start = text("sweep_start") or "auto"
     if start not in STARTS:
-        raise RodInputError(f"-sweep_start {start}: use nearest or scene")
+        raise RodInputError(f"-sweep_start {start}: use auto, nearest or scene")
     steps = text("sweep_warm_steps") or "1"
     if not steps.isdigit() or int(steps) < 1:
         raise RodInputError(f"-sweep_warm_steps {steps}: a whole number of at least 1")
@@ -197,7 +202,10 @@ class Sweep:
 
     def warm_start(self, case):
         """The converged case, of the same mesh, nearest to ``case``, or None."""
-        if self.settings.start != "nearest" or "rod_initial" in case.options:
+        if self.settings.start == "scene" or "rod_initial" in case.options:
+            return None
+        if (self.settings.start == "auto"
+                and self.value(case, "rod_initial_shape") in GOOD_OWN_STARTS):
             return None
         same_mesh = [(c, f) for c, f in self.converged
                      if all(self.value(c, o) == self.value(case, o) for o in MESH_OPTIONS)]

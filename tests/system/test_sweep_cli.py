@@ -56,6 +56,8 @@ def test_offset_sweep_writes_a_file_per_case_and_the_summary(offset_sweep):
     assert list(rows) == CASES
     for name, row in rows.items():
         assert row["status"] == "converged", row
+        # -sweep_start auto: a case that starts from its catenary starts from it
+        assert row["start"] == "own start", row
         with h5py.File(folder / f"{name}.h5", "r") as f:
             assert f.attrs["converged"] == 1
             # the summary's numbers are the file's attributes (full precision in the CSV)
@@ -93,7 +95,8 @@ def test_warm_starts_take_fewer_iterations(tmp_path):
     (straight, 4 steps): measured 43 and 39 against about 300 iterations; asserted only
     that the warm start takes less than half."""
     warm, cold = tmp_path / "warm", tmp_path / "cold"
-    for folder, start in ((warm, "nearest"), (cold, "scene")):
+    # -sweep_start auto (the default) warm-starts a case whose own start is straight
+    for folder, start in ((warm, "auto"), (cold, "scene")):
         process = run_module("petsc_rod.sweep", RISER + STRAIGHT + OFFSETS + [
             "-sweep_output", str(folder), "-sweep_start", start])
         assert process.returncode == 0, describe(process)
@@ -117,7 +120,8 @@ def test_a_failing_case_is_marked_and_the_next_runs(tmp_path):
     folder = tmp_path / "out"
     process = run_module("petsc_rod.sweep", ["-options_file", "options/riser_catenary.opts",
                                              "-rod_elements", "200", "-sweep_cases", str(cases),
-                                             "-sweep_output", str(folder)])
+                                             "-sweep_output", str(folder),
+                                             "-sweep_start", "nearest"])
     assert process.returncode == 3, describe(process)
     rows = read_summary(folder)
     assert list(rows) == ["base", "capped", "far"]
