@@ -87,7 +87,8 @@ def draw(figure, S, result, labels):
                   label=f"{side} over cases")
         axis.set_xlabel("S (m)")
         axis.set_ylabel(f"{label} ({unit})")
-        axis.set_title(f"{label}: {side} {np.nanmax(bound) if side == 'max' else np.nanmin(bound):.4g} {unit}")
+        extreme = np.nanmax(bound) if side == "max" else np.nanmin(bound)
+        axis.set_title(f"{label}: {side} {extreme:.4g} {unit}")
         axis.grid(True, alpha=0.3)
     if names:
         axes[0].legend(fontsize=7, loc="best")

@@ -272,6 +272,12 @@ def run_sweep(comm=None):
     def say(text):
         PETSc.Sys.Print(text, comm=comm)
 
+    if database.hasName("help"):
+        say("petsc_rod.sweep options (docs/sweeps.md; every -rod_* option of petsc_rod is "
+            "the base of the cases):")
+        for name, meaning in SWEEP_OPTIONS.items():
+            say(f"  -{name} {meaning}")
+        return 0
     try:
         check_same_on_every_rank(comm)
         settings = read_settings()

@@ -1,8 +1,9 @@
 """Sweeps and the report from the command line (spawns python -m petsc_rod.sweep and
 python -m petsc_rod.report: serial): a 3-case offset sweep of a small riser (the SCR of
-options/riser_catenary.opts on 200 elements, about 40 iterations a case) on 1 and 2 ranks gives the same summary; a case that fails
-in the middle is marked and the next still runs; warm starts take fewer iterations than
-each case's own start (a straight start in 4 steps); bad sweep input is one line, exit 2, before any run; the report's
+options/riser_catenary.opts on 200 elements, about 40 iterations a case) on 1 and 2
+ranks gives the same summary; a case that fails in the middle is marked and the next
+still runs; warm starts take fewer iterations than each case's own start (a straight
+start in 4 steps); bad sweep input is one line, exit 2, before any run; the report's
 table holds the files' numbers and its pictures are drawn."""
 
 import base64
