@@ -4,8 +4,9 @@ result file's root attributes, written as CSV and Markdown with the units in the
 
 The columns are the riser numbers where the file has them (riser/quantities.py,
 riser/pressures.py, riser/section_numbers.py), then any other scalar root attribute
-named ``max_*``, ``min_*`` or ``top_*`` (the utilisation, von Mises stress, end forces
-that newer versions add), so that the table shows what the files hold. The sweep
+named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
+(what newer versions add: a utilisation, a von Mises stress, end forces), so that the
+table shows what the files hold. The sweep
 (sweep/runner.py) and the report (report/page.py) both make their tables here.
 """
 
@@ -31,6 +32,8 @@ NUMBERS = [
 ]
 # Other root attributes shown when present and scalar.
 EXTRA_PREFIXES = ("max_", "min_", "top_")
+# ... and any scalar attribute whose name says it is a stress check.
+EXTRA_WORDS = ("utilisation", "utilization", "von_mises", "stress")
 # Root attributes that are not results (a run's bookkeeping).
 NOT_RESULTS = {"total_iterations", "total_halvings", "undone_iterations"}
 # What an exit code says, for a case without a result file.
@@ -74,7 +77,7 @@ def number_columns(files):
     columns = [(c, a, units.get(a, unit)) for c, a, unit in NUMBERS if a in present]
     known = {a for _, a, _ in NUMBERS} | NOT_RESULTS
     for attribute in sorted(present - known):
-        if attribute.startswith(EXTRA_PREFIXES):
+        if attribute.startswith(EXTRA_PREFIXES) or any(w in attribute for w in EXTRA_WORDS):
             if all(isinstance(values.get(attribute, 0.0), (int, float)) for values, _ in files):
                 columns.append((attribute, attribute, units.get(attribute, "")))
     return columns

@@ -240,3 +240,25 @@ def test_the_report_of_one_file_and_a_bad_source(offset_sweep, tmp_path):
     assert len(page.images) == 1
     process = run_module("petsc_rod.report", [str(tmp_path), "-o", str(output)])
     assert process.returncode == 2 and "sweep.json" in process.stderr, describe(process)
+
+
+@pytest.mark.serial
+def test_the_summary_shows_what_newer_files_add(tmp_path):
+    """Attributes this version does not write (a utilisation, a von Mises stress) appear
+    in the table with the file's unit; a vector attribute does not."""
+    import json
+
+    from petsc_rod.sweep import summary
+
+    path = tmp_path / "a.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs.update(converged=1, total_iterations=7, top_tension=1.5e6,
+                       max_utilisation=0.61, max_von_mises=2.9e8, end_force=[1.0, 2.0, 3.0],
+                       attribute_units=json.dumps({"top_tension": "N", "max_utilisation": "1",
+                                                   "max_von_mises": "Pa"}))
+    header, rows = summary.table([{"name": "a", "options": {}, "code": 0, "start": "",
+                                   "file": str(path)}], [])
+    cells = dict(zip(header, rows[0]))
+    assert cells["top_tension (N)"] == 1.5e6 and cells["iterations (1)"] == 7
+    assert cells["max_utilisation (1)"] == 0.61 and cells["max_von_mises (Pa)"] == 2.9e8
+    assert not any(h.startswith("end_force") for h in header)
