@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from petsc4py import PETSc
 
 from petsc_rod.cli.main import run
+from petsc_rod.cli.signals import Interrupts
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options
 from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError
 from petsc_rod.sweep import cases as sweep_cases
@@ -295,19 +296,29 @@ def run_sweep(comm=None):
     say(f"petsc_rod.sweep: {len(made)} case(s) varying "
         f"{', '.join('-' + v for v in sweep.varied) or 'nothing'}, into {settings.output}")
     stopped = None
-    for number, case in enumerate(made, start=1):
-        record = sweep.run_case(number, case)
-        sweep.records.append(record)
-        sweep.write()
-        if record["code"] >= 128:
-            stopped = record["code"]
-            break
+    # a stop signal between two cases (each run records its own: cli/signals.py) ends
+    # the sweep before the next, as one during a case ends it after that one
+    with Interrupts(comm) as interrupts:
+        for number, case in enumerate(made, start=1):
+            received = interrupts.received()
+            if received:
+                say(f"petsc_rod.sweep: stopped by {Interrupts.name(received)} before case "
+                    f"{case.name}")
+                stopped = 128 + received
+                break
+            record = sweep.run_case(number, case)
+            sweep.records.append(record)
+            sweep.write()
+            if record["code"] >= 128:
+                stopped = record["code"]
+                break
     text = sweep.write()
     if text:
         say(text.rstrip())
     failed = [r["name"] for r in sweep.records if r["code"] != 0]
     say(f"petsc_rod.sweep: {len(sweep.records) - len(failed)} of {len(made)} case(s) "
         f"converged" + (f"; not: {', '.join(failed)}" if failed else "")
+        + (f"; {len(made) - len(sweep.records)} not run" if stopped is not None else "")
         + f"; summary in {os.path.join(settings.output, 'summary.md')}")
     database.setValue("options_left", "0")
     if stopped is not None:

@@ -12,6 +12,7 @@ table shows what the files hold. The sweep
 
 import csv
 import json
+import signal
 
 import h5py
 import numpy as np
@@ -44,7 +45,10 @@ EXIT_REASONS = {0: "converged", 2: "bad input", 3: "not converged", 4: "diverged
 def exit_reason(code):
     """The words of a case's exit code (docs/errors.md)."""
     if code >= 128:
-        return f"stopped by signal {code - 128}"
+        try:
+            return f"stopped by {signal.Signals(code - 128).name}"
+        except ValueError:
+            return f"stopped by signal {code - 128}"
     return EXIT_REASONS.get(code, f"exit {code}")
 
 

@@ -129,6 +129,8 @@ def test_a_failing_case_is_marked_and_the_next_runs(tmp_path):
     assert rows["capped"]["exit"] == "3"
     assert rows["capped"]["status"] == "not converged (max_it)"
     assert rows["capped"]["top_tension (N)"] == ""         # no equilibrium: no numbers
+    # the warm start failed, then the case's own start (-sweep_retry)
+    assert rows["capped"]["start"] == "own start (from base: exit 3)"
     assert rows["far"]["status"] == "converged"
     # the cap was the case's own: the next case ran with the default again
     assert rows["far"]["-rod_al_max_it"] == "(base)"
@@ -137,6 +139,27 @@ def test_a_failing_case_is_marked_and_the_next_runs(tmp_path):
         assert "-rod_al_max_it 2000" in f.attrs["options_in_effect"]
     assert "1 case(s)" not in process.stdout
     assert "2 of 3 case(s) converged; not: capped" in process.stdout
+
+
+@pytest.mark.serial
+def test_a_case_with_bad_input_is_marked_and_the_sweep_goes_on(tmp_path):
+    """A value petsc_rod refuses is that case's bad input (exit 2 in the table), not the
+    sweep's: the paper scene (80 elements) with a two-number end position in the middle."""
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_end_position\nxf16 16,4,0\nwrong 1,2\nxf15 15,5,0\n")
+    folder = tmp_path / "out"
+    process = run_module("petsc_rod.sweep", ["-options_file", "options/paper.opts",
+                                             "-sweep_cases", str(cases),
+                                             "-sweep_output", str(folder)])
+    assert process.returncode == 3, describe(process)
+    assert "-rod_end_position '1,2': expected 3 comma-separated numbers" in process.stdout
+    rows = read_summary(folder)
+    assert [(r["exit"], r["status"]) for r in rows.values()] == [
+        ("0", "converged"), ("2", "bad input"), ("0", "converged")]
+    # the paper scene needs its 8 steps from straight; from xf16, one
+    assert rows["xf15"]["start"] == "from xf16"
+    assert int(rows["xf15"]["iterations (1)"]) < int(rows["xf16"]["iterations (1)"]) / 2
+    assert not (folder / "wrong.h5").exists()
 
 
 @pytest.mark.serial
