@@ -1,0 +1,40 @@
+"""``python -m petsc_rod.report RESULT.h5|SWEEP_DIR -o report.html``: the report page
+of a result file or of a sweep's folder (report/page.py). Serial; no PETSc. Exit 0, or
+2 with one line when the input is not a result file or a sweep's folder."""
+
+import argparse
+import os
+import sys
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m petsc_rod.report",
+                                     description="one self-contained HTML page of a result "
+                                                 "file or a sweep's folder")
+    parser.add_argument("source", help="a result file (HDF5) or a sweep's -sweep_output DIR")
+    parser.add_argument("-o", "--output", default="report.html", help="the HTML file")
+    args = parser.parse_args(argv)
+    source = args.source
+    if os.path.isdir(source) and not os.path.exists(os.path.join(source, "sweep.json")):
+        sys.stderr.write(f"petsc_rod.report: error: {source}: a folder without sweep.json is "
+                         "not a sweep's output (-sweep_output DIR)\n")
+        return 2
+    if not os.path.exists(source):
+        sys.stderr.write(f"petsc_rod.report: error: {source}: no such file or folder\n")
+        return 2
+    import h5py
+    if not os.path.isdir(source) and not h5py.is_hdf5(source):
+        sys.stderr.write(f"petsc_rod.report: error: {source}: not a result file (HDF5)\n")
+        return 2
+    from petsc_rod.report import page
+    try:
+        page.write(source, args.output)
+    except OSError as error:
+        sys.stderr.write(f"petsc_rod.report: error: {args.output}: {error.strerror or error}\n")
+        return 2
+    print(f"petsc_rod.report: wrote {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,172 @@
+"""The report page (serial post-processing; h5py, numpy, matplotlib, never PETSc): one
+self-contained HTML file, every figure a PNG embedded as base64 and the style inline,
+that an engineer attaches to a design note:
+
+1. the inputs: the options in effect (the file's ``options_in_effect``; for a sweep,
+   those of its first case and the options the cases vary), the line types' table when
+   the file has one (``parameters/line_types_table``);
+2. the summary table, one row per case (sweep/summary.py: the same numbers as the
+   sweep's summary.csv, read from the result files' attributes);
+3. for a sweep, the range graphs along S (report/envelopes.py);
+4. the pictures of each case, as ``petsc_rod.plots.result_figure`` draws them.
+"""
+
+import base64
+import html
+import io
+import os
+from datetime import datetime, timezone
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from petsc_rod import plots  # noqa: E402
+from petsc_rod.report import envelopes  # noqa: E402
+from petsc_rod.sweep import summary  # noqa: E402
+
+STYLE = """
+body { font-family: sans-serif; margin: 2em; color: #222; max-width: 1400px; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #aaa; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
+th, td { border: 1px solid #bbb; padding: 2px 6px; text-align: right; }
+th { background: #eee; } td.text { text-align: left; }
+tr.failed td { background: #fde0e0; }
+pre { background: #f6f6f6; padding: 0.5em; font-size: 0.8em; overflow-x: auto; }
+img { max-width: 100%; border: 1px solid #ddd; }
+"""
+DPI = 100
+
+
+def png(figure):
+    """``figure`` as a base64 PNG (the figure closed)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=DPI)
+    plt.close(figure)
+    return base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def image(figure, alt):
+    """An <img> of ``figure``, embedded."""
+    return (f'<img alt="{html.escape(alt)}" '
+            f'src="data:image/png;base64,{png(figure)}">')
+
+
+def file_inputs(path):
+    """(options in effect as text, the line types' table as text or None) of a result
+    file."""
+    with h5py.File(path, "r") as f:
+        options = f.attrs.get("options_in_effect", "")
+        options = options.decode() if isinstance(options, bytes) else str(options)
+        types = None
+        group = f.get("parameters")
+        if group is not None and "line_types_table" in group.attrs:
+            types = group.attrs["line_types_table"]
+            types = types.decode() if isinstance(types, bytes) else str(types)
+    return options, types
+
+
+def line_types_html(text):
+    """The line types' table (a header row and rows of words; '#' comments dropped)."""
+    rows = [line.split("#", 1)[0].split() for line in text.splitlines()]
+    rows = [row for row in rows if row]
+    if not rows:
+        return ""
+    head = "".join(f"<th>{html.escape(w)}</th>" for w in rows[0])
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(w)}</td>" for w in row) + "</tr>"
+                   for row in rows[1:])
+    return f'<table id="line_types"><tr>{head}</tr>{body}</table>'
+
+
+def table_html(header, rows, codes):
+    """The summary table; rows of cases that did not converge shaded."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    lines = []
+    for row, code in zip(rows, codes):
+        cells = "".join(
+            f'<td{"" if isinstance(v, (int, float)) else " class=text"}>'
+            f"{html.escape(summary.cell(v))}</td>" for v in row)
+        lines.append(f'<tr{" class=failed" if code else ""}>{cells}</tr>')
+    return f'<table id="summary"><tr>{head}</tr>{"".join(lines)}</table>'
+
+
+def single_record(path):
+    """The summary record of a lone result file."""
+    with h5py.File(path, "r") as f:
+        converged = int(f.attrs.get("converged", 0))
+    name = os.path.splitext(os.path.basename(path))[0]
+    return {"name": name, "options": {}, "code": 0 if converged else 3, "start": "",
+            "file": os.path.abspath(path)}
+
+
+def sweep_records(folder):
+    """(records, varied options) of a sweep's folder (its sweep.json); files looked up in
+    the folder itself, so that a folder moved elsewhere still reports."""
+    record = summary.read_record(os.path.join(folder, "sweep.json"))
+    records = []
+    for case in record["cases"]:
+        local = os.path.join(folder, f"{case['name']}.h5")
+        records.append({**case, "file": local if case.get("file") and os.path.exists(local)
+                        else None})
+    return records, record["varied"]
+
+
+def build(source):
+    """The HTML page of ``source``: a result file or a sweep's folder."""
+    if os.path.isdir(source):
+        records, varied = sweep_records(source)
+        title = f"Sweep {os.path.basename(os.path.normpath(source))}: {len(records)} case(s)"
+    else:
+        records, varied = [single_record(source)], []
+        title = f"Result {os.path.basename(source)}"
+    header, rows = summary.table(records, varied)
+    codes = [r["code"] for r in records]
+    done = [r for r in records if r["file"] and r["code"] == 0]
+    first = next((r for r in records if r["file"]), None)
+    parts = [f"<h1>{html.escape(title)}</h1>",
+             f"<p>petsc_rod report, {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC; "
+             f"{len(done)} of {len(records)} case(s) converged.</p>"]
+    parts.append("<h2>Inputs</h2>")
+    if first is not None:
+        options, types = file_inputs(first["file"])
+        if varied:
+            parts.append(f"<p>The options in effect in case <b>{html.escape(first['name'])}"
+                         "</b>; the cases vary " + ", ".join(
+                             f"<code>-{html.escape(v)}</code>" for v in varied)
+                         + " (their values in the summary).</p>")
+        parts.append(f'<pre id="options">{html.escape(options)}</pre>')
+        if types:
+            parts.append("<h3>Line types</h3>" + line_types_html(types))
+    parts.append("<h2>Summary</h2>")
+    parts.append(table_html(header, rows, codes))
+    parts.append("<p>Units in the header; a shaded row is a case that did not converge "
+                 "(its numbers are left out: its state is no equilibrium of the case).</p>")
+    if len(done) > 1:
+        S, result = envelopes.envelopes([envelopes.along_line(r["file"]) for r in done])
+        if result:
+            figure = plt.figure(figsize=(5 * len(result), 4.2), layout="constrained")
+            envelopes.draw(figure, S, result, [r["name"] for r in done])
+            parts.append("<h2>Range graphs</h2><p>Along the line, every converged case and "
+                         "the envelope over them (shaded: least to largest).</p>")
+            parts.append(image(figure, "range graphs"))
+    parts.append("<h2>Cases</h2>")
+    for record in records:
+        parts.append(f"<h3>{html.escape(record['name'])}</h3>")
+        if record["file"] is None:
+            parts.append(f"<p>No result file: {html.escape(summary.exit_reason(record['code']))}"
+                         ".</p>")
+            continue
+        parts.append(image(plots.result_figure(record["file"]), record["name"]))
+    body = "\n".join(parts)
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>"
+            f"{html.escape(title)}</title><style>{STYLE}</style></head>\n<body>\n{body}\n"
+            "</body></html>\n")
+
+
+def write(source, output):
+    """Write the page of ``source`` to ``output``."""
+    text = build(source)
+    with open(output, "w", encoding="utf-8") as f:
+        f.write(text)

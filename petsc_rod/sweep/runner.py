@@ -1,0 +1,326 @@
+"""Run a sweep: every case in this process, on the ranks given, one after the other.
+
+Each case is a whole run of the command line (cli.main.run builds, runs and destroys the
+mesh, the problem and the solver), with the case's options set in PETSc's options
+database before it and the database put back as it was after it (options added removed,
+options changed restored), so that nothing of one case reaches the next. A case starts
+from the nearest converged case's result file (-rod_initial, walked in
+-sweep_warm_steps steps from that case's scene to its own: docs/method.md §7; by
+default not a case that starts from its catenary, which no neighbour beats), and
+again from its own start when that fails; a case that fails all the same is recorded
+and the sweep goes on. After each case the summary (DIR/summary.csv, DIR/summary.md) and
+the record DIR/sweep.json are rewritten on rank 0, so a sweep stopped part way keeps
+the table of what ran.
+
+Exit code: 0 when every case converged, 3 when some did not (the table says which and
+why), 2 for bad sweep input before any run, 128 + n when a signal stopped a case (the
+sweep stops there).
+"""
+
+import difflib
+import os
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+
+from petsc_rod.cli.main import run
+from petsc_rod.cli.signals import Interrupts
+from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options
+from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError
+from petsc_rod.sweep import cases as sweep_cases
+from petsc_rod.sweep import summary
+
+# The options that decide the mesh: a case warm-starts only from a case with the same.
+MESH_OPTIONS = ("rod_elements", "rod_length", "rod_mesh_grading", "rod_sections",
+                "rod_line_types")
+STARTS = ("auto", "nearest", "scene")
+# With -sweep_start auto, the own starts that a neighbour's state does not beat
+# (docs/sweeps.md, measured): the catenary of the case's own scene.
+GOOD_OWN_STARTS = ("catenary",)
+
+
+@dataclass(frozen=True)
+class SweepSettings:
+    """The -sweep_* options."""
+
+    cases: str = ""              # -sweep_cases FILE
+    output: str = ""             # -sweep_output DIR
+    offsets: tuple = ()          # -sweep_offsets d1,d2,... (m)
+    headings: tuple = sweep_cases.HEADINGS   # -sweep_headings near,far,cross
+    current_headings: tuple = ()  # -sweep_current_headings deg,...
+    current_speed: float = None  # -sweep_current_speed m/s
+    start: str = "auto"          # -sweep_start auto|nearest|scene
+    warm_steps: int = 1          # -sweep_warm_steps K
+    retry: bool = True           # -sweep_retry: a failed warm start again from the scene
+
+
+SWEEP_OPTIONS = {
+    "sweep_cases": "FILE: a header row naming options (without '-'; optionally 'name'), one "
+                   "row per case",
+    "sweep_output": "DIR: DIR/<case>.h5, DIR/summary.csv, DIR/summary.md, DIR/sweep.json",
+    "sweep_offsets": "d1,d2,...: vessel offsets of the hang-off, m",
+    "sweep_headings": "near,far,cross: offset headings (near: toward the anchor; far: away; "
+                      "cross: 90 deg anticlockwise from far seen from above)",
+    "sweep_current_headings": "deg,...: headings of a uniform current, anticlockwise from +x",
+    "sweep_current_speed": "m/s: their speed (default the base -rod_current's)",
+    "sweep_start": "auto|nearest|scene: warm start from the nearest converged case, or "
+                   "each case's own start; auto: nearest but for a case that starts from "
+                   "its catenary (-rod_initial_shape catenary)",
+    "sweep_warm_steps": "K: steps of the walk from the nearest case's scene (1)",
+    "sweep_retry": "bool: a warm start that fails is run again from the case's own start "
+                   "(true)",
+}
+
+
+def read_settings():
+    """The -sweep_* options, refused (RodInputError) when unknown or malformed."""
+    database = PETSc.Options()
+    for name in database.getAll():
+        if name.startswith("sweep_") and name not in SWEEP_OPTIONS:
+            close = difflib.get_close_matches(name, list(SWEEP_OPTIONS), n=1)
+            hint = f"; did you mean -{close[0]}?" if close else ""
+            raise RodInputError(f"unknown option -{name}{hint}")
+
+    def text(name):
+        return database.getString(name, "") if database.hasName(name) else ""
+
+    def numbers(name):
+        value = text(name)
+        return tuple(sweep_cases.numbers(value, f"-{name}")) if value else ()
+
+    output = text("sweep_output")
+    if not output:
+        raise RodInputError("-sweep_output DIR is needed: the folder of the cases' result "
+                            "files and the summary")
+    start = text("sweep_start") or "auto"
+    if start not in STARTS:
+        raise RodInputError(f"-sweep_start {start}: use auto, nearest or scene")
+    steps = text("sweep_warm_steps") or "1"
+    if not steps.isdigit() or int(steps) < 1:
+        raise RodInputError(f"-sweep_warm_steps {steps}: a whole number of at least 1")
+    speed = numbers("sweep_current_speed")
+    if len(speed) > 1 or (speed and speed[0] < 0):
+        raise RodInputError(f"-sweep_current_speed {text('sweep_current_speed')}: one speed "
+                            "(m/s), not negative")
+    headings = text("sweep_headings")
+    retry = text("sweep_retry").lower() if database.hasName("sweep_retry") else "true"
+    if retry not in ("", "1", "true", "yes", "on", "0", "false", "no", "off"):
+        raise RodInputError(f"-sweep_retry {retry}: expected true or false")
+    settings = SweepSettings(
+        cases=text("sweep_cases"), output=output, offsets=numbers("sweep_offsets"),
+        headings=tuple(h.strip() for h in headings.split(",")) if headings
+        else sweep_cases.HEADINGS,
+        current_headings=numbers("sweep_current_headings"),
+        current_speed=speed[0] if speed else None, start=start, warm_steps=int(steps),
+        retry=retry not in ("0", "false", "no", "off"))
+    if not (settings.cases or settings.offsets or settings.current_headings):
+        raise RodInputError("a sweep needs cases: -sweep_cases FILE, -sweep_offsets d1,... "
+                            "or -sweep_current_headings deg,...")
+    return settings
+
+
+def known_option(name):
+    """Whether ``name`` (without '-') is an option a case may set."""
+    return name in BY_NAME or name.startswith(SOLVER_PREFIXES)
+
+
+known_option.names = list(BY_NAME)      # for the hint of the closest name
+
+
+def make_cases(settings, values):
+    """The sweep's cases: the product of the case file's rows, the offsets and the
+    current headings (sweep/cases.py)."""
+    listed = sweep_cases.read_cases(settings.cases, known_option) if settings.cases else None
+    offsets = (sweep_cases.offset_cases(settings.offsets, settings.headings, values)
+               if settings.offsets else None)
+    currents = (sweep_cases.current_cases(settings.current_headings, settings.current_speed,
+                                          values) if settings.current_headings else None)
+    made = sweep_cases.product(listed, offsets, currents)
+    sweep_cases.check_unique(made, "the sweep")
+    return made
+
+
+def make_folder(comm, path):
+    """Create the output folder on rank 0; a folder that cannot be made is bad input on
+    every rank."""
+    problem = None
+    if comm.getRank() == 0:
+        try:
+            os.makedirs(path, exist_ok=True)
+            if not os.access(path, os.W_OK):
+                problem = "cannot write in it"
+        except OSError as error:
+            problem = error.strerror or str(error)
+    problem = comm.tompi4py().bcast(problem, root=0)
+    if problem:
+        raise RodInputError(f"-sweep_output {path}: {problem}")
+
+
+def with_options(comm, options, action):
+    """``action()`` with ``options`` ({name: text}) set in PETSc's options database, the
+    database put back as it was afterwards: options added (by the case or by the run)
+    removed, options changed restored."""
+    database = PETSc.Options()
+    before = database.getAll()
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        return action()
+    finally:
+        after = database.getAll()
+        for name in after:
+            if name not in before:
+                database.delValue(name)
+        for name, value in before.items():
+            if after.get(name, object()) != value:
+                database.setValue(name, "" if value is None else value)
+
+
+class Sweep:
+    """The state of a running sweep: the cases, what has converged, the records."""
+
+    def __init__(self, comm, settings, cases, base):
+        self.comm, self.settings, self.cases = comm, settings, cases
+        self.base = base                         # the base options database, {name: text}
+        self.varied = sweep_cases.varied(cases)
+        self.scales = sweep_cases.spreads([self.swept(c) for c in cases])
+        self.records = []
+        self.converged = []                      # (case, its file) of the converged cases
+
+    def say(self, text):
+        PETSc.Sys.Print(text, comm=self.comm)
+
+    def file(self, case):
+        return os.path.join(self.settings.output, f"{case.name}.h5")
+
+    def value(self, case, name):
+        """The text of option ``name`` in effect for ``case`` (its own or the base's)."""
+        return case.options.get(name, self.base.get(name))
+
+    def swept(self, case):
+        return {name: self.value(case, name) for name in self.varied
+                if self.value(case, name) is not None}
+
+    def warm_start(self, case):
+        """The converged case, of the same mesh, nearest to ``case``, or None."""
+        if self.settings.start == "scene" or "rod_initial" in case.options:
+            return None
+        if (self.settings.start == "auto"
+                and self.value(case, "rod_initial_shape") in GOOD_OWN_STARTS):
+            return None
+        same_mesh = [(c, f) for c, f in self.converged
+                     if all(self.value(c, o) == self.value(case, o) for o in MESH_OPTIONS)]
+        index = sweep_cases.nearest(self.swept(case), [self.swept(c) for c, _ in same_mesh],
+                                    self.scales)
+        return None if index is None else same_mesh[index]
+
+    def run_case(self, number, case):
+        """Run one case (a warm start, then its own start if that fails and -sweep_retry);
+        returns its record."""
+        options = {**case.options, "rod_output": self.file(case)}
+        shown = " ".join(f"-{k} {v}" for k, v in case.options.items()) or "(the base options)"
+        warm = self.warm_start(case)
+        code = None
+        start = "own start"
+        if warm is not None:
+            source, path = warm
+            walk = {"rod_initial": path}
+            if "rod_steps" not in case.options:
+                walk["rod_steps"] = str(self.settings.warm_steps)
+            self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}; warm "
+                     f"start from {source.name}")
+            code = with_options(self.comm, {**options, **walk}, lambda: run(self.comm))
+            start = f"from {source.name}"
+            if code in (3, 4) and self.settings.retry:
+                self.say(f"sweep: case {case.name}: the warm start from {source.name} ended "
+                         f"with exit {code}; again from the case's own start")
+                start = f"own start (from {source.name}: exit {code})"
+                code = None
+        if code is None:
+            if warm is None:
+                self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}")
+            code = with_options(self.comm, options, lambda: run(self.comm))
+        if code == 0:
+            self.converged.append((case, self.file(case)))
+        if code == 2:                   # refused before it started
+            start = ""
+        written = code in (0, 3) and os.path.exists(self.file(case))
+        return {"name": case.name, "options": self.swept(case), "set": case.options,
+                "code": code, "start": start,
+                "file": os.path.abspath(self.file(case)) if written else None}
+
+    def write(self):
+        """Rewrite the summary and the record (rank 0)."""
+        if self.comm.getRank() != 0:
+            return None
+        header, rows = summary.table(self.records, self.varied)
+        folder = self.settings.output
+        summary.write_csv(os.path.join(folder, "summary.csv"), header, rows)
+        summary.write_markdown(os.path.join(folder, "summary.md"), header, rows,
+                               title=f"Sweep of {len(self.cases)} case(s)")
+        summary.write_record(os.path.join(folder, "sweep.json"), {
+            "base_options": self.base, "varied": self.varied, "cases": self.records,
+            "settings": {k: list(v) if isinstance(v, tuple) else v
+                         for k, v in vars(self.settings).items()}})
+        return summary.markdown(header, rows)
+
+
+def run_sweep(comm=None):
+    """The whole sweep on ``comm``; returns the exit code."""
+    comm = comm or PETSc.COMM_WORLD
+    database = PETSc.Options()
+
+    def say(text):
+        PETSc.Sys.Print(text, comm=comm)
+
+    if database.hasName("help"):
+        say("petsc_rod.sweep options (docs/sweeps.md; every -rod_* option of petsc_rod is "
+            "the base of the cases):")
+        for name, meaning in SWEEP_OPTIONS.items():
+            say(f"  -{name} {meaning}")
+        return 0
+    try:
+        check_same_on_every_rank(comm)
+        settings = read_settings()
+        values, _ = read_options()
+        made = make_cases(settings, values)
+        make_folder(comm, settings.output)
+    except RodError as error:
+        say(f"petsc_rod.sweep: error: {error}")
+        database.setValue("options_left", "0")
+        return error.exit_code
+    base = {name: ("" if value is None else value) for name, value in database.getAll().items()
+            if name.startswith("rod_")}
+    base.pop("rod_output", None)
+    sweep = Sweep(comm, settings, made, base)
+    say(f"petsc_rod.sweep: {len(made)} case(s) varying "
+        f"{', '.join('-' + v for v in sweep.varied) or 'nothing'}, into {settings.output}")
+    stopped = None
+    # a stop signal between two cases (each run records its own: cli/signals.py) ends
+    # the sweep before the next, as one during a case ends it after that one
+    with Interrupts(comm) as interrupts:
+        for number, case in enumerate(made, start=1):
+            received = interrupts.received()
+            if received:
+                say(f"petsc_rod.sweep: stopped by {Interrupts.name(received)} before case "
+                    f"{case.name}")
+                stopped = 128 + received
+                break
+            record = sweep.run_case(number, case)
+            sweep.records.append(record)
+            sweep.write()
+            if record["code"] >= 128:
+                stopped = record["code"]
+                break
+    text = sweep.write()
+    if text:
+        say(text.rstrip())
+    failed = [r["name"] for r in sweep.records if r["code"] != 0]
+    say(f"petsc_rod.sweep: {len(sweep.records) - len(failed)} of {len(made)} case(s) "
+        f"converged" + (f"; not: {', '.join(failed)}" if failed else "")
+        + (f"; {len(made) - len(sweep.records)} not run" if stopped is not None else "")
+        + f"; summary in {os.path.join(settings.output, 'summary.md')}")
+    database.setValue("options_left", "0")
+    if stopped is not None:
+        return stopped
+    return 0 if not failed else RodNotConvergedError.exit_code

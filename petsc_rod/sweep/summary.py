@@ -1,0 +1,156 @@
+"""The summary table of a sweep (h5py and numpy only; serial): one row per case, from
+the case's record (name, the options it varied, exit code, how it started) and its
+result file's root attributes, written as CSV and Markdown with the units in the header.
+
+The columns are the riser numbers where the file has them (riser/quantities.py,
+riser/pressures.py, riser/section_numbers.py), then any other scalar root attribute
+named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
+(what newer versions add: a utilisation, a von Mises stress, end forces), so that the
+table shows what the files hold. The sweep
+(sweep/runner.py) and the report (report/page.py) both make their tables here.
+"""
+
+import csv
+import json
+import signal
+
+import h5py
+import numpy as np
+
+# The columns every summary tries first: (column, root attribute, unit if the file
+# gives none).
+NUMBERS = [
+    ("iterations", "total_iterations", "1"),
+    ("top_tension", "top_tension", "N"),
+    ("top_angle", "top_angle", "deg"),
+    ("touchdown_S", "touchdown_S", "m"),
+    ("grounded_length", "grounded_length", "m"),
+    ("min_bend_radius", "min_bend_radius", "m"),
+    ("min_bend_radius_S", "max_curvature_S", "m"),
+    ("max_curvature", "max_curvature", "1/m"),
+    ("max_wall_tension", "max_wall_tension", "N"),
+    ("max_wall_tension_S", "max_wall_tension_S", "m"),
+]
+# Other root attributes shown when present and scalar.
+EXTRA_PREFIXES = ("max_", "min_", "top_")
+# ... and any scalar attribute whose name says it is a stress check.
+EXTRA_WORDS = ("utilisation", "utilization", "von_mises", "stress")
+# Root attributes that are not results (a run's bookkeeping).
+NOT_RESULTS = {"total_iterations", "total_halvings", "undone_iterations"}
+# What an exit code says, for a case without a result file.
+EXIT_REASONS = {0: "converged", 2: "bad input", 3: "not converged", 4: "diverged",
+                5: "result not written"}
+
+
+def exit_reason(code):
+    """The words of a case's exit code (docs/errors.md)."""
+    if code >= 128:
+        try:
+            return f"stopped by {signal.Signals(code - 128).name}"
+        except ValueError:
+            return f"stopped by signal {code - 128}"
+    return EXIT_REASONS.get(code, f"exit {code}")
+
+
+def file_numbers(path):
+    """({attribute: value} of the scalar numeric root attributes, {attribute: unit}) of
+    result file ``path``; ({}, {}) when there is no readable file."""
+    try:
+        with h5py.File(path, "r") as f:
+            units = json.loads(f.attrs.get("attribute_units", "{}") or "{}")
+            values = {}
+            for key, value in f.attrs.items():
+                value = np.asarray(value)
+                if value.shape == () and np.issubdtype(value.dtype, np.number):
+                    values[key] = value.item()
+                elif value.dtype.kind in "SUO" and value.shape == ():
+                    values[key] = value.item().decode() if isinstance(value.item(), bytes) \
+                        else str(value.item())
+            return values, units
+    except (OSError, ValueError, KeyError):
+        return {}, {}
+
+
+def number_columns(files):
+    """[(column, attribute, unit)]: NUMBERS present in any of ``files`` ((values, units)
+    pairs), then the other scalar max_/min_/top_ attributes present, sorted."""
+    present = set().union(*(values for values, _ in files)) if files else set()
+    units = {}
+    for _, u in files:
+        units.update(u)
+    columns = [(c, a, units.get(a, unit)) for c, a, unit in NUMBERS if a in present]
+    known = {a for _, a, _ in NUMBERS} | NOT_RESULTS
+    for attribute in sorted(present - known):
+        if attribute.startswith(EXTRA_PREFIXES) or any(w in attribute for w in EXTRA_WORDS):
+            if all(isinstance(values.get(attribute, 0.0), (int, float)) for values, _ in files):
+                columns.append((attribute, attribute, units.get(attribute, "")))
+    return columns
+
+
+def table(records, varied):
+    """(header, rows) of the summary: case, the varied options, status, start, then the
+    number columns. ``records``: dicts with name, options, code, file, start."""
+    files = [file_numbers(r["file"]) if r.get("file") else ({}, {}) for r in records]
+    columns = number_columns([f for f in files if f[0]])
+    header = (["case"] + [f"-{name}" for name in varied] + ["exit", "status", "start"]
+              + [f"{column} ({unit})" for column, _, unit in columns])
+    rows = []
+    for record, (values, _) in zip(records, files):
+        status = exit_reason(record["code"])
+        reason = values.get("stop_reason")
+        if record["code"] == 3 and reason:
+            status = f"not converged ({reason})"
+        row = ([record["name"]] + [record["options"].get(name, "(base)") for name in varied]
+               + [record["code"], status, record.get("start", "")])
+        # a case that did not converge: its state is no equilibrium of the case, only
+        # its iterations are shown
+        shown = values if record["code"] == 0 else {"total_iterations":
+                                                    values.get("total_iterations", "")}
+        row += [shown.get(attribute, "") for _, attribute, _ in columns]
+        rows.append(row)
+    return header, rows
+
+
+def cell(value):
+    """A table cell as text: numbers to 6 significant digits, inf as 'inf'."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def write_csv(path, header, rows):
+    """The table as CSV, numbers at full precision."""
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(header)
+        for row in rows:
+            writer.writerow([repr(v) if isinstance(v, float) else v for v in row])
+
+
+def markdown(header, rows):
+    """The table as Markdown text."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for row in rows:
+        lines.append("| " + " | ".join(cell(v).replace("|", "\\|") for v in row) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_markdown(path, header, rows, title=None):
+    """The table as a Markdown file (with a title line when given)."""
+    with open(path, "w", encoding="utf-8") as f:
+        if title:
+            f.write(f"# {title}\n\n")
+        f.write(markdown(header, rows))
+
+
+def read_record(path):
+    """The sweep's record (DIR/sweep.json: the base options, the varied options, one
+    entry per case)."""
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def write_record(path, record):
+    """Write the sweep's record as JSON."""
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(record, f, indent=1)

@@ -1,0 +1,287 @@
+"""Sweeps and the report from the command line (spawns python -m petsc_rod.sweep and
+python -m petsc_rod.report: serial): a 3-case offset sweep of a small riser (the SCR of
+options/riser_catenary.opts on 200 elements, about 40 iterations a case) on 1 and 2
+ranks gives the same summary; a case that fails in the middle is marked and the next
+still runs; warm starts take fewer iterations than each case's own start (a straight
+start in 4 steps); bad sweep input is one line, exit 2, before any run; the report's
+table holds the files' numbers and its pictures are drawn."""
+
+import base64
+import csv
+import html.parser
+import io
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import REPO_ROOT, child_env, describe, mpiexec
+
+TIMEOUT = 300
+RISER = ["-options_file", "options/riser_catenary.opts", "-rod_elements", "200"]
+# started straight in 4 steps, a cold start that costs its continuation
+STRAIGHT = ["-rod_initial_shape", "straight", "-rod_steps", "4"]
+OFFSETS = ["-sweep_offsets", "0,50", "-sweep_headings", "near,far"]
+CASES = ["offset0", "near50", "far50"]
+
+
+def run_module(module, args, ranks=1):
+    """``python -m module args`` (under mpiexec for several ranks) from the repository."""
+    command = mpiexec(ranks) + [sys.executable, "-m", module] + list(args)
+    return subprocess.run(command, cwd=REPO_ROOT, env=child_env(), capture_output=True,
+                          text=True, timeout=TIMEOUT, check=False)
+
+
+def read_summary(folder):
+    """{case: {column: text}} of a sweep's summary.csv."""
+    with open(os.path.join(folder, "summary.csv"), newline="") as f:
+        return {row["case"]: row for row in csv.DictReader(f)}
+
+
+@pytest.fixture(scope="module")
+def offset_sweep(tmp_path_factory):
+    """The 3-case offset sweep on one rank: (its folder, the process)."""
+    folder = tmp_path_factory.mktemp("sweep") / "offsets"
+    process = run_module("petsc_rod.sweep", RISER + OFFSETS + ["-sweep_output", str(folder)])
+    return folder, process
+
+
+@pytest.mark.serial
+def test_offset_sweep_writes_a_file_per_case_and_the_summary(offset_sweep):
+    folder, process = offset_sweep
+    assert process.returncode == 0, describe(process)
+    rows = read_summary(folder)
+    assert list(rows) == CASES
+    for name, row in rows.items():
+        assert row["status"] == "converged", row
+        # -sweep_start auto: a case that starts from its catenary starts from it
+        assert row["start"] == "own start", row
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            assert f.attrs["converged"] == 1
+            # the summary's numbers are the file's attributes (full precision in the CSV)
+            assert float(row["top_tension (N)"]) == float(f.attrs["top_tension"])
+            assert float(row["min_bend_radius (m)"]) == float(f.attrs["min_bend_radius"])
+            assert float(row["touchdown_S (m)"]) == float(f.attrs["touchdown_S"])
+    # the offsets: near toward the anchor (x smaller), far away from it
+    assert rows["near50"]["-rod_end_position"] == "1107,0,1000"
+    assert rows["far50"]["-rod_end_position"] == "1207,0,1000"
+    # physics: the far offset pulls the line tighter
+    tension = {k: float(v["top_tension (N)"]) for k, v in rows.items()}
+    assert tension["near50"] < tension["offset0"] < tension["far50"]
+    assert (folder / "summary.md").read_text().count("\n| ") == 1 + len(CASES)
+
+
+@pytest.mark.serial
+def test_the_same_summary_on_two_ranks(offset_sweep, tmp_path):
+    folder, _ = offset_sweep
+    other = tmp_path / "two"
+    process = run_module("petsc_rod.sweep", RISER + OFFSETS + ["-sweep_output", str(other)],
+                         ranks=2)
+    assert process.returncode == 0, describe(process)
+    one, two = read_summary(folder), read_summary(other)
+    assert list(one) == list(two) == CASES
+    for name in CASES:
+        for column in ("top_tension (N)", "top_angle (deg)", "touchdown_S (m)",
+                       "min_bend_radius (m)", "max_curvature (1/m)"):
+            assert float(one[name][column]) == pytest.approx(float(two[name][column]),
+                                                             rel=1e-6), (name, column)
+
+
+@pytest.mark.serial
+def test_warm_starts_take_fewer_iterations(tmp_path):
+    """Each offset case from the converged offset0 (a one-step walk) against its own start
+    (straight, 4 steps): measured 43 and 39 against about 300 iterations; asserted only
+    that the warm start takes less than half."""
+    warm, cold = tmp_path / "warm", tmp_path / "cold"
+    # -sweep_start auto (the default) warm-starts a case whose own start is straight
+    for folder, start in ((warm, "auto"), (cold, "scene")):
+        process = run_module("petsc_rod.sweep", RISER + STRAIGHT + OFFSETS + [
+            "-sweep_output", str(folder), "-sweep_start", start])
+        assert process.returncode == 0, describe(process)
+    warm_rows, cold_rows = read_summary(warm), read_summary(cold)
+    for name in ("near50", "far50"):
+        assert warm_rows[name]["start"] == "from offset0"
+        assert cold_rows[name]["start"] == "own start"
+        assert int(warm_rows[name]["iterations (1)"]) < int(cold_rows[name]["iterations (1)"]) / 2
+        assert float(warm_rows[name]["top_tension (N)"]) == pytest.approx(
+            float(cold_rows[name]["top_tension (N)"]), rel=1e-6)
+
+
+@pytest.mark.serial
+def test_a_failing_case_is_marked_and_the_next_runs(tmp_path):
+    cases = tmp_path / "cases.txt"
+    cases.write_text("# offsets, the middle case with one iteration allowed\n"
+                     "name rod_end_position rod_al_max_it\n"
+                     "base 1157,0,1000 -\n"
+                     "capped 1107,0,1000 1\n"
+                     "far 1207,0,1000 -\n")
+    folder = tmp_path / "out"
+    process = run_module("petsc_rod.sweep", ["-options_file", "options/riser_catenary.opts",
+                                             "-rod_elements", "200", "-sweep_cases", str(cases),
+                                             "-sweep_output", str(folder),
+                                             "-sweep_start", "nearest"])
+    assert process.returncode == 3, describe(process)
+    rows = read_summary(folder)
+    assert list(rows) == ["base", "capped", "far"]
+    assert rows["capped"]["exit"] == "3"
+    assert rows["capped"]["status"] == "not converged (max_it)"
+    assert rows["capped"]["top_tension (N)"] == ""         # no equilibrium: no numbers
+    # the warm start failed, then the case's own start (-sweep_retry)
+    assert rows["capped"]["start"] == "own start (from base: exit 3)"
+    assert rows["far"]["status"] == "converged"
+    # the cap was the case's own: the next case ran with the default again
+    assert rows["far"]["-rod_al_max_it"] == "(base)"
+    assert rows["far"]["start"] == "from base"              # never from the failed case
+    with h5py.File(folder / "far.h5", "r") as f:
+        assert "-rod_al_max_it 2000" in f.attrs["options_in_effect"]
+    assert "1 case(s)" not in process.stdout
+    assert "2 of 3 case(s) converged; not: capped" in process.stdout
+
+
+@pytest.mark.serial
+def test_a_case_with_bad_input_is_marked_and_the_sweep_goes_on(tmp_path):
+    """A value petsc_rod refuses is that case's bad input (exit 2 in the table), not the
+    sweep's: the paper scene (80 elements) with a two-number end position in the middle."""
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_end_position\nxf16 16,4,0\nwrong 1,2\nxf15 15,5,0\n")
+    folder = tmp_path / "out"
+    process = run_module("petsc_rod.sweep", ["-options_file", "options/paper.opts",
+                                             "-sweep_cases", str(cases),
+                                             "-sweep_output", str(folder)])
+    assert process.returncode == 3, describe(process)
+    assert "-rod_end_position '1,2': expected 3 comma-separated numbers" in process.stdout
+    rows = read_summary(folder)
+    assert [(r["exit"], r["status"]) for r in rows.values()] == [
+        ("0", "converged"), ("2", "bad input"), ("0", "converged")]
+    # the paper scene needs its 8 steps from straight; from xf16, one
+    assert rows["xf15"]["start"] == "from xf16"
+    assert int(rows["xf15"]["iterations (1)"]) < int(rows["xf16"]["iterations (1)"]) / 2
+    assert not (folder / "wrong.h5").exists()
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("content, args, message", [
+    ("name rod_end_positio\na 1,2,3\n", [], "column rod_end_positio is not a petsc_rod option"),
+    ("name rod_end_position\na 1,2,3 4\n", [], "3 value(s) for 2 column(s)"),
+    ("name rod_output\na x.h5\n", [], "the sweep sets -rod_output itself"),
+    ("name rod_end_position\na 1,2,3\na 1,2,4\n", [], "two cases are named a"),
+    ("name rod_end_position\n", [], "at least one case row"),
+    ("name rod_end_position\na 1,2,3\n", ["-sweep_offset", "1"], "did you mean -sweep_offsets"),
+    ("name rod_end_position\na 1,2,3\n", ["-sweep_headings", "up"], "unknown heading up"),
+])
+def test_bad_sweep_input_is_one_line_and_exit_2(tmp_path, content, args, message):
+    cases = tmp_path / "cases.txt"
+    cases.write_text(content)
+    folder = tmp_path / "out"
+    extra = ["-sweep_offsets", "10"] if "-sweep_headings" in args else []
+    process = run_module("petsc_rod.sweep", ["-options_file", "options/riser_catenary.opts",
+                                             "-sweep_cases", str(cases), "-sweep_output",
+                                             str(folder)] + args + extra)
+    assert process.returncode == 2, describe(process)
+    lines = [line for line in process.stdout.splitlines() if line.strip()]
+    assert len(lines) == 1 and message in lines[0], describe(process)
+    assert not folder.exists()
+
+
+class Tables(html.parser.HTMLParser):
+    """The cells of the <table id=summary> and the embedded PNGs of a page."""
+
+    def __init__(self):
+        super().__init__()
+        self.rows, self.images, self._in, self._cell = [], [], False, None
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "table":
+            self._in = attrs.get("id") == "summary"
+        elif tag == "tr" and self._in:
+            self.rows.append([])
+        elif tag in ("td", "th") and self._in:
+            self._cell = ""
+        elif tag == "img":
+            self.images.append(attrs["src"])
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self.rows[-1].append(self._cell)
+            self._cell = None
+        elif tag == "table":
+            self._in = False
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell += data
+
+
+@pytest.mark.serial
+def test_the_report_of_a_sweep(offset_sweep, tmp_path):
+    import matplotlib.image
+
+    folder, _ = offset_sweep
+    output = tmp_path / "report.html"
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    text = output.read_text()
+    assert "http://" not in text and "https://" not in text      # self-contained
+    page = Tables()
+    page.feed(text)
+    header, rows = page.rows[0], {row[0]: row for row in page.rows[1:]}
+    assert list(rows) == CASES
+    for name, row in rows.items():
+        cells = dict(zip(header, row))
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            for column, attribute in (("top_tension (N)", "top_tension"),
+                                      ("top_angle (deg)", "top_angle"),
+                                      ("touchdown_S (m)", "touchdown_S"),
+                                      ("min_bend_radius (m)", "min_bend_radius")):
+                assert float(cells[column]) == pytest.approx(float(f.attrs[attribute]),
+                                                             rel=1e-5), (name, column)
+    # the range graphs and one picture per case, each a PNG with something drawn
+    assert len(page.images) == 1 + len(CASES)
+    for source in page.images:
+        assert source.startswith("data:image/png;base64,")
+        data = base64.b64decode(source.split(",", 1)[1])
+        assert data[:8] == b"\x89PNG\r\n\x1a\n"
+        pixels = matplotlib.image.imread(io.BytesIO(data), format="png")[..., :3]
+        drawn = float(np.mean(np.any(pixels < 0.95, axis=-1)))
+        assert 0.02 < drawn < 0.9, drawn
+    assert "<pre id=\"options\">" in text and "-rod_stiffness" in text
+
+
+@pytest.mark.serial
+def test_the_report_of_one_file_and_a_bad_source(offset_sweep, tmp_path):
+    folder, _ = offset_sweep
+    output = tmp_path / "one.html"
+    process = run_module("petsc_rod.report", [str(folder / "far50.h5"), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    page = Tables()
+    page.feed(output.read_text())
+    assert len(page.rows) == 2 and page.rows[1][0] == "far50"
+    assert len(page.images) == 1
+    process = run_module("petsc_rod.report", [str(tmp_path), "-o", str(output)])
+    assert process.returncode == 2 and "sweep.json" in process.stderr, describe(process)
+
+
+@pytest.mark.serial
+def test_the_summary_shows_what_newer_files_add(tmp_path):
+    """Attributes this version does not write (a utilisation, a von Mises stress) appear
+    in the table with the file's unit; a vector attribute does not."""
+    import json
+
+    from petsc_rod.sweep import summary
+
+    path = tmp_path / "a.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs.update(converged=1, total_iterations=7, top_tension=1.5e6,
+                       max_utilisation=0.61, max_von_mises=2.9e8, end_force=[1.0, 2.0, 3.0],
+                       attribute_units=json.dumps({"top_tension": "N", "max_utilisation": "1",
+                                                   "max_von_mises": "Pa"}))
+    header, rows = summary.table([{"name": "a", "options": {}, "code": 0, "start": "",
+                                   "file": str(path)}], [])
+    cells = dict(zip(header, rows[0]))
+    assert cells["top_tension (N)"] == 1.5e6 and cells["iterations (1)"] == 7
+    assert cells["max_utilisation (1)"] == 0.61 and cells["max_von_mises (Pa)"] == 2.9e8
+    assert not any(h.startswith("end_force") for h in header)
