@@ -119,8 +119,9 @@ def _table(header, rows):
 
 def summary(attributes):
     """The lines of the run's final summary from the last step's attributes (at load
-    factor 1): the riser's numbers, the flex joints' angles, and per section its
-    largest tension and smallest bend radius and where; [] for a scene with none of
+    factor 1): the riser's numbers, the flex joints' angles, per section its largest
+    tension and smallest bend radius and where, and the same per region of the line
+    (riser/regions.py) with its largest bending moment; [] for a scene with none of
     them (a rod of the paper's kind: its energy and strains are in the file)."""
     a = attributes
     out = []
@@ -151,6 +152,18 @@ def summary(attributes):
                     a["section_names"], a["section_bounds"], a["section_max_tension"],
                     a["section_max_tension_S"], a["section_min_bend_radius"],
                     a["section_max_curvature_S"])]
+        out += _table(header, rows)
+    if "region_names" in a:
+        header = ["region", "S from (m)", "S to (m)", "max tension (kN)", "at S (m)",
+                  "min bend radius (m)", "at S (m)", "max moment (kN m)", "at S (m)"]
+        rows = [[name, f"{bounds[0]:.6g}", f"{bounds[1]:.6g}", f"{tension / 1e3:.6g}",
+                 f"{tension_S:.6g}", f"{radius:.4g}", f"{radius_S:.6g}",
+                 f"{moment / 1e3:.4g}", f"{moment_S:.6g}"]
+                for name, bounds, tension, tension_S, radius, radius_S, moment, moment_S
+                in zip(a["region_names"], a["region_bounds"], a["region_max_tension"],
+                       a["region_max_tension_S"], a["region_min_bend_radius"],
+                       a["region_min_bend_radius_S"], a["region_max_bending_moment"],
+                       a["region_max_bending_moment_S"])]
         out += _table(header, rows)
     return ["petsc_rod: at load factor 1:"] + out if out else []
 

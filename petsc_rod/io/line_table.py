@@ -1,6 +1,6 @@
-"""The converged result along the line as a CSV table (-rod_table FILE.csv), the regions'
-summary beside it (FILE's stem + ``_regions.csv``) and printed at the end of the run
-(docs/output.md, docs/riser.md §5).
+"""The converged result along the line as a CSV table (-rod_table FILE.csv) and the
+regions' summary beside it (FILE's stem + ``_regions.csv``; the run's final summary
+prints it too, cli/lines.summary) (docs/output.md, docs/riser.md §5).
 
 One row per vertex: S, x, y, z (absolute), u1, u2 (the signed curvatures about d1 and
 d2) and every result along the line the run has (TABLE_DATASETS, those of its terms),
@@ -24,7 +24,6 @@ import numpy as np
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
-from petsc_rod.riser import regions
 from petsc_rod.riser.quantities import effective_tension
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
@@ -137,11 +136,11 @@ def write_tables(path, comm, vertex, attributes):
 
 
 def finish_run(problem, path, say):
-    """After a converged run: the regions' summary said, the table written when ``path``
-    (-rod_table) is given. Collective."""
+    """After a converged run: the table written when ``path`` (-rod_table) is given (the
+    regions' summary is the run's final summary's, cli/lines.summary). Collective."""
+    if not path:
+        return
     vertex, attributes = final_record(problem)
-    for line in regions.summary_lines(attributes):
-        say(line)
     if path:
         write_tables(path, problem.mesh.comm, vertex, attributes)
         say(f"petsc_rod: table {path}" + (f", regions {regions_path(path)}"

@@ -179,22 +179,3 @@ def region_report(problem, vertex, seabed=None):
         "region_min_bend_radius": radius, "region_min_bend_radius_S": kappa[:, 1],
         "region_max_bending_moment": moment[:, 0],
         "region_max_bending_moment_S": moment[:, 1]})
-
-
-def summary_lines(attributes):
-    """The regions' table for the end of a run: a header and a line per region."""
-    if "region_names" not in attributes:
-        return []
-    lines = [f"{'region':<15}{'S from, to (m)':>22}{'max tension (N)':>18}{'at S (m)':>10}"
-             f"{'min bend radius (m)':>21}{'at S (m)':>10}{'max moment (N m)':>18}"
-             f"{'at S (m)':>10}"]
-    a = attributes
-    for i, name in enumerate(a["region_names"]):
-        low, high = a["region_bounds"][i]
-        lines.append(
-            f"{name:<15}{low:>11.6g},{high:>10.6g}{a['region_max_tension'][i]:>18.6g}"
-            f"{a['region_max_tension_S'][i]:>10.6g}{a['region_min_bend_radius'][i]:>21.6g}"
-            f"{a['region_min_bend_radius_S'][i]:>10.6g}"
-            f"{a['region_max_bending_moment'][i]:>18.6g}"
-            f"{a['region_max_bending_moment_S'][i]:>10.6g}")
-    return lines
