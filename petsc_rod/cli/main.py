@@ -28,7 +28,7 @@ from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
                                          scene_from_options, settings_from_options)
 from petsc_rod.cli.session import run_continuation
-from petsc_rod.io.tables import read_text
+from petsc_rod.tables import read_text
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver

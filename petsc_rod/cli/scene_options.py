@@ -117,7 +117,7 @@ def sections_from_options(values, given, content=None):
     ``content`` when already read) and -rod_sections, or [] when neither is given;
     RodInputError for one without the other, an unknown type, a length that disagrees
     with -rod_length, or an option the sections replace."""
-    from petsc_rod.io.tables import read_table
+    from petsc_rod.tables import read_table
     from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
                                        line_types_from_table, parse_sections)
     if "rod_sections" not in given:

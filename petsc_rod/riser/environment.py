@@ -11,6 +11,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.boundary import is_held
+from petsc_rod.tables import read_text
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
@@ -104,13 +105,7 @@ def read_profile(path, largest=np.inf):
     def refuse(what):
         raise RodInputError(f"-rod_current_profile {path}: {what}")
 
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            lines = handle.read().splitlines()
-    except FileNotFoundError:
-        refuse("no such file")
-    except OSError as error:
-        refuse(f"cannot be read ({error.strerror})")
+    lines = read_text(path, "-rod_current_profile").splitlines()
     rows = [line.split("#", 1)[0].replace(",", " ").split() for line in lines]
     rows = [row for row in rows if row]
     try:

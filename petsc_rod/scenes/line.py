@@ -125,7 +125,7 @@ class LineType:
 
 
 def line_types_from_table(table, option):
-    """{name: LineType} from the columns of a -rod_line_types table (io/tables.py
+    """{name: LineType} from the columns of a -rod_line_types table (petsc_rod/tables.py
     read_table with LINE_TYPE_COLUMNS and LINE_TYPE_OPTIONAL); RodInputError naming
     ``option`` for a row that does not give exactly one bending form (the other forms'
     columns left blank, '-') or gives a value out of range."""

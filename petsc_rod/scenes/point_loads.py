@@ -18,6 +18,7 @@ physics/point_loads.py.
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.tables import read_text
 
 # The columns a table may name; ``s`` is required. Every column but ``name`` is a number.
 COLUMNS = ("s", "mass", "volume", "fx", "fy", "fz", "cda", "name")
@@ -54,13 +55,7 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
     def refuse(what):
         raise RodInputError(f"{option}: {what}")
 
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            lines = handle.read().splitlines()
-    except FileNotFoundError:
-        refuse("no such file")
-    except OSError as error:
-        refuse(f"cannot be read ({error.strerror})")
+    lines = read_text(path, "-rod_point_loads").splitlines()
     rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
             for k, line in enumerate(lines)]
     rows = [(k, row) for k, row in rows if row]
