@@ -134,3 +134,11 @@ class Term:
 
     def destroy(self):
         """Free the term's PETSc objects (collective)."""
+
+
+class ReportTerm(Term):
+    """A term that only reports (``outputs``): it adds nothing to the equations, so the
+    turn of an axially symmetric scene leaves the problem unchanged whatever it reports
+    (Scene.axially_symmetric decides)."""
+
+    axially_symmetric = True

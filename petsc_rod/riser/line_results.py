@@ -31,7 +31,7 @@ vertical to 1e-12).
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.riser.quantities import _at_vertex, effective_tension, top_end, unit_tangent
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
@@ -111,7 +111,7 @@ def end_numbers(problem, vertex):
             "hang_off_azimuth": azimuth(away)}
 
 
-class LineResults(Term):
+class LineResults(ReportTerm):
     """Reports the results along the line and at its ends (module docstring); built for
     every scene (problem/build.py)."""
 

@@ -21,7 +21,7 @@ over EA; docs/riser.md §2b).
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.riser.quantities import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
@@ -29,7 +29,7 @@ DATASET_UNITS = {"external_pressure": "Pa", "internal_pressure": "Pa", "wall_ten
 ATTRIBUTE_UNITS = {"max_wall_tension": "N", "max_wall_tension_S": "m"}
 
 
-class PipePressures(Term):
+class PipePressures(ReportTerm):
     """Reports the pressures and the wall tension (module docstring) of a line of
     sections (problem/build.py)."""
 

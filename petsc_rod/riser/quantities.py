@@ -18,7 +18,7 @@ positions reported (touchdown, largest curvature) are absolute: the start positi
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.scenes.boundary import is_held
 
 # Units of the datasets and attributes this module adds to the result file.
@@ -29,7 +29,7 @@ ATTRIBUTE_UNITS = {
     "max_curvature_position": "m", "min_bend_radius": "m"}
 
 
-class RiserNumbers(Term):
+class RiserNumbers(ReportTerm):
     """The riser numbers as a term that only reports (physics/term.py): built for every
     scene with a seabed or a current, with the SeabedTerm (riser/terms.py) or None."""
 

@@ -28,7 +28,7 @@ candidates and each region's largest values are combined by allgathers of small 
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.riser.line_results import bending_moment, curvature
 from petsc_rod.riser.quantities import _at_vertex, effective_tension, top_end, touchdown
 
@@ -42,7 +42,7 @@ END_FRACTION = 0.05
 PROMINENCE = 1e-3
 
 
-class LineRegions(Term):
+class LineRegions(ReportTerm):
     """Reports the regions (module docstring); built for a scene with a seabed, a current
     or line types, with the riser's SeabedTerm (or None)."""
 

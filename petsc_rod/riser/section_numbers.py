@@ -8,7 +8,7 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.riser.quantities import effective_tension
 from petsc_rod.scenes.line import section_index
 
@@ -19,7 +19,7 @@ ATTRIBUTE_UNITS = {"section_names": "text", "section_bounds": "m",
                    "section_min_bend_radius": "m"}
 
 
-class SectionNumbers(Term):
+class SectionNumbers(ReportTerm):
     """Reports the sections' numbers (module docstring); built for a line of sections
     (problem/build.py)."""
 

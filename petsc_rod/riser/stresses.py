@@ -32,7 +32,7 @@ equilibrium is not changed.
 
 import numpy as np
 
-from petsc_rod.physics.term import Term, TermOutput
+from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.riser import pressures as pipe_pressures
 from petsc_rod.riser.line_results import bending_moment, torque
 from petsc_rod.riser.quantities import effective_tension, top_end
@@ -79,7 +79,7 @@ def pipe_von_mises(wall, moment, twist, p_i, p_e, od, inner):
     return np.where(inner > 0, largest, np.nan)
 
 
-class PipeStresses(Term):
+class PipeStresses(ReportTerm):
     """Reports the von Mises stress and the utilisation (module docstring) of a line of
     sections some of which have an inner diameter (problem/build.py)."""
 
