@@ -79,11 +79,22 @@ def main(argv):
         parser.print_usage(sys.stderr)
         sys.stderr.write(f"the last file is the figure to write, not a result: {output}\n")
         return 2
-    if len(inputs) == 1:
-        plot_result(inputs[0], output, args.min_bend_radius)
-    else:
-        labels = [os.path.basename(p).removesuffix(".h5") for p in inputs]
-        save(sweep_figure(inputs, labels, args.min_bend_radius), output)
+    radius = args.min_bend_radius
+    if radius is not None and not (radius > 0 and radius < float("inf")):
+        sys.stderr.write(f"petsc_rod.plots: error: --min-bend-radius {radius:g}: give the "
+                         "allowable bend radius in m, positive and finite\n")
+        return 2
+    try:
+        if len(inputs) == 1:
+            plot_result(inputs[0], output, radius)
+        else:
+            labels = [os.path.basename(p).removesuffix(".h5") for p in inputs]
+            save(sweep_figure(inputs, labels, radius), output)
+    except (OSError, KeyError, ValueError) as error:
+        sys.stderr.write(f"petsc_rod.plots: error: {' '.join(inputs)}: cannot be drawn "
+                         f"({error.__class__.__name__}: {error}); give result files written "
+                         "with -rod_output\n")
+        return 2
     return 0
 
 

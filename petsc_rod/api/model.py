@@ -45,7 +45,9 @@ class LineType:
     ``cd`` normal drag coefficient (1), ``drag_d`` hydrodynamic diameter (m; None: the
     od), ``id`` inner diameter (m; 0: no bore), ``ei_end`` (N m^2) the bending
     stiffness at the end of each section of the type where it tapers linearly from
-    ``ei`` (a bend stiffener). The submerged weight is (mass - rho_w pi od^2 / 4) g.
+    ``ei`` (a bend stiffener), ``smys`` the wall's yield stress (Pa; None: no
+    utilisation), ``stress_od`` the steel wall's outer diameter under a jacket or
+    coating (m; None: the od). The submerged weight is (mass - rho_w pi od^2 / 4) g.
     """
 
     name: str
@@ -58,6 +60,8 @@ class LineType:
     drag_d: float = None
     id: float = 0.0
     ei_end: float = None
+    smys: float = None
+    stress_od: float = None
 
     def row(self):
         """The type's row of a -rod_line_types table, in COLUMNS order ('-' blank)."""
@@ -75,12 +79,14 @@ class LineType:
             raise RodInputError(f"line type {self.name}: ei is one number or a pair (EI1, EI2)")
         return ([self.name, _number(self.od), _number(self.mass), _number(self.gj)] + bending
                 + [_number(self.ea), _number(self.cd),
-                   blank if self.drag_d is None else _number(self.drag_d), _number(self.id)])
+                   blank if self.drag_d is None else _number(self.drag_d), _number(self.id),
+                   blank if self.smys is None else _number(self.smys),
+                   blank if self.stress_od is None else _number(self.stress_od)])
 
 
 # The columns LineType.row fills (scenes/line.py: LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL).
 COLUMNS = ("name", "od", "mass", "gj", "ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd",
-           "drag_d", "id")
+           "drag_d", "id", "smys", "stress_od")
 
 
 def line_types_table(types):

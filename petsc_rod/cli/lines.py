@@ -143,6 +143,14 @@ def summary(attributes):
     if "max_wall_tension" in a:
         out.append(f"  largest wall tension {a['max_wall_tension'] / 1e3:.6g} kN at S = "
                    f"{a['max_wall_tension_S']:.6g} m")
+    if "max_von_mises" in a and a["max_von_mises"] == a["max_von_mises"]:
+        text = (f"  largest von Mises stress {a['max_von_mises'] / 1e6:.5g} MPa at S = "
+                f"{a['max_von_mises_S']:.6g} m")
+        if a.get("max_utilisation", float("nan")) == a.get("max_utilisation"):
+            text += (f"; utilisation up to {a['max_utilisation']:.4g} at S = "
+                     f"{a['max_utilisation_S']:.6g} m (design factor "
+                     f"{a['design_factor']:.4g})")
+        out.append(text)
     if "section_names" in a:
         header = ["section", "S from (m)", "S to (m)", "max tension (kN)", "at S (m)",
                   "min bend radius (m)", "at S (m)"]

@@ -99,8 +99,10 @@ def run(comm=None):
             code = run_continuation(solver, path, say=say, writer=writer,
                                     options=options_record(), interrupts=interrupts).code
             writer = None
-            if code == 0:                   # the regions' summary, the CSV table
+            if code == 0:                   # the CSV table of the converged result
                 line_table.finish_run(problem, values["rod_table"], say)
+            elif values["rod_table"]:       # none for this run: not an earlier run's either
+                line_table.discard(values["rod_table"], comm, say)
             for name in unused_options():
                 say(f"petsc_rod: warning: option -{name} was set but not used")
             return code

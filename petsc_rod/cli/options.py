@@ -196,7 +196,7 @@ OPTIONS = [
     Option("rod_design_factor", _real, default_of(Scene, "design_factor"), "f",
            "the allowable von Mises stress of a line type with id and smys is f smys "
            "(utilisation = von Mises / (f smys); default the API RP 2RD operating basic "
-           "allowable 0.67)", (lambda v: 0 < v <= 1, "must be in (0, 1]")),
+           "allowable 2/3)", (lambda v: 0 < v <= 1, "must be in (0, 1]")),
     # attachments (scenes/point_loads.py, physics/point_loads.py; docs/riser.md)
     Option("rod_point_loads", _string, None, "FILE",
            "attachments: a table with a header row naming its columns, s (arc length, m; "

@@ -59,6 +59,20 @@ def check_table_path(path, output, comm):
         check_output_path(name, comm, "-rod_table")
 
 
+def discard(path, comm, say):
+    """After a run that did not converge: no table is written, and a table (and its
+    regions') left at ``path`` by an earlier run is removed, so that no table stands
+    beside this run's result file as if it were its. Collective."""
+    names = [name for name in (path, regions_path(path)) if os.path.exists(name)]
+    comm.tompi4py().barrier()
+    if comm.getRank() == 0:
+        for name in names:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(name)
+    text = f"; removed {' and '.join(names)}, an earlier run's" if names else ""
+    say(f"petsc_rod: no table written (-rod_table {path}): the run did not converge{text}")
+
+
 def final_record(problem):
     """(vertex datasets with the terms' and r absolute, and the effective tension n.t
     where no term wrote it; the terms' attributes) of the problem's state. Collective."""

@@ -32,6 +32,11 @@ def main(argv=None):
     except OSError as error:
         sys.stderr.write(f"petsc_rod.report: error: {args.output}: {error.strerror or error}\n")
         return 2
+    except (KeyError, ValueError) as error:     # json.JSONDecodeError is a ValueError
+        sys.stderr.write(f"petsc_rod.report: error: {source}: not a petsc_rod result file or "
+                         f"sweep ({error.__class__.__name__}: {error}); give a file written "
+                         "with -rod_output or a -sweep_output folder\n")
+        return 2
     print(f"petsc_rod.report: wrote {args.output}")
     return 0
 

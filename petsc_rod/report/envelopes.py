@@ -49,7 +49,11 @@ def envelopes(cases):
     """(S, {quantity: (values of each case (cases, n), least, largest)}) on the first
     case's S, for the quantities every case has. ``cases``: along_line dicts."""
     S = cases[0]["S"]
-    names = [name for name, *_ in QUANTITIES if all(name in c for c in cases)]
+    # the quantities every case has, with a finite value somewhere (a straight line's
+    # bend radius is inf all along, a line type without smys has no utilisation)
+    names = [name for name, *_ in QUANTITIES
+             if all(name in c for c in cases)
+             and any(np.any(np.isfinite(c[name])) for c in cases)]
     result = {}
     for name in names:
         stacked = np.array([c[name] if c["S"].shape == S.shape and np.allclose(c["S"], S)

@@ -1,11 +1,12 @@
 """The pipe's pressures and its wall tension, as riser practice reports them (docs/riser.md
-§2b), for a line of line types (scenes/line.py: each section's outer and inner
-diameters od, id).
+§2b), for a line of line types (scenes/line.py: each section's wall outer diameter od_w,
+the line type's stress_od (its od unless a buoyancy jacket or coating outside the wall
+carries its own pressure), and inner diameter id).
 
 The line's loads are its submerged weight and its effective tension T_e = n.t is what
 the equilibrium carries (Sparks' effective tension). The pipe wall itself carries
 
-    T_w = T_e + p_i A_i - p_e A_e,        A_e = pi od^2 / 4,  A_i = pi id^2 / 4,
+    T_w = T_e + p_i A_i - p_e A_e,        A_e = pi od_w^2 / 4,  A_i = pi id^2 / 4,
 
 with the external hydrostatic pressure p_e = rho_w g max(z_s - z, 0) below the sea
 surface z_s (-rod_sea_surface; default the higher held end, a hang-off at the surface),
@@ -60,7 +61,7 @@ def pressure_report(problem, scene, vertex):
     S, z = vertex["S"], vertex["r"][:, 2]
     top = problem.end_state if top_end(problem) == 1 else problem.start_state
     external, internal = pressures(scene, z, float(top.position[2]))
-    od = piecewise_constant(scene.sections, S, "od")
+    od = piecewise_constant(scene.sections, S, "stress_od")        # the steel wall's
     inner = piecewise_constant(scene.sections, S, "id")
     wall = wall_tension(effective_tension(vertex), external, internal, od, inner)
     k = int(np.argmax(wall)) if wall.size else 0

@@ -19,7 +19,7 @@ tending to the thin-wall p D / 2 t as the wall thins):
 evaluated at four fibres, the outer and the inner one on the tension and on the
 compression side of the bending, and the largest taken (the stresses vary monotonically
 in r and linearly across the section between them). The utilisation is
-s_vm / (f smys), f the design factor (-rod_design_factor, default 0.67 = 2/3, the
+s_vm / (f smys), f the design factor (-rod_design_factor, default 2/3, the
 basic allowable of API RP 2RD for the operating case, C_f C_a with C_a = 2/3, C_f = 1).
 
 Sources: G. Lame (1852), as in S. Timoshenko and J. N. Goodier, "Theory of Elasticity"
@@ -109,7 +109,7 @@ def stress_report(problem, scene, vertex):
     S, z = vertex["S"], vertex["r"][:, 2]
     top = problem.end_state if top_end(problem) == 1 else problem.start_state
     p_e, p_i = pipe_pressures.pressures(scene, z, float(top.position[2]))
-    od = piecewise_constant(scene.sections, S, "od")
+    od = piecewise_constant(scene.sections, S, "stress_od")        # the steel wall's
     inner = piecewise_constant(scene.sections, S, "id")
     smys = piecewise_constant(scene.sections, S, "smys")
     wall = pipe_pressures.wall_tension(effective_tension(vertex), p_e, p_i, od, inner)

@@ -22,7 +22,8 @@ class Section:
     N/m, (3,) (the submerged weight along -z); drag: c = rho Cd D / 2, kg/m^2, of the
     normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
     mass: kg/m in air; smys: the specified minimum yield stress of the pipe's wall, Pa
-    (NaN: not given; riser/stresses.py).
+    (NaN: not given; riser/stresses.py); stress_od: the outer diameter of the pipe's
+    wall, m, below a buoyancy jacket or coating (NaN: od; riser/pressures.py).
     """
 
     name: str
@@ -37,6 +38,7 @@ class Section:
     mass: float = np.nan
     id: float = 0.0
     smys: float = np.nan
+    stress_od: float = np.nan
 
     def __post_init__(self):
         self.stiffness_start = np.asarray(self.stiffness_start, dtype=float)
@@ -80,7 +82,7 @@ def piecewise_constant(sections, S, name):
 # The columns of a line-type table (-rod_line_types): required, and optional.
 LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
 LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d", "id",
-                      "smys")
+                      "smys", "stress_od")
 # The ways of giving the bending stiffness, one per line type (the others' columns left
 # blank, '-'): isotropic, anisotropic (about d1 and d2), and a linear taper along each
 # section of the type.
@@ -95,7 +97,10 @@ class LineType:
     tapered), torsional ``gj`` (N m^2), axial ``ea`` (N, inf: inextensible), normal drag
     coefficient ``cd``, hydrodynamic diameter ``drag_d`` (m) and inner diameter ``id``
     (m, 0: no bore; the internal pressure's area, riser/pressures.py), and the wall's
-    specified minimum yield stress ``smys`` (Pa, NaN: not given; riser/stresses.py)."""
+    specified minimum yield stress ``smys`` (Pa, NaN: not given; riser/stresses.py), and
+    ``stress_od`` the outer diameter of the steel wall that carries the wall tension and
+    the stresses (m; default ``od``: a buoyancy jacket or a coating has its own larger
+    ``od`` for weight and drag, but the external pressure on it is carried by it)."""
 
     name: str
     od: float
@@ -108,6 +113,7 @@ class LineType:
     drag_d: float = np.nan
     id: float = 0.0
     smys: float = np.nan
+    stress_od: float = np.nan
 
     def submerged_weight(self, water_density, gravity):
         """(mass - rho_w pi od^2 / 4) g, N/m: positive sinks, negative floats."""
@@ -121,7 +127,8 @@ class LineType:
                        np.append(self.bending_end, self.gj), self.ea,
                        np.array([0.0, 0.0, -self.submerged_weight(water_density, gravity)]),
                        0.5 * water_density * self.cd * self.drag_d, self.od, self.mass,
-                       self.id, self.smys)
+                       self.id, self.smys,
+                       self.od if np.isnan(self.stress_od) else self.stress_od)
 
 
 def line_types_from_table(table, option):
@@ -184,12 +191,20 @@ def line_types_from_table(table, option):
         row = int(np.flatnonzero(bad)[0])
         raise RodInputError(f"{option}: line type {names[row]}: smys {smys[row]:g} must be "
                             "a positive, finite yield stress (Pa), or blank ('-')")
+    wall = column("stress_od", np.nan)
+    wall = np.where(np.isnan(wall), table["od"], wall)
+    bad = ~((wall > inner) & (wall <= table["od"]) & np.isfinite(wall))
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise RodInputError(f"{option}: line type {names[row]}: stress_od {wall[row]:g} must "
+                            f"be above id {inner[row]:g} and at most od {table['od'][row]:g} (m)")
     if not np.all((cd >= 0) & np.isfinite(cd)):
         row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
         raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
                             "finite number, 0 or more")
     return {name: LineType(name, table["od"][i], table["mass"][i], start[i], end[i],
-                           table["gj"][i], ea[i], cd[i], drag_d[i], inner[i], smys[i])
+                           table["gj"][i], ea[i], cd[i], drag_d[i], inner[i], smys[i],
+                           wall[i])
             for i, name in enumerate(names)}
 
 

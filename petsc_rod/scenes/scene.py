@@ -70,7 +70,7 @@ class Scene:
     internal_pressure: float = 0.0
     # the stress check (riser/stresses.py): the allowable von Mises stress is this
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
-    design_factor: float = 0.67
+    design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
     # pinned end, 0 for none, and the neutral axis a its d3 is held to (unit; default e_x,
     # the reference tangent); fixed, not on the load path

@@ -24,7 +24,7 @@ from petsc_rod.errors import RodInputError
 # A case's name is its result file's name: DIR/<name>.h5.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+=-]*$")
 # The options a sweep sets itself, per case: a case may not set them.
-SWEEP_OWNED = ("rod_output",)
+SWEEP_OWNED = ("rod_output", "rod_table")
 # In a case file, the value that leaves an option as the base options give it.
 AS_BASE = "-"
 # The headings of the offset analysis.
@@ -76,7 +76,8 @@ def read_cases(path, known):
             continue
         if column in SWEEP_OWNED:
             raise RodInputError(f"{where}: column {column}: the sweep sets -{column} itself "
-                                "(-sweep_output DIR: DIR/<name>.h5)")
+                                "(-sweep_output DIR: DIR/<name>.h5, and DIR/<name>.csv "
+                                "when the base options ask for -rod_table)")
         if not known(column):
             close = difflib.get_close_matches(column, [o for o in known.names], n=1) \
                 if hasattr(known, "names") else []
@@ -208,10 +209,18 @@ def current_cases(headings, speed, values):
 
 def product(*lists):
     """Every combination of one case from each list, names joined by '_' and options
-    merged (a later list's option wins); the lists that are None or empty are left out."""
+    merged; the lists that are None or empty are left out. An option set by two lists is
+    refused (RodInputError): the later would silently overwrite the earlier."""
     lists = [cases for cases in lists if cases]
     combined = [Case("", {})]
-    for cases in lists:
+    for k, cases in enumerate(lists):
+        twice = set().union(*(c.options for c in cases)) & set().union(
+            *(c.options for other in lists[:k] for c in other))
+        if twice:
+            raise RodInputError(
+                f"-{sorted(twice)[0]} is set by two sources of cases (a case file and a "
+                "generator, or two generators): the later would overwrite the earlier; give "
+                "it in one of them")
         combined = [Case("_".join(filter(None, (a.name, b.name))), {**a.options, **b.options})
                     for a in combined for b in cases]
     return combined

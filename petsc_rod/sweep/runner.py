@@ -218,6 +218,8 @@ class Sweep:
         """Run one case (a warm start, then its own start if that fails and -sweep_retry);
         returns its record."""
         options = {**case.options, "rod_output": self.file(case)}
+        if self.base.get("rod_table"):          # the table of each case beside its file
+            options["rod_table"] = self.file(case)[:-3] + ".csv"
         shown = " ".join(f"-{k} {v}" for k, v in case.options.items()) or "(the base options)"
         warm = self.warm_start(case)
         code = None

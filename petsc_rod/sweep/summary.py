@@ -5,7 +5,8 @@ result file's root attributes, written as CSV and Markdown with the units in the
 The columns are the riser numbers where the file has them (riser/quantities.py,
 riser/pressures.py, riser/section_numbers.py), then any other scalar root attribute
 named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
-(what newer versions add: a utilisation, a von Mises stress, end forces), so that the
+(what newer versions add: a utilisation, a von Mises stress; vectors such as the end
+forces are not columns), so that the
 table shows what the files hold. The sweep
 (sweep/runner.py) and the report (report/page.py) both make their tables here.
 """

@@ -97,3 +97,20 @@ def test_the_steel_riser_s_wall_tension_against_a_hand_calculation(tmp_path):
                effective[-1] + 1e7 * inner]
     np.testing.assert_allclose([wall[0], wall[-1]], by_hand, rtol=1e-12)
     assert 1.15 < wall[-1] / effective[-1] < 1.25          # 2.67 against 2.25 MN
+
+
+def test_a_buoyancy_jacket_does_not_change_the_wall_tension(tmp_path):
+    """Review of issue 24: with one od for weight and wall, the wall tension jumped by
+    690 kN at the buoyancy modules' jacket (od 0.40 m) while the effective tension is
+    continuous. With the umbilical's wall (stress_od 0.15 m) under the jacket,
+    T_w - T_e = -p_e A_w changes by the hydrostatic head of one element only: at most
+    rho g dz pi 0.15^2 / 4 = 178 N per metre of height."""
+    path = tmp_path / "lw.h5"
+    done = run_petsc_rod(["-options_file", "options/lazy_wave_types.opts", "-rod_output",
+                          str(path)], 1, 600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(path, "r") as f:
+        difference = f["wall_tension"][:] - f["effective_tension"][:]
+        z = f["r"][:, 2]
+    step = np.abs(np.diff(difference))
+    assert np.all(step <= 1025 * 9.80665 * np.pi * 0.15**2 / 4 * np.abs(np.diff(z)) + 1e-6)

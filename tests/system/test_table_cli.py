@@ -78,9 +78,13 @@ def test_the_riser_s_von_mises_stress_and_utilisation_by_hand(riser):
     moment M only that of the vertex strain, 26 N m): s_a = T_w / A + M r_i / I with
     A = pi/4 (0.2731^2 - 0.2319^2) = 0.016341 m^2, I = pi/4 (r_o^4 - r_i^4); at the bore
     s_h = p_i (r_o^2 + r_i^2) / (r_o^2 - r_i^2), s_r = -p_i; s_vm = sqrt(s_a^2 + s_h^2
-    + s_r^2 - s_a s_h - s_h s_r - s_r s_a); the utilisation s_vm / (0.67 448 MPa)."""
-    _, output, _, _ = riser
+    + s_r^2 - s_a s_h - s_h s_r - s_r s_a); the utilisation s_vm / (2/3 448 MPa)."""
+    done, output, _, _ = riser
     with h5py.File(output, "r") as f:
+        # the run's final summary gives the largest stress and utilisation
+        summary = [line for line in done.stdout.splitlines() if "von Mises" in line]
+        assert len(summary) == 1, done.stdout
+        assert f"{f.attrs['max_utilisation']:.4g}" in summary[0]
         wall, stress = f["wall_tension"][-1], f["von_mises"][-1]
         moment = f["bending_moment"][-1]
         utilisation = f["utilisation"][:]
@@ -94,8 +98,8 @@ def test_the_riser_s_von_mises_stress_and_utilisation_by_hand(riser):
                       - radial * axial)
     assert 140e6 < by_hand < 170e6
     assert stress == pytest.approx(by_hand, rel=1e-12)
-    assert design == 0.67
-    assert utilisation[-1] == pytest.approx(stress / (0.67 * 448e6), rel=1e-12)
+    assert design == pytest.approx(2 / 3, rel=1e-15)
+    assert utilisation[-1] == pytest.approx(stress / (2 / 3 * 448e6), rel=1e-12)
     assert largest == pytest.approx(np.nanmax(utilisation), rel=1e-15)
     assert 0.4 < largest < 0.7
 
@@ -107,6 +111,19 @@ def test_no_table_after_a_run_that_did_not_converge(tmp_path):
     done = run_petsc_rod(SCR + ["-rod_al_max_it", "2", "-rod_max_halvings", "0",
                                 "-rod_table", str(table)], 1, 300)
     assert done.returncode == 3, done.stdout + done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_an_earlier_run_s_table_does_not_stay_beside_a_failed_run(tmp_path):
+    """Review of issue 24: a converged run's table stayed beside a later failed run's
+    result file as if it were its. The failed run removes it and says so."""
+    table, regions = tmp_path / "scr.csv", tmp_path / "scr_regions.csv"
+    table.write_text("an earlier run's table\n")
+    regions.write_text("an earlier run's regions\n")
+    done = run_petsc_rod(SCR + ["-rod_al_max_it", "2", "-rod_max_halvings", "0",
+                                "-rod_table", str(table)], 1, 300)
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert "no table written" in done.stdout and "an earlier run's" in done.stdout
     assert os.listdir(tmp_path) == []
 
 

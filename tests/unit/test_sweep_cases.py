@@ -72,3 +72,22 @@ def test_read_cases(tmp_path):
     path.write_text("name rod_x\nbad/name 1\n")
     with pytest.raises(RodInputError, match="case name"):
         cases.read_cases(str(path), lambda name: True)
+
+
+def test_an_option_set_by_two_sources_is_refused():
+    """Review of issue 24: a case file's end position combined with -sweep_offsets was
+    overwritten by the offsets' without a word."""
+    listed = [cases.Case("far100", {"rod_end_position": "1700,0,1500"})]
+    with pytest.raises(RodInputError, match="-rod_end_position is set by two sources"):
+        cases.product(listed, cases.offset_cases((100.0,), ("near",), RISER))
+
+
+def test_the_envelopes_leave_out_what_has_no_finite_value():
+    """Review of issue 24: two straight cases (bend radius inf all along) crashed the
+    report's range graphs; a line type without smys drew an empty utilisation panel."""
+    from petsc_rod.report import envelopes
+    S = np.linspace(0.0, 1.0, 5)
+    straight = [{"S": S, "effective_tension": S + k, "bend_radius": np.full(5, np.inf),
+                 "utilisation": np.full(5, np.nan)} for k in range(2)]
+    S_out, result = envelopes.envelopes(straight)
+    assert list(result) == ["effective_tension"]
