@@ -313,6 +313,12 @@ class NewtonPolish:
         g[:, 2] += w[:, None] * mu
         state.tau[:] = frames
         state.lam[:] = -g / w[:, None, None]
+        # a flex joint on an extensible end acts in the local step (§12): the Uzawa
+        # multipliers leave its gradient out, and its Hessian block is its whole curvature
+        for term in self.problem.terms:
+            local_gradient = getattr(term, "local_gradient", None)
+            if local_gradient is not None:
+                local_gradient(state.lam, state, scale=1.0 / w)
         return g
 
     def least_penalty(self):

@@ -23,6 +23,7 @@ from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
 from petsc_rod.mesh.elements import (cut_gauss_rule, p2_basis, p2_integrals,
                                      quadrature_weights)
 from petsc_rod.problem import penalty as penalty_policy
+from petsc_rod.physics.flex_joint import FlexJoint, joint_local_step
 from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.state import RodState
 from petsc_rod.scenes.boundary import clamped_nodes
@@ -43,6 +44,16 @@ class RodProblem:
                                               penalty_policy.matrix_split)
         # the problem's scale of R, N (penalty.default_penalty): what "far below" means
         self.scale = penalty_policy.default_penalty(scene)
+        # flex joints on an extensible end act in the local step at their node (§12),
+        # not in the global step: marked before it is built
+        self._local_joints = []
+        if scene.extensible:
+            for term in self.terms:
+                if isinstance(term, FlexJoint) and np.isfinite(scene.axial_stiffness_at(
+                        0.0 if term.which == "start" else scene.length)):
+                    term.local = True
+                    if term.node is not None:
+                        self._local_joints.append(term)
         self.state = RodState(mesh)
         try:
             self.global_step = GlobalStep(mesh, scene, self.coefficients, float(penalty),
@@ -119,12 +130,15 @@ class RodProblem:
         node (projection.stretched_rotation: one majorise-minimise pass from the last
         eps, the passes being carried by the iteration itself) and tau holds the
         targets (tau1, tau2, (1 + eps) tau3): the global step, the multiplier update
-        and the residual read the stretched tangent where they read tau3."""
+        and the residual read the stretched tangent where they read tau3. A flex joint
+        on an extensible end replaces its node's targets by those of its own local step
+        (flex_joint.joint_local_step, from the node's last rotation; §12)."""
         state, R = self.state, self.penalty
         self.global_step.solve(state)
         EVENTS["projection"].begin()
         directors = state.take_directors()
         stretch = None if self.axial is None else 1.0 + state.strain()
+        starts = [self._joint_start(term.node) for term in self._local_joints]
         b = np.multiply(directors, R, out=state.tau)       # b = R d + lambda, in place
         b += state.lam
         if stretch is None:
@@ -132,12 +146,25 @@ class RodProblem:
         else:
             stretched_rotation(b, self.axial, R, start=stretch, out=state.tau,
                                passes=ITERATION_PASSES)
+            for term, start in zip(self._local_joints, starts):
+                node = term.node
+                b_node = R * directors[node] + state.lam[node]
+                state.tau[node] = joint_local_step(
+                    b_node, start, term.axis, term.k / state.node_weights[node],
+                    self.axial[node], R)
             if self._stretched_clamps:
                 self._stretch_clamps()
         EVENTS["projection"].end()
         EVENTS["multiplier"].begin()
         update_multipliers(state.lam, directors, state.tau, R)
         EVENTS["multiplier"].end()
+
+    def _joint_start(self, node):
+        """The rotation of the last targets at a joint's ``node`` (their third row
+        normalised), the start of its local step's Newton iteration."""
+        start = self.state.tau[node].copy()
+        start[2] /= np.linalg.norm(start[2])
+        return nearest_rotation(start[None])[0]
 
     def _stretch_clamps(self):
         """At a clamped end the slope is prescribed, r' = (1 + eps) d3, and the local

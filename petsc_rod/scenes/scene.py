@@ -431,13 +431,6 @@ class Scene:
                 raise RodInputError(
                     f"-rod_{which}_joint_axis needs -rod_{which}_rotational_stiffness k > 0 "
                     "(the axis of a flex joint; without one the end is a plain pin)")
-            at = 0.0 if which == "start" else self.length
-            if k > 0 and np.isfinite(self.axial_stiffness_at(at)):
-                raise RodInputError(
-                    f"-rod_{which}_rotational_stiffness with an extensible line at the "
-                    f"{which} (-rod_axial_stiffness or the line type's ea): a flex joint on "
-                    "a stretching end is not supported yet (its spring loads the end's "
-                    "strain; docs/method.md §12); use a pin there, or an inextensible line")
             for name in (f"rod_{which}_rotational_stiffness", f"rod_{which}_joint_axis"):
                 if (name in used or k > 0) and kind != "pin":
                     raise RodInputError(

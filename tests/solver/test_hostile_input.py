@@ -529,13 +529,14 @@ def test_a_line_held_taut_under_point_loads_only_is_refused(options):
         scene_from_options(values, names)
 
 
-def test_a_flex_joint_on_a_stretching_end_is_refused(options):
-    """Review of issue 22: the joint's spring loaded the end node's strain (0.9 % of the
-    tension there at 2400 elements, growing with refinement): refused until resolved."""
+def test_a_flex_joint_on_a_stretching_end_is_accepted(options):
+    """Review of issue 22: the joint's spring loaded the end node's strain; it now acts in
+    the local step on an extensible end (tests/solver/test_flex_joint_stretch.py), and
+    the scene is accepted."""
     from petsc_rod.cli.scene_options import scene_from_options
     values, names = options(rod_length="100", rod_start="pin", rod_end="pin",
                             rod_end_position="80,0,-30", rod_load="0,0,-100",
                             rod_axial_stiffness="1e5",
                             rod_start_rotational_stiffness="1e3")()
-    with pytest.raises(RodInputError, match="flex joint on a stretching end"):
-        scene_from_options(values, names)
+    scene = scene_from_options(values, names)
+    assert scene.start_rotational_stiffness == 1e3 and scene.extensible

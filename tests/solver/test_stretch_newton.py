@@ -51,6 +51,11 @@ FD_ENDS = {"pins": dict(start="pin", end="pin", end_position=(0.8, 0.0, 0.1)),
            "clamp and free": dict(start="clamp", end="free"),
            "pins, half inextensible": dict(start="pin", end="pin",
                                            end_position=(0.8, 0.0, 0.1)),
+           # a flex joint at the start of an extensible line: it acts in the local step,
+           # its gradient is that of the direction only and its block its whole curvature
+           "pins, flex joint": dict(start="pin", end="pin", end_position=(0.8, 0.0, 0.1),
+                                    start_rotational_stiffness=0.05,
+                                    start_joint_axis=(0.6, 0.0, -0.8)),
            # two sections of other stiffnesses (the second tapered) and EA: the stretch
            # blocks with field 3's own K_{2 a3} (global_step/coefficients.py)
            "pins, two sections": dict(
