@@ -160,6 +160,7 @@ class DragTerm(NodalLoadTerm):
         super().__init__(mesh, "drag")
         self.scene = scene
         self.drag = NodalLoad(mesh, self._nodes)
+        self._node_S = mesh.node_S()            # where each node's section's drag applies
 
     def node_loads(self, state):
         """sum_k w_k c_k |v_n,k| v_n,k at the owned nodes (N/m), (n_nodes, 3), over the
@@ -169,9 +170,8 @@ class DragTerm(NodalLoadTerm):
         currents = self.scene.drag_loads(self.t)
         z = (state.node_positions()[:, 2] if any(c.depths.size > 1 for _, c in currents)
              else np.zeros(self.mesh.n_local_nodes))
-        S = self.mesh.node_S()
         return sum(w * normal_drag(state.tau[:, 2], c.velocity(z),
-                                   self.scene.drag_at(S, c)[:, None])
+                                   self.scene.drag_at(self._node_S, c)[:, None])
                    for w, c in currents)
 
     def add_iterate_load(self, rhs, state):
