@@ -8,7 +8,8 @@ import numpy as np
 
 from petsc_rod.api.model import Model
 from petsc_rod.api.results import Results
-from petsc_rod.cli.main import build_solver, check_mesh, run_record, start_from
+from petsc_rod.cli.main import (build_solver, check_mesh, destroy_run, run_record,
+                                start_from)
 from petsc_rod.cli.options import parse_values
 from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
 from petsc_rod.cli.session import run_continuation
@@ -135,9 +136,4 @@ def solve(model, comm=None, output=None, say=None):
     finally:
         if keeper is not None:
             keeper.abort()
-        if solver is not None:
-            solver.destroy()
-        if problem is not None:
-            problem.destroy()
-        if mesh is not None:
-            mesh.destroy()
+        destroy_run(solver, problem, mesh)

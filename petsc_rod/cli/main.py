@@ -124,13 +124,16 @@ def run(comm=None):
         finally:
             if writer is not None:          # any failure before the file was finished
                 writer.abort()
-            if solver is not None:
-                solver.destroy()
-            if problem is not None:
-                problem.destroy()
-            if mesh is not None:
-                mesh.destroy()
+            destroy_run(solver, problem, mesh)
             failures.Free()
+
+
+def destroy_run(solver, problem, mesh):
+    """Destroy what a run built, in reverse order, skipping what was not built (None);
+    collective (cli.main.run, api.run.solve)."""
+    for built in (solver, problem, mesh):
+        if built is not None:
+            built.destroy()
 
 
 def petsc_message(error):

@@ -87,13 +87,16 @@ def test_series_and_closed_forms_of_the_joint_factors_agree():
         assert curvature_factor(theta) == pytest.approx(exact, rel=1e-6)
 
 
+@pytest.mark.parametrize("axial", [np.inf, 1e8], ids=["inextensible", "EA 1e8"])
 @pytest.mark.parametrize("k", [1.0, 0.5])
-def test_a_tip_couple_turns_the_root_by_m_over_k_then_bends_an_arc(comm, k):
+def test_a_tip_couple_turns_the_root_by_m_over_k_then_bends_an_arc(comm, k, axial):
     """Root angle p = M/k (0.5 and 1 rad), then curvature M/EI: tip = ((sin(p + ML/EI) -
-    sin p), (cos p - cos(p + ML/EI))) EI/M; the joint reports angle M/k and moment M."""
+    sin p), (cos p - cos(p + ML/EI))) EI/M; the joint reports angle M/k and moment M.
+    With EA = 1e8 N (the joint in the local step of an extensible end, docs/method.md
+    §12) the same to O(1/EA) and the iteration's tolerance."""
     moment = 0.5
     report, r, joints = solve(comm, dict(start="pin", end="free",
-                                         start_rotational_stiffness=k),
+                                         start_rotational_stiffness=k, axial_stiffness=axial),
                               [lambda mesh: TipCouple(mesh, moment)], steps=2)
     p, kappa = moment / k, moment / EI
     tip = np.array([np.sin(p + kappa * LENGTH) - np.sin(p),

@@ -7,7 +7,8 @@ against 2 ranks of the command line.
 Before, the joint's quadratic in the global step left k (1 - cos theta) / w_n in the end
 node's lambda3.t: the end strain was wrong by that much, growing with the mesh (the steel
 riser: 5.5, 10.7, 20.2 kN at 600, 1200, 2400 elements; now 112, 136, 152 N, the model's
-2 a3 kappa^2 of §12 at the hang-off's curvature).
+2 a3 kappa^2 of §12 at the hang-off's curvature). The tip couple's closed form with
+EA = 1e8 N is tests/solver/test_flex_joint.py's, parametrised over EA.
 """
 
 import h5py
@@ -15,7 +16,7 @@ import numpy as np
 import pytest
 
 from helpers import describe, run_petsc_rod
-from test_flex_joint import LENGTH, EI, TipCouple, solve
+from test_flex_joint import LENGTH, EI, solve
 
 EXAMPLE = ["-rod_length", "100", "-rod_stiffness", "1e3,1e3,1e3", "-rod_start", "pin",
            "-rod_end", "pin", "-rod_end_position", "80,0,-30", "-rod_load", "0,0,-100",
@@ -77,25 +78,6 @@ def test_one_and_two_ranks_agree(tmp_path):
     assert two["start_joint_angle"] == pytest.approx(one["start_joint_angle"], rel=1e-8)
     assert two["axial_tension_gap"] == pytest.approx(one["axial_tension_gap"], rel=1e-4,
                                                       abs=1e-9)
-
-
-@pytest.mark.parametrize("k", [1.0, 0.5])
-def test_a_tip_couple_on_a_stiff_extensible_line(comm, k):
-    """test_flex_joint (a) with EA = 1e8 N: the closed form of the inextensible cantilever
-    (the root turns by M/k, then an arc of curvature M/EI) to O(1/EA) and the iteration's
-    tolerance."""
-    moment = 0.5
-    report, r, joints = solve(comm, dict(start="pin", end="free",
-                                         start_rotational_stiffness=k,
-                                         axial_stiffness=1e8),
-                              [lambda mesh: TipCouple(mesh, moment)], steps=2)
-    p, kappa = moment / k, moment / EI
-    tip = np.array([np.sin(p + kappa * LENGTH) - np.sin(p),
-                    np.cos(p) - np.cos(p + kappa * LENGTH), 0.0]) / kappa
-    assert np.linalg.norm(r[-1] - tip) < 1e-6 * LENGTH, (r[-1], tip)
-    angle, joint_moment = joints[0]
-    assert angle == pytest.approx(np.degrees(p), rel=1e-6)
-    assert joint_moment == pytest.approx(moment, rel=1e-6)
 
 
 @pytest.mark.parametrize("k", [1.0, 10.0])
