@@ -7,14 +7,18 @@ import numpy as np
 from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
+from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
 from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
                                          check_ends_above, default_stiffness,
                                          largest_stiffness, read_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
+from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
+                                   parse_sections, section_elements)
 from petsc_rod.scenes.point_loads import quick_point_loads, read_point_loads
 from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+from petsc_rod.tables import read_table
 
 # The options behind each Scene field a restart compares (scenes/blend.py).
 FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
@@ -117,9 +121,6 @@ def sections_from_options(values, given, content=None):
     ``content`` when already read) and -rod_sections, or [] when neither is given;
     RodInputError for one without the other, an unknown type, a length that disagrees
     with -rod_length, or an option the sections replace."""
-    from petsc_rod.tables import read_table
-    from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
-                                       line_types_from_table, parse_sections)
     if "rod_sections" not in given:
         if "rod_line_types" in given:
             raise RodInputError("-rod_line_types needs -rod_sections TYPE:LENGTH[:ELEMENTS],"
@@ -158,8 +159,6 @@ def mesh_pieces(values, scene, given=()):
     shared out by length; None for a line without sections. A -rod_elements (in
     ``given``) that disagrees with counts given for every section is refused, and so is
     an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
-    from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
-    from petsc_rod.scenes.line import parse_sections, section_elements
     if not scene.sections:
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")

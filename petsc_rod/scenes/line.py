@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from petsc_rod.errors import RodInputError
+
 
 @dataclass
 class Section:
@@ -136,8 +138,6 @@ def line_types_from_table(table, option):
     read_table with LINE_TYPE_COLUMNS and LINE_TYPE_OPTIONAL); RodInputError naming
     ``option`` for a row that does not give exactly one bending form (the other forms'
     columns left blank, '-') or gives a value out of range."""
-    from petsc_rod.errors import RodInputError
-
     names = table["name"]
     rows = len(names)
     if len(set(names)) != rows:
@@ -212,8 +212,6 @@ def parse_sections(text, option):
     """[(type name, length m, elements or None)] from 'TYPE:LENGTH[:ELEMENTS],...';
     RodInputError naming ``option`` for an entry of another form, a length that is not
     positive or a count that is not a whole number of at least 1."""
-    from petsc_rod.errors import RodInputError
-
     entries = []
     for entry in text.split(","):
         parts = entry.strip().split(":")

@@ -17,6 +17,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.frames import rotation_about, rotation_log
+from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
 
 REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 END_KINDS = ("clamp", "pin", "free")
@@ -132,7 +133,6 @@ class Scene:
         S = np.asarray(S, dtype=float)
         if not self.sections:
             return np.broadcast_to(self.stiffness, S.shape + (3,)).copy()
-        from petsc_rod.scenes.line import piecewise_linear
         return piecewise_linear(self.sections, S, "stiffness_start", "stiffness_end",
                                 inside)
 
@@ -159,7 +159,6 @@ class Scene:
         S = np.asarray(S, dtype=float)
         if not self.sections:
             return np.full(S.shape, float(self.axial_stiffness))
-        from petsc_rod.scenes.line import piecewise_constant
         return piecewise_constant(self.sections, S, "axial_stiffness")
 
     def drag_at(self, S, current):
@@ -168,7 +167,6 @@ class Scene:
         S = np.asarray(S, dtype=float)
         if not self.sections:
             return np.full(S.shape, float(current.drag))
-        from petsc_rod.scenes.line import piecewise_constant
         return piecewise_constant(self.sections, S, "drag")
 
     @property
