@@ -36,14 +36,23 @@ delta_i3. So H gains the rows of k:
 and the chord forms the columns w_n d3_n of delta int r' dS. The stretch of a clamped
 node (from the force balance, §12) and of a node with EA infinite is held: its row is
 replaced by the identity, as a clamped rotation is.
+
+A term whose energy depends on the heights of the nodes (the seabed, Term.uses_heights)
+makes the vertex heights u_i and the multipliers nu_e of their chain unknowns too
+(analysis/heights.py): one more unknown per node, u at a vertex and nu at a midpoint.
+H is then the KKT matrix of the chain, whose inertia has n_elements negative eigenvalues
+more than the second variation on the rotations; they are counted off, and the mass of
+the extra unknowns is 0 (a shift moves the rotations' eigenvalues only).
 """
 
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.analysis.heights import HALF, SIMPSON, slope_rows
 from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
+from petsc_rod.scenes.boundary import is_held
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
@@ -75,7 +84,9 @@ class SecondVariation:
     """H of the module docstring at the state of a problem (problem/problem.py) at the
     last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
     P2 nodes (3 per node, node n = 2 vertex + slot; 4 on an extensible line, the fourth
-    the stretch k), with what the inertia test needs;
+    the stretch k; ``unknowns`` of them, and one more, ``block`` in all, when a term
+    reads the heights: u at a vertex, nu at a midpoint, module docstring), with what the
+    inertia test needs;
     the problem's terms add their own curvature (Term.add_hessian). Collective;
     ``destroy()`` frees every PETSc object."""
 
@@ -85,20 +96,35 @@ class SecondVariation:
         self.comm = mesh.comm
         # unknowns per node: the rotation vector, and on an extensible line its stretch
         self.stretch = getattr(problem, "axial", None) is not None
-        self.block = block = 4 if self.stretch else 3
+        self.unknowns = 4 if self.stretch else 3
+        # the heights' chain (analysis/heights.py) where a term's energy reads them
+        self.heights = any(term.uses_heights for term in problem.terms)
+        # the resultants' chain of a load that follows the line (analysis/jacobian.py):
+        # three slots per node, identity rows here (H is the frozen load's)
+        self.resultants = any(term.follower for term in problem.terms)
+        self.resultant_slot = self.unknowns + int(self.heights)
+        self.block = block = self.resultant_slot + 3 * int(self.resultants)
+        # the chain's multipliers: negative eigenvalues of the KKT matrix beyond H's
+        self.chain_constraints = mesh.n_elements if self.heights else 0
         n_local = block * mesh.n_local_nodes
         self.first_row = 2 * block * mesh.vertex_start
         self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
                                             nnz=(5 * block, 2 * block), comm=self.comm)
         self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        self._clamped = self._clamped_rows()
+        self.held_rows = self._clamped = self._clamped_rows()
+        # the resultants' rows: identities in H (added in _assemble, no zeroRowsColumns:
+        # it costs seconds on ten thousand rows)
+        nodes = self.first_row + block * np.arange(mesh.n_local_nodes)
+        self.resultant_rows = ((nodes[:, None] + self.resultant_slot + np.arange(3)).ravel()
+                               if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
         self.constraint = []
         self._constraint_solves = []      # (H - shift M)^-1 of each, at the last factorisation
         self._fill()
         self.mass = self._mass()
-        self._mass_or_one = self.mass.copy()           # M with 1 at the clamped rows
-        self._mass_or_one.getArray()[self._clamped - self.first_row] = 1.0
+        self._mass_or_one = self.mass.copy()           # M with 1 where it is 0
+        ones = self._mass_or_one.getArray()
+        ones[ones == 0.0] = 1.0
         self._work = self.mass.duplicate()
         self._create_solver()
 
@@ -135,7 +161,7 @@ class SecondVariation:
         # ghost exchange is collective, also on a rank that owns no element
         d = np.stack([element_dofs(f.ghosted(), mesh.element_local, P2)
                       for f in problem.state.frame_fields], axis=2)
-        B = self.block
+        B, U = self.block, self.unknowns
         if ne:
             # 2 a_i times the unit K, or each field's K_{2 a_i} along a line of sections
             weights, stiffness = problem.coefficients.hessian_stiffness()
@@ -144,8 +170,8 @@ class SecondVariation:
                 third = stiffness[2] if np.ndim(stiffness) == 4 else stiffness
                 blocks = self._stretch_blocks(d, weights[2], third, blocks)
             rows = (self.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :]))
-            rows = (rows[:, :, None] + np.arange(B)).reshape(ne, 3 * B).astype(PETSc.IntType)
-            self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 3 * B, 3 * B),
+            rows = (rows[:, :, None] + np.arange(U)).reshape(ne, 3 * U).astype(PETSc.IntType)
+            self.matrix.setValuesRCV(rows, rows, blocks.reshape(ne, 3 * U, 3 * U),
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
         tau, lam, w = problem.state.tau, problem.state.lam, problem.state.node_weights
@@ -161,12 +187,67 @@ class SecondVariation:
                                                     np.zeros((len(w), 1, 1))], axis=2)],
                                    axis=1)
         rows = (self.first_row + B * np.arange(mesh.n_local_nodes)[:, None]
-                + np.arange(B)).astype(PETSc.IntType)
+                + np.arange(U)).astype(PETSc.IntType)
         if rows.size:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
+        if self.heights:
+            self._add_chain(d)
+        if self.resultants:
+            self._add_blocks(self.resultant_rows[:, None], self.resultant_rows[:, None],
+                             np.ones((self.resultant_rows.size, 1, 1)))
         for term in problem.terms:
             term.add_hessian(self)
         self.matrix.assemble()
+
+    # --- the heights' chain (module docstring, analysis/heights.py) ---------------------
+    def _add_chain(self, d):
+        """The chain's rows nu_e (u_e+1 - u_e - h_e SIMPSON.s_e = 0) and their transposes,
+        from the fields d (ne, 3 nodes, 3 dirs, 3); keeps the element columns and rows of
+        the slopes for add_height_curvature."""
+        mesh, B, U = self.problem.mesh, self.block, self.unknowns
+        ne = mesh.n_local_elements
+        nodes = self.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
+        # columns (u_e, u_e+1, x_L.., x_M.., x_R..) and the slopes' rows on x (ne, 3, U)
+        self._heights_u = nodes[:, [0, 2]] + U
+        self._heights_x = (nodes[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
+        self._slope_rows = slope_rows(d[:, :, 2, :], self.stretch) if ne else \
+            np.zeros((0, 3, U))
+        h = mesh.element_h
+        coefficients = np.concatenate([
+            -np.ones((ne, 1)), np.ones((ne, 1)),
+            (-h[:, None, None] * SIMPSON[None, :, None] * self._slope_rows).reshape(ne, 3 * U)],
+            axis=1)
+        multiplier = (nodes[:, 1] + U)[:, None]
+        columns = np.concatenate([self._heights_u, self._heights_x], axis=1)
+        if ne:
+            self._add_blocks(multiplier, columns, coefficients[:, None, :])
+            self._add_blocks(columns, multiplier, coefficients[:, :, None])
+            # a 0 on nu's diagonal: in the pattern, so that a shift (setDiagonal) adds
+            # no nonzero to the copy the factorisations were analysed for
+            self._add_blocks(multiplier, multiplier, np.zeros((ne, 1, 1)))
+
+    def _add_blocks(self, rows, columns, values):
+        self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
+                                 values, addv=PETSc.InsertMode.ADD_VALUES)
+
+    def add_height_curvature(self, curvature):
+        """Add a height energy's second derivative d2E/dz_n^2 (n_nodes,), N/m, at the owned
+        nodes (Term.add_hessian, before assembly): on u_i at a vertex; at a midpoint on
+        its height u_e + h_e HALF.s_e, a rank-one block on (u_e, the element's x)."""
+        c = np.asarray(curvature, dtype=float)
+        mesh, B, U = self.problem.mesh, self.block, self.unknowns
+        ne = mesh.n_local_elements
+        vertices = (self.first_row + B * np.arange(0, c.size, 2) + U)[:, None]
+        if vertices.size:
+            self._add_blocks(vertices, vertices, c[0::2, None, None])
+        if ne:
+            h = mesh.element_h
+            v = np.concatenate([np.ones((ne, 1)), (h[:, None, None] * HALF[None, :, None]
+                                                   * self._slope_rows).reshape(ne, 3 * U)],
+                               axis=1)
+            index = np.concatenate([self._heights_u[:, :1], self._heights_x], axis=1)
+            self._add_blocks(index, index, c[1:2 * ne:2, None, None] * v[:, :, None]
+                             * v[:, None, :])
 
     @staticmethod
     def _element_blocks(d, weights, stiffness):
@@ -225,13 +306,24 @@ class SecondVariation:
 
     def _clamped_rows(self):
         """Global rows of the rotation vectors at clamped nodes (and, on an extensible
-        line, of the stretch held there and where EA is infinite)."""
+        line, of the stretch held there and where EA is infinite; with the heights'
+        chain, of the height at the held end). A clamped node's chain unknowns (u, nu,
+        the resultants) are not held: the chains run through it."""
         nodes = np.flatnonzero(~self.problem.free_nodes)
         B = self.block
-        rows = (self.first_row + B * nodes[:, None] + np.arange(B)).ravel()
+        rows = (self.first_row + B * nodes[:, None] + np.arange(self.unknowns)).ravel()
         if self.stretch:
             held = np.flatnonzero(~np.isfinite(self.problem.axial) & self.problem.free_nodes)
             rows = np.sort(np.concatenate([rows, self.first_row + B * held + 3]))
+        if self.heights:
+            # the height at the held end (the start's, else the end's) is held: u_a = 0
+            mesh = self.problem.mesh
+            if is_held(self.problem.start_state):
+                anchor = [0] if mesh.on_lower_boundary else []
+            else:
+                anchor = [mesh.n_local_nodes - 1] if mesh.on_upper_boundary else []
+            pins = self.first_row + B * np.array(anchor, dtype=int) + self.unknowns
+            rows = np.sort(np.concatenate([rows, pins]))
         return rows.astype(PETSc.IntType)
 
     def chord_forms(self, tangents):
@@ -244,6 +336,9 @@ class SecondVariation:
         if self.stretch:
             forms = np.concatenate([forms, (w[:, None] * unit(tangents))[:, :, None]],
                                    axis=2)                              # (n, k, 4)
+        if self.block > self.unknowns:                   # 0 on u, nu and the resultants
+            forms = np.concatenate([forms, np.zeros(forms.shape[:2]
+                                                    + (self.block - self.unknowns,))], axis=2)
         columns = []
         for k in range(3):
             vec = self.matrix.createVecLeft()
@@ -278,9 +373,23 @@ class SecondVariation:
         """The lumped mass diag(w_n) on each rotation component (0 at the clamped rows,
         whose unit diagonal no shift moves), as a Vec."""
         vec = self.matrix.createVecLeft()
-        vec.getArray()[:] = np.repeat(self.problem.state.node_weights, self.block)
+        mass = np.zeros((self.problem.mesh.n_local_nodes, self.block))
+        mass[:, :self.unknowns] = self.problem.state.node_weights[:, None]
+        vec.getArray()[:] = mass.ravel()
         self._zero_clamped(vec)
         return vec
+
+    def to_vec(self, values):
+        """A new Vec from the nodes' unknowns ``values`` (n_nodes, unknowns), 0 on u, nu."""
+        vec = self.matrix.createVecLeft()
+        array = vec.getArray().reshape(-1, self.block)
+        array[:] = 0.0
+        array[:, :self.unknowns] = values
+        return vec
+
+    def from_vec(self, vec):
+        """The nodes' unknowns (n_nodes, unknowns) of a Vec (u, nu left out), a copy."""
+        return vec.getArray(readonly=True).reshape(-1, self.block)[:, :self.unknowns].copy()
 
     def _zero_clamped(self, vec):
         local = self._clamped - self.first_row
@@ -317,12 +426,17 @@ class SecondVariation:
     def negative_directions(self, shift):
         """Eigenvalues of H below ``shift`` (times the mass M) on the constraint set."""
         self.factorise(shift)
-        negative, _, _ = self.factor.getInertia()
+        negative = self.negative_pivots()
         if not self.constraint:
             return int(negative)
         self._constraint_solves = [self.solve(column) for column in self.constraint]
         schur = np.array([[c.dot(y) for y in self._constraint_solves] for c in self.constraint])
         return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
+
+    def negative_pivots(self):
+        """Negative eigenvalues of the last factorisation's H - shift M, those of the
+        heights' chain counted off (module docstring)."""
+        return int(self.factor.getInertia()[0]) - self.chain_constraints
 
     def solve_in_constraint_span(self, columns):
         """(H - shift M)^-1 c, new Vecs, for the Vecs c of ``columns`` that lie in the span
@@ -349,15 +463,21 @@ class SecondVariation:
         """TOLERANCE times max_i |H_ii| / M_ii: an eigenvalue of H / M above -tolerance
         is zero to round-off (the free roll of a section with K1 = K2 between pins)."""
         self._work.pointwiseDivide(self._diagonal, self._mass_or_one)
-        if self.stretch:
-            # the rotations' rows: EA w on the stretch rows is no scale of a buckling mode
-            ratios = np.abs(self._work.getArray(readonly=True).reshape(-1, self.block)[:, :3])
-            return TOLERANCE * self.problem.mesh.global_max(float(ratios.max(initial=0.0)))
-        return TOLERANCE * self._work.norm(PETSc.NormType.INFINITY)
+        # the rotations' rows: EA w on the stretch rows, or the seabed's k w on the
+        # heights, is no scale of a buckling mode
+        ratios = np.abs(self._work.getArray(readonly=True).reshape(-1, self.block)[:, :3])
+        return TOLERANCE * self.problem.mesh.global_max(float(ratios.max(initial=0.0)))
 
     def lower_bound(self):
         """Gershgorin: every eigenvalue of H / M is at least min_i (H_ii - sum_j |H_ij|)
-        / M_ii (M diagonal)."""
+        / M_ii (M diagonal). With the heights' chain H is a KKT matrix, to which the
+        bound does not apply: the shift is lowered tenfold from -tolerance until no
+        eigenvalue lies below it (one factorisation each)."""
+        if self.heights:
+            lower = -10 * self.tolerance()
+            while self.negative_directions(lower) > 0:
+                lower *= 10
+            return lower
         indptr, _, values = self.matrix.getValuesCSR()
         absolute = np.add.reduceat(np.abs(values), indptr[:-1]) if values.size else np.zeros(0)
         diagonal = self._diagonal.getArray(readonly=True)
@@ -389,15 +509,23 @@ class SecondVariation:
         self._zero_clamped(vector)
         work = vector.duplicate()
         for _ in range(INVERSE_STEPS):
+            self._zero_heights(vector)
             self._project(vector)
             self.ksp.solve(vector, work)
             work.copy(vector)
+            self._zero_heights(vector)
             vector.scale(1.0 / vector.norm())
         self._project(vector)
-        direction = vector.getArray().reshape(-1, self.block).copy()
+        direction = self.from_vec(vector)
         vector.destroy()
         work.destroy()
         return direction
+
+    def _zero_heights(self, vector):
+        """0 on the heights' unknowns u, nu and the resultants' (the inverse iteration's
+        right-hand sides)."""
+        if self.block > self.unknowns:
+            vector.getArray().reshape(-1, self.block)[:, self.unknowns:] = 0.0
 
     def _project(self, vector):
         """Remove the components along the (orthonormal) chord forms."""

@@ -287,8 +287,8 @@ OPTIONS = [
            "system of the energy's second variation), taken only where it is positive "
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once; after a failed attempt the wait "
-           "doubles; not with a seabed or a current (on an extensible line the strains are "
-           "Newton unknowns too)"),
+           "doubles; with a seabed the node heights are unknowns too, on an extensible line "
+           "the strains, with a current the resultants of the drag (an LU solve)"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",

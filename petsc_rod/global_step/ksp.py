@@ -1,6 +1,7 @@
 """The direct solvers of the project, made in one place: the chain solvers of the global
-step (the three P2 problems, and the seabed's vertical problem) and the MUMPS LDL^T of
-the second variation (analysis/stability.py).
+step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
+the second variation (analysis/stability.py) and the MUMPS LU of the Newton Jacobian
+with a drag (analysis/jacobian.py).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
 defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
@@ -53,15 +54,30 @@ def inertia_solver(comm, operator):
     detecting null pivots instead of failing on them (ICNTL 24). The symbolic
     factorisation is made at the first set-up and kept while the pattern stays. The
     caller owns the KSP (the factor is the PC's)."""
+    ksp, factor = _mumps(comm, operator, PETSc.PC.Type.CHOLESKY)
+    factor.setMumpsIcntl(13, 1)
+    return ksp, factor
+
+
+def lu_solver(comm, operator):
+    """A KSP for an unsymmetric ``operator``: preonly + MUMPS's LU with null pivots
+    detected (ICNTL 24) (the Newton Jacobian of a problem with a load that has no
+    potential, analysis/jacobian.py): the free roll of a section with K1 = K2 between
+    pins is a null vector. The caller owns it."""
+    return _mumps(comm, operator, PETSc.PC.Type.LU)[0]
+
+
+def _mumps(comm, operator, factorisation):
+    """(ksp, factor): preonly + MUMPS's ``factorisation`` of ``operator``, null pivots
+    detected instead of fatal (ICNTL 24)."""
     ksp = PETSc.KSP().create(comm=comm)
     ksp.setOperators(operator)
     ksp.setType(PETSc.KSP.Type.PREONLY)
     pc = ksp.getPC()
-    pc.setType(PETSc.PC.Type.CHOLESKY)
+    pc.setType(factorisation)
     pc.setFactorSolverType("mumps")
     pc.setFactorSetUpSolverType()
     factor = pc.getFactorMatrix()
-    factor.setMumpsIcntl(13, 1)
     factor.setMumpsIcntl(24, 1)
     return ksp, factor
 

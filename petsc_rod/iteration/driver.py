@@ -85,7 +85,7 @@ class UzawaSolver:
     @property
     def uses_newton(self):
         """Whether the iteration hands over to Newton (newton.py): asked for, and every
-        term of the problem is in the Newton steps (not yet a seabed or a current)."""
+        term of the problem is in the Newton steps."""
         return self.settings.newton and self.problem.in_newton
 
     @property
@@ -189,8 +189,11 @@ class UzawaSolver:
                 self._raise_penalty(step, raised, events.RAISED_NEWTON)
             return
         step.newton_failed(outcome)
+        # no early escape where the heights enter the energy (the seabed): there an
+        # iterate's H is indefinite long before it nears a saddle (newton._newton_step),
+        # so only a converged state is tested and left
         if (outcome != newton.INDEFINITE or not self.tests_stability
-                or not step.wants_early_escape()):
+                or self.newton.reads_heights or not step.wants_early_escape()):
             return
         stable, direction = self.check_stability()
         if stable is False:

@@ -48,6 +48,7 @@ force balance's, §12) and of a node with EA infinite is held.
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.analysis.jacobian import NewtonJacobian
 from petsc_rod.analysis.stability import skew, unit
 from petsc_rod.frames import rotations
 
@@ -79,6 +80,19 @@ class NewtonPolish:
         self.problem = problem
         self._product = problem.field_stiffness(0)[1].createVecLeft()
         self._free = problem.free_nodes
+        # a term reads the heights (the seabed): the first step's curvature (_newton_step)
+        self.reads_heights = any(term.uses_heights for term in problem.terms)
+        # a load that follows the line (the drag): the steps solve with its Jacobian
+        # (analysis/jacobian.py), and each must lower |grad L| (no energy to descend)
+        self.follows = any(term.follower for term in problem.terms)
+        self._jacobian = None
+        # the free roll: where K1 = K2 all along and no frame is clamped, turning every
+        # cross-section by one angle about its own tangent changes nothing (a null vector
+        # of the Newton system, which LU turns into a step of round-off's size); the
+        # steps leave it out (_without_roll)
+        stiffness = problem.scene.stiffness_values()
+        self._free_roll = (bool(np.all(stiffness[:, 0] == stiffness[:, 1]))
+                           and problem.mesh.global_min(int(np.all(self._free))) == 1)
         # an extensible line: the stretch k is an unknown of each node but where it is
         # held (a clamp's, from the force balance; EA infinite)
         self.stretch = getattr(problem, "axial", None) is not None
@@ -104,17 +118,28 @@ class NewtonPolish:
         frames[clamped] = state.node_directors()[clamped]      # the prescribed frames
         mu = None
         previous = np.inf
+        residual = np.inf                 # |grad L| of the last step's start (followers)
         outcome = FAILED
         regularised = False
         try:
             for _ in range(MAX_STEPS):
                 state.set_node_directors(frames)
                 g = problem.energy_gradient(self._product)
+                first = mu is None
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
-                omega, dmu = self._newton_step(frames, g, mu, regularised)
+                # the first step's curvature from the iteration's multipliers where the
+                # heights enter (see _newton_step)
+                curvature = saved["lam"] if first and self.reads_heights else None
+                omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None:
                     outcome = INDEFINITE
                     break
+                if self.follows:
+                    # no energy to descend: the residual must fall at every step
+                    norm = self._residual_norm
+                    if not norm < residual:
+                        break
+                    residual = norm
                 largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
                 if (self.stretch and not regularised and np.isfinite(previous)
                         and not largest <= SHRINK * previous):
@@ -199,20 +224,32 @@ class NewtonPolish:
         total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
         return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
 
-    def _newton_step(self, frames, g, mu, regularised=False):
+    def _newton_step(self, frames, g, mu, regularised=False, curvature=None):
         """(omega (n_nodes, 3), dmu (3,)) of the KKT system, or (None, None) where H is
-        not positive definite on the constraint set."""
+        not positive definite on the constraint set. ``curvature``: multipliers (n_nodes,
+        3, 3) for H's curvature term in place of -g / w (the gradient stays the exact
+        one). The first step of an attempt on a line whose heights enter the energy (the
+        seabed) takes the iteration's: the heights are integrals of the frames over the
+        whole line, so an iterate's small errors in angle are errors of metres in height,
+        and -g / w there holds the seabed's answer to those (k times them, hundreds of
+        times the weight on a cable), which makes H indefinite; the iteration's
+        multipliers hold the forces of the state it is near. That step fixes the heights,
+        and the next ones are exact Newton steps."""
         gradient = self._gradient(frames, g, mu)
+        self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
+        if curvature is not None:
+            self.problem.state.lam[:] = curvature
         hessian = self.problem.second_variation()
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
             if not self._positive_definite(hessian, regularised):
                 return None, None
             self.verified = hessian.decidable
-            rhs = hessian.matrix.createVecLeft()
+            # the Jacobian with the followers' linearisation, else H's factor
+            solver = self._jacobian_of(hessian) if self.follows else hessian
+            rhs = hessian.to_vec(-gradient)
             vecs.append(rhs)
-            rhs.getArray()[:] = -gradient.ravel()
-            direction = hessian.solve(rhs)
+            direction = solver.solve(rhs)
             vecs.append(direction)
             dmu = np.zeros(3)
             if self._bordered():
@@ -221,18 +258,39 @@ class NewtonPolish:
                 columns = hessian.chord_forms(frames[:, 2])
                 vecs.extend(columns)
                 # the inertia test solved for a basis of the same forms (decidable)
-                solved = (hessian.solve_in_constraint_span(columns) if hessian.decidable
-                          else [hessian.solve(column) for column in columns])
+                solved = (hessian.solve_in_constraint_span(columns)
+                          if hessian.decidable and not self.follows
+                          else [solver.solve(column) for column in columns])
                 vecs.extend(solved)
                 schur = np.array([[c.dot(s) for s in solved] for c in columns])
                 right = self._chord_residual(frames) + np.array([c.dot(direction)
                                                                  for c in columns])
                 dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
                 direction.maxpy(-dmu, solved)
-            return direction.getArray().reshape(-1, hessian.block).copy(), dmu
+            step = hessian.from_vec(direction)
+            if self._free_roll:
+                self._without_roll(step, frames)
+            return step, dmu
         finally:
             for vec in vecs:
                 vec.destroy()
+
+    def _without_roll(self, step, frames):
+        """Remove from ``step`` (n_nodes, 3 or 4) its mean turn about the tangents (the
+        free roll, __init__), weighted by the node weights: omega_n -= a d3_n with
+        a = sum_n w_n omega_n.d3_n / sum_n w_n. Collective."""
+        tangents = unit(frames[:, 2])
+        w = self.problem.state.node_weights
+        along, total = self.problem.mesh.global_sum(np.array([
+            float(np.sum(w * np.einsum("nc,nc->n", step[:, :3], tangents))), float(w.sum())]))
+        step[:, :3] -= (along / total) * tangents
+
+    def _jacobian_of(self, hessian):
+        """The NewtonJacobian at H's state, assembled and factored."""
+        if self._jacobian is None:
+            self._jacobian = NewtonJacobian(hessian)
+        self._jacobian.assemble()
+        return self._jacobian
 
     def _gradient(self, frames, g, mu):
         """grad L at ``frames`` (n_nodes, 3), or (n_nodes, 4) with d/dk on an extensible
@@ -279,7 +337,7 @@ class NewtonPolish:
                 negative = hessian.negative_directions(shift)
             else:
                 hessian.factorise(shift)
-                negative = int(hessian.factor.getInertia()[0])
+                negative = hessian.negative_pivots()
             if negative == 0:
                 return True
         return False
@@ -347,3 +405,5 @@ class NewtonPolish:
 
     def destroy(self):
         self._product.destroy()
+        if self._jacobian is not None:
+            self._jacobian.destroy()

@@ -95,6 +95,9 @@ def gram(weights, a, b):
 
 # Simpson's weights of the P2 nodes (left vertex, midpoint, right vertex) on [0, 1].
 NODE_WEIGHTS = np.array([1.0, 4.0, 1.0]) / 6.0
+# int_0^{1/2} of the P2 shape functions on [0, 1]: r(S_e + h/2) - r(S_e) =
+# h (5 r'_0 + 8 r'_m - r'_1) / 24 for a P2 slope r'
+HALF_ELEMENT = np.array([5.0, 8.0, -1.0]) / 24.0
 
 
 def lumped_mass(h):

@@ -19,8 +19,9 @@ When each is called:
   slope, for the components of ``slope_components``;
 * the energy and its derivatives (problem.energy, problem.energy_gradient, the Newton
   steps of §11 and the second variation of §10): ``energy``, ``add_gradient``,
-  ``add_strain_gradient``, ``add_hessian``; ``conservative`` and ``in_newton`` say whether they are the term's
-  whole contribution;
+  ``add_strain_gradient``, ``add_hessian`` and, for a load without potential,
+  ``add_jacobian``; ``conservative``, ``in_newton``, ``uses_heights`` and ``follower``
+  say what they are;
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
   force n(S), ``outputs`` for datasets, attributes and the step line.
 """
@@ -56,6 +57,15 @@ class Term:
     # components of the slope r' (0, 1, 2 for x, y, z) that the term solves itself in
     # the global step (solve_slope) in place of the P2 solve (the seabed: z)
     slope_components = ()
+    # the term's energy depends on the heights of the nodes (the seabed): the Newton
+    # system and the stability test then carry the heights' chain (analysis/heights.py),
+    # and add_hessian may call hessian.add_height_curvature
+    uses_heights = False
+    # the term's load follows the line and has no potential (the drag): its
+    # linearisation enters the Newton Jacobian (add_jacobian, analysis/jacobian.py),
+    # which is then unsymmetric and solved by LU; H (the stability test, the safeguard)
+    # is that of the load held at its current value
+    follower = False
 
     # --- the global step --------------------------------------------------------------
     def add_slope_matrices(self, matrices):
@@ -114,6 +124,11 @@ class Term:
         """Add the second derivative of E_term in the directors, beyond what its gradient
         gives through the multipliers (§10), to the SecondVariation ``hessian`` before it
         is assembled (a term linear in the directors adds nothing)."""
+
+    def add_jacobian(self, jacobian):
+        """A follower's linearisation in the Newton Jacobian (analysis/jacobian.py
+        NewtonJacobian, before assembly): its load's derivative in the frames, through
+        the resultants' chain."""
 
     # --- outputs --------------------------------------------------------------------
     def force_beyond(self, state):

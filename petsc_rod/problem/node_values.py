@@ -18,11 +18,10 @@ owned node values in node order (the last vertex's midpoint slot is a phantom). 
 
 import numpy as np
 
+from petsc_rod.mesh.elements import HALF_ELEMENT
 from petsc_rod.mesh.fields import CHUNK, blocks, element_slices
 from petsc_rod.scenes.scene import REFERENCE_FRAME
 
-# r(S_e + h/2) - r(S_e) = h (5 r'_0 + 8 r'_m - r'_1) / 24 for the P2 slope
-HALF_ELEMENT = np.array([5.0, 8.0, -1.0]) / 24.0
 
 
 class NodeValues:

@@ -246,10 +246,14 @@ class RodProblem:
     def energy_gradient(self, work):
         """g_i = dE/dd_i at the owned P2 nodes, (n_nodes, 3, 3), with the fields of the
         state as the frames: 2 a_i K d_i (a_i varying along a line of sections) and the
-        terms' (Term.add_gradient: -b on d3 for the loads). ``work``: a Vec of K's layout
-        for the products."""
+        terms' (Term.add_gradient: -b on d3 for the loads; r is integrated from the fields
+        first where a term reads the heights). ``work``: a Vec of K's layout for the
+        products."""
         n = self.mesh.n_local_nodes
         g = np.empty((n, 3, 3))
+        if any(term.uses_heights or term.follower for term in self.terms):
+            # the centreline of the fields, whose heights those terms read
+            self.global_step.integrate_slope(self.state)
         for i, field in enumerate(self.state.frame_fields):
             factor, stiffness = self.field_stiffness(i)
             for c, vec in enumerate(field.components):

@@ -5,7 +5,12 @@ Per metre of line with unit tangent t, in a current v (m/s):
     f = c |v_n| v_n,   v_n = v - (v.t) t,   c = rho C_d D / 2  (kg/m^2; f in N/m).
 
 The tangential (skin friction) drag is not modelled. The drag follows the line: it is
-evaluated at the deformed state, lagged by one iteration (terms.py).
+evaluated at the deformed state, lagged by one iteration (terms.py). Its derivative in a
+turn omega of the tangent, delta t = omega x t, is (drag_jacobian)
+
+    delta f = c (|v_n| I + v_n v_n^T / |v_n|) (t v^T + (v.t) I) [t]x omega
+
+(delta v_n = -(t v^T + (v.t) I) delta t; f is C^1 with zero derivative where v_n = 0).
 """
 
 import numpy as np
@@ -17,3 +22,25 @@ def normal_drag(tangent, velocity, drag):
     t = tangent / np.linalg.norm(tangent, axis=1, keepdims=True)
     normal = velocity - np.einsum("nc,nc->n", velocity, t)[:, None] * t
     return drag * np.linalg.norm(normal, axis=1, keepdims=True) * normal
+
+
+def drag_jacobian(tangent, velocity, drag):
+    """G, (n, 3, 3): the derivative of normal_drag in a turn omega of each tangent,
+    delta f = G omega (module docstring), for tangents (n, 3) (normalised here), current
+    velocities (n, 3) m/s and c = ``drag`` (n,) kg/m^2."""
+    t = tangent / np.linalg.norm(tangent, axis=1, keepdims=True)
+    along = np.einsum("nc,nc->n", velocity, t)
+    normal = velocity - along[:, None] * t
+    speed = np.linalg.norm(normal, axis=1)
+    unit_normal = np.divide(normal, speed[:, None], out=np.zeros_like(normal),
+                            where=speed[:, None] > 0)
+    eye = np.eye(3)[None]
+    stiffness = np.asarray(drag, dtype=float).reshape(-1)[:, None, None] * (
+        speed[:, None, None] * eye + speed[:, None, None]
+        * unit_normal[:, :, None] * unit_normal[:, None, :])
+    turn = t[:, :, None] * velocity[:, None, :] + along[:, None, None] * eye
+    cross = np.zeros((len(t), 3, 3))                  # [t]x
+    cross[:, 0, 1], cross[:, 0, 2] = -t[:, 2], t[:, 1]
+    cross[:, 1, 0], cross[:, 1, 2] = t[:, 2], -t[:, 0]
+    cross[:, 2, 0], cross[:, 2, 1] = -t[:, 1], t[:, 0]
+    return stiffness @ turn @ cross

@@ -42,7 +42,7 @@ class NodalLoad:
         self._integrals = element_integrals(h)
         after = (self._integrals[:, None, :]
                  - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_l, (ne, nq, 3)
-        self._tail_integrals = gram(quadrature_weights(h), phi, after)
+        self.tail_integrals = gram(quadrature_weights(h), phi, after)
         self.set(np.zeros((mesh.n_local_nodes, 3)))
 
     def set(self, values):
@@ -65,5 +65,5 @@ class NodalLoad:
         F = B_e + offset + sum_l f_l int_S^{S_e+1} N_l, the integrals of g_k and of
         g_k int_S N_l are constants of the mesh (made in __init__)."""
         out = self._integrals[:, :, None] * (self._beyond + offset)[:, None, :]
-        out += np.matmul(self._tail_integrals, self.element_values)
+        out += np.matmul(self.tail_integrals, self.element_values)
         return out

@@ -84,11 +84,5 @@ class SeabedContact:
         """k (z_b - z)_+ (N/m), the seabed's upward force per metre of line at heights z."""
         return self.seabed.stiffness * np.maximum(self.seabed.height - z, 0.0)
 
-    def energy(self, y):
-        """E_s of the module docstring (J). Collective."""
-        gap = np.maximum(self.seabed.height - self.heights(y), 0.0)
-        return float(self.mesh.global_sum(0.5 * self.seabed.stiffness
-                                          * np.sum(self.weights * gap**2)))
-
     def destroy(self):
         self._local.destroy()

@@ -12,16 +12,24 @@ only for a scene that has them (problem/build.py).
   itself; on a restart's blended path two currents, scenes/blend.py): a function of the
   iterate, so that Anderson mixing sees it. It has no energy (a follower load).
 
-Neither is yet in the Newton steps (in_newton False): the iteration alone converges
-with them.
+The seabed is in the Newton steps (docs/method.md §11): its energy is a function of the
+node heights, so its gradient in the slopes is the adjoint of their integral
+(analysis/heights.height_gradient) and its curvature k w_n on the active nodes enters
+the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
+semi-smooth Newton step, the active set that of the iterate. The drag is in them as a
+follower (Term.follower): its gradient -b on the d3 rows at the frames' tangents, and its
+linearisation in the unsymmetric Newton Jacobian through the resultants' chain
+(analysis/jacobian.py).
 """
 
 import numpy as np
 
-from petsc_rod.mesh.elements import P2
-from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
+from petsc_rod.analysis.heights import height_gradient
+from petsc_rod.analysis.stability import skew
+from petsc_rod.mesh.elements import P2, element_integrals
+from petsc_rod.mesh.fields import VectorField, element_dofs, scatter_element_vectors
 from petsc_rod.physics.term import Term
-from petsc_rod.riser.current import normal_drag
+from petsc_rod.riser.current import drag_jacobian, normal_drag
 from petsc_rod.riser.hermite import VerticalProblem
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.seabed import SeabedContact
@@ -54,6 +62,17 @@ class NodalLoadTerm(Term):
         """Add int F.g dS of the loads.NodalLoad ``load`` to the slope's right-hand side
         ``rhs`` (VectorField), F(S) = int_S^L f_h dS + offset, the offset -int_0^L f_h when
         the start is free (docs/method.md §5)."""
+        for vec, part in zip(rhs.components, self._load_field(load).components):
+            vec.axpy(1.0, part)
+
+    def load_vector(self, load):
+        """add_to_rhs's int F.g dS at the owned P2 dofs, (2 n_owned, 3): rows in node
+        order, the last vertex's phantom slot last, N. Collective."""
+        return np.stack([vec.getArray(readonly=True)
+                         for vec in self._load_field(load).components], axis=1)
+
+    def _load_field(self, load):
+        """int F.g dS of ``load`` (add_to_rhs) in a VectorField of the term's. Collective."""
         if self._rhs is None:
             self._rhs = VectorField(self.mesh, "nodal_load_rhs")
         offset = np.zeros(3) if is_held(self.start_state) else -load.total
@@ -61,8 +80,7 @@ class NodalLoadTerm(Term):
         self._rhs.add_ghosted(scatter_element_vectors(
             mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
             load.element_vectors(offset)))
-        for vec, part in zip(rhs.components, self._rhs.components):
-            vec.axpy(1.0, part)
+        return self._rhs
 
     def _nodal_load(self, state):
         load = NodalLoad(self.mesh, self._nodes)
@@ -93,13 +111,13 @@ class SeabedTerm(NodalLoadTerm):
     the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2."""
 
     slope_components = (2,)
-    in_newton = False           # its gradient and Hessian are not in the Newton steps yet
+    uses_heights = True
 
     def __init__(self, mesh, seabed):
         super().__init__(mesh, "seabed")
         self.seabed = seabed
-        self.y = None                   # Hermite dofs of z after the last global step
         self.vertical = self.contact = None
+        self._gradient = None           # ghost exchange of the gradient's element vectors
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -119,15 +137,43 @@ class SeabedTerm(NodalLoadTerm):
 
     def solve_slope(self, rhs, state, bordered):
         """z' from the vertical problem with the contact (seabed.SeabedContact.solve)."""
-        self.y = self.contact.solve(rhs.components[2], state.slope.components[2])
+        self.contact.solve(rhs.components[2], state.slope.components[2])
         if bordered:
             state.chord_multiplier[2] = self.vertical.end_residual()
 
+    def _height_derivatives(self, state):
+        """dE_s/dz_n = -k w_n (z_b - z_n)_+ and d2E_s/dz_n^2 = k w_n [z_n < z_b] at the owned
+        nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline."""
+        gap = self.seabed.height - state.node_positions()[:, 2]
+        spring = self.seabed.stiffness * state.node_weights * (gap > 0)
+        return -spring * gap, spring
+
     def energy(self, state):
-        """E_s at the last global step's heights, J."""
-        if self.y is None:
-            return 0.0
-        return self.contact.energy(self.y)
+        """E_s at the heights of the state's centreline, J. Collective."""
+        gap = np.maximum(self.seabed.height - state.node_positions()[:, 2], 0.0)
+        return float(self.mesh.global_sum(0.5 * self.seabed.stiffness
+                                          * np.sum(state.node_weights * gap**2)))
+
+    def add_gradient(self, g, state):
+        """dE_s/dr'_z at the nodes (heights.height_gradient) into g's d3 z rows; the state's
+        r is that of its fields (RodProblem.energy_gradient). Collective."""
+        derivative, _ = self._height_derivatives(state)
+        vectors, factor = height_gradient(self.mesh, derivative, is_held(self.start_state))
+        if self._gradient is None:
+            self._gradient = VectorField(self.mesh, "seabed_gradient")
+        mesh = self.mesh
+        element = np.zeros(vectors.shape + (3,))
+        element[:, :, 2] = vectors
+        self._gradient.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, element))
+        n = g.shape[0]
+        g[:, 2, 2] += (self._gradient.components[2].getArray(readonly=True)[:n]
+                       + factor * state.node_weights)
+
+    def add_hessian(self, hessian):
+        """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
+        its gradient gives through the multipliers)."""
+        hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
 
     def pressure(self, z):
         """The seabed's upward force per metre (N/m) at heights z."""
@@ -146,15 +192,18 @@ class SeabedTerm(NodalLoadTerm):
 
     def destroy(self):
         self._destroy_vertical()
+        if self._gradient is not None:
+            self._gradient.destroy()
         super().destroy()
 
 
 class DragTerm(NodalLoadTerm):
     """The Morison normal drag of a steady current (environment.Current) on the line, a
-    follower load of the iterate (module docstring)."""
+    follower load of the iterate (module docstring); in the Newton steps through its
+    linearisation (analysis/jacobian.py)."""
 
     conservative = False
-    in_newton = False
+    follower = True
 
     def __init__(self, mesh, scene):
         super().__init__(mesh, "drag")
@@ -162,17 +211,73 @@ class DragTerm(NodalLoadTerm):
         self.drag = NodalLoad(mesh, self._nodes)
         self._node_S = mesh.node_S()            # where each node's section's drag applies
 
-    def node_loads(self, state):
+    def node_loads(self, state, tangents=None):
         """sum_k w_k c_k |v_n,k| v_n,k at the owned nodes (N/m), (n_nodes, 3), over the
         (weight, current) pairs of scene.drag_loads(t) (w = t for one current), from the
-        tangents tau3 and, for a current that varies with depth, the heights of the last
-        global step. Collective when one does (a ghost exchange)."""
+        tangents tau3 (or ``tangents``, (n_nodes, 3)) and, for a current that varies with
+        depth, the heights of the last global step. Collective when one does (a ghost
+        exchange)."""
         currents = self.scene.drag_loads(self.t)
         z = (state.node_positions()[:, 2] if any(c.depths.size > 1 for _, c in currents)
              else np.zeros(self.mesh.n_local_nodes))
-        return sum(w * normal_drag(state.tau[:, 2], c.velocity(z),
+        tangents = state.tau[:, 2] if tangents is None else tangents
+        return sum(w * normal_drag(tangents, c.velocity(z),
                                    self.scene.drag_at(self._node_S, c)[:, None])
                    for w, c in currents)
+
+    def add_gradient(self, g, state):
+        """-b on the d3 rows, b = int F.g dS of the drag at the fields' tangents (the
+        frames, in the Newton steps) and the heights of their centreline
+        (RodProblem.energy_gradient integrates it). Collective."""
+        self.drag.set(self.node_loads(state, state.node_directors()[:, 2].copy()))
+        g[:, 2, :] -= self.load_vector(self.drag)[:g.shape[0]]
+
+    def add_jacobian(self, jacobian):
+        """The drag's entries of J (analysis/jacobian.py module docstring): the frames'
+        rows on the resultants and on the element's turns, and the resultants' chain, at
+        the fields' tangents and heights. The depth derivative of a current profile is
+        left out (J is then inexact on a sheared current: the steps converge linearly,
+        fast where the shear over a step's height change is small)."""
+        mesh, hessian = self.mesh, jacobian.hessian
+        state = jacobian.problem.state
+        ne = mesh.n_local_elements
+        if not ne:
+            return
+        B, U, P = hessian.block, hessian.unknowns, hessian.resultant_slot
+        tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
+        h = mesh.element_h
+        r = state.r.ghosted()                              # Hermite (z, z') at the vertices
+        left, right = r[mesh.element_local], r[mesh.element_local + 1]
+        z = np.stack([left[:, 0, 2], 0.5 * (left[:, 0, 2] + right[:, 0, 2])
+                      + h / 8 * (left[:, 1, 2] - right[:, 1, 2]), right[:, 0, 2]], axis=1)
+        S = mesh.element_S[:, None] + h[:, None] * np.array([0.0, 0.5, 1.0])
+        flat_t = tangents.reshape(-1, 3)
+        G = sum(w * drag_jacobian(flat_t, c.velocity(z.ravel()),
+                                  self.scene.drag_at(S.ravel(), c))
+                for w, c in self.scene.drag_loads(self.t)).reshape(ne, 3, 3, 3)
+        # the frames' rows of -delta b: -[t]x on omega, -t/|t| on the stretch
+        rows_map = -skew(tangents)                                               # (ne, a, 3, 3)
+        if U == 4:
+            unit = tangents / np.linalg.norm(tangents, axis=2, keepdims=True)
+            rows_map = np.concatenate([rows_map, -unit[:, :, None, :]], axis=2)  # (ne, a, 4, 3)
+        integrals = element_integrals(h)                                         # (ne, 3)
+        tails = self.drag.tail_integrals                                         # (ne, a, b)
+        base = hessian.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
+        x_rows = (base[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
+        turns = (base[:, :, None] + np.arange(3)).reshape(ne, 9)
+        psi = base[:, [0, 2]][:, :, None] + P + np.arange(3)                     # (ne, 2, 3)
+        jacobian.add(x_rows, psi[:, 1],
+                     (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3))
+        coupling = np.einsum("eaij,eab,ebjk->eaibk", rows_map, tails, G)
+        jacobian.add(x_rows, turns, coupling.reshape(ne, 3 * U, 9))
+        # the chain: Psi_e - Psi_e+1 - sum_l I_l G_l omega_l = 0 in Psi_e's row from a
+        # held start, its negative in Psi_e+1's from a held end (the diagonal 1 is H's)
+        held_start = is_held(self.start_state)
+        row, other, sign = (psi[:, 0], psi[:, 1], -1.0) if held_start else \
+            (psi[:, 1], psi[:, 0], 1.0)
+        jacobian.add(row, other, np.broadcast_to(-np.eye(3), (ne, 3, 3)))
+        chain = sign * np.einsum("eb,ebjk->ejbk", integrals, G).reshape(ne, 3, 9)
+        jacobian.add(row, turns, chain)
 
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""

@@ -25,12 +25,12 @@ from petsc_rod.scenes.catenary import catenary
 
 
 def solved(solver_factory, comm, n_elements, scene, start="straight", rtol=1e-12,
-           ctol=1e-12):
+           ctol=1e-12, newton=False):
     """(mesh, solver, report) of ``scene`` (Scene keywords) at the default penalty,
-    without Newton steps (a scene with a seabed has none: the counts compare)."""
+    without Newton steps unless asked (the iteration's counts compare)."""
     penalty = default_penalty(Scene(**scene))
     mesh, solver = solver_factory(comm, n_elements, scene, penalty, rtol=rtol, ctol=ctol,
-                                  max_it=20000, newton=False)
+                                  max_it=20000, newton=newton)
     if start == "catenary":
         solver.problem.state.set_from_curve(catenary_start(solver.problem.scene, 1.0))
     else:
@@ -49,18 +49,19 @@ GROUNDED = dict(length=10.0, stiffness=(1e-6, 1e-6, 1e-6), start="pin", end="pin
                 seabed=Seabed(0.0, 1e6))
 
 
-def grounded_errors(comm, solver_factory, n_elements):
+def grounded_errors(comm, solver_factory, n_elements, newton=False, start="straight"):
     """Max errors of r and n away from the touchdown zone (|S - S_td| > 1 m) and the
     anchor (S > 0.5 m: the anchor pin carries the weight of its half element), and the
-    riser report's numbers, against the closed form."""
-    mesh, solver, report = solved(solver_factory, comm, n_elements, GROUNDED)
+    riser report's numbers, against the closed form (and the solve's report)."""
+    mesh, solver, report = solved(solver_factory, comm, n_elements, GROUNDED, start=start,
+                                  newton=newton)
     assert report.converged and report.stable
     fields = vertex_fields(solver.problem)
     numbers = riser_output(solver.problem, fields).attributes
     S, r, n = (gather(comm, fields[key]) for key in ("S", "r", "n"))
     exact, tangent, force, (_, touchdown) = grounded_catenary(10.0, GROUNDED_CHORD, 1.0, 0.0, S)
     away = (np.abs(S - touchdown) > 1.0) & (S > 0.5)
-    return dict(r=np.linalg.norm(r - exact, axis=1)[away].max(),
+    return dict(report=report, r=np.linalg.norm(r - exact, axis=1)[away].max(),
                 n=np.linalg.norm(n - force, axis=1)[away].max(),
                 numbers=numbers, touchdown=touchdown, top_force=force[-1], top_tangent=tangent[-1],
                 h=10.0 / n_elements)

@@ -1,0 +1,88 @@
+"""The Newton Jacobian of a problem whose load follows the line (the drag of a current),
+kept banded by a chain of resultants (docs/method.md §11, "A load without potential").
+
+A load f_j given at the P2 nodes (N/m, interpolated in P2) enters the gradient of the
+reduced problem as -b on the d3 rows, b_n = int F phi_n dS with F(S) = int_S^L f_h dS
+(plus, when the start is free, minus the whole: F(S) = -int_0^S f_h), the resultant of
+the load beyond S (riser/loads.py). Where f depends on the frames (the drag on the
+tangent), b depends on every node beyond n: its derivative is dense. It is kept banded
+by making the resultants at the vertices, Psi_i = delta F(S_i) (3 each), unknowns with
+one equation per element,
+
+    Psi_e - Psi_e+1 - sum_l I_e,l delta f_e,l = 0,    I_e = int_e phi (Simpson's),
+
+in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
+(Psi_0 = 0, the equation's sign reversed), and
+
+    delta b_n = sum_{e ni n} ( I_e,n Psi_e+1 + sum_l T_e,nl delta f_e,l ),
+    T_e,nl = int_e phi_n(S) int_S^{S_e+1} phi_l dS'.
+
+The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
+delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
+(analysis/stability.py, with the resultants' slots as identity rows) plus these
+entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.lu_solver). H's curvature
+term is the load's at its current value, symmetrised: the antisymmetric rest is the
+torque balance, zero at a solution, so the steps still converge quadratically.
+"""
+
+from petsc4py import PETSc
+
+from petsc_rod.global_step.ksp import lu_solver
+
+
+class NewtonJacobian:
+    """J on the layout of a SecondVariation ``hessian`` (its resultants' slots), made
+    from H and the followers' add_jacobian at each ``assemble``; owns its matrix and
+    LU solver, ``destroy()``."""
+
+    def __init__(self, hessian):
+        self.hessian = hessian
+        self.problem = hessian.problem
+        self.matrix = None
+        self.ksp = None
+
+    def assemble(self):
+        """J at the state H was last assembled at, factored. Collective."""
+        hessian = self.hessian
+        if self.matrix is None:
+            # H's preallocation (a node's row meets the 5 nodes of its elements), the
+            # pattern kept through zeroRows: one symbolic factorisation for the run
+            block = hessian.block
+            self.matrix = PETSc.Mat().createAIJ(hessian.matrix.getSizes(),
+                                                nnz=(5 * block, 2 * block),
+                                                comm=self.problem.mesh.comm)
+            self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+            self.matrix.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        else:
+            self.matrix.zeroEntries()
+        indptr, columns, values = hessian.matrix.getValuesCSR()
+        self.matrix.setValuesCSR(indptr, columns, values, addv=PETSc.InsertMode.ADD_VALUES)
+        for term in self.problem.terms:
+            term.add_jacobian(self)
+        self.matrix.assemble()
+        # the held unknowns keep their identity rows (what the followers added there
+        # is dropped); their columns meet a zero step
+        self.matrix.zeroRows(hessian.held_rows, diag=1.0)
+        if self.ksp is None:
+            self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
+        else:
+            self.ksp.setOperators(self.matrix)
+        self.ksp.setUp()
+
+    def add(self, rows, columns, values):
+        """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
+        ``columns`` (k, c), before assembly."""
+        if len(rows):
+            self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
+                                     values, addv=PETSc.InsertMode.ADD_VALUES)
+
+    def solve(self, rhs):
+        """J^-1 rhs, a new Vec."""
+        solution = rhs.duplicate()
+        self.ksp.solve(rhs, solution)
+        return solution
+
+    def destroy(self):
+        for obj in (self.ksp, self.matrix):
+            if obj is not None:
+                obj.destroy()
