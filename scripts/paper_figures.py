@@ -3,14 +3,15 @@
     python scripts/paper_figures.py [--quick] [--out docs/paper]
 
 Runs the paper's continuation, the pinned end moved along y = 20 - x from X_F = 20 down
-to X_F = 2 in 0.5 m steps, for both readings of the torsion stiffness:
+to X_F = 2 in 0.5 m steps (36 steps), for both readings of the torsion stiffness:
 - K3 = 200 on 80 elements, R = 400, rolled by 0.01 rad at each step (options/paper.opts);
 - the same without the roll, the plain iteration and no stability test: the planar
   branch (u3 = 0; it does not depend on K3), which the plain iteration follows from a
   symmetric start while the default iteration leaves it (it is a saddle);
 - K3 = 100 (non-convex split, docs/method.md §2) on 80 elements.
 and writes into OUT: steps.csv (one row per run and step: X_F, converged, iterations,
-wall time, u3(0), energy, max |z|, constraint residual), profiles.npz (r and u3 along
+wall time, u3(0), energy, max |z|, constraint residual, Newton steps among the
+iterations), profiles.npz (r and u3 along
 the cable at X_F = 19, 16 and 2) and three PNGs:
 - projections.png: the cable on the planes xy, xz, yz at X_F = 19 and 16;
 - twist_at_clamp.png: u3(0) against X_F, with the range where the rolled run leaves the
@@ -21,7 +22,7 @@ the cable at X_F = 19, 16 and 2) and three PNGs:
 The runs use the command line's continuation loop: a step that does not converge is
 retried with half the increment (the sub-steps are rows of steps.csv too), and a run
 that still fails ends there. Progress: one line per step. The whole run
-takes about half an hour on one core; `--quick` (X_F = 20 to 19 in 2 steps, coarse
+takes about 10 s of CPU on one core (docs/paper.md); `--quick` (X_F = 20 to 19 in 2 steps, coarse
 meshes) takes seconds and is what the tests run.
 """
 
@@ -43,10 +44,9 @@ RTOL, CTOL, PENALTY = 1e-7, 1e-5, 400.0
 MAX_ITERATIONS = 200000
 PROFILE_X = (19.0, 16.0, 2.0)
 # |z| above this (0.05% of L) on a rolled run means the cable has left the plane z = 0.
-# On the planar side of the pitchfork the roll of 0.01 rad put in at each step has not
-# quite died out when the step stops (|z| ~ 3e-4 m, u3(0) ~ 2e-4 /m, the energy equal to
-# the planar one to 1e-4 J); next to the pitchfork it dies out slowly (|z| = 6e-3 m at
-# X_F = 5, K3 = 200, W within 1e-4 J of the planar state).
+# On the planar side of the pitchfork the Newton steps take the roll of 0.01 rad put in
+# at each step out to round-off (|z| below 1e-16 m, docs/paper.md); the last out-of-plane
+# steps are far above it (|z| = 0.29 m at X_F = 5.5, K3 = 200; 0.028 m at 3.5, K3 = 100).
 OUT_OF_PLANE = 1e-2
 
 FULL = {"end_x": 2.0, "steps": 36,
@@ -56,7 +56,8 @@ QUICK = {"end_x": 19.0, "steps": 2,
          "runs": (("K3 = 200", 200.0, 20, 0.01), ("planar", 200.0, 20, 0.0),
                   ("K3 = 100", 100.0, 10, 0.01))}
 STEP_COLUMNS = ("run", "K3", "elements", "penalty", "X_F", "converged", "iterations",
-                "wall_time", "u3_clamp", "energy", "max_abs_z", "constraint_residual")
+                "wall_time", "u3_clamp", "energy", "max_abs_z", "constraint_residual",
+                "newton_steps")
 
 
 def gather(comm, owned):
@@ -104,10 +105,11 @@ def continuation_run(comm, label, k3, n_elements, imperfection, end_x, steps, sa
                          wall_time=time.perf_counter() - clock,
                          u3_clamp=fields["u"][0, 2], energy=solver.problem.energy(),
                          max_abs_z=np.abs(fields["r"][:, 2]).max(),
-                         constraint_residual=report.constraint_residual))
+                         constraint_residual=report.constraint_residual,
+                         newton_steps=report.newton_steps))
         outcome = "converged" if report.converged else "NOT converged"
         say(f"{label:9s} X_F = {x_f:5.2f}: {outcome}"
-            f" in {report.iterations:6d} its, u3(0) = {fields['u'][0, 2]:+.5f} /m, "
+            f" in {report.iterations:6d} its ({report.newton_steps} Newton), u3(0) = {fields['u'][0, 2]:+.5f} /m, "
             f"W = {rows[-1]['energy']:.4f} J, max|z| = {rows[-1]['max_abs_z']:.3g} m "
             f"({rows[-1]['wall_time']:.1f} s)")
         for x in PROFILE_X:
