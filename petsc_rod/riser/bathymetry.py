@@ -1,0 +1,109 @@
+"""The shape of a seabed that is not flat (docs/riser.md §1a): a plane of given slope and
+direction, or a profile of heights along a direction; its height z_b(x, y), gradient
+and unit normal at given horizontal positions, vectorised (any shape of x and y).
+
+Conventions, those of OrcaFlex's seabed data: a seabed origin p0 = (x0, y0) on the
+seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
+(anticlockwise seen from above), and d = (p - p0).e the distance along it.
+
+* ``Plane``: z_b = z0 + tan(alpha) d, alpha the largest upward slope (rad; negative:
+  the seabed falls along e), constant across e. gradient g = tan(alpha) e.
+* ``Profile``: z_b = the linear interpolant of the rows (d_i, z_i), d_i strictly
+  increasing, constant across e and beyond the first and last rows; on a row's
+  segment g = (z_i+1 - z_i) / (d_i+1 - d_i) e (the segment ahead at a row, 0 beyond
+  the rows). ``covers`` tells whether a point lies within the rows.
+
+The unit normal pointing up out of the seabed is (-g, 1) / sqrt(1 + |g|^2), and the
+local slope atan |g|. Heights in m, in whichever frame the shape was made in
+(``moved``: the same seabed in a frame whose origin is at ``offset``).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def unit_normal(gradient):
+    """(-g, 1) / sqrt(1 + |g|^2) of gradients (..., 2): (..., 3)."""
+    g = np.asarray(gradient, dtype=float)
+    normal = np.concatenate([-g, np.ones(g.shape[:-1] + (1,))], axis=-1)
+    return normal / np.sqrt(1.0 + np.sum(g**2, axis=-1, keepdims=True))
+
+
+@dataclass(frozen=True)
+class Plane:
+    """z_b = z0 + g.((x, y) - origin): ``origin`` (2,) m, ``z0`` m, ``slope_vector`` g
+    (2,) = tan(alpha) e (module docstring)."""
+
+    origin: np.ndarray
+    z0: float
+    slope_vector: np.ndarray
+
+    @classmethod
+    def sloping(cls, origin, z0, slope_deg, direction):
+        """The plane through (origin, z0) rising at ``slope_deg`` degrees along the unit
+        horizontal vector ``direction`` (2,)."""
+        e = np.asarray(direction, dtype=float)
+        return cls(np.asarray(origin, dtype=float), float(z0),
+                   np.tan(np.radians(slope_deg)) * e)
+
+    def height(self, x, y):
+        """z_b at (x, y), m, the shape of x."""
+        return (self.z0 + self.slope_vector[0] * (np.asarray(x, dtype=float) - self.origin[0])
+                + self.slope_vector[1] * (np.asarray(y, dtype=float) - self.origin[1]))
+
+    def gradient(self, x, y):
+        """dz_b/d(x, y), (shape of x) + (2,)."""
+        return np.broadcast_to(self.slope_vector, np.shape(x) + (2,)).copy()
+
+    def normal(self, x, y):
+        """The unit normal up out of the seabed, (shape of x) + (3,)."""
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        """A plane covers every point."""
+        return np.ones(np.shape(x), dtype=bool)
+
+    def moved(self, offset):
+        """The same plane in the frame whose origin is at ``offset`` (3,)."""
+        return Plane(self.origin - offset[:2], self.z0 - offset[2], self.slope_vector)
+
+
+@dataclass(frozen=True)
+class Profile:
+    """z_b the linear interpolant of ``heights`` (m,) at ``distances`` (m,), strictly
+    increasing, along the unit horizontal vector ``direction`` (2,) from ``origin``
+    (2,) (module docstring)."""
+
+    origin: np.ndarray
+    direction: np.ndarray
+    distances: np.ndarray
+    heights: np.ndarray
+
+    def along(self, x, y):
+        """d = ((x, y) - origin).e, the shape of x."""
+        return ((np.asarray(x, dtype=float) - self.origin[0]) * self.direction[0]
+                + (np.asarray(y, dtype=float) - self.origin[1]) * self.direction[1])
+
+    def height(self, x, y):
+        return np.interp(self.along(x, y), self.distances, self.heights)
+
+    def gradient(self, x, y):
+        d = self.along(x, y)
+        segment = np.clip(np.searchsorted(self.distances, d, side="right") - 1, 0,
+                          self.distances.size - 2)
+        slope = (np.diff(self.heights) / np.diff(self.distances))[segment]
+        slope = np.where((d < self.distances[0]) | (d >= self.distances[-1]), 0.0, slope)
+        return slope[..., None] * self.direction
+
+    def normal(self, x, y):
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        """Whether (x, y) lies within the profile's rows, d_0 <= d <= d_last."""
+        d = self.along(x, y)
+        return (d >= self.distances[0]) & (d <= self.distances[-1])
+
+    def moved(self, offset):
+        return Profile(self.origin - offset[:2], self.direction, self.distances,
+                       self.heights - offset[2])
