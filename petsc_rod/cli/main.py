@@ -365,6 +365,11 @@ def options_in_effect(values, solver, start):
         parameters["current_profile_table"] = np.column_stack([current.depths,
                                                                current.velocities])
         units["current_profile_table"] = "m, m/s, m/s, m/s (depth, ux, uy, uz)"
+    if values["rod_seabed_profile"]:            # the seabed profile itself, to repeat the run
+        shape = scene.seabed.shape
+        parameters["seabed_profile_table"] = np.column_stack([shape.distances,
+                                                              shape.heights + origin[2]])
+        units["seabed_profile_table"] = "m, m (distance, height)"
     if values["rod_line_types"]:                # the line types' table, to repeat the run
         parameters["line_types_table"] = read_text(values["rod_line_types"],
                                                    "-rod_line_types")

@@ -58,13 +58,15 @@ def point_loads_from_options(values, length, points=None):
             sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
 
 
-def scene_from_options(values, given, profile=None, line_types=None, points=None):
+def scene_from_options(values, given, profile=None, line_types=None, points=None,
+                       seabed_rows=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
     ``points`` (S, forces, drag areas) the point loads when already resolved (a result
-    file's point_loads_table)."""
+    file's point_loads_table); ``seabed_rows`` (distances, heights) the seabed profile's
+    rows when already read (a result file's seabed_profile_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
@@ -99,7 +101,8 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
                   point_load_drag_areas=point_areas,
                   water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
-    scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
+    scene.seabed, scene.current = environment_from_options(values, given, scene, profile,
+                                                           seabed_rows)
     pressures_from_options(values, given, scene)
     check_taut(scene)
     check_applied_forces(scene, given)
@@ -494,8 +497,10 @@ def scene_from_parameters(parameters):
         points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
         areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
         points = (points[:, 0], points[:, 1:4], areas)
+    seabed = parameters.get("seabed_profile_table")
+    seabed = None if seabed is None else (seabed[:, 0], seabed[:, 1])
     return scene_from_options(values, given, profile, parameters.get("line_types_table"),
-                              points)
+                              points, seabed)
 
 
 def restart_path(scene, parameters, t_file):
