@@ -237,7 +237,9 @@ OPTIONS = [
     Option("rod_seabed_profile", _string, None, "FILE",
            "seabed profile: rows 'distance height' (m; '#' comments, commas allowed) along "
            "-rod_seabed_direction from -rod_seabed_origin, distances strictly increasing, "
-           "heights absolute (z up), linear in between; in place of -rod_seabed",
+           "heights absolute (z up), linear in between; or a grid, rows 'x y height' (x, y "
+           "from -rod_seabed_origin, every x with every y), bilinear; in place of "
+           "-rod_seabed",
            unit="text"),
     Option("rod_current", _reals(3), None, "ux,uy,uz",
            "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),

@@ -9,10 +9,11 @@ from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.riser.bathymetry import Plane, Profile
+from petsc_rod.riser.bathymetry import Grid, Plane, Profile
 from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
                                          check_covered, check_ends_above, default_stiffness,
-                                         largest_stiffness, read_profile, read_seabed_profile)
+                                         grid_axes, largest_stiffness, read_profile,
+                                         read_seabed_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
@@ -65,7 +66,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
     ``points`` (S, forces, drag areas) the point loads when already resolved (a result
-    file's point_loads_table); ``seabed_rows`` (distances, heights) the seabed profile's
+    file's point_loads_table); ``seabed_rows`` (n, 2 or 3) the seabed profile's or grid's
     rows when already read (a result file's seabed_profile_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
@@ -343,8 +344,9 @@ def seabed_direction(values):
 def seabed_shape(values, given, origin, profile_rows=None):
     """The bathymetry.Plane or Profile of the seabed options in the scene's frame (its
     origin at ``origin`` (3,), absolute), or None for a flat seabed (no slope, or a slope
-    of 0: today's plane z = -rod_seabed, bit for bit). ``profile_rows`` the profile's
-    (distances, heights) when already read (a result file's seabed_profile_table)."""
+    of 0: today's plane z = -rod_seabed, bit for bit). ``profile_rows`` the profile's or
+    grid's rows (n, 2 or 3), heights absolute, when already read (a result file's
+    seabed_profile_table)."""
     profile = "rod_seabed_profile" in given or profile_rows is not None
     if profile and ("rod_seabed" in given or "rod_seabed_slope" in given):
         raise RodInputError("-rod_seabed_profile gives the seabed's heights: drop "
@@ -353,11 +355,16 @@ def seabed_shape(values, given, origin, profile_rows=None):
     seabed_origin = np.asarray(values["rod_seabed_origin"] if values["rod_seabed_origin"]
                                is not None else (0.0, 0.0), dtype=float)
     if profile:
-        distances, heights = (profile_rows if profile_rows is not None else
-                              read_seabed_profile(values["rod_seabed_profile"],
-                                                  MAX_MAGNITUDE))
-        return Profile(seabed_origin, direction, np.asarray(distances, dtype=float),
-                       np.asarray(heights, dtype=float)).moved(origin)
+        table = np.asarray(profile_rows if profile_rows is not None else
+                           read_seabed_profile(values["rod_seabed_profile"], MAX_MAGNITUDE),
+                           dtype=float)
+        if table.shape[1] == 2:
+            return Profile(seabed_origin, direction, table[:, 0], table[:, 1]).moved(origin)
+        if "rod_seabed_direction" in given:
+            raise RodInputError("-rod_seabed_direction: a grid's rows give x and y (from "
+                                "-rod_seabed_origin); drop the direction")
+        xs, ys, heights = grid_axes(table, RodInputError)
+        return Grid(seabed_origin, xs, ys, heights).moved(origin)
     slope = values["rod_seabed_slope"]
     if slope is None or slope == 0:
         return None
@@ -438,7 +445,7 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
     """(Seabed or None, Current or None) for a validated ``scene``, checked against it
     (``profile``: as in current_from_options), their heights in the scene's frame (the
     options' less the start's z, docs/method.md §5); ``seabed_rows`` the seabed
-    profile's (distances, heights) when already read."""
+    profile's or grid's rows when already read."""
     z0 = float(scene.start_position[2])
     values = dict(values)
     for name in ("rod_seabed", "rod_sea_surface"):
@@ -498,7 +505,6 @@ def scene_from_parameters(parameters):
         areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
         points = (points[:, 0], points[:, 1:4], areas)
     seabed = parameters.get("seabed_profile_table")
-    seabed = None if seabed is None else (seabed[:, 0], seabed[:, 1])
     return scene_from_options(values, given, profile, parameters.get("line_types_table"),
                               points, seabed)
 

@@ -107,3 +107,64 @@ class Profile:
     def moved(self, offset):
         return Profile(self.origin - offset[:2], self.direction, self.distances,
                        self.heights - offset[2])
+
+
+@dataclass(frozen=True)
+class Grid:
+    """z_b bilinear on a rectangular grid of heights ``heights`` (nx, ny) at ``xs`` (nx,)
+    and ``ys`` (ny,), strictly increasing, measured from ``origin`` (2,) along +x and +y
+    (a 3-D bathymetry: OrcaFlex's 3D seabed, Flexcom's 3D profile, on a regular grid).
+    In a cell, with (s, t) in [0, 1]^2 the position's fractions,
+    z_b = (1-s)(1-t) z00 + s(1-t) z10 + (1-s) t z01 + s t z11, and its gradient is that
+    of this bilinear form (continuous across the cells' edges in the height, not in the
+    slope). Level beyond the grid's edges at the nearest edge's heights (gradient 0
+    across it); ``covers`` tells whether a point lies within it."""
+
+    origin: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+    heights: np.ndarray
+
+    def _cell(self, x, y):
+        """(i, j, s, t, inside_x, inside_y): cell indices and fractions, clipped to the
+        grid, and whether the point lies within it along x and y."""
+        u = np.asarray(x, dtype=float) - self.origin[0]
+        v = np.asarray(y, dtype=float) - self.origin[1]
+        i = np.clip(np.searchsorted(self.xs, u, side="right") - 1, 0, self.xs.size - 2)
+        j = np.clip(np.searchsorted(self.ys, v, side="right") - 1, 0, self.ys.size - 2)
+        dx, dy = self.xs[i + 1] - self.xs[i], self.ys[j + 1] - self.ys[j]
+        s = np.clip((u - self.xs[i]) / dx, 0.0, 1.0)
+        t = np.clip((v - self.ys[j]) / dy, 0.0, 1.0)
+        inside_x = (u >= self.xs[0]) & (u < self.xs[-1])
+        inside_y = (v >= self.ys[0]) & (v < self.ys[-1])
+        return i, j, s, t, inside_x, inside_y
+
+    def height(self, x, y):
+        i, j, s, t, _, _ = self._cell(x, y)
+        z = self.heights
+        return ((1 - s) * (1 - t) * z[i, j] + s * (1 - t) * z[i + 1, j]
+                + (1 - s) * t * z[i, j + 1] + s * t * z[i + 1, j + 1])
+
+    def gradient(self, x, y):
+        i, j, s, t, inside_x, inside_y = self._cell(x, y)
+        z = self.heights
+        dx, dy = self.xs[i + 1] - self.xs[i], self.ys[j + 1] - self.ys[j]
+        gx = ((1 - t) * (z[i + 1, j] - z[i, j]) + t * (z[i + 1, j + 1] - z[i, j + 1])) / dx
+        gy = ((1 - s) * (z[i, j + 1] - z[i, j]) + s * (z[i + 1, j + 1] - z[i + 1, j])) / dy
+        return np.stack([np.where(inside_x, gx, 0.0), np.where(inside_y, gy, 0.0)], axis=-1)
+
+    def normal(self, x, y):
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        u = np.asarray(x, dtype=float) - self.origin[0]
+        v = np.asarray(y, dtype=float) - self.origin[1]
+        return ((u >= self.xs[0]) & (u <= self.xs[-1]) & (v >= self.ys[0])
+                & (v <= self.ys[-1]))
+
+    def along(self, x, y):
+        """The distance from the origin along +x (the messages' measure)."""
+        return np.asarray(x, dtype=float) - self.origin[0]
+
+    def moved(self, offset):
+        return Grid(self.origin - offset[:2], self.xs, self.ys, self.heights - offset[2])

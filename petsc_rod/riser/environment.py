@@ -186,10 +186,12 @@ def read_profile(path, largest=np.inf):
 
 
 def read_seabed_profile(path, largest=np.inf):
-    """(distances (m,), heights (m,)) from a text file of rows 'distance height' (m; '#'
-    starts a comment, commas allowed): at least two rows, distances strictly increasing
-    (a height for each distance: the profile is a function), every magnitude at most
-    ``largest``. RodInputError otherwise, naming the row."""
+    """The rows of a seabed profile or grid file, (n, 2) 'distance height' or (n, 3)
+    'x y height' (m; '#' starts a comment, commas allowed; x, y from the seabed origin,
+    heights absolute): every row of the same count, at least two rows, every magnitude at
+    most ``largest``; a profile's distances strictly increasing (a height for each
+    distance: the profile is a function), a grid checked by ``grid_axes``.
+    RodInputError otherwise, naming the line."""
     def refuse(what):
         raise RodInputError(f"-rod_seabed_profile {path}: {what}")
 
@@ -197,16 +199,17 @@ def read_seabed_profile(path, largest=np.inf):
     rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
             for k, line in enumerate(lines)]
     rows = [(k, row) for k, row in rows if row]
-    expected = ("expected rows of 2 numbers: distance along -rod_seabed_direction from "
-                "-rod_seabed_origin (m), height (m, z up)")
+    expected = ("expected rows of 2 numbers, distance along -rod_seabed_direction from "
+                "-rod_seabed_origin (m) and height (m, z up), or of 3, x, y from the "
+                "seabed origin and height (a grid)")
     table = []
     for k, row in rows:
         try:
             values = [float(v) for v in row]
         except ValueError:
             refuse(f"line {k} '{' '.join(row)}': {expected}")
-        if len(values) != 2:
-            refuse(f"line {k} '{' '.join(row)}': {expected}")
+        if len(values) not in (2, 3) or (table and len(values) != len(table[0][1])):
+            refuse(f"line {k} '{' '.join(row)}': {expected}, the same in every row")
         if not np.all(np.isfinite(values)) or np.any(np.abs(values) > largest):
             refuse(f"line {k}: a number that is not finite or above {largest:g} in "
                    "magnitude; give distances and heights in m")
@@ -214,6 +217,9 @@ def read_seabed_profile(path, largest=np.inf):
     if len(table) < 2:
         refuse(f"needs at least 2 rows; {expected}")
     lines_of, data = [k for k, _ in table], np.array([v for _, v in table])
+    if data.shape[1] == 3:
+        grid_axes(data, refuse)
+        return data
     steps = np.diff(data[:, 0])
     if np.any(steps <= 0):
         i = int(np.flatnonzero(steps <= 0)[0])
@@ -221,7 +227,22 @@ def read_seabed_profile(path, largest=np.inf):
                f"{data[i, 0]:g} m; the distances must increase strictly from row to row "
                "(a seabed profile is one height per distance; sort the rows and drop "
                "repeated distances)")
-    return data[:, 0], data[:, 1]
+    return data
+
+
+def grid_axes(table, refuse):
+    """(xs (nx,), ys (ny,), heights (nx, ny)) of grid rows 'x y height' (n, 3) in any
+    order, every x with every y exactly once, at least 2 of each; else refuse(what)."""
+    xs, ys = np.unique(table[:, 0]), np.unique(table[:, 1])
+    order = np.lexsort((table[:, 1], table[:, 0]))
+    ordered = table[order]
+    if (xs.size < 2 or ys.size < 2 or len(table) != xs.size * ys.size
+            or np.any(ordered[:, 0] != np.repeat(xs, ys.size))
+            or np.any(ordered[:, 1] != np.tile(ys, xs.size))):
+        refuse(f"a grid's rows must hold every x with every y exactly once, at least 2 of "
+               f"each (found {xs.size} x values, {ys.size} y values and {len(table)} rows; "
+               f"a full grid of them has {xs.size * ys.size})")
+    return xs, ys, ordered[:, 2].reshape(xs.size, ys.size)
 
 
 def check_ends_above(seabed, ends, length, origin_z=0.0):
@@ -251,6 +272,14 @@ def check_covered(seabed, points, what, option="-rod_seabed_profile"):
     outside = ~seabed.shape.covers(points[:, 0], points[:, 1])
     if np.any(outside):
         shape = seabed.shape
+        if hasattr(shape, "xs"):
+            u, v = points[:, 0] - shape.origin[0], points[:, 1] - shape.origin[1]
+            raise RodInputError(
+                f"{option}: the grid covers x from {shape.xs[0]:g} to {shape.xs[-1]:g} m "
+                f"and y from {shape.ys[0]:g} to {shape.ys[-1]:g} m from the seabed origin "
+                f"but {what} lie at x from {u.min():.6g} to {u.max():.6g} m, y from "
+                f"{v.min():.6g} to {v.max():.6g} m; extend the grid to cover the line's "
+                "footprint")
         d = shape.along(points[:, 0], points[:, 1])
         low, high = float(d.min()), float(d.max())
         raise RodInputError(

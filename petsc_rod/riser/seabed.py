@@ -57,6 +57,7 @@ class SeabedContact:
         self.active = None                                          # (ne, 3) booleans
         # z_b and k at the nodes: the flat seabed's numbers, else (ne, 3) arrays (follow)
         self.base, self.stiffness = seabed.height, seabed.stiffness
+        self.gradients = None                                       # (ne, 3, 2), follow
         self.solves = 0                                             # since the last reset
         self._local = mesh.da.createLocalVec()
 
@@ -125,13 +126,16 @@ class SeabedContact:
         seabed that is not flat: the normal force with the penetration of the vertical
         problem's heights z_n (Hermite dofs ``y``) under the z_b,n, k_n, g_n of the last
         ``follow``, so that it is the reaction this problem carried (slope_load.py).
-        Collective."""
-        push = self.stiffness * np.maximum(self.base - self.heights(y), 0.0)    # (ne, 3)
-        per_element = np.concatenate([-push[..., None] * self.gradients, push[..., None]],
-                                     axis=2)                                   # (ne, 3, 3)
+        Collective. Zero before the first ``follow`` (a contact rebuilt at a penalty
+        raise: one iteration without the push, as at a start)."""
         n_owned = self.mesh.vertex_end - self.mesh.vertex_start
         ne = self.mesh.n_local_elements
         nodes = np.zeros((n_owned + ne, 3))
+        if self.gradients is None:
+            return nodes
+        push = self.stiffness * np.maximum(self.base - self.heights(y), 0.0)    # (ne, 3)
+        per_element = np.concatenate([-push[..., None] * self.gradients, push[..., None]],
+                                     axis=2)                                   # (ne, 3, 3)
         nodes[0:2 * ne:2] = per_element[:, 0]
         nodes[1:2 * ne:2] = per_element[:, 1]
         if n_owned > ne and ne:                 # the last vertex, right of the last element

@@ -50,6 +50,14 @@ BAD = {
                            ["-rod_seabed_profile", "at least 2 rows"]),
     "missing profile": (["-rod_seabed_profile", "{folder}/nowhere.txt"],
                         ["-rod_seabed_profile", "no such file"]),
+    "grid with a hole": (["-rod_seabed_profile", "{holed}"],
+                         ["-rod_seabed_profile", "every x with every y", "found 2 x values"]),
+    "grid short of the end": (["-rod_seabed_profile", "{small_grid}"],
+                              ["-rod_seabed_profile", "the grid covers x from 0 to 5 m", "extend"]),
+    "grid with a direction": (["-rod_seabed_profile", "{grid}", "-rod_seabed_direction", "30"],
+                              ["-rod_seabed_direction", "drop the direction"]),
+    "rows of 2 and 3 numbers": (["-rod_seabed_profile", "{mixed}"],
+                                ["-rod_seabed_profile", "line 2", "the same in every row"]),
     "profile and height": (["-rod_seabed", "0", "-rod_seabed_profile", "{plane}"],
                            ["-rod_seabed_profile", "drop -rod_seabed"]),
     "slope without seabed": (["-rod_seabed_slope", "3"],
@@ -67,7 +75,11 @@ def files(folder):
         short=write(folder, "short.txt", "0 0\n5 0\n"),
         backwards=write(folder, "backwards.txt", "0 0\n8 0\n5 0.5\n"),
         word=write(folder, "word.txt", "0 0\n8 deep\n"),
-        one=write(folder, "one.txt", "0 0\n"), folder=folder)
+        one=write(folder, "one.txt", "0 0\n"),
+        holed=write(folder, "holed.txt", "-1 -1 0\n-1 1 0\n9 -1 0\n"),
+        small_grid=write(folder, "small.txt", "0 -1 0\n0 1 0\n5 -1 0\n5 1 0\n"),
+        grid=write(folder, "grid.txt", "-1 -1 0\n-1 1 0\n9 -1 0\n9 1 0\n"),
+        mixed=write(folder, "mixed.txt", "-1 0\n9 0 0\n"), folder=folder)
 
 
 @pytest.mark.parametrize("case", list(BAD))
@@ -136,3 +148,23 @@ def run_figure(path, png):
     return subprocess.run([sys.executable, "-m", "petsc_rod.plots", str(path), str(png)],
                           cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
                           timeout=TIMEOUT)
+
+
+def test_a_grid_gives_the_plane_it_samples(tmp_path):
+    """A 3 x 3 grid of heights on the plane z = x tan 4 deg + y tan 3 deg (bilinear is
+    exact on a plane) and the same plane as -rod_seabed_slope 4.997 deg (atan of the
+    gradient's length) along the gradient: the same state to 1e-9 m; the line, pinned
+    in the plane y = 0, is pushed toward -y, down the slope."""
+    a, b = np.tan(np.radians(4.0)), np.tan(np.radians(3.0))
+    rows = "".join(f"{x:g} {y:g} {a * x + b * y:.17g}\n" for x in (-2.0, 5.0, 12.0)
+                   for y in (-3.0, 0.0, 3.0))
+    grid = write(tmp_path, "grid.txt", "# x y z\n" + rows)
+    slope = np.degrees(np.arctan(np.hypot(a, b)))
+    plane, _ = solved(tmp_path, "plane", ["-rod_seabed", "0", "-rod_seabed_slope",
+                                          f"{slope:.17g}", "-rod_seabed_direction",
+                                          f"{a:.17g},{b:.17g}"])
+    sampled, _ = solved(tmp_path, "grid", ["-rod_seabed_profile", grid])
+    with h5py.File(plane, "r") as f, h5py.File(sampled, "r") as g:
+        assert np.abs(f["r"][:] - g["r"][:]).max() < 1e-9
+        assert f["r"][:, 1].min() < -0.01
+        assert g["parameters"].attrs["seabed_profile_table"].shape == (9, 3)
