@@ -1,11 +1,12 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
-pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (and the horizontal
-push of a sloping one), the drag and the riser numbers only where the scene has a seabed or a current (docs/riser.md); the
-axial stretch only where some EA is finite (docs/method.md §12); the results along the
-line (riser/line_results.py) always, its regions (riser/regions.py) on a riser-like
-scene (a seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a
-line of line types with an inner diameter."""
+pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (with the
+horizontal push of a sloping one, riser/slope_load.py), the drag and the riser numbers
+only where the scene has a seabed or a current (docs/riser.md); the axial stretch only
+where some EA is finite (docs/method.md §12); the results along the line
+(riser/line_results.py) always, its regions (riser/regions.py) on a riser-like scene (a
+seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a line of
+line types with an inner diameter."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
