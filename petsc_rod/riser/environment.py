@@ -11,7 +11,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.boundary import is_held
-from petsc_rod.tables import read_text
+from petsc_rod.tables import numbered_rows, read_text
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
@@ -195,10 +195,7 @@ def read_seabed_profile(path, largest=np.inf):
     def refuse(what):
         raise RodInputError(f"-rod_seabed_profile {path}: {what}")
 
-    lines = read_text(path, "-rod_seabed_profile").splitlines()
-    rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
-            for k, line in enumerate(lines)]
-    rows = [(k, row) for k, row in rows if row]
+    rows = numbered_rows(path, "-rod_seabed_profile")
     expected = ("expected rows of 2 numbers, distance along -rod_seabed_direction from "
                 "-rod_seabed_origin (m) and height (m, z up), or of 3, x, y from the "
                 "seabed origin and height (a grid)")

@@ -12,23 +12,17 @@ import pytest
 
 from helpers import REPO_ROOT, child_env, png_summary, run_petsc_rod
 from test_hostile_cli import assert_one_line_and_nothing_left
+from test_riser_cli import SCENE, write
 
 pytestmark = pytest.mark.serial
 
 TIMEOUT = 300
-# test_riser_cli.py's 10 m line of 1 N/m pinned 7 m across and 4 m up, on 16 elements
-SCENE = ["-rod_length", "10", "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position",
-         "7,0,4", "-rod_load", "0,0,-1", "-rod_elements", "16"]
+# SCENE: test_riser_cli.py's 10 m line of 1 N/m pinned 7 m across and 4 m up, on 16
+# elements
 
 
 def run(args, ranks=1):
     return run_petsc_rod(args, ranks, TIMEOUT)
-
-
-def write(folder, name, text):
-    path = folder / name
-    path.write_text(text)
-    return str(path)
 
 
 BAD = {
