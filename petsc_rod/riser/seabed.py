@@ -58,6 +58,7 @@ class SeabedContact:
         # z_b and k at the nodes: the flat seabed's numbers, else (ne, 3) arrays (follow)
         self.base, self.stiffness = seabed.height, seabed.stiffness
         self.gradients = None                                       # (ne, 3, 2), follow
+        self.solution = None                # the Hermite dofs y of the last solve (a Vec)
         self.solves = 0                                             # since the last reset
         self._local = mesh.da.createLocalVec()
 
@@ -119,21 +120,22 @@ class SeabedContact:
             if not self.mesh.global_sum(int(np.any(active != self.active))):
                 break
             self._set_active(active)
+        self.solution = y
         return y
 
-    def node_force(self, y):
+    def node_force(self):
         """k_n (z_b,n - z_n)_+ (-g_n, 1) at the owned P2 nodes (N/m), (n_nodes, 3), of a
-        seabed that is not flat: the normal force with the penetration of the vertical
-        problem's heights z_n (Hermite dofs ``y``) under the z_b,n, k_n, g_n of the last
-        ``follow``, so that it is the reaction this problem carried (slope_load.py).
-        Collective. Zero before the first ``follow`` (a contact rebuilt at a penalty
-        raise: one iteration without the push, as at a start)."""
+        seabed that is not flat: the normal force with the penetration of the last
+        vertical solve's heights z_n under the z_b,n, k_n, g_n it was solved with (the
+        ``follow`` before it), so that it is the reaction that problem carried
+        (slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
+        start; a contact rebuilt at a penalty raise: one iteration without the push)."""
         n_owned = self.mesh.vertex_end - self.mesh.vertex_start
         ne = self.mesh.n_local_elements
         nodes = np.zeros((n_owned + ne, 3))
-        if self.gradients is None:
+        if self.gradients is None or self.solution is None:
             return nodes
-        push = self.stiffness * np.maximum(self.base - self.heights(y), 0.0)    # (ne, 3)
+        push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
         per_element = np.concatenate([-push[..., None] * self.gradients, push[..., None]],
                                      axis=2)                                   # (ne, 3, 3)
         nodes[0:2 * ne:2] = per_element[:, 0]

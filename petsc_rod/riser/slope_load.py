@@ -22,8 +22,6 @@ would need its derivatives in x and y, which they do not have: the term says so
 (``conservative``, ``in_newton`` False), so the run takes neither.
 """
 
-import numpy as np
-
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.terms import NodalLoadTerm
 
@@ -41,17 +39,20 @@ class SeabedSlopeLoad(NodalLoadTerm):
         self.load = NodalLoad(mesh, self._nodes)
 
     def node_loads(self, state):
-        """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0; 0 before the
-        vertical problem has been solved once: the start's own penetration (a straight
-        start under a rising seabed: metres) is not a reaction, and k times it would
-        throw the first iterate far away (measured: diverged at iteration 1)."""
-        if self.contact.y is None:
-            return np.zeros((self.mesh.n_local_nodes, 3))
-        force = self.contact.contact.node_force(self.contact.y)
+        """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of
+        the last vertical solve (seabed.SeabedContact.node_force). Zero before the first
+        solve: the start's own penetration (a straight start under a rising seabed:
+        metres) is not a reaction, and k times it would throw the first iterate far away
+        (measured: diverged at iteration 1). Collective."""
+        force = self.contact.contact.node_force()
         force[:, 2] = 0.0
         return force
 
     def add_iterate_load(self, rhs, state):
-        """Add int F.g of f_h to the slope problem's right-hand side."""
+        """Add int F.g of f_h to the slope problem's right-hand side, then move the
+        seabed's heights and springs under the nodes of the last global step for this
+        step's vertical solve (seabed.SeabedContact.follow; this term is built after the
+        seabed's, and add_iterate_load comes before every solve of the global step)."""
         self.load.set(self.node_loads(state))
         self.add_to_rhs(rhs, self.load)
+        self.contact.contact.follow(state.r.ghosted())

@@ -89,9 +89,8 @@ class NodalLoadTerm(Term):
 
 
 class SeabedTerm(NodalLoadTerm):
-    """An elastic seabed (environment.Seabed) under the line: the z slope solved with
-    the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2 (on a
-    slope or a profile z_b and k at each node, its horizontal push slope_load.py)."""
+    """A flat elastic seabed (environment.Seabed) under the line: the z slope solved with
+    the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2."""
 
     slope_components = (2,)
     in_newton = False           # its gradient and Hessian are not in the Newton steps yet
@@ -120,8 +119,6 @@ class SeabedTerm(NodalLoadTerm):
 
     def solve_slope(self, rhs, state, bordered):
         """z' from the vertical problem with the contact (seabed.SeabedContact.solve)."""
-        if not self.seabed.flat:        # z_b and k under the nodes of the last step
-            self.contact.follow(state.r.ghosted())
         self.y = self.contact.solve(rhs.components[2], state.slope.components[2])
         if bordered:
             state.chord_multiplier[2] = self.vertical.end_residual()
@@ -138,10 +135,10 @@ class SeabedTerm(NodalLoadTerm):
 
     def node_loads(self, state):
         loads = np.zeros((self.mesh.n_local_nodes, 3))
-        if self.seabed.flat or self.y is None:
+        if self.seabed.flat or self.contact.solution is None:
             loads[:, 2] = self.seabed.force(state.node_positions())[:, 2]
-        else:                           # the reaction the vertical problem carried
-            loads[:, 2] = self.contact.node_force(self.y)[:, 2]
+        else:                           # a slope: the reaction the vertical problem carried
+            loads[:, 2] = self.contact.node_force()[:, 2]
         return loads
 
     def _destroy_vertical(self):
