@@ -9,9 +9,19 @@ seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
 * ``Plane``: z_b = z0 + tan(alpha) d, alpha the largest upward slope (rad; negative:
   the seabed falls along e), constant across e. gradient g = tan(alpha) e.
 * ``Profile``: z_b = the linear interpolant of the rows (d_i, z_i), d_i strictly
-  increasing, constant across e and beyond the first and last rows; on a row's
-  segment g = (z_i+1 - z_i) / (d_i+1 - d_i) e (the segment ahead at a row, 0 beyond
-  the rows). ``covers`` tells whether a point lies within the rows.
+  increasing, constant across e and beyond the first and last rows. Its gradient is
+  the secant over a width delta = SMOOTHING times the closest rows' spacing,
+  g = (z_b(d + delta/2) - z_b(d - delta/2)) / delta e: the segment's slope away from the
+  rows, and turning linearly from one segment's to the next over delta about a row
+  (and to 0 about the first and last). Why: the contact's horizontal push is lagged
+  (slope_load.py), and with the slope jumping at a row a node there flips between the
+  two pushes from one iteration to the next and the iteration never settles (measured:
+  a line pushed over the edge of a grid's slope stalled at a change of 1e-5); a
+  gradient continuous in the position gives it a fixed point. ``covers`` tells whether
+  a point lies within the rows.
+* ``Grid``: bilinear in each cell of a rectangular grid, its gradient the secant over
+  SMOOTHING times the closest grid lines' spacing along x and along y, for the same
+  reason.
 
 The unit normal pointing up out of the seabed is (-g, 1) / sqrt(1 + |g|^2), and the
 local slope atan |g|. Heights in m, in whichever frame the shape was made in
@@ -21,6 +31,10 @@ local slope atan |g|. Heights in m, in whichever frame the shape was made in
 from dataclasses import dataclass
 
 import numpy as np
+
+# The width over which a profile's or grid's slope turns at a row or grid line, of the
+# closest rows' spacing (module docstring).
+SMOOTHING = 0.1
 
 
 def unit_normal(gradient):
@@ -89,11 +103,12 @@ class Profile:
         return np.interp(self.along(x, y), self.distances, self.heights)
 
     def gradient(self, x, y):
+        """The secant slope over SMOOTHING times the closest rows' spacing along e
+        (module docstring), (shape of x) + (2,)."""
         d = self.along(x, y)
-        segment = np.clip(np.searchsorted(self.distances, d, side="right") - 1, 0,
-                          self.distances.size - 2)
-        slope = (np.diff(self.heights) / np.diff(self.distances))[segment]
-        slope = np.where((d < self.distances[0]) | (d >= self.distances[-1]), 0.0, slope)
+        half = 0.5 * SMOOTHING * np.min(np.diff(self.distances))
+        slope = (np.interp(d + half, self.distances, self.heights)
+                 - np.interp(d - half, self.distances, self.heights)) / (2 * half)
         return slope[..., None] * self.direction
 
     def normal(self, x, y):
@@ -115,10 +130,10 @@ class Grid:
     and ``ys`` (ny,), strictly increasing, measured from ``origin`` (2,) along +x and +y
     (a 3-D bathymetry: OrcaFlex's 3D seabed, Flexcom's 3D profile, on a regular grid).
     In a cell, with (s, t) in [0, 1]^2 the position's fractions,
-    z_b = (1-s)(1-t) z00 + s(1-t) z10 + (1-s) t z01 + s t z11, and its gradient is that
-    of this bilinear form (continuous across the cells' edges in the height, not in the
-    slope). Level beyond the grid's edges at the nearest edge's heights (gradient 0
-    across it); ``covers`` tells whether a point lies within it."""
+    z_b = (1-s)(1-t) z00 + s(1-t) z10 + (1-s) t z01 + s t z11; level beyond the grid's
+    edges at the nearest edge's heights; its gradient the secant of the module
+    docstring (the bilinear form's own slope inside a cell away from its edges);
+    ``covers`` tells whether a point lies within it."""
 
     origin: np.ndarray
     xs: np.ndarray
@@ -126,8 +141,8 @@ class Grid:
     heights: np.ndarray
 
     def _cell(self, x, y):
-        """(i, j, s, t, inside_x, inside_y): cell indices and fractions, clipped to the
-        grid, and whether the point lies within it along x and y."""
+        """(i, j, s, t): cell indices and fractions, clipped to the grid (level
+        beyond it)."""
         u = np.asarray(x, dtype=float) - self.origin[0]
         v = np.asarray(y, dtype=float) - self.origin[1]
         i = np.clip(np.searchsorted(self.xs, u, side="right") - 1, 0, self.xs.size - 2)
@@ -135,23 +150,23 @@ class Grid:
         dx, dy = self.xs[i + 1] - self.xs[i], self.ys[j + 1] - self.ys[j]
         s = np.clip((u - self.xs[i]) / dx, 0.0, 1.0)
         t = np.clip((v - self.ys[j]) / dy, 0.0, 1.0)
-        inside_x = (u >= self.xs[0]) & (u < self.xs[-1])
-        inside_y = (v >= self.ys[0]) & (v < self.ys[-1])
-        return i, j, s, t, inside_x, inside_y
+        return i, j, s, t
 
     def height(self, x, y):
-        i, j, s, t, _, _ = self._cell(x, y)
+        i, j, s, t = self._cell(x, y)
         z = self.heights
         return ((1 - s) * (1 - t) * z[i, j] + s * (1 - t) * z[i + 1, j]
                 + (1 - s) * t * z[i, j + 1] + s * t * z[i + 1, j + 1])
 
     def gradient(self, x, y):
-        i, j, s, t, inside_x, inside_y = self._cell(x, y)
-        z = self.heights
-        dx, dy = self.xs[i + 1] - self.xs[i], self.ys[j + 1] - self.ys[j]
-        gx = ((1 - t) * (z[i + 1, j] - z[i, j]) + t * (z[i + 1, j + 1] - z[i, j + 1])) / dx
-        gy = ((1 - s) * (z[i, j + 1] - z[i, j]) + s * (z[i + 1, j + 1] - z[i + 1, j])) / dy
-        return np.stack([np.where(inside_x, gx, 0.0), np.where(inside_y, gy, 0.0)], axis=-1)
+        """The secant slopes over SMOOTHING times the closest grid lines' spacing along
+        x and y (module docstring), (shape of x) + (2,)."""
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        hx = 0.5 * SMOOTHING * np.min(np.diff(self.xs))
+        hy = 0.5 * SMOOTHING * np.min(np.diff(self.ys))
+        gx = (self.height(x + hx, y) - self.height(x - hx, y)) / (2 * hx)
+        gy = (self.height(x, y + hy) - self.height(x, y - hy)) / (2 * hy)
+        return np.stack([gx, gy], axis=-1)
 
     def normal(self, x, y):
         return unit_normal(self.gradient(x, y))

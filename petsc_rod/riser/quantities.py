@@ -10,7 +10,9 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   angle of its tangent from the vertical (degrees);
 * the touchdown point: where the line, followed from the top, first reaches the seabed
   (the gap z - z_b(x, y) changes sign between two vertices, interpolated linearly), its
-  arc length and position; the grounded length, the length of line below z_b;
+  arc length and position; the grounded length, the length of line below z_b; on a
+  seabed profile or grid, the number of vertices beyond its rows, where it is taken
+  level (``seabed_vertices_beyond``, said in the step line when not 0);
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
   and where they occur.
 
@@ -27,7 +29,8 @@ from petsc_rod.scenes.boundary import is_held
 DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m", "seabed_height": "m"}
 ATTRIBUTE_UNITS = {
     "top_tension": "N", "top_angle": "deg", "touchdown_S": "m", "touchdown_position": "m",
-    "grounded_length": "m", "max_curvature": "1/m", "max_curvature_S": "m",
+    "grounded_length": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
+    "max_curvature_S": "m",
     "max_curvature_position": "m", "min_bend_radius": "m"}
 
 
@@ -163,6 +166,14 @@ def riser_report(problem, vertex, seabed=None):
         attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
+        if not seabed.seabed.flat:       # a profile or grid taken level beyond its rows
+            r = vertex["r"]
+            beyond = int(mesh.global_sum(int(np.sum(~seabed.seabed.shape.covers(r[:, 0],
+                                                                                r[:, 1])))))
+            attributes["seabed_vertices_beyond"] = beyond
+            if beyond:
+                text += (f", {beyond} vertices beyond the seabed profile's rows (taken level "
+                         "there: extend -rod_seabed_profile)")
     text += (f", largest curvature {kappa:.4g} 1/m (bend radius "
              f"{attributes['min_bend_radius']:.4g} m) at S = {kappa_S:.6g} m")
     return TermOutput(datasets, attributes, text)

@@ -162,3 +162,18 @@ def test_a_grid_gives_the_plane_it_samples(tmp_path):
         assert np.abs(f["r"][:] - g["r"][:]).max() < 1e-9
         assert f["r"][:, 1].min() < -0.01
         assert g["parameters"].attrs["seabed_profile_table"].shape == (9, 3)
+
+
+def test_vertices_beyond_a_profile_are_counted_and_said(tmp_path):
+    """A level grid 2 cm wide across the line's plane and a current across it: the
+    grounded part drifts out of the grid (1.56 m sideways at the touchdown point), where
+    the seabed is taken level; the step line and the file say how many vertices lie
+    beyond it."""
+    grid = write(tmp_path, "narrow.txt", "-1 -0.01 0\n-1 0.01 0\n8 -0.01 0\n8 0.01 0\n")
+    path, text = solved(tmp_path, "narrow", ["-rod_seabed_profile", grid, "-rod_current",
+                                             "0,0.2,0", "-rod_drag", "1025,1.2,0.05"])
+    with h5py.File(path, "r") as f:
+        beyond = int(f.attrs["seabed_vertices_beyond"])
+        y = f["r"][:, 1]
+    assert beyond == int(np.sum(np.abs(y) > 0.01)) > 10
+    assert f"{beyond} vertices beyond the seabed profile's rows" in text

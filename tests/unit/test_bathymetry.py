@@ -29,15 +29,21 @@ def test_a_plane_rises_at_its_slope_along_its_direction():
     assert np.abs(moved.height(x - 10.0, y + 3.0) - (plane.height(x, y) - 7.0)).max() < 1e-12
 
 
-def test_a_profile_is_its_rows_linear_in_between_and_level_beyond():
+def test_a_profile_is_its_rows_linear_in_between_and_level_beyond_its_slope_smoothed():
     e = np.array([0.6, 0.8])
     profile = Profile(np.zeros(2), e, np.array([0.0, 10.0, 30.0]), np.array([1.0, 3.0, 2.0]))
     d = np.array([-5.0, 0.0, 5.0, 10.0, 20.0, 30.0, 40.0])
     x, y = d * e[0] + 7.0 * e[1], d * e[1] - 7.0 * e[0]        # 7 m across the direction
     assert np.allclose(profile.height(x, y), [1.0, 1.0, 2.0, 3.0, 2.5, 2.0, 2.0],
                        rtol=0, atol=1e-14)
+    # the segments' slopes away from the rows; about a row (SMOOTHING x 10 m = 1 m wide)
+    # the secant turns from one to the next: halfway at the row itself
     slopes = profile.gradient(x, y) @ e
-    assert np.allclose(slopes, [0.0, 0.2, 0.2, -0.05, -0.05, 0.0, 0.0], rtol=0, atol=1e-15)
+    assert np.allclose(slopes, [0.0, 0.1, 0.2, 0.075, -0.05, -0.025, 0.0], rtol=0,
+                       atol=1e-15)
+    d = np.linspace(-1.0, 1.0, 2001)                    # continuous across the row d = 0
+    # a ramp of 0.2 over 1 m: 2e-4 per step of 1 mm
+    assert np.abs(np.diff(profile.gradient(d * e[0], d * e[1]) @ e)).max() <= 2e-4 + 1e-15
     assert np.abs(profile.gradient(x, y) @ np.array([-e[1], e[0]])).max() < 1e-16
     assert list(profile.covers(x, y)) == [False] + [True] * 5 + [False]
 
@@ -46,14 +52,17 @@ def test_a_grid_is_bilinear_and_exact_on_a_plane():
     xs, ys = np.array([-20.0, -5.0, 3.0, 20.0]), np.array([-20.0, 0.0, 20.0])
     a, b = 0.07, -0.03
     grid = Grid(np.zeros(2), xs, ys, 1.0 + a * xs[:, None] + b * ys[None, :])
-    x, y = POINTS.T
+    x, y = 0.9 * POINTS.T       # inside: the secant of the gradient does not reach the edge
     assert np.abs(grid.height(x, y) - (1.0 + a * x + b * y)).max() < 1e-14
-    assert np.abs(grid.gradient(x, y) - [a, b]).max() < 1e-15
+    assert np.abs(grid.gradient(x, y) - [a, b]).max() < 1e-13
+    # across the edge x = 20 the slope along x turns to 0 over 0.8 m (SMOOTHING x 8 m)
+    assert grid.gradient(20.0, 0.0)[0] == pytest.approx(a / 2, abs=1e-13)
+    assert grid.gradient(20.5, 0.0)[0] == 0.0
     # in one cell, the bilinear form's cross term
     saddle = Grid(np.zeros(2), np.array([0.0, 1.0]), np.array([0.0, 1.0]),
                   np.array([[0.0, 0.0], [0.0, 1.0]]))
     assert saddle.height(0.5, 0.25) == pytest.approx(0.125, abs=1e-16)
-    assert np.allclose(saddle.gradient(0.5, 0.25), [0.25, 0.5], rtol=0, atol=1e-16)
+    assert np.allclose(saddle.gradient(0.5, 0.25), [0.25, 0.5], rtol=0, atol=1e-15)
     assert not saddle.covers(1.5, 0.5) and saddle.covers(1.0, 0.0)
 
 
