@@ -23,6 +23,15 @@ def read_text(path, option):
         raise RodInputError(f"{option} {path}: cannot be read ({error.strerror})") from None
 
 
+def numbered_rows(path, option):
+    """[(line number from 1, words)] of the non-empty rows of the file ``path`` given to
+    ``option``: '#' starts a comment, whitespace or commas separate the words."""
+    lines = read_text(path, option).splitlines()
+    rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
+            for k, line in enumerate(lines)]
+    return [(k, row) for k, row in rows if row]
+
+
 def read_table(path, option, required, optional=(), text=("name",), content=None):
     """{column: values} from the file ``path`` given to ``option`` (or its ``content``,
     already read: a result file's copy): float arrays (m,), or lists of str for the

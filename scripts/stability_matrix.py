@@ -282,6 +282,27 @@ def check_current_catenary(speed, bound):
     return check
 
 
+# A sloping seabed (docs/riser.md §1a, §3a): the riser above on a plane rising (or
+# falling) along +x, the plane of its ends, against the catenary on an incline
+# (validation/incline_catenary.py), 20 m away from the touchdown point and the ends.
+SEABED_PROFILE = "scripts/matrix_seabed_profile.txt"
+
+
+def check_incline(slope_deg, bound):
+    from petsc_rod.validation.incline_catenary import incline_catenary
+    line = incline_catenary(1800.0, 1200.0, np.radians(slope_deg), 1157.0, 1000.0)
+
+    def check(result):
+        S = result["S"]
+        x, z, _, _ = line.at(S)
+        away = ((np.abs(S - line.grounded) > RISER_ZONE) & (S > RISER_ZONE)
+                & (S < 1800.0 - RISER_ZONE))
+        exact = np.stack([x, np.zeros_like(x), z], axis=1)
+        return (max_error(result["r"][away], exact[away]), bound,
+                "r vs the catenary on an incline, 20 m from the touchdown and the ends, m")
+    return check
+
+
 # Lines of line types and stretch (issue 22): the riser above, extensible, with EA / EI
 # from 1e2 to 1e6 per m^2 (EA 1e7 N, 15 % stretch at the top, to 1e9 N, 0.15 %; EI at
 # most 1e5 N m^2, a bending length of 0.4 m), against the elastic catenary with
@@ -447,6 +468,20 @@ def cases():
     add(Case("riser", "lazy wave (options/lazy_wave.opts)",
              {"options_file": "options/lazy_wave.opts", "elements": 2000}, ranks=2,
              notes="no closed form"))
+    # a sloping or profiled seabed (docs/riser.md §3a)
+    for deg in (3.0, 5.0, -5.0):
+        add(Case("seabed", f"catenary riser, seabed sloping {deg:g} deg along its plane",
+                 riser(seabed_slope=deg), check_incline(deg, 2e-3), ranks=2,
+                 notes="rising toward the top" if deg > 0 else "falling toward the top"))
+    add(Case("seabed", "catenary riser, seabed profile of the 3 deg plane",
+             {k: v for k, v in riser(seabed_profile=SEABED_PROFILE).items() if k != "seabed"},
+             check_incline(3.0, 2e-3),
+             notes="21 rows"))
+    add(Case("seabed", "catenary riser, seabed sloping 3 deg across its plane",
+             riser(seabed_slope=3, seabed_direction=90), ranks=2,
+             notes="no closed form; the grounded part slides down the slope"))
+    add(Case("seabed", "catenary riser, 3 deg slope, straight start, 1 step",
+             riser(seabed_slope=3, initial_shape="straight"), check_incline(3.0, 2e-3)))
     # lines of line types and stretch (issue 22)
     for stiffness, axial in ((1e5, 1e7), (1e5, 1e9), (1e3, 1e9)):
         add(Case("lines", f"riser, EA / EI = {axial / stiffness:.0e} per m^2",

@@ -72,8 +72,9 @@ def short_stability(report):
 
 def riser_text(attributes):
     """The engineer's numbers of a riser step (riser/quantities.py, in ``attributes``):
-    top tension (kN) and its angle from the vertical, the touchdown's S and the smallest
-    bend radius; '' for a scene without them."""
+    top tension (kN) and its angle from the vertical, the touchdown's S (and the
+    vertices beyond a seabed profile's rows, where there are any) and the smallest bend
+    radius; '' for a scene without them."""
     if "top_tension" not in attributes:
         return ""
     text = (f"; top tension {attributes['top_tension'] / 1e3:.6g} kN at "
@@ -81,6 +82,9 @@ def riser_text(attributes):
     if "touchdown_S" in attributes:
         S = attributes["touchdown_S"]
         text += (f", touchdown S = {S:.6g} m" if S == S else ", no touchdown")
+    beyond = attributes.get("seabed_vertices_beyond", 0)
+    if beyond:                          # riser/quantities.py: a profile taken level there
+        text += f", {beyond} vertices beyond the seabed profile's rows (level there)"
     return text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
 
 

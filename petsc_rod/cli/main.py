@@ -28,6 +28,7 @@ from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
                                          scene_from_options, settings_from_options)
 from petsc_rod.cli.session import run_continuation
+from petsc_rod.riser.environment import read_seabed_profile
 from petsc_rod.tables import read_text
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.iteration.continuation import PathSettings
@@ -365,6 +366,9 @@ def options_in_effect(values, solver, start):
         parameters["current_profile_table"] = np.column_stack([current.depths,
                                                                current.velocities])
         units["current_profile_table"] = "m, m/s, m/s, m/s (depth, ux, uy, uz)"
+    if values["rod_seabed_profile"]:            # the seabed profile itself, to repeat the run
+        parameters["seabed_profile_table"] = read_seabed_profile(values["rod_seabed_profile"])
+        units["seabed_profile_table"] = "m (distance, height; or x, y, height)"
     if values["rod_line_types"]:                # the line types' table, to repeat the run
         parameters["line_types_table"] = read_text(values["rod_line_types"],
                                                    "-rod_line_types")

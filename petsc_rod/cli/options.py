@@ -112,6 +112,10 @@ POSITIVE = (lambda v: np.all(np.asarray(v) > 0), "must be positive")
 SCALE = (lambda v: np.all(np.asarray(v) >= 1 / MAX_MAGNITUDE),
          f"must be positive (at least {1 / MAX_MAGNITUDE:g})")
 NON_NEGATIVE = (lambda v: np.all(np.asarray(v) >= 0), "must not be negative")
+# a seabed slope, degrees: a plane at 90 degrees or more is a wall, not a seabed
+SLOPE = (lambda v: abs(v) < 90, "must lie strictly between -90 and 90 degrees (a "
+         "seabed's slope above the horizontal; moderate slopes, a few degrees, are the "
+         "model's range)")
 # a stopping tolerance: a change or residual of 1 or more would accept any iterate
 TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
              f"must be positive (at least {1 / MAX_MAGNITUDE:g}) and below 1: a tolerance of "
@@ -219,6 +223,24 @@ OPTIONS = [
            "seabed stiffness, N/m per m of line per m of penetration; default w / "
            f"{DEFAULT_PENETRATION * 1e3:g} mm, w the largest downward -rod_load (N/m)", SCALE,
            "N/m^2"),
+    Option("rod_seabed_slope", _real, None, "deg",
+           "the seabed a plane rising at this angle (degrees above the horizontal, "
+           "negative: falling) along -rod_seabed_direction, through the height -rod_seabed "
+           "at -rod_seabed_origin; the contact acts normal to it", SLOPE, "deg"),
+    Option("rod_seabed_direction", _reals(), None, "azimuth|dx,dy",
+           "direction of the seabed's slope (upward) or profile: an azimuth, degrees from "
+           "+x toward +y (anticlockwise seen from above), or a horizontal vector; default "
+           "+x", unit="deg or 1"),
+    Option("rod_seabed_origin", _reals(2), None, "x,y",
+           "the seabed origin, m (absolute): where -rod_seabed gives the height of a "
+           "sloping seabed and a profile's distances start; default 0,0", unit="m"),
+    Option("rod_seabed_profile", _string, None, "FILE",
+           "seabed profile: rows 'distance height' (m; '#' comments, commas allowed) along "
+           "-rod_seabed_direction from -rod_seabed_origin, distances strictly increasing, "
+           "heights absolute (z up), linear in between; or a grid, rows 'x y height' (x, y "
+           "from -rod_seabed_origin, every x with every y), bilinear; in place of "
+           "-rod_seabed",
+           unit="text"),
     Option("rod_current", _reals(3), None, "ux,uy,uz",
            "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),
     Option("rod_current_profile", _string, None, "FILE",

@@ -9,9 +9,11 @@ from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
+from petsc_rod.riser.bathymetry import Grid, Plane, Profile
 from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
-                                         check_ends_above, default_stiffness,
-                                         largest_stiffness, read_profile)
+                                         check_covered, check_ends_above, default_stiffness,
+                                         grid_axes, largest_stiffness, read_profile,
+                                         read_seabed_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
@@ -57,13 +59,15 @@ def point_loads_from_options(values, length, points=None):
             sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
 
 
-def scene_from_options(values, given, profile=None, line_types=None, points=None):
+def scene_from_options(values, given, profile=None, line_types=None, points=None,
+                       seabed_rows=None):
     """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
     rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
     ``points`` (S, forces, drag areas) the point loads when already resolved (a result
-    file's point_loads_table)."""
+    file's point_loads_table); ``seabed_rows`` (n, 2 or 3) the seabed profile's or grid's
+    rows when already read (a result file's seabed_profile_table)."""
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
@@ -98,7 +102,8 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
                   point_load_drag_areas=point_areas,
                   water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
-    scene.seabed, scene.current = environment_from_options(values, given, scene, profile)
+    scene.seabed, scene.current = environment_from_options(values, given, scene, profile,
+                                                           seabed_rows)
     pressures_from_options(values, given, scene)
     check_taut(scene)
     check_applied_forces(scene, given)
@@ -313,12 +318,70 @@ def checked_default_penalty(scene):
     return scales[name]
 
 
-def seabed_from_options(values, given, load_values):
-    """The Seabed of -rod_seabed and -rod_seabed_stiffness, or None."""
-    if "rod_seabed" not in given:
-        if "rod_seabed_stiffness" in given:
-            raise RodInputError("-rod_seabed_stiffness needs -rod_seabed (the height of the "
-                                "seabed plane)")
+# The options that shape the seabed (riser/bathymetry.py, docs/riser.md §1a).
+SEABED_SHAPE = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin",
+                "rod_seabed_profile")
+
+
+def seabed_direction(values):
+    """The unit horizontal vector of -rod_seabed_direction (an azimuth in degrees, or a
+    vector dx,dy), default +x."""
+    given = values["rod_seabed_direction"]
+    if given is None:
+        return np.array([1.0, 0.0])
+    given = np.asarray(given, dtype=float)
+    if given.size == 1:
+        angle = np.radians(given[0])
+        return np.array([np.cos(angle), np.sin(angle)])
+    norm = float(np.hypot(*given)) if given.size == 2 else 0.0
+    if given.size != 2 or norm == 0:
+        raise RodInputError(f"-rod_seabed_direction {','.join(f'{v:g}' for v in given)}: give "
+                            "an azimuth in degrees (one number) or a horizontal vector dx,dy "
+                            "(two numbers, not both 0)")
+    return given / norm
+
+
+def seabed_shape(values, given, origin, profile_rows=None):
+    """The bathymetry.Plane or Profile of the seabed options in the scene's frame (its
+    origin at ``origin`` (3,), absolute), or None for a flat seabed (no slope, or a slope
+    of 0: today's plane z = -rod_seabed, bit for bit). ``profile_rows`` the profile's or
+    grid's rows (n, 2 or 3), heights absolute, when already read (a result file's
+    seabed_profile_table)."""
+    profile = "rod_seabed_profile" in given or profile_rows is not None
+    if profile and ("rod_seabed" in given or "rod_seabed_slope" in given):
+        raise RodInputError("-rod_seabed_profile gives the seabed's heights: drop "
+                            "-rod_seabed and -rod_seabed_slope, or the profile")
+    direction = seabed_direction(values)
+    seabed_origin = np.asarray(values["rod_seabed_origin"] if values["rod_seabed_origin"]
+                               is not None else (0.0, 0.0), dtype=float)
+    if profile:
+        table = np.asarray(profile_rows if profile_rows is not None else
+                           read_seabed_profile(values["rod_seabed_profile"], MAX_MAGNITUDE),
+                           dtype=float)
+        if table.shape[1] == 2:
+            return Profile(seabed_origin, direction, table[:, 0], table[:, 1]).moved(origin)
+        if "rod_seabed_direction" in given:
+            raise RodInputError("-rod_seabed_direction: a grid's rows give x and y (from "
+                                "-rod_seabed_origin); drop the direction")
+        xs, ys, heights = grid_axes(table, RodInputError)
+        return Grid(seabed_origin, xs, ys, heights).moved(origin)
+    slope = values["rod_seabed_slope"]
+    if slope is None or slope == 0:
+        return None
+    return Plane.sloping(seabed_origin, values["rod_seabed"], slope,
+                         direction).moved(origin)
+
+
+def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_rows=None):
+    """The Seabed of -rod_seabed (or -rod_seabed_profile), its shape's options and
+    -rod_seabed_stiffness, or None; heights in the scene's frame (its origin at
+    ``origin`` (3,), absolute; -rod_seabed already less origin[2])."""
+    if "rod_seabed" not in given and "rod_seabed_profile" not in given and (
+            profile_rows is None):
+        for name in ("rod_seabed_stiffness",) + SEABED_SHAPE:
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_seabed (the seabed's height) or "
+                                    "-rod_seabed_profile")
         return None
     stiffness = values["rod_seabed_stiffness"]
     if stiffness is None:
@@ -326,7 +389,13 @@ def seabed_from_options(values, given, load_values):
         if stiffness is None:
             raise RodInputError("-rod_seabed: no -rod_load points down to set the default "
                                 "stiffness (weight / 1 mm); give -rod_seabed_stiffness")
-    return Seabed(float(values["rod_seabed"]), float(stiffness))
+    absolute = dict(values)
+    if values["rod_seabed"] is not None:
+        absolute["rod_seabed"] = values["rod_seabed"] + origin[2]
+    shape = seabed_shape(absolute, given, origin, profile_rows)
+    if shape is None:
+        return Seabed(float(values["rod_seabed"]), float(stiffness))
+    return Seabed(float(shape.height(0.0, 0.0)), float(stiffness), shape)
 
 
 def current_from_options(values, given, surface_default, profile_rows=None,
@@ -372,18 +441,25 @@ def current_from_options(values, given, surface_default, profile_rows=None,
     return Current.morison(depths, velocities, surface, *values["rod_drag"])
 
 
-def environment_from_options(values, given, scene, profile=None):
+def environment_from_options(values, given, scene, profile=None, seabed_rows=None):
     """(Seabed or None, Current or None) for a validated ``scene``, checked against it
     (``profile``: as in current_from_options), their heights in the scene's frame (the
-    options' less the start's z, docs/method.md §5)."""
+    options' less the start's z, docs/method.md §5); ``seabed_rows`` the seabed
+    profile's or grid's rows when already read."""
     z0 = float(scene.start_position[2])
     values = dict(values)
     for name in ("rod_seabed", "rod_sea_surface"):
         if values[name] is not None:
             values[name] = values[name] - z0
-    seabed = seabed_from_options(values, given, scene.load_values)
-    ends = [("-rod_start", scene.start_state(t)) for t in (0.0, 1.0)]
-    ends += [("-rod_end", scene.end_state(t)) for t in (0.0, 1.0)]
+    seabed = seabed_from_options(values, given, scene.load_values, scene.start_position,
+                                 seabed_rows)
+    # a flat seabed: also the unloaded reference's ends (straight along e_x on it); a
+    # sloping one crosses that line, so only the loaded ends are held to it
+    loads = (0.0, 1.0) if seabed is None or seabed.flat else (1.0,)
+    ends = [("-rod_start", scene.start_state(t)) for t in loads]
+    ends += [("-rod_end", scene.end_state(t)) for t in loads]
+    check_covered(seabed, [state.position for _, state in ends if is_held(state)],
+                  "the held ends")
     check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
@@ -428,8 +504,9 @@ def scene_from_parameters(parameters):
         points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
         areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
         points = (points[:, 0], points[:, 1:4], areas)
+    seabed = parameters.get("seabed_profile_table")
     return scene_from_options(values, given, profile, parameters.get("line_types_table"),
-                              points)
+                              points, seabed)
 
 
 def restart_path(scene, parameters, t_file):

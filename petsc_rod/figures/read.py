@@ -27,6 +27,7 @@ class Result:
     bending_moment: np.ndarray = None    # |(m.d1, m.d2)|, N m
     curvature: np.ndarray = None         # (n, 2): in the vertical plane (+ sag), lateral
     seabed: float = None        # height of the seabed, m
+    seabed_height: np.ndarray = None     # z_b under each vertex, m: a seabed not flat
     sea_surface: float = None   # height of the sea surface, m
     anchor: int = 0             # vertex index of the lower held end
     top: int = -1               # vertex index of the higher held end (the hang-off)
@@ -70,7 +71,8 @@ def read_result(path):
         S, r, u = f["S"][:], f["r"][:], f["u"][:]
         d1, d2, d3 = f["d1"][:], f["d2"][:], f["d3"][:]
         optional = {name: f[name][:] for name in ("effective_tension", "wall_tension",
-                                                   "seabed_reaction", "bending_moment")
+                                                   "seabed_reaction", "bending_moment",
+                                                   "seabed_height")
                     if name in f}
         m, n = f["m"][:], f["n"][:]
         result = Result(
@@ -84,7 +86,7 @@ def read_result(path):
             seabed_reaction=optional.get("seabed_reaction"),
             bending_moment=optional.get("bending_moment", along.bending_moment(m, d1, d2)),
             curvature=along.curvature_components(u, d1, d2, d3),
-            seabed=number(p, "seabed"),
+            seabed=number(p, "seabed"), seabed_height=optional.get("seabed_height"),
             top_tension=number(a, "top_tension"), top_angle=number(a, "top_angle"),
             touchdown_S=number(a, "touchdown_S"),
             touchdown_position=vector(a, "touchdown_position"),

@@ -86,17 +86,29 @@ def draw_elevation(axis, result, colour=None, label=None, single=True):
 
 def draw_water(axis, result):
     """The sea surface and the seabed of ``result`` across the elevation, named on the
-    panel; the lower limit set below the seabed, the upper above the surface. The
-    elevation fills its panel: its two scales differ (the plan's are equal)."""
+    panel; the lower limit set below the seabed, the upper above the surface. A seabed
+    that is not flat (a slope, a profile) is drawn under the line, its height z_b under
+    each vertex (the file's seabed_height) against the elevation's horizontal distance.
+    The elevation fills its panel: its two scales differ (the plan's are equal)."""
     x, z = elevation_coordinates(result)
-    low = min(z.min(), result.seabed if result.seabed is not None else z.min())
+    bed = result.seabed_height
+    floor = (bed.min() if bed is not None else
+             result.seabed if result.seabed is not None else z.min())
+    low = min(z.min(), floor)
     high = max(z.max(), result.sea_surface)
     margin = 0.08 * max(high - low, 1e-9)
     axis.set_ylim(low - margin, high + margin)
     axis.axhline(result.sea_surface, color=style.SEA, lw=2, zorder=0)
     axis.text(0.5, result.sea_surface, "sea surface", color=style.SEA, va="bottom",
               ha="center", transform=axis.get_yaxis_transform(), fontsize=9)
-    if result.seabed is not None:
+    if bed is not None:
+        order = np.argsort(x, kind="stable")
+        axis.fill_between(x[order], low - 2 * margin, bed[order], color=style.SEABED_FILL,
+                          zorder=0, lw=0)
+        axis.plot(x[order], bed[order], color=style.SEABED, lw=2, zorder=0.5)
+        axis.text(x[order][-1], bed[order][-1], "seabed ", color=style.SEABED, va="top",
+                  ha="right", fontsize=9)
+    elif result.seabed is not None:
         axis.axhspan(low - 2 * margin, result.seabed, color=style.SEABED_FILL, zorder=0, lw=0)
         axis.axhline(result.seabed, color=style.SEABED, lw=2, zorder=0.5)
         axis.text(0.99, result.seabed, "seabed ", color=style.SEABED, va="top", ha="right",

@@ -31,7 +31,8 @@ from petsc_rod.riser.quantities import effective_tension
 TABLE_DATASETS = ("curvature", "bend_radius", "bending_moment", "torque", "shear",
                   "effective_tension", "wall_tension", "external_pressure",
                   "internal_pressure", "von_mises", "utilisation", "declination",
-                  "seabed_reaction", "axial_strain", "axial_tension", "section")
+                  "seabed_reaction", "seabed_height", "axial_strain", "axial_tension",
+                  "section")
 # The regions' table: its columns and the attributes they come from.
 REGION_COLUMNS = (("S_from (m)", None), ("S_to (m)", None),
                   ("max_effective_tension (N)", "region_max_tension"),

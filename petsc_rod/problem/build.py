@@ -1,11 +1,12 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
-pinned end given a rotational stiffness (physics/flex_joint.py); the seabed, the drag and
-the riser numbers only where the scene has a seabed or a current (docs/riser.md); the
-axial stretch only where some EA is finite (docs/method.md §12); the results along the
-line (riser/line_results.py) always, its regions (riser/regions.py) on a riser-like
-scene (a seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a
-line of line types with an inner diameter."""
+pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (with the
+horizontal push of a sloping one, riser/slope_load.py), the drag and the riser numbers
+only where the scene has a seabed or a current (docs/riser.md); the axial stretch only
+where some EA is finite (docs/method.md §12); the results along the line
+(riser/line_results.py) always, its regions (riser/regions.py) on a riser-like scene (a
+seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a line of
+line types with an inner diameter."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
@@ -16,6 +17,7 @@ from petsc_rod.riser.pressures import PipePressures
 from petsc_rod.riser.quantities import RiserNumbers
 from petsc_rod.riser.regions import LineRegions
 from petsc_rod.riser.section_numbers import SectionNumbers
+from petsc_rod.riser.slope_load import SeabedSlopeLoad
 from petsc_rod.riser.stresses import PipeStresses
 from petsc_rod.riser.terms import DragTerm, SeabedTerm
 
@@ -29,6 +31,8 @@ def scene_terms(mesh, scene):
     seabed = SeabedTerm(mesh, scene.seabed) if scene.seabed is not None else None
     if seabed is not None:
         terms.append(seabed)
+        if not scene.seabed.flat:               # a slope or a profile: its horizontal push
+            terms.append(SeabedSlopeLoad(mesh, seabed))
     drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
     if drag:
         terms.append(DragTerm(mesh, scene))

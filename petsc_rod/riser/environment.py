@@ -11,7 +11,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.boundary import is_held
-from petsc_rod.tables import read_text
+from petsc_rod.tables import numbered_rows, read_text
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
@@ -24,12 +24,71 @@ MIN_RELATIVE_PENETRATION = 1e-14
 
 @dataclass(frozen=True)
 class Seabed:
-    """A flat, frictionless, elastic seabed: the plane z = ``height`` (m) pushes a line
-    below it up with k (height - z) per metre of line, k = ``stiffness`` (N/m per m of
-    line per m of penetration, i.e. N/m^2)."""
+    """A frictionless, elastic seabed: the plane z = ``height`` (m), or, with a ``shape``
+    (riser/bathymetry.py: a sloping Plane or a Profile), the surface z = z_b(x, y), its
+    ``height`` then z_b under the scene's origin. It pushes a line below it out along
+    its unit normal N = (-g, 1) / sqrt(1 + |g|^2) (g = grad z_b) with k times the normal
+    penetration per metre of line, k = ``stiffness`` (N/m per m of line per m of
+    penetration, i.e. N/m^2).
+
+    With p = (z_b(x, y) - z)_+ the vertical penetration and p cos(theta) the normal one
+    (tan(theta) = |g|), the force per metre is k p cos(theta) N = k_v p (-g, 1) with
+    k_v = k / (1 + |g|^2): the vertical part k_v p, the horizontal part -k_v p g (N
+    tan(theta) downhill). It is minus the gradient of the energy k_v/2 p^2 per metre on
+    a plane (k_v constant). On the flat seabed k_v = k and the force is k p e_z."""
 
     height: float
     stiffness: float
+    shape: object = None
+
+    @property
+    def flat(self):
+        """The plane z = height (no shape)."""
+        return self.shape is None
+
+    def heights(self, x, y):
+        """z_b at horizontal positions (x, y), m, the shape of x."""
+        if self.shape is None:
+            return np.full(np.shape(x), self.height)
+        return self.shape.height(x, y)
+
+    def gradients(self, x, y):
+        """grad z_b at (x, y), (shape of x) + (2,)."""
+        if self.shape is None:
+            return np.zeros(np.shape(x) + (2,))
+        return self.shape.gradient(x, y)
+
+    def vertical_stiffness(self, gradient):
+        """k_v = k / (1 + |g|^2) (N/m^2) for gradients (..., 2)."""
+        return self.stiffness / (1.0 + np.sum(np.asarray(gradient)**2, axis=-1))
+
+    def gap(self, r):
+        """z - z_b(x, y) at positions r (..., 3), m: negative below the seabed."""
+        if self.shape is None:
+            return r[..., 2] - self.height
+        return r[..., 2] - self.shape.height(r[..., 0], r[..., 1])
+
+    def force(self, r):
+        """The seabed's force per metre on the line at positions r (n, 3), N/m, (n, 3)
+        (class docstring); on the flat seabed (0, 0, k (z_b - z)_+)."""
+        force = np.zeros(np.shape(r))
+        if self.shape is None:
+            force[:, 2] = self.stiffness * np.maximum(self.height - r[:, 2], 0.0)
+            return force
+        g = self.shape.gradient(r[:, 0], r[:, 1])
+        push = self.vertical_stiffness(g) * np.maximum(-self.gap(r), 0.0)
+        force[:, :2] = -push[:, None] * g
+        force[:, 2] = push
+        return force
+
+    def reaction(self, r):
+        """|force| (N/m) at positions r (n, 3): k times the normal penetration,
+        k (z_b - z)_+ cos(theta)."""
+        if self.shape is None:
+            return self.stiffness * np.maximum(self.height - r[:, 2], 0.0)
+        g = self.shape.gradient(r[:, 0], r[:, 1])
+        return (self.stiffness * np.maximum(-self.gap(r), 0.0)
+                / np.sqrt(1.0 + np.sum(g**2, axis=-1)))
 
 
 @dataclass(frozen=True)
@@ -126,6 +185,63 @@ def read_profile(path, largest=np.inf):
     return table[:, 0], table[:, 1:]
 
 
+def read_seabed_profile(path, largest=np.inf):
+    """The rows of a seabed profile or grid file, (n, 2) 'distance height' or (n, 3)
+    'x y height' (m; '#' starts a comment, commas allowed; x, y from the seabed origin,
+    heights absolute): every row of the same count, at least two rows, every magnitude at
+    most ``largest``; a profile's distances strictly increasing (a height for each
+    distance: the profile is a function), a grid checked by ``grid_axes``.
+    RodInputError otherwise, naming the line."""
+    def refuse(what):
+        raise RodInputError(f"-rod_seabed_profile {path}: {what}")
+
+    rows = numbered_rows(path, "-rod_seabed_profile")
+    expected = ("expected rows of 2 numbers, distance along -rod_seabed_direction from "
+                "-rod_seabed_origin (m) and height (m, z up), or of 3, x, y from the "
+                "seabed origin and height (a grid)")
+    table = []
+    for k, row in rows:
+        try:
+            values = [float(v) for v in row]
+        except ValueError:
+            refuse(f"line {k} '{' '.join(row)}': {expected}")
+        if len(values) not in (2, 3) or (table and len(values) != len(table[0][1])):
+            refuse(f"line {k} '{' '.join(row)}': {expected}, the same in every row")
+        if not np.all(np.isfinite(values)) or np.any(np.abs(values) > largest):
+            refuse(f"line {k}: a number that is not finite or above {largest:g} in "
+                   "magnitude; give distances and heights in m")
+        table.append((k, values))
+    if len(table) < 2:
+        refuse(f"needs at least 2 rows; {expected}")
+    lines_of, data = [k for k, _ in table], np.array([v for _, v in table])
+    if data.shape[1] == 3:
+        grid_axes(data, refuse)
+        return data
+    steps = np.diff(data[:, 0])
+    if np.any(steps <= 0):
+        i = int(np.flatnonzero(steps <= 0)[0])
+        refuse(f"line {lines_of[i + 1]}: distance {data[i + 1, 0]:g} m after "
+               f"{data[i, 0]:g} m; the distances must increase strictly from row to row "
+               "(a seabed profile is one height per distance; sort the rows and drop "
+               "repeated distances)")
+    return data
+
+
+def grid_axes(table, refuse):
+    """(xs (nx,), ys (ny,), heights (nx, ny)) of grid rows 'x y height' (n, 3) in any
+    order, every x with every y exactly once, at least 2 of each; else refuse(what)."""
+    xs, ys = np.unique(table[:, 0]), np.unique(table[:, 1])
+    order = np.lexsort((table[:, 1], table[:, 0]))
+    ordered = table[order]
+    if (xs.size < 2 or ys.size < 2 or len(table) != xs.size * ys.size
+            or np.any(ordered[:, 0] != np.repeat(xs, ys.size))
+            or np.any(ordered[:, 1] != np.tile(ys, xs.size))):
+        refuse(f"a grid's rows must hold every x with every y exactly once, at least 2 of "
+               f"each (found {xs.size} x values, {ys.size} y values and {len(table)} rows; "
+               f"a full grid of them has {xs.size * ys.size})")
+    return xs, ys, ordered[:, 2].reshape(xs.size, ys.size)
+
+
 def check_ends_above(seabed, ends, length, origin_z=0.0):
     """Refuse a held end below the seabed (``ends``: (name, EndState) pairs at t = 1); an
     end on it (an anchor) is fine, to round-off of the length. Heights in the scene's
@@ -133,9 +249,38 @@ def check_ends_above(seabed, ends, length, origin_z=0.0):
     if seabed is None:
         return
     for name, state in ends:
-        depth = seabed.height - state.position[2]
+        depth = -float(seabed.gap(np.asarray(state.position, dtype=float)))
         if is_held(state) and depth > 1e-12 * length:
+            below = depth + state.position[2] + origin_z
+            where = (f"-rod_seabed {seabed.height + origin_z:g}" if seabed.flat
+                     else f"the seabed is at z = {below:.6g} m there")
             raise RodInputError(
                 f"{name}: the end is held at z = {state.position[2] + origin_z:.6g} m, "
-                f"{depth:.3g} m below the seabed (-rod_seabed {seabed.height + origin_z:g}); "
-                "hold it on or above it")
+                f"{depth:.3g} m below the seabed ({where}); hold it on or above it")
+
+
+def check_covered(seabed, points, what, option="-rod_seabed_profile"):
+    """Refuse a seabed profile that does not reach under ``points`` (n, 3), positions in
+    the scene's frame that the line must lie over (its held ends, its start's nodes):
+    ``what`` names them in the message."""
+    if seabed is None or seabed.flat:
+        return
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    outside = ~seabed.shape.covers(points[:, 0], points[:, 1])
+    if np.any(outside):
+        shape = seabed.shape
+        if hasattr(shape, "xs"):
+            u, v = points[:, 0] - shape.origin[0], points[:, 1] - shape.origin[1]
+            raise RodInputError(
+                f"{option}: the grid covers x from {shape.xs[0]:g} to {shape.xs[-1]:g} m "
+                f"and y from {shape.ys[0]:g} to {shape.ys[-1]:g} m from the seabed origin "
+                f"but {what} lie at x from {u.min():.6g} to {u.max():.6g} m, y from "
+                f"{v.min():.6g} to {v.max():.6g} m; extend the grid to cover the line's "
+                "footprint")
+        d = shape.along(points[:, 0], points[:, 1])
+        low, high = float(d.min()), float(d.max())
+        raise RodInputError(
+            f"{option}: the profile's distances run from {shape.distances[0]:g} to "
+            f"{shape.distances[-1]:g} m but {what} lie from {low:.6g} to {high:.6g} m along "
+            "its direction from the seabed origin; extend the profile's rows to cover the "
+            "line's footprint")

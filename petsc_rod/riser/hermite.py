@@ -124,6 +124,15 @@ class VerticalProblem:
         self.added_rhs.assemble()
         self._constrain()
 
+    def set_added_rhs(self, element_vectors):
+        """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added
+        matrix kept (a seabed whose heights moved but not its springs)."""
+        self.added_rhs.zeroEntries()
+        if len(self.rows):
+            self.added_rhs.setValues(self.rows.ravel(), np.ravel(element_vectors),
+                                     addv=PETSc.InsertMode.ADD_VALUES)
+        self.added_rhs.assemble()
+
     def _constrain(self):
         self.matrix.copy(self.constrained, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.constrained.zeroRowsColumns(self.fixed, diag=1.0)

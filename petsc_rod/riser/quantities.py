@@ -2,13 +2,17 @@
 vectorised on each rank's owned vertices and elements, combined by MPI reductions.
 
 * effective tension n.t (N), t = d3 / |d3| the unit tangent, and the seabed reaction k (z_b - z)_+ (N/m) at the vertices
-  (datasets ``effective_tension``, ``seabed_reaction``). With the submerged weight as the
+  (datasets ``effective_tension``, ``seabed_reaction``; on a seabed that is not flat the
+  reaction is the normal force k (z_b - z)_+ cos(theta), environment.Seabed.reaction,
+  and ``seabed_height`` z_b(x, y) under each vertex, m, absolute). With the submerged weight as the
   load, n.d3 is the effective tension of riser practice.
 * the top: the held end that is higher (S = L on a tie); its tension |n| (N) and the
   angle of its tangent from the vertical (degrees);
 * the touchdown point: where the line, followed from the top, first reaches the seabed
-  (the height crosses z_b between two vertices, interpolated linearly), its arc length
-  and position; the grounded length, the length of line below z_b;
+  (the gap z - z_b(x, y) changes sign between two vertices, interpolated linearly), its
+  arc length and position; the grounded length, the length of line below z_b; on a
+  seabed profile or grid, the number of vertices beyond its rows, where it is taken
+  level (``seabed_vertices_beyond``, said in the step line when not 0);
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
   and where they occur.
 
@@ -22,10 +26,11 @@ from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.scenes.boundary import is_held
 
 # Units of the datasets and attributes this module adds to the result file.
-DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m"}
+DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m", "seabed_height": "m"}
 ATTRIBUTE_UNITS = {
     "top_tension": "N", "top_angle": "deg", "touchdown_S": "m", "touchdown_position": "m",
-    "grounded_length": "m", "max_curvature": "1/m", "max_curvature_S": "m",
+    "grounded_length": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
+    "max_curvature_S": "m",
     "max_curvature_position": "m", "min_bend_radius": "m"}
 
 
@@ -86,7 +91,7 @@ def touchdown(problem, seabed, top):
     ghosted = problem.state.r.ghosted()[:, 0]
     left = mesh.element_local
     r0, r1 = ghosted[left], ghosted[left + 1]
-    gap0, gap1 = r0[:, 2] - seabed.height, r1[:, 2] - seabed.height
+    gap0, gap1 = seabed.gap(r0), seabed.gap(r1)
     S0, S1 = mesh.element_S, mesh.element_S + mesh.element_h
     # the fraction of each element below the seabed, with its heights linear in S: 1 or 0
     # when both ends are on one side, else the crossing's gap0 / (gap0 - gap1) from the
@@ -114,8 +119,8 @@ def touchdown(problem, seabed, top):
         pick = np.argmin(S) if top == 0 else np.argmax(S)
         local = (S[pick], position[pick])
     found = _extreme(mesh, local[0], local, largest=top == 1)
-    end_z = _at_vertex(mesh, problem.state.r.owned()[:, 0, 2], top * mesh.n_elements)
-    if end_z < seabed.height:          # the line lies on the seabed up to the top
+    end_gap = _at_vertex(mesh, seabed.gap(problem.state.r.owned()[:, 0]), top * mesh.n_elements)
+    if end_gap < 0:                    # the line lies on the seabed up to the top
         found = (top * mesh.length,
                  _at_vertex(mesh, problem.state.r.owned()[:, 0], top * mesh.n_elements))
     if found is None:
@@ -130,8 +135,13 @@ def riser_report(problem, vertex, seabed=None):
     mesh = problem.mesh
     z = vertex["r"][:, 2]
     tension = effective_tension(vertex)
-    reaction = seabed.pressure(z) if seabed is not None else np.zeros_like(z)
+    reaction = (seabed.seabed.reaction(vertex["r"]) if seabed is not None
+                else np.zeros_like(z))
     datasets = {"effective_tension": tension, "seabed_reaction": reaction}
+    if seabed is not None and not seabed.seabed.flat:
+        r = vertex["r"]
+        datasets["seabed_height"] = (seabed.seabed.heights(r[:, 0], r[:, 1])
+                                     + problem.scene.start_position[2])
     top = top_end(problem)
     index = top * mesh.n_elements
     top_force = _at_vertex(mesh, vertex["n"], index)
@@ -156,6 +166,14 @@ def riser_report(problem, vertex, seabed=None):
         attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
+        if not seabed.seabed.flat:       # a profile or grid taken level beyond its rows
+            r = vertex["r"]
+            beyond = int(mesh.global_sum(int(np.sum(~seabed.seabed.shape.covers(r[:, 0],
+                                                                                r[:, 1])))))
+            attributes["seabed_vertices_beyond"] = beyond
+            if beyond:
+                text += (f", {beyond} vertices beyond the seabed profile's rows (taken level "
+                         "there: extend -rod_seabed_profile)")
     text += (f", largest curvature {kappa:.4g} 1/m (bend radius "
              f"{attributes['min_bend_radius']:.4g} m) at S = {kappa_S:.6g} m")
     return TermOutput(datasets, attributes, text)

@@ -11,7 +11,16 @@ convex and piecewise quadratic in the Hermite dofs y of the vertical problem
 Lagrangian by an active-set (semi-smooth Newton) loop: with A the nodes below z_b,
 solve (M + k sum_A w_n e_n e_n^T) y = b + k z_b sum_A w_n e_n, take the new A, and repeat
 until A no longer changes (e_n: z_n from the element's Hermite dofs). The matrix is
-refactored only when A changes. Why implicit: the iteration's compliance to a load on a
+refactored only when A changes.
+
+A seabed that is not flat (environment.Seabed with a shape: slope, profile) has at each
+node the height z_b,n = z_b(x_n, y_n) and the vertical stiffness k_n = k / (1 + |g_n|^2)
+at the node's horizontal position of the last global step (``follow``, lagged like the
+drag's depths): E_s = 1/2 sum_n k_n w_n (z_b,n - z_n)_+^2, the same loop. The
+horizontal part of the normal force, -k_n (z_b,n - z_n)_+ g_n, is a nodal load of the
+iterate (slope_load.py). On a plane k_n is constant and only the right-hand side
+follows the line; on a profile the matrix is rebuilt when a node's k_n changes (it
+crosses a row). Why implicit: the iteration's compliance to a load on a
 stretch l of line is about l^2 / R, so an explicit (lagged) spring k is amplified
 k l^2 / R times per iteration, 1e5 or more for a seabed stiff enough to hold the line
 within a millimetre (measured in docs/riser.md).
@@ -46,17 +55,50 @@ class SeabedContact:
         self.weights = h[:, None] * NODE_WEIGHTS[None, :]          # (ne, 3), per element
         self.rows = node_rows(h)
         self.active = None                                          # (ne, 3) booleans
+        # z_b and k at the nodes: the flat seabed's numbers, else (ne, 3) arrays (follow)
+        self.base, self.stiffness = seabed.height, seabed.stiffness
+        self.gradients = None                                       # (ne, 3, 2), follow
+        self.solution = None                # the Hermite dofs y of the last solve (a Vec)
         self.solves = 0                                             # since the last reset
         self._local = mesh.da.createLocalVec()
 
     def _set_active(self, active):
         """The spring k w_n at the active nodes: element matrices E^T diag(k w) E and
         vectors k z_b E^T (k w), (ne, 4, 4) and (ne, 4)."""
-        spring = self.seabed.stiffness * self.weights * active
+        spring = self.stiffness * self.weights * active
         weighted = self.rows.transpose(0, 2, 1) * spring[:, None, :]         # (ne, 4, 3)
-        self.problem.set_added(np.matmul(weighted, self.rows),
-                               self.seabed.height * weighted.sum(axis=2))
+        self.problem.set_added(np.matmul(weighted, self.rows), self._pull(weighted))
         self.active = active
+
+    def _pull(self, weighted):
+        """k z_b E^T (k w) of the active nodes, (ne, 4), from E^T diag(k w), (ne, 4, 3)."""
+        if np.ndim(self.base) == 0:
+            return self.base * weighted.sum(axis=2)
+        return np.einsum("ekn,en->ek", weighted, self.base)
+
+    def follow(self, ghosted_r):
+        """A seabed that is not flat: z_b and k at the nodes from the positions of the
+        last global step, ``ghosted_r`` the r field's ghosted (vertex, slope) pairs
+        (n_ghosted, 2, 3) (module docstring). The matrix is rebuilt if k changed at an
+        active node, else only the right-hand side."""
+        left = self.mesh.element_local
+        dofs = np.stack([ghosted_r[left, 0], ghosted_r[left, 1], ghosted_r[left + 1, 0],
+                         ghosted_r[left + 1, 1]], axis=1)                  # (ne, 4, 3)
+        nodes = np.einsum("enk,ekc->enc", self.rows, dofs)                  # (ne, 3, 3)
+        x, y = nodes[..., 0], nodes[..., 1]
+        stiffness = self.seabed.vertical_stiffness(self.seabed.gradients(x, y))
+        changed = np.shape(self.stiffness) != stiffness.shape or np.any(
+            self.stiffness != stiffness)
+        self.base, self.stiffness = self.seabed.heights(x, y), stiffness
+        self.gradients = self.seabed.gradients(x, y)                       # (ne, 3, 2)
+        if self.active is None:
+            return
+        if self.mesh.global_sum(int(changed)):
+            self._set_active(self.active)
+        else:
+            spring = self.stiffness * self.weights * self.active
+            self.problem.set_added_rhs(
+                self._pull(self.rows.transpose(0, 2, 1) * spring[:, None, :]))
 
     def heights(self, y):
         """z at the three nodes of each owned element, (ne, 3), from the Hermite dofs y."""
@@ -74,11 +116,33 @@ class SeabedContact:
         for _ in range(MAX_SOLVES):
             y = self.problem.solve(slope_rhs, slope)
             self.solves += 1
-            active = self.heights(y) < self.seabed.height
+            active = self.heights(y) < self.base
             if not self.mesh.global_sum(int(np.any(active != self.active))):
                 break
             self._set_active(active)
+        self.solution = y
         return y
+
+    def node_force(self):
+        """k_n (z_b,n - z_n)_+ (-g_n, 1) at the owned P2 nodes (N/m), (n_nodes, 3), of a
+        seabed that is not flat: the normal force with the penetration of the last
+        vertical solve's heights z_n under the z_b,n, k_n, g_n it was solved with (the
+        ``follow`` before it), so that it is the reaction that problem carried
+        (slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
+        start; a contact rebuilt at a penalty raise: one iteration without the push)."""
+        n_owned = self.mesh.vertex_end - self.mesh.vertex_start
+        ne = self.mesh.n_local_elements
+        nodes = np.zeros((n_owned + ne, 3))
+        if self.gradients is None or self.solution is None:
+            return nodes
+        push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
+        per_element = np.concatenate([-push[..., None] * self.gradients, push[..., None]],
+                                     axis=2)                                   # (ne, 3, 3)
+        nodes[0:2 * ne:2] = per_element[:, 0]
+        nodes[1:2 * ne:2] = per_element[:, 1]
+        if n_owned > ne and ne:                 # the last vertex, right of the last element
+            nodes[-1] = per_element[-1, 2]
+        return nodes
 
     def pressure(self, z):
         """k (z_b - z)_+ (N/m), the seabed's upward force per metre of line at heights z."""

@@ -143,16 +143,21 @@ class SeabedTerm(NodalLoadTerm):
 
     def _height_derivatives(self, state):
         """dE_s/dz_n = -k w_n (z_b - z_n)_+ and d2E_s/dz_n^2 = k w_n [z_n < z_b] at the owned
-        nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline."""
+        nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline (on
+        a flat seabed: the Newton steps are not taken on another, slope_load.py)."""
         gap = self.seabed.height - state.node_positions()[:, 2]
         spring = self.seabed.stiffness * state.node_weights * (gap > 0)
         return -spring * gap, spring
 
     def energy(self, state):
-        """E_s at the heights of the state's centreline, J. Collective."""
-        gap = np.maximum(self.seabed.height - state.node_positions()[:, 2], 0.0)
-        return float(self.mesh.global_sum(0.5 * self.seabed.stiffness
-                                          * np.sum(state.node_weights * gap**2)))
+        """E_s = sum_n w_n k_v,n / 2 (z_b,n - z_n)_+^2 at the state's centreline, J, with
+        z_b,n and k_v,n under each node (environment.Seabed; k_v = k on a flat seabed).
+        Collective."""
+        r = state.node_positions()
+        gap = np.maximum(-self.seabed.gap(r), 0.0)
+        stiffness = self.seabed.vertical_stiffness(self.seabed.gradients(r[:, 0], r[:, 1]))
+        return float(self.mesh.global_sum(0.5 * np.sum(stiffness * state.node_weights
+                                                       * gap**2)))
 
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (heights.height_gradient) into g's d3 z rows; the state's
@@ -181,7 +186,10 @@ class SeabedTerm(NodalLoadTerm):
 
     def node_loads(self, state):
         loads = np.zeros((self.mesh.n_local_nodes, 3))
-        loads[:, 2] = self.pressure(state.node_positions()[:, 2])
+        if self.seabed.flat or self.contact.solution is None:
+            loads[:, 2] = self.seabed.force(state.node_positions())[:, 2]
+        else:                           # a slope: the reaction the vertical problem carried
+            loads[:, 2] = self.contact.node_force()[:, 2]
         return loads
 
     def _destroy_vertical(self):

@@ -18,7 +18,7 @@ physics/point_loads.py.
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.tables import read_text
+from petsc_rod.tables import numbered_rows
 
 # The columns a table may name; ``s`` is required. Every column but ``name`` is a number.
 COLUMNS = ("s", "mass", "volume", "fx", "fy", "fz", "cda", "name")
@@ -55,10 +55,7 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
     def refuse(what):
         raise RodInputError(f"{option}: {what}")
 
-    lines = read_text(path, "-rod_point_loads").splitlines()
-    rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
-            for k, line in enumerate(lines)]
-    rows = [(k, row) for k, row in rows if row]
+    rows = numbered_rows(path, "-rod_point_loads")
     if not rows:
         refuse("is empty; give a header row (s and any of mass volume fx fy fz name) and "
                "one row per attachment")

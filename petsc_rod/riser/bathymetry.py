@@ -1,0 +1,185 @@
+"""The shape of a seabed that is not flat (docs/riser.md §1a): a plane of given slope and
+direction, or a profile of heights along a direction; its height z_b(x, y), gradient
+and unit normal at given horizontal positions, vectorised (any shape of x and y).
+
+Conventions, those of OrcaFlex's seabed data: a seabed origin p0 = (x0, y0) on the
+seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
+(anticlockwise seen from above), and d = (p - p0).e the distance along it.
+
+* ``Plane``: z_b = z0 + tan(alpha) d, alpha the largest upward slope (rad; negative:
+  the seabed falls along e), constant across e. gradient g = tan(alpha) e.
+* ``Profile``: z_b = the linear interpolant of the rows (d_i, z_i), d_i strictly
+  increasing, constant across e and beyond the first and last rows. Its gradient is
+  the secant over a width delta = SMOOTHING times the closest rows' spacing,
+  g = (z_b(d + delta/2) - z_b(d - delta/2)) / delta e: the segment's slope away from the
+  rows, and turning linearly from one segment's to the next over delta about a row
+  (and to 0 about the first and last). Why: the contact's horizontal push is lagged
+  (slope_load.py), and with the slope jumping at a row a node there flips between the
+  two pushes from one iteration to the next and the iteration never settles (measured:
+  a line pushed over the edge of a grid's slope stalled at a change of 1e-5); a
+  gradient continuous in the position gives it a fixed point. ``covers`` tells whether
+  a point lies within the rows.
+* ``Grid``: bilinear in each cell of a rectangular grid, its gradient the secant over
+  SMOOTHING times the closest grid lines' spacing along x and along y, for the same
+  reason.
+
+The unit normal pointing up out of the seabed is (-g, 1) / sqrt(1 + |g|^2), and the
+local slope atan |g|. Heights in m, in whichever frame the shape was made in
+(``moved``: the same seabed in a frame whose origin is at ``offset``).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# The width over which a profile's or grid's slope turns at a row or grid line, of the
+# closest rows' spacing (module docstring).
+SMOOTHING = 0.1
+
+
+def unit_normal(gradient):
+    """(-g, 1) / sqrt(1 + |g|^2) of gradients (..., 2): (..., 3)."""
+    g = np.asarray(gradient, dtype=float)
+    normal = np.concatenate([-g, np.ones(g.shape[:-1] + (1,))], axis=-1)
+    return normal / np.sqrt(1.0 + np.sum(g**2, axis=-1, keepdims=True))
+
+
+@dataclass(frozen=True)
+class Plane:
+    """z_b = z0 + g.((x, y) - origin): ``origin`` (2,) m, ``z0`` m, ``slope_vector`` g
+    (2,) = tan(alpha) e (module docstring)."""
+
+    origin: np.ndarray
+    z0: float
+    slope_vector: np.ndarray
+
+    @classmethod
+    def sloping(cls, origin, z0, slope_deg, direction):
+        """The plane through (origin, z0) rising at ``slope_deg`` degrees along the unit
+        horizontal vector ``direction`` (2,)."""
+        e = np.asarray(direction, dtype=float)
+        return cls(np.asarray(origin, dtype=float), float(z0),
+                   np.tan(np.radians(slope_deg)) * e)
+
+    def height(self, x, y):
+        """z_b at (x, y), m, the shape of x."""
+        return (self.z0 + self.slope_vector[0] * (np.asarray(x, dtype=float) - self.origin[0])
+                + self.slope_vector[1] * (np.asarray(y, dtype=float) - self.origin[1]))
+
+    def gradient(self, x, y):
+        """dz_b/d(x, y), (shape of x) + (2,)."""
+        return np.broadcast_to(self.slope_vector, np.shape(x) + (2,)).copy()
+
+    def normal(self, x, y):
+        """The unit normal up out of the seabed, (shape of x) + (3,)."""
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        """A plane covers every point."""
+        return np.ones(np.shape(x), dtype=bool)
+
+    def moved(self, offset):
+        """The same plane in the frame whose origin is at ``offset`` (3,)."""
+        return Plane(self.origin - offset[:2], self.z0 - offset[2], self.slope_vector)
+
+
+@dataclass(frozen=True)
+class Profile:
+    """z_b the linear interpolant of ``heights`` (m,) at ``distances`` (m,), strictly
+    increasing, along the unit horizontal vector ``direction`` (2,) from ``origin``
+    (2,) (module docstring)."""
+
+    origin: np.ndarray
+    direction: np.ndarray
+    distances: np.ndarray
+    heights: np.ndarray
+
+    def along(self, x, y):
+        """d = ((x, y) - origin).e, the shape of x."""
+        return ((np.asarray(x, dtype=float) - self.origin[0]) * self.direction[0]
+                + (np.asarray(y, dtype=float) - self.origin[1]) * self.direction[1])
+
+    def height(self, x, y):
+        return np.interp(self.along(x, y), self.distances, self.heights)
+
+    def gradient(self, x, y):
+        """The secant slope over SMOOTHING times the closest rows' spacing along e
+        (module docstring), (shape of x) + (2,)."""
+        d = self.along(x, y)
+        half = 0.5 * SMOOTHING * np.min(np.diff(self.distances))
+        slope = (np.interp(d + half, self.distances, self.heights)
+                 - np.interp(d - half, self.distances, self.heights)) / (2 * half)
+        return slope[..., None] * self.direction
+
+    def normal(self, x, y):
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        """Whether (x, y) lies within the profile's rows, d_0 <= d <= d_last."""
+        d = self.along(x, y)
+        return (d >= self.distances[0]) & (d <= self.distances[-1])
+
+    def moved(self, offset):
+        return Profile(self.origin - offset[:2], self.direction, self.distances,
+                       self.heights - offset[2])
+
+
+@dataclass(frozen=True)
+class Grid:
+    """z_b bilinear on a rectangular grid of heights ``heights`` (nx, ny) at ``xs`` (nx,)
+    and ``ys`` (ny,), strictly increasing, measured from ``origin`` (2,) along +x and +y
+    (a 3-D bathymetry: OrcaFlex's 3D seabed, Flexcom's 3D profile, on a regular grid).
+    In a cell, with (s, t) in [0, 1]^2 the position's fractions,
+    z_b = (1-s)(1-t) z00 + s(1-t) z10 + (1-s) t z01 + s t z11; level beyond the grid's
+    edges at the nearest edge's heights; its gradient the secant of the module
+    docstring (the bilinear form's own slope inside a cell away from its edges);
+    ``covers`` tells whether a point lies within it."""
+
+    origin: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+    heights: np.ndarray
+
+    def _cell(self, x, y):
+        """(i, j, s, t): cell indices and fractions, clipped to the grid (level
+        beyond it)."""
+        u = np.asarray(x, dtype=float) - self.origin[0]
+        v = np.asarray(y, dtype=float) - self.origin[1]
+        i = np.clip(np.searchsorted(self.xs, u, side="right") - 1, 0, self.xs.size - 2)
+        j = np.clip(np.searchsorted(self.ys, v, side="right") - 1, 0, self.ys.size - 2)
+        dx, dy = self.xs[i + 1] - self.xs[i], self.ys[j + 1] - self.ys[j]
+        s = np.clip((u - self.xs[i]) / dx, 0.0, 1.0)
+        t = np.clip((v - self.ys[j]) / dy, 0.0, 1.0)
+        return i, j, s, t
+
+    def height(self, x, y):
+        i, j, s, t = self._cell(x, y)
+        z = self.heights
+        return ((1 - s) * (1 - t) * z[i, j] + s * (1 - t) * z[i + 1, j]
+                + (1 - s) * t * z[i, j + 1] + s * t * z[i + 1, j + 1])
+
+    def gradient(self, x, y):
+        """The secant slopes over SMOOTHING times the closest grid lines' spacing along
+        x and y (module docstring), (shape of x) + (2,)."""
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        hx = 0.5 * SMOOTHING * np.min(np.diff(self.xs))
+        hy = 0.5 * SMOOTHING * np.min(np.diff(self.ys))
+        gx = (self.height(x + hx, y) - self.height(x - hx, y)) / (2 * hx)
+        gy = (self.height(x, y + hy) - self.height(x, y - hy)) / (2 * hy)
+        return np.stack([gx, gy], axis=-1)
+
+    def normal(self, x, y):
+        return unit_normal(self.gradient(x, y))
+
+    def covers(self, x, y):
+        u = np.asarray(x, dtype=float) - self.origin[0]
+        v = np.asarray(y, dtype=float) - self.origin[1]
+        return ((u >= self.xs[0]) & (u <= self.xs[-1]) & (v >= self.ys[0])
+                & (v <= self.ys[-1]))
+
+    def along(self, x, y):
+        """The distance from the origin along +x (the messages' measure)."""
+        return np.asarray(x, dtype=float) - self.origin[0]
+
+    def moved(self, offset):
+        return Grid(self.origin - offset[:2], self.xs, self.ys, self.heights - offset[2])
