@@ -21,7 +21,8 @@ from petsc4py import PETSc
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
-from petsc_rod.iteration.controller import EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH, NEWTON_WORTH
+from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
+                                            NEWTON_SWITCH_FAR, NEWTON_WORTH)
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
@@ -304,12 +305,14 @@ OPTIONS = [
            "are unknowns of it too"),
     Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
-           f"{NEWTON_SWITCH:g} and more than {NEWTON_WORTH} iterations would remain at the "
+           f"{NEWTON_SWITCH:g} ({NEWTON_SWITCH_FAR:g} with a seabed or a current) and more "
+           f"than {NEWTON_WORTH} iterations would remain at the "
            "recent rate, try Newton steps on the reduced problem (frames turned by the KKT "
            "system of the energy's second variation), taken only where it is positive "
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
-           "the state is near a saddle and is left at once; after a failed attempt the wait "
-           "doubles; with a seabed the node heights are unknowns too, on an extensible line "
+           "the state is near a saddle and is left at once (not with a seabed); after a "
+           "failed attempt the wait doubles; with a seabed the node heights are unknowns "
+           "too, on an extensible line "
            "the strains, with a current the resultants of the drag (an LU solve)"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),

@@ -35,6 +35,13 @@ from petsc_rod.problem.penalty import ADAPT_WINDOW, penalty_too_low
 # NEWTON_SWITCH: near a solution, where the accelerated iteration is slow.
 NEWTON_AFTER = 15
 NEWTON_SWITCH = 0.1
+# Where the Newton system reads what the whole line beyond a node does (the heights a
+# seabed reads, the drag's resultants: docs/method.md §11), an iterate at 0.1 is
+# metres off in height or in the resultant and every attempt finds H indefinite; each
+# attempt restarts Anderson's history, and on the riser from the straight start their
+# restarts kept a step from converging in 2000 iterations. There the switch is at
+# NEWTON_SWITCH_FAR (the scenes' counts are the same at 1e-2 and 1e-3).
+NEWTON_SWITCH_FAR = 1e-2
 # An attempt costs as much as tens of iterations (a sparse LDL^T factorisation per Newton
 # step: docs/performance.md): it is made only while the iteration would still need more
 # than NEWTON_WORTH iterations at its recent rate. After each attempt that did not
@@ -81,13 +88,15 @@ ITERATE = Decision(Action.ITERATE)
 
 class StepController:
     """One step's state machine (module docstring). ``settings`` (stopping.Settings),
-    ``scale`` the problem's scale of R (N), ``newton`` whether Newton steps may be tried,
+    ``scale`` the problem's scale of R (N), ``newton`` whether Newton steps may be tried
+    (True, or the switch's threshold in place of NEWTON_SWITCH),
     ``label`` the step's name in messages, ``observer(iteration, change, residual)``
     asked after every iteration (True: stop, STOP_OBSERVER), with change and residual
     divided by the deformation's size, as the stopping test reads them."""
 
     def __init__(self, settings, scale, newton, label="", observer=None):
-        self.settings, self.scale, self.newton = settings, scale, newton
+        self.settings, self.scale, self.newton = settings, scale, bool(newton)
+        self.newton_switch = NEWTON_SWITCH if newton is True else float(newton or 0.0)
         self.label, self.observer = label, observer
         self.clock = time.perf_counter()
         self.history = []           # (change, residual, wall time) rows, one per iteration
@@ -160,7 +169,7 @@ class StepController:
                               residual / self.deformation):
             return Decision(Action.CONVERGED)
         if (self.newton and iteration >= self.newton_next
-                and max(change, residual) <= NEWTON_SWITCH
+                and max(change, residual) <= self.newton_switch
                 and stopping.remaining_iterations(self.history, settings.rtol,
                                                   settings.ctol) > NEWTON_WORTH):
             return Decision(Action.TRY_NEWTON)

@@ -109,7 +109,7 @@ class UzawaSolver:
         """
         self.problem.prepare(t)
         step = self._controller = control.StepController(
-            self.settings, self.problem.scale, self.newton is not None, label, observer)
+            self.settings, self.problem.scale, self._newton_switch(), label, observer)
         try:
             self._iterate(step)
             while step.converged and self.tests_stability:
@@ -175,6 +175,16 @@ class UzawaSolver:
         largest = problem.mesh.global_max(float(np.linalg.norm(direction[:, :3], axis=1)
                                                 .max(initial=0.0)))
         problem.state.turn_frames(angle * direction / largest)
+
+    def _newton_switch(self):
+        """False without Newton steps; the controller's switch threshold where the Newton
+        system reads the whole line beyond a node (heights, resultants:
+        NEWTON_SWITCH_FAR), else True (NEWTON_SWITCH)."""
+        if self.newton is None:
+            return False
+        if self.newton.reads_heights or self.newton.follows:
+            return control.NEWTON_SWITCH_FAR
+        return True
 
     def _polish(self, step):
         """Newton steps from the current state (newton.py), each recorded as an
