@@ -74,6 +74,7 @@ class VerticalProblem:
         self.rhs, self.solution, self.bc, self._work, self._product = (
             self.base.createVecLeft() for _ in range(5))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
+        self._added = None              # the last set_added's (matrices, vectors)
         # the slope problem's solver and defaults: the natural order on one rank, in
         # which the chain is a band matrix without fill
         self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
@@ -112,14 +113,29 @@ class VerticalProblem:
     def set_added(self, element_matrices, element_vectors):
         """Add sum_e element_matrices (ne, 4, 4) to the matrix and sum_e element_vectors
         (ne, 4) to the right-hand side (replacing the last ones); refactored at the next
-        solve."""
-        self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.added_rhs.zeroEntries()
-        if len(self.rows):
-            self.matrix.setValuesRCV(self.rows, self.rows, element_matrices,
+        solve. Only the elements whose terms changed are added again, as the difference
+        (the seabed's active set changes at a few nodes near the touchdown between
+        iterations: a full assembly of every element each time cost as much as the rest
+        of the vertical problem)."""
+        matrices = np.asarray(element_matrices, dtype=float)
+        vectors = np.asarray(element_vectors, dtype=float)
+        if self._added is None:
+            self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.added_rhs.zeroEntries()
+            rows, delta_matrices, delta_vectors = self.rows, matrices, vectors
+        else:
+            last_matrices, last_vectors = self._added
+            changed = (np.any(matrices != last_matrices, axis=(1, 2))
+                       | np.any(vectors != last_vectors, axis=1))
+            rows = self.rows[changed]
+            delta_matrices = matrices[changed] - last_matrices[changed]
+            delta_vectors = vectors[changed] - last_vectors[changed]
+        if len(rows):
+            self.matrix.setValuesRCV(rows, rows, delta_matrices,
                                      addv=PETSc.InsertMode.ADD_VALUES)
-            self.added_rhs.setValues(self.rows.ravel(), np.ravel(element_vectors),
+            self.added_rhs.setValues(rows.ravel(), np.ravel(delta_vectors),
                                      addv=PETSc.InsertMode.ADD_VALUES)
+        self._added = (matrices.copy(), vectors.copy())
         self.matrix.assemble()
         self.added_rhs.assemble()
         self._constrain()
