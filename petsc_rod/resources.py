@@ -10,16 +10,23 @@ from petsc_rod.errors import RodInputError
 
 # Memory of a run: per element (fields, matrices and their factors, the node state,
 # Anderson's history, the stability test's factorisation; the measured peak of the
-# largest run, rounded up: docs/stability.md, "Catenary and long lines") and per rank
-# (the interpreter, PETSc, MPI).
+# default run, 17 KiB at 1e5 elements, rounded up: docs/performance.md, "Memory in
+# proportion") and per rank (the interpreter, PETSc, MPI).
 BYTES_PER_ELEMENT = 20 * 2**10
 BYTES_PER_RANK = 80 * 2**20
 # Anderson mixing keeps 2 m vectors of the node state (18 numbers at 2 nodes per
-# element): 576 bytes per element and unit of depth. Its default depth is the largest
-# up to DEFAULT_DEPTH whose history takes at most ANDERSON_SHARE of the memory available.
+# element): 576 bytes per element and unit of depth, allocated (and written: PETSc zeroes
+# them) when the SNES is set up. Its default depth is the largest up to DEFAULT_DEPTH
+# whose history fits the larger of HISTORY_FLOOR (per machine, shared by its ranks: the
+# depth that hard scenes need, e.g. options/greenhill.opts, kept up to about 2e4
+# elements) and HISTORY_PER_ELEMENT per element (so that a run stays within 10 KiB per
+# element at 1e5 elements and more, with the map's 5 KiB and the SNES's own vectors),
+# and at most ANDERSON_SHARE of the memory available; never below MIN_DEPTH.
 ANDERSON_BYTES = 2 * 18 * 2 * 8
 DEFAULT_DEPTH = 30
 MIN_DEPTH = 5
+HISTORY_FLOOR = 320 * 2**20
+HISTORY_PER_ELEMENT = 3 * 2**10
 ANDERSON_SHARE = 0.25
 # The DMDA has 2 dofs per vertex, indexed by PETSc integers.
 MAX_ELEMENTS = int(np.iinfo(PETSc.IntType).max) // 2 - 1
@@ -32,11 +39,15 @@ def needed_memory(elements, ranks):
 
 def anderson_depth(local_elements, ranks_here):
     """The default depth m of Anderson mixing for a rank with ``local_elements``
-    elements on a machine shared by ``ranks_here`` ranks (see ANDERSON_SHARE)."""
-    available = available_memory()
-    if available is None or local_elements == 0:
+    elements on a machine shared by ``ranks_here`` ranks: its history 2 m x 576 bytes
+    per element within max(HISTORY_FLOOR / ranks_here, HISTORY_PER_ELEMENT per element)
+    and ANDERSON_SHARE of the memory available (see the constants)."""
+    if local_elements == 0:
         return DEFAULT_DEPTH
-    budget = ANDERSON_SHARE * available / ranks_here
+    budget = max(HISTORY_FLOOR / ranks_here, HISTORY_PER_ELEMENT * local_elements)
+    available = available_memory()
+    if available is not None:
+        budget = min(budget, ANDERSON_SHARE * available / ranks_here)
     return int(min(DEFAULT_DEPTH, max(MIN_DEPTH, budget // (ANDERSON_BYTES * local_elements))))
 
 

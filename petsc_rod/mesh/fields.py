@@ -88,10 +88,19 @@ def scatter_element_vectors(n_ghosted, element_local, element, vectors):
     """Sum element vectors (ne, ndofs, 3) into a ghosted array (n_ghosted, 2, 3).
 
     One vectorised add per element dof: within one dof the target vertices are distinct.
+    A rank's elements are consecutive (a 1-D DMDA), so each add is a slice, not an
+    indexed scatter; the same sums in the same order either way.
     """
     out = np.zeros((n_ghosted, 2, 3))
+    ne = len(element_local)
+    first = int(element_local[0]) if ne else 0
+    consecutive = bool(np.all(np.diff(element_local) == 1))
     for k in range(element.ndofs):
-        out[element_local + element.offsets[k], element.slots[k]] += vectors[:, k]
+        if consecutive:
+            start = first + int(element.offsets[k])
+            out[start:start + ne, element.slots[k]] += vectors[:, k]
+        else:
+            out[element_local + element.offsets[k], element.slots[k]] += vectors[:, k]
     return out
 
 

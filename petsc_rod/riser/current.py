@@ -19,9 +19,9 @@ import numpy as np
 def normal_drag(tangent, velocity, drag):
     """f = c |v_n| v_n, (n, 3) N/m, for tangents (n, 3) (normalised here), current
     velocities (n, 3) m/s and c = ``drag`` (kg/m^2)."""
-    t = tangent / np.linalg.norm(tangent, axis=1, keepdims=True)
+    t = tangent / np.sqrt(_squares(tangent))[:, None]
     normal = velocity - np.einsum("nc,nc->n", velocity, t)[:, None] * t
-    return drag * np.linalg.norm(normal, axis=1, keepdims=True) * normal
+    return drag * np.sqrt(_squares(normal))[:, None] * normal
 
 
 def drag_jacobian(tangent, velocity, drag):
@@ -44,3 +44,9 @@ def drag_jacobian(tangent, velocity, drag):
     cross[:, 1, 0], cross[:, 1, 2] = t[:, 2], -t[:, 0]
     cross[:, 2, 0], cross[:, 2, 1] = -t[:, 1], t[:, 0]
     return stiffness @ turn @ cross
+
+
+def _squares(vectors):
+    """|v|^2 of rows (n, 3): an einsum, a third of np.linalg.norm's passes (once per
+    iteration at every node with a current)."""
+    return np.einsum("nc,nc->n", vectors, vectors)

@@ -74,6 +74,7 @@ class VerticalProblem:
         self.rhs, self.solution, self.bc, self._work, self._product = (
             self.base.createVecLeft() for _ in range(5))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
+        self._added = None              # the last set_added's (matrices, vectors)
         # the slope problem's solver and defaults: the natural order on one rank, in
         # which the chain is a band matrix without fill
         self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
@@ -112,17 +113,45 @@ class VerticalProblem:
     def set_added(self, element_matrices, element_vectors):
         """Add sum_e element_matrices (ne, 4, 4) to the matrix and sum_e element_vectors
         (ne, 4) to the right-hand side (replacing the last ones); refactored at the next
-        solve."""
-        self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.added_rhs.zeroEntries()
-        if len(self.rows):
-            self.matrix.setValuesRCV(self.rows, self.rows, element_matrices,
+        solve. After the first call only the elements whose terms changed are added
+        again, as the difference, to the matrix and to its constrained copy (the fixed
+        rows and columns left out): the seabed's active set moves at a few nodes near the
+        touchdown between iterations, and a full assembly, copy and zeroing of the
+        rows cost as much as the rest of the vertical problem. The constrained matrix
+        gets the same sums in the same order as the matrix, so it stays the matrix with
+        the fixed rows and columns zeroed."""
+        matrices = np.asarray(element_matrices, dtype=float)
+        vectors = np.asarray(element_vectors, dtype=float)
+        if self._added is None:
+            self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.added_rhs.zeroEntries()
+            if len(self.rows):
+                self.matrix.setValuesRCV(self.rows, self.rows, matrices,
+                                         addv=PETSc.InsertMode.ADD_VALUES)
+                self.added_rhs.setValues(self.rows.ravel(), vectors.ravel(),
+                                         addv=PETSc.InsertMode.ADD_VALUES)
+            self._added = (matrices.copy(), vectors.copy())
+            self.matrix.assemble()
+            self.added_rhs.assemble()
+            self._constrain()
+            return
+        last_matrices, last_vectors = self._added
+        changed = (np.any(matrices != last_matrices, axis=(1, 2))
+                   | np.any(vectors != last_vectors, axis=1))
+        rows = self.rows[changed]
+        if len(rows):
+            delta = matrices[changed] - last_matrices[changed]
+            self.matrix.setValuesRCV(rows, rows, delta, addv=PETSc.InsertMode.ADD_VALUES)
+            free = ~np.isin(rows, self.fixed)
+            self.constrained.setValuesRCV(rows, rows, delta * free[:, :, None] * free[:, None, :],
+                                          addv=PETSc.InsertMode.ADD_VALUES)
+            self.added_rhs.setValues(rows.ravel(), np.ravel(vectors[changed]
+                                                            - last_vectors[changed]),
                                      addv=PETSc.InsertMode.ADD_VALUES)
-            self.added_rhs.setValues(self.rows.ravel(), np.ravel(element_vectors),
-                                     addv=PETSc.InsertMode.ADD_VALUES)
-        self.matrix.assemble()
-        self.added_rhs.assemble()
-        self._constrain()
+            np.copyto(last_matrices, matrices)
+            np.copyto(last_vectors, vectors)
+        for obj in (self.matrix, self.constrained, self.added_rhs):
+            obj.assemble()
 
     def set_added_rhs(self, element_vectors):
         """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added

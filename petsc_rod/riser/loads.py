@@ -14,19 +14,9 @@ elements of later ranks: one prefix sum (Mesh.prefix_sum), nothing gathered.
 
 import numpy as np
 
-from petsc_rod.mesh.elements import (GAUSS_POINTS, P2, element_integrals, gram,
+from petsc_rod.mesh.elements import (GAUSS_POINTS, element_integrals, gram,
                                      p2_basis, p2_integrals, quadrature_weights)
-from petsc_rod.mesh.fields import element_dofs
-
-
-def node_slots(mesh, values):
-    """Values at the owned P2 nodes (n_nodes, ...) in the DMDA's vertex slots (n_owned,
-    2, ...): (vertex, midpoint to its right), the phantom midpoint of the last vertex 0."""
-    n_owned = mesh.vertex_end - mesh.vertex_start
-    slots = np.zeros((n_owned, 2) + values.shape[1:])
-    slots[:, 0] = values[0::2]
-    slots[:mesh.n_local_elements, 1] = values[1::2]
-    return slots
+from petsc_rod.mesh.fields import element_slices
 
 
 class NodalLoad:
@@ -43,15 +33,29 @@ class NodalLoad:
         after = (self._integrals[:, None, :]
                  - p2_integrals(GAUSS_POINTS, h))          # int_S^{S_e+1} N_l, (ne, nq, 3)
         self.tail_integrals = gram(quadrature_weights(h), phi, after)
+        self.element_values = None                     # (ne, 3 nodes, 3), made by set
         self.set(np.zeros((mesh.n_local_nodes, 3)))
 
     def set(self, values):
         """The nodal values (n_nodes, 3), N/m. Collective (a ghost exchange and a prefix
-        sum)."""
+        sum). The owned nodes go straight into the field's slots (vertex, midpoint) and
+        the element values are gathered from stride-2 views of its ghosted arrays
+        (fields.element_slices): no (n, 2, 3) staging array, no index gather."""
         mesh = self.mesh
-        self._field.set_owned(node_slots(mesh, values))
-        self.element_values = element_dofs(self._field.ghosted(), mesh.element_local, P2)
-        pieces = np.einsum("ek,ekc->ec", self._integrals, self.element_values)
+        ne = mesh.n_local_elements
+        for c, vec in enumerate(self._field.components):
+            slots = vec.getArray()
+            slots[0::2] = values[0::2, c]
+            slots[1:2 * ne:2] = values[1::2, c]
+            slots[2 * ne + 1::2] = 0.0                  # the phantom midpoint of the last vertex
+        first = int(mesh.element_local[0]) if ne else 0
+        element_values = self.element_values
+        if element_values is None or element_values.shape[0] != ne:
+            element_values = self.element_values = np.empty((ne, 3, 3))
+        for c, ghosted in enumerate(self._field.ghosted_components()):
+            for k, dofs in enumerate(element_slices(ghosted, first, ne)):
+                element_values[:, k, c] = dofs
+        pieces = np.einsum("ek,ekc->ec", self._integrals, element_values)
         self.before = mesh.prefix_sum(pieces)          # int_0^{S_i} f_h at owned vertices
         self.total = mesh.global_sum(pieces.sum(axis=0))
         self._beyond = self.total - self.before[:mesh.n_local_elements] - pieces
