@@ -155,12 +155,16 @@ class VerticalProblem:
 
     def set_added_rhs(self, element_vectors):
         """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added
-        matrix kept (a seabed whose heights moved but not its springs)."""
+        matrix kept (a seabed whose heights moved but not its springs); set_added's
+        record of the last vectors follows, so that its next differences start here."""
+        vectors = np.asarray(element_vectors, dtype=float)
         self.added_rhs.zeroEntries()
         if len(self.rows):
-            self.added_rhs.setValues(self.rows.ravel(), np.ravel(element_vectors),
+            self.added_rhs.setValues(self.rows.ravel(), vectors.ravel(),
                                      addv=PETSc.InsertMode.ADD_VALUES)
         self.added_rhs.assemble()
+        if self._added is not None:
+            np.copyto(self._added[1], vectors)
 
     def _constrain(self):
         self.matrix.copy(self.constrained, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
