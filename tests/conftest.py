@@ -16,7 +16,12 @@ import shutil
 import sys
 import tempfile
 
-import petsc4py
+# one BLAS thread, as python -m petsc_rod runs (petsc_rod/__main__.py): the thread count
+# changes numpy's round-off, and an accelerated iteration's path with it (on
+# 2026-12-02 a flex-joint case converged with one thread and stagnated with two)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import petsc4py  # noqa: E402
 
 petsc4py.init(sys.argv[:1])
 

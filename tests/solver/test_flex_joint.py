@@ -192,9 +192,8 @@ def test_the_joint_acts_through_the_seabeds_vertical_problem(comm, seabed_height
     scene = dict(start="pin", end="pin", end_position=(0.7, 0.0, 0.3),
                  load_values=[(0.0, 0.0, -1.0)], end_rotational_stiffness=k,
                  end_joint_axis=(0.0, 0.0, 1.0))
-    # 3 steps: in 2 the first (t = 0.5) of the bare line stagnated on one machine at a
-    # constraint residual of 0.14, in 4 the seabed's at 0.38 (docs/stability.md,
-    # "Stagnations that depend on the machine")
+    # 3 steps: in 2 the first (t = 0.5) of the bare line stagnates at a constraint
+    # residual of 0.14 (docs/stability.md, "Stagnations that depend on round-off")
     bare = solve(comm, scene, steps=3)
     with_seabed = solve(comm, dict(scene, seabed=Seabed(seabed_height, 1e3)), steps=3)
     angle, moment = with_seabed[2][0]
