@@ -135,9 +135,13 @@ class NewtonPolish:
                     outcome = INDEFINITE
                     break
                 if self.follows:
-                    # no energy to descend: the residual must fall at every step
+                    # no energy to descend: the residual must fall at every step, but at
+                    # the round-off floor (the last turn below FLOOR_TURN, as below)
                     norm = self._residual_norm
                     if not norm < residual:
+                        if previous <= FLOOR_TURN:
+                            self._hand_over(frames, mu)
+                            return CONVERGED
                         break
                     residual = norm
                 largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
