@@ -219,6 +219,10 @@ class StepController:
         """An attempt did not converge (``outcome``: newton.INDEFINITE or FAILED)."""
         self.events.append(events.NewtonAttempt(self.label, len(self.history), outcome))
         self.newton_failures += 1
+        if self.newton_switch < NEWTON_SWITCH:
+            # the far-reaching systems (NEWTON_SWITCH_FAR): an iterate where the attempt
+            # failed was too far for it; the next waits for one ten times nearer
+            self.newton_switch /= 10
 
     def stability_tested(self, stable):
         """The stability test's verdict on the converged state (True, False, None)."""
