@@ -42,7 +42,10 @@ makes the vertex heights u_i and the multipliers nu_e of their chain unknowns to
 (analysis/heights.py): one more unknown per node, u at a vertex and nu at a midpoint.
 H is then the KKT matrix of the chain, whose inertia has n_elements negative eigenvalues
 more than the second variation on the rotations; they are counted off, and the mass of
-the extra unknowns is 0 (a shift moves the rotations' eigenvalues only).
+the extra unknowns is 0 (a shift moves the rotations' eigenvalues only). A load that
+follows the line (the drag, Term.follower) adds three more per node, the resultants of
+the Newton Jacobian (analysis/jacobian.py): identity rows here, H being the second
+variation with that load held fixed.
 """
 
 import numpy as np
@@ -84,9 +87,10 @@ class SecondVariation:
     """H of the module docstring at the state of a problem (problem/problem.py) at the
     last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
     P2 nodes (3 per node, node n = 2 vertex + slot; 4 on an extensible line, the fourth
-    the stretch k; ``unknowns`` of them, and one more, ``block`` in all, when a term
-    reads the heights: u at a vertex, nu at a midpoint, module docstring), with what the
-    inertia test needs;
+    the stretch k; ``unknowns`` of them, and, ``block`` in all, one more when a term
+    reads the heights (u at a vertex, nu at a midpoint) and three more when a load
+    follows the line (the resultants): module docstring), with what the inertia test
+    needs;
     the problem's terms add their own curvature (Term.add_hessian). Collective;
     ``destroy()`` frees every PETSc object."""
 
