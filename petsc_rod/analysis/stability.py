@@ -115,7 +115,7 @@ class SecondVariation:
         self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
                                             nnz=(5 * block, 2 * block), comm=self.comm)
         self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        self.held_rows = self._clamped = self._clamped_rows()
+        self.held_rows = self._clamped_rows()
         # the resultants' rows: identities in H (added in _assemble, no zeroRowsColumns:
         # it costs seconds on ten thousand rows)
         nodes = self.first_row + block * np.arange(mesh.n_local_nodes)
@@ -146,7 +146,7 @@ class SecondVariation:
         self._factored = False
         self._drop_constraint_solves()
         self._assemble()
-        self.matrix.zeroRowsColumns(self._clamped, diag=1.0)
+        self.matrix.zeroRowsColumns(self.held_rows, diag=1.0)
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.matrix.getDiagonal(self._diagonal)
         for vec in self.constraint:
@@ -396,7 +396,7 @@ class SecondVariation:
         return vec.getArray(readonly=True).reshape(-1, self.block)[:, :self.unknowns].copy()
 
     def _zero_clamped(self, vec):
-        local = self._clamped - self.first_row
+        local = self.held_rows - self.first_row
         vec.getArray()[local] = 0.0
 
     # --- inertia --------------------------------------------------------------------
