@@ -15,6 +15,8 @@ turn omega of the tangent, delta t = omega x t, is (drag_jacobian)
 
 import numpy as np
 
+from petsc_rod.analysis.stability import skew
+
 
 def normal_drag(tangent, velocity, drag):
     """f = c |v_n| v_n, (n, 3) N/m, for tangents (n, 3) (normalised here), current
@@ -39,11 +41,7 @@ def drag_jacobian(tangent, velocity, drag):
         speed[:, None, None] * eye + speed[:, None, None]
         * unit_normal[:, :, None] * unit_normal[:, None, :])
     turn = t[:, :, None] * velocity[:, None, :] + along[:, None, None] * eye
-    cross = np.zeros((len(t), 3, 3))                  # [t]x
-    cross[:, 0, 1], cross[:, 0, 2] = -t[:, 2], t[:, 1]
-    cross[:, 1, 0], cross[:, 1, 2] = t[:, 2], -t[:, 0]
-    cross[:, 2, 0], cross[:, 2, 1] = -t[:, 1], t[:, 0]
-    return stiffness @ turn @ cross
+    return stiffness @ turn @ skew(t)
 
 
 def _squares(vectors):

@@ -32,7 +32,7 @@ from petsc_rod.physics.term import Term
 from petsc_rod.riser.current import drag_jacobian, normal_drag
 from petsc_rod.riser.hermite import VerticalProblem
 from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.riser.seabed import SeabedContact
+from petsc_rod.riser.seabed import SeabedContact, node_rows
 from petsc_rod.scenes.boundary import is_held
 
 # The KSP options prefix of the vertical (seabed) problem.
@@ -254,10 +254,10 @@ class DragTerm(NodalLoadTerm):
         B, U, P = hessian.block, hessian.unknowns, hessian.resultant_slot
         tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
         h = mesh.element_h
-        r = state.r.ghosted()                              # Hermite (z, z') at the vertices
-        left, right = r[mesh.element_local], r[mesh.element_local + 1]
-        z = np.stack([left[:, 0, 2], 0.5 * (left[:, 0, 2] + right[:, 0, 2])
-                      + h / 8 * (left[:, 1, 2] - right[:, 1, 2]), right[:, 0, 2]], axis=1)
+        r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
+        left = mesh.element_local
+        z = np.einsum("enk,ek->en", node_rows(h),
+                      np.concatenate([r[left], r[left + 1]], axis=1))    # (ne, 3 nodes)
         S = mesh.element_S[:, None] + h[:, None] * np.array([0.0, 0.5, 1.0])
         flat_t = tangents.reshape(-1, 3)
         G = sum(w * drag_jacobian(flat_t, c.velocity(z.ravel()),
