@@ -362,6 +362,56 @@ def check_paper_reference(bound, stiffness):
     return check
 
 
+# Seabed friction (docs/riser.md §3b). A line lying on the seabed, 200 m of 100 N/m, EA
+# 1e6 N, pinned at the anchor and pulled 5 kN along the seabed at its free end: the
+# tension falls by mu w per metre from the pull and is 0 beyond the stick-slip front
+# (tests/solver/test_seabed_friction.py); the default penalty F / 2 is too soft for the
+# friction's stick springs (docs/riser.md §3b).
+PULLED_LINE = {"length": 200, "stiffness": "1,1,1", "start": "pin", "end": "free",
+               "end_force": "5000,0,0", "load": "0,0,-100", "seabed": 0,
+               "seabed_stiffness": 1e6, "axial_stiffness": 1e6, "elements": 200,
+               "al_penalty": 1e6}
+# 100 m on the seabed pinned at both ends 100 m apart, EA 1e6 N, in a current across:
+# drag c v^2 with c = 61.5 kg/m^2 against the friction mu w = 50 N/m at mu = 0.5, which
+# a current of 0.902 m/s just overcomes.
+GROUNDED_LINE = {"length": 100, "stiffness": "1,1,1", "start": "pin", "end": "pin",
+                 "end_position": "100,0,0", "load": "0,0,-100", "seabed": 0,
+                 "axial_stiffness": 1e6, "drag": "1025,1.2,0.1", "elements": 100,
+                 "seabed_friction": 0.5}
+
+
+def check_pulled(mu):
+    """The bound is the model's own error: the stick's elastic zone at the front, where
+    the slip is below mu w / k_s, is sqrt(2 EA / k_s) = 4.5 m long (k_s = 1e5 N/m^2, a
+    tenth of the seabed's) and the tension there is off by up to half its drop."""
+    bound = mu * 100.0 * np.sqrt(2 * 1e6 / 1e5) / 2 / 5000.0
+
+    def check(result):
+        exact = np.maximum(5000.0 - mu * 100.0 * (200.0 - result["S"]), 0.0)
+        return (float(np.max(np.abs(result["effective_tension"] - exact))) / 5000.0, bound,
+                "tension vs max(F - mu w (L - S), 0), over F")
+    return check
+
+
+def check_friction_bound(bound):
+    """The friction nowhere above mu R: the largest |f|_mu / R less 1. The force is that
+    of the last solve, whose secant spring is the previous positions': it exceeds mu R by
+    the last iteration's move over the slip (1e-9 of 1800 m over a slip of a metre:
+    2e-6), so the bound is 1e-5."""
+    def check(result):
+        return (float(result["friction_max_use"]) - 1.0, bound,
+                "largest friction over its limit mu R, less 1")
+    return check
+
+
+def check_stuck(bound):
+    """A line that sticks: its largest slip from where it lay (y = 0), m."""
+    def check(result):
+        return (float(np.max(np.abs(result["r"][:, 1]))), bound,
+                "largest sideways slip, m (mobilisation mu w / k_s = 5 mm)")
+    return check
+
+
 def cases():
     """The matrix (docs/stability.md, "The cases")."""
     matrix = []
@@ -482,6 +532,22 @@ def cases():
              notes="no closed form; the grounded part slides down the slope"))
     add(Case("seabed", "catenary riser, 3 deg slope, straight start, 1 step",
              riser(seabed_slope=3, initial_shape="straight"), check_incline(3.0, 2e-3)))
+    # seabed friction (docs/riser.md §3b)
+    for mu in (0.25, 0.5, 1.0):
+        add(Case("friction", f"line pulled along the seabed, mu {mu:g}: a stick-slip front",
+                 dict(PULLED_LINE, seabed_friction=mu), check_pulled(mu), ranks=2,
+                 notes=f"the front {200 - 5000 / (mu * 100):g} m from the anchor"
+                 if mu > 0.25 else "all slides"))
+    for mu in (0.01, 0.5, 2.0):
+        add(Case("friction", f"catenary riser, current 1 m/s across, mu {mu:g}",
+                 riser(current="0,1,0", drag="1025,1.2,0.324", seabed_friction=mu),
+                 check_friction_bound(1e-5),
+                 notes="no closed form; frictionless the touchdown is 113 m off the plane"))
+    add(Case("friction", "line on the seabed, current 0.85 m/s across: drag below friction",
+             dict(GROUNDED_LINE, current="0,0.85,0"), check_stuck(5.1e-3)))
+    add(Case("friction", "line on the seabed, current 0.95 m/s across: just overcomes it",
+             dict(GROUNDED_LINE, current="0,0.95,0"), check_friction_bound(1e-5), ranks=2,
+             notes="no closed form; net load 11 % of mu w"))
     # lines of line types and stretch (issue 22)
     for stiffness, axial in ((1e5, 1e7), (1e5, 1e9), (1e3, 1e9)):
         add(Case("lines", f"riser, EA / EI = {axial / stiffness:.0e} per m^2",
@@ -549,6 +615,9 @@ def read_result(path):
     import h5py
     with h5py.File(path, "r") as f:
         result = {k: np.array(f[k]) for k in ("S", "r", "d1", "d2", "d3", "u")}
+        result.update({k: np.array(f[k]) for k in ("effective_tension", "friction_force",
+                                                   "friction_state", "seabed_reaction")
+                       if k in f})
         result.update({k: f.attrs[k] for k in f.attrs})
         steps = f["steps"]
         result["total_iterations"] = int(sum(steps[k].attrs["iterations"] for k in steps))

@@ -178,13 +178,18 @@ class Attachment:
 @dataclass(frozen=True)
 class Environment:
     """The sea: a flat seabed at height ``seabed`` (m; None: none) of stiffness
-    ``seabed_stiffness`` (N/m^2; None: weight / 1 mm), the sea surface at height
+    ``seabed_stiffness`` (N/m^2; None: weight / 1 mm) with Coulomb friction
+    ``seabed_friction`` (None: none; mu, or (mu_axial, mu_lateral)) of stick stiffness
+    ``seabed_friction_stiffness`` (N/m^2; None: a tenth of the seabed's; docs/riser.md
+    §3b), the sea surface at height
     ``surface`` (m; None: the higher held end), a ``current``: None, a velocity (3,) in
     m/s (uniform), or a profile of rows (depth m, ux, uy, uz m/s) below the surface;
     ``water_density`` (kg/m^3) and ``gravity`` (m/s^2)."""
 
     seabed: float = None
     seabed_stiffness: float = None
+    seabed_friction: object = None
+    seabed_friction_stiffness: float = None
     surface: float = None
     current: object = None
     water_density: float = 1025.0
@@ -241,9 +246,12 @@ class Model:
                 texts[f"rod_{which}_force"] = _numbers(end.force)
         sea = self.environment
         for name, value in (("seabed", sea.seabed), ("seabed_stiffness", sea.seabed_stiffness),
+                            ("seabed_friction_stiffness", sea.seabed_friction_stiffness),
                             ("sea_surface", sea.surface)):
             if value is not None:
                 texts[f"rod_{name}"] = _number(value)
+        if sea.seabed_friction is not None:
+            texts["rod_seabed_friction"] = _numbers(np.atleast_1d(sea.seabed_friction))
         if sea.current is not None:
             if sea.profile() is None:
                 texts["rod_current"] = _numbers(sea.current)

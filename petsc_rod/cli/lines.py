@@ -85,7 +85,22 @@ def riser_text(attributes):
     beyond = attributes.get("seabed_vertices_beyond", 0)
     if beyond:                          # riser/quantities.py: a profile taken level there
         text += f", {beyond} vertices beyond the seabed profile's rows (level there)"
-    return text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
+    return (text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
+            + friction_text(attributes))
+
+
+def friction_text(attributes):
+    """The seabed friction's numbers (riser/friction.py) for the step line: the grounded
+    lengths that stick and slide, the largest friction per metre and the touchdown's
+    offset from the ends' plane; '' without friction."""
+    a = attributes
+    if "friction_stick_length" not in a:
+        return ""
+    offset = a.get("touchdown_offset", float("nan"))
+    return (f"; friction: {a['friction_stick_length']:.4g} m stick, "
+            f"{a['friction_slide_length']:.4g} m slide, largest "
+            f"{a['friction_max_force']:.4g} N/m"
+            + (f", touchdown {offset:.4g} m off the ends' plane" if offset == offset else ""))
 
 
 def step_line(event, record):
@@ -139,6 +154,8 @@ def summary(attributes):
         text += (f"; smallest bend radius {a['min_bend_radius']:.4g} m at S = "
                  f"{a['max_curvature_S']:.6g} m")
         out.append(text)
+    if "friction_stick_length" in a:
+        out.append("  seabed" + friction_text(a)[1:])
     joints = [f"{which} joint {a[f'{which}_joint_angle']:.4g} deg, "
               f"{a[f'{which}_joint_moment'] / 1e3:.4g} kN m"
               for which in ("start", "end") if f"{which}_joint_angle" in a]

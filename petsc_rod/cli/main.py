@@ -348,6 +348,8 @@ def options_in_effect(values, solver, start):
         resolved["rod_axial_stiffness"] = None
     if scene.seabed is not None:                # the default stiffness (riser/environment.py)
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
+        if scene.seabed.friction is not None:   # its default stick stiffness
+            resolved["rod_seabed_friction_stiffness"] = scene.seabed.friction.stiffness
     if values["rod_current_profile"]:
         resolved["rod_sea_surface"] = scene.current.surface + origin[2]
     if scene.sections:                          # the length the sections add up to

@@ -224,6 +224,17 @@ OPTIONS = [
            "seabed stiffness, N/m per m of line per m of penetration; default w / "
            f"{DEFAULT_PENETRATION * 1e3:g} mm, w the largest downward -rod_load (N/m)", SCALE,
            "N/m^2"),
+    Option("rod_seabed_friction", _reals(), None, "mu|mu_axial,mu_lateral",
+           "Coulomb friction of the seabed, both coefficients positive: the friction at a "
+           "grounded point opposes its slip from where the run starts (updated at every "
+           "load step) and is at most mu times its contact reaction, mu between mu_axial "
+           "along the line and mu_lateral across it (an ellipse); default none",
+           POSITIVE, "1"),
+    Option("rod_seabed_friction_stiffness", _real, None, "k_s",
+           "the stick stiffness of the seabed friction, N/m per m of line per m of slip: "
+           "a point moves up to mu R / k_s before it slides (R its contact reaction, N/m); "
+           "default a tenth of the seabed stiffness (at its default, mu x 1 cm)",
+           SCALE, "N/m^2"),
     Option("rod_seabed_slope", _real, None, "deg",
            "the seabed a plane rising at this angle (degrees above the horizontal, "
            "negative: falling) along -rod_seabed_direction, through the height -rod_seabed "

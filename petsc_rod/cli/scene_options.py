@@ -10,7 +10,7 @@ from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
 from petsc_rod.riser.bathymetry import Grid, Plane, Profile
-from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Seabed,
+from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Friction, Seabed,
                                          check_covered, check_ends_above, default_stiffness,
                                          grid_axes, largest_stiffness, read_profile,
                                          read_seabed_profile)
@@ -378,7 +378,7 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
     ``origin`` (3,), absolute; -rod_seabed already less origin[2])."""
     if "rod_seabed" not in given and "rod_seabed_profile" not in given and (
             profile_rows is None):
-        for name in ("rod_seabed_stiffness",) + SEABED_SHAPE:
+        for name in ("rod_seabed_stiffness",) + SEABED_SHAPE + SEABED_FRICTION:
             if name in given:
                 raise RodInputError(f"-{name} needs -rod_seabed (the seabed's height) or "
                                     "-rod_seabed_profile")
@@ -389,13 +389,43 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
         if stiffness is None:
             raise RodInputError("-rod_seabed: no -rod_load points down to set the default "
                                 "stiffness (weight / 1 mm); give -rod_seabed_stiffness")
+    friction = friction_from_options(values, given, float(stiffness))
     absolute = dict(values)
     if values["rod_seabed"] is not None:
         absolute["rod_seabed"] = values["rod_seabed"] + origin[2]
     shape = seabed_shape(absolute, given, origin, profile_rows)
     if shape is None:
-        return Seabed(float(values["rod_seabed"]), float(stiffness))
-    return Seabed(float(shape.height(0.0, 0.0)), float(stiffness), shape)
+        return Seabed(float(values["rod_seabed"]), float(stiffness), friction=friction)
+    return Seabed(float(shape.height(0.0, 0.0)), float(stiffness), shape, friction)
+
+
+# The default stick stiffness of the friction over the seabed's stiffness: at the default
+# seabed stiffness (weight / 1 mm) the weight mobilises the friction over mu x 1 cm, as
+# pipe-soil practice has it (a few mm axially, a tenth of a diameter laterally); stiffer
+# sticks slowed the iteration down (docs/riser.md §3b).
+FRICTION_STIFFNESS_RATIO = 0.1
+
+# The options of the seabed's friction (riser/friction.py, docs/riser.md §3b).
+SEABED_FRICTION = ("rod_seabed_friction", "rod_seabed_friction_stiffness")
+
+
+def friction_from_options(values, given, seabed_stiffness):
+    """The environment.Friction of -rod_seabed_friction (one coefficient, or axial and
+    lateral) and -rod_seabed_friction_stiffness (default the seabed's ``seabed_stiffness``),
+    or None without friction."""
+    if "rod_seabed_friction" not in given:
+        if "rod_seabed_friction_stiffness" in given:
+            raise RodInputError("-rod_seabed_friction_stiffness needs -rod_seabed_friction "
+                                "(the friction coefficient)")
+        return None
+    mu = np.asarray(values["rod_seabed_friction"], dtype=float)
+    if mu.size not in (1, 2):
+        raise RodInputError(f"-rod_seabed_friction {','.join(f'{v:g}' for v in mu)}: give "
+                            "one coefficient mu or two, mu_axial,mu_lateral")
+    stiffness = values["rod_seabed_friction_stiffness"]
+    if stiffness is None:
+        stiffness = FRICTION_STIFFNESS_RATIO * seabed_stiffness
+    return Friction(float(mu[0]), float(mu[-1]), float(stiffness))
 
 
 def current_from_options(values, given, surface_default, profile_rows=None,

@@ -218,7 +218,9 @@ class GlobalStep:
         ends are held, then r at the vertices by integration. The components a term
         solves itself (Term.solve_slope: with a seabed z) are left to it."""
         components = self._slope_components
-        if self.bordered:
+        if not components:                      # every component solved by a term
+            state.chord_multiplier = np.zeros(3)
+        elif self.bordered:
             chord = self.end_state.position - self.start_state.position
             state.chord_multiplier = self.slope_problem.solve_constrained(
                 self.rhs[2], state.slope, chord, components)

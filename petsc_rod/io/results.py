@@ -44,8 +44,8 @@ from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
 from petsc_rod.physics import point_loads as point_load_term
 from petsc_rod.riser import quantities as riser_quantities
-from petsc_rod.riser import (line_results, pressures, regions, section_numbers,
-                             stresses)
+from petsc_rod.riser import (friction, line_results, pressures, regions,
+                             section_numbers, stresses)
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -58,7 +58,7 @@ DATASET_UNITS = {
     "change": "1", "constraint_residual": "1", "wall_time": "s",
     **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
     **pressures.DATASET_UNITS, **line_results.DATASET_UNITS, **stresses.DATASET_UNITS,
-    **stretch.DATASET_UNITS,
+    **stretch.DATASET_UNITS, **friction.DATASET_UNITS,
 }
 # ... and of every attribute of a step group and of the root ("text": a string).
 ATTRIBUTE_UNITS = {
@@ -74,7 +74,7 @@ ATTRIBUTE_UNITS = {
     **pressures.ATTRIBUTE_UNITS, **line_results.ATTRIBUTE_UNITS,
     **regions.ATTRIBUTE_UNITS, **stresses.ATTRIBUTE_UNITS,
     **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
-    **point_load_term.ATTRIBUTE_UNITS,
+    **point_load_term.ATTRIBUTE_UNITS, **friction.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.

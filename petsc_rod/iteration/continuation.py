@@ -218,6 +218,7 @@ def continuation(solver, path=PathSettings(), stop=None):
             break
         path.accept()
         predictor.accept(t, state)
+        problem.accept_step()
         link = report.link if track_link else None
     if stop is not None and stop():
         yield events.Interrupted("after the last step", path.factor(path.reached))

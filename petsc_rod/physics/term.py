@@ -22,6 +22,8 @@ When each is called:
   ``add_strain_gradient``, ``add_hessian`` and, for a load without potential,
   ``add_jacobian``; ``conservative``, ``in_newton``, ``uses_heights`` and ``follower``
   say what they are;
+* the load path (iteration/continuation.py): ``accept_step`` at the end of every
+  accepted load step (a path-dependent term's memory: the friction's anchors);
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
   force n(S), ``outputs`` for datasets, attributes and the step line.
 """
@@ -129,6 +131,12 @@ class Term:
         """A follower's linearisation in the Newton Jacobian (analysis/jacobian.py
         NewtonJacobian, before assembly): its load's derivative in the frames, through
         the resultants' chain."""
+
+    # --- the load path -----------------------------------------------------------------
+    def accept_step(self, state):
+        """At the end of an accepted load step, the RodState ``state`` its equilibrium:
+        commit what the term remembers along the path (a step that is undone and
+        retried never reaches here). Collective."""
 
     # --- outputs --------------------------------------------------------------------
     def force_beyond(self, state):

@@ -1,7 +1,8 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
 pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (with the
-horizontal push of a sloping one, riser/slope_load.py), the drag and the riser numbers
+horizontal push of a sloping one, riser/slope_load.py, and its friction,
+riser/friction.py), the drag and the riser numbers
 only where the scene has a seabed or a current (docs/riser.md); the axial stretch only
 where some EA is finite (docs/method.md §12); the results along the line
 (riser/line_results.py) always, its regions (riser/regions.py) on a riser-like scene (a
@@ -12,6 +13,7 @@ from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.flex_joint import FlexJoint
 from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.stretch import AxialStretch
+from petsc_rod.riser.friction import FrictionTerm
 from petsc_rod.riser.line_results import LineResults
 from petsc_rod.riser.pressures import PipePressures
 from petsc_rod.riser.quantities import RiserNumbers
@@ -33,6 +35,8 @@ def scene_terms(mesh, scene):
         terms.append(seabed)
         if not scene.seabed.flat:               # a slope or a profile: its horizontal push
             terms.append(SeabedSlopeLoad(mesh, seabed))
+        if scene.seabed.friction is not None:   # after the seabed: it reads its reaction
+            terms.append(FrictionTerm(mesh, seabed))
     drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
     if drag:
         terms.append(DragTerm(mesh, scene))

@@ -94,6 +94,12 @@ class RodProblem:
         return self.scene.axially_symmetric and all(term.axially_symmetric
                                                     for term in self.terms)
 
+    def accept_step(self):
+        """The state is an accepted load step's equilibrium: the terms commit their path
+        memory (Term.accept_step). Collective."""
+        for term in self.terms:
+            term.accept_step(self.state)
+
     # --- the global step and the map --------------------------------------------------------
     @property
     def penalty(self):

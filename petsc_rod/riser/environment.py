@@ -23,8 +23,21 @@ MIN_RELATIVE_PENETRATION = 1e-14
 
 
 @dataclass(frozen=True)
+class Friction:
+    """Coulomb friction of the seabed (riser/friction.py, docs/riser.md §3b): the
+    coefficients along the line (``axial``) and across it (``lateral``), both positive,
+    1; the stick stiffness ``stiffness`` (N/m per m of line per m of slip, N/m^2) of
+    the elastic-perfectly-plastic spring that stands for the stick: a grounded point
+    moves up to mu R / stiffness before it slides (R its contact reaction, N/m)."""
+
+    axial: float
+    lateral: float
+    stiffness: float
+
+
+@dataclass(frozen=True)
 class Seabed:
-    """A frictionless, elastic seabed: the plane z = ``height`` (m), or, with a ``shape``
+    """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the plane z = ``height`` (m), or, with a ``shape``
     (riser/bathymetry.py: a sloping Plane or a Profile), the surface z = z_b(x, y), its
     ``height`` then z_b under the scene's origin. It pushes a line below it out along
     its unit normal N = (-g, 1) / sqrt(1 + |g|^2) (g = grad z_b) with k times the normal
@@ -40,6 +53,7 @@ class Seabed:
     height: float
     stiffness: float
     shape: object = None
+    friction: Friction = None             # None: frictionless
 
     @property
     def flat(self):

@@ -1,5 +1,6 @@
-"""The vertical component of the slope problem in Hermite dofs, where a spring on the
-height z is banded (docs/riser.md, "The seabed in the global step").
+"""A component of the slope problem in Hermite dofs, where a spring on that coordinate
+of the nodes is banded (docs/riser.md, "The seabed in the global step"): z for the
+seabed, x and y for its friction (friction.py). Written below for z.
 
 The global step solves for the slope r' (P2), not for r (docs/method.md §4). A
 seabed spring acts on z = z(a) + int_a^S r'_z, a non-local function of the slope: its
@@ -49,9 +50,10 @@ def midpoint_values(h):
     return np.stack([np.full_like(h, 0.5), h / 8, np.full_like(h, 0.5), -h / 8], axis=1)
 
 
-class VerticalProblem:
-    """T^T A T y = T^T b for the z component of the slope, plus a symmetric term added
-    per element (set_added: the seabed), with essential conditions on y.
+class HermiteProblem:
+    """T^T A T y = T^T b for the component ``component`` (0, 1, 2: x, y, z) of the slope,
+    plus a symmetric term added per element (set_added: the seabed's springs on z, the
+    friction's on x and y), with essential conditions on y.
 
     ``slope_matrices`` (ne, 3, 3) are the element matrices of the slope problem (2 c3 K +
     R W). The KSP (prefix ``prefix``) is the chain solver of the global step
@@ -59,8 +61,9 @@ class VerticalProblem:
     substructuring on several).
     """
 
-    def __init__(self, mesh, slope_matrices, prefix):
+    def __init__(self, mesh, slope_matrices, prefix, component=2):
         self.mesh = mesh
+        self.component = component
         self.name = prefix
         h = mesh.element_h
         self.rows = hermite_rows(mesh)
@@ -93,14 +96,16 @@ class VerticalProblem:
         return matrix
 
     def set_end_states(self, start, end):
-        """Essential conditions from the end states: z at a held end, z' at a clamp."""
+        """Essential conditions from the end states: the coordinate at a held end, its
+        slope at a clamp (d3's component; a clamped end of an extensible line is not
+        stretched here)."""
         last = 2 * self.mesh.n_elements
         fixed = []
         for row, state in ((0, start), (last, end)):
             if is_held(state):
-                fixed.append((row, state.position[2]))
+                fixed.append((row, state.position[self.component]))
             if state.kind == "clamp":
-                fixed.append((row + 1, state.frame[2, 2]))
+                fixed.append((row + 1, state.frame[2, self.component]))
         start_row, end_row = self.base.getOwnershipRange()
         self.fixed = np.array([r for r, _ in fixed], dtype=PETSc.IntType)
         owned = [(r - start_row, v) for r, v in fixed if start_row <= r < end_row]
@@ -185,8 +190,8 @@ class VerticalProblem:
         return self.solution
 
     def end_residual(self):
-        """(b - M y) at the row of z(L) after a solve (summed over the ranks): the z part of
-        the chord multiplier mu of the slope problem, T^T c = e_z(L) - e_z(0)
+        """(b - M y) at the row of z(L) after a solve (summed over the ranks): the
+        component's part of the chord multiplier mu of the slope problem, T^T c = e_z(L) - e_z(0)
         (docs/riser.md). Collective."""
         residual = self._product
         self.matrix.mult(self.solution, residual)

@@ -10,7 +10,8 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   angle of its tangent from the vertical (degrees);
 * the touchdown point: where the line, followed from the top, first reaches the seabed
   (the gap z - z_b(x, y) changes sign between two vertices, interpolated linearly), its
-  arc length and position; the grounded length, the length of line below z_b; on a
+  arc length and position, and its offset from the vertical plane through the ends
+  (``touchdown_offset``: a current across, friction); the grounded length, the length of line below z_b; on a
   seabed profile or grid, the number of vertices beyond its rows, where it is taken
   level (``seabed_vertices_beyond``, said in the step line when not 0);
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
@@ -25,11 +26,15 @@ import numpy as np
 from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.scenes.boundary import is_held
 
+# The step line gives the touchdown's offset from the ends' plane when it is above this
+# times the length (not round-off of an in-plane line).
+OFFSET_SHOWN = 1e-9
+
 # Units of the datasets and attributes this module adds to the result file.
 DATASET_UNITS = {"effective_tension": "N", "seabed_reaction": "N/m", "seabed_height": "m"}
 ATTRIBUTE_UNITS = {
     "top_tension": "N", "top_angle": "deg", "touchdown_S": "m", "touchdown_position": "m",
-    "grounded_length": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
+    "grounded_length": "m", "touchdown_offset": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
     "max_curvature_S": "m",
     "max_curvature_position": "m", "min_bend_radius": "m"}
 
@@ -128,6 +133,18 @@ def touchdown(problem, seabed, top):
     return float(found[0]), np.asarray(found[1], dtype=float), grounded
 
 
+def plane_offset(point, start, end):
+    """The signed horizontal distance (m) of ``point`` (3,) from the vertical plane
+    through ``start`` and ``end`` (3,), positive to the left of start -> end seen from
+    above; NaN when the two are one above the other (no plane)."""
+    chord = np.asarray(end, dtype=float)[:2] - np.asarray(start, dtype=float)[:2]
+    length = float(np.hypot(*chord))
+    if length == 0.0:
+        return np.nan
+    relative = np.asarray(point, dtype=float)[:2] - np.asarray(start, dtype=float)[:2]
+    return float(chord[0] * relative[1] - chord[1] * relative[0]) / length
+
+
 def riser_report(problem, vertex, seabed=None):
     """The datasets, attributes and step-line text (a physics.term.TermOutput) of a riser
     scene from the vertex fields ``vertex`` (outputs.vertex_fields), with the touchdown
@@ -162,10 +179,15 @@ def riser_report(problem, vertex, seabed=None):
             f"vertical")
     if seabed is not None:
         S, position, grounded = touchdown(problem, seabed.seabed, top)
+        offset = plane_offset(position, problem.start_state.position,
+                              problem.end_state.position)
         position = position + origin
-        attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded)
+        attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded,
+                          touchdown_offset=offset)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
+        if abs(offset) > OFFSET_SHOWN * mesh.length:
+            text += f", {offset:.6g} m off the ends' plane"
         if not seabed.seabed.flat:       # a profile or grid taken level beyond its rows
             r = vertex["r"]
             beyond = int(mesh.global_sum(int(np.sum(~seabed.seabed.shape.covers(r[:, 0],

@@ -37,6 +37,21 @@ from petsc_rod.riser.hermite import midpoint_values
 MAX_SOLVES = 30
 
 
+def owned_nodes(mesh, per_element):
+    """Values at the element nodes (ne, 3 nodes, ...) as values at the owned P2 nodes
+    (n_local_nodes, ...): each element's left vertex and midpoint, and the last vertex
+    from the last element's right node when this rank owns it (a vertex shared by two
+    elements has the same value in both)."""
+    per_element = np.asarray(per_element)
+    ne = mesh.n_local_elements
+    nodes = np.zeros((mesh.n_local_nodes,) + per_element.shape[2:])
+    nodes[0:2 * ne:2] = per_element[:, 0]
+    nodes[1:2 * ne:2] = per_element[:, 1]
+    if mesh.n_local_nodes > 2 * ne and ne:
+        nodes[-1] = per_element[-1, 2]
+    return nodes
+
+
 def node_rows(h):
     """E, (ne, 3 nodes, 4): z at the element's (left vertex, midpoint, right vertex) as
     rows acting on its Hermite dofs (z_e, z'_e, z_e+1, z'_e+1)."""
@@ -130,19 +145,20 @@ class SeabedContact:
         ``follow`` before it), so that it is the reaction that problem carried
         (slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
         start; a contact rebuilt at a penalty raise: one iteration without the push)."""
-        n_owned = self.mesh.vertex_end - self.mesh.vertex_start
-        ne = self.mesh.n_local_elements
-        nodes = np.zeros((n_owned + ne, 3))
         if self.gradients is None or self.solution is None:
-            return nodes
+            return np.zeros((self.mesh.n_local_nodes, 3))
         push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
-        per_element = np.concatenate([-push[..., None] * self.gradients, push[..., None]],
-                                     axis=2)                                   # (ne, 3, 3)
-        nodes[0:2 * ne:2] = per_element[:, 0]
-        nodes[1:2 * ne:2] = per_element[:, 1]
-        if n_owned > ne and ne:                 # the last vertex, right of the last element
-            nodes[-1] = per_element[-1, 2]
-        return nodes
+        return owned_nodes(self.mesh, np.concatenate(
+            [-push[..., None] * self.gradients, push[..., None]], axis=2))
+
+    def reaction(self):
+        """R = k (z_b,n - z_n)_+ cos(theta_n) at the element nodes (ne, 3), N/m: the
+        normal contact force per metre of the last vertical solve (environment.Seabed;
+        k_v sqrt(1 + |g|^2) = k cos(theta)). Collective."""
+        push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
+        if self.gradients is None:
+            return push
+        return push * np.sqrt(1.0 + np.sum(self.gradients**2, axis=-1))
 
     def pressure(self, z):
         """k (z_b - z)_+ (N/m), the seabed's upward force per metre of line at heights z."""

@@ -30,7 +30,7 @@ from petsc_rod.mesh.elements import P2, element_integrals
 from petsc_rod.mesh.fields import VectorField, element_dofs, scatter_element_vectors
 from petsc_rod.physics.term import Term
 from petsc_rod.riser.current import drag_jacobian, normal_drag
-from petsc_rod.riser.hermite import VerticalProblem
+from petsc_rod.riser.hermite import HermiteProblem
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.seabed import SeabedContact, node_rows
 from petsc_rod.scenes.boundary import is_held
@@ -123,7 +123,7 @@ class SeabedTerm(NodalLoadTerm):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
         (ne, 3, 3): at the start and after every penalty raise."""
         self._destroy_vertical()
-        self.vertical = VerticalProblem(self.mesh, slope_matrices, VERTICAL_PREFIX)
+        self.vertical = HermiteProblem(self.mesh, slope_matrices, VERTICAL_PREFIX)
         self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
         if self.start_state is not None:
             self.vertical.set_end_states(self.start_state, self.end_state)

@@ -106,3 +106,23 @@ def test_an_option_the_model_gives_is_refused_in_its_options():
         model(options={"seabed": 1.0}).option_texts()
     texts = model(options={"al_rtol": 1e-10, "al_stability": False}).option_texts()
     assert texts["rod_al_rtol"] == "1e-10" and texts["rod_al_stability"] == "0"
+
+
+def test_the_seabed_friction_of_the_environment_reaches_the_options_and_the_line():
+    """Environment.seabed_friction (one coefficient, or axial and lateral) and its stick
+    stiffness become -rod_seabed_friction and -rod_seabed_friction_stiffness; solved, the
+    grounded line's friction is reported (docs/riser.md §3b)."""
+    sea = Environment(seabed=0.0, surface=60.0, current=[0.0, 0.3, 0.0],
+                      seabed_friction=(0.4, 0.6), seabed_friction_stiffness=2e4)
+    texts = model(environment=sea).option_texts()
+    assert texts["rod_seabed_friction"] == "0.4,0.6"
+    assert float(texts["rod_seabed_friction_stiffness"]) == 2e4
+    results = solve(model(environment=sea),
+                    comm=PETSc.COMM_WORLD)
+    assert results.converged
+    grounded = results.scalars["grounded_length"]
+    assert grounded > 1.0
+    assert (results.scalars["friction_stick_length"] + results.scalars["friction_slide_length"]
+            == pytest.approx(grounded, abs=2 * 2.0))
+    assert results.scalars["friction_max_use"] <= 1.0 + 1e-6
+    assert results.units["friction_force"] == "N/m"

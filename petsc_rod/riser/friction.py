@@ -1,0 +1,273 @@
+"""Coulomb friction of the seabed in statics (docs/riser.md §3b), a term of physics
+(physics/term.py) built beside the seabed's where -rod_seabed_friction is given.
+
+The model (that of OrcaFlex's and RIFLEX's statics): at each grounded P2 node n, the
+seabed holds the line's horizontal position x_n (2,) to an anchor a_n by an
+elastic-perfectly-plastic spring: the friction per metre is
+
+    f_n = -k_s (x_n - a_n)                 if |k_s (x_n - a_n)|_mu <= R_n   (stick),
+    f_n = -k_s (x_n - a_n) R_n / |.|_mu    otherwise                        (slide),
+
+with R_n the normal contact reaction (N/m, seabed.SeabedContact.reaction), k_s the stick
+stiffness (N/m^2, -rod_seabed_friction_stiffness) and |f|_mu the elliptic norm
+sqrt((f.a / mu_a)^2 + (f.l / mu_l)^2) in the node's axial and lateral horizontal
+directions a, l (so a sliding node is resisted by mu R, mu between mu_a along the line
+and mu_l across it, opposite its slip). On a seabed that is not flat the friction lies in
+its tangent plane: its horizontal part is f, its vertical part g.f (g = grad z_b), and
+the norm is that of the whole force, |f|_mu sqrt(1 + (g.f)^2 / |f|^2) (so a block on an
+incline of angle theta sticks up to tan(theta) = mu).
+
+Friction depends on the path: the anchors are the nodes' positions where the run starts
+(its start shape, or the file of a restart: the line as laid), and at the end of every
+accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
+a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
+carries none).
+
+In the global step the friction is implicit, like the seabed: x and y are solved in
+Hermite dofs (hermite.py), where a spring on a node's position is banded, in place of
+the P2 solve of their slopes, with a spring k_n w_n toward its anchor at every node: k_s
+at a sticking node, the secant k_s R_n / |k_s (x_n - a_n)|_mu at a sliding one (whose
+force is then the sliding friction). The springs are those of the last solve's positions
+and the loop solves again until none changes by more than SECANT_RTOL k_s: the secant
+(Kacanov) iteration of a convex problem, which never carries a node past its anchor.
+A sliding force held fixed instead flipped its sign from one solve to the next and the
+map cycled (measured, docs/riser.md §3b). The contact reaction is that of the same
+global step's vertical solve (the seabed term comes first). Why implicit: an explicit
+(lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
+(seabed.py).
+
+Not in the Newton steps nor the stability test (``in_newton``, ``conservative`` False):
+friction dissipates, and the Newton system would need the horizontal positions as
+unknowns beside the heights (analysis/heights.py); docs/riser.md §3b.
+"""
+
+import numpy as np
+
+from petsc_rod.mesh.elements import NODE_WEIGHTS
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.riser.hermite import HermiteProblem, slope_map
+from petsc_rod.riser.loads import NodalLoad
+from petsc_rod.riser.seabed import MAX_SOLVES, node_rows, owned_nodes
+from petsc_rod.riser.terms import NodalLoadTerm
+
+# The secant loop of one global step ends when no node's spring changed by more than
+# this times k_s (the next global step starts from the last springs). Measured on the
+# riser across a current (docs/riser.md §3b): 1e-9 took 808 iterations and 25 s, 1e-2
+# and 1e-1 about 740 and 4.4 s.
+SECANT_RTOL = 1e-2
+
+# The KSP options prefixes of the x and y problems.
+PREFIXES = ("rod_x_", "rod_y_")
+
+# Units of the datasets and attributes this module adds to the result file.
+DATASET_UNITS = {"friction_force": "N/m", "friction_state": "1"}
+ATTRIBUTE_UNITS = {"friction_stick_length": "m", "friction_slide_length": "m",
+                   "friction_max_force": "N/m", "friction_max_use": "1"}
+
+# friction_state at a vertex: off the seabed, sticking, sliding
+OFF, STICK, SLIDE = 0, 1, 2
+
+
+def elliptic_norm(force, tangents, friction):
+    """|f|_mu = sqrt((f.a / mu_a)^2 + (f.l / mu_l)^2), (...), of horizontal forces
+    ``force`` (..., 2) with a the unit horizontal part of ``tangents`` (..., 2) and l
+    a turned by 90 degrees (a = e_x where the tangent is vertical: there the norm is
+    taken isotropic in mu_l, a grounded line being near horizontal)."""
+    length = np.linalg.norm(tangents, axis=-1, keepdims=True)
+    axial = np.divide(tangents, length, out=np.zeros_like(tangents), where=length > 0)
+    axial[length[..., 0] == 0] = (1.0, 0.0)
+    along = np.einsum("...c,...c->...", force, axial)
+    across = force[..., 1] * axial[..., 0] - force[..., 0] * axial[..., 1]
+    return np.hypot(along / friction.axial, across / friction.lateral)
+
+
+def tangent_factor(force, gradients):
+    """|f_t| / |f| = sqrt(1 + (g.f)^2 / |f|^2), (...): the friction's whole size over
+    that of its horizontal part f (..., 2) on a seabed of gradient g (..., 2); 1 where
+    f = 0 or the seabed is flat (``gradients`` None)."""
+    if gradients is None:
+        return np.ones(force.shape[:-1])
+    size = np.einsum("...c,...c->...", force, force)
+    rise = np.einsum("...c,...c->...", force, gradients)
+    return np.sqrt(1.0 + np.divide(rise**2, size, out=np.zeros_like(size), where=size > 0))
+
+
+class FrictionTerm(NodalLoadTerm):
+    """The seabed friction of the SeabedTerm ``seabed_term`` (module docstring)."""
+
+    slope_components = (0, 1)
+    conservative = False
+    in_newton = False
+
+    def __init__(self, mesh, seabed_term):
+        super().__init__(mesh, "friction")
+        self.seabed_term = seabed_term
+        self.friction = seabed_term.seabed.friction         # environment.Friction
+        h = mesh.element_h
+        self.weights = h[:, None] * NODE_WEIGHTS[None, :]          # (ne, 3)
+        self.rows = node_rows(h)                                    # positions (ne, 3, 4)
+        self.slope_rows = slope_map(h)                              # slopes (ne, 3, 4)
+        self.problems = []
+        ne = mesh.n_local_elements
+        self.anchors = None                 # a_n (ne, 3, 2): from the first solve's start
+        self.spring = np.zeros((ne, 3))             # k_n, N/m^2: k_s (stick), the secant
+        self.force = np.zeros((ne, 3, 3))           # f of the last solve, with its g.f
+        self.positions = None                       # x_n (ne, 3, 2) of the last solve
+        self.reaction = np.zeros((ne, 3))           # R_n of the last solve
+        self.use = np.zeros((ne, 3))                # |f|_mu / R of the last solve
+        self.load = NodalLoad(mesh, self._nodes)
+        self._local = mesh.da.createLocalVec()
+
+    # --- the global step --------------------------------------------------------------
+    def build(self, slope_matrices, penalty):
+        """The x and y problems with the slope problem's element matrices (at the start
+        and after every penalty raise; the anchors and the springs are kept)."""
+        self._destroy_problems()
+        self.problems = [HermiteProblem(self.mesh, slope_matrices, prefix, component)
+                         for component, prefix in enumerate(PREFIXES)]
+        if self.start_state is not None:
+            for problem in self.problems:
+                problem.set_end_states(self.start_state, self.end_state)
+
+    def ksps(self):
+        return [problem.ksp for problem in self.problems]
+
+    def prepare(self, t, start, end):
+        super().prepare(t, start, end)
+        for problem in self.problems:
+            problem.set_end_states(start, end)
+
+    def add_iterate_load(self, rhs, state):
+        """On a seabed that is not flat: the friction's vertical part g.f of the last
+        solve, a nodal load on the slope's right-hand side (its z part, which the
+        seabed's vertical problem solves; lagged like the slope's push, slope_load.py)."""
+        if self.seabed_term.seabed.flat:
+            return
+        vertical = np.zeros((self.mesh.n_local_nodes, 3))
+        vertical[:, 2] = owned_nodes(self.mesh, self.force[..., 2])
+        self.load.set(vertical)
+        self.add_to_rhs(rhs, self.load)
+
+    def solve_slope(self, rhs, state, bordered):
+        """x' and y' from the Hermite problems with the friction (module docstring): the
+        secant loop over the nodes' springs; with both ends held their part of the chord
+        multiplier. Collective."""
+        contact = self.seabed_term.contact
+        reaction = contact.reaction()
+        gradients = contact.gradients
+        if self.anchors is None:            # the start: the run's first global step
+            r = state.r.ghosted()
+            self.anchors = self._node_values([r[:, :, 0], r[:, :, 1]], self.rows)
+        stiffness = self.friction.stiffness
+        for _ in range(MAX_SOLVES):
+            self._set_springs()
+            solutions = [self._ghosted(problem.solve(rhs.components[c],
+                                                     state.slope.components[c]))
+                         for c, problem in enumerate(self.problems)]
+            positions = self._node_values(solutions, self.rows)
+            tangents = self._node_values(solutions, self.slope_rows)
+            carried = -self.spring[..., None] * (positions - self.anchors)
+            trial = -stiffness * (positions - self.anchors)
+            size = (elliptic_norm(trial, tangents, self.friction)
+                    * tangent_factor(trial, gradients))
+            spring = stiffness * np.divide(reaction, np.maximum(size, reaction),
+                                           out=np.zeros_like(size), where=reaction > 0)
+            change = self.mesh.global_max(float(np.max(np.abs(spring - self.spring),
+                                                       initial=0.0)))
+            self.spring = spring
+            if change <= SECANT_RTOL * stiffness:
+                break
+        self._record(carried, positions, tangents, reaction, gradients)
+        if bordered:
+            for c, problem in enumerate(self.problems):
+                state.chord_multiplier[c] = problem.end_residual()
+
+    def _record(self, carried, positions, tangents, reaction, gradients):
+        """Keep the last solve's friction (with its vertical part g.f), positions,
+        reactions and use |f|_mu / R."""
+        self.positions, self.reaction = positions, reaction
+        self.force[..., :2] = carried
+        self.force[..., 2] = (0.0 if gradients is None
+                              else np.einsum("enc,enc->en", carried, gradients))
+        size = elliptic_norm(carried, tangents, self.friction) * tangent_factor(carried,
+                                                                                 gradients)
+        self.use = np.divide(size, reaction, out=np.zeros_like(size), where=reaction > 0)
+
+    @property
+    def stick(self):
+        """The nodes whose spring is the stick stiffness (ne, 3): grounded and within
+        their limit."""
+        return self.spring >= self.friction.stiffness
+
+    def _set_springs(self):
+        """The springs k_n w_n in both problems' matrices and k_n w_n a_n on their
+        right-hand sides, (ne, 4, 4) and (ne, 4) per component (set_added: only the
+        elements whose spring changed are added again; the solve refactors). Collective."""
+        spring = self.spring * self.weights                                          # (ne, 3)
+        transposed = self.rows.transpose(0, 2, 1)                                     # (ne, 4, 3)
+        matrices = np.matmul(transposed * spring[:, None, :], self.rows)
+        vectors = np.einsum("ekn,enc->cek", transposed, spring[..., None] * self.anchors)
+        for problem, vector in zip(self.problems, vectors):
+            problem.set_added(matrices, vector)
+
+    def _node_values(self, ghosted, rows):
+        """rows (ne, 3, 4) applied to each element's Hermite dofs, (ne, 3, 2), from the
+        ghosted (value, slope) pairs (n_ghosted, 2) of x and y in ``ghosted``."""
+        left = self.mesh.element_local
+        return np.stack([np.einsum("enk,ek->en", rows,
+                                   np.concatenate([pairs[left], pairs[left + 1]], axis=1))
+                         for pairs in ghosted], axis=2)
+
+    def _ghosted(self, vec):
+        """The ghosted (value, slope) pairs of the Hermite solution ``vec``, (n_ghosted, 2)
+        (a copy). Collective (a ghost exchange)."""
+        self.mesh.da.globalToLocal(vec, self._local)
+        return self._local.getArray(readonly=True).reshape(-1, 2).copy()
+
+    # --- the load path --------------------------------------------------------------
+    def accept_step(self, state):
+        """At the end of an accepted load step: every anchor to x_n + f_n / k_s of the
+        last solve (the return map: a sticking node keeps its anchor, a sliding one's
+        follows it, a node off the seabed has its own position)."""
+        if self.positions is not None:
+            self.anchors = self.positions + self.force[..., :2] / self.friction.stiffness
+
+    # --- outputs --------------------------------------------------------------------
+    def node_loads(self, state):
+        """The friction per metre at the owned P2 nodes of the last solve (N/m),
+        (n_nodes, 3), for the internal force (NodalLoadTerm.force_beyond)."""
+        return owned_nodes(self.mesh, self.force)
+
+    def outputs(self, problem, vertex):
+        """The friction force and state (off, stick, slide) at the vertices; the grounded
+        lengths that stick and slide (Simpson weights of the P2 nodes), the largest
+        friction per metre and the largest use |f|_mu / R. Collective."""
+        mesh = self.mesh
+        grounded = self.reaction > 0
+        stick = self.stick & grounded
+        lengths = mesh.global_sum(np.array([np.sum(self.weights * stick),
+                                            np.sum(self.weights * (grounded & ~stick))]))
+        size = np.linalg.norm(self.force, axis=2)
+        largest = mesh.global_max(float(size.max()) if size.size else 0.0)
+        use = mesh.global_max(float(self.use.max()) if self.use.size else 0.0)
+        state = np.where(grounded, np.where(self.stick, STICK, SLIDE), OFF)
+        vertices = owned_nodes(mesh, np.stack([self.force[..., c] for c in range(3)] + [state],
+                                              axis=2))[0::2]
+        attributes = {"friction_stick_length": float(lengths[0]),
+                      "friction_slide_length": float(lengths[1]),
+                      "friction_max_force": largest, "friction_max_use": use}
+        text = (f"friction: {lengths[0]:.6g} m stick, {lengths[1]:.6g} m slide, largest "
+                f"{largest:.4g} N/m")
+        return TermOutput({"friction_force": vertices[:, :3],
+                           "friction_state": vertices[:, 3].astype(np.int32)},
+                          attributes, text)
+
+    def _destroy_problems(self):
+        for problem in self.problems:
+            problem.destroy()
+        self.problems = []
+
+    def destroy(self):
+        self._destroy_problems()
+        self._local.destroy()
+        super().destroy()

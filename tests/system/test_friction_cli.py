@@ -1,0 +1,84 @@
+"""Seabed friction from the command line (riser/friction.py, docs/riser.md §3b): the
+riser catenary under a current across its plane, whose grounded part slid 100 m
+sideways on a frictionless seabed, is held by friction, with the stick and slide
+lengths, the largest friction and the touchdown's offset in the step line and the file;
+bad friction input ends with one line, exit 2, no file. Spawns processes: marked
+``serial``."""
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import run_petsc_rod
+from test_hostile_cli import assert_one_line_and_nothing_left
+from test_riser_cli import SCENE
+
+pytestmark = pytest.mark.serial
+
+TIMEOUT = 300
+MU = 0.5
+
+BAD = {
+    "negative coefficient": (["-rod_seabed", "0", "-rod_seabed_friction", "-0.3"],
+                             ["-rod_seabed_friction -0.3", "positive"]),
+    "a zero coefficient": (["-rod_seabed", "0", "-rod_seabed_friction", "0.5,0"],
+                           ["-rod_seabed_friction 0.5,0", "positive"]),
+    "three coefficients": (["-rod_seabed", "0", "-rod_seabed_friction", "0.5,0.6,0.7"],
+                           ["-rod_seabed_friction 0.5,0.6,0.7", "one coefficient"]),
+    "friction without a seabed": (["-rod_seabed_friction", "0.5"],
+                                  ["-rod_seabed_friction needs -rod_seabed"]),
+    "stiffness without friction": (["-rod_seabed", "0", "-rod_seabed_friction_stiffness",
+                                    "1e5"], ["-rod_seabed_friction_stiffness needs "
+                                             "-rod_seabed_friction"]),
+    "negative stiffness": (["-rod_seabed", "0", "-rod_seabed_friction", "0.5",
+                            "-rod_seabed_friction_stiffness", "-1"],
+                           ["-rod_seabed_friction_stiffness -1", "positive"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_bad_friction_exits_2_with_one_line_and_no_file(tmp_path, case, ranks):
+    args, words = BAD[case]
+    path = tmp_path / "out.h5"
+    done = run_petsc_rod(SCENE + args + ["-rod_output", str(path)], ranks, TIMEOUT)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
+CROSS_CURRENT = ["-options_file", "options/riser_catenary.opts", "-rod_current", "0,1,0",
+                 "-rod_elements", "300"]
+
+
+def cross_current(tmp_path, name, args):
+    path = tmp_path / f"{name}.h5"
+    done = run_petsc_rod(CROSS_CURRENT + args + ["-rod_output", str(path)], 1, TIMEOUT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return path, done.stdout
+
+
+def test_friction_holds_the_riser_under_a_cross_current(tmp_path):
+    """options/riser_catenary.opts with 1 m/s across (300 elements): frictionless, the
+    touchdown ends 113.5 m off the riser's plane and the grounded line swings round the
+    anchor (29 m off at 90 m from it); with mu = 0.5 (the drag near the seabed is far below mu w = 600 N/m) the
+    touchdown is 19.6 m off and the sticking part of the grounded line stays within the
+    mobilisation distance mu R / k_s of where it was laid (the start's plane); the
+    friction is nowhere above mu R, and the step line says it (measured)."""
+    free, _ = cross_current(tmp_path, "free", [])
+    held, text = cross_current(tmp_path, "held", ["-rod_seabed_friction", str(MU)])
+    with h5py.File(free, "r") as a, h5py.File(held, "r") as b:
+        assert abs(a.attrs["touchdown_offset"]) > 100.0
+        offset = b.attrs["touchdown_offset"]
+        assert 10.0 < offset < 30.0
+        assert b.attrs["friction_max_use"] <= 1.0 + 1e-6
+        state, r = b["friction_state"][:], b["r"][:]
+        reaction = b["seabed_reaction"][:]
+        stiffness = 0.1 * 1.2e6            # the default: a tenth of the seabed's k
+        stick = state == 1
+        assert stick.sum() > 40 and (state == 2).sum() > 15     # 59 and 31 measured
+        assert np.all(np.abs(r[stick, 1]) <= MU * reaction[stick] / stiffness * 1.01 + 1e-9)
+        force = np.linalg.norm(b["friction_force"][:], axis=1)
+        assert np.all(force[reaction > 0] <= MU * reaction[reaction > 0] * (1 + 1e-6))
+        assert b.attrs["friction_stick_length"] + b.attrs["friction_slide_length"] == \
+            pytest.approx(b.attrs["grounded_length"], abs=3.0)
+    assert "m stick" in text and "m slide" in text and "off the ends' plane" in text
