@@ -661,7 +661,7 @@ def run_case(case, folder, before=False, ranks=None, initial=None, keep=None, en
         row["outcome"], row["reason"] = "converged", ""
         if case.check is not None:
             error, bound, what = case.check(result)
-            row.update(error=f"{error:.2e}", bound=f"{bound:.0e}", what=what)
+            row.update(error=f"{error:.2e}", bound=f"{bound:.2g}", what=what)
             if not error <= bound:
                 # handed back as converged: WRONG, unless the run said it may be that far
                 row["outcome"] = "warned" if warnings else "WRONG"

@@ -29,7 +29,8 @@ the P2 solve of their slopes, with a spring k_n w_n toward its anchor at every n
 at a sticking node, the secant k_s R_n / |k_s (x_n - a_n)|_mu at a sliding one (whose
 force is then the sliding friction). The springs are those of the last solve's positions
 and the loop solves again until none changes by more than SECANT_RTOL k_s: the secant
-(Kacanov) iteration of a convex problem, which never carries a node past its anchor.
+(Kacanov) iteration, of a convex problem for an isotropic mu and given R (with mu_a !=
+mu_l the law has no convex potential), which never carries a node past its anchor.
 A sliding force held fixed instead flipped its sign from one solve to the next and the
 map cycled (measured, docs/riser.md §3b). The contact reaction is that of the same
 global step's vertical solve (the seabed term comes first). Why implicit: an explicit

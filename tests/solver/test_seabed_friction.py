@@ -4,7 +4,9 @@ from the pull toward the anchor (mobilised friction) and is 0 beyond the stick-s
 front; a line on an incline (the load tilted by theta on a flat seabed) that sticks for
 tan(theta) < mu and slides for tan(theta) > mu with the anchor's tension of the sliding
 block; a line lying along the contour of a sloping seabed held by friction with the
-block's forces (friction in the seabed's tangent plane). One rank and two agree.
+block's forces (friction in the seabed's tangent plane); the pulled line held at both
+ends (the chord multiplier); the anchors' return map after each load step; the ellipse
+of mu_axial and mu_lateral; a free start. One rank and two agree.
 Serial and under mpiexec -n 2; bounds from measured runs (docs/riser.md §3b)."""
 
 import numpy as np
@@ -164,3 +166,92 @@ def test_one_rank_and_all_ranks_agree():
     assert np.abs(one["friction_force"] - all_["friction_force"]).max() < 1e-6 * MU * WEIGHT
     assert np.array_equal(one["friction_state"], all_["friction_state"])
     assert abs(a_one["friction_slide_length"] - a_all["friction_slide_length"]) < 1e-9
+
+
+# The pulled line held at both ends: its end pinned 0.25 m beyond its length, the
+# stretch int T / EA = T_L^2 / (2 mu w EA) = 0.25 m sets T_L = sqrt(2 mu w EA 0.25) =
+# 5000 N, and the tension falls by mu w per metre toward the anchor as when pulled by a
+# force (the chord multiplier carries the end's force in x).
+STRETCHED = dict(PULLED, end="pin", end_position=np.array([LENGTH + 0.25, 0.0, 0.0]),
+                 end_force=np.zeros(3))
+
+
+def test_a_line_stretched_between_two_pins_has_the_pulled_line_s_tension():
+    """To 1.2 % of T_L (the stick's elastic zone at the front, as pulled), the front
+    within 3.5 m of S = 100 m."""
+    report, fields, attributes = solve(PETSc.COMM_WORLD, 200,
+                                       dict(STRETCHED, seabed=seabed(1e5)))
+    assert report.converged
+    exact = np.maximum(PULL - MU * WEIGHT * (LENGTH - fields["S"]), 0.0)
+    assert np.abs(fields["effective_tension"] - exact).max() < 0.015 * PULL
+    assert abs(attributes["friction_slide_length"] - 100.0) < 3.5
+
+
+@pytest.mark.parametrize("steps", [1, 3])
+def test_the_anchors_follow_the_return_map_at_each_step(steps):
+    """After the last accepted step of a continuation of the stretched line, each
+    anchor is x + f / k_s: the spring k_s (x - a) is the friction itself, so its size
+    is at most R and equals R where the line slides; and 3 steps reach the 1 step's
+    state (monotone loading)."""
+    from helpers import continuation
+    from petsc_rod.riser.friction import FrictionTerm, elliptic_norm
+
+    scene = dict(STRETCHED, seabed=seabed(1e5))
+    mesh, solver = make_solver(PETSc.COMM_WORLD, 100, scene, PENALTY, rtol=1e-9, ctol=1e-9,
+                               max_it=20000, newton=False)
+    try:
+        report = continuation(solver, steps)
+        assert report.converged
+        term = next(t for t in solver.problem.terms if isinstance(t, FrictionTerm))
+        spring = -term.friction.stiffness * (term.positions - term.anchors)
+        size = elliptic_norm(spring, np.ones_like(spring) * [1.0, 0.0], term.friction)
+        sliding = (term.reaction > 0) & ~term.stick
+        assert np.all(size <= term.reaction * (1 + 1e-6) + 1e-9)
+        assert np.all(np.abs(size[sliding] - term.reaction[sliding])
+                      <= 1e-6 * term.reaction[sliding])
+        assert PETSc.COMM_WORLD.tompi4py().allreduce(int(sliding.sum())) > 50
+        r = gather(PETSc.COMM_WORLD, solver.problem.state.r.owned()[:, 0])
+    finally:
+        solver.destroy()
+        solver.problem.destroy()
+        mesh.destroy()
+    _, fields, _ = solve(PETSc.COMM_WORLD, 100, scene)
+    assert np.abs(r - fields["r"]).max() < 1e-6
+
+
+@pytest.mark.parametrize("axis", ["axial", "lateral"])
+def test_the_friction_ellipse_takes_mu_axial_along_the_line_and_mu_lateral_across(axis):
+    """mu_a = 0.3 along the line, mu_l = 0.8 across it, the weight tilted by 35 deg
+    (tan 35 = 0.70): along the line it slides with the anchor carrying L w (sin - mu_a
+    cos) to 1 %; across it, it sticks with the friction at tan(35) / mu_l = 0.875 of its
+    limit away from the pin."""
+    theta = np.radians(35.0)
+    w = WEIGHT
+    drive = [w * np.sin(theta), 0.0] if axis == "axial" else [0.0, w * np.sin(theta)]
+    scene = dict(tilted(35.0), load_values=[[*drive, -w * np.cos(theta)]],
+                 seabed=Seabed(0.0, 1e6, None, Friction(0.3, 0.8, 1e6)))
+    report, fields, attributes = solve(PETSc.COMM_WORLD, 100, scene)
+    assert report.converged
+    if axis == "axial":
+        exact = INCLINE_LENGTH * w * (np.sin(theta) - 0.3 * np.cos(theta))
+        assert abs(np.linalg.norm(fields["n"][0]) - exact) < 1e-2 * exact
+        assert attributes["friction_stick_length"] < 0.05 * INCLINE_LENGTH
+    else:
+        inner = (fields["S"] > 20.0) & (fields["S"] < INCLINE_LENGTH - 5.0)
+        use = (np.linalg.norm(fields["friction_force"][inner], axis=1)
+               / (0.8 * fields["seabed_reaction"][inner]))
+        assert np.abs(use - np.tan(theta) / 0.8).max() < 1e-2
+        assert attributes["friction_slide_length"] < 0.02 * INCLINE_LENGTH
+
+
+def test_a_free_start_pulled_from_a_held_end():
+    """The tilted line of 35 deg held at its end instead (the start free, the drive
+    toward the start): the end carries L w (sin - mu cos) to 1 %."""
+    theta = np.radians(35.0)
+    scene = dict(tilted(35.0), start="free", end="pin",
+                 end_position=np.array([INCLINE_LENGTH, 0.0, 0.0]),
+                 load_values=[[-WEIGHT * np.sin(theta), 0.0, -WEIGHT * np.cos(theta)]])
+    report, fields, _ = solve(PETSc.COMM_WORLD, 100, scene)
+    assert report.converged
+    exact = INCLINE_LENGTH * WEIGHT * (np.sin(theta) - MU * np.cos(theta))
+    assert abs(np.linalg.norm(fields["n"][-1]) - exact) < 1e-2 * exact
