@@ -21,6 +21,14 @@ def started(event):
             f"R = {event.penalty:g}, {event.steps} step(s){origin}")
 
 
+def no_newton(terms):
+    """The line that says a run takes no Newton steps, naming the ``terms`` (physics
+    Term) that are not in them (their newton_gap)."""
+    names = ", ".join(dict.fromkeys(term.newton_gap or type(term).__name__ for term in terms))
+    return (f"petsc_rod: no Newton steps with {names}: the plain accelerated iteration, "
+            "hundreds of iterations where Newton steps take tens")
+
+
 def failure_text(failure):
     """An attempt's failure (a sentence or a RodDivergedError) with the advice that a
     diverged iteration carries."""

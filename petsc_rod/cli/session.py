@@ -50,6 +50,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     for event in continuation(solver, path, stop):
         if isinstance(event, events.RunStarted):
             say(lines.started(event))
+            if solver.settings.newton and not problem.in_newton:
+                say(lines.no_newton([t for t in problem.terms if not t.in_newton]))
         elif isinstance(event, events.PenaltyRaised):
             raises.append(event)
         elif isinstance(event, events.StepHalved):

@@ -68,6 +68,7 @@ class PointLoads(DeadLoads):
         # the drag of attachments in a current (module docstring): no energy
         self.dragged = bool(scene.point_drags(0.5))
         self.conservative = self.in_newton = not self.dragged
+        self.newton_gap = "attachments with a drag area (docs/riser.md §9)" if self.dragged else ""
         self._drag_rhs = VectorField(mesh, "point_drag_rhs") if self.dragged else None
 
     @property

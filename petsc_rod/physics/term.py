@@ -68,6 +68,9 @@ class Term:
     # which is then unsymmetric and solved by LU; H (the stability test, the safeguard)
     # is that of the load held at its current value
     follower = False
+    # when in_newton is False: what the term is and where its limits are documented, for
+    # the line that says a run takes no Newton steps (cli/lines.no_newton)
+    newton_gap = ""
 
     # --- the global step --------------------------------------------------------------
     def add_slope_matrices(self, matrices):

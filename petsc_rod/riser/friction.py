@@ -99,6 +99,7 @@ class FrictionTerm(NodalLoadTerm):
     slope_components = (0, 1)
     conservative = False
     in_newton = False
+    newton_gap = "seabed friction (docs/riser.md §3b)"
 
     def __init__(self, mesh, seabed_term):
         super().__init__(mesh, "friction")

@@ -31,6 +31,7 @@ class SeabedSlopeLoad(NodalLoadTerm):
 
     conservative = False
     in_newton = False
+    newton_gap = "a seabed that is not flat (docs/riser.md §3a)"
 
     def __init__(self, mesh, contact):
         super().__init__(mesh, "seabed_slope")

@@ -63,7 +63,8 @@ def test_friction_holds_the_riser_under_a_cross_current(tmp_path):
     anchor (29 m off at 90 m from it); with mu = 0.5 (the drag near the seabed is far below mu w = 600 N/m) the
     touchdown is 19.6 m off and the sticking part of the grounded line stays within the
     mobilisation distance mu R / k_s of where it was laid (the start's plane); the
-    friction is nowhere above mu R, and the step line says it (measured)."""
+    friction is nowhere above mu R, and the step line says it (measured); the run says
+    that it takes no Newton steps, and why."""
     free, _ = cross_current(tmp_path, "free", [])
     held, text = cross_current(tmp_path, "held", ["-rod_seabed_friction", str(MU)])
     with h5py.File(free, "r") as a, h5py.File(held, "r") as b:
@@ -82,3 +83,4 @@ def test_friction_holds_the_riser_under_a_cross_current(tmp_path):
         assert b.attrs["friction_stick_length"] + b.attrs["friction_slide_length"] == \
             pytest.approx(b.attrs["grounded_length"], abs=3.0)
     assert "m stick" in text and "m slide" in text and "off the ends' plane" in text
+    assert "no Newton steps with seabed friction (docs/riser.md §3b)" in text
