@@ -30,7 +30,7 @@ from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
-SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_")
+SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_")
 
 # Every number must be finite and at most this large in magnitude (and a positive scale,
 # such as a length or a tolerance, at least its inverse): the solver forms products of

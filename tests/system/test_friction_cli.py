@@ -84,3 +84,15 @@ def test_friction_holds_the_riser_under_a_cross_current(tmp_path):
             pytest.approx(b.attrs["grounded_length"], abs=3.0)
     assert "m stick" in text and "m slide" in text and "off the ends' plane" in text
     assert "no Newton steps with seabed friction (docs/riser.md §3b)" in text
+
+
+def test_the_friction_solvers_take_their_options(tmp_path):
+    """-rod_x_* and -rod_y_* reach the KSPs of the friction's x and y problems (they
+    were refused as unknown options before the review, measured) and are used."""
+    path = tmp_path / "xy.h5"
+    done = run_petsc_rod(SCENE + ["-rod_seabed", "0", "-rod_seabed_friction", "0.5",
+                                  "-rod_x_ksp_type", "preonly", "-rod_y_ksp_type", "preonly",
+                                  "-options_left", "-rod_output", str(path)], 1, TIMEOUT)
+    text = done.stdout + done.stderr
+    assert done.returncode == 0, text
+    assert "unknown option" not in text and "There are no unused options" in text, text
