@@ -20,14 +20,15 @@ in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
 The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
 delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
 (analysis/stability.py, with the resultants' slots as identity rows) plus these
-entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.lu_solver). H's curvature
-term is the load's at its current value, symmetrised: the antisymmetric rest is the
-torque balance, zero at a solution, so the steps still converge quadratically.
+entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.lu_solver, options
+-rod_newton_*). H's curvature term is the load's at its current value, symmetrised: the
+antisymmetric rest is the torque balance, zero at a solution, so the steps still
+converge quadratically.
 """
 
 from petsc4py import PETSc
 
-from petsc_rod.global_step.ksp import lu_solver
+from petsc_rod.global_step.ksp import lu_solver, set_up_lu
 
 
 class NewtonJacobian:
@@ -67,7 +68,7 @@ class NewtonJacobian:
             self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
         else:
             self.ksp.setOperators(self.matrix)
-        self.ksp.setUp()
+        set_up_lu(self.ksp)
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and

@@ -37,12 +37,14 @@ and the chord forms the columns w_n d3_n of delta int r' dS. The stretch of a cl
 node (from the force balance, §12) and of a node with EA infinite is held: its row is
 replaced by the identity, as a clamped rotation is.
 
-A term whose energy depends on the heights of the nodes (the seabed, Term.uses_heights)
-makes the vertex heights u_i and the multipliers nu_e of their chain unknowns too
-(analysis/heights.py): one more unknown per node, u at a vertex and nu at a midpoint.
-H is then the KKT matrix of the chain, whose inertia has n_elements negative eigenvalues
-more than the second variation on the rotations; they are counted off, and the mass of
-the extra unknowns is 0 (a shift moves the rotations' eigenvalues only). A load that
+A term whose energy depends on components of the node positions (the seabed on the
+heights, the friction on the horizontal positions: Term.position_components) makes the
+vertex positions u^c_i of those components and the multipliers nu^c_e of their chains
+unknowns too (analysis/positions.py): one more unknown per node and component, u at a
+vertex and nu at a midpoint. H is then the KKT matrix of the chains, whose inertia has
+n_elements negative eigenvalues per component more than the second variation on the
+rotations; they are counted off, and the mass of the extra unknowns is 0 (a shift moves
+the rotations' eigenvalues only). A load that
 follows the line (the drag, Term.follower) adds three more per node, the resultants of
 the Newton Jacobian (analysis/jacobian.py): identity rows here, H being the second
 variation with that load held fixed.
@@ -51,7 +53,7 @@ variation with that load held fixed.
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.analysis.heights import HALF, SIMPSON, slope_rows
+from petsc_rod.analysis.positions import HALF, HEIGHT, SIMPSON, slope_rows
 from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
@@ -87,10 +89,10 @@ class SecondVariation:
     """H of the module docstring at the state of a problem (problem/problem.py) at the
     last construction or ``update()``, as a PETSc matrix on the rotation vectors of the
     P2 nodes (3 per node, node n = 2 vertex + slot; 4 on an extensible line, the fourth
-    the stretch k; ``unknowns`` of them, and, ``block`` in all, one more when a term
-    reads the heights (u at a vertex, nu at a midpoint) and three more when a load
-    follows the line (the resultants): module docstring), with what the inertia test
-    needs;
+    the stretch k; ``unknowns`` of them, and, ``block`` in all, one more per component of
+    the positions the terms read (u at a vertex, nu at a midpoint; slots
+    ``position_slot``) and three more when a load follows the line (the resultants):
+    module docstring), with what the inertia test needs;
     the problem's terms add their own curvature (Term.add_hessian). Collective;
     ``destroy()`` frees every PETSc object."""
 
@@ -101,15 +103,18 @@ class SecondVariation:
         # unknowns per node: the rotation vector, and on an extensible line its stretch
         self.stretch = getattr(problem, "axial", None) is not None
         self.unknowns = 4 if self.stretch else 3
-        # the heights' chain (analysis/heights.py) where a term's energy reads them
-        self.heights = any(term.uses_heights for term in problem.terms)
+        # the positions' chains (analysis/positions.py) of the components the terms'
+        # energies read, one slot each after the node's unknowns
+        self.positions = tuple(sorted({c for term in problem.terms
+                                       for c in term.position_components}))
+        self.position_slot = {c: self.unknowns + i for i, c in enumerate(self.positions)}
         # the resultants' chain of a load that follows the line (analysis/jacobian.py):
         # three slots per node, identity rows here (H is the frozen load's)
         self.resultants = any(term.follower for term in problem.terms)
-        self.resultant_slot = self.unknowns + int(self.heights)
+        self.resultant_slot = self.unknowns + len(self.positions)
         self.block = block = self.resultant_slot + 3 * int(self.resultants)
-        # the chain's multipliers: negative eigenvalues of the KKT matrix beyond H's
-        self.chain_constraints = mesh.n_elements if self.heights else 0
+        # the chains' multipliers: negative eigenvalues of the KKT matrix beyond H's
+        self.chain_constraints = mesh.n_elements * len(self.positions)
         n_local = block * mesh.n_local_nodes
         self.first_row = 2 * block * mesh.vertex_start
         self.matrix = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
@@ -194,8 +199,8 @@ class SecondVariation:
                 + np.arange(U)).astype(PETSc.IntType)
         if rows.size:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
-        if self.heights:
-            self._add_chain(d)
+        if self.positions:
+            self._add_chains(d)
         if self.resultants:
             self._add_blocks(self.resultant_rows[:, None], self.resultant_rows[:, None],
                              np.ones((self.resultant_rows.size, 1, 1)))
@@ -203,55 +208,81 @@ class SecondVariation:
             term.add_hessian(self)
         self.matrix.assemble()
 
-    # --- the heights' chain (module docstring, analysis/heights.py) ---------------------
-    def _add_chain(self, d):
-        """The chain's rows nu_e (u_e+1 - u_e - h_e SIMPSON.s_e = 0) and their transposes,
-        from the fields d (ne, 3 nodes, 3 dirs, 3); keeps the element columns and rows of
-        the slopes for add_height_curvature."""
+    # --- the positions' chains (module docstring, analysis/positions.py) -----------------
+    def _add_chains(self, d):
+        """Each chain's rows nu^c_e (u^c_e+1 - u^c_e - h_e SIMPSON.s^c_e = 0) and their
+        transposes, from the fields d (ne, 3 nodes, 3 dirs, 3); keeps, per component, the
+        midpoint's position as a row on (u^c_e, the element's unknowns) for
+        position_blocks."""
         mesh, B, U = self.problem.mesh, self.block, self.unknowns
         ne = mesh.n_local_elements
-        nodes = self.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
-        # columns (u_e, u_e+1, x_L.., x_M.., x_R..) and the slopes' rows on x (ne, 3, U)
-        self._heights_u = nodes[:, [0, 2]] + U
-        self._heights_x = (nodes[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
-        self._slope_rows = slope_rows(d[:, :, 2, :], self.stretch) if ne else \
-            np.zeros((0, 3, U))
         h = mesh.element_h
-        coefficients = np.concatenate([
-            -np.ones((ne, 1)), np.ones((ne, 1)),
-            (-h[:, None, None] * SIMPSON[None, :, None] * self._slope_rows).reshape(ne, 3 * U)],
-            axis=1)
-        multiplier = (nodes[:, 1] + U)[:, None]
-        columns = np.concatenate([self._heights_u, self._heights_x], axis=1)
-        if ne:
-            self._add_blocks(multiplier, columns, coefficients[:, None, :])
-            self._add_blocks(columns, multiplier, coefficients[:, :, None])
-            # a 0 on nu's diagonal: in the pattern, so that a shift (setDiagonal) adds
-            # no nonzero to the copy the factorisations were analysed for
-            self._add_blocks(multiplier, multiplier, np.zeros((ne, 1, 1)))
+        nodes = self.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
+        unknowns = (nodes[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
+        self._midpoint_index, self._midpoint_rows = {}, {}
+        for component, slot in self.position_slot.items():
+            # the slopes' rows on the element's unknowns (ne, 3, U)
+            rows = slope_rows(d[:, :, 2, :], self.stretch, component) if ne else \
+                np.zeros((0, 3, U))
+            ends = nodes[:, [0, 2]] + slot                          # u_e, u_e+1
+            coefficients = np.concatenate([
+                -np.ones((ne, 1)), np.ones((ne, 1)),
+                (-h[:, None, None] * SIMPSON[None, :, None] * rows).reshape(ne, 3 * U)],
+                axis=1)
+            multiplier = (nodes[:, 1] + slot)[:, None]
+            columns = np.concatenate([ends, unknowns], axis=1)
+            self._midpoint_index[component] = np.concatenate([ends[:, :1], unknowns], axis=1)
+            self._midpoint_rows[component] = np.concatenate(
+                [np.ones((ne, 1)),
+                 (h[:, None, None] * HALF[None, :, None] * rows).reshape(ne, 3 * U)], axis=1)
+            if ne:
+                self._add_blocks(multiplier, columns, coefficients[:, None, :])
+                self._add_blocks(columns, multiplier, coefficients[:, :, None])
+                # a 0 on nu's diagonal: in the pattern, so that a shift (setDiagonal)
+                # adds no nonzero to the copy the factorisations were analysed for
+                self._add_blocks(multiplier, multiplier, np.zeros((ne, 1, 1)))
 
     def _add_blocks(self, rows, columns, values):
         self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
                                  values, addv=PETSc.InsertMode.ADD_VALUES)
 
+    def position_blocks(self, values, rows, columns):
+        """The entries sum_ij values[n, i, j] delta x^{rows_i}_n delta x^{columns_j}_n of a
+        second derivative in the node positions, ``values`` (n_nodes, len rows, len
+        columns) at the owned nodes (rows and columns: components among ``positions``),
+        as (rows, columns, blocks) triples for an add (this matrix's, or the Newton
+        Jacobian's): at a vertex on its u's; at a midpoint, whose position is
+        u_e + h_e HALF.s_e, outer products of those rows on (u_e, the element's
+        unknowns). Needs the chains of the last assembly (_add_chains)."""
+        values = np.asarray(values, dtype=float)
+        mesh, B = self.problem.mesh, self.block
+        ne = mesh.n_local_elements
+        vertices = self.first_row + B * np.arange(0, values.shape[0], 2)
+        triples = [(vertices[:, None] + np.array([self.position_slot[a] for a in rows]),
+                    vertices[:, None] + np.array([self.position_slot[b] for b in columns]),
+                    values[0::2])]
+        if ne:
+            middle = values[1:2 * ne:2]
+            for i, a in enumerate(rows):
+                for j, b in enumerate(columns):
+                    triples.append((self._midpoint_index[a], self._midpoint_index[b],
+                                    middle[:, i, j, None, None]
+                                    * self._midpoint_rows[a][:, :, None]
+                                    * self._midpoint_rows[b][:, None, :]))
+        return [t for t in triples if t[0].size]
+
+    def add_position_curvature(self, values, components):
+        """Add a position energy's second derivative (module docstring of positions.py),
+        ``values`` (n_nodes, m, m) in the ``components`` (m,) of the owned nodes' positions,
+        N/m (Term.add_hessian, before assembly)."""
+        for rows, columns, blocks in self.position_blocks(values, components, components):
+            self._add_blocks(rows, columns, blocks)
+
     def add_height_curvature(self, curvature):
         """Add a height energy's second derivative d2E/dz_n^2 (n_nodes,), N/m, at the owned
-        nodes (Term.add_hessian, before assembly): on u_i at a vertex; at a midpoint on
-        its height u_e + h_e HALF.s_e, a rank-one block on (u_e, the element's x)."""
-        c = np.asarray(curvature, dtype=float)
-        mesh, B, U = self.problem.mesh, self.block, self.unknowns
-        ne = mesh.n_local_elements
-        vertices = (self.first_row + B * np.arange(0, c.size, 2) + U)[:, None]
-        if vertices.size:
-            self._add_blocks(vertices, vertices, c[0::2, None, None])
-        if ne:
-            h = mesh.element_h
-            v = np.concatenate([np.ones((ne, 1)), (h[:, None, None] * HALF[None, :, None]
-                                                   * self._slope_rows).reshape(ne, 3 * U)],
-                               axis=1)
-            index = np.concatenate([self._heights_u[:, :1], self._heights_x], axis=1)
-            self._add_blocks(index, index, c[1:2 * ne:2, None, None] * v[:, :, None]
-                             * v[:, None, :])
+        nodes (add_position_curvature of the heights alone)."""
+        self.add_position_curvature(np.asarray(curvature, dtype=float)[:, None, None],
+                                    (HEIGHT,))
 
     @staticmethod
     def _element_blocks(d, weights, stiffness):
@@ -310,23 +341,25 @@ class SecondVariation:
 
     def _clamped_rows(self):
         """Global rows of the rotation vectors at clamped nodes (and, on an extensible
-        line, of the stretch held there and where EA is infinite; with the heights'
-        chain, of the height at the held end). A clamped node's chain unknowns (u, nu,
-        the resultants) are not held: the chains run through it."""
+        line, of the stretch held there and where EA is infinite; with the positions'
+        chains, of the positions at the held end). A clamped node's chain unknowns (u,
+        nu, the resultants) are not held: the chains run through it."""
         nodes = np.flatnonzero(~self.problem.free_nodes)
         B = self.block
         rows = (self.first_row + B * nodes[:, None] + np.arange(self.unknowns)).ravel()
         if self.stretch:
             held = np.flatnonzero(~np.isfinite(self.problem.axial) & self.problem.free_nodes)
             rows = np.sort(np.concatenate([rows, self.first_row + B * held + 3]))
-        if self.heights:
-            # the height at the held end (the start's, else the end's) is held: u_a = 0
+        if self.positions:
+            # the position at the held end (the start's, else the end's) is held: u_a = 0
             mesh = self.problem.mesh
             if is_held(self.problem.start_state):
                 anchor = [0] if mesh.on_lower_boundary else []
             else:
                 anchor = [mesh.n_local_nodes - 1] if mesh.on_upper_boundary else []
-            pins = self.first_row + B * np.array(anchor, dtype=int) + self.unknowns
+            slots = np.array(list(self.position_slot.values()))
+            pins = (self.first_row + B * np.array(anchor, dtype=int)[:, None]
+                    + slots[None, :]).ravel()
             rows = np.sort(np.concatenate([rows, pins]))
         return rows.astype(PETSc.IntType)
 
@@ -350,6 +383,21 @@ class SecondVariation:
             self._zero_clamped(vec)
             columns.append(vec)
         return columns
+
+    def constrain_roll(self, tangents):
+        """Add the mean roll omega -> sum_n w_n omega_n . t_n / |t_n| (tangents t
+        (n_nodes, 3)) to the constraints of the inertia test, until the next update: where
+        K1 = K2 all along and nothing is clamped, turning every section by one angle about
+        its tangent is a null vector of H (the free roll, which the Newton steps leave
+        out), and an iterate's multipliers make its eigenvalue slightly negative (measured
+        on the riser with seabed friction: -10 to -1000 times the tolerance, at change
+        1e-5 to 1e-6)."""
+        w = self.problem.state.node_weights
+        vec = self.to_vec(np.concatenate(
+            [w[:, None] * unit(tangents), np.zeros((len(w), self.unknowns - 3))], axis=1))
+        self._zero_clamped(vec)
+        self._drop_constraint_solves()
+        self.constraint = self._independent(self.constraint + [vec])
 
     def _chord_columns(self):
         """An orthonormal basis of the chord forms at tau3 (the constraint of the test)."""
@@ -439,7 +487,7 @@ class SecondVariation:
 
     def negative_pivots(self):
         """Negative eigenvalues of the last factorisation's H - shift M, those of the
-        heights' chain counted off (module docstring)."""
+        positions' chains counted off (module docstring)."""
         return int(self.factor.getInertia()[0]) - self.chain_constraints
 
     def solve_in_constraint_span(self, columns):
@@ -474,10 +522,10 @@ class SecondVariation:
 
     def lower_bound(self):
         """Gershgorin: every eigenvalue of H / M is at least min_i (H_ii - sum_j |H_ij|)
-        / M_ii (M diagonal). With the heights' chain H is a KKT matrix, to which the
+        / M_ii (M diagonal). With the positions' chains H is a KKT matrix, to which the
         bound does not apply: the shift is lowered tenfold from -tolerance until no
         eigenvalue lies below it (one factorisation each)."""
-        if self.heights:
+        if self.positions:
             lower = -10 * self.tolerance()
             while self.negative_directions(lower) > 0:
                 lower *= 10
@@ -513,11 +561,11 @@ class SecondVariation:
         self._zero_clamped(vector)
         work = vector.duplicate()
         for _ in range(INVERSE_STEPS):
-            self._zero_heights(vector)
+            self._zero_chains(vector)
             self._project(vector)
             self.ksp.solve(vector, work)
             work.copy(vector)
-            self._zero_heights(vector)
+            self._zero_chains(vector)
             vector.scale(1.0 / vector.norm())
         self._project(vector)
         direction = self.from_vec(vector)
@@ -525,8 +573,8 @@ class SecondVariation:
         work.destroy()
         return direction
 
-    def _zero_heights(self, vector):
-        """0 on the heights' unknowns u, nu and the resultants' (the inverse iteration's
+    def _zero_chains(self, vector):
+        """0 on the chains' unknowns u, nu and the resultants' (the inverse iteration's
         right-hand sides)."""
         if self.block > self.unknowns:
             vector.getArray().reshape(-1, self.block)[:, self.unknowns:] = 0.0

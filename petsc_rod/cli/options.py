@@ -2,7 +2,8 @@
 
 Every option has the root prefix ``rod_``. The KSPs of the global step have their own
 prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``; ``rod_z_`` the seabed's vertical
-problem), the SNES of the iteration ``rod_snes_``;
+problem, ``rod_x_`` and ``rod_y_`` its friction's), the SNES of the iteration
+``rod_snes_``, the Newton Jacobian's LU ``rod_newton_``;
 they read the usual PETSc options. A
 ``-rod_*`` name that is not in the table is an error (with the closest known name); any
 other option nobody read is reported at the end of the run.
@@ -30,7 +31,8 @@ from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
-SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_")
+SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_",
+                   "rod_newton_")
 
 # Every number must be finite and at most this large in magnitude (and a positive scale,
 # such as a length or a tolerance, at least its inverse): the solver forms products of
@@ -323,8 +325,9 @@ OPTIONS = [
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once (not with a seabed); after a "
            "failed attempt the wait doubles; with a seabed the node heights are unknowns "
-           "too, on an extensible line "
-           "the strains, with a current the resultants of the drag (an LU solve)"),
+           "too (with its friction the horizontal positions, an LU solve), on an "
+           "extensible line the strains, with a current the resultants of the drag (an "
+           "LU solve)"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",
@@ -436,9 +439,13 @@ def help_text():
         lines.append(f"  -{option.name} <{option.metavar}>: {option.help} "
                      f"(default {default})")
     lines.append("  Global-step solvers: -rod_slope_ksp_*, -rod_slope_pc_* (the slope r'), -rod_d1_*, -rod_d2_* "
-                 "(directors), -rod_z_* (the height, with -rod_seabed); default preonly + "
+                 "(directors), -rod_z_* (the height, with -rod_seabed), -rod_x_*, -rod_y_* "
+                 "(with -rod_seabed_friction); default preonly + "
                  "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
                  "python) on several.")
+    lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
+                 "their unsymmetric Jacobian (default preonly + MUMPS LU, "
+                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering).")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres | qn | ncg (the SNES "
                  "types that need no Jacobian), and the SNES options under the same prefix "

@@ -14,7 +14,7 @@ from petsc4py import PETSc
 
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.global_step import substructuring
-from petsc_rod.petsc_defaults import set_from_options_with_defaults
+from petsc_rod.petsc_defaults import defaults_in_effect, set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
                for name in dir(PETSc.KSP.ConvergedReason) if not name.startswith("_")}
@@ -59,18 +59,44 @@ def inertia_solver(comm, operator):
     return ksp, factor
 
 
-def lu_solver(comm, operator):
+# The options prefix of the Newton Jacobian's LU (analysis/jacobian.py).
+NEWTON_PREFIX = "rod_newton_"
+# Its defaults: MUMPS's approximate minimum fill ordering (ICNTL 7 = 2), unless the
+# options say otherwise. MUMPS's automatic choice for an unsymmetric matrix on these
+# chains is PORD, whose analysis took 8.1 s for the riser catenary's Jacobian at 18 000
+# elements (252 007 unknowns), against 0.48 s with AMF and fewer entries in the factors
+# (5.0e6 against 7.1e6), the same residual (docs/performance.md). MUMPS reads its
+# controls at the symbolic factorisation, so they are in effect at each set-up
+# (set_up_lu); MatMumpsSetIcntl(7) before it did not take (PETSc 3.18, measured).
+LU_DEFAULTS = {"mat_mumps_icntl_7": "2"}
+
+
+def lu_solver(comm, operator, prefix=NEWTON_PREFIX):
     """A KSP for an unsymmetric ``operator``: preonly + MUMPS's LU with null pivots
     detected (ICNTL 24) (the Newton Jacobian of a problem with a load that has no
     potential, analysis/jacobian.py): the free roll of a section with K1 = K2 between
-    pins is a null vector. The caller owns it."""
-    return _mumps(comm, operator, PETSc.PC.Type.LU)[0]
+    pins is a null vector. Options under ``prefix``; set it up with set_up_lu. The
+    caller owns it."""
+    ksp = _mumps(comm, operator, PETSc.PC.Type.LU, prefix)[0]
+    ksp.setFromOptions()
+    return ksp
 
 
-def _mumps(comm, operator, factorisation):
+def set_up_lu(ksp):
+    """``ksp.setUp()`` for an lu_solver, with LU_DEFAULTS in effect under its prefix (the
+    factorisation reads them)."""
+    prefix = ksp.getOptionsPrefix() or ""
+    with defaults_in_effect({f"{prefix}{key}": value for key, value in LU_DEFAULTS.items()}):
+        ksp.setUp()
+
+
+def _mumps(comm, operator, factorisation, prefix=None):
     """(ksp, factor): preonly + MUMPS's ``factorisation`` of ``operator``, null pivots
-    detected instead of fatal (ICNTL 24)."""
+    detected instead of fatal (ICNTL 24); options under ``prefix``, the factor's
+    (-<prefix>mat_mumps_icntl_*) included."""
     ksp = PETSc.KSP().create(comm=comm)
+    if prefix is not None:
+        ksp.setOptionsPrefix(prefix)
     ksp.setOperators(operator)
     ksp.setType(PETSc.KSP.Type.PREONLY)
     pc = ksp.getPC()
@@ -78,6 +104,8 @@ def _mumps(comm, operator, factorisation):
     pc.setFactorSolverType("mumps")
     pc.setFactorSetUpSolverType()
     factor = pc.getFactorMatrix()
+    if prefix is not None:
+        factor.setOptionsPrefix(prefix)     # MatGetFactor gave it none (PETSc 3.18)
     factor.setMumpsIcntl(24, 1)
     return ksp, factor
 

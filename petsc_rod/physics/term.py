@@ -20,8 +20,8 @@ When each is called:
 * the energy and its derivatives (problem.energy, problem.energy_gradient, the Newton
   steps of §11 and the second variation of §10): ``energy``, ``add_gradient``,
   ``add_strain_gradient``, ``add_hessian`` and, for a load without potential,
-  ``add_jacobian``; ``conservative``, ``in_newton``, ``uses_heights`` and ``follower``
-  say what they are;
+  ``add_jacobian``; ``conservative``, ``in_newton``, ``position_components``,
+  ``follower`` and ``unsymmetric`` say what they are;
 * the load path (iteration/continuation.py): ``accept_step`` at the end of every
   accepted load step (a path-dependent term's memory: the friction's anchors);
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
@@ -59,15 +59,19 @@ class Term:
     # components of the slope r' (0, 1, 2 for x, y, z) that the term solves itself in
     # the global step (solve_slope) in place of the P2 solve (the seabed: z)
     slope_components = ()
-    # the term's energy depends on the heights of the nodes (the seabed): the Newton
-    # system and the stability test then carry the heights' chain (analysis/heights.py),
-    # and add_hessian may call hessian.add_height_curvature
-    uses_heights = False
-    # the term's load follows the line and has no potential (the drag): its
-    # linearisation enters the Newton Jacobian (add_jacobian, analysis/jacobian.py),
-    # which is then unsymmetric and solved by LU; H (the stability test, the safeguard)
-    # is that of the load held at its current value
+    # the components (0, 1, 2 for x, y, z) of the node positions the term's energy or
+    # load reads (the seabed: the heights; the friction: the horizontal positions): the
+    # Newton system and the stability test then carry their chains
+    # (analysis/positions.py), and add_hessian may call hessian.add_position_curvature
+    position_components = ()
+    # the term's load follows the line and has no potential (the drag): the resultants'
+    # chain of analysis/jacobian.py carries its linearisation
     follower = False
+    # add_jacobian adds entries beyond H (a follower's; the friction's, whose limit
+    # follows the contact reaction): the Newton steps then solve with that unsymmetric
+    # Jacobian by LU and each must lower |grad L|; H (the stability test, the safeguard)
+    # is that of the term's load held at its current value
+    unsymmetric = False
     # when in_newton is False: what the term is and where its limits are documented, for
     # the line that says a run takes no Newton steps (cli/lines.no_newton)
     newton_gap = ""
@@ -131,9 +135,9 @@ class Term:
         is assembled (a term linear in the directors adds nothing)."""
 
     def add_jacobian(self, jacobian):
-        """A follower's linearisation in the Newton Jacobian (analysis/jacobian.py
-        NewtonJacobian, before assembly): its load's derivative in the frames, through
-        the resultants' chain."""
+        """An unsymmetric term's entries of the Newton Jacobian beyond H
+        (analysis/jacobian.py NewtonJacobian, before assembly): a follower's load's
+        derivative in the frames, through the resultants' chain."""
 
     # --- the load path -----------------------------------------------------------------
     def accept_step(self, state):

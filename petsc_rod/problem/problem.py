@@ -257,8 +257,8 @@ class RodProblem:
         products."""
         n = self.mesh.n_local_nodes
         g = np.empty((n, 3, 3))
-        if any(term.uses_heights or term.follower for term in self.terms):
-            # the centreline of the fields, whose heights those terms read
+        if any(term.position_components or term.follower for term in self.terms):
+            # the centreline of the fields, whose positions those terms read
             self.global_step.integrate_slope(self.state)
         for i, field in enumerate(self.state.frame_fields):
             factor, stiffness = self.field_stiffness(i)

@@ -15,7 +15,7 @@ them (problem/build.py).
     current.py      Morison drag at the nodes from the tangents, and its derivative
     loads.py        nodal loads (P2 interpolated) as the slope problem's right-hand side
     terms.py        SeabedTerm and DragTerm: the seabed and the drag as terms, with
-                    their parts of the Newton steps (analysis/heights.py, jacobian.py)
+                    their parts of the Newton steps (analysis/positions.py, jacobian.py)
     friction.py     FrictionTerm: Coulomb friction, stick springs and sliding forces in
                     the x and y Hermite problems, anchors moved at each load step
     quantities.py   RiserNumbers: top tension and angle, touchdown, curvature, datasets

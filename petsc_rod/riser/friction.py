@@ -37,19 +37,39 @@ global step's vertical solve (the seabed term comes first). Why implicit: an exp
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (seabed.py).
 
-Not in the Newton steps nor the stability test (``in_newton``, ``conservative`` False):
-friction dissipates, and the Newton system would need the horizontal positions as
-unknowns beside the heights (analysis/heights.py); docs/riser.md §3b.
+In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed:
+within a load step the anchors are fixed, and the law above is a function of the node
+positions, f_n(x_n, z_n), through d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work
+enters the gradient like the seabed's energy, -w_n f_n on the horizontal positions,
+carried by their chains (analysis/positions.py; ``position_components`` (0, 1)), and its
+derivative -w_n df_n is the Newton system's block of the friction (a semi-smooth Newton
+step: stick, slide and off the seabed those of the iterate):
+
+    stick:  w_n k_s I,
+    slide:  w_n R_n / |d_n|_mu (I - d_n (M_n d_n)^T / |d_n|_mu^2)   on x_n,
+            -w_n k d_n / |d_n|_mu                                   on z_n,
+
+with |d|_mu^2 = d^T M d, M = a a^T / mu_a^2 + l l^T / mu_l^2. Its symmetric part on x
+goes into H (the safeguard and the stability test see the friction with its limit held
+at its current value); the rest (the z column: the limit follows the contact reaction,
+and the antisymmetric part of an anisotropic slide) into the unsymmetric Newton Jacobian
+(``unsymmetric``; analysis/jacobian.py). The turn of the axes a, l with the tangent
+(mu_a != mu_l only) is left out of J: the steps then converge linearly there. Not
+conservative: friction dissipates, so the run gives no stability verdict (as with the
+drag). On a seabed that is not flat the run takes no Newton steps (slope_load.py).
 """
 
 import numpy as np
 
-from petsc_rod.mesh.elements import NODE_WEIGHTS
+from petsc_rod.analysis.positions import HEIGHT, position_gradient
+from petsc_rod.mesh.elements import NODE_WEIGHTS, P2
+from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.physics.term import TermOutput
 from petsc_rod.riser.hermite import HermiteProblem, slope_map
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.seabed import MAX_SOLVES, node_rows, owned_nodes
 from petsc_rod.riser.terms import NodalLoadTerm
+from petsc_rod.scenes.boundary import is_held
 
 # The secant loop of one global step ends when no node's spring changed by more than
 # this times k_s (the next global step starts from the last springs). Measured on the
@@ -96,10 +116,10 @@ def tangent_factor(force, gradients):
 class FrictionTerm(NodalLoadTerm):
     """The seabed friction of the SeabedTerm ``seabed_term`` (module docstring)."""
 
-    slope_components = (0, 1)
+    slope_components = position_components = (0, 1)
     conservative = False
-    in_newton = False
-    newton_gap = "seabed friction (docs/riser.md §3b)"
+    unsymmetric = True
+    newton_gap = "seabed friction on a seabed that is not flat (docs/riser.md §3b)"
 
     def __init__(self, mesh, seabed_term):
         super().__init__(mesh, "friction")
@@ -119,6 +139,15 @@ class FrictionTerm(NodalLoadTerm):
         self.use = np.zeros((ne, 3))                # |f|_mu / R of the last solve
         self.load = NodalLoad(mesh, self._nodes)
         self._local = mesh.da.createLocalVec()
+        self._gradient = None           # ghost exchange of the gradient's element vectors
+        # the state was set by Newton steps: the next global step's springs are those of
+        # its positions (solve_slope)
+        self._springs_stale = False
+
+    @property
+    def in_newton(self):
+        """On a flat seabed (module docstring)."""
+        return self.seabed_term.seabed.flat
 
     # --- the global step --------------------------------------------------------------
     def build(self, slope_matrices, penalty):
@@ -161,6 +190,8 @@ class FrictionTerm(NodalLoadTerm):
             r = state.r.ghosted()
             self.anchors = self._node_values([r[:, :, 0], r[:, :, 1]], self.rows)
         stiffness = self.friction.stiffness
+        if self._springs_stale:
+            self._springs_from(state, reaction)
         for _ in range(MAX_SOLVES):
             self._set_springs()
             solutions = [self._ghosted(problem.solve(rhs.components[c],
@@ -195,6 +226,21 @@ class FrictionTerm(NodalLoadTerm):
                                                                                  gradients)
         self.use = np.divide(size, reaction, out=np.zeros_like(size), where=reaction > 0)
 
+    def _springs_from(self, state, reaction):
+        """The secant springs of the state's positions (those of the P2 slope's integral,
+        RodState.node_positions) and the reactions ``reaction`` (ne, 3): after Newton
+        steps, so that the global step that follows them starts from their friction and
+        keeps their fixed point. Collective (a ghost exchange)."""
+        self.load.set(state.node_positions())
+        positions = self.load.element_values[..., :2].copy()
+        self.load.set(state.node_directors()[:, 2])
+        tangents = self.load.element_values[..., :2].copy()
+        trial = -self.friction.stiffness * (positions - self.anchors)
+        size = elliptic_norm(trial, tangents, self.friction)
+        self.spring = self.friction.stiffness * np.divide(
+            reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
+        self._springs_stale = False
+
     @property
     def stick(self):
         """The nodes whose spring is the stick stiffness (ne, 3): grounded and within
@@ -225,6 +271,84 @@ class FrictionTerm(NodalLoadTerm):
         (a copy). Collective (a ghost exchange)."""
         self.mesh.da.globalToLocal(vec, self._local)
         return self._local.getArray(readonly=True).reshape(-1, 2).copy()
+
+    # --- the Newton steps (module docstring) -------------------------------------------
+    def _newton_law(self, state):
+        """The law at the state's centreline (the frames' integral: the Newton steps), at
+        the owned nodes: (-w_n f_n (n, 2), N, the derivative of -w f in x (n, 2, 2) and
+        in z (n, 2), N/m)."""
+        seabed = self.seabed_term.seabed
+        r = state.node_positions().copy()
+        tangents = state.node_directors()[:, 2, :2].copy()
+        w = state.node_weights
+        d = r[:, :2] - owned_nodes(self.mesh, self.anchors)
+        reaction = seabed.stiffness * np.maximum(seabed.height - r[:, 2], 0.0)
+        stiffness = self.friction.stiffness
+        norm = elliptic_norm(d, tangents, self.friction)                  # |d|_mu
+        slide = (reaction > 0) & (stiffness * norm > reaction)
+        stick = (reaction > 0) & ~slide
+        force = np.where(stick[:, None], -stiffness * d, 0.0)
+        scale = np.divide(reaction, norm, out=np.zeros_like(norm), where=slide)
+        force[slide] = -(scale[:, None] * d)[slide]
+        # M d: the metric's image of d, along a and l of the horizontal tangent
+        length = np.linalg.norm(tangents, axis=1, keepdims=True)
+        axial = np.divide(tangents, length, out=np.zeros_like(tangents), where=length > 0)
+        axial[length[:, 0] == 0] = (1.0, 0.0)
+        lateral = np.stack([-axial[:, 1], axial[:, 0]], axis=1)
+        metric = (np.einsum("nc,nc->n", axial, d)[:, None] * axial / self.friction.axial**2
+                  + np.einsum("nc,nc->n", lateral, d)[:, None] * lateral
+                  / self.friction.lateral**2)
+        squared = np.where(slide, norm**2, 1.0)
+        in_x = (stick * stiffness)[:, None, None] * np.eye(2) + scale[:, None, None] * (
+            np.eye(2) - d[:, :, None] * metric[:, None, :] / squared[:, None, None])
+        in_z = -seabed.stiffness * np.divide(d, norm[:, None], out=np.zeros_like(d),
+                                             where=slide[:, None])
+        return -w[:, None] * force, w[:, None, None] * in_x, w[:, None] * in_z
+
+    def add_gradient(self, g, state):
+        """-w_n f_n on the horizontal positions, into g's d3 x and y rows through their
+        chains (positions.position_gradient), at the state's centreline (the frames'
+        integral, RodProblem.energy_gradient). Collective."""
+        self._springs_stale = True
+        if self.anchors is None:            # no global step yet: no reference
+            return
+        derivative = self._newton_law(state)[0]
+        held_start = is_held(self.start_state)
+        mesh = self.mesh
+        element = np.zeros((mesh.n_local_elements, 3, 3))
+        factors = np.zeros(3)
+        for c in self.position_components:
+            element[:, :, c], factors[c] = position_gradient(mesh, derivative[:, c], held_start)
+        if self._gradient is None:
+            self._gradient = VectorField(mesh, "friction_gradient")
+        self._gradient.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, element))
+        n = g.shape[0]
+        for c in self.position_components:
+            g[:, 2, c] += (self._gradient.components[c].getArray(readonly=True)[:n]
+                           + factors[c] * state.node_weights)
+
+    def add_hessian(self, hessian):
+        """The symmetric part of -w_n df_n/dx_n on the horizontal positions (module
+        docstring)."""
+        if self.anchors is None:
+            return
+        in_x = self._newton_law(hessian.problem.state)[1]
+        hessian.add_position_curvature(0.5 * (in_x + in_x.transpose(0, 2, 1)),
+                                       self.position_components)
+
+    def add_jacobian(self, jacobian):
+        """J beyond H: the antisymmetric part of -w_n df_n/dx_n and its column on the
+        heights (the limit mu R following the contact reaction)."""
+        if self.anchors is None:
+            return
+        hessian = jacobian.hessian
+        _, in_x, in_z = self._newton_law(hessian.problem.state)
+        rest = np.concatenate([0.5 * (in_x - in_x.transpose(0, 2, 1)), in_z[:, :, None]],
+                              axis=2)
+        for rows, columns, blocks in hessian.position_blocks(
+                rest, self.position_components, self.position_components + (HEIGHT,)):
+            jacobian.add(rows, columns, blocks)
 
     # --- the load path --------------------------------------------------------------
     def accept_step(self, state):
@@ -272,4 +396,6 @@ class FrictionTerm(NodalLoadTerm):
     def destroy(self):
         self._destroy_problems()
         self._local.destroy()
+        if self._gradient is not None:
+            self._gradient.destroy()
         super().destroy()

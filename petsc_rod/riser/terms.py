@@ -14,7 +14,7 @@ only for a scene that has them (problem/build.py).
 
 The seabed is in the Newton steps (docs/method.md §11): its energy is a function of the
 node heights, so its gradient in the slopes is the adjoint of their integral
-(analysis/heights.height_gradient) and its curvature k w_n on the active nodes enters
+(analysis/positions.position_gradient) and its curvature k w_n on the active nodes enters
 the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
 semi-smooth Newton step, the active set that of the iterate. The drag is in them as a
 follower (Term.follower): its gradient -b on the d3 rows at the frames' tangents, and its
@@ -24,7 +24,7 @@ linearisation in the unsymmetric Newton Jacobian through the resultants' chain
 
 import numpy as np
 
-from petsc_rod.analysis.heights import height_gradient
+from petsc_rod.analysis.positions import HEIGHT, position_gradient
 from petsc_rod.analysis.stability import skew
 from petsc_rod.mesh.elements import P2, element_integrals
 from petsc_rod.mesh.fields import VectorField, element_dofs, scatter_element_vectors
@@ -110,8 +110,8 @@ class SeabedTerm(NodalLoadTerm):
     """A flat elastic seabed (environment.Seabed) under the line: the z slope solved with
     the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2."""
 
-    slope_components = (2,)
-    uses_heights = True
+    slope_components = (HEIGHT,)
+    position_components = (HEIGHT,)
 
     def __init__(self, mesh, seabed):
         super().__init__(mesh, "seabed")
@@ -160,10 +160,10 @@ class SeabedTerm(NodalLoadTerm):
                                                        * gap**2)))
 
     def add_gradient(self, g, state):
-        """dE_s/dr'_z at the nodes (heights.height_gradient) into g's d3 z rows; the state's
+        """dE_s/dr'_z at the nodes (positions.position_gradient) into g's d3 z rows; the state's
         r is that of its fields (RodProblem.energy_gradient). Collective."""
         derivative, _ = self._height_derivatives(state)
-        vectors, factor = height_gradient(self.mesh, derivative, is_held(self.start_state))
+        vectors, factor = position_gradient(self.mesh, derivative, is_held(self.start_state))
         if self._gradient is None:
             self._gradient = VectorField(self.mesh, "seabed_gradient")
         mesh = self.mesh
@@ -211,7 +211,7 @@ class DragTerm(NodalLoadTerm):
     linearisation (analysis/jacobian.py)."""
 
     conservative = False
-    follower = True
+    follower = unsymmetric = True
 
     def __init__(self, mesh, scene):
         super().__init__(mesh, "drag")

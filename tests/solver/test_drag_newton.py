@@ -24,7 +24,7 @@ from petsc_rod.iteration.newton import NewtonPolish
 from petsc_rod.riser.environment import Current
 from petsc_rod.riser.terms import DragTerm
 from petsc_rod.scenes.starts import catenary_start
-from test_seabed_newton import heights, moved
+from test_seabed_newton import heights, moved, random_direction
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
 
@@ -76,12 +76,7 @@ def test_jacobian_against_finite_differences(comm, solver_factory, line):
         jacobian = polish._jacobian_of(hessian)
         n, B, U = mesh.n_local_nodes, hessian.block, hessian.unknowns
         drag = next(term for term in problem.terms if isinstance(term, DragTerm))
-        nodes = 2 * mesh.vertex_start + np.arange(n)
-        v = np.array([np.random.default_rng(3000 + i).standard_normal(4)
-                      for i in nodes])[:, :U]
-        v[~problem.free_nodes] = 0.0
-        if polish.stretch:
-            v[polish._held_stretch, 3] = 0.0
+        v = random_direction(polish, 3000)
         s = 1e-6
 
         def evaluate(h):
@@ -96,7 +91,7 @@ def test_jacobian_against_finite_differences(comm, solver_factory, line):
         derivative = (g_plus - g_minus) / (2 * s)
         x = hessian.to_vec(v)
         rows = x.getArray().reshape(n, B)
-        if hessian.heights:
+        if hessian.positions:
             rows[0::2, U] = ((z_plus - z_minus) / (2 * s))[0::2]
         rows[0::2, hessian.resultant_slot:] = (f_plus - f_minus) / (2 * s)
         y = x.duplicate()

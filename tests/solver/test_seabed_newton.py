@@ -1,5 +1,5 @@
 """Newton steps and the stability test with a seabed (docs/method.md §11, "Terms of the
-heights"; analysis/heights.py), on one rank (PETSc.COMM_SELF) and on all ranks
+heights"; analysis/positions.py), on one rank (PETSc.COMM_SELF) and on all ranks
 (PETSc.COMM_WORLD: under ``mpiexec -n 2`` the parallel run).
 
 The seabed's energy k/2 sum_n w_n (z_b - z_n)_+^2 reads the node heights, integrals of
@@ -65,6 +65,21 @@ def moved(polish, frames, step):
     return np.einsum("nkl,nil->nik", rotations(step), frames)
 
 
+def random_direction(polish, seed):
+    """A variation of the nodes' unknowns (n_nodes, 3 or 4), the same on any number of
+    ranks (node i's row from the generator seeded ``seed`` + i), 0 where held."""
+    problem = polish.problem
+    mesh = problem.mesh
+    nodes = 2 * mesh.vertex_start + np.arange(mesh.n_local_nodes)
+    unknowns = 4 if polish.stretch else 3
+    v = np.array([np.random.default_rng(seed + i).standard_normal(4)
+                  for i in nodes])[:, :unknowns]
+    v[~problem.free_nodes] = 0.0
+    if polish.stretch:
+        v[polish._held_stretch, 3] = 0.0
+    return v
+
+
 def heights(problem, frames):
     problem.state.set_node_directors(frames)
     problem.global_step.integrate_slope(problem.state)
@@ -117,7 +132,7 @@ def test_gradient_and_hessian_against_finite_differences(comm, solver_factory, e
         mu = np.array([0.3, -0.2, 0.5])
         gradient = polish.lagrangian_gradient(frames, mu)
         hessian = problem.second_variation()
-        assert hessian.heights and hessian.block == U + 1
+        assert hessian.positions == (2,) and hessian.block == U + 1
         v = random[:, 1].copy()
         v[held] = 0.0
         # [v; u(v); 0]: u the vertex heights' first variation (0 at the held end)
