@@ -1,5 +1,7 @@
 """The Newton Jacobian of a problem whose load follows the line (the drag of a current),
-kept banded by a chain of resultants (docs/method.md §11, "A load without potential").
+kept banded by a chain of resultants (docs/method.md §11, "A load without potential"),
+or with another term whose derivative is not symmetric (``Term.unsymmetric``: the
+seabed friction, whose limit follows the contact reaction, riser/friction.py).
 
 A load f_j given at the P2 nodes (N/m, interpolated in P2) enters the gradient of the
 reduced problem as -b on the d3 rows, b_n = int F phi_n dS with F(S) = int_S^L f_h dS
@@ -32,9 +34,9 @@ from petsc_rod.global_step.ksp import lu_solver, set_up_lu
 
 
 class NewtonJacobian:
-    """J on the layout of a SecondVariation ``hessian`` (its resultants' slots), made
-    from H and the followers' add_jacobian at each ``assemble``; owns its matrix and
-    LU solver, ``destroy()``."""
+    """J on the layout of a SecondVariation ``hessian`` (its chains' and resultants'
+    slots), made from H and the unsymmetric terms' add_jacobian at each ``assemble``;
+    owns its matrix and LU solver, ``destroy()``."""
 
     def __init__(self, hessian):
         self.hessian = hessian

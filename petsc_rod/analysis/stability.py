@@ -20,7 +20,8 @@ local minimiser when H is positive semi-definite there, a saddle when H has a ne
 eigenvalue. Sylvester's law of inertia counts those without an eigen-solve: the
 symmetric-indefinite factorisation of H (MUMPS) gives the number of negative pivots,
 and the chord constraint is taken into account by the Schur complement,
-n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - 3 (C: its 3 columns).
+n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - m (C: its m columns, the
+chord's 3 and, in a Newton step's test where K1 = K2, the mean roll: constrain_roll).
 The plain iteration is a descent method and leaves a saddle by itself, slowly; an
 accelerated one may converge to it, hence this check.
 

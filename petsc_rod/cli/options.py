@@ -325,7 +325,8 @@ OPTIONS = [
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once (not with a seabed); after a "
            "failed attempt the wait doubles; with a seabed the node heights are unknowns "
-           "too (with its friction the horizontal positions, an LU solve), on an "
+           "too (with its friction, of one coefficient, the horizontal positions, an LU "
+           "solve), on an "
            "extensible line the strains, with a current the resultants of the drag (an "
            "LU solve)"),
     Option("rod_al_monitor", _bool, default_of(Settings, "monitor"), "",

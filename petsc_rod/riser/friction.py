@@ -37,8 +37,9 @@ global step's vertical solve (the seabed term comes first). Why implicit: an exp
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (seabed.py).
 
-In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed:
-within a load step the anchors are fixed, and the law above is a function of the node
+In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed
+and with one coefficient (mu_a = mu_l): within a load step the anchors are fixed, and the
+law above is a function of the node
 positions, f_n(x_n, z_n), through d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work
 enters the gradient like the seabed's energy, -w_n f_n on the horizontal positions,
 carried by their chains (analysis/positions.py; ``position_components`` (0, 1)), and its
@@ -49,14 +50,17 @@ step: stick, slide and off the seabed those of the iterate):
     slide:  w_n R_n / |d_n|_mu (I - d_n (M_n d_n)^T / |d_n|_mu^2)   on x_n,
             -w_n k d_n / |d_n|_mu                                   on z_n,
 
-with |d|_mu^2 = d^T M d, M = a a^T / mu_a^2 + l l^T / mu_l^2. Its symmetric part on x
-goes into H (the safeguard and the stability test see the friction with its limit held
-at its current value); the rest (the z column: the limit follows the contact reaction,
-and the antisymmetric part of an anisotropic slide) into the unsymmetric Newton Jacobian
-(``unsymmetric``; analysis/jacobian.py). The turn of the axes a, l with the tangent
-(mu_a != mu_l only) is left out of J: the steps then converge linearly there. Not
-conservative: friction dissipates, so the run gives no stability verdict (as with the
-drag). On a seabed that is not flat the run takes no Newton steps (slope_load.py).
+with |d|_mu^2 = d^T M d, M = a a^T / mu_a^2 + l l^T / mu_l^2 (with one coefficient
+M = I / mu^2 and the slide's block is symmetric). It goes into H (the safeguard and the
+stability test see the friction with its limit held at its current value); the z column
+(the limit follows the contact reaction) into the unsymmetric Newton Jacobian
+(``unsymmetric``; analysis/jacobian.py). With mu_a != mu_l the slide's block is
+unsymmetric, its symmetric part indefinite where the slip is oblique to the line, and
+the turn of the axes a, l with the tangent, left out, is of the order of R: the steps
+failed there (the riser across a current at mu 0.3, 0.8: 910 iterations with 5 failed
+attempts against 768 without), so such a run takes none (``in_newton``); nor on a seabed
+that is not flat (slope_load.py). Not conservative: friction dissipates, so the run
+gives no stability verdict (as with the drag).
 """
 
 import numpy as np
@@ -119,7 +123,8 @@ class FrictionTerm(NodalLoadTerm):
     slope_components = position_components = (0, 1)
     conservative = False
     unsymmetric = True
-    newton_gap = "seabed friction on a seabed that is not flat (docs/riser.md §3b)"
+    newton_gap = ("seabed friction with two coefficients or on a seabed that is not flat "
+                  "(docs/riser.md §3b)")
 
     def __init__(self, mesh, seabed_term):
         super().__init__(mesh, "friction")
@@ -140,14 +145,17 @@ class FrictionTerm(NodalLoadTerm):
         self.load = NodalLoad(mesh, self._nodes)
         self._local = mesh.da.createLocalVec()
         self._gradient = None           # ghost exchange of the gradient's element vectors
-        # the state was set by Newton steps: the next global step's springs are those of
-        # its positions (solve_slope)
+        # the state may have been set by Newton steps (add_gradient ran since the last
+        # global step): the next global step's springs are those of its positions
+        # (solve_slope; after an attempt that failed, those of the restored state, the
+        # last solve's)
         self._springs_stale = False
 
     @property
     def in_newton(self):
-        """On a flat seabed (module docstring)."""
-        return self.seabed_term.seabed.flat
+        """On a flat seabed with one coefficient (module docstring)."""
+        return (self.seabed_term.seabed.flat
+                and self.friction.axial == self.friction.lateral)
 
     # --- the global step --------------------------------------------------------------
     def build(self, slope_matrices, penalty):
@@ -338,8 +346,10 @@ class FrictionTerm(NodalLoadTerm):
                                        self.position_components)
 
     def add_jacobian(self, jacobian):
-        """J beyond H: the antisymmetric part of -w_n df_n/dx_n and its column on the
-        heights (the limit mu R following the contact reaction)."""
+        """J beyond H: the antisymmetric part of -w_n df_n/dx_n (zero with one
+        coefficient, the only case in the Newton steps) and its column on the heights
+        (the limit mu R following the contact reaction), which the seabed's chain
+        carries (the seabed term reads them)."""
         if self.anchors is None:
             return
         hessian = jacobian.hessian
