@@ -20,7 +20,7 @@ from petsc_rod.scenes import starts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
 from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
                                  fewest_elements, largest_grading)
-from petsc_rod.cli.options import (BY_NAME, OPTIONS, check_anderson_depth,
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
@@ -144,9 +144,11 @@ def petsc_message(error):
 
 def petsc_failure(error):
     """The one line of a PETSc error raised during the run (exit 4, no result file)."""
+    solvers = ", ".join(f"-{prefix}*" for prefix in SOLVER_PREFIXES
+                        if prefix != "rod_snes_")
     return (f"PETSc failed during the solve: {petsc_message(error)}; check the "
             "-rod_snes_* options (the iteration has no Jacobian) and the solvers' "
-            "-rod_slope_*, -rod_d1_*, -rod_d2_* options")
+            f"{solvers} options")
 
 
 def every_rank_failed(failures, wait=FAILURE_WAIT):
