@@ -182,7 +182,7 @@ class UzawaSolver:
         NEWTON_SWITCH_FAR), else True (NEWTON_SWITCH)."""
         if self.newton is None:
             return False
-        if self.newton.reads_heights or self.newton.follows:
+        if self.newton.reads_positions or self.newton.unsymmetric:
             return control.NEWTON_SWITCH_FAR
         return True
 
@@ -203,7 +203,7 @@ class UzawaSolver:
         # iterate's H is indefinite long before it nears a saddle (newton._newton_step),
         # so only a converged state is tested and left
         if (outcome != newton.INDEFINITE or not self.tests_stability
-                or self.newton.reads_heights or not step.wants_early_escape()):
+                or self.newton.reads_positions or not step.wants_early_escape()):
             return
         stable, direction = self.check_stability()
         if stable is False:

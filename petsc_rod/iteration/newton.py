@@ -82,11 +82,11 @@ class NewtonPolish:
         self._free = problem.free_nodes
         # a term reads the positions (the seabed, the friction): the first step's
         # curvature (_newton_step)
-        self.reads_heights = any(term.position_components for term in problem.terms)
+        self.reads_positions = any(term.position_components for term in problem.terms)
         # a term with unsymmetric entries (the drag, a load that follows the line; the
         # friction): the steps solve with the Jacobian (analysis/jacobian.py), and each
         # must lower |grad L| (no energy to descend)
-        self.follows = any(term.unsymmetric for term in problem.terms)
+        self.unsymmetric = any(term.unsymmetric for term in problem.terms)
         self._jacobian = None
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
@@ -131,12 +131,12 @@ class NewtonPolish:
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
                 # the first step's curvature from the iteration's multipliers where the
                 # heights enter (see _newton_step)
-                curvature = saved["lam"] if first and self.reads_heights else None
+                curvature = saved["lam"] if first and self.reads_positions else None
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None:
                     outcome = INDEFINITE
                     break
-                if self.follows:
+                if self.unsymmetric:
                     # no energy to descend: the residual must fall at every step, but at
                     # the round-off floor (the last turn below FLOOR_TURN, as below);
                     # from the second step on where the first took the iteration's
@@ -259,7 +259,7 @@ class NewtonPolish:
                 return None, None
             self.verified = hessian.decidable
             # the Jacobian with the followers' linearisation, else H's factor
-            solver = self._jacobian_of(hessian) if self.follows else hessian
+            solver = self._jacobian_of(hessian) if self.unsymmetric else hessian
             rhs = hessian.to_vec(-gradient)
             vecs.append(rhs)
             direction = solver.solve(rhs)
@@ -272,7 +272,7 @@ class NewtonPolish:
                 vecs.extend(columns)
                 # the inertia test solved for a basis of the same forms (decidable)
                 solved = (hessian.solve_in_constraint_span(columns)
-                          if hessian.decidable and not self.follows
+                          if hessian.decidable and not self.unsymmetric
                           else [solver.solve(column) for column in columns])
                 vecs.extend(solved)
                 schur = np.array([[c.dot(s) for s in solved] for c in columns])

@@ -65,15 +65,13 @@ gives no stability verdict (as with the drag).
 
 import numpy as np
 
-from petsc_rod.analysis.positions import HEIGHT, position_gradient
-from petsc_rod.mesh.elements import NODE_WEIGHTS, P2
-from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
+from petsc_rod.analysis.positions import HEIGHT
+from petsc_rod.mesh.elements import NODE_WEIGHTS
 from petsc_rod.physics.term import TermOutput
 from petsc_rod.riser.hermite import HermiteProblem, slope_map
 from petsc_rod.riser.loads import NodalLoad
 from petsc_rod.riser.seabed import MAX_SOLVES, node_rows, owned_nodes
 from petsc_rod.riser.terms import NodalLoadTerm
-from petsc_rod.scenes.boundary import is_held
 
 # The secant loop of one global step ends when no node's spring changed by more than
 # this times k_s (the next global step starts from the last springs). Measured on the
@@ -144,7 +142,6 @@ class FrictionTerm(NodalLoadTerm):
         self.use = np.zeros((ne, 3))                # |f|_mu / R of the last solve
         self.load = NodalLoad(mesh, self._nodes)
         self._local = mesh.da.createLocalVec()
-        self._gradient = None           # ghost exchange of the gradient's element vectors
         # the state may have been set by Newton steps (add_gradient ran since the last
         # global step): the next global step's springs are those of its positions
         # (solve_slope; after an attempt that failed, those of the restored state, the
@@ -315,26 +312,14 @@ class FrictionTerm(NodalLoadTerm):
 
     def add_gradient(self, g, state):
         """-w_n f_n on the horizontal positions, into g's d3 x and y rows through their
-        chains (positions.position_gradient), at the state's centreline (the frames'
-        integral, RodProblem.energy_gradient). Collective."""
+        chains (NodalLoadTerm.add_position_gradient), at the state's centreline (the
+        frames' integral, RodProblem.energy_gradient). Collective."""
         self._springs_stale = True
         if self.anchors is None:            # no global step yet: no reference
             return
         derivative = self._newton_law(state)[0]
-        held_start = is_held(self.start_state)
-        mesh = self.mesh
-        element = np.zeros((mesh.n_local_elements, 3, 3))
-        factors = np.zeros(3)
-        for c in self.position_components:
-            element[:, :, c], factors[c] = position_gradient(mesh, derivative[:, c], held_start)
-        if self._gradient is None:
-            self._gradient = VectorField(mesh, "friction_gradient")
-        self._gradient.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, element))
-        n = g.shape[0]
-        for c in self.position_components:
-            g[:, 2, c] += (self._gradient.components[c].getArray(readonly=True)[:n]
-                           + factors[c] * state.node_weights)
+        self.add_position_gradient(g, state, {c: derivative[:, c]
+                                              for c in self.position_components})
 
     def add_hessian(self, hessian):
         """The symmetric part of -w_n df_n/dx_n on the horizontal positions (module
@@ -406,6 +391,4 @@ class FrictionTerm(NodalLoadTerm):
     def destroy(self):
         self._destroy_problems()
         self._local.destroy()
-        if self._gradient is not None:
-            self._gradient.destroy()
         super().destroy()

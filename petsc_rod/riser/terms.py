@@ -50,6 +50,8 @@ class NodalLoadTerm(Term):
         self.start_state = self.end_state = None
         self._nodes = VectorField(mesh, f"{name}_nodes")      # ghost exchange of nodal loads
         self._rhs = None                                      # made at the first add_to_rhs
+        self._name = name
+        self._gradient = None       # ghost exchange of a position gradient's element vectors
 
     def prepare(self, t, start, end):
         self.t, self.start_state, self.end_state = t, start, end
@@ -82,6 +84,27 @@ class NodalLoadTerm(Term):
             load.element_vectors(offset)))
         return self._rhs
 
+    def add_position_gradient(self, g, state, derivatives):
+        """Add the derivative of an energy (or work) of the node positions in the slopes
+        into g's d3 rows: for each component c of ``derivatives`` {c: dE/dx^c at the
+        owned nodes (n_nodes,), N}, sum_m dE/dx^c_m dx^c_m/ds^c_n
+        (positions.position_gradient), the element vectors summed into the nodes by one
+        ghost update. Collective."""
+        mesh = self.mesh
+        held_start = is_held(self.start_state)
+        element = np.zeros((mesh.n_local_elements, 3, 3))
+        factors = {}
+        for c, derivative in derivatives.items():
+            element[:, :, c], factors[c] = position_gradient(mesh, derivative, held_start)
+        if self._gradient is None:
+            self._gradient = VectorField(mesh, f"{self._name}_gradient")
+        self._gradient.add_ghosted(scatter_element_vectors(
+            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, element))
+        n = g.shape[0]
+        for c, factor in factors.items():
+            g[:, 2, c] += (self._gradient.components[c].getArray(readonly=True)[:n]
+                           + factor * state.node_weights)
+
     def _nodal_load(self, state):
         load = NodalLoad(self.mesh, self._nodes)
         load.set(self.node_loads(state))
@@ -102,8 +125,9 @@ class NodalLoadTerm(Term):
 
     def destroy(self):
         self._nodes.destroy()
-        if self._rhs is not None:
-            self._rhs.destroy()
+        for field in (self._rhs, self._gradient):
+            if field is not None:
+                field.destroy()
 
 
 class SeabedTerm(NodalLoadTerm):
@@ -117,7 +141,6 @@ class SeabedTerm(NodalLoadTerm):
         super().__init__(mesh, "seabed")
         self.seabed = seabed
         self.vertical = self.contact = None
-        self._gradient = None           # ghost exchange of the gradient's element vectors
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -160,20 +183,9 @@ class SeabedTerm(NodalLoadTerm):
                                                        * gap**2)))
 
     def add_gradient(self, g, state):
-        """dE_s/dr'_z at the nodes (positions.position_gradient) into g's d3 z rows; the state's
-        r is that of its fields (RodProblem.energy_gradient). Collective."""
-        derivative, _ = self._height_derivatives(state)
-        vectors, factor = position_gradient(self.mesh, derivative, is_held(self.start_state))
-        if self._gradient is None:
-            self._gradient = VectorField(self.mesh, "seabed_gradient")
-        mesh = self.mesh
-        element = np.zeros(vectors.shape + (3,))
-        element[:, :, 2] = vectors
-        self._gradient.add_ghosted(scatter_element_vectors(
-            mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, element))
-        n = g.shape[0]
-        g[:, 2, 2] += (self._gradient.components[2].getArray(readonly=True)[:n]
-                       + factor * state.node_weights)
+        """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; the
+        state's r is that of its fields (RodProblem.energy_gradient). Collective."""
+        self.add_position_gradient(g, state, {HEIGHT: self._height_derivatives(state)[0]})
 
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
@@ -200,8 +212,6 @@ class SeabedTerm(NodalLoadTerm):
 
     def destroy(self):
         self._destroy_vertical()
-        if self._gradient is not None:
-            self._gradient.destroy()
         super().destroy()
 
 
