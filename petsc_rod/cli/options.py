@@ -4,7 +4,8 @@ Every option has the root prefix ``rod_``. The KSPs of the global step have thei
 prefixes (``rod_slope_``, ``rod_d1_``, ``rod_d2_``; ``rod_z_`` the seabed's vertical
 problem, ``rod_x_`` and ``rod_y_`` its friction's), the SNES of the iteration
 ``rod_snes_``, the Newton Jacobian's LU ``rod_newton_``;
-they read the usual PETSc options. A
+they read the usual PETSc options (the second variation's LDL^T, ``rod_inertia_``,
+only MUMPS's). A
 ``-rod_*`` name that is not in the table is an error (with the closest known name); any
 other option nobody read is reported at the end of the run.
 """
@@ -30,9 +31,10 @@ from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS,
 from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
 
-# Prefixes of PETSc objects: the KSPs of the global step and the SNES of the iteration.
+# Prefixes of PETSc objects: the KSPs of the global step, the SNES of the iteration and
+# the MUMPS factorisations of the Newton steps and the stability test.
 SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_",
-                   "rod_newton_")
+                   "rod_newton_", "rod_inertia_")
 
 # Every number must be finite and at most this large in magnitude (and a positive scale,
 # such as a length or a tolerance, at least its inverse): the solver forms products of
@@ -447,6 +449,9 @@ def help_text():
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
                  "their unsymmetric Jacobian (default preonly + MUMPS LU, "
                  "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering).")
+    lines.append("  The stability test and the Newton steps' positive-definiteness test: "
+                 "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
+                 "ordering unless given).")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres | qn | ncg (the SNES "
                  "types that need no Jacobian), and the SNES options under the same prefix "

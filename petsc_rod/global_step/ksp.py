@@ -1,7 +1,7 @@
 """The direct solvers of the project, made in one place: the chain solvers of the global
 step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
-the second variation (analysis/stability.py) and the MUMPS LU of the Newton Jacobian
-with a drag (analysis/jacobian.py).
+the second variation (analysis/stability.py, options -rod_inertia_*) and the MUMPS LU
+of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
 defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
@@ -48,27 +48,34 @@ def chain_solver(comm, operator, prefix):
     return ksp
 
 
-def inertia_solver(comm, operator):
+# The options prefixes of the LDL^T of the second variation (analysis/stability.py: the
+# stability test and the Newton steps' positive-definiteness test) and of the Newton
+# Jacobian's LU (analysis/jacobian.py).
+INERTIA_PREFIX = "rod_inertia_"
+NEWTON_PREFIX = "rod_newton_"
+# The Newton LU's defaults: MUMPS's approximate minimum fill ordering (ICNTL 7 = 2),
+# unless the options say otherwise. MUMPS's automatic choice for an unsymmetric matrix
+# on these chains is PORD, whose analysis took 8.1 s for the riser catenary's Jacobian at
+# 18 000 elements (252 007 unknowns) on one rank, against 0.48 s with AMF and fewer
+# entries in the factors (5.0e6 against 7.1e6), the same residual (docs/performance.md).
+# MUMPS reads its controls at the symbolic factorisation, so they are in effect at each
+# set-up (set_up_lu); MatMumpsSetIcntl(7) before it did not take (PETSc 3.18, measured).
+# The LDL^T keeps MUMPS's own choice: AMF on one rank; on several, AMF's analysis
+# overflows the default 8 MiB stack from about 5e4 elements (docs/performance.md).
+LU_DEFAULTS = {"mat_mumps_icntl_7": "2"}
+
+
+def inertia_solver(comm, operator, prefix=INERTIA_PREFIX):
     """(ksp, factor): preonly + MUMPS's symmetric-indefinite factorisation of
     ``operator``, reporting the inertia of the whole matrix on every rank (ICNTL 13) and
-    detecting null pivots instead of failing on them (ICNTL 24). The symbolic
-    factorisation is made at the first set-up and kept while the pattern stays. The
-    caller owns the KSP (the factor is the PC's)."""
-    ksp, factor = _mumps(comm, operator, PETSc.PC.Type.CHOLESKY)
+    detecting null pivots instead of failing on them (ICNTL 24); MUMPS's controls read
+    under ``prefix`` (-<prefix>mat_mumps_icntl_*; the KSP and PC are not the options':
+    the inertia needs this factorisation). The symbolic factorisation is made at the
+    first set-up and kept while the pattern stays. The caller owns the KSP (the factor
+    is the PC's)."""
+    ksp, factor = _mumps(comm, operator, PETSc.PC.Type.CHOLESKY, prefix)
     factor.setMumpsIcntl(13, 1)
     return ksp, factor
-
-
-# The options prefix of the Newton Jacobian's LU (analysis/jacobian.py).
-NEWTON_PREFIX = "rod_newton_"
-# Its defaults: MUMPS's approximate minimum fill ordering (ICNTL 7 = 2), unless the
-# options say otherwise. MUMPS's automatic choice for an unsymmetric matrix on these
-# chains is PORD, whose analysis took 8.1 s for the riser catenary's Jacobian at 18 000
-# elements (252 007 unknowns), against 0.48 s with AMF and fewer entries in the factors
-# (5.0e6 against 7.1e6), the same residual (docs/performance.md). MUMPS reads its
-# controls at the symbolic factorisation, so they are in effect at each set-up
-# (set_up_lu); MatMumpsSetIcntl(7) before it did not take (PETSc 3.18, measured).
-LU_DEFAULTS = {"mat_mumps_icntl_7": "2"}
 
 
 def lu_solver(comm, operator, prefix=NEWTON_PREFIX):

@@ -14,7 +14,10 @@ interior rows ordered first, A = [A_II A_IG; A_GI A_GG] and
 
 W has two columns per rank (g_p, g_{p+1}) and S is (P-1) x (P-1) and tridiagonal; both
 are formed once per matrix (set-up: two local solves and one allgather), and S is
-factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A solve
+factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A matrix
+whose values change on the same pattern (the riser's vertical problem at each change of
+the seabed's active set) is refactored numerically (``ChainSolver.refactor``): the
+symbolic factorisation of the interior blocks is kept. A solve
 is then one local half-chain Cholesky solve per right-hand side, an allgather of 2 k
 numbers per rank (k right-hand sides),
 the small tridiagonal solve, and x_I -= W x_G: it does the work of the serial Cholesky
@@ -24,9 +27,10 @@ solves and reductions per right-hand side (docs/performance.md).
 ``ChainSolver`` does the algebra on numpy views of the local rows; ``InterfacePC`` is
 the same solve as a PETSc python preconditioner (``-rod_d1_pc_type python
 -rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so
-that KSP preonly with it is a direct solver. The PETSc objects (the interior matrix, its factor,
-two work vectors, the same for S: SeqCholesky) are created in ChainSolver.__init__ and
-destroyed in ChainSolver.destroy().
+that KSP preonly with it is a direct solver. The PETSc objects (the interior matrix, its
+factor, two work vectors, the same for S: SeqCholesky) are ChainSolver's: made in
+__init__ (and anew by refactor where the interior block's pattern grows or S's
+changes) and destroyed in ChainSolver.destroy().
 """
 
 import numpy as np
@@ -37,14 +41,15 @@ PYTHON_TYPE = "petsc_rod.global_step.substructuring.InterfacePC"
 
 class SeqCholesky:
     """A sequential sparse SPD matrix given in CSR (indptr, indices, values) with its
-    PETSc Cholesky factor in the natural order (a band matrix: no fill), and
-    solve(b, x) on numpy arrays without copies (the arrays are placed in two Vecs)."""
+    PETSc Cholesky factor in the natural order (a band matrix: no fill), solve(b, x) on
+    numpy arrays without copies (the arrays are placed in two Vecs), and refactor(values)
+    for new values on the same pattern."""
 
     def __init__(self, n, indptr, indices, values):
+        self._csr = (np.asarray(indptr, dtype=PETSc.IntType),
+                     np.asarray(indices, dtype=PETSc.IntType))
         self.matrix = PETSc.Mat().createAIJ(
-            (n, n), comm=PETSc.COMM_SELF,
-            csr=(np.asarray(indptr, dtype=PETSc.IntType),
-                 np.asarray(indices, dtype=PETSc.IntType), np.asarray(values, dtype=float)))
+            (n, n), comm=PETSc.COMM_SELF, csr=self._csr + (np.asarray(values, dtype=float),))
         self.matrix.assemble()
         self.matrix.setOption(PETSc.Mat.Option.SPD, True)
         self._pc = PETSc.PC().create(comm=PETSc.COMM_SELF)
@@ -55,6 +60,18 @@ class SeqCholesky:
         self.factor = self._pc.getFactorMatrix()
         self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
         self._x = self._b.duplicate()
+
+    def has_pattern(self, indptr, indices):
+        """Whether the CSR pattern (indptr, indices) is this matrix's."""
+        return np.array_equal(indptr, self._csr[0]) and np.array_equal(indices, self._csr[1])
+
+    def refactor(self, values):
+        """The numeric factorisation of the matrix with ``values`` in place of its own,
+        on the same CSR pattern (the symbolic one kept)."""
+        indptr, indices = self._csr
+        self.matrix.setValuesCSR(indptr, indices, np.asarray(values, dtype=float))
+        self.matrix.assemble()
+        self._pc.setUp()
 
     def solve(self, b, x):
         """x = A^-1 b, contiguous float arrays (n,)."""
@@ -111,19 +128,81 @@ class ChainSolver:
         self.width = width
         first = start + self.offset
         n_interior = end - first
-        keep = (row_of >= first) & (cols >= first) & (cols < end) & (
-            (values != 0.0) | (cols == row_of))
-        counts = np.bincount(row_of[keep] - first, minlength=n_interior)
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
-        self.interior = SeqCholesky(n_interior, indptr, cols[keep] - first, values[keep])
+        self._inside = (row_of >= first) & (cols >= first) & (cols < end)
+        self._keep = self._envelope(row_of, cols, values, start, end)
+        self.interior = self._interior_block(row_of, cols, values, first, n_interior)
         self.W = np.zeros((2 * width, n_interior))     # rows: columns of W, contiguous
         self._work = np.zeros(n_interior)
+        self.schur = None
+        self._pattern = (rows, cols)        # the local rows' (refactor)
+        self._couple_and_reduce(row_of, cols, values, start, end)
+
+    def _envelope(self, row_of, cols, values, start, end):
+        """Which entries of the local rows make the interior block A_II: its nonzero
+        ones, its diagonal, and its zeros within the envelope of the nonzero ones (entry
+        (i, j) with min(i, j) at or right of the first nonzero column of row max(i, j)).
+        A banded factor in the natural order lies within that envelope, so the zeros
+        there widen nothing; kept, they keep the pattern when one becomes nonzero
+        (refactor): the coupling of a vertex's value and slope in the riser's vertical
+        problem cancels on a uniform mesh until the seabed's spring acts at the vertex.
+        Zeros outside the envelope are left out: the P2 chains' DMDA stencil couples a
+        midpoint to the next midpoint with zeros, which would widen the band."""
+        nonzero = self._inside & ((values != 0.0) | (cols == row_of))
+        first_column = np.full(end - start, end)
+        np.minimum.at(first_column, row_of[nonzero] - start, cols[nonzero])
+        later = np.maximum(row_of, cols)
+        within = np.zeros_like(nonzero)
+        within[self._inside] = (np.minimum(row_of, cols)[self._inside]
+                                >= first_column[later[self._inside] - start])
+        return nonzero | within
+
+    def _interior_block(self, row_of, cols, values, first, n_interior):
+        """A_II, the entries self._keep of the local rows, factored."""
+        counts = np.bincount(row_of[self._keep] - first, minlength=n_interior)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
+        return SeqCholesky(n_interior, indptr, cols[self._keep] - first, values[self._keep])
+
+    def _couple_and_reduce(self, row_of, cols, values, start, end):
+        """W from the interior factor and the couplings, and S factored (refactored
+        where its pattern is the last one's)."""
+        self.W[:] = 0.0
         for column, (index, value) in enumerate(self._coupling):
             if index.size:
-                b = np.zeros(n_interior)
+                b = np.zeros(self.W.shape[1])
                 b[index] = value
                 self.interior.solve(b, self.W[column])
         self._factor_interface(row_of, cols, values, start, end)
+
+    def refactor(self, matrix):
+        """Take the values of ``matrix`` where its local rows have the pattern of the
+        one this solver was made from and it is still a chain split at the same
+        interface: the interior block refactored numerically (its symbolic
+        factorisation kept; an entry that became zero stays as a zero), W and S made
+        anew. Where an interior entry left out as a zero (_envelope) is not, the
+        interior block's pattern grows by it and is factored anew, symbolic phase
+        included; it keeps the entry from then on. Returns whether it took the values
+        (on every rank; if not, the solver is as it was, and ``matrix`` needs a new
+        ChainSolver). Collective."""
+        rows, cols, values = matrix.getValuesCSR()
+        start, end = matrix.getOwnershipRange()
+        fits = np.array_equal(rows, self._pattern[0]) and np.array_equal(cols, self._pattern[1])
+        coupling = self._coupling
+        if fits:
+            row_of = np.repeat(np.arange(start, end), np.diff(rows))
+            fits = self._split(row_of, cols, values, start, end, self.width) is None
+        if not all(self._mpi.allgather(fits)):
+            self._coupling = coupling                   # as it was
+            return False
+        grown = (values != 0.0) & self._inside & ~self._keep
+        if grown.any():
+            self._keep |= grown
+            self.interior.destroy()
+            first = start + self.offset
+            self.interior = self._interior_block(row_of, cols, values, first, end - first)
+        else:
+            self.interior.refactor(values[self._keep])
+        self._couple_and_reduce(row_of, cols, values, start, end)
+        return True
 
     def _split(self, row_of, cols, values, start, end, width):
         """With the interface ``width`` rows wide: None if it splits the matrix (and the
@@ -175,7 +254,6 @@ class ChainSolver:
                 if index.size:
                     entries.append((i, j, -(value @ self.W[b, index])))
         everything = [e for part in self._mpi.allgather(entries) for e in part]
-        self.schur = None
         if n:
             diagonal = [(r, r, 0.0) for r in range(n)]      # stored even if all zero
             i, j, v = (np.array([e[k] for e in everything + diagonal]) for k in range(3))
@@ -185,8 +263,13 @@ class ChainSolver:
             np.add.at(summed, where, v.astype(float))
             rows, columns = key // n, key % n
             self.diagonal = summed[rows == columns]
-            self.schur = SeqCholesky(n, np.r_[0, np.cumsum(np.bincount(rows, minlength=n))],
-                                     columns, summed)
+            indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=n))]
+            if self.schur is not None and self.schur.has_pattern(indptr, columns):
+                self.schur.refactor(summed)
+            else:
+                if self.schur is not None:
+                    self.schur.destroy()
+                self.schur = SeqCholesky(n, indptr, columns, summed)
             self._interface = np.zeros(n)
         else:
             self.diagonal = np.zeros(0)
@@ -238,8 +321,12 @@ class InterfacePC:
         self.solver = None
 
     def setUp(self, pc):
-        self.destroy(pc)
+        """The solver of the PC's Pmat: the last one refactored where the pattern is
+        the same (ChainSolver.refactor), else a new one."""
         _, pmat = pc.getOperators()
+        if self.solver is not None and self.solver.refactor(pmat):
+            return
+        self.destroy(pc)
         self.solver = ChainSolver(pmat)
 
     def apply(self, pc, b, x):

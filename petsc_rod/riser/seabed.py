@@ -70,6 +70,7 @@ class SeabedContact:
         self.weights = h[:, None] * NODE_WEIGHTS[None, :]          # (ne, 3), per element
         self.rows = node_rows(h)
         self.active = None                                          # (ne, 3) booleans
+        self._elements = None       # the element matrices and vectors of the last set
         # z_b and k at the nodes: the flat seabed's numbers, else (ne, 3) arrays (follow)
         self.base, self.stiffness = seabed.height, seabed.stiffness
         self.gradients = None                                       # (ne, 3, 2), follow
@@ -77,19 +78,39 @@ class SeabedContact:
         self.solves = 0                                             # since the last reset
         self._local = mesh.da.createLocalVec()
 
-    def _set_active(self, active):
+    def _set_active(self, active, only_changed=False):
         """The spring k w_n at the active nodes: element matrices E^T diag(k w) E and
-        vectors k z_b E^T (k w), (ne, 4, 4) and (ne, 4)."""
-        spring = self.stiffness * self.weights * active
-        weighted = self.rows.transpose(0, 2, 1) * spring[:, None, :]         # (ne, 4, 3)
-        self.problem.set_added(np.matmul(weighted, self.rows), self._pull(weighted))
+        vectors k z_b E^T (k w), (ne, 4, 4) and (ne, 4). ``only_changed``: k and z_b as
+        at the last call, so that only the elements where the set changed are made
+        anew (the active set moves at a few nodes near the touchdown), in place (the
+        vertical problem keeps copies)."""
+        if only_changed and self._elements is not None:
+            matrices, vectors = self._elements
+            changed = np.flatnonzero(np.any(active != self.active, axis=1))
+            matrices[changed], vectors[changed] = self._element_terms(active, changed)
+        else:
+            matrices, vectors = self._element_terms(active, slice(None))
+        self._elements = matrices, vectors
+        self.problem.set_added(matrices, vectors)
         self.active = active
 
-    def _pull(self, weighted):
-        """k z_b E^T (k w) of the active nodes, (ne, 4), from E^T diag(k w), (ne, 4, 3)."""
-        if np.ndim(self.base) == 0:
-            return self.base * weighted.sum(axis=2)
-        return np.einsum("ekn,en->ek", weighted, self.base)
+    def _element_terms(self, active, elements):
+        """The element matrices and vectors of _set_active for ``elements`` (an index)."""
+        spring = np.asarray(self.stiffness * self.weights)
+        spring = spring[elements] if spring.ndim else spring
+        spring = spring * active[elements]
+        rows = self.rows[elements]
+        weighted = rows.transpose(0, 2, 1) * spring[:, None, :]             # (k, 4, 3)
+        base = self.base[elements] if np.ndim(self.base) else self.base
+        return np.matmul(weighted, rows), self._pull(weighted, base)
+
+    def _pull(self, weighted, base=None):
+        """k z_b E^T (k w) of the active nodes, (k, 4), from E^T diag(k w), (k, 4, 3),
+        and z_b (a number, or (k, 3): the seabed's heights of those elements)."""
+        base = self.base if base is None else base
+        if np.ndim(base) == 0:
+            return base * weighted.sum(axis=2)
+        return np.einsum("ekn,en->ek", weighted, base)
 
     def follow(self, ghosted_r):
         """A seabed that is not flat: z_b and k at the nodes from the positions of the
@@ -112,8 +133,9 @@ class SeabedContact:
             self._set_active(self.active)
         else:
             spring = self.stiffness * self.weights * self.active
-            self.problem.set_added_rhs(
-                self._pull(self.rows.transpose(0, 2, 1) * spring[:, None, :]))
+            vectors = self._pull(self.rows.transpose(0, 2, 1) * spring[:, None, :])
+            self.problem.set_added_rhs(vectors)
+            self._elements = self._elements[0], vectors
 
     def heights(self, y):
         """z at the three nodes of each owned element, (ne, 3), from the Hermite dofs y."""
@@ -134,7 +156,7 @@ class SeabedContact:
             active = self.heights(y) < self.base
             if not self.mesh.global_sum(int(np.any(active != self.active))):
                 break
-            self._set_active(active)
+            self._set_active(active, only_changed=True)
         self.solution = y
         return y
 

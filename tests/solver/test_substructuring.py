@@ -151,6 +151,70 @@ def test_a_hermite_matrix_gets_an_interface_two_rows_wide():
         mesh.destroy()
 
 
+def set_symmetric(matrix, row, column, value):
+    """Set the entries (row, column) and (column, row), both in this rank's rows."""
+    matrix.setValue(row, column, value)
+    matrix.setValue(column, row, value)
+
+
+def test_refactor_keeps_the_interior_factor_where_a_zero_in_the_envelope_becomes_nonzero():
+    # the riser's vertical problem: a vertex's value-slope entry cancels until the
+    # seabed's spring acts there; the interior block keeps it as a zero (it lies in the
+    # envelope Cholesky fills), so new values there are a numeric refactorisation
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, _ = hermite_matrix(comm, 24)
+    start, _ = matrix.getOwnershipRange()
+    row = start + 4            # a vertex's value row, interior on every rank
+    set_symmetric(matrix, row, row + 1, 0.0)
+    matrix.assemble()
+    solver = substructuring.ChainSolver(matrix)
+    interior = solver.interior
+    try:
+        set_symmetric(matrix, row, row + 1, 0.3)
+        matrix.assemble()
+        matrix.shift(1.0)
+        assert solver.refactor(matrix)
+        assert solver.interior is interior        # refactored, not made anew
+        rhs = right_hand_sides(mesh, 2)
+        solution = [np.zeros_like(column) for column in rhs]
+        solver.solve(rhs, solution)
+        assert_solves(comm, matrix, rhs, solution)
+        # the same factor as a solver made from the new matrix: the same numbers
+        fresh = substructuring.ChainSolver(matrix)
+        again = [np.zeros_like(column) for column in rhs]
+        fresh.solve(rhs, again)
+        fresh.destroy()
+        assert all(np.array_equal(x, y) for x, y in zip(solution, again))
+    finally:
+        solver.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope():
+    # the P2 chain's DMDA stencil holds zeros between a midpoint and the next midpoint,
+    # left out of the interior block; one that becomes nonzero must enter it
+    comm = PETSc.COMM_WORLD
+    mesh, matrix = chain_matrix(comm, 40, (81,))      # the phantom slot pinned
+    start, _ = matrix.getOwnershipRange()
+    row = start + 3            # a midpoint row, interior on every rank
+    solver = substructuring.ChainSolver(matrix)
+    interior = solver.interior
+    try:
+        set_symmetric(matrix, row, row + 2, 0.01)
+        matrix.assemble()
+        assert solver.refactor(matrix)
+        assert solver.interior is not interior     # the pattern grew
+        rhs = right_hand_sides(mesh, 2)
+        solution = [np.zeros_like(column) for column in rhs]
+        solver.solve(rhs, solution)
+        assert_solves(comm, matrix, rhs, solution)
+    finally:
+        solver.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
 def test_a_matrix_that_is_no_chain_is_refused():
     comm = PETSc.COMM_WORLD
     if comm.getSize() == 1:
