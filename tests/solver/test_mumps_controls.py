@@ -7,6 +7,8 @@ minimum fill ordering (ICNTL 7 = 2) unless given. A default is in effect only du
 the set-up: it is not left in the options database (it would be reported as an option
 nobody used)."""
 
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
@@ -32,22 +34,30 @@ def indefinite_matrix(comm):
     return matrix
 
 
+@contextmanager
+def option_given(name, value):
+    """-name value in the options database for the block (nothing where value is None)."""
+    options = PETSc.Options()
+    if value is not None:
+        options[name] = value
+    try:
+        yield options
+    finally:
+        if value is not None:
+            options.delValue(name)
+
+
 @pytest.mark.parametrize("given", [None, "2"])
 def test_the_ldlt_reads_its_prefix_and_counts_the_negative_eigenvalues(given):
     comm = PETSc.COMM_WORLD
-    options = PETSc.Options()
-    name = f"{INERTIA_PREFIX}mat_mumps_icntl_7"
-    if given is not None:
-        options[name] = given
     matrix = indefinite_matrix(comm)
     ksp, factor = inertia_solver(comm, matrix)
     try:
-        ksp.setUp()
+        with option_given(f"{INERTIA_PREFIX}mat_mumps_icntl_7", given):
+            ksp.setUp()
         assert factor.getMumpsIcntl(7) == (MUMPS_AUTOMATIC if given is None else int(given))
         assert factor.getInertia()[0] == SIZE // 2
     finally:
-        if given is not None:
-            options.delValue(name)
         ksp.destroy()
         matrix.destroy()
 
@@ -55,17 +65,15 @@ def test_the_ldlt_reads_its_prefix_and_counts_the_negative_eigenvalues(given):
 @pytest.mark.parametrize("given", [None, "0"])
 def test_the_newton_lu_takes_amf_unless_given(given):
     comm = PETSc.COMM_WORLD
-    options = PETSc.Options()
     name = f"{NEWTON_PREFIX}mat_mumps_icntl_7"
-    if given is not None:
-        options[name] = given
     matrix = indefinite_matrix(comm)
     ksp = lu_solver(comm, matrix)
     try:
-        set_up_lu(ksp)
+        with option_given(name, given) as options:
+            set_up_lu(ksp)
+            assert options.hasName(name) == (given is not None)
         assert ksp.getPC().getFactorMatrix().getMumpsIcntl(7) == (
             2 if given is None else int(given))
-        assert options.hasName(name) == (given is not None)
         b, x = matrix.createVecs()
         b.set(1.0)
         ksp.solve(b, x)
@@ -76,7 +84,5 @@ def test_the_newton_lu_takes_amf_unless_given(given):
         for vec in (b, x, residual):
             vec.destroy()
     finally:
-        if given is not None:
-            options.delValue(name)
         ksp.destroy()
         matrix.destroy()
