@@ -134,7 +134,7 @@ class ChainSolver:
         self.W = np.zeros((2 * width, n_interior))     # rows: columns of W, contiguous
         self._work = np.zeros(n_interior)
         self.schur = None
-        self._pattern = (rows, cols)        # the local rows' (refactor)
+        self._pattern = (rows, cols, row_of)        # the local rows' (refactor)
         self._couple_and_reduce(row_of, cols, values, start, end)
 
     def _envelope(self, row_of, cols, values, start, end):
@@ -185,10 +185,10 @@ class ChainSolver:
         ChainSolver). Collective."""
         rows, cols, values = matrix.getValuesCSR()
         start, end = matrix.getOwnershipRange()
-        fits = np.array_equal(rows, self._pattern[0]) and np.array_equal(cols, self._pattern[1])
+        old_rows, old_cols, row_of = self._pattern
+        fits = np.array_equal(rows, old_rows) and np.array_equal(cols, old_cols)
         coupling = self._coupling
         if fits:
-            row_of = np.repeat(np.arange(start, end), np.diff(rows))
             fits = self._split(row_of, cols, values, start, end, self.width) is None
         if not all(self._mpi.allgather(fits)):
             self._coupling = coupling                   # as it was

@@ -96,9 +96,8 @@ class SeabedContact:
 
     def _element_terms(self, active, elements):
         """The element matrices and vectors of _set_active for ``elements`` (an index)."""
-        spring = np.asarray(self.stiffness * self.weights)
-        spring = spring[elements] if spring.ndim else spring
-        spring = spring * active[elements]
+        stiffness = self.stiffness[elements] if np.ndim(self.stiffness) else self.stiffness
+        spring = stiffness * self.weights[elements] * active[elements]
         rows = self.rows[elements]
         weighted = rows.transpose(0, 2, 1) * spring[:, None, :]             # (k, 4, 3)
         base = self.base[elements] if np.ndim(self.base) else self.base

@@ -65,6 +65,13 @@ def serial_cholesky(n_elements, prescribed_rows, rhs):
         mesh.destroy()
 
 
+def solved(solver, rhs):
+    """The solver's solutions of the right-hand sides ``rhs`` (local arrays)."""
+    solution = [np.zeros_like(column) for column in rhs]
+    solver.solve(rhs, solution)
+    return solution
+
+
 def assert_solves(comm, matrix, rhs, solution):
     """A x = b to round-off for every column, on the owned rows of every rank."""
     b, x = matrix.createVecs()
@@ -89,8 +96,7 @@ def test_chain_solver_agrees_with_serial_cholesky(n_elements):
     solver = substructuring.ChainSolver(matrix)
     try:
         rhs = right_hand_sides(mesh, 3)
-        solution = [np.zeros_like(column) for column in rhs]
-        solver.solve(rhs, solution)
+        solution = solved(solver, rhs)
         whole = [gather(comm, x) for x in solution]
         reference = serial_cholesky(n_elements, fixed, [gather(comm, b) for b in rhs])
         for x, y in zip(whole, reference):
@@ -142,8 +148,7 @@ def test_a_hermite_matrix_gets_an_interface_two_rows_wide():
     try:
         assert solver.width == (2 if comm.getSize() > 1 else 1)
         rhs = right_hand_sides(mesh, 2)
-        solution = [np.zeros_like(column) for column in rhs]
-        solver.solve(rhs, solution)
+        solution = solved(solver, rhs)
         assert_solves(comm, matrix, rhs, solution)
     finally:
         solver.destroy()
@@ -176,13 +181,11 @@ def test_refactor_keeps_the_interior_factor_where_a_zero_in_the_envelope_becomes
         assert solver.refactor(matrix)
         assert solver.interior is interior        # refactored, not made anew
         rhs = right_hand_sides(mesh, 2)
-        solution = [np.zeros_like(column) for column in rhs]
-        solver.solve(rhs, solution)
+        solution = solved(solver, rhs)
         assert_solves(comm, matrix, rhs, solution)
         # the same factor as a solver made from the new matrix: the same numbers
         fresh = substructuring.ChainSolver(matrix)
-        again = [np.zeros_like(column) for column in rhs]
-        fresh.solve(rhs, again)
+        again = solved(fresh, rhs)
         fresh.destroy()
         assert all(np.array_equal(x, y) for x, y in zip(solution, again))
     finally:
@@ -206,8 +209,7 @@ def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope()
         assert solver.refactor(matrix)
         assert solver.interior is not interior     # the pattern grew
         rhs = right_hand_sides(mesh, 2)
-        solution = [np.zeros_like(column) for column in rhs]
-        solver.solve(rhs, solution)
+        solution = solved(solver, rhs)
         assert_solves(comm, matrix, rhs, solution)
     finally:
         solver.destroy()
