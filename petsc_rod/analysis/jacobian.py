@@ -30,7 +30,7 @@ converge quadratically.
 
 from petsc4py import PETSc
 
-from petsc_rod.global_step.ksp import lu_solver, set_up_lu
+from petsc_rod.global_step.ksp import lu_solver, set_up_mumps
 
 
 class NewtonJacobian:
@@ -70,7 +70,7 @@ class NewtonJacobian:
             self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
         else:
             self.ksp.setOperators(self.matrix)
-        set_up_lu(self.ksp)
+        set_up_mumps(self.ksp, hessian.block)
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and

@@ -55,7 +55,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.positions import HALF, HEIGHT, SIMPSON, slope_rows
-from petsc_rod.global_step.ksp import inertia_solver
+from petsc_rod.global_step.ksp import inertia_solver, set_up_mumps
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
 from petsc_rod.scenes.boundary import is_held
@@ -451,21 +451,42 @@ class SecondVariation:
     # --- inertia --------------------------------------------------------------------
     def _create_solver(self):
         """One KSP (preonly, MUMPS LDL^T) for H - shift M at every shift: the symbolic
-        factorisation is made once, the numeric one per shift."""
-        self.shifted = self.matrix.duplicate(copy=True)
+        factorisation is made once, the numeric one per shift. With a follower load the
+        factored matrix leaves out the resultants' identity rows (``_kept``): they are
+        decoupled from the rest with eigenvalue 1 (nothing to count), and they made
+        MUMPS's analysis on several ranks slow (docs/performance.md). The factored
+        matrix has ``_node_unknowns`` rows a node (set_up_mumps, whose defaults leave
+        an LDL^T's analysis to MUMPS)."""
+        self._kept = self._kept_mass = None
+        self._node_unknowns = self.block - 3 * int(self.resultants)
+        if self.resultants:
+            start, end = self.matrix.getOwnershipRange()
+            kept = np.setdiff1d(np.arange(start, end), self.resultant_rows)
+            self._kept = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=self.comm)
+            self.shifted = self.matrix.createSubMatrix(self._kept, self._kept)
+            view = self.mass.getSubVector(self._kept)
+            self._kept_mass = view.copy()
+            self.mass.restoreSubVector(self._kept, view)
+        else:
+            self.shifted = self.matrix.duplicate(copy=True)
         self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self._shift_work = self.shifted.createVecLeft()
         self.ksp, self.factor = inertia_solver(self.comm, self.shifted)
 
     def factorise(self, shift):
         """Factor H - shift M (the constraint solves of the previous factorisation are
         dropped)."""
         self._drop_constraint_solves()
-        self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.mass.copy(self._work)
-        self._work.scale(-shift)
-        self.shifted.setDiagonal(self._work, addv=PETSc.InsertMode.ADD_VALUES)
+        if self._kept is None:
+            self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.mass.copy(self._shift_work)
+        else:
+            self.matrix.createSubMatrix(self._kept, self._kept, submat=self.shifted)
+            self._kept_mass.copy(self._shift_work)
+        self._shift_work.scale(-shift)
+        self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
         self.ksp.setOperators(self.shifted)
-        self.ksp.setUp()
+        set_up_mumps(self.ksp, self._node_unknowns)
         self._factored = True
 
     def solve(self, rhs):
@@ -473,8 +494,21 @@ class SecondVariation:
         if not self._factored:
             raise RuntimeError("SecondVariation.solve needs factorise after the last update")
         solution = rhs.duplicate()
-        self.ksp.solve(rhs, solution)
+        self._solve_into(rhs, solution)
         return solution
+
+    def _solve_into(self, rhs, solution):
+        """solution = (H - shift M)^-1 rhs with the last factorisation; on the resultants'
+        identity rows (left out of the factor, _create_solver) solution = rhs."""
+        if self._kept is None:
+            self.ksp.solve(rhs, solution)
+            return
+        rhs.copy(solution)
+        kept_rhs = rhs.getSubVector(self._kept)
+        kept_solution = solution.getSubVector(self._kept)
+        self.ksp.solve(kept_rhs, kept_solution)
+        solution.restoreSubVector(self._kept, kept_solution)
+        rhs.restoreSubVector(self._kept, kept_rhs)
 
     def negative_directions(self, shift):
         """Eigenvalues of H below ``shift`` (times the mass M) on the constraint set."""
@@ -564,7 +598,7 @@ class SecondVariation:
         for _ in range(INVERSE_STEPS):
             self._zero_chains(vector)
             self._project(vector)
-            self.ksp.solve(vector, work)
+            self._solve_into(vector, work)
             work.copy(vector)
             self._zero_chains(vector)
             vector.scale(1.0 / vector.norm())
@@ -588,5 +622,7 @@ class SecondVariation:
     def destroy(self):
         self._drop_constraint_solves()
         for obj in [self.ksp, self.shifted, self.matrix, self.mass, self._mass_or_one,
+                    self._shift_work,
+                    *[obj for obj in (self._kept, self._kept_mass) if obj is not None],
                     self._work, self._diagonal, *self.constraint]:
             obj.destroy()

@@ -304,7 +304,8 @@ OPTIONS = [
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
-           "min(K1, K2) with M = K3 a / L for a clamped end turned by a", SCALE, "N"),
+           "min(K1, K2) with M = K3 a / L for a clamped end turned by a, and the largest "
+           "tension of a -rod_initial_shape catenary start", SCALE, "N"),
     Option("rod_al_max_it", _int, default_of(Settings, "max_it"), "n", "iteration cap per step",
            POSITIVE),
     Option("rod_al_rtol", _real, default_of(Settings, "rtol"), "tol",
@@ -447,8 +448,10 @@ def help_text():
                  "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
                  "python) on several.")
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
-                 "their unsymmetric Jacobian (default preonly + MUMPS LU, "
-                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering).")
+                 "their unsymmetric Jacobian (default preonly + MUMPS LU, the ordering "
+                 "-rod_newton_mat_mumps_icntl_7 2 (AMF) on one rank, 4 (PORD) on several, "
+                 "the analysis on the nodes' graph, -rod_newton_mat_mumps_icntl_15 -B for "
+                 "B unknowns a node).")
     lines.append("  The stability test and the Newton steps' positive-definiteness test: "
                  "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
                  "ordering unless given).")

@@ -15,6 +15,7 @@ from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Fric
                                          grid_axes, largest_stiffness, read_profile,
                                          read_seabed_profile)
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
+from petsc_rod.scenes import starts
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
                                    parse_sections, section_elements)
@@ -287,7 +288,7 @@ def check_applied_forces(scene, given):
 def settings_from_options(values, scene):
     penalty = values["rod_al_penalty"]
     if penalty is None:
-        penalty = checked_default_penalty(scene)
+        penalty = checked_default_penalty(scene, start_tension(values, scene))
     return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
@@ -296,10 +297,25 @@ def settings_from_options(values, scene):
                     newton=values["rod_al_newton"])
 
 
-def checked_default_penalty(scene):
-    """default_penalty(scene), refused above MAX_MAGNITUDE (the bound of -rod_al_penalty)
-    with the options behind the scale that sets it (problem/penalty.penalty_scales)."""
-    scales = penalty_scales(scene)
+def start_tension(values, scene):
+    """The largest tension of the first step's start, N (the default penalty's start
+    scale, problem/penalty.py): that of the catenary at the first step's load factor
+    1 / -rod_steps where -rod_initial_shape catenary starts it, 0 for the straight start
+    and a restart (whose multipliers are the file's). 0 too for a scene without a
+    catenary: the start refuses it (cli/main.start_from), after -help has been said."""
+    if values["rod_initial_shape"] != "catenary" or values["rod_initial"]:
+        return 0.0
+    try:
+        return starts.largest_tension(scene, 1.0 / values["rod_steps"])
+    except RodInputError:
+        return 0.0
+
+
+def checked_default_penalty(scene, start_tension=0.0):
+    """default_penalty(scene, start_tension), refused above MAX_MAGNITUDE (the bound of
+    -rod_al_penalty) with the options behind the scale that sets it
+    (problem/penalty.penalty_scales)."""
+    scales = penalty_scales(scene, start_tension)
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
         stiffness = ("-rod_stiffness" if not scene.sections
@@ -310,7 +326,9 @@ def checked_default_penalty(scene):
             "twist": (f"-rod_end_twist (or -rod_end_frame) with {stiffness}",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
             "stretch": ("-rod_axial_stiffness with -rod_end_position",
-                        "EA (|r_L| - L) / 2L")}[name]
+                        "EA (|r_L| - L) / 2L"),
+            "start": ("-rod_load with -rod_initial_shape catenary",
+                      "the catenary start's largest tension")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
             f"above {MAX_MAGNITUDE:g}, beyond what double precision carries through the "

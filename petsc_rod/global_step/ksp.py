@@ -53,16 +53,29 @@ def chain_solver(comm, operator, prefix):
 # Jacobian's LU (analysis/jacobian.py).
 INERTIA_PREFIX = "rod_inertia_"
 NEWTON_PREFIX = "rod_newton_"
-# The Newton LU's defaults: MUMPS's approximate minimum fill ordering (ICNTL 7 = 2),
-# unless the options say otherwise. MUMPS's automatic choice for an unsymmetric matrix
-# on these chains is PORD, whose analysis took 8.1 s for the riser catenary's Jacobian at
-# 18 000 elements (252 007 unknowns) on one rank, against 0.48 s with AMF and fewer
-# entries in the factors (5.0e6 against 7.1e6), the same residual (docs/performance.md).
-# MUMPS reads its controls at the symbolic factorisation, so they are in effect at each
-# set-up (set_up_lu); MatMumpsSetIcntl(7) before it did not take (PETSc 3.18, measured).
-# The LDL^T keeps MUMPS's own choice: AMF on one rank; on several, AMF's analysis
-# overflows the default 8 MiB stack from about 5e4 elements (docs/performance.md).
-LU_DEFAULTS = {"mat_mumps_icntl_7": "2"}
+
+
+def mumps_defaults(kind, block, ranks):
+    """The MUMPS controls in effect at a set-up (set_up_mumps) unless the options give
+    them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU) of a matrix of
+    ``block`` unknowns per node on ``ranks`` ranks (docs/performance.md). The LU:
+
+    * ICNTL 15 = -block, the analysis on the graph of the nodes: on these chains the
+      elimination tree of the unknowns is a path, and MUMPS's mapping of it onto several
+      ranks grows like the square of its length; the nodes' path is block times
+      shorter;
+    * ICNTL 7 the ordering: AMF (2) on one rank, an analysis many times faster than
+      MUMPS's own choice there, PORD; PORD (4) on several, whose tree has branches to
+      map (AMF's is still a path).
+
+    The LDL^T keeps MUMPS's choices (AMF on one rank, PORD on several; no blocks: on
+    the nodes' graph its solves gave NaN on the riser with seabed friction, where the
+    unknowns' graph gave a factor).
+    """
+    if kind != PETSc.PC.Type.LU:
+        return {}
+    return {"mat_mumps_icntl_15": str(-int(block)),
+            "mat_mumps_icntl_7": "2" if ranks == 1 else "4"}
 
 
 def inertia_solver(comm, operator, prefix=INERTIA_PREFIX):
@@ -70,9 +83,9 @@ def inertia_solver(comm, operator, prefix=INERTIA_PREFIX):
     ``operator``, reporting the inertia of the whole matrix on every rank (ICNTL 13) and
     detecting null pivots instead of failing on them (ICNTL 24); MUMPS's controls read
     under ``prefix`` (-<prefix>mat_mumps_icntl_*; the KSP and PC are not the options':
-    the inertia needs this factorisation). The symbolic factorisation is made at the
-    first set-up and kept while the pattern stays. The caller owns the KSP (the factor
-    is the PC's)."""
+    the inertia needs this factorisation). Set it up with set_up_mumps; the symbolic
+    factorisation is made at the first set-up and kept while the pattern stays. The
+    caller owns the KSP (the factor is the PC's)."""
     ksp, factor = _mumps(comm, operator, PETSc.PC.Type.CHOLESKY, prefix)
     factor.setMumpsIcntl(13, 1)
     return ksp, factor
@@ -82,18 +95,21 @@ def lu_solver(comm, operator, prefix=NEWTON_PREFIX):
     """A KSP for an unsymmetric ``operator``: preonly + MUMPS's LU with null pivots
     detected (ICNTL 24) (the Newton Jacobian of a problem with a load that has no
     potential, analysis/jacobian.py): the free roll of a section with K1 = K2 between
-    pins is a null vector. Options under ``prefix``; set it up with set_up_lu. The
+    pins is a null vector. Options under ``prefix``; set it up with set_up_mumps. The
     caller owns it."""
     ksp = _mumps(comm, operator, PETSc.PC.Type.LU, prefix)[0]
     ksp.setFromOptions()
     return ksp
 
 
-def set_up_lu(ksp):
-    """``ksp.setUp()`` for an lu_solver, with LU_DEFAULTS in effect under its prefix (the
-    factorisation reads them)."""
+def set_up_mumps(ksp, block):
+    """``ksp.setUp()`` for an inertia_solver or lu_solver of a matrix of ``block``
+    unknowns per node, with mumps_defaults in effect under its prefix (MUMPS reads its
+    controls at the symbolic factorisation; MatMumpsSetIcntl(7) before it did not take,
+    PETSc 3.18, measured)."""
     prefix = ksp.getOptionsPrefix() or ""
-    with defaults_in_effect({f"{prefix}{key}": value for key, value in LU_DEFAULTS.items()}):
+    defaults = mumps_defaults(ksp.getPC().getType(), block, ksp.getComm().getSize())
+    with defaults_in_effect({f"{prefix}{key}": value for key, value in defaults.items()}):
         ksp.setUp()
 
 

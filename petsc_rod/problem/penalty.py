@@ -17,10 +17,10 @@ ADAPT_PROGRESS = 0.5
 ADAPT_WINDOW = 200
 
 
-def default_penalty(scene):
-    """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2), T / 2), N.
+def default_penalty(scene, start_tension=0.0):
+    """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2), T / 2, T_s), N.
 
-    Three scales, each a lower bound below which the iteration crawls or leaves the
+    The scales, each a lower bound below which the iteration crawls or leaves the
     branch (docs/method.md §3; measurements in docs/stability.md, History C):
     * bending and torsion, 100 sqrt(min K max K) / L^2: the count grows with R over the
       softest stiffness and the iteration fails when R is far below the stiffest one;
@@ -32,15 +32,20 @@ def default_penalty(scene):
       (M / 2K_b)^2 + P / K_b = (pi / L)^2, K_b = min(K1, K2);
     * on an extensible line held taut (ends d > L apart, docs/method.md §12), its
       tension T / 2 with T = (d - L) / int dS / EA, which lambda3 must reach as it must
-      reach the loads' (0 on an inextensible or slack line).
+      reach the loads' (0 on an inextensible or slack line);
+    * the tension the start holds, ``start_tension`` T_s (the largest tension of a
+      catenary start, scenes/starts.largest_tension; 0 for the straight start): lambda3
+      starts at the tension there, and with R below it the hanging lines' iteration was
+      measured to crawl (docs/method.md §3).
     """
-    return max(penalty_scales(scene).values())
+    return max(penalty_scales(scene, start_tension).values())
 
 
-def penalty_scales(scene):
+def penalty_scales(scene, start_tension=0.0):
     """The scales of default_penalty, N: {'bending': 100 sqrt(min K max K) / L^2,
-    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2}; the command
-    line names the options behind the one that makes a default penalty out of range.
+    'tension': F / 2, 'twist': 2 M^2 / min(K1, K2), 'stretch': T / 2, 'start': T_s};
+    the command line names the options behind the one that makes a default penalty out
+    of range.
 
     Where the stiffness varies along the line (sections), min K and max K are taken over
     the three stiffnesses and the whole line (Scene.stiffness_values: the softest and the
@@ -61,7 +66,8 @@ def penalty_scales(scene):
     return {"bending": 100.0 * np.sqrt(stiffness.min() * stiffness.max()) / scene.length**2,
             "tension": 0.5 * scene.applied_force(),
             "twist": 2.0 * moment**2 / bending,
-            "stretch": 0.5 * taut_tension(scene)}
+            "stretch": 0.5 * taut_tension(scene),
+            "start": float(start_tension)}
 
 
 def torsional_compliance(sections):

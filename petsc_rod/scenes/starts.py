@@ -67,6 +67,15 @@ def catenary_start(scene, t):
     return planar_curve(shape, normal, start.position)
 
 
+def largest_tension(scene, t=1.0, samples=4097):
+    """The largest tension |n| of the catenary start at load factor t (catenary_start,
+    sampled at ``samples`` arc lengths, both ends among them), N: the multiplier the
+    iteration starts from (lambda3 = n), and the tension scale of the default penalty
+    (problem/penalty.py). RodInputError where the scene has no catenary start."""
+    force = catenary_start(scene, t)(np.linspace(0.0, scene.length, samples))[2]
+    return float(np.linalg.norm(force, axis=-1).max())
+
+
 def planar_curve(shape, normal, origin):
     """The curve S -> (r, frame, force) of a planar ``shape`` S -> (r, tangent, force)
     (r from ``origin``): d1 = ``normal`` to the plane, d2 = d3 x d1, d3 the tangent."""

@@ -13,13 +13,16 @@ H plus the drag's linearisation through the resultants' chain, factored by LU.
     plane between pins, inextensible and extensible, and a hanging line (free start,
     clamped end) in a current (the seabed's part of J, through the heights' chain, is
     test_seabed_newton's);
-(b) Newton steps on the catenary reach the iteration's state in fewer iterations.
+(b) Newton steps on the catenary reach the iteration's state in fewer iterations;
+(c) the LDL^T of H leaves the resultants' identity rows out (SecondVariation's kept
+    rows): its inertia and its solves are those of the whole H, factored apart.
 """
 
 import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.iteration.newton import NewtonPolish
 from petsc_rod.riser.environment import Current
 from petsc_rod.riser.terms import DragTerm
@@ -132,3 +135,43 @@ def test_newton_in_a_current_reaches_the_iterations_state(comm, solver_factory):
         assert np.abs(a - b).max() < 1e-8
     assert np.allclose(plain.problem.end_reaction(), polished.problem.end_reaction(),
                        rtol=0, atol=1e-8)
+
+
+# --- (c) the LDL^T without the resultants' rows -------------------------------------------------
+def test_the_ldlt_without_the_resultants_rows_is_that_of_the_whole_h(comm, solver_factory):
+    """At the converged catenary in the current (K1 != K2: no free roll, so H is
+    regular), H - shift M for shifts from 0 to well into the spectrum: the negative
+    pivots SecondVariation counts (its factor leaves out the resultants' identity rows)
+    equal those of the whole matrix factored by MUMPS, and its solve equals that of the
+    whole matrix."""
+    line = dict(LINES["catenary"], stiffness=(1e-1, 2e-1, 1e-1))
+    mesh, solver, report = converged(solver_factory, comm, line, newton=True, n_elements=20)
+    assert report.converged
+    hessian = solver.problem.second_variation()
+    assert hessian.resultants and hessian.shifted.getSize()[0] < hessian.matrix.getSize()[0]
+    whole = hessian.matrix.duplicate(copy=True)
+    ksp, factor = inertia_solver(whole.getComm(), whole)
+    rhs, expected = whole.createVecs()
+    rhs.setRandom()
+    counts = []
+    try:
+        for shift in (0.0, 1e-2, 1e-1, 1.0):
+            hessian.matrix.copy(whole)
+            scaled = hessian.mass.copy()
+            scaled.scale(-shift)
+            whole.setDiagonal(scaled, addv=PETSc.InsertMode.ADD_VALUES)
+            scaled.destroy()
+            ksp.setOperators(whole)
+            ksp.setUp()
+            hessian.factorise(shift)
+            counts.append(hessian.negative_pivots())
+            assert counts[-1] == factor.getInertia()[0] - hessian.chain_constraints
+            ksp.solve(rhs, expected)
+            solution = hessian.solve(rhs)
+            solution.axpy(-1.0, expected)
+            assert solution.norm() < 1e-10 * expected.norm()
+            solution.destroy()
+        assert counts[0] == 0 and counts[-1] > 0        # positive definite, then not
+    finally:
+        for obj in (ksp, whole, rhs, expected):
+            obj.destroy()

@@ -1,6 +1,6 @@
 """The rules of the iteration and the catenary start, numpy only: the catenary closed
-form and start, the default penalty's three scales, the stall projection, and when a
-penalty is too low."""
+form and start, the default penalty's scales (the start's tension among them), the
+stall projection, and when a penalty is too low."""
 
 import numpy as np
 import pytest
@@ -10,7 +10,7 @@ from petsc_rod.problem.penalty import ADAPT_WINDOW, default_penalty, penalty_too
 from petsc_rod.iteration.stopping import (STALL_MARGIN, STALL_WINDOW, remaining_iterations,
                                           stalled_projection)
 from petsc_rod.scenes.scene import Scene
-from petsc_rod.scenes.starts import catenary_start
+from petsc_rod.scenes.starts import catenary_start, largest_tension
 from petsc_rod.validation.closed_forms import catenary
 
 
@@ -97,6 +97,26 @@ def test_default_penalty_is_the_largest_of_bending_load_and_twist_scales():
     assert default_penalty(one_radian) == pytest.approx(100.0)
     soft_torsion = Scene(length=1.0, stiffness=[1, 1, 0.01], end="clamp", end_twist=1.0)
     assert default_penalty(soft_torsion) == pytest.approx(10.0)     # M^2/K1 = 1e-4 N
+
+
+def test_the_default_penalty_reaches_the_tension_of_a_catenary_start():
+    """Ends level and s = 2000 m apart, L = 3000 m, w = 1000 N/m: the catenary's
+    parameter a solves L = 2a sinh(s / 2a) (bisection here), its largest tension, at
+    the ends, is w sqrt(a^2 + (L/2)^2) (T = w a cosh(x / a), sinh(s / 2a) = L / 2a).
+    largest_tension gives it; the default penalty takes it where it is above the other
+    scales (here above F / 2 = 1.5e6 N), and keeps F / 2 for a start below it."""
+    span, weight = 2000.0, 1000.0
+    scene = Scene(length=LENGTH, stiffness=[1e5, 1e5, 7.5e4], start="pin", end="pin",
+                  end_position=[span, 0.0, 0.0], load_values=[[0.0, 0.0, -weight]])
+    low, high = 1.0, 1e6                      # 2a sinh(s / 2a) falls from inf to s
+    for _ in range(200):
+        a = 0.5 * (low + high)
+        low, high = (a, high) if 2 * a * np.sinh(span / (2 * a)) > LENGTH else (low, a)
+    tension = weight * np.hypot(a, LENGTH / 2)
+    assert tension > 0.5 * weight * LENGTH
+    assert largest_tension(scene) == pytest.approx(tension, rel=1e-9)
+    assert default_penalty(scene, largest_tension(scene)) == pytest.approx(tension, rel=1e-9)
+    assert default_penalty(scene, 1.0) == pytest.approx(0.5 * weight * LENGTH)
 
 
 def test_stall_projection():
