@@ -70,7 +70,7 @@ class NewtonJacobian:
             self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
         else:
             self.ksp.setOperators(self.matrix)
-        set_up_mumps(self.ksp, hessian.block)
+        set_up_mumps(self.ksp)
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and

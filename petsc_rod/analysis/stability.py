@@ -454,11 +454,8 @@ class SecondVariation:
         factorisation is made once, the numeric one per shift. With a follower load the
         factored matrix leaves out the resultants' identity rows (``_kept``): they are
         decoupled from the rest with eigenvalue 1 (nothing to count), and they made
-        MUMPS's analysis on several ranks slow (docs/performance.md). The factored
-        matrix has ``_node_unknowns`` rows a node (set_up_mumps, whose defaults leave
-        an LDL^T's analysis to MUMPS)."""
+        MUMPS's analysis on several ranks slow (docs/performance.md)."""
         self._kept = self._kept_mass = None
-        self._node_unknowns = self.block - 3 * int(self.resultants)
         if self.resultants:
             start, end = self.matrix.getOwnershipRange()
             kept = np.setdiff1d(np.arange(start, end), self.resultant_rows)
@@ -486,7 +483,7 @@ class SecondVariation:
         self._shift_work.scale(-shift)
         self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
         self.ksp.setOperators(self.shifted)
-        set_up_mumps(self.ksp, self._node_unknowns)
+        set_up_mumps(self.ksp)
         self._factored = True
 
     def solve(self, rhs):

@@ -448,10 +448,8 @@ def help_text():
                  "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
                  "python) on several.")
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
-                 "their unsymmetric Jacobian (default preonly + MUMPS LU, the ordering "
-                 "-rod_newton_mat_mumps_icntl_7 2 (AMF) on one rank, 4 (PORD) on several, "
-                 "the analysis on the nodes' graph, -rod_newton_mat_mumps_icntl_15 -B for "
-                 "B unknowns a node).")
+                 "their unsymmetric Jacobian (default preonly + MUMPS LU, "
+                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering).")
     lines.append("  The stability test and the Newton steps' positive-definiteness test: "
                  "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
                  "ordering unless given).")

@@ -55,27 +55,22 @@ INERTIA_PREFIX = "rod_inertia_"
 NEWTON_PREFIX = "rod_newton_"
 
 
-def mumps_defaults(kind, block, ranks):
+def mumps_defaults(kind):
     """The MUMPS controls in effect at a set-up (set_up_mumps) unless the options give
-    them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU) of a matrix of
-    ``block`` unknowns per node on ``ranks`` ranks (docs/performance.md). The LU:
+    them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU)
+    (docs/performance.md): for the LU the
+    AMF ordering (ICNTL 7 = 2), an analysis many times faster than MUMPS's own choice,
+    PORD, on these chains. The LDL^T keeps MUMPS's choice (AMF on one rank, PORD on
+    several).
 
-    * ICNTL 15 = -block, the analysis on the graph of the nodes: on these chains the
-      elimination tree of the unknowns is a path, and MUMPS's mapping of it onto several
-      ranks grows like the square of its length; the nodes' path is block times
-      shorter;
-    * ICNTL 7 the ordering: AMF (2) on one rank, an analysis many times faster than
-      MUMPS's own choice there, PORD; PORD (4) on several, whose tree has branches to
-      map (AMF's is still a path).
-
-    The LDL^T keeps MUMPS's choices (AMF on one rank, PORD on several; no blocks: on
-    the nodes' graph its solves gave NaN on the riser with seabed friction, where the
-    unknowns' graph gave a factor).
+    Not defaults, measured: on several ranks the analysis on the graph of the nodes
+    (ICNTL 15 = -B, B unknowns a node) with PORD is many times faster than AMF on the unknowns', whose
+    elimination tree is a path MUMPS maps onto the ranks in a time that grows like the
+    square of its length; but the Newton steps then take other round-off than on one
+    rank, and a riser's iteration count with a free roll doubled on 2 ranks. The
+    LDL^T's solves on the nodes' graph gave NaN on a riser with seabed friction.
     """
-    if kind != PETSc.PC.Type.LU:
-        return {}
-    return {"mat_mumps_icntl_15": str(-int(block)),
-            "mat_mumps_icntl_7": "2" if ranks == 1 else "4"}
+    return {"mat_mumps_icntl_7": "2"} if kind == PETSc.PC.Type.LU else {}
 
 
 def inertia_solver(comm, operator, prefix=INERTIA_PREFIX):
@@ -102,13 +97,12 @@ def lu_solver(comm, operator, prefix=NEWTON_PREFIX):
     return ksp
 
 
-def set_up_mumps(ksp, block):
-    """``ksp.setUp()`` for an inertia_solver or lu_solver of a matrix of ``block``
-    unknowns per node, with mumps_defaults in effect under its prefix (MUMPS reads its
-    controls at the symbolic factorisation; MatMumpsSetIcntl(7) before it did not take,
-    PETSc 3.18, measured)."""
+def set_up_mumps(ksp):
+    """``ksp.setUp()`` for an inertia_solver or lu_solver, with mumps_defaults in effect
+    under its prefix (MUMPS reads its controls at the symbolic factorisation;
+    MatMumpsSetIcntl(7) before it did not take, PETSc 3.18, measured)."""
     prefix = ksp.getOptionsPrefix() or ""
-    defaults = mumps_defaults(ksp.getPC().getType(), block, ksp.getComm().getSize())
+    defaults = mumps_defaults(ksp.getPC().getType())
     with defaults_in_effect({f"{prefix}{key}": value for key, value in defaults.items()}):
         ksp.setUp()
 

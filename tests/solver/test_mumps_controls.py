@@ -1,10 +1,10 @@
 """The MUMPS factorisations of global_step/ksp.py read their controls under their own
 prefixes: the LDL^T of the second variation (inertia_solver) under -rod_inertia_, with
 MUMPS's own ordering unless given (ICNTL 7 = 7, automatic), and the Newton Jacobian's LU
-(lu_solver) under -rod_newton_, with AMF on one rank and PORD on several (ICNTL 7 = 2,
-4) unless given, and on the graph of the nodes (ICNTL 15 = -block; the LDL^T on the
-unknowns', MUMPS's 0) unless given (set_up_mumps; docs/performance.md). A default is in effect only during the set-up: it
-is not left in the options database (it would be reported as an option nobody used)."""
+(lu_solver) under -rod_newton_, with the approximate minimum fill ordering (ICNTL 7 = 2)
+unless given (set_up_mumps; docs/performance.md). A default is in effect only during
+the set-up: it is not left in the options database (it would be reported as an option
+nobody used)."""
 
 from contextlib import contextmanager
 
@@ -16,7 +16,6 @@ from petsc_rod.global_step.ksp import (INERTIA_PREFIX, NEWTON_PREFIX, inertia_so
                                        lu_solver, set_up_mumps)
 
 SIZE = 40
-BLOCK = 2                    # unknowns per node of the test matrix (SIZE a multiple)
 MUMPS_AUTOMATIC = 7          # ICNTL(7)'s value for "MUMPS chooses the ordering"
 
 
@@ -54,9 +53,8 @@ def test_the_ldlt_reads_its_prefix_and_counts_the_negative_eigenvalues(given):
     ksp, factor = inertia_solver(comm, matrix)
     try:
         with option_given(f"{INERTIA_PREFIX}mat_mumps_icntl_7", given):
-            set_up_mumps(ksp, BLOCK)
+            set_up_mumps(ksp)
         assert factor.getMumpsIcntl(7) == (MUMPS_AUTOMATIC if given is None else int(given))
-        assert factor.getMumpsIcntl(15) == 0
         assert factor.getInertia()[0] == SIZE // 2
     finally:
         ksp.destroy()
@@ -64,20 +62,17 @@ def test_the_ldlt_reads_its_prefix_and_counts_the_negative_eigenvalues(given):
 
 
 @pytest.mark.parametrize("given", [None, "0"])
-def test_the_newton_lu_takes_amf_on_one_rank_pord_on_several_unless_given(given):
+def test_the_newton_lu_takes_amf_unless_given(given):
     comm = PETSc.COMM_WORLD
     name = f"{NEWTON_PREFIX}mat_mumps_icntl_7"
-    blocks = f"{NEWTON_PREFIX}mat_mumps_icntl_15"
     matrix = indefinite_matrix(comm)
     ksp = lu_solver(comm, matrix)
     try:
-        with option_given(name, given) as options, option_given(blocks, given):
-            set_up_mumps(ksp, BLOCK)
+        with option_given(name, given) as options:
+            set_up_mumps(ksp)
             assert options.hasName(name) == (given is not None)
-        factor = ksp.getPC().getFactorMatrix()
-        ordering = 2 if comm.getSize() == 1 else 4
-        assert factor.getMumpsIcntl(7) == (ordering if given is None else int(given))
-        assert factor.getMumpsIcntl(15) == (-BLOCK if given is None else int(given))
+        assert ksp.getPC().getFactorMatrix().getMumpsIcntl(7) == (
+            2 if given is None else int(given))
         b, x = matrix.createVecs()
         b.set(1.0)
         ksp.solve(b, x)
