@@ -58,17 +58,17 @@ NEWTON_PREFIX = "rod_newton_"
 def mumps_defaults(kind):
     """The MUMPS controls in effect at a set-up (set_up_mumps) unless the options give
     them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU)
-    (docs/performance.md): for the LU the
-    AMF ordering (ICNTL 7 = 2), an analysis many times faster than MUMPS's own choice,
-    PORD, on these chains. The LDL^T keeps MUMPS's choice (AMF on one rank, PORD on
-    several).
+    (docs/performance.md): for the LU the AMF ordering (ICNTL 7 = 2), an analysis many
+    times faster than MUMPS's own choice, PORD, on these chains. The LDL^T keeps
+    MUMPS's choice (AMF on one rank, PORD on several).
 
     Not defaults, measured: on several ranks the analysis on the graph of the nodes
-    (ICNTL 15 = -B, B unknowns a node) with PORD is many times faster than AMF on the unknowns', whose
-    elimination tree is a path MUMPS maps onto the ranks in a time that grows like the
-    square of its length; but the Newton steps then take other round-off than on one
-    rank, and a riser's iteration count with a free roll doubled on 2 ranks. The
-    LDL^T's solves on the nodes' graph gave NaN on a riser with seabed friction.
+    (ICNTL 15 = -B, B unknowns a node) with PORD is many times faster than AMF on the
+    unknowns', whose elimination tree is a path MUMPS maps onto the ranks in a time
+    that grows like the square of its length; but the Newton steps then take other
+    round-off than on one rank, and a riser's iteration count with a free roll doubled
+    on 2 ranks. The LDL^T's solves on the nodes' graph gave NaN on a riser with seabed
+    friction.
     """
     return {"mat_mumps_icntl_7": "2"} if kind == PETSc.PC.Type.LU else {}
 
