@@ -8,6 +8,8 @@ multiple right-hand-side path. Under a serial run COMM_WORLD is one rank: the so
 then the interior Cholesky alone.
 """
 
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
@@ -22,6 +24,17 @@ from petsc_rod.mesh.mesh import Mesh
 # round-off of a direct solve of these matrices (condition ~ 1e4 to 1e6 here), relative
 # to the size of the solution
 ROUND_OFF = 1e-12
+
+
+@contextmanager
+def destroyed_after(*objects):
+    """The block, then ``destroy()`` of each object, in order, whatever the block did
+    (collective: every rank runs the same block)."""
+    try:
+        yield
+    finally:
+        for obj in objects:
+            obj.destroy()
 
 
 def chain_matrix(comm, n_elements, prescribed_rows=()):
@@ -94,7 +107,7 @@ def test_chain_solver_agrees_with_serial_cholesky(n_elements):
     fixed = (0, 1, 2 * n_elements, 2 * n_elements + 1)      # clamp, clamp, phantom
     mesh, matrix = chain_matrix(comm, n_elements, fixed)
     solver = substructuring.ChainSolver(matrix)
-    try:
+    with destroyed_after(solver, matrix, mesh):
         rhs = right_hand_sides(mesh, 3)
         solution = solved(solver, rhs)
         whole = [gather(comm, x) for x in solution]
@@ -102,26 +115,18 @@ def test_chain_solver_agrees_with_serial_cholesky(n_elements):
         for x, y in zip(whole, reference):
             assert np.abs(x - y).max() <= ROUND_OFF * np.abs(y).max()
         assert_solves(comm, matrix, rhs, solution)
-    finally:
-        solver.destroy()
-        matrix.destroy()
-        mesh.destroy()
 
 
 def test_every_rank_owns_interior_rows_and_the_interface_is_one_row_per_boundary():
     comm = PETSc.COMM_WORLD
     mesh, matrix = chain_matrix(comm, 20, (41,))      # the phantom slot pinned
     solver = substructuring.ChainSolver(matrix)
-    try:
+    with destroyed_after(solver, matrix, mesh):
         start, end = matrix.getOwnershipRange()
         assert solver.interior.matrix.getSize()[0] == end - start - (comm.getRank() > 0)
         assert solver.width == 1
         assert solver.diagonal.shape == (comm.getSize() - 1,)
         assert np.all(solver.diagonal > 0)
-    finally:
-        solver.destroy()
-        matrix.destroy()
-        mesh.destroy()
 
 
 def hermite_matrix(comm, n_elements):
@@ -145,15 +150,11 @@ def test_a_hermite_matrix_gets_an_interface_two_rows_wide():
     comm = PETSc.COMM_WORLD
     mesh, matrix, _ = hermite_matrix(comm, 12)
     solver = substructuring.ChainSolver(matrix)
-    try:
+    with destroyed_after(solver, matrix, mesh):
         assert solver.width == (2 if comm.getSize() > 1 else 1)
         rhs = right_hand_sides(mesh, 2)
         solution = solved(solver, rhs)
         assert_solves(comm, matrix, rhs, solution)
-    finally:
-        solver.destroy()
-        matrix.destroy()
-        mesh.destroy()
 
 
 def set_symmetric(matrix, row, column, value):
@@ -174,7 +175,7 @@ def test_refactor_keeps_the_interior_factor_where_a_zero_in_the_envelope_becomes
     matrix.assemble()
     solver = substructuring.ChainSolver(matrix)
     interior = solver.interior
-    try:
+    with destroyed_after(solver, matrix, mesh):
         set_symmetric(matrix, row, row + 1, 0.3)
         matrix.assemble()
         matrix.shift(1.0)
@@ -188,10 +189,6 @@ def test_refactor_keeps_the_interior_factor_where_a_zero_in_the_envelope_becomes
         again = solved(fresh, rhs)
         fresh.destroy()
         assert all(np.array_equal(x, y) for x, y in zip(solution, again))
-    finally:
-        solver.destroy()
-        matrix.destroy()
-        mesh.destroy()
 
 
 def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope():
@@ -203,7 +200,7 @@ def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope()
     row = start + 3            # a midpoint row, interior on every rank
     solver = substructuring.ChainSolver(matrix)
     interior = solver.interior
-    try:
+    with destroyed_after(solver, matrix, mesh):
         set_symmetric(matrix, row, row + 2, 0.01)
         matrix.assemble()
         assert solver.refactor(matrix)
@@ -211,10 +208,6 @@ def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope()
         rhs = right_hand_sides(mesh, 2)
         solution = solved(solver, rhs)
         assert_solves(comm, matrix, rhs, solution)
-    finally:
-        solver.destroy()
-        matrix.destroy()
-        mesh.destroy()
 
 
 def test_a_matrix_that_is_no_chain_is_refused():
