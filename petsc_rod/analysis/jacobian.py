@@ -30,7 +30,7 @@ converge quadratically.
 
 from petsc4py import PETSc
 
-from petsc_rod.global_step.ksp import lu_solver, set_up_mumps
+from petsc_rod.global_step.ksp import lu_solver, set_up_mumps, solve_vecs
 
 
 class NewtonJacobian:
@@ -79,11 +79,10 @@ class NewtonJacobian:
             self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
                                      values, addv=PETSc.InsertMode.ADD_VALUES)
 
-    def solve(self, rhs):
-        """J^-1 rhs, a new Vec."""
-        solution = rhs.duplicate()
-        self.ksp.solve(rhs, solution)
-        return solution
+    def solve_many(self, columns):
+        """[J^-1 c for the Vecs c of ``columns``], new Vecs, in one MUMPS solve
+        (global_step/ksp.solve_vecs)."""
+        return solve_vecs(self.ksp, columns)
 
     def destroy(self):
         for obj in (self.ksp, self.matrix):

@@ -55,7 +55,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.positions import HALF, HEIGHT, SIMPSON, slope_rows
-from petsc_rod.global_step.ksp import inertia_solver, set_up_mumps
+from petsc_rod.global_step.ksp import inertia_solver, set_up_mumps, solve_columns, solve_vecs
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
 from petsc_rod.scenes.boundary import is_held
@@ -455,10 +455,11 @@ class SecondVariation:
         factored matrix leaves out the resultants' identity rows (``_kept``): they are
         decoupled from the rest with eigenvalue 1 (nothing to count), and they made
         MUMPS's analysis on several ranks slow (docs/performance.md)."""
-        self._kept = self._kept_mass = None
+        self._kept = self._kept_mass = self._kept_rows = None
         if self.resultants:
             start, end = self.matrix.getOwnershipRange()
             kept = np.setdiff1d(np.arange(start, end), self.resultant_rows)
+            self._kept_rows = kept - start          # local rows of the factored matrix
             self._kept = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=self.comm)
             self.shifted = self.matrix.createSubMatrix(self._kept, self._kept)
             view = self.mass.getSubVector(self._kept)
@@ -488,24 +489,25 @@ class SecondVariation:
 
     def solve(self, rhs):
         """(H - shift M)^-1 rhs, a new Vec, with the last ``factorise`` (of this H)."""
-        if not self._factored:
-            raise RuntimeError("SecondVariation.solve needs factorise after the last update")
-        solution = rhs.duplicate()
-        self._solve_into(rhs, solution)
-        return solution
+        return self.solve_many([rhs])[0]
+
+    def solve_many(self, columns):
+        """[(H - shift M)^-1 c for the Vecs c of ``columns``], new Vecs, with the last
+        ``factorise`` (of this H), in one MUMPS solve (global_step/ksp.solve_columns); on
+        the resultants' identity rows (left out of the factor, _create_solver) the
+        solution is c."""
+        self._check_factored()
+        return solve_vecs(self.ksp, columns, self._kept_rows)
 
     def _solve_into(self, rhs, solution):
-        """solution = (H - shift M)^-1 rhs with the last factorisation; on the resultants'
-        identity rows (left out of the factor, _create_solver) solution = rhs."""
-        if self._kept is None:
-            self.ksp.solve(rhs, solution)
-            return
-        rhs.copy(solution)
-        kept_rhs = rhs.getSubVector(self._kept)
-        kept_solution = solution.getSubVector(self._kept)
-        self.ksp.solve(kept_rhs, kept_solution)
-        solution.restoreSubVector(self._kept, kept_solution)
-        rhs.restoreSubVector(self._kept, kept_rhs)
+        """solution = (H - shift M)^-1 rhs with the last factorisation (as solve_many)."""
+        self._check_factored()
+        solution.getArray()[:] = solve_columns(self.ksp, [rhs.getArray(readonly=True)],
+                                               self._kept_rows)[0]
+
+    def _check_factored(self):
+        if not self._factored:
+            raise RuntimeError("SecondVariation needs factorise after the last update to solve")
 
     def negative_directions(self, shift):
         """Eigenvalues of H below ``shift`` (times the mass M) on the constraint set."""
@@ -513,7 +515,7 @@ class SecondVariation:
         negative = self.negative_pivots()
         if not self.constraint:
             return int(negative)
-        self._constraint_solves = [self.solve(column) for column in self.constraint]
+        self._constraint_solves = self.solve_many(self.constraint)
         schur = np.array([[c.dot(y) for y in self._constraint_solves] for c in self.constraint])
         return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
 

@@ -10,6 +10,7 @@ several (PARALLEL_DEFAULTS); ``-<prefix>ksp_type``, ``-<prefix>pc_type`` and the
 override them as for any PETSc KSP.
 """
 
+import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.errors import RodDivergedError
@@ -105,6 +106,59 @@ def set_up_mumps(ksp):
     defaults = mumps_defaults(ksp.getPC().getType())
     with defaults_in_effect({f"{prefix}{key}": value for key, value in defaults.items()}):
         ksp.setUp()
+
+
+def solve_columns(ksp, columns, rows=None):
+    """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
+    the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve:
+    MUMPS's solve phase on these chains costs several times its flops per right-hand
+    side, and k of them at once cost about what one does (docs/performance.md).
+    ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
+    rows out), the local indices of its rows in them; the other rows of x_j are b_j.
+    Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed
+    KSP solve does (the Newton steps stop at a step that is not finite)."""
+    columns = [np.asarray(column) for column in columns]
+    solutions = [column.copy() for column in columns]
+    if not columns:
+        return solutions
+    factor = ksp.getPC().getFactorMatrix()
+    operator = ksp.getOperators()[0]
+    local, total = operator.getSizes()[0]
+    right = PETSc.Mat().createDense(((local, total), (PETSc.DECIDE, len(columns))),
+                                    comm=operator.getComm())
+    right.setUp()
+    block = right.getDenseArray()
+    for j, column in enumerate(columns):
+        block[:, j] = column if rows is None else column[rows]
+    right.assemble()
+    unknown = right.duplicate()
+    try:
+        if factor.getMumpsInfog(1) < 0:
+            unknown.getDenseArray()[:] = np.inf
+        else:
+            factor.matSolve(right, unknown)
+        values = unknown.getDenseArray(readonly=True)
+        for j, solution in enumerate(solutions):
+            if rows is None:
+                solution[:] = values[:, j]
+            else:
+                solution[rows] = values[:, j]
+    finally:
+        right.destroy()
+        unknown.destroy()
+    return solutions
+
+
+def solve_vecs(ksp, vecs, rows=None):
+    """solve_columns for the Vecs ``vecs``: new Vecs x_j = A^-1 b_j (the caller's to
+    destroy). Collective."""
+    arrays = solve_columns(ksp, [vec.getArray(readonly=True) for vec in vecs], rows)
+    solutions = []
+    for vec, array in zip(vecs, arrays):
+        solution = vec.duplicate()
+        solution.getArray()[:] = array
+        solutions.append(solution)
+    return solutions
 
 
 def _mumps(comm, operator, factorisation, prefix=None):

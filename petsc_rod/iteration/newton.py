@@ -59,7 +59,14 @@ EVENT = PETSc.Log.Event("rod_newton")
 MAX_STEPS = 8
 STEP_TOLERANCE = 1e-10
 # A step must shrink to at most this fraction of the previous one, or the polish stops
-# (Newton contracts quadratically near a regular minimiser).
+# (Newton contracts quadratically near a regular minimiser). On a line whose energy
+# reads its positions (the seabed) a step that does not shrink but turns no more than
+# the one before it is taken where that one lowered |grad L| to at most this fraction,
+# above FLOOR_TURN: the contact's active set moves with the steps (a semi-smooth
+# Newton), and while it settles a step may turn about as much as the one before it
+# (measured on options/riser_catenary.opts without its current: turns 3.7e-4, then
+# 2.5e-4 with |grad L| 2.5e5 -> 3.8e4, then 5.0e-5, 9.5e-11). The residual's fall at
+# every such step, and MAX_STEPS, keep an attempt from cycling.
 SHRINK = 0.5
 # Steps stop shrinking at the round-off floor of the Newton system, about cond(H) eps
 # (cond(H) grows like the square of the element count; docs/performance.md has it at
@@ -67,6 +74,19 @@ SHRINK = 0.5
 # stopped shrinking has reached that floor: its state is handed over, and the iteration,
 # whose tests decide convergence, goes on from there.
 FLOOR_TURN = 1e-7
+# Near the solution a step of a problem whose steps solve with the Jacobian (a follower
+# load, the friction: ``unsymmetric``) reuses the last step's matrices and factors (a
+# chord step): where the previous step turned by at most FREEZE_TURN rad, J has changed
+# by about that much since it was factored, and a step with it contracts the error by a
+# factor of about as much, without H's and J's assembly, the LU and the inertia's LDL^T
+# (docs/performance.md). A chord step that does not shrink to FROZEN_SHRINK of the
+# previous one is taken again with fresh factors (above FLOOR_TURN; at the floor the
+# state is handed over, as after any step that does not shrink). Such a problem has no
+# energy: the inertia test is its steps' safeguard, not a stability verdict, and it was
+# passed at most about FREEZE_TURN rad from the result. A conservative problem's steps
+# stay exact.
+FREEZE_TURN = 1e-5
+FROZEN_SHRINK = 0.1
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
@@ -101,7 +121,8 @@ class NewtonPolish:
         self._held_stretch = (~self._free | ~np.isfinite(problem.axial)) if self.stretch \
             else None
         # whether the last step's H was tested on the constraint set (decidable) and found
-        # positive definite: the stability test's verdict, at 1e-10 rad from the result
+        # positive definite, with the state's own curvature: the stability test's verdict,
+        # at 1e-10 rad from the result (a chord step, FREEZE_TURN, tests nothing)
         self.verified = False
 
     def run(self, record=None):
@@ -121,6 +142,7 @@ class NewtonPolish:
         mu = None
         previous = np.inf
         residual = np.inf                 # |grad L| of the last step's start (followers)
+        start_norm = np.inf               # |grad L| of the last step's start (all)
         outcome = FAILED
         regularised = False
         try:
@@ -132,7 +154,19 @@ class NewtonPolish:
                 # the first step's curvature from the iteration's multipliers where the
                 # heights enter (see _newton_step)
                 curvature = saved["lam"] if first and self.reads_positions else None
-                omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
+                frozen = self.unsymmetric and previous <= FREEZE_TURN
+                omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, frozen)
+                if (frozen and previous > FLOOR_TURN
+                        and not self._largest(omega) <= FROZEN_SHRINK * previous):
+                    # a chord step that did not contract: fresh factors (at the round-off
+                    # floor the shrink test below hands the state over instead)
+                    omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
+                if omega is None and curvature is None and self.reads_positions:
+                    # H indefinite after a step on a line whose heights enter: the step
+                    # again with the iteration's curvature, as the first (_newton_step),
+                    # and like the first exempt from the residual's fall below
+                    curvature = saved["lam"]
+                    omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None:
                     outcome = INDEFINITE
                     break
@@ -151,9 +185,16 @@ class NewtonPolish:
                             return CONVERGED
                         break
                     residual = np.inf if curvature is not None else norm
-                largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
-                if (self.stretch and not regularised and np.isfinite(previous)
-                        and not largest <= SHRINK * previous):
+                largest = self._largest(omega)
+                # a step that turns no more than the last one, taken on a line whose
+                # heights enter where the last step halved |grad L| (SHRINK), above the
+                # round-off floor (at the first step start_norm is inf and previous too)
+                settling = (self.reads_positions and previous > FLOOR_TURN
+                            and largest <= previous
+                            and self._residual_norm <= SHRINK * start_norm)
+                start_norm = self._residual_norm
+                if (self.stretch and not regularised and not settling
+                        and np.isfinite(previous) and not largest <= SHRINK * previous):
                     # a zero mode whose pivot round-off left positive (the roll of
                     # K1 = K2 between pins): the step again with H + tolerance M, and so
                     # on to the end of the attempt (_positive_definite)
@@ -162,8 +203,8 @@ class NewtonPolish:
                     if omega is None:
                         outcome = INDEFINITE
                         break
-                    largest = problem.mesh.global_max(float(np.abs(omega).max(initial=0.0)))
-                if not np.isfinite(largest) or largest > SHRINK * previous:
+                    largest = self._largest(omega)
+                if not np.isfinite(largest) or (largest > SHRINK * previous and not settling):
                     if np.isfinite(largest) and previous <= FLOOR_TURN:
                         self._hand_over(frames, mu)
                         return CONVERGED
@@ -235,7 +276,12 @@ class NewtonPolish:
         total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
         return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
 
-    def _newton_step(self, frames, g, mu, regularised=False, curvature=None):
+    def _largest(self, step):
+        """The largest |component| of ``step`` (n_nodes, 3 or 4) over the ranks, rad (not
+        finite where a component is not). Collective."""
+        return self.problem.mesh.global_max(float(np.abs(step).max(initial=0.0)))
+
+    def _newton_step(self, frames, g, mu, regularised=False, curvature=None, frozen=False):
         """(omega (n_nodes, 3), dmu (3,)) of the KKT system, or (None, None) where H is
         not positive definite on the constraint set. ``curvature``: multipliers (n_nodes,
         3, 3) for H's curvature term in place of -g / w (the gradient stays the exact
@@ -245,36 +291,45 @@ class NewtonPolish:
         and -g / w there holds the seabed's answer to those (k times them, hundreds of
         times the weight on a cable), which makes H indefinite; the iteration's
         multipliers hold the forces of the state it is near. That step fixes the heights,
-        and the next ones are exact Newton steps."""
+        and the next ones are exact Newton steps, but where H is indefinite after a step
+        that left errors in height (measured on options/riser_catenary.opts without its
+        current, 900 elements: a first turn of 0.016 rad), which ``run`` takes again with
+        the iteration's curvature. ``frozen``: a chord step, with the matrices and
+        factors of the last step (FREEZE_TURN)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         if curvature is not None:
             self.problem.state.lam[:] = curvature
-        hessian = self.problem.second_variation()
-        if self._free_roll:
+        frozen = frozen and self._jacobian is not None
+        hessian = self._jacobian.hessian if frozen else self.problem.second_variation()
+        if self._free_roll and not frozen:
             hessian.constrain_roll(frames[:, 2])
         vecs = []                   # every Vec made here, destroyed on the way out
         try:
-            if not self._positive_definite(hessian, regularised):
-                return None, None
-            self.verified = hessian.decidable
+            if not frozen:
+                if not self._positive_definite(hessian, regularised):
+                    return None, None
+                # a verdict on the state's own H, not on one with another curvature
+                self.verified = hessian.decidable and curvature is None
             # the Jacobian with the followers' linearisation, else H's factor
-            solver = self._jacobian_of(hessian) if self.unsymmetric else hessian
+            solver = (self._jacobian if frozen else self._jacobian_of(hessian)) \
+                if self.unsymmetric else hessian
             rhs = hessian.to_vec(-gradient)
             vecs.append(rhs)
-            direction = solver.solve(rhs)
-            vecs.append(direction)
+            columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
+            vecs.extend(columns)
+            if columns and hessian.decidable and not self.unsymmetric:
+                # the inertia test solved for a basis of the same forms
+                solved = [solver.solve(rhs)] + hessian.solve_in_constraint_span(columns)
+            else:
+                # the step's right-hand side and the forms in one solve
+                solved = solver.solve_many([rhs] + columns)
+            vecs.extend(solved)
+            direction, solved = solved[0], solved[1:]
             dmu = np.zeros(3)
-            if self._bordered():
+            if columns:
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
                 # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
-                columns = hessian.chord_forms(frames[:, 2])
-                vecs.extend(columns)
-                # the inertia test solved for a basis of the same forms (decidable)
-                solved = (hessian.solve_in_constraint_span(columns)
-                          if hessian.decidable and not self.unsymmetric
-                          else [solver.solve(column) for column in columns])
-                vecs.extend(solved)
                 schur = np.array([[c.dot(s) for s in solved] for c in columns])
                 right = self._chord_residual(frames) + np.array([c.dot(direction)
                                                                  for c in columns])

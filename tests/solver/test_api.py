@@ -124,5 +124,5 @@ def test_the_seabed_friction_of_the_environment_reaches_the_options_and_the_line
     assert grounded > 1.0
     assert (results.scalars["friction_stick_length"] + results.scalars["friction_slide_length"]
             == pytest.approx(grounded, abs=2 * 2.0))
-    assert results.scalars["friction_max_use"] <= 1.0 + 1e-6
+    assert results.scalars["friction_max_use"] <= 1.0 + 1e-12
     assert results.units["friction_force"] == "N/m"

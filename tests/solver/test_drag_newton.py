@@ -15,7 +15,9 @@ H plus the drag's linearisation through the resultants' chain, factored by LU.
     test_seabed_newton's);
 (b) Newton steps on the catenary reach the iteration's state in fewer iterations;
 (c) the LDL^T of H leaves the resultants' identity rows out (SecondVariation's kept
-    rows): its inertia and its solves are those of the whole H, factored apart.
+    rows): its inertia and its solves are those of the whole H, factored apart;
+(d) near the solution the steps reuse the last factorisation (chord steps,
+    newton.FREEZE_TURN), and reach the state of exact steps.
 """
 
 import numpy as np
@@ -175,3 +177,37 @@ def test_the_ldlt_without_the_resultants_rows_is_that_of_the_whole_h(comm, solve
     finally:
         for obj in (ksp, whole, rhs, expected):
             obj.destroy()
+
+
+# --- (d) chord steps near the solution ------------------------------------------------------
+def test_chord_steps_reuse_the_factors_and_reach_the_same_state(comm, solver_factory,
+                                                                monkeypatch):
+    """The catenary of (c) (K1 != K2) at 40 elements with Newton steps: where the previous
+    step turned by at most FREEZE_TURN the step reuses the last J's LU (a chord step),
+    so J is factored fewer times than steps are taken, where exact steps (FREEZE_TURN =
+    0) factor it at every step; both reach the same state, to the tolerance (measured:
+    turns 0.39, 0.15, 1.8e-3, 9.8e-6, then a chord step of 2.1e-12 rad)."""
+    from petsc_rod.analysis.jacobian import NewtonJacobian
+    from petsc_rod.iteration import newton as newton_module
+    factored = []
+    assemble = NewtonJacobian.assemble
+
+    def counted(self):
+        factored.append(1)
+        assemble(self)
+
+    monkeypatch.setattr(NewtonJacobian, "assemble", counted)
+    runs = {}
+    for freeze in (newton_module.FREEZE_TURN, 0.0):
+        monkeypatch.setattr(newton_module, "FREEZE_TURN", freeze)
+        factored.clear()
+        _, solver, report = converged(solver_factory, comm,
+                                      dict(LINES["catenary"], stiffness=(1e-1, 2e-1, 1e-1)),
+                                      newton=True, n_elements=40)
+        assert report.converged and report.newton_steps > 0
+        runs[freeze] = (report.newton_steps, len(factored),
+                        solver.problem.state.r.owned().copy())
+    (steps, factorisations, r), (exact_steps, exact_factorisations, exact_r) = runs.values()
+    assert factorisations < steps
+    assert exact_factorisations == exact_steps
+    assert np.abs(r - exact_r).max() < 1e-9

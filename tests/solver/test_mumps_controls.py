@@ -4,7 +4,7 @@ MUMPS's own ordering unless given (ICNTL 7 = 7, automatic), and the Newton Jacob
 (lu_solver) under -rod_newton_, with the approximate minimum fill ordering (ICNTL 7 = 2)
 unless given (set_up_mumps; docs/performance.md). A default is in effect only during
 the set-up: it is not left in the options database (it would be reported as an option
-nobody used)."""
+nobody used). solve_columns solves several right-hand sides in one MatMatSolve."""
 
 from contextlib import contextmanager
 
@@ -13,7 +13,7 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.global_step.ksp import (INERTIA_PREFIX, NEWTON_PREFIX, inertia_solver,
-                                       lu_solver, set_up_mumps)
+                                       lu_solver, set_up_mumps, solve_columns)
 
 SIZE = 40
 MUMPS_AUTOMATIC = 7          # ICNTL(7)'s value for "MUMPS chooses the ordering"
@@ -85,3 +85,46 @@ def test_the_newton_lu_takes_amf_unless_given(given):
     finally:
         ksp.destroy()
         matrix.destroy()
+
+
+@pytest.mark.parametrize("kind", ["lu", "ldlt"])
+def test_several_right_hand_sides_at_once_are_the_solves_one_by_one(kind):
+    """solve_columns: k right-hand sides in one MatMatSolve give KSP's solves of each,
+    for the LU of an unsymmetric matrix and the LDL^T of an indefinite one; with
+    ``rows`` (a submatrix of the rows kept) the rows left out return the right-hand
+    side (SecondVariation's resultants' identity rows)."""
+    comm = PETSc.COMM_WORLD
+    matrix = indefinite_matrix(comm)
+    start, end = matrix.getOwnershipRange()
+    if kind == "lu":                    # unsymmetric: a superdiagonal of its own
+        for i in range(start, min(end, SIZE - 1)):
+            matrix.setValue(i, i + 1, 0.3)
+        matrix.assemble()
+        ksp = lu_solver(comm, matrix)
+    else:
+        ksp = inertia_solver(comm, matrix)[0]
+    kept = np.arange(start, end)[np.arange(start, end) % 3 != 1]   # every third left out
+    index = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=comm)
+    sub = matrix.createSubMatrix(index, index)
+    sub_ksp = lu_solver(comm, sub) if kind == "lu" else inertia_solver(comm, sub)[0]
+    b, x = matrix.createVecs()
+    sub_b, sub_x = sub.createVecs()
+    try:
+        for solver in (ksp, sub_ksp):
+            set_up_mumps(solver)
+        columns = [np.sin((j + 1) * np.arange(start, end)) for j in range(3)]
+        for j, solution in enumerate(solve_columns(ksp, columns)):
+            b.getArray()[:] = columns[j]
+            ksp.solve(b, x)
+            assert np.abs(solution - x.getArray()).max() <= 1e-13 * np.abs(x.getArray()).max()
+        rows = kept - start
+        for j, solution in enumerate(solve_columns(sub_ksp, columns, rows)):
+            sub_b.getArray()[:] = columns[j][rows]
+            sub_ksp.solve(sub_b, sub_x)
+            assert np.abs(solution[rows] - sub_x.getArray()).max() <= 1e-13 * np.abs(
+                sub_x.getArray()).max()
+            left_out = np.setdiff1d(np.arange(end - start), rows)
+            assert np.array_equal(solution[left_out], columns[j][left_out])
+    finally:
+        for obj in (ksp, sub_ksp, sub, index, matrix, b, x, sub_b, sub_x):
+            obj.destroy()

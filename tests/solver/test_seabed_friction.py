@@ -81,7 +81,7 @@ def test_pulled_line_tension_falls_by_mu_w(pulled_runs):
     error, slide, attributes = pulled_runs[1e7]
     assert error < 1.5e-3
     assert abs(slide - 100.0) < 0.3
-    assert attributes["friction_max_use"] <= 1.0 + 1e-8
+    assert attributes["friction_max_use"] <= 1.0 + 1e-12   # the return map's
     assert abs(attributes["friction_max_force"] - MU * WEIGHT) < 1e-6 * MU * WEIGHT
 
 
