@@ -248,10 +248,10 @@ def test_the_newton_attempt_converges_while_the_touchdown_settles(comm, solver_f
     """The steel riser's one Newton attempt converges and the step ends in about 20
     iterations (measured: 22, 6 of them Newton steps), where before it failed at its
     second step and the iteration took 84: after a first turn of 0.016 rad H is
-    indefinite (the step is taken again with the iteration's curvature), and two steps
-    turn by 3.7e-4 and 2.5e-4 rad while |grad L| falls sevenfold (the touchdown's active
-    set settling: a step that does not shrink is taken). The state is the iteration's
-    without Newton steps, to its tolerance."""
+    indefinite (the step is taken again with the iteration's curvature), and the steps
+    turn by 5.4e-4, then 5.0e-4 rad (the touchdown's active set settling: a step that
+    does not shrink is taken where |grad L| halved), then 1.3e-4, 6.2e-10 and 1.6e-14.
+    The state is the iteration's without Newton steps, to its tolerance."""
     from petsc_rod.iteration.events import NewtonAttempt
     from petsc_rod.iteration.newton import SHRINK
     curvatures = []                 # whether each step took the iteration's curvature
