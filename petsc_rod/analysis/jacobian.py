@@ -70,7 +70,9 @@ class NewtonJacobian:
             self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
         else:
             self.ksp.setOperators(self.matrix)
-        set_up_mumps(self.ksp)
+        # the rows come node by node, hessian.block each: the LU's analysis on the nodes'
+        # graph (ksp.mumps_defaults)
+        set_up_mumps(self.ksp, hessian.block)
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and

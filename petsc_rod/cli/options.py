@@ -322,9 +322,10 @@ OPTIONS = [
     Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
            f"{NEWTON_SWITCH:g} ({NEWTON_SWITCH_FAR:g} with a seabed or a current) and more "
-           f"than {NEWTON_WORTH} iterations would remain at the "
-           "recent rate, try Newton steps on the reduced problem (frames turned by the KKT "
-           "system of the energy's second variation), taken only where it is positive "
+           f"than {NEWTON_WORTH} iterations would remain at the recent rate (with a "
+           "seabed or a current at any rate), try Newton steps on the reduced problem "
+           "(frames turned by the KKT system of the energy's second variation), taken "
+           "only where it is positive "
            f"definite; where it is not and change and residual are below {EARLY_ESCAPE:g}, "
            "the state is near a saddle and is left at once (not with a seabed); after a "
            "failed attempt the wait doubles; with a seabed the node heights are unknowns "
@@ -449,7 +450,9 @@ def help_text():
                  "python) on several.")
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
                  "their unsymmetric Jacobian (default preonly + MUMPS LU, "
-                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering).")
+                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering, "
+                 "-rod_newton_mat_mumps_icntl_15 -B: on the graph of the nodes, B "
+                 "unknowns a node).")
     lines.append("  The stability test and the Newton steps' positive-definiteness test: "
                  "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
                  "ordering unless given).")

@@ -56,22 +56,30 @@ INERTIA_PREFIX = "rod_inertia_"
 NEWTON_PREFIX = "rod_newton_"
 
 
-def mumps_defaults(kind):
+def mumps_defaults(kind, block=None):
     """The MUMPS controls in effect at a set-up (set_up_mumps) unless the options give
-    them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU)
-    (docs/performance.md): for the LU the AMF ordering (ICNTL 7 = 2), an analysis many
-    times faster than MUMPS's own choice, PORD, on these chains. The LDL^T keeps
-    MUMPS's choice (AMF on one rank, PORD on several).
+    them, for a factorisation ``kind`` (PETSc.PC.Type.CHOLESKY or LU) of a matrix whose
+    unknowns come in ``block``s of a node (docs/performance.md): for the LU the AMF
+    ordering (ICNTL 7 = 2), an analysis many times faster than MUMPS's own choice,
+    PORD, on these chains, on the graph of the nodes (ICNTL 15 = -block) where the
+    block is given. The LDL^T keeps MUMPS's choice (AMF on one rank, PORD on several)
+    on the unknowns' graph.
 
-    Not defaults, measured: on several ranks the analysis on the graph of the nodes
-    (ICNTL 15 = -B, B unknowns a node) with PORD is many times faster than AMF on the
-    unknowns', whose elimination tree is a path MUMPS maps onto the ranks in a time
-    that grows like the square of its length; but the Newton steps then take other
-    round-off than on one rank, and a riser's iteration count with a free roll doubled
-    on 2 ranks. The LDL^T's solves on the nodes' graph gave NaN on a riser with seabed
-    friction.
+    The nodes' graph: AMF on the unknowns' graph makes the elimination tree a path of
+    one node per unknown, and MUMPS's mapping of a path onto several ranks grows like
+    the square of its length (1.5 s for the 18 000-element riser's LU on 2 ranks, 69 s
+    at 60 000 elements); a node per P2 node shortens it sevenfold on the riser (0.3 s
+    on 2 ranks), and on one rank the factorisation and the solves are a quarter faster
+    as well. Not defaults, measured: PORD on the nodes' graph for the LU on several
+    ranks (a faster analysis still, larger factors); the LDL^T on the nodes' graph
+    gave NaN solves on a riser with seabed friction.
     """
-    return {"mat_mumps_icntl_7": "2"} if kind == PETSc.PC.Type.LU else {}
+    if kind != PETSc.PC.Type.LU:
+        return {}
+    defaults = {"mat_mumps_icntl_7": "2"}
+    if block is not None and block > 1:
+        defaults["mat_mumps_icntl_15"] = str(-int(block))
+    return defaults
 
 
 def inertia_solver(comm, operator, prefix=INERTIA_PREFIX):
@@ -98,12 +106,14 @@ def lu_solver(comm, operator, prefix=NEWTON_PREFIX):
     return ksp
 
 
-def set_up_mumps(ksp):
+def set_up_mumps(ksp, block=None):
     """``ksp.setUp()`` for an inertia_solver or lu_solver, with mumps_defaults in effect
     under its prefix (MUMPS reads its controls at the symbolic factorisation;
-    MatMumpsSetIcntl(7) before it did not take, PETSc 3.18, measured)."""
+    MatMumpsSetIcntl(7) before it did not take, PETSc 3.18, measured). ``block``: the
+    unknowns of a node, where the matrix's rows come node by node (the LU then analyses
+    the nodes' graph)."""
     prefix = ksp.getOptionsPrefix() or ""
-    defaults = mumps_defaults(ksp.getPC().getType())
+    defaults = mumps_defaults(ksp.getPC().getType(), block)
     with defaults_in_effect({f"{prefix}{key}": value for key, value in defaults.items()}):
         ksp.setUp()
 

@@ -85,7 +85,7 @@ FLOOR_TURN = 1e-7
 # energy: the inertia test is its steps' safeguard, not a stability verdict, and it was
 # passed at most about FREEZE_TURN rad from the result. A conservative problem's steps
 # stay exact.
-FREEZE_TURN = 1e-5
+FREEZE_TURN = 1e-4
 FROZEN_SHRINK = 0.1
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"

@@ -2,7 +2,8 @@
 prefixes: the LDL^T of the second variation (inertia_solver) under -rod_inertia_, with
 MUMPS's own ordering unless given (ICNTL 7 = 7, automatic), and the Newton Jacobian's LU
 (lu_solver) under -rod_newton_, with the approximate minimum fill ordering (ICNTL 7 = 2)
-unless given (set_up_mumps; docs/performance.md). A default is in effect only during
+unless given, on the graph of the nodes (ICNTL 15 = -B) where the caller gives the B
+unknowns of a node (set_up_mumps; docs/performance.md). A default is in effect only during
 the set-up: it is not left in the options database (it would be reported as an option
 nobody used). solve_columns solves several right-hand sides in one MatMatSolve."""
 
@@ -61,32 +62,6 @@ def test_the_ldlt_reads_its_prefix_and_counts_the_negative_eigenvalues(given):
         matrix.destroy()
 
 
-@pytest.mark.parametrize("given", [None, "0"])
-def test_the_newton_lu_takes_amf_unless_given(given):
-    comm = PETSc.COMM_WORLD
-    name = f"{NEWTON_PREFIX}mat_mumps_icntl_7"
-    matrix = indefinite_matrix(comm)
-    ksp = lu_solver(comm, matrix)
-    try:
-        with option_given(name, given) as options:
-            set_up_mumps(ksp)
-            assert options.hasName(name) == (given is not None)
-        assert ksp.getPC().getFactorMatrix().getMumpsIcntl(7) == (
-            2 if given is None else int(given))
-        b, x = matrix.createVecs()
-        b.set(1.0)
-        ksp.solve(b, x)
-        residual = b.duplicate()
-        matrix.mult(x, residual)
-        residual.axpy(-1.0, b)
-        assert residual.norm() <= 1e-13 * np.sqrt(SIZE)
-        for vec in (b, x, residual):
-            vec.destroy()
-    finally:
-        ksp.destroy()
-        matrix.destroy()
-
-
 @pytest.mark.parametrize("kind", ["lu", "ldlt"])
 def test_several_right_hand_sides_at_once_are_the_solves_one_by_one(kind):
     """solve_columns: k right-hand sides in one MatMatSolve give KSP's solves of each,
@@ -128,3 +103,33 @@ def test_several_right_hand_sides_at_once_are_the_solves_one_by_one(kind):
     finally:
         for obj in (ksp, sub_ksp, sub, index, matrix, b, x, sub_b, sub_x):
             obj.destroy()
+
+
+@pytest.mark.parametrize("control, block, given, expected", [
+    (7, None, None, 2), (7, None, "0", 0),                  # AMF unless given
+    (15, None, None, 0), (15, 2, None, -2), (15, 2, "-4", -4)])
+def test_the_newton_lu_s_ordering_controls(control, block, given, expected):
+    """ICNTL 7 = 2 (AMF) unless given; ICNTL 15 = -B with a block of B unknowns a node
+    (NewtonJacobian passes the second variation's), 0 (the unknowns' graph) without
+    one, the option where given; a given option stays the user's, a default does not
+    stay in the database; the solve is exact either way."""
+    comm = PETSc.COMM_WORLD
+    name = f"{NEWTON_PREFIX}mat_mumps_icntl_{control}"
+    matrix = indefinite_matrix(comm)
+    ksp = lu_solver(comm, matrix)
+    try:
+        with option_given(name, given) as options:
+            set_up_mumps(ksp, block)
+            assert options.hasName(name) == (given is not None)
+        assert ksp.getPC().getFactorMatrix().getMumpsIcntl(control) == expected
+        column = np.cos(np.arange(*matrix.getOwnershipRange()))
+        solution = solve_columns(ksp, [column])[0]
+        b, x = matrix.createVecs()
+        x.getArray()[:] = solution
+        matrix.mult(x, b)
+        assert np.abs(b.getArray() - column).max() <= 1e-13 * np.sqrt(SIZE)
+        for vec in (b, x):
+            vec.destroy()
+    finally:
+        ksp.destroy()
+        matrix.destroy()
