@@ -22,27 +22,27 @@ in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
 The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
 delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
 (analysis/stability.py, with the resultants' slots as identity rows) plus these
-entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.lu_solver, options
--rod_newton_*). H's curvature term is the load's at its current value, symmetrised: the
-antisymmetric rest is the torque balance, zero at a solution, so the steps still
-converge quadratically.
+entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.direct_factor: on
+several ranks by substructuring, each rank its interior; options -rod_newton_*). H's
+curvature term is the load's at its current value, symmetrised: the antisymmetric rest
+is the torque balance, zero at a solution, so the steps still converge quadratically.
 """
 
 from petsc4py import PETSc
 
-from petsc_rod.global_step.ksp import lu_solver, set_up_mumps, solve_vecs
+from petsc_rod.global_step.ksp import NEWTON_PREFIX, direct_factor, solve_vecs
 
 
 class NewtonJacobian:
     """J on the layout of a SecondVariation ``hessian`` (its chains' and resultants'
     slots), made from H and the unsymmetric terms' add_jacobian at each ``assemble``;
-    owns its matrix and LU solver, ``destroy()``."""
+    owns its matrix and LU factorisation (ksp.direct_factor), ``destroy()``."""
 
     def __init__(self, hessian):
         self.hessian = hessian
         self.problem = hessian.problem
         self.matrix = None
-        self.ksp = None
+        self.factor = None
 
     def assemble(self):
         """J at the state H was last assembled at, factored. Collective."""
@@ -66,13 +66,13 @@ class NewtonJacobian:
         # the held unknowns keep their identity rows (what the followers added there
         # is dropped); their columns meet a zero step
         self.matrix.zeroRows(hessian.held_rows, diag=1.0)
-        if self.ksp is None:
-            self.ksp = lu_solver(self.problem.mesh.comm, self.matrix)
-        else:
-            self.ksp.setOperators(self.matrix)
-        # the rows come node by node, hessian.block each: the LU's analysis on the nodes'
-        # graph (ksp.mumps_defaults)
-        set_up_mumps(self.ksp, hessian.block)
+        if self.factor is None:
+            # the rows come node by node, hessian.block each: the LU's analysis on the
+            # nodes' graph (ksp.mumps_defaults), the ranks' first nodes the interface of
+            # the substructuring (chain_factor.py)
+            self.factor = direct_factor(self.matrix, PETSc.PC.Type.LU, hessian.block,
+                                        NEWTON_PREFIX)
+        self.factor.set_up(self.matrix)
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
@@ -82,11 +82,11 @@ class NewtonJacobian:
                                      values, addv=PETSc.InsertMode.ADD_VALUES)
 
     def solve_many(self, columns):
-        """[J^-1 c for the Vecs c of ``columns``], new Vecs, in one MUMPS solve
+        """[J^-1 c for the Vecs c of ``columns``], new Vecs, in one solve
         (global_step/ksp.solve_vecs)."""
-        return solve_vecs(self.ksp, columns)
+        return solve_vecs(self.factor, columns)
 
     def destroy(self):
-        for obj in (self.ksp, self.matrix):
+        for obj in (self.factor, self.matrix):
             if obj is not None:
                 obj.destroy()

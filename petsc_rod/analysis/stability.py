@@ -18,7 +18,9 @@ on the omega with omega_n = 0 at a clamp and, when both ends are held,
 sum_n w_n (omega_n x tau3_n) = 0 (the chord int r' dS stays fixed). The state is a
 local minimiser when H is positive semi-definite there, a saddle when H has a negative
 eigenvalue. Sylvester's law of inertia counts those without an eigen-solve: the
-symmetric-indefinite factorisation of H (MUMPS) gives the number of negative pivots,
+symmetric-indefinite factorisation of H (MUMPS; on several ranks by substructuring,
+global_step/chain_factor.py: the interiors' negative pivots plus the interface Schur
+complement's negative eigenvalues) gives the number of negative eigenvalues,
 and the chord constraint is taken into account by the Schur complement,
 n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - m (C: its m columns, the
 chord's 3 and, in a Newton step's test where K1 = K2, the mean roll: constrain_roll).
@@ -55,7 +57,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.positions import HALF, HEIGHT, SIMPSON, slope_rows
-from petsc_rod.global_step.ksp import inertia_solver, set_up_mumps, solve_columns, solve_vecs
+from petsc_rod.global_step.ksp import INERTIA_PREFIX, direct_factor, solve_vecs
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
 from petsc_rod.scenes.boundary import is_held
@@ -450,11 +452,12 @@ class SecondVariation:
 
     # --- inertia --------------------------------------------------------------------
     def _create_solver(self):
-        """One KSP (preonly, MUMPS LDL^T) for H - shift M at every shift: the symbolic
-        factorisation is made once, the numeric one per shift. With a follower load the
-        factored matrix leaves out the resultants' identity rows (``_kept``): they are
-        decoupled from the rest with eigenvalue 1 (nothing to count), and they made
-        MUMPS's analysis on several ranks slow (docs/performance.md)."""
+        """One LDL^T (global_step/ksp.direct_factor: MUMPS's, by substructuring on several
+        ranks) for H - shift M at every shift: the symbolic factorisation is made once,
+        the numeric one per shift. With a follower load the factored matrix leaves out
+        the resultants' identity rows (``_kept``): they are decoupled from the rest with
+        eigenvalue 1 (nothing to count), and they made MUMPS's analysis on several ranks
+        slow (docs/performance.md)."""
         self._kept = self._kept_mass = self._kept_rows = None
         if self.resultants:
             start, end = self.matrix.getOwnershipRange()
@@ -469,7 +472,10 @@ class SecondVariation:
             self.shifted = self.matrix.duplicate(copy=True)
         self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self._shift_work = self.shifted.createVecLeft()
-        self.ksp, self.factor = inertia_solver(self.comm, self.shifted)
+        # the factored rows come node by node: block less the resultants' three
+        kept_block = self.block - 3 * int(self.resultants)
+        self.solver = direct_factor(self.shifted, PETSc.PC.Type.CHOLESKY, kept_block,
+                                    INERTIA_PREFIX)
 
     def factorise(self, shift):
         """Factor H - shift M (the constraint solves of the previous factorisation are
@@ -483,8 +489,7 @@ class SecondVariation:
             self._kept_mass.copy(self._shift_work)
         self._shift_work.scale(-shift)
         self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
-        self.ksp.setOperators(self.shifted)
-        set_up_mumps(self.ksp)
+        self.solver.set_up(self.shifted)
         self._factored = True
 
     def solve(self, rhs):
@@ -493,17 +498,17 @@ class SecondVariation:
 
     def solve_many(self, columns):
         """[(H - shift M)^-1 c for the Vecs c of ``columns``], new Vecs, with the last
-        ``factorise`` (of this H), in one MUMPS solve (global_step/ksp.solve_columns); on
+        ``factorise`` (of this H), in one solve (global_step/ksp.solve_vecs); on
         the resultants' identity rows (left out of the factor, _create_solver) the
         solution is c."""
         self._check_factored()
-        return solve_vecs(self.ksp, columns, self._kept_rows)
+        return solve_vecs(self.solver, columns, self._kept_rows)
 
     def _solve_into(self, rhs, solution):
         """solution = (H - shift M)^-1 rhs with the last factorisation (as solve_many)."""
         self._check_factored()
-        solution.getArray()[:] = solve_columns(self.ksp, [rhs.getArray(readonly=True)],
-                                               self._kept_rows)[0]
+        solution.getArray()[:] = self.solver.solve_columns([rhs.getArray(readonly=True)],
+                                                           self._kept_rows)[0]
 
     def _check_factored(self):
         if not self._factored:
@@ -522,7 +527,7 @@ class SecondVariation:
     def negative_pivots(self):
         """Negative eigenvalues of the last factorisation's H - shift M, those of the
         positions' chains counted off (module docstring)."""
-        return int(self.factor.getInertia()[0]) - self.chain_constraints
+        return self.solver.negative_pivots() - self.chain_constraints
 
     def solve_in_constraint_span(self, columns):
         """(H - shift M)^-1 c, new Vecs, for the Vecs c of ``columns`` that lie in the span
@@ -620,7 +625,7 @@ class SecondVariation:
 
     def destroy(self):
         self._drop_constraint_solves()
-        for obj in [self.ksp, self.shifted, self.matrix, self.mass, self._mass_or_one,
+        for obj in [self.solver, self.shifted, self.matrix, self.mass, self._mass_or_one,
                     self._shift_work,
                     *[obj for obj in (self._kept, self._kept_mass) if obj is not None],
                     self._work, self._diagonal, *self.constraint]:

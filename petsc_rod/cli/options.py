@@ -452,10 +452,14 @@ def help_text():
                  "their unsymmetric Jacobian (default preonly + MUMPS LU, "
                  "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering, "
                  "-rod_newton_mat_mumps_icntl_15 -B: on the graph of the nodes, B "
-                 "unknowns a node).")
+                 "unknowns a node); on several ranks -rod_newton_substructuring <bool> "
+                 "(default true): each rank factors its part of the chain with "
+                 "sequential MUMPS, the ranks' first nodes the interface, whose Schur "
+                 "complement every rank solves; false: MUMPS on all ranks.")
     lines.append("  The stability test and the Newton steps' positive-definiteness test: "
                  "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
-                 "ordering unless given).")
+                 "ordering unless given); -rod_inertia_substructuring <bool> as for the "
+                 "Newton steps' LU (the inertia the interiors' and the interface's).")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres | qn | ncg (the SNES "
                  "types that need no Jacobian), and the SNES options under the same prefix "

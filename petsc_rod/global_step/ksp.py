@@ -1,7 +1,9 @@
 """The direct solvers of the project, made in one place: the chain solvers of the global
 step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
 the second variation (analysis/stability.py, options -rod_inertia_*) and the MUMPS LU
-of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*).
+of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*),
+both through direct_factor: MUMPS on one rank, by substructuring on several
+(chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
 defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
@@ -15,6 +17,7 @@ from petsc4py import PETSc
 
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.global_step import substructuring
+from petsc_rod.global_step.chain_factor import ChainFactor
 from petsc_rod.petsc_defaults import defaults_in_effect, set_from_options_with_defaults
 
 KSP_REASONS = {getattr(PETSc.KSP.ConvergedReason, name): name
@@ -159,16 +162,75 @@ def solve_columns(ksp, columns, rows=None):
     return solutions
 
 
-def solve_vecs(ksp, vecs, rows=None):
-    """solve_columns for the Vecs ``vecs``: new Vecs x_j = A^-1 b_j (the caller's to
-    destroy). Collective."""
-    arrays = solve_columns(ksp, [vec.getArray(readonly=True) for vec in vecs], rows)
+def solve_vecs(factor, vecs, rows=None):
+    """``factor.solve_columns`` (a direct_factor's) for the Vecs ``vecs``: new Vecs
+    x_j = A^-1 b_j (the caller's to destroy). Collective."""
+    arrays = factor.solve_columns([vec.getArray(readonly=True) for vec in vecs], rows)
     solutions = []
     for vec, array in zip(vecs, arrays):
         solution = vec.duplicate()
         solution.getArray()[:] = array
         solutions.append(solution)
     return solutions
+
+
+# Where the Newton steps' systems are factored by substructuring on several ranks
+# (chain_factor.py) unless -<prefix>substructuring 0: MUMPS on all ranks factors these
+# chains no faster than on one and solves them slower (docs/performance.md).
+SUBSTRUCTURING = "substructuring"
+
+
+class MumpsFactor:
+    """MUMPS's factorisation ``kind`` (PETSc.PC.Type.LU: lu_solver; CHOLESKY:
+    inertia_solver) of an operator on its ranks, under ``prefix``, with ``block``
+    unknowns a node (set_up_mumps); the interface direct_factor's factorisations share
+    (set_up, solve_columns, negative_pivots, destroy). Owns its KSP."""
+
+    def __init__(self, operator, kind, block, prefix):
+        comm = operator.getComm()
+        if kind == PETSc.PC.Type.LU:
+            self.ksp = lu_solver(comm, operator, prefix)
+        else:
+            self.ksp = inertia_solver(comm, operator, prefix)[0]
+        self.block = block
+
+    def set_up(self, operator):
+        """Factor ``operator`` (the symbolic factorisation kept while its pattern
+        stays). Collective."""
+        self.ksp.setOperators(operator)
+        set_up_mumps(self.ksp, self.block)
+
+    def solve_columns(self, columns, rows=None):
+        return solve_columns(self.ksp, columns, rows)
+
+    def negative_pivots(self):
+        """Negative eigenvalues of the last factorised (symmetric) operator (ICNTL 13)."""
+        return int(self.ksp.getPC().getFactorMatrix().getInertia()[0])
+
+    def destroy(self):
+        self.ksp.destroy()
+
+
+def direct_factor(operator, kind, block, prefix):
+    """The factorisation ``kind`` (LU or CHOLESKY) of the Newton steps' ``operator``, a
+    chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/stability.py):
+    on several ranks by substructuring (chain_factor.ChainFactor: each rank its interior
+    by sequential MUMPS, the interface's Schur complement on every rank) unless
+    -<prefix>substructuring 0 or the operator is no chain; else MumpsFactor. Collective."""
+    comm = operator.getComm()
+    chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)
+    if comm.getSize() > 1 and chosen:
+        if kind == PETSc.PC.Type.LU:
+            def make(local_comm, local):
+                return lu_solver(local_comm, local, prefix)
+        else:
+            def make(local_comm, local):
+                return inertia_solver(local_comm, local, prefix)[0]
+        try:
+            return ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns)
+        except substructuring.NotAChainError:
+            pass
+    return MumpsFactor(operator, kind, block, prefix)
 
 
 def _mumps(comm, operator, factorisation, prefix=None):

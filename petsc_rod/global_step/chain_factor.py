@@ -1,0 +1,316 @@
+"""Direct factorisations of the Newton steps' systems on several ranks, by
+substructuring (docs/performance.md, "Issue 21, third pass").
+
+The Newton Jacobian J (analysis/jacobian.py) and the second variation H
+(analysis/stability.py) are chains of nodes: B unknowns a node, the nodes of a rank in
+contiguous rows, every rank's rows starting at a vertex, a node's rows coupled only to
+the nodes of its elements. MUMPS on several ranks factors such a chain no faster than
+on one (its elimination tree is a path) and solves it slower. As the global step's
+substructuring.py does for its scalar chains, the first node of every rank but the
+first is the interface (G_p, B rows, on rank p) and the rest of a rank's rows its
+interior I_p, which couples to G_p and G_p+1 only:
+
+    A_II y = b_I                      (each rank its own interior: sequential MUMPS)
+    S x_G = b_G - A_GI y,   S = A_GG - A_GI W,   W = A_II^-1 A_IG,
+    x_I = y - W x_G.
+
+W has 2 B columns a rank (B where a rank has one neighbour) and is made at each
+factorisation, with one multiple-right-hand-side solve; S is ((P - 1) B) square, block
+tridiagonal, assembled from every rank's contribution and inverted on every rank: dense,
+equilibrated (R S C by Ruiz's iteration, every row and column's largest entry about
+1; E S E of a symmetric S: its unknowns are turns, heights and resultants, whose
+scales differ by 1e7 on the riser) and pseudo-inverted,
+its null directions (a null pivot: the free roll) dropped. Of a symmetric matrix the
+number of negative eigenvalues is the interiors' (their LDL^T's, null pivots not
+counted) plus S's (Haynsworth's inertia additivity; E S E has S's inertia, Sylvester),
+what the stability test and the Newton steps' positive-definiteness test count.
+
+A solve is a local solve, an allgather of 2 B k numbers a rank (k right-hand sides), a
+dense product with S^-1 and x_I -= W x_G: the work of the serial factorisation divided
+by the ranks, where MUMPS on two ranks factored the riser's Jacobian in the one-rank
+time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
+objects (the interior submatrix and its sequential MUMPS solver, the index set of the
+interior rows): ``destroy()``.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.global_step.substructuring import NotAChainError
+
+# The equilibrated interface's pseudo-inverse drops singular values (eigenvalues) below
+# this fraction of the largest: a null pivot, the free roll of a section with K1 = K2
+# between pins (there the smallest falls to 3e-12 of the largest as an attempt
+# converges, and is kept, as MUMPS on all ranks keeps its pivot: docs/performance.md).
+NULL_PIVOT = 1e-13
+# Ruiz sweeps of the Schur complement's equilibration: each halves the logarithm of a
+# row's or column's largest entry, so 20 bring a range of 1e16 to within 1e-5 of 1.
+RUIZ_SWEEPS = 20
+
+
+class ChainFactor:
+    """The factorisation of the module docstring of an assembled MPIAIJ ``matrix`` (its
+    pattern; the values are read at each ``set_up``) with ``block`` unknowns a node:
+    ``kind`` PETSc.PC.Type.LU or CHOLESKY (then symmetric, with its inertia). The
+    interiors' sequential MUMPS factorisations are the solvers ``make_solver(comm,
+    operator)`` gives (ksp.lu_solver or ksp.inertia_solver on COMM_SELF, options under
+    their prefix), set up with ``set_up(ksp, block)`` (ksp.set_up_mumps) and solved
+    with ``solve(ksp, columns)`` (ksp.solve_columns). Raises NotAChainError where a
+    rank's rows couple otherwise (on every rank): a rank without an interior node, a
+    middle rank whose interface reaches the next one's (a single element).
+
+    Stored: W (2 B, n_I) (its columns as rows: the own interface's B first where there
+    is one, then the next's), the own interface's rows A_G_p,I_p on the interior's first
+    head_columns columns (B, head_columns), and the next interface's rows A_G_p+1,I_p on
+    its last next_back (B, next_back)."""
+
+    def __init__(self, matrix, kind, block, make_solver, set_up, solve):
+        comm = matrix.getComm()
+        self._mpi = comm.tompi4py()
+        self.size, self.rank = comm.getSize(), comm.getRank()
+        self.kind, self.block = kind, block
+        self._make_solver, self._set_up, self._solve = make_solver, set_up, solve
+        self.symmetric = kind == PETSc.PC.Type.CHOLESKY
+        start, end = matrix.getOwnershipRange()
+        self.n = end - start
+        self.offset = block if self.rank > 0 else 0
+        self.has_next = self.rank < self.size - 1
+        self._split(matrix)
+        self._index = PETSc.IS().createStride(self.n - self.offset, first=self.offset, step=1,
+                                              comm=PETSc.COMM_SELF)
+        self.interior = None
+        self.ksp = None
+        self.failed = False
+        self.negative = None
+
+    def _split(self, matrix):
+        """The reaches of the couplings (_reach) and the local pattern's size, checked on
+        every rank; NotAChainError (on every rank) where they are no chain's."""
+        start, end = matrix.getOwnershipRange()
+        why = self._reach(matrix, start, end)
+        refused = [text for text in self._mpi.allgather(why) if text is not None]
+        if refused:
+            raise NotAChainError(refused[0])
+        # how far the next rank's interface rows reach back into this rank's rows (the
+        # columns of A_G_p+1,I_p; of an unsymmetric matrix not those of A_I_p,G_p+1)
+        backs = self._mpi.allgather(self.back)
+        self.next_back = backs[self.rank + 1] if self.has_next else 0
+        if not all(self._mpi.allgather(self.next_back <= self.n - self.offset)):
+            raise NotAChainError("an interface's rows reach beyond the previous rank's "
+                                 "interior")
+        self._nonzeros = _nonzeros(matrix)
+
+    def _reach(self, matrix, start, end):
+        """None where the local rows couple as a chain split at the ranks' first nodes,
+        else why not; sets how far the couplings reach (in rows of this rank):
+        ``head`` the interior rows coupled to the own interface's columns, ``head_columns``
+        the interior columns the own interface's rows couple to, ``tail`` the interior
+        rows coupled to the next interface's columns, ``back`` the previous rank's rows
+        (counted back from its end) whose columns the own interface's rows couple to."""
+        B, off = self.block, self.offset
+        indptr, columns, _ = matrix.getValuesCSR()
+        rows = np.repeat(np.arange(self.n), np.diff(indptr))
+        if self.n - off < B:
+            return f"rows {start} to {end - 1}: no interior node on a rank"
+        if self.n % B:
+            return f"rows {start} to {end - 1}: not whole nodes of {B} unknowns"
+        interior = rows >= off
+        own = interior & (columns >= start) & (columns < start + off)
+        following = interior & (columns >= end) & (columns < end + B)
+        inside = (columns >= start) & (columns < end)
+        stray = interior & ~inside & ~following
+        if off:
+            # the interface's rows: its own rows, the interior and the previous rank
+            stray |= ~interior & (columns >= end)
+        if stray.any():
+            i = int(np.flatnonzero(stray)[0])
+            return (f"row {start + rows[i]} couples to row {columns[i]}: not a chain split "
+                    "at the ranks' first nodes")
+        self.head = int(rows[own].max()) + 1 - off if own.any() else 0
+        self.tail = self.n - int(rows[following].min()) if following.any() else 0
+        into_interior = ~interior & (columns >= start + off) & (columns < end)
+        self.head_columns = (int(columns[into_interior].max()) + 1 - start - off
+                             if into_interior.any() else 0)
+        backward = ~interior & (columns < start)
+        self.back = start - int(columns[backward].min()) if backward.any() else 0
+        return None
+
+    # --- the factorisation ------------------------------------------------------------
+    def set_up(self, matrix):
+        """Factor ``matrix`` (the pattern of the one this was made for; the interior's
+        symbolic factorisation is kept). Collective."""
+        B, off = self.block, self.offset
+        start, end = matrix.getOwnershipRange()
+        if self._mpi.allreduce(int(_nonzeros(matrix) != self._nonzeros)):
+            # the pattern grew (a new nonzero): the reaches and the interior anew
+            self._split(matrix)
+            for obj in (self.ksp, self.interior):
+                if obj is not None:
+                    obj.destroy()
+            self.ksp = self.interior = None
+        diagonal = matrix.getDiagonalBlock() if self.size > 1 else matrix
+        self.interior = diagonal.createSubMatrix(self._index, self._index, submat=self.interior)
+        if self.ksp is None:
+            self.ksp = self._make_solver(PETSc.COMM_SELF, self.interior)
+        else:
+            self.ksp.setOperators(self.interior)
+        self._set_up(self.ksp, B)
+        factor = self.ksp.getPC().getFactorMatrix()
+        self.failed = bool(self._mpi.allreduce(int(factor.getMumpsInfog(1) < 0)))
+        # a failed factorisation: solves give Inf, and a symmetric matrix counts as all
+        # negative (no step is taken with it)
+        self.negative = matrix.getSize()[0] if self.symmetric else None
+        if self.failed:
+            return
+        n_interior = self.n - off
+        # the couplings: A_I,G (W's right-hand sides) and A_G,I on the reaching rows
+        head = np.arange(start + off, start + off + self.head, dtype=PETSc.IntType)
+        tail = np.arange(end - self.tail, end, dtype=PETSc.IntType)
+        own = np.arange(start, start + off, dtype=PETSc.IntType)
+        following = np.arange(end, end + B, dtype=PETSc.IntType) if self.has_next else own[:0]
+        columns = []
+        if off:
+            block = np.zeros((n_interior, B))
+            block[:self.head] = matrix.getValues(head, own) if self.head else 0.0
+            columns += list(block.T)
+            reached = np.arange(start + off, start + off + self.head_columns,
+                                dtype=PETSc.IntType)
+            self._own_rows = (matrix.getValues(own, reached) if self.head_columns
+                              else np.zeros((B, 0)))
+            self._own_block = matrix.getValues(own, own)
+        if self.has_next:
+            block = np.zeros((n_interior, B))
+            block[n_interior - self.tail:] = matrix.getValues(tail, following) if self.tail else 0.0
+            columns += list(block.T)
+        # A_G_p,I_p-1: the own interface's rows on the previous rank's reaching columns,
+        # sent to that rank, which holds y and W of I_p-1
+        previous = (matrix.getValues(own, np.arange(start - self.back, start,
+                                                     dtype=PETSc.IntType))
+                    if off and self.back else np.zeros((B if off else 0, 0)))
+        received = self._mpi.allgather(previous)
+        self._next_rows = received[self.rank + 1] if self.has_next else np.zeros((0, 0))
+        self.W = np.array(self._interior_solve(columns)).reshape(len(columns), n_interior)
+        self._factor_interface(int(factor.getInertia()[0]) if self.symmetric else 0)
+
+    def _interior_solve(self, columns):
+        """A_II^-1 of the local arrays ``columns`` (n_interior,) each, in one solve."""
+        return self._solve(self.ksp, columns) if columns else []
+
+    def _factor_interface(self, interior_negative):
+        """S from every rank's contributions (module docstring), its pseudo-inverse, and
+        (symmetric) the negative eigenvalues of the whole matrix, from the interiors'
+        counts ``interior_negative`` (this rank's) and S's, the same on every rank
+        (rank 0's). Not finite: failed."""
+        B, off = self.block, self.offset
+        m = (self.size - 1) * B
+        parts = []
+        own_slot = (self.rank - 1) * B if off else None
+        next_slot = self.rank * B if self.has_next else None
+        W_own = self.W[:B] if off else None
+        W_next = self.W[-B:] if self.has_next else None
+        n_interior = self.n - off
+        if off:
+            rows = np.zeros((B, n_interior))
+            rows[:, :self.head_columns] = self._own_rows
+            parts.append((own_slot, own_slot, self._own_block - rows @ W_own.T))
+            if self.has_next:
+                parts.append((own_slot, next_slot, -rows @ W_next.T))
+        if self.has_next:
+            rows = np.zeros((B, n_interior))
+            rows[:, n_interior - self.next_back:] = self._next_rows
+            parts.append((next_slot, next_slot, -rows @ W_next.T))
+            if off:
+                parts.append((next_slot, own_slot, -rows @ W_own.T))
+        schur = np.zeros((m, m))
+        for rank_parts in self._mpi.allgather(parts):
+            for i, j, values in rank_parts:
+                schur[i:i + B, j:j + B] += values
+        negative = self._mpi.allreduce(interior_negative)
+        if not np.all(np.isfinite(schur)):
+            self.failed = True
+            return
+        rows, columns = _equilibration(schur, self.symmetric)
+        balanced = rows[:, None] * schur * columns[None, :]
+        if self.symmetric:
+            values, vectors = np.linalg.eigh(0.5 * (balanced + balanced.T))
+            kept = np.abs(values) > NULL_PIVOT * np.abs(values).max(initial=0.0)
+            inverse = (vectors[:, kept] / values[kept]) @ vectors[:, kept].T
+            self.negative = self._mpi.bcast(negative + int(np.sum(values[kept] < 0)), root=0)
+        else:
+            inverse = np.linalg.pinv(balanced, rcond=NULL_PIVOT) if m else balanced
+        # S = R^-1 balanced C^-1, so S^+ = C balanced^+ R
+        self._inverse = columns[:, None] * inverse * rows[None, :]
+
+    # --- solves ---------------------------------------------------------------------
+    def solve_columns(self, columns, rows=None):
+        """x_j = A^-1 b_j for the local arrays ``columns`` (as ksp.solve_columns: ``rows``
+        the local rows of a submatrix in the columns' layout, the others returning b_j;
+        Inf where the factorisation failed). Collective."""
+        columns = [np.asarray(column) for column in columns]
+        solutions = [column.copy() for column in columns]
+        if not columns:
+            return solutions
+        B, off = self.block, self.offset
+        b = np.array([column if rows is None else column[rows] for column in columns])
+        if self.failed:
+            x = np.full_like(b, np.inf)
+        else:
+            y = np.array(self._interior_solve(list(b[:, off:])))           # (k, n_I)
+            n_interior = self.n - off
+            sent = np.zeros((2, B, len(columns)))
+            if off:
+                sent[0] = b[:, :off].T - self._own_rows @ y[:, :self.head_columns].T
+            if self.has_next:
+                sent[1] = -self._next_rows @ y[:, n_interior - self.next_back:].T
+            parts = np.empty((self.size, 2, B, len(columns)))
+            self._mpi.Allgather(sent, parts)
+            right = (parts[1:, 0] + parts[:-1, 1]).reshape(-1, len(columns))
+            interface = self._inverse @ right                               # ((P-1) B, k)
+            x = np.empty_like(b)
+            if off:
+                x_own = interface[(self.rank - 1) * B:self.rank * B]
+                x[:, :off] = x_own.T
+                y -= x_own.T @ self.W[:B]
+            if self.has_next:
+                y -= interface[self.rank * B:(self.rank + 1) * B].T @ self.W[-B:]
+            x[:, off:] = y
+        for j, solution in enumerate(solutions):
+            if rows is None:
+                solution[:] = x[j]
+            else:
+                solution[rows] = x[j]
+        return solutions
+
+    def negative_pivots(self):
+        """The number of negative eigenvalues of the last factorised symmetric matrix."""
+        return self.negative
+
+    def destroy(self):
+        for obj in (self.ksp, self.interior, self._index):
+            if obj is not None:
+                obj.destroy()
+
+
+def _equilibration(matrix, symmetric, sweeps=RUIZ_SWEEPS):
+    """(r, c): row and column scales that bring every row and column of the dense
+    ``matrix`` to a largest entry of about 1, by Ruiz's iteration: r_i /= sqrt(max_j
+    |M_ij|), c_j /= sqrt(max_i |M_ij|) for M = diag(r) A diag(c), repeated (it halves
+    the logarithm of each row's and column's distance from 1 a sweep, whatever the
+    units of the unknowns and of the equations: D A D and R A C alike). Of a symmetric
+    matrix r = c at every sweep (E A E keeps the inertia, Sylvester). A zero row or
+    column keeps 1."""
+    def inverse_root(largest):
+        return 1.0 / np.sqrt(np.where(largest > 0.0, largest, 1.0))
+    magnitude = np.abs(matrix)
+    rows, columns = np.ones(len(matrix)), np.ones(len(matrix))
+    for _ in range(sweeps):
+        scaled = rows[:, None] * magnitude * columns[None, :]
+        rows = rows * inverse_root(scaled.max(axis=1, initial=0.0))
+        columns = rows.copy() if symmetric else columns * inverse_root(
+            scaled.max(axis=0, initial=0.0))
+    return rows, columns
+
+
+def _nonzeros(matrix):
+    """The nonzeros stored in this rank's rows of ``matrix`` (a change of pattern)."""
+    return int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)["nz_allocated"])

@@ -1,0 +1,258 @@
+"""The substructured factorisation of the Newton steps' systems on several ranks
+(global_step/chain_factor.py): on a chain of nodes of B unknowns laid out as the Newton
+systems are (a rank's rows start at a vertex; element e couples nodes 2e, 2e + 1,
+2e + 2), its solves agree with a dense solve of the whole matrix to round-off, for the
+LU of an unsymmetric matrix and the LDL^T of a symmetric indefinite one, whose count of
+negative eigenvalues is the dense matrix's; with ``rows`` (a submatrix of the kept rows,
+as the second variation leaves out the drag's resultants) the left-out rows return the
+right-hand side. A singular interface (a null vector through the whole chain, as the
+free roll) gives a finite solution of the consistent system. direct_factor chooses it
+on several ranks unless -<prefix>substructuring 0 (here the prefix test_chain_). Under a
+serial run the factor is the interior's alone; under 3 or more ranks a middle rank has
+both interfaces (run by hand, `mpiexec -n 3` and `-n 4`: CI runs 1 and 2). An operator
+that is no chain is factored by MUMPS on all ranks."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import gather
+from petsc_rod.global_step import ksp as solvers
+from petsc_rod.global_step.chain_factor import ChainFactor
+from petsc_rod.mesh.mesh import Mesh
+
+BLOCK = 3
+N_ELEMENTS = 24
+
+
+def chain(comm, kind, singular=False, scales=(1.0, 1.0, 1.0), column_scales=None):
+    """(mesh, matrix, dense whole matrix) of random element blocks (3 B square, SPD
+    plus a diagonal of either sign for the LDL^T; unsymmetric for the LU, its pattern
+    too); ``singular``: symmetric positive semi-definite with each slot's constant as
+    a null vector; ``scales`` multiply each slot's rows (B of them) and its columns,
+    or ``column_scales`` these (R A C: equations and unknowns of different units)."""
+    mesh = Mesh(comm, N_ELEMENTS, 1.0)
+    n = BLOCK * (2 * N_ELEMENTS + 1)
+    rng = np.random.default_rng(5)
+    blocks = rng.standard_normal((N_ELEMENTS, 3 * BLOCK, 3 * BLOCK))
+    if singular:
+        difference = np.kron(np.array([[1.0, -1.0, 0.0], [0.0, 1.0, -1.0]]), np.eye(BLOCK))
+        blocks = np.array([difference.T @ np.diag(rng.uniform(1, 2, 2 * BLOCK)) @ difference
+                           for _ in range(N_ELEMENTS)])
+    elif kind == PETSc.PC.Type.CHOLESKY:
+        blocks = blocks @ blocks.transpose(0, 2, 1) * 0.1
+        signs = np.where(rng.random((N_ELEMENTS, 3 * BLOCK)) < 0.3, -4.0, 4.0)
+        blocks += signs[:, :, None] * np.eye(3 * BLOCK)
+    else:
+        blocks += 6.0 * np.eye(3 * BLOCK)
+        # the left vertex's rows do not reach the right vertex, whose rows reach back
+        # to it: the interface's rows reach further into the previous rank than that
+        # rank's rows reach the interface (as the drag's chain rows of J)
+        blocks[:, :BLOCK, 2 * BLOCK:] = 0.0
+    skipped = {(0, 2)} if kind == PETSc.PC.Type.LU and not singular else set()
+    # unknowns of other units (turns against heights and resultants on the riser): D A D
+    slots = np.tile(np.asarray(scales, dtype=float), 3)
+    column_slots = slots if column_scales is None else np.tile(
+        np.asarray(column_scales, dtype=float), 3)
+    blocks = slots[None, :, None] * blocks * column_slots[None, None, :]
+    dense = np.zeros((n, n))
+    for e in range(N_ELEMENTS):
+        rows = np.arange(2 * e * BLOCK, (2 * e + 3) * BLOCK)
+        dense[np.ix_(rows, rows)] += blocks[e]
+    first = 2 * mesh.vertex_start * BLOCK
+    local = BLOCK * mesh.n_local_nodes
+    matrix = PETSc.Mat().createAIJ(((local, n), (local, n)), nnz=(5 * BLOCK, 2 * BLOCK),
+                                   comm=comm)
+    for e in range(mesh.element_start, mesh.element_end):
+        for a in range(3):
+            for c in range(3):
+                if (a, c) in skipped:
+                    continue
+                rows = np.arange((2 * e + a) * BLOCK, (2 * e + a + 1) * BLOCK,
+                                 dtype=PETSc.IntType)
+                columns = np.arange((2 * e + c) * BLOCK, (2 * e + c + 1) * BLOCK,
+                                    dtype=PETSc.IntType)
+                matrix.setValues(rows, columns, blocks[e, a * BLOCK:(a + 1) * BLOCK,
+                                                       c * BLOCK:(c + 1) * BLOCK],
+                                 addv=PETSc.InsertMode.ADD_VALUES)
+    matrix.assemble()
+    assert first == matrix.getOwnershipRange()[0]
+    return mesh, matrix, dense
+
+
+def self_and_transposed(comm, a, b):
+    """Every rank's pair (a, b) and (b, a), for the dense copy."""
+    return [pair for a_r, b_r in comm.tompi4py().allgather((a, b))
+            for pair in ((a_r, b_r), (b_r, a_r))]
+
+
+def factor_of(matrix, kind):
+    if kind == PETSc.PC.Type.LU:
+        def make(comm, local):
+            return solvers.lu_solver(comm, local, "test_chain_")
+    else:
+        def make(comm, local):
+            return solvers.inertia_solver(comm, local, "test_chain_")[0]
+    factor = ChainFactor(matrix, kind, BLOCK, make, solvers.set_up_mumps, solvers.solve_columns)
+    factor.set_up(matrix)
+    return factor
+
+
+@pytest.mark.parametrize("kind, scales, column_scales", [
+    (kind, scales, None) for kind in (PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY)
+    for scales in ((1.0, 1.0, 1.0), (1.0, 1e4, 1e-4))] + [
+    (PETSc.PC.Type.LU, (1e3, 1.0, 1e-3), (1e-2, 1e3, 1.0))])
+def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, column_scales):
+    """Unknowns of units 1e8 apart too (D A D, D the slots' scales): the interface's
+    Schur complement spans 1e16 there, and its inertia and inverse must not lose the
+    small ones; of the LU also equations and unknowns of other scales (R A C). The
+    solutions are compared in the unscaled unknowns C x, with A's own dense solve (the
+    scaled matrix's is 1e8 times worse conditioned), to round-off."""
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, dense = chain(comm, kind, scales=scales, column_scales=column_scales)
+    slots = np.tile(np.asarray(scales), len(dense) // BLOCK)
+    column_slots = slots if column_scales is None else np.tile(
+        np.asarray(column_scales), len(dense) // BLOCK)
+    factor = factor_of(matrix, kind)
+
+    def assert_solves(column, solution):
+        unscaled = dense / slots[:, None] / column_slots[None, :]
+        expected = np.linalg.solve(unscaled, gather(comm, column) / slots)
+        error = column_slots * gather(comm, solution) - expected
+        assert np.abs(error).max() <= 1e-12 * np.abs(expected).max()
+
+    try:
+        start, end = matrix.getOwnershipRange()
+        columns = [np.sin((j + 1) * np.arange(start, end)) for j in range(3)]
+        for column, solution in zip(columns, factor.solve_columns(columns)):
+            assert_solves(column, solution)
+        if kind == PETSc.PC.Type.CHOLESKY:
+            # of the unscaled matrix, whose inertia D A D has (Sylvester): eigvalsh of
+            # the scaled one miscounts (39 against 35) at 1e-16 of its 1e8 norm
+            unscaled = dense / slots[:, None] / slots[None, :]
+            negative = int(np.sum(np.linalg.eigvalsh(unscaled) < 0))
+            assert negative > 0 and factor.negative_pivots() == negative
+        # new values on the same pattern, then a new nonzero inside each rank's interior
+        # (a wider band there): the factorisation follows them
+        matrix.shift(0.5)
+        dense += 0.5 * np.eye(len(dense))
+        for grown in (False, True):
+            if grown:
+                first = start + (BLOCK if comm.getRank() > 0 else 0)
+                a, b = first + 1, first + 3 * BLOCK + 1
+                matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+                matrix.setValue(a, b, 0.25)
+                matrix.setValue(b, a, 0.25)
+                matrix.assemble()
+                for i, j in self_and_transposed(comm, a, b):
+                    dense[i, j] += 0.25
+            factor.set_up(matrix)
+            assert_solves(columns[0], factor.solve_columns(columns[:1])[0])
+    finally:
+        factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_a_submatrix_s_left_out_rows_return_the_right_hand_side():
+    comm = PETSc.COMM_WORLD
+    kind = PETSc.PC.Type.CHOLESKY
+    mesh, matrix, dense = chain(comm, kind)
+    start, end = matrix.getOwnershipRange()
+    kept = np.arange(start, end)[np.arange(start, end) % BLOCK != 2]     # 2 of 3 a node
+    index = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=comm)
+    sub = matrix.createSubMatrix(index, index)
+
+    def make(local_comm, local):
+        return solvers.inertia_solver(local_comm, local, "test_chain_")[0]
+    factor = ChainFactor(sub, kind, BLOCK - 1, make, solvers.set_up_mumps,
+                         solvers.solve_columns)
+    try:
+        factor.set_up(sub)
+        column = np.cos(np.arange(start, end))
+        solution = factor.solve_columns([column], kept - start)[0]
+        whole_kept = np.flatnonzero(np.arange(len(dense)) % BLOCK != 2)
+        expected = np.linalg.solve(dense[np.ix_(whole_kept, whole_kept)],
+                                   gather(comm, column[kept - start]))
+        assert np.abs(gather(comm, solution[kept - start]) - expected).max() <= 1e-12 * np.abs(
+            expected).max()
+        left_out = np.setdiff1d(np.arange(end - start), kept - start)
+        assert np.array_equal(solution[left_out], column[left_out])
+    finally:
+        for obj in (factor, sub, index, matrix, mesh):
+            obj.destroy()
+
+
+def test_a_null_vector_through_the_chain_gives_a_finite_consistent_solution():
+    """The element blocks act on differences of neighbouring nodes: each slot's constant
+    is a null vector through the whole chain (as the free roll), which every rank's
+    interior block, coupled to its interfaces, does not have, and the interface's
+    Schur complement does. A right-hand side orthogonal to them is solved to round-off,
+    with no Inf or NaN."""
+    comm = PETSc.COMM_WORLD
+    kind = PETSc.PC.Type.CHOLESKY
+    mesh, matrix, dense = chain(comm, kind, singular=True)
+    start, end = matrix.getOwnershipRange()
+    factor = factor_of(matrix, kind)
+    try:
+        whole = np.sin(np.arange(len(dense)) * 0.7).reshape(-1, BLOCK)
+        whole -= whole.mean(axis=0)                  # orthogonal to the null vectors
+        column = whole.ravel()[start:end]
+        solution = factor.solve_columns([column])[0]
+        assert np.all(np.isfinite(solution))
+        residual = dense @ gather(comm, solution) - whole.ravel()
+        assert np.abs(residual).max() <= 1e-10 * np.abs(whole).max()
+    finally:
+        factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("given", [None, "0"])
+def test_direct_factor_substructures_on_several_ranks_unless_told_not_to(given):
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, _ = chain(comm, PETSc.PC.Type.LU)
+    options = PETSc.Options()
+    if given is not None:
+        options["test_chain_substructuring"] = given
+    factor = solvers.direct_factor(matrix, PETSc.PC.Type.LU, BLOCK, "test_chain_")
+    try:
+        substructured = comm.getSize() > 1 and given is None
+        assert isinstance(factor, ChainFactor) == substructured
+    finally:
+        if given is not None:
+            options.delValue("test_chain_substructuring")
+        factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
+    """A coupling of the first node to the last (a ring, as no Newton system of a line
+    has): on several ranks the interface does not separate the ranks' interiors, so
+    direct_factor falls back to MUMPS on all ranks, whose solve agrees with the dense
+    one."""
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, dense = chain(comm, PETSc.PC.Type.LU)
+    n = len(dense)
+    matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    if comm.getRank() == 0:
+        matrix.setValue(0, n - 1, 0.5)
+        matrix.setValue(n - 1, 0, -0.5)
+    matrix.assemble()
+    dense[0, n - 1] += 0.5
+    dense[n - 1, 0] -= 0.5
+    factor = solvers.direct_factor(matrix, PETSc.PC.Type.LU, BLOCK, "test_chain_")
+    try:
+        assert not isinstance(factor, ChainFactor)
+        factor.set_up(matrix)
+        start, end = matrix.getOwnershipRange()
+        column = np.sin(np.arange(start, end) + 0.3)
+        solution = factor.solve_columns([column])[0]
+        expected = np.linalg.solve(dense, gather(comm, column))
+        assert np.abs(gather(comm, solution) - expected).max() <= 1e-12 * np.abs(
+            expected).max()
+    finally:
+        factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
