@@ -27,7 +27,9 @@ what the stability test and the Newton steps' positive-definiteness test count.
 
 A solve is a local solve, an allgather of 2 B k numbers a rank (k right-hand sides), a
 dense product with S^-1 and x_I -= W x_G: the work of the serial factorisation divided
-by the ranks, where MUMPS on two ranks factored the riser's Jacobian in the one-rank
+by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
+factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
+scalable to many), where MUMPS on two ranks factored the riser's Jacobian in the one-rank
 time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
 objects (the interior submatrix and its sequential MUMPS solver, the index set of the
 interior rows): ``destroy()``.
@@ -40,12 +42,17 @@ from petsc_rod.global_step.substructuring import NotAChainError
 
 # The equilibrated interface's pseudo-inverse drops singular values (eigenvalues) below
 # this fraction of the largest: a null pivot, the free roll of a section with K1 = K2
-# between pins (there the smallest falls to 3e-12 of the largest as an attempt
-# converges, and is kept, as MUMPS on all ranks keeps its pivot: docs/performance.md).
+# between pins (there the smallest falls to 1e-15 of the largest at the attempt's last
+# factorisation, and is dropped, as MUMPS on all ranks drops it: docs/performance.md).
 NULL_PIVOT = 1e-13
 # Ruiz sweeps of the Schur complement's equilibration: each halves the logarithm of a
-# row's or column's largest entry, so 20 bring a range of 1e16 to within 1e-5 of 1.
+# row's or column's largest entry, so 20 bring a range of 1e16 to within 4e-5 of 1.
 RUIZ_SWEEPS = 20
+
+
+class SingularInteriorError(NotAChainError):
+    """A rank's interior block is singular (a null pivot of its LDL^T or LU): the
+    substructuring does not apply to this matrix, whatever the whole's regularity."""
 
 
 class ChainFactor:
@@ -137,8 +144,10 @@ class ChainFactor:
 
     # --- the factorisation ------------------------------------------------------------
     def set_up(self, matrix):
-        """Factor ``matrix`` (the pattern of the one this was made for; the interior's
-        symbolic factorisation is kept). Collective."""
+        """Factor ``matrix`` (the pattern of the one this was made for, or grown; the
+        interior's symbolic factorisation is kept while the pattern stays). Raises
+        NotAChainError (on every rank) where the grown pattern is no chain's, and its
+        SingularInteriorError where a rank's interior has a null pivot. Collective."""
         B, off = self.block, self.offset
         start, end = matrix.getOwnershipRange()
         if self._mpi.allreduce(int(_nonzeros(matrix) != self._nonzeros)):
@@ -156,6 +165,13 @@ class ChainFactor:
             self.ksp.setOperators(self.interior)
         self._set_up(self.ksp, B)
         factor = self.ksp.getPC().getFactorMatrix()
+        # a null pivot of an interior (MUMPS detects it, ICNTL 24, and goes on) voids
+        # W, S and the inertia count (Haynsworth needs A_II nonsingular), though the
+        # whole matrix may be regular (a saddle's multiplier coupled to the interface
+        # alone): the caller factors the whole instead (ksp.direct_factor). On one rank
+        # the interior is the whole, whose null pivots are its own (as MUMPS's)
+        if self.size > 1 and self._mpi.allreduce(int(factor.getMumpsInfog(28) > 0)):
+            raise SingularInteriorError("a rank's interior has a null pivot")
         self.failed = bool(self._mpi.allreduce(int(factor.getMumpsInfog(1) < 0)))
         # a failed factorisation: solves give Inf, and a symmetric matrix counts as all
         # negative (no step is taken with it)

@@ -184,7 +184,10 @@ class MumpsFactor:
     """MUMPS's factorisation ``kind`` (PETSc.PC.Type.LU: lu_solver; CHOLESKY:
     inertia_solver) of an operator on its ranks, under ``prefix``, with ``block``
     unknowns a node (set_up_mumps); the interface direct_factor's factorisations share
-    (set_up, solve_columns, negative_pivots, destroy). Owns its KSP."""
+    (set_up, solve_columns, negative_pivots, destroy; ``substructured`` False). Owns
+    its KSP."""
+
+    substructured = False
 
     def __init__(self, operator, kind, block, prefix):
         comm = operator.getComm()
@@ -211,23 +214,58 @@ class MumpsFactor:
         self.ksp.destroy()
 
 
-def direct_factor(operator, kind, block, prefix):
-    """The factorisation ``kind`` (LU or CHOLESKY) of the Newton steps' ``operator``, a
-    chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/stability.py):
-    on several ranks by substructuring (chain_factor.ChainFactor: each rank its interior
-    by sequential MUMPS, the interface's Schur complement on every rank) unless
-    -<prefix>substructuring 0 or the operator is no chain; else MumpsFactor. Collective."""
-    comm = operator.getComm()
-    chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)
-    if comm.getSize() > 1 and chosen:
+class SubstructuredFactor:
+    """A ChainFactor while it applies, MumpsFactor from the first set_up where it does
+    not (a pattern grown into no chain, a singular interior: chain_factor's
+    NotAChainError), for the rest of its life; the interface direct_factor's
+    factorisations share. ``substructured`` says which. Owns the one it holds."""
+
+    def __init__(self, operator, kind, block, prefix):
+        self.kind, self.block, self.prefix = kind, block, prefix
         if kind == PETSc.PC.Type.LU:
             def make(local_comm, local):
                 return lu_solver(local_comm, local, prefix)
         else:
             def make(local_comm, local):
                 return inertia_solver(local_comm, local, prefix)[0]
+        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns)
+
+    @property
+    def substructured(self):
+        return isinstance(self.factor, ChainFactor)
+
+    def set_up(self, operator):
+        if self.substructured:
+            try:
+                self.factor.set_up(operator)
+                return
+            except substructuring.NotAChainError:
+                self.factor.destroy()
+                self.factor = MumpsFactor(operator, self.kind, self.block, self.prefix)
+        self.factor.set_up(operator)
+
+    def solve_columns(self, columns, rows=None):
+        return self.factor.solve_columns(columns, rows)
+
+    def negative_pivots(self):
+        return self.factor.negative_pivots()
+
+    def destroy(self):
+        self.factor.destroy()
+
+
+def direct_factor(operator, kind, block, prefix):
+    """The factorisation ``kind`` (LU or CHOLESKY) of the Newton steps' ``operator``, a
+    chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/stability.py):
+    on several ranks by substructuring (SubstructuredFactor: each rank its interior by
+    sequential MUMPS, the interface's Schur complement on every rank, MUMPS on all ranks
+    where that does not apply) unless -<prefix>substructuring 0 or the operator is no
+    chain; else MumpsFactor. Collective."""
+    comm = operator.getComm()
+    chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)
+    if comm.getSize() > 1 and chosen:
         try:
-            return ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns)
+            return SubstructuredFactor(operator, kind, block, prefix)
         except substructuring.NotAChainError:
             pass
     return MumpsFactor(operator, kind, block, prefix)

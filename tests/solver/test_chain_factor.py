@@ -10,7 +10,8 @@ free roll) gives a finite solution of the consistent system. direct_factor choos
 on several ranks unless -<prefix>substructuring 0 (here the prefix test_chain_). Under a
 serial run the factor is the interior's alone; under 3 or more ranks a middle rank has
 both interfaces (run by hand, `mpiexec -n 3` and `-n 4`: CI runs 1 and 2). An operator
-that is no chain is factored by MUMPS on all ranks."""
+that is no chain, or a regular one with a singular interior, is factored by MUMPS on all
+ranks."""
 
 import numpy as np
 import pytest
@@ -133,7 +134,7 @@ def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, colum
             negative = int(np.sum(np.linalg.eigvalsh(unscaled) < 0))
             assert negative > 0 and factor.negative_pivots() == negative
         # new values on the same pattern, then a new nonzero inside each rank's interior
-        # (a wider band there): the factorisation follows them
+        # (a wider band there): the factorisation and its inertia follow them
         matrix.shift(0.5)
         dense += 0.5 * np.eye(len(dense))
         for grown in (False, True):
@@ -148,6 +149,9 @@ def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, colum
                     dense[i, j] += 0.25
             factor.set_up(matrix)
             assert_solves(columns[0], factor.solve_columns(columns[:1])[0])
+            if kind == PETSc.PC.Type.CHOLESKY:
+                unscaled = dense / slots[:, None] / slots[None, :]
+                assert factor.negative_pivots() == int(np.sum(np.linalg.eigvalsh(unscaled) < 0))
     finally:
         factor.destroy()
         matrix.destroy()
@@ -218,7 +222,7 @@ def test_direct_factor_substructures_on_several_ranks_unless_told_not_to(given):
     factor = solvers.direct_factor(matrix, PETSc.PC.Type.LU, BLOCK, "test_chain_")
     try:
         substructured = comm.getSize() > 1 and given is None
-        assert isinstance(factor, ChainFactor) == substructured
+        assert factor.substructured == substructured
     finally:
         if given is not None:
             options.delValue("test_chain_substructuring")
@@ -244,7 +248,7 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
     dense[n - 1, 0] -= 0.5
     factor = solvers.direct_factor(matrix, PETSc.PC.Type.LU, BLOCK, "test_chain_")
     try:
-        assert not isinstance(factor, ChainFactor)
+        assert not factor.substructured
         factor.set_up(matrix)
         start, end = matrix.getOwnershipRange()
         column = np.sin(np.arange(start, end) + 0.3)
@@ -252,6 +256,46 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
         expected = np.linalg.solve(dense, gather(comm, column))
         assert np.abs(gather(comm, solution) - expected).max() <= 1e-12 * np.abs(
             expected).max()
+    finally:
+        factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("kind", [PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY])
+def test_a_singular_interior_of_a_regular_matrix_is_factored_whole(kind):
+    """An unknown j of the last rank's interior coupled to its interface unknown g alone,
+    with no diagonal (a saddle's multiplier: rows j and g read x_g = b_j and fix x_j):
+    the whole matrix is regular, the interior singular (a null pivot, MUMPS's INFOG 28),
+    so the substructuring does not apply. From that set_up on, the factor is MUMPS's on
+    all ranks, whose solves and inertia are the dense matrix's."""
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, dense = chain(comm, kind)
+    start, end = matrix.getOwnershipRange()
+    g = comm.tompi4py().allgather(start)[-1]
+    j = g + BLOCK + 1
+    last = comm.getRank() == comm.getSize() - 1
+    matrix.zeroRowsColumns([j] if last else [], diag=0.0)
+    matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    if last:
+        matrix.setValue(j, g, 1.0)
+        matrix.setValue(g, j, 1.0)
+    matrix.assemble()
+    dense[j, :] = 0.0
+    dense[:, j] = 0.0
+    dense[j, g] = dense[g, j] = 1.0
+    factor = solvers.direct_factor(matrix, kind, BLOCK, "test_chain_")
+    try:
+        factor.set_up(matrix)
+        assert not factor.substructured
+        column = np.cos(0.3 * np.arange(start, end))
+        solution = factor.solve_columns([column])[0]
+        expected = np.linalg.solve(dense, gather(comm, column))
+        assert np.abs(gather(comm, solution) - expected).max() <= 1e-12 * np.abs(
+            expected).max()
+        if kind == PETSc.PC.Type.CHOLESKY:
+            negative = int(np.sum(np.linalg.eigvalsh(dense) < 0))
+            assert factor.negative_pivots() == negative
     finally:
         factor.destroy()
         matrix.destroy()
