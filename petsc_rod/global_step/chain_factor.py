@@ -21,9 +21,10 @@ equilibrated (R S C by Ruiz's iteration, every row and column's largest entry ab
 1; E S E of a symmetric S: its unknowns are turns, heights and resultants, whose
 scales differ by 1e7 on the riser) and pseudo-inverted,
 its null directions (a null pivot: the free roll) dropped. Of a symmetric matrix the
-number of negative eigenvalues is the interiors' (their LDL^T's, null pivots not
-counted) plus S's (Haynsworth's inertia additivity; E S E has S's inertia, Sylvester),
-what the stability test and the Newton steps' positive-definiteness test count.
+number of negative eigenvalues is the interiors' (their LDL^T's) plus S's
+(Haynsworth's inertia additivity, which needs regular interiors: an interior with a
+null pivot is refused, SingularInteriorError; E S E has S's inertia, Sylvester), what
+the stability test and the Newton steps' positive-definiteness test count.
 
 A solve is a local solve, an allgather of 2 B k numbers a rank (k right-hand sides), a
 dense product with S^-1 and x_I -= W x_G: the work of the serial factorisation divided
