@@ -180,6 +180,14 @@ def solve_vecs(factor, vecs, rows=None):
 SUBSTRUCTURING = "substructuring"
 
 
+def mumps_solver(comm, operator, kind, prefix):
+    """The KSP of MUMPS's factorisation ``kind`` of ``operator`` on ``comm``: lu_solver
+    for PETSc.PC.Type.LU, inertia_solver's for CHOLESKY, options under ``prefix``."""
+    if kind == PETSc.PC.Type.LU:
+        return lu_solver(comm, operator, prefix)
+    return inertia_solver(comm, operator, prefix)[0]
+
+
 class MumpsFactor:
     """MUMPS's factorisation ``kind`` (PETSc.PC.Type.LU: lu_solver; CHOLESKY:
     inertia_solver) of an operator on its ranks, under ``prefix``, with ``block``
@@ -190,11 +198,7 @@ class MumpsFactor:
     substructured = False
 
     def __init__(self, operator, kind, block, prefix):
-        comm = operator.getComm()
-        if kind == PETSc.PC.Type.LU:
-            self.ksp = lu_solver(comm, operator, prefix)
-        else:
-            self.ksp = inertia_solver(comm, operator, prefix)[0]
+        self.ksp = mumps_solver(operator.getComm(), operator, kind, prefix)
         self.block = block
 
     def set_up(self, operator):
@@ -222,12 +226,9 @@ class SubstructuredFactor:
 
     def __init__(self, operator, kind, block, prefix):
         self.kind, self.block, self.prefix = kind, block, prefix
-        if kind == PETSc.PC.Type.LU:
-            def make(local_comm, local):
-                return lu_solver(local_comm, local, prefix)
-        else:
-            def make(local_comm, local):
-                return inertia_solver(local_comm, local, prefix)[0]
+
+        def make(local_comm, local):
+            return mumps_solver(local_comm, local, kind, prefix)
         self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns)
 
     @property

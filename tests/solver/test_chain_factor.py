@@ -88,12 +88,8 @@ def self_and_transposed(comm, a, b):
 
 
 def factor_of(matrix, kind):
-    if kind == PETSc.PC.Type.LU:
-        def make(comm, local):
-            return solvers.lu_solver(comm, local, "test_chain_")
-    else:
-        def make(comm, local):
-            return solvers.inertia_solver(comm, local, "test_chain_")[0]
+    def make(comm, local):
+        return solvers.mumps_solver(comm, local, kind, "test_chain_")
     factor = ChainFactor(matrix, kind, BLOCK, make, solvers.set_up_mumps, solvers.solve_columns)
     factor.set_up(matrix)
     return factor
@@ -168,7 +164,7 @@ def test_a_submatrix_s_left_out_rows_return_the_right_hand_side():
     sub = matrix.createSubMatrix(index, index)
 
     def make(local_comm, local):
-        return solvers.inertia_solver(local_comm, local, "test_chain_")[0]
+        return solvers.mumps_solver(local_comm, local, kind, "test_chain_")
     factor = ChainFactor(sub, kind, BLOCK - 1, make, solvers.set_up_mumps,
                          solvers.solve_columns)
     try:
