@@ -214,13 +214,30 @@ class StepController:
         """Newton may be tried again NEWTON_AFTER 2^failures iterations from now."""
         self.newton_next = len(self.history) + NEWTON_AFTER * 2**self.newton_failures
 
-    def newton_converged(self, verified, least_penalty, penalty):
+    def newton_converged(self, verified, least_penalty, penalty, norms=None):
         """An attempt converged; ``verified``: with H positive definite on the constraint
-        set at its last step. Returns the penalty to raise R (N) to when the handed-over
-        state needs at least ``least_penalty`` to stay a fixed point, else None."""
+        set at its last step. ``norms``: the stopping quantities of its last step
+        (state.Norms, measured as §6 measures an iteration: the change of X from the
+        state before it, the residual of the constraints, exact to round-off at a
+        Newton state) where its steps converged on the whole problem
+        (newton.NewtonPolish.solved_norms), None where it met the round-off floor. With
+        them the last step's row holds them, the observer is asked, and the step
+        converges there, in Newton's terms, where they pass the stopping test: the
+        state is Newton's solution, not iterated again (docs/method.md §11,
+        "Hand-over"). Returns the penalty to raise R (N) to when the handed-over state
+        needs at least ``least_penalty`` to stay a fixed point, else None."""
         self.events.append(events.NewtonAttempt(self.label, len(self.history), "converged"))
         if verified:
             self.newton_verified = len(self.history)
+        if norms is not None:
+            self.history[-1] = (norms.change, norms.residual, self.history[-1][2])
+            self.deformation = norms.scale
+            change, residual = norms.change / norms.scale, norms.residual / norms.scale
+            if self.observer is not None and self.observer(len(self.history), change,
+                                                           residual):
+                self.decision = Decision(Action.STOP, stopping.STOP_OBSERVER)
+            elif stopping.converged(self.settings, change, residual):
+                self.decision = Decision(Action.CONVERGED)
         return NEWTON_RAISE * least_penalty if least_penalty >= penalty else None
 
     def newton_failed(self, outcome):
@@ -238,8 +255,10 @@ class StepController:
 
     @property
     def verified_by_newton(self):
-        """Newton's last factorisation, one iteration ago, showed the state stable."""
-        return self.newton_verified == len(self.history) - 1
+        """Newton's last factorisation showed the state stable: the step converged at
+        its attempt, or at the iteration after it."""
+        return self.newton_verified is not None and \
+            len(self.history) - self.newton_verified in (0, 1)
 
     def wants_early_escape(self):
         """After an attempt that found negative curvature: whether the state is near

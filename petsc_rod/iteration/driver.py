@@ -153,6 +153,8 @@ class UzawaSolver:
             if decision.action is control.Action.TRY_NEWTON:
                 step.resume()
                 self._polish(step)
+                if step.finished:       # converged in Newton's terms, or the observer
+                    return
                 step.wait_for_newton()
             elif decision.action is control.Action.RAISE_PENALTY:
                 step.resume()
@@ -194,7 +196,7 @@ class UzawaSolver:
         outcome = self.newton.run(step.record_newton_step)
         if outcome == newton.CONVERGED:
             raised = step.newton_converged(self.newton.verified, self.newton.least_penalty(),
-                                           self.penalty)
+                                           self.penalty, self.newton.solved_norms)
             if raised is not None:
                 self._raise_penalty(step, raised, events.RAISED_NEWTON)
             return

@@ -120,15 +120,26 @@ class NewtonPolish:
         self.stretch = getattr(problem, "axial", None) is not None
         self._held_stretch = (~self._free | ~np.isfinite(problem.axial)) if self.stretch \
             else None
+        # whether the steps solve the whole problem: not where a clamp's stretch is held
+        # at the force balance's value of the last iteration (§12), which the iterations
+        # after the hand-over bring up to date
+        self._whole = not (self.stretch and problem.mesh.global_max(
+            int(np.any(~self._free & np.isfinite(problem.axial)))))
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite, with the state's own curvature: the stability test's verdict,
         # at 1e-10 rad from the result (a chord step, FREEZE_TURN, tests nothing)
         self.verified = False
+        # the stopping quantities (state.Norms, §6) of the last step of an attempt whose
+        # steps converged (below STEP_TOLERANCE) on the whole problem; None after any
+        # other attempt (one handed over at the round-off floor included): the step's
+        # convergence in Newton's terms (run)
+        self.solved_norms = None
 
     def run(self, record=None):
         """Newton steps from the state's current tau (rotations near the fields). Returns
-        CONVERGED (to STEP_TOLERANCE, or to the round-off floor of FLOOR_TURN; the state
-        is then the Uzawa fixed point of the module docstring to that accuracy),
+        CONVERGED (to STEP_TOLERANCE, with ``solved_norms`` the last step's stopping
+        quantities, or to the round-off floor of FLOOR_TURN; the state is then the Uzawa
+        fixed point of the module docstring to that accuracy),
         INDEFINITE (H has a direction of negative curvature: near a saddle) or FAILED
         (the steps did not converge); in the last two cases the state is as it was.
         ``record(turn)`` is called after each step with its largest turn, rad."""
@@ -138,6 +149,7 @@ class NewtonPolish:
         saved = state.snapshot()
         frames = state.tau.copy()
         clamped = ~self._free
+        self.solved_norms = None
         frames[clamped] = state.node_directors()[clamped]      # the prescribed frames
         mu = None
         previous = np.inf
@@ -220,7 +232,7 @@ class NewtonPolish:
                 if record is not None:
                     record(largest)
                 if largest < STEP_TOLERANCE:
-                    self._hand_over(frames, mu)
+                    self.solved_norms = self._hand_over(frames, mu, measured=self._whole)
                     return CONVERGED
             state.restore(saved)
             return outcome
@@ -417,18 +429,33 @@ class NewtonPolish:
         return (problem.mesh.global_sum(local)
                 - (problem.end_state.position - problem.start_state.position))
 
-    def _hand_over(self, frames, mu):
-        """The state as the Uzawa fixed point at ``frames``: fields, r, tau = d and
-        lambda = -g / w (with the chord's share in lambda3; 0 at a clamped node)."""
+    def _hand_over(self, frames, mu, measured=False):
+        """The state as the Uzawa fixed point at ``frames``: fields, r, tau = d,
+        lambda = -g / w (with the chord's share in lambda3; 0 at a clamped node) and the
+        chord multiplier mu (the internal force n = force beyond - mu reads it), so that
+        every output is the Newton state's. ``measured``: returns the stopping
+        quantities of the step from the state's fields to ``frames`` (state.Norms, as
+        §6 measures an iteration), else None. Collective."""
         problem = self.problem
         state = problem.state
+        if measured:
+            # the fields before the step, the reference of its change
+            problem.global_step.integrate_slope(state)
+            state.remember()
         state.set_node_directors(frames)
         problem.global_step.integrate_slope(state)
+        if self._bordered():
+            state.chord_multiplier = np.array(mu, dtype=float)
         self._set_multipliers(frames, problem.energy_gradient(self._product), mu)
         # a clamped frame is prescribed, not solved for: its multiplier is free, and 0
         # is one the local step keeps (P(R d) = d)
         state.lam[~self._free] = 0.0
+        norms = None
+        if measured:
+            state.take_directors()
+            norms = problem.norms()
         state.remember()
+        return norms
 
     def _set_multipliers(self, frames, g, mu):
         """tau = frames and lambda = -g / w with g the gradient of L (the chord's mu w in

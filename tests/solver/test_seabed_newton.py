@@ -20,7 +20,9 @@ chain, so that its matrix stays banded:
 (d) a steel riser (options/riser_catenary.opts without its current) whose touchdown's
     active set settles during the steps: the attempt converges, the iteration's state;
 (e) the same riser's first global step starts its active-set loop from the catenary's
-    touchdown, not from an empty set.
+    touchdown, not from an empty set;
+(f) the same riser's step ends at its Newton attempt, with Newton's state: the same at
+    R and 4 R, where the Uzawa map's fixed point depends on R by its round-off.
 """
 
 import numpy as np
@@ -322,3 +324,37 @@ def test_the_first_active_set_is_the_start_s_touchdown(comm, solver_factory):
     assert solves <= 4 and moved <= 20
     empty_solves, _ = first_loop_solves(solver_factory, comm, from_start=False)
     assert empty_solves == MAX_SOLVES
+
+
+# --- (f) the step ends at the attempt, with Newton's state -------------------------------
+def newton_solution(solver_factory, comm, factor):
+    """(report, gathered vertex positions, gathered internal force n, N) of STEEL_RISER
+    at 900 elements from its catenary at ``factor`` times the default penalty."""
+    from petsc_rod.scenes.starts import catenary_start, largest_tension
+    scene = Scene(**STEEL_RISER)
+    penalty = factor * default_penalty(scene, largest_tension(scene, 1.0))
+    mesh, solver = solver_factory(comm, 900, STEEL_RISER, penalty, rtol=1e-9, ctol=1e-9,
+                                  max_it=2000)
+    solver.problem.state.set_from_curve(catenary_start(scene, 1.0))
+    report = solver.solve_step(1.0)
+    return (report, gather(comm, solver.problem.state.r.owned()[:, 0]),
+            gather(comm, solver.problem.internal_force()))
+
+
+def test_the_step_ends_at_the_attempt_with_newton_s_state(comm, solver_factory):
+    """The attempt converges on the whole problem and its last step passes the stopping
+    tests (docs/method.md §11, "Convergence in Newton's terms"): the step ends there,
+    and its state does not depend on R (measured: 2e-12 m and 8e-9 N between R and 4 R).
+    Iterating on from the hand-over, as before, ended at the map's fixed point, which
+    does: 4e-9 m and 6e-5 N apart (3e-6 m and 1e-2 N for the map alone at its
+    tolerance). The internal force reads the attempt's chord multiplier."""
+    from petsc_rod.iteration.events import NewtonAttempt
+    runs = [newton_solution(solver_factory, comm, factor) for factor in (1.0, 4.0)]
+    for report, _, _ in runs:
+        attempts = [event for event in report.events if isinstance(event, NewtonAttempt)]
+        assert report.converged and attempts[-1].outcome == "converged"
+        assert attempts[-1].iteration == report.iterations      # no iteration after it
+        assert report.change <= 1e-9 and report.constraint_residual <= 1e-9
+    (_, r, n), (_, r_4, n_4) = runs
+    assert np.abs(r - r_4).max() < 1e-10                        # m, on 1800 m
+    assert np.abs(n - n_4).max() < 1e-6                         # N, of 1.5e6

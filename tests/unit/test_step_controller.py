@@ -106,3 +106,44 @@ def test_a_newton_solution_that_needs_a_larger_penalty_raises_it():
     assert step.newton_failures == 1
     outcomes = [event.outcome for event in step.events if isinstance(event, events.NewtonAttempt)]
     assert outcomes == ["converged", "converged", "indefinite"]
+
+
+def newton_rows(norms, observer=None):
+    """A controller after two iterations and two Newton steps (turns 1e-5 and 1e-11 rad)
+    of an attempt that converged, with the last step's stopping quantities ``norms``."""
+    from petsc_rod.problem.state import Norms
+    step, _ = fed([(1e-3, 1e-3), (1e-4, 1e-4)], newton=True, observer=observer)
+    step.resume()
+    for turn in (1e-5, 1e-11):
+        step.record_newton_step(turn)
+    step.newton_converged(True, least_penalty=0.5, penalty=1.0,
+                          norms=None if norms is None else Norms(*norms))
+    return step
+
+
+def test_a_newton_solution_whose_last_step_passes_the_tests_ends_the_step():
+    """Measured as an iteration, the last step's change and residual over the
+    deformation's scale are tested (docs/method.md §11, "Convergence in Newton's terms"),
+    and its row holds them; the observer sees that row."""
+    calls = []
+    step = newton_rows((2e-12, 1e-13, 0.01), observer=lambda *row: calls.append(row) and False)
+    assert step.converged and step.finished and step.verified_by_newton
+    report = step.report()
+    assert report.iterations == 4 and report.newton_steps == 2
+    assert report.change == pytest.approx(2e-10) and report.constraint_residual == pytest.approx(1e-11)
+    assert calls[-1] == (4, pytest.approx(2e-10), pytest.approx(1e-11))
+    # over the scale the change fails rtol: the iteration goes on from the hand-over
+    step = newton_rows((2e-11, 0.0, 0.01))
+    assert not step.finished and step.history[-1][0] == 2e-11
+    # at the round-off floor (no norms) the iteration goes on, the step's row the turn
+    step = newton_rows(None)
+    assert not step.finished and step.history[-1][0] == 1e-11
+    assert step.verified_by_newton          # for the iteration after the attempt
+    step.observe(1e-10, 1e-10, penalty=1.0)
+    assert step.converged and step.verified_by_newton
+
+
+def test_an_observer_can_stop_a_step_newton_solved():
+    step = newton_rows((2e-12, 0.0, 1.0), observer=lambda *row: True)
+    assert step.finished and not step.converged
+    assert step.report().reason == STOP_OBSERVER
