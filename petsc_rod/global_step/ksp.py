@@ -52,6 +52,19 @@ def chain_solver(comm, operator, prefix):
     return ksp
 
 
+def note_changed_rows(ksp, rows, before):
+    """Tell the substructuring PC of ``ksp``, where it has one, that only the values of
+    ``rows`` (global indices) of its operator changed since the operator's object state
+    ``before`` (substructuring.InterfacePC.note_changed_rows: its next refactorisation
+    reads those rows alone); any other PC reads the matrix as PETSc gives it."""
+    pc = ksp.getPC()
+    if pc.getType() != PETSc.PC.Type.PYTHON:
+        return
+    context = pc.getPythonContext()
+    if isinstance(context, substructuring.InterfacePC):
+        context.note_changed_rows(ksp.getOperators()[1], rows, before)
+
+
 # The options prefixes of the LDL^T of the second variation (analysis/stability.py: the
 # stability test and the Newton steps' positive-definiteness test) and of the Newton
 # Jacobian's LU (analysis/jacobian.py).

@@ -21,7 +21,7 @@ of vertex i of the mesh's DMDA, as the P2 pair (vertex, midpoint) of the slope d
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.ksp import chain_solver, check_solved
+from petsc_rod.global_step.ksp import chain_solver, check_solved, note_changed_rows
 from petsc_rod.global_step.matrices import assemble_matrix
 from petsc_rod.scenes.boundary import is_held
 
@@ -144,6 +144,7 @@ class HermiteProblem:
         changed = (np.any(matrices != last_matrices, axis=(1, 2))
                    | np.any(vectors != last_vectors, axis=1))
         rows = self.rows[changed]
+        before = self.constrained.stateGet()
         if len(rows):
             delta = matrices[changed] - last_matrices[changed]
             self.matrix.setValuesRCV(rows, rows, delta, addv=PETSc.InsertMode.ADD_VALUES)
@@ -157,6 +158,12 @@ class HermiteProblem:
             np.copyto(last_vectors, vectors)
         for obj in (self.matrix, self.constrained, self.added_rhs):
             obj.assemble()
+        # the rows the changed elements add into, and the first owned vertex's (z, z'),
+        # which the previous rank's last element adds into: on several ranks the
+        # substructuring's refactorisation reads these rows alone
+        first = self.constrained.getOwnershipRange()[0]
+        note_changed_rows(self.ksp, np.concatenate([rows.ravel(), [first, first + 1]]),
+                          before)
 
     def set_added_rhs(self, element_vectors):
         """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added

@@ -279,23 +279,34 @@ def test_scalar_problem_on_all_ranks_agrees_with_one_rank(bordered):
         assert np.abs(mu_many - mu_one).max() <= ROUND_OFF * np.abs(mu_one).max()
 
 
+def python_pc_ksp(matrix, prefix):
+    """A preonly KSP on ``matrix`` whose PC is the substructuring's python PC, chosen by
+    options under ``prefix`` as a user would (the options removed once read)."""
+    database = PETSc.Options()
+    names = {f"{prefix}pc_type": "python",
+             f"{prefix}pc_python_type": substructuring.PYTHON_TYPE}
+    for name, value in names.items():
+        database.setValue(name, value)
+    ksp = PETSc.KSP().create(comm=matrix.getComm())
+    try:
+        ksp.setOperators(matrix)
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        ksp.setOptionsPrefix(prefix)
+        ksp.setFromOptions()
+    finally:
+        for name in names:
+            database.delValue(name)
+    return ksp
+
+
 def test_the_python_pc_is_selected_by_options_and_solves_through_ksp():
     """-<prefix>pc_type python with the PC's class: exact through KSPSolve (the path of
     any caller that is not ScalarProblem.solve), on one rank too."""
     comm = PETSc.COMM_WORLD
     fixed = (0, 81)
     mesh, matrix = chain_matrix(comm, 40, fixed)
-    database = PETSc.Options()
-    names = {"test_pc_pc_type": "python",
-             "test_pc_pc_python_type": substructuring.PYTHON_TYPE}
-    for name, value in names.items():
-        database.setValue(name, value)
-    ksp = PETSc.KSP().create(comm=comm)
+    ksp = python_pc_ksp(matrix, "test_pc_")
     try:
-        ksp.setOperators(matrix)
-        ksp.setType(PETSc.KSP.Type.PREONLY)
-        ksp.setOptionsPrefix("test_pc_")
-        ksp.setFromOptions()
         assert ksp.getPC().getType() == PETSc.PC.Type.PYTHON
         b, x = matrix.createVecs()
         b.getArray()[:] = right_hand_sides(mesh, 1)[0]
@@ -307,13 +318,69 @@ def test_the_python_pc_is_selected_by_options_and_solves_through_ksp():
         b.destroy()
         x.destroy()
     finally:
-        for name in names:
-            database.delValue(name)
-        ksp.destroy()
-        matrix.destroy()
-        mesh.destroy()
+        for obj in (ksp, matrix, mesh):
+            obj.destroy()
 
 
 def test_one_rank_keeps_the_cholesky_factorisation():
     _, _, kind = problem_on(PETSc.COMM_SELF, "test_sub_", False)
     assert kind == PETSc.PC.Type.CHOLESKY
+
+
+def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
+    """The riser's vertical problem changes a few elements at each change of the
+    seabed's active set and notes their rows (ksp.note_changed_rows): the next set-up
+    reads those rows alone, and the solves stay exact. A change not noted, before or
+    after a noted one, makes the set-up read every row (else the factor would be of a
+    matrix that is not the operator)."""
+    from petsc_rod.global_step.ksp import note_changed_rows
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, _ = hermite_matrix(comm, 24)
+    ksp = python_pc_ksp(matrix, "test_rows_")
+    read = []                   # the rows each refactorisation was told of
+    refactor = substructuring.ChainSolver.refactor
+
+    def recorded(self, operator, changed=None):
+        read.append(None if changed is None else sorted(changed))
+        return refactor(self, operator, changed)
+
+    monkeypatch.setattr(substructuring.ChainSolver, "refactor", recorded)
+    b, x = matrix.createVecs()
+    start, _ = matrix.getOwnershipRange()
+
+    def add_to_element(element, value, noted):
+        """value I added to an element's 4 x 4 block (rows 2e to 2e + 3), by the rank
+        that owns the element, noted as changed on every rank or not."""
+        rows = 2 * element + np.arange(4)
+        before = matrix.stateGet()
+        if mesh.element_start <= element < mesh.element_end:
+            matrix.setValuesRCV(rows[None, :].astype(PETSc.IntType),
+                                rows[None, :].astype(PETSc.IntType),
+                                value * np.eye(4)[None], addv=PETSc.InsertMode.ADD_VALUES)
+        matrix.assemble()
+        if noted:
+            note_changed_rows(ksp, np.concatenate([rows, [start, start + 1]]), before)
+
+    def solve_exactly():
+        b.getArray()[:] = right_hand_sides(mesh, 1)[0]
+        ksp.solve(b, x)
+        assert_solves(comm, matrix, [b.getArray().copy()], [x.getArray().copy()])
+
+    try:
+        solve_exactly()
+        element = mesh.element_start + 2            # an interior element on every rank
+        add_to_element(element, 0.5, noted=True)
+        solve_exactly()
+        owned = [r for r in list(2 * element + np.arange(4)) + [start, start + 1]
+                 if matrix.getOwnershipRange()[0] <= r < matrix.getOwnershipRange()[1]]
+        assert read[-1] == sorted(set(owned))
+        add_to_element(element + 1, 0.25, noted=False)      # not noted: every row read
+        solve_exactly()
+        assert read[-1] is None
+        add_to_element(element, 0.5, noted=False)           # not noted, then noted
+        add_to_element(element + 1, 0.5, noted=True)
+        solve_exactly()
+        assert read[-1] is None
+    finally:
+        for obj in (ksp, b, x, matrix, mesh):
+            obj.destroy()
