@@ -21,7 +21,8 @@ from petsc_rod.errors import RodDivergedError, RodError, RodInputError
 from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
                                  fewest_elements, largest_grading)
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
-                                   check_same_on_every_rank, check_snes_type, format_value,
+                                   check_same_on_every_rank, check_snes_type,
+                                   check_substructuring_switches, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
 from petsc_rod.scenes.blend import BlendedPath
@@ -64,6 +65,7 @@ def run(comm=None):
             values, given = read_options()
             check_anderson_depth()          # before any PETSc object is made
             check_snes_type()
+            check_substructuring_switches()
             if database.hasName("help"):
                 for line in help_text():
                     say(line)

@@ -403,6 +403,28 @@ def check_snes_type():
             f"of {'|'.join(FUNCTION_ONLY_SNES)} (and their -rod_snes_* options)")
 
 
+# The switches of the Newton systems' factorisation on several ranks (global_step/ksp.py,
+# SUBSTRUCTURING), read by PETSc's options database only when the first Newton system is
+# factored: checked here, before any work.
+SUBSTRUCTURING_SWITCHES = ("rod_newton_substructuring", "rod_inertia_substructuring")
+
+
+def check_substructuring_switches():
+    """Refuse a -rod_newton_substructuring or -rod_inertia_substructuring that is not a
+    true or false, before any work (PETSc's own error came only at the first Newton
+    step, after the iterations before it)."""
+    database = PETSc.Options()
+    for name in SUBSTRUCTURING_SWITCHES:
+        if database.hasName(name):
+            text = database.getString(name, "")
+            try:
+                _bool(text)
+            except ValueError:
+                raise RodInputError(
+                    f"-{name} {text}: expected true or false (whether the Newton steps' "
+                    "systems are factored by substructuring on several ranks)") from None
+
+
 def check_same_on_every_rank(comm):
     """Refuse a run whose ranks were given different options (e.g. an option on one rank
     only), which would otherwise crash or deadlock in the first collective call: the

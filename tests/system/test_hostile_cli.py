@@ -268,6 +268,20 @@ def test_an_unknown_solver_type_exits_2(tmp_path):
 
 
 CANTILEVER = ["-options_file", "options/cantilever.opts", "-rod_elements", "8"]
+
+
+@pytest.mark.parametrize("name, ranks", [("rod_newton_substructuring", 2),
+                                         ("rod_inertia_substructuring", 1)])
+def test_a_substructuring_switch_that_is_no_bool_is_refused_before_any_work(tmp_path, name,
+                                                                           ranks):
+    """PETSc read it only at the first Newton system's factorisation: an error of its
+    own (exit 4) after the iterations before it."""
+    path = tmp_path / "out.h5"
+    done = run(CANTILEVER + [f"-{name}", "maybe", "-rod_output", str(path)], ranks)
+    text = done.stdout + done.stderr
+    assert_one_line_and_nothing_left(done.returncode, text, 2,
+                                     [f"-{name} maybe", "true or false"], path)
+    assert "elements on" not in text, text          # refused before the run started
 JACOBIAN_SNES = ["newtonls", "newtontr", "ngs", "ksponly", "fas", "nasm", "composite",
                  "shell", "vinewtonrsls"]
 
