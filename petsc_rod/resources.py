@@ -14,6 +14,13 @@ from petsc_rod.errors import RodInputError
 # proportion") and per rank (the interpreter, PETSc, MPI).
 BYTES_PER_ELEMENT = 20 * 2**10
 BYTES_PER_RANK = 80 * 2**20
+# A run whose Newton steps carry the node heights (a seabed: the positions' chain of
+# analysis/positions.py in the Newton systems and their factors) needs more than twice
+# that: options/riser_catenary.opts at 72 000 elements peaked at 3.27 GB on one rank (45
+# KiB per element, with or without its current) and 3.96 GB on two (53 KiB), against
+# 1.18 GB on one rank without Newton steps and 1.39 GB for options/catenary.opts (19 KiB);
+# rounded up (docs/performance.md, "Issue 21, fourth pass").
+BYTES_PER_ELEMENT_HEIGHTS = 56 * 2**10
 # Anderson mixing keeps 2 m vectors of the node state (18 numbers at 2 nodes per
 # element): 576 bytes per element and unit of depth, allocated (and written: PETSc zeroes
 # them) when the SNES is set up. Its default depth is the largest up to DEFAULT_DEPTH
@@ -32,9 +39,16 @@ ANDERSON_SHARE = 0.25
 MAX_ELEMENTS = int(np.iinfo(PETSc.IntType).max) // 2 - 1
 
 
-def needed_memory(elements, ranks):
-    """Bytes a run of ``elements`` elements on ``ranks`` ranks needs, estimated."""
-    return ranks * BYTES_PER_RANK + elements * BYTES_PER_ELEMENT
+def bytes_per_element(heights_in_newton):
+    """The memory estimate per element: BYTES_PER_ELEMENT, or BYTES_PER_ELEMENT_HEIGHTS
+    where the Newton steps carry the node heights (``heights_in_newton``)."""
+    return BYTES_PER_ELEMENT_HEIGHTS if heights_in_newton else BYTES_PER_ELEMENT
+
+
+def needed_memory(elements, ranks, per_element=BYTES_PER_ELEMENT):
+    """Bytes a run of ``elements`` elements on ``ranks`` ranks needs, estimated with
+    ``per_element`` bytes an element."""
+    return ranks * BYTES_PER_RANK + elements * per_element
 
 
 def anderson_depth(local_elements, ranks_here):
@@ -89,10 +103,11 @@ def size_text(nbytes):
         nbytes /= 1024
 
 
-def check_elements_fit(comm, elements):
+def check_elements_fit(comm, elements, per_element=BYTES_PER_ELEMENT):
     """Refuse an element count PETSc cannot index or distribute (every rank owns a
-    vertex), or whose estimated memory exceeds what a machine has available (the share
-    of the ranks it runs). Collective."""
+    vertex), or whose estimated memory (``per_element`` bytes an element,
+    bytes_per_element) exceeds what a machine has available (the share of the ranks it
+    runs). Collective."""
     if elements > MAX_ELEMENTS:
         raise RodInputError(f"-rod_elements {elements}: at most {MAX_ELEMENTS} elements fit "
                             "in PETSc's integers (2 dofs per vertex)")
@@ -102,15 +117,15 @@ def check_elements_fit(comm, elements):
                             f"needs a vertex; use at least {mpi.Get_size() - 1} elements or "
                             "fewer ranks")
     here = ranks_on_this_machine(comm)
-    needed = needed_memory(elements * here / mpi.Get_size(), here)
+    needed = needed_memory(elements * here / mpi.Get_size(), here, per_element)
     known = [value for value in mpi.allgather(available_memory()) if value is not None]
     available = min(known) if known else None
     if available is not None and needed > available:
-        largest = max(int((available - here * BYTES_PER_RANK) / BYTES_PER_ELEMENT
+        largest = max(int((available - here * BYTES_PER_RANK) / per_element
                           * mpi.Get_size() / here), 0)
         raise RodInputError(
             f"-rod_elements {elements}: the run needs about {size_text(needed)} of memory "
-            f"({size_text(BYTES_PER_ELEMENT)} per element), this machine has "
+            f"({size_text(per_element)} per element), this machine has "
             f"{size_text(available)} available; use at most about {largest:.2g} elements, "
             "or more machines")
 

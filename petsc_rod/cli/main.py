@@ -74,7 +74,8 @@ def run(comm=None):
             pieces = mesh_pieces(values, scene, given)
             if pieces is not None:          # the sections' elements, every section end a vertex
                 values["rod_elements"] = int(pieces.counts.sum())
-            check_mesh(comm, values)
+            check_mesh(comm, values, resources.bytes_per_element(
+                settings.newton and scene.seabed is not None))
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:
@@ -178,8 +179,9 @@ def abort_alone(comm, message, partial=None):
     comm.tompi4py().Abort(RodDivergedError.exit_code)
 
 
-def check_mesh(comm, values):
-    """Refuse, before it is allocated, a mesh the machine cannot hold, a grading the
+def check_mesh(comm, values, per_element=resources.BYTES_PER_ELEMENT):
+    """Refuse, before it is allocated, a mesh the machine cannot hold (``per_element``
+    bytes an element: resources.bytes_per_element), a grading the
     mesh's smooth map cannot build on that many elements (mesh.largest_grading: 1 for 1
     or 2 elements, about 3 N^2 / pi^2 for N), or one whose smallest elements double
     precision cannot resolve. Any mesh of N elements whose largest element is q times its
@@ -187,7 +189,7 @@ def check_mesh(comm, values):
     first, so a grading no mesh could resolve is said as such."""
     elements, length = values["rod_elements"], values["rod_length"]
     grading = values["rod_mesh_grading"]
-    resources.check_elements_fit(comm, elements)
+    resources.check_elements_fit(comm, elements, per_element)
 
     def unresolved(smallest):
         return RodInputError(
