@@ -39,10 +39,11 @@ ANDERSON_SHARE = 0.25
 MAX_ELEMENTS = int(np.iinfo(PETSc.IntType).max) // 2 - 1
 
 
-def bytes_per_element(heights_in_newton):
+def bytes_per_element(heights_factored):
     """The memory estimate per element: BYTES_PER_ELEMENT, or BYTES_PER_ELEMENT_HEIGHTS
-    where the Newton steps carry the node heights (``heights_in_newton``)."""
-    return BYTES_PER_ELEMENT_HEIGHTS if heights_in_newton else BYTES_PER_ELEMENT
+    where a second variation that carries the node heights may be factored
+    (``heights_factored``: a seabed, with Newton steps or the stability test on)."""
+    return BYTES_PER_ELEMENT_HEIGHTS if heights_factored else BYTES_PER_ELEMENT
 
 
 def needed_memory(elements, ranks, per_element=BYTES_PER_ELEMENT):

@@ -75,7 +75,8 @@ def run(comm=None):
             if pieces is not None:          # the sections' elements, every section end a vertex
                 values["rod_elements"] = int(pieces.counts.sum())
             check_mesh(comm, values, resources.bytes_per_element(
-                settings.newton and scene.seabed is not None))
+                scene.seabed is not None
+                and (settings.newton or settings.check_stability)))
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:

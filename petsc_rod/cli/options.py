@@ -413,10 +413,10 @@ def check_substructuring_switches():
     """Refuse a -rod_newton_substructuring or -rod_inertia_substructuring that is not a
     true or false, before any work (PETSc's own error came only at the first Newton
     step, after the iterations before it)."""
-    database = PETSc.Options()
+    given = PETSc.Options().getAll()        # read without marking them used
     for name in SUBSTRUCTURING_SWITCHES:
-        if database.hasName(name):
-            text = database.getString(name, "")
+        if name in given:
+            text = given[name]
             try:
                 _bool(text)
             except ValueError:

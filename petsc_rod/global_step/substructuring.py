@@ -53,7 +53,7 @@ class SeqCholesky:
     def __init__(self, n, indptr, indices, values):
         self._csr = (np.array(indptr, dtype=PETSc.IntType),
                      np.array(indices, dtype=PETSc.IntType),
-                     np.array(values, dtype=float))
+                     np.array(values, dtype=PETSc.ScalarType))
         self.matrix = PETSc.Mat().createAIJWithArrays((n, n), self._csr,
                                                       comm=PETSc.COMM_SELF)
         self.matrix.assemble()
@@ -349,8 +349,8 @@ class InterfacePC:
 
     def __init__(self):
         self.solver = None
-        self._state = None          # the Pmat's object state at the last set-up
-        self._changes = None        # (state, owned rows) noted since (note_changed_rows)
+        self._state = None          # (Pmat, its object state) at the last set-up
+        self._changes = None        # (Pmat, state, owned rows) noted since (note_changed_rows)
 
     def note_changed_rows(self, pmat, rows, before):
         """The caller changed only the values of ``rows`` (global indices; the owned
@@ -361,12 +361,13 @@ class InterfacePC:
         start, end = pmat.getOwnershipRange()
         rows = np.asarray(rows, dtype=np.int64)
         rows = rows[(rows >= start) & (rows < end)]
-        if self._changes is not None and self._changes[0] == before:
-            rows = np.union1d(self._changes[1], rows)
-        elif before != self._state:
+        if (self._changes is not None and self._changes[0] == pmat.handle
+                and self._changes[1] == before):
+            rows = np.union1d(self._changes[2], rows)
+        elif (pmat.handle, before) != self._state:
             self._changes = None
             return
-        self._changes = (pmat.stateGet(), np.unique(rows))
+        self._changes = (pmat.handle, pmat.stateGet(), np.unique(rows))
 
     def setUp(self, pc):
         """The solver of the PC's Pmat: the last one refactored where the pattern is
@@ -374,10 +375,10 @@ class InterfacePC:
         change since the last set-up was noted), else a new one."""
         _, pmat = pc.getOperators()
         state = pmat.stateGet()
-        changed = (self._changes[1] if self._changes is not None
-                   and self._changes[0] == state else None)
+        changed = (self._changes[2] if self._changes is not None
+                   and self._changes[:2] == (pmat.handle, state) else None)
         self._changes = None
-        self._state = state
+        self._state = (pmat.handle, state)
         if self.solver is not None and self.solver.refactor(pmat, changed):
             return
         self.destroy(pc)

@@ -9,6 +9,7 @@ A Decision is one of
     ITERATE        go on with the SNES
     CONVERGED      both stopping tests hold (§6)
     TRY_NEWTON     near a solution and still slow: Newton steps (§11), then the SNES again
+                   (or CONVERGED at the attempt: newton_converged)
     RAISE_PENALTY  R far below the problem's scale and the residual not falling: refactor
     STOP           not converged, with a reason (stopping.STOP_* or "snes_<reason>")
     DIVERGED       the iteration diverged; ``error`` holds the RodDivergedError
@@ -224,7 +225,7 @@ class StepController:
         them the last step's row holds them, the observer is asked, and the step
         converges there, in Newton's terms, where they pass the stopping test: the
         state is Newton's solution, not iterated again (docs/method.md §11,
-        "Hand-over"). Returns the penalty to raise R (N) to when the handed-over state
+        "Convergence in Newton's terms"). Returns the penalty to raise R (N) to when the handed-over state
         needs at least ``least_penalty`` to stay a fixed point, else None."""
         self.events.append(events.NewtonAttempt(self.label, len(self.history), "converged"))
         if verified:

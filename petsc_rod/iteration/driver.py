@@ -114,7 +114,8 @@ class UzawaSolver:
             self._iterate(step)
             while step.converged and self.tests_stability:
                 if step.verified_by_newton:
-                    # Newton's last factorisation, one iteration ago, showed it stable
+                    # Newton's last factorisation, at the attempt the step ended at or
+                    # one iteration before, showed it stable
                     step.stability_tested(True)
                     break
                 stable, direction = self.check_stability()

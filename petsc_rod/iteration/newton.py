@@ -25,8 +25,10 @@ A step is taken only where H is positive definite on the constraint set (the ine
 its factorisation, as in the stability test): Newton then heads for a local minimiser,
 never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
 Uzawa iteration goes on from where it was. On success the state is handed back as a
-fixed point of the Uzawa iteration: tau = d and lambda = -g / w, so that the next
-iteration (whose tests decide convergence, as always) moves it only by round-off.
+fixed point of the Uzawa iteration: tau = d and lambda = -g / w. Where the attempt's
+steps converged on the whole problem its last step, measured as an iteration, may end
+the step (``solved_norms``, controller.newton_converged); otherwise the next iteration,
+whose tests then decide convergence, moves it only by the map's round-off.
 
 On an extensible line (docs/method.md §12) the fields are g = (d1, d2, k d3), k = 1 + eps
 the stretch of each node, and what the Uzawa fixed point is stationary for is
@@ -120,11 +122,14 @@ class NewtonPolish:
         self.stretch = getattr(problem, "axial", None) is not None
         self._held_stretch = (~self._free | ~np.isfinite(problem.axial)) if self.stretch \
             else None
-        # whether the steps solve the whole problem: not where a clamp's stretch is held
-        # at the force balance's value of the last iteration (§12), which the iterations
-        # after the hand-over bring up to date
-        self._whole = not (self.stretch and problem.mesh.global_max(
-            int(np.any(~self._free & np.isfinite(problem.axial)))))
+        # whether a converged attempt's state is the step's result: not where a clamp's
+        # stretch is held at the force balance's value of the last iteration (§12), nor
+        # where a term's outputs are those of the last global step (Term
+        # .outputs_of_state: the friction), which the iterations after the hand-over
+        # bring up to date
+        self._whole = all(term.outputs_of_state for term in problem.terms) and not (
+            self.stretch and problem.mesh.global_max(
+                int(np.any(~self._free & np.isfinite(problem.axial)))))
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite, with the state's own curvature: the stability test's verdict,
         # at 1e-10 rad from the result (a chord step, FREEZE_TURN, tests nothing)

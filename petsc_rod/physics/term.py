@@ -21,7 +21,7 @@ When each is called:
   steps of §11 and the second variation of §10): ``energy``, ``add_gradient``,
   ``add_strain_gradient``, ``add_hessian`` and, for a load without potential,
   ``add_jacobian``; ``conservative``, ``in_newton``, ``position_components``,
-  ``follower`` and ``unsymmetric`` say what they are;
+  ``follower``, ``unsymmetric`` and ``outputs_of_state`` say what they are;
 * the load path (iteration/continuation.py): ``accept_step`` at the end of every
   accepted load step (a path-dependent term's memory: the friction's anchors);
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
@@ -72,6 +72,12 @@ class Term:
     # Jacobian by LU and each must lower |grad L|; H (the stability test, the safeguard)
     # is that of the term's load held at its current value
     unsymmetric = False
+    # the term's outputs and its share of the internal force are functions of the state
+    # (fields, frames, multipliers), so that a step may end at a Newton state (§11,
+    # "Convergence in Newton's terms"); False where they are what the last global step
+    # solved (the friction's return map at its solved positions): a step that Newton
+    # steps finish then ends at an iteration after them, which solves them anew
+    outputs_of_state = True
     # when in_newton is False: what the term is and where its limits are documented, for
     # the line that says a run takes no Newton steps (cli/lines.no_newton)
     newton_gap = ""

@@ -121,6 +121,9 @@ class FrictionTerm(NodalLoadTerm):
     slope_components = position_components = (0, 1)
     conservative = False
     unsymmetric = True
+    # the recorded force, reactions and use are the last global step's (_record): a
+    # step that Newton steps finish ends at the iteration after them (Term)
+    outputs_of_state = False
     newton_gap = ("seabed friction with two coefficients or on a seabed that is not flat "
                   "(docs/riser.md §3b)")
 

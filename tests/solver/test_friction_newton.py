@@ -27,6 +27,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import make_solver
+from petsc_rod.iteration.events import NewtonAttempt
 from petsc_rod.iteration.newton import NewtonPolish
 from petsc_rod.riser.environment import Friction, Seabed
 from petsc_rod.riser.friction import FrictionTerm
@@ -199,6 +200,34 @@ def test_newton_reaches_the_iterations_state(comm):
     length = LINES[line][0]["length"]
     assert np.abs(r_plain - r_newton).max() < 1e-6 * length
     assert np.allclose(end_plain, end_newton, rtol=1e-6, atol=1e-6 * np.abs(end_plain).max())
+
+
+def test_a_friction_step_ends_after_its_newton_attempt(comm):
+    """The friction's force, reactions and use are the last global step's (its return
+    map at the solved positions): a step that Newton steps finish ends at an iteration
+    after them (Term.outputs_of_state, docs/method.md §11), and the friction's outputs
+    and the reaction they make are those of the iteration without Newton steps. The
+    line with a free start at 80 elements ended at its attempt without this (19
+    iterations, the attempt at 19), its recorded friction that of the iterate before
+    the attempt."""
+    runs = {}
+    for newton in (False, True):
+        mesh, solver, report = converged(comm, "free start", newton=newton, n_elements=80)
+        problem = solver.problem
+        friction = next(term for term in problem.terms if isinstance(term, FrictionTerm))
+        runs[newton] = (report, problem.end_reaction(),
+                        mesh.global_max(float(np.abs(friction.force).max())))
+        solver.destroy()
+        problem.destroy()
+        mesh.destroy()
+    (plain, end_plain, force_plain), (polished, end_newton, force_newton) = runs[False], runs[True]
+    assert plain.converged and polished.converged
+    attempts = [event for event in polished.events if isinstance(event, NewtonAttempt)]
+    assert attempts[-1].outcome == "converged"
+    assert attempts[-1].iteration < polished.iterations
+    # the two runs' states agree to their tolerance, as in the test above
+    assert np.allclose(end_newton, end_plain, rtol=1e-6, atol=1e-6 * np.abs(end_plain).max())
+    assert force_newton == pytest.approx(force_plain, rel=1e-6)
 
 
 def test_newton_steps_take_friction_of_one_coefficient(comm):

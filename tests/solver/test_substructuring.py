@@ -331,8 +331,8 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
     """The riser's vertical problem changes a few elements at each change of the
     seabed's active set and notes their rows (ksp.note_changed_rows): the next set-up
     reads those rows alone, and the solves stay exact. A change not noted, before or
-    after a noted one, makes the set-up read every row (else the factor would be of a
-    matrix that is not the operator)."""
+    after a noted one, before the next set-up, makes the set-up read every row (else the
+    factor would be of a matrix that is not the operator)."""
     from petsc_rod.global_step.ksp import note_changed_rows
     comm = PETSc.COMM_WORLD
     mesh, matrix, _ = hermite_matrix(comm, 24)
@@ -379,6 +379,10 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
         assert read[-1] is None
         add_to_element(element, 0.5, noted=False)           # not noted, then noted
         add_to_element(element + 1, 0.5, noted=True)
+        solve_exactly()
+        assert read[-1] is None
+        add_to_element(element, 0.5, noted=True)            # noted, then not noted
+        add_to_element(element + 1, 0.5, noted=False)
         solve_exactly()
         assert read[-1] is None
     finally:
