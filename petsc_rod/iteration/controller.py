@@ -225,8 +225,9 @@ class StepController:
         them the last step's row holds them, the observer is asked, and the step
         converges there, in Newton's terms, where they pass the stopping test: the
         state is Newton's solution, not iterated again (docs/method.md §11,
-        "Convergence in Newton's terms"). Returns the penalty to raise R (N) to when the handed-over state
-        needs at least ``least_penalty`` to stay a fixed point, else None."""
+        "Convergence in Newton's terms"). Returns the penalty to raise R (N) to when
+        the handed-over state needs at least ``least_penalty`` to stay a fixed point,
+        else None."""
         self.events.append(events.NewtonAttempt(self.label, len(self.history), "converged"))
         if verified:
             self.newton_verified = len(self.history)
