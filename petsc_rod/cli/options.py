@@ -21,6 +21,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.global_step.ksp import INERTIA_PREFIX, NEWTON_PREFIX, SUBSTRUCTURING
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
@@ -406,7 +407,8 @@ def check_snes_type():
 # The switches of the Newton systems' factorisation on several ranks (global_step/ksp.py,
 # SUBSTRUCTURING), read by PETSc's options database only when the first Newton system is
 # factored: checked here, before any work.
-SUBSTRUCTURING_SWITCHES = ("rod_newton_substructuring", "rod_inertia_substructuring")
+SUBSTRUCTURING_SWITCHES = tuple(f"{prefix}{SUBSTRUCTURING}"
+                                for prefix in (NEWTON_PREFIX, INERTIA_PREFIX))
 
 
 def check_substructuring_switches():
