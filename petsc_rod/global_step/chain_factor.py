@@ -116,31 +116,33 @@ class ChainFactor:
         rows coupled to the next interface's columns, ``back`` the previous rank's rows
         (counted back from its end) whose columns the own interface's rows couple to."""
         B, off = self.block, self.offset
-        indptr, columns, _ = matrix.getValuesCSR()
-        rows = np.repeat(np.arange(self.n), np.diff(indptr))
         if self.n - off < B:
             return f"rows {start} to {end - 1}: no interior node on a rank"
         if self.n % B:
             return f"rows {start} to {end - 1}: not whole nodes of {B} unknowns"
-        interior = rows >= off
-        own = interior & (columns >= start) & (columns < start + off)
-        following = interior & (columns >= end) & (columns < end + B)
-        inside = (columns >= start) & (columns < end)
-        stray = interior & ~inside & ~following
-        if off:
-            # the interface's rows: its own rows, the interior and the previous rank
-            stray |= ~interior & (columns >= end)
+        indptr, columns, _ = matrix.getValuesCSR()
+        lowest, highest = _row_reach(indptr, columns, start, end)
+        # an interior row reaches the own interface, the interior and the next rank's
+        # interface: columns [start, end + B); the interface's rows reach back into the
+        # previous rank and forward into the interior, not beyond it
+        stray = lowest < start
+        stray[off:] |= highest[off:] >= end + B
+        stray[:off] = highest[:off] >= end
         if stray.any():
             i = int(np.flatnonzero(stray)[0])
-            return (f"row {start + rows[i]} couples to row {columns[i]}: not a chain split "
+            column = lowest[i] if i >= off and lowest[i] < start else highest[i]
+            return (f"row {start + i} couples to row {column}: not a chain split "
                     "at the ranks' first nodes")
-        self.head = int(rows[own].max()) + 1 - off if own.any() else 0
-        self.tail = self.n - int(rows[following].min()) if following.any() else 0
-        into_interior = ~interior & (columns >= start + off) & (columns < end)
-        self.head_columns = (int(columns[into_interior].max()) + 1 - start - off
-                             if into_interior.any() else 0)
-        backward = ~interior & (columns < start)
-        self.back = start - int(columns[backward].min()) if backward.any() else 0
+        interior_low, interior_high = lowest[off:], highest[off:]
+        own = np.flatnonzero(interior_low < start + off)
+        self.head = int(own[-1]) + 1 if own.size else 0
+        following = np.flatnonzero(interior_high >= end)
+        self.tail = self.n - off - int(following[0]) if following.size else 0
+        interface_high, interface_low = highest[:off], lowest[:off]
+        reached = interface_high[interface_high >= start + off]
+        self.head_columns = int(reached.max()) + 1 - start - off if reached.size else 0
+        backward = interface_low[interface_low < start]
+        self.back = start - int(backward.min()) if backward.size else 0
         return None
 
     # --- the factorisation ------------------------------------------------------------
@@ -326,6 +328,21 @@ def _equilibration(matrix, symmetric, sweeps=RUIZ_SWEEPS):
         columns = rows.copy() if symmetric else columns * inverse_root(
             scaled.max(axis=0, initial=0.0))
     return rows, columns
+
+
+def _row_reach(indptr, columns, start, end):
+    """(lowest, highest): the least and the greatest column of each local row of a CSR
+    pattern (indptr (n + 1,), columns (nnz,)) of the rank's rows [start, end); a row
+    without entries reaches nothing (end and start - 1). One pass over the entries, in
+    C: the chain's checks then look at n rows, not at every entry."""
+    n = len(indptr) - 1
+    lowest, highest = np.full(n, end, dtype=np.int64), np.full(n, start - 1, dtype=np.int64)
+    filled = np.flatnonzero(np.diff(indptr) > 0)
+    if filled.size:
+        first = indptr[:-1][filled]
+        lowest[filled] = np.minimum.reduceat(columns, first)
+        highest[filled] = np.maximum.reduceat(columns, first)
+    return lowest, highest
 
 
 def _nonzeros(matrix):

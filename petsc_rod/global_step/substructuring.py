@@ -137,7 +137,7 @@ class ChainSolver:
         first = start + self.offset
         n_interior = end - first
         self._inside = (row_of >= first) & (cols >= first) & (cols < end)
-        self._keep = self._envelope(row_of, cols, values, start, end)
+        self._keep = self._envelope(rows, row_of, cols, values, start, end)
         self.interior = self._interior_block(row_of, cols, values, first, n_interior)
         self.W = np.zeros((2 * width, n_interior))     # rows: columns of W, contiguous
         self._work = np.zeros(n_interior)
@@ -146,7 +146,7 @@ class ChainSolver:
         self._values = values                       # their values, of the last factorisation
         self._couple_and_reduce(row_of, cols, values, start, end)
 
-    def _envelope(self, row_of, cols, values, start, end):
+    def _envelope(self, indptr, row_of, cols, values, start, end):
         """Which entries of the local rows make the interior block A_II: its nonzero
         ones, its diagonal, and its zeros within the envelope of the nonzero ones (entry
         (i, j) with min(i, j) at or right of the first nonzero column of row max(i, j)).
@@ -157,8 +157,13 @@ class ChainSolver:
         Zeros outside the envelope are left out: the P2 chains' DMDA stencil couples a
         midpoint to the next midpoint with zeros, which would widen the band."""
         nonzero = self._inside & ((values != 0.0) | (cols == row_of))
+        # each row's first nonzero column (end where it has none): a minimum over the
+        # row's entries, which the CSR keeps together
         first_column = np.full(end - start, end)
-        np.minimum.at(first_column, row_of[nonzero] - start, cols[nonzero])
+        filled = np.flatnonzero(np.diff(indptr) > 0)
+        if filled.size:
+            first_column[filled] = np.minimum.reduceat(np.where(nonzero, cols, end),
+                                                       indptr[:-1][filled])
         later = np.maximum(row_of, cols)
         within = np.zeros_like(nonzero)
         within[self._inside] = (np.minimum(row_of, cols)[self._inside]

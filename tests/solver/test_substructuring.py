@@ -388,3 +388,53 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
     finally:
         for obj in (ksp, b, x, matrix, mesh):
             obj.destroy()
+
+
+def test_a_change_beside_a_rank_boundary_refactors_the_next_rank_s_interface():
+    """The riser's vertical problem (riser/hermite.py): a spring changed on the last
+    element of a rank adds into the next rank's first vertex (z, z'), its interface
+    rows, though none of that rank's elements changed. HermiteProblem.set_added notes
+    those rows on every rank, so the refactorisation that reads only noted rows
+    (ksp.note_changed_rows) reads them there; the solve then equals a new problem's
+    with the same springs, to round-off. On one rank the element is the middle one."""
+    from petsc_rod.riser.hermite import HermiteProblem
+    from petsc_rod.scenes.scene import EndState
+    comm = PETSc.COMM_WORLD
+    n_elements = 24
+    mesh = Mesh(comm, n_elements, 2.0)
+    starts = comm.tompi4py().allgather(mesh.element_start)
+    changed_element = starts[1] - 1 if comm.getSize() > 1 else n_elements // 2
+    slope_matrices = p2_element_matrices(mesh.element_h, 2.0, 50.0)
+    ends = [EndState("pin", np.array(p, dtype=float), np.eye(3), np.zeros(3))
+            for p in ((0.0, 0.0, 0.0), (2.0, 0.0, 0.5))]
+    owned = np.arange(mesh.element_start, mesh.element_end)
+
+    def springs(stiffer):
+        """k I on each element's (z, z') of both vertices, k larger on one element."""
+        k = 10.0 + 40.0 * (owned == changed_element) * stiffer
+        return k[:, None, None] * np.eye(4), 0.1 * k[:, None] * np.ones(4)
+
+    def solved(problem):
+        slope_rhs = mesh.da.createGlobalVec()
+        slope = slope_rhs.duplicate()
+        vertices = np.arange(2 * mesh.vertex_start, 2 * mesh.vertex_end)
+        slope_rhs.getArray()[:] = np.sin(0.3 * vertices)
+        y = problem.solve(slope_rhs, slope).getArray().copy()
+        for vec in (slope_rhs, slope):
+            vec.destroy()
+        return y
+
+    updated = HermiteProblem(mesh, slope_matrices, "test_boundary_")
+    fresh = HermiteProblem(mesh, slope_matrices, "test_boundary_fresh_")
+    with destroyed_after(updated, fresh, mesh):
+        for problem in (updated, fresh):
+            problem.set_end_states(*ends)
+        updated.set_added(*springs(False))
+        solved(updated)                             # factored with the first springs
+        updated.set_added(*springs(True))           # refactored from the noted rows
+        fresh.set_added(*springs(True))
+        y, reference = solved(updated), solved(fresh)
+        scale = global_max(comm, np.abs(reference).max())
+        assert global_max(comm, np.abs(y - reference).max()) <= ROUND_OFF * scale
+        if comm.getSize() > 1 and comm.getRank() == 1:
+            assert mesh.element_start == changed_element + 1      # none of its own
