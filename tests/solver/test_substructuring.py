@@ -414,7 +414,7 @@ def test_a_change_beside_a_rank_boundary_refactors_the_next_rank_s_interface():
         k = 10.0 + 40.0 * (owned == changed_element) * stiffer
         return k[:, None, None] * np.eye(4), 0.1 * k[:, None] * np.ones(4)
 
-    def solved(problem):
+    def hermite_solution(problem):
         slope_rhs = mesh.da.createGlobalVec()
         slope = slope_rhs.duplicate()
         vertices = np.arange(2 * mesh.vertex_start, 2 * mesh.vertex_end)
@@ -430,10 +430,10 @@ def test_a_change_beside_a_rank_boundary_refactors_the_next_rank_s_interface():
         for problem in (updated, fresh):
             problem.set_end_states(*ends)
         updated.set_added(*springs(False))
-        solved(updated)                             # factored with the first springs
+        hermite_solution(updated)                   # factored with the first springs
         updated.set_added(*springs(True))           # refactored from the noted rows
         fresh.set_added(*springs(True))
-        y, reference = solved(updated), solved(fresh)
+        y, reference = hermite_solution(updated), hermite_solution(fresh)
         scale = global_max(comm, np.abs(reference).max())
         assert global_max(comm, np.abs(y - reference).max()) <= ROUND_OFF * scale
         if comm.getSize() > 1 and comm.getRank() == 1:
