@@ -39,7 +39,7 @@ interior rows): ``destroy()``.
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.substructuring import NotAChainError
+from petsc_rod.global_step.substructuring import NotAChainError, row_reduce
 
 # The equilibrated interface's pseudo-inverse drops singular values (eigenvalues) below
 # this fraction of the largest: a null pivot, the free roll of a section with K1 = K2
@@ -121,7 +121,9 @@ class ChainFactor:
         if self.n % B:
             return f"rows {start} to {end - 1}: not whole nodes of {B} unknowns"
         indptr, columns, _ = matrix.getValuesCSR()
-        lowest, highest = _row_reach(indptr, columns, start, end)
+        # each row's least and greatest column; a row without entries reaches nothing
+        lowest = row_reduce(np.minimum, indptr, columns, end)
+        highest = row_reduce(np.maximum, indptr, columns, start - 1)
         # an interior row reaches the own interface, the interior and the next rank's
         # interface: columns [start, end + B); the interface's rows reach back into the
         # previous rank and forward into the interior, not beyond it
@@ -328,21 +330,6 @@ def _equilibration(matrix, symmetric, sweeps=RUIZ_SWEEPS):
         columns = rows.copy() if symmetric else columns * inverse_root(
             scaled.max(axis=0, initial=0.0))
     return rows, columns
-
-
-def _row_reach(indptr, columns, start, end):
-    """(lowest, highest): the least and the greatest column of each local row of a CSR
-    pattern (indptr (n + 1,), columns (nnz,)) of the rank's rows [start, end); a row
-    without entries reaches nothing (end and start - 1). One pass over the entries, in
-    C: the chain's checks then look at n rows, not at every entry."""
-    n = len(indptr) - 1
-    lowest, highest = np.full(n, end, dtype=np.int64), np.full(n, start - 1, dtype=np.int64)
-    filled = np.flatnonzero(np.diff(indptr) > 0)
-    if filled.size:
-        first = indptr[:-1][filled]
-        lowest[filled] = np.minimum.reduceat(columns, first)
-        highest[filled] = np.maximum.reduceat(columns, first)
-    return lowest, highest
 
 
 def _nonzeros(matrix):

@@ -95,6 +95,19 @@ class SeqCholesky:
             obj.destroy()
 
 
+def row_reduce(ufunc, indptr, values, empty):
+    """``ufunc`` (np.minimum, np.maximum) over each row's entries ``values`` (nnz,) of a
+    CSR pattern with row pointers ``indptr`` (n + 1,), as an (n,) int64 array; ``empty``
+    where a row has none. One pass over the entries in C (reduceat), where the checks
+    and envelopes that follow look at n rows, not at every entry."""
+    n = len(indptr) - 1
+    reduced = np.full(n, empty, dtype=np.int64)
+    filled = np.flatnonzero(np.diff(indptr) > 0)
+    if filled.size:
+        reduced[filled] = ufunc.reduceat(values, indptr[:-1][filled])
+    return reduced
+
+
 class NotAChainError(ValueError):
     """The matrix couples an interior row to a row of another rank other than the next
     rank's first row: the substructuring of this module does not apply."""
@@ -157,13 +170,8 @@ class ChainSolver:
         Zeros outside the envelope are left out: the P2 chains' DMDA stencil couples a
         midpoint to the next midpoint with zeros, which would widen the band."""
         nonzero = self._inside & ((values != 0.0) | (cols == row_of))
-        # each row's first nonzero column (end where it has none): a minimum over the
-        # row's entries, which the CSR keeps together
-        first_column = np.full(end - start, end)
-        filled = np.flatnonzero(np.diff(indptr) > 0)
-        if filled.size:
-            first_column[filled] = np.minimum.reduceat(np.where(nonzero, cols, end),
-                                                       indptr[:-1][filled])
+        # each row's first nonzero column (end where it has none)
+        first_column = row_reduce(np.minimum, indptr, np.where(nonzero, cols, end), end)
         later = np.maximum(row_of, cols)
         within = np.zeros_like(nonzero)
         within[self._inside] = (np.minimum(row_of, cols)[self._inside]
