@@ -15,7 +15,11 @@ interior I_p, which couples to G_p and G_p+1 only:
     x_I = y - W x_G.
 
 W has 2 B columns a rank (B where a rank has one neighbour) and is made at each
-factorisation, with one multiple-right-hand-side solve; S is ((P - 1) B) square, block
+factorisation, with one solve of sparse right-hand sides (A_IG is nonzero on the
+interior's first and last few rows only: MUMPS's forward elimination visits the paths
+of its elimination tree from them to the root, near which the AMF ordering places the
+first rows of the numbering; the first rank, whose coupling is its interior's tail,
+numbers its interior from its end); S is ((P - 1) B) square, block
 tridiagonal, assembled from every rank's contribution and inverted on every rank: dense,
 equilibrated (R S C by Ruiz's iteration, every row and column's largest entry about
 1; E S E of a symmetric S: its unknowns are turns, heights and resultants, whose
@@ -63,29 +67,37 @@ class ChainFactor:
     interiors' sequential MUMPS factorisations are the solvers ``make_solver(comm,
     operator)`` gives (ksp.lu_solver or ksp.inertia_solver on COMM_SELF, options under
     their prefix), set up with ``set_up(ksp, block)`` (ksp.set_up_mumps) and solved
-    with ``solve(ksp, columns)`` (ksp.solve_columns). Raises NotAChainError where a
+    with ``solve(ksp, columns)`` (ksp.solve_columns) and ``solve_sparse(ksp, rows,
+    values)`` (ksp.solve_sparse_columns: W's). Raises NotAChainError where a
     rank's rows couple otherwise (on every rank): a rank without an interior node, a
     middle rank whose interface reaches the next one's (a single element).
 
     Stored: W (2 B, n_I) (its columns as rows: the own interface's B first where there
     is one, then the next's), the own interface's rows A_G_p,I_p on the interior's first
     head_columns columns (B, head_columns), and the next interface's rows A_G_p+1,I_p on
-    its last next_back (B, next_back)."""
+    its last next_back (B, next_back); ``reversed``: the interior block's rows are the
+    rank's interior rows from its last (the first rank's), which ``_interior_solve``
+    undoes."""
 
-    def __init__(self, matrix, kind, block, make_solver, set_up, solve):
+    def __init__(self, matrix, kind, block, make_solver, set_up, solve, solve_sparse):
         comm = matrix.getComm()
         self._mpi = comm.tompi4py()
         self.size, self.rank = comm.getSize(), comm.getRank()
         self.kind, self.block = kind, block
         self._make_solver, self._set_up, self._solve = make_solver, set_up, solve
+        self._solve_sparse = solve_sparse
         self.symmetric = kind == PETSc.PC.Type.CHOLESKY
         start, end = matrix.getOwnershipRange()
         self.n = end - start
         self.offset = block if self.rank > 0 else 0
         self.has_next = self.rank < self.size - 1
         self._split(matrix)
-        self._index = PETSc.IS().createStride(self.n - self.offset, first=self.offset, step=1,
-                                              comm=PETSc.COMM_SELF)
+        # the first rank's interior numbered from its end: its couplings, to the next
+        # interface, come first, near the root of the elimination tree (W's solve)
+        self.reversed = self.offset == 0 and self.has_next
+        interior = np.arange(self.offset, self.n, dtype=PETSc.IntType)
+        self._index = PETSc.IS().createGeneral(interior[::-1] if self.reversed else interior,
+                                               comm=PETSc.COMM_SELF)
         self.interior = None
         self.ksp = None
         self.failed = False
@@ -184,25 +196,23 @@ class ChainFactor:
         if self.failed:
             return
         n_interior = self.n - off
-        # the couplings: A_I,G (W's right-hand sides) and A_G,I on the reaching rows
+        # the couplings: A_I,G (W's right-hand sides, on the interior's first head rows
+        # and last tail rows) and A_G,I on the reaching rows
         head = np.arange(start + off, start + off + self.head, dtype=PETSc.IntType)
         tail = np.arange(end - self.tail, end, dtype=PETSc.IntType)
         own = np.arange(start, start + off, dtype=PETSc.IntType)
         following = np.arange(end, end + B, dtype=PETSc.IntType) if self.has_next else own[:0]
-        columns = []
+        coupled = np.union1d(np.arange(self.head), np.arange(n_interior - self.tail, n_interior))
+        couplings = np.zeros((coupled.size, len(own) + len(following)))
         if off:
-            block = np.zeros((n_interior, B))
-            block[:self.head] = matrix.getValues(head, own) if self.head else 0.0
-            columns += list(block.T)
+            couplings[:self.head, :B] = matrix.getValues(head, own) if self.head else 0.0
             reached = np.arange(start + off, start + off + self.head_columns,
                                 dtype=PETSc.IntType)
             self._own_rows = (matrix.getValues(own, reached) if self.head_columns
                               else np.zeros((B, 0)))
             self._own_block = matrix.getValues(own, own)
-        if self.has_next:
-            block = np.zeros((n_interior, B))
-            block[n_interior - self.tail:] = matrix.getValues(tail, following) if self.tail else 0.0
-            columns += list(block.T)
+        if self.has_next and self.tail:
+            couplings[coupled.size - self.tail:, off:] = matrix.getValues(tail, following)
         # A_G_p,I_p-1: the own interface's rows on the previous rank's reaching columns,
         # sent to that rank, which holds y and W of I_p-1
         previous = (matrix.getValues(own, np.arange(start - self.back, start,
@@ -210,12 +220,27 @@ class ChainFactor:
                     if off and self.back else np.zeros((B if off else 0, 0)))
         received = self._mpi.allgather(previous)
         self._next_rows = received[self.rank + 1] if self.has_next else np.zeros((0, 0))
-        self.W = np.array(self._interior_solve(columns)).reshape(len(columns), n_interior)
+        self.W = self._coupling_solve(coupled, couplings)
         self._factor_interface(int(factor.getInertia()[0]) if self.symmetric else 0)
+
+    def _coupling_solve(self, rows, values):
+        """W = A_II^-1 A_IG, (k, n_interior), from A_IG's nonzero ``rows`` (interior
+        numbering) and their ``values`` (len(rows), k), by sparse right-hand sides."""
+        n_interior = self.n - self.offset
+        if not rows.size:
+            return np.zeros((values.shape[1], n_interior))
+        if self.reversed:
+            rows = n_interior - 1 - rows
+        W = self._solve_sparse(self.ksp, rows, values)
+        return np.ascontiguousarray(W[:, ::-1]) if self.reversed else W
 
     def _interior_solve(self, columns):
         """A_II^-1 of the local arrays ``columns`` (n_interior,) each, in one solve."""
-        return self._solve(self.ksp, columns) if columns else []
+        if not columns:
+            return []
+        if self.reversed:
+            return [x[::-1] for x in self._solve(self.ksp, [c[::-1] for c in columns])]
+        return self._solve(self.ksp, columns)
 
     def _factor_interface(self, interior_negative):
         """S from every rank's contributions (module docstring), its pseudo-inverse, and

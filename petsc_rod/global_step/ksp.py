@@ -175,6 +175,37 @@ def solve_columns(ksp, columns, rows=None):
     return solutions
 
 
+def solve_sparse_columns(ksp, rows, values):
+    """x_j = A^-1 b_j for right-hand sides zero but at the ``rows`` (r,) of the local
+    operator, where b_j is values[:, j] (``values`` (r, k)), with the factored operator
+    A of a sequential inertia_solver or lu_solver: MUMPS's sparse right-hand sides
+    (ICNTL 20, through MatMatSolve of a transposed AIJ), whose forward elimination visits
+    only the paths of the elimination tree from those rows to its root, about half the
+    cost of a dense solve where the rows sit near the root (docs/performance.md; the
+    backward one gives every row). Returns x, (k, n). A failed factorisation gives Inf."""
+    factor = ksp.getPC().getFactorMatrix()
+    operator = ksp.getOperators()[0]
+    comm, n, k = operator.getComm(), operator.getSize()[0], values.shape[1]
+    if factor.getMumpsInfog(1) < 0:
+        return np.full((k, n), np.inf)
+    order = np.argsort(rows)
+    transposed = PETSc.Mat().createAIJ((k, n), nnz=len(rows), comm=comm)
+    transposed.setValuesCSR(np.arange(k + 1, dtype=PETSc.IntType) * len(rows),
+                            np.tile(np.asarray(rows, dtype=PETSc.IntType)[order], k),
+                            np.ascontiguousarray(values[order].T))
+    transposed.assemble()
+    right = PETSc.Mat().createTranspose(transposed)
+    unknown = PETSc.Mat().createDense((n, k), comm=comm)
+    unknown.setUp()
+    unknown.assemble()
+    try:
+        factor.matSolve(right, unknown)
+        return unknown.getDenseArray(readonly=True).T.copy()
+    finally:
+        for obj in (right, transposed, unknown):
+            obj.destroy()
+
+
 def solve_vecs(factor, vecs, rows=None):
     """``factor.solve_columns`` (a direct_factor's) for the Vecs ``vecs``: new Vecs
     x_j = A^-1 b_j (the caller's to destroy). Collective."""
@@ -242,7 +273,8 @@ class SubstructuredFactor:
 
         def make(local_comm, local):
             return mumps_solver(local_comm, local, kind, prefix)
-        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns)
+        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns,
+                                  solve_sparse_columns)
 
     @property
     def substructured(self):

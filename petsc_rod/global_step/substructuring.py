@@ -13,14 +13,15 @@ interior rows ordered first, A = [A_II A_IG; A_GI A_GG] and
     x_I = y - W x_G.
 
 W has two columns per rank (g_p, g_{p+1}) and S is (P-1) x (P-1) and tridiagonal; both
-are formed once per matrix (set-up: two local solves and one allgather), and S is
-factored on every rank (PETSc's sequential Cholesky, like the interior blocks). A matrix
-whose values change on the same pattern (the riser's vertical problem at each change of
-the seabed's active set) is refactored numerically (``ChainSolver.refactor``): the
-symbolic factorisation of the interior blocks is kept, and where the caller noted which
-rows changed (``InterfacePC.note_changed_rows``: the vertical problem, a few elements
-beside the touchdown) only those rows are read, not every row by MatGetRow (on the
-riser at 18 000 elements, 2 ranks, a refactorisation 5.8 → 2.4 ms). A solve
+are formed once per matrix (set-up: two local solves and one Allgather of a few numbers
+a rank), and S is factored on every rank (PETSc's sequential Cholesky, like the interior
+blocks). A matrix whose values change on the same pattern (the riser's vertical problem
+at each change of the seabed's active set) is refactored numerically
+(``ChainSolver.refactor``): the symbolic factorisation of the interior blocks is kept,
+and where the caller noted which rows changed (``InterfacePC.note_changed_rows``: the
+vertical problem, a few elements beside the touchdown) only those rows are read (not
+every row by MatGetRow) and only their entries copied into the interior block
+(docs/performance.md has the costs). A solve
 is then one local half-chain Cholesky solve per right-hand side, an allgather of 2 k
 numbers per rank (k right-hand sides),
 the small tridiagonal solve, and x_I -= W x_G: it does the work of the serial Cholesky
@@ -67,16 +68,19 @@ class SeqCholesky:
         self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
         self._x = self._b.duplicate()
 
-    def has_pattern(self, indptr, indices):
-        """Whether the CSR pattern (indptr, indices) is this matrix's."""
-        return np.array_equal(indptr, self._csr[0]) and np.array_equal(indices, self._csr[1])
-
     def refactor(self, values):
         """The numeric factorisation of the matrix with ``values`` in place of its own,
         on the same CSR pattern (the symbolic one kept): the values copied into the
         matrix's own array, and its state raised (an assembly) so that the PC factors
         again."""
         np.copyto(self._csr[2], values)
+        self.matrix.assemble()
+        self._pc.setUp()
+
+    def refactor_entries(self, positions, values):
+        """refactor with ``values`` at the CSR ``positions`` (indices into the matrix's
+        values) and its other values kept: a change at a few rows copies those alone."""
+        self._csr[2][positions] = values
         self.matrix.assemble()
         self._pc.setUp()
 
@@ -157,7 +161,7 @@ class ChainSolver:
         self.schur = None
         self._pattern = (rows, cols, row_of)        # the local rows' (refactor)
         self._values = values                       # their values, of the last factorisation
-        self._couple_and_reduce(row_of, cols, values, start, end)
+        self._couple_and_reduce(values, start, end)
 
     def _envelope(self, indptr, row_of, cols, values, start, end):
         """Which entries of the local rows make the interior block A_II: its nonzero
@@ -179,12 +183,14 @@ class ChainSolver:
         return nonzero | within
 
     def _interior_block(self, row_of, cols, values, first, n_interior):
-        """A_II, the entries self._keep of the local rows, factored."""
+        """A_II, the entries self._keep of the local rows, factored; self._position: where
+        each local entry kept lies among A_II's values (refactor)."""
+        self._position = np.cumsum(self._keep) - 1
         counts = np.bincount(row_of[self._keep] - first, minlength=n_interior)
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
         return SeqCholesky(n_interior, indptr, cols[self._keep] - first, values[self._keep])
 
-    def _couple_and_reduce(self, row_of, cols, values, start, end):
+    def _couple_and_reduce(self, values, start, end):
         """W from the interior factor and the couplings, and S factored (refactored
         where its pattern is the last one's)."""
         self.W[:] = 0.0
@@ -193,7 +199,7 @@ class ChainSolver:
                 b = np.zeros(self.W.shape[1])
                 b[index] = value
                 self.interior.solve(b, self.W[column])
-        self._factor_interface(row_of, cols, values, start, end)
+        self._factor_interface(values, start, end)
 
     def refactor(self, matrix, changed=None):
         """Take the values of ``matrix`` where its local rows have the pattern of the
@@ -214,30 +220,34 @@ class ChainSolver:
         if changed is None:
             rows, cols, values = matrix.getValuesCSR()
             fits = np.array_equal(rows, old_rows) and np.array_equal(cols, old_cols)
+            entries = np.arange(len(values))
         else:
-            values, fits = self._values.copy(), True
+            values, fits, spans = self._values.copy(), True, []
             for row in changed:
                 first, last = old_rows[row - start], old_rows[row - start + 1]
                 row_cols, row_values = matrix.getRow(row)
                 fits = fits and np.array_equal(row_cols, old_cols[first:last])
                 if fits:
                     values[first:last] = row_values
+                    spans.append(np.arange(first, last))
+            entries = np.concatenate(spans) if spans else np.zeros(0, dtype=np.int64)
         coupling = self._coupling
         if fits:
             fits = self._split(row_of, cols, values, start, end, self.width) is None
         if not all(self._mpi.allgather(fits)):
             self._coupling = coupling                   # as it was
             return False
-        grown = (values != 0.0) & self._inside & ~self._keep
-        if grown.any():
-            self._keep |= grown
+        grown = entries[(values[entries] != 0.0) & self._inside[entries] & ~self._keep[entries]]
+        if grown.size:
+            self._keep[grown] = True
             self.interior.destroy()
             first = start + self.offset
             self.interior = self._interior_block(row_of, cols, values, first, end - first)
         else:
-            self.interior.refactor(values[self._keep])
+            kept = entries[self._keep[entries]]
+            self.interior.refactor_entries(self._position[kept], values[kept])
         self._values = values
-        self._couple_and_reduce(row_of, cols, values, start, end)
+        self._couple_and_reduce(values, start, end)
         return True
 
     def _split(self, row_of, cols, values, start, end, width):
@@ -267,55 +277,72 @@ class ChainSolver:
         self._coupling = [(outside_rows[mask] - first, outside_values[mask]) for mask in masks]
         return None
 
-    def _factor_interface(self, row_of, cols, values, start, end):
-        """S = A_GG - A_GI W, block tridiagonal with w x w blocks: each rank sends its
-        entries of S as (row, column, value) in the interface numbering, (q - 1) w + k
-        for row k of rank q's interface: its own interface rows' entries in A_GG (to its
-        own and the next rank's interface, with the symmetric one), and -A_GI W on its
-        two neighbouring interfaces; every rank assembles and factors S."""
-        w = self.width
-        n = (self.size - 1) * w
-        mine = [(self.rank - 1) * w + k for k in range(w)] if self.offset else []
-        mine += [self.rank * w + k for k in range(w)] if not self.last else []
-        slots = ([k for k in range(w)] if self.offset else []) + (
-            [w + k for k in range(w)] if not self.last else [])
-        entries = []
-        if self.offset:
-            for k in range(w):
-                row = row_of == start + k
-                for col, value in zip(cols[row], values[row]):
-                    j = col - start                 # own interface: 0..w-1, next: end..
-                    if 0 <= j < w:
-                        entries.append(((self.rank - 1) * w + k, (self.rank - 1) * w + j,
-                                        value))
-                    elif not self.last and end <= col < end + w:
-                        i, j = (self.rank - 1) * w + k, self.rank * w + col - end
-                        entries += [(i, j, value), (j, i, value)]
-        for a, i in zip(slots, mine):
-            index, value = self._coupling[a]
-            for b, j in zip(slots, mine):
-                if index.size:
-                    entries.append((i, j, -(value @ self.W[b, index])))
-        everything = [e for part in self._mpi.allgather(entries) for e in part]
-        if n:
-            diagonal = [(r, r, 0.0) for r in range(n)]      # stored even if all zero
-            i, j, v = (np.array([e[k] for e in everything + diagonal]) for k in range(3))
-            key, where = np.unique(i.astype(np.int64) * n + j.astype(np.int64),
-                                   return_inverse=True)     # sorted by row, then column
-            summed = np.zeros(key.size)
-            np.add.at(summed, where, v.astype(float))
-            rows, columns = key // n, key % n
-            self.diagonal = summed[rows == columns]
-            indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=n))]
-            if self.schur is not None and self.schur.has_pattern(indptr, columns):
-                self.schur.refactor(summed)
-            else:
-                if self.schur is not None:
-                    self.schur.destroy()
-                self.schur = SeqCholesky(n, indptr, columns, summed)
+    def _factor_interface(self, values, start, end):
+        """S = A_GG - A_GI W, block tridiagonal with w x w blocks (interface numbering:
+        (q - 1) w + k for row k of rank q's interface): every rank sends its part of S on
+        its two neighbouring interfaces, own then next (_interface_part), in one
+        Allgather of (2w, 2w) numbers; every rank sums them in the same order into S's
+        fixed pattern (_schur_pattern) and factors it (refactored after the first)."""
+        n = (self.size - 1) * self.width
+        if not n:
+            return
+        parts = np.empty((self.size,) + (2 * self.width,) * 2)
+        self._mpi.Allgather(self._interface_part(values, start, end), parts)
+        if self.schur is None:
+            self._schur_pattern()
+        indptr, columns, positions, taken = self._schur
+        summed = np.bincount(positions, weights=parts[taken], minlength=len(columns))
+        if self.schur is None:
+            self.schur = SeqCholesky(n, indptr, columns, summed)
             self._interface = np.zeros(n)
         else:
-            self.diagonal = np.zeros(0)
+            self.schur.refactor(summed)
+
+    def _interface_part(self, values, start, end):
+        """This rank's part of S, (2w, 2w) on its own interface's w rows (none on the
+        first rank) then the next rank's (none on the last): its own interface rows'
+        entries of A_GG, on the own interface and the next one (with the symmetric
+        entry), and -A_GI W on both."""
+        w = self.width
+        part = np.zeros((2 * w, 2 * w))
+        if self.offset:
+            indptr, cols = self._pattern[:2]
+            for k in range(w):                          # the own interface's rows
+                row = slice(indptr[k], indptr[k + 1])
+                row_cols, row_values = cols[row], values[row]
+                own = (row_cols >= start) & (row_cols < start + w)
+                part[k, row_cols[own] - start] += row_values[own]
+                if not self.last:
+                    following = (row_cols >= end) & (row_cols < end + w)
+                    part[k, w + row_cols[following] - end] += row_values[following]
+                    part[w + row_cols[following] - end, k] += row_values[following]
+        for a, (index, value) in enumerate(self._coupling):
+            if index.size:                  # W's rows are zero where their coupling is
+                part[a] -= self.W[:, index] @ value
+        return part
+
+    def _schur_pattern(self):
+        """S's CSR pattern, block tridiagonal: row r of interface block q = r // w holds
+        the columns of blocks q - 1 to q + 1 (those that exist), every entry stored; and
+        where rank p's part (_interface_part) adds into its values: self._schur =
+        (indptr, columns, positions, taken), ``taken`` the entries of the parts
+        (P, 2w, 2w) that exist (the own interface on ranks after the first, the next one
+        on ranks before the last) and ``positions`` their places among S's values."""
+        w, P = self.width, self.size
+        n = (P - 1) * w
+        block = np.arange(n) // w
+        first = np.maximum(block - 1, 0) * w
+        indptr = np.r_[0, np.cumsum(np.minimum(block + 2, P - 1) * w - first)]
+        row_of_entry = np.repeat(np.arange(n), np.diff(indptr))
+        columns = first[row_of_entry] + np.arange(indptr[-1]) - indptr[row_of_entry]
+        rank = np.arange(P)[:, None]
+        slot = np.arange(2 * w)[None, :]
+        index = np.where(slot < w, (rank - 1) * w + slot, rank * w + slot - w)   # (P, 2w)
+        exists = np.where(slot < w, rank > 0, rank < P - 1)
+        taken = exists[:, :, None] & exists[:, None, :]                      # (P, 2w, 2w)
+        rows = np.broadcast_to(index[:, :, None], taken.shape)[taken]
+        cols = np.broadcast_to(index[:, None, :], taken.shape)[taken]
+        self._schur = (indptr, columns, indptr[rows] + cols - first[rows], taken)
 
     def solve(self, rhs, solution):
         """solution = A^-1 rhs for k right-hand sides: lists of k local arrays (n,) of

@@ -90,7 +90,8 @@ def self_and_transposed(comm, a, b):
 def factor_of(matrix, kind):
     def make(comm, local):
         return solvers.mumps_solver(comm, local, kind, "test_chain_")
-    factor = ChainFactor(matrix, kind, BLOCK, make, solvers.set_up_mumps, solvers.solve_columns)
+    factor = ChainFactor(matrix, kind, BLOCK, make, solvers.set_up_mumps, solvers.solve_columns,
+                         solvers.solve_sparse_columns)
     factor.set_up(matrix)
     return factor
 
@@ -166,7 +167,7 @@ def test_a_submatrix_s_left_out_rows_return_the_right_hand_side():
     def make(local_comm, local):
         return solvers.mumps_solver(local_comm, local, kind, "test_chain_")
     factor = ChainFactor(sub, kind, BLOCK - 1, make, solvers.set_up_mumps,
-                         solvers.solve_columns)
+                         solvers.solve_columns, solvers.solve_sparse_columns)
     try:
         factor.set_up(sub)
         column = np.cos(np.arange(start, end))

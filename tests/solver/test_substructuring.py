@@ -125,8 +125,13 @@ def test_every_rank_owns_interior_rows_and_the_interface_is_one_row_per_boundary
         start, end = matrix.getOwnershipRange()
         assert solver.interior.matrix.getSize()[0] == end - start - (comm.getRank() > 0)
         assert solver.width == 1
-        assert solver.diagonal.shape == (comm.getSize() - 1,)
-        assert np.all(solver.diagonal > 0)
+        if comm.getSize() == 1:
+            assert solver.schur is None
+        else:       # S, of one row per boundary, positive definite (S's diagonal)
+            assert solver.schur.matrix.getSize() == (comm.getSize() - 1,) * 2
+            diagonal = solver.schur.matrix.getDiagonal()
+            assert np.all(diagonal.getArray() > 0)
+            diagonal.destroy()
 
 
 def hermite_matrix(comm, n_elements):
