@@ -132,10 +132,7 @@ class ChainFactor:
             return f"rows {start} to {end - 1}: no interior node on a rank"
         if self.n % B:
             return f"rows {start} to {end - 1}: not whole nodes of {B} unknowns"
-        indptr, columns, _ = matrix.getValuesCSR()
-        # each row's least and greatest column; a row without entries reaches nothing
-        lowest = row_reduce(np.minimum, indptr, columns, end)
-        highest = row_reduce(np.maximum, indptr, columns, start - 1)
+        lowest, highest = _column_range(matrix, start, end)
         # an interior row reaches the own interface, the interior and the next rank's
         # interface: columns [start, end + B); the interface's rows reach back into the
         # previous rank and forward into the interior, not beyond it
@@ -355,6 +352,35 @@ def _equilibration(matrix, symmetric, sweeps=RUIZ_SWEEPS):
         columns = rows.copy() if symmetric else columns * inverse_root(
             scaled.max(axis=0, initial=0.0))
     return rows, columns
+
+
+def _column_range(matrix, start, end):
+    """(lowest, highest), (n,) each: every local row's least and greatest global column
+    (end and start - 1 where it has no entry). From the diagonal block's CSR pattern,
+    whose rows PETSc keeps sorted (its first and last entry), and, for the rows with
+    entries beyond it (more entries in the local rows' whole pattern than in the block:
+    a chain's couplings to the next and previous ranks, a few nodes'), from the whole
+    pattern's entries of those rows. Two patterns without values, where the whole CSR
+    with its values and a reduction over every entry took three times as long on the
+    riser's Jacobian."""
+    several = matrix.getComm().getSize() > 1
+    indptr, columns = (matrix.getDiagonalBlock() if several else matrix).getRowIJ()
+    lowest = np.full(end - start, end, dtype=np.int64)
+    highest = np.full(end - start, start - 1, dtype=np.int64)
+    filled = np.flatnonzero(np.diff(indptr) > 0)
+    lowest[filled] = columns[indptr[filled]] + start
+    highest[filled] = columns[indptr[filled + 1] - 1] + start
+    if several:
+        whole_indptr, whole_columns = matrix.getRowIJ()
+        beyond = np.flatnonzero(np.diff(whole_indptr) > np.diff(indptr))
+        if beyond.size:
+            counts = np.diff(whole_indptr)[beyond]
+            entries = (np.repeat(whole_indptr[beyond] - np.r_[0, np.cumsum(counts)[:-1]], counts)
+                       + np.arange(counts.sum()))
+            spans = np.r_[0, np.cumsum(counts)]
+            lowest[beyond] = row_reduce(np.minimum, spans, whole_columns[entries], end)
+            highest[beyond] = row_reduce(np.maximum, spans, whole_columns[entries], start - 1)
+    return lowest, highest
 
 
 def _nonzeros(matrix):
