@@ -132,7 +132,7 @@ class ChainFactor:
             return f"rows {start} to {end - 1}: no interior node on a rank"
         if self.n % B:
             return f"rows {start} to {end - 1}: not whole nodes of {B} unknowns"
-        lowest, highest = _column_range(matrix, start, end)
+        lowest, highest = _column_range(matrix, start, end, edge=3 * B)
         # an interior row reaches the own interface, the interior and the next rank's
         # interface: columns [start, end + B); the interface's rows reach back into the
         # previous rank and forward into the interior, not beyond it
@@ -354,35 +354,49 @@ def _equilibration(matrix, symmetric, sweeps=RUIZ_SWEEPS):
     return rows, columns
 
 
-def _column_range(matrix, start, end):
+def _column_range(matrix, start, end, edge=None):
     """(lowest, highest), (n,) each: every local row's least and greatest global column
     (end and start - 1 where it has no entry). From the diagonal block's CSR pattern,
     whose rows PETSc keeps sorted (its first and last entry), and, for the rows with
-    entries beyond it (more entries in the local rows' whole pattern than in the block:
-    a chain's couplings to the next and previous ranks, a few nodes'), from the whole
-    pattern's entries of those rows. Two patterns without values, where the whole CSR
-    with its values and a reduction over every entry took three times as long on the
-    riser's Jacobian."""
+    entries beyond it (a chain's couplings to the previous and next ranks), from those
+    rows' own entries: read one by one on the first and last ``edge`` rows where these
+    hold every entry beyond the block (the local count of stored entries less the
+    block's), else from the whole local pattern (MatGetRowIJ, which copies the local rows
+    with their values). The whole CSR with its values and a reduction over every entry
+    took three times as long on the riser's Jacobian."""
     several = matrix.getComm().getSize() > 1
     indptr, columns = (matrix.getDiagonalBlock() if several else matrix).getRowIJ()
-    lowest = np.full(end - start, end, dtype=np.int64)
-    highest = np.full(end - start, start - 1, dtype=np.int64)
+    n = end - start
+    lowest = np.full(n, end, dtype=np.int64)
+    highest = np.full(n, start - 1, dtype=np.int64)
     filled = np.flatnonzero(np.diff(indptr) > 0)
     lowest[filled] = columns[indptr[filled]] + start
     highest[filled] = columns[indptr[filled + 1] - 1] + start
-    if several:
-        whole_indptr, whole_columns = matrix.getRowIJ()
-        beyond = np.flatnonzero(np.diff(whole_indptr) > np.diff(indptr))
-        if beyond.size:
-            counts = np.diff(whole_indptr)[beyond]
-            entries = (np.repeat(whole_indptr[beyond] - np.r_[0, np.cumsum(counts)[:-1]], counts)
-                       + np.arange(counts.sum()))
-            spans = np.r_[0, np.cumsum(counts)]
-            lowest[beyond] = row_reduce(np.minimum, spans, whole_columns[entries], end)
-            highest[beyond] = row_reduce(np.maximum, spans, whole_columns[entries], start - 1)
+    if not several:
+        return lowest, highest
+    beyond_block = _nonzeros(matrix, "nz_used") - int(indptr[-1])
+    if beyond_block == 0:
+        return lowest, highest
+    rows = np.unique(np.r_[np.arange(min(edge or 0, n)), np.arange(max(n - (edge or 0), 0), n)])
+    entries = [matrix.getRow(start + int(row))[0] for row in rows]
+    if sum(len(row_columns) for row_columns in entries) - int(
+            np.sum(np.diff(indptr)[rows])) == beyond_block:
+        for row, row_columns in zip(rows, entries):
+            if len(row_columns):
+                lowest[row], highest[row] = row_columns.min(), row_columns.max()
+        return lowest, highest
+    whole_indptr, whole_columns = matrix.getRowIJ()
+    beyond = np.flatnonzero(np.diff(whole_indptr) > np.diff(indptr))
+    counts = np.diff(whole_indptr)[beyond]
+    entries = (np.repeat(whole_indptr[beyond] - np.r_[0, np.cumsum(counts)[:-1]], counts)
+               + np.arange(counts.sum()))
+    spans = np.r_[0, np.cumsum(counts)]
+    lowest[beyond] = row_reduce(np.minimum, spans, whole_columns[entries], end)
+    highest[beyond] = row_reduce(np.maximum, spans, whole_columns[entries], start - 1)
     return lowest, highest
 
 
-def _nonzeros(matrix):
-    """The nonzeros stored in this rank's rows of ``matrix`` (a change of pattern)."""
-    return int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)["nz_allocated"])
+def _nonzeros(matrix, kind="nz_allocated"):
+    """The nonzeros allocated (a change of pattern), or ``kind`` "nz_used" stored, in
+    this rank's rows of ``matrix``."""
+    return int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)[kind])

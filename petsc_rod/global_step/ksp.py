@@ -136,9 +136,9 @@ def set_up_mumps(ksp, block=None):
 
 def solve_columns(ksp, columns, rows=None):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
-    the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve:
-    MUMPS's solve phase on these chains costs several times its flops per right-hand
-    side, and k of them at once cost about what one does (docs/performance.md).
+    the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve
+    (one call into MUMPS's solve phase; on the riser's chains its cost grows with k
+    about in proportion, docs/performance.md, "Issue 21, fifth pass").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
     rows out), the local indices of its rows in them; the other rows of x_j are b_j.
     Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed

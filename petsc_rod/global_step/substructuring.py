@@ -191,8 +191,7 @@ class ChainSolver:
         return SeqCholesky(n_interior, indptr, cols[self._keep] - first, values[self._keep])
 
     def _couple_and_reduce(self, values, start, end):
-        """W from the interior factor and the couplings, and S factored (refactored
-        where its pattern is the last one's)."""
+        """W from the interior factor and the couplings, and S factored (_factor_interface)."""
         self.W[:] = 0.0
         for column, (index, value) in enumerate(self._coupling):
             if index.size:

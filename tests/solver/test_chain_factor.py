@@ -19,7 +19,8 @@ from petsc4py import PETSc
 
 from helpers import gather
 from petsc_rod.global_step import ksp as solvers
-from petsc_rod.global_step.chain_factor import ChainFactor
+from petsc_rod.global_step.chain_factor import ChainFactor, _column_range
+from petsc_rod.global_step.substructuring import NotAChainError
 from petsc_rod.mesh.mesh import Mesh
 
 BLOCK = 3
@@ -255,6 +256,36 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
             expected).max()
     finally:
         factor.destroy()
+        matrix.destroy()
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("stray", [False, True], ids=["chain", "a middle row beyond"])
+def test_each_row_s_column_range_is_its_least_and_greatest_column(stray):
+    """chain_factor._column_range (the chain's reaches) against every entry of the
+    local rows (MatGetRow): on the chain, whose entries beyond the diagonal block lie on
+    the ranks' first and last rows (read one by one), and with a middle row of every
+    rank coupled beyond the next rank's interface (the whole local pattern read): the
+    least and greatest columns of every row; the second is no chain on several ranks
+    (ChainFactor refuses it)."""
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, dense = chain(comm, PETSc.PC.Type.LU)
+    n = len(dense)
+    start, end = matrix.getOwnershipRange()
+    if stray:
+        matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        matrix.setValue((start + end) // 2, (end + BLOCK) % n, 0.25)
+    matrix.assemble()
+    try:
+        if stray and comm.getSize() > 1:          # collective: before any assertion
+            with pytest.raises(NotAChainError):
+                ChainFactor(matrix, PETSc.PC.Type.LU, BLOCK, None, None, None, None)
+        lowest, highest = _column_range(matrix, start, end, edge=3 * BLOCK)
+        reaches = np.array([(row.min(), row.max()) for row in
+                            (matrix.getRow(r)[0] for r in range(start, end))])
+        assert np.array_equal(lowest, reaches[:, 0])
+        assert np.array_equal(highest, reaches[:, 1])
+    finally:
         matrix.destroy()
         mesh.destroy()
 
