@@ -77,7 +77,7 @@ class ChainFactor:
     head_columns columns (B, head_columns), and the next interface's rows A_G_p+1,I_p on
     its last next_back (B, next_back); ``reversed``: the interior block's rows are the
     rank's interior rows from its last (the first rank's), which ``_interior_solve``
-    undoes."""
+    and ``_coupling_solve`` undo."""
 
     def __init__(self, matrix, kind, block, make_solver, set_up, solve, solve_sparse):
         comm = matrix.getComm()
@@ -366,12 +366,13 @@ def _column_range(matrix, start, end, edge=None):
     took three times as long on the riser's Jacobian."""
     several = matrix.getComm().getSize() > 1
     indptr, columns = (matrix.getDiagonalBlock() if several else matrix).getRowIJ()
+    first_column = matrix.getOwnershipRangeColumn()[0]      # the block's column 0
     n = end - start
     lowest = np.full(n, end, dtype=np.int64)
     highest = np.full(n, start - 1, dtype=np.int64)
     filled = np.flatnonzero(np.diff(indptr) > 0)
-    lowest[filled] = columns[indptr[filled]] + start
-    highest[filled] = columns[indptr[filled + 1] - 1] + start
+    lowest[filled] = columns[indptr[filled]] + first_column
+    highest[filled] = columns[indptr[filled + 1] - 1] + first_column
     if not several:
         return lowest, highest
     beyond_block = _nonzeros(matrix, "nz_used") - int(indptr[-1])

@@ -182,7 +182,8 @@ def solve_sparse_columns(ksp, rows, values):
     (ICNTL 20, through MatMatSolve of a transposed AIJ), whose forward elimination visits
     only the paths of the elimination tree from those rows to its root, about half the
     cost of a dense solve where the rows sit near the root (docs/performance.md; the
-    backward one gives every row). Returns x, (k, n). A failed factorisation gives Inf."""
+    backward one gives every row). ``rows`` distinct. Returns x, (k, n). A failed
+    factorisation gives Inf."""
     factor = ksp.getPC().getFactorMatrix()
     operator = ksp.getOperators()[0]
     comm, n, k = operator.getComm(), operator.getSize()[0], values.shape[1]
@@ -190,20 +191,22 @@ def solve_sparse_columns(ksp, rows, values):
         return np.full((k, n), np.inf)
     order = np.argsort(rows)
     transposed = PETSc.Mat().createAIJ((k, n), nnz=len(rows), comm=comm)
-    transposed.setValuesCSR(np.arange(k + 1, dtype=PETSc.IntType) * len(rows),
-                            np.tile(np.asarray(rows, dtype=PETSc.IntType)[order], k),
-                            np.ascontiguousarray(values[order].T))
-    transposed.assemble()
-    right = PETSc.Mat().createTranspose(transposed)
-    unknown = PETSc.Mat().createDense((n, k), comm=comm)
-    unknown.setUp()
-    unknown.assemble()
+    right = unknown = None
     try:
+        transposed.setValuesCSR(np.arange(k + 1, dtype=PETSc.IntType) * len(rows),
+                                np.tile(np.asarray(rows, dtype=PETSc.IntType)[order], k),
+                                np.ascontiguousarray(values[order].T))
+        transposed.assemble()
+        right = PETSc.Mat().createTranspose(transposed)
+        unknown = PETSc.Mat().createDense((n, k), comm=comm)
+        unknown.setUp()
+        unknown.assemble()
         factor.matSolve(right, unknown)
         return unknown.getDenseArray(readonly=True).T.copy()
     finally:
         for obj in (right, transposed, unknown):
-            obj.destroy()
+            if obj is not None:
+                obj.destroy()
 
 
 def solve_vecs(factor, vecs, rows=None):

@@ -33,8 +33,8 @@ the same solve as a PETSc python preconditioner (``-rod_d1_pc_type python
 -rod_d1_pc_python_type petsc_rod.global_step.substructuring.InterfacePC``), exact, so
 that KSP preonly with it is a direct solver. The PETSc objects (the interior matrix, its
 factor, two work vectors, the same for S: SeqCholesky) are ChainSolver's: made in
-__init__ (and anew by refactor where the interior block's pattern grows or S's
-changes) and destroyed in ChainSolver.destroy().
+__init__ (the interior's anew by refactor where its pattern grows) and destroyed in
+ChainSolver.destroy().
 """
 
 import numpy as np
@@ -316,7 +316,7 @@ class ChainSolver:
                     part[k, w + row_cols[following] - end] += row_values[following]
                     part[w + row_cols[following] - end, k] += row_values[following]
         for a, (index, value) in enumerate(self._coupling):
-            if index.size:                  # W's rows are zero where their coupling is
+            if index.size:                  # W's row is zero where its coupling is empty
                 part[a] -= self.W[:, index] @ value
         return part
 

@@ -260,6 +260,36 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
         mesh.destroy()
 
 
+@pytest.mark.parametrize("kind", [PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY])
+def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
+    """ksp.solve_sparse_columns (W's solve) on a sequential MUMPS factorisation: k = 3
+    right-hand sides nonzero on a few rows given out of order, against a dense solve of
+    the same matrix (unsymmetric for the LU, symmetric indefinite for the LDL^T)."""
+    n = 40
+    rng = np.random.default_rng(3)
+    dense = rng.standard_normal((n, n)) + 8.0 * np.eye(n)
+    if kind == PETSc.PC.Type.CHOLESKY:
+        dense = dense + dense.T - 24.0 * np.diag(rng.random(n) < 0.3)
+    matrix = PETSc.Mat().createAIJ((n, n), nnz=n, comm=PETSc.COMM_SELF)
+    matrix.setValuesCSR(np.arange(n + 1, dtype=PETSc.IntType) * n,
+                        np.tile(np.arange(n, dtype=PETSc.IntType), n), dense.ravel())
+    matrix.assemble()
+    ksp = solvers.mumps_solver(PETSc.COMM_SELF, matrix, kind, "test_chain_")
+    try:
+        solvers.set_up_mumps(ksp)
+        rows = np.array([37, 2, 19, 3, 0])
+        values = rng.standard_normal((len(rows), 3))
+        right = np.zeros((n, 3))
+        right[rows] = values
+        solution = solvers.solve_sparse_columns(ksp, rows, values)
+        expected = np.linalg.solve(dense, right).T
+        assert solution.shape == (3, n)
+        assert np.abs(solution - expected).max() <= 1e-12 * np.abs(expected).max()
+    finally:
+        ksp.destroy()
+        matrix.destroy()
+
+
 @pytest.mark.parametrize("stray", [False, True], ids=["chain", "a middle row beyond"])
 def test_each_row_s_column_range_is_its_least_and_greatest_column(stray):
     """chain_factor._column_range (the chain's reaches) against every entry of the
