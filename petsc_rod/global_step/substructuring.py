@@ -68,18 +68,11 @@ class SeqCholesky:
         self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
         self._x = self._b.duplicate()
 
-    def refactor(self, values):
-        """The numeric factorisation of the matrix with ``values`` in place of its own,
-        on the same CSR pattern (the symbolic one kept): the values copied into the
-        matrix's own array, and its state raised (an assembly) so that the PC factors
-        again."""
-        np.copyto(self._csr[2], values)
-        self.matrix.assemble()
-        self._pc.setUp()
-
-    def refactor_entries(self, positions, values):
-        """refactor with ``values`` at the CSR ``positions`` (indices into the matrix's
-        values) and its other values kept: a change at a few rows copies those alone."""
+    def refactor(self, values, positions=slice(None)):
+        """The numeric factorisation of the matrix with ``values`` in place of its own at
+        the CSR ``positions`` (indices into its values; all of them by default), on the
+        same CSR pattern (the symbolic one kept): the values copied into the matrix's own
+        array, and its state raised (an assembly) so that the PC factors again."""
         self._csr[2][positions] = values
         self.matrix.assemble()
         self._pc.setUp()
@@ -244,7 +237,7 @@ class ChainSolver:
             self.interior = self._interior_block(row_of, cols, values, first, end - first)
         else:
             kept = entries[self._keep[entries]]
-            self.interior.refactor_entries(self._position[kept], values[kept])
+            self.interior.refactor(values[kept], self._position[kept])
         self._values = values
         self._couple_and_reduce(values, start, end)
         return True
