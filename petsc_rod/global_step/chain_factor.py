@@ -362,8 +362,8 @@ def _column_range(matrix, start, end, edge=None):
     rows' own entries: read one by one on the first and last ``edge`` rows where these
     hold every entry beyond the block (the local count of stored entries less the
     block's), else from the whole local pattern (MatGetRowIJ, which copies the local rows
-    with their values). The whole CSR with its values and a reduction over every entry
-    took three times as long on the riser's Jacobian."""
+    with their values), not the whole CSR with its values and a reduction over every
+    entry (the costs: docs/performance.md, "Issue 21, sixth pass")."""
     several = matrix.getComm().getSize() > 1
     indptr, columns = (matrix.getDiagonalBlock() if several else matrix).getRowIJ()
     first_column = matrix.getOwnershipRangeColumn()[0]      # the block's column 0
