@@ -378,11 +378,9 @@ def _column_range(matrix, start, end, edge=None):
     beyond_block = _nonzeros(matrix, "nz_used") - int(indptr[-1])
     if beyond_block == 0:
         return lowest, highest
-    rows = np.unique(np.r_[np.arange(min(edge or 0, n)), np.arange(max(n - (edge or 0), 0), n)])
-    entries = [matrix.getRow(start + int(row))[0] for row in rows]
-    if sum(len(row_columns) for row_columns in entries) - int(
-            np.sum(np.diff(indptr)[rows])) == beyond_block:
-        for row, row_columns in zip(rows, entries):
+    edge_rows = _edge_rows(matrix, start, indptr, edge, beyond_block)
+    if edge_rows is not None:
+        for row, row_columns in edge_rows:
             if len(row_columns):
                 lowest[row], highest[row] = row_columns.min(), row_columns.max()
         return lowest, highest
@@ -395,6 +393,21 @@ def _column_range(matrix, start, end, edge=None):
     lowest[beyond] = row_reduce(np.minimum, spans, whole_columns[entries], end)
     highest[beyond] = row_reduce(np.maximum, spans, whole_columns[entries], start - 1)
     return lowest, highest
+
+
+def _edge_rows(matrix, start, indptr, edge, beyond_block):
+    """[(row, its global columns)] of the first and last ``edge`` local rows (local
+    numbers; MatGetRow one by one) where these hold all ``beyond_block`` entries of the
+    local rows beyond the diagonal block (whose CSR row pointers are ``indptr``), else
+    None: a chain's couplings to the neighbouring ranks sit there, and then the reaches
+    need no other row's entries (_column_range)."""
+    n = len(indptr) - 1
+    edge = edge or 0
+    rows = np.unique(np.r_[np.arange(min(edge, n)), np.arange(max(n - edge, 0), n)])
+    entries = [matrix.getRow(start + int(row))[0] for row in rows]
+    outside = sum(len(row_columns) for row_columns in entries) - int(
+        np.sum(np.diff(indptr)[rows]))
+    return list(zip(rows, entries)) if outside == beyond_block else None
 
 
 def _nonzeros(matrix, kind="nz_allocated"):

@@ -19,7 +19,7 @@ from petsc4py import PETSc
 
 from helpers import gather
 from petsc_rod.global_step import ksp as solvers
-from petsc_rod.global_step.chain_factor import ChainFactor, _column_range
+from petsc_rod.global_step.chain_factor import ChainFactor, _column_range, _edge_rows
 from petsc_rod.global_step.substructuring import NotAChainError
 from petsc_rod.mesh.mesh import Mesh
 
@@ -297,7 +297,8 @@ def test_each_row_s_column_range_is_its_least_and_greatest_column(stray):
     the ranks' first and last rows (read one by one), and with a middle row of every
     rank coupled beyond the next rank's interface (the whole local pattern read): the
     least and greatest columns of every row; the second is no chain on several ranks
-    (ChainFactor refuses it)."""
+    (ChainFactor refuses it). On several ranks the chain's reaches come from its edge
+    rows alone (_edge_rows), the stray row's from the whole pattern."""
     comm = PETSc.COMM_WORLD
     mesh, matrix, dense = chain(comm, PETSc.PC.Type.LU)
     n = len(dense)
@@ -311,6 +312,12 @@ def test_each_row_s_column_range_is_its_least_and_greatest_column(stray):
             with pytest.raises(NotAChainError):
                 ChainFactor(matrix, PETSc.PC.Type.LU, BLOCK, None, None, None, None)
         lowest, highest = _column_range(matrix, start, end, edge=3 * BLOCK)
+        if comm.getSize() > 1:
+            indptr = matrix.getDiagonalBlock().getRowIJ()[0]
+            beyond_block = int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)["nz_used"]) - int(
+                indptr[-1])
+            edge_rows = _edge_rows(matrix, start, indptr, 3 * BLOCK, beyond_block)
+            assert (edge_rows is None) == stray
         reaches = np.array([(row.min(), row.max()) for row in
                             (matrix.getRow(r)[0] for r in range(start, end))])
         assert np.array_equal(lowest, reaches[:, 0])
