@@ -63,7 +63,7 @@ class NewtonJacobian:
             # H's entries added in C (MatAXPY), not through numpy's CSR copies: J's
             # pattern holds H's since the first assembly (kept through zeroEntries),
             # and an entry new to it is inserted all the same (row by row, J takes
-            # new nonzeros); 30-35 against 55 ms on the 18 000-element riser's J
+            # new nonzeros; docs/performance.md has the cost)
             self.matrix.zeroEntries()
             self.matrix.axpy(1.0, hessian.matrix,
                              structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
