@@ -19,7 +19,8 @@ from petsc4py import PETSc
 
 from helpers import gather
 from petsc_rod.global_step import ksp as solvers
-from petsc_rod.global_step.chain_factor import ChainFactor, _column_range, _edge_rows
+from petsc_rod.global_step import chain_factor
+from petsc_rod.global_step.chain_factor import ChainFactor, _column_range
 from petsc_rod.global_step.substructuring import NotAChainError
 from petsc_rod.mesh.mesh import Mesh
 
@@ -291,33 +292,40 @@ def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
 
 
 @pytest.mark.parametrize("stray", [False, True], ids=["chain", "a middle row beyond"])
-def test_each_row_s_column_range_is_its_least_and_greatest_column(stray):
+def test_each_row_s_column_range_is_its_least_and_greatest_column(stray, monkeypatch):
     """chain_factor._column_range (the chain's reaches) against every entry of the
     local rows (MatGetRow): on the chain, whose entries beyond the diagonal block lie on
     the ranks' first and last rows (read one by one), and with a middle row of every
     rank coupled beyond the next rank's interface (the whole local pattern read): the
     least and greatest columns of every row; the second is no chain on several ranks
-    (ChainFactor refuses it). On several ranks the chain's reaches come from its edge
-    rows alone (_edge_rows), the stray row's from the whole pattern."""
+    (ChainFactor refuses it). On several ranks _column_range takes the chain's reaches
+    from its edge rows (_edge_rows gives them) and the stray row's from the whole pattern
+    (_edge_rows gives None), where that row lies beyond the edge rows."""
     comm = PETSc.COMM_WORLD
     mesh, matrix, dense = chain(comm, PETSc.PC.Type.LU)
     n = len(dense)
     start, end = matrix.getOwnershipRange()
+    middle, edge = (start + end) // 2, 3 * BLOCK
     if stray:
         matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        matrix.setValue((start + end) // 2, (end + BLOCK) % n, 0.25)
+        matrix.setValue(middle, (end + BLOCK) % n, 0.25)
     matrix.assemble()
+    edge_rows = []                  # what _edge_rows gave inside _column_range
+    original = chain_factor._edge_rows
+    monkeypatch.setattr(chain_factor, "_edge_rows",
+                        lambda *args: edge_rows.append(original(*args)) or edge_rows[-1])
     try:
         if stray and comm.getSize() > 1:          # collective: before any assertion
             with pytest.raises(NotAChainError):
                 ChainFactor(matrix, PETSc.PC.Type.LU, BLOCK, None, None, None, None)
-        lowest, highest = _column_range(matrix, start, end, edge=3 * BLOCK)
-        if comm.getSize() > 1:
-            indptr = matrix.getDiagonalBlock().getRowIJ()[0]
-            beyond_block = int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)["nz_used"]) - int(
-                indptr[-1])
-            edge_rows = _edge_rows(matrix, start, indptr, 3 * BLOCK, beyond_block)
-            assert (edge_rows is None) == stray
+        edge_rows.clear()
+        lowest, highest = _column_range(matrix, start, end, edge=edge)
+        if comm.getSize() == 1:
+            assert edge_rows == []                  # no rows beyond a block
+        elif not stray:
+            assert len(edge_rows) == 1 and edge_rows[0] is not None
+        elif start + edge <= middle < end - edge:
+            assert edge_rows == [None]
         reaches = np.array([(row.min(), row.max()) for row in
                             (matrix.getRow(r)[0] for r in range(start, end))])
         assert np.array_equal(lowest, reaches[:, 0])
