@@ -292,8 +292,12 @@ class DragTerm(NodalLoadTerm):
         psi = base[:, [0, 2]][:, :, None] + P + np.arange(3)                     # (ne, 2, 3)
         jacobian.add(x_rows, psi[:, 1],
                      (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3))
-        coupling = np.einsum("eaij,eab,ebjk->eaibk", rows_map, tails, G)
-        jacobian.add(x_rows, turns, coupling.reshape(ne, 3 * U, 9))
+        # rows_map_a tails_ab G_b for each node pair (a, b) of an element, (ne, a, b, U,
+        # 3), by a batched matmul (a three-operand einsum loops over every index:
+        # docs/performance.md), then in the order of the rows (a, U) and columns (b, 3)
+        coupling = np.matmul(rows_map[:, :, None], G[:, None])
+        coupling *= tails[:, :, :, None, None]
+        jacobian.add(x_rows, turns, coupling.transpose(0, 1, 3, 2, 4).reshape(ne, 3 * U, 9))
         # the chain: Psi_e - Psi_e+1 - sum_l I_l G_l omega_l = 0 in Psi_e's row from a
         # held start, its negative in Psi_e+1's from a held end (the diagonal 1 is H's)
         held_start = is_held(self.start_state)
