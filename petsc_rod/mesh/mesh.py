@@ -209,6 +209,14 @@ class Mesh:
     def n_local_elements(self):
         return self.element_end - self.element_start
 
+    def element_ends(self, ghosted):
+        """(left, right): each owned element's values at its left and right vertex,
+        (ne, ...) each, from ``ghosted`` values at the ghosted vertices (n_ghosted, ...):
+        views (the owned elements' vertices are consecutive in the ghosted range), not
+        the copies of an index array's gather."""
+        first, ne = self.element_start - self.ghost_start, self.n_local_elements
+        return ghosted[first:first + ne], ghosted[first + 1:first + ne + 1]
+
     @property
     def n_local_nodes(self):
         """P2 nodes this rank owns: its vertices and the midpoints stored with them, in

@@ -274,9 +274,8 @@ class FrictionTerm(NodalLoadTerm):
     def _node_values(self, ghosted, rows):
         """rows (ne, 3, 4) applied to each element's Hermite dofs, (ne, 3, 2), from the
         ghosted (value, slope) pairs (n_ghosted, 2) of x and y in ``ghosted``."""
-        left = self.mesh.element_local
         return np.stack([np.einsum("enk,ek->en", rows,
-                                   np.concatenate([pairs[left], pairs[left + 1]], axis=1))
+                                   np.concatenate(self.mesh.element_ends(pairs), axis=1))
                          for pairs in ghosted], axis=2)
 
     def _ghosted(self, vec):

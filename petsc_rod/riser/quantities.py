@@ -94,8 +94,7 @@ def touchdown(problem, seabed, top):
     it. Collective."""
     mesh = problem.mesh
     ghosted = problem.state.r.ghosted()[:, 0]
-    left = mesh.element_local
-    r0, r1 = ghosted[left], ghosted[left + 1]
+    r0, r1 = mesh.element_ends(ghosted)
     gap0, gap1 = seabed.gap(r0), seabed.gap(r1)
     S0, S1 = mesh.element_S, mesh.element_S + mesh.element_h
     # the fraction of each element below the seabed, with its heights linear in S: 1 or 0

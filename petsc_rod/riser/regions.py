@@ -59,9 +59,9 @@ def _extremes(problem):
     the higher (crest) or lower (trough) end height."""
     mesh = problem.mesh
     ghosted = problem.state.r.ghosted()
-    left = mesh.element_local
-    z0, z1 = ghosted[left, 0, 2], ghosted[left + 1, 0, 2]
-    t0, t1 = ghosted[left, 1, 2], ghosted[left + 1, 1, 2]
+    left, right = mesh.element_ends(ghosted)
+    z0, z1 = left[:, 0, 2], right[:, 0, 2]
+    t0, t1 = left[:, 1, 2], right[:, 1, 2]
     crest = (t0 > 0) & (t1 <= 0)
     trough = (t0 < 0) & (t1 >= 0)
     found = []

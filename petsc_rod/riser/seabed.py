@@ -120,9 +120,8 @@ class SeabedContact:
         last global step, ``ghosted_r`` the r field's ghosted (vertex, slope) pairs
         (n_ghosted, 2, 3) (module docstring). The matrix is rebuilt if k changed at an
         active node, else only the right-hand side."""
-        left = self.mesh.element_local
-        dofs = np.stack([ghosted_r[left, 0], ghosted_r[left, 1], ghosted_r[left + 1, 0],
-                         ghosted_r[left + 1, 1]], axis=1)                  # (ne, 4, 3)
+        left, right = self.mesh.element_ends(ghosted_r)
+        dofs = np.concatenate([left, right], axis=1)                      # (ne, 4, 3)
         nodes = np.einsum("enk,ekc->enc", self.rows, dofs)                  # (ne, 3, 3)
         x, y = nodes[..., 0], nodes[..., 1]
         stiffness = self.seabed.vertical_stiffness(self.seabed.gradients(x, y))
@@ -148,8 +147,7 @@ class SeabedContact:
     def _heights_of(self, ghosted):
         """z at the three nodes of each owned element, (ne, 3), from ghosted Hermite pairs
         (z, z') at the vertices, (n_ghosted, 2)."""
-        left = self.mesh.element_local
-        dofs = np.concatenate([ghosted[left], ghosted[left + 1]], axis=1)
+        dofs = np.concatenate(self.mesh.element_ends(ghosted), axis=1)
         return np.einsum("enk,ek->en", self.rows, dofs)
 
     def solve(self, slope_rhs, slope, ghosted_r=None):

@@ -271,9 +271,8 @@ class DragTerm(NodalLoadTerm):
         tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
         h = mesh.element_h
         r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
-        left = mesh.element_local
         z = np.einsum("enk,ek->en", node_rows(h),
-                      np.concatenate([r[left], r[left + 1]], axis=1))    # (ne, 3 nodes)
+                      np.concatenate(mesh.element_ends(r), axis=1))      # (ne, 3 nodes)
         S = mesh.element_S[:, None] + h[:, None] * np.array([0.0, 0.5, 1.0])
         flat_t = tangents.reshape(-1, 3)
         G = sum(w * drag_jacobian(flat_t, c.velocity(z.ravel()),
