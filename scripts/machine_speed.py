@@ -3,10 +3,9 @@
 
     python scripts/machine_speed.py
 
-The timings in docs/ quote it beside their numbers: on the 2-core machine they were
-measured on, it took 0.62-0.70 s when the machine ran fast and up to 1.7 s when other
-jobs loaded it. (Run inside a function, where names are local, the same loop takes
-about 2.3 times less: compare only like with like.)
+The timings in docs/ quote it beside their numbers (the README says what it takes when
+the machine runs fast). Run inside a function, where names are local, the same loop is
+faster: compare only like with like.
 """
 
 import time

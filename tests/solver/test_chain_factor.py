@@ -18,8 +18,8 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather
-from petsc_rod.global_step import ksp as solvers
 from petsc_rod.global_step import chain_factor
+from petsc_rod.global_step import ksp as solvers
 from petsc_rod.global_step.chain_factor import ChainFactor, _column_range
 from petsc_rod.global_step.substructuring import NotAChainError
 from petsc_rod.mesh.mesh import Mesh
@@ -312,8 +312,12 @@ def test_each_row_s_column_range_is_its_least_and_greatest_column(stray, monkeyp
     matrix.assemble()
     edge_rows = []                  # what _edge_rows gave inside _column_range
     original = chain_factor._edge_rows
-    monkeypatch.setattr(chain_factor, "_edge_rows",
-                        lambda *args: edge_rows.append(original(*args)) or edge_rows[-1])
+
+    def recorded(*args):
+        edge_rows.append(original(*args))
+        return edge_rows[-1]
+
+    monkeypatch.setattr(chain_factor, "_edge_rows", recorded)
     try:
         if stray and comm.getSize() > 1:          # collective: before any assertion
             with pytest.raises(NotAChainError):
