@@ -23,7 +23,8 @@ last, two more measures:
   same states; the best of each, and the median of the pairs' ratios.
 
 The page also gives the time of scripts/machine_speed.py (a pure-Python loop) before and
-after, which says how fast the (shared, virtual) machine ran meanwhile.
+after, alone and two copies at once, which says how fast the (shared, virtual) machine's
+cores ran meanwhile: a second rank gains only if the second core is as fast as the first.
 
 The targets (issue 21, 1 rank, idle machine): at most 120 iterations per scene, the
 800 m cable under 2 s, the 18 000-element riser in at most 150 plain iterations' worth of
@@ -148,11 +149,19 @@ def paired_speedup(arguments, pairs, folder):
             float(np.median(times[:, 0] / times[:, 1])))
 
 
-def loop_seconds():
-    """scripts/machine_speed.py's time (s): the machine's speed now."""
-    done = subprocess.run([sys.executable, str(HERE / "machine_speed.py")], check=True,
-                          capture_output=True, text=True)
-    return float(done.stdout)
+def loop_seconds(copies=1):
+    """scripts/machine_speed.py's times (s), ``copies`` of it run at once: the speed of
+    as many of the machine's cores now (two at once: whether a second rank has a core of
+    its own)."""
+    runs = [subprocess.Popen([sys.executable, str(HERE / "machine_speed.py")],
+                             stdout=subprocess.PIPE, text=True) for _ in range(copies)]
+    return [float(run.communicate()[0]) for run in runs]
+
+
+def machine(label):
+    """'x s <label> (y and z s two at once)': loop_seconds alone, then two copies."""
+    alone, pair = loop_seconds()[0], loop_seconds(2)
+    return f"{alone:.2f} s {label} ({pair[0]:.2f} and {pair[1]:.2f} s two at once)"
 
 
 HEADER = ["case", "outcome", "iterations", "solve (s)", "process (s)", "top tension (N)",
@@ -191,7 +200,7 @@ def main():
     args = parser.parse_args()
     pairs = args.pairs or args.repeats
     words = [w for w in args.only.split(",") if w]
-    loop_before = loop_seconds()
+    machine_before = machine("before")
     rows, fine = [], None
     with tempfile.TemporaryDirectory() as folder:
         for name, arguments in cases():
@@ -229,8 +238,8 @@ def main():
             "# Riser benchmark\n\n"
             f"Written by `{command}` (1 rank unless said; default settings; best of "
             f"{args.repeats} runs; load average {load:.2f} when it ended; "
-            f"`scripts/machine_speed.py` {loop_before:.2f} s before, {loop_seconds():.2f} s "
-            "after). `solve` is the "
+            f"`scripts/machine_speed.py` {machine_before}, {machine('after')}). "
+            "`solve` is the "
             "result file's wall_time (the continuation), `process` the whole command. "
             "The targets are those of issue 21 (at most "
             f"{MAX_ITERATIONS} iterations per scene, the 800 m cable under "
