@@ -153,9 +153,13 @@ def loop_seconds(copies=1):
     """scripts/machine_speed.py's times (s), ``copies`` of it run at once: the speed of
     as many of the machine's cores now (two at once: whether a second rank has a core of
     its own)."""
-    runs = [subprocess.Popen([sys.executable, str(HERE / "machine_speed.py")],
-                             stdout=subprocess.PIPE, text=True) for _ in range(copies)]
-    return [float(run.communicate()[0]) for run in runs]
+    command = [sys.executable, str(HERE / "machine_speed.py")]
+    runs = [subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
+            for _ in range(copies)]
+    outputs = [run.communicate()[0] for run in runs]
+    if any(run.returncode for run in runs):
+        raise subprocess.CalledProcessError(max(run.returncode for run in runs), command)
+    return [float(output) for output in outputs]
 
 
 def machine(label):
