@@ -157,15 +157,16 @@ def loop_seconds(copies=1):
     runs = [subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
             for _ in range(copies)]
     outputs = [run.communicate()[0] for run in runs]
-    if any(run.returncode for run in runs):
-        raise subprocess.CalledProcessError(max(run.returncode for run in runs), command)
+    failed = [run.returncode for run in runs if run.returncode]
+    if failed:
+        raise subprocess.CalledProcessError(failed[0], command)
     return [float(output) for output in outputs]
 
 
 def machine(label):
-    """'x s <label> (y and z s two at once)': loop_seconds alone, then two copies."""
+    """'x s <label>, y and z s two at once': loop_seconds alone, then two copies."""
     alone, pair = loop_seconds()[0], loop_seconds(2)
-    return f"{alone:.2f} s {label} ({pair[0]:.2f} and {pair[1]:.2f} s two at once)"
+    return f"{alone:.2f} s {label}, {pair[0]:.2f} and {pair[1]:.2f} s two at once"
 
 
 HEADER = ["case", "outcome", "iterations", "solve (s)", "process (s)", "top tension (N)",
@@ -204,7 +205,7 @@ def main():
     args = parser.parse_args()
     pairs = args.pairs or args.repeats
     words = [w for w in args.only.split(",") if w]
-    machine_before = machine("before")
+    machine_before = None if words else machine("before")      # for the page
     rows, fine = [], None
     with tempfile.TemporaryDirectory() as folder:
         for name, arguments in cases():
@@ -242,7 +243,7 @@ def main():
             "# Riser benchmark\n\n"
             f"Written by `{command}` (1 rank unless said; default settings; best of "
             f"{args.repeats} runs; load average {load:.2f} when it ended; "
-            f"`scripts/machine_speed.py` {machine_before}, {machine('after')}). "
+            f"`scripts/machine_speed.py` {machine_before}; {machine('after')}). "
             "`solve` is the "
             "result file's wall_time (the continuation), `process` the whole command. "
             "The targets are those of issue 21 (at most "
