@@ -48,28 +48,29 @@ class NewtonJacobian:
         """J at the state H was last assembled at, factored. Collective."""
         hessian = self.hessian
         if self.matrix is None:
-            # H's preallocation (a node's row meets the 5 nodes of its elements), the
-            # pattern kept through zeroRows: one symbolic factorisation for the run
+            # the followers' entries first, in H's preallocation (a node's row meets the
+            # 5 nodes of its elements), then H added in C by MatAXPY, which makes the
+            # union of the two patterns (numpy's CSR copies of H cost three times as
+            # much: docs/performance.md); the pattern is kept through zeroEntries and
+            # zeroRows: one symbolic factorisation for the run
             block = hessian.block
             self.matrix = PETSc.Mat().createAIJ(hessian.matrix.getSizes(),
                                                 nnz=(5 * block, 2 * block),
                                                 comm=self.problem.mesh.comm)
             self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+            self._add_terms()
+            self.matrix.axpy(1.0, hessian.matrix,
+                             structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
             self.matrix.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
-            indptr, columns, values = hessian.matrix.getValuesCSR()
-            self.matrix.setValuesCSR(indptr, columns, values,
-                                     addv=PETSc.InsertMode.ADD_VALUES)
         else:
-            # H's entries added in C (MatAXPY), not through numpy's CSR copies: J's
-            # pattern holds H's since the first assembly (kept through zeroEntries),
-            # and an entry new to it is inserted all the same (row by row, J takes
-            # new nonzeros; docs/performance.md has the cost)
+            # H's entries added in C (MatAXPY): J's pattern holds H's since the first
+            # assembly, and an entry new to it is inserted all the same (row by row, J
+            # takes new nonzeros; docs/performance.md has the cost)
             self.matrix.zeroEntries()
             self.matrix.axpy(1.0, hessian.matrix,
                              structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        for term in self.problem.terms:
-            term.add_jacobian(self)
-        self.matrix.assemble()
+            self._add_terms()
         # the held unknowns keep their identity rows (what the followers added there
         # is dropped); their columns meet a zero step
         self.matrix.zeroRows(hessian.held_rows, diag=1.0)
@@ -80,6 +81,12 @@ class NewtonJacobian:
             self.factor = direct_factor(self.matrix, PETSc.PC.Type.LU, hessian.block,
                                         NEWTON_PREFIX)
         self.factor.set_up(self.matrix)
+
+    def _add_terms(self):
+        """The unsymmetric terms' entries (Term.add_jacobian) added, and J assembled."""
+        for term in self.problem.terms:
+            term.add_jacobian(self)
+        self.matrix.assemble()
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and

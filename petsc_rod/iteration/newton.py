@@ -80,17 +80,33 @@ FLOOR_TURN = 1e-7
 # load, the friction: ``unsymmetric``) reuses the last step's matrices and factors (a
 # chord step): where the previous step turned by at most FREEZE_TURN rad, J has changed
 # by about that much since it was factored, and a step with it contracts the error by a
-# factor of about as much, without H's and J's assembly, the LU and the inertia's LDL^T
-# (docs/performance.md). A chord step that does not shrink to FROZEN_SHRINK of the
-# previous one is taken again with fresh factors (above FLOOR_TURN; at the floor the
-# state is handed over, as after any step that does not shrink). Such a problem has no
-# energy: the inertia test is its steps' safeguard, not a stability verdict, and it was
-# passed at most about FREEZE_TURN rad from the result. A conservative problem's steps
-# stay exact.
+# factor of about as much, without H's and J's assembly, the LU and the inertia's LDL^T,
+# and with one right-hand side: the chord forms' solves are the last exact step's too
+# (the KKT matrix frozen whole; docs/performance.md). A chord step that does not shrink
+# to FROZEN_SHRINK of the previous one is taken again with fresh factors (above
+# FLOOR_TURN; at the floor the state is handed over, as after any step that does not
+# shrink). Such a problem has no energy: the inertia test is its steps' safeguard, not a
+# stability verdict, and it was passed at most about FREEZE_TURN rad from the result. A
+# conservative problem's steps stay exact.
 FREEZE_TURN = 1e-4
 FROZEN_SHRINK = 0.1
+# A chord step converges linearly, by the factor theta = turn / previous turn (at most
+# FROZEN_SHRINK): the error it leaves is about theta / (1 - theta) times its turn (the
+# geometric rest), and a chord step whose rest is below STEP_TOLERANCE rad is the last
+# (the stopping test of simplified Newton iterations, Hairer & Wanner, Solving Ordinary
+# Differential Equations II, §IV.8), as an exact step below STEP_TOLERANCE is, whose rest
+# is about its square (_chord_rest).
+
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
+
+
+def _chord_rest(turn, previous):
+    """theta / (1 - theta) * turn, theta = turn / previous: the error left by a chord step
+    that turned ``turn`` rad after one of ``previous`` rad (the comment above), inf where
+    the steps did not contract."""
+    theta = turn / previous
+    return theta / (1.0 - theta) * turn if theta < 1.0 else np.inf
 
 
 class NewtonPolish:
@@ -110,6 +126,8 @@ class NewtonPolish:
         # must lower |grad L| (no energy to descend)
         self.unsymmetric = any(term.unsymmetric for term in problem.terms)
         self._jacobian = None
+        # the last exact step's KKT pieces, for the chord steps (_keep_kkt)
+        self._kkt = None
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
         # of the Newton system, which LU turns into a step of round-off's size); the
@@ -173,10 +191,12 @@ class NewtonPolish:
                 curvature = saved["lam"] if first and self.reads_positions else None
                 frozen = self.unsymmetric and previous <= FREEZE_TURN
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, frozen)
-                if (frozen and previous > FLOOR_TURN
+                chord = frozen and self._kkt is not None
+                if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
                     # a chord step that did not contract: fresh factors (at the round-off
                     # floor the shrink test below hands the state over instead)
+                    chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None and curvature is None and self.reads_positions:
                     # H indefinite after a step on a line whose heights enter: the step
@@ -233,10 +253,13 @@ class NewtonPolish:
                 else:
                     frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
                 mu = mu + dmu
+                # the error the step leaves: about its square after an exact step, the
+                # geometric rest of a chord step's contraction (_chord_rest)
+                rest = _chord_rest(largest, previous) if chord else largest
                 previous = largest
                 if record is not None:
                     record(largest)
-                if largest < STEP_TOLERANCE:
+                if rest < STEP_TOLERANCE:
                     self.solved_norms = self._hand_over(frames, mu, measured=self._whole)
                     return CONVERGED
             state.restore(saved)
@@ -312,12 +335,13 @@ class NewtonPolish:
         that left errors in height (measured on options/riser_catenary.opts without its
         current, 900 elements: a first turn of 0.016 rad), which ``run`` takes again with
         the iteration's curvature. ``frozen``: a chord step, with the matrices and
-        factors of the last step (FREEZE_TURN)."""
+        factors of the last exact step, and its chord forms' solves (FREEZE_TURN,
+        _keep_kkt)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         if curvature is not None:
             self.problem.state.lam[:] = curvature
-        frozen = frozen and self._jacobian is not None
+        frozen = frozen and self._kkt is not None
         hessian = self._jacobian.hessian if frozen else self.problem.second_variation()
         if self._free_roll and not frozen:
             hessian.constrain_roll(frames[:, 2])
@@ -333,21 +357,31 @@ class NewtonPolish:
                 if self.unsymmetric else hessian
             rhs = hessian.to_vec(-gradient)
             vecs.append(rhs)
-            columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
-            vecs.extend(columns)
-            if columns and hessian.decidable and not self.unsymmetric:
-                # the inertia test solved for a basis of the same forms
-                solved = [solver.solve(rhs)] + hessian.solve_in_constraint_span(columns)
+            if frozen:
+                # a chord step: the whole KKT matrix of the last exact step, its chord
+                # forms and their solves included, so one right-hand side is solved
+                columns, solved, schur = self._kkt
+                direction = solver.solve_many([rhs])[0]
+                vecs.append(direction)
             else:
-                # the step's right-hand side and the forms in one solve
-                solved = solver.solve_many([rhs] + columns)
-            vecs.extend(solved)
-            direction, solved = solved[0], solved[1:]
+                columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
+                vecs.extend(columns)
+                if columns and hessian.decidable and not self.unsymmetric:
+                    # the inertia test solved for a basis of the same forms
+                    solved = [solver.solve(rhs)] + hessian.solve_in_constraint_span(columns)
+                else:
+                    # the step's right-hand side and the forms in one solve
+                    solved = solver.solve_many([rhs] + columns)
+                vecs.extend(solved)
+                direction, solved = solved[0], solved[1:]
+                schur = np.array([[c.dot(s) for s in solved] for c in columns])
+                if self.unsymmetric:
+                    # kept for the chord steps that follow (their Vecs leave ``vecs``)
+                    self._keep_kkt(columns, solved, schur, vecs)
             dmu = np.zeros(3)
             if columns:
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
                 # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
-                schur = np.array([[c.dot(s) for s in solved] for c in columns])
                 right = self._chord_residual(frames) + np.array([c.dot(direction)
                                                                  for c in columns])
                 dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
@@ -359,6 +393,21 @@ class NewtonPolish:
         finally:
             for vec in vecs:
                 vec.destroy()
+
+    def _keep_kkt(self, columns, solved, schur, vecs):
+        """Keep an exact step's chord forms C (Vecs), their solves J^-1 C and the Schur
+        matrix C J^-1 C^T for the chord steps after it (_newton_step), the last ones
+        freed; the kept Vecs are taken out of ``vecs`` (the step's, freed after it)."""
+        self._drop_kkt()
+        kept = set(map(id, columns + solved))
+        vecs[:] = [vec for vec in vecs if id(vec) not in kept]
+        self._kkt = (list(columns), list(solved), schur)
+
+    def _drop_kkt(self):
+        if self._kkt is not None:
+            for vec in self._kkt[0] + self._kkt[1]:
+                vec.destroy()
+        self._kkt = None
 
     def _without_roll(self, step, frames):
         """Remove from ``step`` (n_nodes, 3 or 4) its mean turn about the tangents (the
@@ -505,5 +554,6 @@ class NewtonPolish:
 
     def destroy(self):
         self._product.destroy()
+        self._drop_kkt()
         if self._jacobian is not None:
             self._jacobian.destroy()

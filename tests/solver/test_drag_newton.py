@@ -17,7 +17,9 @@ H plus the drag's linearisation through the resultants' chain, factored by LU.
 (c) the LDL^T of H leaves the resultants' identity rows out (SecondVariation's kept
     rows): its inertia and its solves are those of the whole H, factored apart;
 (d) near the solution the steps reuse the last factorisation (chord steps,
-    newton.FREEZE_TURN), and reach the state of exact steps.
+    newton.FREEZE_TURN), and reach the state of exact steps; a chord step solves one
+    right-hand side, and the attempt ends at the first whose rest (the error its
+    contraction leaves) is below newton.STEP_TOLERANCE.
 """
 
 import numpy as np
@@ -186,7 +188,7 @@ def test_chord_steps_reuse_the_factors_and_reach_the_same_state(comm, solver_fac
     step turned by at most FREEZE_TURN the step reuses the last J's LU (a chord step),
     so J is factored fewer times than steps are taken, where exact steps (FREEZE_TURN =
     0) factor it at every step; both reach the same state, to the tolerance (measured:
-    turns 0.39, 0.15, 1.8e-3, 9.8e-6, then a chord step of 2.1e-12 rad)."""
+    turns 0.39, 0.15, 1.8e-3, 9.8e-6, then a chord step of 6.8e-13 rad)."""
     from petsc_rod.analysis.jacobian import NewtonJacobian
     from petsc_rod.iteration import newton as newton_module
     factored = []
@@ -210,4 +212,51 @@ def test_chord_steps_reuse_the_factors_and_reach_the_same_state(comm, solver_fac
     (steps, factorisations, r), (exact_steps, exact_factorisations, exact_r) = runs.values()
     assert factorisations < steps
     assert exact_factorisations == exact_steps
+    assert np.abs(r - exact_r).max() < 1e-9
+
+
+def test_a_chord_step_solves_one_right_hand_side_and_ends_by_its_rest(comm, solver_factory,
+                                                                      monkeypatch):
+    """The catenary of (d) with chord steps from 1e-2 rad (FREEZE_TURN), so that two are
+    taken (measured: exact steps of 0.39, 0.15 and 1.8e-3 rad, then chord steps of
+    9.8e-6 and 3.3e-9 rad). An exact step solves J for its right-hand side and the three
+    chord forms between the pins (4 columns); a chord step for its right-hand side alone,
+    the forms' solves being the last exact step's. The attempt ends at the first chord
+    step whose rest theta / (1 - theta) turn (theta the turn over the previous one) is
+    below STEP_TOLERANCE, though its turn is not, at the state of exact steps to 1e-9."""
+    from petsc_rod.analysis.jacobian import NewtonJacobian
+    from petsc_rod.iteration import newton as newton_module
+    events = []
+    assemble, solve_many = NewtonJacobian.assemble, NewtonJacobian.solve_many
+
+    def factored(self):
+        events.append("factor")
+        assemble(self)
+
+    def solved(self, columns):
+        events.append(len(columns))
+        return solve_many(self, columns)
+
+    monkeypatch.setattr(NewtonJacobian, "assemble", factored)
+    monkeypatch.setattr(NewtonJacobian, "solve_many", solved)
+    scene = dict(LINES["catenary"], stiffness=(1e-1, 2e-1, 1e-1))
+    states = {}
+    for freeze in (1e-2, 0.0):
+        monkeypatch.setattr(newton_module, "FREEZE_TURN", freeze)
+        events.clear()
+        _, solver, report = converged(solver_factory, comm, scene, newton=True)
+        assert report.converged
+        states[freeze] = (list(events), [change for change, residual, _ in report.history
+                                         if residual == 0.0],
+                          solver.problem.state.r.owned().copy())
+    (events, turns, r), (_, _, exact_r) = states.values()
+    exact = [columns for before, columns in zip(events, events[1:]) if before == "factor"]
+    chords = [columns for before, columns in zip(events, events[1:])
+              if before != "factor" and columns != "factor"]
+    assert exact and set(exact) == {4}
+    assert len(chords) >= 2 and set(chords) == {1}
+    rests = [newton_module._chord_rest(turn, previous)
+             for previous, turn in zip(turns, turns[1:])][-len(chords):]
+    assert turns[-1] > newton_module.STEP_TOLERANCE
+    assert rests[-1] < newton_module.STEP_TOLERANCE <= min(rests[:-1])
     assert np.abs(r - exact_r).max() < 1e-9
