@@ -22,14 +22,17 @@ in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
 The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
 delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
 (analysis/stability.py, with the resultants' slots as identity rows) plus these
-entries: unsymmetric, factored by MUMPS's LU (global_step/ksp.direct_factor: on
-several ranks by substructuring, each rank its interior; options -rod_newton_*). H's
-curvature term is the load's at its current value, symmetrised: the antisymmetric rest
-is the torque balance, zero at a solution, so the steps still converge quadratically.
+entries (a copy of H's values on H's pattern, which holds these places as zeros from
+H's first assembly: Term.jacobian_pattern): unsymmetric, factored by MUMPS's LU
+(global_step/ksp.direct_factor: on several ranks by substructuring, each rank its
+interior; options -rod_newton_*). H's curvature term is the load's at its current
+value, symmetrised: the antisymmetric rest is the torque balance, zero at a solution,
+so the steps still converge quadratically.
 """
 
 from petsc4py import PETSc
 
+from petsc_rod.global_step.chain_factor import stored_entries
 from petsc_rod.global_step.ksp import NEWTON_PREFIX, direct_factor, solve_vecs
 
 
@@ -48,29 +51,26 @@ class NewtonJacobian:
         """J at the state H was last assembled at, factored. Collective."""
         hessian = self.hessian
         if self.matrix is None:
-            # the followers' entries first, in H's preallocation (a node's row meets the
-            # 5 nodes of its elements), then H added in C by MatAXPY, which makes the
-            # union of the two patterns (numpy's CSR copies of H cost three times as
-            # much: docs/performance.md); the pattern is kept through zeroEntries and
-            # zeroRows: one symbolic factorisation for the run
-            block = hessian.block
-            self.matrix = PETSc.Mat().createAIJ(hessian.matrix.getSizes(),
-                                                nnz=(5 * block, 2 * block),
-                                                comm=self.problem.mesh.comm)
-            self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-            self._add_terms()
-            self.matrix.axpy(1.0, hessian.matrix,
-                             structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            # a copy of H, whose pattern holds the terms' entries whose places the mesh
+            # fixes (Term.jacobian_pattern); the pattern is kept through zeroRows: one
+            # symbolic factorisation for the run
+            self.matrix = hessian.matrix.duplicate(copy=True)
+            self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, False)
             self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
             self.matrix.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        elif self._pattern_of_h():
+            # the same pattern as H (J took no entry beyond it): a copy of the values,
+            # which MatAXPY's general path costs ten times (docs/performance.md)
+            hessian.matrix.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         else:
-            # H's entries added in C (MatAXPY): J's pattern holds H's since the first
-            # assembly, and an entry new to it is inserted all the same (row by row, J
-            # takes new nonzeros; docs/performance.md has the cost)
+            # J took entries beyond H's pattern (a term whose places depend on the
+            # state: the friction): H's entries added row by row (MatAXPY)
             self.matrix.zeroEntries()
             self.matrix.axpy(1.0, hessian.matrix,
                              structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-            self._add_terms()
+        for term in self.problem.terms:
+            term.add_jacobian(self)
+        self.matrix.assemble()
         # the held unknowns keep their identity rows (what the followers added there
         # is dropped); their columns meet a zero step
         self.matrix.zeroRows(hessian.held_rows, diag=1.0)
@@ -82,11 +82,13 @@ class NewtonJacobian:
                                         NEWTON_PREFIX)
         self.factor.set_up(self.matrix)
 
-    def _add_terms(self):
-        """The unsymmetric terms' entries (Term.add_jacobian) added, and J assembled."""
-        for term in self.problem.terms:
-            term.add_jacobian(self)
-        self.matrix.assemble()
+    def _pattern_of_h(self):
+        """Whether J's pattern is H's on every rank: J starts as H's copy and only grows
+        (new nonzeros), so the same count of stored entries is the same pattern.
+        Collective."""
+        same = (stored_entries(self.matrix, "nz_used")
+                == stored_entries(self.hessian.matrix, "nz_used"))
+        return bool(self.problem.mesh.global_min(int(same)))
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
@@ -104,3 +106,4 @@ class NewtonJacobian:
         for obj in (self.factor, self.matrix):
             if obj is not None:
                 obj.destroy()
+

@@ -130,6 +130,7 @@ class SecondVariation:
         self.resultant_rows = ((nodes[:, None] + self.resultant_slot + np.arange(3)).ravel()
                                if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
+        self._reserved = False           # J's pattern in H (_assemble)
         self.constraint = []
         self._constraint_solves = []      # (H - shift M)^-1 of each, at the last factorisation
         self._fill()
@@ -209,6 +210,14 @@ class SecondVariation:
                              np.ones((self.resultant_rows.size, 1, 1)))
         for term in problem.terms:
             term.add_hessian(self)
+        if not self._reserved:
+            # the Newton Jacobian's entries beyond H as zeros, kept by zeroEntries:
+            # J is then a copy of H on its pattern (analysis/jacobian.py)
+            for term in problem.terms:
+                for rows, columns in term.jacobian_pattern(self):
+                    self._add_blocks(rows, columns,
+                                     np.zeros(rows.shape + columns.shape[1:]))
+            self._reserved = True
         self.matrix.assemble()
 
     # --- the positions' chains (module docstring, analysis/positions.py) -----------------

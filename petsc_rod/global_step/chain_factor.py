@@ -118,7 +118,7 @@ class ChainFactor:
         if not all(self._mpi.allgather(self.next_back <= self.n - self.offset)):
             raise NotAChainError("an interface's rows reach beyond the previous rank's "
                                  "interior")
-        self._nonzeros = _nonzeros(matrix)
+        self._nonzeros = stored_entries(matrix)
 
     def _reach(self, matrix, start, end):
         """None where the local rows couple as a chain split at the ranks' first nodes,
@@ -164,7 +164,7 @@ class ChainFactor:
         SingularInteriorError where a rank's interior has a null pivot. Collective."""
         B, off = self.block, self.offset
         start, end = matrix.getOwnershipRange()
-        if self._mpi.allreduce(int(_nonzeros(matrix) != self._nonzeros)):
+        if self._mpi.allreduce(int(stored_entries(matrix) != self._nonzeros)):
             # the pattern grew (a new nonzero): the reaches and the interior anew
             self._split(matrix)
             for obj in (self.ksp, self.interior):
@@ -375,7 +375,7 @@ def _column_range(matrix, start, end, edge=None):
     highest[filled] = columns[indptr[filled + 1] - 1] + first_column
     if not several:
         return lowest, highest
-    beyond_block = _nonzeros(matrix, "nz_used") - int(indptr[-1])
+    beyond_block = stored_entries(matrix, "nz_used") - int(indptr[-1])
     if beyond_block == 0:
         return lowest, highest
     edge_rows = _edge_rows(matrix, start, indptr, edge, beyond_block)
@@ -410,7 +410,7 @@ def _edge_rows(matrix, start, indptr, edge, beyond_block):
     return list(zip(rows, entries)) if outside == beyond_block else None
 
 
-def _nonzeros(matrix, kind="nz_allocated"):
+def stored_entries(matrix, kind="nz_allocated"):
     """The nonzeros allocated (a change of pattern), or ``kind`` "nz_used" stored, in
     this rank's rows of ``matrix``."""
     return int(matrix.getInfo(PETSc.Mat.InfoType.LOCAL)[kind])

@@ -145,6 +145,14 @@ class Term:
         (analysis/jacobian.py NewtonJacobian, before assembly): a follower's load's
         derivative in the frames, through the resultants' chain."""
 
+    def jacobian_pattern(self, hessian):
+        """Where add_jacobian adds entries whatever the state, as [(rows (k, r),
+        columns (k, c)), ...] of global indices in the layout of the SecondVariation
+        ``hessian``: H holds zeros there from its first assembly, so that J is a copy
+        of H on the same pattern (analysis/jacobian.py). [] where the entries depend
+        on the state (J then takes them as new nonzeros)."""
+        return []
+
     # --- the load path -----------------------------------------------------------------
     def accept_step(self, state):
         """At the end of an accepted load step, the RodState ``state`` its equilibrium:

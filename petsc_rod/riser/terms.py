@@ -267,7 +267,8 @@ class DragTerm(NodalLoadTerm):
         ne = mesh.n_local_elements
         if not ne:
             return
-        B, U, P = hessian.block, hessian.unknowns, hessian.resultant_slot
+        U = hessian.unknowns
+        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
         tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
         h = mesh.element_h
         r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
@@ -285,10 +286,6 @@ class DragTerm(NodalLoadTerm):
             rows_map = np.concatenate([rows_map, -unit[:, :, None, :]], axis=2)  # (ne, a, 4, 3)
         integrals = element_integrals(h)                                         # (ne, 3)
         tails = self.drag.tail_integrals                                         # (ne, a, b)
-        base = hessian.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
-        x_rows = (base[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
-        turns = (base[:, :, None] + np.arange(3)).reshape(ne, 9)
-        psi = base[:, [0, 2]][:, :, None] + P + np.arange(3)                     # (ne, 2, 3)
         jacobian.add(x_rows, psi[:, 1],
                      (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3))
         # rows_map_a tails_ab G_b for each node pair (a, b) of an element, (ne, a, b, U,
@@ -299,12 +296,33 @@ class DragTerm(NodalLoadTerm):
         jacobian.add(x_rows, turns, coupling.transpose(0, 1, 3, 2, 4).reshape(ne, 3 * U, 9))
         # the chain: Psi_e - Psi_e+1 - sum_l I_l G_l omega_l = 0 in Psi_e's row from a
         # held start, its negative in Psi_e+1's from a held end (the diagonal 1 is H's)
-        held_start = is_held(self.start_state)
-        row, other, sign = (psi[:, 0], psi[:, 1], -1.0) if held_start else \
-            (psi[:, 1], psi[:, 0], 1.0)
+        sign = -1.0 if is_held(self.start_state) else 1.0
         jacobian.add(row, other, np.broadcast_to(-np.eye(3), (ne, 3, 3)))
         chain = sign * np.einsum("eb,ebjk->ejbk", integrals, G).reshape(ne, 3, 9)
         jacobian.add(row, turns, chain)
+
+    def _jacobian_indices(self, hessian):
+        """The global rows and columns of add_jacobian's blocks, per owned element (ne):
+        the frames' rows of its three nodes (ne, 3 U), their turns (ne, 9), the
+        resultants at its two vertices (ne, 2, 3), and the chain's rows and the other
+        vertex's resultants (ne, 3) each (Psi_e's row from a held start, Psi_e+1's from
+        a held end)."""
+        ne = self.mesh.n_local_elements
+        B, U, P = hessian.block, hessian.unknowns, hessian.resultant_slot
+        base = hessian.first_row + B * (2 * np.arange(ne)[:, None] + np.arange(3)[None, :])
+        x_rows = (base[:, :, None] + np.arange(U)).reshape(ne, 3 * U)
+        turns = (base[:, :, None] + np.arange(3)).reshape(ne, 9)
+        psi = base[:, [0, 2]][:, :, None] + P + np.arange(3)                     # (ne, 2, 3)
+        row, other = (psi[:, 0], psi[:, 1]) if is_held(self.start_state) else \
+            (psi[:, 1], psi[:, 0])
+        return x_rows, turns, psi, row, other
+
+    def jacobian_pattern(self, hessian):
+        """add_jacobian's blocks, whose places the mesh fixes (Term.jacobian_pattern)."""
+        if not self.mesh.n_local_elements:
+            return []
+        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
+        return [(x_rows, psi[:, 1]), (x_rows, turns), (row, other), (row, turns)]
 
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""

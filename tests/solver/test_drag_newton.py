@@ -9,10 +9,11 @@ H plus the drag's linearisation through the resultants' chain, factored by LU.
     converged state (where H's symmetrised curvature term is the exact one), u the
     heights' and Psi the resultants' first variations (central differences of the
     centreline and of the drag's resultant beyond each vertex): the frames' rows equal
-    the derivative, the resultants' rows vanish. A catenary in a current across its
-    plane between pins, inextensible and extensible, and a hanging line (free start,
-    clamped end) in a current (the seabed's part of J, through the heights' chain, is
-    test_seabed_newton's);
+    the derivative, the resultants' rows vanish; J assembled again at the same state
+    (a copy of H on H's pattern, which holds the drag's places) is the same matrix. A
+    catenary in a current across its plane between pins, inextensible and extensible,
+    and a hanging line (free start, clamped end) in a current (the seabed's part of J,
+    through the heights' chain, is test_seabed_newton's);
 (b) Newton steps on the catenary reach the iteration's state in fewer iterations;
 (c) the LDL^T of H leaves the resultants' identity rows out (SecondVariation's kept
     rows): its inertia and its solves are those of the whole H, factored apart;
@@ -26,6 +27,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.global_step.chain_factor import stored_entries
 from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.iteration.newton import NewtonPolish
 from petsc_rod.riser.environment import Current
@@ -81,6 +83,15 @@ def test_jacobian_against_finite_differences(comm, solver_factory, line):
         gradient = polish.lagrangian_gradient(frames, mu)
         hessian = problem.second_variation()
         jacobian = polish._jacobian_of(hessian)
+        # J again at the same state: a copy of H's values on H's pattern (which holds
+        # the drag's places from its first assembly), the same matrix exactly
+        assert stored_entries(jacobian.matrix, "nz_used") == \
+            stored_entries(hessian.matrix, "nz_used")
+        first = jacobian.matrix.duplicate(copy=True)
+        jacobian = polish._jacobian_of(hessian)
+        first.axpy(-1.0, jacobian.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        assert first.norm(PETSc.NormType.INFINITY) == 0.0
+        first.destroy()
         n, B, U = mesh.n_local_nodes, hessian.block, hessian.unknowns
         drag = next(term for term in problem.terms if isinstance(term, DragTerm))
         v = random_direction(polish, 3000)
