@@ -46,31 +46,46 @@ class NewtonJacobian:
         self.problem = hessian.problem
         self.matrix = None
         self.factor = None
+        self._h_entries = None          # H's stored entries when J took its values
 
     def assemble(self):
         """J at the state H was last assembled at, factored. Collective."""
         hessian = self.hessian
-        if self.matrix is None:
-            # a copy of H, whose pattern holds the terms' entries whose places the mesh
-            # fixes (Term.jacobian_pattern); the pattern is kept through zeroRows: one
-            # symbolic factorisation for the run
+        added = False                               # the terms' entries in J already
+        if self.matrix is None and self._reserved():
+            # a copy of H, whose pattern holds the terms' entries (Term.jacobian_pattern);
+            # the pattern is kept through zeroRows: one symbolic factorisation for the run
             self.matrix = hessian.matrix.duplicate(copy=True)
             self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, False)
+        elif self.matrix is None:
+            # a term's entries that H's pattern does not hold (the friction's): in H's
+            # preallocation (a node's row meets the 5 nodes of its elements), then H
+            # added (MatAXPY: the union of the patterns); the copy of H's pattern would
+            # take them as new nonzeros, each a reallocation of the whole matrix
+            block = hessian.block
+            self.matrix = PETSc.Mat().createAIJ(hessian.matrix.getSizes(),
+                                                nnz=(5 * block, 2 * block),
+                                                comm=self.problem.mesh.comm)
             self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-            self.matrix.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+            self._add_terms()
+            added = True
+            self.matrix.axpy(1.0, hessian.matrix,
+                             structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         elif self._pattern_of_h():
-            # the same pattern as H (J took no entry beyond it): a copy of the values,
-            # which MatAXPY's general path costs ten times (docs/performance.md)
-            hessian.matrix.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            # the same pattern as H: a copy of the values (MatCopy), where MatAXPY's
+            # general path costs ten times as much (docs/performance.md, ninth pass)
+            hessian.matrix.copy(self.matrix,
+                                structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         else:
-            # J took entries beyond H's pattern (a term whose places depend on the
-            # state: the friction): H's entries added row by row (MatAXPY)
+            # J holds entries beyond H's pattern: H's added row by row (MatAXPY)
             self.matrix.zeroEntries()
             self.matrix.axpy(1.0, hessian.matrix,
                              structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        for term in self.problem.terms:
-            term.add_jacobian(self)
-        self.matrix.assemble()
+        self.matrix.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        self.matrix.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        self._h_entries = stored_entries(hessian.matrix, "nz_used")
+        if not added:
+            self._add_terms()
         # the held unknowns keep their identity rows (what the followers added there
         # is dropped); their columns meet a zero step
         self.matrix.zeroRows(hessian.held_rows, diag=1.0)
@@ -82,13 +97,26 @@ class NewtonJacobian:
                                         NEWTON_PREFIX)
         self.factor.set_up(self.matrix)
 
+    def _reserved(self):
+        """Whether H's pattern holds every unsymmetric term's entries of J (the terms
+        whose places the mesh fixes say so: Term.jacobian_reserved)."""
+        return all(term.jacobian_reserved for term in self.problem.terms
+                   if term.unsymmetric)
+
     def _pattern_of_h(self):
-        """Whether J's pattern is H's on every rank: J starts as H's copy and only grows
-        (new nonzeros), so the same count of stored entries is the same pattern.
-        Collective."""
-        same = (stored_entries(self.matrix, "nz_used")
-                == stored_entries(self.hessian.matrix, "nz_used"))
+        """Whether J's pattern is H's on every rank: J was H's copy or holds H's pattern,
+        and only grows (new nonzeros), and H's count of stored entries is the one J was
+        made from, so the same count is the same pattern. Collective."""
+        h_entries = stored_entries(self.hessian.matrix, "nz_used")
+        same = (h_entries == self._h_entries
+                and stored_entries(self.matrix, "nz_used") == h_entries)
         return bool(self.problem.mesh.global_min(int(same)))
+
+    def _add_terms(self):
+        """The unsymmetric terms' entries (Term.add_jacobian) added, and J assembled."""
+        for term in self.problem.terms:
+            term.add_jacobian(self)
+        self.matrix.assemble()
 
     def add(self, rows, columns, values):
         """Add blocks ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
@@ -106,4 +134,3 @@ class NewtonJacobian:
         for obj in (self.factor, self.matrix):
             if obj is not None:
                 obj.destroy()
-

@@ -57,7 +57,8 @@ from petsc_rod.frames import rotations
 EVENT = PETSc.Log.Event("rod_newton")
 
 # At most this many Newton steps per attempt; a step whose largest turn is below
-# STEP_TOLERANCE rad is the last (the error after it is about its square).
+# STEP_TOLERANCE rad is the last (the error after it is about its square), and so is a
+# chord step whose rest is (FROZEN_SHRINK, below).
 MAX_STEPS = 8
 STEP_TOLERANCE = 1e-10
 # A step must shrink to at most this fraction of the previous one, or the polish stops
@@ -77,12 +78,13 @@ SHRINK = 0.5
 # whose tests decide convergence, goes on from there.
 FLOOR_TURN = 1e-7
 # Near the solution a step of a problem whose steps solve with the Jacobian (a follower
-# load, the friction: ``unsymmetric``) reuses the last step's matrices and factors (a
-# chord step): where the previous step turned by at most FREEZE_TURN rad, J has changed
-# by about that much since it was factored, and a step with it contracts the error by a
-# factor of about as much, without H's and J's assembly, the LU and the inertia's LDL^T,
-# and with one right-hand side: the chord forms' solves are the last exact step's too
-# (the KKT matrix frozen whole; docs/performance.md). A chord step that does not shrink
+# load, the friction: ``unsymmetric``) reuses the last exact step's matrices and factors
+# (a chord step): where the previous step turned by at most FREEZE_TURN rad, J has
+# changed since it was factored by about the turns since that exact step, and a step
+# with it contracts the error by a factor of about as much, without H's and J's
+# assembly, the LU and the inertia's LDL^T, and with one right-hand side: the chord
+# forms' solves are the exact step's too (the KKT matrix frozen whole; docs/performance.md,
+# "Issue 21, ninth pass"). A chord step that does not shrink
 # to FROZEN_SHRINK of the previous one is taken again with fresh factors (above
 # FLOOR_TURN; at the floor the state is handed over, as after any step that does not
 # shrink). Such a problem has no energy: the inertia test is its steps' safeguard, not a
@@ -189,9 +191,10 @@ class NewtonPolish:
                 # the first step's curvature from the iteration's multipliers where the
                 # heights enter (see _newton_step)
                 curvature = saved["lam"] if first and self.reads_positions else None
-                frozen = self.unsymmetric and previous <= FREEZE_TURN
-                omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, frozen)
-                chord = frozen and self._kkt is not None
+                # a chord step (FREEZE_TURN) from the last exact step's KKT matrix
+                chord = (self.unsymmetric and previous <= FREEZE_TURN
+                         and self._kkt is not None)
+                omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, chord)
                 if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
                     # a chord step that did not contract: fresh factors (at the round-off
@@ -203,6 +206,7 @@ class NewtonPolish:
                     # again with the iteration's curvature, as the first (_newton_step),
                     # and like the first exempt from the residual's fall below
                     curvature = saved["lam"]
+                    chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None:
                     outcome = INDEFINITE
@@ -236,6 +240,7 @@ class NewtonPolish:
                     # K1 = K2 between pins): the step again with H + tolerance M, and so
                     # on to the end of the attempt (_positive_definite)
                     regularised = True
+                    chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised)
                     if omega is None:
                         outcome = INDEFINITE
@@ -253,8 +258,8 @@ class NewtonPolish:
                 else:
                     frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
                 mu = mu + dmu
-                # the error the step leaves: about its square after an exact step, the
-                # geometric rest of a chord step's contraction (_chord_rest)
+                # what is compared with STEP_TOLERANCE: an exact step's turn (the error
+                # it leaves is about its square), a chord step's geometric rest
                 rest = _chord_rest(largest, previous) if chord else largest
                 previous = largest
                 if record is not None:
@@ -265,6 +270,8 @@ class NewtonPolish:
             state.restore(saved)
             return outcome
         finally:
+            # the kept KKT pieces serve this attempt's chord steps only
+            self._drop_kkt()
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
@@ -395,15 +402,17 @@ class NewtonPolish:
                 vec.destroy()
 
     def _keep_kkt(self, columns, solved, schur, vecs):
-        """Keep an exact step's chord forms C (Vecs), their solves J^-1 C and the Schur
-        matrix C J^-1 C^T for the chord steps after it (_newton_step), the last ones
-        freed; the kept Vecs are taken out of ``vecs`` (the step's, freed after it)."""
+        """Keep an exact step's chord forms C^T (Vecs, one a row of C), their solves
+        J^-1 C^T and the Schur matrix C J^-1 C^T (3, 3) for the chord steps after it
+        (_newton_step), the last ones freed; the kept Vecs are taken out of ``vecs``
+        (the step's, freed after it)."""
         self._drop_kkt()
         kept = set(map(id, columns + solved))
         vecs[:] = [vec for vec in vecs if id(vec) not in kept]
         self._kkt = (list(columns), list(solved), schur)
 
     def _drop_kkt(self):
+        """Free the kept KKT pieces (_keep_kkt): after an attempt, or for new ones."""
         if self._kkt is not None:
             for vec in self._kkt[0] + self._kkt[1]:
                 vec.destroy()

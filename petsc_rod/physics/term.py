@@ -72,6 +72,9 @@ class Term:
     # Jacobian by LU and each must lower |grad L|; H (the stability test, the safeguard)
     # is that of the term's load held at its current value
     unsymmetric = False
+    # H's pattern holds add_jacobian's entries (jacobian_pattern), so that J is a copy
+    # of H (analysis/jacobian.py); otherwise J is made with room for them
+    jacobian_reserved = False
     # the term's outputs and its share of the internal force are functions of the state
     # (fields, frames, multipliers), so that a step may end at a Newton state (§11,
     # "Convergence in Newton's terms"); False where they are what the last global step
@@ -146,11 +149,10 @@ class Term:
         derivative in the frames, through the resultants' chain."""
 
     def jacobian_pattern(self, hessian):
-        """Where add_jacobian adds entries whatever the state, as [(rows (k, r),
-        columns (k, c)), ...] of global indices in the layout of the SecondVariation
-        ``hessian``: H holds zeros there from its first assembly, so that J is a copy
-        of H on the same pattern (analysis/jacobian.py). [] where the entries depend
-        on the state (J then takes them as new nonzeros)."""
+        """Where add_jacobian adds entries, as [(rows (k, r), columns (k, c)), ...] of
+        global indices in the layout of the SecondVariation ``hessian``, of a term whose
+        ``jacobian_reserved``: H holds zeros there from its first assembly, so that J is
+        a copy of H on the same pattern (analysis/jacobian.py)."""
         return []
 
     # --- the load path -----------------------------------------------------------------

@@ -227,7 +227,7 @@ class DragTerm(NodalLoadTerm):
     linearisation (analysis/jacobian.py)."""
 
     conservative = False
-    follower = unsymmetric = True
+    follower = unsymmetric = jacobian_reserved = True
 
     def __init__(self, mesh, scene):
         super().__init__(mesh, "drag")
@@ -318,7 +318,7 @@ class DragTerm(NodalLoadTerm):
         return x_rows, turns, psi, row, other
 
     def jacobian_pattern(self, hessian):
-        """add_jacobian's blocks, whose places the mesh fixes (Term.jacobian_pattern)."""
+        """add_jacobian's blocks (Term.jacobian_pattern)."""
         if not self.mesh.n_local_elements:
             return []
         x_rows, turns, psi, row, other = self._jacobian_indices(hessian)

@@ -14,7 +14,9 @@ Jacobian unsymmetric.
     they should. A line pulled along the seabed (extensible; the sliding part slides
     along the line: the limit's column on the heights matters) and a line between pins
     pushed across its plane (inextensible; its grounded part slides sideways). The
-    stick/slide/off sets are the same at the three states (no kink crossed).
+    stick/slide/off sets are the same at the three states (no kink crossed). J
+    assembled again at the same state (H's values added on J's own pattern) is the same
+    matrix to round-off.
 (b) Newton steps reach the iteration's state in fewer iterations: the pulled line
     (measured: 47 iterations with 2 Newton steps against 222). The line pushed across
     gains little (2404 against 2668; without friction 772 against 1030: its attempts
@@ -122,6 +124,15 @@ def test_jacobian_against_finite_differences(comm, line):
         hessian = problem.second_variation()
         assert hessian.positions == (0, 1, 2)
         jacobian = polish._jacobian_of(hessian)
+        # J again at the same state (H's values added to J's own pattern, which holds
+        # the friction's entries beyond H's): the same matrix, to the round-off of the
+        # sums' order (the first J summed the friction's entries first)
+        first = jacobian.matrix.duplicate(copy=True)
+        jacobian = polish._jacobian_of(hessian)
+        first.axpy(-1.0, jacobian.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        size = jacobian.matrix.norm(PETSc.NormType.INFINITY)
+        assert first.norm(PETSc.NormType.INFINITY) <= 1e-14 * size
+        first.destroy()
         n, B, U = mesh.n_local_nodes, hessian.block, hessian.unknowns
         v = random_direction(polish, 4000)
         s = 1e-7
