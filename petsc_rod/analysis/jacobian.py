@@ -98,8 +98,8 @@ class NewtonJacobian:
         self.factor.set_up(self.matrix)
 
     def _reserved(self):
-        """Whether H's pattern holds every unsymmetric term's entries of J (the terms
-        whose places the mesh fixes say so: Term.jacobian_reserved)."""
+        """Whether H's pattern holds every unsymmetric term's entries of J (each term
+        that reserves them there by its jacobian_pattern says so: Term.jacobian_reserved)."""
         return all(term.jacobian_reserved for term in self.problem.terms
                    if term.unsymmetric)
 

@@ -83,12 +83,12 @@ FLOOR_TURN = 1e-7
 # changed since it was factored by about the turns since that exact step, and a step
 # with it contracts the error by a factor of about as much, without H's and J's
 # assembly, the LU and the inertia's LDL^T, and with one right-hand side: the chord
-# forms' solves are the exact step's too (the KKT matrix frozen whole; docs/performance.md,
-# "Issue 21, ninth pass"). A chord step that does not shrink
-# to FROZEN_SHRINK of the previous one is taken again with fresh factors (above
-# FLOOR_TURN; at the floor the state is handed over, as after any step that does not
-# shrink). Such a problem has no energy: the inertia test is its steps' safeguard, not a
-# stability verdict, and it was passed at most about FREEZE_TURN rad from the result. A
+# forms' solves are the exact step's too (the KKT matrix frozen whole;
+# docs/performance.md, "Issue 21, ninth pass"). A chord step that does not shrink to
+# FROZEN_SHRINK of the previous one is taken again with fresh factors (above FLOOR_TURN;
+# at the floor the state is handed over, as after any step that does not shrink). Such a
+# problem has no energy: the inertia test is its steps' safeguard, not a stability
+# verdict, and it was passed at most about FREEZE_TURN rad from the result. A
 # conservative problem's steps stay exact.
 FREEZE_TURN = 1e-4
 FROZEN_SHRINK = 0.1
@@ -402,8 +402,8 @@ class NewtonPolish:
                 vec.destroy()
 
     def _keep_kkt(self, columns, solved, schur, vecs):
-        """Keep an exact step's chord forms C^T (Vecs, one a row of C), their solves
-        J^-1 C^T and the Schur matrix C J^-1 C^T (3, 3) for the chord steps after it
+        """Keep an exact step's chord forms C^T (k Vecs, one a row of C), their solves
+        J^-1 C^T and the Schur matrix C J^-1 C^T (k, k) for the chord steps after it
         (_newton_step), the last ones freed; the kept Vecs are taken out of ``vecs``
         (the step's, freed after it)."""
         self._drop_kkt()
