@@ -343,12 +343,11 @@ class NewtonPolish:
         current, 900 elements: a first turn of 0.016 rad), which ``run`` takes again with
         the iteration's curvature. ``frozen``: a chord step, with the matrices and
         factors of the last exact step, and its chord forms' solves (FREEZE_TURN,
-        _keep_kkt)."""
+        _keep_kkt; ``run`` takes one only where they are kept)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         if curvature is not None:
             self.problem.state.lam[:] = curvature
-        frozen = frozen and self._kkt is not None
         hessian = self._jacobian.hessian if frozen else self.problem.second_variation()
         if self._free_roll and not frozen:
             hessian.constrain_roll(frames[:, 2])
