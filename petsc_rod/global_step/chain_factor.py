@@ -95,9 +95,15 @@ class ChainFactor:
         # the first rank's interior numbered from its end: its couplings, to the next
         # interface, come first, near the root of the elimination tree (W's solve)
         self.reversed = self.offset == 0 and self.has_next
-        interior = np.arange(self.offset, self.n, dtype=PETSc.IntType)
-        self._index = PETSc.IS().createGeneral(interior[::-1] if self.reversed else interior,
-                                               comm=PETSc.COMM_SELF)
+        # a stride where the order is the natural one: MatCreateSubMatrix copies
+        # contiguous columns row by row (3.4 against 8.2 ms on a half of the
+        # 18 000-element riser's J)
+        if self.reversed:
+            interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
+            self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
+        else:
+            self._index = PETSc.IS().createStride(self.n - self.offset, self.offset, 1,
+                                                  comm=PETSc.COMM_SELF)
         self.interior = None
         self.ksp = None
         self.failed = False
@@ -251,19 +257,20 @@ class ChainFactor:
         next_slot = self.rank * B if self.has_next else None
         W_own = self.W[:B] if off else None
         W_next = self.W[-B:] if self.has_next else None
-        n_interior = self.n - off
+        # A_GI W on the interior columns the interface rows reach (the head's, the
+        # tail's): A_GI is zero elsewhere, and W is (B, n_interior)
         if off:
-            rows = np.zeros((B, n_interior))
-            rows[:, :self.head_columns] = self._own_rows
-            parts.append((own_slot, own_slot, self._own_block - rows @ W_own.T))
+            head = slice(0, self.head_columns)
+            rows = self._own_rows
+            parts.append((own_slot, own_slot, self._own_block - rows @ W_own[:, head].T))
             if self.has_next:
-                parts.append((own_slot, next_slot, -rows @ W_next.T))
+                parts.append((own_slot, next_slot, -rows @ W_next[:, head].T))
         if self.has_next:
-            rows = np.zeros((B, n_interior))
-            rows[:, n_interior - self.next_back:] = self._next_rows
-            parts.append((next_slot, next_slot, -rows @ W_next.T))
+            tail = slice(self.n - off - self.next_back, None)
+            rows = self._next_rows
+            parts.append((next_slot, next_slot, -rows @ W_next[:, tail].T))
             if off:
-                parts.append((next_slot, own_slot, -rows @ W_own.T))
+                parts.append((next_slot, own_slot, -rows @ W_own[:, tail].T))
         schur = np.zeros((m, m))
         for rank_parts in self._mpi.allgather(parts):
             for i, j, values in rank_parts:
