@@ -36,8 +36,8 @@ by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
 factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
 scalable to many), where MUMPS on two ranks factored the riser's Jacobian in the one-rank
 time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
-objects (the interior submatrix and its sequential MUMPS solver, the index set of the
-interior rows): ``destroy()``.
+objects (the interior submatrix, on one rank a reference to the matrix itself, and its
+sequential MUMPS solver, the index set of the interior rows): ``destroy()``.
 """
 
 import numpy as np
@@ -97,7 +97,9 @@ class ChainFactor:
         self.reversed = self.offset == 0 and self.has_next
         # a stride where the order is the natural one: MatCreateSubMatrix copies
         # contiguous columns row by row (3.4 against 8.2 ms on a half of the
-        # 18 000-element riser's J)
+        # 18 000-element riser's J). On one rank (tests only: direct_factor substructures
+        # on several) the stride is the whole matrix, and the interior is that matrix
+        # itself, a reference: nothing here changes the interior in place
         if self.reversed:
             interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
             self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
@@ -257,20 +259,21 @@ class ChainFactor:
         next_slot = self.rank * B if self.has_next else None
         W_own = self.W[:B] if off else None
         W_next = self.W[-B:] if self.has_next else None
-        # A_GI W on the interior columns the interface rows reach (the head's, the
-        # tail's): A_GI is zero elsewhere, and W is (B, n_interior)
+        # A_GI W on the interior columns the interface rows reach (the first
+        # head_columns, the last next_back): A_GI is zero elsewhere; W_own and W_next
+        # are (B, n_interior)
         if off:
-            head = slice(0, self.head_columns)
+            own_reach = slice(0, self.head_columns)
             rows = self._own_rows
-            parts.append((own_slot, own_slot, self._own_block - rows @ W_own[:, head].T))
+            parts.append((own_slot, own_slot, self._own_block - rows @ W_own[:, own_reach].T))
             if self.has_next:
-                parts.append((own_slot, next_slot, -rows @ W_next[:, head].T))
+                parts.append((own_slot, next_slot, -rows @ W_next[:, own_reach].T))
         if self.has_next:
-            tail = slice(self.n - off - self.next_back, None)
+            next_reach = slice(self.n - off - self.next_back, None)
             rows = self._next_rows
-            parts.append((next_slot, next_slot, -rows @ W_next[:, tail].T))
+            parts.append((next_slot, next_slot, -rows @ W_next[:, next_reach].T))
             if off:
-                parts.append((next_slot, own_slot, -rows @ W_own[:, tail].T))
+                parts.append((next_slot, own_slot, -rows @ W_own[:, next_reach].T))
         schur = np.zeros((m, m))
         for rank_parts in self._mpi.allgather(parts):
             for i, j, values in rank_parts:
