@@ -16,8 +16,9 @@ current across its plane, and the riser catenary at 18 000 elements (0.1 m). For
 last, two more measures:
 
 * the time of one plain iteration of the same line without seabed and current
-  (``nrichardson``, no Newton; the solve times of 40 and 20 iterations differenced, so
-  that the step's set-up cancels), and the solve's time in those units;
+  (``nrichardson``, no Newton; the solve times of 100 and 20 iterations differenced, so
+  that the step's set-up cancels, over a difference of 80 iterations, so that a run's
+  noise of 0.1 s moves it by about 1 ms), and the solve's time in those units;
 * its solve time on 2 ranks, and the speed-up over 1 rank: 1-rank and 2-rank runs
   alternated (``--pairs`` pairs, default N), so that both see the shared machine in the
   same states; the best of each, and the median of the pairs' ratios.
@@ -48,7 +49,8 @@ sys.path.insert(0, str(HERE))
 
 from benchmark_iterations import run_child  # noqa: E402
 
-PLAIN_ITERATIONS = 20
+# the plain line's runs: their difference is the time of PLAIN_LONG - PLAIN_SHORT iterations
+PLAIN_SHORT, PLAIN_LONG = 20, 100
 PLAIN = ["-rod_snes_type", "nrichardson", "-rod_al_newton", "0", "-rod_al_stability", "0",
          "-rod_max_halvings", "0"]          # the step at its cap is not retried
 RISER = ROOT / "options" / "riser_catenary.opts"
@@ -101,11 +103,11 @@ def plain_line(iterations):
 
 def plain_iteration_time(repeats, folder):
     """The time of one plain iteration of plain_line, s: the difference of the solve
-    times of runs of 2 PLAIN_ITERATIONS and PLAIN_ITERATIONS iterations (best of
+    times of runs of PLAIN_LONG and PLAIN_SHORT iterations (best of
     ``repeats`` each) over the difference of the iterations their files count, so that
     the step's set-up cancels."""
     (_, short, _, few), (_, long, _, many) = (
-        measure(plain_line(k * PLAIN_ITERATIONS), repeats, folder) for k in (1, 2))
+        measure(plain_line(count), repeats, folder) for count in (PLAIN_SHORT, PLAIN_LONG))
     return (long - short) / (int(many["total_iterations"]) - int(few["total_iterations"]))
 
 
@@ -224,8 +226,8 @@ def main():
             worth, speedup = solve / per_iteration, solve_1 / solve_2
             notes = [
                 f"- {FINE} elements: one plain iteration of the line without seabed and "
-                f"current takes {1e3 * per_iteration:.1f} ms (runs of {2 * PLAIN_ITERATIONS} "
-                f"less runs of {PLAIN_ITERATIONS} iterations, best of {args.repeats} each); "
+                f"current takes {1e3 * per_iteration:.1f} ms (runs of {PLAIN_LONG} "
+                f"less runs of {PLAIN_SHORT} iterations, best of {args.repeats} each); "
                 f"the solve takes {worth:.0f} of them (target "
                 f"<= {FINE_PLAIN_WORTH}: {'met' if worth <= FINE_PLAIN_WORTH else 'missed'}).",
                 f"- {FINE} elements on 2 ranks ({pairs} runs alternated with runs on 1, "
