@@ -96,10 +96,11 @@ class ChainFactor:
         # interface, come first, near the root of the elimination tree (W's solve)
         self.reversed = self.offset == 0 and self.has_next
         # a stride where the order is the natural one: MatCreateSubMatrix copies
-        # contiguous columns row by row (3.4 against 8.2 ms on a half of the
-        # 18 000-element riser's J). On one rank (tests only: direct_factor substructures
-        # on several) the stride is the whole matrix, and the interior is that matrix
-        # itself, a reference: nothing here changes the interior in place
+        # contiguous columns row by row, faster than for a general index set
+        # (docs/performance.md, "Issue 21, tenth pass"). On one rank (tests only:
+        # direct_factor substructures on several) the stride is the whole matrix, and the
+        # interior is that matrix itself, a reference: nothing here changes the interior
+        # in place
         if self.reversed:
             interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
             self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
