@@ -19,7 +19,9 @@ factorisation, with one solve of sparse right-hand sides (A_IG is nonzero on the
 interior's first and last few rows only: MUMPS's forward elimination visits the paths
 of its elimination tree from them to the root, near which the AMF ordering places the
 first rows of the numbering; the first rank, whose coupling is its interior's tail,
-numbers its interior from its end); S is ((P - 1) B) square, block
+numbers its interior from its end for an LU, while an LDL^T, whose factorisation that
+order slows by more than it saves in W, keeps the natural order and then factors the
+rank's diagonal block itself, without extracting it); S is ((P - 1) B) square, block
 tridiagonal, assembled from every rank's contribution and inverted on every rank: dense,
 equilibrated (R S C by Ruiz's iteration, every row and column's largest entry about
 1; E S E of a symmetric S: its unknowns are turns, heights and resultants, whose
@@ -36,8 +38,9 @@ by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
 factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
 scalable to many), where MUMPS on two ranks factored the riser's Jacobian in the one-rank
 time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
-objects (the interior submatrix, on one rank a reference to the matrix itself, and its
-sequential MUMPS solver, the index set of the interior rows): ``destroy()``.
+objects (the interior submatrix, on the first rank of an LDL^T a reference to the
+diagonal block itself, and its sequential MUMPS solver, the index set of the interior
+rows): ``destroy()``.
 """
 
 import numpy as np
@@ -76,8 +79,8 @@ class ChainFactor:
     is one, then the next's), the own interface's rows A_G_p,I_p on the interior's first
     head_columns columns (B, head_columns), and the next interface's rows A_G_p+1,I_p on
     its last next_back (B, next_back); ``reversed``: the interior block's rows are the
-    rank's interior rows from its last (the first rank's), which ``_interior_solve``
-    and ``_coupling_solve`` undo."""
+    rank's interior rows from its last (the first rank's, of an LU), which
+    ``_interior_solve`` and ``_coupling_solve`` undo."""
 
     def __init__(self, matrix, kind, block, make_solver, set_up, solve, solve_sparse):
         comm = matrix.getComm()
@@ -92,15 +95,18 @@ class ChainFactor:
         self.offset = block if self.rank > 0 else 0
         self.has_next = self.rank < self.size - 1
         self._split(matrix)
-        # the first rank's interior numbered from its end: its couplings, to the next
-        # interface, come first, near the root of the elimination tree (W's solve)
-        self.reversed = self.offset == 0 and self.has_next
+        # the first rank's interior of an LU numbered from its end: its couplings, to
+        # the next interface, come first, near the root of the elimination tree (W's
+        # solve); an LDL^T's factorisation takes longer in that order than W's solve
+        # saves (docs/performance.md, "Issue 21, tenth pass"): the natural order, in
+        # which the first rank's interior is its diagonal block, taken without a copy
+        self.reversed = self.offset == 0 and self.has_next and not self.symmetric
         # a stride where the order is the natural one: MatCreateSubMatrix copies
         # contiguous columns row by row, faster than for a general index set
-        # (docs/performance.md, "Issue 21, tenth pass"). On one rank (tests only:
-        # direct_factor substructures on several) the stride is the whole matrix, and the
-        # interior is that matrix itself, a reference: nothing here changes the interior
-        # in place
+        # (docs/performance.md, "Issue 21, tenth pass"). Where the stride is the whole
+        # block (the first rank's LDL^T; one rank, in tests only: direct_factor
+        # substructures on several) the interior is that block itself, a reference:
+        # nothing here changes the interior in place
         if self.reversed:
             interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
             self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
