@@ -40,7 +40,7 @@ scalable to many), where MUMPS on two ranks factored the riser's Jacobian in the
 time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
 objects (the interior submatrix, on the first rank of an LDL^T a reference to the
 diagonal block itself, and its sequential MUMPS solver, the index set of the interior
-rows): ``destroy()``.
+rows where it is not the whole block): ``destroy()``.
 """
 
 import numpy as np
@@ -101,18 +101,21 @@ class ChainFactor:
         # saves (docs/performance.md, "Issue 21, tenth pass"): the natural order, in
         # which the first rank's interior is its diagonal block, taken without a copy
         self.reversed = self.offset == 0 and self.has_next and not self.symmetric
-        # a stride where the order is the natural one: MatCreateSubMatrix copies
-        # contiguous columns row by row, faster than for a general index set
-        # (docs/performance.md, "Issue 21, tenth pass"). Where the stride is the whole
-        # block (the first rank's LDL^T; one rank, in tests only: direct_factor
-        # substructures on several) the interior is that block itself, a reference:
-        # nothing here changes the interior in place
+        # the interior rows: None where they are the whole diagonal block (the first
+        # rank's LDL^T; one rank, in tests only: direct_factor substructures on
+        # several), whose interior is then the block itself, a reference taken at each
+        # set_up (nothing here changes it in place); else a stride where the order is
+        # the natural one (MatCreateSubMatrix copies contiguous columns row by row,
+        # faster than for a general index set: docs/performance.md, "Issue 21, tenth
+        # pass"), the reversed rows where it is not
         if self.reversed:
             interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
             self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
-        else:
+        elif self.offset:
             self._index = PETSc.IS().createStride(self.n - self.offset, self.offset, 1,
                                                   comm=PETSc.COMM_SELF)
+        else:
+            self._index = None
         self.interior = None
         self.ksp = None
         self.failed = False
@@ -186,8 +189,15 @@ class ChainFactor:
                 if obj is not None:
                     obj.destroy()
             self.ksp = self.interior = None
-        diagonal = matrix.getDiagonalBlock() if self.size > 1 else matrix
-        self.interior = diagonal.createSubMatrix(self._index, self._index, submat=self.interior)
+        diagonal = matrix.getDiagonalBlock()        # a reference of its own
+        if self._index is None:
+            if self.interior is not None:
+                self.interior.destroy()
+            self.interior = diagonal
+        else:
+            self.interior = diagonal.createSubMatrix(self._index, self._index,
+                                                     submat=self.interior)
+            diagonal.destroy()
         if self.ksp is None:
             self.ksp = self._make_solver(PETSc.COMM_SELF, self.interior)
         else:
