@@ -22,12 +22,12 @@ last, two more measures:
   1-rank time: of the N runs and of the pairs' runs below, the same command);
 * its solve time on 2 ranks, and the speed-up over 1 rank: 1-rank and 2-rank runs
   alternated (``--pairs`` P pairs, default 20), so that both see the shared machine in
-  the same states; the best of each, and the median of the pairs' ratios. Many pairs:
-  a 2-rank run waits for the slower of two cores, bound one a rank, where a 1-rank run
-  needs one core and the system may move it to the quieter, so the best of few pairs
-  overstates the 2-rank time more than the 1-rank one (docs/performance.md, "Issue 21,
-  eleventh pass": best to best 1.57–1.69x over 6 pairs within minutes, 1.63–1.68x over
-  15 to 30).
+  the same states; the best of each (the target's reading: an idle machine), and the
+  median of the pairs' ratios (the machine as it was). Many pairs: a 2-rank run waits
+  for the slower of two cores, bound one a rank, where a 1-rank run needs one core and
+  the system may move it to the quieter, so a busy moment slows the 2-rank run more.
+  Even so, the machine's state over minutes moves both readings by more than the
+  number of pairs does (docs/performance.md, "Issue 21, eleventh pass").
 
 The page also gives the time of scripts/machine_speed.py (a pure-Python loop) before and
 after, alone and two copies at once, which says how fast the (shared, virtual) machine's
