@@ -213,6 +213,8 @@ def main():
                         help=f"alternated 1- and 2-rank runs of the fine riser (default {PAIRS})")
     parser.add_argument("--out", default=str(ROOT / "docs" / "riser_benchmark.md"))
     args = parser.parse_args()
+    if args.repeats < 1 or args.pairs < 1:
+        parser.error("--repeats and --pairs take a count of runs, at least 1")
     pairs = args.pairs
     words = [w for w in args.only.split(",") if w]
     machine_before = None if words else machine("before")      # for the page
