@@ -70,17 +70,21 @@ class ChainFactor:
     interiors' sequential MUMPS factorisations are the solvers ``make_solver(comm,
     operator)`` gives (ksp.lu_solver or ksp.inertia_solver on COMM_SELF, options under
     their prefix), set up with ``set_up(ksp, block)`` (ksp.set_up_mumps) and solved
-    with ``solve(ksp, columns)`` (ksp.solve_columns) and ``solve_sparse(ksp, rows,
-    values)`` (ksp.solve_sparse_columns: W's). Raises NotAChainError where a
-    rank's rows couple otherwise (on every rank): a rank without an interior node, a
-    middle rank whose interface reaches the next one's (a single element).
+    with ``solve(ksp, right)`` ((n_I, k) Fortran-ordered columns: ksp.solve_dense) and
+    ``solve_sparse(ksp, rows, values)`` (ksp.solve_sparse_columns: W's). Raises
+    NotAChainError where a rank's rows couple otherwise (on every rank): a rank without
+    an interior node, a middle rank whose interface reaches the next one's (a single
+    element).
 
     Stored: W (2 B, n_I) (its columns as rows: the own interface's B first where there
-    is one, then the next's), the own interface's rows A_G_p,I_p on the interior's first
-    head_columns columns (B, head_columns), and the next interface's rows A_G_p+1,I_p on
-    its last next_back (B, next_back); ``reversed``: the interior block's rows are the
-    rank's interior rows from its last (the first rank's, of an LU), which
-    ``_interior_solve`` and ``_coupling_solve`` undo."""
+    is one, then the next's; along the interior in the factor's order, below), the own
+    interface's rows A_G_p,I_p on the interior's first head_columns columns (B,
+    head_columns), and the next interface's rows A_G_p+1,I_p on its last next_back (B,
+    next_back); ``reversed``: the interior block's rows are the rank's interior rows
+    from its last (the first rank's, of an LU). Arrays along the interior (W, the
+    solves' columns) stay in that factor's order, reversed or not, from the gather of
+    the right-hand sides to the scatter of the solutions; ``_natural`` reads a range of
+    the natural order from them (the interface's couplings)."""
 
     def __init__(self, matrix, kind, block, make_solver, set_up, solve, solve_sparse):
         comm = matrix.getComm()
@@ -246,23 +250,23 @@ class ChainFactor:
         self._factor_interface(int(factor.getInertia()[0]) if self.symmetric else 0)
 
     def _coupling_solve(self, rows, values):
-        """W = A_II^-1 A_IG, (k, n_interior), from A_IG's nonzero ``rows`` (interior
-        numbering) and their ``values`` (len(rows), k), by sparse right-hand sides."""
+        """W = A_II^-1 A_IG, (k, n_interior) in the factor's order, from A_IG's nonzero
+        ``rows`` (the interior's natural numbering) and their ``values`` (len(rows), k),
+        by sparse right-hand sides."""
         n_interior = self.n - self.offset
         if not rows.size:
             return np.zeros((values.shape[1], n_interior))
         if self.reversed:
             rows = n_interior - 1 - rows
-        W = self._solve_sparse(self.ksp, rows, values)
-        return np.ascontiguousarray(W[:, ::-1]) if self.reversed else W
+        return self._solve_sparse(self.ksp, rows, values)
 
-    def _interior_solve(self, columns):
-        """A_II^-1 of the local arrays ``columns`` (n_interior,) each, in one solve."""
-        if not columns:
-            return []
-        if self.reversed:
-            return [x[::-1] for x in self._solve(self.ksp, [c[::-1] for c in columns])]
-        return self._solve(self.ksp, columns)
+    def _natural(self, array, start, stop):
+        """The interior's natural positions start to stop - 1 of ``array`` (along its
+        last axis, the interior in the factor's order), in the natural order: a view."""
+        if not self.reversed:
+            return array[..., start:stop]
+        n_interior = self.n - self.offset
+        return array[..., n_interior - stop:n_interior - start][..., ::-1]
 
     def _factor_interface(self, interior_negative):
         """S from every rank's contributions (module docstring), its pseudo-inverse, and
@@ -274,23 +278,22 @@ class ChainFactor:
         parts = []
         own_slot = (self.rank - 1) * B if off else None
         next_slot = self.rank * B if self.has_next else None
-        W_own = self.W[:B] if off else None
-        W_next = self.W[-B:] if self.has_next else None
         # A_GI W on the interior columns the interface rows reach (the first
-        # head_columns, the last next_back): A_GI is zero elsewhere; W_own and W_next
-        # are (B, n_interior)
+        # head_columns, the last next_back): A_GI is zero elsewhere; W's first B rows
+        # are the own interface's columns, its last B the next one's
+        n_interior = self.n - off
         if off:
-            own_reach = slice(0, self.head_columns)
             rows = self._own_rows
-            parts.append((own_slot, own_slot, self._own_block - rows @ W_own[:, own_reach].T))
+            reached = self._natural(self.W, 0, self.head_columns)
+            parts.append((own_slot, own_slot, self._own_block - rows @ reached[:B].T))
             if self.has_next:
-                parts.append((own_slot, next_slot, -rows @ W_next[:, own_reach].T))
+                parts.append((own_slot, next_slot, -rows @ reached[-B:].T))
         if self.has_next:
-            next_reach = slice(self.n - off - self.next_back, None)
             rows = self._next_rows
-            parts.append((next_slot, next_slot, -rows @ W_next[:, next_reach].T))
+            reached = self._natural(self.W, n_interior - self.next_back, n_interior)
+            parts.append((next_slot, next_slot, -rows @ reached[-B:].T))
             if off:
-                parts.append((next_slot, own_slot, -rows @ W_own[:, next_reach].T))
+                parts.append((next_slot, own_slot, -rows @ reached[:B].T))
         schur = np.zeros((m, m))
         for rank_parts in self._mpi.allgather(parts):
             for i, j, values in rank_parts:
@@ -315,40 +318,58 @@ class ChainFactor:
     def solve_columns(self, columns, rows=None):
         """x_j = A^-1 b_j for the local arrays ``columns`` (as ksp.solve_columns: ``rows``
         the local rows of a submatrix in the columns' layout, the others returning b_j;
-        Inf where the factorisation failed). Collective."""
+        Inf where the factorisation failed). Each column is read once into the
+        interior's right-hand sides (in the factor's order), solved there in place of
+        a copy (ksp.solve_dense), corrected there and written once into its solution.
+        Collective."""
         columns = [np.asarray(column) for column in columns]
-        solutions = [column.copy() for column in columns]
         if not columns:
-            return solutions
-        B, off = self.block, self.offset
-        b = np.array([column if rows is None else column[rows] for column in columns])
-        if self.failed:
-            x = np.full_like(b, np.inf)
+            return []
+        B, off, k = self.block, self.offset, len(columns)
+        n_interior = self.n - off
+        # the interior's rows in the factor's order, as positions in a column
+        interior_rows = (slice(self.n - 1, off - 1 if off else None, -1) if self.reversed
+                         else slice(off, None))
+        if rows is not None:
+            rows = np.asarray(rows)
+            interface_rows, interior_rows = rows[:off], rows[interior_rows]
         else:
-            y = np.array(self._interior_solve(list(b[:, off:])))           # (k, n_I)
-            n_interior = self.n - off
-            sent = np.zeros((2, B, len(columns)))
+            interface_rows = slice(0, off)
+        right = np.empty((n_interior, k), order="F")
+        for j, column in enumerate(columns):
+            if rows is None:
+                right[:, j] = column[interior_rows]
+            else:                   # gathered straight into the column, no temporary
+                np.take(column, interior_rows, out=right[:, j], mode="clip")
+        b_interface = np.array([column[interface_rows] for column in columns])   # (k, off)
+        if self.failed:
+            y, x_interface = np.full((k, n_interior), np.inf), np.full((k, off), np.inf)
+        else:
+            y = self._solve(self.ksp, right).T              # (k, n_I), factor's order
+            sent = np.zeros((2, B, k))
             if off:
-                sent[0] = b[:, :off].T - self._own_rows @ y[:, :self.head_columns].T
+                sent[0] = b_interface.T - self._own_rows @ self._natural(
+                    y, 0, self.head_columns).T
             if self.has_next:
-                sent[1] = -self._next_rows @ y[:, n_interior - self.next_back:].T
-            parts = np.empty((self.size, 2, B, len(columns)))
+                sent[1] = -self._next_rows @ self._natural(
+                    y, n_interior - self.next_back, n_interior).T
+            parts = np.empty((self.size, 2, B, k))
             self._mpi.Allgather(sent, parts)
-            right = (parts[1:, 0] + parts[:-1, 1]).reshape(-1, len(columns))
-            interface = self._inverse @ right                               # ((P-1) B, k)
-            x = np.empty_like(b)
+            right_side = (parts[1:, 0] + parts[:-1, 1]).reshape(-1, k)
+            interface = self._inverse @ right_side                          # ((P-1) B, k)
+            x_interface = np.zeros((k, off))
             if off:
                 x_own = interface[(self.rank - 1) * B:self.rank * B]
-                x[:, :off] = x_own.T
+                x_interface[:] = x_own.T
                 y -= x_own.T @ self.W[:B]
             if self.has_next:
                 y -= interface[self.rank * B:(self.rank + 1) * B].T @ self.W[-B:]
-            x[:, off:] = y
-        for j, solution in enumerate(solutions):
-            if rows is None:
-                solution[:] = x[j]
-            else:
-                solution[rows] = x[j]
+        solutions = []
+        for j, column in enumerate(columns):
+            solution = column.copy() if rows is not None else np.empty(len(column))
+            solution[interface_rows] = x_interface[j]
+            solution[interior_rows] = y[j]
+            solutions.append(solution)
         return solutions
 
     def negative_pivots(self):

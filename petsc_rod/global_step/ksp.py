@@ -175,6 +175,29 @@ def solve_columns(ksp, columns, rows=None):
     return solutions
 
 
+def solve_dense(ksp, right):
+    """X = A^-1 B for the k columns of ``right`` (n, k), in Fortran order (each column
+    contiguous, as PETSc's dense matrices hold them), with the factored sequential
+    operator A of a set-up inertia_solver or lu_solver: one MatMatSolve on dense
+    matrices laid on ``right`` and on the new array X, which it returns, (n, k) in
+    Fortran order. No column is copied on the way in or out (solve_columns copies each
+    twice, and allocates both matrices anew: on the two ranks' halves of the riser's
+    Jacobian those copies cost as much as on the whole, docs/performance.md, "Issue 21,
+    twelfth pass"). A failed factorisation gives Inf."""
+    factor = ksp.getPC().getFactorMatrix()
+    solution = np.empty(right.shape, order="F")
+    if factor.getMumpsInfog(1) < 0:
+        solution[:] = np.inf
+        return solution
+    matrices = [_dense_on(array) for array in (right, solution)]
+    try:
+        factor.matSolve(*matrices)
+    finally:
+        for matrix in matrices:
+            matrix.destroy()
+    return solution
+
+
 def solve_sparse_columns(ksp, rows, values):
     """x_j = A^-1 b_j for right-hand sides zero but at the ``rows`` (r,) of the local
     operator, where b_j is values[:, j] (``values`` (r, k)), with the factored operator
@@ -182,7 +205,8 @@ def solve_sparse_columns(ksp, rows, values):
     (ICNTL 20, through MatMatSolve of a transposed AIJ), whose forward elimination visits
     only the paths of the elimination tree from those rows to its root, about half the
     cost of a dense solve where the rows sit near the root (docs/performance.md; the
-    backward one gives every row). ``rows`` distinct. Returns x, (k, n). A failed
+    backward one gives every row). ``rows`` distinct. Returns x, (k, n), C-contiguous
+    (the transpose of the solve's own Fortran-ordered array, not a copy). A failed
     factorisation gives Inf."""
     factor = ksp.getPC().getFactorMatrix()
     operator = ksp.getOperators()[0]
@@ -190,6 +214,7 @@ def solve_sparse_columns(ksp, rows, values):
     if factor.getMumpsInfog(1) < 0:
         return np.full((k, n), np.inf)
     order = np.argsort(rows)
+    solution = np.empty((n, k), order="F")
     transposed = PETSc.Mat().createAIJ((k, n), nnz=len(rows), comm=comm)
     right = unknown = None
     try:
@@ -198,15 +223,21 @@ def solve_sparse_columns(ksp, rows, values):
                                 np.ascontiguousarray(values[order].T))
         transposed.assemble()
         right = PETSc.Mat().createTranspose(transposed)
-        unknown = PETSc.Mat().createDense((n, k), comm=comm)
-        unknown.setUp()
-        unknown.assemble()
+        unknown = _dense_on(solution)
         factor.matSolve(right, unknown)
-        return unknown.getDenseArray(readonly=True).T.copy()
+        return solution.T
     finally:
         for obj in (right, transposed, unknown):
             if obj is not None:
                 obj.destroy()
+
+
+def _dense_on(array):
+    """A sequential dense Mat whose values are the Fortran-ordered (n, k) ``array``
+    itself (petsc4py keeps a reference to it), assembled."""
+    matrix = PETSc.Mat().createDense(array.shape, array=array, comm=PETSc.COMM_SELF)
+    matrix.assemble()
+    return matrix
 
 
 def solve_vecs(factor, vecs, rows=None):
@@ -276,7 +307,7 @@ class SubstructuredFactor:
 
         def make(local_comm, local):
             return mumps_solver(local_comm, local, kind, prefix)
-        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_columns,
+        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_dense,
                                   solve_sparse_columns)
 
     @property

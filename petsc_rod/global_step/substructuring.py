@@ -214,15 +214,7 @@ class ChainSolver:
             fits = np.array_equal(rows, old_rows) and np.array_equal(cols, old_cols)
             entries = np.arange(len(values))
         else:
-            values, fits, spans = self._values.copy(), True, []
-            for row in changed:
-                first, last = old_rows[row - start], old_rows[row - start + 1]
-                row_cols, row_values = matrix.getRow(row)
-                fits = fits and np.array_equal(row_cols, old_cols[first:last])
-                if fits:
-                    values[first:last] = row_values
-                    spans.append(np.arange(first, last))
-            entries = np.concatenate(spans) if spans else np.zeros(0, dtype=np.int64)
+            values, fits, entries = self._read_rows(matrix, changed, start)
         coupling = self._coupling
         if fits:
             fits = self._split(row_of, cols, values, start, end, self.width) is None
@@ -241,6 +233,30 @@ class ChainSolver:
         self._values = values
         self._couple_and_reduce(values, start, end)
         return True
+
+    def _read_rows(self, matrix, changed, start):
+        """(values, fits, entries): the last factorisation's values with those of the
+        ``changed`` rows (global indices, owned) read from ``matrix`` (MatGetRow each) at
+        their ``entries`` (positions in the local CSR), and whether those rows still have
+        the pattern's columns (else the values are not to be used). One comparison and
+        one copy for all the rows, not one a row (a change of the seabed's active set
+        notes about 20 rows)."""
+        indptr, cols = self._pattern[:2]
+        local = np.asarray(changed, dtype=np.int64) - start
+        firsts, lasts = indptr[local], indptr[local + 1]
+        read = [matrix.getRow(int(row)) for row in changed]
+        lengths = lasts - firsts
+        values = self._values.copy()
+        if not np.array_equal([len(row_cols) for row_cols, _ in read], lengths):
+            return values, False, np.zeros(0, dtype=np.int64)
+        # every changed row's CSR positions, first to last, row after row
+        entries = np.repeat(firsts - np.cumsum(lengths) + lengths, lengths) + np.arange(
+            lengths.sum())
+        if read and not np.array_equal(np.concatenate([c for c, _ in read]), cols[entries]):
+            return values, False, entries
+        if read:
+            values[entries] = np.concatenate([v for _, v in read])
+        return values, True, entries
 
     def _split(self, row_of, cols, values, start, end, width):
         """With the interface ``width`` rows wide: None if it splits the matrix (and the

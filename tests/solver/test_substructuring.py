@@ -215,6 +215,33 @@ def test_refactor_grows_the_interior_block_by_a_new_entry_outside_the_envelope()
         assert_solves(comm, matrix, rhs, solution)
 
 
+def test_a_noted_row_whose_pattern_grew_is_refused_and_the_solver_made_anew():
+    """A refactorisation told which rows changed (ksp.note_changed_rows) reads those
+    rows alone; where one of them has an entry the pattern had not (a new nonzero two
+    vertices away, within the rank), it takes none of the values and says so on every
+    rank (refactor False), and a solver made from the new matrix solves it exactly."""
+    comm = PETSc.COMM_WORLD
+    mesh, matrix, _ = hermite_matrix(comm, 24)
+    start, end = matrix.getOwnershipRange()
+    grown = PETSc.Mat().createAIJ(matrix.getSizes(), nnz=(12, 4), comm=comm)
+    grown.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    rows, cols, values = matrix.getValuesCSR()
+    for i in range(len(rows) - 1):
+        grown.setValues(start + i, cols[rows[i]:rows[i + 1]], values[rows[i]:rows[i + 1]])
+    grown.assemble()
+    solver = substructuring.ChainSolver(grown)
+    row = start + 4             # a vertex's value row, interior on every rank
+    with destroyed_after(solver, grown, matrix, mesh):
+        set_symmetric(grown, row, row + 4, 0.01)
+        grown.assemble()
+        assert not solver.refactor(grown, changed=[row, row + 4])
+        fresh = substructuring.ChainSolver(grown)
+        rhs = right_hand_sides(mesh, 2)
+        solution = solved(fresh, rhs)
+        fresh.destroy()
+        assert_solves(comm, grown, rhs, solution)
+
+
 def test_a_matrix_that_is_no_chain_is_refused():
     comm = PETSc.COMM_WORLD
     if comm.getSize() == 1:
