@@ -46,7 +46,7 @@ rows where it is not the whole block): ``destroy()``.
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.substructuring import NotAChainError, row_reduce
+from petsc_rod.global_step.substructuring import NotAChainError, csr_positions, row_reduce
 
 # The equilibrated interface's pseudo-inverse drops singular values (eigenvalues) below
 # this fraction of the largest: a null pivot, the free roll of a section with K1 = K2
@@ -70,7 +70,8 @@ class ChainFactor:
     interiors' sequential MUMPS factorisations are the solvers ``make_solver(comm,
     operator)`` gives (ksp.lu_solver or ksp.inertia_solver on COMM_SELF, options under
     their prefix), set up with ``set_up(ksp, block)`` (ksp.set_up_mumps) and solved
-    with ``solve(ksp, right)`` ((n_I, k) Fortran-ordered columns: ksp.solve_dense) and
+    with ``solve(ksp, right)`` ((n_I, k) Fortran-ordered columns; it returns a new,
+    writeable (n_I, k) array, which the solves correct in place: ksp.solve_dense) and
     ``solve_sparse(ksp, rows, values)`` (ksp.solve_sparse_columns: W's). Raises
     NotAChainError where a rank's rows couple otherwise (on every rank): a rank without
     an interior node, a middle rank whose interface reaches the next one's (a single
@@ -318,28 +319,30 @@ class ChainFactor:
     def solve_columns(self, columns, rows=None):
         """x_j = A^-1 b_j for the local arrays ``columns`` (as ksp.solve_columns: ``rows``
         the local rows of a submatrix in the columns' layout, the others returning b_j;
-        Inf where the factorisation failed). Each column is read once into the
-        interior's right-hand sides (in the factor's order), solved there in place of
-        a copy (ksp.solve_dense), corrected there and written once into its solution.
-        Collective."""
+        Inf where the factorisation failed). Each column's interior rows are read once
+        into a Fortran-ordered right-hand side in the factor's order, MUMPS solves into
+        a new array of the same layout (ksp.solve_dense), the interface's corrections
+        act on it in place, and each solution is written from it once (where ``rows``
+        is given, over a copy of the column). Collective."""
         columns = [np.asarray(column) for column in columns]
         if not columns:
             return []
         B, off, k = self.block, self.offset, len(columns)
         n_interior = self.n - off
-        # the interior's rows in the factor's order, as positions in a column
-        interior_rows = (slice(self.n - 1, off - 1 if off else None, -1) if self.reversed
-                         else slice(off, None))
+        # the interior's rows in the factor's order, as positions in a column (a
+        # reversed interior is the first rank's: off is 0 there)
+        in_factor_order = slice(None, None, -1) if self.reversed else slice(off, None)
         if rows is not None:
             rows = np.asarray(rows)
-            interface_rows, interior_rows = rows[:off], rows[interior_rows]
+            interface_rows, interior_rows = rows[:off], rows[in_factor_order]
         else:
-            interface_rows = slice(0, off)
+            interface_rows, interior_rows = slice(0, off), in_factor_order
         right = np.empty((n_interior, k), order="F")
         for j, column in enumerate(columns):
             if rows is None:
                 right[:, j] = column[interior_rows]
-            else:                   # gathered straight into the column, no temporary
+            else:   # gathered straight into the column, no temporary ("clip": no
+                # buffered copy for the bounds check; the rows are the submatrix's own)
                 np.take(column, interior_rows, out=right[:, j], mode="clip")
         b_interface = np.array([column[interface_rows] for column in columns])   # (k, off)
         if self.failed:
@@ -435,8 +438,7 @@ def _column_range(matrix, start, end, edge=None):
     whole_indptr, whole_columns = matrix.getRowIJ()
     beyond = np.flatnonzero(np.diff(whole_indptr) > np.diff(indptr))
     counts = np.diff(whole_indptr)[beyond]
-    entries = (np.repeat(whole_indptr[beyond] - np.r_[0, np.cumsum(counts)[:-1]], counts)
-               + np.arange(counts.sum()))
+    entries = csr_positions(whole_indptr[beyond], counts)
     spans = np.r_[0, np.cumsum(counts)]
     lowest[beyond] = row_reduce(np.minimum, spans, whole_columns[entries], end)
     highest[beyond] = row_reduce(np.maximum, spans, whole_columns[entries], start - 1)

@@ -180,12 +180,13 @@ def solve_dense(ksp, right):
     contiguous, as PETSc's dense matrices hold them), with the factored sequential
     operator A of a set-up inertia_solver or lu_solver: one MatMatSolve on dense
     matrices laid on ``right`` and on the new array X, which it returns, (n, k) in
-    Fortran order. No column is copied on the way in or out (solve_columns copies each
-    twice, and allocates both matrices anew: on the two ranks' halves of the riser's
-    Jacobian those copies cost as much as on the whole, docs/performance.md, "Issue 21,
-    twelfth pass"). A failed factorisation gives Inf."""
+    Fortran order. No column is copied in Python on the way in or out (PETSc copies B
+    into X once, for MUMPS to solve in place): solve_columns copies each twice more and
+    allocates both matrices anew, and on the two ranks' halves of the riser's Jacobian
+    those copies cost as much as on the whole (docs/performance.md, "Issue 21, twelfth
+    pass"). A failed factorisation gives Inf."""
     factor = ksp.getPC().getFactorMatrix()
-    solution = np.empty(right.shape, order="F")
+    solution = np.empty(right.shape, dtype=PETSc.ScalarType, order="F")
     if factor.getMumpsInfog(1) < 0:
         solution[:] = np.inf
         return solution
@@ -214,7 +215,7 @@ def solve_sparse_columns(ksp, rows, values):
     if factor.getMumpsInfog(1) < 0:
         return np.full((k, n), np.inf)
     order = np.argsort(rows)
-    solution = np.empty((n, k), order="F")
+    solution = np.empty((n, k), dtype=PETSc.ScalarType, order="F")
     transposed = PETSc.Mat().createAIJ((k, n), nnz=len(rows), comm=comm)
     right = unknown = None
     try:
@@ -233,8 +234,14 @@ def solve_sparse_columns(ksp, rows, values):
 
 
 def _dense_on(array):
-    """A sequential dense Mat whose values are the Fortran-ordered (n, k) ``array``
-    itself (petsc4py keeps a reference to it), assembled."""
+    """A sequential dense Mat whose values are the (n, k) ``array`` itself (petsc4py
+    keeps a reference to it), assembled. The array must be writeable, Fortran-ordered
+    and of PETSc's scalar type: petsc4py would otherwise copy it without a word, and a
+    solve into the Mat would leave the array as it was."""
+    if not (array.flags.f_contiguous and array.flags.writeable
+            and array.dtype == PETSc.ScalarType):
+        raise ValueError("a dense Mat laid on an array needs a writeable Fortran-ordered "
+                         f"{np.dtype(PETSc.ScalarType)} array")
     matrix = PETSc.Mat().createDense(array.shape, array=array, comm=PETSc.COMM_SELF)
     matrix.assemble()
     return matrix

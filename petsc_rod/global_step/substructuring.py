@@ -92,6 +92,16 @@ class SeqCholesky:
             obj.destroy()
 
 
+def csr_positions(firsts, lengths):
+    """The positions firsts[i], ..., firsts[i] + lengths[i] - 1 of some rows' entries
+    in a CSR array, row after row, as one int64 array (sum(lengths),): np.repeat of each
+    row's offset from its place in the result plus a running count, not one arange a
+    row."""
+    lengths = np.asarray(lengths, dtype=np.int64)
+    offsets = np.asarray(firsts, dtype=np.int64) - (np.cumsum(lengths) - lengths)
+    return np.repeat(offsets, lengths) + np.arange(lengths.sum())
+
+
 def row_reduce(ufunc, indptr, values, empty):
     """``ufunc`` (np.minimum, np.maximum) over each row's entries ``values`` (nnz,) of a
     CSR pattern with row pointers ``indptr`` (n + 1,), as an (n,) int64 array; ``empty``
@@ -243,20 +253,17 @@ class ChainSolver:
         notes about 20 rows)."""
         indptr, cols = self._pattern[:2]
         local = np.asarray(changed, dtype=np.int64) - start
-        firsts, lasts = indptr[local], indptr[local + 1]
+        firsts, lengths = indptr[local], indptr[local + 1] - indptr[local]
         read = [matrix.getRow(int(row)) for row in changed]
-        lengths = lasts - firsts
+        entries = csr_positions(firsts, lengths)
         values = self._values.copy()
-        if not np.array_equal([len(row_cols) for row_cols, _ in read], lengths):
-            return values, False, np.zeros(0, dtype=np.int64)
-        # every changed row's CSR positions, first to last, row after row
-        entries = np.repeat(firsts - np.cumsum(lengths) + lengths, lengths) + np.arange(
-            lengths.sum())
-        if read and not np.array_equal(np.concatenate([c for c, _ in read]), cols[entries]):
-            return values, False, entries
-        if read:
+        if not read:
+            return values, True, entries
+        fits = (np.array_equal([len(row_cols) for row_cols, _ in read], lengths)
+                and np.array_equal(np.concatenate([c for c, _ in read]), cols[entries]))
+        if fits:
             values[entries] = np.concatenate([v for _, v in read])
-        return values, True, entries
+        return values, fits, entries
 
     def _split(self, row_of, cols, values, start, end, width):
         """With the interface ``width`` rows wide: None if it splits the matrix (and the

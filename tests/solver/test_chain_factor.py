@@ -264,13 +264,10 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
         mesh.destroy()
 
 
-@pytest.mark.parametrize("kind", [PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY])
-def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
-    """ksp.solve_sparse_columns (W's solve) on a sequential MUMPS factorisation: k = 3
-    right-hand sides nonzero on a few rows given out of order, against a dense solve of
-    the same matrix (unsymmetric for the LU, symmetric indefinite for the LDL^T)."""
-    n = 40
-    rng = np.random.default_rng(3)
+def sequential_mumps(kind, rng, n=40):
+    """(dense, matrix, ksp): an n x n matrix, unsymmetric for the LU, symmetric
+    indefinite for the LDL^T, as a dense array and as a sequential AIJ, and its MUMPS
+    factorisation ``kind``, set up (the caller destroys the ksp and the matrix)."""
     dense = rng.standard_normal((n, n)) + 8.0 * np.eye(n)
     if kind == PETSc.PC.Type.CHOLESKY:
         dense = dense + dense.T - 24.0 * np.diag(rng.random(n) < 0.3)
@@ -279,8 +276,19 @@ def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
                         np.tile(np.arange(n, dtype=PETSc.IntType), n), dense.ravel())
     matrix.assemble()
     ksp = solvers.mumps_solver(PETSc.COMM_SELF, matrix, kind, "test_chain_")
+    solvers.set_up_mumps(ksp)
+    return dense, matrix, ksp
+
+
+@pytest.mark.parametrize("kind", [PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY])
+def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
+    """ksp.solve_sparse_columns (W's solve) on a sequential MUMPS factorisation: k = 3
+    right-hand sides nonzero on a few rows given out of order, against a dense solve of
+    the same matrix."""
+    rng = np.random.default_rng(3)
+    dense, matrix, ksp = sequential_mumps(kind, rng)
+    n = len(dense)
     try:
-        solvers.set_up_mumps(ksp)
         rows = np.array([37, 2, 19, 3, 0])
         values = rng.standard_normal((len(rows), 3))
         right = np.zeros((n, 3))
@@ -289,6 +297,29 @@ def test_sparse_right_hand_sides_solve_as_dense_ones(kind):
         expected = np.linalg.solve(dense, right).T
         assert solution.shape == (3, n)
         assert np.abs(solution - expected).max() <= 1e-12 * np.abs(expected).max()
+    finally:
+        ksp.destroy()
+        matrix.destroy()
+
+
+@pytest.mark.parametrize("kind", [PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY])
+def test_dense_right_hand_sides_solve_in_the_arrays_given(kind):
+    """ksp.solve_dense (the interiors' solves): k = 3 Fortran-ordered columns against a
+    dense solve of the same matrix, the right-hand sides left as they were; an array
+    petsc4py would copy (C-ordered) is refused, not solved into a copy."""
+    rng = np.random.default_rng(5)
+    dense, matrix, ksp = sequential_mumps(kind, rng)
+    n = len(dense)
+    try:
+        right = np.asfortranarray(rng.standard_normal((n, 3)))
+        given = right.copy()
+        solution = solvers.solve_dense(ksp, right)
+        expected = np.linalg.solve(dense, given)
+        assert solution.shape == (n, 3) and solution.flags.f_contiguous
+        assert np.abs(solution - expected).max() <= 1e-12 * np.abs(expected).max()
+        assert np.array_equal(right, given)
+        with pytest.raises(ValueError, match="Fortran-ordered"):
+            solvers.solve_dense(ksp, np.ascontiguousarray(rng.standard_normal((n, 3))))
     finally:
         ksp.destroy()
         matrix.destroy()

@@ -235,8 +235,10 @@ def test_a_noted_row_whose_pattern_grew_is_refused_and_the_solver_made_anew():
         set_symmetric(grown, row, row + 4, 0.01)
         grown.assemble()
         assert not solver.refactor(grown, changed=[row, row + 4])
-        fresh = substructuring.ChainSolver(grown)
         rhs = right_hand_sides(mesh, 2)
+        # refused, the solver is as it was: the factorisation of the matrix before
+        assert_solves(comm, matrix, rhs, solved(solver, rhs))
+        fresh = substructuring.ChainSolver(grown)
         solution = solved(fresh, rhs)
         fresh.destroy()
         assert_solves(comm, grown, rhs, solution)
@@ -370,11 +372,13 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
     mesh, matrix, _ = hermite_matrix(comm, 24)
     ksp = python_pc_ksp(matrix, "test_rows_")
     read = []                   # the rows each refactorisation was told of
+    taken = []                  # whether it took the values (else a new solver is made)
     refactor = substructuring.ChainSolver.refactor
 
     def recorded(self, operator, changed=None):
         read.append(None if changed is None else sorted(changed))
-        return refactor(self, operator, changed)
+        taken.append(refactor(self, operator, changed))
+        return taken[-1]
 
     monkeypatch.setattr(substructuring.ChainSolver, "refactor", recorded)
     b, x = matrix.createVecs()
@@ -406,6 +410,7 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
         owned = [r for r in list(2 * element + np.arange(4)) + [start, start + 1]
                  if matrix.getOwnershipRange()[0] <= r < matrix.getOwnershipRange()[1]]
         assert read[-1] == sorted(set(owned))
+        assert taken[-1]            # the noted rows' values taken, not a new solver
         add_to_element(element + 1, 0.25, noted=False)      # not noted: every row read
         solve_exactly()
         assert read[-1] is None
