@@ -337,7 +337,7 @@ class ChainFactor:
             interface_rows, interior_rows = rows[:off], rows[in_factor_order]
         else:
             interface_rows, interior_rows = slice(0, off), in_factor_order
-        right = np.empty((n_interior, k), order="F")
+        right = np.empty((n_interior, k), dtype=PETSc.ScalarType, order="F")
         for j, column in enumerate(columns):
             if rows is None:
                 right[:, j] = column[interior_rows]
