@@ -14,6 +14,14 @@ class RodInputError(RodError):
     exit_code = 2
 
 
+class NoCatenaryStart(RodInputError):
+    """The catenary start (scenes/starts.py) cannot be drawn for this scene's loads and
+    seabed (a grounded line too long to lie taut, pieces whose catenary has no solution
+    or dips below the seabed, a load not straight down onto a seabed), though the scene
+    itself is sound: the start falls back to the straight line and says why
+    (cli/main.start_from). ``str(error)`` is the reason, without advice."""
+
+
 class RodNotConvergedError(RodError):
     """The Uzawa iteration hit its cap; the result file (if any) says converged = 0."""
 

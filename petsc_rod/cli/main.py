@@ -17,7 +17,7 @@ from petsc_rod import resources
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.scenes import starts
-from petsc_rod.errors import RodDivergedError, RodError, RodInputError
+from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
 from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
                                  fewest_elements, largest_grading)
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
@@ -238,7 +238,10 @@ def build_solver(mesh, scene, settings, say):
 
 def start_from(problem, values, given, say):
     """Set the state the first step starts from, a restart file or -rod_initial_shape;
-    returns the load factor the load path goes on from (0 but for a restart)."""
+    returns the load factor the load path goes on from (0 but for a restart). A catenary
+    start that cannot be drawn for a sound scene (NoCatenaryStart: discrete buoyancy
+    modules on a grounded line, a buoyancy section whose catenary dips below the seabed)
+    becomes the straight start, in one line saying why."""
     shape = values["rod_initial_shape"]
     if shape not in starts.SHAPES:
         raise RodInputError(f"-rod_initial_shape {shape}: unknown shape; use one of "
@@ -253,8 +256,14 @@ def start_from(problem, values, given, say):
         raise RodInputError("-rod_initial_load_factor needs -rod_initial (the state it is "
                             "the load factor of); drop it or give the file")
     if shape == "catenary":
-        problem.state.set_from_curve(starts.catenary_start(problem.scene,
-                                                           1.0 / values["rod_steps"]))
+        try:
+            curve = starts.catenary_start(problem.scene, 1.0 / values["rod_steps"])
+        except NoCatenaryStart as reason:   # a sound scene: the paper's trivial start
+            say(f"petsc_rod: {reason}: the run starts from the straight line instead "
+                "(-rod_initial_shape straight)")
+            problem.state.set_straight()
+        else:
+            problem.state.set_from_curve(curve)
     else:
         problem.state.set_straight()
     return 0.0

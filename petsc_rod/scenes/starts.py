@@ -13,7 +13,7 @@ import numpy as np
 from petsc_rod.scenes import section_catenary
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
-from petsc_rod.errors import RodInputError
+from petsc_rod.errors import NoCatenaryStart, RodInputError
 from petsc_rod.scenes.scene import REFERENCE_FRAME
 from petsc_rod.scenes.touchdown import seabed_shape
 
@@ -37,8 +37,9 @@ def catenary_start(scene, t):
     buoyancy) gives the catenary of those weights, section_start.
 
     Raises RodInputError for scenes that have no catenary: an end not held, a load that
-    is zero (or, in pieces, not vertical), the ends L or more apart, or a chord along
-    the load.
+    is zero, the ends L or more apart, or a chord along the load; NoCatenaryStart for a
+    sound scene whose catenary cannot be drawn (section_start, touchdown.seabed_shape),
+    which the caller replaces by the straight start.
     """
     start, end = scene.start_state(t), scene.end_state(t)
     if not (is_held(start) and is_held(end)):
@@ -91,12 +92,12 @@ def planar_curve(shape, normal, origin):
 def section_start(scene, t, start, end):
     """The catenary of a line of sections (section_catenary.py) at load factor t: the
     weights of the load's pieces, which must all be vertical; resting on the seabed
-    from S = 0 where the start lies on it. RodInputError where there is none, or where
+    from S = 0 where the start lies on it. NoCatenaryStart where there is none, or where
     the line would pass below the seabed."""
     loads = t * scene.load_values
     if np.any(loads[:, :2]) or not np.any(loads[:, 2]):
-        raise RodInputError("-rod_initial_shape catenary with -rod_load_breaks needs "
-                            "vertical loads (0,0,fz per piece), not all zero")
+        raise NoCatenaryStart("-rod_initial_shape catenary with -rod_load_breaks needs "
+                              "vertical loads (0,0,fz per piece), not all zero")
     chord = end.position - start.position
     span = float(np.hypot(chord[0], chord[1]))
     seabed = scene.seabed
@@ -106,17 +107,17 @@ def section_start(scene, t, start, end):
         line = section_catenary.solve(scene.load_piece_ends, -loads[:, 2], span,
                                       float(chord[2]), on_seabed)
     except ValueError as error:
-        raise RodInputError(f"-rod_initial_shape catenary: no catenary of the load's pieces "
-                            f"({str(error).removeprefix('section catenary: ')}); use the "
-                            "straight start") from None
+        raise NoCatenaryStart("-rod_initial_shape catenary: no catenary of the load's "
+                              f"pieces ({str(error).removeprefix('section catenary: ')})"
+                              ) from None
     along = np.array([chord[0], chord[1], 0.0]) / span
     up = np.array([0.0, 0.0, 1.0])
     if seabed is not None and not on_seabed:        # on it: section_catenary checks
         lowest = line.at(np.linspace(0.0, scene.length, 4097))[1].min() + start.position[2]
         if lowest < seabed.height:
-            raise RodInputError("-rod_initial_shape catenary: the catenary of the load's "
-                                "pieces passes below the seabed and its start is not on "
-                                "it; use the straight start")
+            raise NoCatenaryStart("-rod_initial_shape catenary: the catenary of the "
+                                  "load's pieces passes below the seabed and its start is "
+                                  "not on it")
 
     def shape(S):
         x, z, V = line.at(S)

@@ -23,7 +23,7 @@ sqrt(a^2 + sigma^2) - a, the horizontal distance a asinh(sigma / a), the tangent
 import numpy as np
 
 from petsc_rod.scenes.catenary import increasing_root
-from petsc_rod.errors import RodInputError
+from petsc_rod.errors import NoCatenaryStart
 
 
 def touchdown_parameter(length, span, h0, h1):
@@ -80,19 +80,19 @@ def grounded_catenary(length, chord, weight, seabed, S):
 def seabed_shape(scene, chord, load, hanging):
     """The shape S -> (r, tangent, force) of a catenary start (starts.catenary_start) with
     the seabed: ``hanging`` (the free catenary) when it stays above the seabed, else the
-    grounded catenary. RodInputError when the load is not vertical (the grounded part
+    grounded catenary. NoCatenaryStart when the load is not vertical (the grounded part
     would not lie still on a frictionless seabed) or the line cannot lie taut on it."""
     height = scene.seabed.height
     lowest = hanging(np.linspace(0.0, scene.length, 1025))[0][:, 2].min()
     if lowest >= height:
         return hanging
     if np.any(load[:2]) or load[2] >= 0:
-        raise RodInputError("-rod_initial_shape catenary with -rod_seabed needs a load "
-                            "straight down (0,0,-w)")
+        raise NoCatenaryStart("-rod_initial_shape catenary with -rod_seabed needs a "
+                              "load straight down (0,0,-w)")
     try:
         grounded_catenary(scene.length, chord, -load[2], height, [0.0])
     except ValueError:
-        raise RodInputError("-rod_initial_shape catenary with -rod_seabed: the line is too "
-                            "long to lie taut on the seabed between its ends; use the "
-                            "straight start") from None
+        raise NoCatenaryStart("-rod_initial_shape catenary with -rod_seabed: the line "
+                              "is too long to lie taut on the seabed between its "
+                              "ends") from None
     return lambda S: grounded_catenary(scene.length, chord, -load[2], height, S)[:3]

@@ -251,3 +251,27 @@ def test_the_plan_shows_a_riser_pushed_sideways(tmp_path):
     drawn = [ln for ln in elevation.lines if len(ln.get_xdata()) == len(r)]
     np.testing.assert_allclose(drawn[-1].get_xdata(), np.hypot(r[:, 0], r[:, 1]))
     assert "projected on the vertical plane of the ends" in [ln.get_label() for ln in drawn]
+
+
+def test_a_catenary_start_that_cannot_be_drawn_falls_back_to_the_straight_start(tmp_path):
+    """The 80 m cable with its buoyancy as 20 discrete modules, its top moved to 90 m
+    from the anchor: 170 m of line is longer than the 156 m path along the seabed and up,
+    so no grounded catenary of its weight exists (touchdown.seabed_shape). The run says
+    so in one line, starts straight and reaches the straight start's own answer."""
+    common = ["-options_file", "options/cable_80m.opts", "-rod_end_position", "90,0,66",
+              "-rod_load", "0,0,-157.8003", "-rod_load_breaks", "",
+              "-rod_point_loads", "scripts/matrix_buoyancy_modules.txt",
+              "-rod_elements", "170"]
+    answers = {}
+    for shape in ("catenary", "straight"):
+        path = tmp_path / f"{shape}.h5"
+        process = run(common + ["-rod_initial_shape", shape, "-rod_output", str(path)])
+        text = process.stdout + process.stderr
+        assert process.returncode == 0, text
+        fell_back = [line for line in text.splitlines() if "starts from the straight" in line]
+        assert len(fell_back) == (shape == "catenary"), text
+        with h5py.File(path, "r") as f:
+            answers[shape] = (f["r"][:], float(f.attrs["top_tension"]))
+    (r_fell, top_fell), (r_straight, top_straight) = answers["catenary"], answers["straight"]
+    assert np.abs(r_fell - r_straight).max() < 1e-9 * 170.215
+    assert abs(top_fell - top_straight) < 1e-9 * top_straight
