@@ -285,3 +285,30 @@ def test_the_summary_shows_what_newer_files_add(tmp_path):
     assert cells["top_tension (N)"] == 1.5e6 and cells["iterations (1)"] == 7
     assert cells["max_utilisation (1)"] == 0.61 and cells["max_von_mises (Pa)"] == 2.9e8
     assert not any(h.startswith("end_force") for h in header)
+
+
+@pytest.mark.serial
+def test_warm_starts_across_attachments(tmp_path):
+    """-sweep_start nearest over a point load (the 3 km catenary on 20 elements): each
+    case after the first warm-starts from a file with other attachments (none, one, two,
+    none again) and converges to the state of its own start."""
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_point_load\nnone -\none 1000,0,0,-5e5\n"
+                     "two 1000,0,0,-5e5,2000,0,0,2e5\nagain -\n")
+    rows = {}
+    for start in ("nearest", "scene"):
+        folder = tmp_path / start
+        process = run_module("petsc_rod.sweep", ["-options_file", "options/catenary.opts",
+                                                 "-rod_elements", "20", "-sweep_cases",
+                                                 str(cases), "-sweep_output", str(folder),
+                                                 "-sweep_start", start])
+        assert process.returncode == 0, describe(process)
+        assert "Traceback" not in process.stdout + process.stderr
+        rows[start] = read_summary(folder)
+    assert [r["start"] for r in rows["nearest"].values()] == [
+        "own start", "from none", "from none", "from none"]
+    for name, row in rows["nearest"].items():
+        assert row["status"] == "converged"
+        with h5py.File(tmp_path / "nearest" / f"{name}.h5", "r") as warm, \
+                h5py.File(tmp_path / "scene" / f"{name}.h5", "r") as own:
+            assert abs(warm["r"][:] - own["r"][:]).max() < 1e-5, name
