@@ -15,13 +15,13 @@ import csv
 import html
 import io
 import json
-import os
 import re
 import signal
-import tempfile
 
 import h5py
 import numpy as np
+
+from petsc_rod.io.same_file import write_text_whole
 
 # The columns every summary tries first: (column, root attribute, unit if the file
 # gives none).
@@ -150,21 +150,6 @@ def markdown_cell(text):
     return text.replace("\r", " ").replace("\n", " ")
 
 
-def write_text(path, text):
-    """``text`` into a new file beside ``path``, renamed onto it when complete, so that
-    ``path`` holds either the old text or the new, never part of one."""
-    folder, name = os.path.split(os.path.abspath(path))
-    descriptor, partial = tempfile.mkstemp(prefix=f".{name}.", suffix=".partial", dir=folder)
-    try:
-        with os.fdopen(descriptor, "w", newline="", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(partial, path)
-    except BaseException:
-        if os.path.exists(partial):
-            os.remove(partial)
-        raise
-
-
 def write_csv(path, header, rows):
     """The table as CSV, numbers at full precision, text cells kept from running as
     formulas (csv_cell)."""
@@ -173,7 +158,7 @@ def write_csv(path, header, rows):
     writer.writerow(header)
     for row in rows:
         writer.writerow([csv_cell(v) for v in row])
-    write_text(path, buffer.getvalue())
+    write_text_whole(path, buffer.getvalue())
 
 
 def markdown(header, rows):
@@ -187,7 +172,7 @@ def markdown(header, rows):
 
 def write_markdown(path, header, rows, title=None):
     """The table as a Markdown file (with a title line when given)."""
-    write_text(path, (f"# {markdown_cell(title)}\n\n" if title else "")
+    write_text_whole(path, (f"# {markdown_cell(title)}\n\n" if title else "")
                + markdown(header, rows))
 
 
@@ -199,5 +184,5 @@ def read_record(path):
 
 
 def write_record(path, record):
-    """Write the sweep's record as JSON (write_text: never half-written)."""
-    write_text(path, json.dumps(record, indent=1))
+    """Write the sweep's record as JSON (write_text_whole: never half-written)."""
+    write_text_whole(path, json.dumps(record, indent=1))
