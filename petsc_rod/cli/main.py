@@ -38,6 +38,9 @@ from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.problem.problem import RodProblem
 
+# The options that name a file the run reads.
+INPUT_FILE_OPTIONS = tuple(option.name for option in OPTIONS
+                           if option.metavar == "FILE" and option.name != "rod_output")
 # How long the ranks wait for each other after a PETSc error before taking it for one
 # rank's alone, s.
 FAILURE_WAIT = 10.0
@@ -233,8 +236,7 @@ def check_inputs_kept(values, comm):
     clash = None
     if comm.getRank() == 0:
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
-        read += [(f"-{option.name}", values[option.name]) for option in OPTIONS
-                 if option.metavar == "FILE" and option.name != "rod_output"]
+        read += [(f"-{name}", values[name]) for name in INPUT_FILE_OPTIONS]
         clash = replaced_input(written, read)
     clash = comm.tompi4py().bcast(clash, root=0)
     if clash:

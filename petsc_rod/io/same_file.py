@@ -22,15 +22,14 @@ def same_file(a, b):
     return (first.st_dev, first.st_ino) == (second.st_dev, second.st_ino)
 
 
-def replaced_input(outputs, inputs):
-    """The first clash of an output with an input, as one sentence, or None.
-    ``outputs``, ``inputs``: (what names it, e.g. an option, path) pairs; empty paths
-    are skipped."""
+def replaced_input(outputs, inputs, fix="writing would replace; name another file"):
+    """The first clash of an output with an input, as one sentence ending in ``fix``, or
+    None. ``outputs``, ``inputs``: (what names it, e.g. an option, path) pairs; empty
+    paths are skipped."""
     for written, path in outputs:
         for read, source in inputs:
             if path and source and same_file(path, source):
-                return (f"{written} {path}: is the {read} {source} file, an input of this "
-                        "run that writing would replace; name another file")
+                return f"{written} {path}: is the {read} {source} file, an input that {fix}"
     return None
 
 

@@ -46,7 +46,7 @@ def test_the_report_does_not_write_over_its_result(tmp_path, capsys):
     before = path.read_bytes()
     assert report([str(path), "-o", str(tmp_path / "." / "run.h5")]) == 2
     line = one_error_line(capsys.readouterr(), "report")
-    assert "-o" in line and "an input of this run" in line
+    assert "-o" in line and "an input that writing would replace" in line
     assert path.read_bytes() == before
 
 
