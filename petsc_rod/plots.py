@@ -99,6 +99,8 @@ def main(argv):
     clash = replaced_input([("the figure", output)], [("result", path) for path in inputs])
     if clash:
         return parser.refuse(clash)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(output))):
+        return parser.refuse(f"the figure {output}: its folder does not exist")
     radius = args.min_bend_radius
     if radius is not None and not (radius > 0 and radius < float("inf")):
         sys.stderr.write(f"petsc_rod.plots: error: --min-bend-radius {radius:g}: give the "

@@ -32,6 +32,8 @@ def main(argv=None):
     read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)]
             if os.path.isdir(source) else [("result", source)])
     clash = replaced_input([("-o", args.output)], read)
+    if not clash and not os.path.isdir(os.path.dirname(os.path.abspath(args.output))):
+        clash = f"-o {args.output}: its folder does not exist"
     if clash:
         sys.stderr.write(f"petsc_rod.report: error: {clash}\n")
         return 2

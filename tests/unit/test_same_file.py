@@ -73,6 +73,11 @@ def test_the_plots_do_not_write_over_a_result_by_a_link(tmp_path, capsys):
     # a wrong call is one line too, with the usage in it
     assert plots.main(["plots", str(path)]) == 2
     assert "usage: " in one_error_line(capsys.readouterr(), "plots")
+    # a figure in a missing folder: said as such, before any drawing
+    assert plots.main(["plots", str(path), str(tmp_path / "no" / "f.png")]) == 2
+    assert "its folder does not exist" in one_error_line(capsys.readouterr(), "plots")
+    assert report([str(path), "-o", str(tmp_path / "no" / "r.html")]) == 2
+    assert "its folder does not exist" in one_error_line(capsys.readouterr(), "report")
 
 
 def test_a_write_that_fails_leaves_the_old_file(tmp_path):
