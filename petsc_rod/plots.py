@@ -25,6 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from petsc_rod.figures.read import read_result  # noqa: E402
 from petsc_rod.figures.riser import riser_figure, sweep_overlay  # noqa: E402
 from petsc_rod.figures.rod import rod_figure  # noqa: E402
+from petsc_rod.io.same_file import replaced_input, write_whole  # noqa: E402
 
 DPI = 110
 
@@ -54,13 +55,33 @@ def plot_result(path, output, min_bend_radius=None):
 
 
 def save(figure, output):
-    """Write ``figure`` to ``output`` and close it."""
-    figure.savefig(output, dpi=DPI)
-    plt.close(figure)
+    """Write ``figure`` to ``output`` (whole or not at all: io.same_file.write_whole) and
+    close it."""
+    try:
+        write_whole(output, lambda partial: figure.savefig(partial, dpi=DPI))
+    finally:
+        plt.close(figure)
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose refusal is one line, ``petsc_rod.<module>: error:
+    <message>; usage: ...``, and exit 2 (argparse's own prints the usage on a line of its own)."""
+
+    def line(self, message):
+        usage = self.format_usage().strip().removeprefix("usage: ")
+        return f"{self.prog.removeprefix('python -m ')}: error: {message}; usage: {usage}\n"
+
+    def refuse(self, message):
+        """Say the line on stderr; returns the exit code 2."""
+        sys.stderr.write(self.line(message))
+        return 2
+
+    def error(self, message):
+        self.exit(2, self.line(message))
 
 
 def main(argv):
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="python -m petsc_rod.plots",
         usage="python -m petsc_rod.plots RESULT.h5 [MORE.h5 ...] FIGURE.png "
               "[--min-bend-radius R]",
@@ -71,14 +92,15 @@ def main(argv):
                         help="allowable bend radius (m), drawn against the curvature")
     args = parser.parse_args(argv[1:])
     if len(args.files) < 2:
-        parser.print_usage(sys.stderr)
-        sys.stderr.write("give a result file and the figure to write\n")
-        return 2
+        return parser.refuse("give a result file and the figure to write")
     *inputs, output = args.files
     if output.lower().endswith((".h5", ".hdf5")):     # never write a figure over a result
-        parser.print_usage(sys.stderr)
-        sys.stderr.write(f"the last file is the figure to write, not a result: {output}\n")
-        return 2
+        return parser.refuse(f"the last file is the figure to write, not a result: {output}")
+    clash = replaced_input([("the figure", output)], [("result", path) for path in inputs])
+    if clash:
+        return parser.refuse(clash)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(output))):
+        return parser.refuse(f"the figure {output}: its folder does not exist")
     radius = args.min_bend_radius
     if radius is not None and not (radius > 0 and radius < float("inf")):
         sys.stderr.write(f"petsc_rod.plots: error: --min-bend-radius {radius:g}: give the "

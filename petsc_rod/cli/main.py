@@ -25,6 +25,8 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_ande
                                    check_substructuring_switches, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli import lines
+from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.io.same_file import replaced_input
 from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
                                          scene_from_options, settings_from_options)
@@ -36,6 +38,9 @@ from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.problem.problem import RodProblem
 
+# The options that name a file the run reads.
+INPUT_FILE_OPTIONS = tuple(option.name for option in OPTIONS
+                           if option.metavar == "FILE" and option.name != "rod_output")
 # How long the ranks wait for each other after a PETSc error before taking it for one
 # rank's alone, s.
 FAILURE_WAIT = 10.0
@@ -81,6 +86,7 @@ def run(comm=None):
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:
                 line_table.check_table_path(values["rod_table"], values["rod_output"], comm)
+            check_inputs_kept(values, comm)
             mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                         pieces)
             path_scene, notes = walked_scene(scene, values, comm)
@@ -214,6 +220,27 @@ def check_mesh(comm, values, per_element=resources.BYTES_PER_ELEMENT):
     smallest = end_element_lengths(elements, length, grading).min()
     if not smallest >= MIN_RELATIVE_ELEMENT * length:
         raise unresolved(smallest)
+
+
+def check_inputs_kept(values, comm):
+    """Refuse, before any work, an output (-rod_output, -rod_table and its regions'
+    table) that names one of the run's inputs, which writing it would replace: an
+    options file, or the file of an input option (-rod_initial, -rod_line_types,
+    -rod_point_loads, the profiles: every option whose value is a FILE). Collective:
+    rank 0 decides."""
+    written = [("-rod_output", values["rod_output"])]
+    if values["rod_table"]:
+        written += [("-rod_table", values["rod_table"]),
+                    ("the regions' table of -rod_table",
+                     line_table.regions_path(values["rod_table"]))]
+    clash = None
+    if comm.getRank() == 0:
+        read = [("-options_file", path) for path in every_options_file(sys.argv)]
+        read += [(f"-{name}", values[name]) for name in INPUT_FILE_OPTIONS]
+        clash = replaced_input(written, read)
+    clash = comm.tompi4py().bcast(clash, root=0)
+    if clash:
+        raise RodInputError(clash)
 
 
 def build_solver(mesh, scene, settings, say):

@@ -185,3 +185,33 @@ def options_file_error(argv, environ=None):
     except OptionsFileError as error:
         return f"{error} (PETSc reads {path} unasked; -skip_petscrc skips it)"
     return ""
+
+
+def every_options_file(argv, environ=None):
+    """The paths of the options files PETSc reads for command line ``argv`` (those of
+    the command line, of PETSC_OPTIONS, the petscrc files, and those they include), each
+    once; a file that cannot be read is left out (options_file_error says why)."""
+    environ = os.environ if environ is None else environ
+    found = []
+
+    def visit(path):
+        if path is None or not os.path.isfile(path) or any(
+                os.path.samefile(path, seen) for seen in found):
+            return
+        found.append(path)
+        try:
+            with open(path, encoding="utf-8", errors="replace") as handle:
+                nested = nested_files(path, handle.read())
+        except (OSError, OptionsFileError):
+            return
+        for _, name in nested:
+            visit(expanded(name))
+
+    try:
+        tops = (options_files(argv) + environment_files(environ)
+                + petscrc_files(argv, environ))
+    except OptionsFileError:
+        return found
+    for path in tops:
+        visit(path)
+    return found

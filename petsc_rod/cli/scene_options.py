@@ -37,7 +37,8 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                     for name in ("rotational_stiffness", "joint_axis")},
                  "point_load_S": "the point loads (-rod_point_loads|-rod_point_load)",
                  "point_load_forces": ("the point loads (-rod_point_loads|-rod_point_load, "
-                                       "-rod_water_density, -rod_gravity)")}
+                                       "-rod_water_density, -rod_gravity)"),
+                 "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)"}
 
 
 def point_loads_from_options(values, length, points=None):

@@ -2,15 +2,17 @@
 of a result file or of a sweep's folder (report/page.py). Serial; no PETSc. Exit 0, or
 2 with one line when the input is not a result file or a sweep's folder."""
 
-import argparse
 import os
 import sys
 
+from petsc_rod.io.same_file import replaced_input
+from petsc_rod.plots import OneLineParser
+
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m petsc_rod.report",
-                                     description="one self-contained HTML page of a result "
-                                                 "file or a sweep's folder")
+    parser = OneLineParser(prog="python -m petsc_rod.report",
+                           description="one self-contained HTML page of a result file or a "
+                                       "sweep's folder")
     parser.add_argument("source", help="a result file (HDF5) or a sweep's -sweep_output DIR")
     parser.add_argument("-o", "--output", default="report.html", help="the HTML file")
     args = parser.parse_args(argv)
@@ -25,6 +27,15 @@ def main(argv=None):
     import h5py
     if not os.path.isdir(source) and not h5py.is_hdf5(source):
         sys.stderr.write(f"petsc_rod.report: error: {source}: not a result file (HDF5)\n")
+        return 2
+    # a sweep's folder: every file in it (its record, its cases' files, its summary)
+    read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)]
+            if os.path.isdir(source) else [("result", source)])
+    clash = replaced_input([("-o", args.output)], read)
+    if not clash and not os.path.isdir(os.path.dirname(os.path.abspath(args.output))):
+        clash = f"-o {args.output}: its folder does not exist"
+    if clash:
+        sys.stderr.write(f"petsc_rod.report: error: {clash}\n")
         return 2
     from petsc_rod.report import page
     try:

@@ -6,8 +6,10 @@ The quantities are read from the result files where they are datasets
 (``effective_tension``, ``wall_tension``, ``bend_radius``, ``von_mises``,
 ``utilisation``: the newer ones only where the files have them); the bend radius of a
 file without the dataset is 1 / |(u1, u2)| from its strains ``u`` (docs/output.md), and
-the tension of a file without ``effective_tension`` is |n|. Cases on other meshes are
-interpolated onto the first case's S.
+the tension of a file without ``effective_tension`` is |n|. The envelope is drawn on
+every S of every case (their union): each case is interpolated onto the S within its
+own length and has no value beyond it, so a longer case is not cut at a shorter one's
+end and a shorter one is not extended past its own.
 """
 
 import h5py
@@ -45,10 +47,26 @@ def along_line(path):
     return data
 
 
+def on_arcs(S, case_S, values):
+    """``values`` (at ``case_S``, increasing) at the arc lengths ``S``: the value itself
+    where S is one of case_S (an infinite bend radius stays infinite), linear between
+    them, NaN outside [case_S[0], case_S[-1]] (not extended past the case's ends)."""
+    index = np.clip(np.searchsorted(case_S, S), 0, case_S.size - 1)
+    exact = case_S[index] == S
+    finite = np.isfinite(values)
+    between = np.interp(S, case_S[finite], values[finite]) if finite.any() \
+        else np.full(S.shape, np.inf)
+    inside = (S >= case_S[0]) & (S <= case_S[-1])
+    return np.where(exact, values[index], np.where(inside, between, np.nan))
+
+
 def envelopes(cases):
-    """(S, {quantity: (values of each case (cases, n), least, largest)}) on the first
-    case's S, for the quantities every case has. ``cases``: along_line dicts."""
+    """(S, {quantity: (values of each case (cases, n), least, largest)}) on the union of
+    the cases' S (each case NaN beyond its own length: on_arcs), for the quantities every
+    case has. ``cases``: along_line dicts."""
     S = cases[0]["S"]
+    if any(c["S"].shape != S.shape or not np.array_equal(c["S"], S) for c in cases):
+        S = np.unique(np.concatenate([c["S"] for c in cases]))
     # the quantities every case has, with a finite value somewhere (a straight line's
     # bend radius is inf all along, a line type without smys has no utilisation)
     names = [name for name, *_ in QUANTITIES
@@ -56,9 +74,11 @@ def envelopes(cases):
              and any(np.any(np.isfinite(c[name])) for c in cases)]
     result = {}
     for name in names:
-        stacked = np.array([c[name] if c["S"].shape == S.shape and np.allclose(c["S"], S)
-                            else np.interp(S, c["S"], c[name]) for c in cases])
-        result[name] = (stacked, stacked.min(axis=0), stacked.max(axis=0))
+        stacked = np.array([c[name] if c["S"].shape == S.shape and np.array_equal(c["S"], S)
+                            else on_arcs(S, c["S"], c[name]) for c in cases])
+        # fmin/fmax skip a case's NaN where it does not reach
+        result[name] = (stacked, np.fmin.reduce(stacked, axis=0),
+                        np.fmax.reduce(stacked, axis=0))
     return S, result
 
 

@@ -24,6 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod import plots  # noqa: E402
+from petsc_rod.io.same_file import write_text_whole  # noqa: E402
 from petsc_rod.report import envelopes  # noqa: E402
 from petsc_rod.sweep import summary  # noqa: E402
 
@@ -166,7 +167,6 @@ def build(source):
 
 
 def write(source, output):
-    """Write the page of ``source`` to ``output``."""
-    text = build(source)
-    with open(output, "w", encoding="utf-8") as f:
-        f.write(text)
+    """Write the page of ``source`` to ``output``, whole or not at all
+    (io.same_file.write_text_whole)."""
+    write_text_whole(output, build(source))

@@ -18,15 +18,20 @@ sweep stops there).
 """
 
 import difflib
+import fcntl
+import json
 import os
+import sys
 from dataclasses import dataclass
 
 from petsc4py import PETSc
 
-from petsc_rod.cli.main import run
+from petsc_rod.cli.main import INPUT_FILE_OPTIONS, run
+from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options
-from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError
+from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError, on_every_rank
+from petsc_rod.io.same_file import replaced_input
 from petsc_rod.sweep import cases as sweep_cases
 from petsc_rod.sweep import summary
 
@@ -138,6 +143,108 @@ def make_cases(settings, values):
     made = sweep_cases.product(listed, offsets, currents)
     sweep_cases.check_unique(made, "the sweep")
     return made
+
+
+# The sweep's own files in its folder.
+SWEEP_FILES = ("summary.csv", "summary.md", "sweep.json")
+
+
+def case_files(name):
+    """The files a case named ``name`` may leave in the sweep's folder: its result, the
+    steps an interrupted run keeps (io.results.ResultWriter.kept_name), its -rod_table
+    and the regions' table beside it (io/line_table.py)."""
+    return (f"{name}.h5", f"{name}.interrupted.h5", f"{name}.csv", f"{name}_regions.csv")
+
+
+def check_file_names(cases):
+    """Refuse a case whose files (case_files) would be the sweep's own or another case's:
+    a case named ``summary`` would write its table to summary.csv, a case ``a_regions``
+    its table to case ``a``'s regions' table."""
+    owners = {name: "the sweep's own" for name in SWEEP_FILES}
+    for case in cases:
+        for name in case_files(case.name):
+            if name in owners:
+                raise RodInputError(
+                    f"case {case.name}: its file {name} would also be {owners[name]}; rename "
+                    f"the case (a case's files are <name>.h5, <name>.interrupted.h5, "
+                    f"<name>.csv, <name>_regions.csv; the sweep's {', '.join(SWEEP_FILES)})")
+            owners[name] = f"case {case.name}'s"
+
+
+def input_files(settings, values, cases):
+    """(what names it, path) of every file the sweep's cases read: the options files,
+    the case file, each input file option of the base options and of every case."""
+    read = [("-options_file", path) for path in every_options_file(sys.argv)]
+    if settings.cases:
+        read.append(("-sweep_cases", settings.cases))
+    for name in INPUT_FILE_OPTIONS:
+        read.append((f"-{name}", values[name]))
+        read += [(f"-{name} of case {case.name}", case.options[name]) for case in cases
+                 if name in case.options]
+    return read
+
+
+def previous_files(folder):
+    """The files of the folder (names), and those of them a previous sweep wrote there:
+    its own (SWEEP_FILES) and the files of the cases its sweep.json records; None for
+    the latter when the folder holds no readable sweep.json."""
+    entries = sorted(os.listdir(folder))
+    if "sweep.json" not in entries:
+        return entries, None
+    try:
+        with open(os.path.join(folder, "sweep.json"), encoding="utf-8") as f:
+            names = [case["name"] for case in json.load(f)["cases"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return entries, None
+    return entries, set(SWEEP_FILES).union(*(case_files(str(name)) for name in names))
+
+
+def _claim_folder(folder, cases, inputs):
+    """Rank 0's part of claim_folder; returns the locked descriptor of the folder."""
+    where = f"-sweep_output {folder}"
+    lock = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(lock)
+        raise RodInputError(f"{where}: another sweep is writing into it; wait for it or "
+                            "choose another folder") from None
+    try:
+        entries, ours = previous_files(folder)
+        strangers = [name for name in entries if ours is None or name not in ours]
+        if strangers:
+            raise RodInputError(
+                f"{where}: holds {strangers[0]}"
+                + (f" and {len(strangers) - 1} more" if len(strangers) > 1 else "")
+                + ", not a file of an earlier sweep into it (one its sweep.json lists); a "
+                "sweep writes into a new or empty folder, or an earlier sweep's, whose files "
+                "it removes first: choose another folder")
+        names = (entries + list(SWEEP_FILES)
+                 + [name for case in cases for name in case_files(case.name)])
+        clash = replaced_input([("the sweep's file", os.path.join(folder, name))
+                                for name in names], inputs,
+                               "the sweep would remove or replace; choose another folder")
+        if clash:
+            raise RodInputError(f"{where}: {clash}")
+        for name in entries:            # the earlier sweep's files, none an input
+            os.remove(os.path.join(folder, name))
+    except BaseException:
+        os.close(lock)
+        raise
+    return lock
+
+
+def claim_folder(comm, folder, cases, inputs):
+    """Take the output folder for this sweep, before any case runs (docs/sweeps.md,
+    "Output"): locked for the sweep (a second sweep into it is refused while this one
+    runs: flock, released when the process ends); a folder that holds files is taken
+    only when they are an earlier sweep's (its sweep.json's cases' files and its
+    summary), which are then removed, so that every file in the folder is in this
+    sweep's summary; no file removed or written may be an input (``inputs``:
+    input_files). Collective; returns rank 0's lock (a descriptor to close), else
+    None."""
+    return on_every_rank(comm, _claim_folder if comm.getRank() == 0 else lambda *a: None,
+                         folder, cases, inputs)
 
 
 def make_folder(comm, path):
@@ -286,7 +393,9 @@ def run_sweep(comm=None):
         settings = read_settings()
         values, _ = read_options()
         made = make_cases(settings, values)
+        check_file_names(made)
         make_folder(comm, settings.output)
+        lock = claim_folder(comm, settings.output, made, input_files(settings, values, made))
     except RodError as error:
         say(f"petsc_rod.sweep: error: {error}")
         database.setValue("options_left", "0")
@@ -297,6 +406,7 @@ def run_sweep(comm=None):
     sweep = Sweep(comm, settings, made, base)
     say(f"petsc_rod.sweep: {len(made)} case(s) varying "
         f"{', '.join('-' + v for v in sweep.varied) or 'nothing'}, into {settings.output}")
+    sweep.write()           # the folder is this sweep's from the start
     stopped = None
     # a stop signal between two cases (each run records its own: cli/signals.py) ends
     # the sweep before the next, as one during a case ends it after that one
@@ -323,6 +433,8 @@ def run_sweep(comm=None):
         + (f"; {len(made) - len(sweep.records)} not run" if stopped is not None else "")
         + f"; summary in {os.path.join(settings.output, 'summary.md')}")
     database.setValue("options_left", "0")
+    if lock is not None:    # else released when the process ends
+        os.close(lock)
     if stopped is not None:
         return stopped
     return 0 if not failed else RodNotConvergedError.exit_code

@@ -12,11 +12,16 @@ table shows what the files hold. The sweep
 """
 
 import csv
+import html
+import io
 import json
+import re
 import signal
 
 import h5py
 import numpy as np
+
+from petsc_rod.io.same_file import write_text_whole
 
 # The columns every summary tries first: (column, root attribute, unit if the file
 # gives none).
@@ -38,6 +43,13 @@ EXTRA_PREFIXES = ("max_", "min_", "top_")
 EXTRA_WORDS = ("utilisation", "utilization", "von_mises", "stress")
 # Root attributes that are not results (a run's bookkeeping).
 NOT_RESULTS = {"total_iterations", "total_halvings", "undone_iterations"}
+# The first characters that make a spreadsheet read a CSV cell as a formula (OWASP, "CSV
+# injection"): a text cell starting with one of them is written after a single quote.
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+# Text that is numbers (an option's value such as -1157,0,1000): no formula can hide in
+# it, so it stays as it is.
+NUMBERS_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
+                          r"(,[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?)*$")
 # What an exit code says, for a case without a result file.
 EXIT_REASONS = {0: "converged", 2: "bad input", 3: "not converged", 4: "diverged",
                 5: "result not written"}
@@ -119,29 +131,49 @@ def cell(value):
     return str(value)
 
 
+def csv_cell(value):
+    """A CSV cell: a float at full precision (repr); a text cell that a spreadsheet would
+    run as a formula (it starts with one of FORMULA_STARTS and is not numbers) after a
+    single quote, which makes it text (OWASP's advice)."""
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, str) and value.startswith(FORMULA_STARTS) \
+            and not NUMBERS_TEXT.match(value):
+        return "'" + value
+    return value
+
+
+def markdown_cell(text):
+    """``text`` safe in a Markdown table cell: &, <, > as HTML entities (a viewer shows
+    them, runs no HTML), | escaped, line breaks as spaces."""
+    text = html.escape(text, quote=False).replace("|", "\\|")
+    return text.replace("\r", " ").replace("\n", " ")
+
+
 def write_csv(path, header, rows):
-    """The table as CSV, numbers at full precision."""
-    with open(path, "w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(header)
-        for row in rows:
-            writer.writerow([repr(v) if isinstance(v, float) else v for v in row])
+    """The table as CSV, numbers at full precision, text cells kept from running as
+    formulas (csv_cell)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    writer.writerow(header)
+    for row in rows:
+        writer.writerow([csv_cell(v) for v in row])
+    write_text_whole(path, buffer.getvalue())
 
 
 def markdown(header, rows):
-    """The table as Markdown text."""
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    """The table as Markdown text, every cell escaped (markdown_cell)."""
+    lines = ["| " + " | ".join(markdown_cell(h) for h in header) + " |",
+             "|" + "---|" * len(header)]
     for row in rows:
-        lines.append("| " + " | ".join(cell(v).replace("|", "\\|") for v in row) + " |")
+        lines.append("| " + " | ".join(markdown_cell(cell(v)) for v in row) + " |")
     return "\n".join(lines) + "\n"
 
 
 def write_markdown(path, header, rows, title=None):
     """The table as a Markdown file (with a title line when given)."""
-    with open(path, "w", encoding="utf-8") as f:
-        if title:
-            f.write(f"# {title}\n\n")
-        f.write(markdown(header, rows))
+    write_text_whole(path, (f"# {markdown_cell(title)}\n\n" if title else "")
+               + markdown(header, rows))
 
 
 def read_record(path):
@@ -152,6 +184,5 @@ def read_record(path):
 
 
 def write_record(path, record):
-    """Write the sweep's record as JSON."""
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump(record, f, indent=1)
+    """Write the sweep's record as JSON (write_text_whole: never half-written)."""
+    write_text_whole(path, json.dumps(record, indent=1))

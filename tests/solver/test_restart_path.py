@@ -11,6 +11,8 @@ blend is exact). Before issue 25 the restart took one step at t = 1 with B's who
 load: (2) and (3) fail there.
 """
 
+import shutil
+
 import h5py
 import numpy as np
 import pytest
@@ -205,3 +207,72 @@ def test_a_file_written_part_way_along_a_walk_is_refused(shared_tmp):
     assert run_cli({**new, "rod_initial": files["part"], "rod_output": files["again"]}) == 2
     assert run_cli({**walk, "rod_output": files["whole"]}) == 0
     assert run_cli({**new, "rod_initial": files["whole"], "rod_output": files["again"]}) == 0
+
+
+def file_at(path, factor, out):
+    """A copy of result file ``path`` whose root is its step at load factor ``factor``
+    (as a run stopped there leaves it: the converged steps' last one at the root), on
+    rank 0; every rank waits for it."""
+    comm = PETSc.COMM_WORLD.tompi4py()
+    if comm.rank == 0:
+        shutil.copyfile(path, out)
+        with h5py.File(out, "r+") as f:
+            step = next(f["steps"][k] for k in f["steps"]
+                        if f["steps"][k].attrs["load_factor"] == factor)
+            for key in step:
+                if key in f:
+                    del f[key]
+                f[key] = step[key]
+            for key, value in step.attrs.items():
+                f.attrs[key] = value
+    comm.Barrier()
+
+
+def step_positions(path, factor):
+    """r of the step of ``path`` at load factor ``factor``."""
+    with h5py.File(path, "r") as f:
+        return next(np.asarray(f["steps"][k]["r"]) for k in f["steps"]
+                    if f["steps"][k].attrs["load_factor"] == factor)
+
+
+def test_a_restart_from_a_files_load_factor_reaches_the_uninterrupted_states(shared_tmp):
+    """The scene of an end force run in 4 steps (0.25, ..., 1) without a stop, and from
+    its file at load factor 1/2 in 2 steps (0.75, 1): each step of the restart is the
+    uninterrupted run's state at the same load factor (a step at a wrong factor is not:
+    the states at 0.75 and 1 differ by 0.077 of the length)."""
+    force = {"rod_end_force": "0,-3,0"}
+    files = {name: f"{shared_tmp}/{name}.h5" for name in ("whole", "half", "again")}
+    assert run_cli({**force, "rod_steps": "4", "rod_output": files["whole"]}) == 0
+    file_at(files["whole"], 0.5, files["half"])
+    assert run_cli({**force, "rod_initial": files["half"], "rod_steps": "2",
+                    "rod_output": files["again"]}) == 0
+    assert step_factors(files["again"]) == [0.75, 1.0]
+    for factor in (0.75, 1.0):
+        assert np.abs(step_positions(files["again"], factor)
+                      - step_positions(files["whole"], factor)).max() <= AGREEMENT, factor
+    assert np.abs(step_positions(files["whole"], 0.75)
+                  - step_positions(files["whole"], 1.0)).max() > 1e-2
+
+
+def test_a_walk_from_a_file_at_load_factor_one_half(shared_tmp):
+    """A walk from scene A's file at t_f = 1/2 to scene B (end forces F_A, F_B) carries
+    (1 - s) F_A / 2 + s F_B: its middle step is the equilibrium of F_A / 4 + F_B / 2, its
+    end B's (a walk that took A's file at t = 1 reaches F_A / 2 + F_B / 2 at its middle,
+    0.10 of the length away)."""
+    old, new = {"rod_end_force": "0,-3,0"}, {"rod_end_force": "0,-2,1.5"}
+    files = {name: f"{shared_tmp}/{name}.h5"
+             for name in ("old", "half", "walk", "direct", "mean", "wrong")}
+    assert run_cli({**old, "rod_steps": "2", "rod_output": files["old"]}) == 0
+    file_at(files["old"], 0.5, files["half"])
+    assert run_cli({**new, "rod_initial": files["half"], "rod_steps": str(STEPS),
+                    "rod_output": files["walk"]}) == 0
+    assert run_cli({**new, "rod_steps": str(STEPS), "rod_output": files["direct"]}) == 0
+    assert run_cli({"rod_end_force": "0,-1.75,0.75", "rod_steps": str(STEPS),
+                    "rod_output": files["mean"]}) == 0
+    assert run_cli({"rod_end_force": "0,-2.5,0.75", "rod_steps": str(STEPS),
+                    "rod_output": files["wrong"]}) == 0
+    assert step_factors(files["walk"]) == [k / STEPS for k in range(1, STEPS + 1)]
+    assert np.abs(positions(files["walk"]) - positions(files["direct"])).max() <= AGREEMENT
+    middle = positions(files["walk"], f"steps/{STEPS // 2}")
+    assert np.abs(middle - positions(files["mean"])).max() <= AGREEMENT
+    assert np.abs(positions(files["wrong"]) - positions(files["mean"])).max() > 1e-2

@@ -54,3 +54,64 @@ def test_a_failed_step_that_moves_no_load_ends_the_run(lazy_wave):
     assert "increment 0" not in process.stdout and "retrying" not in process.stdout, \
         describe(process)
     assert "moves no load, so halving it cannot help" in process.stdout, describe(process)
+
+
+# The 3 km catenary on 20 elements (a fraction of a second from its catenary start) in
+# a cross current, and two attachments with drag areas: a restart that adds or removes
+# them walks from the file's scene to this one and ends where a run of this scene from
+# its own start does.
+CATENARY = ["-options_file", "options/catenary.opts", "-rod_elements", "20",
+            "-rod_current", "0,0.5,0", "-rod_drag", "1025,1.2,0.2"]
+ATTACHMENTS = "s fz cda\n1000 -5e5 1\n2000 2e5 2\n"
+
+
+def final_positions(path):
+    with h5py.File(path, "r") as f:
+        assert f.attrs["converged"] == 1
+        return f["r"][:]
+
+
+@pytest.fixture(scope="module")
+def catenary_runs(tmp_path_factory):
+    """{'plain': the catenary's file, 'attached': with the attachments} from their own
+    starts, and the attachments' table."""
+    folder = tmp_path_factory.mktemp("attachments")
+    table = folder / "attachments.txt"
+    table.write_text(ATTACHMENTS)
+    files = {}
+    for name, extra in (("plain", []), ("attached", ["-rod_point_loads", str(table)])):
+        files[name] = folder / f"{name}.h5"
+        process = run_petsc_rod(CATENARY + extra + ["-rod_output", str(files[name])],
+                                timeout=TIMEOUT)
+        assert process.returncode == 0, describe(process)
+    return files, table
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("source, target", [("plain", "attached"), ("attached", "plain")])
+def test_a_restart_that_adds_or_removes_attachments(catenary_runs, tmp_path, source, target):
+    files, table = catenary_runs
+    extra = ["-rod_point_loads", str(table)] if target == "attached" else []
+    path = tmp_path / "restarted.h5"
+    process = run_petsc_rod(CATENARY + extra + ["-rod_initial", str(files[source]),
+                                             "-rod_steps", "2", "-rod_output", str(path)],
+                            timeout=TIMEOUT)
+    assert process.returncode == 0, describe(process)
+    assert "Traceback" not in process.stdout + process.stderr
+    walks = [line for line in process.stdout.splitlines() if "walks from the file's scene" in line]
+    assert len(walks) == 1 and "the point loads" in walks[0], describe(process)
+    # the state of this scene, not the file's: within the tolerance of the own start's run
+    # (measured 2e-7 m), where the attachments move the line by 57 m
+    difference = abs(final_positions(path) - final_positions(files[target])).max()
+    assert difference < 1e-5, difference
+    assert abs(final_positions(files["plain"]) - final_positions(files["attached"])).max() > 10
+
+
+def test_every_field_a_restart_compares_names_its_options():
+    """A Scene field that a restart compares (scenes/blend.py) without the options behind
+    it in scene_options.FIELD_OPTIONS was a KeyError as soon as it differed (the
+    attachments' drag areas)."""
+    from petsc_rod.cli.scene_options import FIELD_OPTIONS
+    from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS
+
+    assert set(PATH_FIELDS + FIXED_FIELDS) <= set(FIELD_OPTIONS)

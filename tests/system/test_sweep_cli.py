@@ -285,3 +285,105 @@ def test_the_summary_shows_what_newer_files_add(tmp_path):
     assert cells["top_tension (N)"] == 1.5e6 and cells["iterations (1)"] == 7
     assert cells["max_utilisation (1)"] == 0.61 and cells["max_von_mises (Pa)"] == 2.9e8
     assert not any(h.startswith("end_force") for h in header)
+
+
+@pytest.mark.serial
+def test_warm_starts_across_attachments(tmp_path):
+    """-sweep_start nearest over a point load (the 3 km catenary on 20 elements): each
+    case after the first warm-starts from a file with other attachments (none, one, two,
+    none again) and converges to the state of its own start."""
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_point_load\nnone -\none 1000,0,0,-5e5\n"
+                     "two 1000,0,0,-5e5,2000,0,0,2e5\nagain -\n")
+    rows = {}
+    for start in ("nearest", "scene"):
+        folder = tmp_path / start
+        process = run_module("petsc_rod.sweep", ["-options_file", "options/catenary.opts",
+                                                 "-rod_elements", "20", "-sweep_cases",
+                                                 str(cases), "-sweep_output", str(folder),
+                                                 "-sweep_start", start])
+        assert process.returncode == 0, describe(process)
+        assert "Traceback" not in process.stdout + process.stderr
+        rows[start] = read_summary(folder)
+    assert [r["start"] for r in rows["nearest"].values()] == [
+        "own start", "from none", "from none", "from none"]
+    for name, row in rows["nearest"].items():
+        assert row["status"] == "converged"
+        with h5py.File(tmp_path / "nearest" / f"{name}.h5", "r") as warm, \
+                h5py.File(tmp_path / "scene" / f"{name}.h5", "r") as own:
+            assert abs(warm["r"][:] - own["r"][:]).max() < 1e-5, name
+
+
+# The 3 km catenary on 20 elements: a case runs in a fraction of a second.
+QUICK = ["-options_file", "options/catenary.opts", "-rod_elements", "20"]
+
+
+def quick_sweep(tmp_path, rows, folder, extra=()):
+    """A sweep of QUICK over -rod_point_load with the case file ``rows`` (name value
+    lines) into ``folder``; the process."""
+    cases = tmp_path / f"cases{abs(hash(rows))}.txt"
+    cases.write_text("name rod_point_load\n" + rows)
+    return run_module("petsc_rod.sweep", QUICK + ["-sweep_cases", str(cases),
+                                                  "-sweep_output", str(folder)] + list(extra))
+
+
+def one_line(process, *words):
+    lines = [line for line in process.stdout.splitlines() if line.strip()]
+    assert process.returncode == 2, describe(process)
+    assert len(lines) == 1 and lines[0].startswith("petsc_rod.sweep: error: "), \
+        describe(process)
+    assert all(word in lines[0] for word in words), describe(process)
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("rows, words", [
+    ("summary -\n", ["case summary", "summary.csv", "the sweep's own"]),
+    ("a -\na_regions 1000,0,0,-5e5\n", ["case a_regions", "a_regions.csv", "case a's"]),
+    ("a -\na.interrupted 1000,0,0,-5e5\n", ["case a.interrupted", "case a's"]),
+], ids=["summary", "regions", "interrupted"])
+def test_a_case_whose_files_are_others_is_refused(tmp_path, rows, words):
+    folder = tmp_path / "out"
+    one_line(quick_sweep(tmp_path, rows, folder, ["-rod_table", "t.csv"]), *words)
+    assert not folder.exists()
+
+
+@pytest.mark.serial
+def test_a_folder_reused_holds_only_the_last_sweeps_files(tmp_path):
+    """Two sweeps into one folder, one after the other: the second removes the first's
+    files (its sweep.json lists them) before its first case; every file in the folder is
+    in its summary."""
+    folder = tmp_path / "out"
+    first = quick_sweep(tmp_path, "a -\nb 1000,0,0,-5e5\n", folder, ["-rod_table", "t.csv"])
+    assert first.returncode == 0, describe(first)
+    assert sorted(os.listdir(folder)) == ["a.csv", "a.h5", "b.csv", "b.h5", "summary.csv",
+                                          "summary.md", "sweep.json"]
+    second = quick_sweep(tmp_path, "c 2000,0,0,-5e5\n", folder)
+    assert second.returncode == 0, describe(second)
+    assert list(read_summary(folder)) == ["c"]
+    assert sorted(os.listdir(folder)) == ["c.h5", "summary.csv", "summary.md", "sweep.json"]
+
+
+@pytest.mark.serial
+def test_a_folder_not_a_sweeps_or_holding_an_input_is_refused(tmp_path):
+    import fcntl
+
+    folder = tmp_path / "out"
+    assert quick_sweep(tmp_path, "a -\n", folder).returncode == 0
+    result = (folder / "a.h5").read_bytes()
+    # a file no sweep wrote: refused, nothing removed
+    (folder / "notes.txt").write_text("mine\n")
+    one_line(quick_sweep(tmp_path, "b -\n", folder), "holds notes.txt", "choose another folder")
+    assert (folder / "notes.txt").read_text() == "mine\n" and (folder / "a.h5").exists()
+    (folder / "notes.txt").unlink()
+    # the earlier sweep's file as this sweep's input: refused, the file kept
+    one_line(quick_sweep(tmp_path, "b -\n", folder, ["-rod_initial", str(folder / "a.h5")]),
+             "-rod_initial", "would remove or replace")
+    assert (folder / "a.h5").read_bytes() == result
+    # a sweep still writing into it (its lock held)
+    lock = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        one_line(quick_sweep(tmp_path, "b -\n", folder), "another sweep is writing into it")
+    finally:
+        os.close(lock)
+    assert (folder / "a.h5").read_bytes() == result

@@ -1,0 +1,51 @@
+"""The report's range graphs (report/envelopes.py; no PETSc): the envelope of cases of
+different lengths spans every case's arc length, and a shorter case is not extended
+past its own end."""
+
+import h5py
+import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
+
+from petsc_rod.report import envelopes
+
+matplotlib.use("Agg")
+
+
+def write_case(path, length, elements, tension):
+    """A result file of a straight line of ``length`` m, its effective tension
+    ``tension(S)`` (N) and a bend radius of 100 m."""
+    S = np.linspace(0.0, length, elements + 1)
+    with h5py.File(path, "w") as f:
+        f["S"] = S
+        f["effective_tension"] = tension(S)
+        f["u"] = np.column_stack([np.full_like(S, 0.01), np.zeros_like(S), np.zeros_like(S)])
+    return str(path)
+
+
+def test_the_envelope_spans_every_case(tmp_path):
+    short = write_case(tmp_path / "short.h5", 100.0, 10, lambda S: 1000.0 + S)
+    long = write_case(tmp_path / "long.h5", 250.0, 20, lambda S: 500.0 + 4.0 * S)
+    for order in ([short, long], [long, short]):
+        S, result = envelopes.envelopes([envelopes.along_line(p) for p in order])
+        assert S[0] == 0.0 and S[-1] == 250.0
+        stacked, least, largest = result["effective_tension"]
+        beyond = S > 100.0
+        # beyond the short case's end only the long case: 500 + 4 S, both sides
+        np.testing.assert_allclose(largest[beyond], 500.0 + 4.0 * S[beyond])
+        np.testing.assert_allclose(least[beyond], 500.0 + 4.0 * S[beyond])
+        # within it, the larger and smaller of the two lines
+        within = ~beyond
+        np.testing.assert_allclose(largest[within], np.maximum(1000.0 + S[within],
+                                                               500.0 + 4.0 * S[within]))
+        np.testing.assert_allclose(least[within], np.minimum(1000.0 + S[within],
+                                                             500.0 + 4.0 * S[within]))
+        short_row = stacked[order.index(short)]
+        assert np.all(np.isnan(short_row[beyond]))
+        radius = result["bend_radius"]
+        np.testing.assert_allclose(radius[1], 100.0)
+        np.testing.assert_allclose(radius[2], 100.0)
+        figure = Figure()
+        envelopes.draw(figure, S, result, ["a", "b"])
+        # the largest tension is the long case's end: 1500 N
+        assert figure.axes[0].get_title() == "effective tension: max 1.5 kN"
