@@ -32,10 +32,9 @@ vertical to 1e-12).
 
 import numpy as np
 
-from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.quantities import _at_vertex, effective_tension, top_end, unit_tangent
-from petsc_rod.scenes.boundary import is_held
+from petsc_rod.riser.quantities import (_at_vertex, effective_tension, points_on_held_ends,
+                                        top_end, unit_tangent)
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
                  "torque": "N m", "shear": "N", "declination": "deg"}
@@ -99,18 +98,6 @@ def line_fields(vertex):
             "shear": shear(vertex), "declination": declination(unit_tangent(vertex))}
 
 
-def _points_on_held_ends(problem):
-    """(P at S = 0, P at S = L), N: the point loads that sit on a held end, which its
-    support carries beside the line's n (PointLoads.on_held_ends). Collective."""
-    on_start, on_end = np.zeros(3), np.zeros(3)
-    for term in problem.terms:
-        if isinstance(term, PointLoads):
-            start, end = term.on_held_ends(problem.state, is_held(problem.start_state),
-                                           is_held(problem.end_state))
-            on_start, on_end = on_start + start, on_end + end
-    return on_start, on_end
-
-
 def end_numbers(problem, vertex):
     """The attributes of ATTRIBUTE_UNITS (module docstring). Collective."""
     mesh = problem.mesh
@@ -120,7 +107,7 @@ def end_numbers(problem, vertex):
     top = top_end(problem)
     tangent = _at_vertex(mesh, unit_tangent(vertex), top * last)
     away = tangent if top == 1 else -tangent             # out of the line at the top
-    on_start, on_end = _points_on_held_ends(problem)
+    on_start, on_end = points_on_held_ends(problem)
     return {"start_force": n0 + on_start, "start_moment": m0, "end_force": -nL + on_end,
             "end_moment": -mL,
             "hang_off_S": float(top * mesh.length),

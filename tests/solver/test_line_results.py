@@ -185,3 +185,40 @@ def test_a_span_over_a_trench_is_a_free_span_not_grounded(comm):
     np.testing.assert_allclose(bounds["grounded"], [5.0, FLAT], atol=0.01)
     np.testing.assert_allclose(bounds["free_span"], [3.0, 5.0], atol=0.01)
     np.testing.assert_allclose(bounds["grounded_2"], [0.0, 3.0], atol=0.01)
+
+
+def test_an_anchor_that_lifts_off_is_said_with_its_angle_and_force(comm):
+    """The catenary pinned at an anchor on the seabed (z = 0) and pulled taut enough to
+    rise from it (top at (9, 0, 4)): no touchdown, and the anchor's uplift angle and
+    force are those of the inextensible catenary, atan(V0 / H) and V0 (at EI 5e-3 N m^2
+    the angle is off by the bending layer's 0.9 %, 10 % at EI 0.5; the force by 1e-4 of
+    V0); said in the final lines. Before, only touchdown_S = nan."""
+    from petsc_rod.cli.lines import summary
+    from petsc_rod.scenes.catenary import catenary
+
+    top = np.array([9.0, 0.0, 4.0])
+    vertex, attributes = solve(comm, dict(CATENARY, stiffness=(5e-3, 5e-3, 5e-3),
+                                          end_position=top, seabed=Seabed(0.0, 1e5)),
+                               elements=160)
+    assert np.isnan(attributes["touchdown_S"])
+    _, _, force = catenary(10.0, top, np.array([0.0, 0.0, -2.0]), np.array([0.0]))
+    H, V0 = force[0][0], force[0][2]
+    assert V0 > 0.5                                      # the exact line rises from it
+    assert attributes["anchor_uplift_S"] == 0.0
+    t = vertex["d3"][0]
+    assert attributes["anchor_uplift_angle"] == pytest.approx(
+        np.degrees(np.arctan2(t[2], t[0])), rel=1e-12)
+    assert attributes["anchor_uplift_angle"] == pytest.approx(np.degrees(np.arctan2(V0, H)),
+                                                              rel=1.5e-2)
+    assert attributes["anchor_uplift_force"] == pytest.approx(V0, rel=1e-3)
+    assert attributes["anchor_uplift_force"] == attributes["start_force"][2]
+    lines = "\n".join(summary(attributes))
+    assert "no touchdown: the anchor at S = 0 m lifts off at" in lines
+    assert f"pulled up by {attributes['anchor_uplift_force'] / 1e3:.6g} kN" in lines
+
+
+def test_a_grounded_anchor_says_no_uplift():
+    """The line resting on the seabed (GROUNDED): a touchdown, no uplift numbers."""
+    _, attributes = solve(PETSc.COMM_WORLD, GROUNDED)
+    assert np.isfinite(attributes["touchdown_S"])
+    assert "anchor_uplift_force" not in attributes
