@@ -181,9 +181,11 @@ OPTIONS = [
            "flex joint at a pinned end S = L: rotational stiffness, N m/rad; 0 a plain pin",
            NON_NEGATIVE, "N m/rad"),
     Option("rod_start_joint_axis", _reals(3), None, "x,y,z",
-           "neutral axis of the start's flex joint (normalised); default e_x"),
+           "neutral axis of the start's flex joint (normalised); default the line's "
+           "direction there in its catenary (e_x without one)"),
     Option("rod_end_joint_axis", _reals(3), None, "x,y,z",
-           "neutral axis of the end's flex joint (normalised); default e_x"),
+           "neutral axis of the end's flex joint (normalised); default the line's "
+           "direction there in its catenary (e_x without one)"),
     Option("rod_load", _reals(), default_of(Scene, "load_values").ravel(), "fx,fy,fz[,...]",
            "distributed dead load, N/m: 3 values, or 3 per piece with -rod_load_breaks",
            unit="N/m"),

@@ -73,8 +73,8 @@ class Scene:
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
-    # pinned end, 0 for none, and the neutral axis a its d3 is held to (unit; default e_x,
-    # the reference tangent); fixed, not on the load path
+    # pinned end, 0 for none, and the neutral axis a its d3 is held to (None: the line's
+    # direction at that end in its start shape, joint_axis); fixed, not on the load path
     start_rotational_stiffness: float = 0.0
     end_rotational_stiffness: float = 0.0
     start_joint_axis: np.ndarray = None
@@ -105,8 +105,8 @@ class Scene:
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
         for name in ("start_joint_axis", "end_joint_axis"):
             axis = getattr(self, name)
-            setattr(self, name, REFERENCE_FRAME[2].copy() if axis is None
-                    else np.asarray(axis, dtype=float).ravel())
+            if axis is not None:
+                setattr(self, name, np.asarray(axis, dtype=float).ravel())
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
         self.point_load_S = np.asarray(self.point_load_S, dtype=float).ravel()
@@ -271,14 +271,34 @@ class Scene:
 
     def joints(self):
         """The flex joints, [(which, k, a)]: which 'start' or 'end', k > 0 the rotational
-        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py)."""
+        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py,
+        joint_axis)."""
         joints = []
         for which in ("start", "end"):
             k = float(getattr(self, f"{which}_rotational_stiffness"))
             if k > 0:
-                axis = getattr(self, f"{which}_joint_axis")
-                joints.append((which, k, axis / np.linalg.norm(axis)))
+                joints.append((which, k, self.joint_axis(which)))
         return joints
+
+    def joint_axis(self, which):
+        """The unit neutral axis of the flex joint at ``which`` ('start' or 'end'): the
+        given -rod_*_joint_axis, else the line's direction (d3) at that end in the
+        scene's start shape: the tangent there of its catenary at load factor 1 (the
+        curve -rod_initial_shape catenary starts from: through both held ends, resting
+        on the seabed, the weights of the sections) where it has one, the joint then
+        unloaded in the catenary's static angle, as a flex joint is installed at a
+        hang-off; else e_x, the straight reference (an end free, no load). A default
+        e_x made a riser's hang-off joint turn by 85 degrees."""
+        axis = getattr(self, f"{which}_joint_axis")
+        if axis is None:
+            from petsc_rod.scenes.starts import catenary_start
+            try:
+                frame = catenary_start(self, 1.0)(np.array([0.0 if which == "start"
+                                                            else self.length]))[1][0]
+                axis = frame[2]
+            except RodInputError:
+                axis = REFERENCE_FRAME[2]
+        return np.asarray(axis, dtype=float) / np.linalg.norm(axis)
 
     def drag_loads(self, t):
         """[(weight, Current)]: the drag at load factor t is the sum of each current's
@@ -421,8 +441,8 @@ class Scene:
                     f"-rod_{which}_rotational_stiffness {k:g}: must be finite and not "
                     "negative (N m/rad; 0 is a pin; for an end held in full use "
                     f"-rod_{which} clamp)")
-            if axis.shape != (3,) or not np.all(np.isfinite(axis)) \
-                    or np.linalg.norm(axis) == 0:
+            if axis is not None and (axis.shape != (3,) or not np.all(np.isfinite(axis))
+                                     or np.linalg.norm(axis) == 0):
                 raise RodInputError(f"-rod_{which}_joint_axis: give a nonzero vector x,y,z "
                                     "(the joint's neutral axis; it is normalised)")
             if f"rod_{which}_joint_axis" in used and k == 0:

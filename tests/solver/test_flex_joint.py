@@ -297,3 +297,34 @@ def test_the_inextensible_joints_hessian_against_finite_differences(comm):
                 vec.destroy()
         polish.destroy()
         destroy(mesh, solver)
+
+
+@pytest.mark.parametrize("which", ["start", "end"])
+def test_the_default_joint_axis_is_the_lines_direction_in_its_catenary(comm, which):
+    """A joint without an axis on a catenary between pins (w = 100 N/m, L = 1 m, ends
+    at (0.6, 0, 0.3)): its axis is the catenary's tangent at that end, so that the
+    joint, installed at the cable's static angle, turns by the bending's share only
+    (EI = 1 N m^2 beside w L^2 = 100 N m; measured 6.2 and 4.3 degrees at the start and
+    the end against 34 and 53 about the old default e_x), and the state is the joint's
+    with that axis given. At a pin whose partner is free the axis stays e_x (no
+    catenary). On the steel riser: tests/system/test_riser_cli.py."""
+    from petsc_rod.scenes.starts import catenary_start
+
+    scene = dict(start="pin", end="pin", end_position=(0.6, 0.0, 0.3),
+                 load_values=[(0.0, 0.0, -100.0)], **{f"{which}_rotational_stiffness": 5.0})
+    tangent = catenary_start(Scene(length=LENGTH, stiffness=STIFFNESS, **scene), 1.0)(
+        np.array([0.0 if which == "start" else LENGTH]))[1][0][2]
+    assert Scene(length=LENGTH, stiffness=STIFFNESS, **scene).joint_axis(which) \
+        == pytest.approx(tangent, abs=1e-15)
+    assert abs(tangent[0]) < 0.9                      # far from e_x
+    _, r, joints = solve(comm, scene, steps=2)
+    _, given, given_joints = solve(comm, dict(scene, **{f"{which}_joint_axis": tangent}),
+                                   steps=2)
+    _, _, old_joints = solve(comm, dict(scene, **{f"{which}_joint_axis": (1.0, 0.0, 0.0)}),
+                             steps=2)
+    assert joints[0][0] < 0.25 * old_joints[0][0]
+    assert np.abs(r - given).max() < 1e-9
+    assert joints[0][0] == pytest.approx(given_joints[0][0], rel=1e-9)
+    free = Scene(length=LENGTH, stiffness=STIFFNESS, start="pin", end="free",
+                 start_rotational_stiffness=1.0, end_force=(0.0, -1.0, 0.0))
+    assert np.array_equal(free.joint_axis("start"), [1.0, 0.0, 0.0])

@@ -251,3 +251,23 @@ def test_the_plan_shows_a_riser_pushed_sideways(tmp_path):
     drawn = [ln for ln in elevation.lines if len(ln.get_xdata()) == len(r)]
     np.testing.assert_allclose(drawn[-1].get_xdata(), np.hypot(r[:, 0], r[:, 1]))
     assert "projected on the vertical plane of the ends" in [ln.get_label() for ln in drawn]
+
+
+def test_a_hang_off_joint_without_an_axis_is_installed_at_the_riser_s_angle(tmp_path):
+    """options/steel_catenary_riser.opts with -rod_end_rotational_stiffness 1.72e5 alone
+    (200 elements): the joint's axis is the catenary's top tangent, the joint nearly
+    unloaded (measured 0.019 deg, 57 N m); the issue's default e_x gave 85 deg and
+    254 kN m. The file says the axis used."""
+    path = tmp_path / "joint.h5"
+    process = run_petsc_rod(["-options_file", "options/steel_catenary_riser.opts",
+                             "-rod_sections", "scr10:2400:200",
+                             "-rod_end_rotational_stiffness", "1.72e5",
+                             "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
+    with h5py.File(path) as f:
+        step = f["steps"][max(f["steps"], key=int)]
+        angle, moment = step.attrs["end_joint_angle"], step.attrs["end_joint_moment"]
+        axis = step.attrs["end_joint_axis"]
+    assert angle < 0.1 and moment < 1e3
+    # up and toward the vessel's side, 19 degrees from the vertical like the top tension
+    assert np.degrees(np.arccos(axis[2])) == pytest.approx(19.4, abs=0.5)
