@@ -219,10 +219,10 @@ OPTIONS = [
            "point dead forces, N, at arc lengths S, m: 4 numbers per point", unit="m, N"),
     Option("rod_water_density", _real, default_of(Scene, "water_density"), "rho",
            "sea water density rho_w, kg/m^3 (the buoyancy and drag of line types and "
-           "attachments)", SCALE, "kg/m^3"),
+           "attachments); 0: a line in air", NON_NEGATIVE, "kg/m^3"),
     Option("rod_gravity", _real, default_of(Scene, "gravity"), "g",
-           "gravity, m/s^2, along -z (the weight of line types and attachments)", SCALE,
-           "m/s^2"),
+           "gravity, m/s^2, along -z (the weight of line types and attachments); 0: a "
+           "weightless line", NON_NEGATIVE, "m/s^2"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",

@@ -271,3 +271,53 @@ def test_a_hang_off_joint_without_an_axis_is_installed_at_the_riser_s_angle(tmp_
     assert angle < 0.1 and moment < 1e3
     # up and toward the vessel's side, 19 degrees from the vertical like the top tension
     assert np.degrees(np.arccos(axis[2])) == pytest.approx(19.4, abs=0.5)
+
+
+CABLE_TYPE = """name   od    mass  ei   gj   cd
+cable  0.1   10.0  10.0 10.0 1.0
+"""
+CABLE = ["-rod_sections", "cable:100:100", "-rod_start", "pin", "-rod_end", "pin",
+         "-rod_end_position", "80,0,0"]
+
+
+def last_step(path):
+    with h5py.File(path) as f:
+        step = f["steps"][max(f["steps"], key=int)]
+        return dict(step.attrs), step["r"][:]
+
+
+def test_a_line_in_air_is_the_catenary_of_its_weight_in_air(tmp_path):
+    """-rod_water_density 0 (refused before): a 100 m cable of 10 kg/m between pins 80 m
+    apart hangs as the catenary of w = m g = 98.07 N/m: the end force and the sag within
+    1e-5 (EI 10 N m^2; measured 1e-6)."""
+    from petsc_rod.scenes.catenary import catenary
+
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "air.h5"
+    process = run(["-rod_line_types", types, *CABLE, "-rod_water_density", "0",
+                   "-rod_initial_shape", "catenary", "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
+    attributes, r = last_step(path)
+    exact, _, force = catenary(100.0, np.array([80.0, 0.0, 0.0]),
+                               np.array([0.0, 0.0, -10.0 * 9.80665]), np.array([50.0, 100.0]))
+    assert np.linalg.norm(attributes["end_force"]) == pytest.approx(
+        np.linalg.norm(force[1]), rel=1e-5)
+    assert r[50, 2] == pytest.approx(exact[0, 2], rel=1e-5)
+
+
+def test_a_weightless_line_between_pins_takes_a_point_load_in_two_straight_pieces(
+        tmp_path):
+    """-rod_gravity 0 (refused before): the cable weightless, 1 kN hung at its middle: two
+    straight pieces of 50 m, the point 30 m below the pins, each pin carrying 500 N up
+    and H = 500 / tan(asin(0.6)) = 666.7 N across (the bending rounds the kink over
+    sqrt(EI / T) = 0.1 m: H within 0.5 %, the sag within 0.5 %)."""
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "weightless.h5"
+    process = run(["-rod_line_types", types, *CABLE, "-rod_gravity", "0",
+                   "-rod_point_load", "50,0,0,-1000", "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
+    attributes, r = last_step(path)
+    for name, sign in (("start_force", 1.0), ("end_force", -1.0)):
+        assert attributes[name][2] == pytest.approx(-500.0, rel=1e-9)
+        assert sign * attributes[name][0] == pytest.approx(500.0 / 0.75, rel=5e-3)
+    assert r[50, 2] == pytest.approx(-30.0, rel=5e-3)
