@@ -280,7 +280,13 @@ CABLE = ["-rod_sections", "cable:100:100", "-rod_start", "pin", "-rod_end", "pin
          "-rod_end_position", "80,0,0"]
 
 
-def last_step(path):
+def solve_cable(tmp_path, args):
+    """(attributes, r) of the last step of the cable of CABLE_TYPE between the pins of
+    CABLE with ``args``, a run that must converge."""
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "cable.h5"
+    process = run(["-rod_line_types", types, *CABLE, *args, "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
     with h5py.File(path) as f:
         step = f["steps"][max(f["steps"], key=int)]
         return dict(step.attrs), step["r"][:]
@@ -292,12 +298,8 @@ def test_a_line_in_air_is_the_catenary_of_its_weight_in_air(tmp_path):
     1e-5 (EI 10 N m^2; measured 1e-6)."""
     from petsc_rod.scenes.catenary import catenary
 
-    types = write(tmp_path, "cable.txt", CABLE_TYPE)
-    path = tmp_path / "air.h5"
-    process = run(["-rod_line_types", types, *CABLE, "-rod_water_density", "0",
-                   "-rod_initial_shape", "catenary", "-rod_output", str(path)])
-    assert process.returncode == 0, process.stderr
-    attributes, r = last_step(path)
+    attributes, r = solve_cable(tmp_path, ["-rod_water_density", "0",
+                                           "-rod_initial_shape", "catenary"])
     exact, _, force = catenary(100.0, np.array([80.0, 0.0, 0.0]),
                                np.array([0.0, 0.0, -10.0 * 9.80665]), np.array([50.0, 100.0]))
     assert np.linalg.norm(attributes["end_force"]) == pytest.approx(
@@ -311,12 +313,8 @@ def test_a_weightless_line_between_pins_takes_a_point_load_in_two_straight_piece
     straight pieces of 50 m, the point 30 m below the pins, each pin carrying 500 N up
     and H = 500 / tan(asin(0.6)) = 666.7 N across (the bending rounds the kink over
     sqrt(EI / T) = 0.1 m: H within 0.5 %, the sag within 0.5 %)."""
-    types = write(tmp_path, "cable.txt", CABLE_TYPE)
-    path = tmp_path / "weightless.h5"
-    process = run(["-rod_line_types", types, *CABLE, "-rod_gravity", "0",
-                   "-rod_point_load", "50,0,0,-1000", "-rod_output", str(path)])
-    assert process.returncode == 0, process.stderr
-    attributes, r = last_step(path)
+    attributes, r = solve_cable(tmp_path, ["-rod_gravity", "0",
+                                           "-rod_point_load", "50,0,0,-1000"])
     for name, sign in (("start_force", 1.0), ("end_force", -1.0)):
         assert attributes[name][2] == pytest.approx(-500.0, rel=1e-9)
         assert sign * attributes[name][0] == pytest.approx(500.0 / 0.75, rel=5e-3)
