@@ -163,6 +163,8 @@ OPTIONS = [
            "position of the end S = L (clamp, pin); default the start + (L,0,0)", unit="m"),
     Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
            "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
+    Option("rod_start_frame", _reals(9), None, "d1,d2,d3",
+           "start frame at S = 0, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
     Option("rod_end_twist", _real, default_of(Scene, "end_twist"), "angle",
            "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
            "continuation", unit="rad"),
