@@ -21,7 +21,8 @@ from petsc_rod.riser.regions import LineRegions
 from petsc_rod.riser.section_numbers import SectionNumbers
 from petsc_rod.riser.slope_load import SeabedSlopeLoad
 from petsc_rod.riser.stresses import PipeStresses
-from petsc_rod.riser.terms import DragTerm, SeabedTerm
+from petsc_rod.riser.terms import DragTerm, SeabedTerm, SurfaceTerm, reaches_surface
+from petsc_rod.scenes.boundary import is_held
 
 
 def scene_terms(mesh, scene):
@@ -40,6 +41,10 @@ def scene_terms(mesh, scene):
     drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
     if drag:
         terms.append(DragTerm(mesh, scene))
+    held = [state.position[2] for state in (scene.start_state(1.0), scene.end_state(1.0))
+            if is_held(state)]
+    if reaches_surface(scene, held):            # its weight in air above the sea surface
+        terms.append(SurfaceTerm(mesh, scene))
     if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
     if scene.extensible:

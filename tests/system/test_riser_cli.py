@@ -319,3 +319,51 @@ def test_a_weightless_line_between_pins_takes_a_point_load_in_two_straight_piece
         assert attributes[name][2] == pytest.approx(-500.0, rel=1e-9)
         assert sign * attributes[name][0] == pytest.approx(500.0 / 0.75, rel=5e-3)
     assert r[50, 2] == pytest.approx(-30.0, rel=5e-3)
+
+
+def two_piece_catenary_forces(length, chord, surface, w_water, w_air):
+    """(n(0), n(L)) of the inextensible cable pinned at the origin (under water) and at
+    ``chord`` (x, 0, z) (above the surface z = ``surface``), weighing ``w_water`` below
+    the surface and ``w_air`` above it (N/m): n = (H, 0, V0 + int w dS), each piece a
+    catenary in closed form (x: H/w asinh, z: |n| / w), (H, V0, S_b) such that the line
+    crosses the surface at S_b and ends at the chord."""
+    from scipy.optimize import fsolve
+
+    def piece(H, V, w, s):
+        return (H / w * (np.arcsinh((V + w * s) / H) - np.arcsinh(V / H)),
+                (np.hypot(H, V + w * s) - np.hypot(H, V)) / w, V + w * s)
+
+    def equations(v):
+        H, V0, S_b = v
+        x1, z1, V1 = piece(H, V0, w_water, S_b)
+        x2, z2, _ = piece(H, V1, w_air, length - S_b)
+        return [z1 - surface, x1 + x2 - chord[0], z1 + z2 - chord[2]]
+
+    H, V0, S_b = fsolve(equations, [1000.0, -500.0, 0.8 * length], xtol=1e-14)
+    V_L = V0 + w_water * S_b + w_air * (length - S_b)
+    return np.array([H, 0.0, V0]), np.array([H, 0.0, V_L])
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_line_out_of_the_water_weighs_its_weight_in_air(tmp_path, ranks):
+    """The cable of CABLE_TYPE from a pin 15 m under -rod_sea_surface 15 to one 15 m
+    above it (80, 0, 30): below the surface it weighs (m - rho_w A) g = 19.1 N/m, above
+    it m g = 98.1 N/m. The reactions are those of the two-piece catenary (measured at
+    400 elements: H within 9e-5, the top's vertical force within 0.6 N of 2643 N; 9.4,
+    4.3, 0.57, 0.10 N at 100 to 800 elements, the crossing inside an element). Before,
+    the whole line kept its buoyancy: the top carried 1912 N less the anchor's."""
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "surface.h5"
+    process = run(["-rod_line_types", types, "-rod_sections", "cable:100:400",
+                   "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position", "80,0,30",
+                   "-rod_sea_surface", "15", "-rod_initial_shape", "catenary",
+                   "-rod_output", str(path)], ranks)
+    assert process.returncode == 0, process.stderr
+    with h5py.File(path) as f:
+        attributes = dict(f["steps"][max(f["steps"], key=int)].attrs)
+    w_air = 10.0 * 9.80665
+    w_water = w_air - 1025.0 * 9.80665 * np.pi * 0.1**2 / 4
+    start, end = two_piece_catenary_forces(100.0, (80.0, 0.0, 30.0), 15.0, w_water, w_air)
+    assert attributes["start_force"][0] == pytest.approx(start[0], rel=1e-3)
+    assert attributes["start_force"][2] == pytest.approx(start[2], abs=0.5)
+    assert -attributes["end_force"][2] == pytest.approx(end[2], abs=2.0)
