@@ -38,13 +38,15 @@ def scene_terms(mesh, scene):
             terms.append(SeabedSlopeLoad(mesh, seabed))
         if scene.seabed.friction is not None:   # after the seabed: it reads its reaction
             terms.append(FrictionTerm(mesh, seabed))
-    drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
-    if drag:
-        terms.append(DragTerm(mesh, scene))
     held = [state.position[2] for state in (scene.start_state(1.0), scene.end_state(1.0))
             if is_held(state)]
-    if reaches_surface(scene, held):            # its weight in air above the sea surface
-        terms.append(SurfaceTerm(mesh, scene))
+    # its weight in air above the sea surface, and no drag there
+    surface = SurfaceTerm(mesh, scene) if reaches_surface(scene, held) else None
+    drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
+    if drag:
+        terms.append(DragTerm(mesh, scene, surface))
+    if surface is not None:
+        terms.append(surface)
     if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
     if scene.extensible:

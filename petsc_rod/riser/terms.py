@@ -230,9 +230,12 @@ class DragTerm(NodalLoadTerm):
     conservative = False
     follower = unsymmetric = jacobian_reserved = True
 
-    def __init__(self, mesh, scene):
+    def __init__(self, mesh, scene, surface=None):
         super().__init__(mesh, "drag")
         self.scene = scene
+        # a line that reaches the sea surface (SurfaceTerm): the drag on the part of
+        # each section under it only
+        self.surface = surface
         self.drag = NodalLoad(mesh, self._nodes)
         self._node_S = mesh.node_S()            # where each node's section's drag applies
 
@@ -246,9 +249,12 @@ class DragTerm(NodalLoadTerm):
         z = (state.node_positions()[:, 2] if any(c.depths.size > 1 for _, c in currents)
              else np.zeros(self.mesh.n_local_nodes))
         tangents = state.tau[:, 2] if tangents is None else tangents
-        return sum(w * normal_drag(tangents, c.velocity(z),
-                                   self.scene.drag_at(self._node_S, c)[:, None])
-                   for w, c in currents)
+        loads = sum(w * normal_drag(tangents, c.velocity(z),
+                                    self.scene.drag_at(self._node_S, c)[:, None])
+                    for w, c in currents)
+        if self.surface is not None:
+            loads = loads * (1.0 - self.surface.dry(state))[:, None]
+        return loads
 
     def add_gradient(self, g, state):
         """-b on the d3 rows, b = int F.g dS of the drag at the fields' tangents (the
@@ -392,12 +398,17 @@ class SurfaceTerm(NodalLoadTerm):
                                                           - t[:, 2]) / 24
         return z
 
+    def dry(self, state):
+        """phi, the dry fraction of each owned P2 node's section at the iterate's heights,
+        (n_nodes,). Collective."""
+        return dry_fraction(self.iterate_heights(state) - self.scene.sea_surface,
+                            self.radius)
+
     def node_loads(self, state):
         """-t rho_w g A_o phi e_z at the owned P2 nodes, N/m, (n_nodes, 3). Collective."""
-        z = self.iterate_heights(state)
-        loads = np.zeros((z.size, 3))
-        loads[:, 2] = -self.t * self.buoyancy * dry_fraction(z - self.scene.sea_surface,
-                                                             self.radius)
+        phi = self.dry(state)
+        loads = np.zeros((phi.size, 3))
+        loads[:, 2] = -self.t * self.buoyancy * phi
         return loads
 
     def add_iterate_load(self, rhs, state):
