@@ -140,7 +140,8 @@ class End:
     """One end of the line: ``kind`` 'pin' (held in position: an anchor, a hang-off),
     'clamp' (position and frame) or 'free'; ``position`` (3,), m, absolute, z up (a
     held end's); a flex joint at a pin of rotational stiffness ``stiffness`` (N m/rad)
-    about ``axis`` (3,) (None: e_x; docs/riser.md §8); ``force`` (3,), N, a dead force
+    about ``axis`` (3,) (None: the line's direction at that end in its start shape,
+    Scene.joint_axis; docs/riser.md §8); ``force`` (3,), N, a dead force
     at a free end."""
 
     kind: str = "pin"
@@ -157,7 +158,8 @@ class End:
     @classmethod
     def hang_off(cls, position, flex_joint=0.0, axis=None):
         """The vessel's end at ``position`` (m): a pin, or a flex joint of stiffness
-        ``flex_joint`` (N m/rad) about ``axis`` (default e_x)."""
+        ``flex_joint`` (N m/rad) about ``axis`` (default: the line's direction at the
+        hang-off in its catenary, where the joint is unloaded: Scene.joint_axis)."""
         return cls("pin", tuple(position), flex_joint, None if axis is None else tuple(axis))
 
 

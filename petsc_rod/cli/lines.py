@@ -89,12 +89,24 @@ def riser_text(attributes):
             f"{attributes['top_angle']:.2f} deg")
     if "touchdown_S" in attributes:
         S = attributes["touchdown_S"]
-        text += (f", touchdown S = {S:.6g} m" if S == S else ", no touchdown")
+        text += (f", touchdown S = {S:.6g} m" if S == S else ", no touchdown"
+                 + uplift_text(attributes, 1e3))
     beyond = attributes.get("seabed_vertices_beyond", 0)
     if beyond:                          # riser/quantities.py: a profile taken level there
         text += f", {beyond} vertices beyond the seabed profile's rows (level there)"
     return (text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
             + friction_text(attributes))
+
+
+def uplift_text(attributes, unit):
+    """': the anchor at S = .. lifts off at .. deg, pulled up by .. N' (kN for ``unit``
+    1e3) of an anchor that lifts off (riser/quantities.anchor_uplift); '' otherwise."""
+    if "anchor_uplift_S" not in attributes:
+        return ""
+    a = attributes
+    return (f": the anchor at S = {a['anchor_uplift_S']:.6g} m lifts off at "
+            f"{a['anchor_uplift_angle']:.4g} deg above the horizontal, pulled up by "
+            f"{a['anchor_uplift_force'] / unit:.6g} {'kN' if unit == 1e3 else 'N'}")
 
 
 def friction_text(attributes):
@@ -158,7 +170,7 @@ def summary(attributes):
         if "touchdown_S" in a:
             S = a["touchdown_S"]
             text += (f"; touchdown at S = {S:.6g} m, grounded {a['grounded_length']:.6g} m"
-                     if S == S else "; no touchdown")
+                     if S == S else "; no touchdown" + uplift_text(a, 1e3))
         text += (f"; smallest bend radius {a['min_bend_radius']:.4g} m at S = "
                  f"{a['max_curvature_S']:.6g} m")
         out.append(text)

@@ -372,7 +372,8 @@ def run_record(values, solver, start):
                   # the load factors are a walk's s (scenes/blend.py): read_parameters
                   "restart_walk": int(isinstance(solver.problem.scene, BlendedPath))}
     shaped = {**parameters, "load": np.asarray(parameters["load"]).reshape(-1, 3),
-              "end_frame": np.asarray(parameters["end_frame"]).reshape(3, 3)}
+              "end_frame": np.asarray(parameters["end_frame"]).reshape(3, 3),
+              "start_frame": np.asarray(parameters["start_frame"]).reshape(3, 3)}
     return io.RunRecord(attributes, shaped, units)
 
 
@@ -386,6 +387,7 @@ def options_in_effect(values, solver, start):
     origin = scene.start_position               # the scene's positions are from the start
     resolved = {"rod_end_position": scene.end_position + origin,
                 "rod_start_position": origin, "rod_end_frame": scene.end_frame.ravel(),
+                "rod_start_frame": scene.start_frame.ravel(),
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     if not np.isfinite(scene.axial_stiffness):  # inextensible: written as not given
         resolved["rod_axial_stiffness"] = None

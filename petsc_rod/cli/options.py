@@ -163,6 +163,8 @@ OPTIONS = [
            "position of the end S = L (clamp, pin); default the start + (L,0,0)", unit="m"),
     Option("rod_end_frame", _reals(9), None, "d1,d2,d3",
            "end frame at S = L, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
+    Option("rod_start_frame", _reals(9), None, "d1,d2,d3",
+           "start frame at S = 0, 9 numbers, rows d1 d2 d3 (clamp); default e_y,e_z,e_x"),
     Option("rod_end_twist", _real, default_of(Scene, "end_twist"), "angle",
            "extra roll of the end frame about its d3, rad (clamp); any size, reached by "
            "continuation", unit="rad"),
@@ -181,9 +183,11 @@ OPTIONS = [
            "flex joint at a pinned end S = L: rotational stiffness, N m/rad; 0 a plain pin",
            NON_NEGATIVE, "N m/rad"),
     Option("rod_start_joint_axis", _reals(3), None, "x,y,z",
-           "neutral axis of the start's flex joint (normalised); default e_x"),
+           "neutral axis of the start's flex joint (normalised); default the line's "
+           "direction there in its catenary (e_x without one)"),
     Option("rod_end_joint_axis", _reals(3), None, "x,y,z",
-           "neutral axis of the end's flex joint (normalised); default e_x"),
+           "neutral axis of the end's flex joint (normalised); default the line's "
+           "direction there in its catenary (e_x without one)"),
     Option("rod_load", _reals(), default_of(Scene, "load_values").ravel(), "fx,fy,fz[,...]",
            "distributed dead load, N/m: 3 values, or 3 per piece with -rod_load_breaks",
            unit="N/m"),
@@ -217,10 +221,10 @@ OPTIONS = [
            "point dead forces, N, at arc lengths S, m: 4 numbers per point", unit="m, N"),
     Option("rod_water_density", _real, default_of(Scene, "water_density"), "rho",
            "sea water density rho_w, kg/m^3 (the buoyancy and drag of line types and "
-           "attachments)", SCALE, "kg/m^3"),
+           "attachments); 0: a line in air", NON_NEGATIVE, "kg/m^3"),
     Option("rod_gravity", _real, default_of(Scene, "gravity"), "g",
-           "gravity, m/s^2, along -z (the weight of line types and attachments)", SCALE,
-           "m/s^2"),
+           "gravity, m/s^2, along -z (the weight of line types and attachments); 0: a "
+           "weightless line", NON_NEGATIVE, "m/s^2"),
     # riser terms (petsc_rod/riser, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",

@@ -27,6 +27,7 @@ from petsc_rod.tables import read_table
 FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "start_force": "-rod_start_force", "end_force": "-rod_end_force",
                  "end_position": "-rod_end_position", "end_frame": "-rod_end_frame",
+                 "start_frame": "-rod_start_frame",
                  "end_twist": "-rod_end_twist",
                  "current": ("the current (-rod_current|-rod_current_profile, -rod_sea_surface, "
                              "-rod_drag)"),
@@ -92,7 +93,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
     scene = Scene(**line, start=values["rod_start"], end=values["rod_end"],
                   start_position=origin,
                   end_position=None if end is None else np.asarray(end) - origin,
-                  end_frame=values["rod_end_frame"],
+                  end_frame=values["rod_end_frame"], start_frame=values["rod_start_frame"],
                   end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
                   end_force=values["rod_end_force"],
                   axial_stiffness=values["rod_axial_stiffness"],
@@ -525,7 +526,7 @@ def options_from_parameters(parameters):
     origin = parameters.get("start_position", "")
     origin = np.zeros(3) if isinstance(origin, str) else np.asarray(origin, dtype=float)
     defaults = {"rod_end_position": origin + np.array([length, 0.0, 0.0]),
-                "rod_end_frame": REFERENCE_FRAME}
+                "rod_end_frame": REFERENCE_FRAME, "rod_start_frame": REFERENCE_FRAME}
     values, given = {}, set()
     for option in OPTIONS:
         value = parameters.get(option.name.removeprefix("rod_"), "")

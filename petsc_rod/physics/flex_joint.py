@@ -58,7 +58,7 @@ from petsc_rod.physics.term import Term, TermOutput
 
 # Units of the attributes the joints write into a step group (io/results.py).
 ATTRIBUTE_UNITS = {f"{which}_joint_{name}": unit for which in ("start", "end")
-                   for name, unit in (("angle", "deg"), ("moment", "N m"))}
+                   for name, unit in (("angle", "deg"), ("moment", "N m"), ("axis", "1"))}
 # Below this angle (rad) f' and f'' are taken from their series (round-off of the ratios).
 SMALL_ANGLE = 1e-4
 # theta / sin theta and f'' are evaluated at no more than this angle (rad): they grow
@@ -286,5 +286,6 @@ class FlexJoint(Term):
     def outputs(self, problem, vertex):
         angle, moment = self.angle_and_moment(problem.state)
         return TermOutput(attributes={f"{self.which}_joint_angle": angle,
-                                      f"{self.which}_joint_moment": moment},
+                                      f"{self.which}_joint_moment": moment,
+                                      f"{self.which}_joint_axis": self.axis.copy()},
                           text=f"{self.which} joint {angle:.4g} deg, {moment:.4g} N m")

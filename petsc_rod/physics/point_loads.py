@@ -17,8 +17,10 @@ int_{S_e}^{S_p} N_k dS is the P2 basis integrated over the part of the element
 int_e N_k, those after it nothing.
 
 n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
-(the point counted as before S). A point at S = L acts as an end force there (it is in
-n(L), Term.end_force).
+(the point counted as before S). A point at a free end S = L acts as an end force there
+(it is in n(L), Term.end_force). A point on a held end is carried by the support: the
+line's n is that without it, and the end's reaction (riser/line_results.end_numbers)
+adds it (on_held_ends), so that the reactions balance every load.
 
 An attachment with a drag area C_d A (m^2) in a current also feels the drag
 D_p = 1/2 rho_w C_d A |v| v, v the current at r(S_p) (Scene.point_drags: times the
@@ -141,6 +143,18 @@ class PointLoads(DeadLoads):
         force = self._total_force(state)
         offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
         return force[self._at_end()].sum(axis=0) + offset
+
+    def on_held_ends(self, state, start_held, end_held):
+        """(the points' forces at S = 0, at S = L), N, (3,) each: the sum of the dead
+        forces (and drags) of the points that sit on a held end, which the support
+        carries: such a force never reaches the line's n (a held start's n(0+) does not
+        see it; at a held end the chord multiplier takes it), so the support's reaction
+        (line_results.end_numbers) adds it. Zero at a free end, where the point acts as
+        an end force and is in n already. Collective."""
+        force = self._total_force(state)
+        at_start = force[self.S <= 0.0].sum(axis=0) if start_held else np.zeros(3)
+        at_end = force[self._at_end()].sum(axis=0) if end_held else np.zeros(3)
+        return at_start, at_end
 
     def positions(self, state):
         """r(S_p) of every point, (n_p, 3), m, on every rank: the rank that owns the

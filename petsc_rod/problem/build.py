@@ -21,7 +21,8 @@ from petsc_rod.riser.regions import LineRegions
 from petsc_rod.riser.section_numbers import SectionNumbers
 from petsc_rod.riser.slope_load import SeabedSlopeLoad
 from petsc_rod.riser.stresses import PipeStresses
-from petsc_rod.riser.terms import DragTerm, SeabedTerm
+from petsc_rod.riser.terms import DragTerm, SeabedTerm, SurfaceTerm, reaches_surface
+from petsc_rod.scenes.boundary import is_held
 
 
 def scene_terms(mesh, scene):
@@ -37,9 +38,15 @@ def scene_terms(mesh, scene):
             terms.append(SeabedSlopeLoad(mesh, seabed))
         if scene.seabed.friction is not None:   # after the seabed: it reads its reaction
             terms.append(FrictionTerm(mesh, seabed))
+    held = [state.position[2] for state in (scene.start_state(1.0), scene.end_state(1.0))
+            if is_held(state)]
+    # its weight in air above the sea surface, and no drag there
+    surface = SurfaceTerm(mesh, scene) if reaches_surface(scene, held) else None
     drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
     if drag:
-        terms.append(DragTerm(mesh, scene))
+        terms.append(DragTerm(mesh, scene, surface))
+    if surface is not None:
+        terms.append(surface)
     if seabed is not None or drag:
         terms.append(RiserNumbers(seabed))
     if scene.extensible:

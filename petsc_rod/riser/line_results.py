@@ -20,7 +20,8 @@ force (N) and moment (N m) the line exerts on its support at S = 0 and S = L, in
 global axes: n(0) and m(0) at the start, -n(L) and -m(L) at the end (n(S), m(S) the
 force and moment the part beyond S exerts on the part before it, docs/method.md §6).
 So start_force + end_force = int f dS, the applied loads (the weight, the drag, the
-seabed's and attachments' forces): what the supports carry. At a free end they are the
+seabed's and attachments' forces): what the supports carry. An attachment on a held end
+is carried by its support: it is added to that end's force (it is not in the line's n). At a free end they are the
 applied end force and moment with the sign of a support's. And the hang-off, the higher
 held end (quantities.top_end): ``hang_off_S`` (m), ``hang_off_declination`` (deg, the
 angle from the upward vertical of the tangent pointing away from the line: d3 at S = L,
@@ -32,7 +33,8 @@ vertical to 1e-12).
 import numpy as np
 
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.quantities import _at_vertex, effective_tension, top_end, unit_tangent
+from petsc_rod.riser.quantities import (_at_vertex, effective_tension, points_on_held_ends,
+                                        top_end, unit_tangent)
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
                  "torque": "N m", "shear": "N", "declination": "deg"}
@@ -105,7 +107,9 @@ def end_numbers(problem, vertex):
     top = top_end(problem)
     tangent = _at_vertex(mesh, unit_tangent(vertex), top * last)
     away = tangent if top == 1 else -tangent             # out of the line at the top
-    return {"start_force": n0, "start_moment": m0, "end_force": -nL, "end_moment": -mL,
+    on_start, on_end = points_on_held_ends(problem)
+    return {"start_force": n0 + on_start, "start_moment": m0, "end_force": -nL + on_end,
+            "end_moment": -mL,
             "hang_off_S": float(top * mesh.length),
             "hang_off_declination": float(declination(away)),
             "hang_off_azimuth": azimuth(away)}

@@ -14,6 +14,13 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   (``touchdown_offset``: a current across, friction); the grounded length, the length of line below z_b; on a
   seabed profile or grid, the number of vertices beyond its rows, where it is taken
   level (``seabed_vertices_beyond``, said in the step line when not 0);
+* an anchor that lifts off: where the line has no touchdown and its lower end is held
+  (the anchor), ``anchor_uplift_S`` (m, that end's S), ``anchor_uplift_angle`` (deg,
+  the angle above the horizontal of the tangent leaving the anchor into the line) and
+  ``anchor_uplift_force`` (N, the upward part of the force the line exerts on the
+  anchor, an attachment on it included: line_results.start_force / end_force), said in
+  the step line and the run's final lines (an anchor resting on the seabed holds the
+  line down by its own hold, not the seabed's: a gravity anchor or a pile must take it);
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
   and where they occur.
 
@@ -23,6 +30,7 @@ positions reported (touchdown, largest curvature) are absolute: the start positi
 
 import numpy as np
 
+from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.term import ReportTerm, TermOutput
 from petsc_rod.scenes.boundary import is_held
 
@@ -36,7 +44,8 @@ ATTRIBUTE_UNITS = {
     "top_tension": "N", "top_angle": "deg", "touchdown_S": "m", "touchdown_position": "m",
     "grounded_length": "m", "touchdown_offset": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
     "max_curvature_S": "m",
-    "max_curvature_position": "m", "min_bend_radius": "m"}
+    "max_curvature_position": "m", "min_bend_radius": "m", "anchor_uplift_S": "m",
+    "anchor_uplift_angle": "deg", "anchor_uplift_force": "N"}
 
 
 class RiserNumbers(ReportTerm):
@@ -76,6 +85,35 @@ def _at_vertex(mesh, values, index):
     if mesh.vertex_start <= index < mesh.vertex_end:
         local = np.asarray(values[index - mesh.vertex_start], dtype=float)
     return mesh.global_sum(local)
+
+
+def points_on_held_ends(problem):
+    """(P at S = 0, P at S = L), N: the point loads that sit on a held end, which its
+    support carries beside the line's n (PointLoads.on_held_ends). Collective."""
+    on_start, on_end = np.zeros(3), np.zeros(3)
+    for term in problem.terms:
+        if isinstance(term, PointLoads):
+            start, end = term.on_held_ends(problem.state, is_held(problem.start_state),
+                                           is_held(problem.end_state))
+            on_start, on_end = on_start + start, on_end + end
+    return on_start, on_end
+
+
+def anchor_uplift(problem, vertex, top):
+    """{anchor_uplift_S, anchor_uplift_angle, anchor_uplift_force} (module docstring) of
+    the held end other than the top ``top``; {} when it is not held. Collective."""
+    lower = 1 - top
+    if not is_held(problem.end_state if lower else problem.start_state):
+        return {}
+    mesh = problem.mesh
+    index = lower * mesh.n_elements
+    tangent = _at_vertex(mesh, unit_tangent(vertex), index) * (-1.0 if lower else 1.0)
+    n = _at_vertex(mesh, vertex["n"], index)
+    on_ends = points_on_held_ends(problem)
+    force = -n + on_ends[1] if lower else n + on_ends[0]
+    return {"anchor_uplift_S": float(lower * mesh.length),
+            "anchor_uplift_angle": float(np.degrees(np.arcsin(np.clip(tangent[2], -1, 1)))),
+            "anchor_uplift_force": float(force[2])}
 
 
 def _extreme(mesh, key, payload, largest):
@@ -185,6 +223,12 @@ def riser_report(problem, vertex, seabed=None):
                           touchdown_offset=offset)
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
+        uplift = anchor_uplift(problem, vertex, top) if np.isnan(S) else {}
+        if uplift:
+            attributes.update(uplift)
+            text += (f", the anchor at S = {uplift['anchor_uplift_S']:.6g} m lifts off at "
+                     f"{uplift['anchor_uplift_angle']:.4g} deg above the horizontal, "
+                     f"pulled up by {uplift['anchor_uplift_force']:.6g} N")
         if abs(offset) > OFFSET_SHOWN * mesh.length:
             text += f", {offset:.6g} m off the ends' plane"
         if not seabed.seabed.flat:       # a profile or grid taken level beyond its rows

@@ -18,7 +18,14 @@ the line does not reach the seabed) and L_s = sigma_td the suspended length:
   up (the top, or a crest) down to it: the lower half of a catenary's suspended length;
   ``hog_bend`` (``hog_bend_2``, ... from the top) around each crest (a lazy wave's arch);
 * ``touchdown_zone``: sigma in [sigma_td - 0.05 L_s, sigma_td + 0.05 L_s];
-* ``grounded``: sigma in [sigma_td, L], the line beyond the touchdown point.
+* ``grounded``: the line beyond the touchdown point where it is in contact with the
+  seabed, from sigma_td to where it leaves it (``grounded_2``, ... each later stretch in
+  contact); ``free_span`` (``free_span_2``, ...) each stretch beyond the touchdown that
+  is off it: a span over a seabed cliff or trench, or the line rising to an anchor held
+  above the seabed. In contact means a gap z - z_b(x, y) below the contact's own scale,
+  the largest penetration of the line into the seabed (its weight's on an elastic
+  seabed: a grounded stretch lifted by less is resting on it); the stretches' ends are
+  where the gap, linear along each element, crosses that scale.
 
 A region that does not exist is omitted (no seabed or no touchdown: no touchdown zone,
 no grounded part; no crest: no hog bend). Bounds are S intervals [a, b]; a vertex on a
@@ -88,10 +95,40 @@ def _pruned(points, span):
         points = [p for j, p in enumerate(points) if j not in drop]
 
 
-def region_bounds(length, top, extremes, top_z, td_sigma, td_z):
+def _contact_changes(problem, seabed):
+    """S (list) where the line enters or leaves contact with the environment.Seabed
+    ``seabed`` on this rank's elements (module docstring: the gap, linear along each
+    element, crossing the largest penetration of the whole line). Collective."""
+    mesh = problem.mesh
+    scale = max(0.0, -mesh.global_min(float(np.min(
+        seabed.gap(problem.state.r.owned()[:, 0]), initial=np.inf))))
+    r0, r1 = mesh.element_ends(problem.state.r.ghosted()[:, 0])
+    g0, g1 = seabed.gap(r0) - scale, seabed.gap(r1) - scale
+    k = np.flatnonzero((g0 <= 0) != (g1 <= 0))
+    return (mesh.element_S[k] + mesh.element_h[k] * g0[k] / (g0[k] - g1[k])).tolist()
+
+
+def _beyond_touchdown(length, td_sigma, changes):
+    """[(name, (a, b) in sigma)] of the stretches from the touchdown to the far end,
+    in contact (``grounded``, ``grounded_2``, ...) or not (``free_span``, ...), from
+    the sigmas ``changes`` where the contact changes (those beyond td_sigma count)."""
+    ends = [td_sigma] + sorted(c for c in changes if td_sigma < c < length) + [length]
+    regions, counts = [], {"grounded": 0, "free_span": 0}
+    for k in range(len(ends) - 1):
+        kind = "grounded" if k % 2 == 0 else "free_span"
+        counts[kind] += 1
+        name = kind if counts[kind] == 1 else f"{kind}_{counts[kind]}"
+        if ends[k + 1] > ends[k]:
+            regions.append((name, (ends[k], ends[k + 1])))
+    return regions
+
+
+def region_bounds(length, top, extremes, top_z, td_sigma, td_z, contact_changes=()):
     """[(name, (a, b) in S)] (module docstring) from the extremes [(S, z, kind)] of the
     whole line, the top end (0 or 1) and its height, the touchdown's sigma (NaN: none)
-    and height (the far end's when there is no touchdown)."""
+    and height (the far end's when there is no touchdown), and the S where the line
+    enters or leaves contact (_contact_changes; none: in contact from the touchdown to
+    the far end)."""
     sigma = (lambda S: abs(S - top * length))
     to_S = (lambda s: top * length + (1 - 2 * top) * s)
     grounded = np.isfinite(td_sigma)
@@ -122,7 +159,8 @@ def region_bounds(length, top, extremes, top_z, td_sigma, td_z):
         regions.append(("touchdown_zone", (max(0.0, td_sigma - half),
                                            min(length, td_sigma + half))))
         if td_sigma < length:
-            regions.append(("grounded", (td_sigma, length)))
+            regions += _beyond_touchdown(length, td_sigma,
+                                         [sigma(S) for S in contact_changes])
     return [(name, tuple(sorted((to_S(a), to_S(b))))) for name, (a, b) in regions]
 
 
@@ -156,13 +194,16 @@ def region_report(problem, vertex, seabed=None):
     positions = problem.state.r.owned()[:, 0, 2]
     top_z = float(_at_vertex(mesh, positions, top * mesh.n_elements))
     td_sigma, td_z = np.nan, float(_at_vertex(mesh, positions, (1 - top) * mesh.n_elements))
+    changes = []
     if seabed is not None:
+        changes = [S for part in mesh.comm.tompi4py().allgather(
+            _contact_changes(problem, seabed.seabed)) for S in part]
         S_td, position, _ = touchdown(problem, seabed.seabed, top)
         if np.isfinite(S_td):
             td_sigma, td_z = abs(S_td - top * mesh.length), float(position[2])
     extremes = [p for part in mesh.comm.tompi4py().allgather(_extremes(problem))
                 for p in part]
-    named = region_bounds(mesh.length, top, extremes, top_z, td_sigma, td_z)
+    named = region_bounds(mesh.length, top, extremes, top_z, td_sigma, td_z, changes)
     bounds = np.array([b for _, b in named])
     S = vertex["S"]
     comm = mesh.comm

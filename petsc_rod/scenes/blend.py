@@ -25,7 +25,7 @@ from petsc_rod.scenes.scene import EndState, rolled_frame
 
 # The Scene fields the load path carries, compared to tell whether a restart walks.
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
-               "end_frame", "end_twist", "current", "point_load_S", "point_load_forces",
+               "end_frame", "start_frame", "end_twist", "current", "point_load_S", "point_load_forces",
                "point_load_drag_areas")
 # The Scene fields a restart takes from this run's scene at once.
 FIXED_FIELDS = ("stiffness", "axial_stiffness", "start", "end", "seabed", "sections",

@@ -50,6 +50,8 @@ class Scene:
     end: str = "free"
     end_position: np.ndarray = None
     end_frame: np.ndarray = None
+    # the frame of a clamped start S = 0 (rows d1, d2, d3; default the reference)
+    start_frame: np.ndarray = None
     end_twist: float = 0.0
     start_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     end_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -73,8 +75,8 @@ class Scene:
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
-    # pinned end, 0 for none, and the neutral axis a its d3 is held to (unit; default e_x,
-    # the reference tangent); fixed, not on the load path
+    # pinned end, 0 for none, and the neutral axis a its d3 is held to (None: the line's
+    # direction at that end in its start shape, joint_axis); fixed, not on the load path
     start_rotational_stiffness: float = 0.0
     end_rotational_stiffness: float = 0.0
     start_joint_axis: np.ndarray = None
@@ -98,15 +100,18 @@ class Scene:
             self.end_position = np.array([self.length, 0.0, 0.0])
         if self.end_frame is None:
             self.end_frame = REFERENCE_FRAME.copy()
+        if self.start_frame is None:
+            self.start_frame = REFERENCE_FRAME.copy()
         self.end_position = np.asarray(self.end_position, dtype=float)
         self.start_position = np.asarray(self.start_position, dtype=float).reshape(3)
         self.start_force = np.asarray(self.start_force, dtype=float)
         self.end_force = np.asarray(self.end_force, dtype=float)
         self.end_frame = np.asarray(self.end_frame, dtype=float).reshape(3, 3)
+        self.start_frame = np.asarray(self.start_frame, dtype=float).reshape(3, 3)
         for name in ("start_joint_axis", "end_joint_axis"):
             axis = getattr(self, name)
-            setattr(self, name, REFERENCE_FRAME[2].copy() if axis is None
-                    else np.asarray(axis, dtype=float).ravel())
+            if axis is not None:
+                setattr(self, name, np.asarray(axis, dtype=float).ravel())
         self.load_values = np.asarray(self.load_values, dtype=float).reshape(-1, 3)
         self.load_breaks = np.asarray(self.load_breaks, dtype=float).ravel()
         self.point_load_S = np.asarray(self.point_load_S, dtype=float).ravel()
@@ -118,6 +123,7 @@ class Scene:
             self.point_load_names = tuple(f"point {k + 1}"
                                           for k in range(self.point_load_S.size))
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
+        self._start_rotation = rotation_log(self.start_frame.T @ REFERENCE_FRAME)
 
     @property
     def uniform_stiffness(self):
@@ -248,13 +254,20 @@ class Scene:
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
-        plus |-rod_end_twist|; 0 at a pinned or free end."""
+        plus |-rod_end_twist|, and that of -rod_start_frame where the start is clamped
+        too (a bound on the turn between them); 0 at a pinned or free end."""
         if self.end != "clamp":
             return 0.0
-        return float(np.linalg.norm(self._end_rotation) + abs(self.end_twist))
+        start = np.linalg.norm(self._start_rotation) if self.start == "clamp" else 0.0
+        return float(np.linalg.norm(self._end_rotation) + abs(self.end_twist) + start)
 
     def start_state(self, t):
-        return EndState(self.start, np.zeros(3), REFERENCE_FRAME.copy(), t * self.start_force)
+        """The start at load factor t: at the origin, its frame the reference turned by
+        exp(t log Q0) (Q0 = -rod_start_frame, a clamp's; the reference by default), as
+        end_state turns the end's."""
+        angle = np.linalg.norm(self._start_rotation)
+        q = (rotation_about(self._start_rotation, t * angle) if angle > 0 else np.eye(3))
+        return EndState(self.start, np.zeros(3), REFERENCE_FRAME @ q.T, t * self.start_force)
 
     def end_state(self, t):
         position = (1 - t) * np.array([self.length, 0.0, 0.0]) + t * self.end_position
@@ -271,14 +284,34 @@ class Scene:
 
     def joints(self):
         """The flex joints, [(which, k, a)]: which 'start' or 'end', k > 0 the rotational
-        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py)."""
+        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py,
+        joint_axis)."""
         joints = []
         for which in ("start", "end"):
             k = float(getattr(self, f"{which}_rotational_stiffness"))
             if k > 0:
-                axis = getattr(self, f"{which}_joint_axis")
-                joints.append((which, k, axis / np.linalg.norm(axis)))
+                joints.append((which, k, self.joint_axis(which)))
         return joints
+
+    def joint_axis(self, which):
+        """The unit neutral axis of the flex joint at ``which`` ('start' or 'end'): the
+        given -rod_*_joint_axis, else the line's direction (d3) at that end in the
+        scene's start shape: the tangent there of its catenary at load factor 1 (the
+        curve -rod_initial_shape catenary starts from: through both held ends, resting
+        on the seabed, the weights of the sections) where it has one, the joint then
+        unloaded in the catenary's static angle, as a flex joint is installed at a
+        hang-off; else e_x, the straight reference (an end free, no load). A default
+        e_x made a riser's hang-off joint turn by 85 degrees."""
+        axis = getattr(self, f"{which}_joint_axis")
+        if axis is None:
+            from petsc_rod.scenes.starts import catenary_start
+            try:
+                frame = catenary_start(self, 1.0)(np.array([0.0 if which == "start"
+                                                            else self.length]))[1][0]
+                axis = frame[2]
+            except RodInputError:
+                axis = REFERENCE_FRAME[2]
+        return np.asarray(axis, dtype=float) / np.linalg.norm(axis)
 
     def drag_loads(self, t):
         """[(weight, Current)]: the drag at load factor t is the sum of each current's
@@ -293,7 +326,8 @@ class Scene:
         whose linking number is defined and tracked (analysis/link.py)."""
         axis = REFERENCE_FRAME[2]
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
-        if self.start != "clamp" or self.end != "clamp" or np.linalg.norm(tilt) > 1e-12:
+        if (self.start != "clamp" or self.end != "clamp" or np.linalg.norm(tilt) > 1e-12
+                or np.linalg.norm(self._start_rotation) > 0):
             return None
         return axis.copy()
 
@@ -310,10 +344,12 @@ class Scene:
                                    self.load_values[:, 1:].ravel(),
                                    self.point_load_forces[:, 1:].ravel()])
         tilt = self._end_rotation - (self._end_rotation @ axis) * axis
+        start_tilt = self._start_rotation - (self._start_rotation @ axis) * axis
         values = self.stiffness_values()
         return bool(np.all(values[:, 0] == values[:, 1]) and not np.any(off_axis)
                     and (self.end == "free" or not np.any(self.end_position[1:]))
                     and (self.end != "clamp" or np.linalg.norm(tilt) <= 1e-12)
+                    and np.linalg.norm(start_tilt) <= 1e-12
                     and self.seabed is None and self.current is None)
 
     def end_roll(self, t):
@@ -368,11 +404,15 @@ class Scene:
                 f"-rod_end_position: the ends are {chord:.15g} m apart, "
                 f"{chord - self.length:.3g} m more than the cable's length {self.length:.15g} m "
                 "(inextensible); bring the end within -rod_length, or give -rod_axial_stiffness")
-        frame = self.end_frame
-        if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
-                or np.linalg.det(frame) < 0):
-            raise RodInputError("-rod_end_frame: the rows d1, d2, d3 must be orthonormal and "
-                                "right-handed (d3 = d1 x d2)")
+        for name, frame in (("-rod_end_frame", self.end_frame),
+                            ("-rod_start_frame", self.start_frame)):
+            if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
+                    or np.linalg.det(frame) < 0):
+                raise RodInputError(f"{name}: the rows d1, d2, d3 must be orthonormal and "
+                                    "right-handed (d3 = d1 x d2)")
+        if "rod_start_frame" in used and self.start != "clamp":
+            raise RodInputError(f"-rod_start_frame needs -rod_start clamp (the start is "
+                                f"{self.start}); drop it or change -rod_start")
         requires = {"rod_end_frame": ("clamp",), "rod_end_twist": ("clamp",),
                     "rod_end_position": ("clamp", "pin"), "rod_end_force": ("free",)}
         for name, kinds in requires.items():
@@ -421,8 +461,8 @@ class Scene:
                     f"-rod_{which}_rotational_stiffness {k:g}: must be finite and not "
                     "negative (N m/rad; 0 is a pin; for an end held in full use "
                     f"-rod_{which} clamp)")
-            if axis.shape != (3,) or not np.all(np.isfinite(axis)) \
-                    or np.linalg.norm(axis) == 0:
+            if axis is not None and (axis.shape != (3,) or not np.all(np.isfinite(axis))
+                                     or np.linalg.norm(axis) == 0):
                 raise RodInputError(f"-rod_{which}_joint_axis: give a nonzero vector x,y,z "
                                     "(the joint's neutral axis; it is normalised)")
             if f"rod_{which}_joint_axis" in used and k == 0:

@@ -186,3 +186,46 @@ def test_moment_balance_about_the_origin(solved, name):
     scale = np.linalg.norm(m, axis=1).max()
     assert np.abs(error).max() < 1e-2 * scale
     assert np.linalg.norm(np.cross(r[-1] - r[0], n[-1])) > 0.1 * scale
+
+
+# A clamp at S = 0 turned by 0.7 rad about (1, 2, 3) (-rod_start_frame), its d3 the
+# cantilever's direction; a small tip force across it.
+START_ROTATION = rotation_about(np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0), 0.7)
+START_FRAME = REFERENCE_FRAME @ START_ROTATION.T
+
+
+@pytest.mark.parametrize("steps", [1, 2])
+def test_a_cantilever_clamped_along_a_given_start_frame(steps):
+    """The cantilever clamped at S = 0 in the frame START_FRAME (K1 = K2 = 1 N m^2) under
+    a tip force P d1' + 0.5 P d2' across its axis, |P| L^2 / EI = 1.1e-4: across d3' the
+    tip is P L^3 / (3 EI) along the force (linear theory; geometric terms of relative
+    order 1e-8), along d3' at L less the shortening |P|^2 L^5 / (15 EI^2), and the
+    start's slope and directors are the frame's to round-off.
+    Before, S = 0 could only be clamped along e_x."""
+    from petsc4py import PETSc
+
+    from helpers import destroy, make_solver
+
+    force = 1e-4 * (START_FRAME[0] + 0.5 * START_FRAME[1])
+    scene = dict(length=LENGTH, stiffness=(1.0, 1.0, 0.8), start="clamp", end="free",
+                 start_frame=START_FRAME, end_force=force)
+    comm = PETSc.COMM_WORLD
+    mesh, solver = make_solver(comm, N_ELEMENTS, scene, PENALTY, 1e-12, 1e-12, MAX_IT)
+    try:
+        problem = solver.problem
+        problem.state.set_straight()
+        for k in range(1, steps + 1):
+            assert solver.solve_step(k / steps).converged
+        assert np.abs(problem.scene.start_state(1.0).frame - START_FRAME).max() < ROUND_OFF
+        r = gather(comm, problem.state.r.owned()[:, 0])
+        fields = outputs.vertex_fields(problem)
+        d1, d2, d3 = (gather(comm, fields[name])[0] for name in ("d1", "d2", "d3"))
+    finally:
+        destroy(mesh, solver)
+    axis, deflection = START_FRAME[2], force * LENGTH**3 / 3.0
+    across = r[-1] - (r[-1] @ axis) * axis
+    assert np.linalg.norm(across - deflection) < 1e-6 * np.linalg.norm(deflection)
+    # and along it the length less the bent line's shortening, int w'^2 / 2 dS
+    shortening = (force @ force) * LENGTH**5 / 15.0
+    assert abs(r[-1] @ axis - (LENGTH - shortening)) < 1e-3 * shortening
+    assert np.abs(np.array([d1, d2, d3]) - START_FRAME).max() < 1e-10

@@ -222,3 +222,109 @@ def test_one_rank_and_all_ranks_agree(comm):
     alone = solve(PETSc.COMM_SELF, scene, steps=8)
     assert np.abs(together[1] - alone[1]).max() < 1e-9
     assert together[2][0][0] == pytest.approx(alone[2][0][0], rel=1e-9)
+
+
+# An inextensible line between pins with flex joints at both ends, at a state away from
+# any solution; the joints' axes far from the end tangents (about 40 and 60 degrees), so
+# that both parts of the block, k f''(c) v v^T and k beta (I - d d^T), are of the size of
+# the bending's.
+FD_JOINTS = dict(length=1.0, stiffness=(1e-2, 2e-2, 1.5e-2), load_values=[[0.0, 0.3, -1.0]],
+                 start="pin", end="pin", end_position=(0.8, 0.0, 0.1),
+                 start_rotational_stiffness=0.05, start_joint_axis=(0.6, 0.0, -0.8),
+                 end_rotational_stiffness=0.08, end_joint_axis=(0.0, 0.6, 0.8))
+
+
+def turn(omega):
+    """The step (n, 4) of NewtonPolish._stretched that turns the frames by omega (n, 3)
+    and leaves their stretch."""
+    return np.column_stack([omega, np.zeros(len(omega))])
+
+
+def test_the_inextensible_joints_hessian_against_finite_differences(comm):
+    """The inextensible joint's gradient and Hessian block (add_gradient, add_hessian in
+    the global step's branch, FlexJoint.local False) against central differences of the
+    Lagrangian F + mu.c along frames -> exp(s [omega]x) frames (as
+    test_stretch_newton (a) checks the extensible branch): the second difference to
+    1e-6 of the quadratic form. A block without k f''(c) v v^T, without
+    k beta (I - d d^T), with beta's 1 - c or its theta / sin theta dropped fails it."""
+    from helpers import destroy, make_solver
+    from petsc_rod.iteration.newton import NewtonPolish
+    from petsc_rod.scenes.starts import catenary_start
+    from test_stretch_newton import lagrangian
+
+    mesh, solver = make_solver(comm, 12, FD_JOINTS, 5.0, newton=False)
+    problem = solver.problem
+    joints = [term for term in problem.terms if isinstance(term, FlexJoint)]
+    assert len(joints) == 2 and not any(term.local for term in joints)
+    polish = NewtonPolish(problem)
+    work = problem.field_stiffness(0)[1].createVecLeft()
+    x = y = None
+    try:
+        state = problem.state
+        problem.prepare(1.0)
+        state.set_from_curve(catenary_start(problem.scene, 1.0))
+        n = mesh.n_local_nodes
+        # the same random numbers at a node on any number of ranks
+        nodes = 2 * mesh.vertex_start + np.arange(n)
+        random = np.array([np.random.default_rng(2000 + i).standard_normal(9)
+                           for i in nodes]).reshape(n, 3, 3)
+        start = 0.2 * random[:, 0]
+        start[~problem.free_nodes] = 0.0
+        frames = polish._stretched(state.tau.copy(), turn(start))
+        mu = np.array([0.3, -0.2, 0.5])
+        gradient = polish.lagrangian_gradient(frames, mu)
+        hessian = problem.second_variation()
+        assert hessian.block == 3 and gradient.shape == (n, 3)
+        x, y = hessian.matrix.createVecs()
+        errors = []
+        for trial in (1, 2):
+            v = random[:, trial].copy()
+            v[~problem.free_nodes] = 0.0
+            x.getArray()[:] = v.ravel()
+            hessian.matrix.mult(x, y)
+            quadratic = x.dot(y)
+            slope = mesh.global_sum(np.sum(gradient * v))
+            s = 1e-4
+            plus, zero, minus = (lagrangian(problem, polish._stretched(frames, turn(h * v)),
+                                            mu, work) for h in (s, 0.0, -s))
+            errors.append((abs((plus - minus) / (2 * s) - slope) / abs(slope),
+                           abs((plus - 2 * zero + minus) / s**2 - quadratic) / abs(quadratic)))
+        assert max(e[0] for e in errors) < 1e-4, errors
+        assert max(e[1] for e in errors) < 1e-6, errors
+    finally:
+        for vec in (x, y, work):
+            if vec is not None:
+                vec.destroy()
+        polish.destroy()
+        destroy(mesh, solver)
+
+
+@pytest.mark.parametrize("which", ["start", "end"])
+def test_the_default_joint_axis_is_the_lines_direction_in_its_catenary(comm, which):
+    """A joint without an axis on a catenary between pins (w = 100 N/m, L = 1 m, ends
+    at (0.6, 0, 0.3)): its axis is the catenary's tangent at that end, so that the
+    joint, installed at the cable's static angle, turns by the bending's share only
+    (EI = 1 N m^2 beside w L^2 = 100 N m; measured 6.2 and 4.3 degrees at the start and
+    the end against 34 and 53 about the old default e_x), and the state is the joint's
+    with that axis given. At a pin whose partner is free the axis stays e_x (no
+    catenary). On the steel riser: tests/system/test_riser_cli.py."""
+    from petsc_rod.scenes.starts import catenary_start
+
+    scene = dict(start="pin", end="pin", end_position=(0.6, 0.0, 0.3),
+                 load_values=[(0.0, 0.0, -100.0)], **{f"{which}_rotational_stiffness": 5.0})
+    tangent = catenary_start(Scene(length=LENGTH, stiffness=STIFFNESS, **scene), 1.0)(
+        np.array([0.0 if which == "start" else LENGTH]))[1][0][2]
+    assert Scene(length=LENGTH, stiffness=STIFFNESS, **scene).joint_axis(which) \
+        == pytest.approx(tangent, abs=1e-15)
+    assert abs(tangent[0]) < 0.9                      # far from e_x
+    _, r, joints = solve(comm, scene, steps=2)
+    _, given, given_joints = solve(comm, dict(scene, **{f"{which}_joint_axis": tangent}),
+                                   steps=2)
+    _, _, old_joints = solve(comm, dict(scene, **{f"{which}_joint_axis": (1.0, 0.0, 0.0)}),
+                             steps=2)
+    assert joints[0][0] < 0.25 * old_joints[0][0]
+    assert np.abs(r - given).max() < 1e-9
+    assert joints[0][0] == pytest.approx(given_joints[0][0], rel=1e-9)
+    free = Scene(length=LENGTH, stiffness=STIFFNESS, start="pin", end="free",
+                 start_rotational_stiffness=1.0, end_force=(0.0, -1.0, 0.0))
+    assert np.array_equal(free.joint_axis("start"), [1.0, 0.0, 0.0])

@@ -20,7 +20,10 @@ from test_flex_joint import LENGTH, EI, solve
 
 EXAMPLE = ["-rod_length", "100", "-rod_stiffness", "1e3,1e3,1e3", "-rod_start", "pin",
            "-rod_end", "pin", "-rod_end_position", "80,0,-30", "-rod_load", "0,0,-100",
-           "-rod_axial_stiffness", "1e5", "-rod_start_rotational_stiffness", "1e2"]
+           "-rod_axial_stiffness", "1e5", "-rod_start_rotational_stiffness", "1e2",
+           # the joint turned far from its axis (the default axis, the catenary's
+           # tangent, would leave it nearly unloaded)
+           "-rod_start_joint_axis", "1,0,0"]
 RISER = ["-options_file", "options/steel_catenary_riser.opts",
          "-rod_end_rotational_stiffness", "1e6", "-rod_end_joint_axis", "0.25,0,0.968"]
 

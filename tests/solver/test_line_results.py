@@ -113,8 +113,10 @@ def test_one_rank_and_all_give_the_same_results_and_regions():
     curved = one["curvature"] > 1e-3 * one["curvature"].max()
     np.testing.assert_allclose(every["bend_radius"][curved], one["bend_radius"][curved],
                                rtol=1e-6)
+    # the start, a pin 1 m above the seabed, hangs down to it: a free span, then the
+    # line lies on the seabed up to the touchdown
     assert list(attributes["region_names"]) == ["hang_off", "sag_bend", "touchdown_zone",
-                                                "grounded"]
+                                                "grounded", "free_span"]
     assert list(one_attributes["region_names"]) == list(attributes["region_names"])
     np.testing.assert_allclose(attributes["region_bounds"], one_attributes["region_bounds"],
                                rtol=1e-8, atol=1e-8)
@@ -128,5 +130,95 @@ def test_one_rank_and_all_give_the_same_results_and_regions():
     # the largest tension is at the top, in the hang-off; the grounded part ends at S = 0
     bounds = dict(zip(attributes["region_names"], attributes["region_bounds"]))
     assert attributes["region_max_tension_S"][0] == 10.0
-    assert bounds["grounded"][0] == 0.0
+    assert bounds["free_span"][0] == 0.0
+    assert bounds["free_span"][1] == bounds["grounded"][0]
     assert bounds["grounded"][1] == pytest.approx(bounds["sag_bend"][0], abs=1e-12)
+    landed = every["r"][:, 2] < -1.0 + 1e-3
+    assert every["S"][landed].min() == pytest.approx(bounds["grounded"][0], abs=0.125)
+    assert np.all(every["r"][every["S"] < bounds["grounded"][0] - 0.125, 2] > -1.0 + 1e-3)
+
+
+# A seabed with a trench 1 m deep between x = 3 and 5 (steps of 1 cm), and a line lying on
+# it (1 mm in) from the pin at the origin to x = 6, then rising at 45 degrees to the top:
+# the line spans the trench. A state given as a curve: the regions read the state.
+TRENCH_DEPTH, PENETRATION, FLAT = 1.0, 1e-3, 6.0
+
+
+def trench_line(S):
+    """(r, frames (rows d1, d2, d3), force (a unit tension)) of the line over the trench
+    at S (n,)."""
+    S = np.asarray(S, dtype=float)
+    rising = S > FLAT
+    angle = np.where(rising, np.pi / 4, 0.0)
+    t = np.stack([np.cos(angle), np.zeros_like(S), np.sin(angle)], axis=-1)
+    beyond = np.maximum(S - FLAT, 0.0)
+    r = np.stack([np.minimum(S, FLAT) + beyond * np.cos(np.pi / 4), np.zeros_like(S),
+                  -PENETRATION + beyond * np.sin(np.pi / 4)], axis=-1)
+    d1 = np.broadcast_to([0.0, 1.0, 0.0], t.shape)
+    return r, np.stack([d1, np.cross(t, d1), t], axis=1), t
+
+
+def test_a_span_over_a_trench_is_a_free_span_not_grounded(comm):
+    """Regions of the line over the trench (profile rows 3 | 3.01 and 4.99 | 5): grounded
+    from the touchdown (x = 6) to the trench's far edge, a free span over the trench,
+    grounded again to the anchor. In contact is a gap below the largest penetration
+    (1 mm): the bounds are where the gap crosses it, within the 1 cm steps. Before, the
+    whole line beyond the touchdown was "grounded"."""
+    from petsc_rod.riser.bathymetry import Profile
+
+    profile = Profile(np.zeros(2), np.array([1.0, 0.0]),
+                      np.array([-1.0, 3.0, 3.01, 4.99, 5.0, 20.0]),
+                      np.array([0.0, 0.0, -TRENCH_DEPTH, -TRENCH_DEPTH, 0.0, 0.0]))
+    length = FLAT + 4.0
+    top = trench_line(np.array([length]))[0][0]
+    scene = dict(CATENARY, length=length, end_position=top,
+                 seabed=Seabed(0.0, 1e5, profile))
+    mesh, solver = make_solver(comm, 100, scene, 10.0)
+    try:
+        solver.problem.prepare(1.0)
+        solver.problem.state.set_from_curve(trench_line)
+        _, attributes = final_record(solver.problem)
+    finally:
+        destroy(mesh, solver)
+    bounds = dict(zip(attributes["region_names"], attributes["region_bounds"]))
+    assert list(bounds)[-3:] == ["grounded", "free_span", "grounded_2"]
+    np.testing.assert_allclose(bounds["grounded"], [5.0, FLAT], atol=0.01)
+    np.testing.assert_allclose(bounds["free_span"], [3.0, 5.0], atol=0.01)
+    np.testing.assert_allclose(bounds["grounded_2"], [0.0, 3.0], atol=0.01)
+
+
+def test_an_anchor_that_lifts_off_is_said_with_its_angle_and_force(comm):
+    """The catenary pinned at an anchor on the seabed (z = 0) and pulled taut enough to
+    rise from it (top at (9, 0, 4)): no touchdown, and the anchor's uplift angle and
+    force are those of the inextensible catenary, atan(V0 / H) and V0 (at EI 5e-3 N m^2
+    the angle is off by the bending layer's 0.9 %, 10 % at EI 0.5; the force by 1e-4 of
+    V0); said in the final lines. Before, only touchdown_S = nan."""
+    from petsc_rod.cli.lines import summary
+    from petsc_rod.scenes.catenary import catenary
+
+    top = np.array([9.0, 0.0, 4.0])
+    vertex, attributes = solve(comm, dict(CATENARY, stiffness=(5e-3, 5e-3, 5e-3),
+                                          end_position=top, seabed=Seabed(0.0, 1e5)),
+                               elements=160)
+    assert np.isnan(attributes["touchdown_S"])
+    _, _, force = catenary(10.0, top, np.array([0.0, 0.0, -2.0]), np.array([0.0]))
+    H, V0 = force[0][0], force[0][2]
+    assert V0 > 0.5                                      # the exact line rises from it
+    assert attributes["anchor_uplift_S"] == 0.0
+    t = vertex["d3"][0]
+    assert attributes["anchor_uplift_angle"] == pytest.approx(
+        np.degrees(np.arctan2(t[2], t[0])), rel=1e-12)
+    assert attributes["anchor_uplift_angle"] == pytest.approx(np.degrees(np.arctan2(V0, H)),
+                                                              rel=1.5e-2)
+    assert attributes["anchor_uplift_force"] == pytest.approx(V0, rel=1e-3)
+    assert attributes["anchor_uplift_force"] == attributes["start_force"][2]
+    lines = "\n".join(summary(attributes))
+    assert "no touchdown: the anchor at S = 0 m lifts off at" in lines
+    assert f"pulled up by {attributes['anchor_uplift_force'] / 1e3:.6g} kN" in lines
+
+
+def test_a_grounded_anchor_says_no_uplift():
+    """The line resting on the seabed (GROUNDED): a touchdown, no uplift numbers."""
+    _, attributes = solve(PETSc.COMM_WORLD, GROUNDED)
+    assert np.isfinite(attributes["touchdown_S"])
+    assert "anchor_uplift_force" not in attributes

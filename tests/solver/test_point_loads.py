@@ -269,3 +269,53 @@ def test_the_drag_of_an_attachment_is_its_point_force(comm):
                                 point_load_forces=[drag[0] + [0.0, 0.0, -2.0]]),
                  rtol=1e-11, ctol=1e-11)[1]
     assert np.abs(fields["r"] - dead["r"]).max() < 1e-11
+
+
+# --- a point on a held end ----------------------------------------------------------------
+def reactions_and_shape(comm, scene, start):
+    """(r gathered, start_force, end_force) of Scene(**scene) converged from ``start``
+    ('catenary' or 'straight'): the reactions of line_results.end_numbers."""
+    from petsc_rod.riser.line_results import end_numbers
+
+    mesh, solver = make_solver(comm, 40, scene, default_penalty(Scene(**scene)),
+                               rtol=1e-11, ctol=1e-11, max_it=20000)
+    try:
+        problem = solver.problem
+        if start == "catenary":
+            problem.state.set_from_curve(catenary_start(problem.scene, 1.0))
+        else:
+            problem.state.set_straight()
+        assert solver.solve_step(1.0).converged
+        fields = vertex_fields(problem)
+        numbers = end_numbers(problem, fields)
+        return gather(comm, fields["r"]), numbers["start_force"], numbers["end_force"]
+    finally:
+        destroy(mesh, solver)
+
+
+def test_a_point_on_a_held_end_is_carried_by_its_support(comm):
+    """Points at S = 0 and S = L of the clump-weight chain (both ends pinned): the
+    supports carry them. The reactions (the attributes start_force and end_force, what
+    the line exerts on its supports) balance every load, the weight w L, the clump and
+    the points on the ends, to the iteration's tolerance, each end's by its own point;
+    the shape is that without the end points. Before, a point on a held end was in
+    neither reaction (the sum was off by the points)."""
+    ends = np.array([[0.0, 0.0, -5.0], [1.0, -2.0, -7.0]])
+    scene = dict(CHAIN, point_load_S=[0.0, CLUMP_S, CHAIN_L],
+                 point_load_forces=[ends[0], [0.0, 0.0, -CLUMP], ends[1]])
+    r, start_force, end_force = reactions_and_shape(comm, scene, "catenary")
+    r_bare, start_bare, end_bare = reactions_and_shape(comm, CHAIN, "catenary")
+    loads = np.array([0.0, 0.0, -CHAIN_W * CHAIN_L - CLUMP]) + ends.sum(axis=0)
+    assert np.abs(start_force + end_force - loads).max() < 1e-6 * CHAIN_L * CHAIN_W
+    assert np.abs(start_force - start_bare - ends[0]).max() < 1e-6
+    assert np.abs(end_force - end_bare - ends[1]).max() < 1e-6
+    assert np.abs(r - r_bare).max() < 1e-6
+
+
+def test_a_point_on_a_clamp_is_carried_by_the_clamp(comm):
+    """The unit cantilever with a point on its clamp at S = 0 and one at the free tip:
+    the clamp carries both, start_force = P_0 + P_L (no other load)."""
+    forces = np.array([[0.0, 0.0, -3.0], [0.0, 1e-3, -2e-3]])
+    scene = dict(UNIT, point_load_S=[0.0, 1.0], point_load_forces=forces)
+    _, start_force, _ = reactions_and_shape(comm, scene, "straight")
+    assert np.abs(start_force - forces.sum(axis=0)).max() < 1e-9

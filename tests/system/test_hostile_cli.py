@@ -125,6 +125,20 @@ def test_a_flex_joint_that_cannot_be_exits_2_with_one_line(tmp_path, args, words
                                      path)
 
 
+@pytest.mark.parametrize("args, words", [
+    (["-rod_start_frame", "0,1,0,0,0,1,1,0,nan"], ["-rod_start_frame"]),
+    (["-rod_start_frame", "1,0,0,0,1,0,0,0,2"], ["-rod_start_frame", "orthonormal"]),
+    (["-rod_start_frame", "0,1,0,1,0,0,0,0,1"], ["-rod_start_frame", "right-handed"]),
+    (["-rod_start", "pin", "-rod_end", "pin", "-rod_end_position", "0.5,0,0",
+      "-rod_start_frame", "0,1,0,0,0,1,1,0,0"], ["-rod_start_frame", "needs -rod_start clamp"]),
+], ids=["nan", "not orthonormal", "left-handed", "at a pin"])
+def test_a_start_frame_that_cannot_be_exits_2_with_one_line(tmp_path, args, words):
+    path = tmp_path / "out.h5"
+    done = run(["-rod_elements", "8"] + args + ["-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
 LINE_TYPES = "name od mass ei gj ea\nbare 0.16 36.7 1.99e4 1.99e4 4.69e8\n"
 
 

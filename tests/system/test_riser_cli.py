@@ -275,3 +275,145 @@ def test_a_catenary_start_that_cannot_be_drawn_falls_back_to_the_straight_start(
     (r_fell, top_fell), (r_straight, top_straight) = answers["catenary"], answers["straight"]
     assert np.abs(r_fell - r_straight).max() < 1e-9 * 170.215
     assert abs(top_fell - top_straight) < 1e-9 * top_straight
+
+
+def test_a_hang_off_joint_without_an_axis_is_installed_at_the_riser_s_angle(tmp_path):
+    """options/steel_catenary_riser.opts with -rod_end_rotational_stiffness 1.72e5 alone
+    (200 elements): the joint's axis is the catenary's top tangent, the joint nearly
+    unloaded (measured 0.019 deg, 57 N m); the issue's default e_x gave 85 deg and
+    254 kN m. The file says the axis used."""
+    path = tmp_path / "joint.h5"
+    process = run_petsc_rod(["-options_file", "options/steel_catenary_riser.opts",
+                             "-rod_sections", "scr10:2400:200",
+                             "-rod_end_rotational_stiffness", "1.72e5",
+                             "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
+    with h5py.File(path) as f:
+        step = f["steps"][max(f["steps"], key=int)]
+        angle, moment = step.attrs["end_joint_angle"], step.attrs["end_joint_moment"]
+        axis = step.attrs["end_joint_axis"]
+    assert angle < 0.1 and moment < 1e3
+    # up and toward the vessel's side, 19 degrees from the vertical like the top tension
+    assert np.degrees(np.arccos(axis[2])) == pytest.approx(19.4, abs=0.5)
+
+
+CABLE_TYPE = """name   od    mass  ei   gj   cd
+cable  0.1   10.0  10.0 10.0 1.0
+"""
+CABLE = ["-rod_sections", "cable:100:100", "-rod_start", "pin", "-rod_end", "pin",
+         "-rod_end_position", "80,0,0"]
+
+
+def solve_cable(tmp_path, args):
+    """(attributes, r) of the last step of the cable of CABLE_TYPE between the pins of
+    CABLE with ``args``, a run that must converge."""
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "cable.h5"
+    process = run(["-rod_line_types", types, *CABLE, *args, "-rod_output", str(path)])
+    assert process.returncode == 0, process.stderr
+    with h5py.File(path) as f:
+        step = f["steps"][max(f["steps"], key=int)]
+        return dict(step.attrs), step["r"][:]
+
+
+def test_a_line_in_air_is_the_catenary_of_its_weight_in_air(tmp_path):
+    """-rod_water_density 0 (refused before): a 100 m cable of 10 kg/m between pins 80 m
+    apart hangs as the catenary of w = m g = 98.07 N/m: the end force and the sag within
+    1e-5 (EI 10 N m^2; measured 1e-6)."""
+    from petsc_rod.scenes.catenary import catenary
+
+    attributes, r = solve_cable(tmp_path, ["-rod_water_density", "0",
+                                           "-rod_initial_shape", "catenary"])
+    exact, _, force = catenary(100.0, np.array([80.0, 0.0, 0.0]),
+                               np.array([0.0, 0.0, -10.0 * 9.80665]), np.array([50.0, 100.0]))
+    assert np.linalg.norm(attributes["end_force"]) == pytest.approx(
+        np.linalg.norm(force[1]), rel=1e-5)
+    assert r[50, 2] == pytest.approx(exact[0, 2], rel=1e-5)
+
+
+def test_a_weightless_line_between_pins_takes_a_point_load_in_two_straight_pieces(
+        tmp_path):
+    """-rod_gravity 0 (refused before): the cable weightless, 1 kN hung at its middle: two
+    straight pieces of 50 m, the point 30 m below the pins, each pin carrying 500 N up
+    and H = 500 / tan(asin(0.6)) = 666.7 N across (the bending rounds the kink over
+    sqrt(EI / T) = 0.1 m: H within 0.5 %, the sag within 0.5 %)."""
+    attributes, r = solve_cable(tmp_path, ["-rod_gravity", "0",
+                                           "-rod_point_load", "50,0,0,-1000"])
+    for name, sign in (("start_force", 1.0), ("end_force", -1.0)):
+        assert attributes[name][2] == pytest.approx(-500.0, rel=1e-9)
+        assert sign * attributes[name][0] == pytest.approx(500.0 / 0.75, rel=5e-3)
+    assert r[50, 2] == pytest.approx(-30.0, rel=5e-3)
+
+
+def two_piece_catenary_forces(length, chord, surface, w_water, w_air):
+    """(n(0), n(L)) of the inextensible cable pinned at the origin (under water) and at
+    ``chord`` (x, 0, z) (above the surface z = ``surface``), weighing ``w_water`` below
+    the surface and ``w_air`` above it (N/m): n = (H, 0, V0 + int w dS), each piece a
+    catenary in closed form (x: H/w asinh, z: |n| / w), (H, V0, S_b) such that the line
+    crosses the surface at S_b and ends at the chord."""
+    from scipy.optimize import fsolve
+
+    def piece(H, V, w, s):
+        return (H / w * (np.arcsinh((V + w * s) / H) - np.arcsinh(V / H)),
+                (np.hypot(H, V + w * s) - np.hypot(H, V)) / w, V + w * s)
+
+    def equations(v):
+        H, V0, S_b = v
+        x1, z1, V1 = piece(H, V0, w_water, S_b)
+        x2, z2, _ = piece(H, V1, w_air, length - S_b)
+        return [z1 - surface, x1 + x2 - chord[0], z1 + z2 - chord[2]]
+
+    H, V0, S_b = fsolve(equations, [1000.0, -500.0, 0.8 * length], xtol=1e-14)
+    V_L = V0 + w_water * S_b + w_air * (length - S_b)
+    return np.array([H, 0.0, V0]), np.array([H, 0.0, V_L])
+
+
+# the cable's weights under water and in air, N/m
+WEIGHTS = (10.0 * 9.80665 - 1025.0 * 9.80665 * np.pi * 0.1**2 / 4, 10.0 * 9.80665)
+
+
+def through_the_surface(tmp_path, args, ranks=1, elements=400):
+    """The last step's attributes of the cable of CABLE_TYPE on ``elements`` from a pin
+    15 m under -rod_sea_surface 15 to one at (80, 0, 30), with ``args``."""
+    types = write(tmp_path, "cable.txt", CABLE_TYPE)
+    path = tmp_path / "surface.h5"
+    process = run(["-rod_line_types", types, "-rod_sections", f"cable:100:{elements}",
+                   "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position", "80,0,30",
+                   "-rod_sea_surface", "15", "-rod_initial_shape", "catenary", *args,
+                   "-rod_output", str(path)], ranks)
+    assert process.returncode == 0, process.stderr
+    with h5py.File(path) as f:
+        return dict(f["steps"][max(f["steps"], key=int)].attrs)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_line_out_of_the_water_weighs_its_weight_in_air(tmp_path, ranks):
+    """The cable of CABLE_TYPE from a pin 15 m under -rod_sea_surface 15 to one 15 m
+    above it (80, 0, 30): below the surface it weighs (m - rho_w A) g = 19.1 N/m, above
+    it m g = 98.1 N/m. The reactions are those of the two-piece catenary (measured at
+    400 elements: H within 9e-5, the top's vertical force within 0.6 N of 2643 N; 9.4,
+    4.3, 0.57, 0.10 N at 100 to 800 elements, the crossing inside an element). Before,
+    the whole line kept its buoyancy: the top carried 1912 N less the anchor's."""
+    attributes = through_the_surface(tmp_path, [], ranks)
+    start, end = two_piece_catenary_forces(100.0, (80.0, 0.0, 30.0), 15.0, *WEIGHTS)
+    assert attributes["start_force"][0] == pytest.approx(start[0], rel=1e-3)
+    assert attributes["start_force"][2] == pytest.approx(start[2], abs=0.5)
+    assert -attributes["end_force"][2] == pytest.approx(end[2], abs=2.0)
+
+
+def test_a_current_drags_only_the_line_under_the_surface(tmp_path):
+    """The same cable in a current of 0.05 m/s across its plane (c = rho C_d D / 2 =
+    51.25 kg/m^2, c U^2 = 0.128 N/m, small beside its weight: v stays normal to it to
+    1e-4): the supports carry the drag of the wet length only, the two-piece catenary's
+    crossing S_b = 83.3 m: c U^2 S_b = 10.671 N (measured 10.670 at 400 elements, within
+    1e-3 at 200), not the whole line's 12.81 N as before."""
+    from scipy.optimize import brentq
+
+    attributes = through_the_surface(tmp_path, ["-rod_current", "0,0.05,0"], elements=200)
+    start, _ = two_piece_catenary_forces(100.0, (80.0, 0.0, 30.0), 15.0, *WEIGHTS)
+    H, V0 = start[0], start[2]
+    # the arc length where the under-water piece reaches z = 15 m
+    w = WEIGHTS[0]
+    S_b = brentq(lambda S: (np.hypot(H, V0 + w * S) - np.hypot(H, V0)) / w - 15.0, 1.0, 100.0)
+    lateral = attributes["start_force"][1] + attributes["end_force"][1]
+    assert lateral == pytest.approx(51.25 * 0.05**2 * S_b, rel=1e-3)
