@@ -11,6 +11,7 @@ import numpy as np
 from petsc_rod.analysis.link import changed_class
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.iteration import events
+from petsc_rod.iteration.controller import NEWTON_AFTER
 from petsc_rod.iteration.stopping import STOP_LINK, STOP_OBSERVER
 
 # The most halvings a path may be asked for: the load factors are counted in whole
@@ -134,6 +135,8 @@ def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
     ``stop()`` (collective), if given, is asked after every iteration whether to stop
     (the report's reason is then STOP_OBSERVER, the failure "interrupted")."""
     problem = solver.problem
+    # the twist of round sections spread before the first Newton attempt may be made
+    problem.relax_twist(t, NEWTON_AFTER)
     problem.state.roll_cross_sections(imperfection)
     observer = None if stop is None else (lambda iteration, change, residual: stop())
     try:
