@@ -166,10 +166,11 @@ class RodProblem:
         frames = np.stack([state.tau, state.node_directors()], axis=1)   # (n, 2, 3, 3)
         if mesh.on_lower_boundary:
             frames[0, 0] = self.scene.start_state(t).frame
-        following = mesh.first_of_next_rank(frames)
         if mesh.on_upper_boundary:
             frames[-1, 0] = self.scene.end_state(t).frame
-        else:
+        # the next rank's first node (its clamped end where it owns no element)
+        following = mesh.first_of_next_rank(frames)
+        if not mesh.on_upper_boundary:
             frames = np.concatenate([frames, following[None]])
         # per gap between neighbouring nodes, two per owned element (vertex to midpoint,
         # midpoint to the next vertex): the twist's change and the compliance dS / K3
