@@ -20,7 +20,7 @@ def rolled_line(solver_factory, comm, n_elements, length, penalty, stiffness=(1.
     mesh, solver = solver_factory(comm, n_elements, scene, penalty)
     problem = solver.problem
     problem.state.set_straight()
-    problem.relax_twist(1.0, NEWTON_AFTER)
+    problem.relax_twist(0.0, 1.0, NEWTON_AFTER)
     tau = gather(comm, problem.state.tau)
     S = gather(comm, mesh.node_S())
     end = roll_between(REFERENCE_FRAME, problem.scene.end_state(1.0).frame)
