@@ -42,8 +42,8 @@ def test_a_clamped_cable_rolled_three_turns_converges_in_newtons_count(clamped, 
                                                                         steps):
     """12 steps of a quarter turn; 6 of half a turn, where the clamp's frame alone cannot
     tell which way the step rolls (f2df9b3 lost the three turns at the cap); 1 step of
-    three turns, which the clamp's frame does not see at all (f2df9b3 converged in 18
-    iterations to the untwisted cable): the load path's roll is walked
+    three turns, which the clamp's frame does not see at all (f2df9b3 converged in 1
+    iteration: the untwisted cable it started from): the load path's roll is walked
     (RodProblem._path_roll)."""
     path = clamped.parent / f"rolled_{ranks}_{steps}.h5"
     most = PER_STEP * steps
