@@ -182,9 +182,12 @@ class RodProblem:
         # per gap between neighbouring nodes, two per owned element (vertex to midpoint,
         # midpoint to the next vertex): the twist's change and the compliance dS / K3
         added = np.subtract(*roll_between(frames[:-1], frames[1:]).T)
+        # the clamps' own roll over the step, in the gaps next to them: the first of the
+        # rank of element 0, the last of the rank of the last element (not always the
+        # rank of the last node)
         if mesh.on_lower_boundary and added.size:
             added[0] -= self._path_roll("start", t_from, t)
-        if mesh.on_upper_boundary and added.size:
+        if mesh.element_end == mesh.n_elements and added.size:
             added[-1] += self._path_roll("end", t_from, t)
         h = np.repeat(mesh.element_h / 2, 2)
         middle = np.repeat(mesh.element_S, 2) + h * np.tile([0.5, 1.5], mesh.n_local_elements)
