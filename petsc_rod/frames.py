@@ -94,8 +94,9 @@ def rotation_log(q):
 def roll_between(first, second):
     """The roll (rad, in (-pi, pi]) that takes frames ``first`` to ``second`` (..., 3, 3),
     rows d1, d2, d3, about their tangent: atan2(d1'.d2 - d2'.d1, d1'.d1 + d2'.d2), primes
-    ``second``'s. Between neighbouring nodes of a rod it is the twist u3 dS to second
-    order in the spacing (u3 = d1'.d2, strains); rolling ``second`` by a about its d3,
+    ``second``'s. Between neighbouring nodes of a rod it measures the twist u3 dS
+    (u3 = d1'.d2, strains), exactly where the frames differ by a roll and a bend in one
+    plane (tests/unit/test_roll_between.py); rolling ``second`` by a about its d3,
     (d1, d2) -> (cos a d1 + sin a d2, -sin a d1 + cos a d2), adds a to it where the
     tangents agree."""
     def dot(i, j):
