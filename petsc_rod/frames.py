@@ -89,3 +89,16 @@ def rotation_log(q):
     if axis @ skew < 0:
         axis = -axis
     return angle * axis
+
+
+def roll_between(first, second):
+    """The roll (rad, in (-pi, pi]) that takes frames ``first`` to ``second`` (..., 3, 3),
+    rows d1, d2, d3, about their tangent: atan2(d1'.d2 - d2'.d1, d1'.d1 + d2'.d2), primes
+    ``second``'s. Between neighbouring nodes of a rod it measures the twist u3 dS
+    (u3 = d1'.d2, strains), exactly where the frames differ by a roll and a bend in one
+    plane (tests/unit/test_roll_between.py); rolling ``second`` by a about its d3,
+    (d1, d2) -> (cos a d1 + sin a d2, -sin a d1 + cos a d2), adds a to it where the
+    tangents agree."""
+    def dot(i, j):
+        return np.einsum("...c,...c->...", second[..., i, :], first[..., j, :])
+    return np.arctan2(dot(0, 1) - dot(1, 0), dot(0, 0) + dot(1, 1))

@@ -11,6 +11,7 @@ import numpy as np
 from petsc_rod.analysis.link import changed_class
 from petsc_rod.errors import RodDivergedError
 from petsc_rod.iteration import events
+from petsc_rod.iteration.controller import NEWTON_AFTER
 from petsc_rod.iteration.stopping import STOP_LINK, STOP_OBSERVER
 
 # The most halvings a path may be asked for: the load factors are counted in whole
@@ -126,14 +127,18 @@ class Predictor:
         state.lam[:] = lam1 + ratio * (lam1 - lam0)
 
 
-def attempt(solver, t, imperfection, label, expected_link=None, stop=None):
+def attempt(solver, t, imperfection, label, expected_link=None, stop=None, t_from=None):
     """One try at load factor t from the current state, its cross-sections rolled first:
     (report, failure), ``failure`` None when the step converged, the RodDivergedError
     when it diverged (report None), else a sentence saying how far it got. A converged
     state whose linking number is not ``expected_link`` (turns, link.py) is a failure.
     ``stop()`` (collective), if given, is asked after every iteration whether to stop
-    (the report's reason is then STOP_OBSERVER, the failure "interrupted")."""
+    (the report's reason is then STOP_OBSERVER, the failure "interrupted"). ``t_from``:
+    the load factor of the state it starts from (the last accepted; None: t's, nothing
+    walked), whose end frames the twist's relaxation walks from (RodProblem.relax_twist)."""
     problem = solver.problem
+    # the twist of round sections spread before the first Newton attempt may be made
+    problem.relax_twist(t if t_from is None else t_from, t, NEWTON_AFTER)
     problem.state.roll_cross_sections(imperfection)
     observer = None if stop is None else (lambda iteration, change, residual: stop())
     try:
@@ -189,7 +194,7 @@ def continuation(solver, path=PathSettings(), stop=None):
         predictor.predict(state, t)
         report, failure = attempt(solver, t, settings.imperfection, f"{label} ",
                                   expected_link(problem.scene, link, path.factor(path.reached), t),
-                                  stop)
+                                  stop, path.factor(path.reached))
         if failure == "interrupted":
             yield events.Interrupted(f"in {label} at load factor {t:.6g}, iteration "
                                      f"{report.iterations}", path.factor(path.reached))

@@ -286,6 +286,26 @@ class Mesh:
         running = np.concatenate([np.zeros((1,) + values.shape[1:]), np.cumsum(values, axis=0)])
         return before + running[:self.vertex_end - self.vertex_start]
 
+    def first_of_next_rank(self, values):
+        """The next rank's first row of ``values`` (this rank's owned rows, (n, ...), the
+        same trailing shape on every rank), for a quantity between this rank's last node
+        and the next one's first; zeros on the last rank. Collective (one exchange with
+        each neighbour)."""
+        values = np.ascontiguousarray(values, dtype=float)
+        mpi = self.comm.tompi4py()
+        rank, size = mpi.Get_rank(), mpi.Get_size()
+        received = np.zeros(values.shape[1:])
+        previous = rank - 1 if rank > 0 else None
+        following = rank + 1 if rank < size - 1 else None
+        if previous is not None and following is not None:
+            mpi.Sendrecv(np.ascontiguousarray(values[0]), dest=previous,
+                         recvbuf=received, source=following)
+        elif previous is not None:
+            mpi.Send(np.ascontiguousarray(values[0]), dest=previous)
+        elif following is not None:
+            mpi.Recv(received, source=following)
+        return received
+
     def global_min(self, value):
         """Minimum of a float over all ranks."""
         from mpi4py import MPI

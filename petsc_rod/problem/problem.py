@@ -15,7 +15,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import SecondVariation
-from petsc_rod.frames import strains
+from petsc_rod.frames import roll_between, strains
 from petsc_rod.global_step.coefficients import FieldCoefficients
 from petsc_rod.global_step.global_step import GlobalStep
 from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
@@ -27,6 +27,10 @@ from petsc_rod.physics.flex_joint import FlexJoint, joint_local_step
 from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.state import RodState
 from petsc_rod.scenes.boundary import clamped_nodes
+
+# The load path's roll of a clamp over one step is summed over this many pieces of it
+# (RodProblem._path_roll), each of less than half a turn.
+PATH_PIECES = 64
 
 EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("projection", "multiplier", "norms")}
 
@@ -67,6 +71,11 @@ class RodProblem:
         self._energy_rule = self._stored_energy_rule()
         # the ends' kinds do not change: the clamped nodes are those of the whole run
         self.free_nodes = ~clamped_nodes(mesh, self.start_state, self.end_state)
+        # round sections between two clamps: the torque is uniform at equilibrium
+        # (relax_twist)
+        values = scene.stiffness_values()
+        self.relaxes_twist = bool(scene.start == "clamp" and scene.end == "clamp"
+                                  and np.all(values[:, 0] == values[:, 1]))
         self._second_variation = None
         # EA at the owned nodes, N, for the stretched local step (§12); None, and nothing
         # built for stretch, on an inextensible line
@@ -127,6 +136,81 @@ class RodProblem:
     def prepare(self, t):
         """End conditions and loads at load factor t (GlobalStep.prepare)."""
         self.global_step.prepare(t)
+
+    def relax_twist(self, t_from, t, within):
+        """Roll the sections of a line of round sections (K1 = K2 all along) clamped at
+        both ends at the start of a step from load factor t_from to t, so that the twist
+        the step adds is spread as a uniform torque, keeping the clamps' frames and the
+        centreline (docs/method.md §7, "The twist of round sections"), where the
+        iteration would not spread it itself ``within`` iterations.
+
+        With K1 = K2 the torque m3 = K3 u3 is the same all along at equilibrium (m3' =
+        m'.d3 + m.d3' = -(r' x n).d3 + K1 (d3 x d3').d3' = 0; no term applies a
+        distributed moment). The fields still hold the state at t_from, such an
+        equilibrium (or the start); tau holds the step's start. A roll phi(S) of the
+        sections about their tangent changes u3 by phi' and nothing else, so the roll with
+        phi(0) = phi(L) = 0 and phi' = u3_fields - u3_tau + dM / K3 (dM the one value
+        that closes it) gives tau the twist at t_from plus a uniform torque increment:
+        what the iteration reaches only by diffusion from the clamp, the slowest mode of a
+        long twisted line (which kept Newton steps from converging). u3 dS between
+        neighbouring nodes is frames.roll_between, the clamped nodes taken at their
+        frames at t_from in both; the clamps' roll from t_from to t is added to the end
+        gaps of tau as the load path walks it (_path_roll): a roll of any size, which the
+        frames at t alone give only modulo a turn (a step of half a turn could go either
+        way). On a converged state the roll is zero.
+
+        The iteration damps the slowest roll mode, phi ~ sin(pi S / L), by about
+        1 - pi^2 K3 / (R L^2) per plain iteration (the global step's 2 a K + R W on a
+        roll, a1 = a2 = K3 / 2), and Anderson's mixing, like a Krylov method, needs about
+        the square root of the plain count: e-folds take sqrt(R L int dS / K3) / pi
+        iterations. Where that is within ``within`` (a short rod, the penalty of its
+        stiffness) the twist spreads before a Newton attempt and the roll is not made:
+        it would only move the iteration's first steps (docs/method.md §7). Elsewhere
+        nothing. Collective."""
+        if not self.relaxes_twist:
+            return
+        mesh, state = self.mesh, self.state
+        frames = np.stack([state.tau, state.node_directors()], axis=1)   # (n, 2, 3, 3)
+        if mesh.on_lower_boundary:
+            frames[0] = self.scene.start_state(t_from).frame
+        if mesh.on_upper_boundary:
+            frames[-1] = self.scene.end_state(t_from).frame
+        # the next rank's first node (its clamped end where it owns no element)
+        following = mesh.first_of_next_rank(frames)
+        if not mesh.on_upper_boundary:
+            frames = np.concatenate([frames, following[None]])
+        # per gap between neighbouring nodes, two per owned element (vertex to midpoint,
+        # midpoint to the next vertex): the twist's change and the compliance dS / K3
+        added = np.subtract(*roll_between(frames[:-1], frames[1:]).T)
+        # the clamps' own roll over the step, in the gaps next to them: the first of the
+        # rank of element 0, the last of the rank of the last element (not always the
+        # rank of the last node)
+        if mesh.on_lower_boundary and added.size:
+            added[0] -= self._path_roll("start", t_from, t)
+        if mesh.element_end == mesh.n_elements and added.size:
+            added[-1] += self._path_roll("end", t_from, t)
+        h = np.repeat(mesh.element_h / 2, 2)
+        middle = np.repeat(mesh.element_S, 2) + h * np.tile([0.5, 1.5], mesh.n_local_elements)
+        compliance = h / self.scene.stiffness_at(middle)[:, 2]
+        total = mesh.global_sum(np.array([added.sum(), compliance.sum()]))
+        if self.penalty * mesh.length * total[1] <= (np.pi * within)**2:
+            return
+        change = (total[0] / total[1]) * compliance - added
+        vertex = mesh.prefix_sum(change[0::2] + change[1::2])
+        angle = np.empty(mesh.n_local_nodes)
+        angle[0::2] = vertex
+        angle[1::2] = vertex[:mesh.n_local_elements] + change[0::2]
+        state.roll_nodes(angle)
+
+    def _path_roll(self, which, t_from, t):
+        """The roll (rad) of the clamped frame at ``which`` end ('start', 'end') about its
+        tangent from load factor t_from to t as the load path walks it: the sum of
+        frames.roll_between over PATH_PIECES equal pieces (any size below PATH_PIECES
+        half turns)."""
+        s = np.linspace(t_from, t, PATH_PIECES + 1)
+        states = getattr(self.scene, f"{which}_state")
+        ends = np.array([states(value).frame for value in s])
+        return float(np.sum(roll_between(ends[:-1], ends[1:])))
 
     def iterate(self):
         """One iteration G (docs/method.md §3): global step, local step (nearest rotation

@@ -111,6 +111,13 @@ class RodState:
                                                 node_angle[..., None])
         self.remember()
 
+    def roll_nodes(self, angle):
+        """Roll tau and lambda at each node about its tangent by ``angle`` (n_nodes,) rad:
+        rows (t1, t2) -> (cos a t1 + sin a t2, -sin a t1 + cos a t2), t3 kept (the
+        stretched tangent too). The fields are the next global step's to make."""
+        for frames in (self.tau, self.lam):
+            frames[:, 0], frames[:, 1] = rolled(frames[:, 0], frames[:, 1], angle[:, None])
+
     def turn_frames(self, omega):
         """Turn tau and lambda at each node by exp([omega_n]x), omega (n_nodes, 3):
         rows t_i -> Q t_i (leaving a saddle, docs/method.md §10). On an extensible line
