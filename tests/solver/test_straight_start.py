@@ -8,6 +8,7 @@ with a seabed"), on one rank (PETSc.COMM_SELF) and on all ranks (PETSc.COMM_WORL
     must be the step: converged, at the same state. It was not: with a seabed the
     Newton attempts found H indefinite and the state was not left before it converged
     to the saddle (2000 iterations, not converged).
+    With a seabed the early escape waits for a second indefinite attempt (c).
 (b) A linear-algebra failure of the stability test (a second variation singular to
     round-off at a shift of its bisection) ends the step as a failed attempt, said in
     the step's report, instead of a traceback.
@@ -18,7 +19,7 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.analysis import stability
-from petsc_rod.iteration import stopping
+from petsc_rod.iteration import controller, newton, stopping
 from petsc_rod.problem.penalty import default_penalty
 from petsc_rod.riser.environment import Seabed
 from petsc_rod.scenes.scene import Scene
@@ -76,3 +77,17 @@ def test_a_failed_factorisation_of_the_stability_test_fails_the_step(
     report = solver.solve_step(1.0)
     assert not report.converged
     assert report.reason == stopping.STOP_UNTESTED
+
+
+@pytest.mark.parametrize("switch, first", [(True, True), (controller.NEWTON_SWITCH_FAR, False)])
+def test_a_far_reaching_system_escapes_early_after_a_second_indefinite_attempt(switch, first):
+    """Without a seabed one indefinite attempt near an equilibrium leaves the state at
+    once; with one (NEWTON_SWITCH_FAR) the first attempt's H is an iterate's, and only a
+    second, nearer, is taken for a saddle."""
+    step = controller.StepController(stopping.Settings(asked_penalty=1.0), 1.0, switch)
+    step.observe(1e-3, 1e-3, 1.0)
+    step.newton_failed(newton.INDEFINITE)
+    assert step.wants_early_escape() is first
+    step.observe(1e-4, 1e-4, 1.0)
+    step.newton_failed(newton.INDEFINITE)
+    assert step.wants_early_escape() is True
