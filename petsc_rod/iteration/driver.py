@@ -211,8 +211,9 @@ class UzawaSolver:
         # the test reads the iteration's multipliers, not Newton's -g / w (with a seabed
         # an iterate's -g / w holds its answer to errors of metres in height and makes
         # H indefinite far from any saddle, newton._newton_step): a line with a seabed
-        # is left early too, as a straight start must, whose first steps end the line
-        # nearer than its length and buckle it (docs/method.md §10)
+        # is left early too (after a second indefinite attempt: wants_early_escape), as
+        # a straight start must, whose first steps end the line nearer than its length
+        # and buckle it (docs/method.md §10)
         if (outcome != newton.INDEFINITE or not self.tests_stability
                 or not step.wants_early_escape()):
             return
