@@ -3,7 +3,7 @@ step records (io/outputs.py) as text, with the advice that names the options to 
 Nothing here computes or decides."""
 
 from petsc_rod.errors import RodIterationDiverged
-from petsc_rod.iteration.stopping import STOP_LINK, STOP_SADDLE
+from petsc_rod.iteration.stopping import STOP_LINK, STOP_SADDLE, STOP_UNTESTED
 from petsc_rod.problem.penalty import ADAPT_WINDOW
 
 # What a divergence suggests changing (the iteration itself never names an option).
@@ -265,6 +265,10 @@ def not_converged_reason(report, settings, scale):
         return (f"converged {report.escapes + 1} times to a saddle, an equilibrium that is not "
                 "a minimiser, after turning the frames along its direction of negative "
                 "curvature each time: take more -rod_steps, or -rod_imperfection")
+    if report.reason == STOP_UNTESTED:
+        return ("converged, but the stability test could not decide: its factorisation of "
+                "the second variation failed (singular to round-off at a shift); take more "
+                "-rod_steps")
     if report.stalled:
         return (f"stalled after {report.iterations} iterations ({numbers}): at their rate they "
                 "would not meet the tolerances within -rod_al_max_it: tolerances near round-off "

@@ -266,6 +266,12 @@ class StepController:
         """After an attempt that found negative curvature: whether the state is near
         enough an equilibrium (EARLY_ESCAPE) to be taken for a saddle and left now, with
         the early escapes' budget not spent."""
+        if self.newton_far and self.newton_failures < 2:
+            # a far-reaching system (a seabed, a current): one attempt's H is that of
+            # an iterate metres off in height, indefinite where the iteration may go on
+            # to a minimiser by itself; a second, at an iterate ten times nearer, says
+            # that it lingers by a saddle (docs/method.md §10)
+            return False
         change, residual = self.history[-1][:2] if self.history else (np.inf, np.inf)
         return max(change, residual) <= EARLY_ESCAPE and self.early_escapes < MAX_ESCAPES
 

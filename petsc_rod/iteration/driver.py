@@ -118,7 +118,13 @@ class UzawaSolver:
                     # one iteration before, showed it stable
                     step.stability_tested(True)
                     break
-                stable, direction = self.check_stability()
+                try:
+                    stable, direction = self.check_stability()
+                except np.linalg.LinAlgError:
+                    # H - sigma M singular to round-off at a shift of the test: no
+                    # verdict, a failed attempt of the step (the continuation halves it)
+                    step.stop(stopping.STOP_UNTESTED)
+                    break
                 step.stability_tested(stable)
                 if stable is not False:
                     break
@@ -202,13 +208,19 @@ class UzawaSolver:
                 self._raise_penalty(step, raised, events.RAISED_NEWTON)
             return
         step.newton_failed(outcome)
-        # no early escape where the heights enter the energy (the seabed): there an
-        # iterate's H is indefinite long before it nears a saddle (newton._newton_step),
-        # so only a converged state is tested and left
+        # the test reads the iteration's multipliers, not Newton's -g / w (with a seabed
+        # an iterate's -g / w holds its answer to errors of metres in height and makes
+        # H indefinite far from any saddle, newton._newton_step): a line with a seabed
+        # is left early too (after a second indefinite attempt: wants_early_escape), as
+        # a straight start must, whose first steps end the line nearer than its length
+        # and buckle it (docs/method.md §10)
         if (outcome != newton.INDEFINITE or not self.tests_stability
-                or self.newton.reads_positions or not step.wants_early_escape()):
+                or not step.wants_early_escape()):
             return
-        stable, direction = self.check_stability()
+        try:
+            stable, direction = self.check_stability()
+        except np.linalg.LinAlgError:          # no verdict: the iteration goes on
+            return
         if stable is False:
             angle = step.escape_angle(early=True)
             if angle is not None:

@@ -22,6 +22,7 @@ STOP_STALLED = "stalled"
 STOP_OBSERVER = "observer"      # the caller's observer asked to stop
 STOP_LINK = "link"              # converged, to a state of another linking number (link.py)
 STOP_SADDLE = "saddle"          # converged to a saddle, and left it too often
+STOP_UNTESTED = "untested"      # converged, the stability test's factorisation failed
 
 # The stall test looks at windows of STALL_WINDOW iterations (stalled_projection), and
 # only once both stopping quantities are within STALL_FACTOR of their tolerances: an
