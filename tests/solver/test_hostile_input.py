@@ -560,3 +560,33 @@ def test_a_flex_joint_on_a_stretching_end_is_accepted(options):
                             rod_start_rotational_stiffness="1e3")()
     scene = scene_from_options(values, names)
     assert scene.start_rotational_stiffness == 1e3 and scene.extensible
+
+
+# --- option values longer than petsc4py's getString returns (1023 characters) -------------
+def long_point_loads(points=63):
+    """-rod_point_load of ``points`` points, each S,fx,fy,fz with a force of -5000 N
+    last: over 1023 characters for 63 points."""
+    values = np.column_stack([np.linspace(1.0, 2399.0, points), np.full(points, 12.5),
+                              np.full(points, -0.125), np.full(points, -5000.0)])
+    return ",".join(repr(v) for v in values.ravel()), values
+
+
+def test_an_option_value_over_1023_characters_is_read_whole(options):
+    text, points = long_point_loads()
+    sections = ",".join(f"pipe:{2400 / 121:.14g}" for _ in range(121))
+    assert len(text) > 1100 and len(sections) > 1100
+    values, _ = options(rod_point_load=text, rod_sections=sections)()
+    assert np.array_equal(values["rod_point_load"], points.ravel())
+    assert values["rod_sections"] == sections
+
+
+def test_a_sweep_s_case_values_and_settings_over_1023_characters_are_read_whole(comm):
+    from petsc_rod.sweep.runner import read_settings, with_options
+    text, points = long_point_loads()
+    read = with_options(comm, {"rod_point_load": text}, lambda: read_options()[0])
+    assert np.array_equal(read["rod_point_load"], points.ravel())
+    offsets = ",".join(f"{k * 0.015625:.6f}" for k in range(200))
+    assert len(offsets) > 1100
+    settings = with_options(comm, {"sweep_output": "out", "sweep_offsets": offsets},
+                            read_settings)
+    assert len(settings.offsets) == 200 and settings.offsets[-1] == 199 * 0.015625
