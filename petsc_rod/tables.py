@@ -3,24 +3,65 @@ naming the columns, then one row per entry; whitespace or commas separate the va
 '#' starts a comment; '-' leaves an optional column's value blank. Every failure is one RodInputError naming the option and the file.
 """
 
+import os
+import stat
+
 import numpy as np
 
 from petsc_rod.errors import RodInputError
 
 # A value left blank in an optional column (NaN in the table): a row that does not use it.
 BLANK = "-"
+# The largest input table read, bytes: a seabed grid of a million points is about 30 MiB;
+# a file far larger is not a table (and is read whole on every rank).
+MAX_TABLE_BYTES = 256 * 2**20
+
+
+def file_problem(path):
+    """Why ``path`` cannot be read as an input file, '' when it can: missing, a folder,
+    or not a regular file. A FIFO blocks its reader until a writer comes (for ever, and
+    deaf to SIGTERM while it waits in open) and a device such as /dev/zero never ends, so
+    every input file is checked with os.stat (through links) before it is opened: the
+    tables, the restart file, a sweep's cases, the options files."""
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        return "no such file"
+    except OSError as error:
+        return f"cannot be read ({error.strerror})"
+    if stat.S_ISDIR(info.st_mode):
+        return "is a folder, not a file"
+    if not stat.S_ISREG(info.st_mode):
+        return ("not a regular file (a pipe such as <(...), a FIFO or a device): "
+                "petsc_rod reads only files that end; write it to a file and give its path")
+    return ""
+
+
+def check_input_file(path, option, largest=None):
+    """Refuse (RodInputError naming ``option``) an input file ``path`` that file_problem
+    refuses, or one above ``largest`` bytes (None: MAX_TABLE_BYTES; inf for a file read
+    in slices, a restart file)."""
+    largest = MAX_TABLE_BYTES if largest is None else largest
+    problem = file_problem(path)
+    if not problem and os.stat(path).st_size > largest:
+        problem = (f"is {os.stat(path).st_size / 2**20:.3g} MiB, above the "
+                   f"{largest / 2**20:.3g} MiB an input table may hold; is it the right file?")
+    if problem:
+        raise RodInputError(f"{option} {path}: {problem}")
 
 
 def read_text(path, option):
     """The text of the file ``path`` given to ``option`` (RodInputError if it cannot be
-    read)."""
+    read, is not a regular file or is larger than MAX_TABLE_BYTES)."""
+    check_input_file(path, option)
     try:
         with open(path, encoding="utf-8", errors="replace") as handle:
-            return handle.read()
-    except FileNotFoundError:
-        raise RodInputError(f"{option} {path}: no such file") from None
+            text = handle.read(MAX_TABLE_BYTES + 1)       # a file that grew since
     except OSError as error:
         raise RodInputError(f"{option} {path}: cannot be read ({error.strerror})") from None
+    if len(text) > MAX_TABLE_BYTES:
+        check_input_file(path, option)
+    return text
 
 
 def numbered_rows(path, option):

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.tables import check_input_file
 
 # A case's name is its result file's name: DIR/<name>.h5.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+=-]*$")
@@ -51,6 +52,7 @@ def read_cases(path, known):
     a comment), a header row naming options without the dash (``rod_end_position``) and
     optionally ``name``, then one row per case; a value ``-`` leaves that option as the
     base options give it. ``known(name)`` says whether an option name exists."""
+    check_input_file(path, "-sweep_cases")
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()

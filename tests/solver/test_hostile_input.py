@@ -590,3 +590,81 @@ def test_a_sweep_s_case_values_and_settings_over_1023_characters_are_read_whole(
     settings = with_options(comm, {"sweep_output": "out", "sweep_offsets": offsets},
                             read_settings)
     assert len(settings.offsets) == 200 and settings.offsets[-1] == 199 * 0.015625
+
+
+# --- input files that are not regular files (a FIFO blocks, a device never ends) --------
+def deadline(seconds=10):
+    """A context in which a call still blocked after ``seconds`` raises TimeoutError
+    (SIGALRM: open() of a FIFO is interrupted and Python raises the handler's error)."""
+    import contextlib
+    import signal
+
+    def expire(*_):
+        raise TimeoutError(f"still blocked after {seconds} s")
+
+    @contextlib.contextmanager
+    def context():
+        previous = signal.signal(signal.SIGALRM, expire)
+        signal.alarm(seconds)
+        try:
+            yield
+        finally:
+            signal.alarm(0)
+            signal.signal(signal.SIGALRM, previous)
+    return context()
+
+
+def input_readers():
+    """{option: read(path)} of every reader of an input table."""
+    from petsc_rod.riser.environment import read_profile, read_seabed_profile
+    from petsc_rod.scenes.line import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
+    from petsc_rod.scenes.point_loads import read_point_loads
+    from petsc_rod.sweep.cases import read_cases
+    from petsc_rod.tables import read_table
+    return {"-rod_line_types": lambda p: read_table(p, "-rod_line_types", LINE_TYPE_COLUMNS,
+                                                    LINE_TYPE_OPTIONAL),
+            "-rod_point_loads": lambda p: read_point_loads(p, 1025.0, 9.81, 100.0),
+            "-rod_current_profile": read_profile,
+            "-rod_seabed_profile": read_seabed_profile,
+            "-sweep_cases": lambda p: read_cases(p, lambda name: True)}
+
+
+@pytest.mark.parametrize("option", list(input_readers()))
+@pytest.mark.parametrize("kind", ["fifo", "/dev/zero", "folder"])
+def test_an_input_file_that_is_not_a_regular_file_is_refused_at_once(tmp_path, option,
+                                                                     kind):
+    path = str(tmp_path / "table")
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "folder":
+        os.mkdir(path)
+    else:
+        path = kind
+    with deadline(), pytest.raises(RodInputError) as error:
+        input_readers()[option](path)
+    message = str(error.value)
+    assert message.startswith(f"{option} {path}: ")
+    assert ("not a regular file" if kind != "folder" else "is a folder") in message, message
+
+
+def test_an_input_table_above_the_size_cap_is_refused_unread(tmp_path, monkeypatch):
+    from petsc_rod import tables
+    path = tmp_path / "profile.txt"
+    path.write_text("0 1 0 0\n10 1 0 0\n")
+    monkeypatch.setattr(tables, "MAX_TABLE_BYTES", 16)
+    with pytest.raises(RodInputError, match=r"-rod_current_profile .*above the 1.53e-05 MiB"):
+        input_readers()["-rod_current_profile"](str(path))
+
+
+def test_a_restart_file_that_is_a_fifo_is_refused_on_every_rank(comm, shared_tmp):
+    path = f"{shared_tmp}/restart.h5"
+    if comm.getRank() == 0:
+        os.mkfifo(path)
+    comm.tompi4py().Barrier()
+    mesh = Mesh(comm, 4, 1.0)
+    try:
+        with deadline(), pytest.raises(RodInputError, match="-rod_initial .*not a regular"):
+            assert io.read_parameters(path, comm) is None
+            io.read_restart(path, mesh, {})
+    finally:
+        mesh.destroy()
