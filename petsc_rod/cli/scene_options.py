@@ -142,7 +142,7 @@ def sections_from_options(values, given, content=None):
     types = line_types_from_table(
         read_table(path, "-rod_line_types", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
                    content=content),
-        f"-rod_line_types {path}")
+        f"-rod_line_types {path}", MAX_MAGNITUDE)
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     for name, _, _ in entries:
         if name not in types:
@@ -174,8 +174,19 @@ def mesh_pieces(values, scene, given=()):
         raise RodInputError(
             f"-rod_elements {values['rod_elements']}: -rod_sections gives every section "
             f"its elements, {sum(counts)} in all; drop -rod_elements or a section's count")
-    counts = section_elements([length for _, length, _ in entries], counts,
-                              values["rod_elements"])
+    lengths = np.array([length for _, length, _ in entries])
+    shared = np.array([c is None for c in counts])
+    given_counts = int(sum(c for c in counts if c is not None))
+    counts = section_elements(lengths, counts, values["rod_elements"])
+    if "rod_elements" in given and np.any(shared) and counts.sum() != values["rod_elements"]:
+        raise RodInputError(
+            f"-rod_elements {values['rod_elements']}: -rod_sections gives {given_counts} "
+            f"elements to the sections with a count and needs at least one for each of the "
+            f"{int(shared.sum())} without, {int(counts.sum())} in all; give -rod_elements "
+            f"{int(counts.sum())} or more")
+    check_represented(entries, lengths, counts, shared, given_counts, scene.length,
+                      f"-rod_elements {values['rod_elements']}" if "rod_elements" in given
+                      else f"-rod_sections (the default -rod_elements {values['rod_elements']})")
     ends = [scene.sections[0].start] + [section.end for section in scene.sections]
     smallest = float(np.min(np.diff(ends) / counts))
     if not smallest >= MIN_RELATIVE_ELEMENT * scene.length:
@@ -184,6 +195,36 @@ def mesh_pieces(values, scene, given=()):
             f"of the length, below what double precision resolves ({MIN_RELATIVE_ELEMENT:g}); "
             "lengthen the shortest section or give it fewer elements")
     return Pieces(ends, counts)
+
+
+# The fewest elements a line of sections is meshed with along its length: an element
+# longer than the length over this is a straight chord across a quarter of the line or
+# more, which cannot represent the line's shape (a 2300 m section of one element).
+MIN_LINE_ELEMENTS = 4
+
+
+def check_represented(entries, lengths, counts, shared, given_counts, length, sharing):
+    """Refuse a section whose elements (``counts`` of ``entries``, ``shared`` those
+    without their own count) are longer than length / MIN_LINE_ELEMENTS, saying what
+    mesh is needed: the section's own count, or the -rod_elements that shares enough
+    out to those without one (``sharing``: how the message names what shared them)."""
+    element = lengths / counts
+    coarse = np.flatnonzero(element > length / MIN_LINE_ELEMENTS)
+    if not coarse.size:
+        return
+    k = int(coarse[0])
+    name, section = entries[k][0], lengths[k]
+    what = (f"section {k + 1} ({name}, {section:g} m) has {int(counts[k])} element(s) of "
+            f"{element[k]:.4g} m, longer than a {MIN_LINE_ELEMENTS}th of the line "
+            f"({length:g} m): a mesh that coarse cannot represent the line's shape")
+    needed = int(np.ceil(MIN_LINE_ELEMENTS * section / length))
+    if not shared[k]:
+        raise RodInputError(f"-rod_sections: {what}; give it at least {needed} elements "
+                            f"({name}:{section:g}:{needed})")
+    total = given_counts + int(np.ceil(MIN_LINE_ELEMENTS * lengths[shared].sum() / length)
+                               ) + int(shared.sum())
+    raise RodInputError(f"{sharing}: {what}; give -rod_elements {total} or more (or the "
+                        f"section its own count, {name}:{section:g}:{needed})")
 
 
 def pressures_from_options(values, given, scene):
@@ -198,12 +239,31 @@ def pressures_from_options(values, given, scene):
                 raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
                                     "id give the pipe it applies to)")
         return
+    check_partners(given, scene.sections)
     surface = values["rod_sea_surface"]
     if surface is not None:
         scene.sea_surface = float(surface - scene.start_position[2])
     scene.contents_density = float(values["rod_contents_density"])
     scene.internal_pressure = float(values["rod_internal_pressure"])
     scene.design_factor = float(values["rod_design_factor"])
+
+
+def check_partners(given, sections):
+    """Refuse a pipe setting that does nothing without its partner in the line types:
+    -rod_internal_pressure and -rod_contents_density act on the bore (no type with an
+    id > 0: no bore), -rod_design_factor scales the yield stress (no type with smys: no
+    utilisation)."""
+    bore = any(section.id > 0 for section in sections)
+    yield_stress = any(np.isfinite(section.smys) for section in sections)
+    for name, present, partner in (
+            ("rod_internal_pressure", bore, "an id column (the bore it acts on)"),
+            ("rod_contents_density", bore, "an id column (the bore the contents fill)"),
+            ("rod_design_factor", yield_stress,
+             "an smys column (the yield stress it scales into the allowable stress)")):
+        if name in given and not present:
+            raise RodInputError(f"-{name} needs a line type with {partner}: no line type "
+                                "of -rod_sections has one; give it in -rod_line_types, or "
+                                f"drop -{name}")
 
 
 def check_taut(scene):
