@@ -2,6 +2,8 @@
 (options.py): the one place where option values become the objects the numerical code
 takes (Scene, Seabed, Current, Settings), with the checks that need several options."""
 
+import dataclasses
+
 import numpy as np
 
 from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
@@ -570,8 +572,20 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
                   "the held ends")
     check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
+    seabed = seated(seabed, min(held))
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
     return seabed, current_from_options(values, given, max(held), profile, section_drag)
+
+
+def seated(seabed, lowest):
+    """A flat ``seabed`` lowered to ``lowest`` (m), the lowest held end, where that end
+    lies below it by round-off (check_ends_above accepts 1e-12 of the length): such an
+    end is on the seabed (-rod_seabed 1e-12 against an anchor at z = 0, or 0.1 + 0.2
+    against 0.3), and an anchor pressed into it by round-off started the catenary below
+    the seabed (NaN at the first iteration). A sloping or profiled seabed is kept."""
+    if seabed is None or not seabed.flat or not lowest < seabed.height:
+        return seabed
+    return dataclasses.replace(seabed, height=float(lowest))
 
 
 def options_from_parameters(parameters):
