@@ -268,6 +268,20 @@ def check_partners(given, sections):
                                 f"drop -{name}")
 
 
+def line_names(sections):
+    """How a message names what gives the line's load, stiffness, stretch, drag and
+    length: the options of a uniform line, or what the line types give in their place
+    (SECTION_REPLACES: those options are refused beside -rod_sections)."""
+    if sections:
+        return dict(load="the line types' weight (mass and od in -rod_line_types)",
+                    stiffness="the line types' ei and gj (-rod_line_types)",
+                    stretch="the line types an ea column (EA, N)",
+                    drag="the line types' cd and drag_d (-rod_line_types)",
+                    length="-rod_sections")
+    return dict(load="-rod_load", stiffness="-rod_stiffness", stretch="-rod_axial_stiffness EA",
+                drag="-rod_drag", length="-rod_length")
+
+
 def check_taut(scene):
     """Refuse a loaded inextensible line held at both ends its length apart (Scene.taut):
     it can only be straight, and any tension balances its loads along it, so that the
@@ -281,7 +295,8 @@ def check_taut(scene):
         f"-rod_end_position: the held ends are {chord:.15g} m apart, the line's length "
         f"{scene.length:.15g} m: an inextensible line held taut is straight and any "
         "tension balances its loads, so its tension is undetermined; give "
-        "-rod_axial_stiffness EA to model the stretch, or bring the ends closer")
+        f"{line_names(scene.sections)['stretch']} to model the stretch, or bring the ends "
+        "closer")
 
 
 def check_seabed_stiffness(scene, given):
@@ -302,7 +317,8 @@ def check_seabed_stiffness(scene, given):
     if "rod_seabed_stiffness" in given:
         raise RodInputError(f"-rod_seabed_stiffness {k:g}: {why}; use "
                             f"-rod_seabed_stiffness {largest:.3g} or less")
-    raise RodInputError(f"-rod_load: the default -rod_seabed_stiffness (weight / 1 mm) is "
+    raise RodInputError(f"{line_names(scene.sections)['load']}: the default "
+                        f"-rod_seabed_stiffness (weight / 1 mm) is "
                         f"{k:.3g} N/m^2, above what this line accepts: {why}; give "
                         f"-rod_seabed_stiffness {largest:.3g} or less")
 
@@ -323,24 +339,28 @@ def check_applied_forces(scene, given):
     options themselves): the drag coefficient c = rho C_d D / 2, the largest drag
     c max |v|^2 (N/m) and the total applied force F = int |f| dS + |P_0| + |P_L| + L c
     max |v|^2 (N, Scene.applied_forces), naming the option behind the largest part."""
+    names = line_names(scene.sections)
     if scene.current is not None:
         if scene.current.drag > MAX_MAGNITUDE:
             raise RodInputError(
-                f"-rod_drag: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is above "
-                f"{MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
+                f"{names['drag']}: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is "
+                f"above {MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
         drag = scene.current.largest_drag()
         if drag > MAX_MAGNITUDE:
             raise RodInputError(
-                f"{_current_option(given)} with -rod_drag: the largest drag c max |v|^2 = "
+                f"{_current_option(given)} with {names['drag']}: the largest drag c max "
+                f"|v|^2 = "
                 f"{drag:.3g} N/m is above {MAX_MAGNITUDE:g}; give the current in m/s")
     parts = scene.applied_forces()
     total = sum(parts.values())
     if total > MAX_MAGNITUDE:
         name = max(parts, key=parts.get)
-        option = {"load": "-rod_load (with -rod_length)", "start_force": "-rod_start_force",
+        option = {"load": f"{names['load']} (with {names['length']})",
+                  "start_force": "-rod_start_force",
                   "point_loads": "-rod_point_loads|-rod_point_load",
                   "end_force": "-rod_end_force",
-                  "drag": f"{_current_option(given)} with -rod_drag and -rod_length"}[name]
+                  "drag": f"{_current_option(given)} with {names['drag']} and "
+                          f"{names['length']}"}[name]
         raise RodInputError(
             f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
             f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
@@ -380,16 +400,18 @@ def checked_default_penalty(scene, start_tension=0.0):
     scales = penalty_scales(scene, start_tension)
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
-        stiffness = ("-rod_stiffness" if not scene.sections
-                     else "the line types' ei and gj (-rod_line_types)")
+        names = line_names(scene.sections)
+        stiffness = names["stiffness"]
         option, formula = {
-            "bending": (f"{stiffness} with -rod_length", "100 sqrt(min K max K) / L^2"),
-            "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
+            "bending": (f"{stiffness} with {names['length']}", "100 sqrt(min K max K) / L^2"),
+            "tension": (f"{names['load']}, -rod_start_force, -rod_end_force or the current",
+                        "F / 2"),
             "twist": (f"-rod_end_twist (or -rod_end_frame) with {stiffness}",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
-            "stretch": ("-rod_axial_stiffness with -rod_end_position",
+            "stretch": ("-rod_axial_stiffness with -rod_end_position" if not scene.sections
+                        else "the line types' ea with -rod_end_position",
                         "EA (|r_L| - L) / 2L"),
-            "start": ("-rod_load with -rod_initial_shape catenary",
+            "start": (f"{names['load']} with -rod_initial_shape catenary",
                       "the catenary start's largest tension")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
@@ -467,8 +489,10 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
     if stiffness is None:
         stiffness = default_stiffness(load_values)
         if stiffness is None:
-            raise RodInputError("-rod_seabed: no -rod_load points down to set the default "
-                                "stiffness (weight / 1 mm); give -rod_seabed_stiffness")
+            load = ("no line type sinks (mass above the water displaced)"
+                    if "rod_sections" in given else "no -rod_load points down")
+            raise RodInputError(f"-rod_seabed: {load} to set the default stiffness "
+                                "(weight / 1 mm); give -rod_seabed_stiffness")
     friction = friction_from_options(values, given, float(stiffness))
     absolute = dict(values)
     if values["rod_seabed"] is not None:

@@ -455,8 +455,9 @@ def _read_restart(path, mesh, layout):
             refuse("not a petsc_rod result file (no dataset S)")
         if f["S"].shape != layout["S"][0]:
             elements = f["S"].shape[0] - 1 if f["S"].ndim == 1 else "?"
-            refuse(f"the file has {elements} elements, this run {mesh.n_elements}; use "
-                   f"-rod_elements {elements}")
+            fix = (f"-rod_elements {elements}" if mesh.pieces is None else
+                   f"-rod_sections counts (TYPE:LENGTH:ELEMENTS) of {elements} in all")
+            refuse(f"the file has {elements} elements, this run {mesh.n_elements}; use {fix}")
         data = {key: _read_slice(f, key, *layout[key], refuse) for key in layout}
         if not np.allclose(data["S"], mesh.vertex_S, rtol=1e-12, atol=1e-12 * mesh.length):
             refuse("the file's mesh (length or grading) is not this run's; use the same "

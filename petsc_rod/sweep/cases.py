@@ -196,9 +196,10 @@ def current_cases(headings, speed, values):
             raise RodInputError("-sweep_current_headings needs -sweep_current_speed, or a "
                                 "-rod_current in the base options to take the speed from")
         speed = float(np.linalg.norm(values["rod_current"]))
-    if values["rod_drag"] is None:
+    if values["rod_drag"] is None and not values.get("rod_sections"):
         raise RodInputError("-sweep_current_headings: a current needs -rod_drag rho,Cd,D "
-                            "in the base options")
+                            "in the base options (or -rod_sections, whose line types give "
+                            "the drag)")
     cases = []
     for heading in headings:
         angle = np.radians(heading)

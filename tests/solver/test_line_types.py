@@ -169,6 +169,34 @@ def test_bad_line_types_and_sections_are_refused_in_one_line(options, table, cas
     assert words in message and "\n" not in message, message
 
 
+# Advice on a line of sections names what the user can change there, never an option
+# petsc_rod refuses beside -rod_sections (-rod_length, -rod_load, -rod_axial_stiffness,
+# -rod_drag: SECTION_REPLACES).
+ADVICE = {
+    "ends farther apart than the sections": (dict(rod_end_position="12,0,0"),
+                                             "the line types an ea column"),
+    "ends held taut": (dict(rod_end_position="10,0,0"), "the line types an ea column"),
+    "a floating line on a seabed without a stiffness": (dict(rod_sections="float:10"),
+                                                       "no line type sinks"),
+    "a point beyond the line": (dict(rod_point_load="12,0,0,-5"), "L = 10 m, its length"),
+}
+
+
+@pytest.mark.parametrize("case", list(ADVICE))
+def test_advice_on_sections_names_what_the_sections_take(options, table, case):
+    from petsc_rod.cli.scene_options import SECTION_REPLACES, scene_from_options
+    change, words = ADVICE[case]
+    given = {**CABLE_ENDS, "rod_line_types": table(CABLE_TYPES), "rod_sections": "bare:10",
+             "rod_end_position": "5,0,5", **change}
+    values, names = options(**given)()
+    with pytest.raises(RodInputError) as error:
+        scene_from_options(values, names)
+    message = str(error.value)
+    assert words in message, message
+    for name in list(SECTION_REPLACES) + ["rod_length"]:
+        assert f"-{name} " not in message + " " and f"-{name};" not in message, message
+
+
 def solved_cable(options, given, comm):
     """r and the effective tension of the 80 m cable from its catenary start, and the
     step's iterations."""
