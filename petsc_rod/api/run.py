@@ -151,7 +151,8 @@ def solve(model, comm=None, output=None, say=None):
     settings = settings_from_options(values, scene)
     pieces = mesh_pieces(values, scene)
     values["rod_elements"] = int(pieces.counts.sum())
-    check_mesh(comm, values)
+    check_mesh(comm, values, named=f"the model's Line ({values['rod_elements']} elements in "
+                                   "all: its sections' counts and element_length)")
     if output:
         io.check_output_path(output, comm)
     mesh = problem = solver = keeper = None

@@ -576,3 +576,14 @@ def test_an_anchor_on_the_seabed_to_round_off_is_on_it(tmp_path, seabed):
                   + seabed)
     assert process.returncode == 0, process.stdout + process.stderr
     assert "converged, 18 iterations" in process.stdout
+
+
+def test_a_mesh_of_sections_too_large_names_the_sections_not_rod_elements(tmp_path):
+    """The sections' counts set the mesh; -rod_elements beside them is refused, so the
+    message must not ask for it."""
+    process = run(["-options_file", "options/steel_catenary_riser.opts", "-rod_sections",
+                   "scr10:2400:1000000000"])
+    text = process.stdout + process.stderr
+    assert_one_line_and_nothing_left(process.returncode, text, 2,
+                                     ["-rod_sections (1000000000 elements in all)", "memory"])
+    assert "-rod_elements" not in text
