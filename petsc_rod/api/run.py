@@ -5,6 +5,7 @@ the API that creates and destroys PETSc objects; what it returns holds numpy arr
 only (api/results.py)."""
 
 import hashlib
+import re
 
 import numpy as np
 
@@ -81,6 +82,33 @@ def _run_record(model, values, solver, start, output):
     return record
 
 
+# The model's field behind each option it stands for (Model.option_texts), so that a
+# refusal of the command line's checks names what the caller gave.
+MODEL_FIELDS = {"rod_sections": "Line.sections", "rod_line_types": "the LineTypes",
+                "rod_contents_density": "Line.contents_density",
+                "rod_internal_pressure": "Line.internal_pressure",
+                "rod_steps": "Model.steps", "rod_initial_shape": "Model.initial_shape",
+                "rod_point_loads": "Model.attachments",
+                "rod_current": "Environment.current",
+                "rod_current_profile": "Environment.current",
+                "rod_sea_surface": "Environment.surface",
+                **{f"rod_{name}": f"Environment.{name}" for name in (
+                    "seabed", "seabed_stiffness", "seabed_friction",
+                    "seabed_friction_stiffness", "water_density", "gravity")},
+                **{f"rod_{end}{option}": f"Model.{end}{field}" for end in ("start", "end")
+                   for option, field in (("", ""), ("_position", ".position"),
+                                         ("_rotational_stiffness", ".stiffness"),
+                                         ("_joint_axis", ".axis"), ("_force", ".force"))}}
+
+
+def in_model_terms(error):
+    """RodInputError ``error`` of the command line's checks, its options named as the
+    model's fields (MODEL_FIELDS; a table's stand-in name, '<line types>', dropped)."""
+    text = re.sub(r"-(rod_\w+)(?: <[a-z ]+>)?",
+                  lambda match: MODEL_FIELDS.get(match.group(1), match.group(0)), str(error))
+    return RodInputError(text)
+
+
 def check_options_known(model):
     """Refuse a name of Model.options that is not a -rod_* option, with the nearest
     known name, as the command line refuses it; and a solver option (-rod_newton_*, ...),
@@ -147,9 +175,12 @@ def solve(model, comm=None, output=None, say=None):
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     check_same_model(comm, model)
-    scene, values, given = on_every_rank(comm, scene_of, model)
-    settings = settings_from_options(values, scene)
-    pieces = mesh_pieces(values, scene)
+    try:
+        scene, values, given = on_every_rank(comm, scene_of, model)
+        settings = settings_from_options(values, scene)
+        pieces = mesh_pieces(values, scene)
+    except RodInputError as error:
+        raise in_model_terms(error) from None
     values["rod_elements"] = int(pieces.counts.sum())
     check_mesh(comm, values, named=f"the model's Line ({values['rod_elements']} elements in "
                                    "all: its sections' counts and element_length)")

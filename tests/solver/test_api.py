@@ -180,3 +180,19 @@ def test_models_that_differ_between_ranks_are_refused_on_every_rank(change):
     with pytest.raises(RodInputError, match=f"rank {mpi.Get_size() - 1} was given another "
                                             "model than rank 0"):
         solve(model(**fields))
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(line=Line([(PIPE, 160.0)], internal_pressure=1e6)),
+     "Line.internal_pressure needs a line type with an id"),
+    (dict(end=End.hang_off((300.0, 0.0, 55.0))), "Model.end.position: the ends are"),
+    (dict(start=End.anchor((0.0, 0.0, -1.0))), "Model.start: the end is held at z = -1 m"),
+    (dict(line=Line([(LineType("soft", od=0.2, mass=60.0, ei=1e-300, gj=8e4), 160.0)])),
+     "the LineTypes: line type soft: ei 1e-300"),
+])
+def test_a_refusal_names_the_model_s_fields_not_options(change, words):
+    """The model's checks are the command line's; their messages name what the caller
+    gave (Line.internal_pressure), not options it never saw (-rod_internal_pressure)."""
+    with pytest.raises(RodInputError) as error:
+        solve(model(**change))
+    assert words in str(error.value) and "-rod_" not in str(error.value), str(error.value)
