@@ -64,10 +64,11 @@ def read_text(path, option):
     return text
 
 
-def numbered_rows(path, option):
+def numbered_rows(path, option, content=None):
     """[(line number from 1, words)] of the non-empty rows of the file ``path`` given to
-    ``option``: '#' starts a comment, whitespace or commas separate the words."""
-    lines = read_text(path, option).splitlines()
+    ``option`` (or of its ``content``, already read): '#' starts a comment, whitespace
+    or commas separate the words."""
+    lines = (read_text(path, option) if content is None else content).splitlines()
     rows = [(k + 1, line.split("#", 1)[0].replace(",", " ").split())
             for k, line in enumerate(lines)]
     return [(k, row) for k, row in rows if row]
@@ -79,13 +80,14 @@ def read_table(path, option, required, optional=(), text=("name",), content=None
     columns in ``text``. Every column of ``required`` must be in the header; a column
     outside ``required`` and ``optional`` is refused (a misspelt name would otherwise be
     ignored), as are a repeated column, a row of another length, a value that is not a
-    number, and a table without rows."""
+    number, and a table without rows; a row is named by its line in the file (comments
+    and blank lines counted)."""
     def refuse(what):
         raise RodInputError(f"{option} {path}: {what}")
 
-    lines = (read_text(path, option) if content is None else content).splitlines()
-    rows = [line.split("#", 1)[0].replace(",", " ").split() for line in lines]
-    rows = [row for row in rows if row]
+    numbered = numbered_rows(path, option, content)
+    rows = [row for _, row in numbered]
+    lines = [number for number, _ in numbered[1:]]      # of the rows after the header
     if not rows:
         refuse("is empty; give a header row naming the columns, then one row per entry")
     header = [name.lower() for name in rows[0]]
@@ -102,9 +104,9 @@ def read_table(path, option, required, optional=(), text=("name",), content=None
     if len(rows) == 1:
         refuse("has a header but no rows")
     columns = {name: [] for name in header}
-    for number, row in enumerate(rows[1:], start=2):
+    for number, row in zip(lines, rows[1:]):
         if len(row) != len(header):
-            refuse(f"row {number} has {len(row)} values for {len(header)} columns")
+            refuse(f"line {number} has {len(row)} values for {len(header)} columns")
         for name, value in zip(header, row):
             columns[name].append(value)
     table = {}
@@ -114,13 +116,13 @@ def read_table(path, option, required, optional=(), text=("name",), content=None
             continue
         blank = np.array([v == BLANK for v in values])
         if np.any(blank) and name in required:
-            refuse(f"column {name} is required in every row; row "
-                   f"{int(np.flatnonzero(blank)[0]) + 2} leaves it blank ('{BLANK}')")
+            refuse(f"column {name} is required in every row; line "
+                   f"{lines[int(np.flatnonzero(blank)[0])]} leaves it blank ('{BLANK}')")
         try:
             table[name] = np.array([np.nan if v == BLANK else float(v) for v in values])
         except ValueError:
-            bad = next(v for v in values if v != BLANK and not _is_number(v))
-            refuse(f"column {name}: '{bad}' is not a number")
+            k = next(k for k, v in enumerate(values) if v != BLANK and not _is_number(v))
+            refuse(f"line {lines[k]}, column {name}: '{values[k]}' is not a number")
         if np.any(np.isnan(table[name]) & ~blank):
             refuse(f"column {name} holds a value that is not a number")
     return table

@@ -121,7 +121,12 @@ BAD = {
                                          rod_load="0,0,-1"),
                                     "-rod_contents_density needs -rod_sections"),
     "a blank od": ("name od mass gj ei\nbare - 36.7 1 1\n", "column od is required"),
-    "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "row 2 has 4 values"),
+    "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "line 2 has 4 values"),
+    # a row is named by its line in the file, comments counted
+    "a short row after comments": ("# a data sheet\n\nname od mass ei gj\n# bare cable\n"
+                                   "bare 0.16 36.7 1\n", "line 5 has 4 values"),
+    "a word after comments": ("# sheet\nname od mass ei gj\n\nbare 0.16 heavy 1 1\n",
+                              "line 4, column mass: 'heavy' is not a number"),
     "a word for a number": ("name od mass ei gj\nbare 0.16 heavy 1 1\n", "'heavy' is not"),
     "-rod_stiffness with sections": (dict(rod_sections="bare:10", rod_stiffness="1,1,1"),
                                      "-rod_stiffness with -rod_sections"),
