@@ -217,7 +217,7 @@ def check_represented(entries, lengths, counts, shared, given_counts, length, sh
     k = int(coarse[0])
     name, section = entries[k][0], lengths[k]
     what = (f"section {k + 1} ({name}, {section:g} m) has {int(counts[k])} element(s) of "
-            f"{element[k]:.4g} m, longer than a {MIN_LINE_ELEMENTS}th of the line "
+            f"{element[k]:.4g} m, longer than 1/{MIN_LINE_ELEMENTS} of the line "
             f"({length:g} m): a mesh that coarse cannot represent the line's shape")
     needed = int(np.ceil(MIN_LINE_ELEMENTS * section / length))
     if not shared[k]:
