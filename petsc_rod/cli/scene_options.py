@@ -596,20 +596,25 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
                   "the held ends")
     check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
-    seabed = seated(seabed, min(held))
+    seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
     return seabed, current_from_options(values, given, max(held), profile, section_drag)
 
 
-def seated(seabed, lowest):
-    """A flat ``seabed`` lowered to ``lowest`` (m), the lowest held end, where that end
-    lies below it by round-off (check_ends_above accepts 1e-12 of the length): such an
-    end is on the seabed (-rod_seabed 1e-12 against an anchor at z = 0, or 0.1 + 0.2
-    against 0.3), and an anchor pressed into it by round-off started the catenary below
-    the seabed (NaN at the first iteration). A sloping or profiled seabed is kept."""
-    if seabed is None or not seabed.flat or not lowest < seabed.height:
+def seated(seabed, held):
+    """``seabed`` lowered by the deepest penetration of the held ends at ``held`` (n, 3),
+    m, where one lies below it by round-off (check_ends_above accepts 1e-12 of the
+    length): such an end is on the seabed (-rod_seabed 1e-12 against an anchor at z = 0,
+    or 0.1 + 0.2 against 0.3), and an anchor pressed into it by round-off started the
+    catenary below the seabed (NaN at the first iteration). The whole seabed, flat or
+    shaped, moves down by that round-off."""
+    if seabed is None:
         return seabed
-    return dataclasses.replace(seabed, height=float(lowest))
+    depth = float(np.max(-seabed.gap(np.asarray(held, dtype=float).reshape(-1, 3))))
+    if not depth > 0:
+        return seabed
+    shape = None if seabed.flat else seabed.shape.moved(np.array([0.0, 0.0, depth]))
+    return dataclasses.replace(seabed, height=seabed.height - depth, shape=shape)
 
 
 def options_from_parameters(parameters):

@@ -566,16 +566,22 @@ def test_a_run_stopped_by_a_signal_keeps_its_converged_steps_as_a_restart_file(t
     assert f"restart from {kept}, load factor {factor:.6g}" in again.stdout
 
 
-@pytest.mark.parametrize("seabed", [["-rod_seabed", "1e-12"],
-                                    ["-rod_seabed", "0.30000000000000004",
-                                     "-rod_start_position", "0,0,0.3"]])
-def test_an_anchor_on_the_seabed_to_round_off_is_on_it(tmp_path, seabed):
-    """An anchor 1e-12 m below the seabed (or 0.1 + 0.2 against 0.3) was accepted, then
-    diverged at iteration 1 of every halving (exit 4): it is on the seabed."""
-    process = run(["-options_file", "options/riser_catenary.opts", "-rod_elements", "200"]
-                  + seabed)
+CATENARY_RISER = ["-options_file", "options/riser_catenary.opts", "-rod_elements", "200"]
+
+
+@pytest.mark.parametrize("args, iterations", [
+    (CATENARY_RISER + ["-rod_seabed", "1e-12"], 18),
+    (CATENARY_RISER + ["-rod_seabed", "0.30000000000000004", "-rod_start_position", "0,0,0.3"],
+     18),
+    (["-options_file", "options/steel_catenary_riser_slope.opts", "-rod_seabed", "1e-12",
+      "-rod_sections", "scr10:2400:400"], 36)])
+def test_an_anchor_on_the_seabed_to_round_off_is_on_it(tmp_path, args, iterations):
+    """An anchor 1e-12 m below the seabed, flat or sloping (or 0.1 + 0.2 against 0.3),
+    was accepted, then diverged at iteration 1 of every halving (exit 4): it is on the
+    seabed, and the run converges as with the anchor exactly on it."""
+    process = run(args)
     assert process.returncode == 0, process.stdout + process.stderr
-    assert "converged, 18 iterations" in process.stdout
+    assert f"converged, {iterations} iterations" in process.stdout
 
 
 def test_a_mesh_of_sections_too_large_names_the_sections_not_rod_elements(tmp_path):
