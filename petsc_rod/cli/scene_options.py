@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
+from petsc_rod.cli.options import BY_NAME, MAX_MAGNITUDE, OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
@@ -164,10 +164,17 @@ def sections_from_options(values, given, content=None):
 def mesh_pieces(values, scene, given=()):
     """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
     vertex, with the element counts -rod_sections gives and the rest of -rod_elements
-    shared out by length; None for a line without sections. A -rod_elements (in
+    shared out by length; None for a line without sections (whose -rod_elements is
+    refused below MIN_LINE_ELEMENTS, check_represented's bound). A -rod_elements (in
     ``given``) that disagrees with counts given for every section is refused, and so is
     an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
     if not scene.sections:
+        if values["rod_elements"] < MIN_LINE_ELEMENTS:
+            raise RodInputError(
+                f"-rod_elements {values['rod_elements']}: elements of 1/"
+                f"{values['rod_elements']} of the line are chords too long to represent its "
+                f"shape; give -rod_elements {MIN_LINE_ELEMENTS} or more (the default is "
+                f"{BY_NAME['rod_elements'].default})")
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     counts = [count for _, _, count in entries]
@@ -199,9 +206,9 @@ def mesh_pieces(values, scene, given=()):
     return Pieces(ends, counts)
 
 
-# The fewest elements a line of sections is meshed with along its length: an element
-# longer than the length over this is a straight chord across a quarter of the line or
-# more, which cannot represent the line's shape (a 2300 m section of one element).
+# The fewest elements a line is meshed with along its length: an element longer than
+# the length over this is a straight chord across a quarter of the line or more, which
+# cannot represent the line's shape (a 2300 m section of one element).
 MIN_LINE_ELEMENTS = 4
 
 
