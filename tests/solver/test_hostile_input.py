@@ -680,3 +680,19 @@ def test_a_uniform_line_of_too_few_elements_is_refused(options, elements):
         mesh_pieces(values, scene_from_options(values, given), given)
     values["rod_elements"] = 4
     assert mesh_pieces(values, scene_from_options(values, given), given) is None
+
+
+@pytest.mark.parametrize("pieces", [None, ([0.0, 0.5, 1.0], [4, 6])])
+def test_a_restart_of_another_element_count_asks_for_what_sets_it(result, comm, pieces):
+    """A line of sections takes its count from -rod_sections (-rod_elements beside
+    counts is refused): the advice names the sections' counts there."""
+    from petsc_rod.mesh.mesh import Pieces
+    _, path = result
+    mesh = Mesh(comm, 10, 1.0, 1.0, None if pieces is None else Pieces(*pieces))
+    try:
+        with pytest.raises(RodInputError) as error:
+            io.read_restart(path, mesh, {})
+    finally:
+        mesh.destroy()
+    fix = "use -rod_elements 8" if pieces is None else "use -rod_sections counts"
+    assert "the file has 8 elements, this run 10; " + fix in str(error.value)
