@@ -593,3 +593,21 @@ def test_a_mesh_of_sections_too_large_names_the_sections_not_rod_elements(tmp_pa
     assert_one_line_and_nothing_left(process.returncode, text, 2,
                                      ["-rod_sections (1000000000 elements in all)", "memory"])
     assert "-rod_elements" not in text
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("option", ["-rod_line_types", "-rod_current_profile",
+                                    "-rod_seabed_profile", "-rod_point_loads"])
+def test_a_table_that_is_a_fifo_exits_2_at_once(tmp_path, option, ranks):
+    """A FIFO blocked the run for ever, deaf to SIGTERM: now one line, exit 2."""
+    fifo = str(tmp_path / "table")
+    os.mkfifo(fifo)
+    needs = {"-rod_line_types": ["-rod_sections", "pipe:10"],
+             "-rod_current_profile": ["-rod_drag", "1025,1,0.1"],
+             "-rod_seabed_profile": ["-rod_seabed_stiffness", "1e3"],
+             "-rod_point_loads": []}[option]
+    process = subprocess.run(petsc_rod_command(SMALL + [option, fifo] + needs, ranks),
+                             cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
+                             timeout=30, check=False)
+    assert_one_line_and_nothing_left(process.returncode, process.stdout + process.stderr, 2,
+                                     [option, "not a regular file"])
