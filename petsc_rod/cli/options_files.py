@@ -7,6 +7,7 @@ otherwise crash PETSc or give a misleading message. No PETSc here: it runs first
 import os
 import re
 
+from petsc_rod import tables
 from petsc_rod.tables import file_problem
 
 # A UTF-8 byte-order mark: invisible in an editor, but PETSc reads it as part of the
@@ -126,6 +127,10 @@ def read_options_file(path, reference, nested):
                                "options/ (e.g. options/paper.opts)")
     if problem:
         raise OptionsFileError(f"{reference}: {problem}")
+    if os.stat(path).st_size > tables.MAX_TABLE_BYTES:
+        raise OptionsFileError(f"{reference}: is {os.stat(path).st_size / 2**20:.3g} MiB, "
+                               f"above the {tables.MAX_TABLE_BYTES / 2**20:.3g} MiB an input "
+                               "file may hold; is it the right file?")
     try:
         with open(path, "rb") as scene:
             data = scene.read()
