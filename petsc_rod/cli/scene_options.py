@@ -460,6 +460,12 @@ def seabed_shape(values, given, origin, profile_rows=None):
     if profile and ("rod_seabed" in given or "rod_seabed_slope" in given):
         raise RodInputError("-rod_seabed_profile gives the seabed's heights: drop "
                             "-rod_seabed and -rod_seabed_slope, or the profile")
+    if not profile and "rod_seabed_slope" not in given:
+        for name in ("rod_seabed_direction", "rod_seabed_origin"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_seabed_slope or -rod_seabed_profile "
+                                    "(the flat -rod_seabed has no direction or origin); give "
+                                    f"one of them, or drop -{name}")
     direction = seabed_direction(values)
     seabed_origin = np.asarray(values["rod_seabed_origin"] if values["rod_seabed_origin"]
                                is not None else (0.0, 0.0), dtype=float)

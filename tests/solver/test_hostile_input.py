@@ -696,3 +696,19 @@ def test_a_restart_of_another_element_count_asks_for_what_sets_it(result, comm, 
         mesh.destroy()
     fix = "use -rod_elements 8" if pieces is None else "use -rod_sections counts"
     assert "the file has 8 elements, this run 10; " + fix in str(error.value)
+
+
+@pytest.mark.parametrize("name, value", [("rod_seabed_direction", "45"),
+                                         ("rod_seabed_origin", "10,0")])
+def test_a_seabed_direction_or_origin_without_a_slope_or_profile_is_refused(options, name,
+                                                                            value):
+    """On the flat -rod_seabed they did nothing, in silence."""
+    from petsc_rod.cli.scene_options import scene_from_options
+    scene = dict(rod_start="pin", rod_end="pin", rod_end_position="0.8,0,0",
+                 rod_load="0,0,-1", rod_seabed="-0.5")
+    values, given = options(**scene, **{name: value})()
+    with pytest.raises(RodInputError, match=f"-{name} needs -rod_seabed_slope or "
+                                            "-rod_seabed_profile"):
+        scene_from_options(values, given)
+    values, given = options(rod_seabed_slope="0")()
+    assert scene_from_options(values, given).seabed.flat
