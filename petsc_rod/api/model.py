@@ -50,19 +50,19 @@ def _real(owner, value, allow_inf=False):
 
 
 def _reals(owner, values, sizes):
-    """``values`` as a float array of one of the sizes ``sizes`` (each entry a number,
-    as _real); RodInputError naming ``owner`` otherwise."""
-    if isinstance(values, (str, bytes)) or values is None:
-        raise RodInputError(f"{owner} {values!r}: expected {' or '.join(map(str, sizes))} "
-                            "numbers")
+    """``values`` as a float array of one of the sizes ``sizes``, every entry a finite
+    number (not text or bool); RodInputError naming ``owner`` otherwise."""
+    expected = f"expected {' or '.join(map(str, sizes))} numbers"
     try:
-        entries = list(np.ravel(np.asarray(values, dtype=object)))
-    except (TypeError, ValueError):
-        entries = None
-    if entries is None or len(entries) not in sizes:
-        raise RodInputError(f"{owner} {values!r}: expected {' or '.join(map(str, sizes))} "
-                            "numbers")
-    return np.array([_real(owner, v) for v in entries])
+        array = np.asarray(values)
+    except (TypeError, ValueError):             # rows of several lengths
+        array = np.asarray(None)
+    if array.dtype.kind not in "iuf" or array.size not in sizes:
+        raise RodInputError(f"{owner} {values!r}: {expected}")
+    array = array.astype(float).ravel()
+    if not np.all(np.isfinite(array)):
+        raise RodInputError(f"{owner} {values!r}: {expected}, finite")
+    return array
 
 
 def _optional(owner, value, check, *args):
@@ -289,10 +289,10 @@ class Environment:
         _real("Environment.gravity", self.gravity)
         if self.current is not None:
             try:
-                shape = np.shape(np.asarray(self.current, dtype=object))
+                shape = np.shape(self.current)
             except ValueError:                  # rows of several lengths
                 shape = None
-            if shape not in ((3,),) and not (shape and len(shape) == 2 and shape[1] == 4):
+            if shape != (3,) and not (shape and len(shape) == 2 and shape[1] == 4):
                 raise RodInputError(f"Environment.current {self.current!r}: a velocity (3 "
                                     "numbers, m/s) or rows (depth m, ux, uy, uz m/s)")
             _reals("Environment.current", self.current, (int(np.prod(shape)),))
