@@ -26,6 +26,7 @@ from petsc_rod.figures.read import read_result  # noqa: E402
 from petsc_rod.figures.riser import riser_figure, sweep_overlay  # noqa: E402
 from petsc_rod.figures.rod import rod_figure  # noqa: E402
 from petsc_rod.io.same_file import replaced_input, write_whole  # noqa: E402
+from petsc_rod.tables import file_problem  # noqa: E402
 
 DPI = 110
 
@@ -106,6 +107,11 @@ def main(argv):
         sys.stderr.write(f"petsc_rod.plots: error: --min-bend-radius {radius:g}: give the "
                          "allowable bend radius in m, positive and finite\n")
         return 2
+    for path in inputs:                 # a FIFO would block h5py for ever
+        problem = file_problem(path)
+        if problem:
+            sys.stderr.write(f"petsc_rod.plots: error: {path}: {problem}\n")
+            return 2
     try:
         if len(inputs) == 1:
             plot_result(inputs[0], output, radius)

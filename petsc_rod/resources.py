@@ -104,17 +104,19 @@ def size_text(nbytes):
         nbytes /= 1024
 
 
-def check_elements_fit(comm, elements, per_element=BYTES_PER_ELEMENT):
+def check_elements_fit(comm, elements, per_element=BYTES_PER_ELEMENT, named=None):
     """Refuse an element count PETSc cannot index or distribute (every rank owns a
     vertex), or whose estimated memory (``per_element`` bytes an element,
     bytes_per_element) exceeds what a machine has available (the share of the ranks it
-    runs). Collective."""
+    runs). ``named``: how the message names the count (default '-rod_elements N'; the
+    sections' counts where they set it). Collective."""
+    named = named or f"-rod_elements {elements}"
     if elements > MAX_ELEMENTS:
-        raise RodInputError(f"-rod_elements {elements}: at most {MAX_ELEMENTS} elements fit "
+        raise RodInputError(f"{named}: at most {MAX_ELEMENTS} elements fit "
                             "in PETSc's integers (2 dofs per vertex)")
     mpi = comm.tompi4py()
     if elements + 1 < mpi.Get_size():
-        raise RodInputError(f"-rod_elements {elements} on {mpi.Get_size()} ranks: every rank "
+        raise RodInputError(f"{named} on {mpi.Get_size()} ranks: every rank "
                             f"needs a vertex; use at least {mpi.Get_size() - 1} elements or "
                             "fewer ranks")
     here = ranks_on_this_machine(comm)
@@ -125,7 +127,7 @@ def check_elements_fit(comm, elements, per_element=BYTES_PER_ELEMENT):
         largest = max(int((available - here * BYTES_PER_RANK) / per_element
                           * mpi.Get_size() / here), 0)
         raise RodInputError(
-            f"-rod_elements {elements}: the run needs about {size_text(needed)} of memory "
+            f"{named}: the run needs about {size_text(needed)} of memory "
             f"({size_text(per_element)} per element), this machine has "
             f"{size_text(available)} available; use at most about {largest:.2g} elements, "
             "or more machines")

@@ -35,6 +35,41 @@ def _numbers(values):
     return ",".join(_number(v) for v in np.ravel(values))
 
 
+def _real(owner, value, allow_inf=False):
+    """``value`` (a number, not text or bool) as a float, finite (or +inf where
+    ``allow_inf``); RodInputError naming ``owner`` (e.g. 'End.stiffness') otherwise."""
+    if isinstance(value, (str, bytes, bool, np.bool_)) or value is None:
+        raise RodInputError(f"{owner} {value!r}: expected a number")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise RodInputError(f"{owner} {value!r}: expected a number") from None
+    if not (math.isfinite(number) or (allow_inf and number == math.inf)):
+        raise RodInputError(f"{owner} {value!r}: expected a finite number")
+    return number
+
+
+def _reals(owner, values, sizes):
+    """``values`` as a float array of one of the sizes ``sizes``, every entry a finite
+    number (not text or bool); RodInputError naming ``owner`` otherwise."""
+    expected = f"expected {' or '.join(map(str, sizes))} numbers"
+    try:
+        array = np.asarray(values)
+    except (TypeError, ValueError):             # rows of several lengths
+        array = np.asarray(None)
+    if array.dtype.kind not in "iuf" or array.size not in sizes:
+        raise RodInputError(f"{owner} {values!r}: {expected}")
+    array = array.astype(float).ravel()
+    if not np.all(np.isfinite(array)):
+        raise RodInputError(f"{owner} {values!r}: {expected}, finite")
+    return array
+
+
+def _optional(owner, value, check, *args):
+    """``check(owner, value, *args)`` of a field that may be None."""
+    return None if value is None else check(owner, value, *args)
+
+
 @dataclass(frozen=True)
 class LineType:
     """A line type as a data sheet gives it (scenes/line.LineType):
@@ -62,6 +97,18 @@ class LineType:
     ei_end: float = None
     smys: float = None
     stress_od: float = None
+
+    def __post_init__(self):
+        owner = f"LineType {self.name!r}"
+        if not isinstance(self.name, str) or not self.name or len(self.name.split()) != 1 \
+                or any(c in self.name for c in ",:#"):
+            raise RodInputError(f"{owner}: a name is one word without , : or #")
+        for name in ("od", "mass", "gj", "cd", "id"):
+            _real(f"{owner}.{name}", getattr(self, name))
+        _real(f"{owner}.ea", self.ea, allow_inf=True)
+        _reals(f"{owner}.ei", self.ei, (1, 2))
+        for name in ("drag_d", "ei_end", "smys", "stress_od"):
+            _optional(f"{owner}.{name}", getattr(self, name), _real)
 
     def row(self):
         """The type's row of a -rod_line_types table, in COLUMNS order ('-' blank)."""
@@ -110,6 +157,31 @@ class Line:
     contents_density: float = 0.0
     internal_pressure: float = 0.0
 
+    def __post_init__(self):
+        if not _real("Line.element_length", self.element_length) > 0:
+            raise RodInputError(f"Line.element_length {self.element_length!r}: must be a "
+                                "positive length (m), the elements of the sections without "
+                                "a count")
+        _real("Line.contents_density", self.contents_density)
+        _real("Line.internal_pressure", self.internal_pressure)
+        if isinstance(self.sections, (str, bytes)) or not hasattr(self.sections, "__len__") \
+                or not len(self.sections):
+            raise RodInputError("Line.sections: a sequence of (LineType, length m) or "
+                                "(LineType, length m, elements)")
+        for k, entry in enumerate(self.sections):
+            owner = f"Line.sections[{k}]"
+            if isinstance(entry, (str, bytes)) or not hasattr(entry, "__len__") \
+                    or len(entry) not in (2, 3) or not isinstance(entry[0], LineType):
+                raise RodInputError(f"{owner} {entry!r}: expected (LineType, length m) or "
+                                    "(LineType, length m, elements)")
+            if not _real(f"{owner} length", entry[1]) > 0:
+                raise RodInputError(f"{owner}: the length {entry[1]!r} must be positive (m)")
+            if len(entry) == 3 and (isinstance(entry[2], (bool, np.bool_))
+                                    or not isinstance(entry[2], (int, np.integer))
+                                    or entry[2] < 1):
+                raise RodInputError(f"{owner}: the element count {entry[2]!r} must be a "
+                                    "whole number of at least 1")
+
     def types(self):
         """The distinct LineTypes, in the order met; RodInputError for two types of one
         name that differ."""
@@ -150,6 +222,13 @@ class End:
     axis: tuple = None
     force: tuple = None
 
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise RodInputError(f"End.kind {self.kind!r}: use one of {', '.join(KINDS)}")
+        _real("End.stiffness", self.stiffness)
+        for name in ("position", "axis", "force"):
+            _optional(f"End.{name}", getattr(self, name), _reals, (3,))
+
     @classmethod
     def anchor(cls, position):
         """A pinned end at ``position`` (m), on the seabed or above it."""
@@ -176,6 +255,13 @@ class Attachment:
     cda: float = 0.0
     name: str = None
 
+    def __post_init__(self):
+        for name in ("S", "mass", "volume", "cda"):
+            _real(f"Attachment.{name}", getattr(self, name))
+        _reals("Attachment.force", self.force, (3,))
+        if self.name is not None and (not isinstance(self.name, str) or "\n" in self.name):
+            raise RodInputError(f"Attachment.name {self.name!r}: a name is one line of text")
+
 
 @dataclass(frozen=True)
 class Environment:
@@ -196,6 +282,22 @@ class Environment:
     current: object = None
     water_density: float = 1025.0
     gravity: float = 9.80665
+
+    def __post_init__(self):
+        for name in ("seabed", "seabed_stiffness", "seabed_friction_stiffness", "surface"):
+            _optional(f"Environment.{name}", getattr(self, name), _real)
+        _optional("Environment.seabed_friction", self.seabed_friction, _reals, (1, 2))
+        _real("Environment.water_density", self.water_density)
+        _real("Environment.gravity", self.gravity)
+        if self.current is not None:
+            try:
+                shape = np.shape(self.current)
+            except ValueError:                  # rows of several lengths
+                shape = None
+            if shape != (3,) and not (shape and len(shape) == 2 and shape[1] == 4):
+                raise RodInputError(f"Environment.current {self.current!r}: a velocity (3 "
+                                    "numbers, m/s) or rows (depth m, ux, uy, uz m/s)")
+            _reals("Environment.current", self.current, (int(np.prod(shape)),))
 
     def profile(self):
         """(depths (m,), velocities (m, 3)) of a current profile, None for a uniform
@@ -224,6 +326,26 @@ class Model:
     steps: int = 1
     initial_shape: str = "catenary"
     options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for name, kind in (("line", Line), ("start", End), ("end", End),
+                           ("environment", Environment)):
+            if not isinstance(getattr(self, name), kind):
+                raise RodInputError(f"Model.{name}: expected an api.{kind.__name__}, not "
+                                    f"{type(getattr(self, name)).__name__}")
+        if isinstance(self.attachments, (str, bytes)) or not all(
+                isinstance(a, Attachment) for a in self.attachments):
+            raise RodInputError("Model.attachments: a sequence of api.Attachment")
+        if isinstance(self.steps, (bool, np.bool_)) or not isinstance(
+                self.steps, (int, np.integer)) or self.steps < 1:
+            raise RodInputError(f"Model.steps {self.steps!r}: a whole number of at least 1")
+        if not isinstance(self.initial_shape, str):
+            raise RodInputError(f"Model.initial_shape {self.initial_shape!r}: 'catenary' or "
+                                "'straight'")
+        if not isinstance(self.options, dict) or not all(
+                isinstance(name, str) for name in self.options):
+            raise RodInputError("Model.options: a dict {name: value} of -rod_* options "
+                                "without 'rod_' (e.g. {'al_rtol': 1e-10})")
 
     def option_texts(self, line_types="<line types>"):
         """{'rod_<name>': text} of the options this model stands for; ``line_types`` the

@@ -4,16 +4,19 @@ continuation (cli/session.run_continuation), on the ranks of ``comm``. The one p
 the API that creates and destroys PETSc objects; what it returns holds numpy arrays
 only (api/results.py)."""
 
+import hashlib
+import re
+
 import numpy as np
 
 from petsc_rod.api.model import Model
 from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (build_solver, check_mesh, destroy_run, run_record,
                                 start_from)
-from petsc_rod.cli.options import parse_values
+from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
 from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
 from petsc_rod.cli.session import run_continuation
-from petsc_rod.errors import RodInputError
+from petsc_rod.errors import RodInputError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
@@ -79,11 +82,75 @@ def _run_record(model, values, solver, start, output):
     return record
 
 
+# The model's field behind each option it stands for (Model.option_texts), so that a
+# refusal of the command line's checks names what the caller gave.
+MODEL_FIELDS = {"rod_sections": "Line.sections", "rod_line_types": "the LineTypes",
+                "rod_contents_density": "Line.contents_density",
+                "rod_internal_pressure": "Line.internal_pressure",
+                "rod_steps": "Model.steps", "rod_initial_shape": "Model.initial_shape",
+                "rod_point_loads": "Model.attachments",
+                "rod_current": "Environment.current",
+                "rod_current_profile": "Environment.current",
+                "rod_sea_surface": "Environment.surface",
+                **{f"rod_{name}": f"Environment.{name}" for name in (
+                    "seabed", "seabed_stiffness", "seabed_friction",
+                    "seabed_friction_stiffness", "water_density", "gravity")},
+                **{f"rod_{end}{option}": f"Model.{end}{field}" for end in ("start", "end")
+                   for option, field in (("", ""), ("_position", ".position"),
+                                         ("_rotational_stiffness", ".stiffness"),
+                                         ("_joint_axis", ".axis"), ("_force", ".force"))}}
+
+
+def in_model_terms(error):
+    """RodInputError ``error`` of the command line's checks, its options named as the
+    model's fields (MODEL_FIELDS; a table's stand-in name, '<line types>', dropped)."""
+    text = re.sub(r"-(rod_\w+)(?: <[a-z ]+>)?",
+                  lambda match: MODEL_FIELDS.get(match.group(1), match.group(0)), str(error))
+    return RodInputError(text)
+
+
+def check_options_known(model):
+    """Refuse a name of Model.options that is not a -rod_* option, with the nearest
+    known name, as the command line refuses it; and a solver option (-rod_newton_*, ...),
+    which only PETSc's options database gives its solver."""
+    for name in model.options:
+        full = f"rod_{name}"
+        if full.startswith(SOLVER_PREFIXES) and full not in BY_NAME:
+            raise RodInputError(f"Model.options {name!r}: the solvers' options are read "
+                                "from PETSc's options database; set -" + full + " there "
+                                "(petsc4py.PETSc.Options().setValue) or on the command line")
+        if full not in BY_NAME:
+            hint = nearest_hint(full).replace("-rod_", "'").replace("?", "'?")
+            raise RodInputError(f"Model.options {name!r}: not a petsc_rod option{hint}")
+
+
+def model_digest(model):
+    """A digest of everything ``model`` gives the run: its option texts and the tables
+    it writes (line types, attachments, current profile)."""
+    texts = model.option_texts()
+    profile = model.environment.profile()
+    whole = [sorted(texts.items()), model.line_types_text(), model.attachment_table(),
+             None if profile is None else [p.tobytes() for p in profile]]
+    return hashlib.sha256(repr(whole).encode()).hexdigest()
+
+
+def check_same_model(comm, model):
+    """Refuse, on every rank of ``comm``, a model that any rank finds bad or that differs
+    between ranks (an answer of neither, or a crash in the first collective call of a
+    mesh built of other element lengths). Collective."""
+    digests = comm.tompi4py().allgather(on_every_rank(comm, model_digest, model))
+    if len(set(digests)) != 1:
+        rank = next(k for k, digest in enumerate(digests) if digest != digests[0])
+        raise RodInputError(f"rank {rank} was given another model than rank 0; give every "
+                            "rank the same Model (built from the same numbers)")
+
+
 def scene_of(model):
     """(Scene, option values, given names) of ``model``: its options parsed and made into
     a validated Scene by the command line's own functions."""
     if not isinstance(model, Model):
-        raise TypeError("solve takes an api.Model")
+        raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
+    check_options_known(model)
     texts = model.option_texts()
     values = parse_values(texts)
     given = set(texts)
@@ -105,11 +172,18 @@ def solve(model, comm=None, output=None, say=None):
     from petsc4py import PETSc
 
     comm = comm or PETSc.COMM_WORLD
-    scene, values, given = scene_of(model)
-    settings = settings_from_options(values, scene)
-    pieces = mesh_pieces(values, scene)
+    if not isinstance(model, Model):
+        raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
+    check_same_model(comm, model)
+    try:
+        scene, values, given = on_every_rank(comm, scene_of, model)
+        settings = settings_from_options(values, scene)
+        pieces = mesh_pieces(values, scene)
+    except RodInputError as error:
+        raise in_model_terms(error) from None
     values["rod_elements"] = int(pieces.counts.sum())
-    check_mesh(comm, values)
+    check_mesh(comm, values, named=f"the model's Line ({values['rod_elements']} elements in "
+                                   "all: its sections' counts and element_length)")
     if output:
         io.check_output_path(output, comm)
     mesh = problem = solver = keeper = None

@@ -81,7 +81,9 @@ def run(comm=None):
                 values["rod_elements"] = int(pieces.counts.sum())
             check_mesh(comm, values, resources.bytes_per_element(
                 scene.seabed is not None
-                and (settings.newton or settings.check_stability)))
+                and (settings.newton or settings.check_stability)),
+                None if pieces is None or "rod_elements" in given else
+                f"-rod_sections ({values['rod_elements']} elements in all)")
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:
@@ -186,17 +188,18 @@ def abort_alone(comm, message, partial=None):
     comm.tompi4py().Abort(RodDivergedError.exit_code)
 
 
-def check_mesh(comm, values, per_element=resources.BYTES_PER_ELEMENT):
+def check_mesh(comm, values, per_element=resources.BYTES_PER_ELEMENT, named=None):
     """Refuse, before it is allocated, a mesh the machine cannot hold (``per_element``
     bytes an element: resources.bytes_per_element), a grading the
     mesh's smooth map cannot build on that many elements (mesh.largest_grading: 1 for 1
     or 2 elements, about 3 N^2 / pi^2 for N), or one whose smallest elements double
     precision cannot resolve. Any mesh of N elements whose largest element is q times its
     smallest has a smallest element of at most L / (N - 1 + q): that bound is checked
-    first, so a grading no mesh could resolve is said as such."""
+    first, so a grading no mesh could resolve is said as such. ``named``: how a message
+    names the element count (resources.check_elements_fit)."""
     elements, length = values["rod_elements"], values["rod_length"]
     grading = values["rod_mesh_grading"]
-    resources.check_elements_fit(comm, elements, per_element)
+    resources.check_elements_fit(comm, elements, per_element, named)
 
     def unresolved(smallest):
         return RodInputError(

@@ -353,15 +353,34 @@ def read_options():
 
     Raises RodInputError for an unknown ``-rod_`` name or a malformed value.
     """
-    database = PETSc.Options()
-    given = {name for name in database.getAll() if name.startswith("rod_")}
+    texts = whole_values()
+    given = {name for name in texts if name.startswith("rod_")}
     for name in sorted(given):
         if name not in BY_NAME and not name.startswith(SOLVER_PREFIXES):
-            close = difflib.get_close_matches(name, list(BY_NAME), n=1)
-            hint = f"; did you mean -{close[0]}?" if close else "; see -help"
-            raise RodInputError(f"unknown option -{name}{hint}")
-    return parse_values({name: database.getString(name, "") for name in given
-                         if name in BY_NAME}), given
+            raise RodInputError(f"unknown option -{name}{nearest_hint(name)}")
+    return parse_values({name: texts[name] for name in given if name in BY_NAME}), given
+
+
+def nearest_hint(name):
+    """'; did you mean -NAME?' of the known option closest to ``name`` (no dash), or a
+    pointer to -help."""
+    close = difflib.get_close_matches(name, list(BY_NAME), n=1)
+    return f"; did you mean -{close[0]}?" if close else "; see -help"
+
+
+def whole_values(database=None):
+    """{name: text} of every option in the database ('' for a name without a value),
+    each text whole: petsc4py's Options.getString returns at most 1023 characters of a
+    value and cuts the rest without a word (a long -rod_sections or -rod_point_load
+    would lose sections or digits), getAll the whole of it. Every -rod_* name is read
+    once through getString as well, which marks it used (getAll does not), so that it is
+    not reported as unused."""
+    database = database or PETSc.Options()
+    texts = {name: text or "" for name, text in database.getAll().items()}
+    for name in texts:
+        if name in BY_NAME:
+            database.getString(name, "")
+    return texts
 
 
 def parse_values(texts):

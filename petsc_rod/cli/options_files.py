@@ -7,6 +7,9 @@ otherwise crash PETSc or give a misleading message. No PETSc here: it runs first
 import os
 import re
 
+from petsc_rod import tables
+from petsc_rod.tables import file_problem
+
 # A UTF-8 byte-order mark: invisible in an editor, but PETSc reads it as part of the
 # first option's name ("Unknown first token").
 BOM = b"\xef\xbb\xbf"
@@ -110,17 +113,24 @@ def read_options_file(path, reference, nested):
     """The text of options file ``path`` (``reference``: how it was named, for the
     message; ``nested``: named in another options file), after the checks PETSc would
     otherwise fail on without a clear message."""
-    if os.path.isdir(path):
+    problem = file_problem(path)            # the check of every input file
+    if problem.startswith("is a folder"):
         raise OptionsFileError(f"{reference}: is a folder, not a scene file")
-    if os.path.exists(path) and not os.path.isfile(path):
+    if problem.startswith("not a regular file"):
         raise OptionsFileError(
             f"{reference}: not a regular file (a pipe such as <(...), or a device): "
             "petsc_rod reads an options file before PETSc reads it again, which a pipe "
             "does not allow; write the options to a file and give its path")
-    if not os.path.isfile(path):
+    if problem == "no such file":
         raise OptionsFileError(f"{reference}: no such file" if nested else
                                f"{reference}: no such scene file; the scenes are in "
                                "options/ (e.g. options/paper.opts)")
+    if problem:
+        raise OptionsFileError(f"{reference}: {problem}")
+    if os.stat(path).st_size > tables.MAX_TABLE_BYTES:
+        raise OptionsFileError(f"{reference}: is {os.stat(path).st_size / 2**20:.3g} MiB, "
+                               f"above the {tables.MAX_TABLE_BYTES / 2**20:.3g} MiB an input "
+                               "file may hold; is it the right file?")
     try:
         with open(path, "rb") as scene:
             data = scene.read()

@@ -2,9 +2,11 @@
 (options.py): the one place where option values become the objects the numerical code
 takes (Scene, Seabed, Current, Settings), with the checks that need several options."""
 
+import dataclasses
+
 import numpy as np
 
-from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
+from petsc_rod.cli.options import BY_NAME, MAX_MAGNITUDE, OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
@@ -144,7 +146,7 @@ def sections_from_options(values, given, content=None):
     types = line_types_from_table(
         read_table(path, "-rod_line_types", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
                    content=content),
-        f"-rod_line_types {path}")
+        f"-rod_line_types {path}", MAX_MAGNITUDE)
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     for name, _, _ in entries:
         if name not in types:
@@ -164,10 +166,17 @@ def sections_from_options(values, given, content=None):
 def mesh_pieces(values, scene, given=()):
     """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
     vertex, with the element counts -rod_sections gives and the rest of -rod_elements
-    shared out by length; None for a line without sections. A -rod_elements (in
+    shared out by length; None for a line without sections (whose -rod_elements is
+    refused below MIN_LINE_ELEMENTS, check_represented's bound). A -rod_elements (in
     ``given``) that disagrees with counts given for every section is refused, and so is
     an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
     if not scene.sections:
+        if values["rod_elements"] < MIN_LINE_ELEMENTS:
+            raise RodInputError(
+                f"-rod_elements {values['rod_elements']}: elements of 1/"
+                f"{values['rod_elements']} of the line are chords too long to represent its "
+                f"shape; give -rod_elements {MIN_LINE_ELEMENTS} or more (the default is "
+                f"{BY_NAME['rod_elements'].default})")
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     counts = [count for _, _, count in entries]
@@ -176,8 +185,19 @@ def mesh_pieces(values, scene, given=()):
         raise RodInputError(
             f"-rod_elements {values['rod_elements']}: -rod_sections gives every section "
             f"its elements, {sum(counts)} in all; drop -rod_elements or a section's count")
-    counts = section_elements([length for _, length, _ in entries], counts,
-                              values["rod_elements"])
+    lengths = np.array([length for _, length, _ in entries])
+    shared = np.array([c is None for c in counts])
+    given_counts = int(sum(c for c in counts if c is not None))
+    counts = section_elements(lengths, counts, values["rod_elements"])
+    if "rod_elements" in given and np.any(shared) and counts.sum() != values["rod_elements"]:
+        raise RodInputError(
+            f"-rod_elements {values['rod_elements']}: -rod_sections gives {given_counts} "
+            f"elements to the sections with a count and needs at least one for each of the "
+            f"{int(shared.sum())} without, {int(counts.sum())} in all; give -rod_elements "
+            f"{int(counts.sum())} or more")
+    check_represented(entries, lengths, counts, shared, given_counts, scene.length,
+                      f"-rod_elements {values['rod_elements']}" if "rod_elements" in given
+                      else f"-rod_sections (the default -rod_elements {values['rod_elements']})")
     ends = [scene.sections[0].start] + [section.end for section in scene.sections]
     smallest = float(np.min(np.diff(ends) / counts))
     if not smallest >= MIN_RELATIVE_ELEMENT * scene.length:
@@ -186,6 +206,36 @@ def mesh_pieces(values, scene, given=()):
             f"of the length, below what double precision resolves ({MIN_RELATIVE_ELEMENT:g}); "
             "lengthen the shortest section or give it fewer elements")
     return Pieces(ends, counts)
+
+
+# The fewest elements a line is meshed with along its length: an element longer than
+# the length over this is a straight chord across a quarter of the line or more, which
+# cannot represent the line's shape (a 2300 m section of one element).
+MIN_LINE_ELEMENTS = 4
+
+
+def check_represented(entries, lengths, counts, shared, given_counts, length, sharing):
+    """Refuse a section whose elements (``counts`` of ``entries``, ``shared`` those
+    without their own count) are longer than length / MIN_LINE_ELEMENTS, saying what
+    mesh is needed: the section's own count, or the -rod_elements that shares enough
+    out to those without one (``sharing``: how the message names what shared them)."""
+    element = lengths / counts
+    coarse = np.flatnonzero(element > length / MIN_LINE_ELEMENTS)
+    if not coarse.size:
+        return
+    k = int(coarse[0])
+    name, section = entries[k][0], lengths[k]
+    what = (f"section {k + 1} ({name}, {section:g} m) has {int(counts[k])} element(s) of "
+            f"{element[k]:.4g} m, longer than 1/{MIN_LINE_ELEMENTS} of the line "
+            f"({length:g} m): a mesh that coarse cannot represent the line's shape")
+    needed = int(np.ceil(MIN_LINE_ELEMENTS * section / length))
+    if not shared[k]:
+        raise RodInputError(f"-rod_sections: {what}; give it at least {needed} elements "
+                            f"({name}:{section:g}:{needed})")
+    total = given_counts + int(np.ceil(MIN_LINE_ELEMENTS * lengths[shared].sum() / length)
+                               ) + int(shared.sum())
+    raise RodInputError(f"{sharing}: {what}; give -rod_elements {total} or more (or the "
+                        f"section its own count, {name}:{section:g}:{needed})")
 
 
 def pressures_from_options(values, given, scene):
@@ -200,12 +250,45 @@ def pressures_from_options(values, given, scene):
                 raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
                                     "id give the pipe it applies to)")
         return
+    check_partners(given, scene.sections)
     surface = values["rod_sea_surface"]
     if surface is not None:
         scene.sea_surface = float(surface - scene.start_position[2])
     scene.contents_density = float(values["rod_contents_density"])
     scene.internal_pressure = float(values["rod_internal_pressure"])
     scene.design_factor = float(values["rod_design_factor"])
+
+
+def check_partners(given, sections):
+    """Refuse a pipe setting that does nothing without its partner in the line types:
+    -rod_internal_pressure and -rod_contents_density act on the bore (no type with an
+    id > 0: no bore), -rod_design_factor scales the yield stress (no type with smys: no
+    utilisation)."""
+    bore = any(section.id > 0 for section in sections)
+    yield_stress = any(np.isfinite(section.smys) for section in sections)
+    for name, present, partner in (
+            ("rod_internal_pressure", bore, "an id column (the bore it acts on)"),
+            ("rod_contents_density", bore, "an id column (the bore the contents fill)"),
+            ("rod_design_factor", yield_stress,
+             "an smys column (the yield stress it scales into the allowable stress)")):
+        if name in given and not present:
+            raise RodInputError(f"-{name} needs a line type with {partner}: no line type "
+                                "of -rod_sections has one; give it in -rod_line_types, or "
+                                f"drop -{name}")
+
+
+def line_names(sections):
+    """How a message names what gives the line's load, stiffness, stretch, drag and
+    length: the options of a uniform line, or what the line types give in their place
+    (SECTION_REPLACES: those options are refused beside -rod_sections)."""
+    if sections:
+        return dict(load="the line types' weight (mass and od in -rod_line_types)",
+                    stiffness="the line types' ei and gj (-rod_line_types)",
+                    stretch="the line types an ea column (EA, N)",
+                    drag="the line types' cd and drag_d (-rod_line_types)",
+                    length="-rod_sections")
+    return dict(load="-rod_load", stiffness="-rod_stiffness", stretch="-rod_axial_stiffness EA",
+                drag="-rod_drag", length="-rod_length")
 
 
 def check_taut(scene):
@@ -221,7 +304,8 @@ def check_taut(scene):
         f"-rod_end_position: the held ends are {chord:.15g} m apart, the line's length "
         f"{scene.length:.15g} m: an inextensible line held taut is straight and any "
         "tension balances its loads, so its tension is undetermined; give "
-        "-rod_axial_stiffness EA to model the stretch, or bring the ends closer")
+        f"{line_names(scene.sections)['stretch']} to model the stretch, or bring the ends "
+        "closer")
 
 
 def check_seabed_stiffness(scene, given):
@@ -242,7 +326,8 @@ def check_seabed_stiffness(scene, given):
     if "rod_seabed_stiffness" in given:
         raise RodInputError(f"-rod_seabed_stiffness {k:g}: {why}; use "
                             f"-rod_seabed_stiffness {largest:.3g} or less")
-    raise RodInputError(f"-rod_load: the default -rod_seabed_stiffness (weight / 1 mm) is "
+    raise RodInputError(f"{line_names(scene.sections)['load']}: the default "
+                        f"-rod_seabed_stiffness (weight / 1 mm) is "
                         f"{k:.3g} N/m^2, above what this line accepts: {why}; give "
                         f"-rod_seabed_stiffness {largest:.3g} or less")
 
@@ -263,24 +348,28 @@ def check_applied_forces(scene, given):
     options themselves): the drag coefficient c = rho C_d D / 2, the largest drag
     c max |v|^2 (N/m) and the total applied force F = int |f| dS + |P_0| + |P_L| + L c
     max |v|^2 (N, Scene.applied_forces), naming the option behind the largest part."""
+    names = line_names(scene.sections)
     if scene.current is not None:
         if scene.current.drag > MAX_MAGNITUDE:
             raise RodInputError(
-                f"-rod_drag: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is above "
-                f"{MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
+                f"{names['drag']}: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is "
+                f"above {MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
         drag = scene.current.largest_drag()
         if drag > MAX_MAGNITUDE:
             raise RodInputError(
-                f"{_current_option(given)} with -rod_drag: the largest drag c max |v|^2 = "
+                f"{_current_option(given)} with {names['drag']}: the largest drag c max "
+                f"|v|^2 = "
                 f"{drag:.3g} N/m is above {MAX_MAGNITUDE:g}; give the current in m/s")
     parts = scene.applied_forces()
     total = sum(parts.values())
     if total > MAX_MAGNITUDE:
         name = max(parts, key=parts.get)
-        option = {"load": "-rod_load (with -rod_length)", "start_force": "-rod_start_force",
+        option = {"load": f"{names['load']} (with {names['length']})",
+                  "start_force": "-rod_start_force",
                   "point_loads": "-rod_point_loads|-rod_point_load",
                   "end_force": "-rod_end_force",
-                  "drag": f"{_current_option(given)} with -rod_drag and -rod_length"}[name]
+                  "drag": f"{_current_option(given)} with {names['drag']} and "
+                          f"{names['length']}"}[name]
         raise RodInputError(
             f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
             f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
@@ -320,16 +409,18 @@ def checked_default_penalty(scene, start_tension=0.0):
     scales = penalty_scales(scene, start_tension)
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
-        stiffness = ("-rod_stiffness" if not scene.sections
-                     else "the line types' ei and gj (-rod_line_types)")
+        names = line_names(scene.sections)
+        stiffness = names["stiffness"]
         option, formula = {
-            "bending": (f"{stiffness} with -rod_length", "100 sqrt(min K max K) / L^2"),
-            "tension": ("-rod_load, -rod_start_force, -rod_end_force or the current", "F / 2"),
+            "bending": (f"{stiffness} with {names['length']}", "100 sqrt(min K max K) / L^2"),
+            "tension": (f"{names['load']}, -rod_start_force, -rod_end_force or the current",
+                        "F / 2"),
             "twist": (f"-rod_end_twist (or -rod_end_frame) with {stiffness}",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
-            "stretch": ("-rod_axial_stiffness with -rod_end_position",
+            "stretch": ("-rod_axial_stiffness with -rod_end_position" if not scene.sections
+                        else "the line types' ea with -rod_end_position",
                         "EA (|r_L| - L) / 2L"),
-            "start": ("-rod_load with -rod_initial_shape catenary",
+            "start": (f"{names['load']} with -rod_initial_shape catenary",
                       "the catenary start's largest tension")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
@@ -371,6 +462,12 @@ def seabed_shape(values, given, origin, profile_rows=None):
     if profile and ("rod_seabed" in given or "rod_seabed_slope" in given):
         raise RodInputError("-rod_seabed_profile gives the seabed's heights: drop "
                             "-rod_seabed and -rod_seabed_slope, or the profile")
+    if not profile and "rod_seabed_slope" not in given:
+        for name in ("rod_seabed_direction", "rod_seabed_origin"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_seabed_slope or -rod_seabed_profile "
+                                    "(the flat -rod_seabed has no direction or origin); give "
+                                    f"one of them, or drop -{name}")
     direction = seabed_direction(values)
     seabed_origin = np.asarray(values["rod_seabed_origin"] if values["rod_seabed_origin"]
                                is not None else (0.0, 0.0), dtype=float)
@@ -407,8 +504,10 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
     if stiffness is None:
         stiffness = default_stiffness(load_values)
         if stiffness is None:
-            raise RodInputError("-rod_seabed: no -rod_load points down to set the default "
-                                "stiffness (weight / 1 mm); give -rod_seabed_stiffness")
+            load = ("no line type sinks (mass above the water displaced)"
+                    if "rod_sections" in given else "no -rod_load points down")
+            raise RodInputError(f"-rod_seabed: {load} to set the default stiffness "
+                                "(weight / 1 mm); give -rod_seabed_stiffness")
     friction = friction_from_options(values, given, float(stiffness))
     absolute = dict(values)
     if values["rod_seabed"] is not None:
@@ -512,8 +611,25 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
                   "the held ends")
     check_ends_above(seabed, ends, scene.length, z0)
     held = [state.position[2] for _, state in ends if is_held(state)]
+    seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
     return seabed, current_from_options(values, given, max(held), profile, section_drag)
+
+
+def seated(seabed, held):
+    """``seabed`` lowered by the deepest penetration of the held ends at ``held`` (n, 3),
+    m, where one lies below it by round-off (check_ends_above accepts 1e-12 of the
+    length): such an end is on the seabed (-rod_seabed 1e-12 against an anchor at z = 0,
+    or 0.1 + 0.2 against 0.3), and an anchor pressed into it by round-off started the
+    catenary below the seabed (NaN at the first iteration). The whole seabed, flat or
+    shaped, moves down by that round-off."""
+    if seabed is None:
+        return seabed
+    depth = float(np.max(-seabed.gap(np.asarray(held, dtype=float).reshape(-1, 3))))
+    if not depth > 0:
+        return seabed
+    shape = None if seabed.flat else seabed.shape.moved(np.array([0.0, 0.0, depth]))
+    return dataclasses.replace(seabed, height=seabed.height - depth, shape=shape)
 
 
 def options_from_parameters(parameters):

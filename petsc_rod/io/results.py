@@ -40,6 +40,7 @@ import numpy as np
 from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
+from petsc_rod.tables import check_input_file, file_problem
 from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
 from petsc_rod.physics import point_loads as point_load_term
@@ -439,8 +440,7 @@ def _read_restart(path, mesh, layout):
     def refuse(what):
         raise RodInputError(f"-rod_initial {path}: {what}")
 
-    if os.path.isdir(path) or not os.path.isfile(path):
-        refuse("is a folder" if os.path.isdir(path) else "no such file")
+    check_input_file(path, "-rod_initial", np.inf)
     try:
         handle = h5py.File(path, "r")
     except OSError as error:
@@ -455,8 +455,9 @@ def _read_restart(path, mesh, layout):
             refuse("not a petsc_rod result file (no dataset S)")
         if f["S"].shape != layout["S"][0]:
             elements = f["S"].shape[0] - 1 if f["S"].ndim == 1 else "?"
-            refuse(f"the file has {elements} elements, this run {mesh.n_elements}; use "
-                   f"-rod_elements {elements}")
+            fix = (f"-rod_elements {elements}" if mesh.pieces is None else
+                   f"-rod_sections counts (TYPE:LENGTH:ELEMENTS) of {elements} in all")
+            refuse(f"the file has {elements} elements, this run {mesh.n_elements}; use {fix}")
         data = {key: _read_slice(f, key, *layout[key], refuse) for key in layout}
         if not np.allclose(data["S"], mesh.vertex_S, rtol=1e-12, atol=1e-12 * mesh.length):
             refuse("the file's mesh (length or grading) is not this run's; use the same "
@@ -485,6 +486,8 @@ def read_parameters(path, comm):
 
 def _parameters(path):
     """read_parameters on one process."""
+    if file_problem(path):                  # _read_restart says what; a FIFO would block
+        return None
     try:
         with h5py.File(path, "r") as f:
             group = f.get("parameters")

@@ -133,12 +133,23 @@ class LineType:
                        self.od if np.isnan(self.stress_od) else self.stress_od)
 
 
-def line_types_from_table(table, option):
+def line_types_from_table(table, option, largest=np.inf):
     """{name: LineType} from the columns of a -rod_line_types table (petsc_rod/tables.py
     read_table with LINE_TYPE_COLUMNS and LINE_TYPE_OPTIONAL); RodInputError naming
     ``option`` for a row that does not give exactly one bending form (the other forms'
-    columns left blank, '-') or gives a value out of range."""
+    columns left blank, '-') or gives a value out of range: the bounds of the options'
+    numbers (``largest``, cli/options.MAX_MAGNITUDE), every magnitude at most it and a
+    stiffness, diameter or mass at least its inverse, as -rod_stiffness is."""
     names = table["name"]
+    for name, values in table.items():
+        if name == "name":
+            continue
+        big = np.flatnonzero(np.isfinite(values) & (np.abs(values) > largest))
+        if big.size:
+            row = int(big[0])
+            raise RodInputError(f"{option}: line type {names[row]}: {name} "
+                                f"{values[row]:g} is out of range: magnitudes above "
+                                f"{largest:g} are refused, as in the options")
     rows = len(names)
     if len(set(names)) != rows:
         raise RodInputError(f"{option}: a line type is named twice")
@@ -171,11 +182,12 @@ def line_types_from_table(table, option):
     positive = {"od": table["od"], "mass": table["mass"], "gj": table["gj"], "ea": ea,
                 "drag_d": drag_d, "ei": np.minimum(start, end).min(axis=1)}
     for name, values in positive.items():
-        bad = ~(values > 0)
+        bad = ~(values >= 1 / largest) if name != "mass" else ~(values > 0)
         if np.any(bad):
             row = int(np.flatnonzero(bad)[0])
+            least = f" (at least {1 / largest:g}, as in the options)" if values[row] > 0 else ""
             raise RodInputError(f"{option}: line type {names[row]}: {name} "
-                                f"{values[row]:g} must be positive")
+                                f"{values[row]:g} must be positive{least}")
         if name != "ea" and not np.all(np.isfinite(values)):
             row = int(np.flatnonzero(~np.isfinite(values))[0])
             raise RodInputError(f"{option}: line type {names[row]}: {name} must be finite "

@@ -99,7 +99,7 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
     k = beyond_the_line(columns["s"], length)
     if k is not None:
         refuse(f"line {body[k][0]}: s = {columns['s'][k]:.6g} m is beyond the line (0 <= s "
-               f"<= -rod_length {length:.6g} m); give an arc length on the line")
+               f"<= L = {length:.6g} m, its length); give an arc length on the line")
     names = columns.pop("name", [f"point {k + 1}" for k in range(len(body))])
     areas = columns.get("cda", np.zeros(len(body)))
     return columns["s"], attachment_forces(columns, density, gravity), tuple(names), areas
@@ -117,6 +117,6 @@ def quick_point_loads(values, length):
     if k is not None:
         raise RodInputError(
             f"-rod_point_load: point {k + 1} at S = {table[k, 0]:.6g} m is beyond the line "
-            f"(0 <= S <= -rod_length {length:.6g} m); give an arc length on the line")
+            f"(0 <= S <= L = {length:.6g} m, its length); give an arc length on the line")
     return (table[:, 0], table[:, 1:], tuple(f"point {k + 1}" for k in range(len(table))),
             np.zeros(len(table)))

@@ -403,7 +403,10 @@ class Scene:
             raise RodInputError(
                 f"-rod_end_position: the ends are {chord:.15g} m apart, "
                 f"{chord - self.length:.3g} m more than the cable's length {self.length:.15g} m "
-                "(inextensible); bring the end within -rod_length, or give -rod_axial_stiffness")
+                "(inextensible); " + ("bring the end within the sections' length, or give "
+                                      "the line types an ea column (EA, N)" if self.sections
+                                      else "bring the end within -rod_length, or give "
+                                      "-rod_axial_stiffness"))
         for name, frame in (("-rod_end_frame", self.end_frame),
                             ("-rod_start_frame", self.start_frame)):
             if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8

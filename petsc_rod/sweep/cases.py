@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.tables import check_input_file
 
 # A case's name is its result file's name: DIR/<name>.h5.
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+=-]*$")
@@ -51,6 +52,7 @@ def read_cases(path, known):
     a comment), a header row naming options without the dash (``rod_end_position``) and
     optionally ``name``, then one row per case; a value ``-`` leaves that option as the
     base options give it. ``known(name)`` says whether an option name exists."""
+    check_input_file(path, "-sweep_cases")
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -194,9 +196,10 @@ def current_cases(headings, speed, values):
             raise RodInputError("-sweep_current_headings needs -sweep_current_speed, or a "
                                 "-rod_current in the base options to take the speed from")
         speed = float(np.linalg.norm(values["rod_current"]))
-    if values["rod_drag"] is None:
+    if values["rod_drag"] is None and not values.get("rod_sections"):
         raise RodInputError("-sweep_current_headings: a current needs -rod_drag rho,Cd,D "
-                            "in the base options")
+                            "in the base options (or -rod_sections, whose line types give "
+                            "the drag)")
     cases = []
     for heading in headings:
         angle = np.radians(heading)

@@ -29,7 +29,8 @@ from petsc4py import PETSc
 from petsc_rod.cli.main import INPUT_FILE_OPTIONS, run
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
-from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options
+from petsc_rod.cli.options import (BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options,
+                                   whole_values)
 from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError, on_every_rank
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.sweep import cases as sweep_cases
@@ -86,8 +87,10 @@ def read_settings():
             hint = f"; did you mean -{close[0]}?" if close else ""
             raise RodInputError(f"unknown option -{name}{hint}")
 
+    whole = whole_values(database)
+
     def text(name):
-        return database.getString(name, "") if database.hasName(name) else ""
+        return whole[name] if database.hasName(name) else ""     # hasName marks it used
 
     def numbers(name):
         value = text(name)

@@ -126,3 +126,73 @@ def test_the_seabed_friction_of_the_environment_reaches_the_options_and_the_line
             == pytest.approx(grounded, abs=2 * 2.0))
     assert results.scalars["friction_max_use"] <= 1.0 + 1e-12
     assert results.units["friction_force"] == "N/m"
+
+
+# --- hostile models (issue 47): one RodInputError, on every rank, before any work -------
+NOT_A_MODEL = {
+    "element length 0": lambda: model(line=Line([(PIPE, 160.0)], element_length=0)),
+    "element length -5": lambda: model(line=Line([(PIPE, 160.0)], element_length=-5)),
+    "element length nan": lambda: model(line=Line([(PIPE, 160.0)],
+                                                  element_length=float("nan"))),
+    "element length as text": lambda: model(line=Line([(PIPE, 160.0)], element_length="2")),
+    "a section length as text": lambda: model(line=Line([(PIPE, "160")])),
+    "a force of two numbers": lambda: model(attachments=(Attachment(50.0, force=(0, -1)),)),
+    "an end force of two numbers": lambda: model(end=End("free", force=(1.0, 2.0))),
+    "a nan position": lambda: model(end=End.hang_off((100.0, float("nan"), 55.0))),
+    "an attachment at S given as text": lambda: model(attachments=(Attachment("50"),)),
+    "a mass as text": lambda: model(line=Line([(LineType("p", od=0.2, mass="60", ei=1e5,
+                                                          gj=8e4), 160.0)])),
+    "a ragged current profile": lambda: model(environment=Environment(
+        current=[[0.0, 0.4, 0.1, 0.0], [60.0, 0.1]])),
+    "a misspelt option": lambda: model(options={"al_max_itt": 1}),
+    "a solver option the API cannot set": lambda: model(options={"newton_pc_type": "lu"}),
+    "steps as a fraction": lambda: model(steps=2.5),
+    "a one-element mesh": lambda: model(line=Line([(PIPE, 60.0), (FLOATY, 30.0),
+                                                   (PIPE, 70.0)], element_length=500.0)),
+}
+NOT_A_MODEL_WORDS = {"element length 0": "Line.element_length 0: must be a positive",
+                     "element length -5": "Line.element_length -5: must be a positive",
+                     "a force of two numbers": "Attachment.force (0, -1): expected 3",
+                     "a misspelt option": "did you mean 'al_max_it'",
+                     "a one-element mesh": "cannot represent the line"}
+
+
+@pytest.mark.parametrize("case", list(NOT_A_MODEL))
+def test_a_model_that_cannot_be_is_refused_with_rod_input_error(case):
+    with pytest.raises(RodInputError) as error:
+        solve(NOT_A_MODEL[case]())
+    assert NOT_A_MODEL_WORDS.get(case, "") in str(error.value)
+
+
+@pytest.mark.parametrize("change", ["element_length", "attachment", "option"])
+def test_models_that_differ_between_ranks_are_refused_on_every_rank(change):
+    """An answer of neither model (an attachment of another mass), or MPI_ABORT in the
+    first collective call (other element lengths): now one RodInputError everywhere."""
+    mpi = PETSc.COMM_WORLD.tompi4py()
+    if mpi.Get_size() == 1:
+        pytest.skip("needs 2 ranks")
+    other = mpi.Get_rank() == mpi.Get_size() - 1
+    fields = {"element_length": dict(line=Line([(PIPE, 60.0), (FLOATY, 30.0), (PIPE, 70.0)],
+                                               element_length=3.0 if other else 2.0)),
+              "attachment": dict(attachments=(Attachment(100.0, mass=300.0 if other
+                                                         else 200.0),)),
+              "option": dict(options={"al_rtol": 1e-9 if other else 1e-10})}[change]
+    with pytest.raises(RodInputError, match=f"rank {mpi.Get_size() - 1} was given another "
+                                            "model than rank 0"):
+        solve(model(**fields))
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(line=Line([(PIPE, 160.0)], internal_pressure=1e6)),
+     "Line.internal_pressure needs a line type with an id"),
+    (dict(end=End.hang_off((300.0, 0.0, 55.0))), "Model.end.position: the ends are"),
+    (dict(start=End.anchor((0.0, 0.0, -1.0))), "Model.start: the end is held at z = -1 m"),
+    (dict(line=Line([(LineType("soft", od=0.2, mass=60.0, ei=1e-300, gj=8e4), 160.0)])),
+     "the LineTypes: line type soft: ei 1e-300"),
+])
+def test_a_refusal_names_the_model_s_fields_not_options(change, words):
+    """The model's checks are the command line's; their messages name what the caller
+    gave (Line.internal_pressure), not options it never saw (-rod_internal_pressure)."""
+    with pytest.raises(RodInputError) as error:
+        solve(model(**change))
+    assert words in str(error.value) and "-rod_" not in str(error.value), str(error.value)

@@ -560,3 +560,155 @@ def test_a_flex_joint_on_a_stretching_end_is_accepted(options):
                             rod_start_rotational_stiffness="1e3")()
     scene = scene_from_options(values, names)
     assert scene.start_rotational_stiffness == 1e3 and scene.extensible
+
+
+# --- option values longer than petsc4py's getString returns (1023 characters) -------------
+def long_point_loads(points=63):
+    """-rod_point_load of ``points`` points, each S,fx,fy,fz with a force of -5000 N
+    last: over 1023 characters for 63 points."""
+    values = np.column_stack([np.linspace(1.0, 2399.0, points), np.full(points, 12.5),
+                              np.full(points, -0.125), np.full(points, -5000.0)])
+    return ",".join(repr(v) for v in values.ravel()), values
+
+
+def test_an_option_value_over_1023_characters_is_read_whole(options):
+    text, points = long_point_loads()
+    sections = ",".join(f"pipe:{2400 / 121:.14g}" for _ in range(121))
+    assert len(text) > 1100 and len(sections) > 1100
+    values, _ = options(rod_point_load=text, rod_sections=sections)()
+    assert np.array_equal(values["rod_point_load"], points.ravel())
+    assert values["rod_sections"] == sections
+
+
+def test_a_sweep_s_case_values_and_settings_over_1023_characters_are_read_whole(comm):
+    from petsc_rod.sweep.runner import read_settings, with_options
+    text, points = long_point_loads()
+    read = with_options(comm, {"rod_point_load": text}, lambda: read_options()[0])
+    assert np.array_equal(read["rod_point_load"], points.ravel())
+    offsets = ",".join(f"{k * 0.015625:.6f}" for k in range(200))
+    assert len(offsets) > 1100
+    settings = with_options(comm, {"sweep_output": "out", "sweep_offsets": offsets},
+                            read_settings)
+    assert len(settings.offsets) == 200 and settings.offsets[-1] == 199 * 0.015625
+
+
+# --- input files that are not regular files (a FIFO blocks, a device never ends) --------
+def deadline(seconds=10):
+    """A context in which a call still blocked after ``seconds`` raises TimeoutError
+    (SIGALRM: open() of a FIFO is interrupted and Python raises the handler's error)."""
+    import contextlib
+    import signal
+
+    def expire(*_):
+        raise TimeoutError(f"still blocked after {seconds} s")
+
+    @contextlib.contextmanager
+    def context():
+        previous = signal.signal(signal.SIGALRM, expire)
+        signal.alarm(seconds)
+        try:
+            yield
+        finally:
+            signal.alarm(0)
+            signal.signal(signal.SIGALRM, previous)
+    return context()
+
+
+def input_readers():
+    """{option: read(path)} of every reader of an input table."""
+    from petsc_rod.riser.environment import read_profile, read_seabed_profile
+    from petsc_rod.scenes.line import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
+    from petsc_rod.scenes.point_loads import read_point_loads
+    from petsc_rod.sweep.cases import read_cases
+    from petsc_rod.tables import read_table
+    return {"-rod_line_types": lambda p: read_table(p, "-rod_line_types", LINE_TYPE_COLUMNS,
+                                                    LINE_TYPE_OPTIONAL),
+            "-rod_point_loads": lambda p: read_point_loads(p, 1025.0, 9.81, 100.0),
+            "-rod_current_profile": read_profile,
+            "-rod_seabed_profile": read_seabed_profile,
+            "-sweep_cases": lambda p: read_cases(p, lambda name: True)}
+
+
+@pytest.mark.parametrize("option", list(input_readers()))
+@pytest.mark.parametrize("kind", ["fifo", "/dev/zero", "folder"])
+def test_an_input_file_that_is_not_a_regular_file_is_refused_at_once(tmp_path, option,
+                                                                     kind):
+    path = str(tmp_path / "table")
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "folder":
+        os.mkdir(path)
+    else:
+        path = kind
+    with deadline(), pytest.raises(RodInputError) as error:
+        input_readers()[option](path)
+    message = str(error.value)
+    assert message.startswith(f"{option} {path}: ")
+    assert ("not a regular file" if kind != "folder" else "is a folder") in message, message
+
+
+def test_an_input_table_above_the_size_cap_is_refused_unread(tmp_path, monkeypatch):
+    from petsc_rod import tables
+    path = tmp_path / "profile.txt"
+    path.write_text("0 1 0 0\n10 1 0 0\n")
+    monkeypatch.setattr(tables, "MAX_TABLE_BYTES", 16)
+    with pytest.raises(RodInputError, match=r"-rod_current_profile .*above the 1.53e-05 MiB"):
+        input_readers()["-rod_current_profile"](str(path))
+
+
+def test_a_restart_file_that_is_a_fifo_is_refused_on_every_rank(comm, shared_tmp):
+    path = f"{shared_tmp}/restart.h5"
+    if comm.getRank() == 0:
+        os.mkfifo(path)
+    comm.tompi4py().Barrier()
+    mesh = Mesh(comm, 4, 1.0)
+    try:
+        with deadline(), pytest.raises(RodInputError, match="-rod_initial .*not a regular"):
+            assert io.read_parameters(path, comm) is None
+            io.read_restart(path, mesh, {})
+    finally:
+        mesh.destroy()
+
+
+@pytest.mark.parametrize("elements", ["1", "3"])
+def test_a_uniform_line_of_too_few_elements_is_refused(options, elements):
+    """A line of 1-3 elements (chords across a third of it or more) "converged"."""
+    from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
+    values, given = options(rod_elements=elements, rod_end_force="0,-1,0")()
+    with pytest.raises(RodInputError, match=f"-rod_elements {elements}: .* give "
+                                            "-rod_elements 4 or more"):
+        mesh_pieces(values, scene_from_options(values, given), given)
+    values["rod_elements"] = 4
+    assert mesh_pieces(values, scene_from_options(values, given), given) is None
+
+
+@pytest.mark.parametrize("pieces", [None, ([0.0, 0.5, 1.0], [4, 6])])
+def test_a_restart_of_another_element_count_asks_for_what_sets_it(result, comm, pieces):
+    """A line of sections takes its count from -rod_sections (-rod_elements beside
+    counts is refused): the advice names the sections' counts there."""
+    from petsc_rod.mesh.mesh import Pieces
+    _, path = result
+    mesh = Mesh(comm, 10, 1.0, 1.0, None if pieces is None else Pieces(*pieces))
+    try:
+        with pytest.raises(RodInputError) as error:
+            io.read_restart(path, mesh, {})
+    finally:
+        mesh.destroy()
+    fix = "use -rod_elements 8" if pieces is None else "use -rod_sections counts"
+    assert "the file has 8 elements, this run 10; " + fix in str(error.value)
+
+
+@pytest.mark.parametrize("name, value", [("rod_seabed_direction", "45"),
+                                         ("rod_seabed_origin", "10,0")])
+def test_a_seabed_direction_or_origin_without_a_slope_or_profile_is_refused(options, name,
+                                                                            value):
+    """On the flat -rod_seabed they did nothing, in silence."""
+    from petsc_rod.cli.scene_options import scene_from_options
+    scene = dict(rod_start="pin", rod_end="pin", rod_end_position="0.8,0,0",
+                 rod_load="0,0,-1", rod_seabed="-0.5")
+    values, given = options(**scene, **{name: value})()
+    with pytest.raises(RodInputError, match=f"-{name} needs -rod_seabed_slope or "
+                                            "-rod_seabed_profile"):
+        scene_from_options(values, given)
+    values, given = options(rod_seabed_slope="0")()
+    assert scene_from_options(values, given).seabed.flat

@@ -121,7 +121,12 @@ BAD = {
                                          rod_load="0,0,-1"),
                                     "-rod_contents_density needs -rod_sections"),
     "a blank od": ("name od mass gj ei\nbare - 36.7 1 1\n", "column od is required"),
-    "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "row 2 has 4 values"),
+    "a short row": ("name od mass ei gj\nbare 0.16 36.7 1\n", "line 2 has 4 values"),
+    # a row is named by its line in the file, comments counted
+    "a short row after comments": ("# a data sheet\n\nname od mass ei gj\n# bare cable\n"
+                                   "bare 0.16 36.7 1\n", "line 5 has 4 values"),
+    "a word after comments": ("# sheet\nname od mass ei gj\n\nbare 0.16 heavy 1 1\n",
+                              "line 4, column mass: 'heavy' is not a number"),
     "a word for a number": ("name od mass ei gj\nbare 0.16 heavy 1 1\n", "'heavy' is not"),
     "-rod_stiffness with sections": (dict(rod_sections="bare:10", rod_stiffness="1,1,1"),
                                      "-rod_stiffness with -rod_sections"),
@@ -131,6 +136,23 @@ BAD = {
     "a section of half an element": (dict(rod_sections="bare:10:0.5"), "whole number"),
     "sections without types": (dict(rod_sections="bare:10", rod_line_types=None),
                                "-rod_sections needs -rod_line_types"),
+    # a table obeys the options' bounds (-rod_stiffness refuses below 1e-30, above 1e30)
+    "an ei of 1e-300": ("name od mass ei gj\nbare 0.16 36.7 1e-300 1\n",
+                        "ei 1e-300 must be positive (at least 1e-30"),
+    "a gj of 1e-300": ("name od mass ei gj\nbare 0.16 36.7 1 1e-300\n",
+                       "gj 1e-300 must be positive (at least 1e-30"),
+    "an ea of 1e31": ("name od mass ei gj ea\nbare 0.16 36.7 1 1 1e31\n",
+                      "ea 1e+31 is out of range"),
+    "a mass of 1e300": ("name od mass ei gj\nbare 0.16 1e300 1 1\n",
+                        "mass 1e+300 is out of range"),
+    # a setting that does nothing without its partner in the line types
+    "an internal pressure without an id": (dict(rod_internal_pressure="1e7"),
+                                           "-rod_internal_pressure needs a line type with "
+                                           "an id column"),
+    "contents without an id": (dict(rod_contents_density="800"),
+                               "-rod_contents_density needs a line type with an id"),
+    "a design factor without smys": (dict(rod_design_factor="0.8"),
+                                     "-rod_design_factor needs a line type with an smys"),
 }
 
 
@@ -150,6 +172,34 @@ def test_bad_line_types_and_sections_are_refused_in_one_line(options, table, cas
         scene_from_options(values, names)
     message = str(error.value)
     assert words in message and "\n" not in message, message
+
+
+# Advice on a line of sections names what the user can change there, never an option
+# petsc_rod refuses beside -rod_sections (-rod_length, -rod_load, -rod_axial_stiffness,
+# -rod_drag: SECTION_REPLACES).
+ADVICE = {
+    "ends farther apart than the sections": (dict(rod_end_position="12,0,0"),
+                                             "the line types an ea column"),
+    "ends held taut": (dict(rod_end_position="10,0,0"), "the line types an ea column"),
+    "a floating line on a seabed without a stiffness": (dict(rod_sections="float:10"),
+                                                       "no line type sinks"),
+    "a point beyond the line": (dict(rod_point_load="12,0,0,-5"), "L = 10 m, its length"),
+}
+
+
+@pytest.mark.parametrize("case", list(ADVICE))
+def test_advice_on_sections_names_what_the_sections_take(options, table, case):
+    from petsc_rod.cli.scene_options import SECTION_REPLACES, scene_from_options
+    change, words = ADVICE[case]
+    given = {**CABLE_ENDS, "rod_line_types": table(CABLE_TYPES), "rod_sections": "bare:10",
+             "rod_end_position": "5,0,5", **change}
+    values, names = options(**given)()
+    with pytest.raises(RodInputError) as error:
+        scene_from_options(values, names)
+    message = str(error.value)
+    assert words in message, message
+    for name in list(SECTION_REPLACES) + ["rod_length"]:
+        assert f"-{name} " not in message + " " and f"-{name};" not in message, message
 
 
 def solved_cable(options, given, comm):
@@ -267,13 +317,25 @@ def test_a_stiff_section_beside_a_soft_one_keeps_its_own_curvature(options, tabl
 
 @pytest.mark.parametrize("sections, elements, words", [
     ("bare:52.101:104,float:50:100,bare:68.114:136", "1000", "gives every section its"),
-    ("bare:170.215,float:1e-12", "100", "below what double precision resolves")])
+    ("bare:170.215,float:1e-12", "100", "below what double precision resolves"),
+    # a mesh that cannot represent the line: a section of one element (issue 47)
+    ("bare:20:40,float:150", "10", r"-rod_elements 10: .*needs at least one .* give "
+                                    r"-rod_elements 41 or more"),
+    ("bare:20:40,float:150", "41", r"-rod_elements 41: section 2 \(float, 150 m\) has 1 "
+                                    r"element\(s\) of 150 m, .* cannot represent .* give "
+                                    r"-rod_elements 45 or more .*float:150:4\)"),
+    ("bare:20:40,float:150:3", "43", r"-rod_sections: section 2 \(float, 150 m\) has 3 "
+                                      r"element\(s\) of 50 m.* at least 4 elements"),
+    ("bare:1:70,float:169", None, r"-rod_sections \(the default -rod_elements 64\): "
+                                   r"section 2 .* has 1 element"),
+])
 def test_element_counts_that_cannot_be_are_refused(options, table, sections, elements, words):
     """Review of issue 22: -rod_elements was silently ignored when every section gave
     its count, and a 1e-14 m section built a 1e-14 m element."""
     from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
+    count = {} if elements is None else {"rod_elements": elements}
     values, names = options(rod_line_types=table(CABLE_TYPES), rod_sections=sections,
-                            rod_elements=elements, **CABLE_ENDS)()
+                            **count, **CABLE_ENDS)()
     scene = scene_from_options(values, names)
     with pytest.raises(RodInputError, match=words):
         mesh_pieces(values, scene, names)

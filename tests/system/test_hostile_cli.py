@@ -578,3 +578,50 @@ def test_a_run_stopped_by_a_signal_keeps_its_converged_steps_as_a_restart_file(t
     again = run(LONG[:-6] + ["-rod_steps", "2", "-rod_initial", str(kept)])
     assert again.returncode == 0, again.stdout + again.stderr
     assert f"restart from {kept}, load factor {factor:.6g}" in again.stdout
+
+
+CATENARY_RISER = ["-options_file", "options/riser_catenary.opts", "-rod_elements", "200"]
+
+
+@pytest.mark.parametrize("args, iterations", [
+    (CATENARY_RISER + ["-rod_seabed", "1e-12"], 18),
+    (CATENARY_RISER + ["-rod_seabed", "0.30000000000000004", "-rod_start_position", "0,0,0.3"],
+     18),
+    (["-options_file", "options/steel_catenary_riser_slope.opts", "-rod_seabed", "1e-12",
+      "-rod_sections", "scr10:2400:400"], 36)])
+def test_an_anchor_on_the_seabed_to_round_off_is_on_it(tmp_path, args, iterations):
+    """An anchor 1e-12 m below the seabed, flat or sloping (or 0.1 + 0.2 against 0.3),
+    was accepted, then diverged at iteration 1 of every halving (exit 4): it is on the
+    seabed, and the run converges as with the anchor exactly on it."""
+    process = run(args)
+    assert process.returncode == 0, process.stdout + process.stderr
+    assert f"converged, {iterations} iterations" in process.stdout
+
+
+def test_a_mesh_of_sections_too_large_names_the_sections_not_rod_elements(tmp_path):
+    """The sections' counts set the mesh; -rod_elements beside them is refused, so the
+    message must not ask for it."""
+    process = run(["-options_file", "options/steel_catenary_riser.opts", "-rod_sections",
+                   "scr10:2400:1000000000"])
+    text = process.stdout + process.stderr
+    assert_one_line_and_nothing_left(process.returncode, text, 2,
+                                     ["-rod_sections (1000000000 elements in all)", "memory"])
+    assert "-rod_elements" not in text
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("option", ["-rod_line_types", "-rod_current_profile",
+                                    "-rod_seabed_profile", "-rod_point_loads"])
+def test_a_table_that_is_a_fifo_exits_2_at_once(tmp_path, option, ranks):
+    """A FIFO blocked the run for ever, deaf to SIGTERM: now one line, exit 2."""
+    fifo = str(tmp_path / "table")
+    os.mkfifo(fifo)
+    needs = {"-rod_line_types": ["-rod_sections", "pipe:10"],
+             "-rod_current_profile": ["-rod_drag", "1025,1,0.1"],
+             "-rod_seabed_profile": ["-rod_seabed_stiffness", "1e3"],
+             "-rod_point_loads": []}[option]
+    process = subprocess.run(petsc_rod_command(SMALL + [option, fifo] + needs, ranks),
+                             cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True,
+                             timeout=30, check=False)
+    assert_one_line_and_nothing_left(process.returncode, process.stdout + process.stderr, 2,
+                                     [option, "not a regular file"])

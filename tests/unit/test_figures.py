@@ -3,6 +3,7 @@ matplotlib, no PETSc object, no solve): what the panels draw is the file's data,
 plan shows a line pushed sideways, the PNG has the sea surface's and the sections'
 colours, a sweep overlays its cases, and the plain rod keeps its four panels."""
 
+import os
 import shutil
 import tempfile
 
@@ -223,3 +224,26 @@ def test_a_line_of_load_pieces_is_drawn_in_pieces(folder):
                                                         "load fz = 80.15 N/m"]
     assert pieces[0].get_color() == pieces[2].get_color() != pieces[1].get_color()
     matplotlib.pyplot.close(figure)
+
+
+def test_a_result_that_is_a_fifo_is_refused_not_waited_for(tmp_path, capsys):
+    """h5py would block on a FIFO for ever (deaf to SIGTERM): plots refuses it at once."""
+    import signal
+
+    from petsc_rod import plots
+
+    fifo = tmp_path / "run.h5"
+    os.mkfifo(fifo)
+
+    def expire(*_):
+        raise TimeoutError("plots blocked on the FIFO")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(10)
+    try:
+        code = plots.main(["plots", str(fifo), str(tmp_path / "run.png")])
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert code == 2 and "not a regular file" in capsys.readouterr().err
+    assert not (tmp_path / "run.png").exists()

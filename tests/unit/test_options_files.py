@@ -51,3 +51,14 @@ def test_a_path_with_petsc_s_names_is_expanded_or_left_to_petsc(tmp_path, monkey
     outer.write_text("-options_file ${SCENES}/absent.opts\n")
     error = options_file_error(["prog", "-options_file", str(outer)], NO_PETSCRC)
     assert "absent.opts" in error and "no such file" in error, error
+
+
+def test_an_options_file_above_the_input_size_cap_is_refused(tmp_path, monkeypatch):
+    from petsc_rod import tables
+    scene = tmp_path / "big.opts"
+    scene.write_text("-rod_elements 8\n" * 4)
+    monkeypatch.setattr(tables, "MAX_TABLE_BYTES", 32)
+    assert "above the 3.05e-05 MiB an input file may hold" in options_file_error(
+        ["petsc_rod", "-options_file", str(scene)])
+    monkeypatch.setattr(tables, "MAX_TABLE_BYTES", 64)
+    assert options_file_error(["petsc_rod", "-options_file", str(scene)]) == ""

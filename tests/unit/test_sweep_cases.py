@@ -46,6 +46,10 @@ def test_current_headings_turn_the_base_speed():
     assert np.allclose(velocities, [[0.5, 0, 0], [0, 0.5, 0], [-0.5, 0, 0]])
     with pytest.raises(RodInputError, match="-rod_drag"):
         cases.current_cases((0.0,), 1.0, {**RISER, "rod_drag": None})
+    # a line of sections takes its drag from its line types (-rod_drag is refused there)
+    made = cases.current_cases((90.0,), 1.0, {**RISER, "rod_drag": None,
+                                              "rod_sections": "scr10:2400"})
+    assert made[0].options["rod_current"] == "0,1,0"
 
 
 def test_product_and_nearest():
