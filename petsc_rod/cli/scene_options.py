@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from petsc_rod.cli.options import BY_NAME, MAX_MAGNITUDE, OPTIONS
+from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
@@ -166,17 +166,10 @@ def sections_from_options(values, given, content=None):
 def mesh_pieces(values, scene, given=()):
     """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
     vertex, with the element counts -rod_sections gives and the rest of -rod_elements
-    shared out by length; None for a line without sections (whose -rod_elements is
-    refused below MIN_LINE_ELEMENTS, check_represented's bound). A -rod_elements (in
+    shared out by length; None for a line without sections. A -rod_elements (in
     ``given``) that disagrees with counts given for every section is refused, and so is
     an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
     if not scene.sections:
-        if values["rod_elements"] < MIN_LINE_ELEMENTS:
-            raise RodInputError(
-                f"-rod_elements {values['rod_elements']}: elements of 1/"
-                f"{values['rod_elements']} of the line are chords too long to represent its "
-                f"shape; give -rod_elements {MIN_LINE_ELEMENTS} or more (the default is "
-                f"{BY_NAME['rod_elements'].default})")
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")
     counts = [count for _, _, count in entries]
@@ -208,9 +201,11 @@ def mesh_pieces(values, scene, given=()):
     return Pieces(ends, counts)
 
 
-# The fewest elements a line is meshed with along its length: an element longer than
-# the length over this is a straight chord across a quarter of the line or more, which
-# cannot represent the line's shape (a 2300 m section of one element).
+# The fewest elements a line of sections is meshed with along its length: an element
+# longer than the length over this is a chord across a quarter of the line or more,
+# which cannot represent the shape of a line of several sections (a 2300 m section of
+# one element). A uniform line keeps any count: 2 elements of the P2 rod converge at the
+# mesh's order (docs/stability.md, group mesh).
 MIN_LINE_ELEMENTS = 4
 
 

@@ -670,18 +670,6 @@ def test_a_restart_file_that_is_a_fifo_is_refused_on_every_rank(comm, shared_tmp
         mesh.destroy()
 
 
-@pytest.mark.parametrize("elements", ["1", "3"])
-def test_a_uniform_line_of_too_few_elements_is_refused(options, elements):
-    """A line of 1-3 elements (chords across a third of it or more) "converged"."""
-    from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options
-    values, given = options(rod_elements=elements, rod_end_force="0,-1,0")()
-    with pytest.raises(RodInputError, match=f"-rod_elements {elements}: .* give "
-                                            "-rod_elements 4 or more"):
-        mesh_pieces(values, scene_from_options(values, given), given)
-    values["rod_elements"] = 4
-    assert mesh_pieces(values, scene_from_options(values, given), given) is None
-
-
 @pytest.mark.parametrize("pieces", [None, ([0.0, 0.5, 1.0], [4, 6])])
 def test_a_restart_of_another_element_count_asks_for_what_sets_it(result, comm, pieces):
     """A line of sections takes its count from -rod_sections (-rod_elements beside
