@@ -7,6 +7,7 @@ import sys
 
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.plots import OneLineParser
+from petsc_rod.tables import file_problem
 
 
 def main(argv=None):
@@ -23,6 +24,10 @@ def main(argv=None):
         return 2
     if not os.path.exists(source):
         sys.stderr.write(f"petsc_rod.report: error: {source}: no such file or folder\n")
+        return 2
+    problem = "" if os.path.isdir(source) else file_problem(source)
+    if problem:                         # a FIFO would block h5py for ever
+        sys.stderr.write(f"petsc_rod.report: error: {source}: {problem}\n")
         return 2
     import h5py
     if not os.path.isdir(source) and not h5py.is_hdf5(source):

@@ -226,24 +226,30 @@ def test_a_line_of_load_pieces_is_drawn_in_pieces(folder):
     matplotlib.pyplot.close(figure)
 
 
-def test_a_result_that_is_a_fifo_is_refused_not_waited_for(tmp_path, capsys):
-    """h5py would block on a FIFO for ever (deaf to SIGTERM): plots refuses it at once."""
+@pytest.mark.parametrize("tool", ["plots", "report"])
+def test_a_result_that_is_a_fifo_is_refused_not_waited_for(tmp_path, capsys, tool):
+    """h5py would block on a FIFO for ever (deaf to SIGTERM): the plots and the report
+    refuse it at once."""
     import signal
 
     from petsc_rod import plots
+    from petsc_rod.report import __main__ as report
 
     fifo = tmp_path / "run.h5"
     os.mkfifo(fifo)
+    output = tmp_path / ("run.png" if tool == "plots" else "run.html")
+    call = {"plots": lambda: plots.main(["plots", str(fifo), str(output)]),
+            "report": lambda: report.main([str(fifo), "-o", str(output)])}[tool]
 
     def expire(*_):
-        raise TimeoutError("plots blocked on the FIFO")
+        raise TimeoutError(f"{tool} blocked on the FIFO")
 
     previous = signal.signal(signal.SIGALRM, expire)
     signal.alarm(10)
     try:
-        code = plots.main(["plots", str(fifo), str(tmp_path / "run.png")])
+        code = call()
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
     assert code == 2 and "not a regular file" in capsys.readouterr().err
-    assert not (tmp_path / "run.png").exists()
+    assert not output.exists()
