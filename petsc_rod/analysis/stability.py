@@ -531,6 +531,10 @@ class SecondVariation:
             return int(negative)
         self._constraint_solves = self.solve_many(self.constraint)
         schur = np.array([[c.dot(y) for y in self._constraint_solves] for c in self.constraint])
+        if not np.all(np.isfinite(schur)):
+            # a failed factorisation (its solves give Inf): no count, on every rank alike
+            # (the dot products are reduced)
+            raise np.linalg.LinAlgError("the inertia test's constraint solves are not finite")
         return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
 
     def negative_pivots(self):

@@ -25,7 +25,13 @@ A step is taken only where H is positive definite on the constraint set (the ine
 its factorisation, as in the stability test): Newton then heads for a local minimiser,
 never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
 Uzawa iteration goes on from where it was. On success the state is handed back as a
-fixed point of the Uzawa iteration: tau = d and lambda = -g / w. Where the attempt's
+fixed point of the Uzawa iteration: tau = d and lambda = -g / w. A linear-algebra
+failure on the way (a state the steps cannot start from: a stretch k <= 0 or values that
+are not finite; a factorisation that failed, whose solves give Inf; a Schur matrix,
+gradient or step that is not finite; LAPACK's LinAlgError in a small dense solve or in
+the inertia test's eigenvalues) ends the attempt as FAILED with the state as it was,
+never the run: each such test is made on every rank and its verdict reduced, so that
+every rank takes the same decision (LinearAlgebraFailure). Where the attempt's
 steps converged on the whole problem its last step, measured as an iteration, may end
 the step (``solved_norms``, controller.newton_converged); otherwise the next iteration,
 whose tests then decide convergence, moves it only by the map's round-off.
@@ -101,6 +107,11 @@ FROZEN_SHRINK = 0.1
 
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
+
+
+class LinearAlgebraFailure(Exception):
+    """A step's linear algebra failed on some rank, raised on every rank (the verdict
+    reduced: NewtonPolish._agree); the attempt ends FAILED (module docstring)."""
 
 
 def _chord_rest(turn, previous):
@@ -183,6 +194,7 @@ class NewtonPolish:
         outcome = FAILED
         regularised = False
         try:
+            self._agree(self._usable(frames))
             for _ in range(MAX_STEPS):
                 state.set_node_directors(frames)
                 g = problem.energy_gradient(self._product)
@@ -269,20 +281,41 @@ class NewtonPolish:
                     return CONVERGED
             state.restore(saved)
             return outcome
+        except (LinearAlgebraFailure, np.linalg.LinAlgError):
+            # every rank here at once: the failures are agreed (_agree), and a LinAlgError
+            # comes from LAPACK on numbers every rank holds alike (reductions)
+            state.restore(saved)
+            return FAILED
         finally:
             # the kept KKT pieces serve this attempt's chord steps only
             self._drop_kkt()
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
-    @staticmethod
-    def _stretched(frames, step):
+    def _agree(self, ok):
+        """Raise LinearAlgebraFailure on every rank where ``ok`` is False on any.
+        Collective."""
+        if not self.problem.mesh.global_min(int(bool(ok))):
+            raise LinearAlgebraFailure
+
+    def _usable(self, frames):
+        """Whether the local ``frames`` (n_nodes, 3, 3) are a state the steps can start
+        from: finite, and on an extensible line every stretch |d3| = k positive (the
+        unit tangents d3 / k; the local step keeps k >= 0, and k = 0 is reached by a
+        line soft enough to fold)."""
+        if not np.all(np.isfinite(frames)):
+            return False
+        return not self.stretch or bool(np.all(np.einsum("nc,nc->n", frames[:, 2],
+                                                         frames[:, 2]) > 0.0))
+
+    def _stretched(self, frames, step):
         """Frames (rows d1, d2, k d3) turned by step[:, :3] and stretched by k += step[:, 3];
-        None where a stretch would not stay positive (the attempt fails)."""
+        None on every rank where a stretch would not stay positive on one (the attempt
+        fails). Collective."""
         turned = np.einsum("nkl,nil->nik", rotations(step[:, :3]), frames)
         k = np.sqrt(np.einsum("nc,nc->n", turned[:, 2], turned[:, 2]))
         new = k + step[:, 3]
-        if not np.all(new > 0):
+        if not self.problem.mesh.global_min(int(bool(np.all(new > 0)))):
             return None
         turned[:, 2] *= (new / k)[:, None]
         return turned
@@ -321,7 +354,20 @@ class NewtonPolish:
         normal = np.einsum("nki,nkj->ij", A[free], A[free])
         right = -np.einsum("nki,nk->i", A[free], a[free])
         total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
-        return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
+        return self._small_solve(total[:9].reshape(3, 3), total[9:])
+
+    def _small_solve(self, matrix, right):
+        """The least-squares solution of a small dense system that every rank holds alike
+        (reduced), (k,); LinearAlgebraFailure on every rank where it or the system is
+        not finite or LAPACK fails on one. Collective."""
+        solution = None
+        if np.all(np.isfinite(matrix)) and np.all(np.isfinite(right)):
+            try:
+                solution = np.linalg.lstsq(matrix, right, rcond=None)[0]
+            except np.linalg.LinAlgError:
+                pass
+        self._agree(solution is not None and np.all(np.isfinite(solution)))
+        return solution
 
     def _largest(self, step):
         """The largest |component| of ``step`` (n_nodes, 3 or 4) over the ranks, rad (not
@@ -346,6 +392,7 @@ class NewtonPolish:
         _keep_kkt; ``run`` takes one only where they are kept)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
+        self._agree(np.isfinite(self._residual_norm))        # the same sum on every rank
         if curvature is not None:
             self.problem.state.lam[:] = curvature
         hessian = self._jacobian.hessian if frozen else self.problem.second_variation()
@@ -390,7 +437,7 @@ class NewtonPolish:
                 # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
                 right = self._chord_residual(frames) + np.array([c.dot(direction)
                                                                  for c in columns])
-                dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
+                dmu = self._small_solve(schur, right)
                 direction.maxpy(-dmu, solved)
             step = hessian.from_vec(direction)
             if self._free_roll:
