@@ -144,7 +144,8 @@ class NewtonPolish:
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
         # of the Newton system, which LU turns into a step of round-off's size); the
-        # steps leave it out (_without_roll)
+        # steps leave it out (_without_roll), those with the Jacobian by a constraint of
+        # the step as well (_newton_step)
         stiffness = problem.scene.stiffness_values()
         self._free_roll = (bool(np.all(stiffness[:, 0] == stiffness[:, 1]))
                            and problem.mesh.global_min(int(np.all(self._free))) == 1)
@@ -418,6 +419,13 @@ class NewtonPolish:
                 vecs.append(direction)
             else:
                 columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
+                if self._free_roll and self.unsymmetric:
+                    # the roll held by a constraint of the step, its multiplier dropped:
+                    # J's LU is not shifted (_positive_definite shifts H's), and at an
+                    # iterate the roll is a near-null vector of J, whose component in
+                    # the solves does not vanish with the residual; _without_roll's
+                    # mean is not J's near-null vector, and the steps stopped shrinking
+                    columns.append(hessian.roll_form(frames[:, 2]))
                 vecs.extend(columns)
                 if columns and hessian.decidable and not self.unsymmetric:
                     # the inertia test solved for a basis of the same forms
@@ -434,11 +442,15 @@ class NewtonPolish:
             dmu = np.zeros(3)
             if columns:
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
-                # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
-                right = self._chord_residual(frames) + np.array([c.dot(direction)
-                                                                 for c in columns])
-                dmu = self._small_solve(schur, right)
-                direction.maxpy(-dmu, solved)
+                # (C H^-1 C^T) dmu = c + C H^-1 (-grad L); the roll's c is 0
+                residual = np.zeros(len(columns))
+                if self._bordered():
+                    residual[:3] = self._chord_residual(frames)
+                right = residual + np.array([c.dot(direction) for c in columns])
+                multipliers = self._small_solve(schur, right)
+                direction.maxpy(-multipliers, solved)
+                if self._bordered():
+                    dmu = multipliers[:3]
             step = hessian.from_vec(direction)
             if self._free_roll:
                 self._without_roll(step, frames)
