@@ -105,6 +105,16 @@ FROZEN_SHRINK = 0.1
 # Differential Equations II, §IV.8), as an exact step below STEP_TOLERANCE is, whose rest
 # is about its square (_chord_rest).
 
+# A step with the Jacobian after one that turned by at most ROLL_TURN rad holds the free
+# roll (__init__) by a constraint of the step (_newton_step): near a solution the roll is
+# a near-null vector of J (its eigenvalue of the order of the residual), J's LU is not
+# shifted, and the solves' component along it does not vanish with the residual, so
+# that removing the mean roll afterwards (_without_roll) left steps that stopped
+# shrinking. Farther, after a turn above ROLL_TURN (an attempt's first step, from the
+# iteration's curvature), J is regular along the roll and the constraint would change
+# the step: there the mean roll is only removed (docs/method.md, "The free roll").
+ROLL_TURN = 1e-2
+
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
@@ -139,6 +149,8 @@ class NewtonPolish:
         # must lower |grad L| (no energy to descend)
         self.unsymmetric = any(term.unsymmetric for term in problem.terms)
         self._jacobian = None
+        # whether the last step turned by at most ROLL_TURN (run): near the solution
+        self._near = False
         # the last exact step's KKT pieces, for the chord steps (_keep_kkt)
         self._kkt = None
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
@@ -207,6 +219,7 @@ class NewtonPolish:
                 # a chord step (FREEZE_TURN) from the last exact step's KKT matrix
                 chord = (self.unsymmetric and previous <= FREEZE_TURN
                          and self._kkt is not None)
+                self._near = previous <= ROLL_TURN
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, chord)
                 if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
@@ -419,12 +432,9 @@ class NewtonPolish:
                 vecs.append(direction)
             else:
                 columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
-                if self._free_roll and self.unsymmetric:
-                    # the roll held by a constraint of the step, its multiplier dropped:
-                    # J's LU is not shifted (_positive_definite shifts H's), and at an
-                    # iterate the roll is a near-null vector of J, whose component in
-                    # the solves does not vanish with the residual; _without_roll's
-                    # mean is not J's near-null vector, and the steps stopped shrinking
+                if self._free_roll and self.unsymmetric and self._near:
+                    # the roll held by a constraint of the step, its multiplier dropped
+                    # (ROLL_TURN)
                     columns.append(hessian.roll_form(frames[:, 2]))
                 vecs.extend(columns)
                 if columns and hessian.decidable and not self.unsymmetric:
