@@ -110,9 +110,10 @@ FROZEN_SHRINK = 0.1
 # a near-null vector of J (its eigenvalue of the order of the residual), J's LU is not
 # shifted, and the solves' component along it does not vanish with the residual, so
 # that removing the mean roll afterwards (_without_roll) left steps that stopped
-# shrinking. Farther, after a turn above ROLL_TURN (an attempt's first step, from the
-# iteration's curvature), J is regular along the roll and the constraint would change
-# the step: there the mean roll is only removed (docs/method.md, "The free roll").
+# shrinking. Farther (an attempt's first step, and a step after a turn above ROLL_TURN,
+# such as the first one's from the iteration's curvature) J is regular along the roll
+# and the constraint would change the step: there the mean roll is only removed
+# (docs/method.md, "The free roll").
 ROLL_TURN = 1e-2
 
 # What an attempt ends with (NewtonPolish.run).
