@@ -404,12 +404,17 @@ class SecondVariation:
         out), and an iterate's multipliers make its eigenvalue slightly negative (measured
         on the riser with seabed friction: -10 to -1000 times the tolerance, at change
         1e-5 to 1e-6)."""
+        self._drop_constraint_solves()
+        self.constraint = self._independent(self.constraint + [self.roll_form(tangents)])
+
+    def roll_form(self, tangents):
+        """The mean roll omega -> sum_n w_n omega_n . t_n / |t_n| at tangents t (n_nodes,
+        3), as a new Vec (zero at clamped rows and off the rotations)."""
         w = self.problem.state.node_weights
         vec = self.to_vec(np.concatenate(
             [w[:, None] * unit(tangents), np.zeros((len(w), self.unknowns - 3))], axis=1))
         self._zero_clamped(vec)
-        self._drop_constraint_solves()
-        self.constraint = self._independent(self.constraint + [vec])
+        return vec
 
     def _chord_columns(self):
         """An orthonormal basis of the chord forms at tau3 (the constraint of the test)."""
@@ -531,6 +536,10 @@ class SecondVariation:
             return int(negative)
         self._constraint_solves = self.solve_many(self.constraint)
         schur = np.array([[c.dot(y) for y in self._constraint_solves] for c in self.constraint])
+        if not np.all(np.isfinite(schur)):
+            # a failed factorisation (its solves give Inf): no count, on every rank alike
+            # (the dot products are reduced)
+            raise np.linalg.LinAlgError("the inertia test's constraint solves are not finite")
         return int(negative) + int(np.sum(np.linalg.eigvalsh(schur) > 0)) - len(self.constraint)
 
     def negative_pivots(self):

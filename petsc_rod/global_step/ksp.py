@@ -122,6 +122,18 @@ def lu_solver(comm, operator, prefix=NEWTON_PREFIX):
     return ksp
 
 
+# MUMPS's errors of a workspace too small for the factors (INFOG(1): -8, -9 integer and
+# real workspace of the factorisation, -11, -12, -14 of the solve, -15, -17, -20 of its
+# buffers), which more relaxation of the analysis's estimate (ICNTL 14) cures: on an
+# unsymmetric Jacobian the pivots that the threshold pivoting delays grow the factors
+# beyond the estimate made from the pattern. Each retry multiplies the relaxation by
+# WORKSPACE_GROWTH, at most WORKSPACE_RETRIES times; a factorisation that still fails
+# is a failed one (its solves give Inf, and the Newton attempt fails).
+WORKSPACE_ERRORS = (-8, -9, -11, -12, -14, -15, -17, -20)
+WORKSPACE_GROWTH = 4
+WORKSPACE_RETRIES = 3
+
+
 def set_up_mumps(ksp, block=None):
     """``ksp.setUp()`` for an inertia_solver or lu_solver, with mumps_defaults in effect
     under its prefix (MUMPS reads its controls at the symbolic factorisation;
@@ -132,6 +144,31 @@ def set_up_mumps(ksp, block=None):
     defaults = mumps_defaults(ksp.getPC().getType(), block)
     with defaults_in_effect({f"{prefix}{key}": value for key, value in defaults.items()}):
         ksp.setUp()
+        for _ in range(WORKSPACE_RETRIES):
+            factor = ksp.getPC().getFactorMatrix()
+            if factor.getMumpsInfog(1) not in WORKSPACE_ERRORS:
+                break
+            _with_more_workspace(ksp, factor)
+            ksp.setUp()
+
+
+def _with_more_workspace(ksp, factor):
+    """Give ``ksp`` a new MUMPS factor of its operator with the controls of the failed
+    ``factor`` (the inertia's ICNTL 13, the null pivots' 24) and WORKSPACE_GROWTH times
+    its relaxation (ICNTL 14), to be set up: PETSc does not factor again with a factor
+    whose last factorisation failed (it takes the error for the analysis's), so the
+    retry needs a new factor, made after ksp.reset()."""
+    kept = {control: factor.getMumpsIcntl(control) for control in (13, 24)}
+    relaxation = WORKSPACE_GROWTH * max(factor.getMumpsIcntl(14), 1)
+    operator = ksp.getOperators()[0]
+    pc = ksp.getPC()
+    factorisation = pc.getType()
+    ksp.reset()
+    ksp.setOperators(operator)
+    factor = _mumps_factor(pc, factorisation, ksp.getOptionsPrefix())
+    for control, value in kept.items():
+        factor.setMumpsIcntl(control, value)
+    factor.setMumpsIcntl(14, relaxation)
 
 
 def solve_columns(ksp, columns, rows=None):
@@ -367,15 +404,21 @@ def _mumps(comm, operator, factorisation, prefix=None):
         ksp.setOptionsPrefix(prefix)
     ksp.setOperators(operator)
     ksp.setType(PETSc.KSP.Type.PREONLY)
-    pc = ksp.getPC()
+    factor = _mumps_factor(ksp.getPC(), factorisation, prefix)
+    factor.setMumpsIcntl(24, 1)
+    return ksp, factor
+
+
+def _mumps_factor(pc, factorisation, prefix):
+    """MUMPS's factor matrix of ``factorisation`` for ``pc`` (its operator set), options
+    under ``prefix``, not yet set up."""
     pc.setType(factorisation)
     pc.setFactorSolverType("mumps")
     pc.setFactorSetUpSolverType()
     factor = pc.getFactorMatrix()
     if prefix is not None:
         factor.setOptionsPrefix(prefix)     # MatGetFactor gave it none (PETSc 3.18)
-    factor.setMumpsIcntl(24, 1)
-    return ksp, factor
+    return factor
 
 
 def check_solved(ksp, name):

@@ -25,7 +25,13 @@ A step is taken only where H is positive definite on the constraint set (the ine
 its factorisation, as in the stability test): Newton then heads for a local minimiser,
 never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
 Uzawa iteration goes on from where it was. On success the state is handed back as a
-fixed point of the Uzawa iteration: tau = d and lambda = -g / w. Where the attempt's
+fixed point of the Uzawa iteration: tau = d and lambda = -g / w. A linear-algebra
+failure on the way (a state the steps cannot start from: a stretch k <= 0 or values that
+are not finite; a factorisation that failed, whose solves give Inf; a Schur matrix,
+gradient or step that is not finite; LAPACK's LinAlgError in a small dense solve or in
+the inertia test's eigenvalues) ends the attempt as FAILED with the state as it was,
+never the run: each such test is made on every rank and its verdict reduced, so that
+every rank takes the same decision (LinearAlgebraFailure). Where the attempt's
 steps converged on the whole problem its last step, measured as an iteration, may end
 the step (``solved_norms``, controller.newton_converged); otherwise the next iteration,
 whose tests then decide convergence, moves it only by the map's round-off.
@@ -99,8 +105,24 @@ FROZEN_SHRINK = 0.1
 # Differential Equations II, §IV.8), as an exact step below STEP_TOLERANCE is, whose rest
 # is about its square (_chord_rest).
 
+# A step with the Jacobian after one that turned by at most ROLL_TURN rad holds the free
+# roll (__init__) by a constraint of the step (_newton_step): near a solution the roll is
+# a near-null vector of J (its eigenvalue of the order of the residual), J's LU is not
+# shifted, and the solves' component along it does not vanish with the residual, so
+# that removing the mean roll afterwards (_without_roll) left steps that stopped
+# shrinking. Farther (an attempt's first step, and a step after a turn above ROLL_TURN,
+# such as the first one's from the iteration's curvature) J is regular along the roll
+# and the constraint would change the step: there the mean roll is only removed
+# (docs/method.md, "The free roll").
+ROLL_TURN = 1e-2
+
 # What an attempt ends with (NewtonPolish.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
+
+
+class LinearAlgebraFailure(Exception):
+    """A step's linear algebra failed on some rank, raised on every rank (the verdict
+    reduced: NewtonPolish._agree); the attempt ends FAILED (module docstring)."""
 
 
 def _chord_rest(turn, previous):
@@ -128,12 +150,15 @@ class NewtonPolish:
         # must lower |grad L| (no energy to descend)
         self.unsymmetric = any(term.unsymmetric for term in problem.terms)
         self._jacobian = None
+        # whether the last step turned by at most ROLL_TURN (run): near the solution
+        self._near = False
         # the last exact step's KKT pieces, for the chord steps (_keep_kkt)
         self._kkt = None
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
         # of the Newton system, which LU turns into a step of round-off's size); the
-        # steps leave it out (_without_roll)
+        # steps leave it out (_without_roll), those with the Jacobian by a constraint of
+        # the step as well (_newton_step)
         stiffness = problem.scene.stiffness_values()
         self._free_roll = (bool(np.all(stiffness[:, 0] == stiffness[:, 1]))
                            and problem.mesh.global_min(int(np.all(self._free))) == 1)
@@ -183,6 +208,7 @@ class NewtonPolish:
         outcome = FAILED
         regularised = False
         try:
+            self._agree(self._usable(frames))
             for _ in range(MAX_STEPS):
                 state.set_node_directors(frames)
                 g = problem.energy_gradient(self._product)
@@ -194,6 +220,7 @@ class NewtonPolish:
                 # a chord step (FREEZE_TURN) from the last exact step's KKT matrix
                 chord = (self.unsymmetric and previous <= FREEZE_TURN
                          and self._kkt is not None)
+                self._near = previous <= ROLL_TURN
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, chord)
                 if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
@@ -269,20 +296,41 @@ class NewtonPolish:
                     return CONVERGED
             state.restore(saved)
             return outcome
+        except (LinearAlgebraFailure, np.linalg.LinAlgError):
+            # every rank here at once: the failures are agreed (_agree), and a LinAlgError
+            # comes from LAPACK on numbers every rank holds alike (reductions)
+            state.restore(saved)
+            return FAILED
         finally:
             # the kept KKT pieces serve this attempt's chord steps only
             self._drop_kkt()
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
-    @staticmethod
-    def _stretched(frames, step):
+    def _agree(self, ok):
+        """Raise LinearAlgebraFailure on every rank where ``ok`` is False on any.
+        Collective."""
+        if not self.problem.mesh.global_min(int(bool(ok))):
+            raise LinearAlgebraFailure
+
+    def _usable(self, frames):
+        """Whether the local ``frames`` (n_nodes, 3, 3) are a state the steps can start
+        from: finite, and on an extensible line every stretch |d3| = k positive (the
+        unit tangents d3 / k; the local step keeps k >= 0, and k = 0 is reached by a
+        line soft enough to fold)."""
+        if not np.all(np.isfinite(frames)):
+            return False
+        return not self.stretch or bool(np.all(np.einsum("nc,nc->n", frames[:, 2],
+                                                         frames[:, 2]) > 0.0))
+
+    def _stretched(self, frames, step):
         """Frames (rows d1, d2, k d3) turned by step[:, :3] and stretched by k += step[:, 3];
-        None where a stretch would not stay positive (the attempt fails)."""
+        None on every rank where a stretch would not stay positive on one (the attempt
+        fails). Collective."""
         turned = np.einsum("nkl,nil->nik", rotations(step[:, :3]), frames)
         k = np.sqrt(np.einsum("nc,nc->n", turned[:, 2], turned[:, 2]))
         new = k + step[:, 3]
-        if not np.all(new > 0):
+        if not self.problem.mesh.global_min(int(bool(np.all(new > 0)))):
             return None
         turned[:, 2] *= (new / k)[:, None]
         return turned
@@ -321,7 +369,20 @@ class NewtonPolish:
         normal = np.einsum("nki,nkj->ij", A[free], A[free])
         right = -np.einsum("nki,nk->i", A[free], a[free])
         total = self.problem.mesh.global_sum(np.concatenate([normal.ravel(), right]))
-        return np.linalg.lstsq(total[:9].reshape(3, 3), total[9:], rcond=None)[0]
+        return self._small_solve(total[:9].reshape(3, 3), total[9:])
+
+    def _small_solve(self, matrix, right):
+        """The least-squares solution of a small dense system that every rank holds alike
+        (reduced), (k,); LinearAlgebraFailure on every rank where it or the system is
+        not finite or LAPACK fails on one. Collective."""
+        solution = None
+        if np.all(np.isfinite(matrix)) and np.all(np.isfinite(right)):
+            try:
+                solution = np.linalg.lstsq(matrix, right, rcond=None)[0]
+            except np.linalg.LinAlgError:
+                pass
+        self._agree(solution is not None and np.all(np.isfinite(solution)))
+        return solution
 
     def _largest(self, step):
         """The largest |component| of ``step`` (n_nodes, 3 or 4) over the ranks, rad (not
@@ -346,6 +407,7 @@ class NewtonPolish:
         _keep_kkt; ``run`` takes one only where they are kept)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
+        self._agree(np.isfinite(self._residual_norm))        # the same sum on every rank
         if curvature is not None:
             self.problem.state.lam[:] = curvature
         hessian = self._jacobian.hessian if frozen else self.problem.second_variation()
@@ -371,6 +433,10 @@ class NewtonPolish:
                 vecs.append(direction)
             else:
                 columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
+                if self._free_roll and self.unsymmetric and self._near:
+                    # the roll held by a constraint of the step, its multiplier dropped
+                    # (ROLL_TURN)
+                    columns.append(hessian.roll_form(frames[:, 2]))
                 vecs.extend(columns)
                 if columns and hessian.decidable and not self.unsymmetric:
                     # the inertia test solved for a basis of the same forms
@@ -387,11 +453,15 @@ class NewtonPolish:
             dmu = np.zeros(3)
             if columns:
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
-                # (C H^-1 C^T) dmu = c + C H^-1 (-grad L)
-                right = self._chord_residual(frames) + np.array([c.dot(direction)
-                                                                 for c in columns])
-                dmu = np.linalg.lstsq(schur, right, rcond=None)[0]
-                direction.maxpy(-dmu, solved)
+                # (C H^-1 C^T) dmu = c + C H^-1 (-grad L); the roll's c is 0
+                residual = np.zeros(len(columns))
+                if self._bordered():
+                    residual[:3] = self._chord_residual(frames)
+                right = residual + np.array([c.dot(direction) for c in columns])
+                multipliers = self._small_solve(schur, right)
+                direction.maxpy(-multipliers, solved)
+                if self._bordered():
+                    dmu = multipliers[:3]
             step = hessian.from_vec(direction)
             if self._free_roll:
                 self._without_roll(step, frames)

@@ -21,7 +21,7 @@ from petsc_rod.analysis.stability import skew
 def normal_drag(tangent, velocity, drag):
     """f = c |v_n| v_n, (n, 3) N/m, for tangents (n, 3) (normalised here), current
     velocities (n, 3) m/s and c = ``drag`` (kg/m^2)."""
-    t = tangent / np.sqrt(_squares(tangent))[:, None]
+    t = _unit(tangent)
     normal = velocity - np.einsum("nc,nc->n", velocity, t)[:, None] * t
     return drag * np.sqrt(_squares(normal))[:, None] * normal
 
@@ -30,7 +30,7 @@ def drag_jacobian(tangent, velocity, drag):
     """G, (n, 3, 3): the derivative of normal_drag in a turn omega of each tangent,
     delta f = G omega (module docstring), for tangents (n, 3) (normalised here), current
     velocities (n, 3) m/s and c = ``drag`` (n,) kg/m^2."""
-    t = tangent / np.linalg.norm(tangent, axis=1, keepdims=True)
+    t = _unit(tangent)
     along = np.einsum("nc,nc->n", velocity, t)
     normal = velocity - along[:, None] * t
     speed = np.linalg.norm(normal, axis=1)
@@ -42,6 +42,15 @@ def drag_jacobian(tangent, velocity, drag):
         * unit_normal[:, :, None] * unit_normal[:, None, :])
     turn = t[:, :, None] * velocity[:, None, :] + along[:, None, None] * eye
     return stiffness @ turn @ skew(t)
+
+
+def _unit(tangent):
+    """The unit tangents of rows (n, 3), 0 where a row is 0: a node that the stretched
+    local step compressed to a point (k = 0, docs/method.md §12) has no direction, and
+    the whole current is normal to it (its drag is then finite, and its derivative 0)."""
+    length = np.sqrt(_squares(tangent))[:, None]
+    return np.divide(tangent, length, out=np.zeros_like(tangent, dtype=float),
+                     where=length > 0)
 
 
 def _squares(vectors):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 from petsc4py import PETSc
 
-from petsc_rod.cli.main import INPUT_FILE_OPTIONS, run
+from petsc_rod.cli.main import INPUT_FILE_OPTIONS, abort_alone, every_rank_failed, run
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.cli.options import (BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options,
@@ -286,6 +286,11 @@ def with_options(comm, options, action):
                 database.setValue(name, "" if value is None else value)
 
 
+# The exit code a case is recorded with where its run raised (Sweep._run): that of
+# petsc_rod's RodError, of a failure that is none of the classes with a code of their own.
+FAILED = RodError.exit_code
+
+
 class Sweep:
     """The state of a running sweep: the cases, what has converged, the records."""
 
@@ -296,6 +301,9 @@ class Sweep:
         self.scales = sweep_cases.spreads([self.swept(c) for c in cases])
         self.records = []
         self.converged = []                      # (case, its file) of the converged cases
+        # where the ranks agree on a case's failure (made now: creating it is collective)
+        self._failures = comm.tompi4py().Dup()
+        self._error = None                       # the last case's failure, its words
 
     def say(self, text):
         PETSc.Sys.Print(text, comm=self.comm)
@@ -341,9 +349,9 @@ class Sweep:
                 walk["rod_steps"] = str(self.settings.warm_steps)
             self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}; warm "
                      f"start from {source.name}")
-            code = with_options(self.comm, {**options, **walk}, lambda: run(self.comm))
+            code = self._run(case, {**options, **walk})
             start = f"from {source.name}"
-            if code in (3, 4) and self.settings.retry:
+            if code in (3, 4, FAILED) and self.settings.retry:
                 self.say(f"sweep: case {case.name}: the warm start from {source.name} ended "
                          f"with exit {code}; again from the case's own start")
                 start = f"own start (from {source.name}: exit {code})"
@@ -351,15 +359,41 @@ class Sweep:
         if code is None:
             if warm is None:
                 self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}")
-            code = with_options(self.comm, options, lambda: run(self.comm))
+            code = self._run(case, options)
         if code == 0:
             self.converged.append((case, self.file(case)))
         if code == 2:                   # refused before it started
             start = ""
         written = code in (0, 3) and os.path.exists(self.file(case))
-        return {"name": case.name, "options": self.swept(case), "set": case.options,
-                "code": code, "start": start,
-                "file": os.path.abspath(self.file(case)) if written else None}
+        record = {"name": case.name, "options": self.swept(case), "set": case.options,
+                  "code": code, "start": start,
+                  "file": os.path.abspath(self.file(case)) if written else None}
+        if code == FAILED and self._error:
+            record["error"] = self._error
+        return record
+
+    def _run(self, case, options):
+        """petsc_rod's run of ``case`` with ``options`` set: its exit code, or FAILED
+        where it raised (run turns petsc_rod's errors and PETSc's into codes; anything
+        else, a LinAlgError say, is a failure of this case, not of the sweep), the
+        error's words then kept for the record. Where only some ranks raised, the others
+        wait in a collective call: the ranks meet on a communicator of their own
+        (cli.main.every_rank_failed) and a rank that is alone ends the sweep, as a run
+        ends (cli.main.abort_alone; the summary of the cases before it is written).
+        Collective."""
+        self._error = None
+        try:
+            return with_options(self.comm, options, lambda: run(self.comm))
+        except Exception as error:          # noqa: BLE001 (any failure is the case's)
+            words = f"{type(error).__name__}: {error}".splitlines()[0]
+            if not every_rank_failed(self._failures):
+                abort_alone(self.comm, f"sweep case {case.name}: {words}")
+            self.say(f"petsc_rod.sweep: case {case.name} failed: {words}")
+            self._error = words
+            return FAILED
+
+    def destroy(self):
+        self._failures.Free()
 
     def write(self):
         """Rewrite the summary and the record (rank 0)."""
@@ -427,6 +461,7 @@ def run_sweep(comm=None):
             if record["code"] >= 128:
                 stopped = record["code"]
                 break
+    sweep.destroy()
     text = sweep.write()
     if text:
         say(text.rstrip())

@@ -113,6 +113,8 @@ def table(records, varied):
         reason = values.get("stop_reason")
         if record["code"] == 3 and reason:
             status = f"not converged ({reason})"
+        if record.get("error"):         # a run that raised (runner.Sweep._run)
+            status = f"failed ({record['error']})"
         row = ([record["name"]] + [record["options"].get(name, "(base)") for name in varied]
                + [record["code"], status, record.get("start", "")])
         # a case that did not converge: its state is no equilibrium of the case, only

@@ -6,7 +6,7 @@ import pytest
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.touchdown import grounded_catenary, touchdown_parameter
-from petsc_rod.riser.current import normal_drag
+from petsc_rod.riser.current import drag_jacobian, normal_drag
 from petsc_rod.riser.environment import Current, default_stiffness, read_profile
 from petsc_rod.riser.hermite import midpoint_values, slope_map
 
@@ -55,6 +55,22 @@ def test_normal_drag_is_the_normal_component_squared():
     assert np.allclose(np.einsum("nc,nc->n", f, tangent), 0.0, atol=1e-12)
     assert np.allclose(np.linalg.norm(f, axis=1), c * speed**2 * np.sin(angles) ** 2)
     assert np.all(f[1:-1] @ np.array([1.0, 0.0, 0.0]) > 0)     # downstream
+
+
+def test_a_point_compressed_to_nothing_takes_the_whole_current_as_normal():
+    """A zero tangent (a node of an extensible line that the stretched local step
+    compressed to k = 0) has no direction: its drag is c |v| v, finite, and its
+    derivative in a turn 0; the other rows are unchanged."""
+    tangents = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    velocity = np.array([[0.0, 1.0, 0.5], [0.0, 1.0, 0.5]])
+    with np.errstate(all="raise"):
+        drag = normal_drag(tangents, velocity, 2.0)
+        jacobian = drag_jacobian(tangents, velocity, np.array([2.0, 2.0]))
+    speed = np.linalg.norm(velocity[0])
+    assert np.allclose(drag[0], 2.0 * speed * velocity[0], rtol=1e-15)
+    assert np.allclose(drag[1], 2.0 * speed * velocity[1], rtol=1e-15)   # v normal to e_x
+    assert np.all(jacobian[0] == 0.0)
+    assert np.abs(jacobian[1]).max() > 1.0
 
 
 def test_current_profile_is_linear_in_depth_and_constant_beyond():

@@ -1,0 +1,69 @@
+"""A sweep marks a case whose run failed and goes on, whatever the failure
+(sweep/runner.py, docs/sweeps.md): exit codes of petsc_rod's own errors, and exceptions
+that petsc_rod's run does not turn into one (numpy's LinAlgError, a Python error), raised
+on every rank. In-process on PETSc.COMM_WORLD (serially, and under ``mpiexec -n 2`` on
+two ranks), petsc_rod's run replaced by one that raises for the chosen cases: no solve."""
+
+import csv
+import json
+import os
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.sweep import runner
+
+CASES = {"first": None, "linalg": np.linalg.LinAlgError("SVD did not converge"),
+         "python": KeyError("point_load_drag_areas"), "last": None}
+
+
+@pytest.fixture
+def folder(tmp_path_factory):
+    """One folder for every rank (rank 0's, broadcast)."""
+    comm = PETSc.COMM_WORLD.tompi4py()
+    path = str(tmp_path_factory.mktemp("sweep")) if comm.rank == 0 else None
+    return comm.bcast(path, root=0)
+
+
+def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch):
+    comm = PETSc.COMM_WORLD
+    cases = os.path.join(folder, "cases.txt")
+    if comm.getRank() == 0:
+        with open(cases, "w") as f:
+            f.write("name rod_length\n" + "".join(f"{name} {i + 1}\n"
+                                                   for i, name in enumerate(CASES)))
+    comm.tompi4py().Barrier()
+    ran = []
+
+    def run(comm):
+        name = os.path.basename(PETSc.Options().getString("rod_output"))[:-3]
+        ran.append(name)
+        if CASES[name] is not None:
+            raise CASES[name]
+        return 0
+
+    monkeypatch.setattr(runner, "run", run)
+    output = os.path.join(folder, "out")
+    database = PETSc.Options()
+    options = {"sweep_cases": cases, "sweep_output": output, "sweep_start": "scene"}
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        code = runner.run_sweep(comm)
+    finally:
+        for name in options:
+            database.delValue(name)
+    assert code == 3
+    assert ran == list(CASES)
+    if comm.getRank() == 0:
+        with open(os.path.join(output, "summary.csv"), newline="") as f:
+            rows = {row["case"]: row for row in csv.DictReader(f)}
+        assert list(rows) == list(CASES)
+        assert rows["first"]["status"] == rows["last"]["status"] == "converged"
+        assert rows["linalg"]["exit"] == rows["python"]["exit"] == str(runner.FAILED)
+        assert rows["linalg"]["status"] == "failed (LinAlgError: SVD did not converge)"
+        assert rows["python"]["status"] == "failed (KeyError: 'point_load_drag_areas')"
+        with open(os.path.join(output, "sweep.json")) as f:
+            record = json.load(f)
+        assert [case["code"] for case in record["cases"]] == [0, 1, 1, 0]
