@@ -411,27 +411,6 @@ class SecondVariation:
         self._drop_constraint_solves()
         self.constraint = self._independent(self.constraint + [vec])
 
-    def hold_roll(self, tangents):
-        """Add P w_n t_n t_n^T to each node's rotation block (t_n the unit tangent, P =
-        max_i |H_ii| / M_ii, the scale of the tolerance), until the next update: the
-        turn of each section about its own tangent held (module docstring, "round
-        sections"). Collective."""
-        t = unit(tangents)
-        scale = self.tolerance() / TOLERANCE
-        w = self.problem.state.node_weights
-        blocks = np.zeros((len(w), self.unknowns, self.unknowns))
-        blocks[:, :3, :3] = scale * w[:, None, None] * np.einsum("nk,nl->nkl", t, t)
-        held = np.zeros(self.problem.mesh.n_local_nodes, dtype=bool)
-        held[np.flatnonzero(self.problem.free_nodes)] = True
-        blocks[~held] = 0.0
-        rows = (self.first_row + self.block * np.arange(len(w))[:, None]
-                + np.arange(self.unknowns)).astype(PETSc.IntType)
-        if rows.size:
-            self.matrix.setValuesRCV(rows, rows, blocks, addv=PETSc.InsertMode.ADD_VALUES)
-        self.matrix.assemble()
-        self._factored = False
-        self._drop_constraint_solves()
-
     def _chord_columns(self):
         """An orthonormal basis of the chord forms at tau3 (the constraint of the test)."""
         return self._independent(self.chord_forms(self.problem.state.tau[:, 2]))
