@@ -355,7 +355,9 @@ class NewtonPolish:
         try:
             if not frozen:
                 if not self._positive_definite(hessian, regularised):
-                    if not self._free_roll:
+                    if not self._free_roll or (self.reads_positions and curvature is None):
+                        # (where the heights enter, ``run`` first takes the step again
+                        # with the iteration's curvature, and holds the roll there)
                         return None, None
                     # round sections, nothing clamped: the torque is zero at
                     # equilibrium and the sections' roll nearly free (GJ over the
