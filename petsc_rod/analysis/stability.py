@@ -448,6 +448,25 @@ class SecondVariation:
         self._zero_clamped(vec)
         return vec
 
+    def hold_roll(self, tangents):
+        """Add P w_n t_n t_n^T to each free node's rotation block (t_n the unit tangent at
+        tangents (n_nodes, 3), P = max_i |H_ii| / M_ii, the scale of ``tolerance``), until
+        the next update: each section's turn about its own tangent held, so that the
+        inertia test and the solves are those of the bending (docs/stability.md, "The
+        hanging chain"). Collective."""
+        t = unit(tangents)
+        scale = self.tolerance() / TOLERANCE
+        w = self.problem.state.node_weights * self.problem.free_nodes
+        blocks = np.zeros((len(w), self.unknowns, self.unknowns))
+        blocks[:, :3, :3] = scale * w[:, None, None] * np.einsum("nk,nl->nkl", t, t)
+        rows = (self.first_row + self.block * np.arange(len(w))[:, None]
+                + np.arange(self.unknowns)).astype(PETSc.IntType)
+        if rows.size:
+            self.matrix.setValuesRCV(rows, rows, blocks, addv=PETSc.InsertMode.ADD_VALUES)
+        self.matrix.assemble()
+        self._factored = False
+        self._drop_constraint_solves()
+
     def to_vec(self, values):
         """A new Vec from the nodes' unknowns ``values`` (n_nodes, unknowns), 0 on u, nu."""
         vec = self.matrix.createVecLeft()

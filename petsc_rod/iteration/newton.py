@@ -417,7 +417,19 @@ class NewtonPolish:
         try:
             if not frozen:
                 if not self._positive_definite(hessian, regularised):
-                    return None, None
+                    if not self._free_roll or (self.reads_positions and curvature is None):
+                        # (where the heights enter, ``run`` first takes the step again
+                        # with the iteration's curvature, and holds the roll there)
+                        return None, None
+                    # round sections, nothing clamped: the torque is zero at
+                    # equilibrium and the sections' roll nearly free (GJ over the
+                    # line), and an iterate's shear couples it to the bending; a step
+                    # with each section's roll held, whose test is on the bending
+                    # (SecondVariation.hold_roll; docs/stability.md, "The hanging
+                    # chain")
+                    hessian.hold_roll(frames[:, 2])
+                    if not self._positive_definite(hessian, regularised):
+                        return None, None
                 # a verdict on the state's own H, not on one with another curvature
                 self.verified = hessian.decidable and curvature is None
             # the Jacobian with the followers' linearisation, else H's factor
