@@ -58,7 +58,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
 from petsc_rod.analysis.stability import skew, unit
-from petsc_rod.frames import rotations
+from petsc_rod.frames import roll_between, rotations
 
 EVENT = PETSc.Log.Event("rod_newton")
 
@@ -185,6 +185,26 @@ class NewtonPolish:
         # convergence in Newton's terms (run)
         self.solved_norms = None
 
+    def _untwisting_roll(self, frames):
+        """The roll (rad, (n_local_nodes,)) of each node's frame about its tangent that
+        leaves no twist between neighbouring nodes (frames.roll_between of the rolled
+        frames 0), the first node kept. Where every section is round and nothing is
+        clamped (_free_roll) the torque m3 = K3 u3 is the same all along at equilibrium
+        and zero at an end whose roll is free, so u3 = 0: the iteration spreads its twist
+        only by diffusion over the line, and an attempt that starts with it turns the
+        line about itself and finds H indefinite. Collective."""
+        mesh = self.problem.mesh
+        chain = frames
+        following = mesh.first_of_next_rank(frames)
+        if not mesh.on_upper_boundary:
+            chain = np.concatenate([frames, following[None]])
+        change = -roll_between(chain[:-1], chain[1:])     # two gaps per owned element
+        vertex = mesh.prefix_sum(change[0::2] + change[1::2])
+        angle = np.empty(mesh.n_local_nodes)
+        angle[0::2] = vertex
+        angle[1::2] = vertex[:mesh.n_local_elements] + change[0::2]
+        return angle
+
     def run(self, record=None):
         """Newton steps from the state's current tau (rotations near the fields). Returns
         CONVERGED (to STEP_TOLERANCE, with ``solved_norms`` the last step's stopping
@@ -197,7 +217,10 @@ class NewtonPolish:
         state = problem.state
         EVENT.begin()
         saved = state.snapshot()
+        if self._free_roll:
+            state.roll_nodes(self._untwisting_roll(state.tau))
         frames = state.tau.copy()
+        start_lam = state.lam.copy()
         clamped = ~self._free
         self.solved_norms = None
         frames[clamped] = state.node_directors()[clamped]      # the prescribed frames
@@ -216,7 +239,7 @@ class NewtonPolish:
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
                 # the first step's curvature from the iteration's multipliers where the
                 # heights enter (see _newton_step)
-                curvature = saved["lam"] if first and self.reads_positions else None
+                curvature = start_lam if first and self.reads_positions else None
                 # a chord step (FREEZE_TURN) from the last exact step's KKT matrix
                 chord = (self.unsymmetric and previous <= FREEZE_TURN
                          and self._kkt is not None)
@@ -232,7 +255,7 @@ class NewtonPolish:
                     # H indefinite after a step on a line whose heights enter: the step
                     # again with the iteration's curvature, as the first (_newton_step),
                     # and like the first exempt from the residual's fall below
-                    curvature = saved["lam"]
+                    curvature = start_lam
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
                 if omega is None:
