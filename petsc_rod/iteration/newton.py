@@ -437,6 +437,7 @@ class NewtonPolish:
         if self._free_roll and not frozen:
             hessian.constrain_roll(frames[:, 2])
         vecs = []                   # every Vec made here, destroyed on the way out
+        held = False
         try:
             if not frozen:
                 if not self._positive_definite(hessian, regularised):
@@ -453,8 +454,11 @@ class NewtonPolish:
                     hessian.hold_roll(frames[:, 2])
                     if not self._positive_definite(hessian, regularised):
                         return None, None
-                # a verdict on the state's own H, not on one with another curvature
-                self.verified = hessian.decidable and curvature is None
+                    held = True
+                # a verdict on the state's own H, not on one with another curvature nor
+                # on one with the roll held (H itself was found indefinite: the
+                # stability test decides)
+                self.verified = hessian.decidable and curvature is None and not held
             # the Jacobian with the followers' linearisation, else H's factor
             solver = (self._jacobian if frozen else self._jacobian_of(hessian)) \
                 if self.unsymmetric else hessian
