@@ -205,7 +205,11 @@ def previous_files(folder):
 def _claim_folder(folder, cases, inputs):
     """Rank 0's part of claim_folder; returns the locked descriptor of the folder."""
     where = f"-sweep_output {folder}"
-    lock = os.open(folder, os.O_RDONLY)
+    try:
+        lock = os.open(folder, os.O_RDONLY)
+    except OSError as error:
+        raise RodInputError(f"{where}: cannot be read ({error.strerror}); choose another "
+                            "folder") from None
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
@@ -213,7 +217,11 @@ def _claim_folder(folder, cases, inputs):
         raise RodInputError(f"{where}: another sweep is writing into it; wait for it or "
                             "choose another folder") from None
     try:
-        entries, ours = previous_files(folder)
+        try:
+            entries, ours = previous_files(folder)
+        except OSError as error:
+            raise RodInputError(f"{where}: cannot be listed ({error.strerror}); choose "
+                                "another folder") from None
         strangers = [name for name in entries if ours is None or name not in ours]
         if strangers:
             raise RodInputError(
@@ -230,7 +238,12 @@ def _claim_folder(folder, cases, inputs):
         if clash:
             raise RodInputError(f"{where}: {clash}")
         for name in entries:            # the earlier sweep's files, none an input
-            os.remove(os.path.join(folder, name))
+            try:
+                os.remove(os.path.join(folder, name))
+            except OSError as error:
+                raise RodInputError(f"{where}: the earlier sweep's {name} cannot be "
+                                    f"removed ({error.strerror}); remove it or choose "
+                                    "another folder") from None
     except BaseException:
         os.close(lock)
         raise

@@ -67,3 +67,23 @@ def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch)
         with open(os.path.join(output, "sweep.json")) as f:
             record = json.load(f)
         assert [case["code"] for case in record["cases"]] == [0, 1, 1, 0]
+
+
+def test_an_earlier_sweep_s_file_that_cannot_be_removed_is_one_line_on_every_rank(
+        folder):
+    """An earlier sweep's folder whose listed case file is a folder: removing it raised
+    IsADirectoryError on rank 0 alone (a traceback there, the other ranks waiting in
+    the agreement for ever); now bad input on every rank, nothing removed."""
+    from types import SimpleNamespace
+
+    from petsc_rod.errors import RodInputError
+
+    comm = PETSc.COMM_WORLD
+    if comm.getRank() == 0:
+        with open(os.path.join(folder, "sweep.json"), "w") as f:
+            json.dump({"cases": [{"name": "a"}]}, f)
+        os.mkdir(os.path.join(folder, "a.h5"))
+    comm.tompi4py().Barrier()
+    with pytest.raises(RodInputError, match="the earlier sweep's a.h5 cannot be removed"):
+        runner.claim_folder(comm, folder, [SimpleNamespace(name="b", options={})], [])
+    assert os.path.isdir(os.path.join(folder, "a.h5"))
