@@ -5,6 +5,8 @@ Arrays of frames have shape (..., 3, 3) with rows d1, d2, d3 (docs/method.md §1
 
 import numpy as np
 
+# The frame of the straight reference state r = S e_x: rows d1 = e_y, d2 = e_z, d3 = e_x.
+REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 # |det D| below which strains() takes the pseudo-inverse of a frame
 SINGULAR_FRAME = 1e-12
 

@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.frames import rotation_about, rotation_log
+from petsc_rod.frames import REFERENCE_FRAME, rotation_about, rotation_log
 from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
-
-REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+from petsc_rod.scenes.starts import catenary_start
 END_KINDS = ("clamp", "pin", "free")
 # Held ends closer to the length than this fraction of it make a taut line (Scene.taut):
 # a catenary of sag f has (8/3) f^2 / L of slack, so at 1e-9 L of slack its tension is
@@ -304,7 +303,6 @@ class Scene:
         e_x made a riser's hang-off joint turn by 85 degrees."""
         axis = getattr(self, f"{which}_joint_axis")
         if axis is None:
-            from petsc_rod.scenes.starts import catenary_start
             try:
                 frame = catenary_start(self, 1.0)(np.array([0.0 if which == "start"
                                                             else self.length]))[1][0]

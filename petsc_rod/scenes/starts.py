@@ -14,7 +14,7 @@ from petsc_rod.scenes import section_catenary
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
 from petsc_rod.errors import NoCatenaryStart, RodInputError
-from petsc_rod.scenes.scene import REFERENCE_FRAME
+from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.scenes.touchdown import seabed_shape
 
 SHAPES = ("straight", "catenary")
