@@ -1,9 +1,11 @@
-"""solve(model): a Model (api/model.py) solved as the command line solves its options
-(cli/main.py): the same Scene (cli/scene_options.py), checks, mesh, solver, start and
-continuation (cli/session.run_continuation), on the ranks of ``comm``. The one place of
-the API that creates and destroys PETSc objects; what it returns holds numpy arrays
-only (api/results.py)."""
+"""solve(model): a Model (api/model.py) compiled into its Scene (compile.py, with the
+model's checks naming its fields) and solved as the command line solves its options
+(cli/main.py): the same mesh, solver, start and continuation
+(cli/session.run_continuation), on the ranks of ``comm``. The one place of the API that
+creates and destroys PETSc objects; what it returns holds numpy arrays only
+(api/results.py)."""
 
+import dataclasses
 import hashlib
 import re
 
@@ -14,14 +16,16 @@ from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (build_solver, check_mesh, destroy_run, run_record,
                                 start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
-from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
+from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
+from petsc_rod.compile import compile_scene
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodInputError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.scenes.point_loads import attachment_forces, beyond_the_line
+from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.riser.environment import read_seabed_profile
 
 
 class _LastStep:
@@ -50,62 +54,45 @@ class _LastStep:
             self.inner.abort()
 
 
-def _points(model, length):
-    """(S, forces (n, 3), drag areas) of the model's attachments, or None."""
-    if not model.attachments:
-        return None
-    sea = model.environment
-    S = np.array([a.S for a in model.attachments], dtype=float)
-    k = beyond_the_line(S, length)
-    if k is not None:
-        raise RodInputError(f"attachment {k + 1}: S = {S[k]:.6g} m is beyond the line "
-                            f"[0, {length:.6g}] m")
-    columns = {"s": S, "mass": [a.mass for a in model.attachments],
-               "volume": [a.volume for a in model.attachments],
-               **{f"f{c}": [a.force[i] for a in model.attachments]
-                  for i, c in enumerate("xyz")}}
-    areas = np.array([a.cda for a in model.attachments], dtype=float)
-    if np.any(np.asarray(columns["mass"]) < 0) or np.any(np.asarray(columns["volume"]) < 0) \
-            or np.any(areas < 0):
-        raise RodInputError("an attachment's mass, volume and cda must not be negative")
-    return S, attachment_forces(columns, sea.water_density, sea.gravity), areas
-
-
 def _run_record(model, values, solver, start, output):
-    """cli.main.run_record of the model's run, with its line types' table (which the
-    command line reads from its file) and the model's option texts."""
-    record = run_record({**values, "rod_output": output, "rod_line_types": None}, solver,
-                        start)
+    """cli.main.run_record of the model's run: every option the model stands for (its
+    export, Model.option_texts) with the run's ``values``, its line types' table and
+    seabed rows (which the command line reads from their files)."""
+    export = {**parse_values(model.option_texts()), "rod_elements": values["rod_elements"],
+              "rod_output": output, "rod_line_types": None, "rod_seabed_profile": None}
+    record = run_record(export, solver, start)
     record.parameters["line_types"] = "(Python API)"
     record.parameters["line_types_table"] = model.line_types_text()
     record.units["line_types_table"] = "text"
+    if model.environment.seabed_profile is not None:
+        record.parameters["seabed_profile"] = "(Python API)"
+        record.parameters["seabed_profile_table"] = np.asarray(
+            model.environment.seabed_profile, dtype=float)
+        record.units["seabed_profile_table"] = "m (distance, height; or x, y, height)"
     return record
 
 
-# The model's field behind each option it stands for (Model.option_texts), so that a
-# refusal of the command line's checks names what the caller gave.
-MODEL_FIELDS = {"rod_sections": "Line.sections", "rod_line_types": "the LineTypes",
-                "rod_contents_density": "Line.contents_density",
-                "rod_internal_pressure": "Line.internal_pressure",
-                "rod_steps": "Model.steps", "rod_initial_shape": "Model.initial_shape",
-                "rod_point_loads": "Model.attachments",
-                "rod_current": "Environment.current",
-                "rod_current_profile": "Environment.current",
-                "rod_sea_surface": "Environment.surface",
-                **{f"rod_{name}": f"Environment.{name}" for name in (
-                    "seabed", "seabed_stiffness", "seabed_friction",
-                    "seabed_friction_stiffness", "water_density", "gravity")},
-                **{f"rod_{end}{option}": f"Model.{end}{field}" for end in ("start", "end")
-                   for option, field in (("", ""), ("_position", ".position"),
-                                         ("_rotational_stiffness", ".stiffness"),
-                                         ("_joint_axis", ".axis"), ("_force", ".force"))}}
+# The model's field an option of Model.options sets (where the model leaves it None or
+# at its default): (part of the model, field).
+OPTION_FIELDS = {
+    **{name: ("line", name) for name in ("contents_density", "internal_pressure",
+                                         "design_factor")},
+    **{name: ("environment", name) for name in (
+        "water_density", "gravity", "seabed", "seabed_stiffness", "seabed_friction",
+        "seabed_friction_stiffness", "seabed_slope", "seabed_direction", "seabed_origin",
+        "seabed_profile")},
+    "sea_surface": ("environment", "surface"),
+    **{f"{which}{option}": (which, name) for which in ("start", "end")
+       for option, name in (("_position", "position"), ("_rotational_stiffness", "stiffness"),
+                            ("_joint_axis", "axis"), ("_force", "force"), ("_frame", "frame"),
+                            ("_twist", "twist"))}}
 
 
 def in_model_terms(error):
-    """RodInputError ``error`` of the command line's checks, its options named as the
-    model's fields (MODEL_FIELDS; a table's stand-in name, '<line types>', dropped)."""
-    text = re.sub(r"-(rod_\w+)(?: <[a-z ]+>)?",
-                  lambda match: MODEL_FIELDS.get(match.group(1), match.group(0)), str(error))
+    """RodInputError ``error`` of an option of Model.options, refused as the command line
+    refuses it, the option named as Model.options names it."""
+    text = re.sub(r"-rod_(\w+)", lambda match: f"Model.options {match.group(1)!r}",
+                  str(error))
     return RodInputError(text)
 
 
@@ -126,11 +113,13 @@ def check_options_known(model):
 
 def model_digest(model):
     """A digest of everything ``model`` gives the run: its option texts and the tables
-    it writes (line types, attachments, current profile)."""
+    it writes (line types, attachments, current profile, seabed rows)."""
     texts = model.option_texts()
     profile = model.environment.profile()
+    seabed = model.environment.seabed_profile
     whole = [sorted(texts.items()), model.line_types_text(), model.attachment_table(),
-             None if profile is None else [p.tobytes() for p in profile]]
+             None if profile is None else [p.tobytes() for p in profile],
+             None if seabed is None else np.asarray(seabed, dtype=float).tobytes()]
     return hashlib.sha256(repr(whole).encode()).hexdigest()
 
 
@@ -145,21 +134,45 @@ def check_same_model(comm, model):
                             "rank the same Model (built from the same numbers)")
 
 
+def options_of(model):
+    """(values, given) of the -rod_* options the run takes from ``model``: its steps and
+    initial shape and Model.options, parsed and checked as the command line's (the rest
+    their defaults); RodInputError naming Model.options for a bad one."""
+    check_options_known(model)
+    texts = model.option_texts()        # refuses an option the model's fields give
+    own = {name: texts[name] for name in ("rod_steps", "rod_initial_shape")}
+    own.update({f"rod_{name}": texts[f"rod_{name}"] for name in model.options})
+    try:
+        return parse_values(own), set(own)
+    except RodInputError as error:
+        raise in_model_terms(error) from None
+
+
+def with_options(model, values):
+    """``model`` with the fields Model.options sets (OPTION_FIELDS) set from their parsed
+    ``values`` (a seabed profile's rows read from its file)."""
+    parts = {}
+    for name in model.options:
+        if name not in OPTION_FIELDS:
+            continue
+        part, field = OPTION_FIELDS[name]
+        value = values[f"rod_{name}"]
+        if name == "seabed_profile":
+            value = read_seabed_profile(value)
+        parts.setdefault(part, {})[field] = value
+    changed = {part: dataclasses.replace(getattr(model, part), **fields)
+               for part, fields in parts.items()}
+    return dataclasses.replace(model, **changed) if changed else model
+
+
 def scene_of(model):
-    """(Scene, option values, given names) of ``model``: its options parsed and made into
-    a validated Scene by the command line's own functions."""
+    """(Scene, option values, given names) of ``model``: the model, with the fields its
+    options set, compiled (compile.py) with its refusals naming its fields; the
+    values of the options the run takes from it (options_of)."""
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
-    check_options_known(model)
-    texts = model.option_texts()
-    values = parse_values(texts)
-    given = set(texts)
-    scene = scene_from_options(values, given, model.environment.profile(),
-                               model.line_types_text(), _points(model, model.line.length))
-    if model.attachments:
-        scene.point_load_names = tuple(a.name or f"point {k + 1}"
-                                       for k, a in enumerate(model.attachments))
-    return scene, values, given
+    values, given = options_of(model)
+    return compile_scene(with_options(model, values), FIELD_NAMES), values, given
 
 
 def solve(model, comm=None, output=None, say=None):
@@ -175,12 +188,10 @@ def solve(model, comm=None, output=None, say=None):
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     check_same_model(comm, model)
-    try:
-        scene, values, given = on_every_rank(comm, scene_of, model)
-        settings = settings_from_options(values, scene)
-        pieces = mesh_pieces(values, scene)
-    except RodInputError as error:
-        raise in_model_terms(error) from None
+    scene, values, given = on_every_rank(comm, scene_of, model)
+    settings = settings_from_options(values, scene, FIELD_NAMES)
+    pieces = checked_pieces(scene, model.line.element_counts(FIELD_NAMES),
+                            FIELD_NAMES["sections"])
     values["rod_elements"] = int(pieces.counts.sum())
     check_mesh(comm, values, named=f"the model's Line ({values['rod_elements']} elements in "
                                    "all: its sections' counts and element_length)")

@@ -28,6 +28,8 @@ from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_S
                                             NEWTON_SWITCH_FAR, NEWTON_WORTH)
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
+from petsc_rod.model.line import DEFAULT_ELEMENTS
+from petsc_rod.model.values import MAX_MAGNITUDE  # noqa: F401 (the options' bound)
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
 from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
@@ -37,11 +39,6 @@ from petsc_rod.scenes.scene import Scene
 SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_",
                    "rod_newton_", "rod_inertia_")
 
-# Every number must be finite and at most this large in magnitude (and a positive scale,
-# such as a length or a tolerance, at least its inverse): the solver forms products of
-# a few of them (K / L^2, (K3 a / L)^2 / K, R h), which must stay within double
-# precision.
-MAX_MAGNITUDE = 1e30
 # The largest whole number an integer option may hold: a PETSc integer.
 MAX_INT = int(np.iinfo(PETSc.IntType).max)
 
@@ -142,7 +139,7 @@ def default_of(owner, name):
 
 OPTIONS = [
     Option("rod_length", _real, 1.0, "L", "length of the cable, m", SCALE, "m"),
-    Option("rod_elements", _int, 64, "N", "number of elements", POSITIVE),
+    Option("rod_elements", _int, DEFAULT_ELEMENTS, "N", "number of elements", POSITIVE),
     Option("rod_mesh_grading", _real, MESH_GRADING, "q",
            "ratio of the largest to the smallest element; > 1 refines both ends",
            (lambda v: v >= 1, "must be >= 1")),

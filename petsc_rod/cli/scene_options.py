@@ -1,29 +1,35 @@
-"""The scene, the sea and the iteration's settings from the parsed -rod_* options
-(options.py): the one place where option values become the objects the numerical code
-takes (Scene, Seabed, Current, Settings), with the checks that need several options."""
-
-import dataclasses
+"""The command line's options as a Model (petsc_rod/model), and the Scene compiled from
+it (compile.py): the one place where -rod_* option values (options.py) become the
+model, with the files they name read here (line types, attachments, the seabed's and the
+current's profiles) and the checks of options that go together (an option of the
+uniform line beside -rod_sections, a table without its partner); the model's own checks
+(Model.check) and the compile's name the options (OPTION_NAMES). Also the iteration's
+settings from the options."""
 
 import numpy as np
 
-from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
+from petsc_rod.cli.options import OPTIONS
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
+from petsc_rod.model import (Attachment, End, Environment, Line, Model, UniformLine,
+                             line_types_from_table)
+from petsc_rod.model.line import element_counts
+from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
+from petsc_rod.model.names import Names
+from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.riser.bathymetry import Grid, Plane, Profile
-from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Friction, Seabed,
-                                         check_covered, check_ends_above, default_stiffness,
-                                         grid_axes, largest_stiffness, read_profile,
-                                         read_seabed_profile)
+from petsc_rod.riser.environment import read_profile, read_seabed_profile
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes import starts
-from petsc_rod.scenes.boundary import is_held
-from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
-                                   parse_sections, section_elements)
+from petsc_rod.compile import compile_scene, line_names, rounded_down  # noqa: F401
+from petsc_rod.scenes.line import parse_sections
 from petsc_rod.scenes.point_loads import quick_point_loads, read_point_loads
-from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
+from petsc_rod.scenes.scene import REFERENCE_FRAME
 from petsc_rod.tables import read_table
+
+# How the model's checks name its fields on the command line: their options.
+OPTION_NAMES = Names({}, lambda key: f"-rod_{key}")
 
 # The options behind each Scene field a restart compares (scenes/blend.py).
 FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
@@ -44,30 +50,36 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)"}
 
 
-def point_loads_from_options(values, length, points=None):
-    """(S (n_p,), forces (n_p, 3), names, drag areas (n_p,)) of -rod_point_loads FILE
-    and -rod_point_load (scenes/point_loads.py), the file's first, each on the line
-    [0, ``length``]; ``points`` (S, forces, drag areas) when already resolved (a result
-    file's point_loads_table)."""
+def attachments_from_options(values, length, points=None):
+    """The Attachments of -rod_point_loads FILE and -rod_point_load (scenes/
+    point_loads.py), the file's first, each on the line [0, ``length``], their forces
+    resolved in the options' water and gravity; ``points`` (S, forces, drag areas) when
+    already resolved (a result file's point_loads_table)."""
     if points is not None:
         S, forces, areas = points
-        return S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas
-    parts = []
-    if values["rod_point_loads"]:
-        parts.append(read_point_loads(values["rod_point_loads"], values["rod_water_density"],
-                                      values["rod_gravity"], length, MAX_MAGNITUDE))
-    if values["rod_point_load"] is not None:
-        parts.append(quick_point_loads(values["rod_point_load"], length))
-    if not parts:
-        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0)
-    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-            sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
+        parts = [(S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas)]
+    else:
+        parts = []
+        if values["rod_point_loads"]:
+            parts.append(read_point_loads(values["rod_point_loads"],
+                                          values["rod_water_density"], values["rod_gravity"],
+                                          length, MAX_MAGNITUDE))
+        if values["rod_point_load"] is not None:
+            parts.append(quick_point_loads(values["rod_point_load"], length))
+    return tuple(Attachment(S[k], force=tuple(forces[k]), cda=areas[k], name=names[k])
+                 for S, forces, names, areas in parts for k in range(len(S)))
 
 
-def scene_from_options(values, given, profile=None, line_types=None, points=None,
+def given_value(values, given, name):
+    """The value of option ``name`` where the user gave it, else None."""
+    return values[name] if name in given else None
+
+
+def model_from_options(values, given, profile=None, line_types=None, points=None,
                        seabed_rows=None):
-    """A validated Scene from parsed option values; ``profile`` (depths, velocities) the
-    rows of -rod_current_profile when already read (a result file's
+    """The Model of parsed option values (``given`` the names the user set: a field of
+    an option not given is None, the model's default); ``profile`` (depths, velocities)
+    the rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
     ``points`` (S, forces, drag areas) the point loads when already resolved (a result
@@ -76,44 +88,66 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
     load = np.asarray(values["rod_load"])
     if load.size % 3:
         raise RodInputError("-rod_load: give 3 values (fx,fy,fz) per load piece")
-    line = dict(length=values["rod_length"], stiffness=values["rod_stiffness"],
-                load_values=load.reshape(-1, 3), load_breaks=values["rod_load_breaks"])
-    sections = sections_from_options(values, given, line_types)
-    if sections:
-        line = dict(length=sections[-1].end, stiffness=sections[0].stiffness_start,
-                    load_values=[s.weight for s in sections],
-                    load_breaks=[s.start for s in sections[1:]], sections=tuple(sections))
-    point_S, point_forces, point_names, point_areas = point_loads_from_options(
-        values, line["length"], points)
-    if not (sections or point_S.size):
+    line = line_from_options(values, given, line_types)
+    if line is None:
+        line = UniformLine(length=values["rod_length"], stiffness=values["rod_stiffness"],
+                           load=load.reshape(-1, 3), load_breaks=values["rod_load_breaks"],
+                           axial_stiffness=values["rod_axial_stiffness"],
+                           drag=given_value(values, given, "rod_drag"),
+                           elements=values["rod_elements"],
+                           grading=values["rod_mesh_grading"])
+        for name in ("rod_contents_density", "rod_internal_pressure", "rod_design_factor"):
+            if name in given:
+                raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
+                                    "id give the pipe it applies to)")
+    attachments = attachments_from_options(values, line.length, points)
+    if not (isinstance(line, Line) or attachments):
         for name in ("rod_water_density", "rod_gravity"):
             if name in given:
                 raise RodInputError(f"-{name} needs -rod_sections or attachments "
                                     "(-rod_point_loads): the uniform line takes -rod_load")
-    origin = np.asarray(values["rod_start_position"], dtype=float)
-    end = values["rod_end_position"]
-    scene = Scene(**line, start=values["rod_start"], end=values["rod_end"],
-                  start_position=origin,
-                  end_position=None if end is None else np.asarray(end) - origin,
-                  end_frame=values["rod_end_frame"], start_frame=values["rod_start_frame"],
-                  end_twist=values["rod_end_twist"], start_force=values["rod_start_force"],
-                  end_force=values["rod_end_force"],
-                  axial_stiffness=values["rod_axial_stiffness"],
-                  start_rotational_stiffness=values["rod_start_rotational_stiffness"],
-                  end_rotational_stiffness=values["rod_end_rotational_stiffness"],
-                  start_joint_axis=values["rod_start_joint_axis"],
-                  end_joint_axis=values["rod_end_joint_axis"], point_load_S=point_S,
-                  point_load_forces=point_forces, point_load_names=point_names,
-                  point_load_drag_areas=point_areas,
-                  water_density=values["rod_water_density"], gravity=values["rod_gravity"])
-    scene.validate(given)
-    scene.seabed, scene.current = environment_from_options(values, given, scene, profile,
-                                                           seabed_rows)
-    pressures_from_options(values, given, scene)
-    check_taut(scene)
-    check_applied_forces(scene, given)
-    check_seabed_stiffness(scene, given)
-    return scene
+    ends = {which: End(values[f"rod_{which}"],
+                       given_value(values, given, f"rod_{which}_position"),
+                       given_value(values, given, f"rod_{which}_rotational_stiffness"),
+                       given_value(values, given, f"rod_{which}_joint_axis"),
+                       given_value(values, given, f"rod_{which}_force"),
+                       given_value(values, given, f"rod_{which}_frame"))
+            for which in ("start", "end")}
+    if "rod_end_twist" in given:
+        ends["end"] = End(**{**vars(ends["end"]), "twist": values["rod_end_twist"]})
+    return Model(line, ends["start"], ends["end"],
+                 environment_from_options(values, given, profile, seabed_rows), attachments)
+
+
+def environment_from_options(values, given, profile=None, seabed_rows=None):
+    """The Environment of the sea's options (model_from_options: ``profile`` and
+    ``seabed_rows`` the current's and the seabed's rows when already read)."""
+    if "rod_current" in given and "rod_current_profile" in given:
+        raise RodInputError("-rod_current and -rod_current_profile both give the current; "
+                            "give one of them")
+    current = given_value(values, given, "rod_current")
+    if "rod_current_profile" in given:
+        depths, velocities = (profile if profile is not None else
+                              read_profile(values["rod_current_profile"], MAX_MAGNITUDE))
+        current = np.column_stack([depths, velocities])
+    seabed_profile = seabed_rows
+    if seabed_profile is None and "rod_seabed_profile" in given:
+        seabed_profile = read_seabed_profile(values["rod_seabed_profile"], MAX_MAGNITUDE)
+    fields = {name: given_value(values, given, f"rod_{name}") for name in (
+        "seabed", "seabed_stiffness", "seabed_friction", "seabed_friction_stiffness",
+        "seabed_slope", "seabed_direction", "seabed_origin")}
+    return Environment(**fields, surface=given_value(values, given, "rod_sea_surface"),
+                       current=current, water_density=values["rod_water_density"],
+                       gravity=values["rod_gravity"], seabed_profile=seabed_profile)
+
+
+def scene_from_options(values, given, profile=None, line_types=None, points=None,
+                       seabed_rows=None):
+    """A validated Scene from parsed option values: the Model of model_from_options
+    (its arguments), compiled (compile.py) with its refusals naming the
+    options."""
+    return compile_scene(model_from_options(values, given, profile, line_types, points,
+                                            seabed_rows), OPTION_NAMES)
 
 
 # Options the sections replace, and what gives the value instead.
@@ -126,16 +160,16 @@ SECTION_REPLACES = {"rod_stiffness": "the line types' ei and gj",
                                         "section is meshed uniformly)"}
 
 
-def sections_from_options(values, given, content=None):
-    """The line's Sections (scenes/line.py) from -rod_line_types (its table's text
-    ``content`` when already read) and -rod_sections, or [] when neither is given;
+def line_from_options(values, given, content=None):
+    """The model's Line of -rod_line_types (its table's text ``content`` when already
+    read) and -rod_sections, or None when neither is given (a uniform line);
     RodInputError for one without the other, an unknown type, a length that disagrees
     with -rod_length, or an option the sections replace."""
     if "rod_sections" not in given:
         if "rod_line_types" in given:
             raise RodInputError("-rod_line_types needs -rod_sections TYPE:LENGTH[:ELEMENTS],"
                                 "... (the line from S = 0 as sections of those types)")
-        return []
+        return None
     if "rod_line_types" not in given:
         raise RodInputError("-rod_sections needs -rod_line_types FILE (the table of the "
                             "line types it names)")
@@ -152,229 +186,55 @@ def sections_from_options(values, given, content=None):
         if name not in types:
             raise RodInputError(f"-rod_sections: unknown line type '{name}'; "
                                 f"-rod_line_types {path} has {', '.join(types)}")
-    ends = np.concatenate([[0.0], np.cumsum([length for _, length, _ in entries])])
-    if "rod_length" in given and abs(ends[-1] - values["rod_length"]) > 1e-9 * ends[-1]:
+    line = Line(tuple((types[name], length) + (() if count is None else (count,))
+                      for name, length, count in entries),
+                element_length=None,
+                elements=given_value(values, given, "rod_elements"),
+                **{name: given_value(values, given, f"rod_{name}") for name in (
+                    "contents_density", "internal_pressure", "design_factor")})
+    total = line.length
+    if "rod_length" in given and abs(total - values["rod_length"]) > 1e-9 * total:
         raise RodInputError(
-            f"-rod_sections add up to {ends[-1]:.15g} m, -rod_length is "
+            f"-rod_sections add up to {total:.15g} m, -rod_length is "
             f"{values['rod_length']:.15g} m; the sections set the length: drop -rod_length "
             "or correct a section")
-    rho, g = values["rod_water_density"], values["rod_gravity"]
-    return [types[name].section(ends[k], ends[k + 1], rho, g)
-            for k, (name, _, _) in enumerate(entries)]
+    return line
 
 
 def mesh_pieces(values, scene, given=()):
     """The uniform pieces (mesh.Pieces) of a line of sections, every section end a
     vertex, with the element counts -rod_sections gives and the rest of -rod_elements
-    shared out by length; None for a line without sections. A -rod_elements (in
-    ``given``) that disagrees with counts given for every section is refused, and so is
-    an element too small for double precision (mesh.MIN_RELATIVE_ELEMENT)."""
+    shared out by length (model/line.element_counts); None for a line without sections.
+    An element too small for double precision (mesh.MIN_RELATIVE_ELEMENT) is refused."""
     if not scene.sections:
         return None
     entries = parse_sections(values["rod_sections"], "-rod_sections")
-    counts = [count for _, _, count in entries]
-    if "rod_elements" in given and all(c is not None for c in counts) \
-            and sum(counts) != values["rod_elements"]:
-        raise RodInputError(
-            f"-rod_elements {values['rod_elements']}: -rod_sections gives every section "
-            f"its elements, {sum(counts)} in all; drop -rod_elements or a section's count")
-    lengths = np.array([length for _, length, _ in entries])
-    shared = np.array([c is None for c in counts])
-    given_counts = int(sum(c for c in counts if c is not None))
-    counts = section_elements(lengths, counts, values["rod_elements"])
-    if "rod_elements" in given and np.any(shared) and counts.sum() != values["rod_elements"]:
-        raise RodInputError(
-            f"-rod_elements {values['rod_elements']}: -rod_sections gives {given_counts} "
-            f"elements to the sections with a count and needs at least one for each of the "
-            f"{int(shared.sum())} without, {int(counts.sum())} in all; give -rod_elements "
-            f"{int(counts.sum())} or more")
-    check_represented(entries, lengths, counts, shared, given_counts, scene.length,
-                      f"-rod_elements {values['rod_elements']}" if "rod_elements" in given
-                      else f"-rod_sections (the default -rod_elements {values['rod_elements']})")
+    counts = element_counts([name for name, _, _ in entries],
+                            [length for _, length, _ in entries],
+                            [count for _, _, count in entries], values["rod_elements"],
+                            "rod_elements" in given, OPTION_NAMES)
+    return checked_pieces(scene, counts, "-rod_sections")
+
+
+def checked_pieces(scene, counts, named):
+    """mesh.Pieces of the scene's sections with ``counts`` elements each, refused
+    (naming ``named``) where an element is too small for double precision."""
     ends = [scene.sections[0].start] + [section.end for section in scene.sections]
     smallest = float(np.min(np.diff(ends) / counts))
     if not smallest >= MIN_RELATIVE_ELEMENT * scene.length:
         raise RodInputError(
-            f"-rod_sections: an element of {smallest:.3g} m is {smallest / scene.length:.2g} "
+            f"{named}: an element of {smallest:.3g} m is {smallest / scene.length:.2g} "
             f"of the length, below what double precision resolves ({MIN_RELATIVE_ELEMENT:g}); "
             "lengthen the shortest section or give it fewer elements")
     return Pieces(ends, counts)
 
 
-# The fewest elements a line of sections is meshed with along its length: an element
-# longer than the length over this is a chord across a quarter of the line or more,
-# which cannot represent the shape of a line of several sections (a 2300 m section of
-# one element). A uniform line keeps any count: 2 elements of the P2 rod converge at the
-# mesh's order (docs/stability.md, group mesh).
-MIN_LINE_ELEMENTS = 4
-
-
-def check_represented(entries, lengths, counts, shared, given_counts, length, sharing):
-    """Refuse a section whose elements (``counts`` of ``entries``, ``shared`` those
-    without their own count) are longer than length / MIN_LINE_ELEMENTS, saying what
-    mesh is needed: the section's own count, or the -rod_elements that shares enough
-    out to those without one (``sharing``: how the message names what shared them)."""
-    element = lengths / counts
-    coarse = np.flatnonzero(element > length / MIN_LINE_ELEMENTS)
-    if not coarse.size:
-        return
-    k = int(coarse[0])
-    name, section = entries[k][0], lengths[k]
-    what = (f"section {k + 1} ({name}, {section:g} m) has {int(counts[k])} element(s) of "
-            f"{element[k]:.4g} m, longer than 1/{MIN_LINE_ELEMENTS} of the line "
-            f"({length:g} m): a mesh that coarse cannot represent the line's shape")
-    needed = int(np.ceil(MIN_LINE_ELEMENTS * section / length))
-    if not shared[k]:
-        raise RodInputError(f"-rod_sections: {what}; give it at least {needed} elements "
-                            f"({name}:{section:g}:{needed})")
-    total = given_counts + int(np.ceil(MIN_LINE_ELEMENTS * lengths[shared].sum() / length)
-                               ) + int(shared.sum())
-    raise RodInputError(f"{sharing}: {what}; give -rod_elements {total} or more (or the "
-                        f"section its own count, {name}:{section:g}:{needed})")
-
-
-def pressures_from_options(values, given, scene):
-    """Set the scene's sea surface (in its frame), contents density, internal
-    pressure (riser/pressures.py) and design factor (riser/stresses.py) for a line of
-    sections; refuse them on a line without
-    line types (no diameters to press on)."""
-    if not scene.sections:
-        for name in ("rod_contents_density", "rod_internal_pressure",
-                     "rod_design_factor"):
-            if name in given:
-                raise RodInputError(f"-{name} needs -rod_sections (the line types' od and "
-                                    "id give the pipe it applies to)")
-        return
-    check_partners(given, scene.sections)
-    surface = values["rod_sea_surface"]
-    if surface is not None:
-        scene.sea_surface = float(surface - scene.start_position[2])
-    scene.contents_density = float(values["rod_contents_density"])
-    scene.internal_pressure = float(values["rod_internal_pressure"])
-    scene.design_factor = float(values["rod_design_factor"])
-
-
-def check_partners(given, sections):
-    """Refuse a pipe setting that does nothing without its partner in the line types:
-    -rod_internal_pressure and -rod_contents_density act on the bore (no type with an
-    id > 0: no bore), -rod_design_factor scales the yield stress (no type with smys: no
-    utilisation)."""
-    bore = any(section.id > 0 for section in sections)
-    yield_stress = any(np.isfinite(section.smys) for section in sections)
-    for name, present, partner in (
-            ("rod_internal_pressure", bore, "an id column (the bore it acts on)"),
-            ("rod_contents_density", bore, "an id column (the bore the contents fill)"),
-            ("rod_design_factor", yield_stress,
-             "an smys column (the yield stress it scales into the allowable stress)")):
-        if name in given and not present:
-            raise RodInputError(f"-{name} needs a line type with {partner}: no line type "
-                                "of -rod_sections has one; give it in -rod_line_types, or "
-                                f"drop -{name}")
-
-
-def line_names(sections):
-    """How a message names what gives the line's load, stiffness, stretch, drag and
-    length: the options of a uniform line, or what the line types give in their place
-    (SECTION_REPLACES: those options are refused beside -rod_sections)."""
-    if sections:
-        return dict(load="the line types' weight (mass and od in -rod_line_types)",
-                    stiffness="the line types' ei and gj (-rod_line_types)",
-                    stretch="the line types an ea column (EA, N)",
-                    drag="the line types' cd and drag_d (-rod_line_types)",
-                    length="-rod_sections")
-    return dict(load="-rod_load", stiffness="-rod_stiffness", stretch="-rod_axial_stiffness EA",
-                drag="-rod_drag", length="-rod_length")
-
-
-def check_taut(scene):
-    """Refuse a loaded inextensible line held at both ends its length apart (Scene.taut):
-    it can only be straight, and any tension balances its loads along it, so that the
-    tension the iteration would stop at is arbitrary (docs/method.md §5). An unloaded one
-    (a straight rod twisted between clamps) is kept: its tension is zero, the limit of a
-    stiff extensible rod."""
-    if not scene.taut or not scene.loaded:
-        return
-    chord = np.linalg.norm(scene.end_position - scene.start_state(1.0).position)
-    raise RodInputError(
-        f"-rod_end_position: the held ends are {chord:.15g} m apart, the line's length "
-        f"{scene.length:.15g} m: an inextensible line held taut is straight and any "
-        "tension balances its loads, so its tension is undetermined; give "
-        f"{line_names(scene.sections)['stretch']} to model the stretch, or bring the ends "
-        "closer")
-
-
-def check_seabed_stiffness(scene, given):
-    """Refuse a seabed stiffer than environment.largest_stiffness (given, or the default
-    w / 1 mm of a long line), naming the option and the largest stiffness accepted."""
-    if scene.seabed is None:
-        return
-    force = scene.applied_force()
-    largest = min(largest_stiffness(force, scene.length), MAX_MAGNITUDE)
-    k = scene.seabed.stiffness
-    if k <= largest:
-        return
-    largest = rounded_down(largest)
-    why = (f"the largest accepted is {largest:.3g} N/m^2, under which the line's mean load "
-           f"{force / scene.length:.3g} N/m sinks {MIN_RELATIVE_PENETRATION:g} of the length "
-           "(near the round-off of a height: a stiffer seabed changes nothing but the "
-           "conditioning of the vertical problem)")
-    if "rod_seabed_stiffness" in given:
-        raise RodInputError(f"-rod_seabed_stiffness {k:g}: {why}; use "
-                            f"-rod_seabed_stiffness {largest:.3g} or less")
-    raise RodInputError(f"{line_names(scene.sections)['load']}: the default "
-                        f"-rod_seabed_stiffness (weight / 1 mm) is "
-                        f"{k:.3g} N/m^2, above what this line accepts: {why}; give "
-                        f"-rod_seabed_stiffness {largest:.3g} or less")
-
-
-def rounded_down(value, digits=3):
-    """``value`` > 0 rounded down to ``digits`` significant digits, so that the largest
-    accepted value a message quotes is itself accepted."""
-    unit = 10.0 ** (np.floor(np.log10(value)) - digits + 1)
-    return float(np.floor(value / unit) * unit)
-
-
-def _current_option(given):
-    return "-rod_current_profile" if "rod_current_profile" in given else "-rod_current"
-
-
-def check_applied_forces(scene, given):
-    """Refuse a force the accepted options derive beyond MAX_MAGNITUDE (the bound of the
-    options themselves): the drag coefficient c = rho C_d D / 2, the largest drag
-    c max |v|^2 (N/m) and the total applied force F = int |f| dS + |P_0| + |P_L| + L c
-    max |v|^2 (N, Scene.applied_forces), naming the option behind the largest part."""
-    names = line_names(scene.sections)
-    if scene.current is not None:
-        if scene.current.drag > MAX_MAGNITUDE:
-            raise RodInputError(
-                f"{names['drag']}: c = rho Cd D / 2 = {scene.current.drag:.3g} kg/m^2 is "
-                f"above {MAX_MAGNITUDE:g}; give rho in kg/m^3 and D in m")
-        drag = scene.current.largest_drag()
-        if drag > MAX_MAGNITUDE:
-            raise RodInputError(
-                f"{_current_option(given)} with {names['drag']}: the largest drag c max "
-                f"|v|^2 = "
-                f"{drag:.3g} N/m is above {MAX_MAGNITUDE:g}; give the current in m/s")
-    parts = scene.applied_forces()
-    total = sum(parts.values())
-    if total > MAX_MAGNITUDE:
-        name = max(parts, key=parts.get)
-        option = {"load": f"{names['load']} (with {names['length']})",
-                  "start_force": "-rod_start_force",
-                  "point_loads": "-rod_point_loads|-rod_point_load",
-                  "end_force": "-rod_end_force",
-                  "drag": f"{_current_option(given)} with {names['drag']} and "
-                          f"{names['length']}"}[name]
-        raise RodInputError(
-            f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
-            f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
-            "lengths in m")
-
-
-def settings_from_options(values, scene):
+def settings_from_options(values, scene, names=OPTION_NAMES):
+    """The iteration's Settings of the options, the default penalty resolved for
+    ``scene`` (its refusal worded with ``names``)."""
     penalty = values["rod_al_penalty"]
     if penalty is None:
-        penalty = checked_default_penalty(scene, start_tension(values, scene))
+        penalty = checked_default_penalty(scene, start_tension(values, scene), names)
     return Settings(asked_penalty=penalty, max_it=values["rod_al_max_it"],
                     rtol=values["rod_al_rtol"], ctol=values["rod_al_ctol"],
                     monitor=values["rod_al_monitor"],
@@ -397,234 +257,33 @@ def start_tension(values, scene):
         return 0.0
 
 
-def checked_default_penalty(scene, start_tension=0.0):
+def checked_default_penalty(scene, start_tension=0.0, names=OPTION_NAMES):
     """default_penalty(scene, start_tension), refused above MAX_MAGNITUDE (the bound of
     -rod_al_penalty) with the options behind the scale that sets it
     (problem/penalty.penalty_scales)."""
     scales = penalty_scales(scene, start_tension)
     name = max(scales, key=scales.get)
     if scales[name] > MAX_MAGNITUDE:
-        names = line_names(scene.sections)
+        n = names
+        names = line_names(scene.sections, n)
         stiffness = names["stiffness"]
         option, formula = {
             "bending": (f"{stiffness} with {names['length']}", "100 sqrt(min K max K) / L^2"),
-            "tension": (f"{names['load']}, -rod_start_force, -rod_end_force or the current",
-                        "F / 2"),
-            "twist": (f"-rod_end_twist (or -rod_end_frame) with {stiffness}",
+            "tension": (f"{names['load']}, {n['start_force']}, {n['end_force']} or the "
+                        "current", "F / 2"),
+            "twist": (f"{n['end_twist']} (or {n['end_frame']}) with {stiffness}",
                       "2 (K3 alpha / L)^2 / min(K1, K2)"),
-            "stretch": ("-rod_axial_stiffness with -rod_end_position" if not scene.sections
-                        else "the line types' ea with -rod_end_position",
+            "stretch": (f"{n['axial_stiffness']} with {n['end_position']}"
+                        if not scene.sections
+                        else f"the line types' ea with {n['end_position']}",
                         "EA (|r_L| - L) / 2L"),
-            "start": (f"{names['load']} with -rod_initial_shape catenary",
+            "start": (f"{names['load']} with {n['initial_shape']} catenary",
                       "the catenary start's largest tension")}[name]
         raise RodInputError(
             f"{option}: the default -rod_al_penalty {formula} = {scales[name]:.3g} N is "
             f"above {MAX_MAGNITUDE:g}, beyond what double precision carries through the "
             "solver; check the units (N m^2, m, rad)")
     return scales[name]
-
-
-# The options that shape the seabed (riser/bathymetry.py, docs/riser.md §1a).
-SEABED_SHAPE = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin",
-                "rod_seabed_profile")
-
-
-def seabed_direction(values):
-    """The unit horizontal vector of -rod_seabed_direction (an azimuth in degrees, or a
-    vector dx,dy), default +x."""
-    given = values["rod_seabed_direction"]
-    if given is None:
-        return np.array([1.0, 0.0])
-    given = np.asarray(given, dtype=float)
-    if given.size == 1:
-        angle = np.radians(given[0])
-        return np.array([np.cos(angle), np.sin(angle)])
-    norm = float(np.hypot(*given)) if given.size == 2 else 0.0
-    if given.size != 2 or norm == 0:
-        raise RodInputError(f"-rod_seabed_direction {','.join(f'{v:g}' for v in given)}: give "
-                            "an azimuth in degrees (one number) or a horizontal vector dx,dy "
-                            "(two numbers, not both 0)")
-    return given / norm
-
-
-def seabed_shape(values, given, origin, profile_rows=None):
-    """The bathymetry.Plane or Profile of the seabed options in the scene's frame (its
-    origin at ``origin`` (3,), absolute), or None for a flat seabed (no slope, or a slope
-    of 0: today's plane z = -rod_seabed, bit for bit). ``profile_rows`` the profile's or
-    grid's rows (n, 2 or 3), heights absolute, when already read (a result file's
-    seabed_profile_table)."""
-    profile = "rod_seabed_profile" in given or profile_rows is not None
-    if profile and ("rod_seabed" in given or "rod_seabed_slope" in given):
-        raise RodInputError("-rod_seabed_profile gives the seabed's heights: drop "
-                            "-rod_seabed and -rod_seabed_slope, or the profile")
-    if not profile and "rod_seabed_slope" not in given:
-        for name in ("rod_seabed_direction", "rod_seabed_origin"):
-            if name in given:
-                raise RodInputError(f"-{name} needs -rod_seabed_slope or -rod_seabed_profile "
-                                    "(the flat -rod_seabed has no direction or origin); give "
-                                    f"one of them, or drop -{name}")
-    direction = seabed_direction(values)
-    seabed_origin = np.asarray(values["rod_seabed_origin"] if values["rod_seabed_origin"]
-                               is not None else (0.0, 0.0), dtype=float)
-    if profile:
-        table = np.asarray(profile_rows if profile_rows is not None else
-                           read_seabed_profile(values["rod_seabed_profile"], MAX_MAGNITUDE),
-                           dtype=float)
-        if table.shape[1] == 2:
-            return Profile(seabed_origin, direction, table[:, 0], table[:, 1]).moved(origin)
-        if "rod_seabed_direction" in given:
-            raise RodInputError("-rod_seabed_direction: a grid's rows give x and y (from "
-                                "-rod_seabed_origin); drop the direction")
-        xs, ys, heights = grid_axes(table, RodInputError)
-        return Grid(seabed_origin, xs, ys, heights).moved(origin)
-    slope = values["rod_seabed_slope"]
-    if slope is None or slope == 0:
-        return None
-    return Plane.sloping(seabed_origin, values["rod_seabed"], slope,
-                         direction).moved(origin)
-
-
-def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_rows=None):
-    """The Seabed of -rod_seabed (or -rod_seabed_profile), its shape's options and
-    -rod_seabed_stiffness, or None; heights in the scene's frame (its origin at
-    ``origin`` (3,), absolute; -rod_seabed already less origin[2])."""
-    if "rod_seabed" not in given and "rod_seabed_profile" not in given and (
-            profile_rows is None):
-        for name in ("rod_seabed_stiffness",) + SEABED_SHAPE + SEABED_FRICTION:
-            if name in given:
-                raise RodInputError(f"-{name} needs -rod_seabed (the seabed's height) or "
-                                    "-rod_seabed_profile")
-        return None
-    stiffness = values["rod_seabed_stiffness"]
-    if stiffness is None:
-        stiffness = default_stiffness(load_values)
-        if stiffness is None:
-            load = ("no line type sinks (mass above the water displaced)"
-                    if "rod_sections" in given else "no -rod_load points down")
-            raise RodInputError(f"-rod_seabed: {load} to set the default stiffness "
-                                "(weight / 1 mm); give -rod_seabed_stiffness")
-    friction = friction_from_options(values, given, float(stiffness))
-    absolute = dict(values)
-    if values["rod_seabed"] is not None:
-        absolute["rod_seabed"] = values["rod_seabed"] + origin[2]
-    shape = seabed_shape(absolute, given, origin, profile_rows)
-    if shape is None:
-        return Seabed(float(values["rod_seabed"]), float(stiffness), friction=friction)
-    return Seabed(float(shape.height(0.0, 0.0)), float(stiffness), shape, friction)
-
-
-# The default stick stiffness of the friction over the seabed's stiffness: at the default
-# seabed stiffness (weight / 1 mm) the weight mobilises the friction over mu x 1 cm, as
-# pipe-soil practice has it (a few mm axially, a tenth of a diameter laterally); stiffer
-# sticks slowed the iteration down (docs/riser.md §3b).
-FRICTION_STIFFNESS_RATIO = 0.1
-
-# The options of the seabed's friction (riser/friction.py, docs/riser.md §3b).
-SEABED_FRICTION = ("rod_seabed_friction", "rod_seabed_friction_stiffness")
-
-
-def friction_from_options(values, given, seabed_stiffness):
-    """The environment.Friction of -rod_seabed_friction (one coefficient, or axial and
-    lateral) and -rod_seabed_friction_stiffness (default the seabed's ``seabed_stiffness``),
-    or None without friction."""
-    if "rod_seabed_friction" not in given:
-        if "rod_seabed_friction_stiffness" in given:
-            raise RodInputError("-rod_seabed_friction_stiffness needs -rod_seabed_friction "
-                                "(the friction coefficient)")
-        return None
-    mu = np.asarray(values["rod_seabed_friction"], dtype=float)
-    if mu.size not in (1, 2):
-        raise RodInputError(f"-rod_seabed_friction {','.join(f'{v:g}' for v in mu)}: give "
-                            "one coefficient mu or two, mu_axial,mu_lateral")
-    stiffness = values["rod_seabed_friction_stiffness"]
-    if stiffness is None:
-        stiffness = FRICTION_STIFFNESS_RATIO * seabed_stiffness
-    return Friction(float(mu[0]), float(mu[-1]), float(stiffness))
-
-
-def current_from_options(values, given, surface_default, profile_rows=None,
-                         section_drag=None):
-    """The Current of -rod_current or -rod_current_profile with -rod_drag, or None.
-    ``surface_default``: the sea surface height when -rod_sea_surface is not given;
-    ``profile_rows``: the profile's (depths, velocities) when already read;
-    ``section_drag``: for a line of sections, the largest of their drag coefficients
-    c (kg/m^2), which the current carries in place of -rod_drag's (the drag term takes
-    each section's own, Scene.drag_at)."""
-    uniform, profile = "rod_current" in given, "rod_current_profile" in given
-    if uniform and profile:
-        raise RodInputError("-rod_current and -rod_current_profile both give the current; "
-                            "give one of them")
-    if not (uniform or profile):
-        names = ("rod_drag",) if section_drag is not None else ("rod_drag", "rod_sea_surface")
-        for name in names:
-            if name in given:
-                raise RodInputError(f"-{name} needs a current (-rod_current or "
-                                    "-rod_current_profile)")
-        return None
-    if section_drag is None and "rod_drag" not in given:
-        raise RodInputError("a current needs -rod_drag rho,Cd,D (water density kg/m^3, drag "
-                            "coefficient, hydrodynamic diameter m)")
-    if "rod_sea_surface" in given and not profile and section_drag is None:
-        raise RodInputError("-rod_sea_surface needs -rod_current_profile (a uniform "
-                            "current does not depend on depth) or -rod_sections (the "
-                            "external pressure)")
-    if profile and profile_rows is not None:
-        depths, velocities = profile_rows
-    elif profile:
-        depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
-    else:
-        depths, velocities = np.zeros(1), np.asarray(values["rod_current"]).reshape(1, 3)
-    surface = values["rod_sea_surface"]
-    surface = float(surface_default if surface is None else surface)
-    if section_drag is not None:
-        if section_drag == 0:
-            raise RodInputError("a current on -rod_sections whose line types have no drag: "
-                                "give the line types a cd column")
-        # each section's own c (Scene.drag_at); the current carries the largest
-        return Current(depths, velocities, surface, section_drag)
-    return Current.morison(depths, velocities, surface, *values["rod_drag"])
-
-
-def environment_from_options(values, given, scene, profile=None, seabed_rows=None):
-    """(Seabed or None, Current or None) for a validated ``scene``, checked against it
-    (``profile``: as in current_from_options), their heights in the scene's frame (the
-    options' less the start's z, docs/method.md §5); ``seabed_rows`` the seabed
-    profile's or grid's rows when already read."""
-    z0 = float(scene.start_position[2])
-    values = dict(values)
-    for name in ("rod_seabed", "rod_sea_surface"):
-        if values[name] is not None:
-            values[name] = values[name] - z0
-    seabed = seabed_from_options(values, given, scene.load_values, scene.start_position,
-                                 seabed_rows)
-    # a flat seabed: also the unloaded reference's ends (straight along e_x on it); a
-    # sloping one crosses that line, so only the loaded ends are held to it
-    loads = (0.0, 1.0) if seabed is None or seabed.flat else (1.0,)
-    ends = [("-rod_start", scene.start_state(t)) for t in loads]
-    ends += [("-rod_end", scene.end_state(t)) for t in loads]
-    check_covered(seabed, [state.position for _, state in ends if is_held(state)],
-                  "the held ends")
-    check_ends_above(seabed, ends, scene.length, z0)
-    held = [state.position[2] for _, state in ends if is_held(state)]
-    seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
-    section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
-    return seabed, current_from_options(values, given, max(held), profile, section_drag)
-
-
-def seated(seabed, held):
-    """``seabed`` lowered by the deepest penetration of the held ends at ``held`` (n, 3),
-    m, where one lies below it by round-off (check_ends_above accepts 1e-12 of the
-    length): such an end is on the seabed (-rod_seabed 1e-12 against an anchor at z = 0,
-    or 0.1 + 0.2 against 0.3), and an anchor pressed into it by round-off started the
-    catenary below the seabed (NaN at the first iteration). The whole seabed, flat or
-    shaped, moves down by that round-off."""
-    if seabed is None:
-        return seabed
-    depth = float(np.max(-seabed.gap(np.asarray(held, dtype=float).reshape(-1, 3))))
-    if not depth > 0:
-        return seabed
-    shape = None if seabed.flat else seabed.shape.moved(np.array([0.0, 0.0, depth]))
-    return dataclasses.replace(seabed, height=seabed.height - depth, shape=shape)
 
 
 def options_from_parameters(parameters):

@@ -256,17 +256,18 @@ def grid_axes(table, refuse):
     return xs, ys, ordered[:, 2].reshape(xs.size, ys.size)
 
 
-def check_ends_above(seabed, ends, length, origin_z=0.0):
+def check_ends_above(seabed, ends, length, origin_z=0.0, option="-rod_seabed"):
     """Refuse a held end below the seabed (``ends``: (name, EndState) pairs at t = 1); an
     end on it (an anchor) is fine, to round-off of the length. Heights in the scene's
-    frame; the message adds ``origin_z`` (the start's z, m) to show the options' own."""
+    frame; the message adds ``origin_z`` (the start's z, m) to show the options' own and
+    names the flat seabed's height ``option``."""
     if seabed is None:
         return
     for name, state in ends:
         depth = -float(seabed.gap(np.asarray(state.position, dtype=float)))
         if is_held(state) and depth > 1e-12 * length:
             below = depth + state.position[2] + origin_z
-            where = (f"-rod_seabed {seabed.height + origin_z:g}" if seabed.flat
+            where = (f"{option} {seabed.height + origin_z:g}" if seabed.flat
                      else f"the seabed is at z = {below:.6g} m there")
             raise RodInputError(
                 f"{name}: the end is held at z = {state.position[2] + origin_z:.6g} m, "

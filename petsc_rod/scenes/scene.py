@@ -17,9 +17,10 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.frames import REFERENCE_FRAME, rotation_about, rotation_log
+from petsc_rod.model.model import check_chord
+from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
 from petsc_rod.scenes.starts import catenary_start
-END_KINDS = ("clamp", "pin", "free")
 # Held ends closer to the length than this fraction of it make a taut line (Scene.taut):
 # a catenary of sag f has (8/3) f^2 / L of slack, so at 1e-9 L of slack its tension is
 # above 2000 times its weight, beyond what the constraint tolerance determines.
@@ -186,7 +187,7 @@ class Scene:
     def taut(self):
         """Whether an inextensible line is held at both ends at least its length less
         TAUT_GAP (relative) apart: straight, with an axial force its inextensibility
-        leaves undetermined (cli.scene_options.check_taut)."""
+        leaves undetermined (compile.check_taut)."""
         held = self.start != "free" and self.end != "free"
         chord = np.linalg.norm(self.end_position - self.start_state(1.0).position)
         return held and not self.extensible and chord >= self.length * (1 - TAUT_GAP)
@@ -358,8 +359,8 @@ class Scene:
 
     def _validate_sections(self):
         """The sections follow each other from S = 0 to L, each of positive length, with
-        positive stiffnesses and EA (a Python caller's; the command line's are checked as
-        they are read, scenes/line.py)."""
+        positive stiffnesses and EA (a Python caller's; a model's are made so,
+        compile.py)."""
         starts = np.array([s.start for s in self.sections])
         ends = np.array([s.end for s in self.sections])
         if (starts[0] != 0.0 or ends[-1] != self.length or np.any(ends <= starts)
@@ -371,108 +372,14 @@ class Scene:
                 and all(s.axial_stiffness > 0 for s in self.sections)):
             raise RodInputError("the sections' K1, K2, K3 and EA must be positive (N m^2, N)")
 
-    def validate(self, used):
-        """Raise RodInputError on a scene no cable can realise (an inextensible one: ends
-        held farther apart than its length; an extensible one is then taut, with a
-        tension set by its stretch, docs/method.md §12).
-
-        ``used`` is the set of option names the user set, so that an option the scene
-        would ignore is an error, not a silent no-op.
-        """
-        if self.length <= 0:
-            raise RodInputError(f"-rod_length {self.length:g}: the length must be positive")
+    def validate(self, used=()):
+        """Raise RodInputError on a scene a Python caller built that no cable can realise:
+        sections that do not tile the line, or an inextensible line whose held ends are
+        farther apart than its length (model.check_chord; an extensible one is then taut,
+        docs/method.md §12). A scene compiled from a Model is checked by Model.check
+        (``used``: kept for callers that pass the options they set)."""
         if self.sections:
             self._validate_sections()
-        if np.any(self.stiffness <= 0):
-            raise RodInputError("-rod_stiffness: K1, K2, K3 must all be positive (N m^2)")
-        if not self.axial_stiffness > 0:
-            raise RodInputError(f"-rod_axial_stiffness {self.axial_stiffness:g}: EA must be "
-                                "positive (N; default inf, inextensible)")
-        for name, kind in (("-rod_start", self.start), ("-rod_end", self.end)):
-            if kind not in END_KINDS:
-                raise RodInputError(f"{name} {kind}: unknown end condition; use one of "
-                                    + "|".join(END_KINDS))
-        if self.start == "free" and self.end == "free":
-            raise RodInputError("-rod_start free and -rod_end free: nothing holds the cable "
-                                "(a rigid motion is free); hold one end with clamp or pin")
-        held = self.start != "free" and self.end != "free"
-        chord = np.linalg.norm(self.end_position)
-        if held and chord > self.length * (1 + 1e-12) and not self.extensible:
-            raise RodInputError(
-                f"-rod_end_position: the ends are {chord:.15g} m apart, "
-                f"{chord - self.length:.3g} m more than the cable's length {self.length:.15g} m "
-                "(inextensible); " + ("bring the end within the sections' length, or give "
-                                      "the line types an ea column (EA, N)" if self.sections
-                                      else "bring the end within -rod_length, or give "
-                                      "-rod_axial_stiffness"))
-        for name, frame in (("-rod_end_frame", self.end_frame),
-                            ("-rod_start_frame", self.start_frame)):
-            if (np.abs(frame @ frame.T - np.eye(3)).max() > 1e-8
-                    or np.linalg.det(frame) < 0):
-                raise RodInputError(f"{name}: the rows d1, d2, d3 must be orthonormal and "
-                                    "right-handed (d3 = d1 x d2)")
-        if "rod_start_frame" in used and self.start != "clamp":
-            raise RodInputError(f"-rod_start_frame needs -rod_start clamp (the start is "
-                                f"{self.start}); drop it or change -rod_start")
-        requires = {"rod_end_frame": ("clamp",), "rod_end_twist": ("clamp",),
-                    "rod_end_position": ("clamp", "pin"), "rod_end_force": ("free",)}
-        for name, kinds in requires.items():
-            if name in used and self.end not in kinds:
-                raise RodInputError(f"-{name} needs -rod_end {'|'.join(kinds)} "
-                                    f"(the end is {self.end}); drop it or change -rod_end")
-        if "rod_start_position" in used and self.start == "free":
-            raise RodInputError("-rod_start_position needs a held start (-rod_start clamp|"
-                                "pin): a free start goes where the loads take it; drop it, or "
-                                "give -rod_end_position for the held end")
-        if "rod_start_force" in used and self.start != "free":
-            raise RodInputError(f"-rod_start_force needs -rod_start free (the start is "
-                                f"{self.start}); drop it or change -rod_start")
-        self._validate_joints(used)
-        S = self.point_load_S
-        if S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size:
-            raise RodInputError(f"point loads: {S.size} arc lengths for "
-                                f"{len(self.point_load_forces)} forces")
-        outside = np.flatnonzero((S < 0) | (S > self.length))
-        if outside.size:
-            k = int(outside[0])
-            raise RodInputError(
-                f"point loads: {self.point_load_names[k]} at s = {S[k]:.6g} m is beyond "
-                f"the line (0 <= s <= -rod_length {self.length:.6g} m); give an arc length "
-                "on the line")
-        breaks = self.load_breaks
-        if len(self.load_values) != len(breaks) + 1:
-            raise RodInputError(
-                f"-rod_load has {len(self.load_values)} pieces of 3 values but "
-                f"-rod_load_breaks gives {len(breaks)} breaks; give 3 (m) values for m pieces "
-                "and m - 1 breaks")
-        if np.any(np.diff(self.load_piece_ends) <= 0):
-            raise RodInputError("-rod_load_breaks: the breaks must increase strictly inside "
-                                "(0, -rod_length)")
-
-    def _validate_joints(self, used):
-        """A flex joint (-rod_*_rotational_stiffness, -rod_*_joint_axis) is a spring at a
-        pinned end: k finite and not negative, the axis not zero and given only with
-        k > 0, and the end a pin (a clamp holds the frame already, a free end has nothing
-        to turn against)."""
-        for which, kind in (("start", self.start), ("end", self.end)):
-            k = float(getattr(self, f"{which}_rotational_stiffness"))
-            axis = getattr(self, f"{which}_joint_axis")
-            if not np.isfinite(k) or k < 0:
-                raise RodInputError(
-                    f"-rod_{which}_rotational_stiffness {k:g}: must be finite and not "
-                    "negative (N m/rad; 0 is a pin; for an end held in full use "
-                    f"-rod_{which} clamp)")
-            if axis is not None and (axis.shape != (3,) or not np.all(np.isfinite(axis))
-                                     or np.linalg.norm(axis) == 0):
-                raise RodInputError(f"-rod_{which}_joint_axis: give a nonzero vector x,y,z "
-                                    "(the joint's neutral axis; it is normalised)")
-            if f"rod_{which}_joint_axis" in used and k == 0:
-                raise RodInputError(
-                    f"-rod_{which}_joint_axis needs -rod_{which}_rotational_stiffness k > 0 "
-                    "(the axis of a flex joint; without one the end is a plain pin)")
-            for name in (f"rod_{which}_rotational_stiffness", f"rod_{which}_joint_axis"):
-                if (name in used or k > 0) and kind != "pin":
-                    raise RodInputError(
-                        f"-{name} needs -rod_{which} pin (the {which} is {kind}): a flex "
-                        "joint is a rotational spring at a pinned end; drop it or set "
-                        f"-rod_{which} pin")
+        if self.start != "free" and self.end != "free":
+            check_chord(float(np.linalg.norm(self.end_position)), self.length,
+                        self.extensible, bool(self.sections), FIELD_NAMES)

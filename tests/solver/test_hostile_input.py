@@ -617,7 +617,7 @@ def deadline(seconds=10):
 def input_readers():
     """{option: read(path)} of every reader of an input table."""
     from petsc_rod.riser.environment import read_profile, read_seabed_profile
-    from petsc_rod.scenes.line import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
+    from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
     from petsc_rod.scenes.point_loads import read_point_loads
     from petsc_rod.sweep.cases import read_cases
     from petsc_rod.tables import read_table

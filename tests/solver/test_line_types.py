@@ -272,7 +272,7 @@ def test_a_result_file_rebuilds_its_sections_from_its_own_copy_of_the_table(opti
     ((("a", 0.0, 4.0, 1.0), ("b", 4.0, 10.0, -1.0)), "must be positive")])
 def test_sections_given_in_python_are_checked(sections, words):
     """A Python caller's sections must tile [0, L] with positive stiffnesses."""
-    from petsc_rod.scenes.line import Section
+    from petsc_rod.model.line_type import Section
     from petsc_rod.scenes.scene import Scene
     scene = Scene(length=10.0, stiffness=[1.0, 1.0, 1.0],
                   sections=tuple(Section(name, lo, hi, [k, k, k], [k, k, k])
@@ -343,7 +343,7 @@ def test_element_counts_that_cannot_be_are_refused(options, table, sections, ele
 
 def test_the_shares_of_the_elements_add_up():
     """-rod_elements 200 on sections of 300, 200, 290 and 10 m gave 199 elements."""
-    from petsc_rod.scenes.line import section_elements
+    from petsc_rod.model.line import section_elements
     counts = section_elements([300, 200, 290, 10], [None] * 4, 200)
     assert counts.sum() == 200 and counts.min() >= 1
     assert list(section_elements([1.0, 2.0], [5, None], 11)) == [5, 6]

@@ -25,7 +25,7 @@ from helpers import continuation as solve, fitted_order, gather, make_solver
 from petsc_rod.frames import rotation_about
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.scenes.line import Section
+from petsc_rod.model.line_type import Section
 from petsc_rod.scenes.scene import REFERENCE_FRAME, Scene
 
 # the angle (rad) the end moment turns the end by, and the roll of the twisted line

@@ -29,7 +29,7 @@ from petsc4py import PETSc
 from helpers import destroy, gather, make_solver
 from petsc_rod.iteration.newton import NewtonPolish
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.scenes.line import Section
+from petsc_rod.model.line_type import Section
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.scenes.starts import catenary_start
 from test_stretch import IRVINE, PIPE, TAUT, solve

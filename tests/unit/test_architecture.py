@@ -14,8 +14,9 @@ PACKAGE = os.path.join(REPO_ROOT, "petsc_rod")
 # list of terms and so never import the riser's.
 CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics",
         "problem/problem.py", "problem/state.py", "io/outputs.py")
-# The algorithm layer, whose messages must not name -rod_* options.
-ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step")
+# The algorithm layer and the model, whose messages must not name -rod_* options (the
+# model names its fields through model/names.py, the command line gives its options').
+ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step", "model")
 
 
 def modules():
@@ -105,3 +106,34 @@ def test_the_algorithm_layer_names_no_command_line_option():
                     and id(node) not in skip):
                 assert "-rod_" not in node.value, (f"{path}:{node.lineno} names an option: "
                                                    f"{node.value!r}")
+
+
+# What the model (petsc_rod/model) may import: numpy, the standard library, and of the
+# package only the errors, the tables and itself; never PETSc or a front end.
+MODEL_MAY_IMPORT = ("model", "errors", "tables")
+
+
+def external_imports(tree):
+    """The top-level names of the modules outside petsc_rod a module imports."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module.split(".")[0])
+        elif isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+    return names - {"petsc_rod"}
+
+
+def test_the_model_imports_no_petsc_and_no_front_end():
+    found = 0
+    for path, tree in modules().items():
+        if folder_of(path) != "model":
+            continue
+        found += 1
+        inside = sorted(name for name in imported(tree)
+                        if name.split(".")[0] not in MODEL_MAY_IMPORT)
+        assert not inside, f"{path} imports {inside}: the model knows only itself"
+        outside = sorted(external_imports(tree) - {"numpy", "dataclasses", "math"})
+        assert not outside, f"{path} imports {outside}: the model needs numpy alone"
+    assert found >= 6                                       # the folder was read
+

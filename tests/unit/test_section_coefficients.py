@@ -13,7 +13,7 @@ from petsc_rod.global_step.coefficients import ENERGY, LAGGED, FieldCoefficients
 from petsc_rod.mesh.elements import (GAUSS_POINTS, cut_gauss_rule, p2_basis,
                                      p2_element_matrices, p2_stiffness_matrices)
 from petsc_rod.problem.penalty import matrix_split, penalty_scales
-from petsc_rod.scenes.line import Section
+from petsc_rod.model.line_type import Section
 from petsc_rod.scenes.scene import Scene
 
 # a bend stiffener tapering from 4 to 1 on [0, 0.4], then a line whose K3 exceeds K1 + K2

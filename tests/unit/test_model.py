@@ -1,0 +1,74 @@
+"""The typed model (petsc_rod/model) and the Scene compiled from it (compile.py): the
+checks name the model's fields, or the options a front end gives in their names; the
+seabed, the current and the pipe's pressures are resolved in the compile, in the
+solver's frame."""
+
+import numpy as np
+import pytest
+
+from petsc_rod.compile import compile_scene
+from petsc_rod.errors import RodInputError
+from petsc_rod.model import End, Environment, Line, LineType, Model, UniformLine
+from petsc_rod.model.names import Names
+
+pytestmark = pytest.mark.unit
+
+OPTIONS = Names({}, lambda key: f"-rod_{key}")
+PIPE = LineType("pipe", od=0.2, mass=60.0, ei=1e5, gj=8e4, cd=1.0, id=0.15)
+
+
+def riser(**change):
+    fields = dict(line=Line([(PIPE, 160.0)], element_length=2.0),
+                  start=End.anchor((10.0, 0.0, -100.0)),
+                  end=End.hang_off((110.0, 0.0, -45.0)),
+                  environment=Environment(seabed=-100.5, surface=0.0,
+                                          current=[[0.0, 0.4, 0.0, 0.0],
+                                                   [100.0, 0.1, 0.0, 0.0]]))
+    fields.update(change)
+    return Model(**fields)
+
+
+def test_the_compiled_scene_holds_the_sea_in_the_solver_s_frame():
+    scene = compile_scene(riser(line=Line([(PIPE, 160.0)], internal_pressure=1e6)))
+    assert scene.length == 160.0 and np.array_equal(scene.start_position, [10, 0, -100])
+    assert scene.end_position == pytest.approx([100.0, 0.0, 55.0], abs=0)
+    assert scene.seabed.height == -0.5 and scene.seabed.flat
+    assert scene.current.surface == 100.0 and scene.sea_surface == 100.0
+    assert scene.internal_pressure == 1e6 and scene.design_factor == 2.0 / 3.0
+    weight = (60.0 - 1025.0 * np.pi * 0.2**2 / 4) * 9.80665
+    assert scene.load_values[0, 2] == -weight
+
+
+@pytest.mark.parametrize("change, model_words, option_words", [
+    (dict(end=End("free", frame=(0, 1, 0, 0, 0, 1, 1, 0, 0))),
+     "Model.end.frame needs Model.end clamp", "-rod_end_frame needs -rod_end clamp"),
+    (dict(environment=Environment(seabed_stiffness=1e5)),
+     "Environment.seabed_stiffness needs Environment.seabed",
+     "-rod_seabed_stiffness needs -rod_seabed"),
+    (dict(line=Line([(PIPE, 160.0)], design_factor=0.8)),
+     "Line.design_factor needs a line type with an smys column",
+     "-rod_design_factor needs a line type with an smys column"),
+    (dict(end=End.hang_off((300.0, 0.0, -45.0))), "Model.end.position: the ends are",
+     "-rod_end_position: the ends are"),
+    (dict(start=End.anchor((10.0, 0.0, -101.0))), "Model.start: the end is held at z = -101",
+     "-rod_start: the end is held at z = -101"),
+])
+def test_a_refusal_names_the_fields_as_the_caller_gave_them(change, model_words,
+                                                            option_words):
+    for names, words in ((None, model_words), (OPTIONS, option_words)):
+        with pytest.raises(RodInputError) as error:
+            compile_scene(riser(**change), *(() if names is None else (names,)))
+        assert words in str(error.value), str(error.value)
+
+
+def test_a_uniform_line_compiles_to_its_own_values():
+    model = Model(UniformLine(length=10.0, stiffness=(1.0, 2.0, 3.0),
+                              load=((0.0, 0.0, -1.0), (0.0, 0.0, -2.0)), load_breaks=(4.0,)),
+                  End("clamp"), End("free", force=(0.0, 0.0, 1.0)))
+    scene = compile_scene(model)
+    assert np.array_equal(scene.load_values, [[0, 0, -1], [0, 0, -2]])
+    assert np.array_equal(scene.load_breaks, [4.0]) and np.array_equal(scene.end_force,
+                                                                       [0, 0, 1])
+    with pytest.raises(RodInputError, match="UniformLine.load_breaks: the breaks must"):
+        compile_scene(Model(UniformLine(length=10.0, load=((0, 0, -1), (0, 0, -2)),
+                                        load_breaks=(12.0,)), End("clamp"), End("free")))
