@@ -23,7 +23,7 @@ from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type,
                                    check_substructuring_switches, format_value,
-                                   help_text, read_options, unused_options)
+                                   help_text, read_options, unused_options, values_of)
 from petsc_rod.cli import lines
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.io.same_file import replaced_input
@@ -46,14 +46,19 @@ INPUT_FILE_OPTIONS = tuple(option.name for option in OPTIONS
 FAILURE_WAIT = 10.0
 
 
-def options_record():
-    """The whole options database as '-name value' lines (the file's ``options``)."""
-    return "\n".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items()))
+def options_record(texts=None):
+    """The whole options database, with ``texts`` {name: text} in place of its own
+    where given, as '-name value' lines (the file's ``options``)."""
+    options = {**PETSc.Options().getAll(), **(texts or {})}
+    return "\n".join(f"-{k} {v}".rstrip() for k, v in sorted(options.items()))
 
 
-def run(comm=None):
+def run(comm=None, texts=None):
     """The whole program on ``comm``; returns the exit code. Only this function opens,
-    finishes or aborts the result file, and destroys the PETSc objects."""
+    finishes or aborts the result file, and destroys the PETSc objects. ``texts``
+    {name: text}: the -rod_* options of the run (a sweep's case, sweep/runner.py), in
+    place of those of PETSc's options database, which then gives the solvers' options
+    (-rod_snes_*, -rod_slope_ksp_*, ...) alone."""
     comm = comm or PETSc.COMM_WORLD
     database = PETSc.Options()
     mesh = problem = solver = writer = None
@@ -66,8 +71,11 @@ def run(comm=None):
 
     with Interrupts(comm) as interrupts:
         try:
-            check_same_on_every_rank(comm)
-            values, given = read_options()
+            if texts is None:
+                check_same_on_every_rank(comm)
+                values, given = read_options()
+            else:                           # the same on every rank: the sweep's
+                values, given = values_of(texts)
             check_anderson_depth()          # before any PETSc object is made
             check_snes_type()
             check_substructuring_switches()
@@ -110,7 +118,8 @@ def run(comm=None):
                                 max_halvings=values["rod_max_halvings"],
                                 track_link=values["rod_track_link"])
             code = run_continuation(solver, path, say=say, writer=writer,
-                                    options=options_record(), interrupts=interrupts).code
+                                    options=options_record(texts),
+                                    interrupts=interrupts).code
             writer = None
             if code == 0:                   # the CSV table of the converged result
                 line_table.finish_run(problem, values["rod_table"], say)

@@ -346,11 +346,18 @@ BY_NAME = {option.name: option for option in OPTIONS}
 
 
 def read_options():
-    """Parse every ``-rod_*`` option; returns (values by name, set of names the user gave).
-
-    Raises RodInputError for an unknown ``-rod_`` name or a malformed value.
+    """Parse every ``-rod_*`` option of PETSc's options database; returns (values by
+    name, set of names the user gave) (values_of).
     """
-    texts = whole_values()
+    return values_of(whole_values())
+
+
+def values_of(texts):
+    """(values by name, set of names given) of the ``-rod_*`` options among ``texts``
+    {name: text} (a sweep's case: its base options and its own), parsed and checked as
+    on the command line. Raises RodInputError for an unknown ``-rod_`` name or a
+    malformed value.
+    """
     given = {name for name in texts if name.startswith("rod_")}
     for name in sorted(given):
         if name not in BY_NAME and not name.startswith(SOLVER_PREFIXES):

@@ -146,6 +146,9 @@ def check_pipe(line, n):
     yield_stress = any(kind.smys is not None for kind in types)
     if line.design_factor is not None and not 0 < line.design_factor <= 1:
         raise RodInputError(f"{n['design_factor']} {line.design_factor:g}: must be in (0, 1]")
+    for name in ("contents_density", "internal_pressure"):
+        if getattr(line, name) is not None and getattr(line, name) < 0:
+            raise RodInputError(f"{n[name]} {getattr(line, name):g}: must not be negative")
     for name, present, partner in (
             ("internal_pressure", bore, "an id column (the bore it acts on)"),
             ("contents_density", bore, "an id column (the bore the contents fill)"),

@@ -17,7 +17,8 @@ MAX_MAGNITUDE = 1e30
 
 def real(owner, value, allow_inf=False):
     """``value`` (a number, not text or bool) as a float, finite (or +inf where
-    ``allow_inf``); RodInputError naming ``owner`` (e.g. 'End.stiffness') otherwise."""
+    ``allow_inf``) and of magnitude at most MAX_MAGNITUDE; RodInputError naming
+    ``owner`` (e.g. 'End.stiffness') otherwise."""
     if isinstance(value, (str, bytes, bool, np.bool_)) or value is None:
         raise RodInputError(f"{owner} {value!r}: expected a number")
     try:
@@ -26,12 +27,16 @@ def real(owner, value, allow_inf=False):
         raise RodInputError(f"{owner} {value!r}: expected a number") from None
     if not (math.isfinite(number) or (allow_inf and number == math.inf)):
         raise RodInputError(f"{owner} {value!r}: expected a finite number")
+    if math.isfinite(number) and abs(number) > MAX_MAGNITUDE:
+        raise RodInputError(f"{owner} {value!r}: out of range: magnitudes above "
+                            f"{MAX_MAGNITUDE:g} are refused")
     return number
 
 
-def reals(owner, values, sizes):
+def reals(owner, values, sizes, largest=MAX_MAGNITUDE):
     """``values`` as a float array of one of the sizes ``sizes``, every entry a finite
-    number (not text or bool); RodInputError naming ``owner`` otherwise."""
+    number (not text or bool) of magnitude at most ``largest``; RodInputError naming
+    ``owner`` otherwise."""
     expected = f"expected {' or '.join(map(str, sizes))} numbers"
     try:
         array = np.asarray(values)
@@ -42,6 +47,9 @@ def reals(owner, values, sizes):
     array = array.astype(float).ravel()
     if not np.all(np.isfinite(array)):
         raise RodInputError(f"{owner} {values!r}: {expected}, finite")
+    if np.any(np.abs(array) > largest):
+        raise RodInputError(f"{owner} {values!r}: out of range: magnitudes above "
+                            f"{largest:g} are refused")
     return array
 
 

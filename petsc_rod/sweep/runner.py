@@ -1,9 +1,13 @@
 """Run a sweep: every case in this process, on the ranks given, one after the other.
 
 Each case is a whole run of the command line (cli.main.run builds, runs and destroys the
-mesh, the problem and the solver), with the case's options set in PETSc's options
-database before it and the database put back as it was after it (options added removed,
-options changed restored), so that nothing of one case reaches the next. A case starts
+mesh, the problem and the solver) on the case's -rod_* options, the base options with
+the case's own over them, handed to it as values (cli.main.run's ``texts``: parsed,
+mapped to the model and compiled as the command line's), not written into PETSc's
+options database; only a case's solver options (-rod_snes_*, -rod_slope_ksp_*, ...,
+read by PETSc's objects from the database alone) are set there for the case, and the
+database is put back as it was after it (options added removed, options changed
+restored), so that nothing of one case reaches the next. A case starts
 from the nearest converged case's result file (-rod_initial, walked in
 -sweep_warm_steps steps from that case's scene to its own: docs/method.md §7; by
 default not a case that starts from its catenary, which no neighbour beats), and
@@ -386,7 +390,8 @@ class Sweep:
         return record
 
     def _run(self, case, options):
-        """petsc_rod's run of ``case`` with ``options`` set: its exit code, or FAILED
+        """petsc_rod's run of ``case`` with ``options`` {name: text} over the base ones
+        (its solver options alone set in PETSc's database): its exit code, or FAILED
         where it raised (run turns petsc_rod's errors and PETSc's into codes; anything
         else, a LinAlgError say, is a failure of this case, not of the sweep), the
         error's words then kept for the record. Where only some ranks raised, the others
@@ -395,8 +400,10 @@ class Sweep:
         ends (cli.main.abort_alone; the summary of the cases before it is written).
         Collective."""
         self._error = None
+        texts = {**self.base, **options}
+        solvers = {name: text for name, text in options.items() if name not in BY_NAME}
         try:
-            return with_options(self.comm, options, lambda: run(self.comm))
+            return with_options(self.comm, solvers, lambda: run(self.comm, texts))
         except Exception as error:          # noqa: BLE001 (any failure is the case's)
             words = f"{type(error).__name__}: {error}".splitlines()[0]
             if not every_rank_failed(self._failures):

@@ -196,3 +196,19 @@ def test_a_refusal_names_the_model_s_fields_not_options(change, words):
     with pytest.raises(RodInputError) as error:
         solve(model(**change))
     assert words in str(error.value) and "-rod_" not in str(error.value), str(error.value)
+
+
+def test_the_seabed_s_shape_is_the_environment_s_own_or_its_options():
+    """Issue 48: the model's Environment holds the seabed's slope, direction and origin
+    (they were only Model.options); either way the same scene."""
+    from petsc_rod.api import scene_of
+    by_options, _, _ = scene_of(model(environment=Environment(seabed=0.0, surface=60.0),
+                                      options={"seabed_slope": 2.0,
+                                               "seabed_direction": 30.0}))
+    own, _, _ = scene_of(model(environment=Environment(
+        seabed=0.0, surface=60.0, seabed_slope=2.0, seabed_direction=30.0)))
+    assert not own.seabed.flat and own.seabed.height == by_options.seabed.height
+    assert np.array_equal(own.seabed.shape.slope_vector, by_options.seabed.shape.slope_vector)
+    assert own.seabed.shape.slope_vector[1] > 0
+    with pytest.raises(RodInputError, match="Environment.seabed_slope 95.0: must lie"):
+        scene_of(model(environment=Environment(seabed=0.0, seabed_slope=95.0)))

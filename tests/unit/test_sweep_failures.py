@@ -36,8 +36,8 @@ def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch)
     comm.tompi4py().Barrier()
     ran = []
 
-    def run(comm):
-        name = os.path.basename(PETSc.Options().getString("rod_output"))[:-3]
+    def run(comm, texts):
+        name = os.path.basename(texts["rod_output"])[:-3]
         ran.append(name)
         if CASES[name] is not None:
             raise CASES[name]
@@ -87,3 +87,37 @@ def test_an_earlier_sweep_s_file_that_cannot_be_removed_is_one_line_on_every_ran
     with pytest.raises(RodInputError, match="the earlier sweep's a.h5 cannot be removed"):
         runner.claim_folder(comm, folder, [SimpleNamespace(name="b", options={})], [])
     assert os.path.isdir(os.path.join(folder, "a.h5"))
+
+
+def test_a_case_s_options_reach_its_run_as_values_not_the_database(folder, monkeypatch):
+    """Issue 48: each case's options were written into PETSc's global options database
+    and restored after it; now its -rod_* options reach the run as values (cli.main.run's
+    texts) over the base ones, and only a solver option it varies (-rod_snes_type, which
+    PETSc's SNES reads from the database alone) is set there, for that case."""
+    comm = PETSc.COMM_WORLD
+    cases = os.path.join(folder, "cases.txt")
+    if comm.getRank() == 0:
+        with open(cases, "w") as f:
+            f.write("name rod_length rod_snes_type\na 2 nrichardson\nb 3 anderson\n")
+    comm.tompi4py().Barrier()
+    seen = []
+
+    def run(comm, texts):
+        database = PETSc.Options()
+        seen.append((texts["rod_length"], texts["rod_al_rtol"],
+                     database.hasName("rod_length"), database.getString("rod_snes_type")))
+        return 0
+
+    monkeypatch.setattr(runner, "run", run)
+    database = PETSc.Options()
+    options = {"sweep_cases": cases, "sweep_output": os.path.join(folder, "out"),
+               "sweep_start": "scene", "rod_al_rtol": "1e-9"}
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        assert runner.run_sweep(comm) == 0
+        assert not database.hasName("rod_snes_type")
+    finally:
+        for name in options:
+            database.delValue(name)
+    assert seen == [("2", "1e-9", False, "nrichardson"), ("3", "1e-9", False, "anderson")]
