@@ -50,7 +50,7 @@ class UzawaSolver:
         self._root_weights = np.sqrt(problem.state.node_weights)[:, None]
         self._controller = None
         self._create_snes()
-        self.newton = newton.NewtonPolish(problem) if self.uses_newton else None
+        self.newton = newton.NewtonSolver(problem) if self.uses_newton else None
 
     @property
     def penalty(self):
@@ -159,7 +159,7 @@ class UzawaSolver:
                 return
             if decision.action is control.Action.TRY_NEWTON:
                 step.resume()
-                self._polish(step)
+                self._try_newton(step)
                 if step.finished:       # converged in Newton's terms, or the observer
                     return
                 step.wait_for_newton()
@@ -195,7 +195,7 @@ class UzawaSolver:
             return control.NEWTON_SWITCH_FAR
         return True
 
-    def _polish(self, step):
+    def _try_newton(self, step):
         """Newton steps from the current state (newton.py), each recorded as an
         iteration (change: its largest turn, rad; the frames are rotations). Where the
         second variation has a direction of negative curvature the state is near a

@@ -23,7 +23,7 @@ these are the Uzawa multipliers, and H is exactly the matrix of the stability te
 
 A step is taken only where H is positive definite on the constraint set (the inertia of
 its factorisation, as in the stability test): Newton then heads for a local minimiser,
-never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
+never a saddle. Otherwise, or when the steps stop shrinking, the attempt gives up and the
 Uzawa iteration goes on from where it was. On success the state is handed back as a
 fixed point of the Uzawa iteration: tau = d and lambda = -g / w. A linear-algebra
 failure on the way (a state the steps cannot start from: a stretch k <= 0 or values that
@@ -67,7 +67,7 @@ EVENT = PETSc.Log.Event("rod_newton")
 # chord step whose rest is (FROZEN_SHRINK, below).
 MAX_STEPS = 8
 STEP_TOLERANCE = 1e-10
-# A step must shrink to at most this fraction of the previous one, or the polish stops
+# A step must shrink to at most this fraction of the previous one, or the attempt stops
 # (Newton contracts quadratically near a regular minimiser). On a line whose energy
 # reads its positions (the seabed) a step that does not shrink but turns no more than
 # the one before it is taken where that one lowered |grad L| to at most this fraction,
@@ -116,13 +116,13 @@ FROZEN_SHRINK = 0.1
 # (docs/method.md, "The free roll").
 ROLL_TURN = 1e-2
 
-# What an attempt ends with (NewtonPolish.run).
+# What an attempt ends with (NewtonSolver.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 
 class LinearAlgebraFailure(Exception):
     """A step's linear algebra failed on some rank, raised on every rank (the verdict
-    reduced: NewtonPolish._agree); the attempt ends FAILED (module docstring)."""
+    reduced: NewtonSolver._agree); the attempt ends FAILED (module docstring)."""
 
 
 def _chord_rest(turn, previous):
@@ -133,10 +133,11 @@ def _chord_rest(turn, previous):
     return theta / (1.0 - theta) * turn if theta < 1.0 else np.inf
 
 
-class NewtonPolish:
-    """Newton steps of the module docstring on a problem's state (problem/problem.py).
-    Owns a work Vec for K d (the K are the global step's); ``destroy()`` frees it (the second
-    variation is the problem's, ``RodProblem.second_variation``, updated at each step)."""
+class NewtonSolver:
+    """The Newton solver: the steps of the module docstring on a problem's state
+    (problem/problem.py). Owns a work Vec for K d (the K are the global step's);
+    ``destroy()`` frees it (the second variation is the problem's,
+    ``RodProblem.second_variation``, updated at each step)."""
 
     def __init__(self, problem):
         self.problem = problem

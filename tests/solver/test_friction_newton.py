@@ -30,7 +30,7 @@ from petsc4py import PETSc
 
 from helpers import make_solver
 from petsc_rod.iteration.events import NewtonAttempt
-from petsc_rod.iteration.newton import NewtonPolish
+from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.riser.environment import Friction, Seabed
 from petsc_rod.riser.friction import FrictionTerm
 from petsc_rod.riser.terms import SeabedTerm
@@ -111,7 +111,7 @@ def test_jacobian_against_finite_differences(comm, line):
     mesh, solver, report = converged(comm, line, newton=False)
     assert report.converged
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         state = problem.state
         friction = next(t for t in problem.terms if isinstance(t, FrictionTerm))
@@ -276,7 +276,7 @@ def test_the_mean_roll_is_held_in_a_newton_step_s_inertia_test():
     mesh, solver = make_solver(PETSc.COMM_SELF, 20, scene, 50.0, rtol=1e-12, ctol=1e-12,
                                max_it=20000, newton=False)
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         problem.state.set_straight()
         assert solver.solve_step(1.0).converged

@@ -26,7 +26,7 @@ from petsc_rod.analysis.jacobian import NewtonJacobian
 from petsc_rod.analysis.stability import SecondVariation
 from petsc_rod.global_step import ksp as ksp_module
 from petsc_rod.iteration import newton
-from petsc_rod.iteration.newton import NewtonPolish
+from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.riser.environment import Current
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
@@ -64,7 +64,7 @@ def infinite_solves(self, columns, *args):
 def attempt(problem):
     """(outcome, whether the state is bit for bit as before) of one Newton attempt."""
     before = problem.state.snapshot()
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         outcome = polish.run()
     finally:

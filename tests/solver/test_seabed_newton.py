@@ -31,7 +31,7 @@ from petsc4py import PETSc
 
 from helpers import gather
 from petsc_rod.frames import rotations
-from petsc_rod.iteration.newton import NewtonPolish
+from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.problem.penalty import default_penalty
 from petsc_rod.riser.environment import Seabed
 from petsc_rod.riser.terms import SeabedTerm
@@ -114,7 +114,7 @@ def test_gradient_and_hessian_against_finite_differences(comm, solver_factory, e
              **({"axial_stiffness": 10.0} if extensible else {})}
     mesh, solver = solver_factory(comm, 12, scene, 5.0, newton=False)
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     work = problem.field_stiffness(0)[1].createVecLeft()
     try:
         problem.prepare(1.0)
@@ -272,13 +272,13 @@ def test_the_newton_attempt_converges_while_the_touchdown_settles(comm, solver_f
     from petsc_rod.iteration.events import NewtonAttempt
     from petsc_rod.iteration.newton import SHRINK
     curvatures = []                 # whether each step took the iteration's curvature
-    step = NewtonPolish._newton_step
+    step = NewtonSolver._newton_step
 
     def recorded(self, frames, g, mu, regularised=False, curvature=None, frozen=False):
         curvatures.append(curvature is not None)
         return step(self, frames, g, mu, regularised, curvature, frozen)
 
-    monkeypatch.setattr(NewtonPolish, "_newton_step", recorded)
+    monkeypatch.setattr(NewtonSolver, "_newton_step", recorded)
     (plain, r_plain), (polished, r) = (steel_riser(solver_factory, comm, newton)
                                        for newton in (False, True))
     assert plain.converged and polished.converged
