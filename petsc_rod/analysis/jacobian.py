@@ -21,7 +21,7 @@ in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
 
 The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
 delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
-(analysis/stability.py, with the resultants' slots as identity rows) plus these
+(analysis/second_variation.py, with the resultants' slots as identity rows) plus these
 entries (a copy of H's values on H's pattern, which holds these places as zeros from
 H's first assembly: Term.jacobian_pattern): unsymmetric, factored by MUMPS's LU
 (global_step/ksp.direct_factor: on several ranks by substructuring, each rank its

@@ -227,15 +227,9 @@ class UzawaSolver:
                 self._turn(angle, direction)
 
     def check_stability(self):
-        """(stable, direction) of the current (converged) state (analysis/stability.py):
-        True and None for a local minimiser; False and a rotation-vector field
-        (n_nodes, 3) along which the energy decreases to second order for a saddle;
-        None, None where the test cannot decide (a taut, straight rod)."""
-        hessian = self.problem.second_variation()
-        if not hessian.decidable:
-            return None, None
-        direction = hessian.descent_direction()
-        return direction is None, direction
+        """(stable, direction) of the current (converged) state: the verdict of the
+        stability test (analysis/stability.StabilityTest.verdict)."""
+        return self.problem.second_variation().verdict()
 
     # --- the SNES's view of the iteration -----------------------------------------------
     def _fixed_point_residual(self, snes, x, f):

@@ -18,7 +18,7 @@ d_n <- exp([omega_n]x) d_n, with omega from the KKT system
 L = E + mu . c the Lagrangian of the chord constraint c(d) = sum_n w_n d3_n - chord,
 grad_n L = sum_i d_{n,i} x g_{n,i} (g_i = dL/dd_i = 2 K_{a_i} d_i - b delta_i3 + w mu
 delta_i3), C omega = sum_n w_n omega_n x d3_n, and H the Riemannian Hessian of L: the
-second variation of analysis/stability.py with lambda_n = -g_n / w_n (at a solution
+second variation of analysis/second_variation.py with lambda_n = -g_n / w_n (at a solution
 these are the Uzawa multipliers, and H is exactly the matrix of the stability test).
 
 A step is taken only where H is positive definite on the constraint set (the inertia of
@@ -46,7 +46,7 @@ dE/dg = -w lambda, the local step's stationarity in k gives lambda3.d3 = EA eps,
 rotation sum_i g_i x lambda_i = 0. So each node has 4 unknowns, (omega_n, delta k_n),
 the frames turn as above and k <- k + delta k; the gradient in k is
 d3 . g3-gradient of L + w EA eps (Term.add_strain_gradient), H that of
-analysis/stability.py with its stretch rows, and the chord forms gain the columns
+analysis/second_variation.py with its stretch rows, and the chord forms gain the columns
 w_n d3_n. The hand-over is the same with tau = g (the stretched targets (tau1, tau2,
 k tau3) the state keeps) and lambda = -g-gradient / w (without the axial term: the
 tension is lambda3.d3 = EA eps at the solution). The stretch of a clamped node (the
@@ -57,7 +57,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
-from petsc_rod.analysis.stability import skew, unit
+from petsc_rod.analysis.second_variation import skew, unit
 from petsc_rod.frames import roll_between, rotations
 
 EVENT = PETSc.Log.Event("rod_newton")

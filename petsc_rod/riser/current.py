@@ -15,7 +15,7 @@ turn omega of the tangent, delta t = omega x t, is (drag_jacobian)
 
 import numpy as np
 
-from petsc_rod.analysis.stability import skew
+from petsc_rod.analysis.second_variation import skew
 
 
 def normal_drag(tangent, velocity, drag):

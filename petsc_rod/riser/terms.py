@@ -25,7 +25,7 @@ linearisation in the unsymmetric Newton Jacobian through the resultants' chain
 import numpy as np
 
 from petsc_rod.analysis.positions import HEIGHT, position_gradient
-from petsc_rod.analysis.stability import skew
+from petsc_rod.analysis.second_variation import skew
 from petsc_rod.mesh.elements import P2, element_integrals
 from petsc_rod.mesh.fields import VectorField, element_dofs, scatter_element_vectors
 from petsc_rod.physics.term import Term
