@@ -7,17 +7,18 @@ import dataclasses
 import numpy as np
 
 from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
+from petsc_rod.environment.bathymetry import Grid, Plane, Profile
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.profiles import grid_axes, read_profile, read_seabed_profile
+from petsc_rod.environment.seabed import (MIN_RELATIVE_PENETRATION, Friction, Seabed,
+                                          check_covered, check_ends_above,
+                                          default_stiffness, largest_stiffness)
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.riser.bathymetry import Grid, Plane, Profile
-from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Friction, Seabed,
-                                         check_covered, check_ends_above, default_stiffness,
-                                         grid_axes, largest_stiffness, read_profile,
-                                         read_seabed_profile)
-from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes import starts
+from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
                                    parse_sections, section_elements)
@@ -235,7 +236,7 @@ def check_represented(entries, lengths, counts, shared, given_counts, length, sh
 
 def pressures_from_options(values, given, scene):
     """Set the scene's sea surface (in its frame), contents density, internal
-    pressure (riser/pressures.py) and design factor (riser/stresses.py) for a line of
+    pressure (reports/pressures.py) and design factor (reports/stresses.py) for a line of
     sections; refuse them on a line without
     line types (no diameters to press on)."""
     if not scene.sections:
@@ -424,7 +425,7 @@ def checked_default_penalty(scene, start_tension=0.0):
     return scales[name]
 
 
-# The options that shape the seabed (riser/bathymetry.py, docs/riser.md §1a).
+# The options that shape the seabed (environment/bathymetry.py, docs/riser.md §1a).
 SEABED_SHAPE = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin",
                 "rod_seabed_profile")
 
@@ -519,7 +520,7 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
 # sticks slowed the iteration down (docs/riser.md §3b).
 FRICTION_STIFFNESS_RATIO = 0.1
 
-# The options of the seabed's friction (riser/friction.py, docs/riser.md §3b).
+# The options of the seabed's friction (physics/friction.py, docs/riser.md §3b).
 SEABED_FRICTION = ("rod_seabed_friction", "rod_seabed_friction_stiffness")
 
 

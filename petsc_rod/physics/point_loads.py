@@ -19,14 +19,14 @@ int_e N_k, those after it nothing.
 n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
 (the point counted as before S). A point at a free end S = L acts as an end force there
 (it is in n(L), Term.end_force). A point on a held end is carried by the support: the
-line's n is that without it, and the end's reaction (riser/line_results.end_numbers)
+line's n is that without it, and the end's reaction (reports/line_results.end_numbers)
 adds it (on_held_ends), so that the reactions balance every load.
 
 An attachment with a drag area C_d A (m^2) in a current also feels the drag
 D_p = 1/2 rho_w C_d A |v| v, v the current at r(S_p) (Scene.point_drags: times the
 path's weight of each current), a point force of the iterate added to the slope's
 right-hand side every iteration (add_iterate_load) the same way, at the heights of the
-last global step, as the line's drag (riser/terms.py). It has no energy: the term is then
+last global step, as the line's drag (drag.py). It has no energy: the term is then
 neither conservative nor in the Newton steps (a current makes the line's drag term
 neither anyway).
 """

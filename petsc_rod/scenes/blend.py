@@ -163,6 +163,6 @@ class BlendedPath:
 
     def drag_loads(self, s):
         """[(weight, Current)]: the drag is (1 - s) t_f f_A + s f_B, the sum of each
-        current's drag c |v_n| v_n times its weight (riser/terms.py DragTerm)."""
+        current's drag c |v_n| v_n times its weight (physics/drag.py DragTerm)."""
         return ([((1 - s) * w, c) for w, c in self.old.drag_loads(self.t_old)]
                 + [(s * w, c) for w, c in self.new.drag_loads(1.0)])

@@ -56,7 +56,7 @@ class Scene:
     end_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     load_values: np.ndarray = field(default_factory=lambda: np.zeros((1, 3)))
     load_breaks: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    # riser terms (petsc_rod/riser/environment.py): a Seabed and a Current, or None
+    # environment (petsc_rod/environment/): a Seabed and a Current, or None
     seabed: object = None
     current: object = None
     # the line as sections of line types (scenes/line.py), from S = 0; () for a uniform
@@ -64,13 +64,13 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
-    # the pipe's pressures (riser/pressures.py; a line of sections): the sea surface's
+    # the pipe's pressures (reports/pressures.py; a line of sections): the sea surface's
     # height in the solver's frame (m; None: the higher held end), the contents'
     # density (kg/m^3) and the internal pressure at the top (Pa)
     sea_surface: float = None
     contents_density: float = 0.0
     internal_pressure: float = 0.0
-    # the stress check (riser/stresses.py): the allowable von Mises stress is this
+    # the stress check (reports/stresses.py): the allowable von Mises stress is this
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a

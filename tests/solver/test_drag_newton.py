@@ -27,11 +27,11 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.environment.current import Current
 from petsc_rod.global_step.chain_factor import stored_entries
 from petsc_rod.global_step.ksp import inertia_solver
 from petsc_rod.iteration.newton import NewtonSolver
-from petsc_rod.riser.environment import Current
-from petsc_rod.riser.terms import DragTerm
+from petsc_rod.physics.drag import DragTerm
 from petsc_rod.scenes.starts import catenary_start
 from test_seabed_newton import heights, moved, random_direction
 

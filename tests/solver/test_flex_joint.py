@@ -182,11 +182,11 @@ def test_the_joint_carries_k_theta_at_large_turns(comm, k, force, steps):
 @pytest.mark.parametrize("seabed_height, touches", [(-10.0, False), (-0.08, True)])
 def test_the_joint_acts_through_the_seabeds_vertical_problem(comm, seabed_height, touches):
     """With a seabed the z slope is solved in Hermite dofs from the slope's element
-    matrices (riser/terms.py), which carry the joint's k. Far below the line (no
+    matrices (physics/seabed.py), which carry the joint's k. Far below the line (no
     contact) the seabed changes nothing: the same shape as without it, the joint at
     S = L loaded in the vertical plane by a neutral axis e_z; touched, the line differs
     and the joint still carries k theta."""
-    from petsc_rod.riser.environment import Seabed
+    from petsc_rod.environment.seabed import Seabed
 
     k = 0.05
     scene = dict(start="pin", end="pin", end_position=(0.7, 0.0, 0.3),

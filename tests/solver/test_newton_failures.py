@@ -24,10 +24,10 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
 from petsc_rod.analysis.stability import StabilityTest
+from petsc_rod.environment.current import Current
 from petsc_rod.global_step import ksp as ksp_module
 from petsc_rod.iteration import newton
 from petsc_rod.iteration.newton import NewtonSolver
-from petsc_rod.riser.environment import Current
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
 

@@ -19,9 +19,9 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.analysis import stability
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.iteration import controller, newton, stopping
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.environment import Seabed
 from petsc_rod.scenes.scene import Scene
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
