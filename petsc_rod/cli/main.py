@@ -425,8 +425,9 @@ def options_in_effect(values, solver, start):
         units["line_types_table"] = "text"
     if scene.point_load_S.size:                 # the attachments' forces, to repeat the run
         parameters["point_loads_table"] = np.column_stack([
-            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas])
-        units["point_loads_table"] = "m, N, N, N, m^2 (S, fx, fy, fz, CdA)"
+            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas,
+            scene.point_load_volumes])
+        units["point_loads_table"] = "m, N, N, N, m^2, m^3 (S, fx, fy, fz, CdA, volume)"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

@@ -87,6 +87,9 @@ class Scene:
     point_load_names: tuple = ()
     # their drag areas C_d A (n_p,), m^2: drag 1/2 rho_w C_d A |v| v in the current
     point_load_drag_areas: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # their displaced volumes V (n_p,), m^3, whose buoyancy rho_w g V e_z the forces
+    # include: taken off again above the sea surface (physics/point_loads.py)
+    point_load_volumes: np.ndarray = field(default_factory=lambda: np.zeros(0))
     # where S = 0 is, m: the solver's frame has its origin there (module docstring)
     start_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
@@ -118,6 +121,9 @@ class Scene:
         self.point_load_drag_areas = np.asarray(self.point_load_drag_areas, dtype=float).ravel()
         if self.point_load_drag_areas.size == 0:
             self.point_load_drag_areas = np.zeros(self.point_load_S.size)
+        self.point_load_volumes = np.asarray(self.point_load_volumes, dtype=float).ravel()
+        if self.point_load_volumes.size == 0:
+            self.point_load_volumes = np.zeros(self.point_load_S.size)
         if len(self.point_load_names) != self.point_load_S.size:
             self.point_load_names = tuple(f"point {k + 1}"
                                           for k in range(self.point_load_S.size))
@@ -227,6 +233,16 @@ class Scene:
         if self.current is None or not np.any(self.point_load_drag_areas > 0):
             return []
         return [(t, self.current, self.point_load_drag_areas)]
+
+    def point_buoyancies(self, t):
+        """t rho_w g V_p (n_p,), N: the upward part of the point loads at load factor t
+        that holds in the water only (physics/point_loads.py), aligned with
+        point_loads(t)."""
+        return t * self.water_density * self.gravity * self.point_load_volumes
+
+    def point_volumes(self):
+        """V_p (n_p,), m^3, aligned with point_loads(t) (a restart's walk: both scenes')."""
+        return self.point_load_volumes
 
     def applied_force(self):
         """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| (and the drag) at t = 1, N: the
@@ -429,7 +445,8 @@ class Scene:
                                 f"{self.start}); drop it or change -rod_start")
         self._validate_joints(used)
         S = self.point_load_S
-        if S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size:
+        if (S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size
+                or S.size != self.point_load_volumes.size):
             raise RodInputError(f"point loads: {S.size} arc lengths for "
                                 f"{len(self.point_load_forces)} forces")
         outside = np.flatnonzero((S < 0) | (S > self.length))
