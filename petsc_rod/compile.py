@@ -13,13 +13,15 @@ import dataclasses
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.model.attachment import attachment_columns, attachment_forces
+from petsc_rod.model.attachment import attachment_columns, dead_forces
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.values import MAX_MAGNITUDE
-from petsc_rod.riser.bathymetry import Grid, Plane, Profile
-from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Friction, Seabed,
-                                         check_covered, check_ends_above, default_stiffness,
-                                         grid_axes, largest_stiffness)
+from petsc_rod.environment.bathymetry import Grid, Plane, Profile
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.profiles import grid_axes
+from petsc_rod.environment.seabed import (MIN_RELATIVE_PENETRATION, Friction, Seabed,
+                                          check_covered, check_ends_above,
+                                          default_stiffness, largest_stiffness)
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.scene import Scene
 
@@ -47,7 +49,7 @@ def compile_scene(model, names=FIELD_NAMES):
         shape = dict(length=line.length, stiffness=line.stiffness,
                      load_values=line.load_values, load_breaks=line.load_breaks,
                      axial_stiffness=line.axial_stiffness)
-    S, forces, labels, areas = points_of(span.attachments, sea)
+    S, forces, labels, areas, volumes = points_of(span.attachments, sea)
     bare = Scene(**shape, start=start.kind, end=end.kind, start_position=origin,
                  end_position=None if end.position is None
                  else np.asarray(end.position) - origin,
@@ -59,7 +61,8 @@ def compile_scene(model, names=FIELD_NAMES):
                  end_rotational_stiffness=end.stiffness or 0.0,
                  start_joint_axis=start.axis, end_joint_axis=end.axis, point_load_S=S,
                  point_load_forces=forces, point_load_names=labels,
-                 point_load_drag_areas=areas, water_density=sea.water_density,
+                 point_load_drag_areas=areas, point_load_volumes=volumes,
+                 water_density=sea.water_density,
                  gravity=sea.gravity)
     seabed, current = environment_of(sea, bare, names,
                                      None if span.sections else line.drag)
@@ -72,20 +75,20 @@ def compile_scene(model, names=FIELD_NAMES):
 
 
 def points_of(attachments, sea):
-    """(S (n_p,), forces (n_p, 3), labels, drag areas (n_p,)) of the attachments in the
-    sea ``sea`` (their weight and buoyancy: model/attachment.py)."""
+    """(S (n_p,), forces (n_p, 3), labels, drag areas (n_p,), volumes (n_p,)) of the
+    attachments in the sea ``sea`` (their weight and buoyancy: model/attachment.py)."""
     if not attachments:
-        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0)
+        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0), np.zeros(0)
     columns = attachment_columns(attachments)
-    return (columns["s"], attachment_forces(columns, sea.water_density, sea.gravity),
+    return (columns["s"], dead_forces(attachments, sea.water_density, sea.gravity),
             tuple(a.name or f"point {k + 1}" for k, a in enumerate(attachments)),
-            columns["cda"])
+            columns["cda"], columns["volume"])
 
 
 def pressures_of(line, sea, origin):
     """The Scene's pipe fields of a Line of sections: the sea surface in the solver's
     frame (None: the higher held end), the contents' density, the internal pressure at
-    the top and the design factor (riser/pressures.py, riser/stresses.py)."""
+    the top and the design factor (reports/pressures.py, reports/stresses.py)."""
     fields = dict(contents_density=float(line.contents_density or 0.0),
                   internal_pressure=float(line.internal_pressure or 0.0))
     if line.design_factor is not None:
@@ -141,7 +144,7 @@ def seabed_shape(sea, height, origin, n):
 
 
 def seabed_of(sea, load_values, sections, origin, n):
-    """The Seabed (riser/environment.py) of the sea, or None; heights in the scene's
+    """The Seabed (environment/seabed.py) of the sea, or None; heights in the scene's
     frame (its origin at ``origin`` (3,), absolute)."""
     if not sea.has_seabed:
         return None
@@ -185,19 +188,46 @@ def environment_of(sea, scene, n, drag=None):
     check_ends_above(seabed, ends, scene.length, z0, n["seabed"])
     held = [state.position[2] for _, state in ends if is_held(state)]
     seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
+    return seabed, current_of(sea, scene, held, n, drag)
+
+
+def current_of(sea, scene, held, n, drag=None):
+    """The Current of the sea for the bare ``scene`` (None without one), its surface the
+    sea's or the highest of the held ends' heights ``held`` (the scene's frame); a
+    uniform line's surface (its own, or the current's) not below a held end."""
+    z0 = float(scene.start_position[2])
     rows = sea.current_rows()
     if rows is None:
-        return seabed, None
+        return None
     depths, velocities = rows
     surface = float(max(held) if sea.surface is None else sea.surface - z0)
     if scene.sections:
-        drag = max(s.drag for s in scene.sections)
-        if drag == 0:
+        section_drag = max(s.drag for s in scene.sections)
+        if section_drag == 0:
             raise RodInputError(f"a current on {n['sections']} whose line types have no "
                                 "drag: give the line types a cd column")
         # each section's own c (Scene.drag_at); the current carries the largest
-        return seabed, Current(depths, velocities, surface, drag)
-    return seabed, Current.morison(depths, velocities, surface, *drag)
+        return Current(depths, velocities, surface, section_drag)
+    current = Current.morison(depths, velocities, surface, *drag)
+    check_uniform_line_under_surface(sea, held, z0, n)
+    return current
+
+
+def check_uniform_line_under_surface(sea, held, z0, n):
+    """Refuse a sea surface below a held end of a uniform line: the part above it would
+    keep the submerged weight and the current's drag it has not in the air, and the
+    uniform line's load gives no diameter and mass to take them off (a line of sections
+    does, physics/surface.py). ``held`` the held ends' heights in the scene's frame,
+    ``z0`` the start's height (m)."""
+    surface = None if sea.surface is None else sea.surface - z0   # the scene's frame
+    if surface is None or not max(held) > surface:
+        return
+    raise RodInputError(
+        f"{n['sea_surface']} {surface + z0:g}: the held end at z = "
+        f"{max(held) + z0:g} m is above it, where a line given by {n['load']} would keep "
+        f"its submerged weight and the current's drag; give the line as {n['line_types']} "
+        f"and {n['sections']} (od and mass: its weight in air and no drag above the "
+        "surface), or a surface at or above the held ends")
 
 
 def seated(seabed, held):

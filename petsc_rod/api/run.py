@@ -25,7 +25,7 @@ from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.model.names import FIELD_NAMES
-from petsc_rod.riser.environment import read_seabed_profile
+from petsc_rod.environment.profiles import read_seabed_profile
 
 
 class _LastStep:

@@ -19,12 +19,12 @@ from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
 from petsc_rod.model.names import Names
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.riser.environment import read_profile, read_seabed_profile
-from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
-from petsc_rod.scenes import starts
 from petsc_rod.compile import compile_scene, line_names, rounded_down  # noqa: F401
+from petsc_rod.environment.profiles import read_profile, read_seabed_profile
+from petsc_rod.scenes import starts
+from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.line import parse_sections
-from petsc_rod.scenes.point_loads import quick_point_loads, read_point_loads
+from petsc_rod.scenes.point_loads import quick_point_loads, read_attachments
 from petsc_rod.scenes.scene import REFERENCE_FRAME
 from petsc_rod.tables import read_table
 
@@ -47,27 +47,25 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "point_load_S": "the point loads (-rod_point_loads|-rod_point_load)",
                  "point_load_forces": ("the point loads (-rod_point_loads|-rod_point_load, "
                                        "-rod_water_density, -rod_gravity)"),
-                 "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)"}
+                 "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)",
+                 "point_load_volumes": "the attachments' volumes (-rod_point_loads)"}
 
 
 def attachments_from_options(values, length, points=None):
     """The Attachments of -rod_point_loads FILE and -rod_point_load (scenes/
-    point_loads.py), the file's first, each on the line [0, ``length``], their forces
-    resolved in the options' water and gravity; ``points`` (S, forces, drag areas) when
-    already resolved (a result file's point_loads_table)."""
+    point_loads.py), the file's first, each on the line [0, ``length``]; ``points`` (S,
+    forces, drag areas, volumes) when already resolved (a result file's
+    point_loads_table: weighed attachments)."""
     if points is not None:
-        S, forces, areas = points
-        parts = [(S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas)]
-    else:
-        parts = []
-        if values["rod_point_loads"]:
-            parts.append(read_point_loads(values["rod_point_loads"],
-                                          values["rod_water_density"], values["rod_gravity"],
-                                          length, MAX_MAGNITUDE))
-        if values["rod_point_load"] is not None:
-            parts.append(quick_point_loads(values["rod_point_load"], length))
-    return tuple(Attachment(S[k], force=tuple(forces[k]), cda=areas[k], name=names[k])
-                 for S, forces, names, areas in parts for k in range(len(S)))
+        S, forces, areas, volumes = points
+        return tuple(Attachment(S[k], volume=volumes[k], force=tuple(forces[k]), cda=areas[k],
+                                name=f"point {k + 1}", weighed=True) for k in range(len(S)))
+    attachments = ()
+    if values["rod_point_loads"]:
+        attachments += read_attachments(values["rod_point_loads"], length, MAX_MAGNITUDE)
+    if values["rod_point_load"] is not None:
+        attachments += quick_point_loads(values["rod_point_load"], length)
+    return attachments
 
 
 def given_value(values, given, name):
@@ -82,7 +80,7 @@ def model_from_options(values, given, profile=None, line_types=None, points=None
     the rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
-    ``points`` (S, forces, drag areas) the point loads when already resolved (a result
+    ``points`` (S, forces, drag areas, volumes) the point loads when already resolved (a result
     file's point_loads_table); ``seabed_rows`` (n, 2 or 3) the seabed profile's or grid's
     rows when already read (a result file's seabed_profile_table)."""
     load = np.asarray(values["rod_load"])
@@ -321,9 +319,11 @@ def scene_from_parameters(parameters):
     points = parameters.get("point_loads_table")
     if points is not None:
         points = np.asarray(points, dtype=float)
-        points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
-        areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
-        points = (points[:, 0], points[:, 1:4], areas)
+        # 4 columns before drag areas, 5 before volumes
+        points = points.reshape(-1, points.shape[-1])
+        areas, volumes = (points[:, k] if points.shape[1] > k else np.zeros(len(points))
+                          for k in (4, 5))
+        points = (points[:, 0], points[:, 1:4], areas, volumes)
     seabed = parameters.get("seabed_profile_table")
     return scene_from_options(values, given, profile, parameters.get("line_types_table"),
                               points, seabed)

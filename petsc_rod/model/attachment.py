@@ -13,7 +13,9 @@ class Attachment:
     """A clump weight, a buoyancy module or a point force at arc length ``S`` (m):
     ``mass`` in air (kg), displaced ``volume`` (m^3), ``force`` (3,), N, drag area
     ``cda`` = C_d A (m^2) in a current, ``name`` a label (None: 'point k'). Its dead
-    force is force + (rho_w volume - mass) g e_z (attachment_forces)."""
+    force is force + (rho_w volume - mass) g e_z (attachment_forces); ``weighed``: the
+    ``force`` is that whole dead force already (a result file's table keeps the forces,
+    not the masses), the ``volume`` kept for its buoyancy above the sea surface."""
 
     S: float
     mass: float = 0.0
@@ -21,6 +23,7 @@ class Attachment:
     force: tuple = (0.0, 0.0, 0.0)
     cda: float = 0.0
     name: str = None
+    weighed: bool = False
 
     def __post_init__(self):
         for name in ("S", "mass", "volume", "cda"):
@@ -40,6 +43,16 @@ def attachment_forces(columns, density, gravity):
     force = np.stack([get("fx"), get("fy"), get("fz")], axis=-1)
     force[:, 2] += (density * get("volume") - get("mass")) * gravity
     return force
+
+
+def dead_forces(attachments, density, gravity):
+    """The dead force of each attachment, (n_p, 3), N, in water of ``density`` (kg/m^3)
+    under ``gravity`` (m/s^2): attachment_forces, or its ``force`` where it is weighed."""
+    columns = attachment_columns(attachments)
+    forces = attachment_forces(columns, density, gravity)
+    weighed = np.array([a.weighed for a in attachments], dtype=bool)
+    forces[weighed] = np.array([a.force for a in attachments], dtype=float)[weighed]
+    return forces
 
 
 def attachment_columns(attachments):

@@ -10,14 +10,17 @@ N), ``cda`` (a drag area C_d A, m^2: the drag 1/2 rho_w C_d A |v| v in a current
     P = (fx, fy, fz) + (rho_w volume - mass) g e_z,
 
 z up, rho_w the water density (-rod_water_density, kg/m^3) and g the gravity
-(-rod_gravity, m/s^2): a clump weight pulls down, a buoyancy module up. The quick form
-``-rod_point_load S,fx,fy,fz[,...]`` gives forces alone. The term that applies them is
-physics/point_loads.py.
+(-rod_gravity, m/s^2): a clump weight pulls down, a buoyancy module up. The buoyancy
+rho_w g volume e_z holds in the water only: the volumes are kept beside the forces so
+that above -rod_sea_surface the term takes it off again (physics/point_loads.py). The
+quick form ``-rod_point_load S,fx,fy,fz[,...]`` gives forces alone. The term that
+applies them is physics/point_loads.py.
 """
 
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.model.attachment import Attachment
 from petsc_rod.tables import numbered_rows
 
 # The columns a table may name; ``s`` is required. Every column but ``name`` is a number.
@@ -26,26 +29,16 @@ COLUMN_UNITS = {"s": "m", "mass": "kg", "volume": "m^3", "fx": "N", "fy": "N", "
                 "cda": "m^2"}
 
 
-def attachment_forces(columns, density, gravity):
-    """P = (fx, fy, fz) + (rho_w V - m) g e_z (module docstring), N, (n_p, 3), from
-    the numeric ``columns`` {name: (n_p,)} (absent ones zero)."""
-    n = len(columns["s"])
-    get = lambda name: np.asarray(columns.get(name, np.zeros(n)), dtype=float)  # noqa: E731
-    force = np.stack([get("fx"), get("fy"), get("fz")], axis=-1)
-    force[:, 2] += (density * get("volume") - get("mass")) * gravity
-    return force
-
-
 def beyond_the_line(S, length):
     """The index of the first arc length outside [0, L], or None."""
     outside = np.flatnonzero((np.asarray(S) < 0) | (np.asarray(S) > length))
     return int(outside[0]) if outside.size else None
 
 
-def read_point_loads(path, density, gravity, length, largest=np.inf):
-    """(S (n_p,), forces (n_p, 3), names (n_p,), drag areas (n_p,)) from the table
-    ``path`` (module
-    docstring): whitespace or comma separated, a header row naming the columns, '#'
+def read_attachments(path, length, largest=np.inf):
+    """The model.Attachments of the table ``path`` (module docstring; their forces:
+    model/attachment.attachment_forces): whitespace or comma separated, a header row
+    naming the columns, '#'
     starts a comment. Every problem is one RodInputError that says what to fix: no
     file, no ``s`` column, an unknown or repeated column, a row of another length, a
     value that is not a finite number of magnitude at most ``largest``, a negative mass,
@@ -101,13 +94,16 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
         refuse(f"line {body[k][0]}: s = {columns['s'][k]:.6g} m is beyond the line (0 <= s "
                f"<= L = {length:.6g} m, its length); give an arc length on the line")
     names = columns.pop("name", [f"point {k + 1}" for k in range(len(body))])
-    areas = columns.get("cda", np.zeros(len(body)))
-    return columns["s"], attachment_forces(columns, density, gravity), tuple(names), areas
+    zero = np.zeros(len(body))
+    get = lambda name: columns.get(name, zero)  # noqa: E731
+    return tuple(Attachment(get("s")[k], get("mass")[k], get("volume")[k],
+                            (get("fx")[k], get("fy")[k], get("fz")[k]), get("cda")[k],
+                            names[k]) for k in range(len(body)))
 
 
 def quick_point_loads(values, length):
-    """(S, forces, names, drag areas (zero)) of -rod_point_load S,fx,fy,fz[,...] (a flat
-    array of 4 numbers per point), each S on the line [0, ``length``]."""
+    """The model.Attachments of -rod_point_load S,fx,fy,fz[,...] (a flat array of 4
+    numbers per point: forces alone), each S on the line [0, ``length``]."""
     values = np.asarray(values, dtype=float)
     if values.size % 4:
         raise RodInputError(f"-rod_point_load: {values.size} numbers; give 4 (S,fx,fy,fz: "
@@ -118,5 +114,5 @@ def quick_point_loads(values, length):
         raise RodInputError(
             f"-rod_point_load: point {k + 1} at S = {table[k, 0]:.6g} m is beyond the line "
             f"(0 <= S <= L = {length:.6g} m, its length); give an arc length on the line")
-    return (table[:, 0], table[:, 1:], tuple(f"point {k + 1}" for k in range(len(table))),
-            np.zeros(len(table)))
+    return tuple(Attachment(table[k, 0], force=tuple(table[k, 1:]), name=f"point {k + 1}")
+                 for k in range(len(table)))
