@@ -2,7 +2,7 @@
 stiffness under piecewise-constant loads that the command line also poses
 (UniformLine); each with what meshes it (element counts)."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 
 import numpy as np

@@ -72,3 +72,18 @@ def test_a_uniform_line_compiles_to_its_own_values():
     with pytest.raises(RodInputError, match="UniformLine.load_breaks: the breaks must"):
         compile_scene(Model(UniformLine(length=10.0, load=((0, 0, -1), (0, 0, -2)),
                                         load_breaks=(12.0,)), End("clamp"), End("free")))
+
+
+def test_one_line_type_read_from_a_table_or_made_in_python():
+    """Issue 48: two LineType classes (api/model.py, scenes/line.py); now one, which the
+    table's reader makes and the API exports, giving the same section."""
+    from petsc_rod.api import LineType as ApiLineType
+    from petsc_rod.model import line_types_from_table
+    assert ApiLineType is LineType
+    table = {"name": ["pipe"], "od": np.array([0.2]), "mass": np.array([60.0]),
+             "gj": np.array([8e4]), "ei": np.array([1e5]), "cd": np.array([1.0]),
+             "id": np.array([0.15])}
+    read = line_types_from_table(table, "-rod_line_types t.txt")["pipe"]
+    a, b = read.section(0.0, 10.0, 1025.0, 9.80665), PIPE.section(0.0, 10.0, 1025.0, 9.80665)
+    for name in ("stiffness_start", "stiffness_end", "weight", "drag", "od", "id"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
