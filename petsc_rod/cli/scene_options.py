@@ -104,16 +104,16 @@ def model_from_options(values, given, profile=None, line_types=None, points=None
             if name in given:
                 raise RodInputError(f"-{name} needs -rod_sections or attachments "
                                     "(-rod_point_loads): the uniform line takes -rod_load")
-    ends = {which: End(values[f"rod_{which}"],
-                       given_value(values, given, f"rod_{which}_position"),
-                       given_value(values, given, f"rod_{which}_rotational_stiffness"),
-                       given_value(values, given, f"rod_{which}_joint_axis"),
-                       given_value(values, given, f"rod_{which}_force"),
-                       given_value(values, given, f"rod_{which}_frame"))
-            for which in ("start", "end")}
-    if "rod_end_twist" in given:
-        ends["end"] = End(**{**vars(ends["end"]), "twist": values["rod_end_twist"]})
-    return Model(line, ends["start"], ends["end"],
+    start, end = (End(values[f"rod_{which}"],
+                      given_value(values, given, f"rod_{which}_position"),
+                      given_value(values, given, f"rod_{which}_rotational_stiffness"),
+                      given_value(values, given, f"rod_{which}_joint_axis"),
+                      given_value(values, given, f"rod_{which}_force"),
+                      given_value(values, given, f"rod_{which}_frame"),
+                      given_value(values, given, f"rod_{which}_twist") if which == "end"
+                      else None)
+                  for which in ("start", "end"))
+    return Model(line, start, end,
                  environment_from_options(values, given, profile, seabed_rows), attachments)
 
 

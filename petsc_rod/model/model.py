@@ -200,6 +200,9 @@ def check_ends(span, n):
         if np.abs(rows @ rows.T - np.eye(3)).max() > 1e-8 or np.linalg.det(rows) < 0:
             raise RodInputError(f"{n[key]}: the rows d1, d2, d3 must be orthonormal and "
                                 "right-handed (d3 = d1 x d2)")
+    if start.twist is not None:
+        raise RodInputError(f"{n['start_twist']}: the roll of the clamped end S = L is the "
+                            f"end's ({n['end_twist']}); turn the start by its frame")
     if start.frame is not None and start.kind != "clamp":
         raise RodInputError(f"{n['start_frame']} needs {n['start']} clamp (the start is "
                             f"{start.kind}); drop it or change {n['start']}")

@@ -42,6 +42,8 @@ def test_the_compiled_scene_holds_the_sea_in_the_solver_s_frame():
 @pytest.mark.parametrize("change, model_words, option_words", [
     (dict(end=End("free", frame=(0, 1, 0, 0, 0, 1, 1, 0, 0))),
      "Model.end.frame needs Model.end clamp", "-rod_end_frame needs -rod_end clamp"),
+    (dict(start=End("clamp", twist=1.0)), "Model.start.twist: the roll of the clamped end",
+     "-rod_start_twist: the roll"),
     (dict(environment=Environment(seabed_stiffness=1e5)),
      "Environment.seabed_stiffness needs Environment.seabed",
      "-rod_seabed_stiffness needs -rod_seabed"),
