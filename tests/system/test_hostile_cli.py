@@ -352,6 +352,40 @@ def test_a_petsc_error_inside_a_solve_exits_4_with_one_line(tmp_path, options, r
                                      ["PETSc failed during the solve", "-rod_snes_*"], path)
 
 
+# rank 1 alone fails computing its step's record, after the result file was opened
+ONE_RANK_FAILS = """
+import sys
+import petsc4py
+petsc4py.init(sys.argv)
+from petsc4py import PETSc
+from petsc_rod.cli import main
+from petsc_rod.io import outputs
+main.FAILURE_WAIT = 2.0
+if PETSc.COMM_WORLD.getRank() == 1:
+    def step_record(*args, **kwargs):
+        raise FloatingPointError("injected on rank 1")
+    outputs.step_record = step_record
+sys.exit(main.run())
+"""
+
+
+def test_an_exception_on_one_rank_alone_ends_the_run_without_a_file(tmp_path):
+    """An exception other than a RodError or PETSc error (a numpy error, say) raised on
+    one rank only, while the other writes: the run ends (no hang) with the failing rank's
+    one line and exit 4, and neither the result nor its partial file is left."""
+    path = tmp_path / "out.h5"
+    script = tmp_path / "one_rank_fails.py"
+    script.write_text(ONE_RANK_FAILS)
+    env = {**child_env(), "PYTHONPATH": str(REPO_ROOT)}   # this tree's petsc_rod
+    done = subprocess.run(mpiexec(2) + [sys.executable, str(script)] + CANTILEVER
+                          + ["-rod_output", str(path)], cwd=REPO_ROOT, env=env,
+                          capture_output=True, text=True, timeout=60, check=False)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout, 4,
+                                     ["rank 1 failed alone", "FloatingPointError",
+                                      "injected on rank 1"], path)
+    assert "Traceback" not in done.stderr, describe(done.returncode, done.stderr)
+
+
 def test_ranks_given_different_options_exit_2_without_hanging(tmp_path):
     launcher = mpiexec(2)[0]
     path = tmp_path / "out.h5"
