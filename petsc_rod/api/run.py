@@ -177,7 +177,7 @@ def solve(model, comm=None, output=None, say=None):
     check_same_model(comm, model)
     try:
         scene, values, given = on_every_rank(comm, scene_of, model)
-        settings = settings_from_options(values, scene)
+        settings = settings_from_options(values, scene, given)
         pieces = mesh_pieces(values, scene)
     except RodInputError as error:
         raise in_model_terms(error) from None

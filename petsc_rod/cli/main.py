@@ -75,7 +75,7 @@ def run(comm=None):
                 for line in help_text():
                     say(line)
             scene = scene_from_options(values, given)
-            settings = settings_from_options(values, scene)
+            settings = settings_from_options(values, scene, given)
             pieces = mesh_pieces(values, scene, given)
             if pieces is not None:          # the sections' elements, every section end a vertex
                 values["rod_elements"] = int(pieces.counts.sum())

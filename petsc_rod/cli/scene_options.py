@@ -371,7 +371,10 @@ def check_applied_forces(scene, given):
             "lengths in m")
 
 
-def settings_from_options(values, scene):
+def settings_from_options(values, scene, given=frozenset()):
+    """The iteration's Settings of the options; -rod_al_stability 1 given (``given``:
+    the options set) for a scene without an energy is refused (check_stability_asked)."""
+    check_stability_asked(values, scene, given)
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene))
@@ -381,6 +384,25 @@ def settings_from_options(values, scene):
                     adapt_penalty=values["rod_al_adapt_penalty"],
                     check_stability=values["rod_al_stability"],
                     newton=values["rod_al_newton"])
+
+
+def check_stability_asked(values, scene, given):
+    """Refuse -rod_al_stability 1, given, with a current or seabed friction: the test of
+    the second variation of the energy (docs/method.md §10) needs every load to have an
+    energy, and a current's drag (a follower load) has none, nor friction (it
+    dissipates); the default (true) is then left out in silence, as documented."""
+    if "rod_al_stability" not in given or not values["rod_al_stability"]:
+        return
+    if scene.current is not None:
+        option, load, reason = _current_option(given), "a current", "its drag is a follower load"
+    elif scene.seabed is not None and scene.seabed.friction is not None:
+        option, load, reason = "-rod_seabed_friction", "friction", "it dissipates"
+    else:
+        return
+    raise RodInputError(f"-rod_al_stability 1 with {option}: the stability test is of the "
+                        f"second variation of the energy, and {load} has none ({reason}); "
+                        f"drop -rod_al_stability (a run with {load} gives no stability "
+                        f"verdict), or test the scene without {load}")
 
 
 def start_tension(values, scene):
