@@ -375,6 +375,7 @@ def settings_from_options(values, scene, given=frozenset()):
     """The iteration's Settings of the options; -rod_al_stability 1 given (``given``:
     the options set) for a scene without an energy is refused (check_stability_asked)."""
     check_stability_asked(values, scene, given)
+    check_stretch_domain(scene)
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene))
@@ -384,6 +385,39 @@ def settings_from_options(values, scene, given=frozenset()):
                     adapt_penalty=values["rod_al_adapt_penalty"],
                     check_stability=values["rod_al_stability"],
                     newton=values["rod_al_newton"])
+
+
+# The largest strain eps = |n| / EA of the catenary start's tension accepted on an
+# extensible line (docs/method.md §12): beyond it the linear stretch r' = (1 + eps) d3,
+# energy EA eps^2 / 2, models no line material.
+MAX_CATENARY_STRAIN = 1.0
+
+
+def check_stretch_domain(scene, samples=4097):
+    """Refuse an extensible line whose catenary start (the inextensible line's
+    equilibrium at load factor 1, scenes/starts.py) has a tension |n| above
+    MAX_CATENARY_STRAIN times its EA anywhere: the loads would stretch it by more than
+    its length, outside the domain of the model of stretch. A scene without a catenary
+    start is not checked."""
+    if not scene.extensible:
+        return
+    S = np.linspace(0.0, scene.length, samples)
+    try:
+        force = starts.catenary_start(scene, 1.0)(S)[2]
+    except RodInputError:                   # no catenary start (NoCatenaryStart too)
+        return
+    strain = np.linalg.norm(force, axis=-1) / scene.axial_stiffness_at(S)
+    worst = int(np.argmax(strain))
+    if strain[worst] > MAX_CATENARY_STRAIN:
+        stiffness = scene.axial_stiffness_at(S[worst:worst + 1])[0]
+        option = (f"the line types' ea {stiffness:g} N" if scene.sections
+                  else f"-rod_axial_stiffness {stiffness:g}")
+        raise RodInputError(
+            f"{option}: the line's tension (the catenary's, "
+            f"{np.linalg.norm(force[worst]):.3g} N at S = {S[worst]:.6g} m) would stretch "
+            f"it by {100 * strain[worst]:.3g} %, above {100 * MAX_CATENARY_STRAIN:g} %, "
+            "where the linear stretch models no line material; check EA (in N), or leave "
+            "the line inextensible")
 
 
 def check_stability_asked(values, scene, given):
