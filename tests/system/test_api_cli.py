@@ -11,7 +11,8 @@ import sys
 import h5py
 import pytest
 
-from helpers import REPO_ROOT, child_env, describe, mpiexec, run_petsc_rod
+from helpers import (REPO_ROOT, child_env, describe, mpiexec, partial_files,
+                     run_failing_on_rank_1, run_petsc_rod)
 from test_cli import readme_python_blocks
 
 pytestmark = pytest.mark.serial
@@ -53,20 +54,9 @@ assert along["S"].shape == (1001,) and study[400.0].units["effective_tension"] =
         assert study["400.0"][name] == pytest.approx(cli[name], rel=1e-9, abs=1e-9), name
 
 
-# rank 1 alone fails computing its step's record while the API writes its result file
-API_ONE_RANK_FAILS = """
-import sys
-import petsc4py
-petsc4py.init(sys.argv)
-from petsc4py import PETSc
+# with rank 1 failing alone (helpers.ONE_RANK_FAILS), a small line through api.solve
+API_RUN = """
 from petsc_rod.api import End, Line, LineType, Model, solve
-from petsc_rod.cli import main
-from petsc_rod.io import outputs
-main.FAILURE_WAIT = 2.0
-if PETSc.COMM_WORLD.getRank() == 1:
-    def step_record(*args, **kwargs):
-        raise FloatingPointError("injected on rank 1")
-    outputs.step_record = step_record
 pipe = LineType("pipe", od=0.2, mass=60.0, ei=1e5, gj=8e4)
 model = Model(line=Line([(pipe, 100.0)], element_length=5.0),
               start=End.anchor((0.0, 0.0, 0.0)), end=End.hang_off((80.0, 0.0, 30.0)),
@@ -79,15 +69,8 @@ def test_an_exception_on_one_rank_alone_ends_the_api_without_a_file(tmp_path):
     """api.solve with a result file, an exception other than a RodError raised on one
     rank only: every rank ends (no hang) with the failing rank's one line, exit 4, and
     neither the result nor its partial file is left."""
-    from helpers import partial_files
-
     path = tmp_path / "out.h5"
-    script = tmp_path / "api_one_rank_fails.py"
-    script.write_text(API_ONE_RANK_FAILS)
-    env = {**child_env(), "PYTHONPATH": str(REPO_ROOT)}   # this tree's petsc_rod
-    done = subprocess.run(mpiexec(2) + [sys.executable, str(script), str(path)],
-                          cwd=REPO_ROOT, env=env, capture_output=True, text=True,
-                          timeout=60, check=False)
+    done = run_failing_on_rank_1(tmp_path / "api_one_rank_fails.py", API_RUN, [str(path)])
     assert done.returncode == 4, describe(done)
     errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
     assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \

@@ -17,7 +17,8 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, child_env, mpiexec, partial_files, petsc_rod_command, run_petsc_rod
+from helpers import (REPO_ROOT, child_env, mpiexec, partial_files, petsc_rod_command,
+                     run_failing_on_rank_1, run_petsc_rod)
 
 pytestmark = pytest.mark.serial
 
@@ -352,19 +353,8 @@ def test_a_petsc_error_inside_a_solve_exits_4_with_one_line(tmp_path, options, r
                                      ["PETSc failed during the solve", "-rod_snes_*"], path)
 
 
-# rank 1 alone fails computing its step's record, after the result file was opened
-ONE_RANK_FAILS = """
-import sys
-import petsc4py
-petsc4py.init(sys.argv)
-from petsc4py import PETSc
-from petsc_rod.cli import main
-from petsc_rod.io import outputs
-main.FAILURE_WAIT = 2.0
-if PETSc.COMM_WORLD.getRank() == 1:
-    def step_record(*args, **kwargs):
-        raise FloatingPointError("injected on rank 1")
-    outputs.step_record = step_record
+# with rank 1 failing alone (helpers.ONE_RANK_FAILS), the command line's run
+CLI_RUN = """
 sys.exit(main.run())
 """
 
@@ -374,12 +364,8 @@ def test_an_exception_on_one_rank_alone_ends_the_run_without_a_file(tmp_path):
     one rank only, while the other writes: the run ends (no hang) with the failing rank's
     one line and exit 4, and neither the result nor its partial file is left."""
     path = tmp_path / "out.h5"
-    script = tmp_path / "one_rank_fails.py"
-    script.write_text(ONE_RANK_FAILS)
-    env = {**child_env(), "PYTHONPATH": str(REPO_ROOT)}   # this tree's petsc_rod
-    done = subprocess.run(mpiexec(2) + [sys.executable, str(script)] + CANTILEVER
-                          + ["-rod_output", str(path)], cwd=REPO_ROOT, env=env,
-                          capture_output=True, text=True, timeout=60, check=False)
+    done = run_failing_on_rank_1(tmp_path / "one_rank_fails.py", CLI_RUN,
+                                 CANTILEVER + ["-rod_output", str(path)])
     assert_one_line_and_nothing_left(done.returncode, done.stdout, 4,
                                      ["rank 1 failed alone", "FloatingPointError",
                                       "injected on rank 1"], path)
