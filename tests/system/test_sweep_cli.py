@@ -433,3 +433,21 @@ def test_a_sweep_killed_mid_case_can_be_run_again_into_its_folder(tmp_path):
     (folder / "b.h5.1-abcdef.partial").write_text("x")
     one_line(quick_sweep(tmp_path, rows, folder), "b.h5.1-abcdef.partial", "still running")
     assert (folder / "b.h5.1-abcdef.partial").exists() and (folder / "a.h5").exists()
+
+
+def test_which_partial_files_a_killed_sweep_left():
+    """runner.left_partials: a run's partial file of a case file (its pid gone) and a
+    summary's temporary file are stale; one whose pid lives is live; another name's,
+    or a file that only looks partial, is neither."""
+    from petsc_rod.sweep.runner import SWEEP_FILES, case_files, left_partials
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = int(gone.stdout)
+    files = set(SWEEP_FILES).union(case_files("a"))
+    entries = [f"a.h5.{dead}-0a1b2c.partial", f"a_regions.csv.{dead}-ffffff.partial",
+               ".summary.csv.k3j_x9q2.partial.csv", f"a.h5.{os.getpid()}-0a1b2c.partial",
+               f"b.h5.{dead}-0a1b2c.partial", f"a.h5.{dead}.partial", "a.h5"]
+    stale, live = left_partials(entries, files)
+    assert stale == entries[:3]
+    assert live == [entries[3]]
