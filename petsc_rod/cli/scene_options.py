@@ -387,37 +387,48 @@ def settings_from_options(values, scene, given=frozenset()):
                     newton=values["rod_al_newton"])
 
 
-# The largest strain eps = |n| / EA of the catenary start's tension accepted on an
-# extensible line (docs/method.md §12): beyond it the linear stretch r' = (1 + eps) d3,
-# energy EA eps^2 / 2, models no line material.
-MAX_CATENARY_STRAIN = 1.0
+# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
+# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
+# line material.
+MAX_STRAIN = 1.0
 
 
-def check_stretch_domain(scene, samples=4097):
-    """Refuse an extensible line whose catenary start (the inextensible line's
-    equilibrium at load factor 1, scenes/starts.py) has a tension |n| above
-    MAX_CATENARY_STRAIN times its EA anywhere: the loads would stretch it by more than
-    its length, outside the domain of the model of stretch. A scene without a catenary
-    start is not checked."""
-    if not scene.extensible:
-        return
-    S = np.linspace(0.0, scene.length, samples)
-    try:
-        force = starts.catenary_start(scene, 1.0)(S)[2]
-    except RodInputError:                   # no catenary start (NoCatenaryStart too)
-        return
-    strain = np.linalg.norm(force, axis=-1) / scene.axial_stiffness_at(S)
-    worst = int(np.argmax(strain))
-    if strain[worst] > MAX_CATENARY_STRAIN:
-        stiffness = scene.axial_stiffness_at(S[worst:worst + 1])[0]
-        option = (f"the line types' ea {stiffness:g} N" if scene.sections
-                  else f"-rod_axial_stiffness {stiffness:g}")
+def least_top_strain(scene):
+    """A lower bound of the strain at the higher held end in any equilibrium of a
+    uniform extensible line under a uniform dead load w (N/m of unstretched line), its
+    held ends h apart along the load (m), or None where it does not apply (sections,
+    a free end, attachments, load pieces that differ, a seabed that is not flat or not
+    across the load). Along the suspended line d(T + T^2 / 2EA) = w dz (the cable's
+    balance along its tangent; a current's normal drag has no part along it), from the
+    lowest point (a touchdown, or below the lower end) to the top, T >= 0 there:
+    eps >= sqrt(1 + 2 w h / EA) - 1. Returns (eps, w h)."""
+    if (scene.sections or not np.isfinite(scene.axial_stiffness) or scene.start == "free"
+            or scene.end == "free" or scene.point_load_S.size):
+        return None
+    loads = scene.load_values
+    weight = float(np.linalg.norm(loads[0]))
+    if weight == 0.0 or not np.all(loads == loads[0]):
+        return None
+    down = loads[0] / weight
+    if scene.seabed is not None and not (scene.seabed.flat and down[2] == -1.0):
+        return None
+    height = abs(float((scene.end_position - scene.start_state(1.0).position) @ down))
+    return (float(np.sqrt(1.0 + 2.0 * weight * height / scene.axial_stiffness) - 1.0),
+            weight * height)
+
+
+def check_stretch_domain(scene):
+    """Refuse a uniform extensible line that every equilibrium stretches by more than
+    MAX_STRAIN at its top (least_top_strain), outside the domain of the model of
+    stretch."""
+    least = least_top_strain(scene)
+    if least is not None and least[0] > MAX_STRAIN:
         raise RodInputError(
-            f"{option}: the line's tension (the catenary's, "
-            f"{np.linalg.norm(force[worst]):.3g} N at S = {S[worst]:.6g} m) would stretch "
-            f"it by {100 * strain[worst]:.3g} %, above {100 * MAX_CATENARY_STRAIN:g} %, "
-            "where the linear stretch models no line material; check EA (in N), or leave "
-            "the line inextensible")
+            f"-rod_axial_stiffness {scene.axial_stiffness:g}: any equilibrium stretches the "
+            f"line by about {100 * least[0]:.3g} % or more at its top (a flexible cable's "
+            f"T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load times the ends' height "
+            f"apart), above {100 * MAX_STRAIN:g} %, where the linear stretch models no line "
+            "material; check EA (in N), or leave the line inextensible")
 
 
 def check_stability_asked(values, scene, given):
