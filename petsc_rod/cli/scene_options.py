@@ -395,9 +395,9 @@ MAX_STRAIN = 1.0
 
 def least_top_strain(scene):
     """The least strain at the higher held end in any equilibrium of a uniform
-    extensible flexible line (a bending stiffness's shear moves it a little: 398 %
-    against 400 % on options/riser_catenary.opts with EA 1e5 N) under a uniform dead load w (N/m of unstretched line), its
-    held ends h apart along the load (m), or None where it does not apply (sections,
+    extensible flexible line (a bending stiffness's shear moves it a little: about, for
+    a rod) under a uniform dead load w (N/m of unstretched line), its held ends h apart
+    along the load (m), or None where it does not apply (sections,
     a free end, attachments, load pieces that differ, a seabed that is not flat or not
     across the load). Along the suspended line d(T + T^2 / 2EA) = w dz (the cable's
     balance along its tangent; a current's normal drag has no part along it), from the
