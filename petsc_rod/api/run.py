@@ -14,7 +14,8 @@ from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
                                 destroy_run, every_rank_failed, run_record, start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
-from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
+from petsc_rod.cli.scene_options import (check_stability_asked, mesh_pieces, scene_from_options,
+                                         settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodInputError, on_every_rank
 from petsc_rod.io import outputs
@@ -177,7 +178,8 @@ def solve(model, comm=None, output=None, say=None):
     check_same_model(comm, model)
     try:
         scene, values, given = on_every_rank(comm, scene_of, model)
-        settings = settings_from_options(values, scene, given)
+        settings = settings_from_options(values, scene)
+        check_stability_asked(values, scene, given)
         pieces = mesh_pieces(values, scene)
     except RodInputError as error:
         raise in_model_terms(error) from None

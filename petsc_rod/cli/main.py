@@ -28,8 +28,9 @@ from petsc_rod.cli import lines
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.scenes.blend import BlendedPath
-from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
-                                         scene_from_options, settings_from_options)
+from petsc_rod.cli.scene_options import (check_stability_asked, mesh_pieces, restart_path,
+                                         rounded_down, scene_from_options,
+                                         settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.riser.environment import read_seabed_profile
 from petsc_rod.tables import read_text
@@ -75,7 +76,7 @@ def run(comm=None):
                 for line in help_text():
                     say(line)
             scene = scene_from_options(values, given)
-            settings = settings_from_options(values, scene, given)
+            settings = settings_from_options(values, scene)
             pieces = mesh_pieces(values, scene, given)
             if pieces is not None:          # the sections' elements, every section end a vertex
                 values["rod_elements"] = int(pieces.counts.sum())
@@ -84,6 +85,7 @@ def run(comm=None):
                 and (settings.newton or settings.check_stability)),
                 None if pieces is None or "rod_elements" in given else
                 f"-rod_sections ({values['rod_elements']} elements in all)")
+            check_stability_asked(values, scene, given)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:

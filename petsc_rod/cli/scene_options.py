@@ -371,10 +371,9 @@ def check_applied_forces(scene, given):
             "lengths in m")
 
 
-def settings_from_options(values, scene, given=frozenset()):
-    """The iteration's Settings of the options; -rod_al_stability 1 given (``given``:
-    the options set) for a scene without an energy is refused (check_stability_asked)."""
-    check_stability_asked(values, scene, given)
+def settings_from_options(values, scene):
+    """The iteration's Settings of the options; a line stretched beyond the model of
+    stretch is refused (check_stretch_domain)."""
     check_stretch_domain(scene)
     penalty = values["rod_al_penalty"]
     if penalty is None:
