@@ -30,13 +30,14 @@ class _LastStep:
     io.results.ResultWriter ``inner`` when there is one."""
 
     def __init__(self, inner=None):
-        self.inner, self.vertex, self.attributes = inner, None, None
+        self.inner, self.vertex, self.attributes, self.units = inner, None, None, ({}, {})
 
-    def write_step(self, group, vertex, state, history, attributes):
+    def write_step(self, group, vertex, state, history, attributes, units=None):
         self.vertex = {name: np.array(value, copy=True) for name, value in vertex.items()}
         self.attributes = dict(attributes)
+        self.units = units or ({}, {})
         if self.inner is not None:
-            self.inner.write_step(group, vertex, state, history, attributes)
+            self.inner.write_step(group, vertex, state, history, attributes, units)
 
     def finish(self, *args):
         if self.inner is not None:
@@ -206,7 +207,7 @@ def solve(model, comm=None, output=None, say=None):
         result = run_continuation(solver, path, say=say, writer=keeper)
         keeper.inner = None                     # finished
         return Results(keeper.vertex, keeper.attributes, result.converged,
-                       comm.tompi4py(), mesh.n_elements)
+                       comm.tompi4py(), mesh.n_elements, keeper.units)
     finally:
         if keeper is not None:
             keeper.abort()

@@ -118,6 +118,9 @@ def tangent_factor(force, gradients):
 class FrictionTerm(NodalLoadTerm):
     """The seabed friction of the SeabedTerm ``seabed_term`` (module docstring)."""
 
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
+
     slope_components = position_components = (0, 1)
     conservative = False
     unsymmetric = True
