@@ -297,7 +297,7 @@ class FrictionTerm(NodalLoadTerm):
         tangents = state.node_directors()[:, 2, :2].copy()
         w = state.node_weights
         d = r[:, :2] - owned_nodes(self.mesh, self.anchors)
-        reaction = seabed.stiffness * np.maximum(seabed.height - r[:, 2], 0.0)
+        reaction = seabed.push(r[:, 2])
         stiffness = self.friction.stiffness
         norm = elliptic_norm(d, tangents, self.friction)                  # |d|_mu
         slide = (reaction > 0) & (stiffness * norm > reaction)
