@@ -209,7 +209,10 @@ def current_of(sea, scene, held, n, drag=None):
         # each section's own c (Scene.drag_at); the current carries the largest
         return Current(depths, velocities, surface, section_drag)
     current = Current.morison(depths, velocities, surface, *drag)
-    check_uniform_line_under_surface(sea, held, z0, n)
+    # the loaded line's held ends (a free end is not one)
+    check_uniform_line_under_surface(
+        sea, [state.position[2] for state in (scene.start_state(1.0), scene.end_state(1.0))
+              if is_held(state)], z0, n)
     return current
 
 
@@ -325,3 +328,48 @@ def check_applied_forces(scene, sea, n):
             f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
             f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
             "lengths in m")
+
+
+# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
+# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
+# line material.
+MAX_STRAIN = 1.0
+
+
+def least_top_strain(scene):
+    """The least strain at the higher held end in any equilibrium in tension (T >= 0 at
+    its lowest point) of a uniform extensible flexible line (a bending stiffness's shear moves it a little: about, for
+    a rod) under a uniform dead load w (N/m of unstretched line), its held ends h apart
+    along the load (m), or None where it does not apply (sections,
+    a free end, attachments, load pieces that differ, a seabed that is not flat or not
+    across the load). Along the suspended line d(T + T^2 / 2EA) = w dz (the cable's
+    balance along its tangent; a current's normal drag has no part along it), from the
+    lowest point (a touchdown, or below the lower end) to the top, T >= 0 there:
+    eps >= sqrt(1 + 2 w h / EA) - 1. Returns (eps, w h)."""
+    if (scene.sections or not np.isfinite(scene.axial_stiffness) or scene.start == "free"
+            or scene.end == "free" or scene.point_load_S.size):
+        return None
+    loads = scene.load_values
+    weight = float(np.linalg.norm(loads[0]))
+    if weight == 0.0 or not np.all(loads == loads[0]):
+        return None
+    down = loads[0] / weight
+    if scene.seabed is not None and not (scene.seabed.flat and down[2] == -1.0):
+        return None
+    height = abs(float((scene.end_position - scene.start_state(1.0).position) @ down))
+    return (float(np.sqrt(1.0 + 2.0 * weight * height / scene.axial_stiffness) - 1.0),
+            weight * height)
+
+
+def check_stretch_domain(scene, n=FIELD_NAMES):
+    """Refuse a uniform extensible line that every equilibrium stretches by more than
+    MAX_STRAIN at its top (least_top_strain), outside the domain of the model of
+    stretch; the message names the EA as ``n`` does (model/names.py)."""
+    least = least_top_strain(scene)
+    if least is not None and least[0] > MAX_STRAIN:
+        raise RodInputError(
+            f"{n['axial_stiffness']} {scene.axial_stiffness:g}: hanging in tension it stretches the "
+            f"line by about {100 * least[0]:.3g} % or more at its top (a flexible cable's "
+            f"T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load times the ends' height "
+            f"apart), above {100 * MAX_STRAIN:g} %, where the linear stretch models no line "
+            "material; check EA (in N), or leave the line inextensible")

@@ -13,10 +13,12 @@ import numpy as np
 
 from petsc_rod.api.model import Model
 from petsc_rod.api.results import Results
-from petsc_rod.cli.main import (build_solver, check_mesh, destroy_run, run_record,
-                                start_from)
+from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
+                                check_stability_possible,
+                                destroy_run, every_rank_failed, run_record, start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
-from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
+from petsc_rod.cli.scene_options import (check_stability_asked, checked_pieces,
+                                         settings_from_options)
 from petsc_rod.compile import compile_scene
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodInputError, on_every_rank
@@ -34,13 +36,14 @@ class _LastStep:
     io.results.ResultWriter ``inner`` when there is one."""
 
     def __init__(self, inner=None):
-        self.inner, self.vertex, self.attributes = inner, None, None
+        self.inner, self.vertex, self.attributes, self.units = inner, None, None, ({}, {})
 
-    def write_step(self, group, vertex, state, history, attributes):
+    def write_step(self, group, vertex, state, history, attributes, units=None):
         self.vertex = {name: np.array(value, copy=True) for name, value in vertex.items()}
         self.attributes = dict(attributes)
+        self.units = units or ({}, {})
         if self.inner is not None:
-            self.inner.write_step(group, vertex, state, history, attributes)
+            self.inner.write_step(group, vertex, state, history, attributes, units)
 
     def finish(self, *args):
         if self.inner is not None:
@@ -190,6 +193,7 @@ def solve(model, comm=None, output=None, say=None):
     check_same_model(comm, model)
     scene, values, given = on_every_rank(comm, scene_of, model)
     settings = settings_from_options(values, scene, FIELD_NAMES)
+    check_stability_asked(values, scene, given, FIELD_NAMES, "Model.options['al_stability']")
     pieces = checked_pieces(scene, model.line.element_counts(FIELD_NAMES),
                             FIELD_NAMES["sections"])
     values["rod_elements"] = int(pieces.counts.sum())
@@ -199,10 +203,14 @@ def solve(model, comm=None, output=None, say=None):
         io.check_output_path(output, comm)
     mesh = problem = solver = keeper = None
     say = say or (lambda line: None)
+    # where the ranks agree on a failure (made now: creating it is collective)
+    failures = comm.tompi4py().Dup()
     try:
         mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                     pieces)
         problem, solver = build_solver(mesh, scene, settings, say)
+        check_stability_possible(problem, "rod_al_stability" in given
+                                 and values["rod_al_stability"])
         start = start_from(problem, values, given, say)
         inner = None
         if output:
@@ -217,8 +225,15 @@ def solve(model, comm=None, output=None, say=None):
         result = run_continuation(solver, path, say=say, writer=keeper)
         keeper.inner = None                     # finished
         return Results(keeper.vertex, keeper.attributes, result.converged,
-                       comm.tompi4py(), mesh.n_elements)
+                       comm.tompi4py(), mesh.n_elements, keeper.units)
+    except Exception as error:
+        # one rank's alone (a numpy error, say): the others wait in a collective call
+        if not every_rank_failed(failures):
+            inner = keeper.inner if keeper is not None else None
+            abort_alone(comm, alone_failure(comm, error), getattr(inner, "partial", None))
+        raise
     finally:
         if keeper is not None:
             keeper.abort()
         destroy_run(solver, problem, mesh)
+        failures.Free()

@@ -19,7 +19,9 @@ from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
 from petsc_rod.model.names import Names
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.compile import compile_scene, line_names, rounded_down  # noqa: F401
+from petsc_rod.compile import (check_stretch_domain, compile_scene,  # noqa: F401
+                               line_names,
+                               rounded_down)
 from petsc_rod.environment.profiles import read_profile, read_seabed_profile
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
@@ -229,7 +231,9 @@ def checked_pieces(scene, counts, named):
 
 def settings_from_options(values, scene, names=OPTION_NAMES):
     """The iteration's Settings of the options, the default penalty resolved for
-    ``scene`` (its refusal worded with ``names``)."""
+    ``scene``; a line stretched beyond the model of stretch is refused
+    (compile.check_stretch_domain); refusals worded with ``names``."""
+    check_stretch_domain(scene, names)
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene), names)
@@ -239,6 +243,28 @@ def settings_from_options(values, scene, names=OPTION_NAMES):
                     adapt_penalty=values["rod_al_adapt_penalty"],
                     check_stability=values["rod_al_stability"],
                     newton=values["rod_al_newton"])
+
+
+def check_stability_asked(values, scene, given, names=OPTION_NAMES,
+                          switch="-rod_al_stability"):
+    """Refuse -rod_al_stability 1, given, with a current or seabed friction: the test of
+    the second variation of the energy (docs/method.md §10) needs every load to have an
+    energy, and a current's drag (a follower load) has none, nor friction (it
+    dissipates); the default (true) is then left out in silence, as documented. The
+    message names the switch ``switch`` and the loads as ``names`` does."""
+    if "rod_al_stability" not in given or not values["rod_al_stability"]:
+        return
+    if scene.current is not None:
+        option = names["current_profile" if "rod_current_profile" in given else "current"]
+        load, reason = "a current", "its drag is a follower load"
+    elif scene.seabed is not None and scene.seabed.friction is not None:
+        option, load, reason = names["seabed_friction"], "friction", "it dissipates"
+    else:
+        return
+    raise RodInputError(f"{switch} 1 with {option}: the stability test is of the "
+                        f"second variation of the energy, and {load} has none ({reason}); "
+                        f"drop {switch} (a run with {load} gives no stability "
+                        f"verdict), or test the scene without {load}")
 
 
 def start_tension(values, scene):

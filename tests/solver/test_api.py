@@ -212,3 +212,9 @@ def test_the_seabed_s_shape_is_the_environment_s_own_or_its_options():
     assert own.seabed.shape.slope_vector[1] > 0
     with pytest.raises(RodInputError, match="Environment.seabed_slope 95.0: must lie"):
         scene_of(model(environment=Environment(seabed=0.0, seabed_slope=95.0)))
+def test_a_stability_test_asked_with_a_current_is_refused():
+    """Model.options al_stability True beside the model's current (a drag without an
+    energy) is refused as the command line refuses -rod_al_stability 1 with it."""
+    with pytest.raises(RodInputError, match="a current has none") as refused:
+        solve(model(options={"al_stability": True}))
+    assert "al_stability" in str(refused.value) and "Environment.current" in str(refused.value)
