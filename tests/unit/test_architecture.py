@@ -182,3 +182,23 @@ def test_the_model_imports_no_petsc_and_no_front_end():
         assert not outside, f"{path} imports {outside}: the model needs numpy alone"
     assert found >= 6                                       # the folder was read
 
+
+
+def test_a_scene_is_made_whole_by_its_constructor():
+    """The seabed, the current and the pressures were set on the Scene after it was made
+    (cli/scene_options.py), the attachments' names by the API (api/run.py): now the
+    compile (compile.py) gives every field to the constructor, and no module sets a
+    field of a made scene."""
+    for path, tree in modules().items():
+        if path == os.path.join("scenes", "scene.py"):
+            continue
+        for node in ast.walk(tree):
+            targets = (node.targets if isinstance(node, ast.Assign) else
+                       [node.target] if isinstance(node, (ast.AugAssign, ast.AnnAssign))
+                       else [])
+            for target in targets:
+                for part in ast.walk(target):
+                    assert not (isinstance(part, ast.Attribute)
+                                and isinstance(part.value, ast.Name)
+                                and part.value.id == "scene"), \
+                        f"{path}:{node.lineno} sets scene.{part.attr} on a made Scene"
