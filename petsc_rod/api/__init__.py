@@ -5,9 +5,10 @@ communicator (api/run.py), read its numbers with their units (api/results.py).
     from petsc_rod.api import LineType, Line, End, Environment, Model, solve
 """
 
-from petsc_rod.api.model import Attachment, End, Environment, Line, LineType, Model
+from petsc_rod.api.model import (Attachment, End, Environment, Line, LineType, Model,
+                                 UniformLine)
 from petsc_rod.api.results import Results
 from petsc_rod.api.run import scene_of, solve
 
 __all__ = ["Attachment", "End", "Environment", "Line", "LineType", "Model", "Results",
-           "scene_of", "solve"]
+           "UniformLine", "scene_of", "solve"]

@@ -14,7 +14,8 @@ import numpy as np
 
 from petsc_rod import model as physical
 from petsc_rod.errors import RodInputError
-from petsc_rod.model import Attachment, End, Environment, Line, LineType  # noqa: F401
+from petsc_rod.model import (Attachment, End, Environment, Line, LineType,  # noqa: F401
+                             UniformLine)
 from petsc_rod.model.end import KINDS
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.sea import GRAVITY, WATER_DENSITY
@@ -72,6 +73,21 @@ def sections_text(line):
                         FIELD_NAMES)))
 
 
+def uniform_texts(line):
+    """{'rod_<name>': text} of the options a UniformLine stands for."""
+    texts = {"rod_length": _number(line.length), "rod_stiffness": _numbers(line.stiffness),
+             "rod_load": _numbers(line.load), "rod_elements": str(int(line.elements))}
+    if np.size(line.load_breaks):
+        texts["rod_load_breaks"] = _numbers(line.load_breaks)
+    if np.isfinite(line.axial_stiffness):
+        texts["rod_axial_stiffness"] = _number(line.axial_stiffness)
+    if line.drag is not None:
+        texts["rod_drag"] = _numbers(line.drag)
+    if line.grading is not None:
+        texts["rod_mesh_grading"] = _number(line.grading)
+    return texts
+
+
 @dataclass(frozen=True)
 class Model(physical.Model):
     """The model (model.Model: a line between two ends in the sea, with attachments),
@@ -85,9 +101,6 @@ class Model(physical.Model):
 
     def __post_init__(self):
         super().__post_init__()
-        if not isinstance(self.line, Line):
-            raise RodInputError(f"Model.line: expected an api.Line, not "
-                                f"{type(self.line).__name__}")
         if not whole(self.steps) or self.steps < 1:
             raise RodInputError(f"Model.steps {self.steps!r}: a whole number of at least 1")
         if not isinstance(self.initial_shape, str):
@@ -101,11 +114,14 @@ class Model(physical.Model):
     def option_texts(self, line_types="<line types>"):
         """{'rod_<name>': text} of the options this model stands for; ``line_types`` the
         name said for the line types' table (the table itself: ``line_types_text``)."""
-        texts = {"rod_line_types": line_types, "rod_sections": sections_text(self.line),
-                 "rod_steps": str(int(self.steps)), "rod_initial_shape": self.initial_shape}
-        for name in ("contents_density", "internal_pressure", "design_factor"):
-            if getattr(self.line, name) is not None:
-                texts[f"rod_{name}"] = _number(getattr(self.line, name))
+        texts = {"rod_steps": str(int(self.steps)), "rod_initial_shape": self.initial_shape}
+        if isinstance(self.line, Line):
+            texts.update(rod_line_types=line_types, rod_sections=sections_text(self.line))
+            for name in ("contents_density", "internal_pressure", "design_factor"):
+                if getattr(self.line, name) is not None:
+                    texts[f"rod_{name}"] = _number(getattr(self.line, name))
+        else:
+            texts.update(uniform_texts(self.line))
         for which, end in (("start", self.start), ("end", self.end)):
             if end.kind not in KINDS:
                 raise RodInputError(f"Model.{which}: kind {end.kind!r}; use one of {KINDS}")
@@ -157,7 +173,9 @@ class Model(physical.Model):
         '.line_types.txt', '.point_loads.txt', '.current.txt', '.seabed.txt' for '.opts'.
         Call it on one rank."""
         stem = str(path).removesuffix(".opts")
-        files = {"rod_line_types": (f"{stem}.line_types.txt", self.line_types_text())}
+        files = {}
+        if isinstance(self.line, Line):
+            files["rod_line_types"] = (f"{stem}.line_types.txt", self.line_types_text())
         if self.attachments:
             files["rod_point_loads"] = (f"{stem}.point_loads.txt", self.attachment_table())
         profile = self.environment.profile()
@@ -180,7 +198,9 @@ class Model(physical.Model):
 
     def line_types_text(self):
         """The -rod_line_types table of the line's types; RodInputError for two types of
-        one name that differ."""
+        one name that differ; '' for a UniformLine."""
+        if not isinstance(self.line, Line):
+            return ""
         types = self.line.types()
         for entry in self.line.sections:
             if type_row(entry[0]) != type_row(types[[t.name for t in types].index(

@@ -11,7 +11,7 @@ import re
 
 import numpy as np
 
-from petsc_rod.api.model import Model
+from petsc_rod.api.model import Line, Model, UniformLine
 from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
                                 check_stability_possible,
@@ -64,9 +64,10 @@ def _run_record(model, values, solver, start, output):
     export = {**parse_values(model.option_texts()), "rod_elements": values["rod_elements"],
               "rod_output": output, "rod_line_types": None, "rod_seabed_profile": None}
     record = run_record(export, solver, start)
-    record.parameters["line_types"] = "(Python API)"
-    record.parameters["line_types_table"] = model.line_types_text()
-    record.units["line_types_table"] = "text"
+    if isinstance(model.line, Line):
+        record.parameters["line_types"] = "(Python API)"
+        record.parameters["line_types_table"] = model.line_types_text()
+        record.units["line_types_table"] = "text"
     if model.environment.seabed_profile is not None:
         record.parameters["seabed_profile"] = "(Python API)"
         record.parameters["seabed_profile_table"] = np.asarray(
@@ -178,6 +179,21 @@ def scene_of(model):
     return compile_scene(with_options(model, values), FIELD_NAMES), values, given
 
 
+def mesh_of(line, scene, values):
+    """(mesh.Pieces or None, how a message names the element count) of the model's
+    line, its element count and grading put into ``values`` (check_mesh, Mesh): a Line's
+    sections meshed one piece each, a UniformLine's elements graded."""
+    if isinstance(line, UniformLine):
+        values.update(rod_elements=int(line.elements), rod_length=float(line.length))
+        if line.grading is not None:
+            values["rod_mesh_grading"] = float(line.grading)
+        return None, f"UniformLine.elements ({values['rod_elements']})"
+    pieces = checked_pieces(scene, line.element_counts(FIELD_NAMES), FIELD_NAMES["sections"])
+    values["rod_elements"] = int(pieces.counts.sum())
+    return pieces, (f"the model's Line ({values['rod_elements']} elements in all: its "
+                    "sections' counts and element_length)")
+
+
 def solve(model, comm=None, output=None, say=None):
     """Solve ``model`` (api.Model) on the ranks of ``comm`` (a PETSc communicator;
     default PETSc.COMM_WORLD); collective. ``output``: a result file to write as well
@@ -194,11 +210,8 @@ def solve(model, comm=None, output=None, say=None):
     scene, values, given = on_every_rank(comm, scene_of, model)
     settings = settings_from_options(values, scene, FIELD_NAMES)
     check_stability_asked(values, scene, given, FIELD_NAMES, "Model.options['al_stability']")
-    pieces = checked_pieces(scene, model.line.element_counts(FIELD_NAMES),
-                            FIELD_NAMES["sections"])
-    values["rod_elements"] = int(pieces.counts.sum())
-    check_mesh(comm, values, named=f"the model's Line ({values['rod_elements']} elements in "
-                                   "all: its sections' counts and element_length)")
+    pieces, named = mesh_of(model.line, scene, values)
+    check_mesh(comm, values, named=named)
     if output:
         io.check_output_path(output, comm)
     mesh = problem = solver = keeper = None

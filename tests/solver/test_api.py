@@ -218,3 +218,31 @@ def test_a_stability_test_asked_with_a_current_is_refused():
     with pytest.raises(RodInputError, match="a current has none") as refused:
         solve(model(options={"al_stability": True}))
     assert "al_stability" in str(refused.value) and "Environment.current" in str(refused.value)
+
+
+def test_a_uniform_line_is_a_model_too(tmp_path):
+    """Issue 48: the API is the model, both its lines: a uniform cantilever (the command
+    line's -rod_stiffness, -rod_load) solves to the small-deflection tip w L^4 / 8 EI, and
+    its exported options make the command line's scene of it."""
+    from petsc_rod.api import UniformLine, scene_of
+    from petsc_rod.cli.options import parse_values
+    from petsc_rod.cli.scene_options import scene_from_options
+    cantilever = Model(UniformLine(length=1.0, stiffness=(1.0, 1.0, 1.0),
+                                   load=((0.0, 0.0, -0.01),), elements=16),
+                       start=End("clamp"), end=End("free"), initial_shape="straight")
+    results = solve(cantilever, comm=PETSc.COMM_WORLD)
+    assert results.converged
+    tip = results.along_line(["r"])["r"][-1]
+    assert tip[2] == pytest.approx(-0.01 / 8.0, rel=1e-3)
+    folder = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path))
+    path = f"{folder}/cantilever.opts"
+    if PETSc.COMM_WORLD.getRank() == 0:
+        cantilever.write_options(path)
+    PETSc.COMM_WORLD.tompi4py().Barrier()
+    texts = dict(line[1:].split(" ", 1) for line in open(path).read().splitlines()
+                 if line.startswith("-"))
+    from_file = scene_from_options(parse_values(texts), set(texts))
+    scene, _, _ = scene_of(cantilever)
+    assert from_file.length == scene.length and from_file.end == scene.end == "free"
+    assert np.array_equal(from_file.load_values, scene.load_values)
+    assert np.array_equal(from_file.stiffness, scene.stiffness)
