@@ -1,6 +1,6 @@
 """How the seabed enters the iteration, measured (docs/riser.md, "The seabed in the global
 step"): the implicit treatment of petsc_rod (the vertical slope in Hermite dofs with an
-active-set loop in every global step, riser/seabed.py) against the obvious start, the
+active-set loop in every global step, global_step/seabed_contact.py) against the obvious start, the
 spring lagged by one iteration (its force from the last global step's heights, a nodal
 load on the slope's right-hand side, as the drag is).
 
@@ -26,16 +26,16 @@ import petsc4py  # noqa: E402
 petsc4py.init(sys.argv[:1])
 from petsc4py import PETSc  # noqa: E402
 
+from petsc_rod.environment.seabed import Seabed, default_stiffness  # noqa: E402
 from petsc_rod.errors import RodDivergedError  # noqa: E402
+from petsc_rod.global_step.nodal_loads import NodalLoad  # noqa: E402
 from petsc_rod.iteration.driver import UzawaSolver  # noqa: E402
-from petsc_rod.problem.penalty import default_penalty  # noqa: E402
 from petsc_rod.iteration.stopping import Settings  # noqa: E402
 from petsc_rod.mesh.mesh import Mesh  # noqa: E402
-from petsc_rod.riser.environment import Seabed, default_stiffness  # noqa: E402
-from petsc_rod.riser.loads import NodalLoad  # noqa: E402
 from petsc_rod.physics.dead_loads import DeadLoads  # noqa: E402
+from petsc_rod.physics.nodal_load import NodalLoadTerm  # noqa: E402
+from petsc_rod.problem.penalty import default_penalty  # noqa: E402
 from petsc_rod.problem.problem import RodProblem  # noqa: E402
-from petsc_rod.riser.terms import NodalLoadTerm  # noqa: E402
 from petsc_rod.scenes.scene import Scene  # noqa: E402
 from petsc_rod.scenes.starts import catenary_start  # noqa: E402
 
@@ -54,7 +54,7 @@ SCENES = {
 class LaggedSeabed(NodalLoadTerm):
     """The seabed as a load lagged by one iteration: k (z_b - z)_+ at the nodes from the
     heights of the last global step, added to the slope's right-hand side like the drag
-    (a term of physics, physics/term.py, in place of riser.terms.SeabedTerm); no vertical
+    (a term of physics, physics/term.py, in place of physics.seabed.SeabedTerm); no vertical
     problem, no energy."""
 
     conservative = in_newton = False

@@ -1,12 +1,12 @@
 """The Newton Jacobian of a problem whose load follows the line (the drag of a current),
 kept banded by a chain of resultants (docs/method.md §11, "A load without potential"),
 or with another term whose derivative is not symmetric (``Term.unsymmetric``: the
-seabed friction, whose limit follows the contact reaction, riser/friction.py).
+seabed friction, whose limit follows the contact reaction, physics/friction.py).
 
 A load f_j given at the P2 nodes (N/m, interpolated in P2) enters the gradient of the
 reduced problem as -b on the d3 rows, b_n = int F phi_n dS with F(S) = int_S^L f_h dS
 (plus, when the start is free, minus the whole: F(S) = -int_0^S f_h), the resultant of
-the load beyond S (riser/loads.py). Where f depends on the frames (the drag on the
+the load beyond S (global_step/nodal_loads.py). Where f depends on the frames (the drag on the
 tangent), b depends on every node beyond n: its derivative is dense. It is kept banded
 by making the resultants at the vertices, Psi_i = delta F(S_i) (3 each), unknowns with
 one equation per element,
@@ -20,8 +20,8 @@ in the row of Psi_e from a held start (Psi_N = 0), of Psi_e+1 from a held end
     T_e,nl = int_e phi_n(S) int_S^{S_e+1} phi_l dS'.
 
 The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretch),
-delta f_l = G_l omega_l (riser/current.py drag_jacobian). The matrix is that of H
-(analysis/stability.py, with the resultants' slots as identity rows) plus these
+delta f_l = G_l omega_l (physics/drag.py drag_jacobian). The matrix is that of H
+(analysis/second_variation.py, with the resultants' slots as identity rows) plus these
 entries (a copy of H's values on H's pattern, which holds these places as zeros from
 H's first assembly: Term.jacobian_pattern): unsymmetric, factored by MUMPS's LU
 (global_step/ksp.direct_factor: on several ranks by substructuring, each rank its

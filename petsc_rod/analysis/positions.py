@@ -20,7 +20,7 @@ is a row of the node's unknowns: delta s_n = (omega_n x t_n)_c + delta_k_n (d3_n
 position at the held end is held (u^c_a = 0). The system stays symmetric: (omega, u)
 are primal unknowns and nu the multipliers of the chains, so the KKT matrix has one
 negative eigenvalue per element and component more than the reduced Hessian
-(SecondVariation counts them off).
+(StabilityTest.negative_pivots counts them off).
 
 This module holds the chain's coefficients and the gradient of a position energy in the
 slopes (the adjoint of the chain: a suffix sum, one MPI scan). numpy only.

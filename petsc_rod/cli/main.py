@@ -14,29 +14,29 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod import resources
-from petsc_rod.io import line_table, outputs, provenance
-from petsc_rod.io import results as io
-from petsc_rod.scenes import starts
-from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
-from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
-                                 fewest_elements, largest_grading)
+from petsc_rod.cli import lines
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type,
                                    check_substructuring_switches, format_value,
                                    help_text, read_options, unused_options)
-from petsc_rod.cli import lines
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.io.same_file import replaced_input
-from petsc_rod.scenes.blend import BlendedPath
 from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
                                          scene_from_options, settings_from_options)
 from petsc_rod.cli.session import run_continuation
-from petsc_rod.riser.environment import read_seabed_profile
-from petsc_rod.tables import read_text
 from petsc_rod.cli.signals import Interrupts
+from petsc_rod.environment.profiles import read_seabed_profile
+from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
+from petsc_rod.io import line_table, outputs, provenance
+from petsc_rod.io import results as io
+from petsc_rod.io.same_file import replaced_input
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
+from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
+                                 fewest_elements, largest_grading)
 from petsc_rod.problem.problem import RodProblem
+from petsc_rod.scenes import starts
+from petsc_rod.scenes.blend import BlendedPath
+from petsc_rod.tables import read_text
 
 # The options that name a file the run reads.
 INPUT_FILE_OPTIONS = tuple(option.name for option in OPTIONS
@@ -394,7 +394,7 @@ def options_in_effect(values, solver, start):
                 "rod_al_penalty": solver.settings.asked_penalty, "rod_initial_load_factor": start}
     if not np.isfinite(scene.axial_stiffness):  # inextensible: written as not given
         resolved["rod_axial_stiffness"] = None
-    if scene.seabed is not None:                # the default stiffness (riser/environment.py)
+    if scene.seabed is not None:                # the default stiffness (environment/seabed.py)
         resolved["rod_seabed_stiffness"] = scene.seabed.stiffness
         if scene.seabed.friction is not None:   # its default stick stiffness
             resolved["rod_seabed_friction_stiffness"] = scene.seabed.friction.stiffness
@@ -425,8 +425,9 @@ def options_in_effect(values, solver, start):
         units["line_types_table"] = "text"
     if scene.point_load_S.size:                 # the attachments' forces, to repeat the run
         parameters["point_loads_table"] = np.column_stack([
-            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas])
-        units["point_loads_table"] = "m, N, N, N, m^2 (S, fx, fy, fz, CdA)"
+            scene.point_load_S, scene.point_load_forces, scene.point_load_drag_areas,
+            scene.point_load_volumes])
+        units["point_loads_table"] = "m, N, N, N, m^2, m^3 (S, fx, fy, fz, CdA, volume)"
     for name, value in solver_types(solver).items():
         parameters[name] = value
         units[name] = "text"

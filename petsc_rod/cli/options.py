@@ -20,16 +20,16 @@ from dataclasses import dataclass
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.environment.seabed import DEFAULT_PENETRATION
 from petsc_rod.errors import RodInputError
 from petsc_rod.global_step.ksp import INERTIA_PREFIX, NEWTON_PREFIX, SUBSTRUCTURING
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
-from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
                                             NEWTON_SWITCH_FAR, NEWTON_WORTH)
+from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
-from petsc_rod.riser.environment import DEFAULT_PENETRATION
 from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step, the SNES of the iteration and
@@ -225,7 +225,7 @@ OPTIONS = [
     Option("rod_gravity", _real, default_of(Scene, "gravity"), "g",
            "gravity, m/s^2, along -z (the weight of line types and attachments); 0: a "
            "weightless line", NON_NEGATIVE, "m/s^2"),
-    # riser terms (petsc_rod/riser, docs/riser.md)
+    # the environment (petsc_rod/environment, docs/riser.md)
     Option("rod_seabed", _real, None, "z",
            "height of a flat, frictionless, elastic seabed, m (z up): the line rests on it",
            unit="m"),

@@ -7,17 +7,18 @@ import dataclasses
 import numpy as np
 
 from petsc_rod.cli.options import MAX_MAGNITUDE, OPTIONS
+from petsc_rod.environment.bathymetry import Grid, Plane, Profile
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.profiles import grid_axes, read_profile, read_seabed_profile
+from petsc_rod.environment.seabed import (MIN_RELATIVE_PENETRATION, Friction, Seabed,
+                                          check_covered, check_ends_above,
+                                          default_stiffness, largest_stiffness)
 from petsc_rod.errors import RodInputError
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import MIN_RELATIVE_ELEMENT, Pieces
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.riser.bathymetry import Grid, Plane, Profile
-from petsc_rod.riser.environment import (MIN_RELATIVE_PENETRATION, Current, Friction, Seabed,
-                                         check_covered, check_ends_above, default_stiffness,
-                                         grid_axes, largest_stiffness, read_profile,
-                                         read_seabed_profile)
-from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes import starts
+from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
 from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import (LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL, line_types_from_table,
                                    parse_sections, section_elements)
@@ -41,17 +42,18 @@ FIELD_OPTIONS = {"load_values": "-rod_load", "load_breaks": "-rod_load_breaks",
                  "point_load_S": "the point loads (-rod_point_loads|-rod_point_load)",
                  "point_load_forces": ("the point loads (-rod_point_loads|-rod_point_load, "
                                        "-rod_water_density, -rod_gravity)"),
-                 "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)"}
+                 "point_load_drag_areas": "the attachments' drag areas (-rod_point_loads)",
+                 "point_load_volumes": "the attachments' volumes (-rod_point_loads)"}
 
 
 def point_loads_from_options(values, length, points=None):
-    """(S (n_p,), forces (n_p, 3), names, drag areas (n_p,)) of -rod_point_loads FILE
-    and -rod_point_load (scenes/point_loads.py), the file's first, each on the line
-    [0, ``length``]; ``points`` (S, forces, drag areas) when already resolved (a result
-    file's point_loads_table)."""
+    """(S (n_p,), forces (n_p, 3), names, drag areas (n_p,), volumes (n_p,)) of
+    -rod_point_loads FILE and -rod_point_load (scenes/point_loads.py), the file's first,
+    each on the line [0, ``length``]; ``points`` (S, forces, drag areas, volumes) when
+    already resolved (a result file's point_loads_table)."""
     if points is not None:
-        S, forces, areas = points
-        return S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas
+        S, forces, areas, volumes = points
+        return S, forces, tuple(f"point {k + 1}" for k in range(len(S))), areas, volumes
     parts = []
     if values["rod_point_loads"]:
         parts.append(read_point_loads(values["rod_point_loads"], values["rod_water_density"],
@@ -59,9 +61,10 @@ def point_loads_from_options(values, length, points=None):
     if values["rod_point_load"] is not None:
         parts.append(quick_point_loads(values["rod_point_load"], length))
     if not parts:
-        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0)
-    return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-            sum((tuple(p[2]) for p in parts), ()), np.concatenate([p[3] for p in parts]))
+        return np.zeros(0), np.zeros((0, 3)), (), np.zeros(0), np.zeros(0)
+    S, forces, _, areas, volumes = (np.concatenate([p[k] for p in parts])
+                                    for k in range(5))
+    return S, forces, sum((tuple(p[2]) for p in parts), ()), areas, volumes
 
 
 def scene_from_options(values, given, profile=None, line_types=None, points=None,
@@ -70,7 +73,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
     rows of -rod_current_profile when already read (a result file's
     current_profile_table), else they are read from its file; ``line_types`` the text of
     the -rod_line_types table when already read (a result file's line_types_table);
-    ``points`` (S, forces, drag areas) the point loads when already resolved (a result
+    ``points`` (S, forces, drag areas, volumes) the point loads when already resolved (a result
     file's point_loads_table); ``seabed_rows`` (n, 2 or 3) the seabed profile's or grid's
     rows when already read (a result file's seabed_profile_table)."""
     load = np.asarray(values["rod_load"])
@@ -83,7 +86,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
         line = dict(length=sections[-1].end, stiffness=sections[0].stiffness_start,
                     load_values=[s.weight for s in sections],
                     load_breaks=[s.start for s in sections[1:]], sections=tuple(sections))
-    point_S, point_forces, point_names, point_areas = point_loads_from_options(
+    point_S, point_forces, point_names, point_areas, point_volumes = point_loads_from_options(
         values, line["length"], points)
     if not (sections or point_S.size):
         for name in ("rod_water_density", "rod_gravity"):
@@ -104,7 +107,7 @@ def scene_from_options(values, given, profile=None, line_types=None, points=None
                   start_joint_axis=values["rod_start_joint_axis"],
                   end_joint_axis=values["rod_end_joint_axis"], point_load_S=point_S,
                   point_load_forces=point_forces, point_load_names=point_names,
-                  point_load_drag_areas=point_areas,
+                  point_load_drag_areas=point_areas, point_load_volumes=point_volumes,
                   water_density=values["rod_water_density"], gravity=values["rod_gravity"])
     scene.validate(given)
     scene.seabed, scene.current = environment_from_options(values, given, scene, profile,
@@ -235,7 +238,7 @@ def check_represented(entries, lengths, counts, shared, given_counts, length, sh
 
 def pressures_from_options(values, given, scene):
     """Set the scene's sea surface (in its frame), contents density, internal
-    pressure (riser/pressures.py) and design factor (riser/stresses.py) for a line of
+    pressure (reports/pressures.py) and design factor (reports/stresses.py) for a line of
     sections; refuse them on a line without
     line types (no diameters to press on)."""
     if not scene.sections:
@@ -424,7 +427,7 @@ def checked_default_penalty(scene, start_tension=0.0):
     return scales[name]
 
 
-# The options that shape the seabed (riser/bathymetry.py, docs/riser.md §1a).
+# The options that shape the seabed (environment/bathymetry.py, docs/riser.md §1a).
 SEABED_SHAPE = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin",
                 "rod_seabed_profile")
 
@@ -519,7 +522,7 @@ def seabed_from_options(values, given, load_values, origin=np.zeros(3), profile_
 # sticks slowed the iteration down (docs/riser.md §3b).
 FRICTION_STIFFNESS_RATIO = 0.1
 
-# The options of the seabed's friction (riser/friction.py, docs/riser.md §3b).
+# The options of the seabed's friction (physics/friction.py, docs/riser.md §3b).
 SEABED_FRICTION = ("rod_seabed_friction", "rod_seabed_friction_stiffness")
 
 
@@ -608,7 +611,27 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
     held = [state.position[2] for _, state in ends if is_held(state)]
     seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
-    return seabed, current_from_options(values, given, max(held), profile, section_drag)
+    current = current_from_options(values, given, max(held), profile, section_drag)
+    if not scene.sections:
+        check_uniform_line_under_surface(values, given, held, z0)
+    return seabed, current
+
+
+def check_uniform_line_under_surface(values, given, held, z0):
+    """Refuse -rod_sea_surface below a held end of a uniform line (-rod_load): the part
+    above it would keep the submerged weight and the current's drag it has not in the
+    air, and -rod_load gives no diameter and mass to take them off (a line of sections
+    does, riser/terms.py SurfaceTerm). ``held`` the held ends' heights and the surface
+    in ``values`` in the scene's frame, ``z0`` the start's height (m)."""
+    surface = values["rod_sea_surface"]
+    if "rod_sea_surface" not in given or surface is None or not max(held) > surface:
+        return
+    raise RodInputError(
+        f"-rod_sea_surface {surface + z0:g}: the held end at z = {max(held) + z0:g} m is "
+        "above it, where a line given by -rod_load would keep its submerged weight and "
+        "the current's drag; give the line as -rod_line_types and -rod_sections (od and "
+        "mass: its weight in air and no drag above the surface), or a surface at or above "
+        "the held ends")
 
 
 def seated(seabed, held):
@@ -662,9 +685,11 @@ def scene_from_parameters(parameters):
     points = parameters.get("point_loads_table")
     if points is not None:
         points = np.asarray(points, dtype=float)
-        points = points.reshape(-1, points.shape[-1])     # 4 columns before drag areas
-        areas = points[:, 4] if points.shape[1] > 4 else np.zeros(len(points))
-        points = (points[:, 0], points[:, 1:4], areas)
+        # 4 columns before drag areas, 5 before volumes
+        points = points.reshape(-1, points.shape[-1])
+        areas, volumes = (points[:, k] if points.shape[1] > k else np.zeros(len(points))
+                          for k in (4, 5))
+        points = (points[:, 0], points[:, 1:4], areas, volumes)
     seabed = parameters.get("seabed_profile_table")
     return scene_from_options(values, given, profile, parameters.get("line_types_table"),
                               points, seabed)

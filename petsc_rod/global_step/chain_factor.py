@@ -2,7 +2,7 @@
 substructuring (docs/performance.md, "Issue 21, third pass").
 
 The Newton Jacobian J (analysis/jacobian.py) and the second variation H
-(analysis/stability.py) are chains of nodes: B unknowns a node, the nodes of a rank in
+(analysis/second_variation.py) are chains of nodes: B unknowns a node, the nodes of a rank in
 contiguous rows, every rank's rows starting at a vertex, a node's rows coupled only to
 the nodes of its elements. MUMPS on several ranks factors such a chain no faster than
 on one (its elimination tree is a path) and solves it slower. As the global step's

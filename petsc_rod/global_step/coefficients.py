@@ -80,7 +80,7 @@ class FieldCoefficients:
         return 1.0, (name, i), lambda: self._matrices[name][i]
 
     def hessian_stiffness(self):
-        """The bending and torsion part of the second variation (analysis/stability.py)
+        """The bending and torsion part of the second variation (analysis/second_variation.py)
         as (weights, element matrices): uniform, the three 2 a_i (3,) and the unit K
         (ne, 3, 3); otherwise ones and each field's K_{2 a_i} (3, ne, 3, 3)."""
         if self.uniform:

@@ -380,7 +380,7 @@ class SubstructuredFactor:
 
 def direct_factor(operator, kind, block, prefix):
     """The factorisation ``kind`` (LU or CHOLESKY) of the Newton steps' ``operator``, a
-    chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/stability.py):
+    chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/second_variation.py):
     on several ranks by substructuring (SubstructuredFactor: each rank its interior by
     sequential MUMPS, the interface's Schur complement on every rank, MUMPS on all ranks
     where that does not apply) unless -<prefix>substructuring 0 or the operator is no

@@ -136,7 +136,7 @@ class ScalarProblem:
     def solve(self, rhs, solution, components=(0, 1, 2)):
         """Solve for the given components (x, y, z by default): rhs, solution are
         VectorFields; the other components of ``solution`` are left as they are (the
-        seabed's vertical problem solves z its own way, riser/terms.py).
+        seabed's vertical problem solves z its own way, physics/seabed.py).
 
         The prescribed rows of ``rhs`` take the prescribed values and the lifting is
         subtracted from the rows next to them, in place, for the solve only: those few

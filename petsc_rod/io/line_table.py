@@ -24,7 +24,7 @@ import numpy as np
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
-from petsc_rod.riser.quantities import effective_tension
+from petsc_rod.reports.riser_numbers import effective_tension
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
 # them.
@@ -83,7 +83,7 @@ def final_record(problem):
         vertex.update(output.datasets)
         attributes.update(output.attributes)
     vertex["r"] = vertex["r"] + problem.scene.start_position
-    if "effective_tension" not in vertex:       # a plain rod's (riser/line_results.py)
+    if "effective_tension" not in vertex:       # a plain rod's (reports/line_results.py)
         vertex["effective_tension"] = effective_tension(vertex)
     return vertex, attributes
 

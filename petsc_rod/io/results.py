@@ -44,9 +44,10 @@ from petsc_rod.tables import check_input_file, file_problem
 from petsc_rod.physics import stretch
 from petsc_rod.physics import flex_joint
 from petsc_rod.physics import point_loads as point_load_term
-from petsc_rod.riser import quantities as riser_quantities
-from petsc_rod.riser import (friction, line_results, pressures, regions,
-                             section_numbers, stresses)
+from petsc_rod.physics import friction
+from petsc_rod.reports import riser_numbers as riser_quantities
+from petsc_rod.reports import (line_results, pressures, regions, section_numbers,
+                               stresses)
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
@@ -320,7 +321,7 @@ class ResultWriter:
     def write_step(self, name, vertex, state, history, attributes):
         """Write one solution as group ``name``, after checking that the disk has room."""
         table = np.asarray(history, dtype=float).reshape(-1, len(HISTORY_COLUMNS))
-        # the vertex datasets, and those a riser scene adds (riser/quantities.py)
+        # the vertex datasets, and those a riser scene adds (reports/riser_numbers.py)
         arrays = {key: np.asarray(value) for key, value in vertex.items()}
         arrays.update({key: np.asarray(value) for key, value in state.items()})
         layout = distributed_layout(self.comm, arrays)

@@ -221,7 +221,7 @@ class StepController:
         (state.Norms, measured as §6 measures an iteration: the change of X from the
         state before it, the residual of the constraints, exact to round-off at a
         Newton state) where its steps converged on the whole problem
-        (newton.NewtonPolish.solved_norms), None where it met the round-off floor. With
+        (newton.NewtonSolver.solved_norms), None where it met the round-off floor. With
         them the last step's row holds them, the observer is asked, and the step
         converges there, in Newton's terms, where they pass the stopping test: the
         state is Newton's solution, not iterated again (docs/method.md §11,

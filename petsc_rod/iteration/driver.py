@@ -50,7 +50,7 @@ class UzawaSolver:
         self._root_weights = np.sqrt(problem.state.node_weights)[:, None]
         self._controller = None
         self._create_snes()
-        self.newton = newton.NewtonPolish(problem) if self.uses_newton else None
+        self.newton = newton.NewtonSolver(problem) if self.uses_newton else None
 
     @property
     def penalty(self):
@@ -159,7 +159,7 @@ class UzawaSolver:
                 return
             if decision.action is control.Action.TRY_NEWTON:
                 step.resume()
-                self._polish(step)
+                self._try_newton(step)
                 if step.finished:       # converged in Newton's terms, or the observer
                     return
                 step.wait_for_newton()
@@ -195,7 +195,7 @@ class UzawaSolver:
             return control.NEWTON_SWITCH_FAR
         return True
 
-    def _polish(self, step):
+    def _try_newton(self, step):
         """Newton steps from the current state (newton.py), each recorded as an
         iteration (change: its largest turn, rad; the frames are rotations). Where the
         second variation has a direction of negative curvature the state is near a
@@ -227,15 +227,9 @@ class UzawaSolver:
                 self._turn(angle, direction)
 
     def check_stability(self):
-        """(stable, direction) of the current (converged) state (analysis/stability.py):
-        True and None for a local minimiser; False and a rotation-vector field
-        (n_nodes, 3) along which the energy decreases to second order for a saddle;
-        None, None where the test cannot decide (a taut, straight rod)."""
-        hessian = self.problem.second_variation()
-        if not hessian.decidable:
-            return None, None
-        direction = hessian.descent_direction()
-        return direction is None, direction
+        """(stable, direction) of the current (converged) state: the verdict of the
+        stability test (analysis/stability.StabilityTest.verdict)."""
+        return self.problem.second_variation().verdict()
 
     # --- the SNES's view of the iteration -----------------------------------------------
     def _fixed_point_residual(self, snes, x, f):

@@ -18,12 +18,12 @@ d_n <- exp([omega_n]x) d_n, with omega from the KKT system
 L = E + mu . c the Lagrangian of the chord constraint c(d) = sum_n w_n d3_n - chord,
 grad_n L = sum_i d_{n,i} x g_{n,i} (g_i = dL/dd_i = 2 K_{a_i} d_i - b delta_i3 + w mu
 delta_i3), C omega = sum_n w_n omega_n x d3_n, and H the Riemannian Hessian of L: the
-second variation of analysis/stability.py with lambda_n = -g_n / w_n (at a solution
+second variation of analysis/second_variation.py with lambda_n = -g_n / w_n (at a solution
 these are the Uzawa multipliers, and H is exactly the matrix of the stability test).
 
 A step is taken only where H is positive definite on the constraint set (the inertia of
 its factorisation, as in the stability test): Newton then heads for a local minimiser,
-never a saddle. Otherwise, or when the steps stop shrinking, the polish gives up and the
+never a saddle. Otherwise, or when the steps stop shrinking, the attempt gives up and the
 Uzawa iteration goes on from where it was. On success the state is handed back as a
 fixed point of the Uzawa iteration: tau = d and lambda = -g / w. A linear-algebra
 failure on the way (a state the steps cannot start from: a stretch k <= 0 or values that
@@ -46,7 +46,7 @@ dE/dg = -w lambda, the local step's stationarity in k gives lambda3.d3 = EA eps,
 rotation sum_i g_i x lambda_i = 0. So each node has 4 unknowns, (omega_n, delta k_n),
 the frames turn as above and k <- k + delta k; the gradient in k is
 d3 . g3-gradient of L + w EA eps (Term.add_strain_gradient), H that of
-analysis/stability.py with its stretch rows, and the chord forms gain the columns
+analysis/second_variation.py with its stretch rows, and the chord forms gain the columns
 w_n d3_n. The hand-over is the same with tau = g (the stretched targets (tau1, tau2,
 k tau3) the state keeps) and lambda = -g-gradient / w (without the axial term: the
 tension is lambda3.d3 = EA eps at the solution). The stretch of a clamped node (the
@@ -57,7 +57,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
-from petsc_rod.analysis.stability import skew, unit
+from petsc_rod.analysis.second_variation import skew, unit
 from petsc_rod.frames import roll_between, rotations
 
 EVENT = PETSc.Log.Event("rod_newton")
@@ -67,7 +67,7 @@ EVENT = PETSc.Log.Event("rod_newton")
 # chord step whose rest is (FROZEN_SHRINK, below).
 MAX_STEPS = 8
 STEP_TOLERANCE = 1e-10
-# A step must shrink to at most this fraction of the previous one, or the polish stops
+# A step must shrink to at most this fraction of the previous one, or the attempt stops
 # (Newton contracts quadratically near a regular minimiser). On a line whose energy
 # reads its positions (the seabed) a step that does not shrink but turns no more than
 # the one before it is taken where that one lowered |grad L| to at most this fraction,
@@ -116,13 +116,13 @@ FROZEN_SHRINK = 0.1
 # (docs/method.md, "The free roll").
 ROLL_TURN = 1e-2
 
-# What an attempt ends with (NewtonPolish.run).
+# What an attempt ends with (NewtonSolver.run).
 CONVERGED, INDEFINITE, FAILED = "converged", "indefinite", "failed"
 
 
 class LinearAlgebraFailure(Exception):
     """A step's linear algebra failed on some rank, raised on every rank (the verdict
-    reduced: NewtonPolish._agree); the attempt ends FAILED (module docstring)."""
+    reduced: NewtonSolver._agree); the attempt ends FAILED (module docstring)."""
 
 
 def _chord_rest(turn, previous):
@@ -133,10 +133,11 @@ def _chord_rest(turn, previous):
     return theta / (1.0 - theta) * turn if theta < 1.0 else np.inf
 
 
-class NewtonPolish:
-    """Newton steps of the module docstring on a problem's state (problem/problem.py).
-    Owns a work Vec for K d (the K are the global step's); ``destroy()`` frees it (the second
-    variation is the problem's, ``RodProblem.second_variation``, updated at each step)."""
+class NewtonSolver:
+    """The Newton solver: the steps of the module docstring on a problem's state
+    (problem/problem.py). Owns a work Vec for K d (the K are the global step's);
+    ``destroy()`` frees it (the second variation is the problem's,
+    ``RodProblem.second_variation``, updated at each step)."""
 
     def __init__(self, problem):
         self.problem = problem

@@ -19,16 +19,26 @@ int_e N_k, those after it nothing.
 n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
 (the point counted as before S). A point at a free end S = L acts as an end force there
 (it is in n(L), Term.end_force). A point on a held end is carried by the support: the
-line's n is that without it, and the end's reaction (riser/line_results.end_numbers)
+line's n is that without it, and the end's reaction (reports/line_results.end_numbers)
 adds it (on_held_ends), so that the reactions balance every load.
 
 An attachment with a drag area C_d A (m^2) in a current also feels the drag
 D_p = 1/2 rho_w C_d A |v| v, v the current at r(S_p) (Scene.point_drags: times the
 path's weight of each current), a point force of the iterate added to the slope's
 right-hand side every iteration (add_iterate_load) the same way, at the heights of the
-last global step, as the line's drag (riser/terms.py). It has no energy: the term is then
+last global step, as the line's drag (drag.py). It has no energy: the term is then
 neither conservative nor in the Newton steps (a current makes the line's drag term
 neither anyway).
+
+Above the sea surface z_s (Scene.sea_surface, a line of sections with -rod_sea_surface)
+an attachment has neither buoyancy nor drag: P_p holds its buoyancy B_p = rho_w g V_p
+e_z (Scene.point_buoyancies), so the term adds -(1 - w_p) B_p and takes w_p D_p, with
+w_p = wet_fraction(z_p - z_s, V_p) at the point's height of the last global step: the
+part of a sphere of the attachment's volume under the surface (a body wholly in or out
+of the water as OrcaFlex's clump and buoy; between, the sphere's cap, so that a buoy
+that floats finds its waterline). Forces of the iterate like the drag, without energy:
+built where an attachment can reach the surface (reaches_surface), so that a scene whose
+attachments stay under it keeps its dead forces, its energy and its Newton steps.
 """
 
 import numpy as np
@@ -42,7 +52,38 @@ from petsc_rod.scenes.boundary import is_held
 # Units of the attributes this term adds to each step of the result file.
 ATTRIBUTE_UNITS = {"point_load_S": "m", "point_load_force": "N",
                    "point_load_position": "m", "point_load_drag": "N",
-                   "point_load_names": "text"}
+                   "point_load_names": "text", "point_load_wet": "1"}
+
+
+def wet_fraction(height, volume):
+    """The fraction under the sea surface of a sphere of ``volume`` V (m^3) whose centre is
+    ``height`` (m) above it, the same shapes: with r = (3 V / 4 pi)^(1/3) and the
+    submerged depth d = min(max(r - height, 0), 2 r), the cap's d^2 (3 r - d) / (4 r^3):
+    1 wholly under (height <= -r), 0 wholly above (height >= r), 1/2 at the surface.
+    A point of no volume: 1 under the surface, 0 above, 1/2 on it (a step)."""
+    height = np.asarray(height, dtype=float)
+    r = np.cbrt(3.0 * np.asarray(volume, dtype=float) / (4.0 * np.pi))
+    d = np.clip(r - height, 0.0, 2.0 * r)
+    sphere = d**2 * (3.0 * r - d) / (4.0 * np.where(r > 0, r, 1.0)**3)
+    step = np.where(height < 0, 1.0, np.where(height > 0, 0.0, 0.5))
+    return np.where(r > 0, sphere, step)
+
+
+def reaches_surface(scene):
+    """The sea surface z_s of a line of sections (Scene.sea_surface) where one of its
+    attachments that has a volume or a drag area may rise to it, else None: a held end
+    above z_s less the largest attachment's radius, a buoyant attachment or a buoyant
+    section (that could lift the line to it)."""
+    surface = getattr(scene, "sea_surface", None)
+    volumes = scene.point_volumes()
+    if surface is None or not (np.any(volumes > 0) or scene.point_drags(1.0)):
+        return None
+    reach = float(np.cbrt(3.0 * volumes.max(initial=0.0) / (4.0 * np.pi)))
+    held = [state.position[2] for state in (scene.start_state(1.0), scene.end_state(1.0))
+            if is_held(state)]
+    buoyant = (np.any(scene.point_loads(1.0)[1][:, 2] > 0)
+               or any(section.weight[2] > 0 for section in scene.sections))
+    return surface if buoyant or max(held) > surface - reach else None
 
 
 def point_load_element_vectors(mesh, S, force, offset):
@@ -67,11 +108,17 @@ class PointLoads(DeadLoads):
         self.load = VectorField(mesh, "point_loads")      # b = int F.g dS on the P2 dofs
         self.S, self.force = scene.point_loads(0.0)
         self.held_start = True
-        # the drag of attachments in a current (module docstring): no energy
+        # the drag of attachments in a current and their buoyancy in the water only
+        # (module docstring): forces of the iterate, no energy
         self.dragged = bool(scene.point_drags(0.5))
-        self.conservative = self.in_newton = not self.dragged
-        self.newton_gap = "attachments with a drag area (docs/riser.md §9)" if self.dragged else ""
-        self._drag_rhs = VectorField(mesh, "point_drag_rhs") if self.dragged else None
+        self.surface = reaches_surface(scene)
+        iterative = self.dragged or self.surface is not None
+        self.conservative = self.in_newton = not iterative
+        self.newton_gap = ("attachments that can reach the sea surface (docs/riser.md §9)"
+                           if self.surface is not None else
+                           "attachments with a drag area (docs/riser.md §9)"
+                           if self.dragged else "")
+        self._drag_rhs = VectorField(mesh, "point_drag_rhs") if iterative else None
 
     @property
     def axially_symmetric(self):
@@ -93,39 +140,55 @@ class PointLoads(DeadLoads):
             mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
             point_load_element_vectors(mesh, self.S, self.force, self.offset)))
 
-    def drag_forces(self, state):
-        """D_p = sum_k w_k 1/2 rho_w C_d A_p |v_k| v_k, N, (n_p, 3), v_k the current k at
-        the points' heights (of the last global step; none needed for currents uniform in
-        depth). Zero without a drag area. Collective."""
+    def iterate_forces(self, state):
+        """(D, C, w): the drags w_p D_p, the buoyancy taken off above the surface
+        C_p = -(1 - w_p) B_p e_z, N, (n_p, 3) each, and the wet fractions w_p (n_p,)
+        (module docstring), at the points' heights of the last global step (where a
+        current varies with depth or a surface is reached). Zero drag without a drag
+        area; w = 1 and C = 0 without a surface. Collective."""
         drags = self.scene.point_drags(self.t) if self.dragged else []
-        if not drags:
-            return np.zeros_like(self.force)
-        z = (self.positions(state)[:, 2] if any(c.depths.size > 1 for _, c, _ in drags)
+        profile = any(c.depths.size > 1 for _, c, _ in drags)
+        z = (self.positions(state)[:, 2] if profile or self.surface is not None
              else np.zeros(self.S.size))
-        total = np.zeros_like(self.force)
+        wet = (wet_fraction(z - self.surface, self.scene.point_volumes())
+               if self.surface is not None else np.ones(self.S.size))
+        drag = np.zeros_like(self.force)
         for weight, current, area in drags:
             v = current.velocity(z)
-            total += (weight * 0.5 * self.scene.water_density * area
-                      * np.linalg.norm(v, axis=1))[:, None] * v
-        return total
+            drag += (weight * 0.5 * self.scene.water_density * area
+                     * np.linalg.norm(v, axis=1))[:, None] * v
+        lift = np.zeros_like(self.force)
+        if self.surface is not None:
+            lift[:, 2] = -(1.0 - wet) * self.scene.point_buoyancies(self.t)
+        return drag * wet[:, None], lift, wet
+
+    def drag_forces(self, state):
+        """D_p = sum_k w_k 1/2 rho_w C_d A_p |v_k| v_k, N, (n_p, 3), v_k the current k at
+        the points' heights, times the wet fraction (iterate_forces). Collective."""
+        return self.iterate_forces(state)[0]
 
     def add_iterate_load(self, rhs, state):
-        """Add the attachments' drag's int F.g to the slope's right-hand side (F its steps,
-        offset as for the dead forces). Collective."""
-        if not self.dragged:
+        """Add the int F.g of the attachments' drag and of the buoyancy taken off above
+        the surface to the slope's right-hand side (F their steps, offset as for the dead
+        forces). Collective."""
+        if self._drag_rhs is None:
             return
-        drag = self.drag_forces(state)
-        offset = np.zeros(3) if self.held_start else -drag.sum(axis=0)
+        drag, lift, _ = self.iterate_forces(state)
+        force = drag + lift
+        offset = np.zeros(3) if self.held_start else -force.sum(axis=0)
         mesh = self.mesh
         self._drag_rhs.add_ghosted(scatter_element_vectors(
             mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2,
-            point_load_element_vectors(mesh, self.S, drag, offset)))
+            point_load_element_vectors(mesh, self.S, force, offset)))
         for vec, part in zip(rhs.components, self._drag_rhs.components):
             vec.axpy(1.0, part)
 
     def _total_force(self, state):
-        """The dead forces and, in a current, the drag, (n_p, 3), N. Collective."""
-        return self.force + self.drag_forces(state) if self.dragged else self.force
+        """The dead forces and the forces of the iterate, (n_p, 3), N. Collective."""
+        if self._drag_rhs is None:
+            return self.force
+        drag, lift, _ = self.iterate_forces(state)
+        return self.force + drag + lift
 
     def _at_end(self):
         """The points at S = L (they act as a force at the end), (n_p,) bool."""
@@ -178,18 +241,22 @@ class PointLoads(DeadLoads):
         return mesh.global_sum(local)
 
     def outputs(self, problem, vertex):
-        """The points' S, forces at the step's load factor and absolute positions (the
-        start position added, docs/method.md §5) (attributes point_load_S (n_p,),
-        point_load_force and point_load_position (n_p, 3), point_load_names their labels
-        joined by commas, and in a current point_load_drag (n_p, 3)).
+        """The points' S, forces at the step's load factor (without the buoyancy above the
+        surface) and absolute positions (the start position added, docs/method.md §5)
+        (attributes point_load_S (n_p,), point_load_force and point_load_position
+        (n_p, 3), point_load_names their labels joined by commas, in a current
+        point_load_drag (n_p, 3), where the surface is reached point_load_wet (n_p,)).
         Collective."""
         if not self.S.size:
             return None
         positions = self.positions(problem.state) + problem.scene.start_position
-        attributes = {"point_load_S": self.S.copy(), "point_load_force": self.force.copy(),
+        drag, lift, wet = self.iterate_forces(problem.state)
+        attributes = {"point_load_S": self.S.copy(), "point_load_force": self.force + lift,
                       "point_load_position": positions}
         if self.dragged:
-            attributes["point_load_drag"] = self.drag_forces(problem.state)
+            attributes["point_load_drag"] = drag
+        if self.surface is not None:
+            attributes["point_load_wet"] = wet
         names = self.scene.point_load_names          # a table's labels (no comma in them)
         if len(names) == self.S.size:                # (a restart's walk has both scenes')
             attributes["point_load_names"] = ",".join(names)

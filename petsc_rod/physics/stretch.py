@@ -13,7 +13,7 @@ largest gap between EA eps and n.t of the force balance, t = r'/|r'| (attributes
 ``stretched_length``, ``axial_tension_gap``, relative to the largest |n|).
 
 In the Newton steps (§11) and the stability test (§10) the strain is an unknown of each
-node beside its rotation (analysis/stability.py, iteration/newton.py): this term adds
+node beside its rotation (analysis/second_variation.py, iteration/newton.py): this term adds
 its curvature w EA to the stretch rows of H (``add_hessian``). Its gradient is not one in
 the fields g (the Uzawa multiplier lambda = -dE/dg / w leaves it out: the local step,
 not the global one, carries EA eps): the Newton steps add w EA eps to the gradient in k

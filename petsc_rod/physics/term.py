@@ -4,7 +4,8 @@ elastic energy and its constraint contributes to each part of the method
 
 The problem (problem/problem.py) holds a list of terms, built for its scene
 (problem/build.py): the dead loads (physics/dead_loads.py) always; the seabed, the drag
-and the riser numbers (riser/terms.py, riser/quantities.py) where the scene has them.
+(seabed.py, drag.py) and the riser numbers (reports/riser_numbers.py) where the scene has
+them.
 The core walks the list and calls the methods below; it never asks which terms exist.
 Every default does nothing, so a term overrides only what it contributes. Every method
 is called on every rank, in the same order (collective where a term needs it).

@@ -1,27 +1,29 @@
 """The terms of physics a scene needs (physics/term.py), and nothing it does not: the
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
 pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (with the
-horizontal push of a sloping one, riser/slope_load.py, and its friction,
-riser/friction.py), the drag and the riser numbers
+horizontal push of a sloping one, physics/slope_load.py, and its friction,
+physics/friction.py), the drag and the riser numbers
 only where the scene has a seabed or a current (docs/riser.md); the axial stretch only
 where some EA is finite (docs/method.md §12); the results along the line
-(riser/line_results.py) always, its regions (riser/regions.py) on a riser-like scene (a
-seabed, a current or line types), the pipe's stresses (riser/stresses.py) on a line of
+(reports/line_results.py) always, its regions (reports/regions.py) on a riser-like scene (a
+seabed, a current or line types), the pipe's stresses (reports/stresses.py) on a line of
 line types with an inner diameter."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.drag import DragTerm
 from petsc_rod.physics.flex_joint import FlexJoint
+from petsc_rod.physics.friction import FrictionTerm
 from petsc_rod.physics.point_loads import PointLoads
+from petsc_rod.physics.seabed import SeabedTerm
+from petsc_rod.physics.slope_load import SeabedSlopeLoad
 from petsc_rod.physics.stretch import AxialStretch
-from petsc_rod.riser.friction import FrictionTerm
-from petsc_rod.riser.line_results import LineResults
-from petsc_rod.riser.pressures import PipePressures
-from petsc_rod.riser.quantities import RiserNumbers
-from petsc_rod.riser.regions import LineRegions
-from petsc_rod.riser.section_numbers import SectionNumbers
-from petsc_rod.riser.slope_load import SeabedSlopeLoad
-from petsc_rod.riser.stresses import PipeStresses
-from petsc_rod.riser.terms import DragTerm, SeabedTerm, SurfaceTerm, reaches_surface
+from petsc_rod.physics.surface import SurfaceTerm, reaches_surface
+from petsc_rod.reports.line_results import LineResults
+from petsc_rod.reports.pressures import PipePressures
+from petsc_rod.reports.regions import LineRegions
+from petsc_rod.reports.riser_numbers import RiserNumbers
+from petsc_rod.reports.section_numbers import SectionNumbers
+from petsc_rod.reports.stresses import PipeStresses
 from petsc_rod.scenes.boundary import is_held
 
 

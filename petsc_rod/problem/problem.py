@@ -5,7 +5,7 @@ A RodProblem holds the mesh, the scene, the state (problem/state.py), the global
 (global_step/) and the list of terms of physics (physics/term.py) that the scene needs
 (problem/build.py). It answers what the method and its users ask of the problem: one
 Uzawa iteration G (the map the SNES mixes), the energy E and its gradient, the second
-variation (analysis/stability.py), the link, the end reaction and the internal force,
+variation (analysis/second_variation.py), the link, the end reaction and the internal force,
 and the terms' outputs. The Newton steps, the stability test, the outputs and the
 riser numbers take a RodProblem, never the solver.
 """
@@ -14,7 +14,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
-from petsc_rod.analysis.stability import SecondVariation
+from petsc_rod.analysis.stability import StabilityTest
 from petsc_rod.frames import roll_between, strains
 from petsc_rod.global_step.coefficients import FieldCoefficients
 from petsc_rod.global_step.global_step import GlobalStep
@@ -354,11 +354,13 @@ class RodProblem:
         return g
 
     def second_variation(self):
-        """The SecondVariation at the current state: one object for the problem's life,
-        made at the first call and updated at the next ones, so that its factorisations
-        share one symbolic analysis (the stability test and every Newton step)."""
+        """The second variation at the current state with its stability test
+        (analysis/stability.StabilityTest, a SecondVariation): one object for the
+        problem's life, made at the first call and updated at the next ones, so that its
+        factorisations share one symbolic analysis (the stability test and every Newton
+        step)."""
         if self._second_variation is None:
-            self._second_variation = SecondVariation(self)
+            self._second_variation = StabilityTest(self)
         else:
             self._second_variation.update()
         return self._second_variation

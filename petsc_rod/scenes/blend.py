@@ -26,7 +26,7 @@ from petsc_rod.scenes.scene import EndState, rolled_frame
 # The Scene fields the load path carries, compared to tell whether a restart walks.
 PATH_FIELDS = ("load_values", "load_breaks", "start_force", "end_force", "end_position",
                "end_frame", "start_frame", "end_twist", "current", "point_load_S", "point_load_forces",
-               "point_load_drag_areas")
+               "point_load_drag_areas", "point_load_volumes")
 # The Scene fields a restart takes from this run's scene at once.
 FIXED_FIELDS = ("stiffness", "axial_stiffness", "start", "end", "seabed", "sections",
                 "start_rotational_stiffness", "end_rotational_stiffness", "start_joint_axis",
@@ -75,7 +75,8 @@ class BlendedPath:
     """The scene of a restart's walk from Scene ``old`` at load factor ``t_old`` (the
     file's) to Scene ``new`` at 1 (module docstring), with the interface the terms, the
     global step and the continuation ask of a scene's path: start_state(s), end_state(s),
-    load_beyond(S, s), load_piece_ends, point_loads(s), point_drags(s), end_roll(s),
+    load_beyond(S, s), load_piece_ends, point_loads(s), point_drags(s),
+    point_buoyancies(s), point_volumes(), end_roll(s),
     link_axis, drag_loads(s). Any other attribute (length, stiffness, seabed,
     applied_force, ...) is ``new``'s."""
 
@@ -128,6 +129,16 @@ class BlendedPath:
                 + [(s * w, c, np.concatenate([np.zeros(n_old), a]))
                    for w, c, a in self.new.point_drags(1.0)])
 
+    def point_buoyancies(self, s):
+        """The blend's rho_w g V_p (n_p,), N, aligned with point_loads(s): A's at t_f times
+        (1 - s), B's at 1 times s."""
+        return np.concatenate([(1 - s) * self.old.point_buoyancies(self.t_old),
+                               s * self.new.point_buoyancies(1.0)])
+
+    def point_volumes(self):
+        """A's volumes and B's, aligned with point_loads(s), m^3."""
+        return np.concatenate([self.old.point_volumes(), self.new.point_volumes()])
+
     def end_roll(self, s):
         """(1 - s) roll_A(t_f) + s roll_B(1), rad: continuous along the walk."""
         return (1 - s) * self.old.end_roll(self.t_old) + s * self.new.end_roll(1.0)
@@ -163,6 +174,6 @@ class BlendedPath:
 
     def drag_loads(self, s):
         """[(weight, Current)]: the drag is (1 - s) t_f f_A + s f_B, the sum of each
-        current's drag c |v_n| v_n times its weight (riser/terms.py DragTerm)."""
+        current's drag c |v_n| v_n times its weight (physics/drag.py DragTerm)."""
         return ([((1 - s) * w, c) for w, c in self.old.drag_loads(self.t_old)]
                 + [(s * w, c) for w, c in self.new.drag_loads(1.0)])

@@ -10,7 +10,9 @@ N), ``cda`` (a drag area C_d A, m^2: the drag 1/2 rho_w C_d A |v| v in a current
     P = (fx, fy, fz) + (rho_w volume - mass) g e_z,
 
 z up, rho_w the water density (-rod_water_density, kg/m^3) and g the gravity
-(-rod_gravity, m/s^2): a clump weight pulls down, a buoyancy module up. The quick form
+(-rod_gravity, m/s^2): a clump weight pulls down, a buoyancy module up. The buoyancy
+rho_w g volume e_z holds in the water only: the volumes are kept beside the forces so
+that above -rod_sea_surface the term takes it off again (physics/point_loads.py). The quick form
 ``-rod_point_load S,fx,fy,fz[,...]`` gives forces alone. The term that applies them is
 physics/point_loads.py.
 """
@@ -43,8 +45,8 @@ def beyond_the_line(S, length):
 
 
 def read_point_loads(path, density, gravity, length, largest=np.inf):
-    """(S (n_p,), forces (n_p, 3), names (n_p,), drag areas (n_p,)) from the table
-    ``path`` (module
+    """(S (n_p,), forces (n_p, 3), names (n_p,), drag areas (n_p,), volumes (n_p,)) from
+    the table ``path`` (module
     docstring): whitespace or comma separated, a header row naming the columns, '#'
     starts a comment. Every problem is one RodInputError that says what to fix: no
     file, no ``s`` column, an unknown or repeated column, a row of another length, a
@@ -102,12 +104,15 @@ def read_point_loads(path, density, gravity, length, largest=np.inf):
                f"<= L = {length:.6g} m, its length); give an arc length on the line")
     names = columns.pop("name", [f"point {k + 1}" for k in range(len(body))])
     areas = columns.get("cda", np.zeros(len(body)))
-    return columns["s"], attachment_forces(columns, density, gravity), tuple(names), areas
+    volumes = columns.get("volume", np.zeros(len(body)))
+    return (columns["s"], attachment_forces(columns, density, gravity), tuple(names), areas,
+            volumes)
 
 
 def quick_point_loads(values, length):
-    """(S, forces, names, drag areas (zero)) of -rod_point_load S,fx,fy,fz[,...] (a flat
-    array of 4 numbers per point), each S on the line [0, ``length``]."""
+    """(S, forces, names, drag areas and volumes (zero)) of -rod_point_load
+    S,fx,fy,fz[,...] (a flat array of 4 numbers per point), each S on the line
+    [0, ``length``]."""
     values = np.asarray(values, dtype=float)
     if values.size % 4:
         raise RodInputError(f"-rod_point_load: {values.size} numbers; give 4 (S,fx,fy,fz: "
@@ -119,4 +124,4 @@ def quick_point_loads(values, length):
             f"-rod_point_load: point {k + 1} at S = {table[k, 0]:.6g} m is beyond the line "
             f"(0 <= S <= L = {length:.6g} m, its length); give an arc length on the line")
     return (table[:, 0], table[:, 1:], tuple(f"point {k + 1}" for k in range(len(table))),
-            np.zeros(len(table)))
+            np.zeros(len(table)), np.zeros(len(table)))

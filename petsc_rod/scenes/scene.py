@@ -56,7 +56,7 @@ class Scene:
     end_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     load_values: np.ndarray = field(default_factory=lambda: np.zeros((1, 3)))
     load_breaks: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    # riser terms (petsc_rod/riser/environment.py): a Seabed and a Current, or None
+    # environment (petsc_rod/environment/): a Seabed and a Current, or None
     seabed: object = None
     current: object = None
     # the line as sections of line types (scenes/line.py), from S = 0; () for a uniform
@@ -64,13 +64,13 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
-    # the pipe's pressures (riser/pressures.py; a line of sections): the sea surface's
+    # the pipe's pressures (reports/pressures.py; a line of sections): the sea surface's
     # height in the solver's frame (m; None: the higher held end), the contents'
     # density (kg/m^3) and the internal pressure at the top (Pa)
     sea_surface: float = None
     contents_density: float = 0.0
     internal_pressure: float = 0.0
-    # the stress check (riser/stresses.py): the allowable von Mises stress is this
+    # the stress check (reports/stresses.py): the allowable von Mises stress is this
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
@@ -87,6 +87,9 @@ class Scene:
     point_load_names: tuple = ()
     # their drag areas C_d A (n_p,), m^2: drag 1/2 rho_w C_d A |v| v in the current
     point_load_drag_areas: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # their displaced volumes V (n_p,), m^3, whose buoyancy rho_w g V e_z the forces
+    # include: taken off again above the sea surface (physics/point_loads.py)
+    point_load_volumes: np.ndarray = field(default_factory=lambda: np.zeros(0))
     # where S = 0 is, m: the solver's frame has its origin there (module docstring)
     start_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
     # the sea and the Earth, for weights and buoyancies: rho_w, kg/m^3, and g, m/s^2
@@ -118,6 +121,9 @@ class Scene:
         self.point_load_drag_areas = np.asarray(self.point_load_drag_areas, dtype=float).ravel()
         if self.point_load_drag_areas.size == 0:
             self.point_load_drag_areas = np.zeros(self.point_load_S.size)
+        self.point_load_volumes = np.asarray(self.point_load_volumes, dtype=float).ravel()
+        if self.point_load_volumes.size == 0:
+            self.point_load_volumes = np.zeros(self.point_load_S.size)
         if len(self.point_load_names) != self.point_load_S.size:
             self.point_load_names = tuple(f"point {k + 1}"
                                           for k in range(self.point_load_S.size))
@@ -227,6 +233,16 @@ class Scene:
         if self.current is None or not np.any(self.point_load_drag_areas > 0):
             return []
         return [(t, self.current, self.point_load_drag_areas)]
+
+    def point_buoyancies(self, t):
+        """t rho_w g V_p (n_p,), N: the upward part of the point loads at load factor t
+        that holds in the water only (physics/point_loads.py), aligned with
+        point_loads(t)."""
+        return t * self.water_density * self.gravity * self.point_load_volumes
+
+    def point_volumes(self):
+        """V_p (n_p,), m^3, aligned with point_loads(t) (a restart's walk: both scenes')."""
+        return self.point_load_volumes
 
     def applied_force(self):
         """int_0^L |f| dS + |P_0| + |P_L| + sum_p |P_p| (and the drag) at t = 1, N: the
@@ -429,7 +445,8 @@ class Scene:
                                 f"{self.start}); drop it or change -rod_start")
         self._validate_joints(used)
         S = self.point_load_S
-        if S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size:
+        if (S.size != len(self.point_load_forces) or S.size != self.point_load_drag_areas.size
+                or S.size != self.point_load_volumes.size):
             raise RodInputError(f"point loads: {S.size} arc lengths for "
                                 f"{len(self.point_load_forces)} forces")
         outside = np.flatnonzero((S < 0) | (S > self.length))

@@ -27,11 +27,11 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.environment.current import Current
 from petsc_rod.global_step.chain_factor import stored_entries
 from petsc_rod.global_step.ksp import inertia_solver
-from petsc_rod.iteration.newton import NewtonPolish
-from petsc_rod.riser.environment import Current
-from petsc_rod.riser.terms import DragTerm
+from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.physics.drag import DragTerm
 from petsc_rod.scenes.starts import catenary_start
 from test_seabed_newton import heights, moved, random_direction
 
@@ -76,7 +76,7 @@ def test_jacobian_against_finite_differences(comm, solver_factory, line):
                                      n_elements=20)
     assert report.converged
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         state = problem.state
         frames, mu = state.tau.copy(), state.chord_multiplier.copy()

@@ -182,11 +182,11 @@ def test_the_joint_carries_k_theta_at_large_turns(comm, k, force, steps):
 @pytest.mark.parametrize("seabed_height, touches", [(-10.0, False), (-0.08, True)])
 def test_the_joint_acts_through_the_seabeds_vertical_problem(comm, seabed_height, touches):
     """With a seabed the z slope is solved in Hermite dofs from the slope's element
-    matrices (riser/terms.py), which carry the joint's k. Far below the line (no
+    matrices (physics/seabed.py), which carry the joint's k. Far below the line (no
     contact) the seabed changes nothing: the same shape as without it, the joint at
     S = L loaded in the vertical plane by a neutral axis e_z; touched, the line differs
     and the joint still carries k theta."""
-    from petsc_rod.riser.environment import Seabed
+    from petsc_rod.environment.seabed import Seabed
 
     k = 0.05
     scene = dict(start="pin", end="pin", end_position=(0.7, 0.0, 0.3),
@@ -235,7 +235,7 @@ FD_JOINTS = dict(length=1.0, stiffness=(1e-2, 2e-2, 1.5e-2), load_values=[[0.0, 
 
 
 def turn(omega):
-    """The step (n, 4) of NewtonPolish._stretched that turns the frames by omega (n, 3)
+    """The step (n, 4) of NewtonSolver._stretched that turns the frames by omega (n, 3)
     and leaves their stretch."""
     return np.column_stack([omega, np.zeros(len(omega))])
 
@@ -248,7 +248,7 @@ def test_the_inextensible_joints_hessian_against_finite_differences(comm):
     1e-6 of the quadratic form. A block without k f''(c) v v^T, without
     k beta (I - d d^T), with beta's 1 - c or its theta / sin theta dropped fails it."""
     from helpers import destroy, make_solver
-    from petsc_rod.iteration.newton import NewtonPolish
+    from petsc_rod.iteration.newton import NewtonSolver
     from petsc_rod.scenes.starts import catenary_start
     from test_stretch_newton import lagrangian
 
@@ -256,7 +256,7 @@ def test_the_inextensible_joints_hessian_against_finite_differences(comm):
     problem = solver.problem
     joints = [term for term in problem.terms if isinstance(term, FlexJoint)]
     assert len(joints) == 2 and not any(term.local for term in joints)
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     work = problem.field_stiffness(0)[1].createVecLeft()
     x = y = None
     try:

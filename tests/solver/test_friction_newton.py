@@ -1,4 +1,4 @@
-"""Newton steps with seabed friction (riser/friction.py "In the Newton steps",
+"""Newton steps with seabed friction (physics/friction.py "In the Newton steps",
 docs/method.md §11 "Terms of the positions"), on one rank (PETSc.COMM_SELF) and on all
 ranks (PETSc.COMM_WORLD: under ``mpiexec -n 2`` the parallel run).
 
@@ -29,11 +29,11 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import make_solver
+from petsc_rod.environment.seabed import Friction, Seabed
 from petsc_rod.iteration.events import NewtonAttempt
-from petsc_rod.iteration.newton import NewtonPolish
-from petsc_rod.riser.environment import Friction, Seabed
-from petsc_rod.riser.friction import FrictionTerm
-from petsc_rod.riser.terms import SeabedTerm
+from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.physics.friction import FrictionTerm
+from petsc_rod.physics.seabed import SeabedTerm
 from test_seabed_newton import moved, random_direction
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
@@ -111,7 +111,7 @@ def test_jacobian_against_finite_differences(comm, line):
     mesh, solver, report = converged(comm, line, newton=False)
     assert report.converged
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         state = problem.state
         friction = next(t for t in problem.terms if isinstance(t, FrictionTerm))
@@ -243,7 +243,7 @@ def test_a_friction_step_ends_after_its_newton_attempt(comm):
 
 def test_newton_steps_take_friction_of_one_coefficient(comm):
     """With mu_a != mu_l the run takes no Newton steps (the slide's derivative is
-    unsymmetric and turns with the line's axes: the attempts failed, riser/friction.py),
+    unsymmetric and turns with the line's axes: the attempts failed, physics/friction.py),
     and says why; with one coefficient it takes them."""
     scene, penalty = LINES["pulled along"]
     for friction, expected in ((Friction(0.5, 0.5, 1e5), True),
@@ -276,7 +276,7 @@ def test_the_mean_roll_is_held_in_a_newton_step_s_inertia_test():
     mesh, solver = make_solver(PETSc.COMM_SELF, 20, scene, 50.0, rtol=1e-12, ctol=1e-12,
                                max_it=20000, newton=False)
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         problem.state.set_straight()
         assert solver.solve_step(1.0).converged

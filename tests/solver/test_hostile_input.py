@@ -15,15 +15,15 @@ from petsc4py import PETSc
 
 from helpers import partial_files
 from petsc_rod import resources
-from petsc_rod.io import outputs
-from petsc_rod.io import results as io
 from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
-from petsc_rod.cli.session import record_step
-from petsc_rod.iteration.continuation import LoadPath
-from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.cli.options import (MAX_HALVINGS_CAP, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
+from petsc_rod.cli.session import record_step
+from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
+from petsc_rod.io import outputs
+from petsc_rod.io import results as io
+from petsc_rod.iteration.continuation import LoadPath
+from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.resources import BYTES_PER_ELEMENT, MAX_ELEMENTS, check_elements_fit
 
 CANTILEVER = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
@@ -408,7 +408,7 @@ def test_the_derived_bounds_accept_what_is_within_them(options):
 
 
 def test_a_profile_above_the_bound_is_refused_when_read(tmp_path_factory, comm):
-    from petsc_rod.riser.environment import read_profile
+    from petsc_rod.environment.profiles import read_profile
     folder = tmp_path_factory.mktemp("profile") if comm.getRank() == 0 else None
     folder = comm.tompi4py().bcast(folder)
     path = folder / "huge.txt"
@@ -616,7 +616,7 @@ def deadline(seconds=10):
 
 def input_readers():
     """{option: read(path)} of every reader of an input table."""
-    from petsc_rod.riser.environment import read_profile, read_seabed_profile
+    from petsc_rod.environment.profiles import read_profile, read_seabed_profile
     from petsc_rod.scenes.line import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
     from petsc_rod.scenes.point_loads import read_point_loads
     from petsc_rod.sweep.cases import read_cases

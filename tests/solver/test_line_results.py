@@ -1,5 +1,5 @@
-"""The results along the line and at its ends (riser/line_results.py) and the regions
-(riser/regions.py) of solved lines: against EI times the curvature, the balance of the
+"""The results along the line and at its ends (reports/line_results.py) and the regions
+(reports/regions.py) of solved lines: against EI times the curvature, the balance of the
 end forces with the loads, hand angles, and one rank against all (each scene solved on
 PETSc.COMM_SELF and on PETSc.COMM_WORLD: under mpiexec -n 2 the 1-versus-2-ranks
 check). Serial and under mpiexec -n 2."""
@@ -9,9 +9,9 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather, make_solver, destroy
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.io.line_table import final_record
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.environment import Seabed
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.scenes.starts import catenary_start
 
@@ -164,7 +164,7 @@ def test_a_span_over_a_trench_is_a_free_span_not_grounded(comm):
     grounded again to the anchor. In contact is a gap below the largest penetration
     (1 mm): the bounds are where the gap crosses it, within the 1 cm steps. Before, the
     whole line beyond the touchdown was "grounded"."""
-    from petsc_rod.riser.bathymetry import Profile
+    from petsc_rod.environment.bathymetry import Profile
 
     profile = Profile(np.zeros(2), np.array([1.0, 0.0]),
                       np.array([-1.0, 3.0, 3.01, 4.99, 5.0, 20.0]),

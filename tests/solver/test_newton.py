@@ -72,7 +72,7 @@ def test_newton_stays_quadratic_on_a_fine_mesh(solver_factory, comm):
 def test_the_handed_over_state_is_a_fixed_point_of_the_uzawa_map(solver_factory, comm):
     _, solver = solver_factory(comm, 16, CANTILEVER, 100.0, 1e-3, 1e-3, 5000, newton=False)
     assert continuation(solver, steps=1).converged          # near, not at, the solution
-    polish = newton.NewtonPolish(solver.problem)
+    polish = newton.NewtonSolver(solver.problem)
     try:
         assert polish.run() == newton.CONVERGED
         assert polish.least_penalty() < solver.penalty

@@ -23,11 +23,11 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
-from petsc_rod.analysis.stability import SecondVariation
+from petsc_rod.analysis.stability import StabilityTest
+from petsc_rod.environment.current import Current
 from petsc_rod.global_step import ksp as ksp_module
 from petsc_rod.iteration import newton
-from petsc_rod.iteration.newton import NewtonPolish
-from petsc_rod.riser.environment import Current
+from petsc_rod.iteration.newton import NewtonSolver
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
 
@@ -64,7 +64,7 @@ def infinite_solves(self, columns, *args):
 def attempt(problem):
     """(outcome, whether the state is bit for bit as before) of one Newton attempt."""
     before = problem.state.snapshot()
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         outcome = polish.run()
     finally:
@@ -84,7 +84,7 @@ def test_a_failed_factorisation_is_a_failed_attempt(comm, solver_factory, monkey
     outcome, _ = attempt(problem)
     assert outcome == newton.CONVERGED
     problem = near_solution(solver_factory, comm, scene)
-    owner = NewtonJacobian if failing == "jacobian" else SecondVariation
+    owner = NewtonJacobian if failing == "jacobian" else StabilityTest
     monkeypatch.setattr(owner, "solve_many", infinite_solves)
     outcome, same = attempt(problem)
     assert outcome == newton.FAILED

@@ -251,7 +251,7 @@ def test_the_drag_of_an_attachment_is_its_point_force(comm):
     the surface z = 0, none 1 m down) under a weight that sinks the point: the drag is
     1/2 rho C_d A |v| v at the point's depth, and the state the same as with that force
     given as a dead one (the fixed point). Measured: 2.1e-13 and 3.1e-13 m."""
-    from petsc_rod.riser.environment import Current
+    from petsc_rod.environment.current import Current
     uniform = Current(np.zeros(1), np.array([[0.0, 0.8, 0.0]]), 0.0, 0.0)
     fields, _, drag = with_drag(comm, uniform, [0.0, 0.0, 0.0])
     expected = 0.5 * RHO * CDA * 0.8**2
@@ -275,7 +275,7 @@ def test_the_drag_of_an_attachment_is_its_point_force(comm):
 def reactions_and_shape(comm, scene, start):
     """(r gathered, start_force, end_force) of Scene(**scene) converged from ``start``
     ('catenary' or 'straight'): the reactions of line_results.end_numbers."""
-    from petsc_rod.riser.line_results import end_numbers
+    from petsc_rod.reports.line_results import end_numbers
 
     mesh, solver = make_solver(comm, 40, scene, default_penalty(Scene(**scene)),
                                rtol=1e-11, ctol=1e-11, max_it=20000)

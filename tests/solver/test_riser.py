@@ -1,5 +1,5 @@
-"""The seabed and the current (petsc_rod/riser, docs/riser.md) against closed forms, and
-one rank against two. Serial and under mpiexec -n 2; bounds from measured runs
+"""The seabed and the current (petsc_rod/environment, physics, docs/riser.md) against closed
+forms, and one rank against two. Serial and under mpiexec -n 2; bounds from measured runs
 (docs/riser.md, "Accuracy"), with a margin for the 1-rank / 2-rank round-off only."""
 
 import numpy as np
@@ -7,21 +7,22 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import fitted_order, gather, make_solver
-from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.cli import lines as step_lines
 from petsc_rod.cli.session import record_step
-from petsc_rod.iteration.events import StepEnded
-from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.scenes.touchdown import grounded_catenary
-from petsc_rod.riser.environment import Current, Seabed
-from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.scenes.scene import Scene
-from petsc_rod.scenes.starts import catenary_start
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.global_step.matrices import load_ghosted
+from petsc_rod.global_step.nodal_loads import NodalLoad
+from petsc_rod.io.outputs import vertex_fields
+from petsc_rod.iteration.events import StepEnded
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.mesh.mesh import Mesh
+from petsc_rod.problem.penalty import default_penalty
 from petsc_rod.scenes.catenary import catenary
+from petsc_rod.scenes.scene import Scene
+from petsc_rod.scenes.starts import catenary_start
+from petsc_rod.scenes.touchdown import grounded_catenary
 
 
 def solved(solver_factory, comm, n_elements, scene, start="straight", rtol=1e-12,
@@ -115,7 +116,7 @@ def test_riser_numbers_of_the_grounded_line(grounded_runs):
 
 
 def test_a_seabed_far_below_changes_nothing(comm, solver_factory):
-    """The vertical problem in Hermite dofs (riser/hermite.py) is the slope problem in
+    """The vertical problem in Hermite dofs (global_step/hermite.py) is the slope problem in
     other coordinates: with the seabed out of reach the state is the dead-load one."""
     scene = dict(length=10.0, stiffness=(1.0, 1.0, 0.8), start="pin", end="pin",
                  end_position=(7.0, 1.0, 2.0), load_values=[[0.0, 0.0, -1.0]])

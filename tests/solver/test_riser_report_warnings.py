@@ -1,5 +1,5 @@
 """The riser report of a line lying flat on or below the seabed (issue 25: the shipped
-lazy wave printed "RuntimeWarning: divide by zero" from riser/quantities.py on 2 ranks,
+lazy wave printed "RuntimeWarning: divide by zero" from reports/riser_numbers.py on 2 ranks,
 where two neighbouring vertices sat at the same height below the seabed). Serial and
 under mpiexec -n 2, with RuntimeWarnings turned into errors."""
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from helpers import destroy, make_solver
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.io.outputs import vertex_fields
-from petsc_rod.riser.environment import Seabed
 
 # The straight reference (z = 0 everywhere) under a seabed 0.5 m above it: every
 # element has gap0 = gap1 = -0.5 m, the case that divided by gap0 - gap1 = 0.

@@ -1,4 +1,4 @@
-"""Coulomb friction of the seabed (riser/friction.py, docs/riser.md §3b) against closed
+"""Coulomb friction of the seabed (physics/friction.py, docs/riser.md §3b) against closed
 forms: a grounded line pulled along the seabed, whose tension falls by mu w per metre
 from the pull toward the anchor (mobilised friction) and is 0 beyond the stick-slip
 front; a line on an incline (the load tilted by theta on a flat seabed) that sticks for
@@ -14,9 +14,9 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import fitted_order, gather, make_solver
+from petsc_rod.environment.bathymetry import Plane
+from petsc_rod.environment.seabed import Friction, Seabed
 from petsc_rod.io.outputs import vertex_fields
-from petsc_rod.riser.bathymetry import Plane
-from petsc_rod.riser.environment import Friction, Seabed
 
 # 200 m of line of 100 N/m submerged weight, EI = 1 N m^2 (negligible), EA = 1e6 N, on a
 # seabed of k = 1e6 N/m^2, pinned at the anchor (S = 0) and pulled at the free end by F
@@ -208,7 +208,7 @@ def test_the_anchors_follow_the_return_map_at_each_step(steps):
     is at most R and equals R where the line slides; and 3 steps reach the 1 step's
     state (monotone loading)."""
     from helpers import continuation
-    from petsc_rod.riser.friction import FrictionTerm, elliptic_norm
+    from petsc_rod.physics.friction import FrictionTerm, elliptic_norm
 
     scene = dict(STRETCHED, seabed=seabed(1e5))
     mesh, solver = make_solver(PETSc.COMM_WORLD, 100, scene, PENALTY, rtol=1e-9, ctol=1e-9,

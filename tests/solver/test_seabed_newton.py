@@ -30,11 +30,11 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.frames import rotations
-from petsc_rod.iteration.newton import NewtonPolish
+from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.environment import Seabed
-from petsc_rod.riser.terms import SeabedTerm
 from petsc_rod.scenes.scene import Scene
 from test_riser import GROUNDED, grounded_errors
 from test_stretch_newton import lagrangian as chord_lagrangian
@@ -114,7 +114,7 @@ def test_gradient_and_hessian_against_finite_differences(comm, solver_factory, e
              **({"axial_stiffness": 10.0} if extensible else {})}
     mesh, solver = solver_factory(comm, 12, scene, 5.0, newton=False)
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     work = problem.field_stiffness(0)[1].createVecLeft()
     try:
         problem.prepare(1.0)
@@ -250,7 +250,7 @@ def steel_riser(solver_factory, comm, newton):
 
 
 def seabed_contact(problem):
-    """The seabed term's SeabedContact (riser/seabed.py)."""
+    """The seabed term's SeabedContact (global_step/seabed_contact.py)."""
     return next(term for term in problem.terms if isinstance(term, SeabedTerm)).contact
 
 
@@ -272,13 +272,13 @@ def test_the_newton_attempt_converges_while_the_touchdown_settles(comm, solver_f
     from petsc_rod.iteration.events import NewtonAttempt
     from petsc_rod.iteration.newton import SHRINK
     curvatures = []                 # whether each step took the iteration's curvature
-    step = NewtonPolish._newton_step
+    step = NewtonSolver._newton_step
 
     def recorded(self, frames, g, mu, regularised=False, curvature=None, frozen=False):
         curvatures.append(curvature is not None)
         return step(self, frames, g, mu, regularised, curvature, frozen)
 
-    monkeypatch.setattr(NewtonPolish, "_newton_step", recorded)
+    monkeypatch.setattr(NewtonSolver, "_newton_step", recorded)
     (plain, r_plain), (polished, r) = (steel_riser(solver_factory, comm, newton)
                                        for newton in (False, True))
     assert plain.converged and polished.converged
@@ -294,10 +294,11 @@ def test_the_newton_attempt_converges_while_the_touchdown_settles(comm, solver_f
 # --- (e) the first active set: the start's touchdown --------------------------------------
 def first_loop_solves(solver_factory, comm, from_start):
     """(solves, nodes that changed side) of the first global step's active-set loop
-    (riser/seabed.py) on STEEL_RISER at 900 elements from its catenary; ``from_start``:
-    the loop starts from the start's contact (the default), else from an empty set."""
+    (global_step/seabed_contact.py) on STEEL_RISER at 900 elements from its catenary;
+    ``from_start``: the loop starts from the start's contact (the default), else from an
+    empty set."""
+    from petsc_rod.global_step.seabed_contact import TOUCHING
     from petsc_rod.scenes.starts import catenary_start, largest_tension
-    from petsc_rod.riser.seabed import TOUCHING
     scene = Scene(**STEEL_RISER)
     penalty = default_penalty(scene, largest_tension(scene, 1.0))
     mesh, solver = solver_factory(comm, 900, STEEL_RISER, penalty)
@@ -319,7 +320,7 @@ def test_the_first_active_set_is_the_start_s_touchdown(comm, solver_factory):
     through the seabed and each solve lifted about 6 nodes beside the touchdown: the loop
     stopped at MAX_SOLVES (30) with the set still changing. The catenary lays its grounded
     part on z_b to round-off: most of the line is in contact from the first solve."""
-    from petsc_rod.riser.seabed import MAX_SOLVES
+    from petsc_rod.global_step.seabed_contact import MAX_SOLVES
     solves, moved = first_loop_solves(solver_factory, comm, from_start=True)
     assert solves <= 4 and moved <= 20
     empty_solves, _ = first_loop_solves(solver_factory, comm, from_start=False)

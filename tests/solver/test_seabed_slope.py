@@ -1,4 +1,4 @@
-"""A seabed that is not flat (riser/bathymetry.py, docs/riser.md §3a, §6): a line on a
+"""A seabed that is not flat (environment/bathymetry.py, docs/riser.md §3a, §6): a line on a
 sloping seabed against the catenary on an incline (validation/incline_catenary.py),
 with its grounded part lying along the slope; a profile that equals the plane, or the
 flat seabed where the line touches, gives their states; one rank and two agree.
@@ -9,10 +9,10 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import fitted_order, gather, make_solver
+from petsc_rod.environment.bathymetry import Plane, Profile
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.bathymetry import Plane, Profile
-from petsc_rod.riser.environment import Seabed
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.validation.incline_catenary import incline_catenary
 

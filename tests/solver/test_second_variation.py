@@ -1,4 +1,5 @@
-"""The second variation H (petsc_rod/analysis/stability.py) as the solver keeps it: one
+"""The second variation H (petsc_rod/analysis/second_variation.py, its inertia test
+analysis/stability.py) as the solver keeps it: one
 matrix for the solver's life, updated in place at each Newton step and stability test.
 
 - Updated at a new state, H, its chord constraint and its inertia are those of an H
@@ -12,7 +13,8 @@ matrix for the solver's life, updated in place at each Newton step and stability
 import numpy as np
 
 from helpers import PAPER_SCENE as PAPER, continuation
-from petsc_rod.analysis.stability import SecondVariation, skew
+from petsc_rod.analysis.second_variation import SecondVariation, skew
+from petsc_rod.analysis.stability import StabilityTest
 
 
 def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory, comm):
@@ -26,7 +28,7 @@ def test_an_updated_second_variation_is_the_one_assembled_afresh(solver_factory,
         solver.problem.iterate()
     updated = solver.problem.second_variation()
     assert updated is kept
-    fresh = SecondVariation(solver.problem)
+    fresh = StabilityTest(solver.problem)
     difference = updated.matrix.copy()
     try:
         scale = fresh.matrix.norm(norm_type=3)                  # NORM_INFINITY

@@ -109,12 +109,12 @@ def paper_branches():
     Returns {name: (converged, u3(0), energy, negative directions of the final state)}."""
     from petsc4py import PETSc
     from helpers import make_solver
-    from petsc_rod.analysis.stability import SecondVariation
+    from petsc_rod.analysis.stability import StabilityTest
     results = {}
 
     def record(name, solver, report):
         u = gather(solver.problem.mesh.comm, vertex_fields(solver.problem)["u"])
-        hessian = SecondVariation(solver.problem)
+        hessian = StabilityTest(solver.problem)
         try:
             negative = hessian.negative_directions(-hessian.tolerance())
         finally:

@@ -19,9 +19,9 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.analysis import stability
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.iteration import controller, newton, stopping
 from petsc_rod.problem.penalty import default_penalty
-from petsc_rod.riser.environment import Seabed
 from petsc_rod.scenes.scene import Scene
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
@@ -69,7 +69,7 @@ def test_a_failed_factorisation_of_the_stability_test_fails_the_step(
     def fails(self):
         raise np.linalg.LinAlgError("Eigenvalues did not converge")
 
-    monkeypatch.setattr(stability.SecondVariation, "descent_direction", fails)
+    monkeypatch.setattr(stability.StabilityTest, "descent_direction", fails)
     scene = dict(length=1.0, stiffness=(1.0, 1.0, 1.0), start="clamp", end="free",
                  end_force=(0.0, -3.0, 0.0))
     _, solver = solver_factory(comm, 16, scene, 100.0, newton=False)

@@ -246,7 +246,7 @@ ZONE = 1.0          # m kept clear of the touchdown's and the anchor's bending l
 
 
 def test_elastic_catenary_with_touchdown():
-    from petsc_rod.riser.environment import Seabed
+    from petsc_rod.environment.seabed import Seabed
     scene = dict(length=10.0, stiffness=(1e-6, 1e-6, 1e-6), start="pin", end="pin",
                  end_position=GROUNDED_END, load_values=[[0.0, 0.0, -1.0]],
                  seabed=Seabed(0.0, 1e6), axial_stiffness=GROUNDED_EA)

@@ -27,7 +27,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import destroy, gather, make_solver
-from petsc_rod.iteration.newton import NewtonPolish
+from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.problem.penalty import default_penalty
 from petsc_rod.scenes.line import Section
 from petsc_rod.scenes.scene import Scene
@@ -105,7 +105,7 @@ def test_hessian_against_finite_differences(comm, ends):
     problem = solver.problem
     if ends == "pins, half inextensible":
         make_half_inextensible(problem)
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     work = problem.field_stiffness(0)[1].createVecLeft()
     try:
         state = problem.state
@@ -165,7 +165,7 @@ def test_gradient_vanishes_at_the_uzawa_fixed_point(comm):
     mesh, solver = make_solver(comm, 40, IRVINE, default_penalty(Scene(**IRVINE)),
                                1e-12, 1e-12, 2000, newton=False)
     problem = solver.problem
-    polish = NewtonPolish(problem)
+    polish = NewtonSolver(problem)
     try:
         problem.state.set_from_curve(catenary_start(problem.scene, 1.0))
         assert solver.solve_step(1.0).converged
@@ -232,7 +232,7 @@ def test_newton_converges_from_an_uzawa_state(comm):
     reference = solve(comm, scene, 40, start="catenary")
     mesh, solver = make_solver(comm, 40, scene, default_penalty(Scene(**scene)),
                                1e-12, 1e-12, 20, newton=False)
-    polish = NewtonPolish(solver.problem)
+    polish = NewtonSolver(solver.problem)
     try:
         problem = solver.problem
         problem.state.set_from_curve(catenary_start(problem.scene, 1.0))

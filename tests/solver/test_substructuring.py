@@ -428,13 +428,13 @@ def test_a_refactorisation_reads_only_the_rows_noted_as_changed(monkeypatch):
 
 
 def test_a_change_beside_a_rank_boundary_refactors_the_next_rank_s_interface():
-    """The riser's vertical problem (riser/hermite.py): a spring changed on the last
+    """The riser's vertical problem (global_step/hermite.py): a spring changed on the last
     element of a rank adds into the next rank's first vertex (z, z'), its interface
     rows, though none of that rank's elements changed. HermiteProblem.set_added notes
     those rows on every rank, so the refactorisation that reads only noted rows
     (ksp.note_changed_rows) reads them there; the solve then equals a new problem's
     with the same springs, to round-off. On one rank the element is the middle one."""
-    from petsc_rod.riser.hermite import HermiteProblem
+    from petsc_rod.global_step.hermite import HermiteProblem
     from petsc_rod.scenes.scene import EndState
     comm = PETSc.COMM_WORLD
     n_elements = 24

@@ -25,7 +25,8 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import gather
-from petsc_rod.riser.environment import Current, Friction, Seabed
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.seabed import Friction, Seabed
 from petsc_rod.scenes.scene import Scene
 from petsc_rod.scenes.starts import catenary_start
 

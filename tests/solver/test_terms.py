@@ -6,19 +6,22 @@ import numpy as np
 import pytest
 
 from helpers import gather
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.seabed import Seabed
+from petsc_rod.global_step.nodal_loads import NodalLoad
 from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.drag import DragTerm
+from petsc_rod.physics.nodal_load import NodalLoadTerm
+from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.physics.term import Term
 from petsc_rod.problem.build import scene_terms
 from petsc_rod.problem.problem import RodProblem
-from petsc_rod.riser.environment import Current, Seabed
-from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.riser.line_results import LineResults
-from petsc_rod.riser.quantities import RiserNumbers
-from petsc_rod.riser.regions import LineRegions
-from petsc_rod.riser.terms import DragTerm, NodalLoadTerm, SeabedTerm
+from petsc_rod.reports.line_results import LineResults
+from petsc_rod.reports.regions import LineRegions
+from petsc_rod.reports.riser_numbers import RiserNumbers
 from petsc_rod.scenes.scene import Scene
 
 FORCE = np.array([0.0, -2.0, 1.0])          # N/m
@@ -32,7 +35,7 @@ class NodalUniformLoad(NodalLoadTerm):
     """A uniform load f (N/m) given by its values at the P2 nodes and added to the
     slope's right-hand side every iteration, as a follower load would be: the core knows
     it only through the protocol. Its P2 interpolant is f itself, so it is the dead load
-    f (riser/loads.py), reached by another way."""
+    f (global_step/nodal_loads.py), reached by another way."""
 
     conservative = in_newton = False        # no energy given
 

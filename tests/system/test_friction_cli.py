@@ -1,4 +1,4 @@
-"""Seabed friction from the command line (riser/friction.py, docs/riser.md §3b): the
+"""Seabed friction from the command line (physics/friction.py, docs/riser.md §3b): the
 riser catenary under a current across its plane, whose grounded part slid 100 m
 sideways on a frictionless seabed, is held by friction, with the stick and slide
 lengths, the largest friction and the touchdown's offset in the step line and the file;

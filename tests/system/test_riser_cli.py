@@ -175,7 +175,7 @@ def test_the_stiffest_seabed_accepted_converges(tmp_path, ranks):
     accepted (environment.largest_stiffness, quoted by the refusal) converges, on the
     direct solver of one rank and the CG of two."""
     from petsc_rod.cli.scene_options import rounded_down
-    from petsc_rod.riser.environment import largest_stiffness
+    from petsc_rod.environment.seabed import largest_stiffness
     largest = rounded_down(largest_stiffness(10.0, 10.0))
     path = tmp_path / "out.h5"
     done = run(SCENE + ["-rod_seabed", "0", "-rod_seabed_stiffness", f"{largest:.3g}",

@@ -1,7 +1,8 @@
 """The shape of the package (docs/design.md), read from the code's own imports and
-strings with ``ast``: no loop between folders, the core never imports the riser (its
-terms come in a list, problem/build.py), and the algorithm layer never names a
-command-line option (cli/ says what to change)."""
+strings with ``ast``: no loop between folders, the core never imports the environment,
+the reports or the terms of an application (its terms come in a list,
+problem/build.py), nothing below the front ends imports one, and the algorithm layer
+never names a command-line option (cli/ says what to change)."""
 
 import ast
 import os
@@ -11,9 +12,19 @@ from helpers import REPO_ROOT
 
 PACKAGE = os.path.join(REPO_ROOT, "petsc_rod")
 # Folders and modules that make up the core of the method, which must work with any
-# list of terms and so never import the riser's.
-CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics",
-        "problem/problem.py", "problem/state.py", "io/outputs.py")
+# list of terms and so never import an application's (APPLICATION).
+CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics/term.py",
+        "physics/dead_loads.py", "physics/stretch.py", "physics/flex_joint.py",
+        "physics/point_loads.py", "problem/problem.py", "problem/state.py",
+        "io/outputs.py")
+# What only some scenes build (problem/build.py): the sea and the seabed, the reports,
+# and the terms of the seabed, the current and the sea surface (dotted below petsc_rod).
+APPLICATION = ("environment", "reports", "physics.nodal_load", "physics.seabed",
+               "physics.drag", "physics.surface", "physics.friction", "physics.slope_load")
+# The front ends, which drive the solver and which nothing below them imports.
+FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__")
+BELOW_FRONT_ENDS = CORE + ("physics", "environment", "reports", "problem", "scenes", "io",
+                           "frames.py", "errors.py", "tables.py", "resources.py")
 # The algorithm layer, whose messages must not name -rod_* options.
 ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step")
 
@@ -77,11 +88,24 @@ def test_no_loop_between_folders():
     assert graph["problem"] and graph["iteration"]       # the graph was read
 
 
-def test_the_core_never_imports_the_riser():
+def test_the_core_never_imports_an_application():
     for path, tree in modules().items():
         if path.startswith(CORE):
-            riser = sorted(name for name in imported(tree) if name.startswith("riser"))
-            assert not riser, f"{path} imports {riser}: a term belongs in problem/build.py"
+            found = sorted(name for name in imported(tree)
+                           if name.split(".")[0] in APPLICATION
+                           or ".".join(name.split(".")[:2]) in APPLICATION)
+            assert not found, f"{path} imports {found}: a term belongs in problem/build.py"
+
+
+def test_nothing_below_the_front_ends_imports_one():
+    seen = 0
+    for path, tree in modules().items():
+        if path.startswith(BELOW_FRONT_ENDS):
+            seen += 1
+            found = sorted(name for name in imported(tree)
+                           if name.split(".")[0] in FRONT_ENDS)
+            assert not found, f"{path} imports the front end {found}"
+    assert seen > 50                    # the modules were read
 
 
 def docstrings(tree):

@@ -1,11 +1,11 @@
-"""The seabed's shapes (riser/bathymetry.py) and the catenary on an incline
+"""The seabed's shapes (environment/bathymetry.py) and the catenary on an incline
 (validation/incline_catenary.py): numpy and scipy only."""
 
 import numpy as np
 import pytest
 
-from petsc_rod.riser.bathymetry import Grid, Plane, Profile, unit_normal
-from petsc_rod.riser.environment import Seabed
+from petsc_rod.environment.bathymetry import Grid, Plane, Profile, unit_normal
+from petsc_rod.environment.seabed import Seabed
 from petsc_rod.scenes.touchdown import grounded_catenary
 from petsc_rod.validation.incline_catenary import incline_catenary
 

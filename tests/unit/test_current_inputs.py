@@ -5,7 +5,7 @@ and the dataclass's own c still works for the callers that have it."""
 import numpy as np
 import pytest
 
-from petsc_rod.riser.environment import Current
+from petsc_rod.environment.current import Current
 
 pytestmark = pytest.mark.unit
 

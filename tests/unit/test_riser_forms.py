@@ -1,14 +1,17 @@
-"""The riser's numpy parts (petsc_rod/riser): the catenary with touchdown against its own
-equations, the Morison drag, the current profile and its file, the Hermite slope map."""
+"""The riser's numpy parts (petsc_rod/environment, physics, global_step): the catenary with
+touchdown against its own equations, the Morison drag, the current profile and its file, the
+Hermite slope map."""
 
 import numpy as np
 import pytest
 
+from petsc_rod.environment.current import Current
+from petsc_rod.environment.profiles import read_profile
+from petsc_rod.environment.seabed import default_stiffness
 from petsc_rod.errors import RodInputError
+from petsc_rod.global_step.hermite import midpoint_values, slope_map
+from petsc_rod.physics.drag import drag_jacobian, normal_drag
 from petsc_rod.scenes.touchdown import grounded_catenary, touchdown_parameter
-from petsc_rod.riser.current import drag_jacobian, normal_drag
-from petsc_rod.riser.environment import Current, default_stiffness, read_profile
-from petsc_rod.riser.hermite import midpoint_values, slope_map
 
 LENGTH, WEIGHT = 10.0, 2.0
 

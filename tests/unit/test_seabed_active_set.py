@@ -1,16 +1,16 @@
-"""The seabed's springs in the vertical problem (riser/seabed.py): when the active set
-moves, only the elements where it changed are made anew (SeabedContact._set_active with
-only_changed); the element matrices and vectors handed to the vertical problem must be
-exactly those of making every element anew, on a flat seabed and where z_b and k differ
-from node to node (a seabed that is not flat)."""
+"""The seabed's springs in the vertical problem (global_step/seabed_contact.py): when the
+active set moves, only the elements where it changed are made anew
+(SeabedContact._set_active with only_changed); the element matrices and vectors handed to
+the vertical problem must be exactly those of making every element anew, on a flat seabed
+and where z_b and k differ from node to node (a seabed that is not flat)."""
 
 import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.environment.seabed import Seabed
+from petsc_rod.global_step.seabed_contact import SeabedContact
 from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.riser.environment import Seabed
-from petsc_rod.riser.seabed import SeabedContact
 
 
 class Recorder:

@@ -14,7 +14,7 @@ seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
   g = (z_b(d + delta/2) - z_b(d - delta/2)) / delta e: the segment's slope away from the
   rows, and turning linearly from one segment's to the next over delta about a row
   (and to 0 about the first and last). Why: the contact's horizontal push is lagged
-  (slope_load.py), and with the slope jumping at a row a node there flips between the
+  (physics/slope_load.py), and with the slope jumping at a row a node there flips between the
   two pushes from one iteration to the next and the iteration never settles (measured:
   a line pushed over the edge of a grid's slope stalled at a change of 1e-5); a
   gradient continuous in the position gives it a fixed point. ``covers`` tells whether

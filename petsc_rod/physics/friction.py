@@ -8,7 +8,7 @@ elastic-perfectly-plastic spring: the friction per metre is
     f_n = -k_s (x_n - a_n)                 if |k_s (x_n - a_n)|_mu <= R_n   (stick),
     f_n = -k_s (x_n - a_n) R_n / |.|_mu    otherwise                        (slide),
 
-with R_n the normal contact reaction (N/m, seabed.SeabedContact.reaction), k_s the stick
+with R_n the normal contact reaction (N/m, seabed_contact.SeabedContact.reaction), k_s the stick
 stiffness (N/m^2, -rod_seabed_friction_stiffness) and |f|_mu the elliptic norm
 sqrt((f.a / mu_a)^2 + (f.l / mu_l)^2) in the node's axial and lateral horizontal
 directions a, l (so a sliding node is resisted by mu R, mu between mu_a along the line
@@ -24,7 +24,7 @@ a sticking node keeps its anchor, a sliding one drags it along, a node off the s
 carries none).
 
 In the global step the friction is implicit, like the seabed: x and y are solved in
-Hermite dofs (hermite.py), where a spring on a node's position is banded, in place of
+Hermite dofs (global_step/hermite.py), where a spring on a node's position is banded, in place of
 the P2 solve of their slopes, with a spring k_n w_n toward its anchor at every node: k_s
 at a sticking node, the secant k_s R_n / |k_s (x_n - a_n)|_mu at a sliding one (whose
 force is then the sliding friction). The springs are those of the last solve's positions
@@ -35,7 +35,7 @@ A sliding force held fixed instead flipped its sign from one solve to the next a
 map cycled (measured, docs/riser.md §3b). The contact reaction is that of the same
 global step's vertical solve (the seabed term comes first). Why implicit: an explicit
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
-(seabed.py).
+(global_step/seabed_contact.py).
 
 In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed
 and with one coefficient (mu_a = mu_l): within a load step the anchors are fixed, and the
@@ -66,12 +66,12 @@ gives no stability verdict (as with the drag).
 import numpy as np
 
 from petsc_rod.analysis.positions import HEIGHT
+from petsc_rod.global_step.hermite import HermiteProblem, slope_map
+from petsc_rod.global_step.nodal_loads import NodalLoad
+from petsc_rod.global_step.seabed_contact import MAX_SOLVES, node_rows, owned_nodes
 from petsc_rod.mesh.elements import NODE_WEIGHTS
+from petsc_rod.physics.nodal_load import NodalLoadTerm
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.riser.hermite import HermiteProblem, slope_map
-from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.riser.seabed import MAX_SOLVES, node_rows, owned_nodes
-from petsc_rod.riser.terms import NodalLoadTerm
 
 # The secant loop of one global step ends when no node's spring changed by more than
 # this times k_s (the next global step starts from the last springs). Measured on the

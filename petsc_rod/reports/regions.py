@@ -1,8 +1,8 @@
 """The regions of a riser, a cable or a mooring line, and their largest effective
 tension, smallest bend radius and largest bending moment (docs/riser.md §5a).
 
-With sigma = |S - S_top| the arc length from the top (quantities.top_end: the higher
-held end), sigma_td that of the touchdown point (quantities.touchdown; the far end when
+With sigma = |S - S_top| the arc length from the top (riser_numbers.top_end: the higher
+held end), sigma_td that of the touchdown point (riser_numbers.touchdown; the far end when
 the line does not reach the seabed) and L_s = sigma_td the suspended length:
 
 * ``hang_off``: sigma in [0, 0.05 L_s], the top 5 % of the suspended length;
@@ -36,8 +36,9 @@ candidates and each region's largest values are combined by allgathers of small 
 import numpy as np
 
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.line_results import bending_moment, curvature
-from petsc_rod.riser.quantities import _at_vertex, effective_tension, top_end, touchdown
+from petsc_rod.reports.line_results import bending_moment, curvature
+from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension, top_end,
+                                             touchdown)
 
 ATTRIBUTE_UNITS = {"region_names": "text", "region_bounds": "m",
                    "region_max_tension": "N", "region_max_tension_S": "m",

@@ -50,7 +50,7 @@ ATTRIBUTE_UNITS = {
 
 class RiserNumbers(ReportTerm):
     """The riser numbers as a term that only reports (physics/term.py): built for every
-    scene with a seabed or a current, with the SeabedTerm (riser/terms.py) or None."""
+    scene with a seabed or a current, with the SeabedTerm (physics/seabed.py) or None."""
 
     def __init__(self, seabed=None):
         self.seabed = seabed

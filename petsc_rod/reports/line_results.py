@@ -11,7 +11,7 @@ At the vertices, (n,) each, with t = d3 / |d3| the unit tangent:
 * ``declination``: the angle of t (toward increasing S) from the upward vertical,
   acos(t_z), 0 to 180 deg (OrcaFlex's declination);
 
-The effective tension n.t is not among them: the riser term (riser/quantities.py) writes
+The effective tension n.t is not among them: the riser term (reports/riser_numbers.py) writes
 it for a scene with a seabed or a current, and a file with it is drawn as a riser's
 (plots.py); the CSV table has it for every scene (io/line_table.py).
 
@@ -23,7 +23,7 @@ So start_force + end_force = int f dS, the applied loads (the weight, the drag, 
 seabed's and attachments' forces): what the supports carry. An attachment on a held end
 is carried by its support: it is added to that end's force (it is not in the line's n). At a free end they are the
 applied end force and moment with the sign of a support's. And the hang-off, the higher
-held end (quantities.top_end): ``hang_off_S`` (m), ``hang_off_declination`` (deg, the
+held end (riser_numbers.top_end): ``hang_off_S`` (m), ``hang_off_declination`` (deg, the
 angle from the upward vertical of the tangent pointing away from the line: d3 at S = L,
 -d3 at S = 0; 0 to 180) and ``hang_off_azimuth`` (deg, the direction of that tangent's
 horizontal projection, from +x toward +y, in (-180, 180]; NaN where the tangent is
@@ -33,8 +33,8 @@ vertical to 1e-12).
 import numpy as np
 
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.quantities import (_at_vertex, effective_tension, points_on_held_ends,
-                                        top_end, unit_tangent)
+from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension,
+                                             points_on_held_ends, top_end, unit_tangent)
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
                  "torque": "N m", "shear": "N", "declination": "deg"}

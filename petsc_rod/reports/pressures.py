@@ -23,7 +23,7 @@ over EA; docs/riser.md §2b).
 import numpy as np
 
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.quantities import effective_tension, top_end
+from petsc_rod.reports.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
 DATASET_UNITS = {"external_pressure": "Pa", "internal_pressure": "Pa", "wall_tension": "N"}

@@ -1,8 +1,8 @@
-"""The sea around a riser: seabed, current, drag (made from the options by
-cli/scene_options.py), the current profile file, and the checks against the scene.
+"""The seabed under a line (made from the options by cli/scene_options.py): its
+elastic law, its friction, its stiffness bounds and the checks against the scene.
 
-z is up. The seabed is the plane z = height; the current a velocity field of z only
-(uniform, or a profile of depth below the sea surface). Every quantity in SI units.
+z is up. The seabed is the plane z = height, or a shape (bathymetry.py). Every quantity
+in SI units.
 """
 
 from dataclasses import dataclass
@@ -11,7 +11,6 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.boundary import is_held
-from petsc_rod.tables import numbered_rows, read_text
 
 # The default seabed stiffness lets the line's own weight press it this far in (m).
 DEFAULT_PENETRATION = 1e-3
@@ -24,7 +23,7 @@ MIN_RELATIVE_PENETRATION = 1e-14
 
 @dataclass(frozen=True)
 class Friction:
-    """Coulomb friction of the seabed (riser/friction.py, docs/riser.md §3b): the
+    """Coulomb friction of the seabed (physics/friction.py, docs/riser.md §3b): the
     coefficients along the line (``axial``) and across it (``lateral``), both positive,
     1; the stick stiffness ``stiffness`` (N/m per m of line per m of slip, N/m^2) of
     the elastic-perfectly-plastic spring that stands for the stick: a grounded point
@@ -38,7 +37,7 @@ class Friction:
 @dataclass(frozen=True)
 class Seabed:
     """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the plane z = ``height`` (m), or, with a ``shape``
-    (riser/bathymetry.py: a sloping Plane or a Profile), the surface z = z_b(x, y), its
+    (environment/bathymetry.py: a sloping Plane or a Profile), the surface z = z_b(x, y), its
     ``height`` then z_b under the scene's origin. It pushes a line below it out along
     its unit normal N = (-g, 1) / sqrt(1 + |g|^2) (g = grad z_b) with k times the normal
     penetration per metre of line, k = ``stiffness`` (N/m per m of line per m of
@@ -105,50 +104,6 @@ class Seabed:
                 / np.sqrt(1.0 + np.sum(g**2, axis=-1)))
 
 
-@dataclass(frozen=True)
-class Current:
-    """A steady current and the Morison drag coefficient of the line.
-
-    ``depths`` (m,) increasing depths below the sea surface z = ``surface`` and
-    ``velocities`` (m, 3) the current there (m/s), linear in between and constant
-    beyond the first and last rows; a uniform current is one row. ``drag`` is
-    c = rho C_d D / 2 (kg/m^2), so that the normal drag c |v_n| v_n is in N/m: made
-    from the command line's inputs rho, C_d, D by ``Current.morison`` (``uniform`` for
-    one velocity), as -rod_drag gives them.
-    """
-
-    depths: np.ndarray
-    velocities: np.ndarray
-    surface: float
-    drag: float
-
-    @classmethod
-    def morison(cls, depths, velocities, surface, water_density, cd, diameter):
-        """The current of ``depths`` (m,), m, ``velocities`` (m, 3), m/s, below the sea
-        surface z = ``surface`` (m) on a line of Morison normal drag coefficient ``cd``
-        (1) and hydrodynamic diameter ``diameter`` (m) in water of ``water_density``
-        (kg/m^3): drag c = rho C_d D / 2 (kg/m^2), as -rod_drag rho,Cd,D."""
-        return cls(np.asarray(depths, dtype=float).reshape(-1),
-                   np.asarray(velocities, dtype=float).reshape(-1, 3), float(surface),
-                   0.5 * float(water_density) * float(cd) * float(diameter))
-
-    @classmethod
-    def uniform(cls, velocity, water_density, cd, diameter, surface=0.0):
-        """A uniform current ``velocity`` (3,), m/s, with the drag of ``morison``; the
-        surface (m) only matters to a profile, kept for the record."""
-        return cls.morison([0.0], [velocity], surface, water_density, cd, diameter)
-
-    def velocity(self, z):
-        """The current at heights z (n,), (n, 3)."""
-        depth = self.surface - np.asarray(z, dtype=float)
-        return np.stack([np.interp(depth, self.depths, self.velocities[:, c])
-                         for c in range(3)], axis=-1)
-
-    def largest_drag(self):
-        """c max |v|^2 (N/m): the largest drag per metre the current can exert."""
-        return float(self.drag * np.max(np.sum(self.velocities**2, axis=1)))
-
-
 def default_stiffness(load_values):
     """k = w / DEFAULT_PENETRATION (N/m^2), w the largest downward load per metre over
     the load pieces (N/m): the line's own weight presses the seabed in by about 1 mm.
@@ -169,91 +124,6 @@ def largest_stiffness(applied_force, length):
     round-off of its height anyway, so nothing physical is refused.
     """
     return applied_force / length / (MIN_RELATIVE_PENETRATION * length)
-
-
-def read_profile(path, largest=np.inf):
-    """(depths (m,), velocities (m, 3)) from a text file of rows 'depth ux uy uz' (m,
-    m/s; '#' starts a comment), depths strictly increasing, every magnitude at most
-    ``largest`` (the bound of the options' numbers). RodInputError otherwise."""
-    def refuse(what):
-        raise RodInputError(f"-rod_current_profile {path}: {what}")
-
-    lines = read_text(path, "-rod_current_profile").splitlines()
-    rows = [line.split("#", 1)[0].replace(",", " ").split() for line in lines]
-    rows = [row for row in rows if row]
-    try:
-        table = np.array([[float(v) for v in row] for row in rows], dtype=float)
-    except ValueError:
-        refuse("expected rows of 4 numbers: depth (m), ux, uy, uz (m/s)")
-    if table.ndim != 2 or table.shape[0] == 0 or table.shape[1] != 4:
-        refuse("expected rows of 4 numbers: depth (m), ux, uy, uz (m/s)")
-    if not np.all(np.isfinite(table)):
-        refuse("holds a number that is not finite")
-    if np.any(np.abs(table) > largest):
-        row = int(np.flatnonzero(np.any(np.abs(table) > largest, axis=1))[0])
-        refuse(f"row {row + 1} holds a magnitude above {largest:g}, which the solver cannot "
-               "carry through products such as the drag c |v|^2; give depths in m and "
-               "velocities in m/s")
-    if np.any(np.diff(table[:, 0]) <= 0):
-        refuse("the depths must increase strictly from row to row")
-    return table[:, 0], table[:, 1:]
-
-
-def read_seabed_profile(path, largest=np.inf):
-    """The rows of a seabed profile or grid file, (n, 2) 'distance height' or (n, 3)
-    'x y height' (m; '#' starts a comment, commas allowed; x, y from the seabed origin,
-    heights absolute): every row of the same count, at least two rows, every magnitude at
-    most ``largest``; a profile's distances strictly increasing (a height for each
-    distance: the profile is a function), a grid checked by ``grid_axes``.
-    RodInputError otherwise, naming the line."""
-    def refuse(what):
-        raise RodInputError(f"-rod_seabed_profile {path}: {what}")
-
-    rows = numbered_rows(path, "-rod_seabed_profile")
-    expected = ("expected rows of 2 numbers, distance along -rod_seabed_direction from "
-                "-rod_seabed_origin (m) and height (m, z up), or of 3, x, y from the "
-                "seabed origin and height (a grid)")
-    table = []
-    for k, row in rows:
-        try:
-            values = [float(v) for v in row]
-        except ValueError:
-            refuse(f"line {k} '{' '.join(row)}': {expected}")
-        if len(values) not in (2, 3) or (table and len(values) != len(table[0][1])):
-            refuse(f"line {k} '{' '.join(row)}': {expected}, the same in every row")
-        if not np.all(np.isfinite(values)) or np.any(np.abs(values) > largest):
-            refuse(f"line {k}: a number that is not finite or above {largest:g} in "
-                   "magnitude; give distances and heights in m")
-        table.append((k, values))
-    if len(table) < 2:
-        refuse(f"needs at least 2 rows; {expected}")
-    lines_of, data = [k for k, _ in table], np.array([v for _, v in table])
-    if data.shape[1] == 3:
-        grid_axes(data, refuse)
-        return data
-    steps = np.diff(data[:, 0])
-    if np.any(steps <= 0):
-        i = int(np.flatnonzero(steps <= 0)[0])
-        refuse(f"line {lines_of[i + 1]}: distance {data[i + 1, 0]:g} m after "
-               f"{data[i, 0]:g} m; the distances must increase strictly from row to row "
-               "(a seabed profile is one height per distance; sort the rows and drop "
-               "repeated distances)")
-    return data
-
-
-def grid_axes(table, refuse):
-    """(xs (nx,), ys (ny,), heights (nx, ny)) of grid rows 'x y height' (n, 3) in any
-    order, every x with every y exactly once, at least 2 of each; else refuse(what)."""
-    xs, ys = np.unique(table[:, 0]), np.unique(table[:, 1])
-    order = np.lexsort((table[:, 1], table[:, 0]))
-    ordered = table[order]
-    if (xs.size < 2 or ys.size < 2 or len(table) != xs.size * ys.size
-            or np.any(ordered[:, 0] != np.repeat(xs, ys.size))
-            or np.any(ordered[:, 1] != np.tile(ys, xs.size))):
-        refuse(f"a grid's rows must hold every x with every y exactly once, at least 2 of "
-               f"each (found {xs.size} x values, {ys.size} y values and {len(table)} rows; "
-               f"a full grid of them has {xs.size * ys.size})")
-    return xs, ys, ordered[:, 2].reshape(xs.size, ys.size)
 
 
 def check_ends_above(seabed, ends, length, origin_z=0.0):

@@ -1,6 +1,6 @@
 """The horizontal part of the contact force of a seabed that is not flat (a slope, a
 profile; docs/riser.md §3a), as a nodal load of the iterate beside the seabed's
-vertical problem (seabed.py).
+vertical problem (global_step/seabed_contact.py).
 
 At node n, with p_n = (z_b(x_n, y_n) - z_n)_+ the vertical penetration, g_n = grad z_b
 and k_n = k / (1 + |g_n|^2), the seabed pushes along its normal with
@@ -9,7 +9,7 @@ implicit in the vertical problem, the horizontal part
 
     f_h,n = -k_n p_n g_n    (N/m; N tan(theta) down the slope, N = k_n p_n / cos(theta))
 
-enters the slope problem's right-hand side like the drag (terms.NodalLoadTerm), from
+enters the slope problem's right-hand side like the drag (nodal_load.NodalLoadTerm), from
 the positions of the last global step. Why lagged, and why that is stable: its
 sensitivity to the iterate is that of the reaction k_n p_n, which the vertical problem
 fixes from the line's equilibrium rather than from k, times tan(theta); an error dx of
@@ -22,8 +22,8 @@ would need its derivatives in x and y, which they do not have: the term says so
 (``conservative``, ``in_newton`` False), so the run takes neither.
 """
 
-from petsc_rod.riser.loads import NodalLoad
-from petsc_rod.riser.terms import NodalLoadTerm
+from petsc_rod.global_step.nodal_loads import NodalLoad
+from petsc_rod.physics.nodal_load import NodalLoadTerm
 
 
 class SeabedSlopeLoad(NodalLoadTerm):
@@ -35,13 +35,13 @@ class SeabedSlopeLoad(NodalLoadTerm):
 
     def __init__(self, mesh, contact):
         super().__init__(mesh, "seabed_slope")
-        self.contact = contact                  # the SeabedTerm (riser/terms.py)
+        self.contact = contact                  # the SeabedTerm (seabed.py)
         self.seabed = contact.seabed            # environment.Seabed, not flat
         self.load = NodalLoad(mesh, self._nodes)
 
     def node_loads(self, state):
         """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of
-        the last vertical solve (seabed.SeabedContact.node_force). Zero before the first
+        the last vertical solve (seabed_contact.SeabedContact.node_force). Zero before the first
         solve: the start's own penetration (a straight start under a rising seabed:
         metres) is not a reaction, and k times it would throw the first iterate far away
         (measured: diverged at iteration 1). Collective."""
@@ -52,7 +52,7 @@ class SeabedSlopeLoad(NodalLoadTerm):
     def add_iterate_load(self, rhs, state):
         """Add int F.g of f_h to the slope problem's right-hand side, then move the
         seabed's heights and springs under the nodes of the last global step for this
-        step's vertical solve (seabed.SeabedContact.follow; this term is built after the
+        step's vertical solve (seabed_contact.SeabedContact.follow; this term is built after the
         seabed's, and add_iterate_load comes before every solve of the global step)."""
         self.load.set(self.node_loads(state))
         self.add_to_rhs(rhs, self.load)

@@ -1,6 +1,6 @@
 """A component of the slope problem in Hermite dofs, where a spring on that coordinate
 of the nodes is banded (docs/riser.md, "The seabed in the global step"): z for the
-seabed, x and y for its friction (friction.py). Written below for z.
+seabed, x and y for its friction (physics/friction.py). Written below for z.
 
 The global step solves for the slope r' (P2), not for r (docs/method.md §4). A
 seabed spring acts on z = z(a) + int_a^S r'_z, a non-local function of the slope: its

@@ -18,7 +18,7 @@ node the height z_b,n = z_b(x_n, y_n) and the vertical stiffness k_n = k / (1 + 
 at the node's horizontal position of the last global step (``follow``, lagged like the
 drag's depths): E_s = 1/2 sum_n k_n w_n (z_b,n - z_n)_+^2, the same loop. The
 horizontal part of the normal force, -k_n (z_b,n - z_n)_+ g_n, is a nodal load of the
-iterate (slope_load.py). On a plane k_n is constant and only the right-hand side
+iterate (physics/slope_load.py). On a plane k_n is constant and only the right-hand side
 follows the line; on a profile the matrix is rebuilt when a node's k_n changes (it
 crosses a row). Why implicit: the iteration's compliance to a load on a
 stretch l of line is about l^2 / R, so an explicit (lagged) spring k is amplified
@@ -28,8 +28,8 @@ within a millimetre (measured in docs/riser.md).
 
 import numpy as np
 
+from petsc_rod.global_step.hermite import midpoint_values
 from petsc_rod.mesh.elements import NODE_WEIGHTS
-from petsc_rod.riser.hermite import midpoint_values
 
 # The active-set loop of one global step ends after this many solves even if the set
 # still changes; the next iteration starts from the last set (a cycle between two sets
@@ -180,7 +180,7 @@ class SeabedContact:
         seabed that is not flat: the normal force with the penetration of the last
         vertical solve's heights z_n under the z_b,n, k_n, g_n it was solved with (the
         ``follow`` before it), so that it is the reaction that problem carried
-        (slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
+        (physics/slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
         start; a contact rebuilt at a penalty raise: one iteration without the push)."""
         if self.gradients is None or self.solution is None:
             return np.zeros((self.mesh.n_local_nodes, 3))

@@ -9,7 +9,7 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 import numpy as np
 
 from petsc_rod.physics.term import ReportTerm, TermOutput
-from petsc_rod.riser.quantities import effective_tension
+from petsc_rod.reports.riser_numbers import effective_tension
 from petsc_rod.scenes.line import section_index
 
 DATASET_UNITS = {"section": "1"}

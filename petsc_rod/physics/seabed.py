@@ -1,0 +1,115 @@
+"""The seabed as a term of physics (physics/term.py; docs/riser.md), built only for a
+scene that has one (problem/build.py).
+
+The seabed is part of the global step: the z slope is solved in Hermite dofs with the
+contact by an active-set loop (global_step/hermite.py, global_step/seabed_contact.py) in
+place of the z component of the P2 solve (which then solves x and y only); when both
+ends are held, the z part of the chord multiplier is that problem's residual at z(L).
+
+The seabed is in the Newton steps (docs/method.md §11): its energy is a function of the
+node heights, so its gradient in the slopes is the adjoint of their integral
+(analysis/positions.position_gradient) and its curvature k w_n on the active nodes enters
+the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
+semi-smooth Newton step, the active set that of the iterate.
+"""
+
+import numpy as np
+
+from petsc_rod.analysis.positions import HEIGHT
+from petsc_rod.global_step.hermite import HermiteProblem
+from petsc_rod.global_step.seabed_contact import SeabedContact
+from petsc_rod.physics.nodal_load import NodalLoadTerm
+
+# The KSP options prefix of the vertical (seabed) problem.
+VERTICAL_PREFIX = "rod_z_"
+
+
+class SeabedTerm(NodalLoadTerm):
+    """A flat elastic seabed (environment.Seabed) under the line: the z slope solved with
+    the contact (module docstring); its energy k/2 sum_n w_n (z_b - z_n)_+^2."""
+
+    slope_components = (HEIGHT,)
+    position_components = (HEIGHT,)
+
+    def __init__(self, mesh, seabed):
+        super().__init__(mesh, "seabed")
+        self.seabed = seabed
+        self.vertical = self.contact = None
+
+    def build(self, slope_matrices, penalty):
+        """The vertical problem with the slope problem's element matrices 2 c3 K + R W
+        (ne, 3, 3): at the start and after every penalty raise."""
+        self._destroy_vertical()
+        self.vertical = HermiteProblem(self.mesh, slope_matrices, VERTICAL_PREFIX)
+        self.contact = SeabedContact(self.mesh, self.seabed, self.vertical)
+        if self.start_state is not None:
+            self.vertical.set_end_states(self.start_state, self.end_state)
+
+    def ksps(self):
+        return [self.vertical.ksp]
+
+    def prepare(self, t, start, end):
+        super().prepare(t, start, end)
+        self.vertical.set_end_states(start, end)
+
+    def solve_slope(self, rhs, state, bordered):
+        """z' from the vertical problem with the contact (seabed_contact.SeabedContact.solve; on a
+        flat seabed its first active set from the state's positions: on the matrix's
+        riser on a seabed sloping 3 deg across its plane, whose grounded part slides
+        down the slope from its catenary, the iteration then stagnated for 1200
+        iterations, against 80 from an empty set, docs/riser.md)."""
+        start = (state.r.ghosted() if self.contact.active is None and self.seabed.flat
+                 else None)
+        self.contact.solve(rhs.components[2], state.slope.components[2], start)
+        if bordered:
+            state.chord_multiplier[2] = self.vertical.end_residual()
+
+    def _height_derivatives(self, state):
+        """dE_s/dz_n = -k w_n (z_b - z_n)_+ and d2E_s/dz_n^2 = k w_n [z_n < z_b] at the owned
+        nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline (on
+        a flat seabed: the Newton steps are not taken on another, slope_load.py)."""
+        gap = self.seabed.height - state.node_positions()[:, 2]
+        spring = self.seabed.stiffness * state.node_weights * (gap > 0)
+        return -spring * gap, spring
+
+    def energy(self, state):
+        """E_s = sum_n w_n k_v,n / 2 (z_b,n - z_n)_+^2 at the state's centreline, J, with
+        z_b,n and k_v,n under each node (environment.Seabed; k_v = k on a flat seabed).
+        Collective."""
+        r = state.node_positions()
+        gap = np.maximum(-self.seabed.gap(r), 0.0)
+        stiffness = self.seabed.vertical_stiffness(self.seabed.gradients(r[:, 0], r[:, 1]))
+        return float(self.mesh.global_sum(0.5 * np.sum(stiffness * state.node_weights
+                                                       * gap**2)))
+
+    def add_gradient(self, g, state):
+        """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; the
+        state's r is that of its fields (RodProblem.energy_gradient). Collective."""
+        self.add_position_gradient(g, state, {HEIGHT: self._height_derivatives(state)[0]})
+
+    def add_hessian(self, hessian):
+        """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
+        its gradient gives through the multipliers)."""
+        hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
+
+    def pressure(self, z):
+        """The seabed's upward force per metre (N/m) at heights z."""
+        return self.contact.pressure(z)
+
+    def node_loads(self, state):
+        loads = np.zeros((self.mesh.n_local_nodes, 3))
+        if self.seabed.flat or self.contact.solution is None:
+            loads[:, 2] = self.seabed.force(state.node_positions())[:, 2]
+        else:                           # a slope: the reaction the vertical problem carried
+            loads[:, 2] = self.contact.node_force()[:, 2]
+        return loads
+
+    def _destroy_vertical(self):
+        if self.vertical is not None:
+            self.contact.destroy()
+            self.vertical.destroy()
+        self.vertical = self.contact = None
+
+    def destroy(self):
+        self._destroy_vertical()
+        super().destroy()
