@@ -36,9 +36,8 @@ A solve is a local solve, an allgather of 2 B k numbers a rank (k right-hand sid
 dense product with S^-1 and x_I -= W x_G: the work of the serial factorisation divided
 by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
 factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
-scalable to many), where MUMPS on several ranks factors these chains no faster than on
-one (docs/performance.md, "Newton steps"). The ChainFactor owns its PETSc
-objects (the interior submatrix, on the first rank of an LDL^T a reference to the
+scalable to many; the costs: docs/performance.md, "Newton steps"). The ChainFactor owns
+its PETSc objects (the interior submatrix, on the first rank of an LDL^T a reference to the
 diagonal block itself, and its sequential MUMPS solver, the index set of the interior
 rows where it is not the whole block): ``destroy()``.
 """
