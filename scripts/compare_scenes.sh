@@ -11,10 +11,14 @@
 # for bit) and each exit code with BASELINE/runs.tsv. SCENE names (e.g. twist) restrict
 # the run to those scenes; RANKS="1" runs on one rank only.
 # Exit 0 when every run's file and exit code match the baseline, 1 otherwise.
+# The stability matrix is compared apart (it takes minutes, and writes its table into
+# the document it is given):
+#   python scripts/stability_matrix.py --out DIR --document COPY_OF_docs/stability.md
+#   python scripts/compare_matrix.py BASELINE/matrix/cases.csv DIR/cases.csv
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if [ $# -lt 1 ]; then
-  sed -n '2,14p' "$0"; exit 2
+  sed -n '2,18p' "$0"; exit 2
 fi
 OUT="$(mkdir -p "$1" && cd "$1" && pwd)"; shift
 BASELINE=""

@@ -167,3 +167,32 @@ def png_summary(path):
 
     pixels = matplotlib.image.imread(str(path))[..., :3]
     return pixels.shape[0], pixels.shape[1], float(np.mean(np.any(pixels < 0.95, axis=-1)))
+
+
+# The first lines of a script in which rank 1 alone raises while it computes its first
+# step's record (io.outputs.step_record), after the result file was opened; the ranks
+# wait 2 s for each other (cli.main.FAILURE_WAIT) before rank 1 takes the failure as
+# its own.
+ONE_RANK_FAILS = """
+import sys
+import petsc4py
+petsc4py.init(sys.argv)
+from petsc4py import PETSc
+from petsc_rod.cli import main
+from petsc_rod.io import outputs
+main.FAILURE_WAIT = 2.0
+if PETSc.COMM_WORLD.getRank() == 1:
+    def step_record(*args, **kwargs):
+        raise FloatingPointError("injected on rank 1")
+    outputs.step_record = step_record
+"""
+
+
+def run_failing_on_rank_1(script, body, args, timeout=60):
+    """Write ONE_RANK_FAILS + ``body`` to ``script`` and run it on 2 ranks with ``args``
+    from the repository, this tree's petsc_rod first on the path; CompletedProcess."""
+    script.write_text(ONE_RANK_FAILS + body)
+    env = {**child_env(), "PYTHONPATH": str(REPO_ROOT)}
+    return subprocess.run(mpiexec(2) + [sys.executable, str(script)] + list(args),
+                          cwd=REPO_ROOT, env=env, capture_output=True, text=True,
+                          timeout=timeout, check=False)

@@ -11,10 +11,11 @@ import numpy as np
 
 from petsc_rod.api.model import Model
 from petsc_rod.api.results import Results
-from petsc_rod.cli.main import (build_solver, check_mesh, destroy_run, run_record,
-                                start_from)
+from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
+                                destroy_run, every_rank_failed, run_record, start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
-from petsc_rod.cli.scene_options import mesh_pieces, scene_from_options, settings_from_options
+from petsc_rod.cli.scene_options import (check_stability_asked, mesh_pieces, scene_from_options,
+                                         settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodInputError, on_every_rank
 from petsc_rod.io import outputs
@@ -178,6 +179,7 @@ def solve(model, comm=None, output=None, say=None):
     try:
         scene, values, given = on_every_rank(comm, scene_of, model)
         settings = settings_from_options(values, scene)
+        check_stability_asked(values, scene, given)
         pieces = mesh_pieces(values, scene)
     except RodInputError as error:
         raise in_model_terms(error) from None
@@ -188,6 +190,8 @@ def solve(model, comm=None, output=None, say=None):
         io.check_output_path(output, comm)
     mesh = problem = solver = keeper = None
     say = say or (lambda line: None)
+    # where the ranks agree on a failure (made now: creating it is collective)
+    failures = comm.tompi4py().Dup()
     try:
         mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                     pieces)
@@ -207,7 +211,14 @@ def solve(model, comm=None, output=None, say=None):
         keeper.inner = None                     # finished
         return Results(keeper.vertex, keeper.attributes, result.converged,
                        comm.tompi4py(), mesh.n_elements)
+    except Exception as error:
+        # one rank's alone (a numpy error, say): the others wait in a collective call
+        if not every_rank_failed(failures):
+            inner = keeper.inner if keeper is not None else None
+            abort_alone(comm, alone_failure(comm, error), getattr(inner, "partial", None))
+        raise
     finally:
         if keeper is not None:
             keeper.abort()
         destroy_run(solver, problem, mesh)
+        failures.Free()

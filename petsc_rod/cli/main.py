@@ -20,8 +20,9 @@ from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_ande
                                    check_substructuring_switches, format_value,
                                    help_text, read_options, unused_options)
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.cli.scene_options import (mesh_pieces, restart_path, rounded_down,
-                                         scene_from_options, settings_from_options)
+from petsc_rod.cli.scene_options import (check_stability_asked, mesh_pieces, restart_path,
+                                         rounded_down, scene_from_options,
+                                         settings_from_options)
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.environment.profiles import read_seabed_profile
@@ -84,6 +85,7 @@ def run(comm=None):
                 and (settings.newton or settings.check_stability)),
                 None if pieces is None or "rod_elements" in given else
                 f"-rod_sections ({values['rod_elements']} elements in all)")
+            check_stability_asked(values, scene, given)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:
@@ -134,6 +136,10 @@ def run(comm=None):
             say(f"petsc_rod: error: {petsc_failure(error)}")
             database.setValue("options_left", "0")
             return RodDivergedError.exit_code
+        except Exception as error:          # a numpy error, say: one rank's or every rank's
+            if not every_rank_failed(failures):
+                abort_alone(comm, alone_failure(comm, error), getattr(writer, "partial", None))
+            raise                           # every rank's: the partial file goes in finally
         finally:
             if writer is not None:          # any failure before the file was finished
                 writer.abort()
@@ -163,12 +169,20 @@ def petsc_failure(error):
             f"{solvers} options")
 
 
-def every_rank_failed(failures, wait=FAILURE_WAIT):
+def alone_failure(comm, error):
+    """The one line of an exception other than RodError and PETSc.Error (a numpy error,
+    say) that only this rank raised: the other ranks cannot be told, the run is aborted."""
+    words = f"{type(error).__name__}: {error}".splitlines()[0]
+    return (f"rank {comm.getRank()} failed alone ({words}); the other ranks wait in a "
+            "collective call and cannot be told, so the run is aborted and writes no result")
+
+
+def every_rank_failed(failures, wait=None):
     """Whether every rank of communicator ``failures`` (used for nothing else) reaches
-    this call within ``wait`` seconds, as all do after a PETSc error that every rank
-    raised; a rank-local error leaves the others inside a collective call of PETSc's."""
+    this call within ``wait`` seconds (None: FAILURE_WAIT), as all do after an error that
+    every rank raised; a rank-local error leaves the others inside a collective call."""
     request = failures.Ibarrier()
-    deadline = time.monotonic() + wait
+    deadline = time.monotonic() + (FAILURE_WAIT if wait is None else wait)
     while not request.Test():
         if time.monotonic() > deadline:
             return False

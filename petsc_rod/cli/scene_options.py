@@ -375,6 +375,9 @@ def check_applied_forces(scene, given):
 
 
 def settings_from_options(values, scene):
+    """The iteration's Settings of the options; a line stretched beyond the model of
+    stretch is refused (check_stretch_domain)."""
+    check_stretch_domain(scene)
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene))
@@ -384,6 +387,70 @@ def settings_from_options(values, scene):
                     adapt_penalty=values["rod_al_adapt_penalty"],
                     check_stability=values["rod_al_stability"],
                     newton=values["rod_al_newton"])
+
+
+# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
+# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
+# line material.
+MAX_STRAIN = 1.0
+
+
+def least_top_strain(scene):
+    """The least strain at the higher held end in any equilibrium of a uniform
+    extensible flexible line (a bending stiffness's shear moves it a little: about, for
+    a rod) under a uniform dead load w (N/m of unstretched line), its held ends h apart
+    along the load (m), or None where it does not apply (sections,
+    a free end, attachments, load pieces that differ, a seabed that is not flat or not
+    across the load). Along the suspended line d(T + T^2 / 2EA) = w dz (the cable's
+    balance along its tangent; a current's normal drag has no part along it), from the
+    lowest point (a touchdown, or below the lower end) to the top, T >= 0 there:
+    eps >= sqrt(1 + 2 w h / EA) - 1. Returns (eps, w h)."""
+    if (scene.sections or not np.isfinite(scene.axial_stiffness) or scene.start == "free"
+            or scene.end == "free" or scene.point_load_S.size):
+        return None
+    loads = scene.load_values
+    weight = float(np.linalg.norm(loads[0]))
+    if weight == 0.0 or not np.all(loads == loads[0]):
+        return None
+    down = loads[0] / weight
+    if scene.seabed is not None and not (scene.seabed.flat and down[2] == -1.0):
+        return None
+    height = abs(float((scene.end_position - scene.start_state(1.0).position) @ down))
+    return (float(np.sqrt(1.0 + 2.0 * weight * height / scene.axial_stiffness) - 1.0),
+            weight * height)
+
+
+def check_stretch_domain(scene):
+    """Refuse a uniform extensible line that every equilibrium stretches by more than
+    MAX_STRAIN at its top (least_top_strain), outside the domain of the model of
+    stretch."""
+    least = least_top_strain(scene)
+    if least is not None and least[0] > MAX_STRAIN:
+        raise RodInputError(
+            f"-rod_axial_stiffness {scene.axial_stiffness:g}: any equilibrium stretches the "
+            f"line by about {100 * least[0]:.3g} % or more at its top (a flexible cable's "
+            f"T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load times the ends' height "
+            f"apart), above {100 * MAX_STRAIN:g} %, where the linear stretch models no line "
+            "material; check EA (in N), or leave the line inextensible")
+
+
+def check_stability_asked(values, scene, given):
+    """Refuse -rod_al_stability 1, given, with a current or seabed friction: the test of
+    the second variation of the energy (docs/method.md §10) needs every load to have an
+    energy, and a current's drag (a follower load) has none, nor friction (it
+    dissipates); the default (true) is then left out in silence, as documented."""
+    if "rod_al_stability" not in given or not values["rod_al_stability"]:
+        return
+    if scene.current is not None:
+        option, load, reason = _current_option(given), "a current", "its drag is a follower load"
+    elif scene.seabed is not None and scene.seabed.friction is not None:
+        option, load, reason = "-rod_seabed_friction", "friction", "it dissipates"
+    else:
+        return
+    raise RodInputError(f"-rod_al_stability 1 with {option}: the stability test is of the "
+                        f"second variation of the energy, and {load} has none ({reason}); "
+                        f"drop -rod_al_stability (a run with {load} gives no stability "
+                        f"verdict), or test the scene without {load}")
 
 
 def start_tension(values, scene):
@@ -621,7 +688,7 @@ def check_uniform_line_under_surface(values, given, held, z0):
     """Refuse -rod_sea_surface below a held end of a uniform line (-rod_load): the part
     above it would keep the submerged weight and the current's drag it has not in the
     air, and -rod_load gives no diameter and mass to take them off (a line of sections
-    does, riser/terms.py SurfaceTerm). ``held`` the held ends' heights and the surface
+    does, physics/surface.py SurfaceTerm). ``held`` the held ends' heights and the surface
     in ``values`` in the scene's frame, ``z0`` the start's height (m)."""
     surface = values["rod_sea_surface"]
     if "rod_sea_surface" not in given or surface is None or not max(held) > surface:

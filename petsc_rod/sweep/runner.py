@@ -21,6 +21,7 @@ import difflib
 import fcntl
 import json
 import os
+import re
 import sys
 from dataclasses import dataclass
 
@@ -202,6 +203,39 @@ def previous_files(folder):
     return entries, set(SWEEP_FILES).union(*(case_files(str(name)) for name in names))
 
 
+# A run's partial file (io.results.partial_name: the file, rank 0's pid, a tag) and the
+# temporary file of a summary being written whole (io.same_file.write_whole).
+RUN_PARTIAL = re.compile(r"(?P<file>.+)\.(?P<pid>\d+)-[0-9a-f]{6}\.partial")
+SUMMARY_PARTIAL = re.compile(r"\.(?P<file>.+)\.[^.]+\.partial\.(?:csv|md|json)")
+
+
+def process_alive(pid):
+    """Whether a process ``pid`` runs on this machine (one of another user's counts)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def left_partials(entries, files):
+    """(stale, live): the partial files among ``entries`` (names) of the sweep files
+    ``files`` (its own and its cases' names, case_files), those a killed sweep or run
+    left (its process gone: the folder's lock keeps every other sweep out) and those
+    whose run's process still lives."""
+    stale, live = [], []
+    for entry in entries:
+        run_partial = RUN_PARTIAL.fullmatch(entry)
+        summary_partial = SUMMARY_PARTIAL.fullmatch(entry)
+        if run_partial and run_partial["file"] in files:
+            (live if process_alive(int(run_partial["pid"])) else stale).append(entry)
+        elif summary_partial and summary_partial["file"] in SWEEP_FILES:
+            stale.append(entry)
+    return stale, live
+
+
 def _claim_folder(folder, cases, inputs):
     """Rank 0's part of claim_folder; returns the locked descriptor of the folder."""
     where = f"-sweep_output {folder}"
@@ -222,7 +256,16 @@ def _claim_folder(folder, cases, inputs):
         except OSError as error:
             raise RodInputError(f"{where}: cannot be listed ({error.strerror}); choose "
                                 "another folder") from None
-        strangers = [name for name in entries if ours is None or name not in ours]
+        # a killed sweep's partial files, by the names of its cases or of this sweep's
+        stale, live = left_partials(entries, (ours or set()).union(
+            SWEEP_FILES, *(case_files(case.name) for case in cases)))
+        if live:
+            raise RodInputError(
+                f"{where}: holds {live[0]}, the partial file of a run that is still running "
+                f"(process {RUN_PARTIAL.fullmatch(live[0])['pid']}); wait for it to end, or "
+                "choose another folder")
+        strangers = [name for name in entries
+                     if name not in stale and (ours is None or name not in ours)]
         if strangers:
             raise RodInputError(
                 f"{where}: holds {strangers[0]}"
@@ -257,8 +300,9 @@ def claim_folder(comm, folder, cases, inputs):
     only when they are an earlier sweep's (its sweep.json's cases' files and its
     summary), which are then removed, so that every file in the folder is in this
     sweep's summary; no file removed or written may be an input (``inputs``:
-    input_files). Collective; returns rank 0's lock (a descriptor to close), else
-    None."""
+    input_files). The partial files a killed sweep left, of its cases or of this sweep's
+    (left_partials), are its files too. Collective; returns rank 0's lock (a descriptor
+    to close), else None."""
     return on_every_rank(comm, _claim_folder if comm.getRank() == 0 else lambda *a: None,
                          folder, cases, inputs)
 

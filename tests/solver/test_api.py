@@ -196,3 +196,11 @@ def test_a_refusal_names_the_model_s_fields_not_options(change, words):
     with pytest.raises(RodInputError) as error:
         solve(model(**change))
     assert words in str(error.value) and "-rod_" not in str(error.value), str(error.value)
+
+
+def test_a_stability_test_asked_with_a_current_is_refused():
+    """Model.options al_stability True beside the model's current (a drag without an
+    energy) is refused as the command line refuses -rod_al_stability 1 with it."""
+    with pytest.raises(RodInputError, match="a current has none") as refused:
+        solve(model(options={"al_stability": True}))
+    assert "al_stability" in str(refused.value) and "Environment.current" in str(refused.value)

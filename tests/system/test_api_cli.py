@@ -11,7 +11,8 @@ import sys
 import h5py
 import pytest
 
-from helpers import REPO_ROOT, child_env, describe, mpiexec, run_petsc_rod
+from helpers import (REPO_ROOT, child_env, describe, mpiexec, partial_files,
+                     run_failing_on_rank_1, run_petsc_rod)
 from test_cli import readme_python_blocks
 
 pytestmark = pytest.mark.serial
@@ -51,3 +52,28 @@ assert along["S"].shape == (1001,) and study[400.0].units["effective_tension"] =
         cli = {name: float(f.attrs[name]) for name in NUMBERS}
     for name in NUMBERS:
         assert study["400.0"][name] == pytest.approx(cli[name], rel=1e-9, abs=1e-9), name
+
+
+# with rank 1 failing alone (helpers.ONE_RANK_FAILS), a small line through api.solve
+API_RUN = """
+from petsc_rod.api import End, Line, LineType, Model, solve
+pipe = LineType("pipe", od=0.2, mass=60.0, ei=1e5, gj=8e4)
+model = Model(line=Line([(pipe, 100.0)], element_length=5.0),
+              start=End.anchor((0.0, 0.0, 0.0)), end=End.hang_off((80.0, 0.0, 30.0)),
+              initial_shape="catenary")
+solve(model, output=sys.argv[1])
+"""
+
+
+def test_an_exception_on_one_rank_alone_ends_the_api_without_a_file(tmp_path):
+    """api.solve with a result file, an exception other than a RodError raised on one
+    rank only: every rank ends (no hang) with the failing rank's one line, exit 4, and
+    neither the result nor its partial file is left."""
+    path = tmp_path / "out.h5"
+    done = run_failing_on_rank_1(tmp_path / "api_one_rank_fails.py", API_RUN, [str(path)])
+    assert done.returncode == 4, describe(done)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
+    assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
+        describe(done)
+    assert "Traceback" not in done.stdout + done.stderr, describe(done)
+    assert not path.exists() and not partial_files(path)

@@ -17,7 +17,8 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, child_env, mpiexec, partial_files, petsc_rod_command, run_petsc_rod
+from helpers import (REPO_ROOT, child_env, mpiexec, partial_files, petsc_rod_command,
+                     run_failing_on_rank_1, run_petsc_rod)
 
 pytestmark = pytest.mark.serial
 
@@ -350,6 +351,25 @@ def test_a_petsc_error_inside_a_solve_exits_4_with_one_line(tmp_path, options, r
     done = run(CANTILEVER + options + ["-rod_output", str(path)], ranks)
     assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 4,
                                      ["PETSc failed during the solve", "-rod_snes_*"], path)
+
+
+# with rank 1 failing alone (helpers.ONE_RANK_FAILS), the command line's run
+CLI_RUN = """
+sys.exit(main.run())
+"""
+
+
+def test_an_exception_on_one_rank_alone_ends_the_run_without_a_file(tmp_path):
+    """An exception other than a RodError or PETSc error (a numpy error, say) raised on
+    one rank only, while the other writes: the run ends (no hang) with the failing rank's
+    one line and exit 4, and neither the result nor its partial file is left."""
+    path = tmp_path / "out.h5"
+    done = run_failing_on_rank_1(tmp_path / "one_rank_fails.py", CLI_RUN,
+                                 CANTILEVER + ["-rod_output", str(path)])
+    assert_one_line_and_nothing_left(done.returncode, done.stdout, 4,
+                                     ["rank 1 failed alone", "FloatingPointError",
+                                      "injected on rank 1"], path)
+    assert "Traceback" not in done.stderr, describe(done.returncode, done.stderr)
 
 
 def test_ranks_given_different_options_exit_2_without_hanging(tmp_path):

@@ -417,3 +417,55 @@ def test_a_current_drags_only_the_line_under_the_surface(tmp_path):
     S_b = brentq(lambda S: (np.hypot(H, V0 + w * S) - np.hypot(H, V0)) / w - 15.0, 1.0, 100.0)
     lateral = attributes["start_force"][1] + attributes["end_force"][1]
     assert lateral == pytest.approx(51.25 * 0.05**2 * S_b, rel=1e-3)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("args, words", [
+    (["-options_file", "options/riser_catenary.opts", "-rod_elements", "40",
+      "-rod_current", "0,1,0"], ["-rod_current", "a current has none", "drop -rod_al_stability"]),
+    (["-options_file", "options/mooring_chain.opts", "-rod_seabed_friction", "0.5"],
+     ["-rod_seabed_friction", "friction has none", "drop -rod_al_stability"]),
+], ids=["current", "friction"])
+def test_a_stability_test_asked_for_a_scene_without_energy_is_refused(tmp_path, args,
+                                                                       words, ranks):
+    """-rod_al_stability 1 given with a current or seabed friction (loads without an
+    energy, which the test cannot take) is refused in one line, not left out in silence."""
+    path = tmp_path / "out.h5"
+    done = run(args + ["-rod_al_stability", "1", "-rod_output", str(path)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
+def test_a_current_without_a_stability_switch_still_runs(tmp_path):
+    """The default -rod_al_stability (true) with a current is no refusal: the run goes
+    (here ended by its iteration budget, exit 3)."""
+    done = run(["-options_file", "options/riser_catenary.opts", "-rod_elements", "40",
+                "-rod_current", "0,1,0", "-rod_al_max_it", "3", "-rod_max_halvings", "0"])
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert "-rod_al_stability" not in done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("ranks, stiffness, words", [
+    (1, "1e3", ["-rod_axial_stiffness 1000", "about 4.8e+03 % or more", "w h = 1.2e+06 N"]),
+    (2, "1e3", ["-rod_axial_stiffness 1000", "about 4.8e+03 % or more", "w h = 1.2e+06 N"]),
+    (1, "3e5", ["-rod_axial_stiffness 300000", "about 200 % or more", "above 100 %"]),
+], ids=["1e3-1", "1e3-2", "3e5-1"])
+def test_a_stretch_beyond_the_lines_length_is_refused(tmp_path, ranks, stiffness, words):
+    """The riser (1200 N/m, ends 1000 m apart in height) given EA 1e3 N: any equilibrium
+    stretches it by 4800 % at the top (T + T^2/2EA >= w h; the run spent minutes to exit
+    3); EA 3e5 N by 200 % (the run converged with 595 kN at the top, 198 %): refused
+    in one line on every rank, before any work."""
+    path = tmp_path / "out.h5"
+    done = run(["-options_file", "options/riser_catenary.opts", "-rod_axial_stiffness",
+                stiffness, "-rod_output", str(path)], ranks)
+    assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
+                                     path)
+
+
+def test_a_soft_line_within_the_stretch_domain_still_runs():
+    """EA 1e6 N on that riser (84 % by the bound; the run converges with 852 kN at the
+    top, 85 %) is no refusal: the run goes (here ended by its iteration budget, exit 3)."""
+    done = run(["-options_file", "options/riser_catenary.opts", "-rod_elements", "40",
+                "-rod_axial_stiffness", "1e6", "-rod_al_max_it", "3", "-rod_max_halvings", "0"])
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert "stretches the" not in done.stdout + done.stderr

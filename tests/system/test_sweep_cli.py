@@ -387,3 +387,67 @@ def test_a_folder_not_a_sweeps_or_holding_an_input_is_refused(tmp_path):
     finally:
         os.close(lock)
     assert (folder / "a.h5").read_bytes() == result
+
+
+@pytest.mark.serial
+def test_a_sweep_killed_mid_case_can_be_run_again_into_its_folder(tmp_path):
+    """A sweep killed outright (SIGKILL) while its first case writes leaves that case's
+    partial file: the same sweep run again into the folder removes it (its case's, its
+    process gone) and runs; a partial file of another name stays a stranger, and one of
+    a live process (pid 1) is refused as a run still running."""
+    import signal
+    import time
+
+    folder = tmp_path / "out"
+    rows = "a -\nb 1000,0,0,-5e5\n"
+    cases = tmp_path / "killed.txt"
+    cases.write_text("name rod_point_load\n" + rows)
+    slow = ["-rod_steps", "50", "-rod_snes_type", "nrichardson", "-rod_al_newton", "0",
+            "-rod_al_rtol", "1e-10"]
+    process = subprocess.Popen([sys.executable, "-m", "petsc_rod.sweep"] + QUICK + slow
+                               + ["-sweep_cases", str(cases), "-sweep_output", str(folder)],
+                               cwd=REPO_ROOT, env=child_env(), stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+
+    def partials():
+        return [n for n in os.listdir(folder) if n.endswith(".partial")] if folder.exists() else []
+
+    deadline = time.monotonic() + 120
+    try:
+        while not partials():
+            assert process.poll() is None and time.monotonic() < deadline
+            time.sleep(0.02)
+    finally:
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+    assert len(partials()) == 1 and partials()[0].startswith("a.h5."), partials()
+    again = quick_sweep(tmp_path, rows, folder)
+    assert again.returncode == 0, describe(again)
+    assert sorted(os.listdir(folder)) == ["a.h5", "b.h5", "summary.csv", "summary.md",
+                                          "sweep.json"]
+    # another name's partial file is not the sweep's: refused, kept
+    (folder / "notes.h5.1-abcdef.partial").write_text("x")
+    one_line(quick_sweep(tmp_path, rows, folder), "holds notes.h5.1-abcdef.partial")
+    (folder / "notes.h5.1-abcdef.partial").unlink()
+    # a case's partial file whose process lives: a run still writing, refused, kept
+    (folder / "b.h5.1-abcdef.partial").write_text("x")
+    one_line(quick_sweep(tmp_path, rows, folder), "b.h5.1-abcdef.partial", "still running")
+    assert (folder / "b.h5.1-abcdef.partial").exists() and (folder / "a.h5").exists()
+
+
+def test_which_partial_files_a_killed_sweep_left():
+    """runner.left_partials: a run's partial file of a case file (its pid gone) and a
+    summary's temporary file are stale; one whose pid lives is live; another name's,
+    or a file that only looks partial, is neither."""
+    from petsc_rod.sweep.runner import SWEEP_FILES, case_files, left_partials
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = int(gone.stdout)
+    files = set(SWEEP_FILES).union(case_files("a"))
+    entries = [f"a.h5.{dead}-0a1b2c.partial", f"a_regions.csv.{dead}-ffffff.partial",
+               ".summary.csv.k3j_x9q2.partial.csv", f"a.h5.{os.getpid()}-0a1b2c.partial",
+               f"b.h5.{dead}-0a1b2c.partial", f"a.h5.{dead}.partial", "a.h5"]
+    stale, live = left_partials(entries, files)
+    assert stale == entries[:3]
+    assert live == [entries[3]]

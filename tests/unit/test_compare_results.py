@@ -1,7 +1,7 @@
 """scripts/compare_results.py, the check that a restructuring leaves every result file as
 it was: a changed value, a dataset in one file only and a changed attribute are each
 reported with exit 1; the run's date, wall times, commit and the file's own path are not
-differences."""
+differences. scripts/compare_matrix.py, the same for two runs of the stability matrix."""
 
 import importlib.util
 import os
@@ -13,13 +13,18 @@ import pytest
 from helpers import REPO_ROOT
 
 
-@pytest.fixture(scope="module")
-def script():
-    path = os.path.join(REPO_ROOT, "scripts", "compare_results.py")
-    spec = importlib.util.spec_from_file_location("compare_results", path)
+def load(name):
+    """The module of scripts/<name>.py."""
+    path = os.path.join(REPO_ROOT, "scripts", f"{name}.py")
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+@pytest.fixture(scope="module")
+def script():
+    return load("compare_results")
 
 
 def result(path, r, written="2026-01-01T00:00:00+00:00", wall_time=1.0, extra=None):
@@ -85,3 +90,19 @@ def test_a_changed_attribute_or_history_is_found(script, tmp_path):
     lines = script.compare_files(a, b)
     assert [line.split(":")[0] for line in lines] == [
         "/history/change", "/parameters@elements", "/steps/1@stop_reason"]
+
+
+def test_matrix_runs_are_compared_case_by_case_without_their_wall_times(tmp_path, capsys):
+    """scripts/compare_matrix.py: a case whose iterations changed, or that one run lacks,
+    is a difference; another wall time is not."""
+    matrix = load("compare_matrix")
+    header = "group,case,ranks,elements,outcome,reason,iterations,wall_time\n"
+    old, new, fewer = tmp_path / "old.csv", tmp_path / "new.csv", tmp_path / "fewer.csv"
+    old.write_text(header + "g,a,1,32,converged,,37,1.1\ng,a,2,32,converged,,37,1.5\n")
+    new.write_text(header + "g,a,1,32,converged,,37,9.9\ng,a,2,32,converged,,38,1.5\n")
+    fewer.write_text(header + "g,a,1,32,converged,,37,1.1\n")
+    assert matrix.compare(old, old) == [] and matrix.main([str(old), str(old)]) == 0
+    assert matrix.compare(old, new) == ["a (2 rank(s)): iterations '37' -> '38'"]
+    assert matrix.compare(old, fewer) == [f"a (2 rank(s)): only in {old}"]
+    assert matrix.main([str(old), str(new)]) == 1
+    assert "iterations '37' -> '38'" in capsys.readouterr().out
