@@ -20,16 +20,19 @@ from petsc_rod.io.results import ATTRIBUTE_UNITS, DATASET_UNITS
 
 class Results:
     """The last step of an api.solve run (module docstring). ``converged``: it reached
-    load factor 1 and converged; ``elements``: of the mesh."""
+    load factor 1 and converged; ``elements``: of the mesh; ``units``: ({dataset: unit},
+    {attribute: unit}) of what the run's terms and reports wrote (RodProblem.units)."""
 
-    def __init__(self, owned, scalars, converged, comm, elements):
+    def __init__(self, owned, scalars, converged, comm, elements, units=None):
         self.owned = owned
         self.scalars = scalars
         self.converged = bool(converged)
         self.elements = elements
         self._comm = comm
-        self.units = {name: DATASET_UNITS.get(name, "") for name in owned}
-        self.units.update({name: ATTRIBUTE_UNITS.get(name, "") for name in scalars})
+        given = units or ({}, {})
+        datasets, attributes = {**DATASET_UNITS, **given[0]}, {**ATTRIBUTE_UNITS, **given[1]}
+        self.units = {name: datasets.get(name, "") for name in owned}
+        self.units.update({name: attributes.get(name, "") for name in scalars})
 
     def __getattr__(self, name):
         scalars = self.__dict__.get("scalars", {})

@@ -12,6 +12,7 @@ import numpy as np
 from petsc_rod.api.model import Model
 from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
+                                check_stability_possible,
                                 destroy_run, every_rank_failed, run_record, start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
 from petsc_rod.cli.scene_options import (check_stability_asked, mesh_pieces, scene_from_options,
@@ -31,13 +32,14 @@ class _LastStep:
     io.results.ResultWriter ``inner`` when there is one."""
 
     def __init__(self, inner=None):
-        self.inner, self.vertex, self.attributes = inner, None, None
+        self.inner, self.vertex, self.attributes, self.units = inner, None, None, ({}, {})
 
-    def write_step(self, group, vertex, state, history, attributes):
+    def write_step(self, group, vertex, state, history, attributes, units=None):
         self.vertex = {name: np.array(value, copy=True) for name, value in vertex.items()}
         self.attributes = dict(attributes)
+        self.units = units or ({}, {})
         if self.inner is not None:
-            self.inner.write_step(group, vertex, state, history, attributes)
+            self.inner.write_step(group, vertex, state, history, attributes, units)
 
     def finish(self, *args):
         if self.inner is not None:
@@ -52,7 +54,7 @@ class _LastStep:
 
 
 def _points(model, length):
-    """(S, forces (n, 3), drag areas) of the model's attachments, or None."""
+    """(S, forces (n, 3), drag areas, volumes) of the model's attachments, or None."""
     if not model.attachments:
         return None
     sea = model.environment
@@ -69,7 +71,8 @@ def _points(model, length):
     if np.any(np.asarray(columns["mass"]) < 0) or np.any(np.asarray(columns["volume"]) < 0) \
             or np.any(areas < 0):
         raise RodInputError("an attachment's mass, volume and cda must not be negative")
-    return S, attachment_forces(columns, sea.water_density, sea.gravity), areas
+    return (S, attachment_forces(columns, sea.water_density, sea.gravity), areas,
+            np.asarray(columns["volume"], dtype=float))
 
 
 def _run_record(model, values, solver, start, output):
@@ -196,6 +199,8 @@ def solve(model, comm=None, output=None, say=None):
         mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                     pieces)
         problem, solver = build_solver(mesh, scene, settings, say)
+        check_stability_possible(problem, "rod_al_stability" in given
+                                 and values["rod_al_stability"])
         start = start_from(problem, values, given, say)
         inner = None
         if output:
@@ -210,7 +215,7 @@ def solve(model, comm=None, output=None, say=None):
         result = run_continuation(solver, path, say=say, writer=keeper)
         keeper.inner = None                     # finished
         return Results(keeper.vertex, keeper.attributes, result.converged,
-                       comm.tompi4py(), mesh.n_elements)
+                       comm.tompi4py(), mesh.n_elements, keeper.units)
     except Exception as error:
         # one rank's alone (a numpy error, say): the others wait in a collective call
         if not every_rank_failed(failures):

@@ -396,8 +396,8 @@ MAX_STRAIN = 1.0
 
 
 def least_top_strain(scene):
-    """The least strain at the higher held end in any equilibrium of a uniform
-    extensible flexible line (a bending stiffness's shear moves it a little: about, for
+    """The least strain at the higher held end in any equilibrium in tension (T >= 0 at
+    its lowest point) of a uniform extensible flexible line (a bending stiffness's shear moves it a little: about, for
     a rod) under a uniform dead load w (N/m of unstretched line), its held ends h apart
     along the load (m), or None where it does not apply (sections,
     a free end, attachments, load pieces that differ, a seabed that is not flat or not
@@ -427,7 +427,7 @@ def check_stretch_domain(scene):
     least = least_top_strain(scene)
     if least is not None and least[0] > MAX_STRAIN:
         raise RodInputError(
-            f"-rod_axial_stiffness {scene.axial_stiffness:g}: any equilibrium stretches the "
+            f"-rod_axial_stiffness {scene.axial_stiffness:g}: hanging in tension it stretches the "
             f"line by about {100 * least[0]:.3g} % or more at its top (a flexible cable's "
             f"T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load times the ends' height "
             f"apart), above {100 * MAX_STRAIN:g} %, where the linear stretch models no line "
@@ -679,8 +679,11 @@ def environment_from_options(values, given, scene, profile=None, seabed_rows=Non
     seabed = seated(seabed, [state.position for _, state in ends if is_held(state)])
     section_drag = (max(s.drag for s in scene.sections) if scene.sections else None)
     current = current_from_options(values, given, max(held), profile, section_drag)
-    if not scene.sections:
-        check_uniform_line_under_surface(values, given, held, z0)
+    if not scene.sections:          # the loaded line's held ends (a free end is not one)
+        check_uniform_line_under_surface(
+            values, given, [state.position[2] for state in (scene.start_state(1.0),
+                                                            scene.end_state(1.0))
+                            if is_held(state)], z0)
     return seabed, current
 
 

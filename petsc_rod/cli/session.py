@@ -102,5 +102,5 @@ def record_step(problem, report, t, writer, group, **common):
     record = outputs.step_record(problem, report, t, **common)
     if writer is not None:
         writer.write_step(group, record.vertex, outputs.restart_state(problem), report.history,
-                          record.attributes)
+                          record.attributes, record.units)
     return record

@@ -47,7 +47,14 @@ class Seabed:
     (tan(theta) = |g|), the force per metre is k p cos(theta) N = k_v p (-g, 1) with
     k_v = k / (1 + |g|^2): the vertical part k_v p, the horizontal part -k_v p g (N
     tan(theta) downhill). It is minus the gradient of the energy k_v/2 p^2 per metre on
-    a plane (k_v constant). On the flat seabed k_v = k and the force is k p e_z."""
+    a plane (k_v constant). On the flat seabed k_v = k and the force is k p e_z.
+
+    The contact law is written here once (penetration, push, normal_force,
+    slope_factor, in_contact, height_derivatives, energy) and read by the seabed's term
+    (physics/seabed.py), its active-set solve in the global step
+    (global_step/seabed_contact.py, at the z_b and k_v it lags), its friction
+    (physics/friction.py), its slope load (physics/slope_load.py) and the reports
+    (force, reaction)."""
 
     height: float
     stiffness: float
@@ -81,27 +88,69 @@ class Seabed:
             return r[..., 2] - self.height
         return r[..., 2] - self.shape.height(r[..., 0], r[..., 1])
 
+    # --- the contact law (class docstring) -------------------------------------------
+    def penetration(self, z, base=None):
+        """p = (z_b - z)_+ (m), the vertical penetration of heights z under the seabed
+        heights ``base`` (z_b, m, broadcast with z; default the flat seabed's height)."""
+        return np.maximum((self.height if base is None else base) - z, 0.0)
+
+    def in_contact(self, z, base=None):
+        """Whether heights z lie below the seabed heights ``base`` (default the flat
+        seabed's height): the nodes where the law's spring acts (p > 0)."""
+        return z < (self.height if base is None else base)
+
+    def push(self, z, base=None, stiffness=None):
+        """k_v p (N/m): the vertical part of the seabed's force per metre at heights z
+        under ``base`` (penetration), with the vertical stiffness ``stiffness`` (k_v,
+        N/m^2, vertical_stiffness; default k, the flat seabed's)."""
+        k_v = self.stiffness if stiffness is None else stiffness
+        return k_v * self.penetration(z, base)
+
+    def slope_factor(self, gradient):
+        """sqrt(1 + |g|^2) = 1 / cos(theta) for gradients (..., 2): the normal force per
+        metre is k_v p sqrt(1 + |g|^2) = k p cos(theta)."""
+        return np.sqrt(1.0 + np.sum(gradient**2, axis=-1))
+
+    @staticmethod
+    def normal_force(push, gradient):
+        """k_v p (-g, 1) (N/m), (..., 3): the force along the seabed's normal from its
+        vertical part ``push`` (...,) (push) and the gradients g (..., 2)."""
+        return np.concatenate([-push[..., None] * gradient, push[..., None]], axis=-1)
+
+    def height_derivatives(self, z, weights):
+        """(dE/dz_n, d2E/dz_n^2) of E = k/2 sum_n w_n (z_b - z_n)_+^2 on the flat seabed at
+        the node heights z (n,) with weights w_n (n,), m: -k w_n (z_b - z_n)_+ (N) and
+        k w_n [z_n < z_b] (N/m)."""
+        gap = self.height - z
+        spring = self.stiffness * weights * (gap > 0)
+        return -spring * gap, spring
+
+    def energy(self, r, weights):
+        """sum_n w_n k_v,n / 2 p_n^2 (J) at node positions r (n, 3) with weights w_n (n,),
+        m, z_b and k_v under each node (this rank's part of the energy)."""
+        p = self.penetration(r[:, 2], self.heights(r[:, 0], r[:, 1]))
+        stiffness = self.vertical_stiffness(self.gradients(r[:, 0], r[:, 1]))
+        return 0.5 * np.sum(stiffness * weights * p**2)
+
     def force(self, r):
         """The seabed's force per metre on the line at positions r (n, 3), N/m, (n, 3)
         (class docstring); on the flat seabed (0, 0, k (z_b - z)_+)."""
-        force = np.zeros(np.shape(r))
         if self.shape is None:
-            force[:, 2] = self.stiffness * np.maximum(self.height - r[:, 2], 0.0)
+            force = np.zeros(np.shape(r))
+            force[:, 2] = self.push(r[:, 2])
             return force
         g = self.shape.gradient(r[:, 0], r[:, 1])
-        push = self.vertical_stiffness(g) * np.maximum(-self.gap(r), 0.0)
-        force[:, :2] = -push[:, None] * g
-        force[:, 2] = push
-        return force
+        return self.normal_force(self.push(r[:, 2], self.shape.height(r[:, 0], r[:, 1]),
+                                           self.vertical_stiffness(g)), g)
 
     def reaction(self, r):
         """|force| (N/m) at positions r (n, 3): k times the normal penetration,
         k (z_b - z)_+ cos(theta)."""
         if self.shape is None:
-            return self.stiffness * np.maximum(self.height - r[:, 2], 0.0)
+            return self.push(r[:, 2])
         g = self.shape.gradient(r[:, 0], r[:, 1])
-        return (self.stiffness * np.maximum(-self.gap(r), 0.0)
-                / np.sqrt(1.0 + np.sum(g**2, axis=-1)))
+        return (self.push(r[:, 2], self.shape.height(r[:, 0], r[:, 1]))
+                / self.slope_factor(g))
 
 
 def default_stiffness(load_values):

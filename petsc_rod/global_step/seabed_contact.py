@@ -164,11 +164,12 @@ class SeabedContact:
             if ghosted_r is None:
                 self._set_active(np.zeros(self.weights.shape, dtype=bool))
             else:
-                self._set_active(self._heights_of(ghosted_r[..., 2]) < self.base + TOUCHING)
+                heights = self._heights_of(ghosted_r[..., 2])
+                self._set_active(self.seabed.in_contact(heights, self.base + TOUCHING))
         for _ in range(MAX_SOLVES):
             y = self.problem.solve(slope_rhs, slope)
             self.solves += 1
-            active = self.heights(y) < self.base
+            active = self.seabed.in_contact(self.heights(y), self.base)
             if not self.mesh.global_sum(int(np.any(active != self.active))):
                 break
             self._set_active(active, only_changed=True)
@@ -184,22 +185,25 @@ class SeabedContact:
         start; a contact rebuilt at a penalty raise: one iteration without the push)."""
         if self.gradients is None or self.solution is None:
             return np.zeros((self.mesh.n_local_nodes, 3))
-        push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
-        return owned_nodes(self.mesh, np.concatenate(
-            [-push[..., None] * self.gradients, push[..., None]], axis=2))
+        return owned_nodes(self.mesh, self.seabed.normal_force(self._push(), self.gradients))
 
     def reaction(self):
         """R = k (z_b,n - z_n)_+ cos(theta_n) at the element nodes (ne, 3), N/m: the
         normal contact force per metre of the last vertical solve (environment.Seabed;
         k_v sqrt(1 + |g|^2) = k cos(theta)). Collective."""
-        push = self.stiffness * np.maximum(self.base - self.heights(self.solution), 0.0)
+        push = self._push()
         if self.gradients is None:
             return push
-        return push * np.sqrt(1.0 + np.sum(self.gradients**2, axis=-1))
+        return push * self.seabed.slope_factor(self.gradients)
+
+    def _push(self):
+        """k_n (z_b,n - z_n)_+ at the element nodes (ne, 3), N/m, of the last vertical
+        solve's heights (Seabed.push at the z_b and k the solve had). Collective."""
+        return self.seabed.push(self.heights(self.solution), self.base, self.stiffness)
 
     def pressure(self, z):
         """k (z_b - z)_+ (N/m), the seabed's upward force per metre of line at heights z."""
-        return self.seabed.stiffness * np.maximum(self.seabed.height - z, 0.0)
+        return self.seabed.push(z)
 
     def destroy(self):
         self._local.destroy()

@@ -3,8 +3,8 @@ regions' summary beside it (FILE's stem + ``_regions.csv``; the run's final summ
 prints it too, cli/lines.summary) (docs/output.md, docs/riser.md §5).
 
 One row per vertex: S, x, y, z (absolute), u1, u2 (the signed curvatures about d1 and
-d2) and every result along the line the run has (TABLE_DATASETS, those of its terms),
-a header row naming each column with its unit, e.g. ``effective_tension (N)``.
+d2) and every result along the line the run has (TABLE_DATASETS, those of its terms and
+reports), a header row naming each column with its unit, e.g. ``effective_tension (N)``.
 
 The table is written by rank 0: each rank formats its own vertices' rows and rank 0
 gathers the text, in rank order, into one file (a CSV is one sequential text file, of
@@ -24,7 +24,7 @@ import numpy as np
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
-from petsc_rod.reports.riser_numbers import effective_tension
+from petsc_rod.reports import riser_numbers
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
 # them.
@@ -75,26 +75,27 @@ def discard(path, comm, say):
 
 
 def final_record(problem):
-    """(vertex datasets with the terms' and r absolute, and the effective tension n.t
-    where no term wrote it; the terms' attributes) of the problem's state. Collective."""
-    vertex = outputs.vertex_fields(problem)
-    attributes = {}
-    for output in problem.term_outputs(vertex):
-        vertex.update(output.datasets)
-        attributes.update(output.attributes)
-    vertex["r"] = vertex["r"] + problem.scene.start_position
+    """(vertex datasets with the terms' and reports' and r absolute, and the effective
+    tension n.t where none wrote it; their attributes) of the problem's state
+    (outputs.collect). Collective."""
+    collected = outputs.collect(problem)
+    vertex = collected.vertex
     if "effective_tension" not in vertex:       # a plain rod's (reports/line_results.py)
-        vertex["effective_tension"] = effective_tension(vertex)
-    return vertex, attributes
+        vertex["effective_tension"] = riser_numbers.effective_tension(vertex)
+    return vertex, collected.attributes
 
 
-def table_columns(vertex):
-    """(header names with units, (n, columns) values) of this rank's vertices."""
+def table_columns(vertex, units):
+    """(header names with units, (n, columns) values) of this rank's vertices; ``units``
+    the terms' and reports' ({dataset: unit}, {attribute: unit})."""
     names = ["S (m)", "x (m)", "y (m)", "z (m)", "u1 (rad/m)", "u2 (rad/m)"]
     columns = [vertex["S"], *vertex["r"].T, vertex["u"][:, 0], vertex["u"][:, 1]]
+    # the effective tension final_record adds on a plain rod has the riser numbers' unit
+    known = {**DATASET_UNITS, "effective_tension": riser_numbers.DATASET_UNITS[
+        "effective_tension"], **units[0]}
     for key in TABLE_DATASETS:
         if key in vertex:
-            names.append(f"{key} ({DATASET_UNITS[key]})")
+            names.append(f"{key} ({known[key]})")
             columns.append(np.asarray(vertex[key], dtype=float))
     return names, np.column_stack(columns)
 
@@ -132,10 +133,10 @@ def _write(path, partial, text):
                          "is left") from None
 
 
-def write_tables(path, comm, vertex, attributes):
-    """The CSV table at ``path`` and the regions' beside it (module docstring).
-    Collective."""
-    names, values = table_columns(vertex)
+def write_tables(path, comm, vertex, attributes, units):
+    """The CSV table at ``path`` and the regions' beside it (module docstring); ``units``
+    as table_columns'. Collective."""
+    names, values = table_columns(vertex, units)
     pieces = comm.tompi4py().gather(_rows(values), root=0)
     files = [(path, ",".join(names) + "\n" + "".join(pieces or []))]
     rows = region_rows(attributes)
@@ -157,6 +158,6 @@ def finish_run(problem, path, say):
         return
     vertex, attributes = final_record(problem)
     if path:
-        write_tables(path, problem.mesh.comm, vertex, attributes)
+        write_tables(path, problem.mesh.comm, vertex, attributes, problem.units())
         say(f"petsc_rod: table {path}" + (f", regions {regions_path(path)}"
                                           if "region_names" in attributes else ""))

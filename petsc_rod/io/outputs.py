@@ -1,6 +1,7 @@
 """What a result file holds of a problem's state (problem/problem.py): the vertex fields
-(positions, frames, strains, moment, force, §6, and what the terms add), the restart
-state, and a step's attributes (docs/output.md).
+(positions, frames, strains, moment, force, §6, and what the terms and the reports add:
+collect, the one merge of their outputs for the HDF5 file and the CSV table), the
+restart state, and a step's attributes (docs/output.md).
 
 Every array is this rank's owned vertices (or owned elements and P2 nodes for the
 restart state); nothing is gathered. Strains at a vertex average the limits from the
@@ -84,6 +85,35 @@ def set_state(problem, vertex, saved):
     state.remember()
 
 
+@dataclass
+class Collected:
+    """The outputs of a problem's terms and reports merged (collect): the vertex fields
+    with their datasets, their attributes, their phrases for the step line, and the
+    units ({dataset: unit}, {attribute: unit}) of what they write (RodProblem.units)."""
+
+    vertex: dict
+    attributes: dict
+    texts: list
+    units: tuple
+
+
+def collect(problem, vertex=None):
+    """The Collected of the problem's state: the vertex fields ``vertex`` (vertex_fields
+    when None) updated with the terms' and then the reports' datasets, every output
+    computed from the fields alone before any is merged; r absolute (the solver's frame
+    has its origin at the start, Scene.start_position, docs/method.md §5; the terms and
+    reports translate their own). Collective."""
+    vertex = vertex_fields(problem) if vertex is None else vertex
+    attributes, texts = {}, []
+    for output in problem.outputs(vertex):
+        vertex.update(output.datasets)
+        attributes.update(output.attributes)
+        if output.text:
+            texts.append(output.text)
+    vertex["r"] = vertex["r"] + problem.scene.start_position
+    return Collected(vertex, attributes, texts, problem.units())
+
+
 def stability_code(report):
     """The file's ``stable``: 1 a local minimiser, 0 a saddle, -1 not checked."""
     return -1 if report.stable is None else int(report.stable)
@@ -91,13 +121,16 @@ def stability_code(report):
 
 @dataclass
 class StepRecord:
-    """What a step leaves (step_record): the vertex datasets (the terms' included), the
-    group's attributes, the terms' phrases for the step line, and u3(0) (1/m) for it."""
+    """What a step leaves (step_record): the vertex datasets (the terms' and reports'
+    included), the group's attributes, the terms' and reports' phrases for the step
+    line, u3(0) (1/m) for it, and the units of what the terms and reports wrote
+    (Collected.units)."""
 
     vertex: dict
     attributes: dict
     texts: list
     u3_start: float
+    units: tuple
 
     @property
     def energy(self):
@@ -120,14 +153,8 @@ def step_record(problem, report, t, **common):
                   "load_factor": t, "penalty": problem.penalty, **common}
     if report.link is not None:
         attributes.update(twist_turns=report.link[0], writhe_turns=report.link[1])
-    texts = []
-    for output in problem.term_outputs(vertex):
-        vertex.update(output.datasets)
-        attributes.update(output.attributes)
-        if output.text:
-            texts.append(output.text)
-    # the file's positions are absolute: the solver's frame has its origin at the start
-    # (Scene.start_position, docs/method.md §5); the terms translate their own
-    vertex["r"] = vertex["r"] + problem.scene.start_position
-    return StepRecord(vertex, attributes, texts, u3_start)
+    collected = collect(problem, vertex)
+    attributes.update(collected.attributes)
+    return StepRecord(collected.vertex, attributes, collected.texts, u3_start,
+                      collected.units)
 

@@ -41,28 +41,20 @@ from petsc_rod.io.capture import stderr_captured
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.resources import free_disk, size_text
 from petsc_rod.tables import check_input_file, file_problem
-from petsc_rod.physics import stretch
-from petsc_rod.physics import flex_joint
-from petsc_rod.physics import point_loads as point_load_term
-from petsc_rod.physics import friction
-from petsc_rod.reports import riser_numbers as riser_quantities
-from petsc_rod.reports import (line_results, pressures, regions, section_numbers,
-                               stresses)
 
 VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3", "u", "m", "n")
 RESTART_VERTEX_DATASETS = ("S", "r", "d1", "d2", "d3")
 HISTORY_COLUMNS = ("change", "constraint_residual", "wall_time")
 
-# Units of every dataset ("1": dimensionless) ...
+# Units of the datasets the file has for every run ("1": dimensionless) ...
 DATASET_UNITS = {
     "S": "m", "r": "m", "d1": "1", "d2": "1", "d3": "1", "u": "rad/m", "m": "N m", "n": "N",
     "d1_mid": "1", "d2_mid": "1", "tau": "1", "lambda": "N",
     "change": "1", "constraint_residual": "1", "wall_time": "s",
-    **riser_quantities.DATASET_UNITS, **section_numbers.DATASET_UNITS,
-    **pressures.DATASET_UNITS, **line_results.DATASET_UNITS, **stresses.DATASET_UNITS,
-    **stretch.DATASET_UNITS, **friction.DATASET_UNITS,
 }
-# ... and of every attribute of a step group and of the root ("text": a string).
+# ... and of the attributes of a step group and of the root ("text": a string); the
+# terms and the reports give the units of what they add (RodProblem.units, passed to
+# ResultWriter.write_step).
 ATTRIBUTE_UNITS = {
     "converged": "1", "stop_reason": "text", "iterations": "1", "newton_steps": "1",
     "halvings": "1",
@@ -72,11 +64,6 @@ ATTRIBUTE_UNITS = {
     "asked_penalty": "N",
     "twist_turns": "turn", "writhe_turns": "turn", "options": "text",
     "options_in_effect": "text", "version": "text", "commit": "text", "restart_walk": "1",
-    **riser_quantities.ATTRIBUTE_UNITS, **section_numbers.ATTRIBUTE_UNITS,
-    **pressures.ATTRIBUTE_UNITS, **line_results.ATTRIBUTE_UNITS,
-    **regions.ATTRIBUTE_UNITS, **stresses.ATTRIBUTE_UNITS,
-    **stretch.ATTRIBUTE_UNITS, **flex_joint.ATTRIBUTE_UNITS,
-    **point_load_term.ATTRIBUTE_UNITS, **friction.ATTRIBUTE_UNITS,
 }
 # A step is written only while the disk has this many times its size free, plus
 # SPACE_RESERVE for HDF5's metadata: HDF5 cannot recover from a full disk.
@@ -275,6 +262,10 @@ class ResultWriter:
         self.folder = os.path.dirname(os.path.abspath(path))
         self.file = None
         self.broken = False           # a write failed inside HDF5
+        # the units of every dataset and attribute written so far: the file's own, and
+        # those write_step is given for the terms' and reports' outputs
+        self.dataset_units = dict(DATASET_UNITS)
+        self.attribute_units = dict(ATTRIBUTE_UNITS)
         on_every_rank(self.comm, self._check_room_for_file, minimum_bytes)
         self.file = self._collective(_open, self.partial, "w", self.comm)
 
@@ -318,10 +309,15 @@ class ResultWriter:
             self.broken = self.broken or getattr(error, "hdf5", False)
             raise
 
-    def write_step(self, name, vertex, state, history, attributes):
-        """Write one solution as group ``name``, after checking that the disk has room."""
+    def write_step(self, name, vertex, state, history, attributes, units=None):
+        """Write one solution as group ``name``, after checking that the disk has room;
+        ``units``: ({dataset: unit}, {attribute: unit}) of the datasets and attributes the
+        terms and reports added (RodProblem.units), kept for the root's too."""
+        if units is not None:
+            self.dataset_units.update(units[0])
+            self.attribute_units.update(units[1])
         table = np.asarray(history, dtype=float).reshape(-1, len(HISTORY_COLUMNS))
-        # the vertex datasets, and those a riser scene adds (reports/riser_numbers.py)
+        # the vertex datasets, and those the terms and reports add
         arrays = {key: np.asarray(value) for key, value in vertex.items()}
         arrays.update({key: np.asarray(value) for key, value in state.items()})
         layout = distributed_layout(self.comm, arrays)
@@ -344,7 +340,7 @@ class ResultWriter:
             shape, start, rows = layout[key]
             target = state_group if key in state_keys else group
             data = target.create_dataset(key, shape=shape, dtype="f8")
-            data.attrs["units"] = DATASET_UNITS[key]
+            data.attrs["units"] = self.dataset_units[key]
             if rows:
                 data[start:start + rows] = local
         history_group = group.create_group("history")
@@ -353,7 +349,7 @@ class ResultWriter:
             data.attrs["units"] = DATASET_UNITS[key]
             if self.comm.Get_rank() == 0:
                 data[:] = table[:, column]
-        _set_attributes(group, attributes, ATTRIBUTE_UNITS)
+        _set_attributes(group, attributes, self.attribute_units)
         self.file.flush()
 
     def finish(self, last_group, attributes, name=None):
@@ -375,7 +371,7 @@ class ResultWriter:
         source = self.file[last_group]
         for key in list(source.keys()):
             self.file[key] = source[key]
-        _set_attributes(self.file, attributes, ATTRIBUTE_UNITS)
+        _set_attributes(self.file, attributes, self.attribute_units)
         _set_attributes(self.file.create_group("parameters"), self.run.parameters,
                         self.run.units)
         self.file.close()

@@ -1,7 +1,7 @@
 """Terms of physics (the protocol, term.py), each with its kernel; built for a scene
 that has them (problem/build.py).
 
-    term.py         the protocol: Term, ReportTerm, TermOutput
+    term.py         the protocol: Term, TermOutput
     stretch.py, dead_loads.py, point_loads.py, flex_joint.py
     nodal_load.py   NodalLoadTerm: a load per metre known at the P2 nodes
     seabed.py       SeabedTerm: the elastic seabed, solved with the z slope

@@ -157,6 +157,8 @@ class FlexJoint(Term):
     docstring). Only the rank that holds the end node contributes; outputs are
     reduced over the ranks."""
 
+    attribute_units = ATTRIBUTE_UNITS
+
     # on an extensible end the joint acts in the local step at its node, not in the
     # global step (RodProblem.iterate, joint_local_step; docs/method.md §12)
     local = False

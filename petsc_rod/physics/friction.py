@@ -116,6 +116,9 @@ def tangent_factor(force, gradients):
 class FrictionTerm(NodalLoadTerm):
     """The seabed friction of the SeabedTerm ``seabed_term`` (module docstring)."""
 
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
+
     slope_components = position_components = (0, 1)
     conservative = False
     unsymmetric = True
@@ -291,7 +294,7 @@ class FrictionTerm(NodalLoadTerm):
         tangents = state.node_directors()[:, 2, :2].copy()
         w = state.node_weights
         d = r[:, :2] - owned_nodes(self.mesh, self.anchors)
-        reaction = seabed.stiffness * np.maximum(seabed.height - r[:, 2], 0.0)
+        reaction = seabed.push(r[:, 2])
         stiffness = self.friction.stiffness
         norm = elliptic_norm(d, tangents, self.friction)                  # |d|_mu
         slide = (reaction > 0) & (stiffness * norm > reaction)

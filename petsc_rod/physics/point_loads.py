@@ -102,6 +102,8 @@ class PointLoads(DeadLoads):
     (DeadLoads: energy, gradient and step load from b) with its own b, anchor work and
     share of n(S). Owns the VectorField of b; ``destroy()``."""
 
+    attribute_units = ATTRIBUTE_UNITS
+
     def __init__(self, mesh, scene):
         super().__init__(mesh, scene)
         self.load.destroy()

@@ -67,19 +67,15 @@ class SeabedTerm(NodalLoadTerm):
         """dE_s/dz_n = -k w_n (z_b - z_n)_+ and d2E_s/dz_n^2 = k w_n [z_n < z_b] at the owned
         nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline (on
         a flat seabed: the Newton steps are not taken on another, slope_load.py)."""
-        gap = self.seabed.height - state.node_positions()[:, 2]
-        spring = self.seabed.stiffness * state.node_weights * (gap > 0)
-        return -spring * gap, spring
+        return self.seabed.height_derivatives(state.node_positions()[:, 2],
+                                              state.node_weights)
 
     def energy(self, state):
         """E_s = sum_n w_n k_v,n / 2 (z_b,n - z_n)_+^2 at the state's centreline, J, with
         z_b,n and k_v,n under each node (environment.Seabed; k_v = k on a flat seabed).
         Collective."""
-        r = state.node_positions()
-        gap = np.maximum(-self.seabed.gap(r), 0.0)
-        stiffness = self.seabed.vertical_stiffness(self.seabed.gradients(r[:, 0], r[:, 1]))
-        return float(self.mesh.global_sum(0.5 * np.sum(stiffness * state.node_weights
-                                                       * gap**2)))
+        return float(self.mesh.global_sum(self.seabed.energy(state.node_positions(),
+                                                             state.node_weights)))
 
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; the

@@ -33,6 +33,9 @@ class AxialStretch(Term):
     """EA eps^2 / 2 per metre of unstretched line, for a Scene with a finite EA on a
     Mesh. EA at the owned nodes, N, (n_nodes,); inf (inextensible parts): eps = 0."""
 
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
+
     axially_symmetric = True    # a turn about the x axis leaves |tau3| unchanged
 
     def __init__(self, mesh, scene):

@@ -3,9 +3,8 @@ elastic energy and its constraint contributes to each part of the method
 (docs/design.md, "Terms of physics").
 
 The problem (problem/problem.py) holds a list of terms, built for its scene
-(problem/build.py): the dead loads (physics/dead_loads.py) always; the seabed, the drag
-(seabed.py, drag.py) and the riser numbers (reports/riser_numbers.py) where the scene has
-them.
+(problem/build.py): the dead loads (physics/dead_loads.py) always; the seabed and the drag
+(seabed.py, drag.py) where the scene has them.
 The core walks the list and calls the methods below; it never asks which terms exist.
 Every default does nothing, so a term overrides only what it contributes. Every method
 is called on every rank, in the same order (collective where a term needs it).
@@ -26,7 +25,9 @@ When each is called:
 * the load path (iteration/continuation.py): ``accept_step`` at the end of every
   accepted load step (a path-dependent term's memory: the friction's anchors);
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
-  force n(S), ``outputs`` for datasets, attributes and the step line.
+  force n(S), ``outputs`` for datasets, attributes and the step line, in the units of
+  ``dataset_units`` and ``attribute_units``. What only reports is not a term but a
+  report (reports/report.py), held beside the terms.
 """
 
 from dataclasses import dataclass, field
@@ -34,8 +35,10 @@ from dataclasses import dataclass, field
 
 @dataclass
 class TermOutput:
-    """What a term adds to a step's record: vertex datasets {name: (n_owned, ...)},
-    attributes {name: value} (units in io/results.py) and a phrase for the step line."""
+    """What a term or a report (reports/report.py) adds to a step's record: vertex
+    datasets {name: (n_owned, ...)}, attributes {name: value} (their units in the
+    term's or report's dataset_units and attribute_units) and a phrase for the step
+    line."""
 
     datasets: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
@@ -85,6 +88,10 @@ class Term:
     # when in_newton is False: what the term is and where its limits are documented, for
     # the line that says a run takes no Newton steps (cli/lines.no_newton)
     newton_gap = ""
+    # {name: unit} of the vertex datasets and of the attributes ``outputs`` writes ("1":
+    # dimensionless, "text": a string), gathered by RodProblem.units for the result file
+    dataset_units = {}
+    attribute_units = {}
 
     # --- the global step --------------------------------------------------------------
     def add_slope_matrices(self, matrices):
@@ -181,11 +188,3 @@ class Term:
 
     def destroy(self):
         """Free the term's PETSc objects (collective)."""
-
-
-class ReportTerm(Term):
-    """A term that only reports (``outputs``): it adds nothing to the equations, so the
-    turn of an axially symmetric scene leaves the problem unchanged whatever it reports
-    (Scene.axially_symmetric decides)."""
-
-    axially_symmetric = True

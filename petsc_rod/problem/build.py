@@ -2,12 +2,14 @@
 dead loads always; the point loads (attachments) where it has some; a flex joint at each
 pinned end given a rotational stiffness (physics/flex_joint.py); the seabed (with the
 horizontal push of a sloping one, physics/slope_load.py, and its friction,
-physics/friction.py), the drag and the riser numbers
-only where the scene has a seabed or a current (docs/riser.md); the axial stretch only
-where some EA is finite (docs/method.md §12); the results along the line
-(reports/line_results.py) always, its regions (reports/regions.py) on a riser-like scene (a
-seabed, a current or line types), the pipe's stresses (reports/stresses.py) on a line of
-line types with an inner diameter."""
+physics/friction.py) and the drag only where the scene has a seabed or a current
+(docs/riser.md); the axial stretch only where some EA is finite (docs/method.md §12).
+
+Its reports (reports/report.py), held beside the terms: the riser numbers
+(reports/riser_numbers.py) where it has a seabed or a current; the sections' numbers,
+pressures and, with an inner diameter, the pipe's stresses on a line of line types; the
+results along the line (reports/line_results.py) always; its regions
+(reports/regions.py) on a riser-like scene (a seabed, a current or line types)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.drag import DragTerm
@@ -44,21 +46,29 @@ def scene_terms(mesh, scene):
             if is_held(state)]
     # its weight in air above the sea surface, and no drag there
     surface = SurfaceTerm(mesh, scene) if reaches_surface(scene, held) else None
-    drag = bool(scene.drag_loads(1.0))         # a current anywhere on the load path
-    if drag:
+    if scene.drag_loads(1.0):                  # a current anywhere on the load path
         terms.append(DragTerm(mesh, scene, surface))
     if surface is not None:
         terms.append(surface)
-    if seabed is not None or drag:
-        terms.append(RiserNumbers(seabed))
     if scene.extensible:
         terms.append(AxialStretch(mesh, scene))
-    if scene.sections:
-        terms.append(SectionNumbers(scene.sections))
-        terms.append(PipePressures(scene))
-        if any(section.id > 0 for section in scene.sections):
-            terms.append(PipeStresses(scene))
-    terms.append(LineResults())
-    if seabed is not None or drag or scene.sections:
-        terms.append(LineRegions(seabed))
     return terms
+
+
+def scene_reports(scene, terms):
+    """The list of reports of ``scene`` (module docstring), in the order their outputs
+    are merged; the riser numbers and the regions read the SeabedTerm among ``terms``."""
+    seabed = next((term for term in terms if isinstance(term, SeabedTerm)), None)
+    drag = bool(scene.drag_loads(1.0))
+    reports = []
+    if seabed is not None or drag:
+        reports.append(RiserNumbers(seabed))
+    if scene.sections:
+        reports.append(SectionNumbers(scene.sections))
+        reports.append(PipePressures(scene))
+        if any(section.id > 0 for section in scene.sections):
+            reports.append(PipeStresses(scene))
+    reports.append(LineResults())
+    if seabed is not None or drag or scene.sections:
+        reports.append(LineRegions(seabed))
+    return reports

@@ -2,12 +2,13 @@
 apart from how it is solved (iteration/driver.py: the SNES and the step controller).
 
 A RodProblem holds the mesh, the scene, the state (problem/state.py), the global step
-(global_step/) and the list of terms of physics (physics/term.py) that the scene needs
-(problem/build.py). It answers what the method and its users ask of the problem: one
-Uzawa iteration G (the map the SNES mixes), the energy E and its gradient, the second
-variation (analysis/second_variation.py), the link, the end reaction and the internal force,
-and the terms' outputs. The Newton steps, the stability test, the outputs and the
-riser numbers take a RodProblem, never the solver.
+(global_step/), the list of terms of physics (physics/term.py) that the scene needs and
+its reports beside them (reports/report.py; both made by problem/build.py). It answers
+what the method and its users ask of the problem: one Uzawa iteration G (the map the
+SNES mixes), the energy E and its gradient, the second variation
+(analysis/second_variation.py), the link, the end reaction and the internal force, and the
+terms' and reports' outputs with their units. The Newton steps, the stability test, the
+outputs and the riser numbers take a RodProblem, never the solver.
 """
 
 import numpy as np
@@ -24,7 +25,7 @@ from petsc_rod.mesh.elements import (cut_gauss_rule, p2_basis, p2_integrals,
                                      quadrature_weights)
 from petsc_rod.problem import penalty as penalty_policy
 from petsc_rod.physics.flex_joint import FlexJoint, joint_local_step
-from petsc_rod.problem.build import scene_terms
+from petsc_rod.problem.build import scene_reports, scene_terms
 from petsc_rod.problem.state import RodState
 from petsc_rod.scenes.boundary import clamped_nodes
 
@@ -37,12 +38,15 @@ EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("projection", "multi
 
 class RodProblem:
     """The problem of a Scene on a Mesh at an asked penalty R (N), with the ``terms``
-    (physics/term.py; default: those the scene needs, problem/build.py). Owns the state,
-    the global step, the terms and the second variation; ``destroy()`` releases them."""
+    (physics/term.py) and the ``reports`` (reports/report.py; default: those the scene
+    needs, problem/build.py). Owns the state, the global step, the terms and the second
+    variation; ``destroy()`` releases them."""
 
-    def __init__(self, mesh, scene, penalty, terms=None):
+    def __init__(self, mesh, scene, penalty, terms=None, reports=None):
         self.mesh, self.scene = mesh, scene
         self.terms = list(scene_terms(mesh, scene) if terms is None else terms)
+        self.reports = list(scene_reports(scene, self.terms) if reports is None
+                            else reports)
         # the fields' stiffness along the line: a_i, c_i and their matrices (§2)
         self.coefficients = FieldCoefficients(scene, mesh.element_S, mesh.element_h,
                                               penalty_policy.matrix_split)
@@ -405,11 +409,20 @@ class RodProblem:
         shares = [term.force_beyond(self.state) for term in self.terms]
         return sum(share for share in shares if share is not None) - self.state.chord_multiplier
 
-    def term_outputs(self, vertex):
-        """The terms' TermOutputs for the vertex fields ``vertex``, in list order (None
-        left out). Collective."""
-        outputs = [term.outputs(self, vertex) for term in self.terms]
+    def outputs(self, vertex):
+        """The TermOutputs of the terms, then of the reports, for the vertex fields
+        ``vertex``, in list order (None left out). Collective."""
+        outputs = [source.outputs(self, vertex) for source in (*self.terms, *self.reports)]
         return [output for output in outputs if output is not None]
+
+    def units(self):
+        """({dataset: unit}, {attribute: unit}) of what the terms' and the reports'
+        outputs write (their dataset_units and attribute_units)."""
+        datasets, attributes = {}, {}
+        for source in (*self.terms, *self.reports):
+            datasets.update(source.dataset_units)
+            attributes.update(source.attribute_units)
+        return datasets, attributes
 
     def destroy(self):
         if self._second_variation is not None:

@@ -1,5 +1,8 @@
-"""What a solved state reports beside its fields (ReportTerm, physics/term.py; built in
-problem/build.py): read by io/results.py and io/line_table.py.
+"""What a solved state reports beside its fields, behind one protocol (report.py: its
+outputs and their units), held by the problem beside its terms (problem/build.py) and
+collected once (io/outputs.collect) for the HDF5 file and the CSV table.
+
+    report.py           Report: the protocol
 
     riser_numbers.py    RiserNumbers: top tension and angle, touchdown, anchor uplift
     line_results.py     LineResults: curvature, moments, angles along the line, end numbers

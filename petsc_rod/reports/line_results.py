@@ -11,7 +11,7 @@ At the vertices, (n,) each, with t = d3 / |d3| the unit tangent:
 * ``declination``: the angle of t (toward increasing S) from the upward vertical,
   acos(t_z), 0 to 180 deg (OrcaFlex's declination);
 
-The effective tension n.t is not among them: the riser term (reports/riser_numbers.py) writes
+The effective tension n.t is not among them: the riser numbers (riser_numbers.py) write
 it for a scene with a seabed or a current, and a file with it is drawn as a riser's
 (plots.py); the CSV table has it for every scene (io/line_table.py).
 
@@ -32,7 +32,8 @@ vertical to 1e-12).
 
 import numpy as np
 
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.reports.report import Report
 from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension,
                                              points_on_held_ends, top_end, unit_tangent)
 
@@ -115,9 +116,13 @@ def end_numbers(problem, vertex):
             "hang_off_azimuth": azimuth(away)}
 
 
-class LineResults(ReportTerm):
+class LineResults(Report):
     """Reports the results along the line and at its ends (module docstring); built for
     every scene (problem/build.py)."""
+
+    name = "line_results"
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
 
     def outputs(self, problem, vertex):
         return TermOutput(line_fields(vertex), end_numbers(problem, vertex))

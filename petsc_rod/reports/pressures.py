@@ -22,7 +22,8 @@ over EA; docs/riser.md §2b).
 
 import numpy as np
 
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.reports.report import Report
 from petsc_rod.reports.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
@@ -30,9 +31,13 @@ DATASET_UNITS = {"external_pressure": "Pa", "internal_pressure": "Pa", "wall_ten
 ATTRIBUTE_UNITS = {"max_wall_tension": "N", "max_wall_tension_S": "m"}
 
 
-class PipePressures(ReportTerm):
+class PipePressures(Report):
     """Reports the pressures and the wall tension (module docstring) of a line of
     sections (problem/build.py)."""
+
+    name = "pipe_pressures"
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
 
     def __init__(self, scene):
         self.scene = scene

@@ -35,8 +35,9 @@ candidates and each region's largest values are combined by allgathers of small 
 
 import numpy as np
 
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
 from petsc_rod.reports.line_results import bending_moment, curvature
+from petsc_rod.reports.report import Report
 from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension, top_end,
                                              touchdown)
 
@@ -50,9 +51,12 @@ END_FRACTION = 0.05
 PROMINENCE = 1e-3
 
 
-class LineRegions(ReportTerm):
+class LineRegions(Report):
     """Reports the regions (module docstring); built for a scene with a seabed, a current
     or line types, with the riser's SeabedTerm (or None)."""
+
+    name = "regions"
+    attribute_units = ATTRIBUTE_UNITS
 
     def __init__(self, seabed=None):
         self.seabed = seabed

@@ -31,7 +31,8 @@ positions reported (touchdown, largest curvature) are absolute: the start positi
 import numpy as np
 
 from petsc_rod.physics.point_loads import PointLoads
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.reports.report import Report
 from petsc_rod.scenes.boundary import is_held
 
 # The step line gives the touchdown's offset from the ends' plane when it is above this
@@ -48,9 +49,13 @@ ATTRIBUTE_UNITS = {
     "anchor_uplift_angle": "deg", "anchor_uplift_force": "N"}
 
 
-class RiserNumbers(ReportTerm):
-    """The riser numbers as a term that only reports (physics/term.py): built for every
-    scene with a seabed or a current, with the SeabedTerm (physics/seabed.py) or None."""
+class RiserNumbers(Report):
+    """The riser numbers as a report (report.py): built for every scene with a seabed or
+    a current, with the SeabedTerm (physics/seabed.py) or None."""
+
+    name = "riser_numbers"
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
 
     def __init__(self, seabed=None):
         self.seabed = seabed

@@ -8,7 +8,8 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 
 import numpy as np
 
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
+from petsc_rod.reports.report import Report
 from petsc_rod.reports.riser_numbers import effective_tension
 from petsc_rod.scenes.line import section_index
 
@@ -19,9 +20,13 @@ ATTRIBUTE_UNITS = {"section_names": "text", "section_bounds": "m",
                    "section_min_bend_radius": "m"}
 
 
-class SectionNumbers(ReportTerm):
+class SectionNumbers(Report):
     """Reports the sections' numbers (module docstring); built for a line of sections
     (problem/build.py)."""
+
+    name = "section_numbers"
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
 
     def __init__(self, sections):
         self.sections = tuple(sections)

@@ -32,9 +32,10 @@ equilibrium is not changed.
 
 import numpy as np
 
-from petsc_rod.physics.term import ReportTerm, TermOutput
+from petsc_rod.physics.term import TermOutput
 from petsc_rod.reports import pressures as pipe_pressures
 from petsc_rod.reports.line_results import bending_moment, torque
+from petsc_rod.reports.report import Report
 from petsc_rod.reports.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
@@ -79,9 +80,13 @@ def pipe_von_mises(wall, moment, twist, p_i, p_e, od, inner):
     return np.where(inner > 0, largest, np.nan)
 
 
-class PipeStresses(ReportTerm):
+class PipeStresses(Report):
     """Reports the von Mises stress and the utilisation (module docstring) of a line of
     sections some of which have an inner diameter (problem/build.py)."""
+
+    name = "pipe_stresses"
+    dataset_units = DATASET_UNITS
+    attribute_units = ATTRIBUTE_UNITS
 
     def __init__(self, scene):
         self.scene = scene

@@ -305,7 +305,7 @@ def test_a_stiff_section_beside_a_soft_one_keeps_its_own_curvature(options, tabl
     try:
         solver.problem.state.set_straight()
         assert solver.solve_step(1.0).converged
-        term = [t for t in solver.problem.terms if isinstance(t, SectionNumbers)][0]
+        term = [t for t in solver.problem.reports if isinstance(t, SectionNumbers)][0]
         numbers = term.outputs(solver.problem, vertex_fields(solver.problem)).attributes
     finally:
         solver.destroy()

@@ -210,7 +210,7 @@ RISER = dict(length=50.0, stiffness=(20.0, 20.0, 15.0), start="pin", end="pin",
 def riser_output(problem, fields):
     """The riser numbers (a TermOutput): the first term output of a riser scene (the
     line's results and regions follow)."""
-    output, *_ = problem.term_outputs(fields)
+    output, *_ = problem.outputs(fields)
     return output
 
 
@@ -254,7 +254,7 @@ def test_the_step_line_and_file_attributes_of_a_riser(comm, solver_factory):
     lines, written = [], {}
 
     class Writer:
-        def write_step(self, group, vertex, state, history, attributes):
+        def write_step(self, group, vertex, state, history, attributes, units=None):
             written.update(vertex=vertex, attributes=attributes)
 
     record = record_step(solver.problem, report, 1.0, Writer(), "steps/1")

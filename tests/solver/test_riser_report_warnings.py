@@ -28,7 +28,7 @@ def test_the_riser_report_of_a_flat_line_has_no_warning(comm, height):
         problem = solver.problem
         problem.prepare(1.0)                # the ends at the full load
         problem.state.set_straight()
-        output, *_ = problem.term_outputs(vertex_fields(problem))   # the riser numbers
+        output, *_ = problem.outputs(vertex_fields(problem))   # the riser numbers
         numbers = output.attributes
         expected = 10.0 if height > 0 else 0.0
         assert abs(numbers["grounded_length"] - expected) < 1e-12

@@ -43,7 +43,7 @@ def solve(comm, n_elements, scene, rtol=1e-9, newton=False):
         report = solver.solve_step(1.0)
         fields = vertex_fields(solver.problem)
         attributes = {}
-        for output in solver.problem.term_outputs(fields):
+        for output in solver.problem.outputs(fields):
             fields.update(output.datasets)
             attributes.update(output.attributes)
         whole = {key: gather(comm, value) for key, value in fields.items()

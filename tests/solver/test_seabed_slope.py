@@ -40,7 +40,7 @@ def solve(comm, n_elements, scene, rtol=1e-12):
         solver.problem.state.set_straight()
         report = solver.solve_step(1.0)
         fields = vertex_fields(solver.problem)
-        outputs = [o for o in solver.problem.term_outputs(fields)]
+        outputs = [o for o in solver.problem.outputs(fields)]
         numbers = {}
         for output in outputs:
             fields.update(output.datasets)

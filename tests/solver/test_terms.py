@@ -17,7 +17,7 @@ from petsc_rod.physics.drag import DragTerm
 from petsc_rod.physics.nodal_load import NodalLoadTerm
 from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.physics.term import Term
-from petsc_rod.problem.build import scene_terms
+from petsc_rod.problem.build import scene_reports, scene_terms
 from petsc_rod.problem.problem import RodProblem
 from petsc_rod.reports.line_results import LineResults
 from petsc_rod.reports.regions import LineRegions
@@ -106,7 +106,7 @@ def test_a_scene_builds_only_the_terms_it_needs(comm, sea, expected):
     mesh = Mesh(comm, 4, scene.length)
     terms = scene_terms(mesh, scene)
     try:
-        assert [type(term) for term in terms] == expected
+        assert [type(term) for term in terms + scene_reports(scene, terms)] == expected
     finally:
         for term in terms:
             term.destroy()

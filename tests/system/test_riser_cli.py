@@ -425,7 +425,10 @@ def test_a_current_drags_only_the_line_under_the_surface(tmp_path):
       "-rod_current", "0,1,0"], ["-rod_current", "a current has none", "drop -rod_al_stability"]),
     (["-options_file", "options/mooring_chain.opts", "-rod_seabed_friction", "0.5"],
      ["-rod_seabed_friction", "friction has none", "drop -rod_al_stability"]),
-], ids=["current", "friction"])
+    (["-options_file", "options/steel_catenary_riser_slope.opts"],
+     ["-rod_al_stability 1", "loads without one", "a seabed that is not flat",
+      "drop -rod_al_stability"]),
+], ids=["current", "friction", "slope"])
 def test_a_stability_test_asked_for_a_scene_without_energy_is_refused(tmp_path, args,
                                                                        words, ranks):
     """-rod_al_stability 1 given with a current or seabed friction (loads without an

@@ -183,3 +183,19 @@ def test_a_uniform_line_above_the_surface_is_refused(tmp_path, ranks):
     done = run_petsc_rod(UNIFORM + ["-rod_current_profile", str(profile), "-rod_sea_surface",
                                     "0", "-rod_output", str(path)], ranks, TIMEOUT)
     assert done.returncode == 0, describe(done)
+
+
+def test_a_uniform_line_hanging_below_the_surface_from_its_only_held_end_runs(tmp_path):
+    """A free start is no held end: a line hanging from its pinned end 10 m under the
+    surface (the unloaded reference's start at z = 0 above it) is accepted and solved
+    (it was refused, naming a held end at z = 0 m that does not exist)."""
+    profile = tmp_path / "current.txt"
+    profile.write_text("0 0.05 0 0\n")
+    path = tmp_path / "out.h5"
+    args = ["-rod_length", "20", "-rod_stiffness", "1,1,1", "-rod_start", "free", "-rod_end",
+            "pin", "-rod_end_position", "5,0,-10", "-rod_load", "0,0,-10", "-rod_drag",
+            "1025,1.2,0.1", "-rod_elements", "20", "-rod_current_profile", str(profile),
+            "-rod_sea_surface", "-5", "-rod_output", str(path)]
+    done = run_petsc_rod(args, 1, TIMEOUT)
+    assert done.returncode == 0, describe(done)
+    assert "-rod_sea_surface" not in done.stdout + done.stderr

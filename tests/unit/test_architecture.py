@@ -108,6 +108,26 @@ def test_nothing_below_the_front_ends_imports_one():
     assert seen > 50                    # the modules were read
 
 
+def test_the_result_file_knows_no_term_and_no_report():
+    """io/results.py writes the units the terms and reports give it (RodProblem.units),
+    so it imports none of them."""
+    found = sorted(name for name in imported(modules()[os.path.join("io", "results.py")])
+                   if name.split(".")[0] in ("physics", "reports", "environment"))
+    assert not found, f"io/results.py imports {found}"
+
+
+def test_reports_are_not_terms_and_own_their_units():
+    from petsc_rod.physics.term import Term
+    from petsc_rod.problem import build
+    from petsc_rod.reports.report import Report
+    reports = [value for value in vars(build).values()
+               if isinstance(value, type) and issubclass(value, Report)]
+    assert len(reports) == 6
+    for report in reports:
+        assert not issubclass(report, Term), report
+        assert report.name and report.attribute_units, report
+
+
 def docstrings(tree):
     """The ids of the string nodes that are docstrings."""
     found = set()
