@@ -88,7 +88,7 @@ def points_of(attachments, sea):
 def pressures_of(line, sea, origin):
     """The Scene's pipe fields of a Line of sections: the sea surface in the solver's
     frame (None: the higher held end), the contents' density, the internal pressure at
-    the top and the design factor (reports/pressures.py, reports/stresses.py)."""
+    the top and the design factor (quantities/pressures.py, quantities/stresses.py)."""
     fields = dict(contents_density=float(line.contents_density or 0.0),
                   internal_pressure=float(line.internal_pressure or 0.0))
     if line.design_factor is not None:

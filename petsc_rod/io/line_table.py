@@ -1,6 +1,6 @@
 """The converged result along the line as a CSV table (-rod_table FILE.csv) and the
 regions' summary beside it (FILE's stem + ``_regions.csv``; the run's final summary
-prints it too, cli/lines.summary) (docs/output.md, docs/riser.md §5).
+prints it too, cli/messages.summary) (docs/output.md, docs/riser.md §5).
 
 One row per vertex: S, x, y, z (absolute), u1, u2 (the signed curvatures about d1 and
 d2) and every result along the line the run has (TABLE_DATASETS, those of its terms and
@@ -24,7 +24,7 @@ import numpy as np
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
-from petsc_rod.reports import riser_numbers
+from petsc_rod.quantities import riser_numbers
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
 # them.
@@ -80,7 +80,7 @@ def final_record(problem):
     (outputs.collect). Collective."""
     collected = outputs.collect(problem)
     vertex = collected.vertex
-    if "effective_tension" not in vertex:       # a plain rod's (reports/line_results.py)
+    if "effective_tension" not in vertex:       # a plain rod's (quantities/line_results.py)
         vertex["effective_tension"] = riser_numbers.effective_tension(vertex)
     return vertex, collected.attributes
 
@@ -153,7 +153,7 @@ def write_tables(path, comm, vertex, attributes, units):
 
 def finish_run(problem, path, say):
     """After a converged run: the table written when ``path`` (-rod_table) is given (the
-    regions' summary is the run's final summary's, cli/lines.summary). Collective."""
+    regions' summary is the run's final summary's, cli/messages.summary). Collective."""
     if not path:
         return
     vertex, attributes = final_record(problem)

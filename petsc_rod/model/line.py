@@ -29,8 +29,8 @@ class Line:
     them, at least 1 each) where given, else length / ``element_length`` (m, rounded, at
     least 1) where that is given, else DEFAULT_ELEMENTS shared out. The pipe:
     ``contents_density`` (kg/m^3) and ``internal_pressure`` at the top (Pa) give the
-    reported pressures and wall tension (reports/pressures.py), ``design_factor`` the
-    allowable stress of a type with smys (reports/stresses.py; None: 2/3); None: not
+    reported pressures and wall tension (quantities/pressures.py), ``design_factor`` the
+    allowable stress of a type with smys (quantities/stresses.py; None: 2/3); None: not
     given (0)."""
 
     sections: tuple

@@ -26,8 +26,8 @@ class Section:
     N/m, (3,) (the submerged weight along -z); drag: c = rho Cd D / 2, kg/m^2, of the
     normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
     mass: kg/m in air; smys: the specified minimum yield stress of the pipe's wall, Pa
-    (NaN: not given; reports/stresses.py); stress_od: the outer diameter of the pipe's
-    wall, m, below a buoyancy jacket or coating (NaN: od; reports/pressures.py).
+    (NaN: not given; quantities/stresses.py); stress_od: the outer diameter of the pipe's
+    wall, m, below a buoyancy jacket or coating (NaN: od; quantities/pressures.py).
     """
 
     name: str
@@ -62,10 +62,10 @@ class LineType:
     and d2 for an anisotropic line), ``gj`` torsional stiffness (N m^2), ``ea`` axial
     stiffness (N; inf: inextensible), ``cd`` normal drag coefficient (1), ``drag_d``
     hydrodynamic diameter (m; None: the od), ``id`` inner diameter (m; 0: no bore; the
-    internal pressure's area, reports/pressures.py), ``ei_end`` (N m^2) the bending
+    internal pressure's area, quantities/pressures.py), ``ei_end`` (N m^2) the bending
     stiffness at the end of each section of the type where it tapers linearly from
     ``ei`` (a bend stiffener), ``smys`` the wall's yield stress (Pa; None: no
-    utilisation, reports/stresses.py), ``stress_od`` the steel wall's outer diameter under
+    utilisation, quantities/stresses.py), ``stress_od`` the steel wall's outer diameter under
     a jacket or coating (m; None: the od: a buoyancy jacket or a coating has its own
     larger od for weight and drag, but the external pressure on it is carried by it).
     The submerged weight is (mass - rho_w pi od^2 / 4) g. The values' ranges are

@@ -2,8 +2,8 @@
 the case's record (name, the options it varied, exit code, how it started) and its
 result file's root attributes, written as CSV and Markdown with the units in the header.
 
-The columns are the riser numbers where the file has them (reports/riser_numbers.py,
-reports/pressures.py, reports/section_numbers.py), then any other scalar root attribute
+The columns are the riser numbers where the file has them (quantities/riser_numbers.py,
+quantities/pressures.py, quantities/section_numbers.py), then any other scalar root attribute
 named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
 (what newer versions add: a utilisation, a von Mises stress; vectors such as the end
 forces are not columns), so that the

@@ -33,8 +33,8 @@ vertical to 1e-12).
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension,
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension,
                                              points_on_held_ends, top_end, unit_tangent)
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
