@@ -7,7 +7,8 @@ that an engineer attaches to a design note:
    the file has one (``parameters/line_types_table``);
 2. the summary table, one row per case (sweep/summary.py: the same numbers as the
    sweep's summary.csv, read from the result files' attributes);
-3. for a sweep, the range graphs along S (report/envelopes.py);
+3. for a sweep, the load-excursion and touchdown-excursion graphs (report/excursion.py)
+   and the range graphs along S (report/envelopes.py);
 4. the pictures of each case, as ``petsc_rod.plots.result_figure`` draws them.
 """
 
@@ -25,7 +26,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod import plots  # noqa: E402
 from petsc_rod.io.same_file import write_text_whole  # noqa: E402
-from petsc_rod.report import envelopes  # noqa: E402
+from petsc_rod.report import envelopes, excursion  # noqa: E402
 from petsc_rod.sweep import summary  # noqa: E402
 
 STYLE = """
@@ -144,6 +145,14 @@ def build(source):
     parts.append(table_html(header, rows, codes))
     parts.append("<p>Units in the header; a shaded row is a case that did not converge "
                  "(its numbers are left out: its state is no equilibrium of the case).</p>")
+    excursions = excursion.points(header, rows, codes)
+    if excursions is not None:
+        figure = plt.figure(figsize=(10, 3.6), layout="constrained")
+        excursion.draw(figure, *excursions)
+        parts.append("<h2>Load excursion and touchdown excursion</h2><p>Against the "
+                     "fairlead's offset from the first case along the anchor-to-fairlead "
+                     "direction (the summary's columns).</p>")
+        parts.append(image(figure, "excursion graphs"))
     if len(done) > 1:
         S, result = envelopes.envelopes([envelopes.along_line(r["file"]) for r in done])
         if result:

@@ -239,8 +239,9 @@ def test_the_report_of_a_sweep(offset_sweep, tmp_path):
                                       ("min_bend_radius (m)", "min_bend_radius")):
                 assert float(cells[column]) == pytest.approx(float(f.attrs[attribute]),
                                                              rel=1e-5), (name, column)
-    # the range graphs and one picture per case, each a PNG with something drawn
-    assert len(page.images) == 1 + len(CASES)
+    # the excursion graphs, the range graphs and one picture per case, each a PNG with
+    # something drawn
+    assert len(page.images) == 2 + len(CASES)
     for source in page.images:
         assert source.startswith("data:image/png;base64,")
         data = base64.b64decode(source.split(",", 1)[1])
@@ -249,6 +250,59 @@ def test_the_report_of_a_sweep(offset_sweep, tmp_path):
         drawn = float(np.mean(np.any(pixels < 0.95, axis=-1)))
         assert 0.02 < drawn < 0.9, drawn
     assert "<pre id=\"options\">" in text and "-rod_stiffness" in text
+
+
+# The ends' columns of the summary and the attributes they are.
+END_COLUMNS = ("fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
+               "fairlead_force_x", "fairlead_force_y", "fairlead_force_z", "anchor_tension",
+               "anchor_horizontal", "anchor_vertical", "touchdown_x", "touchdown_y")
+
+
+@pytest.mark.serial
+def test_the_summary_has_the_end_forces_and_the_touchdown_excursion(offset_sweep, tmp_path):
+    """summary.csv holds each case's fairlead and anchor forces, the anchor's uplift
+    flag and the touchdown's position, equal to its file's attributes; the fairlead's
+    offset is -50, 0, 50 m (the pin's position to its constraint residual, 1e-4 m); the
+    touchdown's excursion is the touchdown's x less offset0's (the anchor-to-fairlead
+    direction is +x); the horizontal force grows with the offset (the load-excursion
+    curve) and the touchdown moves toward the anchor; the report's table shows the same
+    numbers. Before, none of these columns."""
+    folder, process = offset_sweep
+    assert process.returncode == 0, describe(process)
+    rows = read_summary(folder)
+    for name, row in rows.items():
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            for column in END_COLUMNS:
+                unit = "m" if column.startswith("touchdown") else "N"
+                assert float(row[f"{column} ({unit})"]) == float(f.attrs[column]), column
+            assert int(row["anchor_uplift (1)"]) == int(f.attrs["anchor_uplift"]) == 0
+            assert float(row["fairlead_horizontal (N)"]) == -float(f.attrs["end_force"][0])
+            np.testing.assert_allclose(f.attrs["fairlead_position"][1:], [0.0, 1000.0],
+                                       atol=1e-4)
+    offset = {k: float(v["fairlead_offset (m)"]) for k, v in rows.items()}
+    assert offset == pytest.approx({"offset0": 0.0, "near50": -50.0, "far50": 50.0},
+                                   abs=1e-4)
+    x0 = float(rows["offset0"]["touchdown_x (m)"])
+    for name, row in rows.items():
+        assert float(row["touchdown_excursion (m)"]) == pytest.approx(
+            float(row["touchdown_x (m)"]) - x0, rel=1e-12, abs=1e-9)
+    H = {k: float(v["fairlead_horizontal (N)"]) for k, v in rows.items()}
+    assert H["near50"] < H["offset0"] < H["far50"]
+    excursion = {k: float(v["touchdown_excursion (m)"]) for k, v in rows.items()}
+    assert excursion["far50"] < -30.0 < 30.0 < excursion["near50"]
+    output = tmp_path / "report.html"
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    page = Tables()
+    page.feed(output.read_text())
+    header, shown = page.rows[0], {row[0]: row for row in page.rows[1:]}
+    for name, row in rows.items():
+        cells = dict(zip(header, shown[name]))
+        for column in ("fairlead_horizontal (N)", "fairlead_offset (m)",
+                       "touchdown_excursion (m)"):
+            assert float(cells[column]) == pytest.approx(float(row[column]), rel=1e-5,
+                                                         abs=1e-9)
+    assert 'alt="excursion graphs"' in output.read_text()
 
 
 @pytest.mark.serial

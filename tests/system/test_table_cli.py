@@ -73,6 +73,31 @@ def test_the_table_has_a_row_per_vertex_and_units_in_its_header(riser):
     assert not partial_files(table)
 
 
+def test_the_ends_table_and_final_lines_give_the_end_forces_and_touchdown(riser):
+    """scr_ends.csv beside the table: the fairlead's and anchor's forces, the uplift
+    flag and the touchdown, one row a number with its unit, equal (12 digits) to the
+    result file's attributes; the final lines say the fairlead's H and V in kN. Before,
+    no such file and no such line."""
+    done, output, table, folder = riser
+    with open(folder / "scr_ends.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["quantity", "value", "unit"]
+    read = {name: (float(value), unit) for name, value, unit in rows[1:]}
+    assert {"fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
+            "fairlead_force_x", "anchor_tension", "anchor_horizontal", "anchor_vertical",
+            "anchor_uplift", "touchdown_S", "touchdown_x", "grounded_length"} <= set(read)
+    with h5py.File(output, "r") as f:
+        for name, (value, unit) in read.items():
+            assert value == pytest.approx(float(f.attrs[name]), rel=1e-11), name
+        assert read["fairlead_vertical"][1] == "N" and read["anchor_uplift"] == (0.0, "1")
+        H, V = f.attrs["fairlead_horizontal"], f.attrs["fairlead_vertical"]
+        assert H == pytest.approx(np.hypot(*f.attrs["end_force"][:2]), rel=1e-15)
+        assert V > H > 0.0                 # a steel riser hangs steeply
+    assert (f"fairlead force {np.hypot(H, V) / 1e3:.6g} kN: horizontal {H / 1e3:.6g} kN, "
+            f"vertical {V / 1e3:.6g} kN") in done.stdout
+    assert f"ends {folder / 'scr_ends.csv'}" in done.stdout
+
+
 def test_the_riser_s_von_mises_stress_and_utilisation_by_hand(riser):
     """At the hang-off (z = 1500 m, the sea surface: p_e = 0, p_i = 10 MPa; a pin: the
     moment M only that of the vertex strain, 26 N m): s_a = T_w / A + M r_i / I with
