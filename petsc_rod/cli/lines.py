@@ -200,6 +200,13 @@ def summary(attributes):
         out += end_force_lines(a)
     if "friction_stick_length" in a:
         out.append("  seabed" + friction_text(a)[1:])
+    if "module_pitch" in a:
+        out.append(f"  buoyancy modules, over the module pitch {a['module_pitch']:.4g} m: "
+                   + "; ".join(f"global {kind} bend radius "
+                               f"{a[f'global_{kind}_bend_radius']:.4g} m at S = "
+                               f"{a[f'global_{kind}_bend_radius_S']:.6g} m (local kink "
+                               f"{a[f'local_{kind}_bend_radius']:.4g} m)"
+                               for kind in ("hog", "sag")))
     joints = [f"{which} joint {a[f'{which}_joint_angle']:.4g} deg, "
               f"{a[f'{which}_joint_moment'] / 1e3:.4g} kN m"
               for which in ("start", "end") if f"{which}_joint_angle" in a]

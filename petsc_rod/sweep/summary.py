@@ -3,7 +3,8 @@ the case's record (name, the options it varied, exit code, how it started) and i
 result file's root attributes, written as CSV and Markdown with the units in the header.
 
 The columns are the riser numbers where the file has them (reports/riser_numbers.py,
-reports/pressures.py, reports/section_numbers.py), then any other scalar root attribute
+reports/line_results.py's end forces, reports/module_bends.py's global and local bend
+radii, reports/pressures.py, reports/section_numbers.py), then any other scalar root attribute
 named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
 (what newer versions add: a utilisation, a von Mises stress; vectors such as the end
 forces are not columns, their scalar parts are), so that the table shows what the files
@@ -53,6 +54,11 @@ NUMBERS = [
     ("min_bend_radius", "min_bend_radius", "m"),
     ("min_bend_radius_S", "max_curvature_S", "m"),
     ("max_curvature", "max_curvature", "1/m"),
+    ("module_pitch", "module_pitch", "m"),
+    ("global_hog_bend_radius", "global_hog_bend_radius", "m"),
+    ("local_hog_bend_radius", "local_hog_bend_radius", "m"),
+    ("global_sag_bend_radius", "global_sag_bend_radius", "m"),
+    ("local_sag_bend_radius", "local_sag_bend_radius", "m"),
     ("max_wall_tension", "max_wall_tension", "N"),
     ("max_wall_tension_S", "max_wall_tension_S", "m"),
 ]
