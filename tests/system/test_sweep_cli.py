@@ -239,9 +239,10 @@ def test_the_report_of_a_sweep(offset_sweep, tmp_path):
                                       ("min_bend_radius (m)", "min_bend_radius")):
                 assert float(cells[column]) == pytest.approx(float(f.attrs[attribute]),
                                                              rel=1e-5), (name, column)
-    # the excursion graphs, the range graphs and one picture per case, each a PNG with
-    # something drawn
-    assert len(page.images) == 2 + len(CASES)
+    # the excursion graphs, one range graph a quantity (effective tension, bend radius,
+    # curvature, bending moment, declination, seabed clearance) and one picture per
+    # case, each a PNG with something drawn
+    assert len(page.images) == 1 + 6 + len(CASES)
     for source in page.images:
         assert source.startswith("data:image/png;base64,")
         data = base64.b64decode(source.split(",", 1)[1])
@@ -303,6 +304,100 @@ def test_the_summary_has_the_end_forces_and_the_touchdown_excursion(offset_sweep
             assert float(cells[column]) == pytest.approx(float(row[column]), rel=1e-5,
                                                          abs=1e-9)
     assert 'alt="excursion graphs"' in output.read_text()
+
+
+class Page(html.parser.HTMLParser):
+    """Every table of a page by its id ({id: rows of cell texts}), the images' alt
+    texts, and the text inside <details>."""
+
+    def __init__(self):
+        super().__init__()
+        self.tables, self.alts, self.folded = {}, [], ""
+        self._table, self._cell, self._details = None, None, 0
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "table":
+            self._table = self.tables.setdefault(attrs.get("id"), [])
+        elif tag == "tr" and self._table is not None:
+            self._table.append([])
+        elif tag in ("td", "th") and self._table is not None:
+            self._cell = ""
+        elif tag == "img":
+            self.alts.append(attrs.get("alt", ""))
+        elif tag == "details":
+            self._details += 1
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self._table[-1].append(self._cell)
+            self._cell = None
+        elif tag == "table":
+            self._table = None
+        elif tag == "details":
+            self._details -= 1
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell += data
+        if self._details:
+            self.folded += data
+
+
+@pytest.mark.serial
+def test_the_report_page_an_engineer_reads(offset_sweep, tmp_path):
+    """The page says its units once and shows the results in kN, m, deg (the files'
+    numbers to the 4 digits shown); the inputs given, not the solver's options (those
+    folded in <details>); a regions' table naming the governing case of each extreme
+    (its numbers the files' region_* attributes); one range graph a quantity, each titled
+    with the case that governs it; the allowable bend radius drawn when given; under a
+    few seconds. Before, one strip of five graphs, numbers in N, every option listed, no
+    region table."""
+    import time
+
+    folder, _ = offset_sweep
+    output = tmp_path / "report.html"
+    begun = time.perf_counter()
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output),
+                                              "--min-bend-radius", "150"])
+    took = time.perf_counter() - begun
+    assert process.returncode == 0, describe(process)
+    assert took < 20.0, took
+    text = output.read_text()
+    assert text.count("Units: forces kN, moments kN m, stresses MPa, angles degrees") == 1
+    page = Page()
+    page.feed(text)
+    results = {row[0]: row for row in page.tables["results"][1:]}
+    assert page.tables["results"][0] == ["quantity", "unit"] + CASES
+    inputs = dict(page.tables["inputs"][1:])
+    assert inputs["-rod_stiffness"] == "5.6e7,5.6e7,4.3e7"
+    assert not any(name.startswith(("-rod_al_", "-rod_d1_", "-sweep_")) for name in inputs)
+    assert "-rod_al_penalty" in page.folded and "-rod_al_penalty" not in inputs
+    regions = {row[0]: row for row in page.tables["regions"][1:]}
+    assert list(regions)[0] == "hang_off" and "grounded" in regions
+    largest, governing = -np.inf, None
+    for k, name in enumerate(CASES):
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            for label, unit, attribute, factor in (
+                    ("top tension", "kN", "top_tension", 1e-3),
+                    ("fairlead horizontal force H", "kN", "fairlead_horizontal", 1e-3),
+                    ("touchdown S", "m", "touchdown_S", 1.0),
+                    ("smallest bend radius", "m", "min_bend_radius", 1.0)):
+                assert results[label][1] == unit
+                assert float(results[label][2 + k]) == pytest.approx(
+                    float(f.attrs[attribute]) * factor, rel=1e-3), (name, label)
+            assert results["anchor lifts off"][2 + k] == "no"
+            names = [n.decode() if isinstance(n, bytes) else n for n in f.attrs["region_names"]]
+            tension = float(f.attrs["region_max_tension"][names.index("hang_off")])
+            if tension > largest:
+                largest, governing = tension, name
+    assert float(regions["hang_off"][3]) == pytest.approx(largest / 1e3, rel=1e-3)
+    assert regions["hang_off"][4] == governing == "far50"
+    graphs = [alt for alt in page.alts if alt.startswith("range graph: ")]
+    assert graphs == [f"range graph: {q}" for q in (
+        "effective tension", "bend radius", "curvature", "bending moment", "declination",
+        "seabed clearance")]
+    assert "the allowable bend radius 150 m" in text
 
 
 @pytest.mark.serial
@@ -505,3 +600,13 @@ def test_which_partial_files_a_killed_sweep_left():
     stale, live = left_partials(entries, files)
     assert stale == entries[:3]
     assert live == [entries[3]]
+
+
+def test_a_bad_allowable_bend_radius_is_one_line_and_exit_2(offset_sweep, tmp_path):
+    folder, _ = offset_sweep
+    output = tmp_path / "r.html"
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output),
+                                              "--min-bend-radius", "-3"])
+    assert process.returncode == 2 and not output.exists()
+    assert process.stderr == ("petsc_rod.report: error: --min-bend-radius -3: the allowable "
+                              "bend radius must be a positive number of metres\n")
