@@ -53,10 +53,14 @@ def number_text(value):
 
 
 def key_results(header, rows, codes):
-    """The key results' table (HTML): a row a quantity, its unit once, a column a case
-    (a case that did not converge shows '-')."""
+    """The key results' table (HTML): the options the cases vary and their status, then
+    a row a quantity, its unit once, a column a case (a case that did not converge shows
+    '-')."""
     where = {name: k for k, name in enumerate(header)}
-    lines = []
+    # first what the cases vary and how each ended, as the summary says them
+    lines = [f"<tr><td class=text><code>{html.escape(name)}</code></td><td></td>"
+             + "".join(f"<td>{html.escape(str(row[k]))}</td>" for row in rows) + "</tr>"
+             for k, name in enumerate(header) if name.startswith("-") or name == "status"]
     for column, label, factor, unit in KEY_RESULTS:
         if column not in where:
             continue
