@@ -225,3 +225,27 @@ def test_a_bad_yield_stress_is_refused(tmp_path):
     lines = done.stdout.strip().splitlines()
     assert len(lines) == 1 and "smys" in lines[0], lines
     assert os.listdir(tmp_path) == ["bad.txt"]
+
+
+def test_the_table_has_the_friction_columns(tmp_path):
+    """With seabed friction (the riser catenary under 1 m/s across, mu = 0.5, 300
+    elements) the table has the file's friction force per metre, its global components
+    friction_force_x, _y, _z (N/m), and the stick/slide state at each vertex, equal to
+    its datasets. Before, the table left them out."""
+    output, table = tmp_path / "f.h5", tmp_path / "f.csv"
+    done = run_petsc_rod(["-options_file", "options/riser_catenary.opts", "-rod_current",
+                          "0,1,0", "-rod_elements", "300", "-rod_seabed_friction", "0.5",
+                          "-rod_output", str(output), "-rod_table", str(table)], 1, 300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    header, values = read_csv(table)
+    for name in ("friction_force_x (N/m)", "friction_force_y (N/m)",
+                 "friction_force_z (N/m)", "friction_state (1)"):
+        assert name in header, name
+    column = {name.split(" (")[0]: values[:, i] for i, name in enumerate(header)}
+    with h5py.File(output, "r") as f:
+        force, state = f["friction_force"][:], f["friction_state"][:]
+    for k, axis in enumerate("xyz"):
+        np.testing.assert_allclose(column[f"friction_force_{axis}"], force[:, k],
+                                   rtol=1e-11, atol=1e-9)
+    np.testing.assert_array_equal(column["friction_state"], state)
+    assert np.abs(force[:, 1]).max() > 10.0           # friction holds the line sideways
