@@ -57,20 +57,23 @@ UNITS = ("Units: forces kN, moments kN m, stresses MPa, angles degrees, lengths 
 # One range graph, inches at DPI: two side by side in a 1400 px window.
 GRAPH_SIZE = (6.6, 3.6)
 DPI = 100
+# A case's picture (16 x 9.5 in): 1280 px wide, within a 1400 px window as drawn, and a
+# third fewer bytes and less time than at DPI.
+CASE_DPI = 80
 
 
-def png(figure):
-    """``figure`` as a base64 PNG (the figure closed)."""
+def png(figure, dpi=DPI):
+    """``figure`` as a base64 PNG at ``dpi`` (the figure closed)."""
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=DPI)
+    figure.savefig(buffer, format="png", dpi=dpi)
     plt.close(figure)
     return base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def image(figure, alt):
-    """An <img> of ``figure``, embedded."""
+def image(figure, alt, dpi=DPI):
+    """An <img> of ``figure`` at ``dpi``, embedded."""
     return (f'<img alt="{html.escape(alt)}" '
-            f'src="data:image/png;base64,{png(figure)}">')
+            f'src="data:image/png;base64,{png(figure, dpi)}">')
 
 
 def file_inputs(path):
@@ -212,7 +215,7 @@ def build(source, min_bend_radius=None):
                          ".</p>")
             continue
         parts.append(image(plots.result_figure(record["file"], min_bend_radius),
-                           record["name"]))
+                           record["name"], CASE_DPI))
     body = "\n".join(parts)
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>"
             f"{html.escape(title)}</title><style>{STYLE}</style></head>\n<body>\n{body}\n"
