@@ -44,7 +44,7 @@ class RodDivergedError(RodError):
 class RodIterationDiverged(RodDivergedError):
     """The iteration's own norms left every meaningful state (stopping.diverged), as
     opposed to a linear solver that failed: a smaller step or a larger penalty helps
-    (the command line says so, cli/lines.py)."""
+    (the command line says so, cli/messages.py)."""
 
 
 class RodIOError(RodError):

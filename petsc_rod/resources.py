@@ -9,17 +9,15 @@ from petsc4py import PETSc
 from petsc_rod.errors import RodInputError
 
 # Memory of a run: per element (fields, matrices and their factors, the node state,
-# Anderson's history, the stability test's factorisation; the measured peak of the
-# default run, 17 KiB at 1e5 elements, rounded up: docs/performance.md, "Memory in
-# proportion") and per rank (the interpreter, PETSc, MPI).
+# Anderson's history, the stability test's factorisation; the default run's peak rounded
+# up: docs/performance.md, "Memory for long lines") and per rank (the interpreter,
+# PETSc, MPI).
 BYTES_PER_ELEMENT = 20 * 2**10
 BYTES_PER_RANK = 80 * 2**20
 # A run whose Newton steps carry the node heights (a seabed: the positions' chain of
 # analysis/positions.py in the Newton systems and their factors) needs more than twice
-# that: options/riser_catenary.opts at 72 000 elements peaked at 3.27 GB on one rank (45
-# KiB per element, with or without its current) and 3.96 GB on two (53 KiB), against
-# 1.18 GB on one rank without Newton steps and 1.39 GB for options/catenary.opts (19 KiB);
-# rounded up (docs/performance.md, "Issue 21, fourth pass").
+# that: the riser's peak on two ranks, rounded up (docs/performance.md, "Memory for long
+# lines").
 BYTES_PER_ELEMENT_HEIGHTS = 56 * 2**10
 # Anderson mixing keeps 2 m vectors of the node state (18 numbers at 2 nodes per
 # element): 576 bytes per element and unit of depth, allocated (and written: PETSc zeroes

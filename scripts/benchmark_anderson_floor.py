@@ -9,8 +9,8 @@ their Gram matrix (with the right-hand side of the least-squares problem updated
 it, no further pass), the iterates for the combination. This script times those two
 passes as single BLAS calls on contiguous (m, 18 (2N + 1)) arrays, one thread (as
 ``python -m petsc_rod`` runs), and prints them per element beside PETSc's Anderson,
-which reads the residuals twice and the iterates once (docs/performance.md, "Why the
-default keeps m = 30"). The best of --repeat runs is kept.
+which reads the residuals twice and the iterates once (docs/performance.md, "Anderson
+mixing"). The best of --repeat runs is kept.
 """
 
 import argparse

@@ -27,7 +27,7 @@ last, two more measures:
   for the slower of two cores, bound one a rank, where a 1-rank run needs one core and
   the system may move it to the quieter, so a busy moment slows the 2-rank run more.
   Even so, the machine's state over minutes moves both readings by more than the
-  number of pairs does (docs/performance.md, "Issue 21, eleventh pass").
+  number of pairs does (docs/riser_benchmark.md).
 
 The page also gives the time of scripts/machine_speed.py (a pure-Python loop) before and
 after, alone and two copies at once, which says how fast the (shared, virtual) machine's

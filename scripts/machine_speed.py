@@ -3,8 +3,8 @@
 
     python scripts/machine_speed.py
 
-The timings in docs/ quote it beside their numbers (the README says what it takes when
-the machine runs fast). Run inside a function, where names are local, the same loop is
+The timings in docs/ quote it beside their numbers (docs/performance.md says what it
+takes when the machine runs fast). Run inside a function, where names are local, the same loop is
 faster: compare only like with like.
 """
 

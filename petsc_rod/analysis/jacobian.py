@@ -72,8 +72,8 @@ class NewtonJacobian:
             self.matrix.axpy(1.0, hessian.matrix,
                              structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         elif self._pattern_of_h():
-            # the same pattern as H: a copy of the values (MatCopy), where MatAXPY's
-            # general path costs ten times as much (docs/performance.md, ninth pass)
+            # the same pattern as H: a copy of the values (MatCopy), far cheaper than
+            # MatAXPY's general path (docs/performance.md, "Newton steps")
             hessian.matrix.copy(self.matrix,
                                 structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         else:

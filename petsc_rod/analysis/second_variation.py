@@ -390,9 +390,8 @@ class SecondVariation:
         (n_nodes, 3)) to the constraints of the inertia test, until the next update: where
         K1 = K2 all along and nothing is clamped, turning every section by one angle about
         its tangent is a null vector of H (the free roll, which the Newton steps leave
-        out), and an iterate's multipliers make its eigenvalue slightly negative (measured
-        on the riser with seabed friction: -10 to -1000 times the tolerance, at change
-        1e-5 to 1e-6)."""
+        out), and an iterate's multipliers make its eigenvalue slightly negative
+        (docs/method.md §11, "The free roll")."""
         self._constraint_changed()
         self.constraint = self._independent(self.constraint + [self.roll_form(tangents)])
 

@@ -150,7 +150,7 @@ class Line:
     (LineType, length m, elements), with ``element_length`` (m) the elements of those
     without a count (each at least 1). ``contents_density`` (kg/m^3) and
     ``internal_pressure`` at the top (Pa) give the reported pressures and wall tension
-    (reports/pressures.py)."""
+    (quantities/pressures.py)."""
 
     sections: tuple
     element_length: float = 1.0

@@ -14,7 +14,7 @@ object: the run's are destroyed before it returns).
 
 import numpy as np
 
-from petsc_rod.cli.lines import summary
+from petsc_rod.cli.messages import summary
 from petsc_rod.io.results import ATTRIBUTE_UNITS, DATASET_UNITS
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod import resources
-from petsc_rod.cli import lines
+from petsc_rod.cli import messages
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, check_anderson_depth,
                                    check_same_on_every_rank, check_snes_type,
                                    check_substructuring_switches, format_value,
@@ -267,7 +267,7 @@ def build_solver(mesh, scene, settings, say):
     -rod_al_monitor; a PETSc error while they set up their solvers (an unknown
     -rod_slope_ksp_type, say) is bad input (what was made is destroyed)."""
     def say_monitor(*row):
-        say(lines.monitor(*row))
+        say(messages.monitor(*row))
 
     monitor = say_monitor if settings.monitor else None
     problem = None

@@ -238,7 +238,7 @@ def check_represented(entries, lengths, counts, shared, given_counts, length, sh
 
 def pressures_from_options(values, given, scene):
     """Set the scene's sea surface (in its frame), contents density, internal
-    pressure (reports/pressures.py) and design factor (reports/stresses.py) for a line of
+    pressure (quantities/pressures.py) and design factor (quantities/stresses.py) for a line of
     sections; refuse them on a line without
     line types (no diameters to press on)."""
     if not scene.sections:

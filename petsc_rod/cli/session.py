@@ -5,7 +5,7 @@ line, the scripts and the tests call run_continuation."""
 
 from dataclasses import dataclass
 
-from petsc_rod.cli import lines
+from petsc_rod.cli import messages
 from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
 from petsc_rod.io import outputs
 from petsc_rod.iteration import events
@@ -32,7 +32,7 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
 
     ``say(line)`` gets the lines (None: silent): a short line per step (lines.step_line),
     its details too (lines.step_details) when the solver's settings ask for the monitor,
-    and the final summary (lines.summary) before the last line; ``writer``
+    and the final summary (messages.summary) before the last line; ``writer``
     (io.results.ResultWriter or None) a group ``steps/<n>`` per StepEnded, with ``options`` (the options database as
     text) among its attributes, and is finished at the end. ``interrupts``
     (signals.Interrupts), if given, are asked after every iteration and before the file
@@ -49,13 +49,13 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     raises = []                 # the PenaltyRaised events of the attempt so far
     for event in continuation(solver, path, stop):
         if isinstance(event, events.RunStarted):
-            say(lines.started(event))
+            say(messages.started(event))
             if solver.settings.newton and not problem.in_newton:
-                say(lines.no_newton([t for t in problem.terms if not t.in_newton]))
+                say(messages.no_newton([t for t in problem.terms if not t.in_newton]))
         elif isinstance(event, events.PenaltyRaised):
             raises.append(event)
         elif isinstance(event, events.StepHalved):
-            say(lines.halved(event))
+            say(messages.halved(event))
             raises = []
         elif isinstance(event, events.StepEnded):
             group = f"steps/{event.number}"
@@ -65,15 +65,15 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 asked_penalty=solver.settings.asked_penalty,
                 total_iterations=event.total_iterations,
                 undone_iterations=event.undone_iterations)
-            say(lines.step_line(event, record))
+            say(messages.step_line(event, record))
             if verbose:
-                say(lines.step_details(event, record))
+                say(messages.step_details(event, record))
             if raises:
-                say(lines.raised(event.label, raises, problem.scale))
+                say(messages.raised(event.label, raises, problem.scale))
             raises = []
             last = (group, record.attributes)
         elif isinstance(event, events.RunDiverged):
-            raise RodDivergedError(lines.diverged_message(event), event.error.iterations)
+            raise RodDivergedError(messages.diverged_message(event), event.error.iterations)
         elif isinstance(event, events.Interrupted):
             number = interrupts.received()
             kept = None
@@ -81,15 +81,15 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 kept = writer.kept_name()
                 writer.finish(last[0], {**last[1], "converged": 0,
                                         "stop_reason": "interrupted"}, kept)
-            raise RodInterrupted(lines.interrupted(interrupts.name(number), event, kept),
+            raise RodInterrupted(messages.interrupted(interrupts.name(number), event, kept),
                                  number)
         elif isinstance(event, events.RunFinished):
             if writer is not None:
                 writer.finish(*last)
             if event.converged and last is not None:
-                for line in lines.summary(last[1]):
+                for line in messages.summary(last[1]):
                     say(line)
-            say(lines.finished(event, solver.settings, problem.scale))
+            say(messages.finished(event, solver.settings, problem.scale))
             code = 0 if event.converged else RodNotConvergedError.exit_code
             return ContinuationResult(code, event.report, event.iterations)
     raise RuntimeError("the continuation ended without a final event")

@@ -1,5 +1,5 @@
 """The line's surroundings, data only (docs/riser.md): nothing here is a term of physics
-(physics/) or a report (reports/).
+(physics/) or a report (quantities/).
 
     seabed.py       the elastic seabed (flat or shaped), its friction, its stiffness
                     bounds, the checks of the ends and the footprint against it

@@ -15,10 +15,9 @@ seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
   rows, and turning linearly from one segment's to the next over delta about a row
   (and to 0 about the first and last). Why: the contact's horizontal push is lagged
   (physics/slope_load.py), and with the slope jumping at a row a node there flips between the
-  two pushes from one iteration to the next and the iteration never settles (measured:
-  a line pushed over the edge of a grid's slope stalled at a change of 1e-5); a
-  gradient continuous in the position gives it a fixed point. ``covers`` tells whether
-  a point lies within the rows.
+  two pushes from one iteration to the next and the iteration never settles
+  (docs/riser.md §3a); a gradient continuous in the position gives it a fixed point.
+  ``covers`` tells whether a point lies within the rows.
 * ``Grid``: bilinear in each cell of a rectangular grid, its gradient the secant over
   SMOOTHING times the closest grid lines' spacing along x and along y, for the same
   reason.

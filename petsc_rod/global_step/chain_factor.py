@@ -1,5 +1,5 @@
 """Direct factorisations of the Newton steps' systems on several ranks, by
-substructuring (docs/performance.md, "Issue 21, third pass").
+substructuring (docs/performance.md, "Newton steps"; docs/options.md).
 
 The Newton Jacobian J (analysis/jacobian.py) and the second variation H
 (analysis/second_variation.py) are chains of nodes: B unknowns a node, the nodes of a rank in
@@ -36,9 +36,8 @@ A solve is a local solve, an allgather of 2 B k numbers a rank (k right-hand sid
 dense product with S^-1 and x_I -= W x_G: the work of the serial factorisation divided
 by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
 factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
-scalable to many), where MUMPS on two ranks factored the riser's Jacobian in the one-rank
-time and solved it in twice that (docs/performance.md). The ChainFactor owns its PETSc
-objects (the interior submatrix, on the first rank of an LDL^T a reference to the
+scalable to many; the costs: docs/performance.md, "Newton steps"). The ChainFactor owns
+its PETSc objects (the interior submatrix, on the first rank of an LDL^T a reference to the
 diagonal block itself, and its sequential MUMPS solver, the index set of the interior
 rows where it is not the whole block): ``destroy()``.
 """
@@ -50,8 +49,8 @@ from petsc_rod.global_step.substructuring import NotAChainError, csr_positions, 
 
 # The equilibrated interface's pseudo-inverse drops singular values (eigenvalues) below
 # this fraction of the largest: a null pivot, the free roll of a section with K1 = K2
-# between pins (there the smallest falls to 1e-15 of the largest at the attempt's last
-# factorisation, and is dropped, as MUMPS on all ranks drops it: docs/performance.md).
+# between pins, dropped as MUMPS on all ranks drops it (docs/performance.md, "Newton
+# steps").
 NULL_PIVOT = 1e-13
 # Ruiz sweeps of the Schur complement's equilibration: each halves the logarithm of a
 # row's or column's largest entry, so 20 bring a range of 1e16 to within 4e-5 of 1.
@@ -103,16 +102,16 @@ class ChainFactor:
         # the first rank's interior of an LU numbered from its end: its couplings, to
         # the next interface, come first, near the root of the elimination tree (W's
         # solve); an LDL^T's factorisation takes longer in that order than W's solve
-        # saves (docs/performance.md, "Issue 21, tenth pass"): the natural order, in
-        # which the first rank's interior is its diagonal block, taken without a copy
+        # saves (docs/performance.md, "Newton steps"): the natural order, in which the
+        # first rank's interior is its diagonal block, taken without a copy
         self.reversed = self.offset == 0 and self.has_next and not self.symmetric
         # the interior rows: None where they are the whole diagonal block (the first
         # rank's LDL^T; one rank, in tests only: direct_factor substructures on
         # several), whose interior is then the block itself, a reference taken at each
         # set_up (nothing here changes it in place); else a stride where the order is
         # the natural one (MatCreateSubMatrix copies contiguous columns row by row,
-        # faster than for a general index set: docs/performance.md, "Issue 21, tenth
-        # pass"), the reversed rows where it is not
+        # faster than for a general index set: docs/performance.md, "Newton steps"),
+        # the reversed rows where it is not
         if self.reversed:
             interior = np.arange(self.n - 1, self.offset - 1, -1, dtype=PETSc.IntType)
             self._index = PETSc.IS().createGeneral(interior, comm=PETSc.COMM_SELF)
@@ -414,7 +413,7 @@ def _column_range(matrix, start, end, edge=None):
     hold every entry beyond the block (the local count of stored entries less the
     block's), else from the whole local pattern (MatGetRowIJ, which copies the local rows
     with their values), not the whole CSR with its values and a reduction over every
-    entry (the costs: docs/performance.md, "Issue 21, sixth pass")."""
+    entry (the costs: docs/performance.md, "Newton steps")."""
     several = matrix.getComm().getSize() > 1
     indptr, columns = (matrix.getDiagonalBlock() if several else matrix).getRowIJ()
     first_column = matrix.getOwnershipRangeColumn()[0]      # the block's column 0

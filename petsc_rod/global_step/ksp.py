@@ -83,12 +83,11 @@ def mumps_defaults(kind, block=None):
 
     The nodes' graph: AMF on the unknowns' graph makes the elimination tree a path of
     one node per unknown, and MUMPS's mapping of a path onto several ranks grows like
-    the square of its length (1.5 s for the 18 000-element riser's LU on 2 ranks, 69 s
-    at 60 000 elements); a node per P2 node shortens it sevenfold on the riser (0.3 s
-    on 2 ranks), and on one rank the factorisation and the solves are a quarter faster
-    as well. Not defaults, measured: PORD on the nodes' graph for the LU on several
-    ranks (a faster analysis still, larger factors); the LDL^T on the nodes' graph
-    gave NaN solves on a riser with seabed friction.
+    the square of its length; a node per P2 node shortens it by the block, and on one
+    rank the factorisation and the solves are faster as well (docs/performance.md,
+    "Newton steps"). Not defaults: PORD on the nodes' graph for the LU on several ranks
+    (a faster analysis still, larger factors); the LDL^T on the nodes' graph, whose
+    solves were not finite on a riser with seabed friction.
     """
     if kind != PETSc.PC.Type.LU:
         return {}
@@ -137,7 +136,7 @@ WORKSPACE_RETRIES = 3
 def set_up_mumps(ksp, block=None):
     """``ksp.setUp()`` for an inertia_solver or lu_solver, with mumps_defaults in effect
     under its prefix (MUMPS reads its controls at the symbolic factorisation;
-    MatMumpsSetIcntl(7) before it did not take, PETSc 3.18, measured). ``block``: the
+    MatMumpsSetIcntl(7) before it does not take in PETSc 3.18). ``block``: the
     unknowns of a node, where the matrix's rows come node by node (the LU then analyses
     the nodes' graph)."""
     prefix = ksp.getOptionsPrefix() or ""
@@ -174,8 +173,8 @@ def _with_more_workspace(ksp, factor):
 def solve_columns(ksp, columns, rows=None):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
     the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve
-    (one call into MUMPS's solve phase; on the riser's chains its cost grows with k
-    about in proportion, docs/performance.md, "Issue 21, fifth pass").
+    (one call into MUMPS's solve phase, whose cost is a fixed part and a part per
+    column: docs/performance.md, "Newton steps").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
     rows out), the local indices of its rows in them; the other rows of x_j are b_j.
     Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed
@@ -219,9 +218,9 @@ def solve_dense(ksp, right):
     matrices laid on ``right`` and on the new array X, which it returns, (n, k) in
     Fortran order. No column is copied in Python on the way in or out (PETSc copies B
     into X once, for MUMPS to solve in place): solve_columns copies each twice more and
-    allocates both matrices anew, and on the two ranks' halves of the riser's Jacobian
-    those copies cost as much as on the whole (docs/performance.md, "Issue 21, twelfth
-    pass"). A failed factorisation gives Inf."""
+    allocates both matrices anew, work that a rank's half of a chain pays as the whole
+    chain does (docs/performance.md, "Newton steps"). A failed factorisation gives
+    Inf."""
     factor = ksp.getPC().getFactorMatrix()
     solution = np.empty(right.shape, dtype=PETSc.ScalarType, order="F")
     if factor.getMumpsInfog(1) < 0:
@@ -241,9 +240,9 @@ def solve_sparse_columns(ksp, rows, values):
     operator, where b_j is values[:, j] (``values`` (r, k)), with the factored operator
     A of a sequential inertia_solver or lu_solver: MUMPS's sparse right-hand sides
     (ICNTL 20, through MatMatSolve of a transposed AIJ), whose forward elimination visits
-    only the paths of the elimination tree from those rows to its root, about half the
-    cost of a dense solve where the rows sit near the root (docs/performance.md; the
-    backward one gives every row). ``rows`` distinct. Returns x, (k, n), C-contiguous
+    only the paths of the elimination tree from those rows to its root, cheaper than a
+    dense solve where the rows sit near the root (docs/performance.md, "Newton steps";
+    the backward one gives every row). ``rows`` distinct. Returns x, (k, n), C-contiguous
     (the transpose of the solve's own Fortran-ordered array, not a copy). A failed
     factorisation gives Inf."""
     factor = ksp.getPC().getFactorMatrix()

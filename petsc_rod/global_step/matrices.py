@@ -144,8 +144,8 @@ class ScalarProblem:
         right-hand side). A direct solver is called past KSPSolve (_direct_solver):
         PETSc's factorisation and the substructuring PC column by column on the Vecs, a
         factorisation with a multiple right-hand-side solve (MUMPS) with the three
-        right-hand sides together (MatMatSolve: one pass instead of three, half the solve
-        time on 2 ranks, docs/performance.md). Any other KSP solves them one by one.
+        right-hand sides together (MatMatSolve: one pass instead of three,
+        docs/performance.md). Any other KSP solves them one by one.
         """
         touched = np.concatenate([self._lift_rows, self._local_rows])
         kept = []

@@ -23,7 +23,7 @@ follows the line; on a profile the matrix is rebuilt when a node's k_n changes (
 crosses a row). Why implicit: the iteration's compliance to a load on a
 stretch l of line is about l^2 / R, so an explicit (lagged) spring k is amplified
 k l^2 / R times per iteration, 1e5 or more for a seabed stiff enough to hold the line
-within a millimetre (measured in docs/riser.md).
+within a millimetre (docs/riser.md).
 """
 
 import numpy as np

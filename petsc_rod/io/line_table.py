@@ -1,6 +1,6 @@
 """The converged result along the line as a CSV table (-rod_table FILE.csv) and the
 regions' summary beside it (FILE's stem + ``_regions.csv``; the run's final summary
-prints it too, cli/lines.summary) and the ends' numbers (FILE's stem + ``_ends.csv``: one
+prints it too, cli/messages.summary) and the ends' numbers (FILE's stem + ``_ends.csv``: one
 row a number, ``quantity,value,unit``: the fairlead's and anchor's forces, the anchor's
 uplift flag, the touchdown and the grounded length, ENDS_NUMBERS, those the run has,
 for a run with the riser numbers)
@@ -28,7 +28,7 @@ import numpy as np
 from petsc_rod.errors import RodInputError, RodIOError, on_every_rank
 from petsc_rod.io import outputs
 from petsc_rod.io.results import DATASET_UNITS, check_output_path, partial_name
-from petsc_rod.reports import riser_numbers
+from petsc_rod.quantities import riser_numbers
 
 # The datasets of the table after S, x, y, z, u1, u2, in this order, where the run has
 # them.
@@ -37,7 +37,7 @@ TABLE_DATASETS = ("curvature", "bend_radius", "bending_moment", "torque", "shear
                   "internal_pressure", "von_mises", "utilisation", "declination",
                   "seabed_reaction", "seabed_height", "friction_force", "friction_state",
                   "axial_strain", "axial_tension", "section")
-# The ends' numbers (reports/line_results.py, reports/riser_numbers.py), in this order.
+# The ends' numbers (quantities/line_results.py, quantities/riser_numbers.py), in this order.
 ENDS_NUMBERS = ("fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
                 "fairlead_force_x", "fairlead_force_y", "fairlead_force_z", "anchor_tension",
                 "anchor_horizontal", "anchor_vertical", "anchor_uplift", "top_tension",
@@ -96,7 +96,7 @@ def final_record(problem):
     (outputs.collect). Collective."""
     collected = outputs.collect(problem)
     vertex = collected.vertex
-    if "effective_tension" not in vertex:       # a plain rod's (reports/line_results.py)
+    if "effective_tension" not in vertex:       # a plain rod's (quantities/line_results.py)
         vertex["effective_tension"] = riser_numbers.effective_tension(vertex)
     return vertex, collected.attributes
 
@@ -187,7 +187,7 @@ def write_tables(path, comm, vertex, attributes, units):
 
 def finish_run(problem, path, say):
     """After a converged run: the table written when ``path`` (-rod_table) is given (the
-    regions' summary is the run's final summary's, cli/lines.summary). Collective."""
+    regions' summary is the run's final summary's, cli/messages.summary). Collective."""
     if not path:
         return
     vertex, attributes = final_record(problem)

@@ -39,20 +39,16 @@ NEWTON_SWITCH = 0.1
 # Where the Newton system reads what the whole line beyond a node does (the heights a
 # seabed reads, the drag's resultants: docs/method.md §11), an iterate at 0.1 is
 # metres off in height or in the resultant and every attempt finds H indefinite; each
-# attempt restarts Anderson's history, and on the riser from the straight start their
-# restarts kept a step from converging in 2000 iterations. There the switch is at
-# NEWTON_SWITCH_FAR (the scenes' counts are the same at 1e-2 and 1e-3).
+# attempt restarts Anderson's history, so that their restarts can keep a step from
+# converging. There the switch is at NEWTON_SWITCH_FAR (docs/method.md §11).
 NEWTON_SWITCH_FAR = 1e-2
 # An attempt costs as much as tens of iterations (a sparse LDL^T factorisation per Newton
 # step: docs/performance.md): it is made only while the iteration would still need more
 # than NEWTON_WORTH iterations at its recent rate. After each attempt that did not
 # converge the wait doubles (an attempt restarts the accelerated iteration). Not where
 # the switch is NEWTON_SWITCH_FAR (a seabed, a current): there the rate keeps falling
-# (the grounded span's slow modes) and the estimate at the recent rate is no guide:
-# options/riser_catenary.opts at 18 000 elements, started with the touchdown where its
-# catenary has it, was estimated at 10 to 18 iterations from the end for 60 iterations
-# on end, made no attempt and took 81 iterations, against 36 with one (docs/method.md
-# §11).
+# (the grounded span's slow modes) and the estimate at the recent rate is no guide
+# (docs/method.md §11).
 NEWTON_WORTH = 30
 # A state where Newton finds negative curvature is left at once (not first converged to)
 # when change and residual are below EARLY_ESCAPE: near an equilibrium, so a saddle.

@@ -2,7 +2,7 @@
 that happened, in order: within an attempt (SaddleLeft, PenaltyRaised, NewtonAttempt,
 recorded by the step controller), then the attempt's end (StepHalved or StepEnded), and
 the run's. The continuation yields them and never formats or writes;
-cli/session.py walks them, with cli/lines.py for the lines a user reads and io/ for the
+cli/session.py walks them, with cli/messages.py for the lines a user reads and io/ for the
 result file.
 """
 

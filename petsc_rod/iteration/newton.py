@@ -73,13 +73,12 @@ STEP_TOLERANCE = 1e-10
 # the one before it is taken where that one lowered |grad L| to at most this fraction,
 # above FLOOR_TURN: the contact's active set moves with the steps (a semi-smooth
 # Newton), and while it settles a step may turn about as much as the one before it
-# (measured on options/riser_catenary.opts without its current: turns 3.7e-4, then
-# 2.5e-4 with |grad L| 2.5e5 -> 3.8e4, then 5.0e-5, 9.5e-11). The residual's fall at
-# every such step, and MAX_STEPS, keep an attempt from cycling.
+# (docs/method.md §11, "Terms of the positions"). The residual's fall at every such
+# step, and MAX_STEPS, keep an attempt from cycling.
 SHRINK = 0.5
 # Steps stop shrinking at the round-off floor of the Newton system, about cond(H) eps
-# (cond(H) grows like the square of the element count; docs/performance.md has it at
-# 10^4 elements). An attempt whose last step was below FLOOR_TURN rad when the next one
+# (cond(H) grows like the square of the element count; docs/method.md §11). An
+# attempt whose last step was below FLOOR_TURN rad when the next one
 # stopped shrinking has reached that floor: its state is handed over, and the iteration,
 # whose tests decide convergence, goes on from there.
 FLOOR_TURN = 1e-7
@@ -89,8 +88,8 @@ FLOOR_TURN = 1e-7
 # changed since it was factored by about the turns since that exact step, and a step
 # with it contracts the error by a factor of about as much, without H's and J's
 # assembly, the LU and the inertia's LDL^T, and with one right-hand side: the chord
-# forms' solves are the exact step's too (the KKT matrix frozen whole;
-# docs/performance.md, "Issue 21, ninth pass"). A chord step that does not shrink to
+# forms' solves are the exact step's too (the KKT matrix frozen whole; docs/method.md
+# §11, "Chord steps"). A chord step that does not shrink to
 # FROZEN_SHRINK of the previous one is taken again with fresh factors (above FLOOR_TURN;
 # at the floor the state is handed over, as after any step that does not shrink). Such a
 # problem has no energy: the inertia test is its steps' safeguard, not a stability
@@ -268,8 +267,7 @@ class NewtonSolver:
                     # from the second step on where the first took the iteration's
                     # curvature: that step fixes the positions with another matrix than
                     # the exact one, and the residual after it may exceed the one before
-                    # (measured with seabed friction: 4.3e3, then 8.2e3, 9.2e-2, 2.3e-4,
-                    # 1.6e-6; the first step turned the grounded line about itself)
+                    # (docs/method.md §11)
                     norm = self._residual_norm
                     if not norm < residual:
                         if previous <= FLOOR_TURN:
@@ -424,11 +422,11 @@ class NewtonSolver:
         times the weight on a cable), which makes H indefinite; the iteration's
         multipliers hold the forces of the state it is near. That step fixes the heights,
         and the next ones are exact Newton steps, but where H is indefinite after a step
-        that left errors in height (measured on options/riser_catenary.opts without its
-        current, 900 elements: a first turn of 0.016 rad), which ``run`` takes again with
-        the iteration's curvature. ``frozen``: a chord step, with the matrices and
-        factors of the last exact step, and its chord forms' solves (FREEZE_TURN,
-        _keep_kkt; ``run`` takes one only where they are kept)."""
+        that left errors in height (a first turn of a hundredth of a radian,
+        docs/method.md §11), which ``run`` takes again with the iteration's curvature.
+        ``frozen``: a chord step, with the matrices and factors of the last exact step,
+        and its chord forms' solves (FREEZE_TURN, _keep_kkt; ``run`` takes one only
+        where they are kept)."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         self._agree(np.isfinite(self._residual_norm))        # the same sum on every rank

@@ -19,16 +19,15 @@ so that at a fixed point (g3 = tau3) the end node feels the moment of the true l
 k theta along p / |p|. The lagged part is of order k theta^3 / 6, small beside the k the
 matrix carries. Only the tangential part is lagged: the radial force stays Q's,
 k (1 - c), so the multiplier at the end node carries no force of order k (a lagged
-k theta/sin theta a would: lambda3 ~ k / w_n there, far above R; the cantilever of
-tests/solver/test_flex_joint.py (b) at k = 100 EI / L took 1056 iterations instead of
-18). The end node's multipliers still carry the boundary fluxes of d1 and d2 that the
-moment calls for, about k theta / h: a very stiff joint may need a larger R where no
-Newton step raises it (docs/method.md §5).
+k theta/sin theta a would: lambda3 ~ k / w_n there, far above R, and the iteration
+crawls). The end node's multipliers still carry the boundary fluxes of d1 and d2 that
+the moment calls for, about k theta / h: a very stiff joint may need a larger R where
+no Newton step raises it (docs/method.md §5).
 
 **On an extensible end** (``local``, set by RodProblem where EA is finite at the joint;
 docs/method.md §12) the quadratic above would leave its radial pull k (|g3| - c) in the
 end node's lambda3, which the stretched local step reads as the tension EA eps: the end
-strain was wrong by k (1 - cos theta) / w_n, growing with the mesh. There the joint is
+strain would be wrong by k (1 - cos theta) / w_n, growing with the mesh. There the joint is
 left out of the global step and acts in the local step at its node instead
 (``joint_local_step``: AL terms, EA eps^2 / 2 and 1/2 (k / w_n) theta(tau3)^2, minimised
 over tau in SO(3) and eps by Newton's method on SO(3)); its energy is 1/2 k theta^2 of

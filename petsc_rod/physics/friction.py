@@ -32,7 +32,7 @@ and the loop solves again until none changes by more than SECANT_RTOL k_s: the s
 (Kacanov) iteration, of a convex problem for an isotropic mu and given R (with mu_a !=
 mu_l the law has no convex potential), which never carries a node past its anchor.
 A sliding force held fixed instead flipped its sign from one solve to the next and the
-map cycled (measured, docs/riser.md §3b). The contact reaction is that of the same
+map cycled (docs/riser.md §3b). The contact reaction is that of the same
 global step's vertical solve (the seabed term comes first). Why implicit: an explicit
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (global_step/seabed_contact.py).
@@ -57,9 +57,8 @@ stability test see the friction with its limit held at its current value); the z
 (``unsymmetric``; analysis/jacobian.py). With mu_a != mu_l the slide's block is
 unsymmetric, its symmetric part indefinite where the slip is oblique to the line, and
 the turn of the axes a, l with the tangent, left out, is of the order of R: the steps
-failed there (the riser across a current at mu 0.3, 0.8: 910 iterations with 5 failed
-attempts against 768 without), so such a run takes none (``in_newton``); nor on a seabed
-that is not flat (slope_load.py). Not conservative: friction dissipates, so the run
+failed there (docs/riser.md §3b), so such a run takes none (``in_newton``); nor on a
+seabed that is not flat (slope_load.py). Not conservative: friction dissipates, so the run
 gives no stability verdict (as with the drag).
 """
 
@@ -74,9 +73,8 @@ from petsc_rod.physics.nodal_load import NodalLoadTerm
 from petsc_rod.physics.term import TermOutput
 
 # The secant loop of one global step ends when no node's spring changed by more than
-# this times k_s (the next global step starts from the last springs). Measured on the
-# riser across a current (docs/riser.md §3b): 1e-9 took 808 iterations and 25 s, 1e-2
-# and 1e-1 about 740 and 4.4 s.
+# this times k_s (the next global step starts from the last springs): a tighter bound
+# costs solves without saving iterations (docs/riser.md §3b).
 SECANT_RTOL = 1e-2
 
 # The KSP options prefixes of the x and y problems.
@@ -222,8 +220,7 @@ class FrictionTerm(NodalLoadTerm):
                 break
         # the return map at the solved positions (the springs just updated): |f|_mu <= R
         # holds to round-off, where the force the solve carried (its springs one pass
-        # behind) exceeds it by their last change, up to 1.4e-8 of mu R at convergence
-        # (measured: tests/solver/test_seabed_friction.py, 2 ranks)
+        # behind) exceeds it by their last change (docs/riser.md §3b, "Outputs")
         force = -self.spring[..., None] * (positions - self.anchors)
         self._record(force, positions, tangents, reaction, gradients)
         if bordered:

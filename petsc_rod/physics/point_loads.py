@@ -19,7 +19,7 @@ int_e N_k, those after it nothing.
 n(S) jumps by -P_p at S_p; at a vertex on S_p the reported n is the one just beyond it
 (the point counted as before S). A point at a free end S = L acts as an end force there
 (it is in n(L), Term.end_force). A point on a held end is carried by the support: the
-line's n is that without it, and the end's reaction (reports/line_results.end_numbers)
+line's n is that without it, and the end's reaction (quantities/line_results.end_numbers)
 adds it (on_held_ends), so that the reactions balance every load.
 
 An attachment with a drag area C_d A (m^2) in a current also feels the drag

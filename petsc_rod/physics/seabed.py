@@ -54,10 +54,9 @@ class SeabedTerm(NodalLoadTerm):
 
     def solve_slope(self, rhs, state, bordered):
         """z' from the vertical problem with the contact (seabed_contact.SeabedContact.solve; on a
-        flat seabed its first active set from the state's positions: on the matrix's
-        riser on a seabed sloping 3 deg across its plane, whose grounded part slides
-        down the slope from its catenary, the iteration then stagnated for 1200
-        iterations, against 80 from an empty set, docs/riser.md)."""
+        flat seabed its first active set from the state's positions; a sloping or
+        profiled one starts from an empty set, where the grounded part slides down the
+        slope from its catenary: docs/riser.md §3)."""
         start = (state.r.ghosted() if self.contact.active is None and self.seabed.flat
                  else None)
         self.contact.solve(rhs.components[2], state.slope.components[2], start)

@@ -14,7 +14,7 @@ the positions of the last global step. Why lagged, and why that is stable: its
 sensitivity to the iterate is that of the reaction k_n p_n, which the vertical problem
 fixes from the line's equilibrium rather than from k, times tan(theta); an error dx of
 the horizontal positions returns as about tan(theta)^2 dx, small for the moderate slopes
-of the seabed data (measured in docs/riser.md §3a).
+of the seabed data (docs/riser.md §3a).
 
 Not a term of the energy: the energy of the seabed term (k_n/2 sum w_n p_n^2) is the
 potential of the whole force on a plane, but the Newton steps and the stability test
@@ -43,8 +43,8 @@ class SeabedSlopeLoad(NodalLoadTerm):
         """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of
         the last vertical solve (seabed_contact.SeabedContact.node_force). Zero before the first
         solve: the start's own penetration (a straight start under a rising seabed:
-        metres) is not a reaction, and k times it would throw the first iterate far away
-        (measured: diverged at iteration 1). Collective."""
+        metres) is not a reaction, and k times it would throw the first iterate far away.
+        Collective."""
         force = self.contact.contact.node_force()
         force[:, 2] = 0.0
         return force

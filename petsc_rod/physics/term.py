@@ -27,7 +27,7 @@ When each is called:
 * the outputs (io/outputs.py): ``force_beyond`` and ``end_force`` for the internal
   force n(S), ``outputs`` for datasets, attributes and the step line, in the units of
   ``dataset_units`` and ``attribute_units``. What only reports is not a term but a
-  report (reports/report.py), held beside the terms.
+  report (quantities/report.py), held beside the terms.
 """
 
 from dataclasses import dataclass, field
@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 @dataclass
 class TermOutput:
-    """What a term or a report (reports/report.py) adds to a step's record: vertex
+    """What a term or a report (quantities/report.py) adds to a step's record: vertex
     datasets {name: (n_owned, ...)}, attributes {name: value} (their units in the
     term's or report's dataset_units and attribute_units) and a phrase for the step
     line."""

@@ -5,11 +5,11 @@ horizontal push of a sloping one, physics/slope_load.py, and its friction,
 physics/friction.py) and the drag only where the scene has a seabed or a current
 (docs/riser.md); the axial stretch only where some EA is finite (docs/method.md §12).
 
-Its reports (reports/report.py), held beside the terms: the riser numbers
-(reports/riser_numbers.py) where it has a seabed or a current; the sections' numbers,
+Its reports (quantities/report.py), held beside the terms: the riser numbers
+(quantities/riser_numbers.py) where it has a seabed or a current; the sections' numbers,
 pressures and, with an inner diameter, the pipe's stresses on a line of line types; the
-results along the line (reports/line_results.py) always; its regions
-(reports/regions.py) on a riser-like scene (a seabed, a current or line types)."""
+results along the line (quantities/line_results.py) always; its regions
+(quantities/regions.py) on a riser-like scene (a seabed, a current or line types)."""
 
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.drag import DragTerm
@@ -20,13 +20,13 @@ from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.physics.slope_load import SeabedSlopeLoad
 from petsc_rod.physics.stretch import AxialStretch
 from petsc_rod.physics.surface import SurfaceTerm, reaches_surface
-from petsc_rod.reports.line_results import LineResults
-from petsc_rod.reports.pressures import PipePressures
-from petsc_rod.reports.module_bends import ModuleBends, module_S
-from petsc_rod.reports.regions import LineRegions
-from petsc_rod.reports.riser_numbers import RiserNumbers
-from petsc_rod.reports.section_numbers import SectionNumbers
-from petsc_rod.reports.stresses import PipeStresses
+from petsc_rod.quantities.line_results import LineResults
+from petsc_rod.quantities.module_bends import ModuleBends, module_S
+from petsc_rod.quantities.pressures import PipePressures
+from petsc_rod.quantities.regions import LineRegions
+from petsc_rod.quantities.riser_numbers import RiserNumbers
+from petsc_rod.quantities.section_numbers import SectionNumbers
+from petsc_rod.quantities.stresses import PipeStresses
 from petsc_rod.scenes.boundary import is_held
 
 

@@ -35,8 +35,8 @@ def default_penalty(scene, start_tension=0.0):
       reach the loads' (0 on an inextensible or slack line);
     * the tension the start holds, ``start_tension`` T_s (the largest tension of a
       catenary start, scenes/starts.largest_tension; 0 for the straight start): lambda3
-      starts at the tension there, and with R below it the hanging lines' iteration was
-      measured to crawl (docs/method.md §3).
+      starts at the tension there, and with R below it the hanging lines' iteration
+      crawls (docs/method.md §3).
     """
     return max(penalty_scales(scene, start_tension).values())
 

@@ -3,7 +3,7 @@ apart from how it is solved (iteration/driver.py: the SNES and the step controll
 
 A RodProblem holds the mesh, the scene, the state (problem/state.py), the global step
 (global_step/), the list of terms of physics (physics/term.py) that the scene needs and
-its reports beside them (reports/report.py; both made by problem/build.py). It answers
+its reports beside them (quantities/report.py; both made by problem/build.py). It answers
 what the method and its users ask of the problem: one Uzawa iteration G (the map the
 SNES mixes), the energy E and its gradient, the second variation
 (analysis/second_variation.py), the link, the end reaction and the internal force, and the
@@ -38,7 +38,7 @@ EVENTS = {name: PETSc.Log.Event(f"rod_{name}") for name in ("projection", "multi
 
 class RodProblem:
     """The problem of a Scene on a Mesh at an asked penalty R (N), with the ``terms``
-    (physics/term.py) and the ``reports`` (reports/report.py; default: those the scene
+    (physics/term.py) and the ``reports`` (quantities/report.py; default: those the scene
     needs, problem/build.py). Owns the state, the global step, the terms and the second
     variation; ``destroy()`` releases them."""
 

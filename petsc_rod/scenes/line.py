@@ -24,8 +24,8 @@ class Section:
     N/m, (3,) (the submerged weight along -z); drag: c = rho Cd D / 2, kg/m^2, of the
     normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
     mass: kg/m in air; smys: the specified minimum yield stress of the pipe's wall, Pa
-    (NaN: not given; reports/stresses.py); stress_od: the outer diameter of the pipe's
-    wall, m, below a buoyancy jacket or coating (NaN: od; reports/pressures.py).
+    (NaN: not given; quantities/stresses.py); stress_od: the outer diameter of the pipe's
+    wall, m, below a buoyancy jacket or coating (NaN: od; quantities/pressures.py).
     """
 
     name: str
@@ -98,8 +98,8 @@ class LineType:
     each section of the type (``bending_start``, ``bending_end``, N m^2, equal unless
     tapered), torsional ``gj`` (N m^2), axial ``ea`` (N, inf: inextensible), normal drag
     coefficient ``cd``, hydrodynamic diameter ``drag_d`` (m) and inner diameter ``id``
-    (m, 0: no bore; the internal pressure's area, reports/pressures.py), and the wall's
-    specified minimum yield stress ``smys`` (Pa, NaN: not given; reports/stresses.py), and
+    (m, 0: no bore; the internal pressure's area, quantities/pressures.py), and the wall's
+    specified minimum yield stress ``smys`` (Pa, NaN: not given; quantities/stresses.py), and
     ``stress_od`` the outer diameter of the steel wall that carries the wall tension and
     the stresses (m; default ``od``: a buoyancy jacket or a coating has its own larger
     ``od`` for weight and drag, but the external pressure on it is carried by it)."""

@@ -64,13 +64,13 @@ class Scene:
     sections: tuple = ()
     # EA, N: the uniform line's axial stiffness (inf: inextensible)
     axial_stiffness: float = np.inf
-    # the pipe's pressures (reports/pressures.py; a line of sections): the sea surface's
+    # the pipe's pressures (quantities/pressures.py; a line of sections): the sea surface's
     # height in the solver's frame (m; None: the higher held end), the contents'
     # density (kg/m^3) and the internal pressure at the top (Pa)
     sea_surface: float = None
     contents_density: float = 0.0
     internal_pressure: float = 0.0
-    # the stress check (reports/stresses.py): the allowable von Mises stress is this
+    # the stress check (quantities/stresses.py): the allowable von Mises stress is this
     # factor times the line types' smys (API RP 2RD operating basic allowable, 2/3)
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a

@@ -130,7 +130,7 @@ def fmt(values):
 def hang_off(values):
     """(the option that places the hang-off, its position, the unit horizontal direction
     from the other held end to it): the hang-off is the higher held end, as for the
-    riser numbers' top (reports/riser_numbers.py: S = L on a tie). ``values``: the base
+    riser numbers' top (quantities/riser_numbers.py: S = L on a tie). ``values``: the base
     options' values (cli.options.read_options)."""
     held = ("clamp", "pin")
     start = np.asarray(values["rod_start_position"], dtype=float)

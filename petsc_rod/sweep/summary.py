@@ -2,9 +2,9 @@
 the case's record (name, the options it varied, exit code, how it started) and its
 result file's root attributes, written as CSV and Markdown with the units in the header.
 
-The columns are the riser numbers where the file has them (reports/riser_numbers.py,
-reports/line_results.py's end forces, reports/module_bends.py's global and local bend
-radii, reports/pressures.py, reports/section_numbers.py), then any other scalar root attribute
+The columns are the riser numbers where the file has them (quantities/riser_numbers.py,
+quantities/line_results.py's end forces, quantities/module_bends.py's global and local bend
+radii, quantities/pressures.py, quantities/section_numbers.py), then any other scalar root attribute
 named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
 (what newer versions add: a utilisation, a von Mises stress; vectors such as the end
 forces are not columns, their scalar parts are), so that the table shows what the files

@@ -1,5 +1,5 @@
-"""The results along the line and at its ends (reports/line_results.py) and the regions
-(reports/regions.py) of solved lines: against EI times the curvature, the balance of the
+"""The results along the line and at its ends (quantities/line_results.py) and the regions
+(quantities/regions.py) of solved lines: against EI times the curvature, the balance of the
 end forces with the loads, hand angles, and one rank against all (each scene solved on
 PETSc.COMM_SELF and on PETSc.COMM_WORLD: under mpiexec -n 2 the 1-versus-2-ranks
 check). Serial and under mpiexec -n 2."""
@@ -193,7 +193,7 @@ def test_an_anchor_that_lifts_off_is_said_with_its_angle_and_force(comm):
     force are those of the inextensible catenary, atan(V0 / H) and V0 (at EI 5e-3 N m^2
     the angle is off by the bending layer's 0.9 %, 10 % at EI 0.5; the force by 1e-4 of
     V0); said in the final lines. Before, only touchdown_S = nan."""
-    from petsc_rod.cli.lines import summary
+    from petsc_rod.cli.messages import summary
     from petsc_rod.scenes.catenary import catenary
 
     top = np.array([9.0, 0.0, 4.0])
@@ -230,7 +230,7 @@ def test_fairlead_and_anchor_forces_are_the_catenary_h_and_v(comm):
     the anchor's H and V0, to 1e-3 (the bending layer's share); the components are the
     end force's, the uplift flagged 1; the final lines say them in kN. Before, only the
     end_force vector and touchdown_S = nan."""
-    from petsc_rod.cli.lines import summary
+    from petsc_rod.cli.messages import summary
     from petsc_rod.scenes.catenary import catenary
 
     top = np.array([9.0, 0.0, 4.0])

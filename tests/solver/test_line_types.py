@@ -294,7 +294,7 @@ def test_a_stiff_section_beside_a_soft_one_keeps_its_own_curvature(options, tabl
     from petsc_rod.iteration.stopping import Settings
     from petsc_rod.mesh.mesh import Mesh
     from petsc_rod.problem.penalty import default_penalty
-    from petsc_rod.reports.section_numbers import SectionNumbers
+    from petsc_rod.quantities.section_numbers import SectionNumbers
     types = "name od mass ei gj\nstiff 0.1 10 1e4 1e4\nsoft 0.1 10 1e2 1e2\n"
     values, names = options(rod_line_types=table(types), rod_sections="stiff:5:50,soft:5:50",
                             rod_gravity="1e-12", rod_start="clamp", rod_end="free",

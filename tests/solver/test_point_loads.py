@@ -275,7 +275,7 @@ def test_the_drag_of_an_attachment_is_its_point_force(comm):
 def reactions_and_shape(comm, scene, start):
     """(r gathered, start_force, end_force) of Scene(**scene) converged from ``start``
     ('catenary' or 'straight'): the reactions of line_results.end_numbers."""
-    from petsc_rod.reports.line_results import end_numbers
+    from petsc_rod.quantities.line_results import end_numbers
 
     mesh, solver = make_solver(comm, 40, scene, default_penalty(Scene(**scene)),
                                rtol=1e-11, ctol=1e-11, max_it=20000)

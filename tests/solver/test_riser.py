@@ -7,7 +7,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import fitted_order, gather, make_solver
-from petsc_rod.cli import lines as step_lines
+from petsc_rod.cli import messages as step_lines
 from petsc_rod.cli.session import record_step
 from petsc_rod.environment.current import Current
 from petsc_rod.environment.seabed import Seabed

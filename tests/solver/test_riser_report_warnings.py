@@ -1,5 +1,5 @@
 """The riser report of a line lying flat on or below the seabed (issue 25: the shipped
-lazy wave printed "RuntimeWarning: divide by zero" from reports/riser_numbers.py on 2 ranks,
+lazy wave printed "RuntimeWarning: divide by zero" from quantities/riser_numbers.py on 2 ranks,
 where two neighbouring vertices sat at the same height below the seabed). Serial and
 under mpiexec -n 2, with RuntimeWarnings turned into errors."""
 

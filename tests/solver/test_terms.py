@@ -19,9 +19,9 @@ from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.physics.term import Term
 from petsc_rod.problem.build import scene_reports, scene_terms
 from petsc_rod.problem.problem import RodProblem
-from petsc_rod.reports.line_results import LineResults
-from petsc_rod.reports.regions import LineRegions
-from petsc_rod.reports.riser_numbers import RiserNumbers
+from petsc_rod.quantities.line_results import LineResults
+from petsc_rod.quantities.regions import LineRegions
+from petsc_rod.quantities.riser_numbers import RiserNumbers
 from petsc_rod.scenes.scene import Scene
 
 FORCE = np.array([0.0, -2.0, 1.0])          # N/m

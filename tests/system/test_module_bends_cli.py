@@ -1,5 +1,5 @@
 """The global hog and sag bend radii of a line with discrete buoyancy modules
-(reports/module_bends.py) from the command line: the 80 m cable of
+(quantities/module_bends.py) from the command line: the 80 m cable of
 options/cable_80m.opts with its buoyancy as 20 modules 2.5 m apart
 (scripts/matrix_buoyancy_modules.txt): the result file, the final lines and the summary
 table give the same numbers, on one rank and two."""

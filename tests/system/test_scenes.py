@@ -76,7 +76,7 @@ def test_the_steel_riser_is_near_its_elastic_catenary(tmp_path):
 
 
 def test_the_steel_riser_s_wall_tension_against_a_hand_calculation(tmp_path):
-    """T_w = T_e + p_i A_i - p_e A_e (reports/pressures.py) on the steel riser with oil of
+    """T_w = T_e + p_i A_i - p_e A_e (quantities/pressures.py) on the steel riser with oil of
     800 kg/m^3 at 10 MPa at the hang-off, at its two ends, by hand: at the anchor
     (z = 0, 1500 m below the surface and the top) p_e = 1025 g 1500 = 15.08 MPa,
     p_i = 10 MPa + 800 g 1500 = 21.77 MPa; at the top p_e = 0, p_i = 10 MPa."""

@@ -1,5 +1,5 @@
 """-rod_table (io/line_table.py), the results along the line and the pipe's stresses
-(reports/stresses.py) from the command line: the CSV's header and rows, the regions'
+(quantities/stresses.py) from the command line: the CSV's header and rows, the regions'
 table, no table after a failed run, a bad path refused, and the steel riser's von Mises
 stress and utilisation against a hand calculation."""
 

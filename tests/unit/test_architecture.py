@@ -19,11 +19,11 @@ CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics/t
         "io/outputs.py")
 # What only some scenes build (problem/build.py): the sea and the seabed, the reports,
 # and the terms of the seabed, the current and the sea surface (dotted below petsc_rod).
-APPLICATION = ("environment", "reports", "physics.nodal_load", "physics.seabed",
+APPLICATION = ("environment", "quantities", "physics.nodal_load", "physics.seabed",
                "physics.drag", "physics.surface", "physics.friction", "physics.slope_load")
 # The front ends, which drive the solver and which nothing below them imports.
 FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__")
-BELOW_FRONT_ENDS = CORE + ("physics", "environment", "reports", "problem", "scenes", "io",
+BELOW_FRONT_ENDS = CORE + ("physics", "environment", "quantities", "problem", "scenes", "io",
                            "frames.py", "errors.py", "tables.py", "resources.py")
 # The algorithm layer, whose messages must not name -rod_* options.
 ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step")
@@ -112,14 +112,14 @@ def test_the_result_file_knows_no_term_and_no_report():
     """io/results.py writes the units the terms and reports give it (RodProblem.units),
     so it imports none of them."""
     found = sorted(name for name in imported(modules()[os.path.join("io", "results.py")])
-                   if name.split(".")[0] in ("physics", "reports", "environment"))
+                   if name.split(".")[0] in ("physics", "quantities", "environment"))
     assert not found, f"io/results.py imports {found}"
 
 
 def test_reports_are_not_terms_and_own_their_units():
     from petsc_rod.physics.term import Term
     from petsc_rod.problem import build
-    from petsc_rod.reports.report import Report
+    from petsc_rod.quantities.report import Report
     reports = [value for value in vars(build).values()
                if isinstance(value, type) and issubclass(value, Report)]
     assert len(reports) == 7          # with module_bends.ModuleBends

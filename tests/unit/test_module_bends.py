@@ -1,4 +1,4 @@
-"""The global hog and sag bend radii over a module pitch (reports/module_bends.py; no
+"""The global hog and sag bend radii over a module pitch (quantities/module_bends.py; no
 PETSc): a line in the x-z plane made of straight pieces kinked every pitch p, the
 tangent turning by p / R at each kink, a hog arc of R = 20 m then a sag arc of R = 35 m:
 the turn over any window of length p is one kink's, so the global radii are 20 and 35 m,
@@ -8,7 +8,7 @@ while the local radius at a kink (the kink's own curvature, turned within 0.25 m
 import numpy as np
 import pytest
 
-from petsc_rod.reports.module_bends import bend_numbers, module_pitch, window_bend_radii
+from petsc_rod.quantities.module_bends import bend_numbers, module_pitch, window_bend_radii
 
 PITCH, HOG, SAG, KINK = 2.5, 20.0, 35.0, 0.25
 S = np.linspace(0.0, 50.0, 2001)                 # h = 0.025 m

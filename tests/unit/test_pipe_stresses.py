@@ -1,13 +1,13 @@
-"""The pipe's stresses (reports/stresses.py, docs/riser.md §2c), the angles of the line's
-results (reports/line_results.py) and the regions (reports/regions.py) against hand
+"""The pipe's stresses (quantities/stresses.py, docs/riser.md §2c), the angles of the line's
+results (quantities/line_results.py) and the regions (quantities/regions.py) against hand
 calculations."""
 
 import numpy as np
 import pytest
 
-from petsc_rod.reports.line_results import azimuth, declination
-from petsc_rod.reports.regions import region_bounds
-from petsc_rod.reports.stresses import lame_stresses, pipe_von_mises, von_mises
+from petsc_rod.quantities.line_results import azimuth, declination
+from petsc_rod.quantities.regions import region_bounds
+from petsc_rod.quantities.stresses import lame_stresses, pipe_von_mises, von_mises
 
 # The 10-inch riser of options/line_types/steel_riser.txt: od 273.1 mm, id 231.9 mm.
 R_O, R_I = 0.2731 / 2, 0.2319 / 2

@@ -36,9 +36,9 @@ candidates and each region's largest values are combined by allgathers of small 
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.line_results import bending_moment, curvature
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension, top_end,
+from petsc_rod.quantities.line_results import bending_moment, curvature
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension, top_end,
                                              touchdown)
 
 ATTRIBUTE_UNITS = {"region_names": "text", "region_bounds": "m",

@@ -79,7 +79,7 @@ def short_stability(report):
 
 
 def riser_text(attributes):
-    """The engineer's numbers of a riser step (reports/riser_numbers.py, in ``attributes``):
+    """The engineer's numbers of a riser step (quantities/riser_numbers.py, in ``attributes``):
     top tension (kN) and its angle from the vertical, the touchdown's S (and the
     vertices beyond a seabed profile's rows, where there are any) and the smallest bend
     radius; '' for a scene without them."""
@@ -92,7 +92,7 @@ def riser_text(attributes):
         text += (f", touchdown S = {S:.6g} m" if S == S else ", no touchdown"
                  + uplift_text(attributes, 1e3))
     beyond = attributes.get("seabed_vertices_beyond", 0)
-    if beyond:                          # reports/riser_numbers.py: a profile taken level there
+    if beyond:                          # quantities/riser_numbers.py: a profile taken level there
         text += f", {beyond} vertices beyond the seabed profile's rows (level there)"
     return (text + f", smallest bend radius {attributes['min_bend_radius']:.4g} m"
             + friction_text(attributes))
@@ -100,7 +100,7 @@ def riser_text(attributes):
 
 def uplift_text(attributes, unit):
     """': the anchor at S = .. lifts off at .. deg, pulled up by .. N' (kN for ``unit``
-    1e3) of an anchor that lifts off (reports/riser_numbers.anchor_uplift); '' otherwise."""
+    1e3) of an anchor that lifts off (quantities/riser_numbers.anchor_uplift); '' otherwise."""
     if "anchor_uplift_S" not in attributes:
         return ""
     a = attributes
@@ -157,7 +157,7 @@ def _table(header, rows):
 
 
 def end_force_lines(attributes):
-    """The final lines' fairlead and anchor forces in kN (reports/line_results.py: the
+    """The final lines' fairlead and anchor forces in kN (quantities/line_results.py: the
     force the line exerts on each support, horizontal H, vertical V, global components),
     and whether the anchor lifts off; [] for a file without them."""
     a = attributes
@@ -181,7 +181,7 @@ def summary(attributes):
     """The lines of the run's final summary from the last step's attributes (at load
     factor 1): the riser's numbers, the flex joints' angles, per section its largest
     tension and smallest bend radius and where, and the same per region of the line
-    (reports/regions.py) with its largest bending moment; [] for a scene with none of
+    (quantities/regions.py) with its largest bending moment; [] for a scene with none of
     them (a rod of the paper's kind: its energy and strains are in the file)."""
     a = attributes
     out = []

@@ -30,8 +30,8 @@ ranks; the vertex tangents are a small part of the state).
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import unit_tangent
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import unit_tangent
 
 KINDS = ("hog", "sag")
 ATTRIBUTE_UNITS = {"module_pitch": "m", **{

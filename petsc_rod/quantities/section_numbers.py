@@ -9,8 +9,8 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import effective_tension
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import effective_tension
 from petsc_rod.scenes.line import section_index
 
 DATASET_UNITS = {"section": "1"}

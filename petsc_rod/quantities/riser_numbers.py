@@ -35,7 +35,7 @@ import numpy as np
 
 from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
+from petsc_rod.quantities.report import Report
 from petsc_rod.scenes.boundary import is_held
 
 # The step line gives the touchdown's offset from the ends' plane when it is above this

@@ -44,8 +44,8 @@ anchor) and ``anchor_position`` (3,) of the anchor, when it is held.
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import (_at_vertex, effective_tension,
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension,
                                              points_on_held_ends, top_end, unit_tangent)
 from petsc_rod.scenes.boundary import is_held
 

@@ -1,7 +1,7 @@
 """The von Mises stress of a pipe's wall and its utilisation (docs/riser.md §2c), for a
 line of line types with an inner diameter (scenes/line.py: od, id, smys).
 
-At each vertex the wall carries the wall tension T_w (reports/pressures.py), the bending
+At each vertex the wall carries the wall tension T_w (quantities/pressures.py), the bending
 moment M = |(m.d1, m.d2)|, the torque Q = m.t and the pressures p_i, p_e. With
 r_o = od / 2, r_i = id / 2, A = pi (r_o^2 - r_i^2), I = pi (r_o^4 - r_i^4) / 4 and
 J = 2 I, at radius r of the wall (Lame's thick cylinder, exact for an elastic tube and
@@ -33,10 +33,10 @@ equilibrium is not changed.
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports import pressures as pipe_pressures
-from petsc_rod.reports.line_results import bending_moment, torque
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import effective_tension, top_end
+from petsc_rod.quantities import pressures as pipe_pressures
+from petsc_rod.quantities.line_results import bending_moment, torque
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
 DATASET_UNITS = {"von_mises": "Pa", "utilisation": "1"}

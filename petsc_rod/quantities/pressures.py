@@ -23,8 +23,8 @@ over EA; docs/riser.md §2b).
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.reports.report import Report
-from petsc_rod.reports.riser_numbers import effective_tension, top_end
+from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
 DATASET_UNITS = {"external_pressure": "Pa", "internal_pressure": "Pa", "wall_tension": "N"}

@@ -1,4 +1,5 @@
-"""What a solved state reports beside its fields, behind one protocol (report.py: its
+"""The quantities an engineer reads from a solved state beside its fields (the
+result file's reports; the page of a sweep is report/), behind one protocol (report.py: its
 outputs and their units), held by the problem beside its terms (problem/build.py) and
 collected once (io/outputs.collect) for the HDF5 file and the CSV table.
 
