@@ -1,11 +1,12 @@
 """The report page of a small sweep rendered in headless Chromium (Debian's ``chromium``
-package; the test is skipped, saying so, where it is not installed: ``apt-get install
-chromium``): the page loads without a script or resource error, every figure is drawn
+package, which scripts/test.sh installs; elsewhere the test is skipped, saying so, where
+it is not installed, but fails under CI, where a skip would hide a missing install): the page loads without a script or resource error, every figure is drawn
 (its PNG decoded) at a readable size, and the page and its tables fit a 1400 px window,
 with the folded parts closed and open. The measures are taken by a script added to a
 copy of the page and read back from the DOM Chromium dumps (no driver needed)."""
 
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -41,6 +42,9 @@ window.addEventListener("load", () => {
 });
 </script>"""
 
+if CHROMIUM is None and os.environ.get("CI"):
+    raise RuntimeError("headless Chromium is missing under CI: scripts/test.sh installs "
+                       "Debian's chromium")
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason=(
     "headless Chromium is not installed (Debian: apt-get install chromium); the report "
     "page's browser check needs it"))
