@@ -42,8 +42,10 @@ def main(argv=None):
     if not os.path.isdir(source) and not h5py.is_hdf5(source):
         sys.stderr.write(f"petsc_rod.report: error: {source}: not a result file (HDF5)\n")
         return 2
-    # a sweep's folder: every file in it (its record, its cases' files, its summary)
-    read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)]
+    # a sweep's folder: every file in it (its record, its cases' files, its summary) but
+    # the page of an earlier report, which this one replaces
+    read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)
+             if not name.endswith(".html")]
             if os.path.isdir(source) else [("result", source)])
     clash = replaced_input([("-o", args.output)], read)
     if not clash and not os.path.isdir(os.path.dirname(os.path.abspath(args.output))):

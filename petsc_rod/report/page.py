@@ -217,7 +217,8 @@ def build(source, min_bend_radius=None):
         parts.append(image(plots.result_figure(record["file"], min_bend_radius),
                            record["name"], CASE_DPI))
     body = "\n".join(parts)
-    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>"
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">{summary.REPORT_MARK}"
+            f"<title>"
             f"{html.escape(title)}</title><style>{STYLE}</style></head>\n<body>\n{body}\n"
             "</body></html>\n")
 

@@ -265,8 +265,11 @@ def _claim_folder(folder, cases, inputs):
                 f"{where}: holds {live[0]}, the partial file of a run that is still running "
                 f"(process {RUN_PARTIAL.fullmatch(live[0])['pid']}); wait for it to end, or "
                 "choose another folder")
+        # the page of a report of the earlier sweep is stale with it
         strangers = [name for name in entries
-                     if name not in stale and (ours is None or name not in ours)]
+                     if name not in stale and (ours is None or name not in ours)
+                     and not (ours is not None and name.endswith(".html")
+                              and summary.is_report_page(os.path.join(folder, name)))]
         if strangers:
             raise RodInputError(
                 f"{where}: holds {strangers[0]}"

@@ -83,6 +83,20 @@ EXCURSION_COLUMNS = [("fairlead_offset", "m"), ("touchdown_excursion", "m")]
 EXIT_REASONS = {0: "converged", 2: "bad input", 3: "not converged", 4: "diverged",
                 5: "result not written"}
 
+# The mark in the head of a report page (report/page.py) by which a sweep knows the page of
+# an earlier report in its folder as that folder's, to remove with the earlier sweep's
+# files (sweep/runner.py claim_folder).
+REPORT_MARK = '<meta name="generator" content="petsc_rod.report">'
+
+
+def is_report_page(path):
+    """Whether the file ``path`` is a report page (REPORT_MARK in its first KiB)."""
+    try:
+        with open(path, "rb") as page:
+            return REPORT_MARK.encode() in page.read(1024)
+    except OSError:
+        return False
+
 
 def exit_reason(code):
     """The words of a case's exit code (docs/errors.md)."""

@@ -610,3 +610,26 @@ def test_a_bad_allowable_bend_radius_is_one_line_and_exit_2(offset_sweep, tmp_pa
     assert process.returncode == 2 and not output.exists()
     assert process.stderr == ("petsc_rod.report: error: --min-bend-radius -3: the allowable "
                               "bend radius must be a positive number of metres\n")
+
+
+@pytest.mark.serial
+def test_a_report_in_the_sweep_s_folder_is_written_again(offset_sweep, tmp_path):
+    """The report page written into the sweep's own folder can be written there again
+    (the second run refused it as a file of the sweep, an input), and the sweep run again
+    into that folder takes the page for its own (it refused the folder)."""
+    import shutil
+
+    folder = tmp_path / "sweep"
+    shutil.copytree(offset_sweep[0], folder)
+    output = folder / "report.html"
+    for _ in range(2):
+        process = run_module("petsc_rod.report", [str(folder), "-o", str(output)])
+        assert process.returncode == 0, describe(process)
+    assert output.stat().st_size > 0
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(folder / "far50.h5")])
+    assert process.returncode == 2 and "far50.h5" in process.stderr, describe(process)
+    # the sweep run again into its folder removes the earlier report's page with its files
+    process = run_module("petsc_rod.sweep", RISER + ["-sweep_offsets", "0",
+                                                     "-sweep_output", str(folder)])
+    assert process.returncode == 0, describe(process)
+    assert not output.exists() and (folder / "offset0.h5").exists()
