@@ -2,11 +2,12 @@
 # Set up petsc_rod on Debian 12: Debian's PETSc/petsc4py, mpi4py, h5py (MPI), matplotlib,
 # scipy, pytest, setuptools and wheel (to build the wheel offline) from apt, when missing,
 # and a virtual environment .venv that sees them.
-# Safe to run again: it only does what is missing. Sourced by run.sh and test.sh.
+# EXTRA_PACKAGES adds Debian packages (test.sh: chromium, for the report page's browser
+# test). Safe to run again: it only does what is missing. Sourced by run.sh and test.sh.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PACKAGES="python3-petsc4py python3-mpi4py python3-h5py-mpi python3-matplotlib python3-scipy \
-python3-pytest python3-setuptools python3-wheel python3-venv openmpi-bin"
+python3-pytest python3-setuptools python3-wheel python3-venv openmpi-bin ${EXTRA_PACKAGES:-}"
 
 missing=""
 for package in $PACKAGES; do

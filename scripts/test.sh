@@ -3,7 +3,8 @@
 # on 2 MPI ranks (rank 0 reports; rank 1's report goes to tests-rank1.log).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-source "$ROOT/scripts/setup.sh"
+# Debian's headless Chromium renders the report page (tests/system/test_report_browser.py)
+EXTRA_PACKAGES="chromium" source "$ROOT/scripts/setup.sh"
 cd "$ROOT"
 echo "== serial =="
 python -m pytest -p no:cacheprovider --color=no "$@" tests

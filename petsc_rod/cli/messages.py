@@ -156,6 +156,27 @@ def _table(header, rows):
             for row in [header, *rows]]
 
 
+def end_force_lines(attributes):
+    """The final lines' fairlead and anchor forces in kN (quantities/line_results.py: the
+    force the line exerts on each support, horizontal H, vertical V, global components),
+    and whether the anchor lifts off; [] for a file without them."""
+    a = attributes
+    if "fairlead_tension" not in a:
+        return []
+    kN = 1e3
+    out = [f"  fairlead force {a['fairlead_tension'] / kN:.6g} kN: horizontal "
+           f"{a['fairlead_horizontal'] / kN:.6g} kN, vertical {a['fairlead_vertical'] / kN:.6g}"
+           f" kN (x, y, z components " + ", ".join(
+               f"{a[f'fairlead_force_{c}'] / kN:.6g}" for c in "xyz") + " kN)"]
+    if "anchor_tension" in a:
+        lifts = {1: "; the anchor lifts off", 0: "; the anchor does not lift"}.get(
+            a.get("anchor_uplift"), "")
+        out.append(f"  anchor force {a['anchor_tension'] / kN:.6g} kN: horizontal "
+                   f"{a['anchor_horizontal'] / kN:.6g} kN, vertical (up) "
+                   f"{a['anchor_vertical'] / kN:.6g} kN" + lifts)
+    return out
+
+
 def summary(attributes):
     """The lines of the run's final summary from the last step's attributes (at load
     factor 1): the riser's numbers, the flex joints' angles, per section its largest
@@ -169,13 +190,23 @@ def summary(attributes):
                 "from the vertical")
         if "touchdown_S" in a:
             S = a["touchdown_S"]
-            text += (f"; touchdown at S = {S:.6g} m, grounded {a['grounded_length']:.6g} m"
+            at = (f" (x, y = {a['touchdown_x']:.6g}, {a['touchdown_y']:.6g} m)"
+                  if "touchdown_x" in a else "")
+            text += (f"; touchdown at S = {S:.6g} m{at}, grounded {a['grounded_length']:.6g} m"
                      if S == S else "; no touchdown" + uplift_text(a, 1e3))
         text += (f"; smallest bend radius {a['min_bend_radius']:.4g} m at S = "
                  f"{a['max_curvature_S']:.6g} m")
         out.append(text)
+        out += end_force_lines(a)
     if "friction_stick_length" in a:
         out.append("  seabed" + friction_text(a)[1:])
+    if "module_pitch" in a:
+        out.append(f"  buoyancy modules, over the module pitch {a['module_pitch']:.4g} m: "
+                   + "; ".join(f"global {kind} bend radius "
+                               f"{a[f'global_{kind}_bend_radius']:.4g} m at S = "
+                               f"{a[f'global_{kind}_bend_radius_S']:.6g} m (local kink "
+                               f"{a[f'local_{kind}_bend_radius']:.4g} m)"
+                               for kind in ("hog", "sag")))
     joints = [f"{which} joint {a[f'{which}_joint_angle']:.4g} deg, "
               f"{a[f'{which}_joint_moment'] / 1e3:.4g} kN m"
               for which in ("start", "end") if f"{which}_joint_angle" in a]

@@ -1,5 +1,5 @@
 """A run of the continuation as the command line makes it: the events of
-iteration/continuation.py said as lines (lines.py) and recorded in the result file
+iteration/continuation.py said as lines (messages.py) and recorded in the result file
 (io/outputs.py, io/results.py), with the run's errors raised as RodErrors. The command
 line, the scripts and the tests call run_continuation."""
 

@@ -1,6 +1,6 @@
 """The graphs against the arc length S: effective (and wall) tension, the curvature in
-the vertical plane and out of it against an allowable bend radius, the bending moment
-and the seabed reaction. Each ``draw_*`` draws one result on one axis, in the colours of
+the vertical plane and out of it against an allowable bend radius, the bending moment,
+the utilisation against its limit 1 (where the file has it) and the seabed reaction. Each ``draw_*`` draws one result on one axis, in the colours of
 one line (``colour`` None) or of a case of a sweep; ``mark_along`` shades the sections
 and marks the touchdown and the attachments."""
 
@@ -74,13 +74,36 @@ def draw_reaction(axis, result, colour=None, label=None):
     axis.set_title("seabed reaction", fontsize=10)
 
 
-GRAPHS = (draw_tension, draw_curvature, draw_moment, draw_reaction)
+def draw_utilisation(axis, result, colour=None, label=None):
+    """The utilisation, von Mises over the allowable stress (reports/stresses.py), with
+    its limit 1 (dashed); NaN where a section has no yield stress is left out."""
+    if result.utilisation is None:
+        return
+    axis.plot(result.S, result.utilisation, "-", color=colour or "black", label=label)
+    axis.axhline(1.0, color=style.ALLOWABLE, ls="--", lw=1,
+                 label=None if colour else "limit 1")
+    axis.set_ylabel("utilisation")
+    title = "utilisation: von Mises / allowable"
+    finite = np.isfinite(result.utilisation)
+    if colour is None and finite.any():
+        k = int(np.nanargmax(np.where(finite, result.utilisation, np.nan)))
+        title += f"\nlargest {result.utilisation[k]:.3g} at S = {result.S[k]:.0f} m"
+        if result.utilisation[k] > 1.0:
+            title += "  ABOVE 1"
+    axis.set_title(title, fontsize=10)
+
+
+GRAPHS = (draw_tension, draw_curvature, draw_moment, draw_utilisation, draw_reaction)
 
 
 def graphs_for(results):
-    """The graphs to draw for ``results``: the seabed reaction only where there is one."""
-    return [g for g in GRAPHS if g is not draw_reaction
-            or any(r.seabed_reaction is not None for r in results)]
+    """The graphs to draw for ``results``: the utilisation and the seabed reaction only
+    where a result has them."""
+    return [g for g in GRAPHS
+            if (g is not draw_reaction or any(r.seabed_reaction is not None for r in results))
+            and (g is not draw_utilisation or any(r.utilisation is not None and
+                                                  np.isfinite(r.utilisation).any()
+                                                  for r in results))]
 
 
 def mark_along(axis, result, colour=None, named=False):

@@ -23,6 +23,8 @@ class Result:
     riser: bool                 # a seabed, a current, line types or attachments
     tension: np.ndarray         # effective tension n.t, N
     wall_tension: np.ndarray = None      # N, on a line of line types
+    utilisation: np.ndarray = None       # von Mises over the allowable, on a line of
+                                         # line types with a yield stress
     seabed_reaction: np.ndarray = None   # N/m, with a seabed
     bending_moment: np.ndarray = None    # |(m.d1, m.d2)|, N m
     curvature: np.ndarray = None         # (n, 2): in the vertical plane (+ sag), lateral
@@ -72,7 +74,7 @@ def read_result(path):
         d1, d2, d3 = f["d1"][:], f["d2"][:], f["d3"][:]
         optional = {name: f[name][:] for name in ("effective_tension", "wall_tension",
                                                    "seabed_reaction", "bending_moment",
-                                                   "seabed_height")
+                                                   "seabed_height", "utilisation")
                     if name in f}
         m, n = f["m"][:], f["n"][:]
         result = Result(
@@ -83,6 +85,7 @@ def read_result(path):
                    or "point_load_S" in a),
             tension=optional.get("effective_tension", along.tension(n, d3)),
             wall_tension=optional.get("wall_tension"),
+            utilisation=optional.get("utilisation"),
             seabed_reaction=optional.get("seabed_reaction"),
             bending_moment=optional.get("bending_moment", along.bending_moment(m, d1, d2)),
             curvature=along.curvature_components(u, d1, d2, d3),

@@ -1,6 +1,10 @@
 """The converged result along the line as a CSV table (-rod_table FILE.csv) and the
 regions' summary beside it (FILE's stem + ``_regions.csv``; the run's final summary
-prints it too, cli/messages.summary) (docs/output.md, docs/riser.md §5).
+prints it too, cli/messages.summary) and the ends' numbers (FILE's stem + ``_ends.csv``: one
+row a number, ``quantity,value,unit``: the fairlead's and anchor's forces, the anchor's
+uplift flag, the touchdown and the grounded length, ENDS_NUMBERS, those the run has,
+for a run with the riser numbers)
+(docs/output.md, docs/riser.md §5).
 
 One row per vertex: S, x, y, z (absolute), u1, u2 (the signed curvatures about d1 and
 d2) and every result along the line the run has (TABLE_DATASETS, those of its terms and
@@ -31,8 +35,13 @@ from petsc_rod.quantities import riser_numbers
 TABLE_DATASETS = ("curvature", "bend_radius", "bending_moment", "torque", "shear",
                   "effective_tension", "wall_tension", "external_pressure",
                   "internal_pressure", "von_mises", "utilisation", "declination",
-                  "seabed_reaction", "seabed_height", "axial_strain", "axial_tension",
-                  "section")
+                  "seabed_reaction", "seabed_height", "friction_force", "friction_state",
+                  "axial_strain", "axial_tension", "section")
+# The ends' numbers (quantities/line_results.py, quantities/riser_numbers.py), in this order.
+ENDS_NUMBERS = ("fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
+                "fairlead_force_x", "fairlead_force_y", "fairlead_force_z", "anchor_tension",
+                "anchor_horizontal", "anchor_vertical", "anchor_uplift", "top_tension",
+                "top_angle", "touchdown_S", "touchdown_x", "touchdown_y", "grounded_length")
 # The regions' table: its columns and the attributes they come from.
 REGION_COLUMNS = (("S_from (m)", None), ("S_to (m)", None),
                   ("max_effective_tension (N)", "region_max_tension"),
@@ -49,11 +58,17 @@ def regions_path(path):
     return f"{stem}_regions{extension or '.csv'}"
 
 
+def ends_path(path):
+    """The ends' table beside the table ``path``: ``run.csv`` -> ``run_ends.csv``."""
+    stem, extension = os.path.splitext(path)
+    return f"{stem}_ends{extension or '.csv'}"
+
+
 def check_table_path(path, output, comm):
-    """Refuse, before any work, a -rod_table (and its regions' file) that could not be
-    written (io.results.check_output_path), or one that names the -rod_output file.
-    Collective."""
-    for name in (path, regions_path(path)):
+    """Refuse, before any work, a -rod_table (and its regions' and ends' files) that
+    could not be written (io.results.check_output_path), or one that names the
+    -rod_output file. Collective."""
+    for name in (path, regions_path(path), ends_path(path)):
         if output and os.path.abspath(name) == os.path.abspath(output):
             raise RodInputError(f"-rod_table {path}: it (or its regions' table {name}) is "
                                 f"the -rod_output file; name another file")
@@ -64,7 +79,8 @@ def discard(path, comm, say):
     """After a run that did not converge: no table is written, and a table (and its
     regions') left at ``path`` by an earlier run is removed, so that no table stands
     beside this run's result file as if it were its. Collective."""
-    names = [name for name in (path, regions_path(path)) if os.path.exists(name)]
+    names = [name for name in (path, regions_path(path), ends_path(path))
+             if os.path.exists(name)]
     comm.tompi4py().barrier()
     if comm.getRank() == 0:
         for name in names:
@@ -95,8 +111,13 @@ def table_columns(vertex, units):
         "effective_tension"], **units[0]}
     for key in TABLE_DATASETS:
         if key in vertex:
-            names.append(f"{key} ({known[key]})")
-            columns.append(np.asarray(vertex[key], dtype=float))
+            values = np.asarray(vertex[key], dtype=float)
+            if values.ndim == 2:        # a vector along the line: its global components
+                names += [f"{key}_{axis} ({known[key]})" for axis in "xyz"]
+                columns += list(values.T)
+            else:
+                names.append(f"{key} ({known[key]})")
+                columns.append(values)
     return names, np.column_stack(columns)
 
 
@@ -118,6 +139,16 @@ def region_rows(attributes):
                                                           REGION_COLUMNS[2:]]
         lines.append(",".join([name] + [f"{v:.12g}" for v in values]))
     return header, "\n".join(lines) + "\n"
+
+
+def ends_rows(attributes, units):
+    """The ends' table as text (module docstring); None for a run without the riser
+    numbers (a rod of the paper's kind, a cantilever: its end forces are in the file)."""
+    if "top_tension" not in attributes:
+        return None
+    present = [key for key in ENDS_NUMBERS if key in attributes]
+    return "quantity,value,unit\n" + "".join(
+        f"{key},{float(attributes[key]):.12g},{units.get(key, '')}\n" for key in present)
 
 
 def _write(path, partial, text):
@@ -142,6 +173,9 @@ def write_tables(path, comm, vertex, attributes, units):
     rows = region_rows(attributes)
     if rows is not None:
         files.append((regions_path(path), rows[0] + "\n" + rows[1]))
+    ends = ends_rows(attributes, units[1])
+    if ends is not None:
+        files.append((ends_path(path), ends))
     partials = [partial_name(name, comm) for name, _ in files]
 
     def write_all():
@@ -160,4 +194,5 @@ def finish_run(problem, path, say):
     if path:
         write_tables(path, problem.mesh.comm, vertex, attributes, problem.units())
         say(f"petsc_rod: table {path}" + (f", regions {regions_path(path)}"
-                                          if "region_names" in attributes else ""))
+                                          if "region_names" in attributes else "")
+            + (f", ends {ends_path(path)}" if ends_rows(attributes, {}) else ""))

@@ -86,7 +86,7 @@ class Term:
     # steps finish then ends at an iteration after them, which solves them anew
     outputs_of_state = True
     # when in_newton is False: what the term is and where its limits are documented, for
-    # the line that says a run takes no Newton steps (cli/lines.no_newton)
+    # the line that says a run takes no Newton steps (cli/messages.no_newton)
     newton_gap = ""
     # {name: unit} of the vertex datasets and of the attributes ``outputs`` writes ("1":
     # dimensionless, "text": a string), gathered by RodProblem.units for the result file

@@ -21,6 +21,7 @@ from petsc_rod.physics.slope_load import SeabedSlopeLoad
 from petsc_rod.physics.stretch import AxialStretch
 from petsc_rod.physics.surface import SurfaceTerm, reaches_surface
 from petsc_rod.quantities.line_results import LineResults
+from petsc_rod.quantities.module_bends import ModuleBends, module_S
 from petsc_rod.quantities.pressures import PipePressures
 from petsc_rod.quantities.regions import LineRegions
 from petsc_rod.quantities.riser_numbers import RiserNumbers
@@ -69,6 +70,8 @@ def scene_reports(scene, terms):
         if any(section.id > 0 for section in scene.sections):
             reports.append(PipeStresses(scene))
     reports.append(LineResults())
+    if module_S(scene).size > 1:                 # buoyancy modules: their global bends
+        reports.append(ModuleBends(module_S(scene)))
     if seabed is not None or drag or scene.sections:
         reports.append(LineRegions(seabed))
     return reports

@@ -28,6 +28,17 @@ angle from the upward vertical of the tangent pointing away from the line: d3 at
 -d3 at S = 0; 0 to 180) and ``hang_off_azimuth`` (deg, the direction of that tangent's
 horizontal projection, from +x toward +y, in (-180, 180]; NaN where the tangent is
 vertical to 1e-12).
+
+The fairlead and the anchor as a mooring or riser engineer reads them: the fairlead is
+the top (riser_numbers.top_end), the anchor the other end when it is held. With F the
+force the line exerts on that support (start_force or end_force, global axes, N):
+``fairlead_force_x``, ``_y``, ``_z`` the components of F at the top;
+``fairlead_tension`` |F|; ``fairlead_horizontal`` |(F_x, F_y)| (the catenary's H, the
+horizontal restoring force of a mooring line); ``fairlead_vertical`` -F_z (the weight the
+top carries, positive for a hanging line: the catenary's V); ``fairlead_position`` (3,)
+where it is, m, absolute. ``anchor_tension`` |F|, ``anchor_horizontal`` |(F_x, F_y)|,
+``anchor_vertical`` F_z (the upward pull on the anchor, positive when it lifts the
+anchor) and ``anchor_position`` (3,) of the anchor, when it is held.
 """
 
 import numpy as np
@@ -36,12 +47,17 @@ from petsc_rod.physics.term import TermOutput
 from petsc_rod.quantities.report import Report
 from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension,
                                              points_on_held_ends, top_end, unit_tangent)
+from petsc_rod.scenes.boundary import is_held
 
 DATASET_UNITS = {"curvature": "1/m", "bend_radius": "m", "bending_moment": "N m",
                  "torque": "N m", "shear": "N", "declination": "deg"}
 ATTRIBUTE_UNITS = {"start_force": "N", "start_moment": "N m", "end_force": "N",
                    "end_moment": "N m", "hang_off_S": "m", "hang_off_declination": "deg",
-                   "hang_off_azimuth": "deg"}
+                   "hang_off_azimuth": "deg", "fairlead_force_x": "N",
+                   "fairlead_force_y": "N", "fairlead_force_z": "N", "fairlead_tension": "N",
+                   "fairlead_horizontal": "N", "fairlead_vertical": "N",
+                   "fairlead_position": "m", "anchor_tension": "N", "anchor_horizontal": "N",
+                   "anchor_vertical": "N", "anchor_position": "m"}
 # A horizontal projection shorter than this (of a unit tangent) has no azimuth.
 VERTICAL = 1e-12
 
@@ -109,11 +125,26 @@ def end_numbers(problem, vertex):
     tangent = _at_vertex(mesh, unit_tangent(vertex), top * last)
     away = tangent if top == 1 else -tangent             # out of the line at the top
     on_start, on_end = points_on_held_ends(problem)
-    return {"start_force": n0 + on_start, "start_moment": m0, "end_force": -nL + on_end,
-            "end_moment": -mL,
-            "hang_off_S": float(top * mesh.length),
-            "hang_off_declination": float(declination(away)),
-            "hang_off_azimuth": azimuth(away)}
+    forces = (n0 + on_start, -nL + on_end)
+    numbers = {"start_force": forces[0], "start_moment": m0, "end_force": forces[1],
+               "end_moment": -mL,
+               "hang_off_S": float(top * mesh.length),
+               "hang_off_declination": float(declination(away)),
+               "hang_off_azimuth": azimuth(away)}
+    origin = problem.scene.start_position          # positions absolute (riser_numbers)
+    positions = [_at_vertex(mesh, vertex["r"], index) + origin for index in (0, last)]
+    fairlead = forces[top]
+    numbers.update(fairlead_force_x=float(fairlead[0]), fairlead_force_y=float(fairlead[1]),
+                   fairlead_force_z=float(fairlead[2]),
+                   fairlead_tension=float(np.linalg.norm(fairlead)),
+                   fairlead_horizontal=float(np.hypot(fairlead[0], fairlead[1])),
+                   fairlead_vertical=float(-fairlead[2]), fairlead_position=positions[top])
+    if is_held(problem.end_state if top == 0 else problem.start_state):
+        anchor = forces[1 - top]
+        numbers.update(anchor_tension=float(np.linalg.norm(anchor)),
+                       anchor_horizontal=float(np.hypot(anchor[0], anchor[1])),
+                       anchor_vertical=float(anchor[2]), anchor_position=positions[1 - top])
+    return numbers
 
 
 class LineResults(Report):

@@ -21,6 +21,9 @@ vectorised on each rank's owned vertices and elements, combined by MPI reduction
   anchor, an attachment on it included: line_results.start_force / end_force), said in
   the step line and the run's final lines (an anchor resting on the seabed holds the
   line down by its own hold, not the seabed's: a gravity anchor or a pile must take it);
+  ``anchor_uplift`` 1 when the anchor lifts off so, else 0 (a flag a table can show);
+* the touchdown's horizontal position ``touchdown_x``, ``touchdown_y`` (m, absolute; NaN
+  without a touchdown), the numbers a sweep's touchdown excursion is drawn from;
 * the largest curvature |(u1, u2)| (1/m), the smallest bend radius 1 / max curvature (m),
   and where they occur.
 
@@ -46,7 +49,8 @@ ATTRIBUTE_UNITS = {
     "grounded_length": "m", "touchdown_offset": "m", "seabed_vertices_beyond": "1", "max_curvature": "1/m",
     "max_curvature_S": "m",
     "max_curvature_position": "m", "min_bend_radius": "m", "anchor_uplift_S": "m",
-    "anchor_uplift_angle": "deg", "anchor_uplift_force": "N"}
+    "anchor_uplift_angle": "deg", "anchor_uplift_force": "N", "anchor_uplift": "1",
+    "touchdown_x": "m", "touchdown_y": "m"}
 
 
 class RiserNumbers(Report):
@@ -225,10 +229,12 @@ def riser_report(problem, vertex, seabed=None):
                               problem.end_state.position)
         position = position + origin
         attributes.update(touchdown_S=S, touchdown_position=position, grounded_length=grounded,
-                          touchdown_offset=offset)
+                          touchdown_offset=offset, touchdown_x=float(position[0]),
+                          touchdown_y=float(position[1]))
         text += (f", touchdown at S = {S:.6g} m (x, y, z = "
                  + ", ".join(f"{v:.6g}" for v in position) + f"), grounded {grounded:.6g} m")
         uplift = anchor_uplift(problem, vertex, top) if np.isnan(S) else {}
+        attributes["anchor_uplift"] = int(bool(uplift))
         if uplift:
             attributes.update(uplift)
             text += (f", the anchor at S = {uplift['anchor_uplift_S']:.6g} m lifts off at "

@@ -1,7 +1,9 @@
-"""``python -m petsc_rod.report RESULT.h5|SWEEP_DIR -o report.html``: the report page
+"""``python -m petsc_rod.report RESULT.h5|SWEEP_DIR -o report.html [--min-bend-radius R]``:
+the report page
 of a result file or of a sweep's folder (report/page.py). Serial; no PETSc. Exit 0, or
 2 with one line when the input is not a result file or a sweep's folder."""
 
+import math
 import os
 import sys
 
@@ -16,8 +18,15 @@ def main(argv=None):
                                        "sweep's folder")
     parser.add_argument("source", help="a result file (HDF5) or a sweep's -sweep_output DIR")
     parser.add_argument("-o", "--output", default="report.html", help="the HTML file")
+    parser.add_argument("--min-bend-radius", type=float, default=None, metavar="R",
+                        help="the allowable bend radius, m, drawn as a limit")
     args = parser.parse_args(argv)
     source = args.source
+    radius = args.min_bend_radius
+    if radius is not None and not (math.isfinite(radius) and radius > 0):
+        sys.stderr.write(f"petsc_rod.report: error: --min-bend-radius {radius:g}: the "
+                         "allowable bend radius must be a positive number of metres\n")
+        return 2
     if os.path.isdir(source) and not os.path.exists(os.path.join(source, "sweep.json")):
         sys.stderr.write(f"petsc_rod.report: error: {source}: a folder without sweep.json is "
                          "not a sweep's output (-sweep_output DIR)\n")
@@ -33,8 +42,10 @@ def main(argv=None):
     if not os.path.isdir(source) and not h5py.is_hdf5(source):
         sys.stderr.write(f"petsc_rod.report: error: {source}: not a result file (HDF5)\n")
         return 2
-    # a sweep's folder: every file in it (its record, its cases' files, its summary)
-    read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)]
+    # a sweep's folder: every file in it (its record, its cases' files, its summary) but
+    # the page of an earlier report, which this one replaces
+    read = ([("file of the sweep", os.path.join(source, name)) for name in os.listdir(source)
+             if not name.endswith(".html")]
             if os.path.isdir(source) else [("result", source)])
     clash = replaced_input([("-o", args.output)], read)
     if not clash and not os.path.isdir(os.path.dirname(os.path.abspath(args.output))):
@@ -44,7 +55,7 @@ def main(argv=None):
         return 2
     from petsc_rod.report import page
     try:
-        page.write(source, args.output)
+        page.write(source, args.output, args.min_bend_radius)
     except OSError as error:
         sys.stderr.write(f"petsc_rod.report: error: {args.output}: {error.strerror or error}\n")
         return 2

@@ -2,13 +2,21 @@
 self-contained HTML file, every figure a PNG embedded as base64 and the style inline,
 that an engineer attaches to a design note:
 
-1. the inputs: the options in effect (the file's ``options_in_effect``; for a sweep,
-   those of its first case and the options the cases vary), the line types' table when
-   the file has one (``parameters/line_types_table``);
-2. the summary table, one row per case (sweep/summary.py: the same numbers as the
-   sweep's summary.csv, read from the result files' attributes);
-3. for a sweep, the range graphs along S (report/envelopes.py);
+1. the inputs an engineer gave (the file's ``options`` without the solver's; for a
+   sweep, those of its first case and the options the cases vary), the line types'
+   table when the file has one (``parameters/line_types_table``), every option in effect
+   (``options_in_effect``) folded away;
+2. the key results of each case in engineering units, a row a quantity (report/tables.py,
+   from sweep/summary.py: the numbers of the sweep's summary.csv, read from the result
+   files' attributes), the regions' extremes over the cases and the case that governs,
+   and the whole summary table in SI units folded away;
+3. for a sweep, the load-excursion and touchdown-excursion graphs (report/excursion.py)
+   and one range graph along S a quantity (report/envelopes.py), the governing case
+   named, the limits drawn (utilisation 1, the allowable bend radius when given);
 4. the pictures of each case, as ``petsc_rod.plots.result_figure`` draws them.
+
+Units: kN, kN m, MPa, degrees, m, said once at the top; the page fits a 1400 px window
+(two range graphs a row, wide tables scroll inside their box).
 """
 
 import base64
@@ -25,34 +33,47 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod import plots  # noqa: E402
 from petsc_rod.io.same_file import write_text_whole  # noqa: E402
-from petsc_rod.report import envelopes  # noqa: E402
+from petsc_rod.report import envelopes, excursion, tables  # noqa: E402
 from petsc_rod.sweep import summary  # noqa: E402
 
 STYLE = """
-body { font-family: sans-serif; margin: 2em; color: #222; max-width: 1400px; }
+* { box-sizing: border-box; }
+body { font-family: sans-serif; margin: 1em auto; padding: 0 1em; color: #222;
+       max-width: 1400px; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #aaa; }
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
 th, td { border: 1px solid #bbb; padding: 2px 6px; text-align: right; }
 th { background: #eee; } td.text { text-align: left; }
 tr.failed td { background: #fde0e0; }
 pre { background: #f6f6f6; padding: 0.5em; font-size: 0.8em; overflow-x: auto; }
-img { max-width: 100%; border: 1px solid #ddd; }
+img { max-width: 100%; height: auto; border: 1px solid #ddd; }
+.scroll { max-width: 100%; overflow-x: auto; }
+.graphs { display: grid; grid-template-columns: repeat(2, minmax(0, 1fr)); gap: 8px; }
+details { margin: 0.5em 0; } summary { cursor: pointer; color: #225; }
 """
+# The units on the page, said once.
+UNITS = ("Units: forces kN, moments kN m, stresses MPa, angles degrees, lengths m (the "
+         "result files and summary.csv keep SI units: N, N m, Pa).")
+# One range graph, inches at DPI: two side by side in a 1400 px window.
+GRAPH_SIZE = (6.6, 3.6)
 DPI = 100
+# A case's picture (16 x 9.5 in): 1280 px wide, within a 1400 px window as drawn, and a
+# third fewer bytes and less time than at DPI.
+CASE_DPI = 80
 
 
-def png(figure):
-    """``figure`` as a base64 PNG (the figure closed)."""
+def png(figure, dpi=DPI):
+    """``figure`` as a base64 PNG at ``dpi`` (the figure closed)."""
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=DPI)
+    figure.savefig(buffer, format="png", dpi=dpi)
     plt.close(figure)
     return base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
-def image(figure, alt):
-    """An <img> of ``figure``, embedded."""
+def image(figure, alt, dpi=DPI):
+    """An <img> of ``figure`` at ``dpi``, embedded."""
     return (f'<img alt="{html.escape(alt)}" '
-            f'src="data:image/png;base64,{png(figure)}">')
+            f'src="data:image/png;base64,{png(figure, dpi)}">')
 
 
 def file_inputs(path):
@@ -114,8 +135,30 @@ def sweep_records(folder):
     return records, record["varied"]
 
 
-def build(source):
-    """The HTML page of ``source``: a result file or a sweep's folder."""
+def range_graphs(done, min_bend_radius):
+    """The range graphs' HTML of the converged cases ``done`` (records): one figure a
+    quantity (report/envelopes.draw_one) with its limit line (utilisation 1, the
+    allowable bend radius when given); '' for fewer than two cases."""
+    if len(done) < 2:
+        return ""
+    S, result = envelopes.envelopes([envelopes.along_line(r["file"]) for r in done])
+    limits = {"utilisation": 1.0, "bend_radius": min_bend_radius}
+    images = []
+    for name, entry in result.items():
+        figure = plt.figure(figsize=GRAPH_SIZE, layout="constrained")
+        envelopes.draw_one(figure, S, name, entry, [r["name"] for r in done],
+                           limits.get(name))
+        images.append(image(figure, f"range graph: {envelopes.shown(name)[0]}"))
+    return ("<h2>Range graphs</h2><p>Along the line, every converged case and the envelope "
+            "over them (shaded: least to largest; bold: the design side); each title names "
+            "the case that governs; red dashed: the limit (utilisation 1"
+            + (f", the allowable bend radius {min_bend_radius:.4g} m" if min_bend_radius
+               else "") + ").</p>" + '<div class="graphs">' + "".join(images) + "</div>")
+
+
+def build(source, min_bend_radius=None):
+    """The HTML page of ``source``: a result file or a sweep's folder; ``min_bend_radius``
+    (m): the allowable bend radius drawn as a limit."""
     if os.path.isdir(source):
         records, varied = sweep_records(source)
         title = f"Sweep {os.path.basename(os.path.normpath(source))}: {len(records)} case(s)"
@@ -128,30 +171,42 @@ def build(source):
     first = next((r for r in records if r["file"]), None)
     parts = [f"<h1>{html.escape(title)}</h1>",
              f"<p>petsc_rod report, {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC; "
-             f"{len(done)} of {len(records)} case(s) converged.</p>"]
+             f"{len(done)} of {len(records)} case(s) converged. {UNITS}</p>"]
     parts.append("<h2>Inputs</h2>")
     if first is not None:
         options, types = file_inputs(first["file"])
         if varied:
-            parts.append(f"<p>The options in effect in case <b>{html.escape(first['name'])}"
-                         "</b>; the cases vary " + ", ".join(
-                             f"<code>-{html.escape(v)}</code>" for v in varied)
+            parts.append(f"<p>The inputs of case <b>{html.escape(first['name'])}</b>; the "
+                         "cases vary " + ", ".join(f"<code>-{html.escape(v)}</code>"
+                                                   for v in varied)
                          + " (their values in the summary).</p>")
-        parts.append(f'<pre id="options">{html.escape(options)}</pre>')
+        parts.append(tables.inputs_html(tables.given_options(first["file"])))
         if types:
             parts.append("<h3>Line types</h3>" + line_types_html(types))
-    parts.append("<h2>Summary</h2>")
-    parts.append(table_html(header, rows, codes))
-    parts.append("<p>Units in the header; a shaded row is a case that did not converge "
-                 "(its numbers are left out: its state is no equilibrium of the case).</p>")
-    if len(done) > 1:
-        S, result = envelopes.envelopes([envelopes.along_line(r["file"]) for r in done])
-        if result:
-            figure = plt.figure(figsize=(5 * len(result), 4.2), layout="constrained")
-            envelopes.draw(figure, S, result, [r["name"] for r in done])
-            parts.append("<h2>Range graphs</h2><p>Along the line, every converged case and "
-                         "the envelope over them (shaded: least to largest).</p>")
-            parts.append(image(figure, "range graphs"))
+        parts.append("<details><summary>Every option in effect, the solver's included"
+                     f'</summary><pre id="options">{html.escape(options)}</pre></details>')
+    parts.append("<h2>Results</h2>")
+    parts.append('<div class="scroll">' + tables.key_results(header, rows, codes) + "</div>")
+    parts.append("<p>'-': a case that did not converge (its state is no equilibrium of the "
+                 "case) or a number the case does not have.</p>")
+    regions = tables.region_rows([r["file"] for r in done], [r["name"] for r in done])
+    if regions:
+        parts.append("<h3>Regions</h3><p>Each region's extremes over the converged cases "
+                     "and the case that governs.</p>" + tables.regions_html(regions))
+    parts.append("<details><summary>The summary table (SI units, the numbers of "
+                 "summary.csv)</summary><div class=\"scroll\">"
+                 + table_html(header, rows, codes) + "</div><p>Units in the header; a "
+                 "shaded row is a case that did not converge (its numbers are left out: "
+                 "its state is no equilibrium of the case).</p></details>")
+    excursions = excursion.points(header, rows, codes)
+    if excursions is not None:
+        figure = plt.figure(figsize=(13, 3.8), layout="constrained")
+        excursion.draw(figure, *excursions)
+        parts.append("<h2>Load excursion and touchdown excursion</h2><p>Against the "
+                     "fairlead's offset from the first case along the anchor-to-fairlead "
+                     "direction (the summary's columns).</p>")
+        parts.append(image(figure, "excursion graphs"))
+    parts.append(range_graphs(done, min_bend_radius))
     parts.append("<h2>Cases</h2>")
     for record in records:
         parts.append(f"<h3>{html.escape(record['name'])}</h3>")
@@ -159,14 +214,16 @@ def build(source):
             parts.append(f"<p>No result file: {html.escape(summary.exit_reason(record['code']))}"
                          ".</p>")
             continue
-        parts.append(image(plots.result_figure(record["file"]), record["name"]))
+        parts.append(image(plots.result_figure(record["file"], min_bend_radius),
+                           record["name"], CASE_DPI))
     body = "\n".join(parts)
-    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>"
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">{summary.REPORT_MARK}"
+            f"<title>"
             f"{html.escape(title)}</title><style>{STYLE}</style></head>\n<body>\n{body}\n"
             "</body></html>\n")
 
 
-def write(source, output):
+def write(source, output, min_bend_radius=None):
     """Write the page of ``source`` to ``output``, whole or not at all
     (io.same_file.write_text_whole)."""
-    write_text_whole(output, build(source))
+    write_text_whole(output, build(source, min_bend_radius))

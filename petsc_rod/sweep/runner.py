@@ -160,8 +160,9 @@ SWEEP_FILES = ("summary.csv", "summary.md", "sweep.json")
 def case_files(name):
     """The files a case named ``name`` may leave in the sweep's folder: its result, the
     steps an interrupted run keeps (io.results.ResultWriter.kept_name), its -rod_table
-    and the regions' table beside it (io/line_table.py)."""
-    return (f"{name}.h5", f"{name}.interrupted.h5", f"{name}.csv", f"{name}_regions.csv")
+    and the regions' and ends' tables beside it (io/line_table.py)."""
+    return (f"{name}.h5", f"{name}.interrupted.h5", f"{name}.csv", f"{name}_regions.csv",
+            f"{name}_ends.csv")
 
 
 def check_file_names(cases):
@@ -175,7 +176,7 @@ def check_file_names(cases):
                 raise RodInputError(
                     f"case {case.name}: its file {name} would also be {owners[name]}; rename "
                     f"the case (a case's files are <name>.h5, <name>.interrupted.h5, "
-                    f"<name>.csv, <name>_regions.csv; the sweep's {', '.join(SWEEP_FILES)})")
+                    f"<name>.csv, <name>_regions.csv, <name>_ends.csv; the sweep's {', '.join(SWEEP_FILES)})")
             owners[name] = f"case {case.name}'s"
 
 
@@ -268,8 +269,11 @@ def _claim_folder(folder, cases, inputs):
                 f"{where}: holds {live[0]}, the partial file of a run that is still running "
                 f"(process {RUN_PARTIAL.fullmatch(live[0])['pid']}); wait for it to end, or "
                 "choose another folder")
+        # the page of a report of the earlier sweep is stale with it
         strangers = [name for name in entries
-                     if name not in stale and (ours is None or name not in ours)]
+                     if name not in stale and (ours is None or name not in ours)
+                     and not (ours is not None and name.endswith(".html")
+                              and summary.is_report_page(os.path.join(folder, name)))]
         if strangers:
             raise RodInputError(
                 f"{where}: holds {strangers[0]}"

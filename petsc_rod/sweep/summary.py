@@ -3,12 +3,20 @@ the case's record (name, the options it varied, exit code, how it started) and i
 result file's root attributes, written as CSV and Markdown with the units in the header.
 
 The columns are the riser numbers where the file has them (quantities/riser_numbers.py,
-quantities/pressures.py, quantities/section_numbers.py), then any other scalar root attribute
+quantities/line_results.py's end forces, quantities/module_bends.py's global and local bend
+radii, quantities/pressures.py, quantities/section_numbers.py), then any other scalar root attribute
 named ``max_*``, ``min_*`` or ``top_*``, or naming a utilisation, von Mises or stress
 (what newer versions add: a utilisation, a von Mises stress; vectors such as the end
-forces are not columns), so that the
-table shows what the files hold. The sweep
-(sweep/runner.py) and the report (report/page.py) both make their tables here.
+forces are not columns, their scalar parts are), so that the table shows what the files
+hold. The sweep (sweep/runner.py) and the report (report/page.py) both make their tables
+here.
+
+Over the cases, two columns that no single file has (excursion_columns): the fairlead's
+offset and the touchdown's excursion, both horizontal distances (m) along the direction
+from the anchor to the fairlead of the first case with a file (the x axis where that
+case has no anchor), from that case's fairlead and touchdown. Against the offset, the
+fairlead's horizontal force is a mooring line's load-excursion curve, and the
+touchdown's excursion is what an SCR's fatigue and a cable's abrasion check need.
 """
 
 import csv
@@ -29,11 +37,28 @@ NUMBERS = [
     ("iterations", "total_iterations", "1"),
     ("top_tension", "top_tension", "N"),
     ("top_angle", "top_angle", "deg"),
+    ("fairlead_tension", "fairlead_tension", "N"),
+    ("fairlead_horizontal", "fairlead_horizontal", "N"),
+    ("fairlead_vertical", "fairlead_vertical", "N"),
+    ("fairlead_force_x", "fairlead_force_x", "N"),
+    ("fairlead_force_y", "fairlead_force_y", "N"),
+    ("fairlead_force_z", "fairlead_force_z", "N"),
+    ("anchor_tension", "anchor_tension", "N"),
+    ("anchor_horizontal", "anchor_horizontal", "N"),
+    ("anchor_vertical", "anchor_vertical", "N"),
+    ("anchor_uplift", "anchor_uplift", "1"),
     ("touchdown_S", "touchdown_S", "m"),
+    ("touchdown_x", "touchdown_x", "m"),
+    ("touchdown_y", "touchdown_y", "m"),
     ("grounded_length", "grounded_length", "m"),
     ("min_bend_radius", "min_bend_radius", "m"),
     ("min_bend_radius_S", "max_curvature_S", "m"),
     ("max_curvature", "max_curvature", "1/m"),
+    ("module_pitch", "module_pitch", "m"),
+    ("global_hog_bend_radius", "global_hog_bend_radius", "m"),
+    ("local_hog_bend_radius", "local_hog_bend_radius", "m"),
+    ("global_sag_bend_radius", "global_sag_bend_radius", "m"),
+    ("local_sag_bend_radius", "local_sag_bend_radius", "m"),
     ("max_wall_tension", "max_wall_tension", "N"),
     ("max_wall_tension_S", "max_wall_tension_S", "m"),
 ]
@@ -50,9 +75,27 @@ FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 # it, so it stays as it is.
 NUMBERS_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
                           r"(,[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?)*$")
+# The vector attributes read beside the scalars (positions, m, absolute).
+POSITIONS = ("fairlead_position", "anchor_position", "touchdown_position")
+# The columns computed over the cases (excursion_columns).
+EXCURSION_COLUMNS = [("fairlead_offset", "m"), ("touchdown_excursion", "m")]
 # What an exit code says, for a case without a result file.
 EXIT_REASONS = {0: "converged", 2: "bad input", 3: "not converged", 4: "diverged",
                 5: "result not written"}
+
+# The mark in the head of a report page (report/page.py) by which a sweep knows the page of
+# an earlier report in its folder as that folder's, to remove with the earlier sweep's
+# files (sweep/runner.py claim_folder).
+REPORT_MARK = '<meta name="generator" content="petsc_rod.report">'
+
+
+def is_report_page(path):
+    """Whether the file ``path`` is a report page (REPORT_MARK in its first KiB)."""
+    try:
+        with open(path, "rb") as page:
+            return REPORT_MARK.encode() in page.read(1024)
+    except OSError:
+        return False
 
 
 def exit_reason(code):
@@ -76,6 +119,8 @@ def file_numbers(path):
                 value = np.asarray(value)
                 if value.shape == () and np.issubdtype(value.dtype, np.number):
                     values[key] = value.item()
+                elif key in POSITIONS and value.shape == (3,):
+                    values[key] = value.astype(float)
                 elif value.dtype.kind in "SUO" and value.shape == ():
                     values[key] = value.item().decode() if isinstance(value.item(), bytes) \
                         else str(value.item())
@@ -98,6 +143,29 @@ def number_columns(files):
             if all(isinstance(values.get(attribute, 0.0), (int, float)) for values, _ in files):
                 columns.append((attribute, attribute, units.get(attribute, "")))
     return columns
+
+
+def excursion_columns(files, codes):
+    """[[fairlead_offset, touchdown_excursion]] (m, module docstring) of each case's
+    (values, units) in ``files``, NaN where a case has no such position or did not
+    converge (``codes``: the exit codes); None when no converged case has a fairlead."""
+    converged = [values for (values, _), code in zip(files, codes)
+                 if code == 0 and "fairlead_position" in values]
+    if not converged:
+        return None
+    first = converged[0]
+    direction = np.array([1.0, 0.0])
+    if "anchor_position" in first:
+        chord = first["fairlead_position"][:2] - first["anchor_position"][:2]
+        if np.hypot(*chord) > 0.0:
+            direction = chord / np.hypot(*chord)
+    nan = np.full(3, np.nan)
+    rows = []
+    for (values, _), code in zip(files, codes):
+        shown = values if code == 0 else {}
+        rows.append([float((shown.get(key, nan)[:2] - first.get(key, nan)[:2]) @ direction)
+                     for key in ("fairlead_position", "touchdown_position")])
+    return rows
 
 
 def table(records, varied):
@@ -123,6 +191,11 @@ def table(records, varied):
                                                     values.get("total_iterations", "")}
         row += [shown.get(attribute, "") for _, attribute, _ in columns]
         rows.append(row)
+    excursions = excursion_columns(files, [record["code"] for record in records])
+    if excursions is not None:
+        header += [f"{column} ({unit})" for column, unit in EXCURSION_COLUMNS]
+        rows = [row + [value if value == value else "" for value in extra]
+                for row, extra in zip(rows, excursions)]
     return header, rows
 
 

@@ -222,3 +222,49 @@ def test_a_grounded_anchor_says_no_uplift():
     _, attributes = solve(PETSc.COMM_WORLD, GROUNDED)
     assert np.isfinite(attributes["touchdown_S"])
     assert "anchor_uplift_force" not in attributes
+
+
+def test_fairlead_and_anchor_forces_are_the_catenary_h_and_v(comm):
+    """The lifted-anchor catenary (top (9, 0, 4), EI 5e-3 N m^2): the fairlead's
+    horizontal and vertical force are the inextensible catenary's H and V(L) = V0 + w L,
+    the anchor's H and V0, to 1e-3 (the bending layer's share); the components are the
+    end force's, the uplift flagged 1; the final lines say them in kN. Before, only the
+    end_force vector and touchdown_S = nan."""
+    from petsc_rod.cli.messages import summary
+    from petsc_rod.scenes.catenary import catenary
+
+    top = np.array([9.0, 0.0, 4.0])
+    _, attributes = solve(comm, dict(CATENARY, stiffness=(5e-3, 5e-3, 5e-3),
+                                     end_position=top, seabed=Seabed(0.0, 1e5)),
+                          elements=160)
+    _, _, force = catenary(10.0, top, np.array([0.0, 0.0, -2.0]), np.array([0.0, 10.0]))
+    H, V0, VL = force[0][0], force[0][2], force[1][2]
+    assert VL == pytest.approx(V0 + 20.0, rel=1e-9)
+    a = attributes
+    assert a["fairlead_horizontal"] == pytest.approx(H, rel=1e-3)
+    assert a["fairlead_vertical"] == pytest.approx(VL, rel=1e-3)
+    assert a["fairlead_tension"] == pytest.approx(np.hypot(H, VL), rel=1e-3)
+    np.testing.assert_array_equal([a[f"fairlead_force_{c}"] for c in "xyz"], a["end_force"])
+    assert a["fairlead_force_x"] < 0.0 and a["fairlead_force_z"] < 0.0   # pulled down, in
+    np.testing.assert_allclose(a["fairlead_position"], top, atol=1e-12)
+    assert a["anchor_horizontal"] == pytest.approx(H, rel=1e-3)
+    assert a["anchor_vertical"] == pytest.approx(V0, rel=1e-3)
+    assert a["anchor_vertical"] == a["anchor_uplift_force"]
+    np.testing.assert_allclose(a["anchor_position"], 0.0, atol=1e-12)
+    assert a["anchor_uplift"] == 1 and np.isnan(a["touchdown_x"])
+    lines = "\n".join(summary(a))
+    assert (f"fairlead force {a['fairlead_tension'] / 1e3:.6g} kN: horizontal "
+            f"{a['fairlead_horizontal'] / 1e3:.6g} kN, vertical "
+            f"{a['fairlead_vertical'] / 1e3:.6g} kN") in lines
+    assert "the anchor lifts off" in lines
+
+
+def test_a_grounded_anchor_is_flagged_not_lifting_with_its_touchdown():
+    """The line resting on the seabed: anchor_uplift 0, the touchdown's x and y those of
+    its position; the anchor holds only what friction-free ground leaves: a horizontal
+    pull, equal to the fairlead's H (the line's horizontal balance, no horizontal load)."""
+    _, a = solve(PETSc.COMM_WORLD, GROUNDED)
+    assert a["anchor_uplift"] == 0
+    assert a["touchdown_x"] == a["touchdown_position"][0] and a["touchdown_y"] == 0.0
+    assert 0.5 < a["touchdown_x"] < 6.0
+    assert a["anchor_horizontal"] == pytest.approx(a["fairlead_horizontal"], rel=1e-9)

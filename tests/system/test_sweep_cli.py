@@ -239,8 +239,10 @@ def test_the_report_of_a_sweep(offset_sweep, tmp_path):
                                       ("min_bend_radius (m)", "min_bend_radius")):
                 assert float(cells[column]) == pytest.approx(float(f.attrs[attribute]),
                                                              rel=1e-5), (name, column)
-    # the range graphs and one picture per case, each a PNG with something drawn
-    assert len(page.images) == 1 + len(CASES)
+    # the excursion graphs, one range graph a quantity (effective tension, bend radius,
+    # curvature, bending moment, declination, seabed clearance) and one picture per
+    # case, each a PNG with something drawn
+    assert len(page.images) == 1 + 6 + len(CASES)
     for source in page.images:
         assert source.startswith("data:image/png;base64,")
         data = base64.b64decode(source.split(",", 1)[1])
@@ -249,6 +251,153 @@ def test_the_report_of_a_sweep(offset_sweep, tmp_path):
         drawn = float(np.mean(np.any(pixels < 0.95, axis=-1)))
         assert 0.02 < drawn < 0.9, drawn
     assert "<pre id=\"options\">" in text and "-rod_stiffness" in text
+
+
+# The ends' columns of the summary and the attributes they are.
+END_COLUMNS = ("fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
+               "fairlead_force_x", "fairlead_force_y", "fairlead_force_z", "anchor_tension",
+               "anchor_horizontal", "anchor_vertical", "touchdown_x", "touchdown_y")
+
+
+@pytest.mark.serial
+def test_the_summary_has_the_end_forces_and_the_touchdown_excursion(offset_sweep, tmp_path):
+    """summary.csv holds each case's fairlead and anchor forces, the anchor's uplift
+    flag and the touchdown's position, equal to its file's attributes; the fairlead's
+    offset is -50, 0, 50 m (the pin's position to its constraint residual, 1e-4 m); the
+    touchdown's excursion is the touchdown's x less offset0's (the anchor-to-fairlead
+    direction is +x); the horizontal force grows with the offset (the load-excursion
+    curve) and the touchdown moves toward the anchor; the report's table shows the same
+    numbers. Before, none of these columns."""
+    folder, process = offset_sweep
+    assert process.returncode == 0, describe(process)
+    rows = read_summary(folder)
+    for name, row in rows.items():
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            for column in END_COLUMNS:
+                unit = "m" if column.startswith("touchdown") else "N"
+                assert float(row[f"{column} ({unit})"]) == float(f.attrs[column]), column
+            assert int(row["anchor_uplift (1)"]) == int(f.attrs["anchor_uplift"]) == 0
+            assert float(row["fairlead_horizontal (N)"]) == -float(f.attrs["end_force"][0])
+            np.testing.assert_allclose(f.attrs["fairlead_position"][1:], [0.0, 1000.0],
+                                       atol=1e-4)
+    offset = {k: float(v["fairlead_offset (m)"]) for k, v in rows.items()}
+    assert offset == pytest.approx({"offset0": 0.0, "near50": -50.0, "far50": 50.0},
+                                   abs=1e-4)
+    x0 = float(rows["offset0"]["touchdown_x (m)"])
+    for name, row in rows.items():
+        assert float(row["touchdown_excursion (m)"]) == pytest.approx(
+            float(row["touchdown_x (m)"]) - x0, rel=1e-12, abs=1e-9)
+    H = {k: float(v["fairlead_horizontal (N)"]) for k, v in rows.items()}
+    assert H["near50"] < H["offset0"] < H["far50"]
+    excursion = {k: float(v["touchdown_excursion (m)"]) for k, v in rows.items()}
+    assert excursion["far50"] < -30.0 < 30.0 < excursion["near50"]
+    output = tmp_path / "report.html"
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    page = Tables()
+    page.feed(output.read_text())
+    header, shown = page.rows[0], {row[0]: row for row in page.rows[1:]}
+    for name, row in rows.items():
+        cells = dict(zip(header, shown[name]))
+        for column in ("fairlead_horizontal (N)", "fairlead_offset (m)",
+                       "touchdown_excursion (m)"):
+            assert float(cells[column]) == pytest.approx(float(row[column]), rel=1e-5,
+                                                         abs=1e-9)
+    assert 'alt="excursion graphs"' in output.read_text()
+
+
+class Page(html.parser.HTMLParser):
+    """Every table of a page by its id ({id: rows of cell texts}), the images' alt
+    texts, and the text inside <details>."""
+
+    def __init__(self):
+        super().__init__()
+        self.tables, self.alts, self.folded = {}, [], ""
+        self._table, self._cell, self._details = None, None, 0
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "table":
+            self._table = self.tables.setdefault(attrs.get("id"), [])
+        elif tag == "tr" and self._table is not None:
+            self._table.append([])
+        elif tag in ("td", "th") and self._table is not None:
+            self._cell = ""
+        elif tag == "img":
+            self.alts.append(attrs.get("alt", ""))
+        elif tag == "details":
+            self._details += 1
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self._table[-1].append(self._cell)
+            self._cell = None
+        elif tag == "table":
+            self._table = None
+        elif tag == "details":
+            self._details -= 1
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell += data
+        if self._details:
+            self.folded += data
+
+
+@pytest.mark.serial
+def test_the_report_page_an_engineer_reads(offset_sweep, tmp_path):
+    """The page says its units once and shows the results in kN, m, deg (the files'
+    numbers to the 4 digits shown); the inputs given, not the solver's options (those
+    folded in <details>); a regions' table naming the governing case of each extreme
+    (its numbers the files' region_* attributes); one range graph a quantity, each titled
+    with the case that governs it; the allowable bend radius drawn when given; under a
+    few seconds. Before, one strip of five graphs, numbers in N, every option listed, no
+    region table."""
+    import time
+
+    folder, _ = offset_sweep
+    output = tmp_path / "report.html"
+    begun = time.perf_counter()
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output),
+                                              "--min-bend-radius", "150"])
+    took = time.perf_counter() - begun
+    assert process.returncode == 0, describe(process)
+    assert took < 20.0, took
+    text = output.read_text()
+    assert text.count("Units: forces kN, moments kN m, stresses MPa, angles degrees") == 1
+    page = Page()
+    page.feed(text)
+    results = {row[0]: row for row in page.tables["results"][1:]}
+    assert page.tables["results"][0] == ["quantity", "unit"] + CASES
+    inputs = dict(page.tables["inputs"][1:])
+    assert inputs["-rod_stiffness"] == "5.6e7,5.6e7,4.3e7"
+    assert not any(name.startswith(("-rod_al_", "-rod_d1_", "-sweep_")) for name in inputs)
+    assert "-rod_al_penalty" in page.folded and "-rod_al_penalty" not in inputs
+    regions = {row[0]: row for row in page.tables["regions"][1:]}
+    assert list(regions)[0] == "hang_off" and "grounded" in regions
+    largest, governing = -np.inf, None
+    for k, name in enumerate(CASES):
+        with h5py.File(folder / f"{name}.h5", "r") as f:
+            for label, unit, attribute, factor in (
+                    ("top tension", "kN", "top_tension", 1e-3),
+                    ("fairlead horizontal force H", "kN", "fairlead_horizontal", 1e-3),
+                    ("touchdown S", "m", "touchdown_S", 1.0),
+                    ("smallest bend radius", "m", "min_bend_radius", 1.0)):
+                assert results[label][1] == unit
+                assert float(results[label][2 + k]) == pytest.approx(
+                    float(f.attrs[attribute]) * factor, rel=1e-3), (name, label)
+            assert results["anchor lifts off"][2 + k] == "no"
+            names = [n.decode() if isinstance(n, bytes) else n for n in f.attrs["region_names"]]
+            tension = float(f.attrs["region_max_tension"][names.index("hang_off")])
+            if tension > largest:
+                largest, governing = tension, name
+    assert float(regions["hang_off"][3]) == pytest.approx(largest / 1e3, rel=1e-3)
+    assert regions["hang_off"][4] == governing == "far50"
+    graphs = [alt for alt in page.alts if alt.startswith("range graph: ")]
+    assert graphs == [f"range graph: {q}" for q in (
+        "effective tension", "bend radius", "curvature", "bending moment", "declination",
+        "seabed clearance")]
+    assert "the allowable bend radius 150 m" in text
 
 
 @pytest.mark.serial
@@ -451,3 +600,36 @@ def test_which_partial_files_a_killed_sweep_left():
     stale, live = left_partials(entries, files)
     assert stale == entries[:3]
     assert live == [entries[3]]
+
+
+def test_a_bad_allowable_bend_radius_is_one_line_and_exit_2(offset_sweep, tmp_path):
+    folder, _ = offset_sweep
+    output = tmp_path / "r.html"
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(output),
+                                              "--min-bend-radius", "-3"])
+    assert process.returncode == 2 and not output.exists()
+    assert process.stderr == ("petsc_rod.report: error: --min-bend-radius -3: the allowable "
+                              "bend radius must be a positive number of metres\n")
+
+
+@pytest.mark.serial
+def test_a_report_in_the_sweep_s_folder_is_written_again(offset_sweep, tmp_path):
+    """The report page written into the sweep's own folder can be written there again
+    (the second run refused it as a file of the sweep, an input), and the sweep run again
+    into that folder takes the page for its own (it refused the folder)."""
+    import shutil
+
+    folder = tmp_path / "sweep"
+    shutil.copytree(offset_sweep[0], folder)
+    output = folder / "report.html"
+    for _ in range(2):
+        process = run_module("petsc_rod.report", [str(folder), "-o", str(output)])
+        assert process.returncode == 0, describe(process)
+    assert output.stat().st_size > 0
+    process = run_module("petsc_rod.report", [str(folder), "-o", str(folder / "far50.h5")])
+    assert process.returncode == 2 and "far50.h5" in process.stderr, describe(process)
+    # the sweep run again into its folder removes the earlier report's page with its files
+    process = run_module("petsc_rod.sweep", RISER + ["-sweep_offsets", "0",
+                                                     "-sweep_output", str(folder)])
+    assert process.returncode == 0, describe(process)
+    assert not output.exists() and (folder / "offset0.h5").exists()

@@ -73,6 +73,31 @@ def test_the_table_has_a_row_per_vertex_and_units_in_its_header(riser):
     assert not partial_files(table)
 
 
+def test_the_ends_table_and_final_lines_give_the_end_forces_and_touchdown(riser):
+    """scr_ends.csv beside the table: the fairlead's and anchor's forces, the uplift
+    flag and the touchdown, one row a number with its unit, equal (12 digits) to the
+    result file's attributes; the final lines say the fairlead's H and V in kN. Before,
+    no such file and no such line."""
+    done, output, table, folder = riser
+    with open(folder / "scr_ends.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["quantity", "value", "unit"]
+    read = {name: (float(value), unit) for name, value, unit in rows[1:]}
+    assert {"fairlead_tension", "fairlead_horizontal", "fairlead_vertical",
+            "fairlead_force_x", "anchor_tension", "anchor_horizontal", "anchor_vertical",
+            "anchor_uplift", "touchdown_S", "touchdown_x", "grounded_length"} <= set(read)
+    with h5py.File(output, "r") as f:
+        for name, (value, unit) in read.items():
+            assert value == pytest.approx(float(f.attrs[name]), rel=1e-11), name
+        assert read["fairlead_vertical"][1] == "N" and read["anchor_uplift"] == (0.0, "1")
+        H, V = f.attrs["fairlead_horizontal"], f.attrs["fairlead_vertical"]
+        assert H == pytest.approx(np.hypot(*f.attrs["end_force"][:2]), rel=1e-15)
+        assert V > H > 0.0                 # a steel riser hangs steeply
+    assert (f"fairlead force {np.hypot(H, V) / 1e3:.6g} kN: horizontal {H / 1e3:.6g} kN, "
+            f"vertical {V / 1e3:.6g} kN") in done.stdout
+    assert f"ends {folder / 'scr_ends.csv'}" in done.stdout
+
+
 def test_the_riser_s_von_mises_stress_and_utilisation_by_hand(riser):
     """At the hang-off (z = 1500 m, the sea surface: p_e = 0, p_i = 10 MPa; a pin: the
     moment M only that of the vertex strain, 26 N m): s_a = T_w / A + M r_i / I with
@@ -200,3 +225,27 @@ def test_a_bad_yield_stress_is_refused(tmp_path):
     lines = done.stdout.strip().splitlines()
     assert len(lines) == 1 and "smys" in lines[0], lines
     assert os.listdir(tmp_path) == ["bad.txt"]
+
+
+def test_the_table_has_the_friction_columns(tmp_path):
+    """With seabed friction (the riser catenary under 1 m/s across, mu = 0.5, 300
+    elements) the table has the file's friction force per metre, its global components
+    friction_force_x, _y, _z (N/m), and the stick/slide state at each vertex, equal to
+    its datasets. Before, the table left them out."""
+    output, table = tmp_path / "f.h5", tmp_path / "f.csv"
+    done = run_petsc_rod(["-options_file", "options/riser_catenary.opts", "-rod_current",
+                          "0,1,0", "-rod_elements", "300", "-rod_seabed_friction", "0.5",
+                          "-rod_output", str(output), "-rod_table", str(table)], 1, 300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    header, values = read_csv(table)
+    for name in ("friction_force_x (N/m)", "friction_force_y (N/m)",
+                 "friction_force_z (N/m)", "friction_state (1)"):
+        assert name in header, name
+    column = {name.split(" (")[0]: values[:, i] for i, name in enumerate(header)}
+    with h5py.File(output, "r") as f:
+        force, state = f["friction_force"][:], f["friction_state"][:]
+    for k, axis in enumerate("xyz"):
+        np.testing.assert_allclose(column[f"friction_force_{axis}"], force[:, k],
+                                   rtol=1e-11, atol=1e-9)
+    np.testing.assert_array_equal(column["friction_state"], state)
+    assert np.abs(force[:, 1]).max() > 10.0           # friction holds the line sideways

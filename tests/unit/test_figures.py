@@ -253,3 +253,25 @@ def test_a_result_that_is_a_fifo_is_refused_not_waited_for(tmp_path, capsys, too
         signal.signal(signal.SIGALRM, previous)
     assert code == 2 and "not a regular file" in capsys.readouterr().err
     assert not output.exists()
+
+
+def test_the_utilisation_panel_with_its_limit(folder):
+    """A file with a utilisation (a line type with a yield stress) has a utilisation
+    panel: the file's values, the limit 1 dashed, the largest and where in the title;
+    a file without one has none. Before, no utilisation panel."""
+    path = write_line(f"{folder}/u.h5")
+    S = np.linspace(0.0, L, 201)
+    with h5py.File(path, "a") as f:
+        f["utilisation"] = 0.2 + 0.9 * np.sin(np.pi * S / L) ** 2
+    figure = plots.result_figure(path)
+    axis = axis_by_labels(figure, "S (m)", "utilisation")
+    curves = {line.get_label(): line for line in axis.lines}
+    drawn = [line for line in axis.lines if len(line.get_ydata()) == S.size]
+    assert len(drawn) == 1
+    np.testing.assert_allclose(drawn[0].get_ydata(), 0.2 + 0.9 * np.sin(np.pi * S / L) ** 2)
+    assert list(curves["limit 1"].get_ydata()) == [1.0, 1.0]
+    assert "largest 1.1 at S = 100 m  ABOVE 1" in axis.get_title()
+    matplotlib.pyplot.close(figure)
+    figure = plots.result_figure(write_line(f"{folder}/plain.h5"))
+    assert not [a for a in figure.axes if a.get_ylabel() == "utilisation"]
+    matplotlib.pyplot.close(figure)

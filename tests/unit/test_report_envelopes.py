@@ -49,3 +49,32 @@ def test_the_envelope_spans_every_case(tmp_path):
         envelopes.draw(figure, S, result, ["a", "b"])
         # the largest tension is the long case's end: 1500 N
         assert figure.axes[0].get_title() == "effective tension: max 1.5 kN"
+
+
+def test_one_graph_a_quantity_names_the_governing_case_and_draws_the_limit(tmp_path):
+    """draw_one: the title gives the extreme on the design side, in the unit shown, and
+    the case and S where it is (the long case's end, 1.5 kN at S = 250 m); the bend
+    radius's graph draws the allowable radius as a line at its value; a utilisation's
+    title has no unit '1'. Before, one strip of panels titled 'max 1.2 1' naming no case."""
+    short = write_case(tmp_path / "short.h5", 100.0, 10, lambda S: 1000.0 + S)
+    long = write_case(tmp_path / "long.h5", 250.0, 20, lambda S: 500.0 + 4.0 * S)
+    for path, scale in ((short, 0.4), (long, 1.2)):
+        with h5py.File(path, "a") as f:
+            f["utilisation"] = scale * f["S"][:] / f["S"][-1]
+    S, result = envelopes.envelopes([envelopes.along_line(p) for p in (short, long)])
+    figure = Figure()
+    envelopes.draw_one(figure, S, "effective_tension", result["effective_tension"],
+                       ["short", "long"])
+    assert figure.axes[0].get_title() == ("effective tension: max 1.5 kN, case long at "
+                                          "S = 250 m")
+    figure = Figure()
+    envelopes.draw_one(figure, S, "bend_radius", result["bend_radius"], ["short", "long"],
+                       limit=30.0)
+    limits = [line for line in figure.axes[0].lines if line.get_label() == "limit 30 m"]
+    assert len(limits) == 1 and limits[0].get_ydata()[0] == 30.0
+    assert figure.axes[0].get_ylim()[0] < 30.0              # the limit is in sight
+    figure = Figure()
+    envelopes.draw_one(figure, S, "utilisation", result["utilisation"], ["short", "long"],
+                       limit=1.0)
+    assert figure.axes[0].get_title() == "utilisation: max 1.2, case long at S = 250 m"
+    assert figure.axes[0].get_ylabel() == "utilisation"
