@@ -8,21 +8,58 @@ from petsc_rod.figures import graphs, scene, style
 from petsc_rod.figures.titles import result_title, sweep_title
 
 
-def layout(count):
+SIZE = (16, 9.5)
+# The fixed layout's margins (in): the tick labels and axis label left of an axes, the
+# height of a line of the suptitle below TOP, and the space of a one-line axes title.
+LEFT, GAP, RIGHT, TOP, TITLE_LINE, TITLE = 0.72, 1.05, 0.15, 0.05, 0.2, 0.3
+
+
+def layout(count, title_lines=None):
     """A figure with the elevation and the plan on top and ``count`` graphs below
-    (sharing S): (figure, elevation, plan, graph axes)."""
-    figure = plt.figure(figsize=(16, 9.5), layout="constrained")
-    top, bottom = figure.subfigures(2, 1, height_ratios=[1.2, 1])
-    elevation, plan = top.subplots(1, 2, width_ratios=[1.9, 1])
-    along = bottom.subplots(1, count, sharex=True)
+    (sharing S): (figure, elevation, plan, graph axes). With ``title_lines`` (the
+    suptitle's lines) the axes are placed at fixed margins in inches (LEFT, GAP, ...),
+    which give the picture of constrained layout for tick labels of up to about six
+    characters at a fraction of its drawing time (constrained layout measures every
+    tick label of every axes several times); without, constrained layout."""
+    if title_lines is None:
+        figure = plt.figure(figsize=SIZE, layout="constrained")
+        top, bottom = figure.subfigures(2, 1, height_ratios=[1.2, 1])
+        elevation, plan = top.subplots(1, 2, width_ratios=[1.9, 1])
+        along = bottom.subplots(1, count, sharex=True)
+        return figure, elevation, plan, list(along)
+    width, height = SIZE
+    figure = plt.figure(figsize=SIZE)
+    span = width - LEFT - RIGHT
+
+    def row(columns, bottom, top, **kwargs):
+        """A row of ``columns`` axes from ``bottom`` to ``top`` (in), GAP apart."""
+        return figure.add_gridspec(
+            1, columns, left=LEFT / width, right=1 - RIGHT / width, bottom=bottom / height,
+            top=top / height, wspace=GAP * columns / (span - GAP * (columns - 1)), **kwargs)
+
+    above = row(2, 4.51, height - TOP - TITLE_LINE * title_lines - TITLE, width_ratios=[1.9, 1])
+    elevation, plan = figure.add_subplot(above[0]), figure.add_subplot(above[1])
+    along = row(count, 0.44, 3.6).subplots(sharex=True, squeeze=False)[0]
     return figure, elevation, plan, list(along)
 
 
 def riser_figure(result, min_bend_radius=None):
     """The figure of one ``Result``; ``min_bend_radius``: the allowable bend radius
-    (m) drawn on the curvature graph."""
+    (m) drawn on the curvature graph. Laid out at fixed margins when every panel fits
+    in them (``clear``), else drawn again with constrained layout."""
+    figure = drawn_figure(result, min_bend_radius, fixed=True)
+    if clear(figure):
+        return figure
+    plt.close(figure)
+    return drawn_figure(result, min_bend_radius, fixed=False)
+
+
+def drawn_figure(result, min_bend_radius, fixed):
+    """riser_figure's figure at fixed margins (``fixed``) or with constrained layout."""
     drawn = graphs.graphs_for([result])
-    figure, elevation, plan, axes = layout(len(drawn))
+    title = result_title(result)
+    figure, elevation, plan, axes = layout(len(drawn),
+                                           title.count("\n") + 1 if fixed else None)
     scene.draw_elevation(elevation, result)
     scene.draw_water(elevation, result)
     elevation.set_title("elevation: height against the true horizontal distance "
@@ -37,8 +74,24 @@ def riser_figure(result, min_bend_radius=None):
             draw(axis, result)
         if len(axis.get_legend_handles_labels()[0]) > 1:
             axis.legend(fontsize=8, loc="best")
-    figure.suptitle(result_title(result))
+    if fixed:
+        figure.suptitle(title, y=1 - TOP / SIZE[1])
+    else:
+        figure.suptitle(title)
     return figure
+
+
+def clear(figure):
+    """Whether every axes of ``figure``, its tick labels, axis labels and title
+    included, lies inside the figure, clear of the others and of the suptitle (the
+    fixed layout fits: else constrained layout makes room)."""
+    renderer = figure.canvas.get_renderer()
+    boxes = [axis.get_tightbbox(renderer) for axis in figure.axes]
+    boxes.append(figure._suptitle.get_window_extent(renderer))
+    inside = all(b.x0 >= 0 and b.y0 >= 0 and b.x1 <= figure.bbox.width
+                 and b.y1 <= figure.bbox.height for b in boxes)
+    return inside and not any(a.overlaps(b) for k, a in enumerate(boxes)
+                              for b in boxes[k + 1:])
 
 
 def sweep_overlay(results, labels, min_bend_radius=None):

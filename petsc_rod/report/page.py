@@ -22,7 +22,9 @@ Units: kN, kN m, MPa, degrees, m, said once at the top; the page fits a 1400 px 
 import base64
 import html
 import io
+import multiprocessing
 import os
+from concurrent.futures import ProcessPoolExecutor
 from datetime import datetime, timezone
 
 import h5py
@@ -72,8 +74,38 @@ def png(figure, dpi=DPI):
 
 def image(figure, alt, dpi=DPI):
     """An <img> of ``figure`` at ``dpi``, embedded."""
-    return (f'<img alt="{html.escape(alt)}" '
-            f'src="data:image/png;base64,{png(figure, dpi)}">')
+    return img(alt, png(figure, dpi))
+
+
+def img(alt, encoded):
+    """An <img> of the base64 PNG ``encoded``."""
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{encoded}">'
+
+
+def range_png(S, name, entry, names, limit):
+    """The base64 PNG of one range graph (report/envelopes.draw_one)."""
+    figure = plt.figure(figsize=GRAPH_SIZE, layout="constrained")
+    envelopes.draw_one(figure, S, name, entry, names, limit)
+    return png(figure)
+
+
+def case_png(path, min_bend_radius):
+    """The base64 PNG of the picture of result file ``path`` at CASE_DPI."""
+    return png(plots.result_figure(path, min_bend_radius), CASE_DPI)
+
+
+def drawn_all(tasks):
+    """The results of ``tasks`` ((function, arguments) pairs, each drawing one figure), in
+    their order. Drawing a figure is serial matplotlib work of a few tenths of a second,
+    independent of the others, so the figures are drawn by a pool of one process a CPU
+    (forked: the workers inherit the imported matplotlib) and the page takes the time of
+    the slowest worker's share rather than of all; one CPU or one task: drawn here."""
+    workers = min(os.cpu_count() or 1, len(tasks))
+    if workers < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return [function(*arguments) for function, arguments in tasks]
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        futures = [pool.submit(function, *arguments) for function, arguments in tasks]
+        return [future.result() for future in futures]
 
 
 def file_inputs(path):
@@ -135,20 +167,25 @@ def sweep_records(folder):
     return records, record["varied"]
 
 
-def range_graphs(done, min_bend_radius):
-    """The range graphs' HTML of the converged cases ``done`` (records): one figure a
-    quantity (report/envelopes.draw_one) with its limit line (utilisation 1, the
-    allowable bend radius when given); '' for fewer than two cases."""
+def range_tasks(done, min_bend_radius):
+    """The drawing tasks (drawn_all) of the range graphs of the converged cases ``done``
+    (records): one figure a quantity (report/envelopes.draw_one) with its limit line
+    (utilisation 1, the allowable bend radius when given), and their alt texts; none for
+    fewer than two cases."""
     if len(done) < 2:
-        return ""
+        return [], []
     S, result = envelopes.envelopes([envelopes.along_line(r["file"]) for r in done])
     limits = {"utilisation": 1.0, "bend_radius": min_bend_radius}
-    images = []
-    for name, entry in result.items():
-        figure = plt.figure(figsize=GRAPH_SIZE, layout="constrained")
-        envelopes.draw_one(figure, S, name, entry, [r["name"] for r in done],
-                           limits.get(name))
-        images.append(image(figure, f"range graph: {envelopes.shown(name)[0]}"))
+    names = [r["name"] for r in done]
+    tasks = [(range_png, (S, name, entry, names, limits.get(name)))
+             for name, entry in result.items()]
+    return tasks, [f"range graph: {envelopes.shown(name)[0]}" for name in result]
+
+
+def range_graphs(images, min_bend_radius):
+    """The range graphs' section of the <img> ``images``; '' for none."""
+    if not images:
+        return ""
     return ("<h2>Range graphs</h2><p>Along the line, every converged case and the envelope "
             "over them (shaded: least to largest; bold: the design side); each title names "
             "the case that governs; red dashed: the limit (utilisation 1"
@@ -206,7 +243,12 @@ def build(source, min_bend_radius=None):
                      "fairlead's offset from the first case along the anchor-to-fairlead "
                      "direction (the summary's columns).</p>")
         parts.append(image(figure, "excursion graphs"))
-    parts.append(range_graphs(done, min_bend_radius))
+    graph_tasks, graph_alts = range_tasks(done, min_bend_radius)
+    drawn = [r for r in records if r["file"] is not None]
+    encoded = iter(drawn_all(graph_tasks + [(case_png, (r["file"], min_bend_radius))
+                                            for r in drawn]))
+    parts.append(range_graphs([img(alt, next(encoded)) for alt in graph_alts],
+                              min_bend_radius))
     parts.append("<h2>Cases</h2>")
     for record in records:
         parts.append(f"<h3>{html.escape(record['name'])}</h3>")
@@ -214,8 +256,7 @@ def build(source, min_bend_radius=None):
             parts.append(f"<p>No result file: {html.escape(summary.exit_reason(record['code']))}"
                          ".</p>")
             continue
-        parts.append(image(plots.result_figure(record["file"], min_bend_radius),
-                           record["name"], CASE_DPI))
+        parts.append(img(record["name"], next(encoded)))
     body = "\n".join(parts)
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">{summary.REPORT_MARK}"
             f"<title>"

@@ -275,3 +275,38 @@ def test_the_utilisation_panel_with_its_limit(folder):
     figure = plots.result_figure(write_line(f"{folder}/plain.h5"))
     assert not [a for a in figure.axes if a.get_ylabel() == "utilisation"]
     matplotlib.pyplot.close(figure)
+
+
+def overlaps(figure):
+    """The pairs of ``figure``'s axes (tick labels, axis labels and title included)
+    and suptitle that overlap, and those not inside the figure."""
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    boxes = [axis.get_tightbbox(renderer) for axis in figure.axes]
+    boxes.append(figure._suptitle.get_window_extent(renderer))
+    outside = [k for k, b in enumerate(boxes) if b.x0 < 0 or b.y0 < 0
+               or b.x1 > figure.bbox.width + 1 or b.y1 > figure.bbox.height]
+    return outside + [(j, k) for j, a in enumerate(boxes) for k, b in enumerate(boxes)
+                      if j < k and a.overlaps(b)]
+
+
+def test_a_riser_picture_has_a_fixed_layout_without_overlaps(folder):
+    """The picture of one riser is laid out at fixed margins (no layout engine: it
+    measures every tick label several times, most of the drawing time of a report's
+    pictures) when its panels fit in them: every panel inside the figure, clear of the
+    others and of the suptitle; else with constrained layout (here five panels, long
+    titles and tick labels seven characters wide)."""
+    path = write_line(f"{folder}/plain.h5")
+    with h5py.File(path, "a") as f:
+        del f["wall_tension"]  # the tension panel's title on one short line
+    figure = plots.result_figure(path)
+    assert figure.get_layout_engine() is None
+    assert overlaps(figure) == []
+    matplotlib.pyplot.close(figure)
+    path = write_line(f"{folder}/u.h5")
+    S = np.linspace(0.0, L, 201)
+    with h5py.File(path, "a") as f:
+        f["utilisation"] = 0.00175 * np.sin(np.pi * S / L) ** 2
+    figure = plots.result_figure(path)
+    assert figure.get_layout_engine() is not None
+    matplotlib.pyplot.close(figure)

@@ -2,6 +2,8 @@
 different lengths spans every case's arc length, and a shorter case is not extended
 past its own end."""
 
+import os
+
 import h5py
 import matplotlib
 import numpy as np
@@ -78,3 +80,22 @@ def test_one_graph_a_quantity_names_the_governing_case_and_draws_the_limit(tmp_p
                        limit=1.0)
     assert figure.axes[0].get_title() == "utilisation: max 1.2, case long at S = 250 m"
     assert figure.axes[0].get_ylabel() == "utilisation"
+
+
+def _pid_of(k):
+    """(k, the id of the process that ran it)."""
+    return k, os.getpid()
+
+
+def test_report_figures_are_drawn_by_a_pool_in_their_order(monkeypatch):
+    """The page's figures are drawn by a pool of one process a CPU and come back in the
+    order asked, whatever worker drew each."""
+    from petsc_rod.report import page
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    drawn = page.drawn_all([(_pid_of, (k,)) for k in range(6)])
+    assert [k for k, _ in drawn] == list(range(6))
+    assert os.getpid() not in {pid for _, pid in drawn}
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)
+    assert page.drawn_all([(_pid_of, (k,)) for k in range(3)]) == [
+        (k, os.getpid()) for k in range(3)]
