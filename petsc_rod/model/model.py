@@ -154,7 +154,9 @@ def check_pipe(line, n):
             ("contents_density", bore, "an id column (the bore the contents fill)"),
             ("design_factor", yield_stress,
              "an smys column (the yield stress it scales into the allowable stress)")):
-        if getattr(line, name) is not None and not present:
+        # a zero pressure or density is the default, no setting (the API's Line took 0)
+        if (getattr(line, name) if name != "design_factor"
+                else getattr(line, name) is not None) and not present:
             raise RodInputError(f"{n[name]} needs a line type with {partner}: no line type "
                                 f"of {n['sections']} has one; give it in {n['line_types']}, "
                                 f"or drop {n[name]}")
@@ -243,7 +245,7 @@ def check_joints(span, n):
             raise RodInputError(
                 f"{axis_name} needs {stiffness} k > 0 (the axis of a flex joint; without "
                 "one the end is a plain pin)")
-        for name, given in ((stiffness, end.stiffness is not None),
+        for name, given in ((stiffness, bool(end.stiffness)),     # 0: no joint
                             (axis_name, axis is not None)):
             if (given or k > 0) and end.kind != "pin":
                 raise RodInputError(

@@ -89,3 +89,20 @@ def test_one_line_type_read_from_a_table_or_made_in_python():
     a, b = read.section(0.0, 10.0, 1025.0, 9.80665), PIPE.section(0.0, 10.0, 1025.0, 9.80665)
     for name in ("stiffness_start", "stiffness_end", "weight", "drag", "od", "id"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_zero_pressures_and_a_zero_joint_stiffness_are_no_settings():
+    """An explicit 0 is the default: a pipe's contents density and internal pressure of 0
+    on line types without a bore, and an end stiffness of 0 on a clamp or a free end,
+    are accepted (the API's Line and End took 0; a merge refused them), while a nonzero
+    one still needs its partner."""
+    bare = LineType("bare", od=0.2, mass=60.0, ei=1e5, gj=8e4, cd=1.0)
+    scene = compile_scene(riser(line=Line([(bare, 160.0)], contents_density=0.0,
+                                          internal_pressure=0.0)))
+    assert scene.internal_pressure == 0.0 and scene.contents_density == 0.0
+    with pytest.raises(RodInputError, match="Line.internal_pressure needs a line type"):
+        compile_scene(riser(line=Line([(bare, 160.0)], internal_pressure=1.0)))
+    for end in (End("clamp", (110.0, 0.0, -45.0), 0.0), End("free", None, 0.0)):
+        compile_scene(riser(end=end))
+    with pytest.raises(RodInputError, match="needs Model.end pin"):
+        compile_scene(riser(end=End("clamp", (110.0, 0.0, -45.0), 1e4)))
