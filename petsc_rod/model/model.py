@@ -111,16 +111,23 @@ def check_span(span, sea, n):
     check_attachments(span, n)
 
 
+def check_positive(length, stiffness, axial_stiffness, n):
+    """A positive length (m), stiffnesses K1, K2, K3 (N m^2) and EA (N; inf:
+    inextensible): of a uniform line (check_uniform) and of a Scene a Python caller
+    built (Scene.validate)."""
+    if not length > 0:
+        raise RodInputError(f"{n['length']} {length:g}: the length must be positive")
+    if not np.all(np.asarray(stiffness, dtype=float) > 0):
+        raise RodInputError(f"{n['stiffness']}: K1, K2, K3 must all be positive (N m^2)")
+    if not axial_stiffness > 0:
+        raise RodInputError(f"{n['axial_stiffness']} {axial_stiffness:g}: EA must be "
+                            "positive (N; default inf, inextensible)")
+
+
 def check_uniform(line, n):
     """A uniform line: positive length, stiffness and EA, as many load pieces as breaks
     allow, the breaks increasing inside the line."""
-    if line.length <= 0:
-        raise RodInputError(f"{n['length']} {line.length:g}: the length must be positive")
-    if np.any(np.asarray(line.stiffness, dtype=float) <= 0):
-        raise RodInputError(f"{n['stiffness']}: K1, K2, K3 must all be positive (N m^2)")
-    if not line.axial_stiffness > 0:
-        raise RodInputError(f"{n['axial_stiffness']} {line.axial_stiffness:g}: EA must be "
-                            "positive (N; default inf, inextensible)")
+    check_positive(line.length, line.stiffness, line.axial_stiffness, n)
     load = np.asarray(line.load, dtype=float)
     if load.size % 3:
         raise RodInputError(f"{n['load']}: give 3 values (fx,fy,fz) per load piece")

@@ -17,7 +17,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.frames import REFERENCE_FRAME, rotation_about, rotation_log
-from petsc_rod.model.model import check_chord
+from petsc_rod.model.model import check_chord, check_positive
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
 from petsc_rod.scenes.starts import catenary_start
@@ -390,10 +390,12 @@ class Scene:
 
     def validate(self, used=()):
         """Raise RodInputError on a scene a Python caller built that no cable can realise:
-        sections that do not tile the line, or an inextensible line whose held ends are
+        a length, stiffness or EA that is not positive, sections that do not tile the
+        line, or an inextensible line whose held ends are
         farther apart than its length (model.check_chord; an extensible one is then taut,
         docs/method.md §12). A scene compiled from a Model is checked by Model.check
         (``used``: kept for callers that pass the options they set)."""
+        check_positive(self.length, self.stiffness, self.axial_stiffness, FIELD_NAMES)
         if self.sections:
             self._validate_sections()
         if self.start != "free" and self.end != "free":
