@@ -10,6 +10,8 @@ from petsc_rod.model.line import Line, UniformLine
 from petsc_rod.model.line_type import LineType, Section, line_types_from_table
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.sea import Environment
+from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
 
-__all__ = ["Attachment", "End", "Environment", "Line", "LineType", "Model", "Section",
-           "Span", "UniformLine", "line_types_from_table"]
+__all__ = ["Attachment", "Body", "Connection", "End", "Environment", "Line", "LineType",
+           "Model", "Point", "Section", "Span", "System", "SystemLine", "UniformLine",
+           "line_types_from_table"]

@@ -1,0 +1,178 @@
+"""A system of lines meeting at points and bodies (a floater on its moorings, with
+risers; an array of floaters sharing anchors): the typed description the system's
+input (a MoorDyn file, the Python API) builds and the coupled solver solves.
+
+A line of a system is a Line of sections of line types (model/line.py) or a
+UniformLine, with the attachments along it; each of its two ends is a Connection to a
+Point or to a Body by name. The sea (Environment) is shared by every line. Plain values
+in SI units, z up, angles in radians; nothing here knows PETSc.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError
+from petsc_rod.model.attachment import Attachment
+from petsc_rod.model.line import Line, UniformLine
+from petsc_rod.model.sea import Environment
+from petsc_rod.model.values import optional, real, reals
+
+# A point is 'fixed' (an anchor: its position held), 'free' (a connection point in
+# equilibrium: a clump weight, a buoy, a joint of two lines) or 'prescribed' (held at a
+# position the load case gives: a fairlead on a vessel moved by hand).
+POINT_KINDS = ("fixed", "free", "prescribed")
+# A line's end at a point or a body is pinned (no moment), clamped (the body's frame
+# holds the line's end frame) or a flex joint (a rotational spring, N m/rad).
+CONNECTION_KINDS = ("pin", "clamp", "flex")
+
+
+def _name(owner, value):
+    if not isinstance(value, str) or not value or any(c.isspace() for c in value):
+        raise RodInputError(f"{owner} {value!r}: a name is one word of text")
+    return value
+
+
+@dataclass(frozen=True)
+class Point:
+    """A point of the system, named ``name``: ``kind`` in POINT_KINDS; ``position``
+    (3,), m, absolute (a free point's: where its equilibrium is sought from); ``mass``
+    (kg) in air and displaced ``volume`` (m^3) (a clump weight, a buoy); ``force`` (3,),
+    N, a constant external force; ``cda`` = C_d A (m^2), its drag area in a current. Its
+    dead force is force + (rho_w volume - mass) g e_z."""
+
+    name: str
+    kind: str = "fixed"
+    position: tuple = (0.0, 0.0, 0.0)
+    mass: float = 0.0
+    volume: float = 0.0
+    force: tuple = (0.0, 0.0, 0.0)
+    cda: float = 0.0
+
+    def __post_init__(self):
+        _name("Point.name", self.name)
+        if self.kind not in POINT_KINDS:
+            raise RodInputError(f"Point {self.name}: kind {self.kind!r}: use one of "
+                                f"{', '.join(POINT_KINDS)}")
+        reals(f"Point {self.name}: position", self.position, (3,))
+        reals(f"Point {self.name}: force", self.force, (3,))
+        for name in ("mass", "volume", "cda"):
+            if real(f"Point {self.name}: {name}", getattr(self, name)) < 0:
+                raise RodInputError(f"Point {self.name}: {name} {getattr(self, name)!r}: "
+                                    "must not be negative")
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body with 6 degrees of freedom, named ``name``. ``position`` (6,): its
+    reference point's x, y, z (m) and its rotation's roll, pitch, yaw (rad; the
+    rotation R = R_z(yaw) R_y(pitch) R_x(roll) takes body axes to global ones), where
+    its equilibrium is sought from. ``mass`` (kg) at ``cog`` (3,), body axes, m;
+    displaced ``volume`` (m^3) with its centre of buoyancy ``cob`` (3,); the waterplane's
+    ``waterplane_area`` (m^2) and its second moments ``waterplane_moments`` (Ixx, Iyy),
+    m^4, about the reference point's vertical; or ``hydrostatic`` (6, 6) given whole
+    (N/m, N, N m/rad about the reference point at its start position, in place of
+    the volume's and waterplane's own); ``load`` (6,): a constant external force (N)
+    and moment (N m) about the reference point, global axes (wind, current, wave
+    drift); ``held`` (6,) bools: the degrees of freedom held at ``position``."""
+
+    name: str
+    position: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    mass: float = 0.0
+    cog: tuple = (0.0, 0.0, 0.0)
+    volume: float = 0.0
+    cob: tuple = (0.0, 0.0, 0.0)
+    waterplane_area: float = 0.0
+    waterplane_moments: tuple = (0.0, 0.0)
+    hydrostatic: tuple = None
+    load: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    held: tuple = (False,) * 6
+
+    def __post_init__(self):
+        _name("Body.name", self.name)
+        owner = f"Body {self.name}:"
+        reals(f"{owner} position", self.position, (6,))
+        reals(f"{owner} load", self.load, (6,))
+        for name in ("cog", "cob"):
+            reals(f"{owner} {name}", getattr(self, name), (3,))
+        reals(f"{owner} waterplane_moments", self.waterplane_moments, (2,))
+        optional(f"{owner} hydrostatic", self.hydrostatic, reals, (36,))
+        for name in ("mass", "volume", "waterplane_area"):
+            if real(f"{owner} {name}", getattr(self, name)) < 0:
+                raise RodInputError(f"{owner} {name} {getattr(self, name)!r}: must not be "
+                                    "negative")
+        held = np.asarray(self.held)
+        if held.shape != (6,) or held.dtype != bool:
+            raise RodInputError(f"{owner} held {self.held!r}: six bools (x, y, z, roll, "
+                                "pitch, yaw)")
+
+
+@dataclass(frozen=True)
+class Connection:
+    """Where a line's end is fixed: to the Point or Body named ``to``; ``local`` (3,),
+    m, the point in the body's axes (a fairlead; zero on a point); ``kind`` in
+    CONNECTION_KINDS, with ``stiffness`` (N m/rad) for a flex joint."""
+
+    to: str
+    local: tuple = (0.0, 0.0, 0.0)
+    kind: str = "pin"
+    stiffness: float = None
+
+    def __post_init__(self):
+        _name("Connection.to", self.to)
+        reals(f"Connection to {self.to}: local", self.local, (3,))
+        if self.kind not in CONNECTION_KINDS:
+            raise RodInputError(f"Connection to {self.to}: kind {self.kind!r}: use one of "
+                                f"{', '.join(CONNECTION_KINDS)}")
+        optional(f"Connection to {self.to}: stiffness", self.stiffness, real)
+
+
+@dataclass(frozen=True)
+class SystemLine:
+    """A line of the system, named ``name``: ``line`` a Line of sections of line types
+    or a UniformLine, from ``start`` (S = 0) to ``end`` (S = L), Connections;
+    ``attachments`` (Attachment, ...) along it."""
+
+    name: str
+    line: object
+    start: Connection
+    end: Connection
+    attachments: tuple = ()
+
+    def __post_init__(self):
+        _name("SystemLine.name", self.name)
+        if not isinstance(self.line, (Line, UniformLine)):
+            raise RodInputError(f"line {self.name}: expected a Line or a UniformLine, not "
+                                f"{type(self.line).__name__}")
+        for which in ("start", "end"):
+            if not isinstance(getattr(self, which), Connection):
+                raise RodInputError(f"line {self.name}: {which}: expected a Connection")
+        if not all(isinstance(a, Attachment) for a in self.attachments):
+            raise RodInputError(f"line {self.name}: attachments: a sequence of Attachment")
+
+
+@dataclass(frozen=True)
+class System:
+    """Lines (SystemLine, ...) between points (Point, ...) and bodies (Body, ...) in
+    one sea (Environment). Names are unique among points and bodies, and among
+    lines."""
+
+    lines: tuple
+    points: tuple = ()
+    bodies: tuple = ()
+    environment: Environment = field(default_factory=Environment)
+
+    def __post_init__(self):
+        for name, kind in (("lines", SystemLine), ("points", Point), ("bodies", Body)):
+            items = getattr(self, name)
+            if isinstance(items, (str, bytes)) or not all(isinstance(i, kind) for i in items):
+                raise RodInputError(f"System.{name}: a sequence of {kind.__name__}")
+        if not isinstance(self.environment, Environment):
+            raise RodInputError("System.environment: expected an Environment")
+
+    def node(self, name):
+        """The Point or Body named ``name``."""
+        for item in (*self.points, *self.bodies):
+            if item.name == name:
+                return item
+        raise RodInputError(f"no point or body is named {name!r}")
