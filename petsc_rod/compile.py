@@ -15,7 +15,7 @@ import numpy as np
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.attachment import attachment_columns, dead_forces
 from petsc_rod.model.names import FIELD_NAMES
-from petsc_rod.model.values import MAX_MAGNITUDE
+from petsc_rod.model.values import MAX_MAGNITUDE, MAX_STRAIN
 from petsc_rod.environment.bathymetry import Grid, Plane, Profile
 from petsc_rod.environment.current import Current
 from petsc_rod.environment.profiles import grid_axes
@@ -328,12 +328,6 @@ def check_applied_forces(scene, sea, n):
             f"{option}: the applied force (int |f| dS + the end forces + the drag) is "
             f"{total:.3g} N, above {MAX_MAGNITUDE:g}; give loads in N/m, forces in N and "
             "lengths in m")
-
-
-# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
-# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
-# line material.
-MAX_STRAIN = 1.0
 
 
 def least_top_strain(scene):

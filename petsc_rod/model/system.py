@@ -15,7 +15,9 @@ import numpy as np
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.attachment import Attachment
 from petsc_rod.model.line import Line, UniformLine
+from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.sea import Environment
+from petsc_rod.model.system_check import check_system
 from petsc_rod.model.values import optional, real, reals
 
 # A point is 'fixed' (an anchor: its position held), 'free' (a connection point in
@@ -169,6 +171,13 @@ class System:
                 raise RodInputError(f"System.{name}: a sequence of {kind.__name__}")
         if not isinstance(self.environment, Environment):
             raise RodInputError("System.environment: expected an Environment")
+
+    def check(self, names=FIELD_NAMES):
+        """Raise RodInputError on a system no equilibrium can be sought for
+        (system_check.check_system): names, connections, each line's own checks worded
+        with ``names`` (names.Names), held points a line cannot span, a point without a
+        line, a body's degree of freedom nothing restores."""
+        check_system(self, names)
 
     def node(self, name):
         """The Point or Body named ``name``."""

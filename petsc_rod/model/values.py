@@ -13,6 +13,10 @@ from petsc_rod.errors import RodInputError
 # a few of them (K / L^2, (K3 a / L)^2 / K, R h), which must stay within double
 # precision.
 MAX_MAGNITUDE = 1e30
+# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
+# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
+# line material.
+MAX_STRAIN = 1.0
 
 
 def real(owner, value, allow_inf=False):

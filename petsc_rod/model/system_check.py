@@ -1,0 +1,254 @@
+"""Every check that decides whether a System (model/system.py) can be solved, before any
+line is meshed: the names, what each line's ends are connected to, each line's own
+checks (those of a single line, model/model.py), a line too short for the held points it
+joins, a point without a line, and a body's degree of freedom that nothing restores.
+Each refusal is one RodInputError saying what is wrong and how to fix it.
+
+The seabed under a sloped or profiled sea is checked per line where the line is compiled
+(compile.py: check_ends_above); here only the flat seabed under the held points.
+"""
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError
+from petsc_rod.model.end import End
+from petsc_rod.model.model import Span, check_pipe, check_sea, check_span
+from petsc_rod.model.values import MAX_STRAIN
+
+# The degrees of freedom of a body, in Body.position's order.
+DOFS = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
+def rotation(roll, pitch, yaw):
+    """R = R_z(yaw) R_y(pitch) R_x(roll), (3, 3): body axes to global ones (angles in
+    rad), as Body.position gives them."""
+    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
+                              np.cos(yaw), np.sin(yaw))
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def connection_position(node, connection):
+    """Where ``connection`` is, (3,), m, global, with its Point or Body ``node`` at its
+    start position: the point's position, or the body's reference point plus its
+    rotation times the local point."""
+    if hasattr(node, "kind"):
+        return np.asarray(node.position, dtype=float)
+    place = np.asarray(node.position, dtype=float)
+    return place[:3] + rotation(*place[3:]) @ np.asarray(connection.local, dtype=float)
+
+
+def is_held(node):
+    """Whether a Point or Body is held where it is: a fixed or prescribed point, a body
+    held in all six degrees of freedom."""
+    return node.kind != "free" if hasattr(node, "kind") else bool(np.all(node.held))
+
+
+def check_system(system, names):
+    """Raise RodInputError on a System no equilibrium can be sought for; the single
+    line's checks word their messages with ``names`` (names.Names), prefixed by the
+    line's name."""
+    if not system.lines:
+        raise RodInputError("System.lines: a system needs at least one line (SystemLine)")
+    check_names(system)
+    nodes = {item.name: item for item in (*system.points, *system.bodies)}
+    for line in system.lines:
+        check_connections(line, nodes)
+    check_lines(system, names)
+    check_points(system)
+    check_held_spans(system, nodes)
+    check_seabed_under(system)
+    sea = system.environment
+    for body in system.bodies:
+        check_restoring(body, [(line, which) for line in system.lines
+                               for which in ("start", "end")
+                               if getattr(line, which).to == body.name],
+                        sea.water_density, sea.gravity)
+
+
+def check_names(system):
+    """Names unique among the points and bodies (a Connection names one of them), and
+    among the lines."""
+    for what, items in (("points or bodies", (*system.points, *system.bodies)),
+                        ("lines", system.lines)):
+        seen = set()
+        for item in items:
+            if item.name in seen:
+                raise RodInputError(f"two {what} are named {item.name}: give each a name "
+                                    "of its own")
+            seen.add(item.name)
+
+
+def check_connections(line, nodes):
+    """Each end of ``line`` names an existing point or body; a point takes a pin at
+    itself (no local point, no clamp: a point has no frame); a flex joint has a
+    stiffness >= 0 and only a flex joint has one; the two ends are not one point."""
+    for which in ("start", "end"):
+        connection = getattr(line, which)
+        owner = f"line {line.name}: {which}"
+        node = nodes.get(connection.to)
+        if node is None:
+            known = ", ".join(sorted(nodes)) or "none"
+            raise RodInputError(f"{owner}: no point or body is named {connection.to} "
+                                f"(the points and bodies: {known}); name one of them")
+        if hasattr(node, "kind"):
+            if connection.kind != "pin":
+                raise RodInputError(
+                    f"{owner}: a {connection.kind} at point {node.name}: a point has no "
+                    "rotation to hold the line's end frame against; connect the end to a "
+                    "Body (held in all degrees of freedom for a fixed clamp), or use a pin")
+            if np.any(np.asarray(connection.local, dtype=float) != 0):
+                raise RodInputError(
+                    f"{owner}: Connection.local {tuple(connection.local)} at point "
+                    f"{node.name}: a local point belongs to a body; move the point instead "
+                    "and give local (0, 0, 0)")
+        if connection.kind == "flex" and not (connection.stiffness is not None
+                                              and connection.stiffness >= 0):
+            raise RodInputError(f"{owner}: a flex joint needs Connection.stiffness >= 0 "
+                                "(N m/rad)")
+        if connection.kind != "flex" and connection.stiffness is not None:
+            raise RodInputError(f"{owner}: Connection.stiffness is a flex joint's; give "
+                                f"kind 'flex' or drop the stiffness (the end is a "
+                                f"{connection.kind})")
+    if line.start.to == line.end.to and hasattr(nodes[line.start.to], "kind"):
+        raise RodInputError(f"line {line.name}: both ends at point {line.start.to}: a line "
+                            "joins two points (or two places of a body)")
+
+
+def check_lines(system, names):
+    """Each line's own checks as a single line's (model.check_span, check_pipe), on a
+    Span pinned at both ends whose positions are left to the system (the chord between
+    held points: check_held_spans), and the sea's with all of them (check_sea)."""
+    spans = []
+    for line in system.lines:
+        span = Span(line.line, End("pin"), End("pin"), tuple(line.attachments))
+        try:
+            check_span(span, system.environment, names)
+            if span.sections:
+                check_pipe(span.line, names)
+        except RodInputError as error:
+            raise RodInputError(f"line {line.name}: {error}") from None
+        spans.append(span)
+    check_sea(system.environment, spans, names)
+
+
+def check_points(system):
+    """Every point is the end of some line (a point with no line is a mistake: a free
+    one has nothing to hold it, a held one holds nothing)."""
+    used = {getattr(line, which).to for line in system.lines for which in ("start", "end")}
+    for point in system.points:
+        if point.name not in used:
+            raise RodInputError(f"point {point.name} ({point.kind}) is the end of no line: "
+                                "connect a line to it, or drop it")
+
+
+def needed_strain(lengths, eas, chord):
+    """The largest strain of a line of sections of ``lengths`` (m,), m, and axial
+    stiffnesses ``eas`` (m,), N (inf: inextensible), pulled straight to ``chord`` (m):
+    the tension T of sum L_i (1 + T / EA_i) = chord, eps = T / min EA; 0 when the line
+    reaches slack, inf when it cannot stretch to it. The least strain of any
+    equilibrium: a weight or a current only adds to it."""
+    lengths, eas = np.asarray(lengths, dtype=float), np.asarray(eas, dtype=float)
+    excess = chord - lengths.sum()
+    if excess <= 1e-12 * lengths.sum():
+        return 0.0
+    compliance = float(np.sum(lengths / eas))
+    return np.inf if compliance == 0 else excess / compliance / float(eas.min())
+
+
+def check_held_spans(system, nodes):
+    """A line between two held points (or bodies held in all degrees of freedom) must
+    reach across them: an inextensible one no shorter than their distance, an extensible
+    one within MAX_STRAIN of it (the bound of the single line's model of stretch)."""
+    for line in system.lines:
+        start, end = nodes[line.start.to], nodes[line.end.to]
+        if not (is_held(start) and is_held(end)):
+            continue
+        chord = float(np.linalg.norm(connection_position(end, line.end)
+                                     - connection_position(start, line.start)))
+        model = line.line
+        if hasattr(model, "sections"):
+            lengths, eas = model.lengths, [entry[0].ea for entry in model.sections]
+        else:
+            lengths, eas = [model.length], [model.axial_stiffness]
+        strain = needed_strain(lengths, eas, chord)
+        if strain == np.inf:
+            raise RodInputError(
+                f"line {line.name}: {line.start.to} and {line.end.to} are held "
+                f"{chord:.6g} m apart, {chord - float(np.sum(lengths)):.3g} m more than "
+                f"its length {float(np.sum(lengths)):.6g} m (inextensible); lengthen the "
+                "line, move the points closer, or give its line types an EA")
+        if strain > MAX_STRAIN:
+            raise RodInputError(
+                f"line {line.name}: {line.start.to} and {line.end.to} are held "
+                f"{chord:.6g} m apart: its length {float(np.sum(lengths)):.6g} m must "
+                f"stretch by {100 * strain:.3g} % or more to reach, above "
+                f"{100 * MAX_STRAIN:g} %, where the linear stretch models no line "
+                "material; lengthen the line, move the points closer, or check its EA (N)")
+
+
+def check_seabed_under(system):
+    """No held point below a flat seabed (to round-off of the lines' length)."""
+    sea = system.environment
+    if sea.seabed is None or sea.seabed_slope is not None:
+        return
+    scale = 1e-12 * max(float(sum(line.line.length for line in system.lines)), 1.0)
+    for point in system.points:
+        depth = sea.seabed - float(point.position[2])
+        if point.kind != "free" and depth > scale:
+            raise RodInputError(
+                f"point {point.name} ({point.kind}) is held at z = {point.position[2]:.6g} "
+                f"m, {depth:.3g} m below the seabed (Environment.seabed {sea.seabed:g}); "
+                "hold it on or above it")
+
+
+def restoring_by_hydrostatics(body, water_density, gravity):
+    """The diagonal (6,) of a body's own restoring at its start: the given hydrostatic
+    matrix's, else rho g A_wp in heave and rho g (I_wp + V z_b) - m g z_g in roll and
+    pitch (body axes about the reference point; none in surge, sway and yaw)."""
+    if body.hydrostatic is not None:
+        return np.diag(np.asarray(body.hydrostatic, dtype=float).reshape(6, 6)).copy()
+    rho_g = water_density * gravity
+    moments = np.asarray(body.waterplane_moments, dtype=float)
+    tilt = (rho_g * (moments + body.volume * float(body.cob[2]))
+            - body.mass * gravity * float(body.cog[2]))
+    return np.array([0.0, 0.0, rho_g * body.waterplane_area, tilt[0], tilt[1], 0.0])
+
+
+def restoring_by_lines(body, ends):
+    """Which of a body's degrees of freedom (6,) bools its lines' ends ``ends`` ((line,
+    'start'|'end'), ...) hold: any line the translations; a rotation about the axis e_k
+    unless every end is a pin and all of them lie on one line along e_k (the body then
+    turns about that line, carrying the ends with it)."""
+    if not ends:
+        return np.zeros(6, dtype=bool)
+    connections = [getattr(line, which) for line, which in ends]
+    if any(c.kind != "pin" for c in connections):
+        return np.ones(6, dtype=bool)
+    turn = rotation(*np.asarray(body.position, dtype=float)[3:])
+    places = np.array([turn @ np.asarray(c.local, dtype=float) for c in connections])
+    offsets = places - places[0]
+    scale = 1e-9 * max(float(np.abs(places).max()), 1.0)
+    spread = np.array([np.abs(np.cross(offsets, axis)).max() > scale for axis in np.eye(3)])
+    return np.concatenate([np.ones(3, dtype=bool), spread])
+
+
+def check_restoring(body, ends, water_density, gravity):
+    """Refuse a body's free degree of freedom that neither its lines (restoring_by_lines)
+    nor its hydrostatics (restoring_by_hydrostatics, a positive diagonal term) restore:
+    the coupled equilibrium's matrix would be singular in it."""
+    if body.hydrostatic is not None and (body.waterplane_area
+                                         or np.any(np.asarray(body.waterplane_moments))):
+        raise RodInputError(f"body {body.name}: give its hydrostatic matrix or its waterplane "
+                            "area and moments, not both (the matrix stands in for them)")
+    hydro = restoring_by_hydrostatics(body, water_density, gravity) > 0
+    loose = ~np.asarray(body.held, dtype=bool) & ~hydro & ~restoring_by_lines(body, ends)
+    if np.any(loose):
+        which = ", ".join(DOFS[k] for k in np.flatnonzero(loose))
+        lines = (f"its {len(ends)} line end(s), all pinned on one line along that axis,"
+                 if ends else "no line")
+        raise RodInputError(
+            f"body {body.name}: nothing restores its {which}: {lines} and no hydrostatic "
+            "stiffness there; attach lines, give Body.hydrostatic (or its waterplane), or "
+            f"hold {which} (Body.held)")

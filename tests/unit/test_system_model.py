@@ -1,0 +1,194 @@
+"""System.check (petsc_rod/model/system_check.py): every refusal of a system of lines,
+points and bodies that cannot be solved, one line each, asserted by its words."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from petsc_rod.errors import RodInputError
+from petsc_rod.model import (Body, Connection, Environment, Line, LineType, Point, System,
+                             SystemLine)
+from petsc_rod.model.system_check import needed_strain, rotation
+
+pytestmark = pytest.mark.unit
+
+CHAIN = LineType("chain", od=0.1, mass=100.0, ei=1e3, gj=1e3, ea=1e9)
+ROPE = LineType("rope", od=0.1, mass=10.0, ei=1e3, gj=1e3)          # inextensible
+FAIRLEADS = ((5.0, 0.0, -10.0), (-2.5, 4.33, -10.0), (-2.5, -4.33, -10.0))
+ANCHORS = ((500.0, 0.0, -200.0), (-250.0, 433.0, -200.0), (-250.0, -433.0, -200.0))
+
+
+def spread(**change):
+    """A floater on three 600 m chains from anchors on a flat seabed at -200 m."""
+    fields = dict(
+        points=tuple(Point(f"A{k + 1}", "fixed", p) for k, p in enumerate(ANCHORS)),
+        bodies=(Body("float", mass=1e6, cog=(0.0, 0.0, -5.0), volume=1e3,
+                     cob=(0.0, 0.0, -3.0), waterplane_area=100.0,
+                     waterplane_moments=(1e4, 1e4)),),
+        lines=tuple(SystemLine(f"L{k + 1}", Line([(CHAIN, 600.0)], element_length=10.0),
+                               Connection(f"A{k + 1}"), Connection("float", f))
+                    for k, f in enumerate(FAIRLEADS)),
+        environment=Environment(seabed=-200.0))
+    fields.update(change)
+    return System(**fields)
+
+
+def refused(system):
+    with pytest.raises(RodInputError) as error:
+        system.check()
+    message = str(error.value)
+    assert "\n" not in message
+    return message
+
+
+def test_the_spread_passes_every_check():
+    spread().check()
+
+
+def test_a_system_needs_a_line():
+    assert "a system needs at least one line" in refused(spread(lines=(), points=()))
+
+
+def test_names_are_unique_among_points_and_bodies_and_among_lines():
+    system = spread()
+    twice = dataclasses.replace(system, bodies=(Body("A1"),))
+    assert refused(twice) == "two points or bodies are named A1: give each a name of its own"
+    lines = system.lines[:2] + (dataclasses.replace(system.lines[2], name="L1"),)
+    assert refused(dataclasses.replace(system, lines=lines)) == (
+        "two lines are named L1: give each a name of its own")
+
+
+def with_line(system, index, **change):
+    lines = list(system.lines)
+    lines[index] = dataclasses.replace(lines[index], **change)
+    return dataclasses.replace(system, lines=tuple(lines))
+
+
+def test_a_connection_names_an_existing_point_or_body():
+    message = refused(with_line(spread(), 1, start=Connection("A9")))
+    assert message == ("line L2: start: no point or body is named A9 (the points and "
+                       "bodies: A1, A2, A3, float); name one of them")
+
+
+def test_a_clamp_or_a_local_point_at_a_point_is_refused():
+    message = refused(with_line(spread(), 0, start=Connection("A1", kind="clamp")))
+    assert message.startswith("line L1: start: a clamp at point A1: a point has no "
+                              "rotation to hold the line's end frame against")
+    message = refused(with_line(spread(), 0, start=Connection("A1", local=(1.0, 0.0, 0.0))))
+    assert "a local point belongs to a body" in message
+
+
+def test_a_flex_joint_and_its_stiffness_go_together():
+    system = spread()
+    assert "a flex joint needs Connection.stiffness >= 0" in refused(
+        with_line(system, 0, end=Connection("float", FAIRLEADS[0], "flex")))
+    assert "Connection.stiffness is a flex joint's" in refused(
+        with_line(system, 0, end=Connection("float", FAIRLEADS[0], "pin", 1e5)))
+    with_line(system, 0, end=Connection("float", FAIRLEADS[0], "flex", 1e5)).check()
+
+
+def test_a_line_does_not_join_a_point_to_itself():
+    assert "both ends at point A1" in refused(with_line(spread(), 0, end=Connection("A1")))
+
+
+def test_a_point_with_no_line_is_refused():
+    system = spread()
+    lonely = dataclasses.replace(system, points=system.points + (Point("buoy", "free"),))
+    assert refused(lonely) == ("point buoy (free) is the end of no line: connect a line to "
+                               "it, or drop it")
+
+
+def held_pair(line_type, length, distance):
+    """One line of ``length`` between a fixed and a prescribed point ``distance`` apart."""
+    return System(lines=(SystemLine("tie", Line([(line_type, length)], element_length=5.0),
+                                    Connection("a"), Connection("b")),),
+                  points=(Point("a", "fixed", (0.0, 0.0, -50.0)),
+                          Point("b", "prescribed", (distance, 0.0, -50.0))))
+
+
+def test_a_line_too_short_for_its_held_points_is_refused():
+    assert refused(held_pair(ROPE, 100.0, 101.0)) == (
+        "line tie: a and b are held 101 m apart, 1 m more than its length 100 m "
+        "(inextensible); lengthen the line, move the points closer, or give its line types "
+        "an EA")
+    held_pair(ROPE, 100.0, 100.0).check()
+    held_pair(CHAIN, 100.0, 101.0).check()              # 1 % of stretch
+    soft = dataclasses.replace(CHAIN, ea=50.0)          # T = 50 N per 100 %
+    assert refused(held_pair(soft, 100.0, 250.0)).startswith(
+        "line tie: a and b are held 250 m apart: its length 100 m must stretch by 150 % or "
+        "more to reach, above 100 %")
+
+
+def test_the_needed_strain_of_sections_in_series():
+    # 100 m at EA 1e6 and 100 m inextensible pulled to 201 m: T = 1 / 1e-4 = 1e4 N
+    assert needed_strain([100.0, 100.0], [1e6, np.inf], 201.0) == pytest.approx(1e-2)
+    assert needed_strain([100.0], [np.inf], 100.5) == np.inf
+    assert needed_strain([100.0], [1e6], 90.0) == 0.0
+
+
+def test_a_held_body_s_fairlead_counts_as_a_held_end():
+    system = held_pair(ROPE, 100.0, 0.0)
+    body = Body("ship", position=(101.0, 0.0, -50.0, 0.0, 0.0, 0.0), held=(True,) * 6)
+    tied = dataclasses.replace(system, points=system.points[:1], bodies=(body,),
+                               lines=(dataclasses.replace(system.lines[0],
+                                                          end=Connection("ship")),))
+    assert "a and ship are held 101 m apart, 1 m more than its length" in refused(tied)
+    # turned by 180 degrees in yaw, the fairlead 2 m ahead of the body lands at 99 m
+    turned = dataclasses.replace(body, position=(101.0, 0.0, -50.0, 0.0, 0.0, np.pi))
+    dataclasses.replace(tied, bodies=(turned,), lines=(dataclasses.replace(
+        tied.lines[0], end=Connection("ship", (2.0, 0.0, 0.0))),)).check()
+
+
+def test_a_body_that_nothing_restores_is_refused():
+    lone = Body("barge", volume=10.0, mass=1e4)
+    system = spread()
+    message = refused(dataclasses.replace(system, bodies=system.bodies + (lone,)))
+    assert message == ("body barge: nothing restores its x, y, z, roll, pitch, yaw: no "
+                       "line and no hydrostatic stiffness there; attach lines, give "
+                       "Body.hydrostatic (or its waterplane), or hold x, y, z, roll, pitch, "
+                       "yaw (Body.held)")
+    held = dataclasses.replace(lone, waterplane_area=10.0, held=(True, True, False, True,
+                                                                 True, True))
+    dataclasses.replace(system, bodies=system.bodies + (held,)).check()
+
+
+def test_a_body_on_one_pinned_line_turns_freely_about_it_in_yaw():
+    system = spread()
+    one = dataclasses.replace(system, lines=system.lines[:1], points=system.points[:1])
+    message = refused(one)
+    assert message.startswith("body float: nothing restores its yaw: its 1 line end(s), "
+                              "all pinned on one line along that axis,")
+    clamped = with_line(one, 0, end=Connection("float", FAIRLEADS[0], "clamp"))
+    clamped.check()
+
+
+def test_a_hydrostatic_matrix_stands_in_for_the_waterplane():
+    system = spread()
+    body = dataclasses.replace(system.bodies[0], hydrostatic=tuple(np.eye(6).ravel()))
+    assert refused(dataclasses.replace(system, bodies=(body,))) == (
+        "body float: give its hydrostatic matrix or its waterplane area and moments, not "
+        "both (the matrix stands in for them)")
+
+
+def test_a_line_s_own_checks_name_the_line():
+    bad = dataclasses.replace(CHAIN, gj=0.0)
+    lines = tuple(dataclasses.replace(line, line=Line([(bad, 600.0)], element_length=10.0))
+                  for line in spread().lines)
+    assert refused(dataclasses.replace(spread(), lines=lines)) == (
+        "line L1: the LineTypes: line type chain: gj 0 must be positive")
+    assert refused(spread(environment=Environment(seabed_stiffness=1e5))) == (
+        "Environment.seabed_stiffness needs Environment.seabed (the seabed's height) or "
+        "Environment.seabed_profile")
+
+
+def test_a_held_point_below_the_flat_seabed_is_refused():
+    message = refused(spread(environment=Environment(seabed=-199.0)))
+    assert message == ("point A1 (fixed) is held at z = -200 m, 1 m below the seabed "
+                       "(Environment.seabed -199); hold it on or above it")
+
+
+def test_the_rotation_takes_body_axes_to_global_ones():
+    assert rotation(0.0, 0.0, np.pi / 2) @ [1.0, 0.0, 0.0] == pytest.approx([0, 1, 0])
+    assert rotation(0.0, np.pi / 2, 0.0) @ [1.0, 0.0, 0.0] == pytest.approx([0, 0, -1])
+    assert rotation(np.pi / 2, 0.0, 0.0) @ [0.0, 1.0, 0.0] == pytest.approx([0, 0, 1])
