@@ -121,14 +121,15 @@ def read_table(path, option, required, optional=(), text=("name",), content=None
         try:
             table[name] = np.array([np.nan if v == BLANK else float(v) for v in values])
         except ValueError:
-            k = next(k for k, v in enumerate(values) if v != BLANK and not _is_number(v))
+            k = next(k for k, v in enumerate(values) if v != BLANK and not is_number(v))
             refuse(f"line {lines[k]}, column {name}: '{values[k]}' is not a number")
         if np.any(np.isnan(table[name]) & ~blank):
             refuse(f"column {name} holds a value that is not a number")
     return table
 
 
-def _is_number(text):
+def is_number(text):
+    """Whether ``text`` reads as a float."""
     try:
         float(text)
     except ValueError:
