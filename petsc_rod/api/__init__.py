@@ -1,14 +1,20 @@
 """The Python API for scripted studies (README, "Python API"): describe a line of line
 types between two ends in the sea (api/model.py), solve it on the ranks of a
-communicator (api/run.py), read its numbers with their units (api/results.py).
+communicator (api/run.py), read its numbers with their units (api/results.py); or
+describe a system of such lines between points and bodies, or read one from a MoorDyn
+file (api/system.py, docs/systems.md).
 
     from petsc_rod.api import LineType, Line, End, Environment, Model, solve
+    from petsc_rod.api import System, Point, Body, Connection, SystemLine, read_moordyn
 """
 
 from petsc_rod.api.model import (Attachment, End, Environment, Line, LineType, Model,
                                  UniformLine)
 from petsc_rod.api.results import Results
 from petsc_rod.api.run import scene_of, solve
+from petsc_rod.api.system import (Body, Connection, Point, System, SystemLine,
+                                  read_moordyn)
 
-__all__ = ["Attachment", "End", "Environment", "Line", "LineType", "Model", "Results",
-           "UniformLine", "scene_of", "solve"]
+__all__ = ["Attachment", "Body", "Connection", "End", "Environment", "Line", "LineType",
+           "Model", "Point", "Results", "System", "SystemLine", "UniformLine",
+           "read_moordyn", "scene_of", "solve"]
