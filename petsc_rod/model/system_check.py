@@ -61,10 +61,13 @@ def check_system(system, names):
     check_seabed_under(system)
     sea = system.environment
     for body in system.bodies:
+        # a line from the body to itself (a bridle) holds nothing against its motion
         check_restoring(body, [(line, which) for line in system.lines
                                for which in ("start", "end")
-                               if getattr(line, which).to == body.name],
+                               if getattr(line, which).to == body.name
+                               and (line.start.to, line.end.to) != (body.name,) * 2],
                         sea.water_density, sea.gravity)
+    check_anchored(system)
 
 
 def check_names(system):
@@ -141,6 +144,49 @@ def check_points(system):
         if point.name not in used:
             raise RodInputError(f"point {point.name} ({point.kind}) is the end of no line: "
                                 "connect a line to it, or drop it")
+
+
+def groups(system):
+    """The names of the points and bodies joined by lines, in groups (lists of names),
+    each group in the order of system.points + system.bodies."""
+    parent = {item.name: item.name for item in (*system.points, *system.bodies)}
+
+    def root(name):
+        while parent[name] != name:
+            name = parent[name]
+        return name
+
+    for line in system.lines:
+        parent[root(line.start.to)] = root(line.end.to)
+    found = {}
+    for name in parent:
+        found.setdefault(root(name), []).append(name)
+    return list(found.values())
+
+
+def check_anchored(system):
+    """Each group of points and bodies joined by lines (groups) is held in x, y and z by
+    a fixed or prescribed point, or a body holding that translation or with a positive
+    hydrostatic term in it; else the group's rigid translation is free (a buoy on a
+    line to a clump weight, nothing else)."""
+    sea = system.environment
+    nodes = {item.name: item for item in (*system.points, *system.bodies)}
+    for names in groups(system):
+        held = np.zeros(3, dtype=bool)
+        for name in names:
+            node = nodes[name]
+            if hasattr(node, "kind"):
+                held |= node.kind != "free"
+            else:
+                held |= np.asarray(node.held, dtype=bool)[:3] | (restoring_by_hydrostatics(
+                    node, sea.water_density, sea.gravity)[:3] > 0)
+        if not np.all(held):
+            which = ", ".join(DOFS[k] for k in np.flatnonzero(~held))
+            shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
+            raise RodInputError(
+                f"nothing holds {shown} in {which}: no fixed or prescribed point, and no "
+                "body held or with hydrostatic stiffness there, among the points and bodies "
+                "its lines join (a rigid motion is free); anchor a line, or hold a body")
 
 
 def needed_strain(lengths, eas, chord):
@@ -247,7 +293,7 @@ def check_restoring(body, ends, water_density, gravity):
     if np.any(loose):
         which = ", ".join(DOFS[k] for k in np.flatnonzero(loose))
         lines = (f"its {len(ends)} line end(s), all pinned on one line along that axis,"
-                 if ends else "no line")
+                 if ends else "no line to another point or body")
         raise RodInputError(
             f"body {body.name}: nothing restores its {which}: {lines} and no hydrostatic "
             "stiffness there; attach lines, give Body.hydrostatic (or its waterplane), or "

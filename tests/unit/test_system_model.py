@@ -145,7 +145,7 @@ def test_a_body_that_nothing_restores_is_refused():
     system = spread()
     message = refused(dataclasses.replace(system, bodies=system.bodies + (lone,)))
     assert message == ("body barge: nothing restores its x, y, z, roll, pitch, yaw: no "
-                       "line and no hydrostatic stiffness there; attach lines, give "
+                       "line to another point or body and no hydrostatic stiffness there; attach lines, give "
                        "Body.hydrostatic (or its waterplane), or hold x, y, z, roll, pitch, "
                        "yaw (Body.held)")
     held = dataclasses.replace(lone, waterplane_area=10.0, held=(True, True, False, True,
@@ -192,3 +192,29 @@ def test_the_rotation_takes_body_axes_to_global_ones():
     assert rotation(0.0, 0.0, np.pi / 2) @ [1.0, 0.0, 0.0] == pytest.approx([0, 1, 0])
     assert rotation(0.0, np.pi / 2, 0.0) @ [1.0, 0.0, 0.0] == pytest.approx([0, 0, -1])
     assert rotation(np.pi / 2, 0.0, 0.0) @ [0.0, 1.0, 0.0] == pytest.approx([0, 0, 1])
+
+
+def test_a_group_of_points_and_bodies_with_nothing_holding_it_is_refused():
+    buoy = System(lines=(SystemLine("riser", Line([(CHAIN, 50.0)], element_length=5.0),
+                                    Connection("buoy"), Connection("clump")),),
+                  points=(Point("buoy", "free", (0.0, 0.0, -10.0), volume=2.0),
+                          Point("clump", "free", (0.0, 0.0, -60.0), mass=1e3)))
+    assert refused(buoy) == (
+        "nothing holds buoy, clump in x, y, z: no fixed or prescribed point, and no body "
+        "held or with hydrostatic stiffness there, among the points and bodies its lines "
+        "join (a rigid motion is free); anchor a line, or hold a body")
+    system = spread()
+    floater = dataclasses.replace(system.bodies[0], name="float2")
+    bridle = (SystemLine("bridle", Line([(CHAIN, 50.0)], element_length=5.0),
+                         Connection("float2", (0.0, 0.0, -1.0)),
+                         Connection("float2", (0.0, 1.0, -1.0))),)
+    assert refused(dataclasses.replace(system, bodies=system.bodies + (floater,),
+                                       lines=system.lines + bridle)).startswith(
+        "body float2: nothing restores its x, y, yaw: no line to another point or body")
+    clump = (SystemLine("pendant", Line([(CHAIN, 50.0)], element_length=5.0),
+                        Connection("float2", (0.0, 0.0, -1.0)), Connection("clump")),)
+    steered = dataclasses.replace(floater, held=(False,) * 5 + (True,))
+    assert refused(dataclasses.replace(
+        system, bodies=system.bodies + (steered,), lines=system.lines + clump,
+        points=system.points + (Point("clump", "free", (0.0, 0.0, -51.0), mass=1e3),)
+    )).startswith("nothing holds clump, float2 in x, y: no fixed or prescribed point")
