@@ -173,6 +173,8 @@ def options(rows, path):
         if key in ("currents", "waterkin", "seafloorfile") or key in DYNAMIC_OPTIONS:
             ignored.append(data[1])
         elif key in STATIC_OPTIONS:
+            if value.lower() == "default":          # MoorDyn-F: the glue code's value
+                continue
             if key == "wtrdpth" and not is_number(value):
                 raise RodInputError(f"{path}:{line}: OPTIONS: WtrDpth {value}: a "
                                     "bathymetry file is not read; give the depth (m)")

@@ -63,6 +63,13 @@ def test_a_body_s_points_become_connections_at_its_local_coordinates():
     assert system.environment.seabed == -320.0          # WtrDpth
 
 
+def test_a_default_static_option_is_not_given():
+    system, notes = parse_moordyn(text(lambda s: s.replace("320           WtrDpth",
+                                                           "DEFAULT       WtrDpth")))
+    assert system.environment.seabed == -320.0
+    assert "the seabed is at the deepest anchor, z = -320 m" in " ".join(notes)
+
+
 def test_a_finer_element_keeps_the_rule_at_its_fraction():
     coarse, _ = read_moordyn(OC3, element_length=10.0)
     ((kind, _, elements),) = coarse.lines[0].line.sections
@@ -140,3 +147,94 @@ def test_a_system_check_refusal_comes_through_the_reader():
                                                "1     Fixed     2853.87")))
     assert message.startswith("line Line1: Point1 and Body1 are held 2856.77 m apart: its "
                               "length 902.2 m must stretch by 217 % or more")
+
+
+SEMI = """--------------------- MoorDyn Input File ------------------------------------
+A free semi on chain and chain-polyester lines, a clump weight at the joint
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.2     200        1.5e9      -1          0          2.4    1.0    1.15    1.0
+poly       0.15    20         1.0e8|3e8  -1          100        1.2    1.0    0.01    0.0
+---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+Can           10       1.0e3     0.6    1.0     1.2      1.0
+---------------------- BODIES ---------------------------------------
+ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      Volume   CdA*   Ca*
+(#)   (word)     (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)  (kg-m^2)  (m^3)   (m^2)  (-)
+1     free        0     0      -5     0       0      10    1e6  -2|0|-8  1e8   1100    0      0
+---------------------- POINTS ---------------------------------------
+ID  Attachment  X       Y     Z      Mass   Volume  CdA    Ca
+(#)   (-)      (m)     (m)   (m)     (kg)   (m^3)   (m^2)  (-)
+1   Fixed      -800     0     -200   0      0       0      0
+2   Free       -300     0     -150   5000   0.5     1      0   ! the clump weight
+3   Body1      -20      0     -10    100    0       0      0
+4   Anchor      400   693     -200   0      0       0      0
+5   Body1       10     17     -10    0      0       0      0
+6   Fixed       400  -693     -200   0      0       0      0
+7   Body1       10    -17     -10    0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain       1        2        520       20       -
+2     poly        2        3        300       600      -
+3     chain       4        5        800       40       -
+4     chain       6        7        800       40       -
+---------------------- OPTIONS -----------------------------------------
+200      WtrDpth
+1025     rho
+9.81     g
+1e6      kBot
+0.5      FrictionCoefficient
+---------------------- EXTERNAL LOADS --------------------------------
+ID    Object          Fext             Blin          Bquad         CSys
+(#)   (name)           (N)            (Ns/m)       (Ns^2/m^2)      (-)
+1    Body1        1e5|0.0|0.0     0.0|0.0|0.0     0.0|0.0|0.0      G
+------------------------- need this line --------------------------------------
+"""
+
+
+def test_a_free_body_a_clump_weight_and_two_line_types(tmp_path):
+    path = tmp_path / "semi.dat"
+    path.write_text(SEMI, encoding="utf-8")
+    system, notes = read_moordyn(path)
+    (body,) = system.bodies
+    assert body.held == (False,) * 6 and body.volume == 1100.0
+    assert body.position == (0.0, 0.0, -5.0, 0.0, 0.0, pytest.approx(np.radians(10.0)))
+    assert body.mass == 1e6 + 100.0                       # the point's mass on the body
+    assert body.cog == pytest.approx(((1e6 * -2.0 + 100.0 * -20.0) / (1e6 + 100.0), 0.0,
+                                      (1e6 * -8.0 + 100.0 * -10.0) / (1e6 + 100.0)))
+    assert body.load == (1e5, 0.0, 0.0, 0.0, 0.0, 0.0)
+    clump = system.points[1]
+    assert (clump.name, clump.kind, clump.mass, clump.volume, clump.cda) == (
+        "Point2", "free", 5000.0, 0.5, 1.0)
+    assert [p.kind for p in system.points] == ["fixed", "free", "fixed", "fixed"]
+    counts = [line.line.sections[0][2] for line in system.lines]
+    assert counts == [520, 600, 800, 800]                 # NumSegs 600 is kept
+    chain, poly = system.lines[0].line.sections[0][0], system.lines[1].line.sections[0][0]
+    assert (poly.ea, poly.ei, poly.gj) == (1.0e8, 100.0, 100.0 / 1.3)
+    weight = abs(200.0 - 1025.0 * np.pi * 0.2 ** 2 / 4) * 9.81
+    assert chain.ei == pytest.approx(0.01 * weight * 200.0, rel=1e-14)
+    sea = system.environment
+    assert (sea.seabed, sea.gravity, sea.seabed_friction) == (-200.0, 9.81, 0.5)
+    assert sea.seabed_stiffness == pytest.approx(1e6 * 0.2)
+    said = " ".join(notes)
+    assert "EA 1.0e8|3e8: the static value 1e+08 is used" in said
+    assert "times the line types' diameter 0.2 m (the largest)" in said
+    assert "line type poly: EI" not in said               # given, not substituted
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("1    Body1        1e5|0.0|0.0     0.0|0.0|0.0     0.0|0.0|0.0      G",
+     "1    Body1        1e5|0.0|0.0     0.0|0.0|0.0     0.0|0.0|0.0      L",
+     "Body1: a force in body axes (CSys L) is not read"),
+    ("1     free        0     0      -5", "1     floating    0     0      -5",
+     "attachment 'floating': use one of"),
+    ("200      WtrDpth", "bathymetry.txt WtrDpth",
+     "OPTIONS: WtrDpth bathymetry.txt: a bathymetry file is not read"),
+    ("2   Free       -300", "2   Body3      -300", "attachment Body3: no body 3 in BODIES"),
+])
+def test_bad_fields_of_the_semi_are_refused(old, new, words):
+    assert old in SEMI
+    assert words in refused(SEMI.replace(old, new))
