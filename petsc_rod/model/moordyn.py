@@ -126,8 +126,12 @@ def parse_moordyn(text, path="<MoorDyn text>", element_length=ELEMENT_LENGTH):
         if depth is not None:
             notes.append(f"no water depth (WtrDpth) in the file: the seabed is at the "
                          f"deepest anchor, z = {-depth:g} m")
-    rows = {row[0]: type_row(row, path) for _, row in sections["types"]}
-    lines, uses = line_rows(sections["lines"], rows, points, attached, element_length, path)
+    rows = {}
+    for line, row in sections["types"]:
+        if row[0] in rows:
+            raise RodInputError(f"{path}:{line}: LINE TYPES: a second line type {row[0]}")
+        rows[row[0]] = type_row(row, f"{path}:{line}")
+    lines, uses = line_rows(sections["lines"], rows, attached, element_length, path)
     types, type_notes = line_types(rows.values(), uses, depth, sea["rho"], sea["g"], path)
     notes[:0] = type_notes
     environment = environment_of(sea, depth, types, notes)
@@ -306,7 +310,7 @@ def apply_loads(rows, points, bodies, path):
                                 "Point<N> of the file (rods are not modelled)")
 
 
-def line_rows(rows, types, points, attached, element_length, path):
+def line_rows(rows, types, attached, element_length, path):
     """The lines (name, type, length m, elements, start, end Connection) of the LINES
     rows (ID LineType AttachA AttachB UnstrLen NumSegs Outputs), and {type: [(length,
     element length), ...]} of the lines of each type."""

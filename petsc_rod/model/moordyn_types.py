@@ -58,10 +58,10 @@ def stiffness(where, column, text, notes):
     return value
 
 
-def type_row(row, path):
-    """{name, od, mass, ea, ei, cd} of one LINE TYPES row (tokens), notes of the
-    viscoelastic forms said in row['notes']."""
-    where = f"{path}: LINE TYPES: line type {row[0]}"
+def type_row(row, place):
+    """{name, od, mass, ea, ei, cd} of one LINE TYPES row (tokens) at ``place``
+    ('path:line'), notes of the viscoelastic forms said in row['notes']."""
+    where = f"{place}: LINE TYPES: line type {row[0]}"
     if len(row) < len(TYPE_COLUMNS):
         raise RodInputError(
             f"{where}: {len(row)} columns, a MoorDyn version 2 line type has "

@@ -129,12 +129,17 @@ def test_a_rod_is_refused():
 @pytest.mark.parametrize("old, new, words", [
     ("main       0.09    77.7066    384.243E6  -0.8        0          1.6    1.0    0.1     0.0",
      "main       0.09    77.7066    384.243E6  -0.8        1.6    1.0    0.1     0.0",
-     "line type main: 9 columns, a MoorDyn version 2 line type has 10 or more"),
+     "case.dat:6: LINE TYPES: line type main: 9 columns, a MoorDyn version 2 line type "
+     "has 10 or more"),
     ("384.243E6", "ea_table.dat", "EA 'ea_table.dat': a nonlinear (tabulated) stiffness"),
     ("2             writeLog", "1             Currents",
      "OPTIONS: Currents 1: a current or a seabed read from MoorDyn's grid files is not "
      "read"),
     ("4     Body1", "4     Body2", "attachment Body2: no body 2 in BODIES"),
+    ("main       0.09    77.7066    384.243E6  -0.8        0          1.6    1.0    0.1     0.0\n",
+     "main       0.09    77.7066    384.243E6  -0.8        0          1.6    1.0    0.1     0.0\n"
+     "main       0.09    77.7066    384.243E6  -0.8        0          1.6    1.0    0.1     0.0\n",
+     "case.dat:7: LINE TYPES: a second line type main"),
     ("1     Fixed     853.87", "1     Anchored  853.87", "attachment 'Anchored': use Fixed"),
 ])
 def test_bad_fields_are_refused_naming_them(old, new, words):
