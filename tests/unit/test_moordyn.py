@@ -243,3 +243,9 @@ def test_a_free_body_a_clump_weight_and_two_line_types(tmp_path):
 def test_bad_fields_of_the_semi_are_refused(old, new, words):
     assert old in SEMI
     assert words in refused(SEMI.replace(old, new))
+
+
+def test_a_missing_file_is_refused_in_one_line(tmp_path):
+    with pytest.raises(RodInputError) as error:
+        read_moordyn(tmp_path / "absent.dat")
+    assert str(error.value).startswith(f"MoorDyn file {tmp_path / 'absent.dat'}: ")
