@@ -38,11 +38,12 @@ TABLES = ("types", "rod types", "bodies", "rods", "points", "lines", "failure", 
           "loads")
 # Options of a static meaning, by their lower-case key.
 STATIC_OPTIONS = {"wtrdpth": "depth", "depth": "depth", "wtrdnsty": "rho", "rho": "rho",
-                  "rhow": "rho", "g": "g", "gravity": "g", "kbot": "kbot",
+                  "rhow": "rho", "g": "g", "gravity": "g", "kbot": "kbot", "kb": "kbot",
                   "frictioncoefficient": "mu", "mu_kt": "mu_kt", "mu_ka": "mu_ka"}
 # Options of the dynamics (time stepping, damping, the initial condition's relaxation,
 # outputs, waves, which have no mean), accepted and ignored.
-DYNAMIC_OPTIONS = ("echo", "writelog", "dtm", "cfl", "tscheme", "cbot", "dtic", "tmaxic",
+DYNAMIC_OPTIONS = ("echo", "writelog", "dtm", "cfl", "tscheme", "cbot", "cb", "dtic",
+                   "tmaxic",
                    "cdscaleic", "threshic", "wavekin", "dtwave", "wavekin_rampt",
                    "unifycurrentgrid", "writeunits", "fricdamp", "statdynfricscale",
                    "dtout", "icgendynamic", "disableoutput", "disableouttime", "mc", "cv",

@@ -249,3 +249,10 @@ def test_a_missing_file_is_refused_in_one_line(tmp_path):
     with pytest.raises(RodInputError) as error:
         read_moordyn(tmp_path / "absent.dat")
     assert str(error.value).startswith(f"MoorDyn file {tmp_path / 'absent.dat'}: ")
+
+
+def test_the_older_option_names_kb_and_cb_are_read():
+    system, notes = parse_moordyn(text(lambda s: s.replace("kBot", "kb").replace("cBot",
+                                                                                  "cb")))
+    assert system.environment.seabed_stiffness == pytest.approx(3.0e6 * 0.09)
+    assert "ignored: writeLog, dtM, cb," in " ".join(notes)
