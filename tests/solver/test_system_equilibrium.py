@@ -1,0 +1,278 @@
+"""The coupled equilibrium of a system (petsc_rod/system/equilibrium.py) with mock lines
+that keep the held line's protocol exactly: a nonlinear axial spring between its ends,
+F = k (|d| - L0) d / |d| on the start (d = end - start), with its analytic 6 x 6.
+Serially and under mpiexec -n 2 (the lines split over the ranks)."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.errors import RodDivergedError, RodInputError
+from petsc_rod.model.line import UniformLine
+from petsc_rod.model.sea import Environment
+from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
+from petsc_rod.system.bodies import exp_rotation, skew
+from petsc_rod.system.equilibrium import Settings, SystemSolver, solve_system
+
+G, RHO = 9.80665, 1025.0
+
+
+class SpringLine:
+    """A held line of the protocol: an axial spring of stiffness ``k`` (N/m) and rest
+    length ``rest`` (m), which fails (keeping its last state, as a warm-started line
+    does) for a span beyond ``limit``."""
+
+    made = []
+
+    def __init__(self, k, rest, comm, limit=np.inf):
+        self.k, self.rest, self.ranks, self.limit = k, rest, comm.size, limit
+        self.ends = None
+        SpringLine.made.append(self)
+
+    def solve(self, start, end):
+        ends = np.array([start, end], dtype=float)
+        if np.linalg.norm(ends[1] - ends[0]) >= self.limit:
+            return False
+        self.ends = ends
+        return True
+
+    def end_forces(self):
+        d = self.ends[1] - self.ends[0]
+        length = np.linalg.norm(d)
+        f = self.k * (length - self.rest) * d / length
+        return np.array([f, -f])
+
+    def stiffness(self):
+        d = self.ends[1] - self.ends[0]
+        length = np.linalg.norm(d)
+        u = d / length
+        K = self.k * ((1 - self.rest / length) * np.eye(3) + self.rest / length * np.outer(u, u))
+        return np.block([[-K, K], [K, -K]])
+
+    def destroy(self):
+        self.ends = None
+
+
+def spring(line, comm):
+    """The factory: the spring's k and rest length ride on the UniformLine's stiffness
+    and length (a mock's convention)."""
+    return SpringLine(line.line.stiffness[0], line.line.length, comm,
+                      limit=line.line.stiffness[1])
+
+
+def link(name, start, end, k, rest, limit=1e9, start_local=(0, 0, 0), end_local=(0, 0, 0),
+         elements=10):
+    return SystemLine(name, UniformLine(length=rest, stiffness=(k, limit, 1.0),
+                                        elements=elements),
+                      Connection(start, start_local), Connection(end, end_local))
+
+
+def spread(load=(0.0,) * 6, radius=60.0, fairlead=10.0, depth=50.0, k=2e5, rest=60.0,
+           clump=None, held=(False,) * 6):
+    """A floater on three springs at 120 degrees to anchors on the seabed, its
+    fairleads at ``fairlead`` m from its axis, 5 m below its reference point; with
+    ``clump`` (mass kg) one line is two springs joined at a free clump weight."""
+    headings = np.radians([0.0, 120.0, 240.0])
+    out = np.stack([np.cos(headings), np.sin(headings), np.zeros(3)], axis=1)
+    points = [Point(f"anchor{i}", "fixed", tuple(radius * out[i] + (0, 0, -depth)))
+              for i in range(3)]
+    lines = [link(f"line{i}", f"anchor{i}", "floater", k, rest,
+                  end_local=tuple(fairlead * out[i] + (0, 0, -5.0))) for i in range(3)]
+    if clump is not None:
+        middle = 0.5 * (np.array(points[0].position) + fairlead * out[0] + (0, 0, -5))
+        points.append(Point("clump", "free", tuple(middle), mass=clump))
+        lines[0] = link("line0a", "anchor0", "clump", 2 * k, rest / 2)
+        lines.append(link("line0b", "clump", "floater", 2 * k, rest / 2,
+                          start_local=(0, 0, 0), end_local=tuple(fairlead * out[0] + (0, 0, -5))))
+    body = Body("floater", mass=2e6, cog=(0.0, 0.0, -8.0), volume=2.2e3, cob=(0.0, 0.0, -6.0),
+                waterplane_area=120.0, waterplane_moments=(4e3, 4e3), load=load, held=held)
+    return System(lines=tuple(lines), points=tuple(points), bodies=(body,),
+                  environment=Environment(water_density=RHO, gravity=G))
+
+
+def test_a_free_point_between_springs_sits_where_the_closed_form_puts_it():
+    k1, k2, L1, L2, span, Fx = 3e4, 5e4, 4.0, 3.0, 10.0, 2e4
+    system = System(lines=(link("left", "a", "p", k1, L1), link("right", "p", "b", k2, L2)),
+                    points=(Point("a", "fixed", (0, 0, 0)), Point("b", "fixed", (span, 0, 0)),
+                            Point("p", "free", (6.0, 0.3, -0.2), force=(Fx, 0, 0))))
+    result, _ = solve_system(system, spring, PETSc.COMM_SELF)
+    x = (k1 * L1 + k2 * (span - L2) + Fx) / (k1 + k2)
+    assert result.points["p"] == pytest.approx([x, 0.0, 0.0], abs=1e-12 * span)
+    assert result.load_factor == 1.0
+    assert result.residual < 1e-10
+
+
+def test_a_symmetric_spread_has_no_net_horizontal_force_and_equal_stiffnesses():
+    solver = SystemSolver(spread(), spring, PETSc.COMM_SELF)
+    try:
+        result = solver.solve()
+        K = solver.body_stiffness("floater")
+    finally:
+        solver.destroy()
+    position = result.bodies["floater"]
+    horizontal = result.end_forces[:, 1, :2].sum(axis=0)
+    tension = np.abs(result.end_forces[:, 1]).max()
+    assert np.abs(horizontal).max() < 1e-12 * tension
+    assert np.abs(position[[0, 1, 3, 4, 5]]).max() < 1e-12
+    M = K.matrix
+    assert M[0, 0] > 0 and M[0, 0] == pytest.approx(M[1, 1], rel=1e-12)
+    assert M[3, 3] == pytest.approx(M[4, 4], rel=1e-12)
+    assert abs(M[0, 1]) < 1e-12 * M[0, 0]
+    assert K.asymmetry < 1e-12                  # no moment about the reference point
+
+
+def equilibrium(system, comm=PETSc.COMM_SELF):
+    solver = SystemSolver(system, spring, comm, settings=Settings(rtol=1e-13))
+    try:
+        result = solver.solve()
+        return solver, result, {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+    finally:
+        solver.destroy()
+
+
+def lines_on_body(system, pose_X, pose_R, name="floater"):
+    """The lines' (F, M) on the body held at (X, R), the free points re-equilibrated."""
+    body = system.bodies[0]
+    angles = __import__("petsc_rod.system.bodies", fromlist=["angles"]).angles(pose_R)
+    moved = Body(body.name, position=tuple(pose_X) + tuple(angles), held=(True,) * 6)
+    held = System(lines=system.lines, points=system.points, bodies=(moved,),
+                  environment=system.environment)
+    solver = SystemSolver(held, spring, PETSc.COMM_SELF, settings=Settings(rtol=1e-14))
+    try:
+        solver.solve()
+        r, _ = solver.lines_part(solver.state, solver.forces, solver.stiffnesses)
+        return r[solver.layout.body_dofs[0]]
+    finally:
+        solver.destroy()
+
+
+def test_the_body_stiffness_is_the_derivative_of_re_solved_equilibria():
+    system = spread(load=(3e5, 1e5, 0.0, 0.0, 0.0, 2e6), clump=2e4)
+    _, result, stiffness = equilibrium(system)
+    K = stiffness["floater"]
+    R = result.rotations["floater"]
+    X = result.bodies["floater"][:3]
+    h = np.array([1e-3] * 3 + [1e-5] * 3)
+    numeric = np.empty((6, 6))
+    for j in range(6):
+        step = np.zeros(6)
+        step[j] = h[j]
+        plus = lines_on_body(system, X + step[:3], exp_rotation(step[3:]) @ R)
+        minus = lines_on_body(system, X - step[:3], exp_rotation(-step[3:]) @ R)
+        numeric[:, j] = -(plus - minus) / (2 * h[j])
+    scale = np.abs(K.matrix).max()
+    assert np.abs(K.matrix - numeric).max() < 1e-6 * scale
+    # the asymmetry is the lines' moment about the reference point, exactly
+    assert np.abs(K.moment).max() > 1e5
+    antisymmetric = K.matrix - K.matrix.T
+    assert antisymmetric[3:, 3:] == pytest.approx(skew(K.moment), abs=1e-9 * scale)
+    assert np.abs(antisymmetric[:3]).max() < 1e-9 * scale
+    assert K.asymmetry == pytest.approx(np.linalg.norm(antisymmetric)
+                                        / np.linalg.norm(K.matrix), rel=1e-12)
+    assert K.asymmetry > 1e-4
+
+
+def test_a_loaded_body_balances_forces_and_moments_to_round_off():
+    load = np.array([4e5, -2e5, 1e5, 3e6, -2e6, 5e6])
+    system = spread(load=tuple(load), clump=1e4)
+    _, result, _ = equilibrium(system)
+    body = system.bodies[0]
+    R = result.rotations["floater"]
+    X = result.bodies["floater"][:3]
+    # every force on the body recomputed here from the mock lines at the solution
+    F, M = load[:3].copy(), load[3:].copy()
+    ends = {ln.name: ln for ln in system.lines}
+    for line in system.lines:
+        for j, c in enumerate((line.start, line.end)):
+            other = (line.end, line.start)[j]
+            if c.to != "floater":
+                continue
+            here = X + R @ np.array(c.local)
+            there = (X + R @ np.array(other.local) if other.to == "floater"
+                     else result.points[other.to])
+            d = here - there
+            f = -ends[line.name].line.stiffness[0] * (np.linalg.norm(d) - line.line.length) \
+                * d / np.linalg.norm(d)
+            F += f
+            M += np.cross(here - X, f)
+    for force, arm in (((0, 0, -body.mass * G), body.cog), ((0, 0, RHO * G * body.volume), body.cob)):
+        F += force
+        M += np.cross(R @ np.array(arm), force)
+    z, (roll, pitch) = X[2], __import__("petsc_rod.system.bodies", fromlist=["log_rotation"]).log_rotation(R)[:2]
+    F[2] -= RHO * G * body.waterplane_area * z
+    M[0] -= RHO * G * body.waterplane_moments[0] * roll
+    M[1] -= RHO * G * body.waterplane_moments[1] * pitch
+    scale = np.abs(result.end_forces).max()
+    assert np.abs(result.bodies["floater"][:2]).max() > 0.5      # it moved
+    assert np.abs(F).max() < 1e-9 * scale
+    assert np.abs(M).max() < 1e-9 * scale * 10.0
+
+
+def test_a_large_offset_is_reached_by_halving_the_load_steps():
+    system = spread(load=(6e6, 0, 0, 0, 0, 0))
+    _, direct, _ = equilibrium(system)
+    # too few Newton iterations for the whole offset at once
+    solver = SystemSolver(system, spring, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-10, max_iterations=3))
+    try:
+        result = solver.solve()
+    finally:
+        solver.destroy()
+    assert direct.bodies["floater"][0] > 20.0
+    assert result.halvings > 0 and result.load_factor == 1.0
+    assert result.bodies["floater"] == pytest.approx(direct.bodies["floater"], abs=1e-9)
+
+
+def test_the_same_numbers_on_one_rank_and_on_every_rank():
+    """COMM_SELF (every line on this rank) against COMM_WORLD: on 2 ranks the four
+    lines are two a rank, and a lone line spans both ranks."""
+    system = spread(load=(3e5, 1e5, 0.0, 0.0, 0.0, 2e6), clump=2e4)
+    _, alone, k_alone = equilibrium(system, PETSc.COMM_SELF)
+    SpringLine.made = []
+    _, shared, k_shared = equilibrium(system, PETSc.COMM_WORLD)
+    size = PETSc.COMM_WORLD.size
+    assert len(SpringLine.made) == {1: 4, 2: 2}[size]
+    assert all(line.ranks == 1 for line in SpringLine.made)
+    assert np.array_equal(alone.bodies["floater"], shared.bodies["floater"])
+    assert np.array_equal(alone.end_forces, shared.end_forces)
+    assert np.array_equal(k_alone["floater"].matrix, k_shared["floater"].matrix)
+    hanging = System(lines=(link("only", "top", "clump", 1e4, 5.0),),
+                     points=(Point("top", "fixed", (0, 0, 0)),
+                             Point("clump", "free", (0.5, 0.2, -6.0), mass=100.0)))
+    SpringLine.made = []
+    result, _ = solve_system(hanging, spring, PETSc.COMM_WORLD)
+    assert [line.ranks for line in SpringLine.made] == [size]
+    assert result.points["clump"] == pytest.approx([0, 0, -5.0 - 100.0 * G / 1e4], abs=1e-12)
+
+
+def test_bad_systems_get_one_line_each():
+    lonely = System(lines=(link("a", "p", "q", 1e3, 1.0),),
+                    points=(Point("p", "fixed", (0, 0, 0)), Point("q", "fixed", (2, 0, 0)),
+                            Point("r", "free", (1, 1, 1))))
+    with pytest.raises(RodInputError, match="point r: free, but no line ends at it"):
+        SystemSolver(lonely, spring, PETSc.COMM_SELF)
+    # fairleads on the body's axis: nothing resists its yaw
+    axis = spread(fairlead=0.0)
+    solver = SystemSolver(axis, spring, PETSc.COMM_SELF)
+    try:
+        with pytest.raises(RodInputError, match="body floater: nothing restores its yaw"):
+            solver.solve()
+    finally:
+        solver.destroy()
+    # ... held, it solves
+    solve_system(spread(fairlead=0.0, held=(False,) * 5 + (True,)), spring, PETSc.COMM_SELF)
+    missing = System(lines=(link("a", "p", "nowhere", 1e3, 1.0),),
+                     points=(Point("p", "fixed", (0, 0, 0)),))
+    with pytest.raises(RodInputError, match="no point or body is named 'nowhere'"):
+        SystemSolver(missing, spring, PETSc.COMM_SELF)
+    # a line that cannot reach its span at any load step: one line, no traceback
+    short = spread(load=(6e6, 0, 0, 0, 0, 0))
+    short = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=75.0,
+                                    end_local=l.end.local) for l in short.lines),
+                   points=short.points, bodies=short.bodies, environment=short.environment)
+    solver = SystemSolver(short, spring, PETSc.COMM_SELF, settings=Settings(max_halvings=3))
+    try:
+        with pytest.raises(RodDivergedError, match="after 3 halvings .*line line[0-9] did not converge at the full step"):
+            solver.solve()
+    finally:
+        solver.destroy()
