@@ -123,10 +123,6 @@ class BodyPose:
         other.R = exp_rotation(step[3:]) @ self.R
         return other
 
-    def arms(self, local):
-        """a = R p (n, 3) of body points p (n, 3)."""
-        return np.asarray(local, dtype=float).reshape(-1, 3) @ self.R.T
-
     @property
     def position(self):
         """(x, y, z, roll, pitch, yaw) (6,)."""

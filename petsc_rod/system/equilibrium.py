@@ -209,14 +209,26 @@ class SystemSolver:
 
     # -- the lines --------------------------------------------------------------------
 
+    def arms(self, state):
+        """(n_lines, 2, 3): each body end's arm R p from its body's X (0 at a point)."""
+        layout = self.layout
+        arms = np.zeros(layout.local.shape)
+        on_body = layout.body_end >= 0
+        if np.any(on_body):
+            rotations = np.array([pose.R for pose in state.poses])
+            arms[on_body] = np.einsum("nij,nj->ni", rotations[layout.body_end[on_body]],
+                                      layout.local[on_body])
+        return arms
+
     def end_positions(self, state):
         """(n_lines, 2, 3): each line end's position, a point's or X + R p."""
-        positions = np.zeros(self.layout.local.shape)
-        on_point = self.layout.point_end >= 0
-        positions[on_point] = state.points[self.layout.point_end[on_point]]
-        for k, pose in enumerate(state.poses):
-            at = self.layout.body_end == k
-            positions[at] = pose.X + pose.arms(self.layout.local[at])
+        layout = self.layout
+        positions = self.arms(state)
+        on_point, on_body = layout.point_end >= 0, layout.body_end >= 0
+        positions[on_point] = state.points[layout.point_end[on_point]]
+        if np.any(on_body):
+            origins = np.array([pose.X for pose in state.poses])
+            positions[on_body] += origins[layout.body_end[on_body]]
         return positions
 
     def evaluate(self, state):
@@ -249,10 +261,7 @@ class SystemSolver:
         (module docstring; the last row and column of the (size + 1)^2 work arrays
         collect the held ends)."""
         layout, n = self.layout, len(self.system.lines)
-        arms = np.zeros((n, 2, 3))
-        for k, pose in enumerate(state.poses):
-            at = layout.body_end == k
-            arms[at] = pose.arms(layout.local[at])
+        arms = self.arms(state)
         T = lever_map(arms.reshape(-1, 3)).reshape(n, 2, 3, 6)
         on_point = layout.body_end < 0
         T[on_point, :, 3:] = 0.0                    # a point's end has no rotation
