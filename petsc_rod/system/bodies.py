@@ -140,11 +140,11 @@ class BodyPose:
         return np.diag([0.0, 0.0, rho_g * body.waterplane_area, rho_g * Ixx, rho_g * Iyy,
                         0.0])
 
-    def own_loads(self, water_density, gravity, load_factor):
+    def own_loads(self, water_density, gravity, load):
         """(loads (6,), d loads / d(dX, dtheta) (6, 6)) of the body's weight at the cog,
         its buoyancy at the cob, its hydrostatic restoring -K_h (q - q0) (q - q0 = (X -
-        X0, log(R R0^T)), its exact derivative K_h diag(I, log_jacobian)) and
-        ``load_factor`` times its external load. With a given ``hydrostatic`` matrix the
+        X0, log(R R0^T)), its exact derivative K_h diag(I, log_jacobian)) and the
+        external ``load`` (6,) (the body's, or a step of the continuation towards it). With a given ``hydrostatic`` matrix the
         buoyancy acts at the cob of the start pose (its restoring is in the matrix)."""
         body = self.body
         weight = np.array([0.0, 0.0, -body.mass * gravity])
@@ -157,7 +157,7 @@ class BodyPose:
         theta = log_rotation(self.R @ self.R0.T)
         K = self.hydrostatic_matrix(water_density, gravity)
         loads = (point_loads(arms, forces) - K @ np.concatenate([self.X - self.X0, theta])
-                 + load_factor * np.asarray(body.load, dtype=float))
+                 + np.asarray(load, dtype=float))
         chain = np.eye(6)
         chain[3:, 3:] = log_jacobian(theta)
         return loads, lever_stiffness(turning, forces[:len(turning)]) - K @ chain

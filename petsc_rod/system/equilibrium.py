@@ -6,12 +6,13 @@ Unknowns: each free point's position (3) and each body's free degrees of freedom
 system/bodies.py). Residual, a force (N) per point and a force and moment (N, N m, about
 the body's reference point X) per body, global axes:
 
-    point:  sum_lines f_end + (rho_w V - m) g e_z + lambda F_point + drag in a current
+    point:  sum_lines f_end + (rho_w V - m) g e_z + F_point + drag in a current
     body:   sum_lines (f, (x_f - X) x f), x_f = X + R p  + weight at the cog + buoyancy
-            at the cob - K_h (q - q0) + lambda load
+            at the cob - K_h (q - q0) + load
 
-with f the force a line exerts on its end (line.end_forces()) and lambda the load
-factor of the continuation. Jacobian: each line's exact 6 x 6 stiffness
+with f the force a line exerts on its end (line.end_forces()); the continuation moves
+the external loads (F_point, load) and the held points' positions from those of the
+last equilibrium (the first time: no loads) to the system's by a load factor. Jacobian: each line's exact 6 x 6 stiffness
 d f / d(x_start, x_end) (line.stiffness()) mapped through dx_f = T dq, T = I on a
 point and T = [I, -[R p]x] (3 x 6) on a body, giving T_i^T K_ij T_j; plus, per body end,
 the geometric term of the moment's lever arm turning with the body,
@@ -21,7 +22,7 @@ symmetric only where the moments about X balance; plus the hydrostatics
 (bodies.BodyPose.own_loads).
 
 Newton with a backtracking line search on the scaled residual's norm, inside a
-continuation of lambda from 0 to 1 (the step halved when an attempt fails: a line that
+continuation of the load factor from 0 to 1 (the step halved when an attempt fails: a line that
 does not converge, a singular or non-finite Jacobian, a line search that finds no
 decrease). The lines are solved where system/placement.py puts them; every rank holds
 every line's end forces and stiffness (small arrays) and solves the same small Newton
@@ -33,7 +34,7 @@ collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces(
 / d(start, end)) and ``destroy()``.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -69,6 +70,38 @@ class State:
         poses = [pose.moved(step[layout.body_dofs[k]] * pose.free)
                  for k, pose in enumerate(self.poses)]
         return State(points, poses)
+
+
+@dataclass(frozen=True)
+class Loads:
+    """What the continuation moves: the bodies' external loads (n_bodies, 6), the free
+    points' forces (n_free, 3) and the held points' positions (n_points, 3) (the free
+    points' rows unused)."""
+
+    bodies: np.ndarray
+    forces: np.ndarray
+    held: np.ndarray
+
+    @classmethod
+    def of(cls, system, layout):
+        return cls(np.array([b.load for b in system.bodies], dtype=float).reshape(-1, 6),
+                   np.array([system.points[i].force for i in layout.point_index],
+                            dtype=float).reshape(-1, 3),
+                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3))
+
+    def towards(self, other, factor):
+        """self + factor (other - self)."""
+        return Loads(*(a + factor * (b - a) for a, b in
+                       ((self.bodies, other.bodies), (self.forces, other.forces),
+                        (self.held, other.held))))
+
+    def unloaded(self):
+        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held)
+
+    def same(self, other):
+        return all(np.array_equal(a, b) for a, b in ((self.bodies, other.bodies),
+                                                     (self.forces, other.forces),
+                                                     (self.held, other.held)))
 
 
 @dataclass(frozen=True)
@@ -117,6 +150,7 @@ class Layout:
                                 "its own")
         kinds = np.array([p.kind for p in system.points], dtype=object)
         self.point_index = np.flatnonzero(kinds == "free")
+        self.held_points = np.flatnonzero(kinds != "free")
         n_free, n_bodies = self.point_index.size, len(system.bodies)
         self.size = 3 * n_free + 6 * n_bodies
         point_dof = np.full((len(system.points), 3), self.size)
@@ -199,7 +233,8 @@ class SystemSolver:
             self.destroy()
             raise
         self.forces = self.stiffnesses = None
-        self.failure = ""
+        self.failure, self.checked = "", False
+        self.loads = Loads.of(system, self.layout).unloaded()
 
     def destroy(self):
         for line in self.lines.values():
@@ -280,8 +315,9 @@ class SystemSolver:
                       np.broadcast_to(spin[..., None, :], geometric.shape)), geometric)
         return r[:-1], J[:-1, :-1]
 
-    def own_part(self, state, load_factor):
-        """The points' and bodies' own loads (size,) and their Jacobian."""
+    def own_part(self, state, loads):
+        """The points' and bodies' own loads (size,) and their Jacobian, under the
+        external ``loads`` (Loads)."""
         layout = self.layout
         r = np.zeros(layout.size)
         J = np.zeros((layout.size, layout.size))
@@ -289,14 +325,13 @@ class SystemSolver:
         if points:
             dead = np.array([[0.0, 0.0, (self.rho * p.volume - p.mass) * self.g]
                              for p in points])
-            applied = np.array([p.force for p in points], dtype=float)
             cda = np.array([p.cda for p in points])
             drag = self._drag(state.points[layout.point_index], cda)
-            r[layout.point_dofs] = (dead + load_factor * applied + drag).ravel()
+            r[layout.point_dofs] = (dead + loads.forces + drag).ravel()
         for k, pose in enumerate(state.poses):
-            loads, jacobian = pose.own_loads(self.rho, self.g, load_factor)
+            own, jacobian = pose.own_loads(self.rho, self.g, loads.bodies[k])
             dofs = layout.body_dofs[k]
-            r[dofs] += loads
+            r[dofs] += own
             J[np.ix_(dofs, dofs)] += jacobian
         return r, J
 
@@ -328,9 +363,9 @@ class SystemSolver:
                        for b in self.system.bodies])
         return np.where(self.layout.is_moment, force * self.length, force)
 
-    def residual(self, state, load_factor, forces, stiffness):
+    def residual(self, state, loads, forces, stiffness):
         r_lines, J_lines = self.lines_part(state, forces, stiffness)
-        r_own, J_own = self.own_part(state, load_factor)
+        r_own, J_own = self.own_part(state, loads)
         return r_lines + r_own, J_lines + J_own
 
     # -- Newton, continuation ------------------------------------------------------------
@@ -348,15 +383,17 @@ class SystemSolver:
             return None
         return self.layout.names[free[int(np.argmax(np.abs(vt[-1])))]]
 
-    def newton(self, state, load_factor, scale):
-        """(state, iterations) at equilibrium for ``load_factor``, or (None, its
-        iterations) with self.failure saying why. self.forces/stiffnesses: the lines'
-        at the returned state."""
-        settings, free = self.settings, self.layout.free
+    def newton(self, state, loads, scale):
+        """(state, iterations) at equilibrium under ``loads`` (Loads; the held points
+        put at its positions), or (None, its iterations) with self.failure saying why.
+        self.forces/stiffnesses: the lines' at the returned state."""
+        settings, free, held = self.settings, self.layout.free, self.layout.held_points
+        state = State(state.points.copy(), state.poses)
+        state.points[held] = loads.held[held]
         ok, forces, stiffness = self.evaluate(state)
         if not ok:
             return None, 0
-        r, J = self.residual(state, load_factor, forces, stiffness)
+        r, J = self.residual(state, loads, forces, stiffness)
         norm = np.linalg.norm(r[free] / scale[free])
         for iteration in range(settings.max_iterations + 1):
             self.forces, self.stiffnesses = forces, stiffness
@@ -382,7 +419,7 @@ class SystemSolver:
                 full = full or ("" if ok or alpha < 1.0 else f" ({self.failure} at the "
                                                              "full step)")
                 if ok:
-                    t_r, t_J = self.residual(trial, load_factor, t_forces, t_stiffness)
+                    t_r, t_J = self.residual(trial, loads, t_forces, t_stiffness)
                     t_norm = np.linalg.norm(t_r[free] / scale[free])
                     if t_norm <= (1.0 - 1e-4 * alpha) * norm:
                         break
@@ -404,7 +441,7 @@ class SystemSolver:
         if not ok:
             raise RodDivergedError(f"system: at the start, {self.failure}")
         self.forces = forces
-        r, J = self.residual(self.state, 0.0, forces, stiffness)
+        r, J = self.residual(self.state, self.loads, forces, stiffness)
         where = self.singular_dof(J, self.scales())
         if where is None:
             return
@@ -417,40 +454,68 @@ class SystemSolver:
                             "slack or in line with it): make it fixed or connect another "
                             "line")
 
-    def solve(self):
-        """The Equilibrium (collective): Newton at load factor 0, then the continuation
-        to 1, each failing step halved up to ``max_halvings`` times; RodDivergedError
-        saying why when that did not help. Leaves the lines at the solution."""
+    def solve(self, system=None):
+        """The Equilibrium (collective) under ``system``'s loads (None: the one the
+        solver was made with; else the same system with other body loads, point
+        forces or held points' positions, started from the last equilibrium with the
+        lines as they stand): Newton where the last equilibrium was (the first time:
+        the system unloaded), then the continuation of the loads towards the new ones,
+        each failing step halved up to ``max_halvings`` times; RodDivergedError saying
+        why when that did not help. Leaves the lines at the solution."""
         settings = self.settings
-        self.check_restoring()
+        if system is not None:
+            self.replace(system)
+        if not self.checked:
+            self.check_restoring()
+            self.checked = True
         scale = self.scales()
-        loaded = (any(np.any(b.load) for b in self.system.bodies)
-                  or any(np.any(p.force) for p in self.system.points))
-        factor, step, halvings, total = (0.0, 1.0 / settings.load_steps, 0, 0) \
-            if loaded else (1.0, 0.0, 0, 0)
-        state, iterations = self.newton(self.state, factor, scale)
+        target = Loads.of(self.system, self.layout)
+        factor, step, halvings, total = ((1.0, 0.0, 0, 0) if self.loads.same(target) else
+                                         (0.0, 1.0 / settings.load_steps, 0, 0))
+        state, iterations = self.newton(self.state, self.loads.towards(target, factor),
+                                        scale)
         total += iterations
         if state is None:
             raise RodDivergedError(f"system: no equilibrium at load factor {factor:g}: "
                                    f"{self.failure}")
         self.state = state
         while factor < 1.0:
-            target = min(1.0, factor + step)
-            state, iterations = self.newton(self.state, target, scale)
+            to = min(1.0, factor + step)
+            state, iterations = self.newton(self.state, self.loads.towards(target, to),
+                                            scale)
             total += iterations
             if state is None:
                 halvings += 1
                 if halvings > settings.max_halvings:
                     raise RodDivergedError(
-                        f"system: no equilibrium at load factor {target:g} after "
+                        f"system: no equilibrium at load factor {to:g} after "
                         f"{settings.max_halvings} halvings of the load step (from "
                         f"{factor:g}): {self.failure}")
                 step *= 0.5
                 continue
-            self.state, factor = state, target
+            self.state, factor, step = state, to, 2.0 * step
+        self.loads = target
         # The lines stand at the last trial; leave them at the solution.
         self.evaluate(self.state)
         return self.result(factor, total, halvings)
+
+    def replace(self, system):
+        """Take ``system``'s loads: RodInputError unless it differs from the solver's
+        only in the bodies' loads, the points' forces and the held points' positions."""
+        old = self.system
+        same = (repr(system.lines) == repr(old.lines)
+                and repr(system.environment) == repr(old.environment)
+                and len(system.points) == len(old.points)
+                and len(system.bodies) == len(old.bodies)
+                and all(replace(new, load=b.load) == b
+                        for new, b in zip(system.bodies, old.bodies))
+                and all(replace(new, force=p.force, position=p.position) == p
+                        for new, p in zip(system.points, old.points)))
+        if not same:
+            raise RodInputError("system: a solver re-solves its system under other body "
+                                "loads, point forces or held points' positions only; make a "
+                                "new one for any other change")
+        self.system = system
 
     def result(self, factor, iterations, halvings):
         state = self.state

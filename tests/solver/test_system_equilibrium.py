@@ -3,6 +3,8 @@ that keep the held line's protocol exactly: a nonlinear axial spring between its
 F = k (|d| - L0) d / |d| on the start (d = end - start), with its analytic 6 x 6.
 Serially and under mpiexec -n 2 (the lines split over the ranks)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
@@ -124,6 +126,7 @@ def test_a_symmetric_spread_has_no_net_horizontal_force_and_equal_stiffnesses():
 
 
 def equilibrium(system, comm=PETSc.COMM_SELF):
+    """(solver, its Equilibrium, {body: BodyStiffness}), tightly converged."""
     solver = SystemSolver(system, spring, comm, settings=Settings(rtol=1e-13))
     try:
         result = solver.solve()
@@ -221,6 +224,36 @@ def test_a_large_offset_is_reached_by_halving_the_load_steps():
     assert direct.bodies["floater"][0] > 20.0
     assert result.halvings > 0 and result.load_factor == 1.0
     assert result.bodies["floater"] == pytest.approx(direct.bodies["floater"], abs=1e-9)
+
+
+def test_a_solver_re_solves_under_new_loads_from_its_last_equilibrium():
+    """A watch circle's step: the body's load turned, an anchor moved (a prescribed
+    point); the answer is a fresh solver's, reached in fewer iterations."""
+    first = spread(load=(1e6, 0, 0, 0, 0, 0))
+    turned = spread(load=(0, 1e6, 0, 0, 0, 0))
+    anchor = turned.points[1]
+    moved = System(lines=turned.lines, bodies=turned.bodies, environment=turned.environment,
+                   points=(turned.points[0], replace(anchor, kind="prescribed"),
+                           turned.points[2]))
+    moved_first = System(lines=first.lines, bodies=first.bodies,
+                         environment=first.environment, points=moved.points)
+    moved = System(lines=moved.lines, bodies=moved.bodies, environment=moved.environment,
+                   points=(moved.points[0], replace(moved.points[1], position=tuple(
+                       np.array(anchor.position) + (3.0, -2.0, 0.0))), moved.points[2]))
+    settings = Settings(rtol=1e-13)
+    solver = SystemSolver(moved_first, spring, PETSc.COMM_SELF, settings=settings)
+    try:
+        solver.solve()
+        again = solver.solve(moved)
+        with pytest.raises(RodInputError, match="re-solves its system under other body "
+                                                "loads, point forces or held points"):
+            solver.solve(spread(load=(0, 1e6, 0, 0, 0, 0), k=3e5))
+    finally:
+        solver.destroy()
+    _, fresh, _ = equilibrium(moved)
+    assert again.bodies["floater"] == pytest.approx(fresh.bodies["floater"], abs=1e-10)
+    assert again.points["anchor1"] == pytest.approx(np.array(anchor.position) + (3, -2, 0))
+    assert again.iterations < fresh.iterations
 
 
 def test_the_same_numbers_on_one_rank_and_on_every_rank():

@@ -35,14 +35,14 @@ def test_the_own_loads_jacobian_is_their_derivative(given):
                 hydrostatic=tuple(hydrostatic) if given else None,
                 load=(1e5, 2e5, 0, 1e6, 0, 3e6))
     pose = BodyPose(body).moved(np.array([0.3, -0.2, 0.4, 0.05, 0.08, -0.2]))
-    loads, J = pose.own_loads(1025.0, 9.81, 0.7)
+    loads, J = pose.own_loads(1025.0, 9.81, body.load)
     h = np.array([1e-4] * 3 + [1e-7] * 3)
     numeric = np.empty((6, 6))
     for k in range(6):
         step = np.zeros(6)
         step[k] = h[k]
-        numeric[:, k] = (pose.moved(step).own_loads(1025.0, 9.81, 0.7)[0]
-                         - pose.moved(-step).own_loads(1025.0, 9.81, 0.7)[0]) / (2 * h[k])
+        numeric[:, k] = (pose.moved(step).own_loads(1025.0, 9.81, body.load)[0]
+                         - pose.moved(-step).own_loads(1025.0, 9.81, body.load)[0]) / (2 * h[k])
     assert np.abs(J - numeric).max() < 1e-6 * np.abs(J).max()
     # the weight's and buoyancy's lever arms make the rotational block unsymmetric
     assert np.abs(J[3:, 3:] - J[3:, 3:].T).max() > 1e3
