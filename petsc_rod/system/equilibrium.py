@@ -38,7 +38,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from petsc_rod.errors import RodDivergedError, RodError, RodInputError
+from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.system.bodies import DOF_NAMES, BodyPose, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
 
@@ -226,9 +226,13 @@ class SystemSolver:
         sizes = [line_elements(line) for line in system.lines] if sizes is None else sizes
         self.placement = Placement.make(comm or PETSc.COMM_WORLD, sizes)
         self.lines = {}
-        try:
+
+        def make_mine():
             for k in self.placement.mine:
                 self.lines[int(k)] = make_line(system.lines[k], self.placement.line_comm)
+
+        try:                                    # a line refused on one group, on all
+            on_every_rank(self.placement.mpi, make_mine)
         except BaseException:
             self.destroy()
             raise
@@ -266,24 +270,33 @@ class SystemSolver:
             positions[on_body] += origins[layout.body_end[on_body]]
         return positions
 
-    def evaluate(self, state):
+    def evaluate(self, state, strict=False):
         """Solve every line at ``state``'s end positions (this rank's lines in turn) and
         share the results: (converged, end forces (n, 2, 3), stiffnesses (n, 6, 6)).
-        A line that raises a solver's RodError has not converged."""
+        A line that raises a solver's RodError has not converged; one that refuses its
+        ends (RodInputError: a span it cannot reach) has not either, except when
+        ``strict`` (the start, where the system itself is at fault): then its error
+        is raised on every rank."""
         positions = self.end_positions(state)
         mine = {}
         for k, line in self.lines.items():
             try:
                 ok = bool(line.solve(positions[k, 0], positions[k, 1]))
-            except RodInputError:
-                raise
+            except RodInputError as error:      # raised below on every rank
+                mine[k] = (False, error)
+                continue
             except (RodError, np.linalg.LinAlgError):
                 ok = False
             mine[k] = ((ok, line.end_forces(), line.stiffness()) if ok else (False,))
         shared = self.placement.share(mine)
+        refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
+        if refused and strict:
+            raise refused[0]
         failed = [k for k in range(len(self.system.lines)) if not shared[k][0]]
         if failed:
-            self.failure = f"line {self.system.lines[failed[0]].name} did not converge"
+            name, entry = self.system.lines[failed[0]].name, shared[failed[0]]
+            self.failure = (f"line {name} refused its ends ({entry[1]})" if len(entry) == 2
+                            else f"line {name} did not converge")
             return False, None, None
         forces = np.array([shared[k][1] for k in range(len(shared))]).reshape(-1, 2, 3)
         stiffness = np.array([shared[k][2] for k in range(len(shared))]).reshape(-1, 6, 6)
@@ -374,12 +387,14 @@ class SystemSolver:
         """The (node, dof) names of the unknown the scaled free Jacobian cannot move
         (its null vector's largest entry), None when it is regular."""
         free = self.layout.free
+        if not free.size:
+            return None
         column = np.where(self.layout.is_moment, 1.0, self.length)
         scaled = J[np.ix_(free, free)] * column[free] / scale[free][:, None]
         if not np.all(np.isfinite(scaled)):
             return ("the Jacobian", "not finite")
         u, s, vt = np.linalg.svd(scaled)
-        if s.size and s[-1] > 1e-12 * s[0]:
+        if s[-1] > 1e-12 * s[0]:
             return None
         return self.layout.names[free[int(np.argmax(np.abs(vt[-1])))]]
 
@@ -437,7 +452,7 @@ class SystemSolver:
     def check_restoring(self):
         """RodInputError naming a body's or a point's degree of freedom that nothing
         restores (the Jacobian at the start is singular in it)."""
-        ok, forces, stiffness = self.evaluate(self.state)
+        ok, forces, stiffness = self.evaluate(self.state, strict=True)
         if not ok:
             raise RodDivergedError(f"system: at the start, {self.failure}")
         self.forces = forces

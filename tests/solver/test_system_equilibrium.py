@@ -292,8 +292,10 @@ def test_bad_systems_get_one_line_each():
             solver.solve()
     finally:
         solver.destroy()
-    # ... held, it solves
+    # ... held, it solves; held in every degree of freedom, nothing is left to solve
     solve_system(spread(fairlead=0.0, held=(False,) * 5 + (True,)), spring, PETSc.COMM_SELF)
+    result, _ = solve_system(spread(held=(True,) * 6), spring, PETSc.COMM_SELF)
+    assert result.iterations == 0 and result.bodies["floater"].tolist() == [0.0] * 6
     missing = System(lines=(link("a", "p", "nowhere", 1e3, 1.0),),
                      points=(Point("p", "fixed", (0, 0, 0)),))
     with pytest.raises(RodInputError, match="no point or body is named 'nowhere'"):
@@ -306,6 +308,47 @@ def test_bad_systems_get_one_line_each():
     solver = SystemSolver(short, spring, PETSc.COMM_SELF, settings=Settings(max_halvings=3))
     try:
         with pytest.raises(RodDivergedError, match="after 3 halvings .*line line[0-9] did not converge at the full step"):
+            solver.solve()
+    finally:
+        solver.destroy()
+
+
+class PickyLine(SpringLine):
+    """A spring that refuses (RodInputError, as a line too short for its span does) a
+    span beyond its limit."""
+
+    def solve(self, start, end):
+        if np.linalg.norm(np.subtract(end, start)) >= self.limit:
+            raise RodInputError(f"a span of {np.linalg.norm(np.subtract(end, start)):.1f} m: "
+                                "the line is too short")
+        return super().solve(start, end)
+
+
+def picky(line, comm):
+    return PickyLine(line.line.stiffness[0], line.line.length, comm,
+                     limit=line.line.stiffness[1])
+
+
+def test_a_line_that_refuses_its_ends_fails_the_attempt_but_is_an_error_at_the_start():
+    """On every rank alike: the line that refuses lives on one rank of two."""
+    loaded = spread(load=(6e6, 0, 0, 0, 0, 0))
+    short = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=75.0,
+                                    end_local=l.end.local) for l in loaded.lines),
+                   points=loaded.points, bodies=loaded.bodies, environment=loaded.environment)
+    solver = SystemSolver(short, picky, PETSc.COMM_WORLD, settings=Settings(max_halvings=2))
+    try:
+        with pytest.raises(RodDivergedError, match=r"after 2 halvings .*line line[0-9] "
+                                                   r"refused its ends \(a span of"):
+            solver.solve()
+    finally:
+        solver.destroy()
+    tight = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=60.0,
+                                    end_local=l.end.local) for l in loaded.lines[:1]),
+                   points=loaded.points, bodies=(replace(loaded.bodies[0], held=(True,) * 6),),
+                   environment=loaded.environment)
+    solver = SystemSolver(tight, picky, PETSc.COMM_WORLD)
+    try:
+        with pytest.raises(RodInputError, match="the line is too short"):
             solver.solve()
     finally:
         solver.destroy()
