@@ -70,15 +70,16 @@ def link(name, start, end, k, rest, limit=1e9, start_local=(0, 0, 0), end_local=
 
 
 def spread(load=(0.0,) * 6, radius=60.0, fairlead=10.0, depth=50.0, k=2e5, rest=60.0,
-           clump=None, held=(False,) * 6):
+           clump=None, held=(False,) * 6, limit=1e9):
     """A floater on three springs at 120 degrees to anchors on the seabed, its
     fairleads at ``fairlead`` m from its axis, 5 m below its reference point; with
-    ``clump`` (mass kg) one line is two springs joined at a free clump weight."""
+    ``clump`` (mass kg) one line is two springs joined at a free clump weight; the
+    springs fail beyond a span of ``limit``."""
     headings = np.radians([0.0, 120.0, 240.0])
     out = np.stack([np.cos(headings), np.sin(headings), np.zeros(3)], axis=1)
     points = [Point(f"anchor{i}", "fixed", tuple(radius * out[i] + (0, 0, -depth)))
               for i in range(3)]
-    lines = [link(f"line{i}", f"anchor{i}", "floater", k, rest,
+    lines = [link(f"line{i}", f"anchor{i}", "floater", k, rest, limit,
                   end_local=tuple(fairlead * out[i] + (0, 0, -5.0))) for i in range(3)]
     if clump is not None:
         middle = 0.5 * (np.array(points[0].position) + fairlead * out[0] + (0, 0, -5))
@@ -286,12 +287,7 @@ def test_bad_systems_get_one_line_each():
         SystemSolver(lonely, spring, PETSc.COMM_SELF)
     # fairleads on the body's axis: nothing resists its yaw
     axis = spread(fairlead=0.0)
-    solver = SystemSolver(axis, spring, PETSc.COMM_SELF)
-    try:
-        with pytest.raises(RodInputError, match="body floater: nothing restores its yaw"):
-            solver.solve()
-    finally:
-        solver.destroy()
+    refused(axis, spring, RodInputError, "body floater: nothing restores its yaw")
     # ... held, it solves; held in every degree of freedom, nothing is left to solve
     solve_system(spread(fairlead=0.0, held=(False,) * 5 + (True,)), spring, PETSc.COMM_SELF)
     result, _ = solve_system(spread(held=(True,) * 6), spring, PETSc.COMM_SELF)
@@ -301,13 +297,16 @@ def test_bad_systems_get_one_line_each():
     with pytest.raises(RodInputError, match="no point or body is named 'nowhere'"):
         SystemSolver(missing, spring, PETSc.COMM_SELF)
     # a line that cannot reach its span at any load step: one line, no traceback
-    short = spread(load=(6e6, 0, 0, 0, 0, 0))
-    short = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=75.0,
-                                    end_local=l.end.local) for l in short.lines),
-                   points=short.points, bodies=short.bodies, environment=short.environment)
-    solver = SystemSolver(short, spring, PETSc.COMM_SELF, settings=Settings(max_halvings=3))
+    refused(spread(load=(6e6, 0, 0, 0, 0, 0), limit=75.0), spring, RodDivergedError,
+            "after 3 halvings .*line line[0-9] did not converge at the full step",
+            max_halvings=3)
+
+
+def refused(system, make_line, error, match, comm=PETSc.COMM_SELF, **settings):
+    """Solving ``system`` raises ``error`` saying ``match``."""
+    solver = SystemSolver(system, make_line, comm, settings=Settings(**settings))
     try:
-        with pytest.raises(RodDivergedError, match="after 3 halvings .*line line[0-9] did not converge at the full step"):
+        with pytest.raises(error, match=match):
             solver.solve()
     finally:
         solver.destroy()
@@ -331,24 +330,9 @@ def picky(line, comm):
 
 def test_a_line_that_refuses_its_ends_fails_the_attempt_but_is_an_error_at_the_start():
     """On every rank alike: the line that refuses lives on one rank of two."""
-    loaded = spread(load=(6e6, 0, 0, 0, 0, 0))
-    short = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=75.0,
-                                    end_local=l.end.local) for l in loaded.lines),
-                   points=loaded.points, bodies=loaded.bodies, environment=loaded.environment)
-    solver = SystemSolver(short, picky, PETSc.COMM_WORLD, settings=Settings(max_halvings=2))
-    try:
-        with pytest.raises(RodDivergedError, match=r"after 2 halvings .*line line[0-9] "
-                                                   r"refused its ends \(a span of"):
-            solver.solve()
-    finally:
-        solver.destroy()
-    tight = System(lines=tuple(link(l.name, l.start.to, l.end.to, 2e5, 60.0, limit=60.0,
-                                    end_local=l.end.local) for l in loaded.lines[:1]),
-                   points=loaded.points, bodies=(replace(loaded.bodies[0], held=(True,) * 6),),
-                   environment=loaded.environment)
-    solver = SystemSolver(tight, picky, PETSc.COMM_WORLD)
-    try:
-        with pytest.raises(RodInputError, match="the line is too short"):
-            solver.solve()
-    finally:
-        solver.destroy()
+    refused(spread(load=(6e6, 0, 0, 0, 0, 0), limit=75.0), picky, RodDivergedError,
+            r"after 2 halvings .*line line[0-9] refused its ends \(a span of",
+            PETSc.COMM_WORLD, max_halvings=2)
+    tight = spread(held=(True,) * 6, limit=60.0)
+    refused(replace(tight, lines=tight.lines[:1]), picky, RodInputError,
+            "the line is too short", PETSc.COMM_WORLD)
