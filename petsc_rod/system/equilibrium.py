@@ -237,7 +237,7 @@ class SystemSolver:
             self.destroy()
             raise
         self.forces = self.stiffnesses = None
-        self.failure, self.checked = "", False
+        self.failure, self.checked, self.last = "", False, None
         self.loads = Loads.of(system, self.layout).unloaded()
 
     def destroy(self):
@@ -276,8 +276,11 @@ class SystemSolver:
         A line that raises a solver's RodError has not converged; one that refuses its
         ends (RodInputError: a span it cannot reach) has not either, except when
         ``strict`` (the start, where the system itself is at fault): then its error
-        is raised on every rank."""
+        is raised on every rank. The ends of the last successful evaluation are not
+        solved again."""
         positions = self.end_positions(state)
+        if self.last is not None and np.array_equal(positions, self.last[0]):
+            return self.last[1]                 # the lines stand there already
         mine = {}
         for k, line in self.lines.items():
             try:
@@ -288,6 +291,7 @@ class SystemSolver:
             except (RodError, np.linalg.LinAlgError):
                 ok = False
             mine[k] = ((ok, line.end_forces(), line.stiffness()) if ok else (False,))
+        self.last = None
         shared = self.placement.share(mine)
         refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
         if refused and strict:
@@ -300,7 +304,8 @@ class SystemSolver:
             return False, None, None
         forces = np.array([shared[k][1] for k in range(len(shared))]).reshape(-1, 2, 3)
         stiffness = np.array([shared[k][2] for k in range(len(shared))]).reshape(-1, 6, 6)
-        return True, forces, stiffness
+        self.last = (positions, (True, forces, stiffness))
+        return self.last[1]
 
     # -- residual and Jacobian ---------------------------------------------------------
 
@@ -510,7 +515,7 @@ class SystemSolver:
                 continue
             self.state, factor, step = state, to, 2.0 * step
         self.loads = target
-        # The lines stand at the last trial; leave them at the solution.
+        # The lines may stand at the last trial; leave them at the solution.
         self.evaluate(self.state)
         return self.result(factor, total, halvings)
 

@@ -1,7 +1,9 @@
 """The coupled equilibrium of a system (petsc_rod/system/equilibrium.py) with mock lines
 that keep the held line's protocol exactly: a nonlinear axial spring between its ends,
-F = k (|d| - L0) d / |d| on the start (d = end - start), with its analytic 6 x 6.
-Serially and under mpiexec -n 2 (the lines split over the ranks)."""
+F = k (|d| - L0) d / |d| on the start (d = end - start), with its analytic 6 x 6; and
+the elastic catenary on a frictionless seabed (validation/elastic_catenary.py) with a
+central-difference 6 x 6 (here only). Serially and under mpiexec -n 2 (the lines split
+over the ranks)."""
 
 from dataclasses import replace
 
@@ -15,6 +17,7 @@ from petsc_rod.model.sea import Environment
 from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
 from petsc_rod.system.bodies import angles, exp_rotation, log_rotation, skew
 from petsc_rod.system.equilibrium import Settings, SystemSolver, solve_system
+from petsc_rod.validation.elastic_catenary import elastic_catenary
 
 G, RHO = 9.80665, 1025.0
 
@@ -91,6 +94,67 @@ def spread(load=(0.0,) * 6, radius=60.0, fairlead=10.0, depth=50.0, k=2e5, rest=
                 waterplane_area=120.0, waterplane_moments=(4e3, 4e3), load=load, held=held)
     return System(lines=tuple(lines), points=tuple(points), bodies=(body,),
                   environment=Environment(water_density=RHO, gravity=G))
+
+
+class CatenaryLine:
+    """A held line of the protocol: the elastic catenary of ``length`` (m), weight
+    ``weight`` (N/m) and EA (N) from an anchor on the seabed (its start) to its end,
+    in the vertical plane through both; its stiffness by central differences of step
+    ``h`` (m)."""
+
+    def __init__(self, length, weight, axial_stiffness, h=1e-3):
+        self.data, self.h, self.ends = (length, weight, axial_stiffness), h, None
+
+    def forces_at(self, ends):
+        d = ends[1] - ends[0]
+        span = np.hypot(d[0], d[1])
+        along = np.array([d[0], d[1], 0.0]) / span
+        line = elastic_catenary(*self.data, span, d[2])
+        top = line.V_A + line.weight * (line.length - line.grounded)
+        return np.array([line.H * along + (0, 0, line.V_A), -line.H * along - (0, 0, top)])
+
+    def solve(self, start, end):
+        self.ends = np.array([start, end], dtype=float)
+        return True
+
+    def end_forces(self):
+        return self.forces_at(self.ends)
+
+    def stiffness(self):
+        steps = self.h * np.eye(6).reshape(6, 2, 3)
+        return np.stack([(self.forces_at(self.ends + e) - self.forces_at(self.ends - e)).ravel()
+                         / (2 * self.h) for e in steps], axis=1)
+
+    def destroy(self):
+        self.ends = None
+
+
+def test_the_oc3_hywind_mooring_stiffness_is_the_published_one():
+    """OC3-Hywind's three catenaries (Jonkman, Definition of the floating system for
+    phase IV of OC3, NREL/TP-500-47566, 2010: anchors at 853.87 m radius in 320 m of
+    water, fairleads at 5.2 m radius 70 m deep, 902.2 m of 698.094 N/m, EA 384.243 MN,
+    lines at 180, 60 and 300 degrees): its linearised mooring stiffness about the
+    platform's reference point at rest, as published to four figures (the crow's
+    foot's added yaw spring left out)."""
+    headings = np.radians([180.0, 60.0, 300.0])
+    out = np.stack([np.cos(headings), np.sin(headings), np.zeros(3)], axis=1)
+    system = System(
+        lines=tuple(SystemLine(f"line{i}", UniformLine(length=902.2),
+                               Connection(f"anchor{i}"),
+                               Connection("spar", tuple(5.2 * out[i] + (0, 0, -70.0))))
+                    for i in range(3)),
+        points=tuple(Point(f"anchor{i}", "fixed", tuple(853.87 * out[i] + (0, 0, -320.0)))
+                     for i in range(3)),
+        bodies=(Body("spar", held=(True,) * 6),))
+    _, stiffness = solve_system(system, lambda line, comm: CatenaryLine(902.2, 698.094,
+                                                                          384.243e6))
+    K = stiffness["spar"].matrix
+    published = {(0, 0): 41180.0, (1, 1): 41180.0, (2, 2): 11940.0, (3, 3): 311.1e6,
+                 (4, 4): 311.1e6, (5, 5): 11.56e6, (0, 4): -2.821e6, (1, 3): 2.821e6,
+                 (4, 0): -2.821e6, (3, 1): 2.821e6}
+    for (i, j), value in published.items():
+        assert K[i, j] == pytest.approx(value, rel=2.5e-3), (i, j)
+    assert stiffness["spar"].asymmetry < 1e-9             # the lines' moment is zero
 
 
 def test_a_free_point_between_springs_sits_where_the_closed_form_puts_it():
