@@ -145,9 +145,10 @@ class Layout:
 
     def __init__(self, system):
         names = [p.name for p in system.points] + [b.name for b in system.bodies]
-        if len(set(names)) != len(names):
-            raise RodInputError("System: two points or bodies share a name; give each "
-                                "its own")
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:
+            raise RodInputError(f"System: two points or bodies are named {twice[0]!r}; "
+                                "give each its own name")
         kinds = np.array([p.kind for p in system.points], dtype=object)
         self.point_index = np.flatnonzero(kinds == "free")
         self.held_points = np.flatnonzero(kinds != "free")

@@ -78,4 +78,6 @@ class Placement:
         return {k: v for part in parts for k, v in part.items()}
 
     def destroy(self):
-        self.sub.Free()
+        if self.sub is not None:
+            self.sub.Free()
+            self.sub = None

@@ -16,7 +16,7 @@ from petsc_rod.model.line import UniformLine
 from petsc_rod.model.sea import Environment
 from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
 from petsc_rod.system.bodies import angles, exp_rotation, log_rotation, skew
-from petsc_rod.system.equilibrium import Settings, SystemSolver, solve_system
+from petsc_rod.system.equilibrium import Loads, Settings, SystemSolver, solve_system
 from petsc_rod.validation.elastic_catenary import elastic_catenary
 
 G, RHO = 9.80665, 1025.0
@@ -239,6 +239,50 @@ def test_the_body_stiffness_is_the_derivative_of_re_solved_equilibria():
     assert K.asymmetry == pytest.approx(np.linalg.norm(antisymmetric)
                                         / np.linalg.norm(K.matrix), rel=1e-12)
     assert K.asymmetry > 1e-4
+
+
+def test_the_jacobian_is_the_derivative_of_the_residual_for_two_bodies_and_a_buoy():
+    """Two floaters moored apart, joined by a line through a free buoy and by a line
+    from fairlead to fairlead, turned and offset away from equilibrium: the assembled
+    Jacobian of every unknown (the cross-body blocks, the lever terms, the hydrostatics)
+    against central differences of the residual with the lines re-solved."""
+    one, two = spread(load=(1e5, 0, 0, 0, 0, 1e6)), spread()
+    far = (300.0, 40.0, 0.0)
+    bodies = (one.bodies[0], replace(two.bodies[0], name="other",
+                                     position=far + (0.02, -0.01, 0.3)))
+    points = one.points + tuple(replace(p, name=p.name + "b", position=tuple(
+        np.add(p.position, far))) for p in two.points) + (
+        Point("buoy", "free", (150.0, 20.0, -20.0), volume=20.0, mass=2e3),)
+    lines = one.lines + tuple(replace(l, name=l.name + "b", start=Connection(
+        l.start.to + "b"), end=Connection("other", l.end.local)) for l in two.lines) + (
+        link("to_buoy", "floater", "buoy", 5e4, 100.0, start_local=(10.0, 0, -5.0)),
+        link("from_buoy", "buoy", "other", 5e4, 100.0, end_local=(-10.0, 0, -5.0)),
+        link("across", "floater", "other", 1e4, 250.0, start_local=(0, 10.0, -5.0),
+             end_local=(0, -10.0, -5.0)))
+    system = System(lines=lines, points=points, bodies=bodies)
+    solver = SystemSolver(system, spring, PETSc.COMM_SELF)
+    try:
+        state = solver.state.moved(np.linspace(-0.5, 0.6, solver.layout.size)
+                                   * np.where(solver.layout.is_moment, 0.05, 1.0),
+                                   solver.layout)
+        loads = solver.loads.towards(Loads.of(system, solver.layout), 0.7)
+
+        def residual(at):
+            return solver.residual(at, loads, *solver.evaluate(at)[1:])
+
+        _, J = residual(state)
+        numeric = np.empty_like(J)
+        for j in range(J.shape[1]):
+            h = 1e-6 if solver.layout.is_moment[j] else 1e-4
+            step = np.zeros(J.shape[1])
+            step[j] = h
+            numeric[:, j] = (residual(state.moved(step, solver.layout))[0]
+                             - residual(state.moved(-step, solver.layout))[0]) / (2 * h)
+    finally:
+        solver.destroy()
+    assert J.shape == (3 + 12, 3 + 12)
+    assert np.abs(J - numeric).max() < 1e-8 * np.abs(J).max()
+    assert np.abs(J[3:9, 9:]).max() > 1e3            # the bodies are coupled
 
 
 def test_a_loaded_body_balances_forces_and_moments_to_round_off():
