@@ -12,21 +12,29 @@ the body's reference point X) per body, global axes:
 
 with f the force a line exerts on its end (line.end_forces()); the continuation moves
 the external loads (F_point, load) and the held points' positions from those of the
-last equilibrium (the first time: no loads) to the system's by a load factor. Jacobian: each line's exact 6 x 6 stiffness
-d f / d(x_start, x_end) (line.stiffness()) mapped through dx_f = T dq, T = I on a
-point and T = [I, -[R p]x] (3 x 6) on a body, giving T_i^T K_ij T_j; plus, per body end,
-the geometric term of the moment's lever arm turning with the body,
-d((R p) x f) = (dtheta x R p) x f = [f]x [R p]x dtheta (bodies.lever_stiffness), which is
-not symmetric: its antisymmetric part is -[(R p) x f]x / 2, so the rotational block is
-symmetric only where the moments about X balance; plus the hydrostatics
-(bodies.BodyPose.own_loads).
+last equilibrium (the first time: no loads) to the system's by a load factor.
+
+Jacobian: each line's exact 6 x 6 stiffness K = d f / d(x_start, x_end)
+(line.stiffness()) mapped through each end's dx_f = T dq, T = I on a free point and
+T = [I, -[R p]x] (3 x 6) on a body, giving T_i^T K_ij T_j; plus, per body end, the
+geometric term of the moment's lever arm turning with the body,
+
+    d((R p) x f) = (dtheta x R p) x f + (R p) x df,   (dtheta x a) x f = [f]x [a]x dtheta,
+
+(bodies.lever_stiffness) which is not symmetric: by Jacobi's identity
+[f]x[a]x - [a]x[f]x = [f x a]x, so its antisymmetric part is -[a x f]x / 2, half the
+skew matrix of the force's moment about X. Turning the body turns the arm, and so
+changes the moment even with the force held; this is where the rotational block's
+asymmetry comes from, and it vanishes only where the moments of the forces at arms
+vanish (BodyStiffness: the mooring stiffness's K - K^T is exactly [M_lines]x). Plus
+the hydrostatics and the weight's and buoyancy's own lever terms (bodies.Bodies).
 
 Newton with a backtracking line search on the scaled residual's norm, inside a
-continuation of the load factor from 0 to 1 (the step halved when an attempt fails: a line that
-does not converge, a singular or non-finite Jacobian, a line search that finds no
-decrease). The lines are solved where system/placement.py puts them; every rank holds
-every line's end forces and stiffness (small arrays) and solves the same small Newton
-system, so every rank has the same numbers on any number of ranks.
+continuation of the load factor from 0 to 1 (the step halved when an attempt fails: a
+line that does not converge, a singular or non-finite Jacobian, a line search that finds
+no decrease). The lines are solved where system/placement.py puts them; every rank
+holds every line's end forces and stiffness (small arrays) and solves the same small
+Newton system, so every rank has the same numbers on any number of ranks.
 
 A line is made by ``make_line(system_line, comm)`` (comm: its group's PETSc.Comm,
 collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces() ->
@@ -39,7 +47,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
-from petsc_rod.system.bodies import DOF_NAMES, BodyPose, lever_map, skew
+from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
 
 
@@ -59,17 +67,16 @@ class Settings:
 
 @dataclass
 class State:
-    """Free and held points' positions (n_points, 3) and the bodies' poses."""
+    """Free and held points' positions (n_points, 3) and the bodies' poses (Bodies)."""
 
     points: np.ndarray
-    poses: list
+    bodies: Bodies
 
     def moved(self, step, layout):
+        """The state after the increment ``step`` (layout.size,) of every unknown."""
         points = self.points.copy()
         points[layout.point_index] += step[layout.point_dofs].reshape(-1, 3)
-        poses = [pose.moved(step[layout.body_dofs[k]] * pose.free)
-                 for k, pose in enumerate(self.poses)]
-        return State(points, poses)
+        return State(points, self.bodies.moved(step[layout.body_dofs]))
 
 
 @dataclass(frozen=True)
@@ -220,7 +227,7 @@ class SystemSolver:
         self.rho, self.g = environment.water_density, environment.gravity
         self.state = State(np.array([p.position for p in system.points],
                                     dtype=float).reshape(-1, 3),
-                           [BodyPose(b) for b in system.bodies])
+                           Bodies(system.bodies, self.rho, self.g))
         self.length = max([1.0] + [float(np.abs(np.asarray(v, float)).max()) for b in
                                    system.bodies for v in (b.cog, b.cob)]
                           + [float(np.abs(self.layout.local).max(initial=0.0))])
@@ -255,8 +262,7 @@ class SystemSolver:
         arms = np.zeros(layout.local.shape)
         on_body = layout.body_end >= 0
         if np.any(on_body):
-            rotations = np.array([pose.R for pose in state.poses])
-            arms[on_body] = np.einsum("nij,nj->ni", rotations[layout.body_end[on_body]],
+            arms[on_body] = np.einsum("nij,nj->ni", state.bodies.R[layout.body_end[on_body]],
                                       layout.local[on_body])
         return arms
 
@@ -267,8 +273,7 @@ class SystemSolver:
         on_point, on_body = layout.point_end >= 0, layout.body_end >= 0
         positions[on_point] = state.points[layout.point_end[on_point]]
         if np.any(on_body):
-            origins = np.array([pose.X for pose in state.poses])
-            positions[on_body] += origins[layout.body_end[on_body]]
+            positions[on_body] += state.bodies.X[layout.body_end[on_body]]
         return positions
 
     def evaluate(self, state, strict=False):
@@ -340,18 +345,18 @@ class SystemSolver:
         layout = self.layout
         r = np.zeros(layout.size)
         J = np.zeros((layout.size, layout.size))
-        points = [self.system.points[i] for i in layout.point_index]
-        if points:
-            dead = np.array([[0.0, 0.0, (self.rho * p.volume - p.mass) * self.g]
-                             for p in points])
-            cda = np.array([p.cda for p in points])
+        if layout.point_dofs.size:
+            points = [self.system.points[i] for i in layout.point_index]
+            mass, volume, cda = (np.array([getattr(p, name) for p in points])
+                                 for name in ("mass", "volume", "cda"))
+            dead = np.outer((self.rho * volume - mass) * self.g, (0.0, 0.0, 1.0))
             drag = self._drag(state.points[layout.point_index], cda)
             r[layout.point_dofs] = (dead + loads.forces + drag).ravel()
-        for k, pose in enumerate(state.poses):
-            own, jacobian = pose.own_loads(self.rho, self.g, loads.bodies[k])
-            dofs = layout.body_dofs[k]
+        if layout.body_dofs.size:
+            own, jacobian = state.bodies.own_loads(loads.bodies)
+            dofs = layout.body_dofs
             r[dofs] += own
-            J[np.ix_(dofs, dofs)] += jacobian
+            J[dofs[:, :, None], dofs[:, None, :]] += jacobian
         return r, J
 
     def _drag(self, positions, cda):
@@ -409,7 +414,7 @@ class SystemSolver:
         put at its positions), or (None, its iterations) with self.failure saying why.
         self.forces/stiffnesses: the lines' at the returned state."""
         settings, free, held = self.settings, self.layout.free, self.layout.held_points
-        state = State(state.points.copy(), state.poses)
+        state = State(state.points.copy(), state.bodies)
         state.points[held] = loads.held[held]
         ok, forces, stiffness = self.evaluate(state)
         if not ok:
@@ -539,13 +544,11 @@ class SystemSolver:
         self.system = system
 
     def result(self, factor, iterations, halvings):
-        state = self.state
+        state, names = self.state, [b.name for b in self.system.bodies]
         points = {p.name: state.points[i].copy() for i, p in enumerate(self.system.points)}
         return Equilibrium(points,
-                           {b.name: pose.position for b, pose in
-                            zip(self.system.bodies, state.poses)},
-                           {b.name: pose.R.copy() for b, pose in
-                            zip(self.system.bodies, state.poses)},
+                           dict(zip(names, state.bodies.positions)),
+                           dict(zip(names, state.bodies.R.copy())),
                            self.forces.copy(), factor, iterations, halvings,
                            float(self.norm))
 
@@ -563,7 +566,7 @@ class SystemSolver:
             K += J[np.ix_(b, p)] @ np.linalg.solve(J[np.ix_(p, p)], J[np.ix_(p, b)])
         moment = r[b[3:]]
         asymmetry = np.linalg.norm(K - K.T) / np.linalg.norm(K)
-        return BodyStiffness(K, self.state.poses[index].X.copy(), moment, float(asymmetry))
+        return BodyStiffness(K, self.state.bodies.X[index].copy(), moment, float(asymmetry))
 
 
 def solve_system(system, make_line, comm=None, sizes=None, settings=Settings(),
