@@ -54,11 +54,15 @@ from petsc_rod.system.placement import Placement, line_elements
 @dataclass(frozen=True)
 class Settings:
     """``rtol``: the scaled residual's norm (forces / the force scale, moments / (the
-    force scale x the length scale)) that ends Newton; ``max_iterations`` per attempt;
-    ``load_steps``: the continuation's first step is 1 / load_steps; ``max_halvings``
-    of a failing step; ``line_search`` halvings of a Newton step."""
+    force scale x the length scale)) that ends Newton; ``floor``: a scaled residual
+    below it that no step of the line search reduces is the lines' own accuracy (their
+    end forces are converged to their tolerances, not to round-off) and is accepted;
+    ``max_iterations`` per attempt; ``load_steps``: the continuation's first step is
+    1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
+    Newton step."""
 
     rtol: float = 1e-10
+    floor: float = 1e-7
     max_iterations: int = 30
     load_steps: int = 1
     max_halvings: int = 12
@@ -350,8 +354,10 @@ class SystemSolver:
             mass, volume, cda = (np.array([getattr(p, name) for p in points])
                                  for name in ("mass", "volume", "cda"))
             dead = np.outer((self.rho * volume - mass) * self.g, (0.0, 0.0, 1.0))
-            drag = self._drag(state.points[layout.point_index], cda)
+            drag, d_drag = self._drag(state.points[layout.point_index], cda)
             r[layout.point_dofs] = (dead + loads.forces + drag).ravel()
+            dofs = layout.point_dofs.reshape(-1, 3)
+            J[dofs, dofs[:, 2:]] += d_drag          # the drag changes with the depth
         if layout.body_dofs.size:
             own, jacobian = state.bodies.own_loads(loads.bodies)
             dofs = layout.body_dofs
@@ -360,21 +366,32 @@ class SystemSolver:
         return r, J
 
     def _drag(self, positions, cda):
-        """The current's drag on free points, 0.5 rho C_d A |u| u (n, 3), N: a uniform
-        current, or a profile's velocity at each point's depth below the surface (the
-        Environment's surface, 0 when none)."""
+        """The current's drag on free points, 0.5 rho C_d A |u| u (n, 3), N, and its
+        derivative in the points' heights (n, 3): a uniform current (none), or a
+        profile's velocity, linear between its rows, at each point's depth below the
+        surface (the Environment's surface, 0 when none), so du/dz = -du/d depth and
+        d(|u| u) = (|u| I + u u^T / |u|) du."""
+        n = positions.shape[0]
         current = self.system.environment.current
         if current is None or not np.any(cda):
-            return np.zeros_like(positions)
+            return np.zeros((n, 3)), np.zeros((n, 3))
         current = np.asarray(current, dtype=float)
         if current.shape == (3,):
-            u = np.broadcast_to(current, positions.shape)
+            u, du = np.broadcast_to(current, (n, 3)), np.zeros((n, 3))
         else:
-            surface = self.system.environment.surface or 0.0
-            depth = surface - positions[:, 2]
-            u = np.stack([np.interp(depth, current[:, 0], current[:, c])
-                          for c in (1, 2, 3)], axis=-1)
-        return 0.5 * self.rho * cda[:, None] * np.linalg.norm(u, axis=1)[:, None] * u
+            depth = (self.system.environment.surface or 0.0) - positions[:, 2]
+            rows, values = current[:, 0], current[:, 1:]
+            u = np.stack([np.interp(depth, rows, column) for column in values.T], axis=-1)
+            k = np.clip(np.searchsorted(rows, depth), 1, max(len(rows) - 1, 1))
+            inside = ((depth > rows[0]) & (depth < rows[-1]))[:, None]
+            slope = ((values[k] - values[k - 1])
+                     / np.maximum(rows[k] - rows[k - 1], np.finfo(float).tiny)[:, None]
+                     if len(rows) > 1 else np.zeros((n, 3)))
+            du = -np.where(inside, slope, 0.0)
+        speed = np.linalg.norm(u, axis=1)[:, None]
+        factor = 0.5 * self.rho * cda[:, None]
+        along = np.einsum("ni,ni->n", u, du)[:, None] / np.maximum(speed, np.finfo(float).tiny)
+        return factor * speed * u, factor * (speed * du + along * u)
 
     def scales(self):
         """The residual's scale per unknown: the force scale (the largest line end
@@ -451,6 +468,9 @@ class SystemSolver:
                         break
                 alpha *= 0.5
             else:
+                if norm <= settings.floor:
+                    self.norm = norm
+                    return state, iteration
                 self.failure = (f"the line search found no decrease of the residual "
                                 f"{norm:.3g}{full}")
                 return None, iteration

@@ -242,24 +242,27 @@ def test_the_body_stiffness_is_the_derivative_of_re_solved_equilibria():
 
 
 def test_the_jacobian_is_the_derivative_of_the_residual_for_two_bodies_and_a_buoy():
-    """Two floaters moored apart, joined by a line through a free buoy and by a line
-    from fairlead to fairlead, turned and offset away from equilibrium: the assembled
-    Jacobian of every unknown (the cross-body blocks, the lever terms, the hydrostatics)
-    against central differences of the residual with the lines re-solved."""
+    """Two floaters moored apart, joined by a line through a free buoy (in a current
+    profile) and by a line from fairlead to fairlead, turned and offset away from
+    equilibrium: the assembled Jacobian of every unknown (the cross-body blocks, the
+    lever terms, the hydrostatics, the buoy's drag changing with its depth) against
+    central differences of the residual with the lines re-solved."""
     one, two = spread(load=(1e5, 0, 0, 0, 0, 1e6)), spread()
     far = (300.0, 40.0, 0.0)
     bodies = (one.bodies[0], replace(two.bodies[0], name="other",
                                      position=far + (0.02, -0.01, 0.3)))
     points = one.points + tuple(replace(p, name=p.name + "b", position=tuple(
         np.add(p.position, far))) for p in two.points) + (
-        Point("buoy", "free", (150.0, 20.0, -20.0), volume=20.0, mass=2e3),)
+        Point("buoy", "free", (150.0, 20.0, -20.0), volume=20.0, mass=2e3, cda=5.0),)
     lines = one.lines + tuple(replace(l, name=l.name + "b", start=Connection(
         l.start.to + "b"), end=Connection("other", l.end.local)) for l in two.lines) + (
         link("to_buoy", "floater", "buoy", 5e4, 100.0, start_local=(10.0, 0, -5.0)),
         link("from_buoy", "buoy", "other", 5e4, 100.0, end_local=(-10.0, 0, -5.0)),
         link("across", "floater", "other", 1e4, 250.0, start_local=(0, 10.0, -5.0),
              end_local=(0, -10.0, -5.0)))
-    system = System(lines=lines, points=points, bodies=bodies)
+    profile = ((0.0, 1.0, 0.2, 0.0), (50.0, 0.5, 0.1, 0.0), (200.0, 0.0, 0.0, 0.0))
+    system = System(lines=lines, points=points, bodies=bodies,
+                    environment=Environment(current=profile, surface=0.0))
     solver = SystemSolver(system, spring, PETSc.COMM_SELF)
     try:
         state = solver.state.moved(np.linspace(-0.5, 0.6, solver.layout.size)
@@ -283,6 +286,7 @@ def test_the_jacobian_is_the_derivative_of_the_residual_for_two_bodies_and_a_buo
     assert J.shape == (3 + 12, 3 + 12)
     assert np.abs(J - numeric).max() < 1e-8 * np.abs(J).max()
     assert np.abs(J[3:9, 9:]).max() > 1e3            # the bodies are coupled
+    assert abs(J[0, 2]) > 10.0                      # the drag's change with depth
 
 
 def test_a_loaded_body_balances_forces_and_moments_to_round_off():
@@ -363,6 +367,36 @@ def test_a_solver_re_solves_under_new_loads_from_its_last_equilibrium():
     assert again.bodies["floater"] == pytest.approx(fresh.bodies["floater"], abs=1e-10)
     assert again.points["anchor1"] == pytest.approx(np.array(anchor.position) + (3, -2, 0))
     assert again.iterations < fresh.iterations
+
+
+class NoisyLine(SpringLine):
+    """A spring whose end forces carry an error of up to 1e-9 of themselves that
+    changes from solve to solve, as that of a line converged to its own tolerance from
+    its last state does."""
+
+    solves = 0
+
+    def solve(self, start, end):
+        self.solves += 1
+        return super().solve(start, end)
+
+    def end_forces(self):
+        return super().end_forces() * (1.0 + 1e-9 * np.sin(self.solves))
+
+
+def test_a_residual_at_the_lines_accuracy_is_accepted_below_the_floor():
+    system = spread(load=(1e6, 0, 0, 0, 0, 0))
+    noisy = lambda line, comm: NoisyLine(line.line.stiffness[0], line.line.length, comm)
+    refused(system, noisy, RodDivergedError, "the line search found no decrease",
+            rtol=1e-15, floor=0.0, max_halvings=1)
+    solver = SystemSolver(system, noisy, PETSc.COMM_SELF, settings=Settings(rtol=1e-15))
+    try:
+        result = solver.solve()
+    finally:
+        solver.destroy()
+    _, exact, _ = equilibrium(system)
+    assert 1e-15 < result.residual < 1e-10
+    assert result.bodies["floater"] == pytest.approx(exact.bodies["floater"], abs=1e-7)
 
 
 def test_the_same_numbers_on_one_rank_and_on_every_rank():
