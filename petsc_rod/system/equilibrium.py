@@ -43,12 +43,31 @@ collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces(
 """
 
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
+
+
+class HeldLine(Protocol):
+    """What the solver asks of a line (a held line, system/held_line.py, or a test's
+    mock): made by ``make_line(system_line, comm)``, collective on ``comm``."""
+
+    def solve(self, start, end):
+        """Its equilibrium with its ends held at ``start`` and ``end`` (3,), m, from
+        its last state; True when it converged. Collective on its comm."""
+
+    def end_forces(self):
+        """(2, 3), N, global axes: the forces it exerts on its start and end points."""
+
+    def stiffness(self):
+        """(6, 6): d end_forces().ravel() / d(start, end), exact."""
+
+    def destroy(self):
+        """Free its PETSc objects."""
 
 
 @dataclass(frozen=True)
