@@ -102,14 +102,17 @@ class CatenaryLine:
     in the vertical plane through both; its stiffness by central differences of step
     ``h`` (m)."""
 
-    def __init__(self, length, weight, axial_stiffness, h=1e-3):
+    def __init__(self, length, weight, axial_stiffness, h=1e-3, seabed=-np.inf):
         self.data, self.h, self.ends = (length, weight, axial_stiffness), h, None
+        self.seabed = seabed
 
     def forces_at(self, ends):
+        """Its end forces (2, 3) between ``ends`` (2, 3); it rests on the seabed when
+        its start is on it."""
         d = ends[1] - ends[0]
         span = np.hypot(d[0], d[1])
         along = np.array([d[0], d[1], 0.0]) / span
-        line = elastic_catenary(*self.data, span, d[2])
+        line = elastic_catenary(*self.data, span, d[2], on_seabed=ends[0, 2] <= self.seabed)
         top = line.V_A + line.weight * (line.length - line.grounded)
         return np.array([line.H * along + (0, 0, line.V_A), -line.H * along - (0, 0, top)])
 
@@ -155,6 +158,30 @@ def test_the_oc3_hywind_mooring_stiffness_is_the_published_one():
     for (i, j), value in published.items():
         assert K[i, j] == pytest.approx(value, rel=2.5e-3), (i, j)
     assert stiffness["spar"].asymmetry < 1e-9             # the lines' moment is zero
+
+
+def test_a_catenary_split_at_a_massless_free_point_is_the_unsplit_catenary():
+    """OC3-Hywind's line resting on the seabed, split in its hanging part at a free
+    point of no mass: the point goes where the unsplit line's point of that arc length
+    is, and the fairlead's force is the unsplit line's."""
+    L, w, EA, span, rise = 902.2, 698.094, 384.243e6, 848.67, 250.0
+    whole = elastic_catenary(L, w, EA, span, rise)
+    lower = whole.grounded + 0.5 * (L - whole.grounded)
+    x, z = (float(v) for v in whole.at(lower)[:2])
+    lengths = {"lower": lower, "upper": L - lower}
+    system = System(lines=(SystemLine("lower", UniformLine(length=lower),
+                                      Connection("anchor"), Connection("joint")),
+                           SystemLine("upper", UniformLine(length=L - lower),
+                                      Connection("joint"), Connection("fairlead"))),
+                    points=(Point("anchor", "fixed", (0.0, 0.0, -320.0)),
+                            Point("joint", "free", (x + 5.0, 2.0, z - 323.0)),
+                            Point("fairlead", "fixed", (span, 0.0, rise - 320.0))))
+    result, _ = solve_system(system, lambda line, comm: CatenaryLine(
+        lengths[line.name], w, EA, seabed=-320.0), PETSc.COMM_SELF)
+    assert result.points["joint"] == pytest.approx([x, 0.0, z - 320.0], abs=1e-6)
+    top = whole.V_A + w * (L - whole.grounded)
+    assert result.end_forces[1, 1] == pytest.approx([-whole.H, 0.0, -top], rel=1e-9,
+                                                    abs=1e-12 * whole.H)
 
 
 def test_a_free_point_between_springs_sits_where_the_closed_form_puts_it():
