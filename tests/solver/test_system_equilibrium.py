@@ -98,11 +98,11 @@ def spread(load=(0.0,) * 6, radius=60.0, fairlead=10.0, depth=50.0, k=2e5, rest=
 
 class CatenaryLine:
     """A held line of the protocol: the elastic catenary of ``length`` (m), weight
-    ``weight`` (N/m) and EA (N) from an anchor on the seabed (its start) to its end,
-    in the vertical plane through both; its stiffness by central differences of step
-    ``h`` (m)."""
+    ``weight`` (N/m) and EA (N) from its start to its end in the vertical plane through
+    both, resting on a flat frictionless seabed at height ``seabed`` (m) when its start
+    is on it; its stiffness by central differences of step ``h`` (m)."""
 
-    def __init__(self, length, weight, axial_stiffness, h=1e-3, seabed=-np.inf):
+    def __init__(self, length, weight, axial_stiffness, seabed, h=1e-3):
         self.data, self.h, self.ends = (length, weight, axial_stiffness), h, None
         self.seabed = seabed
 
@@ -149,8 +149,8 @@ def test_the_oc3_hywind_mooring_stiffness_is_the_published_one():
         points=tuple(Point(f"anchor{i}", "fixed", tuple(853.87 * out[i] + (0, 0, -320.0)))
                      for i in range(3)),
         bodies=(Body("spar", held=(True,) * 6),))
-    _, stiffness = solve_system(system, lambda line, comm: CatenaryLine(902.2, 698.094,
-                                                                          384.243e6))
+    _, stiffness = solve_system(system, lambda line, comm: CatenaryLine(
+        902.2, 698.094, 384.243e6, seabed=-320.0))
     K = stiffness["spar"].matrix
     published = {(0, 0): 41180.0, (1, 1): 41180.0, (2, 2): 11940.0, (3, 3): 311.1e6,
                  (4, 4): 311.1e6, (5, 5): 11.56e6, (0, 4): -2.821e6, (1, 3): 2.821e6,
