@@ -140,7 +140,7 @@ class BodyStiffness:
     loads about ``reference`` (the body's reference point, global axes; N/m, N, N m/rad),
     the free points condensed (they re-equilibrate) and the other bodies held;
     ``moment`` (3,), N m: the lines' moment about the reference point; ``asymmetry``:
-    |K - K^T|_F / |K|_F. Its rotational block's antisymmetric part is exactly
+    |K - K^T|_F / |K|_F (0 for a body no line holds). Its rotational block's antisymmetric part is exactly
     [moment]x / 2 (docs/systems.md)."""
 
     matrix: np.ndarray
@@ -604,7 +604,8 @@ class SystemSolver:
         if p.size:
             K += J[np.ix_(b, p)] @ np.linalg.solve(J[np.ix_(p, p)], J[np.ix_(p, b)])
         moment = r[b[3:]]
-        asymmetry = np.linalg.norm(K - K.T) / np.linalg.norm(K)
+        size = np.linalg.norm(K)
+        asymmetry = np.linalg.norm(K - K.T) / size if size > 0 else 0.0   # no line: K = 0
         return BodyStiffness(K, self.state.bodies.X[index].copy(), moment, float(asymmetry))
 
 

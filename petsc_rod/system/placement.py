@@ -28,6 +28,8 @@ def layout(sizes, ranks):
     the rest by largest remainders), so that a long line spans several ranks."""
     sizes = np.asarray(sizes, dtype=float)
     n = sizes.size
+    if n == 0:                                  # a body on its hydrostatics alone
+        return np.zeros(0, dtype=int), np.array([0, ranks])
     if n >= ranks:
         group = np.empty(n, dtype=int)
         load = np.zeros(ranks)

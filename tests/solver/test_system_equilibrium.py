@@ -426,6 +426,17 @@ def test_a_residual_at_the_lines_accuracy_is_accepted_below_the_floor():
     assert result.bodies["floater"] == pytest.approx(exact.bodies["floater"], abs=1e-7)
 
 
+def test_a_body_on_its_hydrostatics_alone_floats_where_its_weight_is_buoyed():
+    """No line: heave z = (rho V - m) g / (rho g A), on every rank."""
+    body = Body("barge", mass=1e6, volume=1000.0, waterplane_area=400.0,
+                waterplane_moments=(2e4, 3e4), cob=(0, 0, -1.0), cog=(0, 0, -0.5),
+                held=(True, True, False, False, False, True))      # nothing holds them
+    result, stiffness = solve_system(System(lines=(), bodies=(body,)), spring)
+    z = (RHO * 1000.0 - 1e6) / (RHO * 400.0)
+    assert result.bodies["barge"] == pytest.approx([0, 0, z, 0, 0, 0], abs=1e-12)
+    assert not stiffness["barge"].matrix.any() and stiffness["barge"].asymmetry == 0.0
+
+
 def test_the_same_numbers_on_one_rank_and_on_every_rank():
     """COMM_SELF (every line on this rank) against COMM_WORLD: on 2 ranks the four
     lines are two a rank, and a lone line spans both ranks."""

@@ -27,6 +27,8 @@ def test_fewer_lines_than_ranks_share_the_ranks_by_size():
     assert np.diff(first).tolist() == [1, 1, 6]
     group, first = layout([7], 2)
     assert first.tolist() == [0, 2]
+    group, first = layout([], 2)                        # no lines: one idle group
+    assert group.size == 0 and first.tolist() == [0, 2]
 
 
 def test_a_line_costs_its_element_count():
