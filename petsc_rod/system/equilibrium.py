@@ -140,8 +140,10 @@ class BodyStiffness:
     loads about ``reference`` (the body's reference point, global axes; N/m, N, N m/rad),
     the free points condensed (they re-equilibrate) and the other bodies held;
     ``moment`` (3,), N m: the lines' moment about the reference point; ``asymmetry``:
-    |K - K^T|_F / |K|_F (0 for a body no line holds). Its rotational block's antisymmetric part is exactly
-    [moment]x / 2 (docs/systems.md)."""
+    |K - K^T|_F / |K|_F (0 for a body no line holds). Its rotational block's
+    antisymmetric part is exactly [moment]x / 2: turning the body turns the fairleads'
+    arms, which changes the lines' moment by [f]x [a]x dtheta even with their forces
+    held, a term symmetric only where the lines' moment vanishes (docs/systems.md)."""
 
     matrix: np.ndarray
     reference: np.ndarray
