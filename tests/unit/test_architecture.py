@@ -21,14 +21,16 @@ CORE = ("global_step", "iteration", "analysis", "local_step", "mesh", "physics/t
 # and the terms of the seabed, the current and the sea surface (dotted below petsc_rod).
 APPLICATION = ("environment", "quantities", "physics.nodal_load", "physics.seabed",
                "physics.drag", "physics.surface", "physics.friction", "physics.slope_load")
-# The front ends, which drive the solver and which nothing below them imports.
-FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__")
+# The front ends, which drive the solver and which nothing below them imports; system/
+# (a system of lines solved together) drives lines as api/ does, at api/'s level.
+FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__", "system")
 BELOW_FRONT_ENDS = CORE + ("physics", "environment", "quantities", "problem", "scenes", "io",
                            "frames.py", "errors.py", "tables.py", "resources.py", "model",
                            "compile.py")
 # The algorithm layer and the model, whose messages must not name -rod_* options (the
 # model names its fields through model/names.py, the command line gives its options').
-ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step", "model")
+ALGORITHM = ("iteration", "analysis", "problem", "physics", "global_step", "model",
+             "system")
 
 
 def modules():
@@ -108,6 +110,15 @@ def test_nothing_below_the_front_ends_imports_one():
                            if name.split(".")[0] in FRONT_ENDS)
             assert not found, f"{path} imports the front end {found}"
     assert seen > 50                    # the modules were read
+
+
+def test_the_system_solver_imports_no_front_end():
+    """system/ sits beside api/: the command line and the API use it, it uses neither."""
+    others = set(FRONT_ENDS) - {"system"}
+    above = {path: sorted(name for name in imported(tree) if name.split(".")[0] in others)
+             for path, tree in modules().items() if folder_of(path) == "system"}
+    assert len(above) >= 3                                  # the folder was read
+    assert not any(above.values()), f"system/ imports a front end: {above}"
 
 
 def test_the_result_file_knows_no_term_and_no_report():

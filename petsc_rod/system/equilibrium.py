@@ -1,0 +1,625 @@
+"""The coupled static equilibrium of a System (model/system.py): lines, free points and
+rigid bodies in equilibrium together (docs/systems.md, "The coupled equilibrium").
+
+Unknowns: each free point's position (3) and each body's free degrees of freedom of
+(dX, dtheta) (6; the rotation an increment on the left, R <- exp([dtheta]x) R,
+system/bodies.py). Residual, a force (N) per point and a force and moment (N, N m, about
+the body's reference point X) per body, global axes:
+
+    point:  sum_lines f_end + (rho_w V - m) g e_z + F_point + drag in a current
+    body:   sum_lines (f, (x_f - X) x f), x_f = X + R p  + weight at the cog + buoyancy
+            at the cob - K_h (q - q0) + load
+
+with f the force a line exerts on its end (line.end_forces()); the continuation moves
+the external loads (F_point, load) and the held points' positions from those of the
+last equilibrium (the first time: no loads) to the system's by a load factor.
+
+Jacobian: each line's exact 6 x 6 stiffness K = d f / d(x_start, x_end)
+(line.stiffness()) mapped through each end's dx_f = T dq, T = I on a free point and
+T = [I, -[R p]x] (3 x 6) on a body, giving T_i^T K_ij T_j; plus, per body end, the
+geometric term of the moment's lever arm turning with the body,
+
+    d((R p) x f) = (dtheta x R p) x f + (R p) x df,   (dtheta x a) x f = [f]x [a]x dtheta,
+
+(bodies.lever_stiffness) which is not symmetric: by Jacobi's identity
+[f]x[a]x - [a]x[f]x = [f x a]x, so its antisymmetric part is -[a x f]x / 2, half the
+skew matrix of the force's moment about X. Turning the body turns the arm, and so
+changes the moment even with the force held; this is where the rotational block's
+asymmetry comes from, and it vanishes only where the moments of the forces at arms
+vanish (BodyStiffness: the mooring stiffness's K - K^T is exactly [M_lines]x). Plus
+the hydrostatics and the weight's and buoyancy's own lever terms (bodies.Bodies).
+
+Newton with a backtracking line search on the scaled residual's norm, inside a
+continuation of the load factor from 0 to 1 (the step halved when an attempt fails: a
+line that does not converge, a singular or non-finite Jacobian, a line search that finds
+no decrease). The lines are solved where system/placement.py puts them; every rank
+holds every line's end forces and stiffness (small arrays) and solves the same small
+Newton system, so every rank has the same numbers on any number of ranks.
+
+A line is made by ``make_line(system_line, comm)`` (comm: its group's PETSc.Comm,
+collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces() ->
+(2, 3)`` (N, on its start and end points), ``stiffness() -> (6, 6)`` (d end_forces.ravel()
+/ d(start, end)) and ``destroy()``.
+"""
+
+from dataclasses import dataclass, replace
+from typing import Protocol
+
+import numpy as np
+
+from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
+from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
+from petsc_rod.system.placement import Placement, line_elements
+
+
+class HeldLine(Protocol):
+    """What the solver asks of a line (a held line, system/held_line.py, or a test's
+    mock): made by ``make_line(system_line, comm)``, collective on ``comm``."""
+
+    def solve(self, start, end):
+        """Its equilibrium with its ends held at ``start`` and ``end`` (3,), m, from
+        its last state; True when it converged. Collective on its comm."""
+
+    def end_forces(self):
+        """(2, 3), N, global axes: the forces it exerts on its start and end points."""
+
+    def stiffness(self):
+        """(6, 6): d end_forces().ravel() / d(start, end), exact."""
+
+    def destroy(self):
+        """Free its PETSc objects."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``rtol``: the scaled residual's norm (forces / the force scale, moments / (the
+    force scale x the length scale)) that ends Newton; ``floor``: a scaled residual
+    below it that no step of the line search reduces is the lines' own accuracy (their
+    end forces are converged to their tolerances, not to round-off) and is accepted;
+    ``max_iterations`` per attempt; ``load_steps``: the continuation's first step is
+    1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
+    Newton step."""
+
+    rtol: float = 1e-10
+    floor: float = 1e-7
+    max_iterations: int = 30
+    load_steps: int = 1
+    max_halvings: int = 12
+    line_search: int = 10
+
+
+@dataclass
+class State:
+    """Free and held points' positions (n_points, 3) and the bodies' poses (Bodies)."""
+
+    points: np.ndarray
+    bodies: Bodies
+
+    def moved(self, step, layout):
+        """The state after the increment ``step`` (layout.size,) of every unknown."""
+        points = self.points.copy()
+        points[layout.point_index] += step[layout.point_dofs].reshape(-1, 3)
+        return State(points, self.bodies.moved(step[layout.body_dofs]))
+
+
+@dataclass(frozen=True)
+class Loads:
+    """What the continuation moves: the bodies' external loads (n_bodies, 6), the free
+    points' forces (n_free, 3) and the held points' positions (n_points, 3) (the free
+    points' rows unused)."""
+
+    bodies: np.ndarray
+    forces: np.ndarray
+    held: np.ndarray
+
+    @classmethod
+    def of(cls, system, layout):
+        return cls(np.array([b.load for b in system.bodies], dtype=float).reshape(-1, 6),
+                   np.array([system.points[i].force for i in layout.point_index],
+                            dtype=float).reshape(-1, 3),
+                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3))
+
+    def towards(self, other, factor):
+        """self + factor (other - self)."""
+        return Loads(*(a + factor * (b - a) for a, b in
+                       ((self.bodies, other.bodies), (self.forces, other.forces),
+                        (self.held, other.held))))
+
+    def unloaded(self):
+        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held)
+
+    def same(self, other):
+        return all(np.array_equal(a, b) for a, b in ((self.bodies, other.bodies),
+                                                     (self.forces, other.forces),
+                                                     (self.held, other.held)))
+
+
+@dataclass(frozen=True)
+class BodyStiffness:
+    """The 6 x 6 mooring stiffness of a body, K = -d(F, M)/d(dX, dtheta) of the lines'
+    loads about ``reference`` (the body's reference point, global axes; N/m, N, N m/rad),
+    the free points condensed (they re-equilibrate) and the other bodies held;
+    ``moment`` (3,), N m: the lines' moment about the reference point; ``asymmetry``:
+    |K - K^T|_F / |K|_F (0 for a body no line holds). Its rotational block's
+    antisymmetric part is exactly [moment]x / 2: turning the body turns the fairleads'
+    arms, which changes the lines' moment by [f]x [a]x dtheta even with their forces
+    held, a term symmetric only where the lines' moment vanishes (docs/systems.md)."""
+
+    matrix: np.ndarray
+    reference: np.ndarray
+    moment: np.ndarray
+    asymmetry: float
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """A converged system: ``points`` {name: position (3,)}, ``bodies`` {name:
+    (x, y, z, roll, pitch, yaw) (6,)}, ``rotations`` {name: R (3, 3)}, ``end_forces``
+    (n_lines, 2, 3), N, on each line's start and end, ``load_factor`` (1 when
+    complete), ``iterations`` (Newton's, over the continuation), ``residual`` (the scaled
+    norm)."""
+
+    points: dict
+    bodies: dict
+    rotations: dict
+    end_forces: np.ndarray
+    load_factor: float
+    iterations: int
+    halvings: int
+    residual: float
+
+
+class Layout:
+    """Where each node's unknowns are: 3 per free point, 6 per body (its held ones
+    removed in the solve: ``free``); ``ends`` (n_lines, 2, 6) the unknowns each line
+    end moves (``size`` marks none), ``body_end`` (n_lines, 2) the body of an end
+    (-1: a point) and ``local`` (n_lines, 2, 3) its body point."""
+
+    def __init__(self, system):
+        names = [p.name for p in system.points] + [b.name for b in system.bodies]
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:
+            raise RodInputError(f"System: two points or bodies are named {twice[0]!r}; "
+                                "give each its own name")
+        kinds = np.array([p.kind for p in system.points], dtype=object)
+        self.point_index = np.flatnonzero(kinds == "free")
+        self.held_points = np.flatnonzero(kinds != "free")
+        n_free, n_bodies = self.point_index.size, len(system.bodies)
+        self.size = 3 * n_free + 6 * n_bodies
+        point_dof = np.full((len(system.points), 3), self.size)
+        point_dof[self.point_index] = np.arange(3 * n_free).reshape(-1, 3)
+        self.point_dofs = np.arange(3 * n_free)
+        self.body_dofs = 3 * n_free + np.arange(6 * n_bodies).reshape(n_bodies, 6)
+        held = np.array([b.held for b in system.bodies], dtype=bool).reshape(-1, 6)
+        self.free = np.concatenate([self.point_dofs, self.body_dofs[~held]])
+        self.free.sort()
+        self.names = ([(system.points[i].name, DOF_NAMES[k]) for i in self.point_index
+                       for k in range(3)]
+                      + [(b.name, DOF_NAMES[k]) for b in system.bodies for k in range(6)])
+        self.is_moment = np.zeros(self.size, dtype=bool)
+        self.is_moment[self.body_dofs[:, 3:].ravel()] = True
+        where = {p.name: ("point", i) for i, p in enumerate(system.points)}
+        where.update({b.name: ("body", i) for i, b in enumerate(system.bodies)})
+        n = len(system.lines)
+        self.ends = np.full((n, 2, 6), self.size)
+        self.body_end = np.full((n, 2), -1)
+        self.point_end = np.full((n, 2), -1)
+        self.local = np.zeros((n, 2, 3))
+        for k, line in enumerate(system.lines):
+            for j, connection in enumerate((line.start, line.end)):
+                if connection.to not in where:
+                    system.node(connection.to)              # its one-line error
+                kind, i = where[connection.to]
+                self._check(line.name, ("start", "end")[j], connection, kind,
+                            system.points[i].kind if kind == "point" else "body")
+                if kind == "body":
+                    self.body_end[k, j] = i
+                    self.ends[k, j] = self.body_dofs[i]
+                    self.local[k, j] = connection.local
+                else:
+                    self.point_end[k, j] = i
+                    self.ends[k, j, :3] = point_dof[i]
+        reached = np.zeros(len(system.points), dtype=bool)
+        reached[self.point_end[self.point_end >= 0]] = True
+        lonely = [system.points[i].name for i in self.point_index if not reached[i]]
+        if lonely:
+            raise RodInputError(f"point {lonely[0]}: free, but no line ends at it, so "
+                                "nothing holds it: connect a line or make it fixed")
+
+    @staticmethod
+    def _check(line, which, connection, kind, node_kind):
+        if node_kind in ("free", "body") and connection.kind != "pin":
+            raise RodInputError(
+                f"line {line}: {which}: a {connection.kind} end at the {node_kind} "
+                f"{'point ' if kind == 'point' else ''}{connection.to}: the coupled "
+                "equilibrium takes pinned ends at free points and bodies; use kind 'pin'")
+        if kind == "point" and np.any(np.asarray(connection.local, dtype=float) != 0):
+            raise RodInputError(f"line {line}: {which}: local {connection.local!r} at the "
+                                f"point {connection.to}, which has no axes: leave it zero")
+
+
+class SystemSolver:
+    """The coupled equilibrium of ``system`` with lines made by ``make_line`` (module
+    docstring) on the groups of ranks of ``comm`` (a PETSc.Comm; default COMM_WORLD)
+    that system/placement.py lays out by ``sizes`` (elements per line; default the
+    lines' element counts). Collective on ``comm``; ``destroy`` the lines after."""
+
+    def __init__(self, system, make_line, comm=None, sizes=None, settings=Settings()):
+        from petsc4py import PETSc
+        self.system, self.settings = system, settings
+        self.layout = Layout(system)
+        environment = system.environment
+        self.rho, self.g = environment.water_density, environment.gravity
+        self.state = State(np.array([p.position for p in system.points],
+                                    dtype=float).reshape(-1, 3),
+                           Bodies(system.bodies, self.rho, self.g))
+        self.length = max([1.0] + [float(np.abs(np.asarray(v, float)).max()) for b in
+                                   system.bodies for v in (b.cog, b.cob)]
+                          + [float(np.abs(self.layout.local).max(initial=0.0))])
+        sizes = [line_elements(line) for line in system.lines] if sizes is None else sizes
+        self.placement = Placement.make(comm or PETSc.COMM_WORLD, sizes)
+        self.lines = {}
+
+        def make_mine():
+            for k in self.placement.mine:
+                self.lines[int(k)] = make_line(system.lines[k], self.placement.line_comm)
+
+        try:                                    # a line refused on one group, on all
+            on_every_rank(self.placement.mpi, make_mine)
+        except BaseException:
+            self.destroy()
+            raise
+        self.forces = self.stiffnesses = None
+        self.failure, self.checked, self.last = "", False, None
+        self.loads = Loads.of(system, self.layout).unloaded()
+
+    def destroy(self):
+        for line in self.lines.values():
+            line.destroy()
+        self.lines = {}
+        self.placement.destroy()
+
+    # -- the lines --------------------------------------------------------------------
+
+    def arms(self, state):
+        """(n_lines, 2, 3): each body end's arm R p from its body's X (0 at a point)."""
+        layout = self.layout
+        arms = np.zeros(layout.local.shape)
+        on_body = layout.body_end >= 0
+        if np.any(on_body):
+            arms[on_body] = np.einsum("nij,nj->ni", state.bodies.R[layout.body_end[on_body]],
+                                      layout.local[on_body])
+        return arms
+
+    def end_positions(self, state):
+        """(n_lines, 2, 3): each line end's position, a point's or X + R p."""
+        layout = self.layout
+        positions = self.arms(state)
+        on_point, on_body = layout.point_end >= 0, layout.body_end >= 0
+        positions[on_point] = state.points[layout.point_end[on_point]]
+        if np.any(on_body):
+            positions[on_body] += state.bodies.X[layout.body_end[on_body]]
+        return positions
+
+    def evaluate(self, state, strict=False):
+        """Solve every line at ``state``'s end positions (this rank's lines in turn) and
+        share the results: (converged, end forces (n, 2, 3), stiffnesses (n, 6, 6)).
+        A line that raises a solver's RodError has not converged; one that refuses its
+        ends (RodInputError: a span it cannot reach) has not either, except when
+        ``strict`` (the start, where the system itself is at fault): then its error
+        is raised on every rank. The ends of the last successful evaluation are not
+        solved again."""
+        positions = self.end_positions(state)
+        if self.last is not None and np.array_equal(positions, self.last[0]):
+            return self.last[1]                 # the lines stand there already
+        mine = {}
+        for k, line in self.lines.items():
+            try:
+                ok = bool(line.solve(positions[k, 0], positions[k, 1]))
+            except RodInputError as error:      # raised below on every rank
+                mine[k] = (False, error)
+                continue
+            except (RodError, np.linalg.LinAlgError):
+                ok = False
+            mine[k] = ((ok, line.end_forces(), line.stiffness()) if ok else (False,))
+        self.last = None
+        shared = self.placement.share(mine)
+        refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
+        if refused and strict:
+            raise refused[0]
+        failed = [k for k in range(len(self.system.lines)) if not shared[k][0]]
+        if failed:
+            name, entry = self.system.lines[failed[0]].name, shared[failed[0]]
+            self.failure = (f"line {name} refused its ends ({entry[1]})" if len(entry) == 2
+                            else f"line {name} did not converge")
+            return False, None, None
+        forces = np.array([shared[k][1] for k in range(len(shared))]).reshape(-1, 2, 3)
+        stiffness = np.array([shared[k][2] for k in range(len(shared))]).reshape(-1, 6, 6)
+        self.last = (positions, (True, forces, stiffness))
+        return self.last[1]
+
+    # -- residual and Jacobian ---------------------------------------------------------
+
+    def lines_part(self, state, forces, stiffness):
+        """The lines' generalised forces r (size,) and their Jacobian J (size, size)
+        (module docstring; the last row and column of the (size + 1)^2 work arrays
+        collect the held ends)."""
+        layout, n = self.layout, len(self.system.lines)
+        arms = self.arms(state)
+        T = lever_map(arms.reshape(-1, 3)).reshape(n, 2, 3, 6)
+        on_point = layout.body_end < 0
+        T[on_point, :, 3:] = 0.0                    # a point's end has no rotation
+        size = layout.size + 1
+        r = np.zeros(size)
+        np.add.at(r, layout.ends, np.einsum("njia,nji->nja", T, forces))
+        K = stiffness.reshape(n, 2, 3, 2, 3)
+        blocks = np.einsum("niba,nibjc,njcd->nijad", T, K, T)           # (n, 2, 2, 6, 6)
+        rows = np.broadcast_to(layout.ends[:, :, None, :, None], blocks.shape)
+        cols = np.broadcast_to(layout.ends[:, None, :, None, :], blocks.shape)
+        J = np.zeros((size, size))
+        np.add.at(J, (rows, cols), blocks)
+        geometric = np.einsum("njab,njbc->njac", skew(forces), skew(arms))
+        spin = layout.ends[:, :, 3:]
+        np.add.at(J, (np.broadcast_to(spin[..., :, None], geometric.shape),
+                      np.broadcast_to(spin[..., None, :], geometric.shape)), geometric)
+        return r[:-1], J[:-1, :-1]
+
+    def own_part(self, state, loads):
+        """The points' and bodies' own loads (size,) and their Jacobian, under the
+        external ``loads`` (Loads)."""
+        layout = self.layout
+        r = np.zeros(layout.size)
+        J = np.zeros((layout.size, layout.size))
+        if layout.point_dofs.size:
+            points = [self.system.points[i] for i in layout.point_index]
+            mass, volume, cda = (np.array([getattr(p, name) for p in points])
+                                 for name in ("mass", "volume", "cda"))
+            dead = np.outer((self.rho * volume - mass) * self.g, (0.0, 0.0, 1.0))
+            drag, d_drag = self._drag(state.points[layout.point_index], cda)
+            r[layout.point_dofs] = (dead + loads.forces + drag).ravel()
+            dofs = layout.point_dofs.reshape(-1, 3)
+            J[dofs, dofs[:, 2:]] += d_drag          # the drag changes with the depth
+        if layout.body_dofs.size:
+            own, jacobian = state.bodies.own_loads(loads.bodies)
+            dofs = layout.body_dofs
+            r[dofs] += own
+            J[dofs[:, :, None], dofs[:, None, :]] += jacobian
+        return r, J
+
+    def _drag(self, positions, cda):
+        """The current's drag on free points, 0.5 rho C_d A |u| u (n, 3), N, and its
+        derivative in the points' heights (n, 3): a uniform current (none), or a
+        profile's velocity, linear between its rows, at each point's depth below the
+        surface (the Environment's surface, 0 when none), so du/dz = -du/d depth and
+        d(|u| u) = (|u| I + u u^T / |u|) du."""
+        n = positions.shape[0]
+        current = self.system.environment.current
+        if current is None or not np.any(cda):
+            return np.zeros((n, 3)), np.zeros((n, 3))
+        current = np.asarray(current, dtype=float)
+        if current.shape == (3,):
+            u, du = np.broadcast_to(current, (n, 3)), np.zeros((n, 3))
+        else:
+            depth = (self.system.environment.surface or 0.0) - positions[:, 2]
+            rows, values = current[:, 0], current[:, 1:]
+            u = np.stack([np.interp(depth, rows, column) for column in values.T], axis=-1)
+            k = np.clip(np.searchsorted(rows, depth), 1, max(len(rows) - 1, 1))
+            inside = ((depth > rows[0]) & (depth < rows[-1]))[:, None]
+            slope = ((values[k] - values[k - 1])
+                     / np.maximum(rows[k] - rows[k - 1], np.finfo(float).tiny)[:, None]
+                     if len(rows) > 1 else np.zeros((n, 3)))
+            du = -np.where(inside, slope, 0.0)
+        speed = np.linalg.norm(u, axis=1)[:, None]
+        factor = 0.5 * self.rho * cda[:, None]
+        along = np.einsum("ni,ni->n", u, du)[:, None] / np.maximum(speed, np.finfo(float).tiny)
+        return factor * speed * u, factor * (speed * du + along * u)
+
+    def scales(self):
+        """The residual's scale per unknown: the force scale (the largest line end
+        force, dead force or load, at least 1 N) on forces, times the length scale
+        (the bodies' largest lever, at least 1 m) on moments."""
+        force = max([1.0] + [float(np.abs(self.forces).max(initial=0.0))]
+                    + [abs(p.mass - self.rho * p.volume) * self.g + np.abs(p.force).max()
+                       for p in self.system.points]
+                    + [max(b.mass, self.rho * b.volume) * self.g + np.abs(b.load).max()
+                       for b in self.system.bodies])
+        return np.where(self.layout.is_moment, force * self.length, force)
+
+    def residual(self, state, loads, forces, stiffness):
+        r_lines, J_lines = self.lines_part(state, forces, stiffness)
+        r_own, J_own = self.own_part(state, loads)
+        return r_lines + r_own, J_lines + J_own
+
+    # -- Newton, continuation ------------------------------------------------------------
+
+    def singular_dof(self, J, scale):
+        """The (node, dof) names of the unknown the scaled free Jacobian cannot move
+        (its null vector's largest entry), None when it is regular."""
+        free = self.layout.free
+        if not free.size:
+            return None
+        column = np.where(self.layout.is_moment, 1.0, self.length)
+        scaled = J[np.ix_(free, free)] * column[free] / scale[free][:, None]
+        if not np.all(np.isfinite(scaled)):
+            return ("the Jacobian", "not finite")
+        u, s, vt = np.linalg.svd(scaled)
+        if s[-1] > 1e-12 * s[0]:
+            return None
+        return self.layout.names[free[int(np.argmax(np.abs(vt[-1])))]]
+
+    def newton(self, state, loads, scale):
+        """(state, iterations) at equilibrium under ``loads`` (Loads; the held points
+        put at its positions), or (None, its iterations) with self.failure saying why.
+        self.forces/stiffnesses: the lines' at the returned state."""
+        settings, free, held = self.settings, self.layout.free, self.layout.held_points
+        state = State(state.points.copy(), state.bodies)
+        state.points[held] = loads.held[held]
+        ok, forces, stiffness = self.evaluate(state)
+        if not ok:
+            return None, 0
+        r, J = self.residual(state, loads, forces, stiffness)
+        norm = np.linalg.norm(r[free] / scale[free])
+        for iteration in range(settings.max_iterations + 1):
+            self.forces, self.stiffnesses = forces, stiffness
+            if norm <= settings.rtol:
+                self.norm = norm
+                return state, iteration
+            if iteration == settings.max_iterations:
+                break
+            step = np.zeros(self.layout.size)
+            try:
+                step[free] = -np.linalg.solve(J[np.ix_(free, free)], r[free])
+            except np.linalg.LinAlgError:
+                step[free] = np.nan
+            if not np.all(np.isfinite(step)):
+                where = self.singular_dof(J, scale)
+                self.failure = (f"the Jacobian is singular in {where[0]} {where[1]}"
+                                if where else "the Newton step is not finite")
+                return None, iteration
+            alpha, full = 1.0, ""
+            for _ in range(settings.line_search + 1):
+                trial = state.moved(alpha * step, self.layout)
+                ok, t_forces, t_stiffness = self.evaluate(trial)
+                full = full or ("" if ok or alpha < 1.0 else f" ({self.failure} at the "
+                                                             "full step)")
+                if ok:
+                    t_r, t_J = self.residual(trial, loads, t_forces, t_stiffness)
+                    t_norm = np.linalg.norm(t_r[free] / scale[free])
+                    if t_norm <= (1.0 - 1e-4 * alpha) * norm:
+                        break
+                alpha *= 0.5
+            else:
+                if norm <= settings.floor:
+                    self.norm = norm
+                    return state, iteration
+                self.failure = (f"the line search found no decrease of the residual "
+                                f"{norm:.3g}{full}")
+                return None, iteration
+            state, forces, stiffness, r, J, norm = (trial, t_forces, t_stiffness, t_r,
+                                                    t_J, t_norm)
+        self.failure = (f"Newton did not converge in {settings.max_iterations} "
+                        f"iterations (residual {norm:.3g})")
+        return None, settings.max_iterations
+
+    def check_restoring(self):
+        """RodInputError naming a body's or a point's degree of freedom that nothing
+        restores (the Jacobian at the start is singular in it)."""
+        ok, forces, stiffness = self.evaluate(self.state, strict=True)
+        if not ok:
+            raise RodDivergedError(f"system: at the start, {self.failure}")
+        self.forces = forces
+        r, J = self.residual(self.state, self.loads, forces, stiffness)
+        where = self.singular_dof(J, self.scales())
+        if where is None:
+            return
+        node, dof = where
+        if any(b.name == node for b in self.system.bodies):
+            raise RodInputError(f"body {node}: nothing restores its {dof} (no line, weight "
+                                "or hydrostatic stiffness resists it): hold it (Body.held) "
+                                "or add a line or a hydrostatic stiffness")
+        raise RodInputError(f"point {node}: nothing restores its {dof} (its lines are "
+                            "slack or in line with it): make it fixed or connect another "
+                            "line")
+
+    def solve(self, system=None):
+        """The Equilibrium (collective) under ``system``'s loads (None: the one the
+        solver was made with; else the same system with other body loads, point
+        forces or held points' positions, started from the last equilibrium with the
+        lines as they stand): Newton where the last equilibrium was (the first time:
+        the system unloaded), then the continuation of the loads towards the new ones,
+        each failing step halved up to ``max_halvings`` times; RodDivergedError saying
+        why when that did not help. Leaves the lines at the solution."""
+        settings = self.settings
+        if system is not None:
+            self.replace(system)
+        if not self.checked:
+            self.check_restoring()
+            self.checked = True
+        scale = self.scales()
+        target = Loads.of(self.system, self.layout)
+        factor, step, halvings, total = ((1.0, 0.0, 0, 0) if self.loads.same(target) else
+                                         (0.0, 1.0 / settings.load_steps, 0, 0))
+        state, iterations = self.newton(self.state, self.loads.towards(target, factor),
+                                        scale)
+        total += iterations
+        if state is None:
+            raise RodDivergedError(f"system: no equilibrium at load factor {factor:g}: "
+                                   f"{self.failure}")
+        self.state = state
+        while factor < 1.0:
+            to = min(1.0, factor + step)
+            state, iterations = self.newton(self.state, self.loads.towards(target, to),
+                                            scale)
+            total += iterations
+            if state is None:
+                halvings += 1
+                if halvings > settings.max_halvings:
+                    raise RodDivergedError(
+                        f"system: no equilibrium at load factor {to:g} after "
+                        f"{settings.max_halvings} halvings of the load step (from "
+                        f"{factor:g}): {self.failure}")
+                step *= 0.5
+                continue
+            self.state, factor, step = state, to, 2.0 * step
+        self.loads = target
+        # The lines may stand at the last trial; leave them at the solution.
+        self.evaluate(self.state)
+        return self.result(factor, total, halvings)
+
+    def replace(self, system):
+        """Take ``system``'s loads: RodInputError unless it differs from the solver's
+        only in the bodies' loads, the points' forces and the held points' positions."""
+        old = self.system
+        same = (repr(system.lines) == repr(old.lines)
+                and repr(system.environment) == repr(old.environment)
+                and len(system.points) == len(old.points)
+                and len(system.bodies) == len(old.bodies)
+                and all(replace(new, load=b.load) == b
+                        for new, b in zip(system.bodies, old.bodies))
+                and all(replace(new, force=p.force, position=p.position) == p
+                        for new, p in zip(system.points, old.points)))
+        if not same:
+            raise RodInputError("system: a solver re-solves its system under other body "
+                                "loads, point forces or held points' positions only; make a "
+                                "new one for any other change")
+        self.system = system
+
+    def result(self, factor, iterations, halvings):
+        state, names = self.state, [b.name for b in self.system.bodies]
+        points = {p.name: state.points[i].copy() for i, p in enumerate(self.system.points)}
+        return Equilibrium(points,
+                           dict(zip(names, state.bodies.positions)),
+                           dict(zip(names, state.bodies.R.copy())),
+                           self.forces.copy(), factor, iterations, halvings,
+                           float(self.norm))
+
+    # -- the mooring stiffness -----------------------------------------------------------
+
+    def body_stiffness(self, name):
+        """The BodyStiffness of the body ``name`` at the current state: the lines'
+        Jacobian J (lines_part), the free points condensed,
+        K = -(J_bb - J_bp J_pp^-1 J_pb); not symmetrised."""
+        index = [b.name for b in self.system.bodies].index(name)
+        r, J = self.lines_part(self.state, self.forces, self.stiffnesses)
+        b, p = self.layout.body_dofs[index], self.layout.point_dofs
+        K = -J[np.ix_(b, b)]
+        if p.size:
+            K += J[np.ix_(b, p)] @ np.linalg.solve(J[np.ix_(p, p)], J[np.ix_(p, b)])
+        moment = r[b[3:]]
+        size = np.linalg.norm(K)
+        asymmetry = np.linalg.norm(K - K.T) / size if size > 0 else 0.0   # no line: K = 0
+        return BodyStiffness(K, self.state.bodies.X[index].copy(), moment, float(asymmetry))
+
+
+def solve_system(system, make_line, comm=None, sizes=None, settings=Settings(),
+                 stiffness=True):
+    """(Equilibrium, {body name: BodyStiffness}) of ``system`` (SystemSolver); the
+    lines are destroyed before it returns. Collective on ``comm``."""
+    solver = SystemSolver(system, make_line, comm, sizes, settings)
+    try:
+        result = solver.solve()
+        stiffnesses = ({b.name: solver.body_stiffness(b.name) for b in system.bodies}
+                       if stiffness else {})
+        return result, stiffnesses
+    finally:
+        solver.destroy()
