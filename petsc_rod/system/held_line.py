@@ -1,0 +1,395 @@
+"""One line of a system as a component: held at its two ends, solved again whenever
+they move (warm-started from its last equilibrium), with the forces it exerts on them
+and their exact linearisation in the ends' positions (docs/method.md §13).
+
+**The line as a function of its ends.** With q the line's unknowns (the nodes'
+rotations, their stretch on an extensible line, and the positions' chains where a term
+reads the positions: analysis/positions.py), the equilibrium with the ends at x_a
+(S = 0) and x_b (S = L) is the stationary point of
+
+    L(q, mu) = F(q; z_a) + mu . (C(q) - (x_b - x_a)),
+
+F the energy with the work of the loads, C(q) = int r' dS the chord and mu its
+multiplier (iteration/newton.py). The loads per metre do not depend on where the line
+is, so F depends on x_a only through the positions' terms: on a flat seabed through the
+start's height z_a (a node's height is z_a plus the integral of the slope). With
+G(z_a, c) = F at the equilibrium of chord c, the line's potential as a function of its
+ends is Phi(x_a, x_b) = G(z_a, x_b - x_a) - W . x_a, W the load's resultant.
+
+**End forces.** The force the line exerts ON its start point and ON its end point,
+global axes, N: F_b = -dPhi/dx_b = mu (beside an attachment sitting on the end), and
+F_a = -dPhi/dx_a = W + (the seabed's and the attachments' forces) - mu = n(0): the
+reactions the single-line solver reports (quantities/line_results.py: ``start_force``,
+``end_force``), F_a + F_b = the whole applied load.
+
+**Stiffness.** K = d(F_a, F_b)/d(x_a, x_b), (6, 6), N/m, rows the forces (a then b),
+columns the positions (a then b): K = -Hess Phi. From the KKT system at the equilibrium,
+H the second variation (the Hessian of L, analysis/second_variation.py), C^T the chord
+forms (3 columns) and P = dgrad L/dz_a the seabed's curvature times the derivative of
+each node's height (SecondVariation.position_shift), with Y_C = H^-1 C^T, Y_P = H^-1 P,
+S = C Y_C (3, 3), CY = C Y_P (3,), A = sum_n k w_n over the nodes in contact:
+
+    G_cc = S^-1,   G_cz = S^-1 CY,   G_zz = A - P.Y_P + CY . S^-1 CY,
+
+and with T the map (x_a, x_b) -> (z_a, c), K = -T^T [G_zz G_zc; G_cz G_cc] T. H is the
+line's own, factored by the stability test's LDL^T (MUMPS; by substructuring on several
+ranks), unshifted: no finite differences. Without a seabed K_aa = K_bb = -K_ab = -S^-1
+(a translation of the whole line changes nothing). K is symmetric, being a Hessian:
+the line is conservative (dead loads, the elastic seabed, stretch, attachments' dead
+forces). K is negative semi-definite for a stable line in this convention (moving an
+end outward pulls it back): the restoring stiffness of a point on the line is -K.
+
+What it refuses (RodInputError, one line): a stiffness for a line whose loads have no
+energy (a current's drag: a follower load, whose Newton Jacobian is unsymmetric and
+whose total drag moves with the shape; the seabed's friction, which dissipates; a
+sloping or profiled seabed's lagged contact; the sea surface's wet and dry parts).
+
+Every call is collective on the line's communicator, never COMM_WORLD: a system puts
+each line on its own sub-communicator.
+"""
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.cli.main import build_solver, check_mesh, destroy_run
+from petsc_rod.cli.options import parse_values
+from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
+from petsc_rod.compile import compile_scene
+from petsc_rod.errors import NoCatenaryStart, RodError, RodInputError
+from petsc_rod.iteration import events
+from petsc_rod.iteration.continuation import PathSettings, continuation
+from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.mesh.mesh import Mesh
+from petsc_rod.model.line import UniformLine
+from petsc_rod.model.model import Model
+from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.quantities.riser_numbers import points_on_held_ends
+from petsc_rod.scenes import starts
+from petsc_rod.scenes.scene import EndState
+
+
+class HeldEnds:
+    """The load path of a held line's problem (the interface of scenes/blend.py's
+    BlendedPath): the ``scene``'s own path (its load factor t) until the ends are first
+    moved (``move``); from then on every load at its full value and the ends walked in
+    straight lines, s in [0, 1], from where they were to where they go, in the
+    scene's frame (origin: the scene's start). Anything else is the scene's."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.moves = None           # (a from, a to, b from, b to), (3,) each
+
+    def __getattr__(self, name):
+        if name in ("scene", "moves"):
+            raise AttributeError(name)
+        return getattr(self.scene, name)
+
+    def move(self, start, end):
+        """Walk from the ends at the path's end (s = 1) to ``start``, ``end`` (3,), m,
+        in the scene's frame."""
+        self.moves = (self.start_state(1.0).position, np.asarray(start, dtype=float),
+                      self.end_state(1.0).position, np.asarray(end, dtype=float))
+
+    def hold(self, start, end):
+        """The ends held at ``start``, ``end`` (3,) all along the path (after a walk
+        that failed: back where they were)."""
+        self.moves = (np.asarray(start, dtype=float),) * 2 + (np.asarray(end, dtype=float),) * 2
+
+    def _t(self, t):
+        return 1.0 if self.moves is not None else t
+
+    @property
+    def axially_symmetric(self):
+        """Moved ends are off the x axis in general: no family of turned equilibria."""
+        return self.moves is None and self.scene.axially_symmetric
+
+    def load_beyond(self, S, t):
+        return self.scene.load_beyond(S, self._t(t))
+
+    def point_loads(self, t):
+        return self.scene.point_loads(self._t(t))
+
+    def point_drags(self, t):
+        return self.scene.point_drags(self._t(t))
+
+    def point_buoyancies(self, t):
+        return self.scene.point_buoyancies(self._t(t))
+
+    def drag_loads(self, t):
+        return self.scene.drag_loads(self._t(t))
+
+    def end_roll(self, t):
+        return self.scene.end_roll(self._t(t))
+
+    def end_frame_parts(self, t):
+        return self.scene.end_frame_parts(self._t(t))
+
+    def start_state(self, t):
+        return self._held(self.scene.start_state(self._t(t)), t, 0)
+
+    def end_state(self, t):
+        return self._held(self.scene.end_state(self._t(t)), t, 2)
+
+    def _held(self, state, s, first):
+        if self.moves is None:
+            return state
+        old, new = self.moves[first], self.moves[first + 1]
+        return EndState(state.kind, (1.0 - s) * old + s * new, state.frame, state.force)
+
+
+class _CurvatureRecorder:
+    """What a term's add_hessian gives the positions (Term.add_hessian): the seabed's
+    k w_n at the nodes in contact, recorded instead of assembled."""
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.heights = None
+
+    def add_height_curvature(self, curvature):
+        self.heights = np.asarray(curvature, dtype=float)
+
+    def add_position_curvature(self, values, components):
+        raise RodInputError("a line whose energy reads its horizontal positions (the "
+                            "seabed's friction) has no exact stiffness here")
+
+
+def _at_vertex(mesh, values, index):
+    """values[index] of the owned vertex ``index`` (global), on every rank. Collective."""
+    local = np.zeros(np.shape(values)[1:])
+    if mesh.vertex_start <= index < mesh.vertex_end:
+        local = np.asarray(values[index - mesh.vertex_start], dtype=float)
+    return mesh.global_sum(local)
+
+
+def _point(name, value):
+    point = np.asarray(value, dtype=float)
+    if point.shape != (3,) or not np.all(np.isfinite(point)):
+        raise RodInputError(f"HeldLine.solve: {name} {value!r}: three finite numbers (m)")
+    return point
+
+
+class HeldLine:
+    """A line of the typed model held at its two ends, on the ranks of ``comm`` (a
+    PETSc communicator: the line's own; collective on it alone).
+
+    ``span``: a model.model.Span (or a model.Model, whose one span is taken) with both
+    ends held (pin or clamp; a clamp's frame is held as given); ``environment``: the
+    sea (model.sea.Environment; a Model's own by default); ``options``: -rod_* options
+    without ``rod_`` that tune the solver ({'al_rtol': 1e-10}).
+
+    solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
+    stiffness() -> (6, 6); destroy(). ``iterations``: those of the last solve."""
+
+    def __init__(self, span, comm, environment=None, options=None):
+        if isinstance(span, Model):
+            environment = environment or span.environment
+            span = span.spans[0]
+        if environment is None:
+            raise RodInputError("HeldLine: give the line's environment (model.Environment)")
+        self.span, self.environment, self.comm = span, environment, comm
+        for which in ("start", "end"):
+            if getattr(span, which).kind not in ("pin", "clamp"):
+                raise RodInputError(f"HeldLine: the line's {which} is "
+                                    f"{getattr(span, which).kind}; a line of a system is "
+                                    "held at both ends (pin or clamp)")
+        self.values = parse_values({f"rod_{k}": str(v) for k, v in (options or {}).items()})
+        self.scene = self._compile(span.start.position, span.end.position)
+        self.mesh = self.problem = self.solver = self.newton = self.path = None
+        self.iterations = 0
+        self.converged = False
+
+    # --- building ----------------------------------------------------------------------
+    def _compile(self, start, end):
+        """The Scene of the line with its ends at ``start``, ``end`` (absolute, m)."""
+        import dataclasses
+        span = self.span
+        model = Model(span.line, dataclasses.replace(span.start, position=start),
+                      dataclasses.replace(span.end, position=end), self.environment,
+                      tuple(span.attachments))
+        return compile_scene(model, FIELD_NAMES)
+
+    def _build(self, start, end):
+        """Mesh, problem, solver on the scene with the ends at ``start``, ``end``: its
+        frame's origin is ``start`` for the line's life. Collective."""
+        self.scene = scene = self._compile(start, end)
+        values = dict(self.values)
+        line = self.span.line
+        pieces = None
+        if isinstance(line, UniformLine):
+            values.update(rod_elements=int(line.elements), rod_length=float(line.length))
+            if line.grading is not None:
+                values["rod_mesh_grading"] = float(line.grading)
+        else:
+            pieces = checked_pieces(scene, line.element_counts(FIELD_NAMES),
+                                    FIELD_NAMES["sections"])
+            values["rod_elements"] = int(pieces.counts.sum())
+            values["rod_length"] = scene.length
+        check_mesh(self.comm, values)
+        settings = settings_from_options(values, scene, FIELD_NAMES)
+        self.origin = np.array(scene.start_position, dtype=float)
+        self.mesh = Mesh(self.comm, values["rod_elements"], scene.length,
+                         values["rod_mesh_grading"], pieces)
+        self.path = HeldEnds(scene)
+        self.problem, self.solver = build_solver(self.mesh, self.path, settings,
+                                                 lambda line: None)
+        self.newton = NewtonSolver(self.problem)
+
+    def _release(self):
+        if self.newton is not None:
+            self.newton.destroy()
+        destroy_run(self.solver, self.problem, self.mesh)
+        self.mesh = self.problem = self.solver = self.newton = self.path = None
+
+    # --- solving -----------------------------------------------------------------------
+    def solve(self, start_position, end_position):
+        """The line's equilibrium with its start held at ``start_position`` and its end
+        at ``end_position`` ((3,) each, m, absolute): the first time (and after a first
+        solve that failed) from the catenary start in one step, as the command line
+        starts; later walked in one step (halved where it fails, up to 4 times) from
+        the last converged equilibrium, the ends moved in straight lines. Returns
+        whether it converged; a failed walk leaves the last equilibrium as it was.
+        Collective."""
+        a, b = _point("start_position", start_position), _point("end_position", end_position)
+        if self.problem is None or not self.converged:
+            self._release()
+            self._build(a, b)
+            return self._first()
+        return self._walk(a - self.origin, b - self.origin)
+
+    def _first(self):
+        problem = self.problem
+        try:
+            curve = starts.catenary_start(self.path, 1.0)
+        except NoCatenaryStart:
+            problem.state.set_straight()
+        else:
+            problem.state.set_from_curve(curve)
+        self.converged = self._run(PathSettings(steps=1, track_link=False))
+        return self.converged
+
+    def _walk(self, a, b):
+        state = self.problem.state
+        saved = state.snapshot()
+        old = (self.path.start_state(1.0).position, self.path.end_state(1.0).position)
+        self.path.move(a, b)
+        if self._run(PathSettings(steps=1, track_link=False)):
+            self.path.hold(a, b)
+            return True
+        state.restore(saved)
+        self.path.hold(*old)
+        self.problem.prepare(1.0)
+        return False
+
+    def _run(self, path):
+        """The continuation on ``path``: whether it converged (a divergence, a PETSc
+        error of its solves, is a failure). Collective."""
+        self.iterations = 0
+        try:
+            for event in continuation(self.solver, path):
+                if isinstance(event, events.RunFinished):
+                    self.iterations = event.iterations
+                    return bool(event.converged)
+                if isinstance(event, events.RunDiverged):
+                    return False
+        except (RodError, PETSc.Error, FloatingPointError):
+            return False
+        return False
+
+    # --- what it gives the system --------------------------------------------------------
+    def positions(self):
+        """The held ends where the last solve put them, (2, 3), m, absolute."""
+        return np.array([self.path.start_state(1.0).position,
+                         self.path.end_state(1.0).position]) + self.origin
+
+    def end_forces(self):
+        """(2, 3), N, global axes: the force the line exerts ON its start point (row 0)
+        and ON its end point (row 1), an attachment that sits on an end included: n(0)
+        and -n(L) (module docstring; line_results' start_force and end_force).
+        Collective."""
+        self._check_solved()
+        problem, mesh = self.problem, self.mesh
+        n = problem.internal_force()
+        on_start, on_end = points_on_held_ends(problem)
+        return np.array([_at_vertex(mesh, n, 0) + on_start,
+                         -_at_vertex(mesh, n, mesh.n_elements) + on_end])
+
+    def stiffness(self):
+        """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
+        derivative of force component i (0-2 on the start, 3-5 on the end) in position
+        component j (0-2 of the start, 3-5 of the end), at the last equilibrium, from
+        the line's factored second variation (module docstring). Symmetric; negative
+        semi-definite for a stable line. Collective."""
+        self._check_solved()
+        problem = self.problem
+        self._check_exact()
+        state = problem.state
+        saved = state.snapshot()
+        frames = state.tau.copy()
+        held = ~problem.free_nodes
+        frames[held] = state.node_directors()[held]
+        vecs = []
+        try:
+            self.newton.lagrangian_gradient(frames, state.chord_multiplier.copy())
+            hessian = problem.second_variation()
+            recorder = _CurvatureRecorder(problem)
+            for term in problem.terms:
+                if term.position_components:
+                    term.add_hessian(recorder)
+            hessian.factorise(0.0)
+            columns = hessian.chord_forms(frames[:, 2])
+            vecs.extend(columns)
+            if recorder.heights is not None:
+                shift = hessian.position_shift(recorder.heights, 2)
+                vecs.append(shift)
+                columns = columns + [shift]
+            solved = hessian.solve_many(columns)
+            vecs.extend(solved)
+            schur = np.array([[c.dot(y) for y in solved] for c in columns])
+            if not np.all(np.isfinite(schur)):
+                raise np.linalg.LinAlgError("the line's second variation could not be "
+                                            "factored at its equilibrium")
+            curvature = np.zeros((4, 4))
+            inverse = np.linalg.inv(0.5 * (schur[:3, :3] + schur[:3, :3].T))
+            curvature[1:, 1:] = inverse
+            if recorder.heights is not None:
+                along = schur[:3, 3]                        # C H^-1 P
+                total = self.mesh.global_sum(float(recorder.heights.sum()))
+                curvature[1:, 0] = curvature[0, 1:] = inverse @ along
+                curvature[0, 0] = total - schur[3, 3] + along @ inverse @ along
+        finally:
+            for vec in vecs:
+                vec.destroy()
+            state.restore(saved)
+        chain = np.zeros((4, 6))                            # (z_a, c) of (x_a, x_b)
+        chain[0, 2] = 1.0
+        chain[1:, :3] = -np.eye(3)
+        chain[1:, 3:] = np.eye(3)
+        return -chain.T @ curvature @ chain
+
+    def _check_solved(self):
+        if self.problem is None or not self.converged:
+            raise RodInputError("HeldLine: no converged equilibrium yet (solve first, and "
+                                "check what it returns)")
+
+    def _check_exact(self):
+        """Refuse a stiffness where it would not be exact (module docstring)."""
+        scene = self.scene
+        if scene.current is not None:
+            raise RodInputError("HeldLine.stiffness: a current's drag is a follower load "
+                                "(no energy; its total moves with the shape): no exact "
+                                "stiffness of a line in a current yet")
+        if scene.seabed is not None and scene.seabed.friction is not None:
+            raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
+                                "exact stiffness of a line with friction")
+        if scene.seabed is not None and not scene.seabed.flat:
+            raise RodInputError("HeldLine.stiffness: exact on a flat seabed only (a "
+                                "sloping or profiled one's contact is lagged)")
+        if not (self.problem.conservative and self.problem.in_newton):
+            loads = ", ".join(type(t).__name__ for t in self.problem.terms
+                              if not (t.conservative and t.in_newton))
+            raise RodInputError(f"HeldLine.stiffness: loads without an energy ({loads}): "
+                                "no exact stiffness")
+
+    def destroy(self):
+        """Free the line's PETSc objects (all made in _build). Collective."""
+        self._release()

@@ -1,0 +1,168 @@
+"""One line of a system held at its two ends (petsc_rod/system/held_line.py), on one
+rank (PETSc.COMM_SELF) and on all (PETSc.COMM_WORLD: under ``mpiexec -n 2`` the
+parallel run):
+
+(a) its end forces are the single-line solver's reactions (api.solve of the same Model:
+    start_force, end_force);
+(b) its stiffness, from the line's factored second variation, against central finite
+    differences of re-solves: an extensible line hanging between two pins (the elastic
+    catenary; also against the derivative of the closed form, Irvine's), and a mooring
+    line partly on an elastic seabed (where the start's height enters through the
+    seabed's positions);
+(c) the stiffness is symmetric (the line is conservative), and without a seabed a
+    translation of the whole line changes nothing: K_aa = K_bb = -K_ab;
+(d) a small move of the ends, warm-started from the last equilibrium, takes fewer
+    iterations than the first solve;
+(e) the same numbers on one rank and on all;
+(f) a line in a current has no exact stiffness yet: refused in one line.
+"""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import End, Environment, Model, UniformLine, solve
+from petsc_rod.errors import RodInputError
+from petsc_rod.system.held_line import HeldLine
+from petsc_rod.validation.elastic_catenary import elastic_catenary
+
+pytestmark = pytest.mark.solver
+
+COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
+TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
+# the elastic catenary: 100 m of 10 N/m, EA 1e5 N, pins 80 m across and 20 m up
+LENGTH, WEIGHT, EA = 100.0, 10.0, 1e5
+HANGING = (np.zeros(3), np.array([80.0, 0.0, 20.0]))
+# a mooring line: the anchor on an elastic seabed 30 m below the fairlead, 85 m away
+MOORING = (np.array([0.0, 0.0, -30.0]), np.array([85.0, 0.0, 0.0]))
+
+
+def line_model(ends, seabed=None, current=None, elements=40):
+    line = UniformLine(length=LENGTH, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -WEIGHT),
+                       axial_stiffness=EA, elements=elements,
+                       drag=None if current is None else (1025.0, 1.2, 0.1))
+    return Model(line=line, start=End.anchor(tuple(ends[0])), end=End.anchor(tuple(ends[1])),
+                 environment=Environment(seabed=seabed, current=current))
+
+
+def held(model, comm, ends):
+    line = HeldLine(model, comm, options=TIGHT)
+    assert line.solve(*ends)
+    return line
+
+
+def differences(line, ends, step, one_sided=False):
+    """The (6, 6) finite differences of end_forces in the six end coordinates
+    (central; ``one_sided``: forward)."""
+    base = line.end_forces().ravel()
+    columns = []
+    for j in range(6):
+        move = np.zeros(6)
+        move[j] = step
+        assert line.solve(ends[0] + move[:3], ends[1] + move[3:])
+        plus = line.end_forces().ravel()
+        if one_sided:
+            columns.append((plus - base) / step)
+            continue
+        assert line.solve(ends[0] - move[:3], ends[1] - move[3:])
+        columns.append((plus - line.end_forces().ravel()) / (2 * step))
+    assert line.solve(*ends)
+    return np.array(columns).T
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def hanging(request):
+    line = held(line_model(HANGING), COMMS[request.param], HANGING)
+    yield line
+    line.destroy()
+
+
+def test_end_forces_are_the_single_line_solvers_reactions(hanging):
+    results = solve(line_model(HANGING), comm=hanging.comm)
+    forces = hanging.end_forces()
+    assert forces[0] == pytest.approx(results.scalars["start_force"], rel=1e-8, abs=1e-6)
+    assert forces[1] == pytest.approx(results.scalars["end_force"], rel=1e-8, abs=1e-6)
+    # the supports carry the weight
+    assert forces.sum(axis=0) == pytest.approx([0.0, 0.0, -WEIGHT * LENGTH], rel=1e-10)
+
+
+def test_stiffness_of_the_elastic_catenary(hanging):
+    K = hanging.stiffness()
+    scale = np.abs(K).max()
+    # conservative: a Hessian; no seabed: only the chord matters
+    assert np.abs(K - K.T).max() < 1e-10 * scale
+    assert np.abs(K[:3, :3] - K[3:, 3:]).max() < 1e-10 * scale
+    assert np.abs(K[:3, :3] + K[:3, 3:]).max() < 1e-10 * scale
+    assert np.all(np.linalg.eigvalsh(K[3:, 3:]) < 0)            # it pulls back
+    found = differences(hanging, HANGING, 1e-3)
+    assert np.abs(K - found).max() < 1e-5 * scale
+    # the closed form's derivative: F_b = -(H, 0, V_A + w L) at the end (X, Z)
+    def pull(X, Z):
+        line = elastic_catenary(LENGTH, WEIGHT, EA, X, Z, on_seabed=False)
+        return -np.array([line.H, line.V_A + WEIGHT * LENGTH])
+    X, Z, step = HANGING[1][0], HANGING[1][2], 1e-3
+    closed = np.column_stack([(pull(X + step, Z) - pull(X - step, Z)) / (2 * step),
+                              (pull(X, Z + step) - pull(X, Z - step)) / (2 * step)])
+    assert K[3:, 3:][np.ix_([0, 2], [0, 2])] == pytest.approx(closed, rel=2e-5)
+    # across the plane: the string's H / X
+    assert K[4, 4] == pytest.approx(-elastic_catenary(LENGTH, WEIGHT, EA, X, Z, False).H / X,
+                                    rel=2e-5)
+
+
+def test_a_small_move_is_warm_started(hanging):
+    first = HeldLine(line_model(HANGING), hanging.comm, options=TIGHT)
+    assert first.solve(*HANGING)
+    cold = first.iterations
+    assert first.solve(HANGING[0], HANGING[1] + np.array([0.5, 0.0, -0.3]))
+    assert first.iterations < cold
+    first.destroy()
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def mooring(request):
+    line = held(line_model(MOORING, seabed=-30.0, elements=50), COMMS[request.param],
+                MOORING)
+    yield line
+    line.destroy()
+
+
+def test_stiffness_on_an_elastic_seabed(mooring):
+    results = solve(line_model(MOORING, seabed=-30.0, elements=50), comm=mooring.comm)
+    assert results.scalars["touchdown_S"] > 40.0                 # partly grounded
+    forces = mooring.end_forces()
+    assert forces[0] == pytest.approx(results.scalars["start_force"], rel=1e-8, abs=1e-6)
+    assert forces[1] == pytest.approx(results.scalars["end_force"], rel=1e-8, abs=1e-6)
+    K = mooring.stiffness()
+    scale = np.abs(K).max()
+    assert np.abs(K - K.T).max() < 1e-10 * scale
+    # the seabed makes a vertical translation matter: K_aa is not -K_ab
+    assert abs(K[2, 2] + K[2, 5]) > 10.0
+    found = differences(mooring, MOORING, 1e-4)
+    # the anchor sits on the seabed: its own vertical stiffness is that of lifting it
+    # (pressing it in would add the contact of its node); every other entry two-sided
+    mask = np.ones((6, 6), dtype=bool)
+    mask[2, 2] = False
+    assert np.abs(K - found)[mask].max() < 1e-5 * scale
+    lifted = differences(mooring, MOORING, 1e-6, one_sided=True)
+    assert K[2, 2] == pytest.approx(lifted[2, 2], rel=1e-4)
+
+
+def test_one_rank_and_all_agree(mooring):
+    alone = held(line_model(MOORING, seabed=-30.0, elements=50), PETSc.COMM_SELF, MOORING)
+    try:
+        assert mooring.end_forces() == pytest.approx(alone.end_forces(), rel=1e-9, abs=1e-7)
+        K, K1 = mooring.stiffness(), alone.stiffness()
+        assert np.abs(K - K1).max() < 1e-8 * np.abs(K1).max()
+    finally:
+        alone.destroy()
+
+
+def test_a_current_has_no_exact_stiffness_yet():
+    line = HeldLine(line_model(HANGING, current=(0.0, 0.5, 0.0)), PETSc.COMM_WORLD,
+                    options=TIGHT)
+    try:
+        assert line.solve(*HANGING)
+        with pytest.raises(RodInputError, match="follower"):
+            line.stiffness()
+    finally:
+        line.destroy()
