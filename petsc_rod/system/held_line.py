@@ -23,26 +23,30 @@ reactions the single-line solver reports (quantities/line_results.py: ``start_fo
 ``end_force``), F_a + F_b = the whole applied load.
 
 **Stiffness.** K = d(F_a, F_b)/d(x_a, x_b), (6, 6), N/m, rows the forces (a then b),
-columns the positions (a then b): K = -Hess Phi. From the KKT system at the equilibrium,
-H the second variation (the Hessian of L, analysis/second_variation.py), C^T the chord
-forms (3 columns) and P = dgrad L/dz_a the seabed's curvature times the derivative of
-each node's height (SecondVariation.position_shift), with Y_C = H^-1 C^T, Y_P = H^-1 P,
-S = C Y_C (3, 3), CY = C Y_P (3,), A = sum_n k w_n over the nodes in contact:
+columns the positions (a then b). Linearise the equilibrium in its data, the chord
+c = x_b - x_a and the start's height z_a: with A the matrix of the Newton system at the
+equilibrium (H, the second variation, analysis/second_variation.py; in a current the
+Newton Jacobian J, analysis/jacobian.py), C^T the chord forms (3 columns) and
+P = dgrad L/dz_a (the seabed's curvature times each node's height row,
+SecondVariation.position_shift), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3, 3):
 
-    G_cc = S^-1,   G_cz = S^-1 CY,   G_zz = A - P.Y_P + CY . S^-1 CY,
+    dmu = -S^-1 (dc + C Y_P dz_a),   dy = -Y_P dz_a - Y_C dmu,
+    dF_b = dmu,   dF_a = dPsi_0 - (P.dy + sum_n k w_n dz_a) e_z - dmu,
 
-and with T the map (x_a, x_b) -> (z_a, c), K = -T^T [G_zz G_zc; G_cz G_cc] T. H is the
-line's own, factored by the stability test's LDL^T (MUMPS; by substructuring on several
-ranks), unshifted: no finite differences. Without a seabed K_aa = K_bb = -K_ab = -S^-1
-(a translation of the whole line changes nothing). K is symmetric, being a Hessian:
-the line is conservative (dead loads, the elastic seabed, stretch, attachments' dead
-forces). K is negative semi-definite for a stable line in this convention (moving an
-end outward pulls it back): the restoring stiffness of a point on the line is -K.
+Psi_0 the resultant at S = 0 of a load that follows the line (the drag: a row of the
+Jacobian's unknowns, so dPsi_0 a row of dy), sum_n over the nodes in contact. One
+factorisation of A (the stability test's LDL^T of H unshifted, or J's LU; by
+substructuring on several ranks) and four solves: no finite differences. Without a
+current K = -Hess Phi: symmetric, and negative semi-definite for a stable line (moving
+an end outward pulls it back: the restoring stiffness of a point is -K); without a
+seabed K_aa = K_bb = -K_ab = -S^-1 (a translation of the whole line changes nothing).
+In a uniform current K is not symmetric: the drag has no potential, and its resultant
+turns with the line (K[:, :3] = -K[:, 3:] still holds without a seabed).
 
-What it refuses (RodInputError, one line): a stiffness for a line whose loads have no
-energy (a current's drag: a follower load, whose Newton Jacobian is unsymmetric and
-whose total drag moves with the shape; the seabed's friction, which dissipates; a
-sloping or profiled seabed's lagged contact; the sea surface's wet and dry parts).
+What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
+seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged), a
+sheared current (the depth derivative of its drag is not in J), and any load outside
+the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -51,6 +55,7 @@ each line on its own sub-communicator.
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.analysis.jacobian import NewtonJacobian
 from petsc_rod.cli.main import build_solver, check_mesh, destroy_run
 from petsc_rod.cli.options import parse_values
 from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
@@ -195,6 +200,7 @@ class HeldLine:
         self.values = parse_values({f"rod_{k}": str(v) for k, v in (options or {}).items()})
         self.scene = self._compile(span.start.position, span.end.position)
         self.mesh = self.problem = self.solver = self.newton = self.path = None
+        self.jacobian = None
         self.iterations = 0
         self.converged = False
 
@@ -235,8 +241,10 @@ class HeldLine:
         self.newton = NewtonSolver(self.problem)
 
     def _release(self):
-        if self.newton is not None:
-            self.newton.destroy()
+        for owned in (self.jacobian, self.newton):
+            if owned is not None:
+                owned.destroy()
+        self.jacobian = None
         destroy_run(self.solver, self.problem, self.mesh)
         self.mesh = self.problem = self.solver = self.newton = self.path = None
 
@@ -317,8 +325,9 @@ class HeldLine:
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
         derivative of force component i (0-2 on the start, 3-5 on the end) in position
         component j (0-2 of the start, 3-5 of the end), at the last equilibrium, from
-        the line's factored second variation (module docstring). Symmetric; negative
-        semi-definite for a stable line. Collective."""
+        the line's factored second variation, or in a uniform current its Newton
+        Jacobian (module docstring). Symmetric and negative semi-definite for a stable
+        line without a current. Collective."""
         self._check_solved()
         problem = self.problem
         self._check_exact()
@@ -335,27 +344,24 @@ class HeldLine:
             for term in problem.terms:
                 if term.position_components:
                     term.add_hessian(recorder)
-            hessian.factorise(0.0)
             columns = hessian.chord_forms(frames[:, 2])
             vecs.extend(columns)
+            shift = None
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
-                columns = columns + [shift]
-            solved = hessian.solve_many(columns)
+            if hessian.resultants:
+                if self.jacobian is None:
+                    self.jacobian = NewtonJacobian(hessian)
+                self.jacobian.assemble()
+                solver = self.jacobian
+            else:
+                hessian.factorise(0.0)
+                solver = hessian
+            solved = solver.solve_many(columns + ([] if shift is None else [shift]))
             vecs.extend(solved)
-            schur = np.array([[c.dot(y) for y in solved] for c in columns])
-            if not np.all(np.isfinite(schur)):
-                raise np.linalg.LinAlgError("the line's second variation could not be "
-                                            "factored at its equilibrium")
-            curvature = np.zeros((4, 4))
-            inverse = np.linalg.inv(0.5 * (schur[:3, :3] + schur[:3, :3].T))
-            curvature[1:, 1:] = inverse
-            if recorder.heights is not None:
-                along = schur[:3, 3]                        # C H^-1 P
-                total = self.mesh.global_sum(float(recorder.heights.sum()))
-                curvature[1:, 0] = curvature[0, 1:] = inverse @ along
-                curvature[0, 0] = total - schur[3, 3] + along @ inverse @ along
+            response = self._response(hessian, columns, shift, solved,
+                                      recorder.heights)
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -364,7 +370,43 @@ class HeldLine:
         chain[0, 2] = 1.0
         chain[1:, :3] = -np.eye(3)
         chain[1:, 3:] = np.eye(3)
-        return -chain.T @ curvature @ chain
+        return response @ chain
+
+    def _response(self, hessian, columns, shift, solved, heights):
+        """d(F_a, F_b)/d(z_a, c), (6, 4), from the solves Y = A^-1 [C^T, P] (A: H, or
+        J in a current): dmu = -S^-1 (dc + C Y_P dz), dy = -Y_P dz - Y_C dmu, F_b = mu,
+        F_a = W + Psi_0 + R_s e_z - mu with Psi_0 the load's resultant at S = 0 that
+        follows the shape (the drag's, a row of dy) and R_s the seabed's whole reaction,
+        dR_s = -(P.dy + sum k w_n dz). Collective."""
+        mesh = self.mesh
+        Y_C, Y_P = solved[:3], solved[3:]
+        schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
+        if not np.all(np.isfinite(schur)):
+            raise np.linalg.LinAlgError("the line's second variation could not be "
+                                        "factored at its equilibrium")
+        inverse = np.linalg.inv(schur)
+        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(3)
+        dmu = np.zeros((3, 4))                              # d mu / d(z_a, c)
+        dmu[:, 0] = -inverse @ along
+        dmu[:, 1:] = -inverse
+
+        def of_dy(values_C, value_P):
+            """A linear functional of dy (values on Y_C (.., 3) and on Y_P (..,))
+            as a function of (z_a, c)."""
+            return -np.multiply.outer(value_P, [1.0, 0.0, 0.0, 0.0]) - values_C @ dmu
+
+        start = -dmu.copy()
+        if hessian.resultants:
+            slot = hessian.resultant_slot
+            first = [y.getArray(readonly=True).reshape(-1, hessian.block)[0, slot:slot + 3]
+                     if mesh.on_lower_boundary else np.zeros(3) for y in solved]
+            first = mesh.global_sum(np.array(first))        # (3 or 4, 3): Psi_0 of each Y
+            start += of_dy(first[:3].T, first[3] if Y_P else np.zeros(3))
+        if shift is not None:
+            moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]))
+            moved[0] += mesh.global_sum(float(heights.sum()))
+            start[2] -= moved                               # P.dy + sum k w_n dz
+        return np.vstack([start, dmu])
 
     def _check_solved(self):
         if self.problem is None or not self.converged:
@@ -374,21 +416,24 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if scene.current is not None:
-            raise RodInputError("HeldLine.stiffness: a current's drag is a follower load "
-                                "(no energy; its total moves with the shape): no exact "
-                                "stiffness of a line in a current yet")
+        current = scene.current
+        if current is not None and np.ptp(current.velocities, axis=0).max() > 0:
+            raise RodInputError("HeldLine.stiffness: a current profile's depth derivative "
+                                "is not in the Newton Jacobian: no exact stiffness in a "
+                                "sheared current (a uniform one has one)")
         if scene.seabed is not None and scene.seabed.friction is not None:
             raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
                                 "exact stiffness of a line with friction")
         if scene.seabed is not None and not scene.seabed.flat:
             raise RodInputError("HeldLine.stiffness: exact on a flat seabed only (a "
                                 "sloping or profiled one's contact is lagged)")
-        if not (self.problem.conservative and self.problem.in_newton):
-            loads = ", ".join(type(t).__name__ for t in self.problem.terms
-                              if not (t.conservative and t.in_newton))
-            raise RodInputError(f"HeldLine.stiffness: loads without an energy ({loads}): "
-                                "no exact stiffness")
+        loose = [term for term in self.problem.terms if not term.in_newton
+                 or not (term.conservative or term.follower)]
+        if loose:
+            loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
+                                            for term in loose))
+            raise RodInputError(f"HeldLine.stiffness: loads outside the Newton system "
+                                f"({loads}): no exact stiffness")
 
     def destroy(self):
         """Free the line's PETSc objects (all made in _build). Collective."""
