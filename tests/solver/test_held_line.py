@@ -193,3 +193,30 @@ def test_a_sheared_current_has_no_exact_stiffness_yet():
             line.stiffness()
     finally:
         line.destroy()
+
+
+def test_a_solve_that_fails_is_a_result():
+    """Too few iterations: solve says False (no traceback), and the line has no
+    equilibrium to give forces of."""
+    line = HeldLine(line_model(HANGING), PETSc.COMM_WORLD, options={"al_max_it": 2})
+    try:
+        assert not line.solve(*HANGING)
+        with pytest.raises(RodInputError, match="no converged equilibrium"):
+            line.end_forces()
+    finally:
+        line.destroy()
+
+
+def test_a_walk_that_fails_keeps_the_last_equilibrium():
+    line = held(line_model(HANGING), PETSc.COMM_WORLD, HANGING)
+    try:
+        before = line.end_forces()
+        # a budget no walk of 100 m can keep to (the controller reads it every step)
+        line.solver.settings.max_it = 2
+        assert not line.solve(HANGING[0], HANGING[1] - np.array([60.0, 0.0, 0.0]))
+        assert line.end_forces() == pytest.approx(before, rel=1e-12)
+        assert line.positions() == pytest.approx(np.array(HANGING), abs=1e-12)
+        line.solver.settings.max_it = 2000
+        assert line.solve(HANGING[0], HANGING[1] - np.array([1.0, 0.0, 0.0]))
+    finally:
+        line.destroy()
