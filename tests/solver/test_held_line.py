@@ -220,3 +220,23 @@ def test_a_walk_that_fails_keeps_the_last_equilibrium():
         assert line.solve(HANGING[0], HANGING[1] - np.array([1.0, 0.0, 0.0]))
     finally:
         line.destroy()
+
+
+def test_stiffness_with_a_clamped_start():
+    """A clamp holds its frame as the model gives it; an inextensible line's stiffness
+    in the ends' positions is as exact as a pinned one's."""
+    line = UniformLine(length=LENGTH, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -WEIGHT),
+                       elements=40)
+    model = Model(line=line, start=End(kind="clamp", position=tuple(HANGING[0])),
+                  end=End.anchor(tuple(HANGING[1])), environment=Environment())
+    clamped = held(model, PETSc.COMM_WORLD, HANGING)
+    try:
+        results = solve(model, comm=PETSc.COMM_WORLD)
+        assert clamped.end_forces()[0] == pytest.approx(results.scalars["start_force"],
+                                                        rel=1e-8)
+        K = clamped.stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - K.T).max() < 1e-10 * scale
+        assert np.abs(K - differences(clamped, HANGING, 1e-3)).max() < 1e-5 * scale
+    finally:
+        clamped.destroy()
