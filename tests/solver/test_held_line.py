@@ -240,3 +240,25 @@ def test_stiffness_with_a_clamped_start():
         assert np.abs(K - differences(clamped, HANGING, 1e-3)).max() < 1e-5 * scale
     finally:
         clamped.destroy()
+
+
+def test_lines_on_their_own_communicators():
+    """Each rank holds a different line (another mesh, other ends) on a communicator of
+    its own, split from the world's: nothing is collective beyond a line's ranks (a
+    call on the world's would hang or mix the lines)."""
+    world = PETSc.COMM_WORLD.tompi4py()
+    own = PETSc.Comm(world.Split(world.Get_rank()))
+    ends = (HANGING[0], HANGING[1] + np.array([-2.0 * world.Get_rank(), 0.0, 0.0]))
+    model = line_model(ends, elements=30 + 10 * world.Get_rank())
+    line = held(model, own, ends)
+    try:
+        assert line.solve(ends[0], ends[1] + np.array([0.5, 0.0, 0.0]))
+        assert line.solve(*ends)
+        K = line.stiffness()
+        reference = solve(model, comm=PETSc.COMM_SELF)
+        assert line.end_forces()[1] == pytest.approx(reference.scalars["end_force"],
+                                                     rel=1e-8)
+        assert np.abs(K - K.T).max() < 1e-10 * np.abs(K).max()
+    finally:
+        line.destroy()
+        own.tompi4py().Free()
