@@ -67,6 +67,7 @@ from petsc_rod.cli.options import parse_values
 from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
 from petsc_rod.compile import compile_scene
 from petsc_rod.errors import NoCatenaryStart, RodError, RodInputError
+from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import NewtonSolver
@@ -189,7 +190,7 @@ class HeldLine:
     without ``rod_`` that tune the solver ({'al_rtol': 1e-10}).
 
     solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
-    stiffness() -> (6, 6); destroy(). ``iterations``: those of the last solve."""
+    end_moments() -> (2, 3); stiffness() -> (6, 6); positions() -> (2, 3); destroy(). ``iterations``: those of the last solve."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -326,6 +327,16 @@ class HeldLine:
         on_start, on_end = points_on_held_ends(problem)
         return np.array([_at_vertex(mesh, n, 0) + on_start,
                          -_at_vertex(mesh, n, mesh.n_elements) + on_end])
+
+    def end_moments(self):
+        """(2, 3), N m, global axes: the moment the line exerts on its start's support
+        (row 0) and on its end's (row 1), m(0) and -m(L) (line_results' start_moment and
+        end_moment): a clamp's reaction; at a pin the bending of the end element's strain
+        (small: of the discretisation, not a reaction). Collective."""
+        self._check_solved()
+        mesh = self.mesh
+        m = vertex_fields(self.problem)["m"]
+        return np.array([_at_vertex(mesh, m, 0), -_at_vertex(mesh, m, mesh.n_elements)])
 
     def stiffness(self):
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the

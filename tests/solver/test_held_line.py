@@ -234,6 +234,12 @@ def test_stiffness_with_a_clamped_start():
         results = solve(model, comm=PETSc.COMM_WORLD)
         assert clamped.end_forces()[0] == pytest.approx(results.scalars["start_force"],
                                                         rel=1e-8)
+        moments = clamped.end_moments()
+        assert moments[0] == pytest.approx(results.scalars["start_moment"], rel=1e-6,
+                                           abs=1e-6)
+        assert moments[1] == pytest.approx(results.scalars["end_moment"], rel=1e-6,
+                                           abs=1e-6)
+        assert abs(moments[0][1]) > 10.0                    # the clamp's reaction
         K = clamped.stiffness()
         scale = np.abs(K).max()
         assert np.abs(K - K.T).max() < 1e-10 * scale
