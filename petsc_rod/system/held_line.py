@@ -73,7 +73,8 @@ from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.model.line import UniformLine
-from petsc_rod.model.model import Model
+from petsc_rod.model.end import End
+from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.quantities.riser_numbers import points_on_held_ends
 from petsc_rod.scenes import starts
@@ -210,6 +211,24 @@ class HeldLine:
         self.jacobian = None
         self.iterations = 0
         self.converged = False
+
+    @classmethod
+    def of_system_line(cls, line, start, end, comm, environment, options=None):
+        """The HeldLine of a model.system.SystemLine ``line`` whose ends are first at
+        ``start`` and ``end`` ((3,), m, absolute: where the system's points and bodies
+        put its connections): a 'pin' connection a pinned End, 'flex' a pinned End with
+        the connection's rotational stiffness (its axis the line's start direction),
+        'clamp' a clamped End in the reference frame (the body's frame is not passed
+        yet)."""
+        def end_of(connection, position):
+            kind = "clamp" if connection.kind == "clamp" else "pin"
+            stiffness = connection.stiffness if connection.kind == "flex" else None
+            return End(kind=kind, position=tuple(float(v) for v in position),
+                       stiffness=stiffness)
+
+        span = Span(line.line, end_of(line.start, start), end_of(line.end, end),
+                    tuple(line.attachments))
+        return cls(span, comm, environment, options)
 
     # --- building ----------------------------------------------------------------------
     def _compile(self, start, end):

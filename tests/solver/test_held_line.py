@@ -268,3 +268,21 @@ def test_lines_on_their_own_communicators():
     finally:
         line.destroy()
         own.tompi4py().Free()
+
+
+def test_a_line_of_a_system():
+    """A SystemLine (model/system.py) between a fixed point and a point it is held at:
+    its HeldLine is the same line as the Model's."""
+    from petsc_rod.model.system import Connection, SystemLine
+    line = line_model(HANGING).line
+    member = SystemLine("one", line, Connection("anchor"), Connection("fairlead"))
+    held_line = HeldLine.of_system_line(member, *HANGING, PETSc.COMM_WORLD, Environment(),
+                                        TIGHT)
+    reference = held(line_model(HANGING), PETSc.COMM_WORLD, HANGING)
+    try:
+        assert held_line.solve(*HANGING)
+        assert held_line.end_forces() == pytest.approx(reference.end_forces(), rel=1e-10)
+        assert held_line.stiffness() == pytest.approx(reference.stiffness(), rel=1e-8)
+    finally:
+        held_line.destroy()
+        reference.destroy()
