@@ -41,10 +41,13 @@ current K = -Hess Phi: symmetric, and negative semi-definite for a stable line (
 an end outward pulls it back: the restoring stiffness of a point is -K); without a
 seabed K_aa = K_bb = -K_ab = -S^-1 (a translation of the whole line changes nothing).
 In a uniform current K is not symmetric: the drag has no potential, and its resultant
-turns with the line (K[:, :3] = -K[:, 3:] still holds without a seabed).
+turns with the line (K[:, :3] = -K[:, 3:] still holds without a seabed). The seabed's
+contact is semi-smooth: an anchor exactly on the seabed has a one-sided vertical
+stiffness of its own (its node enters the contact when pressed in), and K gives the
+lifting side (its node counts as in contact only below the seabed).
 
-A clamped end holds the frame the model gives it (its moment and the rotations are not
-among the outputs yet). On an extensible line the clamp's own node's stretch is held in
+A clamped end holds the frame the model gives it: its moment is end_moments(), but a
+turn of the clamp's frame is no input yet (no rotational stiffness). On an extensible line the clamp's own node's stretch is held in
 H, as the Newton steps hold it (docs/method.md §12: it comes from the force balance),
 so there K misses that node's share: 7e-5 of the largest entry on a 40-element line,
 against 3e-9 inextensible.
