@@ -194,7 +194,8 @@ class HeldLine:
     without ``rod_`` that tune the solver ({'al_rtol': 1e-10}).
 
     solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
-    end_moments() -> (2, 3); stiffness() -> (6, 6); positions() -> (2, 3); destroy(). ``iterations``: those of the last solve."""
+    end_moments() -> (2, 3); stiffness() -> (6, 6); stable() -> bool or None;
+    positions() -> (2, 3); destroy(). ``iterations``: those of the last solve."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -349,6 +350,20 @@ class HeldLine:
         on_start, on_end = points_on_held_ends(problem)
         return np.array([_at_vertex(mesh, n, 0) + on_start,
                          -_at_vertex(mesh, n, mesh.n_elements) + on_end])
+
+    def stable(self):
+        """The stability test's verdict on the last equilibrium (docs/method.md §10):
+        True a local minimiser, False a saddle, None undecided or a line whose loads
+        have no energy (a current). A system may solve its lines with the test off
+        (options {'al_stability': 0}: a third of a small warm re-solve's time) and ask
+        this once at its own equilibrium. Collective."""
+        self._check_solved()
+        if not self.problem.conservative:
+            return None
+        try:
+            return self.solver.check_stability()[0]
+        except np.linalg.LinAlgError:
+            return None
 
     def end_moments(self):
         """(2, 3), N m, global axes: the moment the line exerts on its start's support

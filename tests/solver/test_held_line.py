@@ -118,6 +118,11 @@ def test_a_small_move_is_warm_started(hanging):
     assert first.solve(HANGING[0], HANGING[1] + np.array([0.5, 0.0, -0.3]))
     assert first.iterations < cold
     first.destroy()
+    # solved without the stability test, asked once at the end
+    untested = HeldLine(line_model(HANGING), hanging.comm, options={**TIGHT, "al_stability": 0})
+    assert untested.solve(*HANGING) and untested.stable() is True
+    assert untested.end_forces() == pytest.approx(hanging.end_forces(), rel=1e-9)
+    untested.destroy()
 
 
 @pytest.fixture(scope="module", params=list(COMMS))
