@@ -291,3 +291,29 @@ def test_a_line_of_a_system():
     finally:
         held_line.destroy()
         reference.destroy()
+
+
+def test_a_line_of_sections_on_the_seabed():
+    """Chain, rope, chain (line types of their own EA and weight) from an anchor on an
+    elastic seabed: the reactions and the stiffness as for a uniform line."""
+    from petsc_rod.api import Line, LineType
+    chain = LineType("chain", od=0.1, mass=100.0, ei=1e2, gj=1e2, ea=5e7)
+    rope = LineType("rope", od=0.15, mass=20.0, ei=1e2, gj=1e2, ea=1e7)
+    line = Line([(chain, 30.0), (rope, 50.0), (chain, 20.0)], element_length=2.0)
+    model = Model(line=line, start=End.anchor(tuple(MOORING[0])),
+                  end=End.anchor(tuple(MOORING[1])), environment=Environment(seabed=-30.0))
+    sections = held(model, PETSc.COMM_WORLD, MOORING)
+    try:
+        results = solve(model, comm=PETSc.COMM_WORLD)
+        assert results.scalars["touchdown_S"] > 25.0
+        assert sections.end_forces()[1] == pytest.approx(results.scalars["end_force"],
+                                                         rel=1e-8)
+        K = sections.stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - K.T).max() < 1e-10 * scale
+        found = differences(sections, MOORING, 1e-4)
+        mask = np.ones((6, 6), dtype=bool)
+        mask[2, 2] = False                  # the anchor on the seabed: one-sided
+        assert np.abs(K - found)[mask].max() < 1e-5 * scale
+    finally:
+        sections.destroy()
