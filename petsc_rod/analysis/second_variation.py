@@ -279,6 +279,32 @@ class SecondVariation:
         for rows, columns, blocks in self.position_blocks(values, components, components):
             self._add_blocks(rows, columns, blocks)
 
+    def position_shift(self, values, component):
+        """The Vec sum_n values_n dx^c_n/dy of the owned nodes' ``values`` (n_nodes,)
+        (a position energy's second derivative, N/m) times the derivative of component c
+        of node n's position in the unknowns y: at a vertex its u^c, at a midpoint the
+        row of u^c_e + h_e HALF.s^c_e (position_blocks). It is d(gradient)/d(shift):
+        how the gradient of that energy moves when every position of component c is
+        shifted by 1 m (the held end moved, system/held_line.py); 0 on held rows.
+        Needs the chains of the last assembly. Collective."""
+        values = np.asarray(values, dtype=float)
+        vec = self.matrix.createVecLeft()
+        vec.zeroEntries()
+        slot = self.position_slot[component]
+        vertices = self.first_row + self.block * np.arange(0, values.shape[0], 2) + slot
+        ne = self.problem.mesh.n_local_elements
+        rows = [vertices]
+        entries = [values[0::2]]
+        if ne:
+            rows.append(self._midpoint_index[component].ravel())
+            entries.append((values[1:2 * ne:2, None]
+                            * self._midpoint_rows[component]).ravel())
+        vec.setValues(np.concatenate(rows).astype(PETSc.IntType), np.concatenate(entries),
+                      addv=PETSc.InsertMode.ADD_VALUES)
+        vec.assemble()
+        self._zero_clamped(vec)
+        return vec
+
     def add_height_curvature(self, curvature):
         """Add a height energy's second derivative d2E/dz_n^2 (n_nodes,), N/m, at the owned
         nodes (add_position_curvature of the heights alone)."""

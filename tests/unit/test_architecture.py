@@ -113,8 +113,9 @@ def test_nothing_below_the_front_ends_imports_one():
 
 
 def test_the_system_solver_imports_no_front_end():
-    """system/ sits beside api/: the command line and the API use it, it uses neither."""
-    others = set(FRONT_ENDS) - {"system"}
+    """system/ sits beside api/: the command line and the API use it, it uses neither
+    (the command line's builders that api/run.py uses as well: the next test)."""
+    others = set(FRONT_ENDS) - {"system", "cli"}
     above = {path: sorted(name for name in imported(tree) if name.split(".")[0] in others)
              for path, tree in modules().items() if folder_of(path) == "system"}
     assert len(above) >= 3                                  # the folder was read
@@ -213,3 +214,25 @@ def test_a_scene_is_made_whole_by_its_constructor():
                                 and isinstance(part.value, ast.Name)
                                 and part.value.id == "scene"), \
                         f"{path}:{node.lineno} sets scene.{part.attr} on a made Scene"
+
+
+# The layer of a system's components (petsc_rod/system), at the level of the front
+# ends' helpers: it drives the solver as the Python API does, so of the front ends it
+# imports only the cli modules api/run.py imports from (its build and start helpers).
+SYSTEM_NOT = ("api", "sweep", "report", "plots", "figures", "__main__")
+
+
+def test_the_system_layer_imports_what_the_api_builds_with():
+    run = imported(modules()[os.path.join("api", "run.py")])
+    allowed = {name for name in run if name.startswith("cli.")}
+    found = 0
+    for path, tree in modules().items():
+        if folder_of(path) != "system":
+            continue
+        found += 1
+        names = imported(tree)
+        front = sorted(name for name in names if name.split(".")[0] in SYSTEM_NOT)
+        assert not front, f"{path} imports the front end {front}"
+        cli = sorted(name for name in names if name.startswith("cli.") and name not in allowed)
+        assert not cli, f"{path} imports {cli}, which api/run.py does not"
+    assert found >= 2                                       # the folder was read

@@ -1,0 +1,319 @@
+"""One line of a system held at its two ends (petsc_rod/system/held_line.py), on one
+rank (PETSc.COMM_SELF) and on all (PETSc.COMM_WORLD: under ``mpiexec -n 2`` the
+parallel run):
+
+(a) its end forces are the single-line solver's reactions (api.solve of the same Model:
+    start_force, end_force);
+(b) its stiffness, from the line's factored second variation, against central finite
+    differences of re-solves: an extensible line hanging between two pins (the elastic
+    catenary; also against the derivative of the closed form, Irvine's), and a mooring
+    line partly on an elastic seabed (where the start's height enters through the
+    seabed's positions);
+(c) the stiffness is symmetric (the line is conservative), and without a seabed a
+    translation of the whole line changes nothing: K_aa = K_bb = -K_ab;
+(d) a small move of the ends, warm-started from the last equilibrium, takes fewer
+    iterations than the first solve;
+(e) the same numbers on one rank and on all;
+(f) in a uniform current (the drag follows the line) the stiffness from the Newton
+    Jacobian against central differences, unsymmetric; in a sheared one (whose depth
+    derivative the Jacobian leaves out) refused in one line.
+"""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import End, Environment, Model, UniformLine, solve
+from petsc_rod.errors import RodInputError
+from petsc_rod.system.held_line import HeldLine
+from petsc_rod.validation.elastic_catenary import elastic_catenary
+
+pytestmark = pytest.mark.solver
+
+COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
+TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
+# the elastic catenary: 100 m of 10 N/m, EA 1e5 N, pins 80 m across and 20 m up
+LENGTH, WEIGHT, EA = 100.0, 10.0, 1e5
+HANGING = (np.zeros(3), np.array([80.0, 0.0, 20.0]))
+# a mooring line: the anchor on an elastic seabed 30 m below the fairlead, 85 m away
+MOORING = (np.array([0.0, 0.0, -30.0]), np.array([85.0, 0.0, 0.0]))
+
+
+def line_model(ends, seabed=None, current=None, elements=40):
+    line = UniformLine(length=LENGTH, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -WEIGHT),
+                       axial_stiffness=EA, elements=elements,
+                       drag=None if current is None else (1025.0, 1.2, 0.1))
+    return Model(line=line, start=End.anchor(tuple(ends[0])), end=End.anchor(tuple(ends[1])),
+                 environment=Environment(seabed=seabed, current=current))
+
+
+def held(model, comm, ends):
+    line = HeldLine(model, comm, options=TIGHT)
+    assert line.solve(*ends)
+    return line
+
+
+def differences(line, ends, step, one_sided=False):
+    """The (6, 6) finite differences of end_forces in the six end coordinates
+    (central; ``one_sided``: forward)."""
+    base = line.end_forces().ravel()
+    columns = []
+    for j in range(6):
+        move = np.zeros(6)
+        move[j] = step
+        assert line.solve(ends[0] + move[:3], ends[1] + move[3:])
+        plus = line.end_forces().ravel()
+        if one_sided:
+            columns.append((plus - base) / step)
+            continue
+        assert line.solve(ends[0] - move[:3], ends[1] - move[3:])
+        columns.append((plus - line.end_forces().ravel()) / (2 * step))
+    assert line.solve(*ends)
+    return np.array(columns).T
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def hanging(request):
+    line = held(line_model(HANGING), COMMS[request.param], HANGING)
+    yield line
+    line.destroy()
+
+
+def test_end_forces_are_the_single_line_solvers_reactions(hanging):
+    results = solve(line_model(HANGING), comm=hanging.comm)
+    forces = hanging.end_forces()
+    assert forces[0] == pytest.approx(results.scalars["start_force"], rel=1e-8, abs=1e-6)
+    assert forces[1] == pytest.approx(results.scalars["end_force"], rel=1e-8, abs=1e-6)
+    # the supports carry the weight
+    assert forces.sum(axis=0) == pytest.approx([0.0, 0.0, -WEIGHT * LENGTH], rel=1e-10)
+
+
+def test_stiffness_of_the_elastic_catenary(hanging):
+    K = hanging.stiffness()
+    scale = np.abs(K).max()
+    # conservative: a Hessian; no seabed: only the chord matters
+    assert np.abs(K - K.T).max() < 1e-10 * scale
+    assert np.abs(K[:3, :3] - K[3:, 3:]).max() < 1e-10 * scale
+    assert np.abs(K[:3, :3] + K[:3, 3:]).max() < 1e-10 * scale
+    assert np.all(np.linalg.eigvalsh(K[3:, 3:]) < 0)            # it pulls back
+    found = differences(hanging, HANGING, 1e-3)
+    assert np.abs(K - found).max() < 1e-5 * scale
+    # the closed form's derivative: F_b = -(H, 0, V_A + w L) at the end (X, Z)
+    def pull(X, Z):
+        line = elastic_catenary(LENGTH, WEIGHT, EA, X, Z, on_seabed=False)
+        return -np.array([line.H, line.V_A + WEIGHT * LENGTH])
+    X, Z, step = HANGING[1][0], HANGING[1][2], 1e-3
+    closed = np.column_stack([(pull(X + step, Z) - pull(X - step, Z)) / (2 * step),
+                              (pull(X, Z + step) - pull(X, Z - step)) / (2 * step)])
+    assert K[3:, 3:][np.ix_([0, 2], [0, 2])] == pytest.approx(closed, rel=2e-5)
+    # across the plane: the string's H / X
+    assert K[4, 4] == pytest.approx(-elastic_catenary(LENGTH, WEIGHT, EA, X, Z, False).H / X,
+                                    rel=2e-5)
+
+
+def test_a_small_move_is_warm_started(hanging):
+    first = HeldLine(line_model(HANGING), hanging.comm, options=TIGHT)
+    assert first.solve(*HANGING)
+    cold = first.iterations
+    assert first.solve(HANGING[0], HANGING[1] + np.array([0.5, 0.0, -0.3]))
+    assert first.iterations < cold
+    first.destroy()
+    # solved without the stability test, asked once at the end
+    untested = HeldLine(line_model(HANGING), hanging.comm, options={**TIGHT, "al_stability": 0})
+    assert untested.solve(*HANGING) and untested.stable() is True
+    assert untested.end_forces() == pytest.approx(hanging.end_forces(), rel=1e-9)
+    untested.destroy()
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def mooring(request):
+    line = held(line_model(MOORING, seabed=-30.0, elements=50), COMMS[request.param],
+                MOORING)
+    yield line
+    line.destroy()
+
+
+def test_stiffness_on_an_elastic_seabed(mooring):
+    results = solve(line_model(MOORING, seabed=-30.0, elements=50), comm=mooring.comm)
+    assert results.scalars["touchdown_S"] > 40.0                 # partly grounded
+    forces = mooring.end_forces()
+    assert forces[0] == pytest.approx(results.scalars["start_force"], rel=1e-8, abs=1e-6)
+    assert forces[1] == pytest.approx(results.scalars["end_force"], rel=1e-8, abs=1e-6)
+    K = mooring.stiffness()
+    scale = np.abs(K).max()
+    assert np.abs(K - K.T).max() < 1e-10 * scale
+    # the seabed makes a vertical translation matter: K_aa is not -K_ab
+    assert abs(K[2, 2] + K[2, 5]) > 10.0
+    found = differences(mooring, MOORING, 1e-4)
+    # the anchor sits on the seabed: its own vertical stiffness is that of lifting it
+    # (pressing it in would add the contact of its node); every other entry two-sided
+    mask = np.ones((6, 6), dtype=bool)
+    mask[2, 2] = False
+    assert np.abs(K - found)[mask].max() < 1e-5 * scale
+    lifted = differences(mooring, MOORING, 1e-6, one_sided=True)
+    assert K[2, 2] == pytest.approx(lifted[2, 2], rel=1e-4)
+
+
+def test_one_rank_and_all_agree(mooring):
+    alone = held(line_model(MOORING, seabed=-30.0, elements=50), PETSc.COMM_SELF, MOORING)
+    try:
+        assert mooring.end_forces() == pytest.approx(alone.end_forces(), rel=1e-9, abs=1e-7)
+        K, K1 = mooring.stiffness(), alone.stiffness()
+        assert np.abs(K - K1).max() < 1e-8 * np.abs(K1).max()
+    finally:
+        alone.destroy()
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def dragged(request):
+    line = held(line_model(HANGING, current=(0.0, 0.5, 0.0)), COMMS[request.param], HANGING)
+    yield line
+    line.destroy()
+
+
+def test_stiffness_in_a_current(dragged):
+    """The drag follows the line: the stiffness is the KKT system's with the Newton
+    Jacobian J, and the start's force moves with the whole drag's resultant."""
+    results = solve(line_model(HANGING, current=(0.0, 0.5, 0.0)), comm=dragged.comm)
+    forces = dragged.end_forces()
+    assert forces[0] == pytest.approx(results.scalars["start_force"], rel=1e-8, abs=1e-6)
+    assert forces[1] == pytest.approx(results.scalars["end_force"], rel=1e-8, abs=1e-6)
+    assert forces[:, 1].sum() > 100.0                       # the current's push
+    K = dragged.stiffness()
+    scale = np.abs(K).max()
+    # no energy: not symmetric; a uniform current and no seabed: only the chord matters
+    assert np.abs(K - K.T).max() > 0.1 * scale
+    assert np.abs(K[:, :3] + K[:, 3:]).max() < 1e-10 * scale
+    found = differences(dragged, HANGING, 1e-3)
+    assert np.abs(K - found).max() < 1e-5 * scale
+
+
+def test_a_sheared_current_has_no_exact_stiffness_yet():
+    line = HeldLine(line_model(HANGING, current=[[0.0, 0.0, 0.5, 0.0],
+                                                 [50.0, 0.0, 0.1, 0.0]]),
+                    PETSc.COMM_WORLD, options=TIGHT)
+    try:
+        assert line.solve(*HANGING)
+        with pytest.raises(RodInputError, match="sheared current"):
+            line.stiffness()
+    finally:
+        line.destroy()
+
+
+def test_a_solve_that_fails_is_a_result():
+    """Too few iterations: solve says False (no traceback), and the line has no
+    equilibrium to give forces of."""
+    line = HeldLine(line_model(HANGING), PETSc.COMM_WORLD, options={"al_max_it": 2})
+    try:
+        assert not line.solve(*HANGING)
+        with pytest.raises(RodInputError, match="no converged equilibrium"):
+            line.end_forces()
+    finally:
+        line.destroy()
+
+
+def test_a_walk_that_fails_keeps_the_last_equilibrium():
+    line = held(line_model(HANGING), PETSc.COMM_WORLD, HANGING)
+    try:
+        before = line.end_forces()
+        # a budget no walk of 100 m can keep to (the controller reads it every step)
+        line.solver.settings.max_it = 2
+        assert not line.solve(HANGING[0], HANGING[1] - np.array([60.0, 0.0, 0.0]))
+        assert line.end_forces() == pytest.approx(before, rel=1e-12)
+        assert line.positions() == pytest.approx(np.array(HANGING), abs=1e-12)
+        line.solver.settings.max_it = 2000
+        assert line.solve(HANGING[0], HANGING[1] - np.array([1.0, 0.0, 0.0]))
+    finally:
+        line.destroy()
+
+
+def test_stiffness_with_a_clamped_start():
+    """A clamp holds its frame as the model gives it; an inextensible line's stiffness
+    in the ends' positions is as exact as a pinned one's."""
+    line = UniformLine(length=LENGTH, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -WEIGHT),
+                       elements=40)
+    model = Model(line=line, start=End(kind="clamp", position=tuple(HANGING[0])),
+                  end=End.anchor(tuple(HANGING[1])), environment=Environment())
+    clamped = held(model, PETSc.COMM_WORLD, HANGING)
+    try:
+        results = solve(model, comm=PETSc.COMM_WORLD)
+        assert clamped.end_forces()[0] == pytest.approx(results.scalars["start_force"],
+                                                        rel=1e-8)
+        moments = clamped.end_moments()
+        assert moments[0] == pytest.approx(results.scalars["start_moment"], rel=1e-6,
+                                           abs=1e-6)
+        assert moments[1] == pytest.approx(results.scalars["end_moment"], rel=1e-6,
+                                           abs=1e-6)
+        assert abs(moments[0][1]) > 10.0                    # the clamp's reaction
+        K = clamped.stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - K.T).max() < 1e-10 * scale
+        assert np.abs(K - differences(clamped, HANGING, 1e-3)).max() < 1e-5 * scale
+    finally:
+        clamped.destroy()
+
+
+def test_lines_on_their_own_communicators():
+    """Each rank holds a different line (another mesh, other ends) on a communicator of
+    its own, split from the world's: nothing is collective beyond a line's ranks (a
+    call on the world's would hang or mix the lines)."""
+    world = PETSc.COMM_WORLD.tompi4py()
+    own = PETSc.Comm(world.Split(world.Get_rank()))
+    ends = (HANGING[0], HANGING[1] + np.array([-2.0 * world.Get_rank(), 0.0, 0.0]))
+    model = line_model(ends, elements=30 + 10 * world.Get_rank())
+    line = held(model, own, ends)
+    try:
+        assert line.solve(ends[0], ends[1] + np.array([0.5, 0.0, 0.0]))
+        assert line.solve(*ends)
+        K = line.stiffness()
+        reference = solve(model, comm=PETSc.COMM_SELF)
+        assert line.end_forces()[1] == pytest.approx(reference.scalars["end_force"],
+                                                     rel=1e-8)
+        assert np.abs(K - K.T).max() < 1e-10 * np.abs(K).max()
+    finally:
+        line.destroy()
+        own.tompi4py().Free()
+
+
+def test_a_line_of_a_system():
+    """A SystemLine (model/system.py) between a fixed point and a point it is held at:
+    its HeldLine is the same line as the Model's."""
+    from petsc_rod.model.system import Connection, SystemLine
+    line = line_model(HANGING).line
+    member = SystemLine("one", line, Connection("anchor"), Connection("fairlead"))
+    held_line = HeldLine.of_system_line(member, *HANGING, PETSc.COMM_WORLD, Environment(),
+                                        TIGHT)
+    reference = held(line_model(HANGING), PETSc.COMM_WORLD, HANGING)
+    try:
+        assert held_line.solve(*HANGING)
+        assert held_line.end_forces() == pytest.approx(reference.end_forces(), rel=1e-10)
+        assert held_line.stiffness() == pytest.approx(reference.stiffness(), rel=1e-8)
+    finally:
+        held_line.destroy()
+        reference.destroy()
+
+
+def test_a_line_of_sections_on_the_seabed():
+    """Chain, rope, chain (line types of their own EA and weight) from an anchor on an
+    elastic seabed: the reactions and the stiffness as for a uniform line."""
+    from petsc_rod.api import Line, LineType
+    chain = LineType("chain", od=0.1, mass=100.0, ei=1e2, gj=1e2, ea=5e7)
+    rope = LineType("rope", od=0.15, mass=20.0, ei=1e2, gj=1e2, ea=1e7)
+    line = Line([(chain, 30.0), (rope, 50.0), (chain, 20.0)], element_length=2.0)
+    model = Model(line=line, start=End.anchor(tuple(MOORING[0])),
+                  end=End.anchor(tuple(MOORING[1])), environment=Environment(seabed=-30.0))
+    sections = held(model, PETSc.COMM_WORLD, MOORING)
+    try:
+        results = solve(model, comm=PETSc.COMM_WORLD)
+        assert results.scalars["touchdown_S"] > 25.0
+        assert sections.end_forces()[1] == pytest.approx(results.scalars["end_force"],
+                                                         rel=1e-8)
+        K = sections.stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - K.T).max() < 1e-10 * scale
+        found = differences(sections, MOORING, 1e-4)
+        mask = np.ones((6, 6), dtype=bool)
+        mask[2, 2] = False                  # the anchor on the seabed: one-sided
+        assert np.abs(K - found)[mask].max() < 1e-5 * scale
+    finally:
+        sections.destroy()
