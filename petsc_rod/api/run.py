@@ -26,7 +26,7 @@ from petsc_rod.io import outputs
 from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.model.names import FIELD_NAMES, Names
 from petsc_rod.environment.profiles import read_seabed_profile
 
 
@@ -94,10 +94,19 @@ OPTION_FIELDS = {
 
 def in_model_terms(error):
     """RodInputError ``error`` of an option of Model.options, refused as the command line
-    refuses it, the option named as Model.options names it."""
-    text = re.sub(r"-rod_(\w+)", lambda match: f"Model.options {match.group(1)!r}",
+    refuses it, the option named as Model.options names it (Model.options['name'])."""
+    text = re.sub(r"-rod_(\w+)", lambda match: f"Model.options[{match.group(1)!r}]",
                   str(error))
     return RodInputError(text)
+
+
+def model_names(model):
+    """How a refusal names what ``model`` gives (model/names.Names): its fields as
+    FIELD_NAMES has them, and the fields an option of Model.options sets as that option
+    (Model.options['end_twist'], not Model.end.twist, which the caller left unset)."""
+    return Names({**FIELD_NAMES.table,
+                  **{name: f"Model.options[{name!r}]" for name in model.options}},
+                 FIELD_NAMES.fallback)
 
 
 def check_options_known(model):
@@ -176,7 +185,7 @@ def scene_of(model):
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     values, given = options_of(model)
-    return compile_scene(with_options(model, values), FIELD_NAMES), values, given
+    return compile_scene(with_options(model, values), model_names(model)), values, given
 
 
 def mesh_of(line, scene, values):
@@ -208,8 +217,9 @@ def solve(model, comm=None, output=None, say=None):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     check_same_model(comm, model)
     scene, values, given = on_every_rank(comm, scene_of, model)
-    settings = settings_from_options(values, scene, FIELD_NAMES)
-    check_stability_asked(values, scene, given, FIELD_NAMES, "Model.options['al_stability']")
+    names = model_names(model)
+    settings = settings_from_options(values, scene, names)
+    check_stability_asked(values, scene, given, names, "Model.options['al_stability']")
     pieces, named = mesh_of(model.line, scene, values)
     check_mesh(comm, values, named=named)
     if output:

@@ -246,3 +246,25 @@ def test_a_uniform_line_is_a_model_too(tmp_path):
     assert from_file.length == scene.length and from_file.end == scene.end == "free"
     assert np.array_equal(from_file.load_values, scene.load_values)
     assert np.array_equal(from_file.stiffness, scene.stiffness)
+
+
+@pytest.mark.parametrize("options, ends, words", [
+    ({"end_twist": 0.5}, dict(end=End("pin", (100.0, 0.0, 55.0))),
+     "Model.options['end_twist'] needs Model.end clamp"),
+    ({"end_twist": "half a turn"}, {}, "Model.options['end_twist'] 'half a turn'"),
+    ({"start_position": [0.0, 0.0, 1.0]}, dict(start=End("free")),
+     "Model.options['start_position'] needs a held start"),
+    ({"start_position": [0.0, 0.0, float("nan")]}, dict(start=End("pin")),
+     "Model.options['start_position'] '0.0,0.0,nan'"),
+    ({"end_force": [1.0, 0.0, 0.0]}, {}, "Model.options['end_force'] needs Model.end free"),
+])
+def test_a_bad_value_of_model_options_is_named_as_model_options(options, ends, words):
+    """A value given through Model.options is refused naming that option
+    (Model.options['end_twist']), not the model field it sets (Model.end.twist), which
+    the caller never gave, nor the command line's -rod_end_twist."""
+    with pytest.raises(RodInputError) as error:
+        solve(model(options=options, **ends))
+    message = str(error.value)
+    assert words in message, message
+    assert "-rod_" not in message and "Model.end.twist" not in message
+    assert "Model.start.position" not in message and "Model.end.force" not in message
