@@ -22,12 +22,13 @@ from petsc_rod.environment.profiles import read_seabed_profile
 
 
 def _run_record(model, values, solver, start):
-    """line_run.run_record of the model's run: every option the model stands for (its
-    export, Model.option_texts) with the run's ``values``, its line types' table and
-    seabed rows (which the command line reads from their files)."""
-    export = {**parse_values(model.option_texts()), "rod_elements": values["rod_elements"],
-              "rod_output": values["rod_output"], "rod_line_types": None,
-              "rod_seabed_profile": None}
+    """line_run.run_record of the model's run, the record the command line writes for the
+    same problem: the run's ``values`` (Model.options and the defaults, the mesh's
+    element count, the output) with the model's own fields as values
+    (Model.model_values: no option text between), its line types' table and seabed rows
+    (which the command line reads from their files)."""
+    export = {**values, **model.model_values(), "rod_elements": values["rod_elements"],
+              "rod_line_types": None, "rod_seabed_profile": None}
     record = run_record(export, solver, start)
     if isinstance(model.line, Line):
         record.parameters["line_types"] = "(Python API)"
@@ -90,12 +91,15 @@ def check_options_known(model):
 
 
 def model_digest(model):
-    """A digest of everything ``model`` gives the run: its option texts and the tables
-    it writes (line types, attachments, current profile, seabed rows)."""
-    texts = model.option_texts()
+    """A digest of everything ``model`` gives the run: its values (Model.model_values),
+    Model.options and the tables it writes (line types, attachments, current profile,
+    seabed rows)."""
+    values = [(name, value.tobytes() if isinstance(value, np.ndarray) else value)
+              for name, value in sorted(model.model_values().items())]
     profile = model.environment.profile()
     seabed = model.environment.seabed_profile
-    whole = [sorted(texts.items()), model.line_types_text(), model.attachment_table(),
+    whole = [values, sorted(model.options_texts().items()), model.line_types_text(),
+             model.attachment_table(),
              None if profile is None else [p.tobytes() for p in profile],
              None if seabed is None else np.asarray(seabed, dtype=float).tobytes()]
     return hashlib.sha256(repr(whole).encode()).hexdigest()
@@ -113,17 +117,17 @@ def check_same_model(comm, model):
 
 
 def options_of(model):
-    """(values, given) of the -rod_* options the run takes from ``model``: its steps and
-    initial shape and Model.options, parsed and checked as the command line's (the rest
-    their defaults); RodInputError naming Model.options for a bad one."""
+    """(values, given) of the -rod_* options the run takes from ``model``: Model.options
+    parsed and checked as the command line's (the rest their defaults) and its steps and
+    initial shape; RodInputError naming Model.options for a bad one."""
     check_options_known(model)
-    texts = model.option_texts()        # refuses an option the model's fields give
-    own = {name: texts[name] for name in ("rod_steps", "rod_initial_shape")}
-    own.update({f"rod_{name}": texts[f"rod_{name}"] for name in model.options})
+    texts = model.options_texts()       # refuses an option the model's fields give
     try:
-        return parse_values(own), set(own)
+        values = parse_values(texts)
     except RodInputError as error:
         raise in_model_terms(error) from None
+    values.update(rod_steps=int(model.steps), rod_initial_shape=model.initial_shape)
+    return values, set(texts) | {"rod_steps", "rod_initial_shape"}
 
 
 def with_options(model, values):
