@@ -19,7 +19,7 @@ class NoCatenaryStart(RodInputError):
     seabed (a grounded line too long to lie taut, pieces whose catenary has no solution
     or dips below the seabed, a load not straight down onto a seabed), though the scene
     itself is sound: the start falls back to the straight line and says why
-    (cli/main.start_from). ``str(error)`` is the reason, without advice."""
+    (cli/line_run.start_from). ``str(error)`` is the reason, without advice."""
 
 
 class RodNotConvergedError(RodError):

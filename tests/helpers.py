@@ -171,16 +171,16 @@ def png_summary(path):
 
 # The first lines of a script in which rank 1 alone raises while it computes its first
 # step's record (io.outputs.step_record), after the result file was opened; the ranks
-# wait 2 s for each other (cli.main.FAILURE_WAIT) before rank 1 takes the failure as
+# wait 2 s for each other (cli.line_run.FAILURE_WAIT) before rank 1 takes the failure as
 # its own.
 ONE_RANK_FAILS = """
 import sys
 import petsc4py
 petsc4py.init(sys.argv)
 from petsc4py import PETSc
-from petsc_rod.cli import main
+from petsc_rod.cli import line_run, main
 from petsc_rod.io import outputs
-main.FAILURE_WAIT = 2.0
+line_run.FAILURE_WAIT = 2.0
 if PETSc.COMM_WORLD.getRank() == 1:
     def step_record(*args, **kwargs):
         raise FloatingPointError("injected on rank 1")

@@ -3,9 +3,10 @@ two ends, the sea, the attachments, docs/riser.md) with the load path that solve
 (steps, initial shape) and any other -rod_* option by name.
 
 api.run.solve compiles the model into the solver's Scene (compile.py) with every check
-of the command line, naming the model's fields; ``Model.write_options`` writes the same
-problem as an options file and its tables, which the command line solves to the same
-numbers. Nothing here knows PETSc; the run is api/run.py.
+of the command line, naming the model's fields, and records its run from the model's
+values (Model.model_values), no option text between; ``Model.write_options`` exports the
+same problem as an options file and its tables, which the command line solves to the
+same numbers. Nothing here knows PETSc; the run is api/run.py.
 """
 
 from dataclasses import dataclass, field
@@ -73,19 +74,34 @@ def sections_text(line):
                         FIELD_NAMES)))
 
 
-def uniform_texts(line):
-    """{'rod_<name>': text} of the options a UniformLine stands for."""
-    texts = {"rod_length": _number(line.length), "rod_stiffness": _numbers(line.stiffness),
-             "rod_load": _numbers(line.load), "rod_elements": str(int(line.elements))}
+def _vector(values):
+    """Numbers as the float array an option's parser gives them (cli/options._reals)."""
+    return np.asarray(values, dtype=float).ravel()
+
+
+def option_text(value):
+    """An option's value as text its parser reads back to the same value (a float by
+    its repr, a whole number or a switch as an integer, text as it is)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (bool, int)):
+        return str(int(value))
+    return _numbers(value)
+
+
+def uniform_values(line):
+    """{'rod_<name>': value} of the options a UniformLine stands for."""
+    values = {"rod_length": float(line.length), "rod_stiffness": _vector(line.stiffness),
+              "rod_load": _vector(line.load), "rod_elements": int(line.elements)}
     if np.size(line.load_breaks):
-        texts["rod_load_breaks"] = _numbers(line.load_breaks)
+        values["rod_load_breaks"] = _vector(line.load_breaks)
     if np.isfinite(line.axial_stiffness):
-        texts["rod_axial_stiffness"] = _number(line.axial_stiffness)
+        values["rod_axial_stiffness"] = float(line.axial_stiffness)
     if line.drag is not None:
-        texts["rod_drag"] = _numbers(line.drag)
+        values["rod_drag"] = _vector(line.drag)
     if line.grading is not None:
-        texts["rod_mesh_grading"] = _number(line.grading)
-    return texts
+        values["rod_mesh_grading"] = float(line.grading)
+    return values
 
 
 @dataclass(frozen=True)
@@ -111,61 +127,80 @@ class Model(physical.Model):
             raise RodInputError("Model.options: a dict {name: value} of -rod_* options "
                                 "without 'rod_' (e.g. {'al_rtol': 1e-10})")
 
-    def option_texts(self, line_types="<line types>"):
-        """{'rod_<name>': text} of the options this model stands for; ``line_types`` the
-        name said for the line types' table (the table itself: ``line_types_text``)."""
-        texts = {"rod_steps": str(int(self.steps)), "rod_initial_shape": self.initial_shape}
+    def model_values(self, line_types="<line types>"):
+        """{'rod_<name>': value} of the options this model's own fields stand for, as the
+        command line's parser gives them (float, int, text, float arrays: options.
+        parse_values), without text between: the parameters its run records (api/run.py)
+        and, as text, its export (option_texts). ``line_types`` the name said for the line
+        types' table (the table itself: ``line_types_text``); the attachments and the
+        current's and seabed's profiles are named by placeholders (their rows are
+        tables)."""
+        values = {"rod_steps": int(self.steps), "rod_initial_shape": self.initial_shape}
         if isinstance(self.line, Line):
-            texts.update(rod_line_types=line_types, rod_sections=sections_text(self.line))
+            values.update(rod_line_types=line_types, rod_sections=sections_text(self.line))
             for name in ("contents_density", "internal_pressure", "design_factor"):
                 if getattr(self.line, name) is not None:
-                    texts[f"rod_{name}"] = _number(getattr(self.line, name))
+                    values[f"rod_{name}"] = float(getattr(self.line, name))
         else:
-            texts.update(uniform_texts(self.line))
+            values.update(uniform_values(self.line))
         for which, end in (("start", self.start), ("end", self.end)):
             if end.kind not in KINDS:
                 raise RodInputError(f"Model.{which}: kind {end.kind!r}; use one of {KINDS}")
-            texts[f"rod_{which}"] = end.kind
+            values[f"rod_{which}"] = end.kind
             if end.position is not None:
-                texts[f"rod_{which}_position"] = _numbers(end.position)
+                values[f"rod_{which}_position"] = _vector(end.position)
             if end.stiffness is not None:
-                texts[f"rod_{which}_rotational_stiffness"] = _number(end.stiffness)
+                values[f"rod_{which}_rotational_stiffness"] = float(end.stiffness)
             for name, value in (("joint_axis", end.axis), ("force", end.force),
                                 ("frame", end.frame)):
                 if value is not None:
-                    texts[f"rod_{which}_{name}"] = _numbers(value)
+                    values[f"rod_{which}_{name}"] = _vector(value)
             if end.twist is not None:
-                texts[f"rod_{which}_twist"] = _number(end.twist)
+                values[f"rod_{which}_twist"] = float(end.twist)
         sea = self.environment
         for name, value in (("seabed", sea.seabed), ("seabed_stiffness", sea.seabed_stiffness),
                             ("seabed_friction_stiffness", sea.seabed_friction_stiffness),
                             ("sea_surface", sea.surface), ("seabed_slope", sea.seabed_slope)):
             if value is not None:
-                texts[f"rod_{name}"] = _number(value)
+                values[f"rod_{name}"] = float(value)
         for name in ("seabed_friction", "seabed_direction", "seabed_origin"):
             if getattr(sea, name) is not None:
-                texts[f"rod_{name}"] = _numbers(np.atleast_1d(getattr(sea, name)))
+                values[f"rod_{name}"] = _vector(np.atleast_1d(getattr(sea, name)))
         if sea.seabed_profile is not None:
-            texts["rod_seabed_profile"] = "<seabed profile>"
+            values["rod_seabed_profile"] = "<seabed profile>"
         if sea.current is not None:
             if sea.profile() is None:
-                texts["rod_current"] = _numbers(sea.current)
+                values["rod_current"] = _vector(sea.current)
             else:
-                texts["rod_current_profile"] = "<current profile>"
+                values["rod_current_profile"] = "<current profile>"
         if (sea.water_density, sea.gravity) != (WATER_DENSITY, GRAVITY):
-            texts["rod_water_density"] = _number(sea.water_density)
-            texts["rod_gravity"] = _number(sea.gravity)
+            values["rod_water_density"] = float(sea.water_density)
+            values["rod_gravity"] = float(sea.gravity)
         if self.attachments:
-            texts["rod_point_loads"] = "<attachments>"
+            values["rod_point_loads"] = "<attachments>"
+        return values
+
+    def options_texts(self):
+        """{'rod_<name>': text} of Model.options (for the command line's parser, which
+        checks them); RodInputError for one the model's own fields give (model_values),
+        or solve's output=, or a restart's (the command line's)."""
+        own = self.model_values()
+        texts = {}
         for name, value in self.options.items():
-            if name in MODEL_OPTIONS or f"rod_{name}" in texts:
+            if name in MODEL_OPTIONS or f"rod_{name}" in own:
                 raise RodInputError(f"Model.options {name!r}: the model's own fields give "
                                     "it (or solve's output=); restarts are the command "
                                     "line's (Model.write_options)")
-            texts[f"rod_{name}"] = (value if isinstance(value, str) else
-                                    str(int(value)) if isinstance(value, (bool, int)) else
-                                    _numbers(value))
+            texts[f"rod_{name}"] = option_text(value)
         return texts
+
+    def option_texts(self, line_types="<line types>"):
+        """{'rod_<name>': text} of the options this model stands for, its own fields'
+        (model_values) and Model.options: the export of write_options (a run of the
+        model reads none of it)."""
+        return {**{name: option_text(value)
+                   for name, value in self.model_values(line_types).items()},
+                **self.options_texts()}
 
     def write_options(self, path):
         """Write the model as an options file ``path`` (``python -m petsc_rod

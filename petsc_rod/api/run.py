@@ -1,9 +1,9 @@
-"""solve(model): a Model (api/model.py) compiled into its Scene (compile.py, with the
-model's checks naming its fields) and solved as the command line solves its options
-(cli/main.py): the same mesh, solver, start and continuation
-(cli/session.run_continuation), on the ranks of ``comm``. The one place of the API that
-creates and destroys PETSc objects; what it returns holds numpy arrays only
-(api/results.py)."""
+"""solve(model): a Model (api/model.py) run on the ranks of ``comm`` on the one path of
+a line's run (cli/line_run.py: plan_line, run_line), which the command line takes too:
+the model, with the fields its Model.options set, compiled into its Scene (compile.py,
+the refusals naming its fields and its options), its mesh, solver, start and
+continuation. What it returns holds numpy arrays only (api/results.py); the run's PETSc
+objects are made and destroyed in run_line."""
 
 import dataclasses
 import hashlib
@@ -11,58 +11,24 @@ import re
 
 import numpy as np
 
-from petsc_rod.api.model import Line, Model, UniformLine
+from petsc_rod.api.model import Line, Model
 from petsc_rod.api.results import Results
-from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
-                                check_stability_possible,
-                                destroy_run, every_rank_failed, run_record, start_from)
+from petsc_rod.cli.line_run import plan_line, run_line, run_record
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
-from petsc_rod.cli.scene_options import (check_stability_asked, checked_pieces,
-                                         settings_from_options)
 from petsc_rod.compile import compile_scene
-from petsc_rod.cli.session import run_continuation
 from petsc_rod.errors import RodInputError, on_every_rank
-from petsc_rod.io import outputs
-from petsc_rod.io import results as io
-from petsc_rod.iteration.continuation import PathSettings
-from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.model.names import FIELD_NAMES, Names
 from petsc_rod.environment.profiles import read_seabed_profile
 
 
-class _LastStep:
-    """A writer for run_continuation that keeps the last step's vertex datasets and
-    attributes (copies of this rank's owned arrays), passing everything on to a
-    io.results.ResultWriter ``inner`` when there is one."""
-
-    def __init__(self, inner=None):
-        self.inner, self.vertex, self.attributes, self.units = inner, None, None, ({}, {})
-
-    def write_step(self, group, vertex, state, history, attributes, units=None):
-        self.vertex = {name: np.array(value, copy=True) for name, value in vertex.items()}
-        self.attributes = dict(attributes)
-        self.units = units or ({}, {})
-        if self.inner is not None:
-            self.inner.write_step(group, vertex, state, history, attributes, units)
-
-    def finish(self, *args):
-        if self.inner is not None:
-            self.inner.finish(*args)
-
-    def kept_name(self):
-        return self.inner.kept_name() if self.inner is not None else None
-
-    def abort(self):
-        if self.inner is not None:
-            self.inner.abort()
-
-
-def _run_record(model, values, solver, start, output):
-    """cli.main.run_record of the model's run: every option the model stands for (its
-    export, Model.option_texts) with the run's ``values``, its line types' table and
-    seabed rows (which the command line reads from their files)."""
-    export = {**parse_values(model.option_texts()), "rod_elements": values["rod_elements"],
-              "rod_output": output, "rod_line_types": None, "rod_seabed_profile": None}
+def _run_record(model, values, solver, start):
+    """line_run.run_record of the model's run, the record the command line writes for the
+    same problem: the run's ``values`` (Model.options and the defaults, the mesh's
+    element count, the output) with the model's own fields as values
+    (Model.model_values: no option text between), its line types' table and seabed rows
+    (which the command line reads from their files)."""
+    export = {**values, **model.model_values(), "rod_elements": values["rod_elements"],
+              "rod_line_types": None, "rod_seabed_profile": None}
     record = run_record(export, solver, start)
     if isinstance(model.line, Line):
         record.parameters["line_types"] = "(Python API)"
@@ -94,10 +60,19 @@ OPTION_FIELDS = {
 
 def in_model_terms(error):
     """RodInputError ``error`` of an option of Model.options, refused as the command line
-    refuses it, the option named as Model.options names it."""
-    text = re.sub(r"-rod_(\w+)", lambda match: f"Model.options {match.group(1)!r}",
+    refuses it, the option named as Model.options names it (Model.options['name'])."""
+    text = re.sub(r"-rod_(\w+)", lambda match: f"Model.options[{match.group(1)!r}]",
                   str(error))
     return RodInputError(text)
+
+
+def model_names(model):
+    """How a refusal names what ``model`` gives (model/names.Names): its fields as
+    FIELD_NAMES has them, and the fields an option of Model.options sets as that option
+    (Model.options['end_twist'], not Model.end.twist, which the caller left unset)."""
+    return Names({**FIELD_NAMES.table,
+                  **{name: f"Model.options[{name!r}]" for name in model.options}},
+                 FIELD_NAMES.fallback)
 
 
 def check_options_known(model):
@@ -116,12 +91,15 @@ def check_options_known(model):
 
 
 def model_digest(model):
-    """A digest of everything ``model`` gives the run: its option texts and the tables
-    it writes (line types, attachments, current profile, seabed rows)."""
-    texts = model.option_texts()
+    """A digest of everything ``model`` gives the run: its values (Model.model_values),
+    Model.options and the tables it writes (line types, attachments, current profile,
+    seabed rows)."""
+    values = [(name, value.tobytes() if isinstance(value, np.ndarray) else value)
+              for name, value in sorted(model.model_values().items())]
     profile = model.environment.profile()
     seabed = model.environment.seabed_profile
-    whole = [sorted(texts.items()), model.line_types_text(), model.attachment_table(),
+    whole = [values, sorted(model.options_texts().items()), model.line_types_text(),
+             model.attachment_table(),
              None if profile is None else [p.tobytes() for p in profile],
              None if seabed is None else np.asarray(seabed, dtype=float).tobytes()]
     return hashlib.sha256(repr(whole).encode()).hexdigest()
@@ -139,17 +117,17 @@ def check_same_model(comm, model):
 
 
 def options_of(model):
-    """(values, given) of the -rod_* options the run takes from ``model``: its steps and
-    initial shape and Model.options, parsed and checked as the command line's (the rest
-    their defaults); RodInputError naming Model.options for a bad one."""
+    """(values, given) of the -rod_* options the run takes from ``model``: Model.options
+    parsed and checked as the command line's (the rest their defaults) and its steps and
+    initial shape; RodInputError naming Model.options for a bad one."""
     check_options_known(model)
-    texts = model.option_texts()        # refuses an option the model's fields give
-    own = {name: texts[name] for name in ("rod_steps", "rod_initial_shape")}
-    own.update({f"rod_{name}": texts[f"rod_{name}"] for name in model.options})
+    texts = model.options_texts()       # refuses an option the model's fields give
     try:
-        return parse_values(own), set(own)
+        values = parse_values(texts)
     except RodInputError as error:
         raise in_model_terms(error) from None
+    values.update(rod_steps=int(model.steps), rod_initial_shape=model.initial_shape)
+    return values, set(texts) | {"rod_steps", "rod_initial_shape"}
 
 
 def with_options(model, values):
@@ -169,29 +147,30 @@ def with_options(model, values):
     return dataclasses.replace(model, **changed) if changed else model
 
 
-def scene_of(model):
-    """(Scene, option values, given names) of ``model``: the model, with the fields its
-    options set, compiled (compile.py) with its refusals naming its fields; the
-    values of the options the run takes from it (options_of)."""
+def prepared(model):
+    """(the model with the fields its options set, option values, given names) of
+    ``model`` (options_of, with_options)."""
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     values, given = options_of(model)
-    return compile_scene(with_options(model, values), FIELD_NAMES), values, given
+    return with_options(model, values), values, given
 
 
-def mesh_of(line, scene, values):
-    """(mesh.Pieces or None, how a message names the element count) of the model's
-    line, its element count and grading put into ``values`` (check_mesh, Mesh): a Line's
-    sections meshed one piece each, a UniformLine's elements graded."""
-    if isinstance(line, UniformLine):
-        values.update(rod_elements=int(line.elements), rod_length=float(line.length))
-        if line.grading is not None:
-            values["rod_mesh_grading"] = float(line.grading)
-        return None, f"UniformLine.elements ({values['rod_elements']})"
-    pieces = checked_pieces(scene, line.element_counts(FIELD_NAMES), FIELD_NAMES["sections"])
-    values["rod_elements"] = int(pieces.counts.sum())
-    return pieces, (f"the model's Line ({values['rod_elements']} elements in all: its "
-                    "sections' counts and element_length)")
+def scene_of(model):
+    """(Scene, option values, given names) of ``model``: the model, with the fields its
+    options set, compiled (compile.py) with its refusals naming its fields and its
+    options (model_names); the values of the options the run takes from it
+    (options_of)."""
+    whole, values, given = prepared(model)
+    return compile_scene(whole, model_names(model)), values, given
+
+
+def mesh_named(pieces, elements):
+    """How a refusal of the mesh names the model's element count (line_run.plan_line)."""
+    if pieces is None:
+        return f"UniformLine.elements ({elements})"
+    return (f"the model's Line ({elements} elements in all: its sections' counts and "
+            "element_length)")
 
 
 def solve(model, comm=None, output=None, say=None):
@@ -207,46 +186,12 @@ def solve(model, comm=None, output=None, say=None):
     if not isinstance(model, Model):
         raise RodInputError(f"solve takes an api.Model, not {type(model).__name__}")
     check_same_model(comm, model)
-    scene, values, given = on_every_rank(comm, scene_of, model)
-    settings = settings_from_options(values, scene, FIELD_NAMES)
-    check_stability_asked(values, scene, given, FIELD_NAMES, "Model.options['al_stability']")
-    pieces, named = mesh_of(model.line, scene, values)
-    check_mesh(comm, values, named=named)
-    if output:
-        io.check_output_path(output, comm)
-    mesh = problem = solver = keeper = None
-    say = say or (lambda line: None)
-    # where the ranks agree on a failure (made now: creating it is collective)
-    failures = comm.tompi4py().Dup()
-    try:
-        mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
-                    pieces)
-        problem, solver = build_solver(mesh, scene, settings, say)
-        check_stability_possible(problem, "rod_al_stability" in given
-                                 and values["rod_al_stability"])
-        start = start_from(problem, values, given, say)
-        inner = None
-        if output:
-            inner = io.ResultWriter(
-                output, mesh,
-                io.minimum_bytes(mesh, outputs.restart_state(problem), values["rod_steps"]),
-                _run_record(model, values, solver, start, output))
-        keeper = _LastStep(inner)
-        path = PathSettings(steps=values["rod_steps"], imperfection=values["rod_imperfection"],
-                            max_halvings=values["rod_max_halvings"],
-                            track_link=values["rod_track_link"])
-        result = run_continuation(solver, path, say=say, writer=keeper)
-        keeper.inner = None                     # finished
-        return Results(keeper.vertex, keeper.attributes, result.converged,
-                       comm.tompi4py(), mesh.n_elements, keeper.units)
-    except Exception as error:
-        # one rank's alone (a numpy error, say): the others wait in a collective call
-        if not every_rank_failed(failures):
-            inner = keeper.inner if keeper is not None else None
-            abort_alone(comm, alone_failure(comm, error), getattr(inner, "partial", None))
-        raise
-    finally:
-        if keeper is not None:
-            keeper.abort()
-        destroy_run(solver, problem, mesh)
-        failures.Free()
+    whole, values, given = on_every_rank(comm, prepared, model)
+    values["rod_output"] = output or None
+    plan = plan_line(comm, whole, values, given, model_names(model), mesh_named)
+    run = run_line(comm, plan, say, keep_last=True,
+                   record=lambda plan, solver, start: _run_record(model, plan.values,
+                                                                  solver, start))
+    last = run.last
+    return Results(last.vertex, last.attributes, run.result.converged, comm.tompi4py(),
+                   run.elements, last.units)

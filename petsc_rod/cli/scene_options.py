@@ -272,7 +272,7 @@ def start_tension(values, scene):
     scale, problem/penalty.py): that of the catenary at the first step's load factor
     1 / -rod_steps where -rod_initial_shape catenary starts it, 0 for the straight start
     and a restart (whose multipliers are the file's). 0 too for a scene without a
-    catenary: the start refuses it (cli/main.start_from), after -help has been said."""
+    catenary: the start refuses it (cli/line_run.start_from), after -help has been said."""
     if values["rod_initial_shape"] != "catenary" or values["rod_initial"]:
         return 0.0
     try:

@@ -106,7 +106,7 @@ def mesh_beta(n_elements, grading):
 def vertex_coordinates(vertex_index, n_elements, length, grading):
     """S of the given global vertex indices of a mesh (Mesh.coordinates): L g(i/N) with
     g the sine map of mesh_beta; ValueError when the grading cannot be built (refused
-    before, with the option's name: cli.main.check_mesh)."""
+    before, with the option's name: cli.line_run.check_mesh)."""
     beta = mesh_beta(n_elements, grading)
     if beta is None:
         raise ValueError(f"a grading of {grading:g} cannot be built on {n_elements} "

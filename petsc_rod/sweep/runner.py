@@ -31,7 +31,8 @@ from dataclasses import dataclass
 
 from petsc4py import PETSc
 
-from petsc_rod.cli.main import INPUT_FILE_OPTIONS, abort_alone, every_rank_failed, run
+from petsc_rod.cli.line_run import abort_alone, every_rank_failed
+from petsc_rod.cli.main import INPUT_FILE_OPTIONS, run
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.cli.options import (BY_NAME, SOLVER_PREFIXES, check_same_on_every_rank, read_options,
@@ -444,8 +445,8 @@ class Sweep:
         else, a LinAlgError say, is a failure of this case, not of the sweep), the
         error's words then kept for the record. Where only some ranks raised, the others
         wait in a collective call: the ranks meet on a communicator of their own
-        (cli.main.every_rank_failed) and a rank that is alone ends the sweep, as a run
-        ends (cli.main.abort_alone; the summary of the cases before it is written).
+        (cli.line_run.every_rank_failed) and a rank that is alone ends the sweep, as a run
+        ends (cli.line_run.abort_alone; the summary of the cases before it is written).
         Collective."""
         self._error = None
         texts = {**self.base, **options}

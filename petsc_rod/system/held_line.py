@@ -65,7 +65,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
-from petsc_rod.cli.main import build_solver, check_mesh, destroy_run
+from petsc_rod.cli.line_run import build_solver, check_mesh
 from petsc_rod.cli.options import parse_values
 from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
 from petsc_rod.compile import compile_scene
@@ -275,7 +275,9 @@ class HeldLine:
             if owned is not None:
                 owned.destroy()
         self.jacobian = None
-        destroy_run(self.solver, self.problem, self.mesh)
+        for built in (self.solver, self.problem, self.mesh):
+            if built is not None:
+                built.destroy()
         self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------

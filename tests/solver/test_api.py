@@ -246,3 +246,57 @@ def test_a_uniform_line_is_a_model_too(tmp_path):
     assert from_file.length == scene.length and from_file.end == scene.end == "free"
     assert np.array_equal(from_file.load_values, scene.load_values)
     assert np.array_equal(from_file.stiffness, scene.stiffness)
+
+
+@pytest.mark.parametrize("options, ends, words", [
+    ({"end_twist": 0.5}, dict(end=End("pin", (100.0, 0.0, 55.0))),
+     "Model.options['end_twist'] needs Model.end clamp"),
+    ({"end_twist": "half a turn"}, {}, "Model.options['end_twist'] 'half a turn'"),
+    ({"start_position": [0.0, 0.0, 1.0]}, dict(start=End("free")),
+     "Model.options['start_position'] needs a held start"),
+    ({"start_position": [0.0, 0.0, float("nan")]}, dict(start=End("pin")),
+     "Model.options['start_position'] '0.0,0.0,nan'"),
+    ({"end_force": [1.0, 0.0, 0.0]}, {}, "Model.options['end_force'] needs Model.end free"),
+])
+def test_a_bad_value_of_model_options_is_named_as_model_options(options, ends, words):
+    """A value given through Model.options is refused naming that option
+    (Model.options['end_twist']), not the model field it sets (Model.end.twist), which
+    the caller never gave, nor the command line's -rod_end_twist."""
+    with pytest.raises(RodInputError) as error:
+        solve(model(options=options, **ends))
+    message = str(error.value)
+    assert words in message, message
+    assert "-rod_" not in message and "Model.end.twist" not in message
+    assert "Model.start.position" not in message and "Model.end.force" not in message
+
+
+def test_the_api_records_its_run_from_the_model_without_option_text(tmp_path, monkeypatch):
+    """Issue 48, the API is the model: its run reads no option text (Model.option_texts,
+    the export, is not called), and its result file records the whole model, here 80
+    sections (a -rod_sections of more than 1023 characters, petsc4py's cut of an option's
+    value) and 30 attachments."""
+    def no_text(*args, **kwargs):
+        raise AssertionError("the run read the model's option texts")
+
+    monkeypatch.setattr(Model, "option_texts", no_text)
+    lengths = 2.0 + 1e-3 * np.arange(80) / 7.0
+    line = Line([(PIPE if k % 2 else FLOATY, length) for k, length in enumerate(lengths)],
+                element_length=1.0)
+    S = 2.5 + 5.0 * np.arange(30)
+    attachments = tuple(Attachment(s, mass=10.0 + k, name=f"clump {k}")
+                        for k, s in enumerate(S))
+    comm = PETSc.COMM_WORLD
+    path = f"{comm.tompi4py().bcast(str(tmp_path))}/long.h5"
+    results = solve(model(line=line, attachments=attachments, steps=1), comm=comm,
+                    output=path)
+    assert results.converged and results.elements == 160
+    with h5py.File(path, "r") as f:
+        parameters = f["parameters"].attrs
+        sections = str(parameters["sections"])
+        table = np.asarray(parameters["point_loads_table"])
+        assert int(parameters["elements"]) == 160
+    assert len(sections) > 1023 and sections.count(",") == 79
+    recorded = [float(entry.split(":")[1]) for entry in sections.split(",")]
+    assert np.array_equal(recorded, lengths)
+    assert table.shape[0] == 30 and np.array_equal(table[:, 0], S)
+    assert table[-1, 3] == pytest.approx(-39.0 * 9.80665, rel=1e-12)

@@ -15,7 +15,7 @@ from petsc4py import PETSc
 
 from helpers import partial_files
 from petsc_rod import resources
-from petsc_rod.cli.main import MIN_RELATIVE_ELEMENT, check_mesh
+from petsc_rod.cli.line_run import MIN_RELATIVE_ELEMENT, check_mesh
 from petsc_rod.cli.options import (MAX_HALVINGS_CAP, MAX_MAGNITUDE, check_same_on_every_rank,
                                read_options)
 from petsc_rod.cli.session import record_step

@@ -88,6 +88,14 @@ def test_a_model_exported_as_options_solves_to_the_same_numbers(tmp_path):
         for name in NUMBERS:
             assert float(api.attrs[name]) == float(cli.attrs[name]), name
         assert float(cli.attrs["top_tension"]) == results.top_tension
+        # the run's record, the API's from the model itself: the command line's, but for
+        # the names of the files the export wrote
+        ours, theirs = dict(api["parameters"].attrs), dict(cli["parameters"].attrs)
+    files = {"output", "line_types", "point_loads", "current_profile", "seabed_profile"}
+    assert set(ours) == set(theirs) and len(ours) > 60
+    assert json.loads(ours.pop("attribute_units")) == json.loads(theirs.pop("attribute_units"))
+    for name in sorted(set(ours) - files):
+        assert np.array_equal(np.asarray(ours[name]), np.asarray(theirs[name])), name
 # with rank 1 failing alone (helpers.ONE_RANK_FAILS), a small line through api.solve
 API_RUN = """
 from petsc_rod.api import End, Line, LineType, Model, solve
