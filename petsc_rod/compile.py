@@ -57,16 +57,19 @@ def compile_scene(model, names=FIELD_NAMES):
                  end_twist=0.0 if end.twist is None else end.twist,
                  start_force=np.zeros(3) if start.force is None else start.force,
                  end_force=np.zeros(3) if end.force is None else end.force,
-                 start_rotational_stiffness=start.stiffness or 0.0,
-                 end_rotational_stiffness=end.stiffness or 0.0,
-                 start_joint_axis=start.axis, end_joint_axis=end.axis, point_load_S=S,
+                 point_load_S=S,
                  point_load_forces=forces, point_load_names=labels,
                  point_load_drag_areas=areas, point_load_volumes=volumes,
                  water_density=sea.water_density,
                  gravity=sea.gravity)
     seabed, current = environment_of(sea, bare, names,
                                      None if span.sections else line.drag)
-    scene = dataclasses.replace(bare, seabed=seabed, current=current,
+    # the joints with the seabed: a joint's default axis is the line's direction in its
+    # start shape, which rests on the seabed (Scene.__post_init__)
+    joints = dict(start_rotational_stiffness=start.stiffness or 0.0,
+                  end_rotational_stiffness=end.stiffness or 0.0,
+                  start_joint_axis=start.axis, end_joint_axis=end.axis)
+    scene = dataclasses.replace(bare, seabed=seabed, current=current, **joints,
                                 **pressures_of(line, sea, origin) if span.sections else {})
     check_taut(scene, names)
     check_applied_forces(scene, sea, names)
