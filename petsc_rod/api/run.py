@@ -14,7 +14,6 @@ import numpy as np
 from petsc_rod.api.model import Line, Model, UniformLine
 from petsc_rod.api.results import Results
 from petsc_rod.cli.main import (abort_alone, alone_failure, build_solver, check_mesh,
-                                check_stability_possible,
                                 destroy_run, every_rank_failed, run_record, start_from)
 from petsc_rod.cli.options import BY_NAME, SOLVER_PREFIXES, nearest_hint, parse_values
 from petsc_rod.cli.scene_options import (check_stability_asked, checked_pieces,
@@ -209,7 +208,6 @@ def solve(model, comm=None, output=None, say=None):
     check_same_model(comm, model)
     scene, values, given = on_every_rank(comm, scene_of, model)
     settings = settings_from_options(values, scene, FIELD_NAMES)
-    check_stability_asked(values, scene, given, FIELD_NAMES, "Model.options['al_stability']")
     pieces, named = mesh_of(model.line, scene, values)
     check_mesh(comm, values, named=named)
     if output:
@@ -222,8 +220,8 @@ def solve(model, comm=None, output=None, say=None):
         mesh = Mesh(comm, values["rod_elements"], scene.length, values["rod_mesh_grading"],
                     pieces)
         problem, solver = build_solver(mesh, scene, settings, say)
-        check_stability_possible(problem, "rod_al_stability" in given
-                                 and values["rod_al_stability"])
+        check_stability_asked(values, given, scene, problem, FIELD_NAMES,
+                              "Model.options['al_stability']")
         start = start_from(problem, values, given, say)
         inner = None
         if output:

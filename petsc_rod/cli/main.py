@@ -93,7 +93,6 @@ def run(comm=None, texts=None):
                 and (settings.newton or settings.check_stability)),
                 None if pieces is None or "rod_elements" in given else
                 f"-rod_sections ({values['rod_elements']} elements in all)")
-            check_stability_asked(values, scene, given)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:
@@ -103,8 +102,7 @@ def run(comm=None, texts=None):
                         pieces)
             path_scene, notes = walked_scene(scene, values, comm)
             problem, solver = build_solver(mesh, path_scene, settings, say)
-            check_stability_possible(problem, "rod_al_stability" in given
-                                     and values["rod_al_stability"])
+            check_stability_asked(values, given, scene, problem)
             if database.hasName("help"):
                 return 0
             start = start_from(problem, values, given, say)
@@ -289,22 +287,6 @@ def build_solver(mesh, scene, settings, say):
         raise RodInputError(f"PETSc refused the solver options: {petsc_message(error)}; "
                             "check the "
                             "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
-
-
-def check_stability_possible(problem, asked):
-    """Refuse -rod_al_stability 1, ``asked`` (given, true), for a problem with a term that
-    has no energy (Term.conservative False: a sloping seabed's lagged contact force, the
-    sea surface's wet and dry parts, attachments that can reach the surface), beside the
-    current and the friction that scene_options.check_stability_asked names by their
-    options: the test would be left out without a word (UzawaSolver.tests_stability)."""
-    if not asked or problem.conservative:
-        return
-    loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
-                                    for term in problem.terms if not term.conservative))
-    raise RodInputError(f"-rod_al_stability 1: the stability test is of the second "
-                        f"variation of the energy, and this scene has loads without one "
-                        f"({loads}); drop -rod_al_stability (such a run gives no "
-                        "stability verdict)")
 
 
 def start_from(problem, values, given, say):
