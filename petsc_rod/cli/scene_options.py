@@ -19,9 +19,8 @@ from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
 from petsc_rod.model.names import Names
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.compile import (check_stretch_domain, compile_scene,  # noqa: F401
-                               line_names,
-                               rounded_down)
+from petsc_rod.compile import check_stretch_domain, compile_scene  # noqa: F401
+from petsc_rod.model.derived import line_names, rounded_down  # noqa: F401
 from petsc_rod.environment.profiles import read_profile, read_seabed_profile
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences

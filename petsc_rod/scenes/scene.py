@@ -17,14 +17,11 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.frames import REFERENCE_FRAME, rotation_about, rotation_log
+from petsc_rod.model.derived import TAUT_GAP, applied_forces
 from petsc_rod.model.model import check_chord, check_positive
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
 from petsc_rod.scenes.starts import start_direction
-# Held ends closer to the length than this fraction of it make a taut line (Scene.taut):
-# a catenary of sag f has (8/3) f^2 / L of slack, so at 1e-9 L of slack its tension is
-# above 2000 times its weight, beyond what the constraint tolerance determines.
-TAUT_GAP = 1e-9
 
 
 def rolled_frame(frame, angle):
@@ -200,7 +197,7 @@ class Scene:
     def taut(self):
         """Whether an inextensible line is held at both ends at least its length less
         TAUT_GAP (relative) apart: straight, with an axial force its inextensibility
-        leaves undetermined (compile.check_taut)."""
+        leaves undetermined (model/derived.check_taut)."""
         held = self.start != "free" and self.end != "free"
         chord = np.linalg.norm(self.end_position - self.start_state(1.0).position)
         return held and not self.extensible and chord >= self.length * (1 - TAUT_GAP)
@@ -259,21 +256,14 @@ class Scene:
         return float(sum(self.applied_forces().values()))
 
     def applied_forces(self):
-        """The parts of applied_force by where they come from, N: {'load': int |f| dS of
-        the dead load, 'drag': L c max |v|^2 of the current and the attachments'
-        1/2 rho_w C_d A max |v|^2 (0 without a current), 'start_force':
-        |P_0|, 'end_force': |P_L|, 'point_loads': sum_p |P_p|}."""
-        drag = 0.0
-        if self.current is not None:            # the largest drag the current can exert
-            drag = self.length * self.current.largest_drag()
-            # and the attachments', 1/2 rho_w C_d A max |v|^2 each
-            drag += (0.5 * self.water_density * self.point_load_drag_areas.sum()
-                     * float(np.max(np.sum(self.current.velocities**2, axis=1))))
-        return {"load": float(np.diff(self.load_piece_ends)
-                              @ np.linalg.norm(self.load_values, axis=1)),
-                "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
-                "end_force": float(np.linalg.norm(self.end_force)),
-                "point_loads": float(np.linalg.norm(self.point_load_forces, axis=1).sum())}
+        """The parts of applied_force by where they come from, N (model/derived.py
+        applied_forces): {'load', 'drag', 'start_force', 'end_force', 'point_loads'}."""
+        current = self.current
+        return applied_forces(self.load_piece_ends, self.load_values, self.start_force,
+                              self.end_force, self.point_load_forces,
+                              self.point_load_drag_areas, self.water_density,
+                              None if current is None else current.drag,
+                              None if current is None else current.velocities)
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
