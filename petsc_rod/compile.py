@@ -5,8 +5,7 @@ stiffness and friction), the current and the pipe's pressures, each resolved her
 given to the Scene's constructor. Model.check refuses a bad model before (the loads it
 derives: model/derived.py); what stays here needs the compiled seabed's geometry
 (environment/bathymetry.py, which the model does not import): a grid's axes, the
-profile or grid under the held ends and the held ends on or above the seabed; and the
-stretch's domain (check_stretch_domain), which the command line asks of its Scene.
+profile or grid under the held ends and the held ends on or above the seabed.
 
     Model --compile_scene--> Scene --RodProblem--> problem --UzawaSolver--> solution
 """
@@ -203,48 +202,3 @@ def seated(seabed, held):
         return seabed
     shape = None if seabed.flat else seabed.shape.moved(np.array([0.0, 0.0, depth]))
     return dataclasses.replace(seabed, height=seabed.height - depth, shape=shape)
-
-
-# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
-# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
-# line material.
-MAX_STRAIN = 1.0
-
-
-def least_top_strain(scene):
-    """The least strain at the higher held end in any equilibrium in tension (T >= 0 at
-    its lowest point) of a uniform extensible flexible line (a bending stiffness's shear moves it a little: about, for
-    a rod) under a uniform dead load w (N/m of unstretched line), its held ends h apart
-    along the load (m), or None where it does not apply (sections,
-    a free end, attachments, load pieces that differ, a seabed that is not flat or not
-    across the load). Along the suspended line d(T + T^2 / 2EA) = w dz (the cable's
-    balance along its tangent; a current's normal drag has no part along it), from the
-    lowest point (a touchdown, or below the lower end) to the top, T >= 0 there:
-    eps >= sqrt(1 + 2 w h / EA) - 1. Returns (eps, w h)."""
-    if (scene.sections or not np.isfinite(scene.axial_stiffness) or scene.start == "free"
-            or scene.end == "free" or scene.point_load_S.size):
-        return None
-    loads = scene.load_values
-    weight = float(np.linalg.norm(loads[0]))
-    if weight == 0.0 or not np.all(loads == loads[0]):
-        return None
-    down = loads[0] / weight
-    if scene.seabed is not None and not (scene.seabed.flat and down[2] == -1.0):
-        return None
-    height = abs(float((scene.end_position - scene.start_state(1.0).position) @ down))
-    return (float(np.sqrt(1.0 + 2.0 * weight * height / scene.axial_stiffness) - 1.0),
-            weight * height)
-
-
-def check_stretch_domain(scene, n=FIELD_NAMES):
-    """Refuse a uniform extensible line that every equilibrium stretches by more than
-    MAX_STRAIN at its top (least_top_strain), outside the domain of the model of
-    stretch; the message names the EA as ``n`` does (model/names.py)."""
-    least = least_top_strain(scene)
-    if least is not None and least[0] > MAX_STRAIN:
-        raise RodInputError(
-            f"{n['axial_stiffness']} {scene.axial_stiffness:g}: hanging in tension it stretches the "
-            f"line by about {100 * least[0]:.3g} % or more at its top (a flexible cable's "
-            f"T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load times the ends' height "
-            f"apart), above {100 * MAX_STRAIN:g} %, where the linear stretch models no line "
-            "material; check EA (in N), or leave the line inextensible")

@@ -19,7 +19,7 @@ from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
 from petsc_rod.model.names import Names
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.compile import check_stretch_domain, compile_scene  # noqa: F401
+from petsc_rod.compile import compile_scene
 from petsc_rod.model.derived import line_names, rounded_down  # noqa: F401
 from petsc_rod.environment.profiles import read_profile, read_seabed_profile
 from petsc_rod.scenes import starts
@@ -230,9 +230,7 @@ def checked_pieces(scene, counts, named):
 
 def settings_from_options(values, scene, names=OPTION_NAMES):
     """The iteration's Settings of the options, the default penalty resolved for
-    ``scene``; a line stretched beyond the model of stretch is refused
-    (compile.check_stretch_domain); refusals worded with ``names``."""
-    check_stretch_domain(scene, names)
+    ``scene``; refusals worded with ``names``."""
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene), names)

@@ -1,8 +1,8 @@
 """The loads a model gives its line, derived from its fields, and the checks that need
 them (Model.check): a default seabed stiffness that some load sets, a current on line
 types with a drag, a uniform line under the sea surface, a line held taut, the derived
-forces within the bound of the model's numbers and the seabed's stiffness within the
-largest a line accepts. Heights in the frame of the line's start (the model's less the
+forces within the bound of the model's numbers, the seabed's stiffness within the
+largest a line accepts and a uniform line's stretch within the model of stretch. Heights in the frame of the line's start (the model's less the
 start's z), as the compiled Scene has them (compile.py)."""
 
 from dataclasses import dataclass
@@ -154,6 +154,7 @@ def check_loads(span, sea, n):
     check_taut(loads, n)
     check_applied_forces(loads, n)
     check_seabed_stiffness(loads, n)
+    check_stretch_domain(loads, n)
 
 
 def check_default_stiffness(loads, n):
@@ -271,3 +272,50 @@ def check_seabed_stiffness(loads, n):
                         f"{n['seabed_stiffness']} (weight / 1 mm) is "
                         f"{k:.3g} N/m^2, above what this line accepts: {why}; give "
                         f"{n['seabed_stiffness']} {largest:.3g} or less")
+
+
+# The largest strain eps = |n| / EA that an extensible line may need (docs/method.md
+# §12): beyond it the linear stretch r' = (1 + eps) d3, energy EA eps^2 / 2, models no
+# line material.
+MAX_STRAIN = 1.0
+
+
+def least_top_strain(loads):
+    """The least strain at the higher held end in any equilibrium in tension (T >= 0 at
+    its lowest point) of a uniform extensible flexible line under a uniform dead load w
+    (N/m of unstretched line), its held ends h apart along the load (m), or None where
+    it does not apply (sections, a free end, attachments, load pieces that differ, a
+    seabed that is not flat or not across the load). Along the suspended line
+    d(T + T^2 / 2EA) = w dz (the cable's balance along its tangent; a current's normal
+    drag has no part along it), from the lowest point (a touchdown, or below the lower
+    end) to the top, T >= 0 there: eps >= sqrt(1 + 2 w h / EA) - 1. Returns (eps, w h)."""
+    span, sea = loads.span, loads.sea
+    if (span.sections or not np.isfinite(span.line.axial_stiffness)
+            or span.start.kind == "free" or span.end.kind == "free" or span.attachments):
+        return None
+    values = loads.load_values
+    weight = float(np.linalg.norm(values[0]))
+    if weight == 0.0 or not np.all(values == values[0]):
+        return None
+    down = values[0] / weight
+    flat = sea.seabed_profile is None and (sea.seabed_slope is None or sea.seabed_slope == 0)
+    if sea.has_seabed and not (flat and down[2] == -1.0):
+        return None
+    height = abs(float(span.end_offset() @ down))
+    return (float(np.sqrt(1.0 + 2.0 * weight * height / span.line.axial_stiffness) - 1.0),
+            weight * height)
+
+
+def check_stretch_domain(loads, n):
+    """Refuse a uniform extensible line that every equilibrium stretches by more than
+    MAX_STRAIN at its top (least_top_strain), outside the domain of the model of
+    stretch."""
+    least = least_top_strain(loads)
+    if least is not None and least[0] > MAX_STRAIN:
+        raise RodInputError(
+            f"{n['axial_stiffness']} {loads.span.line.axial_stiffness:g}: hanging in "
+            f"tension it stretches the line by about {100 * least[0]:.3g} % or more at its "
+            f"top (a flexible cable's T + T^2/2EA >= w h, w h = {least[1]:.3g} N: the load "
+            "times the ends' height apart), above "
+            f"{100 * MAX_STRAIN:g} %, where the linear stretch models no line material; "
+            "check EA (in N), or leave the line inextensible")

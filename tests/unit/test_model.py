@@ -129,12 +129,17 @@ ROPE = dict(length=100.0, stiffness=(1.0, 1.0, 1.0), load=(0.0, 0.0, -10.0))
     (Model(UniformLine(**dict(ROPE, load=(0.0, 0.0, -1e29))), End.anchor((0.0, 0.0, 0.0)),
            End.anchor((60.0, 0.0, 30.0))),
      "UniformLine.load (with Line.length): the applied force"),
+    (Model(UniformLine(**ROPE, axial_stiffness=100.0), End.anchor((0.0, 0.0, 0.0)),
+           End.anchor((60.0, 0.0, 30.0))),
+     "UniformLine.axial_stiffness 100: hanging in tension it stretches the line by about "
+     "165 % or more"),
 ])
 def test_the_model_refuses_the_loads_it_derives_before_a_scene_is_compiled(model, words):
     """Model.check holds the checks of the loads the model derives (model/derived.py):
     a taut line, a default seabed stiffness without a weight, a seabed too stiff, a
     current on line types without drag, a uniform line above the surface, an applied
-    force beyond the bound of the model's numbers; the compile refuses them the same."""
+    force beyond the bound of the model's numbers, a stretch beyond the model of
+    stretch; the compile refuses them the same."""
     with pytest.raises(RodInputError) as refused:
         model.check()
     assert words in str(refused.value), str(refused.value)
