@@ -104,7 +104,6 @@ def plan_line(comm, model, values, given, names=OPTION_NAMES, mesh_named=None):
     check_mesh(comm, values, resources.bytes_per_element(
         scene.seabed is not None and (settings.newton or settings.check_stability)),
         None if mesh_named is None else mesh_named(pieces, values["rod_elements"]))
-    check_stability_asked(values, scene, given, names, names["al_stability"])
     if values["rod_output"]:
         io.check_output_path(values["rod_output"], comm)
     if values["rod_table"]:
@@ -129,15 +128,15 @@ class BuiltLine:
     def build(self, say=None):
         """Make the mesh, the problem and the solver (build_solver: a PETSc error while
         the solvers are set up is bad input); refuse a stability test asked of a problem
-        with loads without an energy (check_stability_possible). Collective."""
+        with loads without an energy (scene_options.check_stability_asked). Collective."""
         plan, values = self.plan, self.plan.values
         self.mesh = Mesh(self.comm, values["rod_elements"], plan.scene.length,
                          values["rod_mesh_grading"], plan.pieces)
         self.scene, self.notes = walked_scene(plan.scene, values, self.comm)
         self.problem, self.solver = build_solver(self.mesh, self.scene, plan.settings,
                                                  say or _silent)
-        check_stability_possible(self.problem, "rod_al_stability" in plan.given
-                                 and values["rod_al_stability"], plan.names["al_stability"])
+        check_stability_asked(values, plan.given, plan.scene, self.problem, plan.names,
+                              plan.names["al_stability"])
         return self
 
     def start(self, say=None):
@@ -391,23 +390,6 @@ def build_solver(mesh, scene, settings, say):
         raise RodInputError(f"PETSc refused the solver options: {petsc_message(error)}; "
                             "check the "
                             "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
-
-
-def check_stability_possible(problem, asked, switch="-rod_al_stability"):
-    """Refuse -rod_al_stability 1, ``asked`` (given, true), for a problem with a term that
-    has no energy (Term.conservative False: a sloping seabed's lagged contact force, the
-    sea surface's wet and dry parts, attachments that can reach the surface), beside the
-    current and the friction that scene_options.check_stability_asked names by their
-    options: the test would be left out without a word (UzawaSolver.tests_stability).
-    The message names the switch as ``switch``."""
-    if not asked or problem.conservative:
-        return
-    loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
-                                    for term in problem.terms if not term.conservative))
-    raise RodInputError(f"{switch} 1: the stability test is of the second "
-                        f"variation of the energy, and this scene has loads without one "
-                        f"({loads}); drop {switch} (such a run gives no "
-                        "stability verdict)")
 
 
 def start_from(problem, values, given, say):

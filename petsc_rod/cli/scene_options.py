@@ -19,9 +19,8 @@ from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
 from petsc_rod.model.names import Names
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.problem.penalty import penalty_scales
-from petsc_rod.compile import (check_stretch_domain, compile_scene,  # noqa: F401
-                               line_names,
-                               rounded_down)
+from petsc_rod.compile import compile_scene
+from petsc_rod.model.derived import line_names, rounded_down  # noqa: F401
 from petsc_rod.environment.profiles import read_profile, read_seabed_profile
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import FIXED_FIELDS, PATH_FIELDS, BlendedPath, differences
@@ -231,9 +230,7 @@ def checked_pieces(scene, counts, named):
 
 def settings_from_options(values, scene, names=OPTION_NAMES):
     """The iteration's Settings of the options, the default penalty resolved for
-    ``scene``; a line stretched beyond the model of stretch is refused
-    (compile.check_stretch_domain); refusals worded with ``names``."""
-    check_stretch_domain(scene, names)
+    ``scene``; refusals worded with ``names``."""
     penalty = values["rod_al_penalty"]
     if penalty is None:
         penalty = checked_default_penalty(scene, start_tension(values, scene), names)
@@ -245,14 +242,20 @@ def settings_from_options(values, scene, names=OPTION_NAMES):
                     newton=values["rod_al_newton"])
 
 
-def check_stability_asked(values, scene, given, names=OPTION_NAMES,
+def check_stability_asked(values, given, scene, problem, names=OPTION_NAMES,
                           switch="-rod_al_stability"):
-    """Refuse -rod_al_stability 1, given, with a current or seabed friction: the test of
-    the second variation of the energy (docs/method.md §10) needs every load to have an
-    energy, and a current's drag (a follower load) has none, nor friction (it
-    dissipates); the default (true) is then left out in silence, as documented. The
-    message names the switch ``switch`` and the loads as ``names`` does."""
+    """Refuse the stability test asked for, ``switch`` 1 given (values and given of the
+    options), on a ``problem`` (problem.RodProblem, built for ``scene``) with a term that
+    has no energy (Term.conservative False): the test is of the second variation of the
+    energy (docs/method.md §10), and would be left out without a word
+    (UzawaSolver.tests_stability). The one place that decides whether a stability
+    verdict is possible: a current (its drag a follower load) and seabed friction (it
+    dissipates) are named by their options as ``names`` does; the other such loads (a
+    sloping seabed's lagged contact force, the sea surface's wet and dry parts,
+    attachments that can reach the surface) by their terms' newton_gap."""
     if "rod_al_stability" not in given or not values["rod_al_stability"]:
+        return
+    if problem.conservative:
         return
     if scene.current is not None:
         option = names["current_profile" if "rod_current_profile" in given else "current"]
@@ -260,7 +263,11 @@ def check_stability_asked(values, scene, given, names=OPTION_NAMES,
     elif scene.seabed is not None and scene.seabed.friction is not None:
         option, load, reason = names["seabed_friction"], "friction", "it dissipates"
     else:
-        return
+        loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
+                                        for term in problem.terms if not term.conservative))
+        raise RodInputError(f"{switch} 1: the stability test is of the second variation "
+                            f"of the energy, and this scene has loads without one ({loads}); "
+                            f"drop {switch} (such a run gives no stability verdict)")
     raise RodInputError(f"{switch} 1 with {option}: the stability test is of the "
                         f"second variation of the energy, and {load} has none ({reason}); "
                         f"drop {switch} (a run with {load} gives no stability "

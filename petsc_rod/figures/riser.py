@@ -47,15 +47,16 @@ def riser_figure(result, min_bend_radius=None):
     """The figure of one ``Result``; ``min_bend_radius``: the allowable bend radius
     (m) drawn on the curvature graph. Laid out at fixed margins when every panel fits
     in them (``clear``), else drawn again with constrained layout."""
-    figure = drawn_figure(result, min_bend_radius, fixed=True)
-    if clear(figure):
+    figure, heading = drawn_figure(result, min_bend_radius, fixed=True)
+    if clear(figure, heading):
         return figure
     plt.close(figure)
-    return drawn_figure(result, min_bend_radius, fixed=False)
+    return drawn_figure(result, min_bend_radius, fixed=False)[0]
 
 
 def drawn_figure(result, min_bend_radius, fixed):
-    """riser_figure's figure at fixed margins (``fixed``) or with constrained layout."""
+    """(figure, its suptitle's Text) of riser_figure at fixed margins (``fixed``) or
+    with constrained layout."""
     drawn = graphs.graphs_for([result])
     title = result_title(result)
     figure, elevation, plan, axes = layout(len(drawn),
@@ -75,19 +76,18 @@ def drawn_figure(result, min_bend_radius, fixed):
         if len(axis.get_legend_handles_labels()[0]) > 1:
             axis.legend(fontsize=8, loc="best")
     if fixed:
-        figure.suptitle(title, y=1 - TOP / SIZE[1])
-    else:
-        figure.suptitle(title)
-    return figure
+        return figure, figure.suptitle(title, y=1 - TOP / SIZE[1])
+    return figure, figure.suptitle(title)
 
 
-def clear(figure):
+def clear(figure, heading):
     """Whether every axes of ``figure``, its tick labels, axis labels and title
-    included, lies inside the figure, clear of the others and of the suptitle (the
-    fixed layout fits: else constrained layout makes room)."""
+    included, lies inside the figure, clear of the others and of the suptitle
+    ``heading`` (the Text figure.suptitle returned; the fixed layout fits: else
+    constrained layout makes room)."""
     renderer = figure.canvas.get_renderer()
     boxes = [axis.get_tightbbox(renderer) for axis in figure.axes]
-    boxes.append(figure._suptitle.get_window_extent(renderer))
+    boxes.append(heading.get_window_extent(renderer))
     inside = all(b.x0 >= 0 and b.y0 >= 0 and b.x1 <= figure.bbox.width
                  and b.y1 <= figure.bbox.height for b in boxes)
     return inside and not any(a.overlaps(b) for k, a in enumerate(boxes)

@@ -29,7 +29,7 @@ class Attachment:
         for name in ("S", "mass", "volume", "cda"):
             real(f"Attachment.{name}", getattr(self, name))
         # the dead force of a heavy attachment may exceed the bound of its numbers: the
-        # applied force's check names it (compile.check_applied_forces)
+        # applied force's check names it (model/derived.check_applied_forces)
         reals("Attachment.force", self.force, (3,), np.inf)
         if self.name is not None and (not isinstance(self.name, str) or "\n" in self.name):
             raise RodInputError(f"Attachment.name {self.name!r}: a name is one line of text")

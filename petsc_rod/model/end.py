@@ -14,10 +14,10 @@ class End:
     'clamp' (position and frame) or 'free'; ``position`` (3,), m, absolute, z up (a
     held end's; None: the start at the origin, the end the start + (L, 0, 0)); a flex
     joint at a pin of rotational stiffness ``stiffness`` (N m/rad) about ``axis`` (3,)
-    (None: the line's direction at that end in its start shape, Scene.joint_axis;
-    docs/riser.md §8); ``force`` (3,), N, a dead force at a free end; ``frame`` (9,) the
-    rows d1, d2, d3 of a clamped end's frame (None: e_y, e_z, e_x) and ``twist`` (rad) an
-    extra roll of a clamped end S = L about its d3. A field left None is not given: a
+    (None: the line's direction at that end in its start shape,
+    scenes/starts.start_direction; docs/riser.md §8); ``force`` (3,), N, a dead force
+    at a free end; ``frame`` (9,) the rows d1, d2, d3 of a clamped end's frame (None:
+    e_y, e_z, e_x) and ``twist`` (rad) an extra roll of a clamped end S = L about its d3. A field left None is not given: a
     field given where the kind has no use for it is refused (Model.check)."""
 
     kind: str = "pin"
@@ -46,6 +46,6 @@ class End:
     def hang_off(cls, position, flex_joint=0.0, axis=None):
         """The vessel's end at ``position`` (m): a pin, or a flex joint of stiffness
         ``flex_joint`` (N m/rad) about ``axis`` (default: the line's direction at the
-        hang-off in its catenary, where the joint is unloaded: Scene.joint_axis)."""
+        hang-off in its catenary, where the joint is unloaded: scenes/starts.start_direction)."""
         return cls("pin", tuple(position), flex_joint or None,
                    None if axis is None else tuple(axis))

@@ -12,6 +12,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.attachment import Attachment
+from petsc_rod.model.derived import check_loads
 from petsc_rod.model.end import KINDS, End
 from petsc_rod.model.line import Line, UniformLine
 from petsc_rod.model.line_type import check_line_types
@@ -98,6 +99,8 @@ class Model:
         for span in self.spans:
             if span.sections:
                 check_pipe(span.line, names)
+        for span in self.spans:             # the loads derived from the fields
+            check_loads(span, self.environment, names)
 
 
 def check_span(span, sea, n):

@@ -12,6 +12,14 @@ from petsc_rod.model.values import optional, real, reals
 WATER_DENSITY = 1025.0
 GRAVITY = 9.80665
 
+# The default seabed stiffness lets the line's own weight press it this far in (m).
+DEFAULT_PENETRATION = 1e-3
+# The stiffest seabed accepted lets the line's mean load press it in by this fraction of
+# the length: 50 times the round-off of a height (2.2e-16 L), below which the contact is
+# decided by round-off and a stiffer seabed changes nothing but the conditioning of the
+# vertical problem (largest_stiffness).
+MIN_RELATIVE_PENETRATION = 1e-14
+
 
 def _shape(value):
     """np.shape(value), None for rows of several lengths."""
@@ -99,3 +107,25 @@ class Environment:
         if profile is not None:
             return profile
         return np.zeros(1), np.asarray(self.current, dtype=float).reshape(1, 3)
+
+
+def default_stiffness(load_values):
+    """k = w / DEFAULT_PENETRATION (N/m^2), w the largest downward load per metre over
+    the load pieces (N/m): the line's own weight presses the seabed in by about 1 mm.
+    None when no piece points down."""
+    downward = float(np.max(-np.asarray(load_values)[:, 2], initial=0.0))
+    return downward / DEFAULT_PENETRATION if downward > 0 else None
+
+
+def largest_stiffness(applied_force, length):
+    """k_max = (F / L) / (MIN_RELATIVE_PENETRATION L), N/m^2: the seabed under which the
+    mean load per metre F / L (F = Scene.applied_force, N) sinks 1e-14 L.
+
+    Why this bound: the vertical problem's matrix adds k w_n (w_n ~ h, the Simpson
+    weights) to the elastic and penalty terms, whose diagonal is at least about R / h
+    with R >= F / 2 (the default penalty's tension scale); the ratio k h^2 / R then stays
+    below 2 (h / L)^2 / MIN_RELATIVE_PENETRATION <= 2e14, within double precision's
+    1 / eps = 4.5e15, on any mesh. A stiffer seabed would hold the line to within
+    round-off of its height anyway, so nothing physical is refused.
+    """
+    return applied_force / length / (MIN_RELATIVE_PENETRATION * length)

@@ -33,7 +33,8 @@ neither anyway).
 Above the sea surface z_s (Scene.sea_surface, a line of sections with -rod_sea_surface)
 an attachment has neither buoyancy nor drag: P_p holds its buoyancy B_p = rho_w g V_p
 e_z (Scene.point_buoyancies), so the term adds -(1 - w_p) B_p and takes w_p D_p, with
-w_p = wet_fraction(z_p - z_s, V_p) at the point's height of the last global step: the
+w_p = wet_fraction(z_p - z_s, V_p) at the point's height of the iterate, as the line's
+buoyancy in air (physics/iterate_heights.py: the heights the SNES mixes): the
 part of a sphere of the attachment's volume under the surface (a body wholly in or out
 of the water as OrcaFlex's clump and buoy; between, the sphere's cap, so that a buoy
 that floats finds its waterline). Forces of the iterate like the drag, without energy:
@@ -46,6 +47,7 @@ import numpy as np
 from petsc_rod.mesh.elements import P2, element_integrals, p2_basis, p2_integrals
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
 from petsc_rod.physics.dead_loads import DeadLoads
+from petsc_rod.physics.iterate_heights import IterateHeights, locate
 from petsc_rod.physics.term import TermOutput
 from petsc_rod.scenes.boundary import is_held
 
@@ -121,6 +123,9 @@ class PointLoads(DeadLoads):
                            "attachments with a drag area (docs/riser.md §9)"
                            if self.dragged else "")
         self._drag_rhs = VectorField(mesh, "point_drag_rhs") if iterative else None
+        self._heights = (IterateHeights(mesh, "point_tangents")
+                         if self.surface is not None else None)
+        self.start_state = self.end_state = None
 
     @property
     def axially_symmetric(self):
@@ -134,6 +139,7 @@ class PointLoads(DeadLoads):
         self.S, self.force = self.scene.point_loads(t)
         total = self.force.sum(axis=0)
         self.held_start = is_held(start)
+        self.start_state, self.end_state = start, end
         self.offset = np.zeros(3) if self.held_start else -total
         anchor = start if self.held_start else end
         self.anchor_work = float(anchor.position @ total)
@@ -145,15 +151,19 @@ class PointLoads(DeadLoads):
     def iterate_forces(self, state):
         """(D, C, w): the drags w_p D_p, the buoyancy taken off above the surface
         C_p = -(1 - w_p) B_p e_z, N, (n_p, 3) each, and the wet fractions w_p (n_p,)
-        (module docstring), at the points' heights of the last global step (where a
-        current varies with depth or a surface is reached). Zero drag without a drag
-        area; w = 1 and C = 0 without a surface. Collective."""
+        (module docstring): the drag at the points' heights of the last global step
+        (where a current varies with depth), as the line's (drag.py), the wet fraction
+        at the iterate's (where a surface is reached), as the line's buoyancy in air
+        (surface.py). Zero drag without a drag area; w = 1 and C = 0 without a surface.
+        Collective."""
         drags = self.scene.point_drags(self.t) if self.dragged else []
         profile = any(c.depths.size > 1 for _, c, _ in drags)
-        z = (self.positions(state)[:, 2] if profile or self.surface is not None
-             else np.zeros(self.S.size))
-        wet = (wet_fraction(z - self.surface, self.scene.point_volumes())
-               if self.surface is not None else np.ones(self.S.size))
+        z = self.positions(state)[:, 2] if profile else np.zeros(self.S.size)
+        wet = np.ones(self.S.size)
+        if self.surface is not None:
+            self._heights.set(state, self.start_state, self.end_state)
+            wet = wet_fraction(self._heights.at(self.S) - self.surface,
+                               self.scene.point_volumes())
         drag = np.zeros_like(self.force)
         for weight, current, area in drags:
             v = current.velocity(z)
@@ -227,16 +237,7 @@ class PointLoads(DeadLoads):
         int_{S_e}^{S_p} r'. Collective."""
         mesh = self.mesh
         local = np.zeros((self.S.size, 3))
-        mine = np.zeros(self.S.size, dtype=bool)
-        e = np.zeros(0, dtype=int)
-        if mesh.n_local_elements:
-            ends = np.append(mesh.element_S, mesh.coordinates(mesh.element_end))
-            last = mesh.element_end == mesh.n_elements
-            mine = (self.S >= ends[0]) & ((self.S < ends[-1]) | (last & (self.S <= ends[-1])))
-            e = np.clip(np.searchsorted(ends, self.S[mine], side="right") - 1,
-                        0, mesh.n_local_elements - 1)
-        h = mesh.element_h[e]
-        xi = np.clip((self.S[mine] - mesh.element_S[e]) / h, 0.0, 1.0)[:, None]
+        mine, e, xi, h = locate(mesh, self.S)
         # on every rank, with or without a point: the ghost updates are collective
         values = state.evaluate(mesh.element_local[e], p2_basis(xi, h), p2_integrals(xi, h))
         local[mine] = values["r"][:, 0]
@@ -268,3 +269,5 @@ class PointLoads(DeadLoads):
         super().destroy()
         if self._drag_rhs is not None:
             self._drag_rhs.destroy()
+        if self._heights is not None:
+            self._heights.destroy()

@@ -5,9 +5,8 @@ it (problem/build.py)."""
 import numpy as np
 
 from petsc_rod.global_step.nodal_loads import NodalLoad
-from petsc_rod.mesh.fields import VectorField
+from petsc_rod.physics.iterate_heights import IterateHeights
 from petsc_rod.physics.nodal_load import NodalLoadTerm
-from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.line import piecewise_constant
 
 def dry_fraction(height, radius):
@@ -28,13 +27,9 @@ class SurfaceTerm(NodalLoadTerm):
     section at the node's height: in the water nothing, in the air the whole buoyancy,
     across the surface the part of the circle above it (the area of a horizontal
     section exactly; a smooth law whose width is the diameter). The heights are those
-    of the iterate x = (tau, lambda / R) the SNES mixes, z(S) = z_a + int tau3_z from
-    the held end a (P2 in S, integrated exactly; iterate_heights), so that the map is a
-    function of x and Anderson mixing sees the load's dependence on it: with the heights
-    of the last global step (hidden from the mixing) the iteration cycled between two
-    states, the crossing moving the weight and the weight the crossing. A load of the
-    iterate like the drag, but without energy or Jacobian here: the scene has neither
-    Newton steps nor the stability test. Built where the line can reach the surface
+    of the iterate x = (tau, lambda / R) the SNES mixes (physics/iterate_heights.py, which
+    says why). A load of the iterate like the drag, but without energy or Jacobian here:
+    the scene has neither Newton steps nor the stability test. Built where the line can reach the surface
     (problem/build.py: a held end within od / 2 of it or above, or a buoyant
     section)."""
 
@@ -49,27 +44,13 @@ class SurfaceTerm(NodalLoadTerm):
         self.radius = od / 2
         self.buoyancy = scene.water_density * scene.gravity * np.pi * od**2 / 4
         self.load = NodalLoad(mesh, self._nodes)
-        self._tangents = NodalLoad(mesh, VectorField(mesh, "surface_tangents"))
+        self._heights = IterateHeights(mesh, "surface_tangents")
 
     def iterate_heights(self, state):
-        """z at the owned P2 nodes, (n_nodes,), m, integrated from the iterate's tangents
-        tau3 (P2 in S: at a vertex z_a + int_0^S, at a midpoint its element's first
-        vertex's plus h (5 t_0 + 8 t_m - t_1) / 24), from the start when it is held,
-        else back from the held end. Collective (a ghost exchange and a prefix sum)."""
-        mesh, tangents = self.mesh, self._tangents
-        tangents.set(np.ascontiguousarray(state.tau[:, 2]))
-        if is_held(self.start_state):
-            vertices = self.start_state.position[2] + tangents.before[:, 2]
-        else:
-            vertices = (self.end_state.position[2] - tangents.total[2]
-                        + tangents.before[:, 2])
-        z = np.empty(mesh.n_local_nodes)
-        z[0::2] = vertices[:z[0::2].size]
-        t = tangents.element_values[:, :, 2]
-        ne = mesh.n_local_elements
-        z[1:2 * ne:2] = vertices[:ne] + mesh.element_h * (5 * t[:, 0] + 8 * t[:, 1]
-                                                          - t[:, 2]) / 24
-        return z
+        """z at the owned P2 nodes, (n_nodes,), m, of the iterate's tangents
+        (iterate_heights.IterateHeights). Collective."""
+        self._heights.set(state, self.start_state, self.end_state)
+        return self._heights.at_nodes()
 
     def dry(self, state):
         """phi, the dry fraction of each owned P2 node's section at the iterate's heights,
@@ -91,7 +72,7 @@ class SurfaceTerm(NodalLoadTerm):
 
     def destroy(self):
         super().destroy()
-        self._tangents._field.destroy()
+        self._heights.destroy()
 
 
 def reaches_surface(scene, held_heights):

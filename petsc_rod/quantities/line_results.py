@@ -44,7 +44,7 @@ anchor) and ``anchor_position`` (3,) of the anchor, when it is held.
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension,
                                              points_on_held_ends, top_end, unit_tangent)
 from petsc_rod.scenes.boundary import is_held
@@ -147,13 +147,14 @@ def end_numbers(problem, vertex):
     return numbers
 
 
-class LineResults(Report):
-    """Reports the results along the line and at its ends (module docstring); built for
-    every scene (problem/build.py)."""
+def line_report(problem, vertex):
+    """The datasets along the line and the end numbers. Collective."""
+    return TermOutput(line_fields(vertex), end_numbers(problem, vertex))
 
-    name = "line_results"
-    dataset_units = DATASET_UNITS
-    attribute_units = ATTRIBUTE_UNITS
 
-    def outputs(self, problem, vertex):
-        return TermOutput(line_fields(vertex), end_numbers(problem, vertex))
+class LineResults(FunctionReport):
+    """The results along the line and at its ends (line_report); built for every scene
+    (problem/build.py)."""
+
+    name, report = "line_results", line_report
+    dataset_units, attribute_units = DATASET_UNITS, ATTRIBUTE_UNITS

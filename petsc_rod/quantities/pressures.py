@@ -23,27 +23,12 @@ over EA; docs/riser.md §2b).
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.quantities.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
 DATASET_UNITS = {"external_pressure": "Pa", "internal_pressure": "Pa", "wall_tension": "N"}
 ATTRIBUTE_UNITS = {"max_wall_tension": "N", "max_wall_tension_S": "m"}
-
-
-class PipePressures(Report):
-    """Reports the pressures and the wall tension (module docstring) of a line of
-    sections (problem/build.py)."""
-
-    name = "pipe_pressures"
-    dataset_units = DATASET_UNITS
-    attribute_units = ATTRIBUTE_UNITS
-
-    def __init__(self, scene):
-        self.scene = scene
-
-    def outputs(self, problem, vertex):
-        return pressure_report(problem, self.scene, vertex)
 
 
 def pressures(scene, z, z_top):
@@ -60,7 +45,7 @@ def wall_tension(tension, external, internal, od, inner):
     return tension + internal * np.pi * inner**2 / 4 - external * np.pi * od**2 / 4
 
 
-def pressure_report(problem, scene, vertex):
+def pressure_report(problem, vertex, scene):
     """A TermOutput: the datasets of DATASET_UNITS at the vertices, the largest wall
     tension and where. Collective."""
     S, z = vertex["S"], vertex["r"][:, 2]
@@ -77,3 +62,11 @@ def pressure_report(problem, scene, vertex):
                        "wall_tension": wall},
                       {"max_wall_tension": float(largest), "max_wall_tension_S": float(where)},
                       f"wall tension up to {largest:.6g} N at S = {where:.6g} m")
+
+
+class PipePressures(FunctionReport):
+    """The pressures and the wall tension (pressure_report) of a line of sections, made
+    with its scene (problem/build.py)."""
+
+    name, report = "pipe_pressures", pressure_report
+    dataset_units, attribute_units = DATASET_UNITS, ATTRIBUTE_UNITS

@@ -37,7 +37,7 @@ import numpy as np
 
 from petsc_rod.physics.term import TermOutput
 from petsc_rod.quantities.line_results import bending_moment, curvature
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.quantities.riser_numbers import (_at_vertex, effective_tension, top_end,
                                              touchdown)
 
@@ -49,20 +49,6 @@ ATTRIBUTE_UNITS = {"region_names": "text", "region_bounds": "m",
 END_FRACTION = 0.05
 # An extreme lower than this fraction of the height span is a wiggle, not a bend.
 PROMINENCE = 1e-3
-
-
-class LineRegions(Report):
-    """Reports the regions (module docstring); built for a scene with a seabed, a current
-    or line types, with the riser's SeabedTerm (or None)."""
-
-    name = "regions"
-    attribute_units = ATTRIBUTE_UNITS
-
-    def __init__(self, seabed=None):
-        self.seabed = seabed
-
-    def outputs(self, problem, vertex):
-        return region_report(problem, vertex, self.seabed)
 
 
 def _extremes(problem):
@@ -225,3 +211,10 @@ def region_report(problem, vertex, seabed=None):
         "region_min_bend_radius": radius, "region_min_bend_radius_S": kappa[:, 1],
         "region_max_bending_moment": moment[:, 0],
         "region_max_bending_moment_S": moment[:, 1]})
+
+
+class LineRegions(FunctionReport):
+    """The regions (region_report); built for a scene with a seabed, a current or line
+    types, with the riser's SeabedTerm (or None)."""
+
+    name, report, attribute_units = "regions", region_report, ATTRIBUTE_UNITS

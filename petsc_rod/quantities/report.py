@@ -26,3 +26,21 @@ class Report:
         phrase for the step line) from the vertex fields ``vertex``
         (io/outputs.vertex_fields) of the problem's state, or None. Collective."""
         return None
+
+
+class FunctionReport(Report):
+    """A report that is a function and its units, and holds no state of its own (the
+    riser numbers, the regions, the sections' numbers, the pipe's pressures and
+    stresses, the results along the line): ``outputs`` is ``report(problem, vertex,
+    *arguments)``, ``arguments`` those it was made with (a SeabedTerm, the scene, the
+    sections). A subclass names the function (``report``) beside ``name`` and the units;
+    a report with state of its own (module_bends.ModuleBends) is a Report."""
+
+    # the function (problem, vertex, *arguments) -> TermOutput or None
+    report = None
+
+    def __init__(self, *arguments):
+        self.arguments = arguments
+
+    def outputs(self, problem, vertex):
+        return type(self).report(problem, vertex, *self.arguments)

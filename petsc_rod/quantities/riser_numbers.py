@@ -35,7 +35,7 @@ import numpy as np
 
 from petsc_rod.physics.point_loads import PointLoads
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.scenes.boundary import is_held
 
 # The step line gives the touchdown's offset from the ends' plane when it is above this
@@ -51,21 +51,6 @@ ATTRIBUTE_UNITS = {
     "max_curvature_position": "m", "min_bend_radius": "m", "anchor_uplift_S": "m",
     "anchor_uplift_angle": "deg", "anchor_uplift_force": "N", "anchor_uplift": "1",
     "touchdown_x": "m", "touchdown_y": "m"}
-
-
-class RiserNumbers(Report):
-    """The riser numbers as a report (report.py): built for every scene with a seabed or
-    a current, with the SeabedTerm (physics/seabed.py) or None."""
-
-    name = "riser_numbers"
-    dataset_units = DATASET_UNITS
-    attribute_units = ATTRIBUTE_UNITS
-
-    def __init__(self, seabed=None):
-        self.seabed = seabed
-
-    def outputs(self, problem, vertex):
-        return riser_report(problem, vertex, self.seabed)
 
 
 def unit_tangent(vertex):
@@ -253,3 +238,11 @@ def riser_report(problem, vertex, seabed=None):
     text += (f", largest curvature {kappa:.4g} 1/m (bend radius "
              f"{attributes['min_bend_radius']:.4g} m) at S = {kappa_S:.6g} m")
     return TermOutput(datasets, attributes, text)
+
+
+class RiserNumbers(FunctionReport):
+    """The riser numbers (riser_report): built for every scene with a seabed or a
+    current, with the SeabedTerm (physics/seabed.py) or None."""
+
+    name, report = "riser_numbers", riser_report
+    dataset_units, attribute_units = DATASET_UNITS, ATTRIBUTE_UNITS

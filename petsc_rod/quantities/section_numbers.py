@@ -9,7 +9,7 @@ sections. Vectorised on each rank's owned vertices, combined by one allgather of
 import numpy as np
 
 from petsc_rod.physics.term import TermOutput
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.quantities.riser_numbers import effective_tension
 from petsc_rod.scenes.line import section_index
 
@@ -18,23 +18,6 @@ ATTRIBUTE_UNITS = {"section_names": "text", "section_bounds": "m",
                    "section_max_tension": "N", "section_max_tension_S": "m",
                    "section_max_curvature": "1/m", "section_max_curvature_S": "m",
                    "section_min_bend_radius": "m"}
-
-
-class SectionNumbers(Report):
-    """Reports the sections' numbers (module docstring); built for a line of sections
-    (problem/build.py)."""
-
-    name = "section_numbers"
-    dataset_units = DATASET_UNITS
-    attribute_units = ATTRIBUTE_UNITS
-
-    def __init__(self, sections):
-        self.sections = tuple(sections)
-
-    def outputs(self, problem, vertex):
-        mesh = problem.mesh
-        owned = np.arange(mesh.element_start, mesh.element_end)
-        return section_report(mesh, self.sections, vertex, problem.end_strains(owned))
 
 
 def _largest_per_section(values, S, sections):
@@ -102,3 +85,19 @@ def section_report(mesh, sections, vertex, element_ends=None):
         for i, s in enumerate(sections))
     return TermOutput({"section": section_index(sections, S).astype(float)}, attributes,
                       "sections: " + text)
+
+
+def section_numbers(problem, vertex, sections):
+    """section_report of the problem's state, with its owned elements' one-sided
+    strains. Collective."""
+    mesh = problem.mesh
+    owned = np.arange(mesh.element_start, mesh.element_end)
+    return section_report(mesh, sections, vertex, problem.end_strains(owned))
+
+
+class SectionNumbers(FunctionReport):
+    """The sections' numbers (section_numbers), made with the sections of a line of
+    sections (problem/build.py)."""
+
+    name, report = "section_numbers", section_numbers
+    dataset_units, attribute_units = DATASET_UNITS, ATTRIBUTE_UNITS

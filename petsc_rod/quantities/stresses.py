@@ -35,7 +35,7 @@ import numpy as np
 from petsc_rod.physics.term import TermOutput
 from petsc_rod.quantities import pressures as pipe_pressures
 from petsc_rod.quantities.line_results import bending_moment, torque
-from petsc_rod.quantities.report import Report
+from petsc_rod.quantities.report import FunctionReport
 from petsc_rod.quantities.riser_numbers import effective_tension, top_end
 from petsc_rod.scenes.line import piecewise_constant
 
@@ -80,21 +80,6 @@ def pipe_von_mises(wall, moment, twist, p_i, p_e, od, inner):
     return np.where(inner > 0, largest, np.nan)
 
 
-class PipeStresses(Report):
-    """Reports the von Mises stress and the utilisation (module docstring) of a line of
-    sections some of which have an inner diameter (problem/build.py)."""
-
-    name = "pipe_stresses"
-    dataset_units = DATASET_UNITS
-    attribute_units = ATTRIBUTE_UNITS
-
-    def __init__(self, scene):
-        self.scene = scene
-
-    def outputs(self, problem, vertex):
-        return stress_report(problem, self.scene, vertex)
-
-
 def _largest(comm, values, S):
     """(largest finite value, its S) over the ranks' owned vertices; (NaN, NaN) when no
     rank has one. Collective."""
@@ -107,7 +92,7 @@ def _largest(comm, values, S):
     return max(candidates) if candidates else (np.nan, np.nan)
 
 
-def stress_report(problem, scene, vertex):
+def stress_report(problem, vertex, scene):
     """A TermOutput: the datasets von_mises (Pa, NaN where a section has no bore) and
     utilisation (1, NaN where its line type has no smys) at the vertices; the largest of
     each and where. Collective."""
@@ -131,3 +116,11 @@ def stress_report(problem, scene, vertex):
                       {"max_von_mises": most, "max_von_mises_S": most_S,
                        "max_utilisation": used, "max_utilisation_S": used_S,
                        "design_factor": scene.design_factor}, text)
+
+
+class PipeStresses(FunctionReport):
+    """The von Mises stress and the utilisation (stress_report) of a line of sections
+    some of which have an inner diameter, made with its scene (problem/build.py)."""
+
+    name, report = "pipe_stresses", stress_report
+    dataset_units, attribute_units = DATASET_UNITS, ATTRIBUTE_UNITS

@@ -17,14 +17,11 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.frames import REFERENCE_FRAME, rotation_about, rotation_log
+from petsc_rod.model.derived import TAUT_GAP, applied_forces
 from petsc_rod.model.model import check_chord, check_positive
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.scenes.line import piecewise_constant, piecewise_linear
-from petsc_rod.scenes.starts import catenary_start
-# Held ends closer to the length than this fraction of it make a taut line (Scene.taut):
-# a catenary of sag f has (8/3) f^2 / L of slack, so at 1e-9 L of slack its tension is
-# above 2000 times its weight, beyond what the constraint tolerance determines.
-TAUT_GAP = 1e-9
+from petsc_rod.scenes.starts import start_direction
 
 
 def rolled_frame(frame, angle):
@@ -76,7 +73,8 @@ class Scene:
     design_factor: float = 2.0 / 3.0
     # flex joints (physics/flex_joint.py): the rotational stiffness k (N m/rad) of a
     # pinned end, 0 for none, and the neutral axis a its d3 is held to (None: the line's
-    # direction at that end in its start shape, joint_axis); fixed, not on the load path
+    # direction at that end in its start shape, resolved in __post_init__ where the joint
+    # has a stiffness: starts.start_direction); fixed, not on the load path
     start_rotational_stiffness: float = 0.0
     end_rotational_stiffness: float = 0.0
     start_joint_axis: np.ndarray = None
@@ -130,6 +128,12 @@ class Scene:
                                           for k in range(self.point_load_S.size))
         self._end_rotation = rotation_log(self.end_frame.T @ REFERENCE_FRAME)
         self._start_rotation = rotation_log(self.start_frame.T @ REFERENCE_FRAME)
+        # a flex joint's default axis, from the start shape of the whole scene: its
+        # seabed is part of it (compile.py gives the joints with the seabed)
+        for which in ("start", "end"):
+            if (getattr(self, f"{which}_joint_axis") is None
+                    and float(getattr(self, f"{which}_rotational_stiffness")) > 0):
+                setattr(self, f"{which}_joint_axis", start_direction(self, which))
 
     @property
     def uniform_stiffness(self):
@@ -193,7 +197,7 @@ class Scene:
     def taut(self):
         """Whether an inextensible line is held at both ends at least its length less
         TAUT_GAP (relative) apart: straight, with an axial force its inextensibility
-        leaves undetermined (compile.check_taut)."""
+        leaves undetermined (model/derived.check_taut)."""
         held = self.start != "free" and self.end != "free"
         chord = np.linalg.norm(self.end_position - self.start_state(1.0).position)
         return held and not self.extensible and chord >= self.length * (1 - TAUT_GAP)
@@ -252,21 +256,14 @@ class Scene:
         return float(sum(self.applied_forces().values()))
 
     def applied_forces(self):
-        """The parts of applied_force by where they come from, N: {'load': int |f| dS of
-        the dead load, 'drag': L c max |v|^2 of the current and the attachments'
-        1/2 rho_w C_d A max |v|^2 (0 without a current), 'start_force':
-        |P_0|, 'end_force': |P_L|, 'point_loads': sum_p |P_p|}."""
-        drag = 0.0
-        if self.current is not None:            # the largest drag the current can exert
-            drag = self.length * self.current.largest_drag()
-            # and the attachments', 1/2 rho_w C_d A max |v|^2 each
-            drag += (0.5 * self.water_density * self.point_load_drag_areas.sum()
-                     * float(np.max(np.sum(self.current.velocities**2, axis=1))))
-        return {"load": float(np.diff(self.load_piece_ends)
-                              @ np.linalg.norm(self.load_values, axis=1)),
-                "drag": drag, "start_force": float(np.linalg.norm(self.start_force)),
-                "end_force": float(np.linalg.norm(self.end_force)),
-                "point_loads": float(np.linalg.norm(self.point_load_forces, axis=1).sum())}
+        """The parts of applied_force by where they come from, N (model/derived.py
+        applied_forces): {'load', 'drag', 'start_force', 'end_force', 'point_loads'}."""
+        current = self.current
+        return applied_forces(self.load_piece_ends, self.load_values, self.start_force,
+                              self.end_force, self.point_load_forces,
+                              self.point_load_drag_areas, self.water_density,
+                              None if current is None else current.drag,
+                              None if current is None else current.velocities)
 
     def end_rotation(self):
         """The angle (rad) by which a clamped end is turned at t = 1: that of -rod_end_frame
@@ -300,33 +297,15 @@ class Scene:
 
     def joints(self):
         """The flex joints, [(which, k, a)]: which 'start' or 'end', k > 0 the rotational
-        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py,
-        joint_axis)."""
+        stiffness (N m/rad), a the unit neutral axis (physics/flex_joint.py; the
+        default resolved when the scene was made, start_direction)."""
         joints = []
         for which in ("start", "end"):
             k = float(getattr(self, f"{which}_rotational_stiffness"))
             if k > 0:
-                joints.append((which, k, self.joint_axis(which)))
+                axis = getattr(self, f"{which}_joint_axis")
+                joints.append((which, k, axis / np.linalg.norm(axis)))
         return joints
-
-    def joint_axis(self, which):
-        """The unit neutral axis of the flex joint at ``which`` ('start' or 'end'): the
-        given -rod_*_joint_axis, else the line's direction (d3) at that end in the
-        scene's start shape: the tangent there of its catenary at load factor 1 (the
-        curve -rod_initial_shape catenary starts from: through both held ends, resting
-        on the seabed, the weights of the sections) where it has one, the joint then
-        unloaded in the catenary's static angle, as a flex joint is installed at a
-        hang-off; else e_x, the straight reference (an end free, no load). A default
-        e_x made a riser's hang-off joint turn by 85 degrees."""
-        axis = getattr(self, f"{which}_joint_axis")
-        if axis is None:
-            try:
-                frame = catenary_start(self, 1.0)(np.array([0.0 if which == "start"
-                                                            else self.length]))[1][0]
-                axis = frame[2]
-            except RodInputError:
-                axis = REFERENCE_FRAME[2]
-        return np.asarray(axis, dtype=float) / np.linalg.norm(axis)
 
     def drag_loads(self, t):
         """[(weight, Current)]: the drag at load factor t is the sum of each current's

@@ -126,3 +126,19 @@ def section_start(scene, t, start, end):
         return x[..., None] * along + z[..., None] * up, tangent, force
 
     return planar_curve(shape, np.cross(up, along), start.position)
+
+
+def start_direction(scene, which):
+    """The line's direction (d3, (3,)) at ``which`` end ('start' or 'end') in the scene's
+    start shape, the default neutral axis of a flex joint there (Scene.__post_init__):
+    the tangent of its catenary at load factor 1 (the curve -rod_initial_shape catenary
+    starts from: through both held ends, resting on the seabed, the weights of the
+    sections) where it has one, the joint then unloaded in the catenary's static angle,
+    as a flex joint is installed at a hang-off; else e_x, the straight reference (an end
+    free, no load). A default e_x made a riser's hang-off joint turn by 85 degrees."""
+    try:
+        frames = catenary_start(scene, 1.0)(np.array([0.0 if which == "start"
+                                                      else scene.length]))[1]
+    except RodInputError:
+        return REFERENCE_FRAME[2].copy()
+    return frames[0][2]

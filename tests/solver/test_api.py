@@ -220,6 +220,17 @@ def test_a_stability_test_asked_with_a_current_is_refused():
     assert "al_stability" in str(refused.value) and "Environment.current" in str(refused.value)
 
 
+def test_a_stability_test_asked_on_a_sloping_seabed_names_the_apis_switch():
+    """One check decides whether a stability verdict is possible: on a sloping seabed
+    without a current (its lagged contact force has no energy) the API's refusal names
+    the API's switch, as it names the current by the model's field."""
+    sea = Environment(seabed=0.0, surface=60.0, seabed_slope=2.0)
+    with pytest.raises(RodInputError, match="a seabed that is not flat") as refused:
+        solve(model(environment=sea, options={"al_stability": True}))
+    assert str(refused.value).startswith("Model.options['al_stability'] 1: ")
+    assert "drop Model.options['al_stability']" in str(refused.value)
+
+
 def test_a_uniform_line_is_a_model_too(tmp_path):
     """Issue 48: the API is the model, both its lines: a uniform cantilever (the command
     line's -rod_stiffness, -rod_load) solves to the small-deflection tip w L^4 / 8 EI, and

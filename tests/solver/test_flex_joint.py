@@ -314,7 +314,7 @@ def test_the_default_joint_axis_is_the_lines_direction_in_its_catenary(comm, whi
                  load_values=[(0.0, 0.0, -100.0)], **{f"{which}_rotational_stiffness": 5.0})
     tangent = catenary_start(Scene(length=LENGTH, stiffness=STIFFNESS, **scene), 1.0)(
         np.array([0.0 if which == "start" else LENGTH]))[1][0][2]
-    assert Scene(length=LENGTH, stiffness=STIFFNESS, **scene).joint_axis(which) \
+    assert getattr(Scene(length=LENGTH, stiffness=STIFFNESS, **scene), f"{which}_joint_axis") \
         == pytest.approx(tangent, abs=1e-15)
     assert abs(tangent[0]) < 0.9                      # far from e_x
     _, r, joints = solve(comm, scene, steps=2)
@@ -327,4 +327,4 @@ def test_the_default_joint_axis_is_the_lines_direction_in_its_catenary(comm, whi
     assert joints[0][0] == pytest.approx(given_joints[0][0], rel=1e-9)
     free = Scene(length=LENGTH, stiffness=STIFFNESS, start="pin", end="free",
                  start_rotational_stiffness=1.0, end_force=(0.0, -1.0, 0.0))
-    assert np.array_equal(free.joint_axis("start"), [1.0, 0.0, 0.0])
+    assert np.array_equal(free.start_joint_axis, [1.0, 0.0, 0.0])

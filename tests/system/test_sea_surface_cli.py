@@ -158,6 +158,39 @@ def test_a_restart_rebuilds_the_attachments_with_their_volumes(tmp_path):
                                rtol=1e-6)
 
 
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_buoy_floats_at_the_surface_in_one_step(tmp_path, ranks):
+    """A buoy of 0.5 m^3 and 20 kg at the middle of the cable, its two pins 60 m apart
+    on the plane 15 m under -rod_sea_surface: it floats, part of it out of the water.
+    Its wet fraction is read at the iterate's heights, as the line's buoyancy in air
+    (physics/iterate_heights.py), so that the mixing sees it: the run converges in its
+    one step (measured 529 iterations at 200 elements, w = 0.2908 with the buoy's centre
+    0.14 m above the surface; before, with the heights of the last global step, the
+    iteration cycled: 4 halvings, not converged at load factor 0.125, exit 3). The
+    reported w is the sphere's cap at the reported height, and the buoy's force its
+    part-wet lift (rho_w V w - m) g."""
+    types, table = tmp_path / "cable.txt", tmp_path / "buoy.txt"
+    types.write_text(CABLE_TYPE)
+    table.write_text("s mass volume cda name\n50 20 0.5 0 buoy\n")
+    path = tmp_path / "buoy.h5"
+    done = run_petsc_rod(["-rod_line_types", str(types), "-rod_sections", "cable:100:200",
+                          "-rod_start", "pin", "-rod_end", "pin", "-rod_end_position",
+                          "60,0,0", "-rod_sea_surface", "15", "-rod_initial_shape",
+                          "catenary", "-rod_point_loads", str(table), "-rod_output",
+                          str(path)], ranks, TIMEOUT)
+    assert done.returncode == 0, describe(done)
+    assert "0 halving(s) of the step" in done.stdout + done.stderr
+    from petsc_rod.physics.point_loads import wet_fraction
+
+    attributes = last_step(path)
+    (wet,), height = attributes["point_load_wet"], attributes["point_load_position"][0, 2]
+    assert 0.1 < wet < 0.9 and abs(height - SURFACE) < 0.49
+    assert wet == pytest.approx(float(wet_fraction(height - SURFACE, 0.5)), abs=1e-6)
+    assert attributes["point_load_force"][0, 2] == pytest.approx(
+        (RHO * 0.5 * wet - 20.0) * G, rel=1e-12)
+    assert attributes["start_force"][2] == pytest.approx(attributes["end_force"][2], rel=1e-6)
+
+
 # a uniform line (-rod_load) from a pin at the origin to one 10 m across and 25 m down,
 # in a current of one row (uniform in depth) measured from -rod_sea_surface
 UNIFORM = ["-rod_length", "30", "-rod_stiffness", "1,1,1", "-rod_start", "pin", "-rod_end",

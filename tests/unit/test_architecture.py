@@ -142,6 +142,30 @@ def test_reports_are_not_terms_and_own_their_units():
         assert report.name and report.attribute_units, report
 
 
+def test_a_report_that_is_a_function_and_its_units_is_one_function_report():
+    """The reports that only wrap a function and a units table are FunctionReports
+    (quantities/report.py): outputs(problem, vertex) is the function of (problem,
+    vertex, *the arguments it was made with); ModuleBends, with state of its own, is a
+    plain Report."""
+    from petsc_rod.quantities import (line_results, module_bends, pressures, regions,
+                                      riser_numbers, section_numbers, stresses)
+    from petsc_rod.quantities.report import FunctionReport
+    shells = {riser_numbers.RiserNumbers: riser_numbers.riser_report,
+              regions.LineRegions: regions.region_report,
+              pressures.PipePressures: pressures.pressure_report,
+              stresses.PipeStresses: stresses.stress_report,
+              section_numbers.SectionNumbers: section_numbers.section_numbers,
+              line_results.LineResults: line_results.line_report}
+    for report, function in shells.items():
+        assert issubclass(report, FunctionReport) and report.report is function, report
+    assert not issubclass(module_bends.ModuleBends, FunctionReport)
+
+    class Echo(FunctionReport):
+        name, report = "echo", lambda problem, vertex, *more: (problem, vertex, more)
+
+    assert Echo("a", 2).outputs("problem", "vertex") == ("problem", "vertex", ("a", 2))
+
+
 def docstrings(tree):
     """The ids of the string nodes that are docstrings."""
     found = set()

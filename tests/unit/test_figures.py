@@ -310,3 +310,14 @@ def test_a_riser_picture_has_a_fixed_layout_without_overlaps(folder):
     figure = plots.result_figure(path)
     assert figure.get_layout_engine() is not None
     matplotlib.pyplot.close(figure)
+
+
+def test_the_fixed_layout_measures_the_suptitle_it_was_given():
+    """figures.riser.clear measures the suptitle's Text that figure.suptitle returned
+    (no private attribute of the figure): clear of the axes it fits, over them not."""
+    from petsc_rod.figures import riser
+    figure = matplotlib.pyplot.figure(figsize=(4, 4))
+    figure.add_axes([0.2, 0.2, 0.6, 0.5])
+    assert riser.clear(figure, figure.suptitle("a title", y=0.97))
+    assert not riser.clear(figure, figure.suptitle("a title", y=0.45))
+    matplotlib.pyplot.close(figure)

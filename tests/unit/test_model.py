@@ -106,3 +106,43 @@ def test_zero_pressures_and_a_zero_joint_stiffness_are_no_settings():
         compile_scene(riser(end=end))
     with pytest.raises(RodInputError, match="needs Model.end pin"):
         compile_scene(riser(end=End("clamp", (110.0, 0.0, -45.0), 1e4)))
+
+
+FLOATY = LineType("floaty", od=0.2, mass=10.0, ei=1e5, gj=8e4, cd=1.0)
+SMOOTH = LineType("smooth", od=0.2, mass=60.0, ei=1e5, gj=8e4)
+ROPE = dict(length=100.0, stiffness=(1.0, 1.0, 1.0), load=(0.0, 0.0, -10.0))
+
+
+@pytest.mark.parametrize("model, words", [
+    (riser(end=End.hang_off((170.0, 0.0, -100.0))),
+     "Model.end.position: the held ends are 160 m apart, the line's length 160 m"),
+    (riser(line=Line([(FLOATY, 160.0)])),
+     "Environment.seabed: no line type sinks (mass above the water displaced)"),
+    (riser(environment=Environment(seabed=-100.5, seabed_stiffness=1e25)),
+     "Environment.seabed_stiffness 1e+25: the largest accepted is"),
+    (riser(line=Line([(SMOOTH, 160.0)])),
+     "a current on Line.sections whose line types have no drag"),
+    (Model(UniformLine(**ROPE, drag=(1025.0, 1.0, 0.1)), End.anchor((0.0, 0.0, 0.0)),
+           End.anchor((60.0, 0.0, 30.0)),
+           Environment(surface=10.0, current=[[0.0, 0.5, 0.0, 0.0], [50.0, 0.1, 0.0, 0.0]])),
+     "Environment.surface 10: the held end at z = 30 m is above it"),
+    (Model(UniformLine(**dict(ROPE, load=(0.0, 0.0, -1e29))), End.anchor((0.0, 0.0, 0.0)),
+           End.anchor((60.0, 0.0, 30.0))),
+     "UniformLine.load (with Line.length): the applied force"),
+    (Model(UniformLine(**ROPE, axial_stiffness=100.0), End.anchor((0.0, 0.0, 0.0)),
+           End.anchor((60.0, 0.0, 30.0))),
+     "UniformLine.axial_stiffness 100: hanging in tension it stretches the line by about "
+     "165 % or more"),
+])
+def test_the_model_refuses_the_loads_it_derives_before_a_scene_is_compiled(model, words):
+    """Model.check holds the checks of the loads the model derives (model/derived.py):
+    a taut line, a default seabed stiffness without a weight, a seabed too stiff, a
+    current on line types without drag, a uniform line above the surface, an applied
+    force beyond the bound of the model's numbers, a stretch beyond the model of
+    stretch; the compile refuses them the same."""
+    with pytest.raises(RodInputError) as refused:
+        model.check()
+    assert words in str(refused.value), str(refused.value)
+    with pytest.raises(RodInputError) as compiled:
+        compile_scene(model)
+    assert str(compiled.value) == str(refused.value)
