@@ -212,3 +212,32 @@ def test_the_figures_are_written(solver, circle, curves, shared_tmp):
         assert png_size(path) == (round(size[0] * DPI), round(size[1] * DPI))
         pixels = matplotlib.image.imread(path)[..., :3]
         assert (pixels < 0.9).any(axis=2).mean() > 0.01             # something drawn
+
+
+def test_a_line_without_a_seabed_reports_no_touchdown():
+    """A line hanging between two pins: no touchdown, no grounded length; its largest
+    tension at the higher end, the force there; its centreline gathered to the first
+    rank of its communicator only."""
+    from petsc_rod.system.held_line import HeldLine
+    ends = (np.zeros(3), np.array([80.0, 0.0, 20.0]))
+    model = Model(line=the_line(), start=End.anchor(tuple(ends[0])),
+                  end=End.anchor(tuple(ends[1])), environment=Environment(), options=TIGHT)
+    line = HeldLine(model, PETSc.COMM_WORLD, options=TIGHT)
+    try:
+        assert line.solve(*ends)
+        summary = line.summary()
+        assert np.isnan(summary["grounded_length"]) and np.isnan(summary["touchdown_S"])
+        assert np.all(np.isnan(summary["touchdown_position"]))
+        assert summary["max_tension_S"] == 100.0
+        assert summary["max_tension_position"] == pytest.approx(ends[1], abs=1e-9)
+        assert summary["max_tension"] == pytest.approx(summary["end_force"], rel=1e-6)
+        assert summary["start_tension"] < summary["end_tension"] == summary["max_tension"]
+        r = line.centreline()
+        if PETSc.COMM_WORLD.rank == 0:
+            assert r.shape == (41, 3)
+            assert r[[0, -1]] == pytest.approx(np.array(ends), abs=1e-9)
+            assert r[:, 2].min() < -5.0                                  # it sags
+        else:
+            assert r is None
+    finally:
+        line.destroy()
