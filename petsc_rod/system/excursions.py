@@ -21,6 +21,10 @@ pitch). The slope d restoring / d offset at F = 0 is the inverse of the complian
 hydrostatics'), K_xx itself when the body's other degrees of freedom are held or
 uncoupled.
 
+A case no equilibrium is found for (the solver's RodDivergedError: a line that cannot
+reach, a load beyond what the lines hold) is a gap in the results (NaN, its reason in
+``failed``), and the next case starts from the last equilibrium found.
+
 Every function is collective on the solver's communicator and returns the same numbers
 on every rank; it leaves the solver at rest again (its system solved anew at the end:
 the solver's ``system`` is what the loads are added to, so it must be the unloaded
@@ -31,6 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from petsc_rod.errors import RodDivergedError, RodInputError
 from petsc_rod.system.outputs import line_summaries
 
 # Units of the results' arrays.
@@ -45,11 +50,15 @@ class Worst:
     ``max_tension_line`` its index in ``lines`` (the lines' names); ``min_grounded`` m,
     the smallest grounded length of a line on the seabed (NaN: no line has a seabed),
     and ``min_grounded_line``; ``rest`` (6,) the reference pose (x, y, z m, roll,
-    pitch, yaw rad); ``units`` of the arrays."""
+    pitch, yaw rad); ``units`` of the arrays; ``failed`` ((heading deg, load N,
+    why), ...) the cases no equilibrium was found for (RodDivergedError's message),
+    NaN in every array (and -1 in the line indices), the next case solved from the
+    last equilibrium."""
 
     body: str
     headings: np.ndarray
     poses: np.ndarray
+    failed: tuple
     max_tension: np.ndarray
     max_tension_line: np.ndarray
     min_grounded: np.ndarray
@@ -78,22 +87,24 @@ class LoadExcursion(Worst):
     offsets: np.ndarray
     restoring: np.ndarray
 
+    def _at(self, value, index, line):
+        if index is None:
+            return value, np.nan, np.nan, None
+        return value, float(self.headings[index[0]]), float(self.loads[index[1]]), line
+
     @property
     def largest_tension(self):
-        """(N, heading deg, load N, line name) of the largest tension over the curves."""
-        value, index, line = self._worst(self.max_tension, self.max_tension_line,
-                                         np.nanargmax)
-        return value, float(self.headings[index[0]]), float(self.loads[index[1]]), line
+        """(N, heading deg, load N, line name) of the largest tension over the curves;
+        NaN and None when no line reports one."""
+        return self._at(*self._worst(self.max_tension, self.max_tension_line,
+                                     np.nanargmax))
 
     @property
     def smallest_grounded(self):
         """(m, heading deg, load N, line name) of the smallest grounded length over the
         curves; NaN and None when no line has a seabed."""
-        value, index, line = self._worst(self.min_grounded, self.min_grounded_line,
-                                         np.nanargmin)
-        if index is None:
-            return value, np.nan, np.nan, None
-        return value, float(self.headings[index[0]]), float(self.loads[index[1]]), line
+        return self._at(*self._worst(self.min_grounded, self.min_grounded_line,
+                                     np.nanargmin))
 
 
 @dataclass(frozen=True)
@@ -108,22 +119,24 @@ class WatchCircle(Worst):
     @property
     def largest_offset(self):
         """The largest horizontal offset over the headings, m."""
-        return float(np.linalg.norm(self.offsets, axis=1).max())
+        return float(np.nanmax(np.linalg.norm(self.offsets, axis=1)))
+
+    def _at(self, value, index, line):
+        return value, (np.nan if index is None else float(self.headings[index[0]])), line
 
     @property
     def largest_tension(self):
-        """(N, heading deg, line name) of the largest tension over the headings."""
-        value, index, line = self._worst(self.max_tension, self.max_tension_line,
-                                         np.nanargmax)
-        return value, float(self.headings[index[0]]), line
+        """(N, heading deg, line name) of the largest tension over the headings;
+        (NaN, NaN, None) when no line reports one."""
+        return self._at(*self._worst(self.max_tension, self.max_tension_line,
+                                     np.nanargmax))
 
     @property
     def smallest_grounded(self):
         """(m, heading deg, line name) of the smallest grounded length over the
         headings; (NaN, NaN, None) when no line has a seabed."""
-        value, index, line = self._worst(self.min_grounded, self.min_grounded_line,
-                                         np.nanargmin)
-        return value, (np.nan if index is None else float(self.headings[index[0]])), line
+        return self._at(*self._worst(self.min_grounded, self.min_grounded_line,
+                                     np.nanargmin))
 
 
 def extremes(summaries):
@@ -167,21 +180,30 @@ def _cases(solver, body, cases):
     base = solver.system
     names = [b.name for b in base.bodies]
     if body not in names:
-        from petsc_rod.errors import RodInputError
         raise RodInputError(f"excursions: no body is named {body!r}; the system's bodies: "
                             f"{', '.join(names) or 'none'}")
     index = names.index(body)
     rest = solver.solve(base).bodies[body].copy()
     rest_force = lines_force(solver, index)
-    poses, forces, worst = [], [], []
+    poses, forces, worst, failed = [], [], [], []
     for heading, magnitude in cases:
-        result = solver.solve(loaded(base, body, magnitude * _direction(heading)))
+        saved = solver.state
+        try:
+            result = solver.solve(loaded(base, body, magnitude * _direction(heading)))
+        except RodDivergedError as error:
+            # the next case starts from the last equilibrium, as if this one was not asked
+            solver.state = saved
+            failed.append((float(heading), float(magnitude), str(error)))
+            poses.append(np.full(6, np.nan))
+            forces.append(np.full(3, np.nan))
+            worst.append((np.nan, -1, np.nan, -1))
+            continue
         poses.append(result.bodies[body].copy())
         forces.append(lines_force(solver, index))
         worst.append(extremes(line_summaries(solver)))
     solver.solve(base)
     return rest, np.array(poses).reshape(-1, 6), np.array(forces).reshape(-1, 3), \
-        rest_force, np.array(worst, dtype=float).reshape(-1, 4)
+        rest_force, np.array(worst, dtype=float).reshape(-1, 4), tuple(failed)
 
 
 def load_excursion(solver, body, loads, headings=(0.0,)):
@@ -192,14 +214,14 @@ def load_excursion(solver, body, loads, headings=(0.0,)):
     loads = np.asarray(loads, dtype=float).ravel()
     headings = np.asarray(headings, dtype=float).ravel()
     cases = [(h, f) for h in headings for f in loads]
-    rest, poses, forces, rest_force, worst = _cases(solver, body, cases)
+    rest, poses, forces, rest_force, worst, failed = _cases(solver, body, cases)
     shape = (headings.size, loads.size)
     e = np.array([_direction(h) for h in headings])                  # (h, 3)
     poses = poses.reshape(shape + (6,))
     offsets = np.einsum("hmi,hi->hm", poses[..., :3] - rest[:3], e)
     restoring = -np.einsum("hmi,hi->hm", forces.reshape(shape + (3,)) - rest_force, e)
     return LoadExcursion(**_worst(solver, body, headings, poses, rest,
-                                  worst.reshape(shape + (4,))),
+                                  worst.reshape(shape + (4,)), failed),
                          loads=loads, offsets=offsets, restoring=restoring)
 
 
@@ -208,14 +230,16 @@ def watch_circle(solver, body, load, headings=np.arange(0.0, 360.0, 15.0)):
     through ``headings`` (deg), one after the next (each equilibrium warm from the
     last), after the rest. Collective."""
     headings = np.asarray(headings, dtype=float).ravel()
-    rest, poses, _, _, worst = _cases(solver, body, [(h, float(load)) for h in headings])
-    return WatchCircle(**_worst(solver, body, headings, poses, rest, worst),
+    rest, poses, _, _, worst, failed = _cases(solver, body,
+                                              [(h, float(load)) for h in headings])
+    return WatchCircle(**_worst(solver, body, headings, poses, rest, worst, failed),
                        load=float(load), offsets=poses[:, :2] - rest[:2])
 
 
-def _worst(solver, body, headings, poses, rest, worst):
+def _worst(solver, body, headings, poses, rest, worst, failed):
     """Worst's fields from the extremes ``worst`` (..., 4)."""
-    return dict(body=body, headings=headings, poses=poses, max_tension=worst[..., 0],
+    return dict(body=body, headings=headings, poses=poses, failed=failed,
+                max_tension=worst[..., 0],
                 max_tension_line=worst[..., 1].astype(int), min_grounded=worst[..., 2],
                 min_grounded_line=worst[..., 3].astype(int), rest=rest,
                 lines=tuple(line.name for line in solver.system.lines), units=UNITS)

@@ -241,3 +241,32 @@ def test_a_line_without_a_seabed_reports_no_touchdown():
             assert r is None
     finally:
         line.destroy()
+
+
+def test_a_heading_without_an_equilibrium_is_a_gap_in_the_circle():
+    """Mock springs that fail beyond a span of 70.5 m (test_system_equilibrium.py): the
+    headings that stretch one line alone past it fail, recorded with why, NaN in the
+    arrays; the next heading is solved from the last equilibrium as if they had not
+    been asked, and equals the circle without the limit. Lines without a summary
+    report no tension."""
+    from test_system_equilibrium import spread as spring_spread, spring
+    from petsc_rod.system.equilibrium import Settings
+    headings = [0.0, 60.0, 120.0, 180.0]
+    circles = []
+    for limit in (1e9, 70.5):
+        mocks = SystemSolver(spring_spread(limit=limit), spring, PETSc.COMM_SELF,
+                             settings=Settings(max_halvings=3))
+        try:
+            circles.append(watch_circle(mocks, "floater", 1e6, headings))
+        finally:
+            mocks.destroy()
+    free, limited = circles
+    assert free.failed == () and np.all(np.isfinite(free.offsets))
+    assert [case[:2] for case in limited.failed] == [(60.0, 1e6), (180.0, 1e6)]
+    assert "line line2 did not converge" in limited.failed[0][2]
+    assert np.all(np.isnan(limited.offsets[[1, 3]]))
+    assert limited.offsets[[0, 2]] == pytest.approx(free.offsets[[0, 2]], abs=1e-9)
+    assert np.abs(free.offsets[2] - turned(free.offsets[0], 120.0)).max() < 1e-9
+    assert limited.largest_offset == pytest.approx(np.linalg.norm(free.offsets[0]))
+    assert np.all(np.isnan(free.max_tension)) and np.all(free.max_tension_line == -1)
+    assert free.largest_tension[2] is None
