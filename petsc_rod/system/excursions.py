@@ -41,6 +41,12 @@ from petsc_rod.system.outputs import line_summaries
 # Units of the results' arrays.
 UNITS = {"headings": "deg", "loads": "N", "load": "N", "poses": "m, rad",
          "offsets": "m", "restoring": "N", "max_tension": "N", "min_grounded": "m"}
+# Units of the columns of the results' tables (``table()``).
+TABLE_UNITS = {"heading": "deg", "load": "N", "offset": "m", "restoring": "N",
+               "x_offset": "m", "y_offset": "m", "x": "m", "y": "m", "z": "m",
+               "roll": "rad", "pitch": "rad", "yaw": "rad", "max_tension": "N",
+               "max_tension_line": "", "min_grounded": "m", "min_grounded_line": ""}
+POSE = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
 @dataclass(frozen=True)
@@ -75,6 +81,18 @@ class Worst:
         index = np.unravel_index(int(pick(values)), values.shape)
         return float(values[index]), index, self.lines[int(lines[index])]
 
+    def _table(self, first):
+        """{column: (k,) array}: the columns ``first`` then the pose and the worst
+        lines' numbers, a row per case (TABLE_UNITS; a line's name, "" where none)."""
+        names = np.array(list(self.lines) + [""], dtype=object)
+        table = dict(first)
+        table.update(zip(POSE, self.poses.reshape(-1, 6).T))
+        table.update(max_tension=self.max_tension.ravel(),
+                     max_tension_line=names[self.max_tension_line.ravel()],
+                     min_grounded=self.min_grounded.ravel(),
+                     min_grounded_line=names[self.min_grounded_line.ravel()])
+        return table
+
 
 @dataclass(frozen=True)
 class LoadExcursion(Worst):
@@ -86,6 +104,13 @@ class LoadExcursion(Worst):
     loads: np.ndarray
     offsets: np.ndarray
     restoring: np.ndarray
+
+    def table(self):
+        """{column: (h m,) array}, a row per heading and load (TABLE_UNITS)."""
+        heading, load = np.meshgrid(self.headings, self.loads, indexing="ij")
+        return self._table({"heading": heading.ravel(), "load": load.ravel(),
+                            "offset": self.offsets.ravel(),
+                            "restoring": self.restoring.ravel()})
 
     def _at(self, value, index, line):
         if index is None:
@@ -115,6 +140,12 @@ class WatchCircle(Worst):
 
     load: float
     offsets: np.ndarray
+
+    def table(self):
+        """{column: (h,) array}, a row per heading (TABLE_UNITS)."""
+        return self._table({"heading": self.headings,
+                            "load": np.full(self.headings.size, self.load),
+                            "x_offset": self.offsets[:, 0], "y_offset": self.offsets[:, 1]})
 
     @property
     def largest_offset(self):

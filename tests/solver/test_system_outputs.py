@@ -153,6 +153,13 @@ def test_the_watch_circle_turns_with_the_spread(solver, circle):
     grounded, _, _ = circle.smallest_grounded
     assert 0.0 < grounded < 55.1
     assert circle.largest_offset == pytest.approx(np.linalg.norm(offsets[0]), rel=1e-7)
+    table = circle.table()
+    assert list(table) == ["heading", "load", "x_offset", "y_offset", "x", "y", "z", "roll",
+                           "pitch", "yaw", "max_tension", "max_tension_line",
+                           "min_grounded", "min_grounded_line"]
+    assert table["yaw"] == pytest.approx(circle.poses[:, 5])
+    assert list(table["max_tension_line"]) == [circle.lines[k]
+                                               for k in circle.max_tension_line]
     # the solver is left at rest
     assert solver.state.bodies.X[0] == pytest.approx(np.zeros(3), abs=1e-7)
 
@@ -175,6 +182,10 @@ def test_the_load_excursion_slope_at_rest_is_the_mooring_stiffness(solver, curve
     assert (tension, load) == (curves.max_tension.max(), 40.0) and line in curves.lines
     grounded, heading, load, line = curves.smallest_grounded
     assert (grounded, load) == (np.nanmin(curves.min_grounded), 40.0)
+    table = curves.table()
+    assert list(table["heading"]) == [0.0] * 3 + [180.0] * 3
+    assert list(table["load"]) == [0.05, 20.0, 40.0] * 2
+    assert table["restoring"] == pytest.approx(curves.restoring.ravel())
 
 
 def png_size(path):
@@ -270,3 +281,4 @@ def test_a_heading_without_an_equilibrium_is_a_gap_in_the_circle():
     assert limited.largest_offset == pytest.approx(np.linalg.norm(free.offsets[0]))
     assert np.all(np.isnan(free.max_tension)) and np.all(free.max_tension_line == -1)
     assert free.largest_tension[2] is None
+    assert list(limited.table()["max_tension_line"]) == [""] * 4
