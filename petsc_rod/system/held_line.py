@@ -79,10 +79,12 @@ from petsc_rod.model.line import UniformLine
 from petsc_rod.model.end import End
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.model.system import Body
 from petsc_rod.quantities.riser_numbers import (_extreme, effective_tension,
                                              points_on_held_ends, top_end, touchdown)
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.scene import EndState
+from petsc_rod.system.bodies import rotation
 
 
 # The units of HeldLine.summary's numbers.
@@ -553,8 +555,6 @@ def connection_position(system, connection):
     """Where the model.system.Connection ``connection`` of ``system`` is at the start,
     (3,), m, absolute: its point's position, or its body's X + R p (R from the body's
     start angles, system/bodies.rotation)."""
-    from petsc_rod.model.system import Body
-    from petsc_rod.system.bodies import rotation
     node = system.node(connection.to)
     if isinstance(node, Body):
         pose = np.asarray(node.position, dtype=float)
