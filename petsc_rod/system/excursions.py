@@ -26,9 +26,9 @@ reach, a load beyond what the lines hold) is a gap in the results (NaN, its reas
 ``failed``), and the next case starts from the last equilibrium found.
 
 Every function is collective on the solver's communicator and returns the same numbers
-on every rank; it leaves the solver at rest again (its system solved anew at the end:
-the solver's ``system`` is what the loads are added to, so it must be the unloaded
-one).
+on every rank; it leaves the solver at rest again (its system solved anew at the end),
+so that the solver's ``system``, which the loads are added to, is the same base case
+for the next call.
 """
 
 from dataclasses import dataclass, replace
