@@ -593,6 +593,23 @@ class SystemSolver:
                            self.forces.copy(), factor, iterations, halvings,
                            float(self.norm))
 
+    # -- the lines' own results -------------------------------------------------------------
+
+    def collect(self, ask, root=None):
+        """[ask(line) for every line of the system], in the system's order: ``ask`` is
+        called on this rank's lines (collective on each line's communicator: every rank
+        of a group calls it) and what its group's root returns is shared to every rank
+        (``root`` None; small values) or gathered to rank ``root`` only (None on the
+        others: a picture's centrelines). Collective on the solver's communicator."""
+        mine = {k: ask(line) for k, line in sorted(self.lines.items())}
+        if root is None:
+            shared = self.placement.share(mine)
+        else:
+            shared = self.placement.gather(mine, root)
+            if shared is None:
+                return None
+        return [shared[k] for k in range(len(self.system.lines))]
+
     # -- the mooring stiffness -----------------------------------------------------------
 
     def body_stiffness(self, name):

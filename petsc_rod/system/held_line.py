@@ -79,9 +79,19 @@ from petsc_rod.model.line import UniformLine
 from petsc_rod.model.end import End
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
-from petsc_rod.quantities.riser_numbers import points_on_held_ends
+from petsc_rod.model.system import Body
+from petsc_rod.quantities.riser_numbers import (_extreme, effective_tension,
+                                             points_on_held_ends, top_end, touchdown)
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.scene import EndState
+from petsc_rod.system.bodies import rotation
+
+
+# The units of HeldLine.summary's numbers.
+SUMMARY_UNITS = {"max_tension": "N", "max_tension_S": "m", "max_tension_position": "m",
+                 "start_tension": "N", "end_tension": "N", "start_force": "N",
+                 "end_force": "N", "touchdown_S": "m", "touchdown_position": "m",
+                 "grounded_length": "m"}
 
 
 class HeldEnds:
@@ -195,7 +205,8 @@ class HeldLine:
 
     solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
     end_moments() -> (2, 3); stiffness() -> (6, 6); stable() -> bool or None;
-    positions() -> (2, 3); destroy(). ``iterations``: those of the last solve."""
+    positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
+    destroy(). ``iterations``: those of the last solve."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -353,6 +364,52 @@ class HeldLine:
         return np.array([_at_vertex(mesh, n, 0) + on_start,
                          -_at_vertex(mesh, n, mesh.n_elements) + on_end])
 
+    def summary(self):
+        """What the line reports at its last equilibrium beyond its end forces, as the
+        single-line reports compute them (quantities/riser_numbers.py; units
+        SUMMARY_UNITS), on every rank of its communicator:
+
+        ``max_tension`` the largest effective tension n.t over the vertices (N), at arc
+        length ``max_tension_S`` (m) and ``max_tension_position`` (3,) (m, absolute);
+        ``start_tension``, ``end_tension`` n.t at S = 0 and S = L: the end element's
+        tension along the line (N); ``start_force``, ``end_force`` |end_forces()| (N):
+        the force on the point, which differs from the tension along the line by the
+        shear an end carries and by an attachment sitting on the end;
+        ``touchdown_S``, ``touchdown_position`` where the line, followed from its higher
+        end, first reaches the seabed (NaN without one or when it does not reach it) and
+        ``grounded_length`` the length below the seabed's height (m; NaN without a
+        seabed). Only reductions of a few numbers: no field is gathered. Collective."""
+        self._check_solved()
+        problem, mesh = self.problem, self.mesh
+        r = problem.state.r.owned()
+        vertex = {"n": problem.internal_force(), "d3": r[:, 1]}
+        tension = effective_tension(vertex)
+        k = int(np.argmax(tension)) if tension.size else 0
+        local = ((tension[k], mesh.vertex_S[k], r[k, 0]) if tension.size
+                 else (None, None, None))
+        largest, largest_S, largest_r = _extreme(mesh, local[0], local, largest=True)
+        ends = [float(_at_vertex(mesh, tension, index)) for index in (0, mesh.n_elements)]
+        forces = np.linalg.norm(self.end_forces(), axis=1)
+        seabed = self.scene.seabed
+        if seabed is None:
+            S, position, grounded = np.nan, np.full(3, np.nan), np.nan
+        else:
+            S, position, grounded = touchdown(problem, seabed, top_end(problem))
+        return {"max_tension": float(largest), "max_tension_S": float(largest_S),
+                "max_tension_position": np.asarray(largest_r, dtype=float) + self.origin,
+                "start_tension": ends[0], "end_tension": ends[1],
+                "start_force": float(forces[0]), "end_force": float(forces[1]),
+                "touchdown_S": float(S), "touchdown_position": position + self.origin,
+                "grounded_length": float(grounded)}
+
+    def centreline(self):
+        """The centreline's vertices at the last equilibrium, (n + 1, 3), m, absolute,
+        gathered to the first rank of the line's communicator (None on the others): for
+        a picture only. Collective."""
+        self._check_solved()
+        parts = self.comm.tompi4py().gather(self.problem.state.r.owned()[:, 0], root=0)
+        return None if parts is None else np.concatenate(parts) + self.origin
+
     def stable(self):
         """The stability test's verdict on the last equilibrium (docs/method.md §10):
         True a local minimiser, False a saddle, None undecided or a line whose loads
@@ -494,3 +551,26 @@ class HeldLine:
     def destroy(self):
         """Free the line's PETSc objects (all made in _build). Collective."""
         self._release()
+
+
+def connection_position(system, connection):
+    """Where the model.system.Connection ``connection`` of ``system`` is at the start,
+    (3,), m, absolute: its point's position, or its body's X + R p (R from the body's
+    start angles, system/bodies.rotation)."""
+    node = system.node(connection.to)
+    if isinstance(node, Body):
+        pose = np.asarray(node.position, dtype=float)
+        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
+    return np.asarray(node.position, dtype=float)
+
+
+def held_lines(system, options=None):
+    """The SystemSolver's ``make_line(system_line, comm)`` of ``system`` (a
+    model.system.System): each line a HeldLine in the system's environment with its
+    ends first where the system's points and bodies put them (connection_position);
+    ``options`` as HeldLine's."""
+    def make_line(line, comm):
+        return HeldLine.of_system_line(line, connection_position(system, line.start),
+                                       connection_position(system, line.end), comm,
+                                       system.environment, options)
+    return make_line

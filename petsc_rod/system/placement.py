@@ -79,6 +79,12 @@ class Placement:
         parts = self.mpi.allgather(values if self.root else {})
         return {k: v for part in parts for k, v in part.items()}
 
+    def gather(self, values, root=0):
+        """share's dict on rank ``root`` of the whole communicator only (None on the
+        others): for what only a picture or a file needs (collective)."""
+        parts = self.mpi.gather(values if self.root else {}, root=root)
+        return None if parts is None else {k: v for part in parts for k, v in part.items()}
+
     def destroy(self):
         if self.sub is not None:
             self.sub.Free()
