@@ -91,7 +91,7 @@ class SecondVariation:
     ``_matrix_changed`` and ``_constraint_changed``. Collective; ``destroy()`` frees
     every PETSc object."""
 
-    def __init__(self, problem):
+    def __init__(self, problem, positions=()):
         self.problem = problem
         mesh = problem.mesh
         self.comm = mesh.comm
@@ -99,9 +99,10 @@ class SecondVariation:
         self.stretch = getattr(problem, "axial", None) is not None
         self.unknowns = 4 if self.stretch else 3
         # the positions' chains (analysis/positions.py) of the components the terms'
-        # energies read, one slot each after the node's unknowns
+        # energies read (and ``positions``: the modes' mass, analysis/modes.py), one slot
+        # each after the node's unknowns
         self.positions = tuple(sorted({c for term in problem.terms
-                                       for c in term.position_components}))
+                                       for c in term.position_components} | set(positions)))
         self.position_slot = {c: self.unknowns + i for i, c in enumerate(self.positions)}
         # the resultants' chain of a load that follows the line (analysis/jacobian.py):
         # three slots per node, identity rows here (H is the frozen load's)
