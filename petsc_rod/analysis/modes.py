@@ -191,10 +191,14 @@ def solve_modes(problem, count, settings=MassSettings()):
 
 
 def _modes(operators, eps, count):
-    """The lowest ``count`` converged eigenpairs of ``eps`` as Modes."""
+    """The lowest ``count`` converged eigenpairs of ``eps`` as Modes. An eigenvalue below
+    the shift is one of the massless unknowns' infinite ones that the spectral
+    transformation returned with the wrong sign (the inertia proved there is none): left
+    out."""
     converged = eps.getConverged()
     values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + SHIFT
-    order = np.argsort(values)[:count]
+    finite = np.flatnonzero(values >= SHIFT)
+    order = finite[np.argsort(values[finite])][:count]
     vector = operators.mass_matrix.createVecRight()
     product = vector.duplicate()
     parts = []

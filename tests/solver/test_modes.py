@@ -1,0 +1,115 @@
+"""The natural modes about a static state (analysis/modes.py, docs/modes.md) against
+closed forms, each with its observed order of convergence in the elements: a taut
+string, a tensioned pinned beam, a cantilever's bending modes, a shaft's torsional
+modes, a heavy chain hanging from one end (the zeros of J0); the same modes on one rank
+and on all ranks; an unstable state's modes refused. Frequencies in Hz."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import continuation, destroy, fitted_order, make_solver
+
+pytest.importorskip("slepc4py")
+
+L = 1.0
+G = 9.80665
+MESHES = (8, 16, 32)
+
+
+def modes_of(scene, n_elements, count, comm=PETSc.COMM_WORLD, stability=True, **mass):
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import solve_modes
+    mesh, solver = make_solver(comm, n_elements, scene, 1e2)
+    solver.settings.check_stability = stability
+    try:
+        continuation(solver)
+        return solve_modes(solver.problem, count, MassSettings(**mass))
+    finally:
+        destroy(mesh, solver)
+
+
+def errors_and_order(scene, count, exact, **mass):
+    errors = np.array([np.abs(modes_of(scene, n, count, **mass).frequencies - exact).max()
+                       / exact.max() for n in MESHES])
+    return errors, fitted_order(np.array(MESHES), errors)
+
+
+def pinned(T, EA, EI):
+    """A line pinned at both ends, stretched by T (N) at EA; its stretched length and
+    mass per stretched length (m of 1 kg per metre unstretched)."""
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, EI), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], axial_stiffness=EA)
+    return scene, L * (1 + e), 1.0 / (1 + e)
+
+
+def test_taut_string():
+    T = 100.0
+    scene, length, m = pinned(T, 1e6, 1e-6)
+    n = np.repeat(np.arange(1, 4), 2)                # in and out of the plane
+    exact = n / (2 * length) * np.sqrt(T / m)
+    errors, order = errors_and_order(scene, 6, exact, mass=1.0)
+    assert errors[-1] < 5e-6 and order > 3.5
+
+
+def test_tensioned_pinned_beam():
+    T, EI = 100.0, 1.0
+    scene, length, m = pinned(T, 1e8, EI)
+    n = np.repeat(np.arange(1, 4), 2)
+    exact = (n / (2 * length) * np.sqrt(T / m)
+             * np.sqrt(1 + n**2 * np.pi**2 * EI / (T * length**2)))
+    errors, order = errors_and_order(scene, 6, exact, mass=1.0)
+    assert errors[-1] < 2e-5 and order > 3.5
+
+
+def test_cantilever_bending_modes():
+    EI, m = 2.0, 3.0
+    beta = np.array([1.8751040687, 4.6940911330, 7.8547574382])
+    exact = np.repeat(beta**2 / (2 * np.pi * L**2) * np.sqrt(EI / m), 2)
+    scene = dict(length=L, stiffness=(EI, EI, EI), start="clamp", end="free")
+    errors, order = errors_and_order(scene, 6, exact, mass=m)
+    assert errors[-1] < 1e-5 and order > 3.5
+
+
+def test_torsional_modes_of_a_shaft():
+    GJ, J = 1.0, 1.0
+    exact = (2 * np.arange(1, 4) - 1) * np.pi / (2 * L) * np.sqrt(GJ / J) / (2 * np.pi)
+    scene = dict(length=L, stiffness=(1e4, 1e4, GJ), start="clamp", end="free")
+    errors, order = errors_and_order(scene, 3, exact, mass=1.0, inertia=J)
+    assert errors[-1] < 5e-6 and order > 3.5
+    modes = modes_of(scene, 8, 3, mass=1.0, inertia=J)
+    assert modes.labels == ["torsional"] * 3
+    assert np.all(modes.shares[:, 3] > 0.999)
+
+
+def test_heavy_chain_hanging_from_one_end():
+    """Gravity along +x (the straight state is the hanging one); EI small: the zeros of
+    J0, omega_n = (j_0n / 2) sqrt(g / L), to within the bending stiffness's effect."""
+    from scipy.special import jn_zeros
+    scene = dict(length=L, stiffness=(1e-4,) * 3, start="pin", end="free",
+                 load_values=[[G, 0.0, 0.0]])          # 1 kg/m
+    exact = np.repeat(jn_zeros(0, 2) / 2 * np.sqrt(G / L) / (2 * np.pi), 2)
+    first = [modes_of(scene, n, 4).frequencies for n in MESHES]
+    errors = np.array([np.abs(f - exact).max() / exact.max() for f in first])
+    assert errors[-1] < 2e-3
+    assert abs(first[-1][0] - exact[0]) < 1e-4 * exact[0]
+
+
+def test_same_modes_on_one_rank_and_all_ranks():
+    scene = pinned(100.0, 1e8, 1.0)[0]
+    one = modes_of(scene, 16, 6, comm=PETSc.COMM_SELF, mass=1.0)
+    every = modes_of(scene, 16, 6, comm=PETSc.COMM_WORLD, mass=1.0)
+    assert np.allclose(one.frequencies, every.frequencies, rtol=1e-9)
+    assert np.allclose(one.modal_mass, every.modal_mass, rtol=1e-6)
+
+
+def test_unstable_state_refused():
+    """A column standing on a pin under its weight (gravity along -x, the straight state
+    an equilibrium with the stability test off): its modes are refused."""
+    from petsc_rod.analysis.modes import ModesRefused
+    scene = dict(length=L, stiffness=(1e-2,) * 3, start="pin", end="free",
+                 load_values=[[-G, 0.0, 0.0]])
+    with pytest.raises(ModesRefused) as refused:
+        modes_of(scene, 8, 3, stability=False)
+    assert refused.value.negative > 0
