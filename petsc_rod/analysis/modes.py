@@ -99,12 +99,12 @@ def classify(shares):
 
 class ModalOperators(SecondVariation):
     """K and M of the module docstring at the problem's state: SecondVariation with the
-    chains of x, y and z, the other end's displacement pinned where both are held, and
+    chains of x, y and z (without the Newton Jacobian's resultants and pattern), the other end's displacement pinned where both are held, and
     the mass ``mass_matrix``. Collective; ``destroy()`` frees every PETSc object."""
 
     def __init__(self, problem, settings=MassSettings()):
         self.settings = settings
-        super().__init__(problem, positions=(0, 1, 2))
+        super().__init__(problem, positions=(0, 1, 2), newton=False)
         tangents = problem.state.tau[:, 2]
         self.translation, self.rotation = nodal_mass(problem.scene, problem.mesh, tangents,
                                                      settings)
@@ -132,12 +132,11 @@ class ModalOperators(SecondVariation):
         mesh, B = self.problem.mesh, self.block
         n_local = B * mesh.n_local_nodes
         mass = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
-                                     nnz=(3 * B, 2 * B), comm=self.comm)
+                                     nnz=(5 * B, 2 * B), comm=self.comm)
         mass.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        axes = (0, 1, 2)
-        for rows, columns, blocks in self.position_blocks(self.translation, axes, axes):
-            mass.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
-                              blocks, addv=PETSc.InsertMode.ADD_VALUES)
+        for rows, blocks in self._translation_blocks():
+            rows = rows.astype(PETSc.IntType)
+            mass.setValuesRCV(rows, rows, blocks, addv=PETSc.InsertMode.ADD_VALUES)
         rows = (self.first_row + B * np.arange(mesh.n_local_nodes)[:, None]
                 + np.arange(3)).astype(PETSc.IntType)
         if rows.size:
@@ -146,6 +145,31 @@ class ModalOperators(SecondVariation):
         mass.zeroRowsColumns(self.held_rows, diag=0.0)
         mass.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return mass
+
+    def _translation_blocks(self):
+        """The translation masses T_n (n, 3, 3) as (rows, blocks): at a vertex on its
+        (u^x, u^y, u^z); at a midpoint, whose position component c is the row
+        R_c = (1, h_e HALF.s^c_e) on (u^c_e, the element's unknowns), sum_ab T_ab R_a R_b^T
+        on (u^x_e, u^y_e, u^z_e, the element's unknowns) in one block per element
+        (position_blocks' entries, added at once)."""
+        mesh, B = self.problem.mesh, self.block
+        T = self.translation
+        vertices = self.first_row + B * np.arange(0, T.shape[0], 2)
+        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
+        triples = [(vertices[:, None] + slots, T[0::2])]
+        ne = mesh.n_local_elements
+        if ne:
+            width = self._midpoint_rows[0].shape[1] - 1           # the element's unknowns
+            rows = np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
+                                  + [self._midpoint_index[0][:, 1:]], axis=1)
+            R = np.zeros((3, ne, 3 + width))
+            for c in (0, 1, 2):
+                R[c, :, c] = self._midpoint_rows[c][:, 0]
+                R[c, :, 3:] = self._midpoint_rows[c][:, 1:]
+            middle = T[1:2 * ne:2]                                   # (ne, 3, 3)
+            blocks = np.einsum("eab,aei,bej->eij", middle, R, R)
+            triples.append((rows, blocks))
+        return [t for t in triples if t[0].size]
 
     def destroy(self):
         self.mass_matrix.destroy()

@@ -27,6 +27,7 @@ from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
+from petsc_rod.cli.modes import run_modes
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.io.same_file import replaced_input
@@ -127,6 +128,8 @@ def run(comm=None, texts=None):
             writer = None
             if code == 0:                   # the CSV table of the converged result
                 line_table.finish_run(problem, values["rod_table"], say)
+                if values["rod_modes"]:
+                    run_modes(problem, values, say)
             elif values["rod_table"]:       # none for this run: not an earlier run's either
                 line_table.discard(values["rod_table"], comm, say)
             for name in unused_options():

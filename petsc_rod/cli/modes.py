@@ -1,0 +1,92 @@
+"""-rod_modes: the natural modes about the converged state after the last step
+(analysis/modes.py, docs/modes.md), as the run's lines (a table of the modes) and the
+CSV files of -rod_modes_table: the modes' table and their shapes along the line."""
+
+import os
+import time
+
+import numpy as np
+
+from petsc_rod.analysis.mass import MassSettings
+from petsc_rod.analysis.modes import CLASSES, ModesRefused, solve_modes
+from petsc_rod.errors import RodIOError
+
+TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
+                 "class", *(f"share_{name.replace('-', '_')}" for name in CLASSES))
+SHAPE_COLUMNS = ("mode", "S_m", "offset_x_m", "offset_y_m", "offset_z_m", "rotation_x_rad",
+                 "rotation_y_rad", "rotation_z_rad")
+
+
+def mass_settings(values):
+    return MassSettings(added_mass=values["rod_modes_added_mass"],
+                        mass=values["rod_modes_mass"], inertia=values["rod_modes_inertia"])
+
+
+def run_modes(problem, values, say):
+    """The modes of -rod_modes about the problem's state: said as a table and written to
+    -rod_modes_table; an unstable state's are refused with a line. Returns the Modes,
+    or None when refused. Collective."""
+    start = time.perf_counter()
+    try:
+        modes = solve_modes(problem, values["rod_modes"], mass_settings(values))
+    except ModesRefused as refused:
+        say(f"modes: refused: {refused}")
+        return None
+    seconds = problem.mesh.global_max(time.perf_counter() - start)
+    for line in table_lines(modes, seconds):
+        say(line)
+    if values["rod_modes_table"]:
+        write_tables(problem.mesh.comm, modes, values["rod_modes_table"], say)
+    return modes
+
+
+def table_lines(modes, seconds):
+    """The run's lines of the modes: one per mode, lowest first; ``seconds`` the time
+    they took."""
+    lines = [f"modes: {len(modes.omega2)} lowest about the static state in {seconds:.3g} s "
+             "(undamped, no drag; shares of the kinetic energy in plane / out of plane / "
+             "axial / torsional)",
+             f"  {'mode':>4} {'f (Hz)':>12} {'T (s)':>12} {'modal mass (kg)':>16}  class"]
+    for k, (f, T, mass, label, shares) in enumerate(zip(
+            modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
+        fractions = " / ".join(f"{share:.2f}" for share in shares)
+        lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
+    return lines
+
+
+def shapes_path(path):
+    stem, extension = os.path.splitext(path)
+    return f"{stem}_shapes{extension or '.csv'}"
+
+
+def write_tables(comm, modes, path, say):
+    """The modes' table to ``path`` and their shapes (gathered in rank order) to
+    shapes_path(path), by rank 0. Collective."""
+    mpi = comm.tompi4py()
+    count = len(modes.omega2)
+    local = np.concatenate([
+        np.broadcast_to(np.arange(1, count + 1)[:, None, None], (count, len(modes.S), 1)),
+        np.broadcast_to(modes.S[None, :, None], (count, len(modes.S), 1)),
+        modes.offset.reshape(count, len(modes.S), 3),
+        modes.rotation.reshape(count, len(modes.S), 3)], axis=2)
+    pieces = mpi.gather(local, root=0)
+    error = None
+    if mpi.Get_rank() == 0:
+        rows = np.concatenate(pieces, axis=1).reshape(-1, len(SHAPE_COLUMNS))
+        try:
+            with open(path, "w") as table:
+                table.write(",".join(TABLE_COLUMNS) + "\n")
+                for k in range(count):
+                    table.write(",".join(
+                        [str(k + 1)] + [f"{v:.10g}" for v in (
+                            modes.frequencies[k], modes.periods[k],
+                            np.sqrt(max(modes.omega2[k], 0.0)), modes.modal_mass[k])]
+                        + [modes.labels[k]] + [f"{v:.6f}" for v in modes.shares[k]]) + "\n")
+            np.savetxt(shapes_path(path), rows, delimiter=",", fmt="%.10g",
+                       header=",".join(SHAPE_COLUMNS), comments="")
+        except OSError as failure:
+            error = f"cannot write -rod_modes_table {path}: {failure.strerror}"
+    error = mpi.bcast(error, root=0)
+    if error:
+        raise RodIOError(error)
+    say(f"modes: table {path}, shapes {shapes_path(path)}")
