@@ -14,19 +14,20 @@ dense one on the rotations alone. K is then the KKT matrix
                                       midpoint's displacement u_e + h_e HALF.s_e),
 
 the held end's u pinned (u = 0), and with both ends held the other end's too: that
-pin is the chord constraint of the stability test. The multipliers nu, the stretches
-and the resultants of a follower load carry no mass; their eigenvalues are infinite
-and shift-invert maps them to 0. M is positive semi-definite and the pencil
-(K - sigma M) nonsingular at a stable state, so the problem is SLEPc's GHEP with
-shift-invert about sigma = SHIFT (a small negative omega^2) on MUMPS's LDL^T of
-K - sigma M, whose inertia counts, less the n_elements negative eigenvalues per
+pin is the chord constraint of the stability test. The multipliers nu and the
+stretches carry no mass; their eigenvalues are infinite and shift-invert maps them to
+0 (the Newton Jacobian's resultants of a follower load are left out). M is positive
+semi-definite and the pencil (K - sigma M) nonsingular at a stable state, so the
+problem is SLEPc's GHEP with shift-invert about sigma = SHIFT (a small negative
+omega^2) on the LDL^T of K - sigma M (global_step/ksp.direct_factor, the stability
+test's: MUMPS on one rank, the chain's substructuring on several), whose inertia counts, less the n_elements negative eigenvalues per
 component of the chains, the eigenvalues below sigma: a state with any is unstable,
 and its modes are refused (never reported as vibrations). Where no node is clamped,
 the sections have no polar inertia and the roll is free (K1 = K2), the roll is held
 (SecondVariation.hold_roll): it has neither stiffness nor mass.
 
-Options: the EPS reads -rod_modes_eps_* (and -rod_modes_st_*), its KSP the factor's
--rod_modes_st_mat_mumps_icntl_*.
+Options: the EPS reads -rod_modes_eps_* (and -rod_modes_st_*), the factorisation
+-rod_modes_st_mat_mumps_icntl_* and -rod_modes_st_substructuring.
 """
 
 from dataclasses import dataclass, field
@@ -37,7 +38,7 @@ from petsc4py import PETSc
 from petsc_rod.analysis.mass import MassSettings, line_inertia, nodal_mass
 from petsc_rod.analysis.second_variation import SecondVariation, unit
 from petsc_rod.errors import RodInputError
-from petsc_rod.global_step.ksp import inertia_solver, set_up_mumps
+from petsc_rod.global_step.ksp import direct_factor
 from petsc_rod.scenes.boundary import is_held
 
 PREFIX = "rod_modes_"
@@ -176,6 +177,30 @@ class ModalOperators(SecondVariation):
         super().destroy()
 
 
+class FactorPC:
+    """A python PC that solves with a factorisation of global_step/ksp.direct_factor
+    (MUMPS's LDL^T on one rank, the chain's substructuring on several): the spectral
+    transformation's solves with the factor whose inertia was counted."""
+
+    def __init__(self, factor):
+        self.factor = factor
+
+    def apply(self, pc, x, y):
+        y.getArray()[:] = self.factor.solve_columns([x.getArray(readonly=True)])[0]
+
+
+def factor_ksp(operator, factor):
+    """preonly + FactorPC(factor) for ``operator``, options under PREFIX + 'st_'."""
+    ksp = PETSc.KSP().create(comm=operator.getComm())
+    ksp.setOptionsPrefix(PREFIX + "st_")
+    ksp.setOperators(operator)
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(PETSc.PC.Type.PYTHON)
+    pc.setPythonContext(FactorPC(factor))
+    return ksp
+
+
 def solve_modes(problem, count, settings=MassSettings()):
     """The ``count`` lowest modes (Modes) of the problem's converged state, or
     ModesRefused where the state is unstable. Collective."""
@@ -187,12 +212,12 @@ def solve_modes(problem, count, settings=MassSettings()):
     shifted = K.duplicate(copy=True)
     shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    ksp, _ = inertia_solver(operators.comm, shifted, PREFIX + "st_")
+    factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
+    ksp = factor_ksp(shifted, factor)
     eps = SLEPc.EPS().create(comm=operators.comm)
     try:
-        set_up_mumps(ksp)
-        negative = (ksp.getPC().getFactorMatrix().getInertia()[0]
-                    - operators.chain_constraints)
+        factor.set_up(shifted)
+        negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
             raise ModesRefused(int(negative))
         eps.setOperators(shifted, M)
@@ -210,6 +235,7 @@ def solve_modes(problem, count, settings=MassSettings()):
     finally:
         eps.destroy()
         ksp.destroy()
+        factor.destroy()
         shifted.destroy()
         operators.destroy()
 
