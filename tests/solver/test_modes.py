@@ -4,6 +4,8 @@ string, a tensioned pinned beam, a cantilever's bending modes, a shaft's torsion
 modes, a heavy chain hanging from one end (the zeros of J0); the same modes on one rank
 and on all ranks; an unstable state's modes refused. Frequencies in Hz."""
 
+import os
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
@@ -113,3 +115,36 @@ def test_unstable_state_refused():
     with pytest.raises(ModesRefused) as refused:
         modes_of(scene, 8, 3, stability=False)
     assert refused.value.negative > 0
+
+
+def test_cli_modes_table(shared_tmp, capsys):
+    """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
+    closed form's (16 elements), its classes in plane and out of plane, and the shapes'
+    file has one row per vertex and mode with a largest offset of 1."""
+    from petsc_rod.cli import main
+    path = os.path.join(shared_tmp, "modes.csv")
+    EI, m = 2.0, 3.0
+    options = {"rod_length": "1", "rod_stiffness": f"{EI},{EI},{EI}", "rod_start": "clamp",
+               "rod_end": "free", "rod_elements": "16", "rod_modes": "4",
+               "rod_modes_mass": str(m), "rod_modes_table": path}
+    database = PETSc.Options()
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        assert main.run(PETSc.COMM_WORLD) == 0
+    finally:
+        for name in options:
+            database.delValue(name)
+    assert "modes: 4 lowest about the static state" in capsys.readouterr().out \
+        or PETSc.COMM_WORLD.getRank() != 0
+    table = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding=None)
+    beta = np.array([1.8751040687, 4.6940911330])
+    exact = np.repeat(beta**2 / (2 * np.pi) * np.sqrt(EI / m), 2)
+    assert np.allclose(table["frequency_Hz"], exact, rtol=1e-4)
+    assert np.allclose(table["period_s"], 1 / exact, rtol=1e-4)
+    assert sorted(table["class"][:2]) == ["in-plane", "out-of-plane"]
+    shapes = np.loadtxt(path.replace(".csv", "_shapes.csv"), delimiter=",", skiprows=1)
+    assert shapes.shape == (4 * 17, 8)
+    for k in range(1, 5):
+        offsets = shapes[shapes[:, 0] == k][:, 2:5]
+        assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
