@@ -28,6 +28,16 @@ from petsc_rod.errors import RodInputError
 from petsc_rod.scenes.line import piecewise_constant
 
 
+MISSING_MASS = "the modes of a uniform line without a load need its mass per length"
+
+
+def mass_known(scene, settings):
+    """Whether line_inertia has a mass per length for the scene: its line types', the
+    settings' or its load's."""
+    return bool(scene.sections) or settings.mass is not None \
+        or float(np.abs(scene.load_values).max(initial=0.0)) > 0
+
+
 @dataclass(frozen=True)
 class MassSettings:
     """The modal analysis's inputs beyond the scene: the added-mass coefficient C_a (1),
@@ -50,13 +60,11 @@ def line_inertia(scene, S, settings):
         added = settings.added_mass * scene.water_density * np.pi * od**2 / 4
         polar = m * (od**2 + inner**2) / 8
         return m, added, polar
+    if not mass_known(scene, settings):
+        raise RodInputError(MISSING_MASS)
     mass = settings.mass
     if mass is None:
-        weight = float(np.abs(scene.load_values).max(initial=0.0))
-        if weight == 0.0:
-            raise RodInputError("the modes of a uniform line without a load need its mass "
-                                "per length: give -rod_modes_mass (kg/m)")
-        mass = weight / scene.gravity
+        mass = float(np.abs(scene.load_values).max(initial=0.0)) / scene.gravity
     n = S.size
     return np.full(n, float(mass)), np.zeros(n), np.full(n, float(settings.inertia))
 

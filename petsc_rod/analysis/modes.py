@@ -37,7 +37,6 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MassSettings, line_inertia, nodal_mass
 from petsc_rod.analysis.second_variation import SecondVariation, unit
-from petsc_rod.errors import RodInputError
 from petsc_rod.global_step.ksp import direct_factor
 from petsc_rod.scenes.boundary import is_held
 
@@ -206,7 +205,7 @@ def solve_modes(problem, count, settings=MassSettings()):
     ModesRefused where the state is unstable. Collective."""
     from slepc4py import SLEPc
     if count < 1:
-        raise RodInputError(f"-rod_modes needs a positive number of modes, got {count}")
+        raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
     operators = ModalOperators(problem, settings)
     K, M = operators.matrix, operators.mass_matrix
     shifted = K.duplicate(copy=True)

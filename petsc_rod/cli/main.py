@@ -27,7 +27,7 @@ from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
-from petsc_rod.cli.modes import run_modes
+from petsc_rod.cli.modes import check_modes_inputs, run_modes
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.io.same_file import replaced_input
@@ -95,6 +95,7 @@ def run(comm=None, texts=None):
                 None if pieces is None or "rod_elements" in given else
                 f"-rod_sections ({values['rod_elements']} elements in all)")
             check_stability_asked(values, scene, given)
+            check_modes_inputs(values, scene, comm)
             if values["rod_output"]:
                 io.check_output_path(values["rod_output"], comm)
             if values["rod_table"]:

@@ -7,9 +7,10 @@ import time
 
 import numpy as np
 
-from petsc_rod.analysis.mass import MassSettings
+from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import CLASSES, ModesRefused, solve_modes
-from petsc_rod.errors import RodIOError
+from petsc_rod.errors import RodInputError, RodIOError
+from petsc_rod.io.results import check_output_path
 
 TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
                  "class", *(f"share_{name.replace('-', '_')}" for name in CLASSES))
@@ -20,6 +21,25 @@ SHAPE_COLUMNS = ("mode", "S_m", "offset_x_m", "offset_y_m", "offset_z_m", "rotat
 def mass_settings(values):
     return MassSettings(added_mass=values["rod_modes_added_mass"],
                         mass=values["rod_modes_mass"], inertia=values["rod_modes_inertia"])
+
+
+def check_modes_inputs(values, scene, comm):
+    """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
+    -rod_modes_mass, -rod_modes_table without -rod_modes, and a -rod_modes_table (or its
+    shapes' file) that could not be written or names another output. Collective."""
+    path = values["rod_modes_table"]
+    if path and not values["rod_modes"]:
+        raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes)")
+    if path:
+        others = [values["rod_output"], values["rod_table"]]
+        for name in (path, shapes_path(path)):
+            if any(other and os.path.abspath(other) == os.path.abspath(name)
+                   for other in others):
+                raise RodInputError(f"-rod_modes_table {path}: it (or its shapes' file "
+                                    f"{name}) is another output of the run; name another file")
+            check_output_path(name, comm, "-rod_modes_table")
+    if values["rod_modes"] and not mass_known(scene, mass_settings(values)):
+        raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
 
 
 def run_modes(problem, values, say):
@@ -61,7 +81,8 @@ def shapes_path(path):
 
 def write_tables(comm, modes, path, say):
     """The modes' table to ``path`` and their shapes (gathered in rank order) to
-    shapes_path(path), by rank 0. Collective."""
+    shapes_path(path), by rank 0, each as a .partial file renamed when complete.
+    Collective."""
     mpi = comm.tompi4py()
     count = len(modes.omega2)
     local = np.concatenate([
@@ -73,8 +94,9 @@ def write_tables(comm, modes, path, say):
     error = None
     if mpi.Get_rank() == 0:
         rows = np.concatenate(pieces, axis=1).reshape(-1, len(SHAPE_COLUMNS))
+        partial = [f"{name}.{os.getpid()}.partial" for name in (path, shapes_path(path))]
         try:
-            with open(path, "w") as table:
+            with open(partial[0], "w") as table:
                 table.write(",".join(TABLE_COLUMNS) + "\n")
                 for k in range(count):
                     table.write(",".join(
@@ -82,9 +104,14 @@ def write_tables(comm, modes, path, say):
                             modes.frequencies[k], modes.periods[k],
                             np.sqrt(max(modes.omega2[k], 0.0)), modes.modal_mass[k])]
                         + [modes.labels[k]] + [f"{v:.6f}" for v in modes.shares[k]]) + "\n")
-            np.savetxt(shapes_path(path), rows, delimiter=",", fmt="%.10g",
+            np.savetxt(partial[1], rows, delimiter=",", fmt="%.10g",
                        header=",".join(SHAPE_COLUMNS), comments="")
+            os.replace(partial[0], path)
+            os.replace(partial[1], shapes_path(path))
         except OSError as failure:
+            for name in partial:
+                if os.path.exists(name):
+                    os.remove(name)
             error = f"cannot write -rod_modes_table {path}: {failure.strerror}"
     error = mpi.bcast(error, root=0)
     if error:

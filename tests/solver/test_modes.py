@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from helpers import continuation, destroy, fitted_order, make_solver
+from helpers import continuation, destroy, fitted_order, make_solver, run_cli
 
 pytest.importorskip("slepc4py")
 
@@ -117,6 +117,20 @@ def test_unstable_state_refused():
     assert refused.value.negative > 0
 
 
+@pytest.mark.parametrize("options, message", [
+    ({"rod_modes": "3"}, "need its mass per length: give -rod_modes_mass"),
+    ({"rod_modes_table": "modes.csv"}, "-rod_modes_table needs -rod_modes N"),
+    ({"rod_modes": "3", "rod_modes_mass": "1", "rod_modes_table": "missing/modes.csv"},
+     "does not exist")])
+def test_modes_inputs_refused_before_the_run(options, message, capsys):
+    """An unloaded uniform line without -rod_modes_mass, a table without -rod_modes and
+    a table that cannot be written: exit 2 with one line, before any step."""
+    assert run_cli({"rod_length": "1", **options}) == 2
+    out = capsys.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        assert message in out and "step 1" not in out
+
+
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, and the shapes'
@@ -127,14 +141,7 @@ def test_cli_modes_table(shared_tmp, capsys):
     options = {"rod_length": "1", "rod_stiffness": f"{EI},{EI},{EI}", "rod_start": "clamp",
                "rod_end": "free", "rod_elements": "16", "rod_modes": "4",
                "rod_modes_mass": str(m), "rod_modes_table": path}
-    database = PETSc.Options()
-    for name, value in options.items():
-        database.setValue(name, value)
-    try:
-        assert main.run(PETSc.COMM_WORLD) == 0
-    finally:
-        for name in options:
-            database.delValue(name)
+    assert run_cli(options) == 0
     assert "modes: 4 lowest about the static state" in capsys.readouterr().out \
         or PETSc.COMM_WORLD.getRank() != 0
     table = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding=None)
