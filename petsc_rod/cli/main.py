@@ -27,7 +27,7 @@ from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
-from petsc_rod.cli.modes import check_modes_inputs, run_modes
+from petsc_rod.cli.modes import check_modes_inputs, run_modes, shapes_path
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.io.same_file import replaced_input
@@ -256,7 +256,7 @@ def check_mesh(comm, values, per_element=resources.BYTES_PER_ELEMENT, named=None
 
 def check_inputs_kept(values, comm):
     """Refuse, before any work, an output (-rod_output, -rod_table and its regions'
-    table) that names one of the run's inputs, which writing it would replace: an
+    table, -rod_modes_table and its shapes') that names one of the run's inputs, which writing it would replace: an
     options file, or the file of an input option (-rod_initial, -rod_line_types,
     -rod_point_loads, the profiles: every option whose value is a FILE). Collective:
     rank 0 decides."""
@@ -265,6 +265,10 @@ def check_inputs_kept(values, comm):
         written += [("-rod_table", values["rod_table"]),
                     ("the regions' table of -rod_table",
                      line_table.regions_path(values["rod_table"]))]
+    if values["rod_modes_table"]:
+        written += [("-rod_modes_table", values["rod_modes_table"]),
+                    ("the shapes' table of -rod_modes_table",
+                     shapes_path(values["rod_modes_table"]))]
     clash = None
     if comm.getRank() == 0:
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
