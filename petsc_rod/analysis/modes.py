@@ -47,6 +47,10 @@ SHIFT = -(2 * np.pi * 1e-4) ** 2
 # the classes of a mode by the share of its kinetic energy; "mixed" below DOMINANT
 CLASSES = ("in-plane", "out-of-plane", "axial", "torsional")
 DOMINANT = 0.6
+# a mode below this frequency (Hz; a period of over 1000 s) is "rigid": a line's
+# vibrations are faster, and the free roll of sections with polar inertia between pins
+# has omega = 0 to round-off
+RIGID = 1e-3
 
 
 class ModesRefused(Exception):
@@ -89,11 +93,12 @@ class Modes:
         return np.where(f > 0, 1 / np.where(f > 0, f, 1.0), np.inf)
 
 
-def classify(shares):
-    """The class of each mode from its shares (n, 4): the largest if at least DOMINANT,
-    else 'mixed'."""
+def classify(shares, frequencies):
+    """The class of each mode from its shares (n, 4): 'rigid' below RIGID Hz, else the
+    largest share's if at least DOMINANT, else 'mixed'."""
     largest = np.argmax(shares, axis=1)
-    return [CLASSES[k] if shares[i, k] >= DOMINANT else "mixed"
+    return ["rigid" if frequencies[i] < RIGID else
+            CLASSES[k] if shares[i, k] >= DOMINANT else "mixed"
             for i, k in enumerate(largest)]
 
 
@@ -260,30 +265,29 @@ def _modes(operators, eps, count):
     stack = [np.array([p[k] for p in parts]) if parts else np.zeros(0) for k in range(5)]
     shares = stack[1].reshape(-1, len(CLASSES))
     S_mid = mesh.element_S + mesh.element_h / 2
-    return Modes(values[order], stack[0], shares, mesh.vertex_S, stack[2], stack[3], S_mid,
-                 stack[4], converged, classify(shares))
+    omega2 = values[order]
+    return Modes(omega2, stack[0], shares, mesh.vertex_S, stack[2], stack[3], S_mid,
+                 stack[4], converged,
+                 classify(shares, np.sqrt(np.maximum(omega2, 0.0)) / (2 * np.pi)))
 
 
 def _shape(operators, vector, product):
     """(modal mass, shares (4,), offset (n_v, 3), rotation (n_v, 3), curvature (n_e, 3))
-    of one eigenvector, normalised to a largest offset of 1 (of a rotation of 1 rad
-    where the mode moves no node) with that offset positive."""
+    of one eigenvector, normalised to a largest offset of 1 (a torsional mode, at least
+    DOMINANT of its energy in the roll, to a largest rotation of 1 rad) with that
+    largest entry positive (the first along the line where several are)."""
     problem, mesh = operators.problem, operators.problem.mesh
     values = vector.getArray(readonly=True).reshape(-1, operators.block)
     slots = [operators.position_slot[c] for c in (0, 1, 2)]
     offset = values[0::2, slots]
     omega = values[:, :3]
-    size = np.linalg.norm(offset, axis=1)
+    shares = _shares(operators, offset, omega)
+    signed = omega if shares[CLASSES.index("torsional")] >= DOMINANT else offset
+    size = np.abs(signed).max(axis=1) if signed is omega else np.linalg.norm(signed, axis=1)
     largest = mesh.global_max(float(size.max(initial=0.0)))
-    turn = mesh.global_max(float(np.abs(omega).max(initial=0.0)))
-    if largest <= 1e-9 * turn * problem.scene.length:
-        size, largest = np.abs(omega).max(axis=1), turn
-        signed = omega
-    else:
-        signed = offset
-    # the sign: the largest entry positive, where it lies first along the line
     local = int(np.argmax(size)) if size.size else -1
     here = size.size and size[local] >= largest * (1 - 1e-12)
+    # rank order: 2 vertex_start + local increases along the line on either array
     index = 2 * mesh.vertex_start + local if here else np.iinfo(np.int32).max
     first = mesh.global_min(float(index))
     entry = signed[local][np.argmax(np.abs(signed[local]))] if here and index == first else 0.0
@@ -292,8 +296,7 @@ def _shape(operators, vector, product):
     operators.mass_matrix.mult(vector, product)
     modal_mass = vector.dot(product) * scale**2
     offset, omega = offset * scale, omega * scale
-    return (modal_mass, _shares(operators, offset, omega), offset, omega[0::2],
-            _curvature(problem, omega))
+    return modal_mass, shares, offset, omega[0::2], _curvature(problem, omega)
 
 
 def _plane_normal(problem):
@@ -325,7 +328,7 @@ def _shares(operators, offset, omega):
     vertex_w = 3 * mesh.node_weights()[0::2]      # (h_left + h_right) / 2
     axial = np.einsum("nc,nc->n", offset, tv)
     out = offset @ normal
-    inplane = np.sum(offset**2, axis=1) - axial**2 - out**2
+    inplane = np.maximum(np.sum(offset**2, axis=1) - axial**2 - out**2, 0.0)
     rotation = operators.rotation
     torsion = np.einsum("nc,nc->n", omega, t)
     about_normal = omega @ normal
@@ -333,7 +336,8 @@ def _shares(operators, offset, omega):
     energies = np.array([
         np.sum(vertex_w * (m + added) * inplane) + np.sum(polar / 2 * about_normal**2),
         np.sum(vertex_w * (m + added) * out**2)
-        + np.sum(polar / 2 * (np.sum(omega**2, axis=1) - torsion**2 - about_normal**2)),
+        + np.sum(polar / 2 * np.maximum(np.sum(omega**2, axis=1) - torsion**2
+                                        - about_normal**2, 0.0)),
         np.sum(vertex_w * m * axial**2),
         np.sum(polar * torsion**2)])
     energies = np.asarray(mesh.global_sum(energies))
