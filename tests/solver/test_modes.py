@@ -155,3 +155,30 @@ def test_cli_modes_table(shared_tmp, capsys):
     for k in range(1, 5):
         offsets = shapes[shapes[:, 0] == k][:, 2:5]
         assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
+
+
+@pytest.mark.parametrize("added_mass", [1.0, 0.0])
+def test_added_mass_of_a_line_type(added_mass):
+    """A neutrally buoyant line type (mass = rho_w pi od^2 / 4: no weight) pinned taut:
+    its transverse modes carry the added mass C_a rho_w pi od^2 / 4 as well,
+    f_n = n/(2L') sqrt(T / (m' (1 + C_a))) sqrt(1 + n^2 pi^2 EI / (T L'^2)), the
+    stretched line's L' and m', lowered by the sections' rotary inertia I_b = m od^2 / 16
+    (Rayleigh's: omega^2 (m (1 + C_a) + I_b k^2) = T k^2 + EI k^4, k = n pi / L); their
+    polar inertia 2 I_b makes the free roll between the pins a rigid mode (the twist's
+    modes above 3.9 Hz)."""
+    from petsc_rod.model.line_type import LineType
+    rho, od, T, EA = 1025.0, 0.2, 100.0, 1e6
+    m = rho * np.pi * od**2 / 4
+    EI, GJ = 1e-2, 10.0
+    section = LineType("neutral", od, m, EI, GJ, ea=EA).section(0.0, L, rho, G)
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, GJ), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], sections=(section,),
+                 axial_stiffness=EA, water_density=rho, load_values=[[0.0, 0.0, 0.0]])
+    modes = modes_of(scene, 16, 5, added_mass=added_mass)
+    n = np.repeat([1, 2], 2)
+    exact = (n / (2 * L * (1 + e)) * np.sqrt(T * (1 + e) / (m * (1 + added_mass)))
+             * np.sqrt(1 + n**2 * np.pi**2 * EI / (T * (L * (1 + e))**2))
+             / np.sqrt(1 + (n * np.pi / L)**2 * (od**2 / 16) / (1 + added_mass)))
+    assert modes.labels[0] == "rigid" and modes.shares[0, 3] > 0.999
+    assert np.allclose(modes.frequencies[1:], exact, rtol=2e-4)
