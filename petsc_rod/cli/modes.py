@@ -10,6 +10,7 @@ import numpy as np
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import CLASSES, ModesRefused, solve_modes
 from petsc_rod.errors import RodInputError, RodIOError
+from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io.results import check_output_path
 
 TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
@@ -72,11 +73,6 @@ def table_lines(modes, seconds):
         fractions = " / ".join(f"{share:.2f}" for share in shares)
         lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
     return lines
-
-
-def shapes_path(path):
-    stem, extension = os.path.splitext(path)
-    return f"{stem}_shapes{extension or '.csv'}"
 
 
 def write_tables(comm, modes, path, say):

@@ -133,8 +133,9 @@ def test_modes_inputs_refused_before_the_run(options, message, capsys):
 
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
-    closed form's (16 elements), its classes in plane and out of plane, and the shapes'
-    file has one row per vertex and mode with a largest offset of 1."""
+    closed form's (16 elements), its classes in plane and out of plane, the shapes'
+    file has one row per vertex and mode with a largest offset of 1, and its picture
+    (figures/modes.py) a panel per mode."""
     from petsc_rod.cli import main
     path = os.path.join(shared_tmp, "modes.csv")
     EI, m = 2.0, 3.0
@@ -155,6 +156,10 @@ def test_cli_modes_table(shared_tmp, capsys):
     for k in range(1, 5):
         offsets = shapes[shapes[:, 0] == k][:, 2:5]
         assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
+    from petsc_rod.figures.modes import modes_figure
+    figure = modes_figure(path)                      # the picture: a panel a mode
+    panels = [axes for axes in figure.axes if axes.get_visible()]
+    assert len(panels) == 4 and panels[2].get_title().startswith("mode 3: 2.86")
 
 
 @pytest.mark.parametrize("added_mass", [1.0, 0.0])
