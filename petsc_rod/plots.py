@@ -110,29 +110,31 @@ def main(argv):
                          "allowable bend radius in m, positive and finite\n")
         return 2
     if len(inputs) == 1 and inputs[0].lower().endswith(".csv"):
-        try:
-            save(modes_figure(inputs[0]), output)
-        except (OSError, KeyError, ValueError) as error:
-            sys.stderr.write(f"petsc_rod.plots: error: {inputs[0]}: cannot be drawn "
-                             f"({error.__class__.__name__}: {error}); give a table written "
-                             "with -rod_modes_table\n")
-            return 2
-        return 0
+        return drawn(lambda: save(modes_figure(inputs[0]), output), inputs,
+                     "a table written with -rod_modes_table")
     for path in inputs:                 # a FIFO would block h5py for ever
         problem = file_problem(path)
         if problem:
             sys.stderr.write(f"petsc_rod.plots: error: {path}: {problem}\n")
             return 2
-    try:
+
+    def draw():
         if len(inputs) == 1:
             plot_result(inputs[0], output, radius)
         else:
             labels = [os.path.basename(p).removesuffix(".h5") for p in inputs]
             save(sweep_figure(inputs, labels, radius), output)
+    return drawn(draw, inputs, "result files written with -rod_output")
+
+
+def drawn(draw, inputs, advice):
+    """0 once ``draw()`` has written the figure; 2 with one line (the ``inputs`` cannot
+    be drawn: give ``advice``) where reading or drawing them failed."""
+    try:
+        draw()
     except (OSError, KeyError, ValueError) as error:
         sys.stderr.write(f"petsc_rod.plots: error: {' '.join(inputs)}: cannot be drawn "
-                         f"({error.__class__.__name__}: {error}); give result files written "
-                         "with -rod_output\n")
+                         f"({error.__class__.__name__}: {error}); give {advice}\n")
         return 2
     return 0
 
