@@ -27,7 +27,7 @@ from petsc_rod.cli.session import run_continuation
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodError, RodInputError
-from petsc_rod.cli.modes import check_modes_inputs, run_modes, shapes_path
+from petsc_rod.cli.modes import check_modes_inputs, report_modes, solve_for_run, shapes_path
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.io.same_file import replaced_input
@@ -123,14 +123,19 @@ def run(comm=None, texts=None):
                                 imperfection=values["rod_imperfection"],
                                 max_halvings=values["rod_max_halvings"],
                                 track_link=values["rod_track_link"])
+            modes = []                      # -rod_modes: found before the file is finished
+
+            def find_modes(writer):
+                modes.append(solve_for_run(problem, values, writer))
             code = run_continuation(solver, path, say=say, writer=writer,
-                                    options=options_record(texts),
-                                    interrupts=interrupts).code
+                                    options=options_record(texts), interrupts=interrupts,
+                                    before_finish=find_modes if values["rod_modes"] else None
+                                    ).code
             writer = None
             if code == 0:                   # the CSV table of the converged result
                 line_table.finish_run(problem, values["rod_table"], say)
-                if values["rod_modes"]:
-                    run_modes(problem, values, say)
+                if modes:
+                    report_modes(problem, values, modes[0], say)
             elif values["rod_table"]:       # none for this run: not an earlier run's either
                 line_table.discard(values["rod_table"], comm, say)
             for name in unused_options():

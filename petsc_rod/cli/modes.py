@@ -1,6 +1,7 @@
 """-rod_modes: the natural modes about the converged state after the last step
-(analysis/modes.py, docs/modes.md), as the run's lines (a table of the modes) and the
-CSV files of -rod_modes_table: the modes' table and their shapes along the line."""
+(analysis/modes.py, docs/modes.md): found before the result file is finished (its group
+``modes``), then said as the run's lines (a table of the modes) and written as the CSV
+files of -rod_modes_table: the modes' table and their shapes along the line."""
 
 import os
 import time
@@ -43,22 +44,31 @@ def check_modes_inputs(values, scene, comm):
         raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
 
 
-def run_modes(problem, values, say):
-    """The modes of -rod_modes about the problem's state: said as a table and written to
-    -rod_modes_table; an unstable state's are refused with a line. Returns the Modes,
-    or None when refused. Collective."""
+def solve_for_run(problem, values, writer):
+    """(Modes or ModesRefused, seconds) of -rod_modes about the problem's converged state,
+    the modes written into the result file where there is one (``writer``). Collective."""
     start = time.perf_counter()
     try:
         modes = solve_modes(problem, values["rod_modes"], mass_settings(values))
     except ModesRefused as refused:
-        say(f"modes: refused: {refused}")
-        return None
+        return refused, problem.mesh.global_max(time.perf_counter() - start)
     seconds = problem.mesh.global_max(time.perf_counter() - start)
+    if writer is not None:
+        writer.write_modes(modes)
+    return modes, seconds
+
+
+def report_modes(problem, values, found, say):
+    """Say the modes of solve_for_run ``found`` as a table (or their refusal) and write
+    -rod_modes_table. Collective."""
+    modes, seconds = found
+    if isinstance(modes, ModesRefused):
+        say(f"modes: refused: {modes}")
+        return
     for line in table_lines(modes, seconds):
         say(line)
     if values["rod_modes_table"]:
         write_tables(problem.mesh.comm, modes, values["rod_modes_table"], say)
-    return modes
 
 
 def table_lines(modes, seconds):

@@ -134,14 +134,16 @@ def test_modes_inputs_refused_before_the_run(options, message, capsys):
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, the shapes'
-    file has one row per vertex and mode with a largest offset of 1, and its picture
-    (figures/modes.py) a panel per mode."""
+    file has one row per vertex and mode with a largest offset of 1, the result file
+    has them in its group ``modes``, and the picture (figures/modes.py) a panel per
+    mode."""
     from petsc_rod.cli import main
     path = os.path.join(shared_tmp, "modes.csv")
     EI, m = 2.0, 3.0
     options = {"rod_length": "1", "rod_stiffness": f"{EI},{EI},{EI}", "rod_start": "clamp",
                "rod_end": "free", "rod_elements": "16", "rod_modes": "4",
-               "rod_modes_mass": str(m), "rod_modes_table": path}
+               "rod_modes_mass": str(m), "rod_modes_table": path,
+               "rod_output": os.path.join(shared_tmp, "modes.h5")}
     assert run_cli(options) == 0
     assert "modes: 4 lowest about the static state" in capsys.readouterr().out \
         or PETSc.COMM_WORLD.getRank() != 0
@@ -156,6 +158,14 @@ def test_cli_modes_table(shared_tmp, capsys):
     for k in range(1, 5):
         offsets = shapes[shapes[:, 0] == k][:, 2:5]
         assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
+    import h5py
+    with h5py.File(options["rod_output"], "r") as f:       # the result file's group
+        group = f["modes"]
+        assert np.allclose(group["frequency"][:], table["frequency_Hz"], rtol=1e-9)
+        assert group["offset"].shape == (17, 4, 3)
+        assert np.allclose(np.moveaxis(group["offset"][:], 0, 1).reshape(-1, 3),
+                           shapes[:, 2:5], atol=1e-9)
+        assert group.attrs["classes"].split(",") == list(table["class"])
     from petsc_rod.figures.modes import modes_figure
     figure = modes_figure(path)                      # the picture: a panel a mode
     panels = [axes for axes in figure.axes if axes.get_visible()]
