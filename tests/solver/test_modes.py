@@ -197,3 +197,44 @@ def test_added_mass_of_a_line_type(added_mass):
              / np.sqrt(1 + (n * np.pi / L)**2 * (od**2 / 16) / (1 + added_mass)))
     assert modes.labels[0] == "rigid" and modes.shares[0, 3] > 0.999
     assert np.allclose(modes.frequencies[1:], exact, rtol=2e-4)
+
+
+@pytest.mark.parametrize("lambda2", [10.0, 60.0])
+def test_suspended_cable_against_irvine(lambda2):
+    """A shallow elastic cable between pins at one height (span 100 m, sag 2 m, 10 N/m),
+    EA chosen for Irvine's parameter lambda^2 = (w l / H)^2 l / (H L_e / EA) below and
+    above the crossover 4 pi^2: in omega_bar = omega l / sqrt(H / m), the first
+    out-of-plane mode is pi, the first antisymmetric in-plane 2 pi, and the first
+    symmetric in-plane the root of tan(x) = x - 4 x^3 / lambda^2, omega_bar = 2 x (Irvine,
+    Cable Structures, 1981, §4.2), below 2 pi under the crossover and above it over."""
+    from scipy.optimize import brentq
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import solve_modes
+    w, span = 10.0, 100.0
+    H0 = w * span**2 / 16                              # sag span / 50
+    EA = lambda2 * H0 * 1.001 / (w * span / H0)**2
+    length = span * (1 + 8 / 3 / 50**2) - H0 / EA * span
+    scene = dict(length=length, stiffness=(1e-2,) * 3, start="pin", end="pin",
+                 end_position=[span, 0.0, 0.0], axial_stiffness=EA,
+                 load_values=[[0.0, 0.0, -w]])
+    mesh, solver = make_solver(PETSc.COMM_WORLD, 64, scene, 1e3)
+    try:
+        continuation(solver, steps=2)
+        problem = solver.problem
+        H = abs(problem.end_reaction()[0])
+        sag = -problem.mesh.global_min(float(problem.state.node_positions()[:, 2].min()))
+        modes = solve_modes(problem, 6, MassSettings())
+    finally:
+        destroy(mesh, solver)
+    actual = (w * span / H)**2 * span / (H * span * (1 + 8 * (sag / span)**2) / EA)
+    bar = 2 * np.pi * modes.frequencies * span / np.sqrt(H * G / w)
+    x = brentq(lambda x: np.tan(x) - x + 4 * x**3 / actual,
+               np.pi / 2 + 1e-9, 3 * np.pi / 2 - 1e-9)
+    labels = np.array(modes.labels)
+    plane, out = bar[labels == "in-plane"], bar[labels == "out-of-plane"]
+    assert abs(out[0] - np.pi) < 2e-3 * np.pi
+    symmetric = plane[np.argmin(np.abs(plane - 2 * x))]
+    antisymmetric = plane[np.argmin(np.abs(plane - 2 * np.pi))]
+    assert abs(symmetric - 2 * x) < 1e-3 * 2 * x
+    assert abs(antisymmetric - 2 * np.pi) < 2e-3 * 2 * np.pi
+    assert (symmetric < antisymmetric) == (actual < 4 * np.pi**2)
