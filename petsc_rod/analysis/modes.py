@@ -44,6 +44,11 @@ PREFIX = "rod_modes_"
 # sigma: omega^2 of the shift, rad^2/s^2, just below 0 so that a free rigid mode
 # (omega = 0) leaves K - sigma M nonsingular: the frequency 1e-4 Hz squared.
 SHIFT = -(2 * np.pi * 1e-4) ** 2
+# the Krylov subspace beyond the modes asked for (SLEPc's ncv = nev + max(SUBSPACE,
+# nev / 2), -rod_modes_eps_ncv overrides it): SLEPc's own for few modes, fewer solves
+# than its 2 nev for many; a smaller one can miss a copy of a repeated frequency (a
+# straight line's pairs, which the iteration finds through round-off)
+SUBSPACE = 15
 # the classes of a mode by the share of its kinetic energy; "mixed" below DOMINANT
 CLASSES = ("in-plane", "out-of-plane", "axial", "torsional")
 DOMINANT = 0.6
@@ -226,7 +231,10 @@ def solve_modes(problem, count, settings=MassSettings()):
             raise ModesRefused(int(negative))
         eps.setOperators(shifted, M)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count)
+        eps.setDimensions(count, count + max(SUBSPACE, count // 2))
+        # the purification's solves (one per vector) change no shape: the massless
+        # unknowns' components it removes are not read (u and omega are)
+        eps.setPurify(False)
         eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
         eps.setTarget(0.0)
         st = eps.getST()
