@@ -12,7 +12,7 @@ line type's mass), m_a = C_a rho_w pi od^2 / 4 the water's added mass normal to 
 I_b = J / 2 the bending mass moment of inertia of the section per length (kg m; a pipe:
 J = m (od^2 + id^2) / 8), and the attachments' mass m_p = rho_w V_p - F_z,p / g (from
 their dead force F and volume V) with their added mass C_a rho_w V_p at the nearest node.
-The line is taken as submerged all along where it has line types (water density > 0).
+The line's added mass acts below the sea surface alone (nodal_mass's ``submerged``).
 A uniform line (-rod_stiffness) takes its m and J from -rod_modes_mass and
 -rod_modes_inertia (m by default its load's magnitude / g; J by default 0).
 
@@ -69,13 +69,16 @@ def line_inertia(scene, S, settings):
     return np.full(n, float(mass)), np.zeros(n), np.full(n, float(settings.inertia))
 
 
-def nodal_mass(scene, mesh, tangents, settings):
+def nodal_mass(scene, mesh, tangents, settings, submerged=None):
     """The lumped mass of the owned P2 nodes: (translation (n, 3, 3), kg; rotation (n, 3,
     3), kg m^2): w_n [m I + m_a (I - t t^T)] and w_n [J t t^T + J/2 (I - t t^T)], t the
     unit tangents (n, 3), plus the attachments' masses at their nearest nodes
-    (point_masses)."""
+    (point_masses); the added mass only at the ``submerged`` nodes (n,) bool, where
+    given."""
     S, w = mesh.node_S(), mesh.node_weights()
     m, added, polar = line_inertia(scene, S, settings)
+    if submerged is not None:
+        added = np.where(submerged, added, 0.0)
     t = tangents / np.linalg.norm(tangents, axis=1)[:, None]
     along = np.einsum("nk,nl->nkl", t, t)
     normal = np.eye(3) - along

@@ -107,6 +107,18 @@ def classify(shares, frequencies):
             for i, k in enumerate(largest)]
 
 
+def submerged(problem):
+    """Whether each owned P2 node is at or below the sea surface (n,): the scene's
+    sea_surface, else the higher held end's height (quantities/pressures.py's); all of
+    them where no end is held."""
+    scene = problem.scene
+    heights = [state.position[2] for state in (problem.start_state, problem.end_state)
+               if is_held(state)]
+    surface = scene.sea_surface if scene.sea_surface is not None else \
+        (max(heights) if heights else np.inf)
+    return problem.state.node_positions()[:, 2] <= surface + 1e-9 * scene.length
+
+
 class ModalOperators(SecondVariation):
     """K and M of the module docstring at the problem's state: SecondVariation with the
     chains of x, y and z (without the Newton Jacobian's resultants and pattern), the other end's displacement pinned where both are held, and
@@ -117,7 +129,7 @@ class ModalOperators(SecondVariation):
         super().__init__(problem, positions=(0, 1, 2), newton=False)
         tangents = problem.state.tau[:, 2]
         self.translation, self.rotation = nodal_mass(problem.scene, problem.mesh, tangents,
-                                                     settings)
+                                                     settings, submerged(problem))
         polar = line_inertia(problem.scene, problem.mesh.node_S(), settings)[2]
         mesh = problem.mesh
         if mesh.global_sum(int((~problem.free_nodes).sum())) == 0 \

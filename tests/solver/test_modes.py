@@ -172,6 +172,20 @@ def test_cli_modes_table(shared_tmp, capsys):
     assert len(panels) == 4 and panels[2].get_title().startswith("mode 3: 2.86")
 
 
+def neutral_line(surface=None):
+    """(scene, m, e, od, EI) of a neutrally buoyant line type pinned taut (T = 100 N)."""
+    from petsc_rod.model.line_type import LineType
+    rho, od, T, EA, EI, GJ = 1025.0, 0.2, 100.0, 1e6, 1e-2, 10.0
+    m = rho * np.pi * od**2 / 4
+    section = LineType("neutral", od, m, EI, GJ, ea=EA).section(0.0, L, rho, G)
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, GJ), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], sections=(section,),
+                 axial_stiffness=EA, water_density=rho, load_values=[[0.0, 0.0, 0.0]],
+                 sea_surface=surface)
+    return scene, m, e, od, EI
+
+
 @pytest.mark.parametrize("added_mass", [1.0, 0.0])
 def test_added_mass_of_a_line_type(added_mass):
     """A neutrally buoyant line type (mass = rho_w pi od^2 / 4: no weight) pinned taut:
@@ -181,15 +195,8 @@ def test_added_mass_of_a_line_type(added_mass):
     (Rayleigh's: omega^2 (m (1 + C_a) + I_b k^2) = T k^2 + EI k^4, k = n pi / L); their
     polar inertia 2 I_b makes the free roll between the pins a rigid mode (the twist's
     modes above 3.9 Hz)."""
-    from petsc_rod.model.line_type import LineType
-    rho, od, T, EA = 1025.0, 0.2, 100.0, 1e6
-    m = rho * np.pi * od**2 / 4
-    EI, GJ = 1e-2, 10.0
-    section = LineType("neutral", od, m, EI, GJ, ea=EA).section(0.0, L, rho, G)
-    e = T / EA
-    scene = dict(length=L, stiffness=(EI, EI, GJ), start="pin", end="pin",
-                 end_position=[L * (1 + e), 0.0, 0.0], sections=(section,),
-                 axial_stiffness=EA, water_density=rho, load_values=[[0.0, 0.0, 0.0]])
+    scene, m, e, od, EI = neutral_line()
+    T = 100.0
     modes = modes_of(scene, 16, 5, added_mass=added_mass)
     n = np.repeat([1, 2], 2)
     exact = (n / (2 * L * (1 + e)) * np.sqrt(T * (1 + e) / (m * (1 + added_mass)))
@@ -197,6 +204,24 @@ def test_added_mass_of_a_line_type(added_mass):
              / np.sqrt(1 + (n * np.pi / L)**2 * (od**2 / 16) / (1 + added_mass)))
     assert modes.labels[0] == "rigid" and modes.shares[0, 3] > 0.999
     assert np.allclose(modes.frequencies[1:], exact, rtol=2e-4)
+
+
+def test_no_added_mass_above_the_sea():
+    """The same line with the sea surface below it (in air: it sags under its weight):
+    the nodes' translation mass is w_n m I, no added mass."""
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import ModalOperators
+    scene, m, *_ = neutral_line(surface=-1.0)
+    mesh, solver = make_solver(PETSc.COMM_WORLD, 8, scene, 1e2)
+    try:
+        continuation(solver)
+        operators = ModalOperators(solver.problem, MassSettings())
+        expected = mesh.node_weights()[:, None, None] * m * np.eye(3)
+        assert np.allclose(operators.translation, expected, rtol=1e-12, atol=0)
+        assert solver.problem.state.node_positions()[:, 2].min() > -1.0
+        operators.destroy()
+    finally:
+        destroy(mesh, solver)
 
 
 @pytest.mark.parametrize("lambda2", [10.0, 60.0])
