@@ -36,6 +36,17 @@ def petsc_error(report):
     return message[-1] if message else ""
 
 
+def start_slepc(argv):
+    """Initialise SLEPc (the modal analysis, analysis/modes.py) with the same ``argv`` as
+    PETSc, where slepc4py is installed; without it the modes are refused when asked
+    for (analysis/modes.py)."""
+    try:
+        import slepc4py
+    except ImportError:
+        return
+    slepc4py.init(argv)
+
+
 def start_petsc(argv):
     """Initialise PETSc with ``argv``; returns '' or, when PETSc refuses the options (a
     line of an options file it cannot parse), its message, instead of PETSc's own
@@ -46,6 +57,7 @@ def start_petsc(argv):
     with stderr_captured() as report:
         try:
             petsc4py.init(argv)         # PETSc starts and reads the options here
+            start_slepc(argv)
         except Exception:               # petsc4py.PETSc.Error, not importable before
             return petsc_error(report()) or "PETSc could not start with these options"
         printed = report()

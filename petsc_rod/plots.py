@@ -2,6 +2,7 @@
 
     python -m petsc_rod.plots RESULT.h5 FIGURE.png [--min-bend-radius R]
     python -m petsc_rod.plots A.h5 B.h5 ... FIGURE.png      (the cases overlaid)
+    python -m petsc_rod.plots MODES.csv FIGURE.png           (-rod_modes_table's modes)
 
 For a plain rod: the centreline projected on the xy, xz and yz planes and the strains
 against S (the paper's Figures 1 and 3, docs/method.md §8). For a riser, a mooring line
@@ -22,6 +23,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from petsc_rod.figures.modes import modes_figure  # noqa: E402
 from petsc_rod.figures.read import read_result  # noqa: E402
 from petsc_rod.figures.riser import riser_figure, sweep_overlay  # noqa: E402
 from petsc_rod.figures.rod import rod_figure  # noqa: E402
@@ -85,7 +87,7 @@ def main(argv):
     parser = OneLineParser(
         prog="python -m petsc_rod.plots",
         usage="python -m petsc_rod.plots RESULT.h5 [MORE.h5 ...] FIGURE.png "
-              "[--min-bend-radius R]",
+              "[--min-bend-radius R] | MODES.csv FIGURE.png",
         description="Draw a result file, or several overlaid (a sweep), as a PNG.")
     parser.add_argument("files", nargs="+", metavar="FILE",
                         help="the result files, then the figure to write")
@@ -107,21 +109,32 @@ def main(argv):
         sys.stderr.write(f"petsc_rod.plots: error: --min-bend-radius {radius:g}: give the "
                          "allowable bend radius in m, positive and finite\n")
         return 2
+    if len(inputs) == 1 and inputs[0].lower().endswith(".csv"):
+        return drawn(lambda: save(modes_figure(inputs[0]), output), inputs,
+                     "a table written with -rod_modes_table")
     for path in inputs:                 # a FIFO would block h5py for ever
         problem = file_problem(path)
         if problem:
             sys.stderr.write(f"petsc_rod.plots: error: {path}: {problem}\n")
             return 2
-    try:
+
+    def draw():
         if len(inputs) == 1:
             plot_result(inputs[0], output, radius)
         else:
             labels = [os.path.basename(p).removesuffix(".h5") for p in inputs]
             save(sweep_figure(inputs, labels, radius), output)
+    return drawn(draw, inputs, "result files written with -rod_output")
+
+
+def drawn(draw, inputs, advice):
+    """0 once ``draw()`` has written the figure; 2 with one line (the ``inputs`` cannot
+    be drawn: give ``advice``) where reading or drawing them failed."""
+    try:
+        draw()
     except (OSError, KeyError, ValueError) as error:
         sys.stderr.write(f"petsc_rod.plots: error: {' '.join(inputs)}: cannot be drawn "
-                         f"({error.__class__.__name__}: {error}); give result files written "
-                         "with -rod_output\n")
+                         f"({error.__class__.__name__}: {error}); give {advice}\n")
         return 2
     return 0
 

@@ -99,6 +99,22 @@ def global_max(comm, value):
     return mpi.allreduce(float(value), op=MPI.MAX)
 
 
+def run_cli(options):
+    """cli.main.run on COMM_WORLD with ``options`` {name: text} in PETSc's options
+    database, removed afterwards; the exit code."""
+    from petsc4py import PETSc
+
+    from petsc_rod.cli import main
+    database = PETSc.Options()
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        return main.run(PETSc.COMM_WORLD)
+    finally:
+        for name in options:
+            database.delValue(name)
+
+
 def continuation(solver, steps=1, imperfection=0.0, **path):
     """From the straight state to load factor 1 by the CLI's continuation loop (halving
     and link check included; ``path``: the other fields of

@@ -91,7 +91,7 @@ class SecondVariation:
     ``_matrix_changed`` and ``_constraint_changed``. Collective; ``destroy()`` frees
     every PETSc object."""
 
-    def __init__(self, problem):
+    def __init__(self, problem, positions=(), newton=True):
         self.problem = problem
         mesh = problem.mesh
         self.comm = mesh.comm
@@ -99,13 +99,15 @@ class SecondVariation:
         self.stretch = getattr(problem, "axial", None) is not None
         self.unknowns = 4 if self.stretch else 3
         # the positions' chains (analysis/positions.py) of the components the terms'
-        # energies read, one slot each after the node's unknowns
+        # energies read (and ``positions``: the modes' mass, analysis/modes.py), one slot
+        # each after the node's unknowns
         self.positions = tuple(sorted({c for term in problem.terms
-                                       for c in term.position_components}))
+                                       for c in term.position_components} | set(positions)))
         self.position_slot = {c: self.unknowns + i for i, c in enumerate(self.positions)}
         # the resultants' chain of a load that follows the line (analysis/jacobian.py):
-        # three slots per node, identity rows here (H is the frozen load's)
-        self.resultants = any(term.follower for term in problem.terms)
+        # three slots per node, identity rows here (H is the frozen load's); not where H
+        # serves no Newton step (``newton`` False: the modes, analysis/modes.py)
+        self.resultants = newton and any(term.follower for term in problem.terms)
         self.resultant_slot = self.unknowns + len(self.positions)
         self.block = block = self.resultant_slot + 3 * int(self.resultants)
         # the chains' multipliers: negative eigenvalues of the KKT matrix beyond H's
@@ -122,7 +124,7 @@ class SecondVariation:
         self.resultant_rows = ((nodes[:, None] + self.resultant_slot + np.arange(3)).ravel()
                                if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
-        self._reserved = False           # J's pattern in H (_assemble)
+        self._reserved = not newton      # J's pattern in H (_assemble)
         self.constraint = []
         self._fill()
         self.mass = self._mass()

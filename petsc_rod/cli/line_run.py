@@ -36,6 +36,7 @@ from petsc4py import PETSc
 from petsc_rod import resources
 from petsc_rod.cli import messages
 from petsc_rod.cli.options import BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value
+from petsc_rod.cli.modes import check_modes_inputs, report_modes, solve_for_run
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
                                          restart_path, rounded_down, settings_from_options)
 from petsc_rod.cli.session import run_continuation
@@ -104,6 +105,7 @@ def plan_line(comm, model, values, given, names=OPTION_NAMES, mesh_named=None):
     check_mesh(comm, values, resources.bytes_per_element(
         scene.seabed is not None and (settings.newton or settings.check_stability)),
         None if mesh_named is None else mesh_named(pieces, values["rod_elements"]))
+    check_modes_inputs(values, scene, comm)
     if values["rod_output"]:
         io.check_output_path(values["rod_output"], comm)
     if values["rod_table"]:
@@ -156,11 +158,13 @@ class BuiltLine:
                             max_halvings=values["rod_max_halvings"],
                             track_link=values["rod_track_link"])
 
-    def run(self, path, say=None, writer=None, options="", interrupts=None):
+    def run(self, path, say=None, writer=None, options="", interrupts=None,
+            before_finish=None):
         """session.run_continuation of the built solver along ``path`` from the state it
-        holds; a ContinuationResult."""
+        holds (``before_finish(writer)`` called before the result file is finished); a
+        ContinuationResult."""
         return run_continuation(self.solver, path, say=say, writer=writer, options=options,
-                                interrupts=interrupts)
+                                interrupts=interrupts, before_finish=before_finish)
 
     def destroy(self):
         """Destroy what was built, in reverse order, skipping what was not. Collective."""
@@ -199,6 +203,10 @@ class LastStep:
     def finish(self, *args):
         if self.inner is not None:
             self.inner.finish(*args)
+
+    def write_modes(self, modes):
+        if self.inner is not None:
+            self.inner.write_modes(modes)
 
     def kept_name(self):
         return self.inner.kept_name() if self.inner is not None else None
@@ -269,11 +277,18 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
                     io.minimum_bytes(built.mesh, outputs.restart_state(built.problem),
                                      values["rod_steps"]), made)
             last = LastStep(writer) if keep_last else None
+            modes = []                      # -rod_modes: found before the file is finished
+
+            def find_modes(writer):
+                modes.append(solve_for_run(built.problem, values, writer))
             result = built.run(path, say=say, writer=last or writer, options=options,
-                               interrupts=interrupts)
+                               interrupts=interrupts,
+                               before_finish=find_modes if values["rod_modes"] else None)
             writer = failures.writer = None             # finished
             if result.code == 0:            # the CSV table of the converged result
                 line_table.finish_run(built.problem, values["rod_table"], say)
+                if modes:
+                    report_modes(built.problem, values, modes[0], say)
             elif values["rod_table"]:       # none for this run: not an earlier run's either
                 line_table.discard(values["rod_table"], comm, say)
             return LineRun(result, last, built.mesh.n_elements)

@@ -11,6 +11,7 @@ import sys
 from petsc4py import PETSc
 
 from petsc_rod.cli.line_run import (AgreedFailures, petsc_failure, plan_line, run_line)
+from petsc_rod.cli.modes import shapes_path
 from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, values_of)
@@ -93,7 +94,7 @@ def run(comm=None, texts=None):
 
 def check_inputs_kept(values, comm):
     """Refuse, before any work, an output (-rod_output, -rod_table and its regions'
-    table) that names one of the run's inputs, which writing it would replace: an
+    table, -rod_modes_table and its shapes') that names one of the run's inputs, which writing it would replace: an
     options file, or the file of an input option (-rod_initial, -rod_line_types,
     -rod_point_loads, the profiles: every option whose value is a FILE). Collective:
     rank 0 decides."""
@@ -102,6 +103,10 @@ def check_inputs_kept(values, comm):
         written += [("-rod_table", values["rod_table"]),
                     ("the regions' table of -rod_table",
                      line_table.regions_path(values["rod_table"]))]
+    if values["rod_modes_table"]:
+        written += [("-rod_modes_table", values["rod_modes_table"]),
+                    ("the shapes' table of -rod_modes_table",
+                     shapes_path(values["rod_modes_table"]))]
     clash = None
     if comm.getRank() == 0:
         read = [("-options_file", path) for path in every_options_file(sys.argv)]

@@ -35,9 +35,12 @@ from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS,
 from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step, the SNES of the iteration and
-# the MUMPS factorisations of the Newton steps and the stability test.
+# the MUMPS factorisations of the Newton steps and the stability test, the modes' SLEPc
+# eigensolver (its EPS, spectral transformation with MUMPS's LDL^T, bases, dense solver,
+# region: analysis/modes.py).
 SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "rod_x_", "rod_y_",
-                   "rod_newton_", "rod_inertia_")
+                   "rod_newton_", "rod_inertia_", "rod_modes_eps_", "rod_modes_st_",
+                   "rod_modes_bv_", "rod_modes_ds_", "rod_modes_rg_")
 
 # The largest whole number an integer option may hold: a PETSc integer.
 MAX_INT = int(np.iinfo(PETSc.IntType).max)
@@ -303,6 +306,25 @@ OPTIONS = [
            "write the converged result along the line as CSV to FILE (one row per vertex: "
            "S, x, y, z and the results along the line, units in the header) and the "
            "regions' summary beside it, FILE's stem + _regions.csv", unit="text"),
+    Option("rod_modes", _int, 0, "n",
+           "after the last step, the n lowest natural modes about the converged state "
+           "(undamped: no drag; SLEPc, options -rod_modes_eps_*; docs/modes.md): "
+           "frequencies, periods, modal masses and classes in the run's lines; 0 none",
+           NON_NEGATIVE),
+    Option("rod_modes_table", _string, None, "FILE.csv",
+           "write the modes' table (one row per mode) to FILE, and their shapes along "
+           "the line (one row per vertex and mode) to FILE's stem + _shapes.csv",
+           unit="text"),
+    Option("rod_modes_mass", _real, None, "m",
+           "a uniform line's mass per length for -rod_modes, kg/m; default its load's "
+           "magnitude / g (a line of line types: their masses)", SCALE, "kg/m"),
+    Option("rod_modes_inertia", _real, 0.0, "J",
+           "a uniform line's polar mass moment of inertia per length for -rod_modes, "
+           "kg m (0: no torsional modes; a line of line types: m (od^2 + id^2) / 8)",
+           NON_NEGATIVE, "kg m"),
+    Option("rod_modes_added_mass", _real, 1.0, "Ca",
+           "the added-mass coefficient C_a of -rod_modes: C_a rho_w pi od^2 / 4 normal "
+           "to the line, C_a rho_w V at an attachment", NON_NEGATIVE),
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "
@@ -511,6 +533,11 @@ def help_text():
                  "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
                  "ordering unless given); -rod_inertia_substructuring <bool> as for the "
                  "Newton steps' LU (the inertia the interiors' and the interface's).")
+    lines.append("  The modes (-rod_modes): SLEPc's options under -rod_modes_ "
+                 "(-rod_modes_eps_nev, -rod_modes_eps_ncv, -rod_modes_eps_tol, "
+                 "-rod_modes_eps_view, ...; default Krylov-Schur, shift-and-invert about "
+                 "omega^2 just below 0), -rod_modes_st_mat_mumps_* MUMPS's controls of "
+                 "the LDL^T of K - sigma M.")
     lines.append("  The iteration: -rod_snes_type anderson (default: Anderson mixing of the "
                  "iterates) | nrichardson (the plain iteration) | ngmres | qn | ncg (the SNES "
                  "types that need no Jacobian), and the SNES options under the same prefix "

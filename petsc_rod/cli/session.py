@@ -27,7 +27,7 @@ class ContinuationResult:
 
 
 def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, options="",
-                     interrupts=None):
+                     interrupts=None, before_finish=None):
     """Walk continuation(solver, path) (iteration/continuation.py) to its end.
 
     ``say(line)`` gets the lines (None: silent): a short line per step (lines.step_line),
@@ -39,7 +39,9 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
     is finished: a signal ends the run with RodInterrupted, the steps written so far kept
     as a finished file of their own (ResultWriter.kept_name: converged = 0,
     stop_reason "interrupted", a restart file). A divergence with no halving left raises
-    RodDivergedError. Returns a ContinuationResult.
+    RodDivergedError. ``before_finish(writer)``, if given, is called once a run has
+    converged, before the file is finished (the modes: cli/modes.py). Returns a
+    ContinuationResult.
     """
     say = say or (lambda line: None)
     verbose = solver.settings.monitor       # -rod_al_monitor: each step's details too
@@ -84,6 +86,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
             raise RodInterrupted(messages.interrupted(interrupts.name(number), event, kept),
                                  number)
         elif isinstance(event, events.RunFinished):
+            if before_finish is not None and event.converged and last is not None:
+                before_finish(writer)
             if writer is not None:
                 writer.finish(*last)
             if event.converged and last is not None:

@@ -352,6 +352,46 @@ class ResultWriter:
         _set_attributes(group, attributes, self.attribute_units)
         self.file.flush()
 
+    def write_modes(self, modes):
+        """The group ``modes`` (docs/modes.md, docs/output.md): per mode (m,)
+        ``frequency`` Hz, ``period`` s, ``omega2`` rad^2/s^2, ``modal_mass`` kg,
+        ``shares`` (m, 4) and the attribute ``classes``; along the line, distributed by
+        rows as the vertex datasets, ``S`` (n,), ``offset`` m and ``rotation`` rad (n, m,
+        3) of the shapes normalised to a largest offset of 1 m, and at the elements'
+        midpoints ``S_mid`` (n_e,) and ``curvature`` (n_e, m, 3) 1/m. ``modes``:
+        analysis/modes.Modes (this rank's rows)."""
+        along = {"S": modes.S, "offset": np.moveaxis(modes.offset, 0, 1),
+                 "rotation": np.moveaxis(modes.rotation, 0, 1), "S_mid": modes.S_mid,
+                 "curvature": np.moveaxis(modes.curvature, 0, 1)}
+        layout = distributed_layout(self.comm, along)
+        nbytes = 8 * sum(int(np.prod(shape)) for shape, _, _ in layout.values())
+        on_every_rank(self.comm, self._check_room_for_step,
+                      SPACE_FACTOR * nbytes + SPACE_RESERVE)
+        self._collective(self._write_modes, modes, along, layout)
+
+    def _write_modes(self, modes, along, layout):
+        group = self.file.require_group("modes")
+        for key, values, unit in (("frequency", modes.frequencies, "Hz"),
+                                  ("period", modes.periods, "s"),
+                                  ("omega2", modes.omega2, "rad^2/s^2"),
+                                  ("modal_mass", modes.modal_mass, "kg"),
+                                  ("shares", modes.shares, "1")):
+            data = group.create_dataset(key, shape=np.shape(values), dtype="f8")
+            data.attrs["units"] = unit
+            if self.comm.Get_rank() == 0:
+                data[...] = values
+        units = {"S": "m", "offset": "m", "rotation": "rad", "S_mid": "m",
+                 "curvature": "1/m"}
+        for key, local in along.items():
+            shape, start, rows = layout[key]
+            data = group.create_dataset(key, shape=shape, dtype="f8")
+            data.attrs["units"] = units[key]
+            if rows:
+                data[start:start + rows] = local
+        group.attrs["classes"] = ",".join(modes.labels)
+        group.attrs["share_columns"] = "in-plane,out-of-plane,axial,torsional"
+        self.file.flush()
+
     def finish(self, last_group, attributes, name=None):
         """Link the root to ``last_group``, set the root attributes (the last step's and
         the run record's) and the group ``parameters``, close and rename to the result's

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_rod.cli import main
+import helpers
 from petsc_rod.frames import rotation_about, rotation_log
 from petsc_rod.scenes.scene import REFERENCE_FRAME
 
@@ -81,15 +81,7 @@ CASES = {
 def run_cli(options):
     """cli.main.run with ``options`` (and COMMON) in the database, removed afterwards;
     the exit code."""
-    database = PETSc.Options()
-    options = {**COMMON, **options}
-    for name, value in options.items():
-        database.setValue(name, value)
-    try:
-        return main.run(PETSc.COMM_WORLD)
-    finally:
-        for name in options:
-            database.delValue(name)
+    return helpers.run_cli({**COMMON, **options})
 
 
 def positions(path, group=""):

@@ -49,7 +49,8 @@ def array_of_floaters():
 
 def written(figure, size, path):
     figure.savefig(path, dpi=DPI)
-    fits = clear(figure)
+    # the suptitle: the figure's topmost text
+    fits = clear(figure, max(figure.texts, key=lambda text: text.get_position()[1]))
     plt.close(figure)
     assert matplotlib.image.imread(path).shape[1::-1] == (round(size[0] * DPI),
                                                          round(size[1] * DPI))

@@ -1,0 +1,375 @@
+"""The natural modes of a line about a converged static state: K phi = omega^2 M phi
+(docs/modes.md, docs/method.md §10-§12), undamped (the drag is left out).
+
+K is the second variation H of the stability test (analysis/second_variation.py: every
+term's stiffness at the state, the seabed's springs, the stretch, the flex joints, the
+load held fixed), with the chains of all three components of the node positions
+(analysis/positions.py) made unknowns: the displacement of a vertex, u^c, is tied to the
+rotations and stretches by u^c_e+1 - u^c_e - h_e SIMPSON.s^c_e = 0 (multiplier nu^c_e),
+so that the translational kinetic energy is a banded mass on (u, omega) instead of a
+dense one on the rotations alone. K is then the KKT matrix
+
+    [ H   C^T ]          [ M  0 ]
+    [ C   0   ],   M  =  [ 0  0 ]   (analysis/mass.py: lumped at the P2 nodes; a
+                                      midpoint's displacement u_e + h_e HALF.s_e),
+
+the held end's u pinned (u = 0), and with both ends held the other end's too: that
+pin is the chord constraint of the stability test. The multipliers nu and the
+stretches carry no mass; their eigenvalues are infinite and shift-invert maps them to
+0 (the Newton Jacobian's resultants of a follower load are left out). M is positive
+semi-definite and the pencil (K - sigma M) nonsingular at a stable state, so the
+problem is SLEPc's GHEP with shift-invert about sigma = SHIFT (a small negative
+omega^2) on the LDL^T of K - sigma M (global_step/ksp.direct_factor, the stability
+test's: MUMPS on one rank, the chain's substructuring on several), whose inertia counts, less the n_elements negative eigenvalues per
+component of the chains, the eigenvalues below sigma: a state with any is unstable,
+and its modes are refused (never reported as vibrations). Where no node is clamped,
+the sections have no polar inertia and the roll is free (K1 = K2), the roll is held
+(SecondVariation.hold_roll): it has neither stiffness nor mass.
+
+Options: the EPS reads -rod_modes_eps_* (and -rod_modes_st_*), the factorisation
+-rod_modes_st_mat_mumps_icntl_* and -rod_modes_st_substructuring.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.analysis.mass import MassSettings, line_inertia, nodal_mass
+from petsc_rod.analysis.second_variation import SecondVariation, unit
+from petsc_rod.global_step.ksp import direct_factor
+from petsc_rod.scenes.boundary import is_held
+
+PREFIX = "rod_modes_"
+# sigma: omega^2 of the shift, rad^2/s^2, just below 0 so that a free rigid mode
+# (omega = 0) leaves K - sigma M nonsingular: the frequency 1e-4 Hz squared.
+SHIFT = -(2 * np.pi * 1e-4) ** 2
+# the Krylov subspace beyond the modes asked for (SLEPc's ncv = nev + max(SUBSPACE,
+# nev / 2), -rod_modes_eps_ncv overrides it): SLEPc's own for few modes, fewer solves
+# than its 2 nev for many; a smaller one can miss a copy of a repeated frequency (a
+# straight line's pairs, which the iteration finds through round-off)
+SUBSPACE = 15
+# the classes of a mode by the share of its kinetic energy; "mixed" below DOMINANT
+CLASSES = ("in-plane", "out-of-plane", "axial", "torsional")
+DOMINANT = 0.6
+# a mode below this frequency (Hz; a period of over 1000 s) is "rigid": a line's
+# vibrations are faster, and the free roll of sections with polar inertia between pins
+# has omega = 0 to round-off
+RIGID = 1e-3
+
+
+class ModesRefused(Exception):
+    """The static state has eigenvalues of K - omega^2 M below 0: unstable, no modes."""
+
+    def __init__(self, negative):
+        super().__init__(f"the static state is unstable ({negative} negative eigenvalue"
+                         f"{'s' if negative != 1 else ''} of K - omega^2 M): no vibration "
+                         "modes about it")
+        self.negative = negative
+
+
+@dataclass
+class Modes:
+    """The modes found, lowest first (n modes): ``omega2`` (rad^2/s^2), frequencies
+    (Hz), periods (s), ``modal_mass`` (kg, of the shape normalised to a largest offset
+    of 1 m), ``shares`` (n, 4) of the kinetic energy in CLASSES, ``labels``; per owned
+    vertex ``S`` (n_v,), ``offset`` (n, n_v, 3) m and ``rotation`` (n, n_v, 3) rad; per
+    owned element midpoint ``S_mid`` and ``curvature`` (n, n_e, 3) 1/m, the change of
+    (u1, u2, u3) = (d1, d2, d3) . omega'."""
+
+    omega2: np.ndarray
+    modal_mass: np.ndarray
+    shares: np.ndarray
+    S: np.ndarray
+    offset: np.ndarray
+    rotation: np.ndarray
+    S_mid: np.ndarray
+    curvature: np.ndarray
+    converged: int = 0
+    labels: list = field(default_factory=list)
+
+    @property
+    def frequencies(self):
+        return np.sqrt(np.maximum(self.omega2, 0.0)) / (2 * np.pi)
+
+    @property
+    def periods(self):
+        f = self.frequencies
+        return np.where(f > 0, 1 / np.where(f > 0, f, 1.0), np.inf)
+
+
+def classify(shares, frequencies):
+    """The class of each mode from its shares (n, 4): 'rigid' below RIGID Hz, else the
+    largest share's if at least DOMINANT, else 'mixed'."""
+    largest = np.argmax(shares, axis=1)
+    return ["rigid" if frequencies[i] < RIGID else
+            CLASSES[k] if shares[i, k] >= DOMINANT else "mixed"
+            for i, k in enumerate(largest)]
+
+
+def submerged(problem):
+    """Whether each owned P2 node is at or below the sea surface (n,): the scene's
+    sea_surface, else the higher held end's height (quantities/pressures.py's); all of
+    them where no end is held."""
+    scene = problem.scene
+    heights = [state.position[2] for state in (problem.start_state, problem.end_state)
+               if is_held(state)]
+    surface = scene.sea_surface if scene.sea_surface is not None else \
+        (max(heights) if heights else np.inf)
+    return problem.state.node_positions()[:, 2] <= surface + 1e-9 * scene.length
+
+
+class ModalOperators(SecondVariation):
+    """K and M of the module docstring at the problem's state: SecondVariation with the
+    chains of x, y and z (without the Newton Jacobian's resultants and pattern), the other end's displacement pinned where both are held, and
+    the mass ``mass_matrix``. Collective; ``destroy()`` frees every PETSc object."""
+
+    def __init__(self, problem, settings=MassSettings()):
+        self.settings = settings
+        super().__init__(problem, positions=(0, 1, 2), newton=False)
+        tangents = problem.state.tau[:, 2]
+        self.translation, self.rotation = nodal_mass(problem.scene, problem.mesh, tangents,
+                                                     settings, submerged(problem))
+        polar = line_inertia(problem.scene, problem.mesh.node_S(), settings)[2]
+        mesh = problem.mesh
+        if mesh.global_sum(int((~problem.free_nodes).sum())) == 0 \
+                and mesh.global_max(float(np.abs(polar).max(initial=0.0))) == 0.0:
+            self.hold_roll(tangents)
+        self.mass_matrix = self._mass_matrix()
+
+    def _clamped_rows(self):
+        rows = super()._clamped_rows()
+        mesh, problem = self.problem.mesh, self.problem
+        if not (is_held(problem.start_state) and is_held(problem.end_state)) \
+                or not mesh.on_upper_boundary:
+            return rows
+        slots = np.array(list(self.position_slot.values()))
+        far = self.first_row + self.block * (mesh.n_local_nodes - 1) + slots
+        return np.union1d(rows, far).astype(PETSc.IntType)
+
+    def _mass_matrix(self):
+        """M (module docstring) on the layout of K: the translation blocks through the
+        chains' vertex and midpoint rows (position_blocks), the rotation blocks on the
+        rotations; 0 on the held rows."""
+        mesh, B = self.problem.mesh, self.block
+        n_local = B * mesh.n_local_nodes
+        mass = PETSc.Mat().createAIJ(((n_local, None), (n_local, None)),
+                                     nnz=(5 * B, 2 * B), comm=self.comm)
+        mass.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        for rows, blocks in self._translation_blocks():
+            rows = rows.astype(PETSc.IntType)
+            mass.setValuesRCV(rows, rows, blocks, addv=PETSc.InsertMode.ADD_VALUES)
+        rows = (self.first_row + B * np.arange(mesh.n_local_nodes)[:, None]
+                + np.arange(3)).astype(PETSc.IntType)
+        if rows.size:
+            mass.setValuesRCV(rows, rows, self.rotation, addv=PETSc.InsertMode.ADD_VALUES)
+        mass.assemble()
+        mass.zeroRowsColumns(self.held_rows, diag=0.0)
+        mass.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        return mass
+
+    def _translation_blocks(self):
+        """The translation masses T_n (n, 3, 3) as (rows, blocks): at a vertex on its
+        (u^x, u^y, u^z); at a midpoint, whose position component c is the row
+        R_c = (1, h_e HALF.s^c_e) on (u^c_e, the element's unknowns), sum_ab T_ab R_a R_b^T
+        on (u^x_e, u^y_e, u^z_e, the element's unknowns) in one block per element
+        (position_blocks' entries, added at once)."""
+        mesh, B = self.problem.mesh, self.block
+        T = self.translation
+        vertices = self.first_row + B * np.arange(0, T.shape[0], 2)
+        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
+        triples = [(vertices[:, None] + slots, T[0::2])]
+        ne = mesh.n_local_elements
+        if ne:
+            width = self._midpoint_rows[0].shape[1] - 1           # the element's unknowns
+            rows = np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
+                                  + [self._midpoint_index[0][:, 1:]], axis=1)
+            R = np.zeros((3, ne, 3 + width))
+            for c in (0, 1, 2):
+                R[c, :, c] = self._midpoint_rows[c][:, 0]
+                R[c, :, 3:] = self._midpoint_rows[c][:, 1:]
+            middle = T[1:2 * ne:2]                                   # (ne, 3, 3)
+            blocks = np.einsum("eab,aei,bej->eij", middle, R, R)
+            triples.append((rows, blocks))
+        return [t for t in triples if t[0].size]
+
+    def destroy(self):
+        self.mass_matrix.destroy()
+        super().destroy()
+
+
+class FactorPC:
+    """A python PC that solves with a factorisation of global_step/ksp.direct_factor
+    (MUMPS's LDL^T on one rank, the chain's substructuring on several): the spectral
+    transformation's solves with the factor whose inertia was counted."""
+
+    def __init__(self, factor):
+        self.factor = factor
+
+    def apply(self, pc, x, y):
+        y.getArray()[:] = self.factor.solve_columns([x.getArray(readonly=True)])[0]
+
+
+def factor_ksp(operator, factor):
+    """preonly + FactorPC(factor) for ``operator``, options under PREFIX + 'st_'."""
+    ksp = PETSc.KSP().create(comm=operator.getComm())
+    ksp.setOptionsPrefix(PREFIX + "st_")
+    ksp.setOperators(operator)
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(PETSc.PC.Type.PYTHON)
+    pc.setPythonContext(FactorPC(factor))
+    return ksp
+
+
+def solve_modes(problem, count, settings=MassSettings()):
+    """The ``count`` lowest modes (Modes) of the problem's converged state, or
+    ModesRefused where the state is unstable. Collective."""
+    from slepc4py import SLEPc
+    if count < 1:
+        raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
+    operators = ModalOperators(problem, settings)
+    K, M = operators.matrix, operators.mass_matrix
+    shifted = K.duplicate(copy=True)
+    shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
+    ksp = factor_ksp(shifted, factor)
+    eps = SLEPc.EPS().create(comm=operators.comm)
+    try:
+        factor.set_up(shifted)
+        negative = factor.negative_pivots() - operators.chain_constraints
+        if negative > 0:
+            raise ModesRefused(int(negative))
+        eps.setOperators(shifted, M)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(count, count + max(SUBSPACE, count // 2))
+        # the purification's solves (one per vector) change no shape: the massless
+        # unknowns' components it removes are not read (u and omega are)
+        eps.setPurify(False)
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+        eps.setTarget(0.0)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        st.setKSP(ksp)
+        eps.setOptionsPrefix(PREFIX)
+        eps.setFromOptions()
+        eps.solve()
+        return _modes(operators, eps, count)
+    finally:
+        eps.destroy()
+        ksp.destroy()
+        factor.destroy()
+        shifted.destroy()
+        operators.destroy()
+
+
+def _modes(operators, eps, count):
+    """The lowest ``count`` converged eigenpairs of ``eps`` as Modes. An eigenvalue below
+    the shift is one of the massless unknowns' infinite ones that the spectral
+    transformation returned with the wrong sign (the inertia proved there is none): left
+    out."""
+    converged = eps.getConverged()
+    values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + SHIFT
+    finite = np.flatnonzero(values >= SHIFT)
+    order = finite[np.argsort(values[finite])][:count]
+    vector = operators.mass_matrix.createVecRight()
+    product = vector.duplicate()
+    parts = []
+    for i in order:
+        eps.getEigenvector(int(i), vector)
+        parts.append(_shape(operators, vector, product))
+    vector.destroy()
+    product.destroy()
+    mesh = operators.problem.mesh
+    stack = [np.array([p[k] for p in parts]) if parts else np.zeros(0) for k in range(5)]
+    shares = stack[1].reshape(-1, len(CLASSES))
+    S_mid = mesh.element_S + mesh.element_h / 2
+    omega2 = values[order]
+    return Modes(omega2, stack[0], shares, mesh.vertex_S, stack[2], stack[3], S_mid,
+                 stack[4], converged,
+                 classify(shares, np.sqrt(np.maximum(omega2, 0.0)) / (2 * np.pi)))
+
+
+def _shape(operators, vector, product):
+    """(modal mass, shares (4,), offset (n_v, 3), rotation (n_v, 3), curvature (n_e, 3))
+    of one eigenvector, normalised to a largest offset of 1 (a torsional mode, at least
+    DOMINANT of its energy in the roll, to a largest rotation of 1 rad) with that
+    largest entry positive (the first along the line where several are)."""
+    problem, mesh = operators.problem, operators.problem.mesh
+    values = vector.getArray(readonly=True).reshape(-1, operators.block)
+    slots = [operators.position_slot[c] for c in (0, 1, 2)]
+    offset = values[0::2, slots]
+    omega = values[:, :3]
+    shares = _shares(operators, offset, omega)
+    signed = omega if shares[CLASSES.index("torsional")] >= DOMINANT else offset
+    size = np.abs(signed).max(axis=1) if signed is omega else np.linalg.norm(signed, axis=1)
+    largest = mesh.global_max(float(size.max(initial=0.0)))
+    local = int(np.argmax(size)) if size.size else -1
+    here = size.size and size[local] >= largest * (1 - 1e-12)
+    # rank order: 2 vertex_start + local increases along the line on either array
+    index = 2 * mesh.vertex_start + local if here else np.iinfo(np.int32).max
+    first = mesh.global_min(float(index))
+    entry = signed[local][np.argmax(np.abs(signed[local]))] if here and index == first else 0.0
+    sign = 1.0 if mesh.global_sum(float(entry)) >= 0 else -1.0
+    scale = sign / largest
+    operators.mass_matrix.mult(vector, product)
+    modal_mass = vector.dot(product) * scale**2
+    offset, omega = offset * scale, omega * scale
+    return modal_mass, shares, offset, omega[0::2], _curvature(problem, omega)
+
+
+def _plane_normal(problem):
+    """The unit normal of the vertical plane that holds the static line best (its
+    principal horizontal direction, e_x where it has none). Collective."""
+    mesh = problem.mesh
+    r = problem.state.node_positions()[0::2]
+    xy = r[:, :2]
+    sums = mesh.global_sum(np.concatenate([[len(xy)], xy.sum(axis=0),
+                                           np.einsum("ni,nj->ij", xy, xy).ravel()]))
+    mean = sums[1:3] / sums[0]
+    spread = sums[3:].reshape(2, 2) / sums[0] - np.outer(mean, mean)
+    values, vectors = np.linalg.eigh(spread)
+    along = vectors[:, 1] if values[1] > 1e-12 * problem.scene.length**2 else np.array([1.0, 0])
+    return np.array([-along[1], along[0], 0.0])
+
+
+def _shares(operators, offset, omega):
+    """The shares of the kinetic energy (in-plane, out-of-plane, axial, torsional) of a
+    shape: the displacements at the vertices with their trapezoid masses, the rotations
+    at the P2 nodes with their rotary inertia; a rotation about the plane's normal is
+    in-plane bending, about the in-plane normal out-of-plane bending. Collective."""
+    problem, mesh = operators.problem, operators.problem.mesh
+    normal = _plane_normal(problem)
+    t = unit(problem.state.tau[:, 2])
+    tv = t[0::2]
+    S = mesh.vertex_S
+    m, added, _ = line_inertia(problem.scene, S, operators.settings)
+    vertex_w = 3 * mesh.node_weights()[0::2]      # (h_left + h_right) / 2
+    axial = np.einsum("nc,nc->n", offset, tv)
+    out = offset @ normal
+    inplane = np.maximum(np.sum(offset**2, axis=1) - axial**2 - out**2, 0.0)
+    rotation = operators.rotation
+    torsion = np.einsum("nc,nc->n", omega, t)
+    about_normal = omega @ normal
+    polar = np.einsum("nc,nck,nk->n", t, rotation, t)       # w J
+    energies = np.array([
+        np.sum(vertex_w * (m + added) * inplane) + np.sum(polar / 2 * about_normal**2),
+        np.sum(vertex_w * (m + added) * out**2)
+        + np.sum(polar / 2 * np.maximum(np.sum(omega**2, axis=1) - torsion**2
+                                        - about_normal**2, 0.0)),
+        np.sum(vertex_w * m * axial**2),
+        np.sum(polar * torsion**2)])
+    energies = np.asarray(mesh.global_sum(energies))
+    return energies / max(energies.sum(), np.finfo(float).tiny)
+
+
+def _curvature(problem, omega):
+    """(d1, d2, d3) . omega' at the owned elements' midpoints, (n_e, 3), 1/m: omega' of
+    the P2 field there, (omega_right - omega_left) / h."""
+    mesh = problem.mesh
+    ne = mesh.n_local_elements
+    right = np.concatenate([omega[2::2], mesh.first_of_next_rank(omega)[None]])[:ne]
+    derivative = (right - omega[0:2 * ne:2]) / mesh.element_h[:, None]
+    d = problem.state.tau[1:2 * ne:2]                       # (n_e, 3 directors, 3)
+    return np.einsum("eic,ec->ei", d, derivative)

@@ -1,0 +1,125 @@
+"""-rod_modes: the natural modes about the converged state after the last step
+(analysis/modes.py, docs/modes.md): found before the result file is finished (its group
+``modes``), then said as the run's lines (a table of the modes) and written as the CSV
+files of -rod_modes_table: the modes' table and their shapes along the line."""
+
+import os
+import time
+
+import numpy as np
+
+from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
+from petsc_rod.analysis.modes import CLASSES, ModesRefused, solve_modes
+from petsc_rod.errors import RodInputError, RodIOError
+from petsc_rod.figures.modes import shapes_path
+from petsc_rod.io.results import check_output_path
+
+TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
+                 "class", *(f"share_{name.replace('-', '_')}" for name in CLASSES))
+SHAPE_COLUMNS = ("mode", "S_m", "offset_x_m", "offset_y_m", "offset_z_m", "rotation_x_rad",
+                 "rotation_y_rad", "rotation_z_rad")
+
+
+def mass_settings(values):
+    return MassSettings(added_mass=values["rod_modes_added_mass"],
+                        mass=values["rod_modes_mass"], inertia=values["rod_modes_inertia"])
+
+
+def check_modes_inputs(values, scene, comm):
+    """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
+    -rod_modes_mass, -rod_modes_table without -rod_modes, and a -rod_modes_table (or its
+    shapes' file) that could not be written or names another output. Collective."""
+    path = values["rod_modes_table"]
+    if path and not values["rod_modes"]:
+        raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes)")
+    if path:
+        others = [values["rod_output"], values["rod_table"]]
+        for name in (path, shapes_path(path)):
+            if any(other and os.path.abspath(other) == os.path.abspath(name)
+                   for other in others):
+                raise RodInputError(f"-rod_modes_table {path}: it (or its shapes' file "
+                                    f"{name}) is another output of the run; name another file")
+            check_output_path(name, comm, "-rod_modes_table")
+    if values["rod_modes"] and not mass_known(scene, mass_settings(values)):
+        raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
+
+
+def solve_for_run(problem, values, writer):
+    """(Modes or ModesRefused, seconds) of -rod_modes about the problem's converged state,
+    the modes written into the result file where there is one (``writer``). Collective."""
+    start = time.perf_counter()
+    try:
+        modes = solve_modes(problem, values["rod_modes"], mass_settings(values))
+    except ModesRefused as refused:
+        return refused, problem.mesh.global_max(time.perf_counter() - start)
+    seconds = problem.mesh.global_max(time.perf_counter() - start)
+    if writer is not None:
+        writer.write_modes(modes)
+    return modes, seconds
+
+
+def report_modes(problem, values, found, say):
+    """Say the modes of solve_for_run ``found`` as a table (or their refusal) and write
+    -rod_modes_table. Collective."""
+    modes, seconds = found
+    if isinstance(modes, ModesRefused):
+        say(f"modes: refused: {modes}")
+        return
+    for line in table_lines(modes, seconds):
+        say(line)
+    if values["rod_modes_table"]:
+        write_tables(problem.mesh.comm, modes, values["rod_modes_table"], say)
+
+
+def table_lines(modes, seconds):
+    """The run's lines of the modes: one per mode, lowest first; ``seconds`` the time
+    they took."""
+    lines = [f"modes: {len(modes.omega2)} lowest about the static state in {seconds:.3g} s "
+             "(undamped, no drag; shares of the kinetic energy in plane / out of plane / "
+             "axial / torsional)",
+             f"  {'mode':>4} {'f (Hz)':>12} {'T (s)':>12} {'modal mass (kg)':>16}  class"]
+    for k, (f, T, mass, label, shares) in enumerate(zip(
+            modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
+        fractions = " / ".join(f"{share:.2f}" for share in shares)
+        lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
+    return lines
+
+
+def write_tables(comm, modes, path, say):
+    """The modes' table to ``path`` and their shapes (gathered in rank order) to
+    shapes_path(path), by rank 0, each as a .partial file renamed when complete.
+    Collective."""
+    mpi = comm.tompi4py()
+    count = len(modes.omega2)
+    local = np.concatenate([
+        np.broadcast_to(np.arange(1, count + 1)[:, None, None], (count, len(modes.S), 1)),
+        np.broadcast_to(modes.S[None, :, None], (count, len(modes.S), 1)),
+        modes.offset.reshape(count, len(modes.S), 3),
+        modes.rotation.reshape(count, len(modes.S), 3)], axis=2)
+    pieces = mpi.gather(local, root=0)
+    error = None
+    if mpi.Get_rank() == 0:
+        rows = np.concatenate(pieces, axis=1).reshape(-1, len(SHAPE_COLUMNS))
+        partial = [f"{name}.{os.getpid()}.partial" for name in (path, shapes_path(path))]
+        try:
+            with open(partial[0], "w") as table:
+                table.write(",".join(TABLE_COLUMNS) + "\n")
+                for k in range(count):
+                    table.write(",".join(
+                        [str(k + 1)] + [f"{v:.10g}" for v in (
+                            modes.frequencies[k], modes.periods[k],
+                            np.sqrt(max(modes.omega2[k], 0.0)), modes.modal_mass[k])]
+                        + [modes.labels[k]] + [f"{v:.6f}" for v in modes.shares[k]]) + "\n")
+            np.savetxt(partial[1], rows, delimiter=",", fmt="%.10g",
+                       header=",".join(SHAPE_COLUMNS), comments="")
+            os.replace(partial[0], path)
+            os.replace(partial[1], shapes_path(path))
+        except OSError as failure:
+            for name in partial:
+                if os.path.exists(name):
+                    os.remove(name)
+            error = f"cannot write -rod_modes_table {path}: {failure.strerror}"
+    error = mpi.bcast(error, root=0)
+    if error:
+        raise RodIOError(error)
+    say(f"modes: table {path}, shapes {shapes_path(path)}")

@@ -1,0 +1,265 @@
+"""The natural modes about a static state (analysis/modes.py, docs/modes.md) against
+closed forms, each with its observed order of convergence in the elements: a taut
+string, a tensioned pinned beam, a cantilever's bending modes, a shaft's torsional
+modes, a heavy chain hanging from one end (the zeros of J0); the same modes on one rank
+and on all ranks; an unstable state's modes refused. Frequencies in Hz."""
+
+import os
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import continuation, destroy, fitted_order, make_solver, run_cli
+
+pytest.importorskip("slepc4py")
+
+L = 1.0
+G = 9.80665
+MESHES = (8, 16, 32)
+
+
+def modes_of(scene, n_elements, count, comm=PETSc.COMM_WORLD, stability=True, **mass):
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import solve_modes
+    mesh, solver = make_solver(comm, n_elements, scene, 1e2)
+    solver.settings.check_stability = stability
+    try:
+        continuation(solver)
+        return solve_modes(solver.problem, count, MassSettings(**mass))
+    finally:
+        destroy(mesh, solver)
+
+
+def errors_and_order(scene, count, exact, **mass):
+    errors = np.array([np.abs(modes_of(scene, n, count, **mass).frequencies - exact).max()
+                       / exact.max() for n in MESHES])
+    return errors, fitted_order(np.array(MESHES), errors)
+
+
+def pinned(T, EA, EI):
+    """A line pinned at both ends, stretched by T (N) at EA; its stretched length and
+    mass per stretched length (m of 1 kg per metre unstretched)."""
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, EI), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], axial_stiffness=EA)
+    return scene, L * (1 + e), 1.0 / (1 + e)
+
+
+def test_taut_string():
+    T = 100.0
+    scene, length, m = pinned(T, 1e6, 1e-6)
+    n = np.repeat(np.arange(1, 4), 2)                # in and out of the plane
+    exact = n / (2 * length) * np.sqrt(T / m)
+    errors, order = errors_and_order(scene, 6, exact, mass=1.0)
+    assert errors[-1] < 5e-6 and order > 3.5
+
+
+def test_tensioned_pinned_beam():
+    T, EI = 100.0, 1.0
+    scene, length, m = pinned(T, 1e8, EI)
+    n = np.repeat(np.arange(1, 4), 2)
+    exact = (n / (2 * length) * np.sqrt(T / m)
+             * np.sqrt(1 + n**2 * np.pi**2 * EI / (T * length**2)))
+    errors, order = errors_and_order(scene, 6, exact, mass=1.0)
+    assert errors[-1] < 2e-5 and order > 3.5
+
+
+def test_cantilever_bending_modes():
+    EI, m = 2.0, 3.0
+    beta = np.array([1.8751040687, 4.6940911330, 7.8547574382])
+    exact = np.repeat(beta**2 / (2 * np.pi * L**2) * np.sqrt(EI / m), 2)
+    scene = dict(length=L, stiffness=(EI, EI, EI), start="clamp", end="free")
+    errors, order = errors_and_order(scene, 6, exact, mass=m)
+    assert errors[-1] < 1e-5 and order > 3.5
+
+
+def test_torsional_modes_of_a_shaft():
+    GJ, J = 1.0, 1.0
+    exact = (2 * np.arange(1, 4) - 1) * np.pi / (2 * L) * np.sqrt(GJ / J) / (2 * np.pi)
+    scene = dict(length=L, stiffness=(1e4, 1e4, GJ), start="clamp", end="free")
+    errors, order = errors_and_order(scene, 3, exact, mass=1.0, inertia=J)
+    assert errors[-1] < 5e-6 and order > 3.5
+    modes = modes_of(scene, 8, 3, mass=1.0, inertia=J)
+    assert modes.labels == ["torsional"] * 3
+    assert np.all(modes.shares[:, 3] > 0.999)
+
+
+def test_heavy_chain_hanging_from_one_end():
+    """Gravity along +x (the straight state is the hanging one); EI small: the zeros of
+    J0, omega_n = (j_0n / 2) sqrt(g / L), to within the bending stiffness's effect."""
+    from scipy.special import jn_zeros
+    scene = dict(length=L, stiffness=(1e-4,) * 3, start="pin", end="free",
+                 load_values=[[G, 0.0, 0.0]])          # 1 kg/m
+    exact = np.repeat(jn_zeros(0, 2) / 2 * np.sqrt(G / L) / (2 * np.pi), 2)
+    first = [modes_of(scene, n, 4).frequencies for n in MESHES]
+    errors = np.array([np.abs(f - exact).max() / exact.max() for f in first])
+    assert errors[-1] < 2e-3
+    assert abs(first[-1][0] - exact[0]) < 1e-4 * exact[0]
+
+
+def test_same_modes_on_one_rank_and_all_ranks():
+    scene = pinned(100.0, 1e8, 1.0)[0]
+    one = modes_of(scene, 16, 6, comm=PETSc.COMM_SELF, mass=1.0)
+    every = modes_of(scene, 16, 6, comm=PETSc.COMM_WORLD, mass=1.0)
+    assert np.allclose(one.frequencies, every.frequencies, rtol=1e-9)
+    assert np.allclose(one.modal_mass, every.modal_mass, rtol=1e-6)
+
+
+def test_unstable_state_refused():
+    """A column standing on a pin under its weight (gravity along -x, the straight state
+    an equilibrium with the stability test off): its modes are refused."""
+    from petsc_rod.analysis.modes import ModesRefused
+    scene = dict(length=L, stiffness=(1e-2,) * 3, start="pin", end="free",
+                 load_values=[[-G, 0.0, 0.0]])
+    with pytest.raises(ModesRefused) as refused:
+        modes_of(scene, 8, 3, stability=False)
+    assert refused.value.negative > 0
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"rod_modes": "3"}, "need its mass per length: give -rod_modes_mass"),
+    ({"rod_modes_table": "modes.csv"}, "-rod_modes_table needs -rod_modes N"),
+    ({"rod_modes": "3", "rod_modes_mass": "1", "rod_modes_table": "missing/modes.csv"},
+     "does not exist")])
+def test_modes_inputs_refused_before_the_run(options, message, capsys):
+    """An unloaded uniform line without -rod_modes_mass, a table without -rod_modes and
+    a table that cannot be written: exit 2 with one line, before any step."""
+    assert run_cli({"rod_length": "1", **options}) == 2
+    out = capsys.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        assert message in out and "step 1" not in out
+
+
+def test_cli_modes_table(shared_tmp, capsys):
+    """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
+    closed form's (16 elements), its classes in plane and out of plane, the shapes'
+    file has one row per vertex and mode with a largest offset of 1, the result file
+    has them in its group ``modes``, and the picture (figures/modes.py) a panel per
+    mode."""
+    from petsc_rod.cli import main
+    path = os.path.join(shared_tmp, "modes.csv")
+    EI, m = 2.0, 3.0
+    options = {"rod_length": "1", "rod_stiffness": f"{EI},{EI},{EI}", "rod_start": "clamp",
+               "rod_end": "free", "rod_elements": "16", "rod_modes": "4",
+               "rod_modes_mass": str(m), "rod_modes_table": path,
+               "rod_output": os.path.join(shared_tmp, "modes.h5")}
+    assert run_cli(options) == 0
+    assert "modes: 4 lowest about the static state" in capsys.readouterr().out \
+        or PETSc.COMM_WORLD.getRank() != 0
+    table = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding=None)
+    beta = np.array([1.8751040687, 4.6940911330])
+    exact = np.repeat(beta**2 / (2 * np.pi) * np.sqrt(EI / m), 2)
+    assert np.allclose(table["frequency_Hz"], exact, rtol=1e-4)
+    assert np.allclose(table["period_s"], 1 / exact, rtol=1e-4)
+    assert sorted(table["class"][:2]) == ["in-plane", "out-of-plane"]
+    shapes = np.loadtxt(path.replace(".csv", "_shapes.csv"), delimiter=",", skiprows=1)
+    assert shapes.shape == (4 * 17, 8)
+    for k in range(1, 5):
+        offsets = shapes[shapes[:, 0] == k][:, 2:5]
+        assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
+    import h5py
+    with h5py.File(options["rod_output"], "r") as f:       # the result file's group
+        group = f["modes"]
+        assert np.allclose(group["frequency"][:], table["frequency_Hz"], rtol=1e-9)
+        assert group["offset"].shape == (17, 4, 3)
+        assert np.allclose(np.moveaxis(group["offset"][:], 0, 1).reshape(-1, 3),
+                           shapes[:, 2:5], atol=1e-9)
+        assert group.attrs["classes"].split(",") == list(table["class"])
+    from petsc_rod.figures.modes import modes_figure
+    figure = modes_figure(path)                      # the picture: a panel a mode
+    panels = [axes for axes in figure.axes if axes.get_visible()]
+    assert len(panels) == 4 and panels[2].get_title().startswith("mode 3: 2.86")
+
+
+def neutral_line(surface=None):
+    """(scene, m, e, od, EI) of a neutrally buoyant line type pinned taut (T = 100 N)."""
+    from petsc_rod.model.line_type import LineType
+    rho, od, T, EA, EI, GJ = 1025.0, 0.2, 100.0, 1e6, 1e-2, 10.0
+    m = rho * np.pi * od**2 / 4
+    section = LineType("neutral", od, m, EI, GJ, ea=EA).section(0.0, L, rho, G)
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, GJ), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], sections=(section,),
+                 axial_stiffness=EA, water_density=rho, load_values=[[0.0, 0.0, 0.0]],
+                 sea_surface=surface)
+    return scene, m, e, od, EI
+
+
+@pytest.mark.parametrize("added_mass", [1.0, 0.0])
+def test_added_mass_of_a_line_type(added_mass):
+    """A neutrally buoyant line type (mass = rho_w pi od^2 / 4: no weight) pinned taut:
+    its transverse modes carry the added mass C_a rho_w pi od^2 / 4 as well,
+    f_n = n/(2L') sqrt(T / (m' (1 + C_a))) sqrt(1 + n^2 pi^2 EI / (T L'^2)), the
+    stretched line's L' and m', lowered by the sections' rotary inertia I_b = m od^2 / 16
+    (Rayleigh's: omega^2 (m (1 + C_a) + I_b k^2) = T k^2 + EI k^4, k = n pi / L); their
+    polar inertia 2 I_b makes the free roll between the pins a rigid mode (the twist's
+    modes above 3.9 Hz)."""
+    scene, m, e, od, EI = neutral_line()
+    T = 100.0
+    modes = modes_of(scene, 16, 5, added_mass=added_mass)
+    n = np.repeat([1, 2], 2)
+    exact = (n / (2 * L * (1 + e)) * np.sqrt(T * (1 + e) / (m * (1 + added_mass)))
+             * np.sqrt(1 + n**2 * np.pi**2 * EI / (T * (L * (1 + e))**2))
+             / np.sqrt(1 + (n * np.pi / L)**2 * (od**2 / 16) / (1 + added_mass)))
+    assert modes.labels[0] == "rigid" and modes.shares[0, 3] > 0.999
+    assert np.allclose(modes.frequencies[1:], exact, rtol=2e-4)
+
+
+def test_no_added_mass_above_the_sea():
+    """The same line with the sea surface below it (in air: it sags under its weight):
+    the nodes' translation mass is w_n m I, no added mass."""
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import ModalOperators
+    scene, m, *_ = neutral_line(surface=-1.0)
+    mesh, solver = make_solver(PETSc.COMM_WORLD, 8, scene, 1e2)
+    try:
+        continuation(solver)
+        operators = ModalOperators(solver.problem, MassSettings())
+        expected = mesh.node_weights()[:, None, None] * m * np.eye(3)
+        assert np.allclose(operators.translation, expected, rtol=1e-12, atol=0)
+        assert solver.problem.state.node_positions()[:, 2].min() > -1.0
+        operators.destroy()
+    finally:
+        destroy(mesh, solver)
+
+
+@pytest.mark.parametrize("lambda2", [10.0, 60.0])
+def test_suspended_cable_against_irvine(lambda2):
+    """A shallow elastic cable between pins at one height (span 100 m, sag 2 m, 10 N/m),
+    EA chosen for Irvine's parameter lambda^2 = (w l / H)^2 l / (H L_e / EA) below and
+    above the crossover 4 pi^2: in omega_bar = omega l / sqrt(H / m), the first
+    out-of-plane mode is pi, the first antisymmetric in-plane 2 pi, and the first
+    symmetric in-plane the root of tan(x) = x - 4 x^3 / lambda^2, omega_bar = 2 x (Irvine,
+    Cable Structures, 1981, §4.2), below 2 pi under the crossover and above it over."""
+    from scipy.optimize import brentq
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import solve_modes
+    w, span = 10.0, 100.0
+    H0 = w * span**2 / 16                              # sag span / 50
+    EA = lambda2 * H0 * 1.001 / (w * span / H0)**2
+    length = span * (1 + 8 / 3 / 50**2) - H0 / EA * span
+    scene = dict(length=length, stiffness=(1e-2,) * 3, start="pin", end="pin",
+                 end_position=[span, 0.0, 0.0], axial_stiffness=EA,
+                 load_values=[[0.0, 0.0, -w]])
+    mesh, solver = make_solver(PETSc.COMM_WORLD, 64, scene, 1e3)
+    try:
+        continuation(solver, steps=2)
+        problem = solver.problem
+        H = abs(problem.end_reaction()[0])
+        sag = -problem.mesh.global_min(float(problem.state.node_positions()[:, 2].min()))
+        modes = solve_modes(problem, 6, MassSettings())
+    finally:
+        destroy(mesh, solver)
+    actual = (w * span / H)**2 * span / (H * span * (1 + 8 * (sag / span)**2) / EA)
+    bar = 2 * np.pi * modes.frequencies * span / np.sqrt(H * G / w)
+    x = brentq(lambda x: np.tan(x) - x + 4 * x**3 / actual,
+               np.pi / 2 + 1e-9, 3 * np.pi / 2 - 1e-9)
+    labels = np.array(modes.labels)
+    plane, out = bar[labels == "in-plane"], bar[labels == "out-of-plane"]
+    assert abs(out[0] - np.pi) < 2e-3 * np.pi
+    symmetric = plane[np.argmin(np.abs(plane - 2 * x))]
+    antisymmetric = plane[np.argmin(np.abs(plane - 2 * np.pi))]
+    assert abs(symmetric - 2 * x) < 1e-3 * 2 * x
+    assert abs(antisymmetric - 2 * np.pi) < 2e-3 * 2 * np.pi
+    assert (symmetric < antisymmetric) == (actual < 4 * np.pi**2)
