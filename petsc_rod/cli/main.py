@@ -59,6 +59,7 @@ def run(comm=None, texts=None):
                     values, given = read_options()
                 else:                       # the same on every rank: the sweep's
                     values, given = values_of(texts)
+                check_system_options(given)
                 check_anderson_depth()      # before any PETSc object is made
                 check_snes_type()
                 check_substructuring_switches()
@@ -89,6 +90,16 @@ def run(comm=None, texts=None):
             say(f"petsc_rod: error: {petsc_failure(error)}")
             database.setValue("options_left", "0")
             return RodDivergedError.exit_code
+
+
+def check_system_options(given):
+    """Refuse a system's option given without -rod_system (a single line's run, where
+    it would be silently unused)."""
+    orphans = [name for name in ("rod_system_element_length", "rod_system_body_load",
+                                 "rod_system_steps") if name in given]
+    if orphans:
+        raise RodInputError(f"-{orphans[0]}: an option of a system, which needs "
+                            "-rod_system FILE; drop it for a single line")
 
 
 def check_inputs_kept(values, comm):

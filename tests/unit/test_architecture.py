@@ -24,7 +24,7 @@ APPLICATION = ("environment", "quantities", "physics.nodal_load", "physics.seabe
 # The front ends, which drive the solver and which nothing below them imports; system/
 # (a system of lines solved together) drives lines as api/ does, at api/'s level.
 FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__", "system",
-              "system_cli")
+              "cli_system")
 BELOW_FRONT_ENDS = CORE + ("physics", "environment", "quantities", "problem", "scenes", "io",
                            "frames.py", "errors.py", "tables.py", "resources.py", "model",
                            "compile.py")
@@ -221,7 +221,7 @@ def test_a_scene_is_made_whole_by_its_constructor():
 # ends' helpers: it drives its lines as the Python API does, on the one run path of a
 # line, so of the front ends it imports cli/line_run.py alone (plan_line, BuiltLine,
 # values_of), never the options, the scene options or the session behind it.
-SYSTEM_NOT = ("api", "sweep", "report", "plots", "figures", "__main__", "system_cli")
+SYSTEM_NOT = ("api", "sweep", "report", "plots", "figures", "__main__", "cli_system")
 
 
 def test_the_system_layer_imports_only_the_run_path():

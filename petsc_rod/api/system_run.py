@@ -1,0 +1,371 @@
+"""solve_system(system): a System (model/system.py, api/system.py) in its coupled static
+equilibrium (system/equilibrium.SystemSolver) with every line a HeldLine
+(system/held_line.py) on its group of ranks, each body's 6 x 6 mooring stiffness, every
+line's results as a single line has them, the result file and the CSV tables: the one
+path of a system's run, the Python API's and the command line's (cli_system.py).
+What it returns holds numpy arrays only (SystemResults); the lines' PETSc objects are
+made and destroyed here."""
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from petsc_rod.api.results import Results
+from petsc_rod.cli.line_run import values_of
+from petsc_rod.cli.options import BY_NAME
+from petsc_rod.errors import RodDivergedError, RodInputError, on_every_rank
+from petsc_rod.io import line_table, outputs
+from petsc_rod.io import results as io
+from petsc_rod.io.system_results import SystemWriter
+from petsc_rod.system.bodies import rotation
+from petsc_rod.system.equilibrium import Settings, SystemSolver
+from petsc_rod.system.held_line import HeldLine
+
+# The options of the system itself (not of its lines): the load continuation's first
+# step is 1 / system_steps of the bodies' loads (Settings.load_steps).
+SYSTEM_OPTIONS = ("system_steps",)
+# The options of a line that a system's lines take (every line the same): the
+# iteration's tolerances and switches (-rod_al_*), the halvings of a line's walk.
+LINE_OPTIONS = tuple(name.removeprefix("rod_") for name in BY_NAME
+                     if name.startswith("rod_al_")) + ("max_halvings",)
+
+
+@dataclass
+class BodyResult:
+    """A body at the equilibrium: ``position`` (6,) x, y, z (m), roll, pitch, yaw (rad);
+    ``rotation`` (3, 3), body axes to global; its mooring ``stiffness`` (6, 6) about
+    ``reference`` (3,), m (its reference point at the equilibrium), N/m, N, N m/rad, not
+    symmetrised, with ``asymmetry`` |K - K^T|_F / |K|_F and the lines' ``moment`` (3,),
+    N m, about the reference point, which is the rotational block's antisymmetric part
+    (docs/systems.md)."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+    stiffness: np.ndarray
+    reference: np.ndarray
+    moment: np.ndarray
+    asymmetry: float
+
+
+@dataclass
+class SystemResults:
+    """A system's equilibrium (solve_system), numpy only, the same on every rank:
+    ``points`` {name: (3,) m}; ``bodies`` {name: BodyResult}; ``end_forces`` {line:
+    (2, 3) N}, the force each line exerts ON its start's and its end's point or body;
+    ``end_tensions`` {line: (2,) N}, the end elements' tension along the line, n.t at
+    S = 0 and S = L; ``lines_converged`` {line: bool}; ``lines`` {line: api.Results}
+    (its arrays along S on this rank, none on a rank outside its group: along_line()
+    gathers them, collectively on the system's communicator); ``converged``,
+    ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
+    (the scaled norm), ``load_factor``."""
+
+    points: dict
+    bodies: dict
+    end_forces: dict
+    end_tensions: dict
+    lines_converged: dict
+    lines: dict
+    converged: bool
+    iterations: int
+    halvings: int
+    residual: float
+    load_factor: float
+
+
+def split_options(options):
+    """(system Settings, the lines' options) of ``options`` {name without ``rod_``:
+    value}; RodInputError naming one that neither takes."""
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(SYSTEM_OPTIONS) - set(LINE_OPTIONS))
+    if unknown:
+        raise RodInputError(f"system option {unknown[0]!r}: not an option of a system; "
+                            f"its options: {', '.join(SYSTEM_OPTIONS + LINE_OPTIONS)}")
+    steps = int(options.pop("system_steps", 1))
+    if steps < 1:
+        raise RodInputError(f"system_steps {steps}: at least 1 (the load continuation's "
+                            "first step is 1 / system_steps of the loads)")
+    line_options = {name: value for name, value in options.items()}
+    values_of(line_options)                 # a malformed value refused before any work
+    return Settings(load_steps=steps), line_options
+
+
+def start_ends(system):
+    """{line name: (start (3,), end (3,))}, m: where the system's points and bodies put
+    each line's ends at the start (a body's local point through its start pose)."""
+    at = {p.name: np.asarray(p.position, dtype=float) for p in system.points}
+    poses = {b.name: np.asarray(b.position, dtype=float) for b in system.bodies}
+
+    def place(connection):
+        if connection.to in at:
+            return at[connection.to]
+        pose = poses[connection.to]
+        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
+
+    return {line.name: (place(line.start), place(line.end)) for line in system.lines}
+
+
+def line_maker(system, options):
+    """make_line(system_line, comm) of SystemSolver: the HeldLine of the line on its
+    group's communicator, every line with the same ``options``."""
+    ends = start_ends(system)
+
+    def make_line(line, comm):
+        return HeldLine.of_system_line(line, *ends[line.name], comm, system.environment,
+                                       options)
+    return make_line
+
+
+def _end_values(mesh, values):
+    """(values at vertex 0, values at the last vertex) of the owned ``values``, on every
+    rank of the mesh. Collective on the mesh's communicator."""
+    first = values[0] if mesh.on_lower_boundary else np.zeros(np.shape(values)[1:])
+    last = values[-1] if mesh.on_upper_boundary else np.zeros(np.shape(values)[1:])
+    return mesh.global_sum(np.asarray(first, float)), mesh.global_sum(np.asarray(last, float))
+
+
+def line_record(line):
+    """(vertex datasets, restart state, attributes, units, end tensions (2,), elements) of a
+    converged HeldLine: what a single line's result file holds for its last step
+    (line_table.final_record: the terms' and reports' outputs, r absolute, the effective
+    tension), with its converged, iterations, stable, load factor and ranks. Collective
+    on the line's communicator."""
+    problem = line.problem
+    vertex, attributes = line_table.final_record(problem)
+    stable = line.stable()
+    attributes.update(converged=1, stop_reason="converged", iterations=line.iterations,
+                      stable=-1 if stable is None else int(stable), load_factor=1.0,
+                      energy=problem.energy(), ranks=line.comm.getSize())
+    tensions = np.array(_end_values(problem.mesh, vertex["effective_tension"]))
+    return (vertex, outputs.restart_state(problem), attributes, problem.units(), tensions,
+            problem.mesh.n_elements)
+
+
+def _shapes(arrays):
+    return {name: (np.shape(value)[1:], np.asarray(value).dtype.str)
+            for name, value in arrays.items()}
+
+
+def _empty(shapes):
+    return {name: np.zeros((0,) + tuple(shape), dtype=dtype)
+            for name, (shape, dtype) in shapes.items()}
+
+
+def gathered_lines(solver):
+    """{line index: (vertex, state, attributes, units, tensions, elements)} on every rank: this
+    rank's own rows of its group's lines, zero rows of the others' (their names and
+    shapes, attributes and units shared from the groups' roots). Collective."""
+    placement = solver.placement
+    mine = {k: line_record(line) for k, line in solver.lines.items()}
+    shared = placement.share({k: (_shapes(v[0]), _shapes(v[1])) + v[2:]
+                              for k, v in mine.items()})
+    return {k: ((mine[k][:2] if k in mine else (_empty(v[0]), _empty(v[1]))) + v[2:])
+            for k, v in shared.items()}
+
+
+def check_finite(results):
+    """RodDivergedError unless every number of the equilibrium is finite: no NaN is
+    ever written or returned as a result."""
+    numbers = ([b.position for b in results.bodies.values()]
+               + [b.stiffness for b in results.bodies.values()]
+               + list(results.points.values()) + list(results.end_forces.values())
+               + list(results.end_tensions.values()))
+    if not all(np.all(np.isfinite(value)) for value in numbers):
+        raise RodDivergedError("system: the equilibrium holds non-finite numbers (NaN or "
+                               "inf); nothing is written")
+
+
+def table_paths(table, system):
+    """{line name or 'system': CSV path} of ``table`` (FILE.csv -> FILE_<line>.csv and
+    FILE_system.csv)."""
+    stem, extension = os.path.splitext(table)
+    names = [line.name for line in system.lines] + ["system"]
+    return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
+
+
+def check_outputs(comm, system, output, table):
+    """Refuse, before any work, a result file or a table that could not be written
+    (io/results.check_output_path, line_table.check_table_path). Collective."""
+    if output:
+        io.check_output_path(output, comm)
+    if table:
+        for path in table_paths(table, system).values():
+            line_table.check_table_path(path, output, comm)
+
+
+def system_datasets(system, results):
+    """({name: array}, {name: unit}) of the result file's ``system`` group."""
+    bodies = list(results.bodies.values())
+    lines = [line.name for line in system.lines]
+    data = {
+        "point_positions": np.array(list(results.points.values())).reshape(-1, 3),
+        "body_positions": np.array([b.position for b in bodies]).reshape(-1, 6),
+        "body_rotations": np.array([b.rotation for b in bodies]).reshape(-1, 3, 3),
+        "body_stiffness": np.array([b.stiffness for b in bodies]).reshape(-1, 6, 6),
+        "body_stiffness_reference": np.array([b.reference for b in bodies]).reshape(-1, 3),
+        "body_stiffness_moment": np.array([b.moment for b in bodies]).reshape(-1, 3),
+        "body_stiffness_asymmetry": np.array([b.asymmetry for b in bodies]),
+        "end_forces": np.array([results.end_forces[n] for n in lines]).reshape(-1, 2, 3),
+        "end_tensions": np.array([results.end_tensions[n] for n in lines]).reshape(-1, 2),
+        "line_converged": np.array([results.lines_converged[n] for n in lines], dtype=float),
+    }
+    units = {"point_positions": "m", "body_positions": "m, m, m, rad, rad, rad",
+             "body_rotations": "1", "body_stiffness": "N/m, N, N m/rad (rows F, M; "
+             "columns dX, dtheta)", "body_stiffness_reference": "m",
+             "body_stiffness_moment": "N m", "body_stiffness_asymmetry": "1",
+             "end_forces": "N", "end_tensions": "N", "line_converged": "1"}
+    return data, units
+
+
+def write_file(comm, output, system, results, records, text, notes):
+    """The system's result file (io/system_results.py): a group per line, the group
+    ``system``, the input file's text and the reader's notes. Collective."""
+    writer = SystemWriter(output, comm)
+    try:
+        for k, line in enumerate(system.lines):
+            vertex, state, attributes, units = records[k][:4]
+            writer.write_line(line.name, vertex, state, attributes, units)
+        data, units = system_datasets(system, results)
+        attributes = {"converged": int(results.converged), "iterations": results.iterations,
+                      "halvings": results.halvings, "residual": results.residual,
+                      "load_factor": results.load_factor, "ranks": comm.getSize(),
+                      "point_names": ",".join(results.points),
+                      "body_names": ",".join(results.bodies),
+                      "line_names": ",".join(line.name for line in system.lines),
+                      "input_text": text or "", "notes": "\n".join(notes)}
+        units.update({"converged": "1", "iterations": "1", "halvings": "1",
+                      "residual": "1", "load_factor": "1", "ranks": "1",
+                      "point_names": "text", "body_names": "text", "line_names": "text",
+                      "input_text": "text", "notes": "text", "written": "text"})
+        writer.finish_system(data, attributes, units)
+        writer = None
+    finally:
+        if writer is not None:
+            writer.abort()
+
+
+def ends_rows(system, results):
+    """The text of FILE_system.csv: a row per line end."""
+    rows = ["line,end,to,force_x (N),force_y (N),force_z (N),tension (N)"]
+    for line in system.lines:
+        forces, tensions = results.end_forces[line.name], results.end_tensions[line.name]
+        for j, (which, connection) in enumerate((("start", line.start), ("end", line.end))):
+            rows.append(",".join([line.name, which, connection.to]
+                                 + [f"{v:.12g}" for v in forces[j]]
+                                 + [f"{tensions[j]:.12g}"]))
+    return "\n".join(rows) + "\n"
+
+
+def write_tables(comm, solver, table, system, results, records):
+    """FILE_<line>.csv (a single line's table, written by the line's group) for every
+    line and FILE_system.csv (rank 0). Collective on ``comm``."""
+    paths = table_paths(table, system)
+
+    def write_all():
+        for k, line in solver.lines.items():
+            name = system.lines[k].name
+            vertex, _, attributes, units = records[k][:4]
+            line_table.write_tables(paths[name], line.comm, vertex, attributes, units)
+        if comm.getRank() == 0:
+            partial = paths["system"] + ".partial"
+            line_table._write(paths["system"], partial, ends_rows(system, results))
+    on_every_rank(comm, write_all)
+
+
+def report_lines(system, results, ranks):
+    """The run's lines: the equilibrium's iterations and residual, a table of the
+    bodies' poses, the lines' end tensions, each body's stiffness diagonal."""
+    lines = [f"petsc_rod: system of {len(system.lines)} line(s), {len(system.points)} "
+             f"point(s), {len(system.bodies)} body(ies) on {ranks} rank(s): equilibrium in "
+             f"{results.iterations} Newton iteration(s) ({results.halvings} halving(s) of "
+             f"the load step), scaled residual {results.residual:.3g}"]
+    if results.bodies:
+        lines.append(f"  {'body':<12} {'x (m)':>12} {'y (m)':>12} {'z (m)':>12} "
+                     f"{'roll (deg)':>11} {'pitch (deg)':>11} {'yaw (deg)':>11}")
+        for name, body in results.bodies.items():
+            x = body.position
+            angles = np.degrees(x[3:])
+            lines.append(f"  {name:<12} {x[0]:12.4f} {x[1]:12.4f} {x[2]:12.4f} "
+                         f"{angles[0]:11.5f} {angles[1]:11.5f} {angles[2]:11.5f}")
+    free = [p.name for p in system.points if p.kind == "free"]
+    for name in free:
+        x = results.points[name]
+        lines.append(f"  point {name}: ({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m")
+    lines.append(f"  {'line':<12} {'start':>10} {'T start (kN)':>13} {'end':>10} "
+                 f"{'T end (kN)':>13} {'|F| end (kN)':>13}")
+    for line in system.lines:
+        tension = results.end_tensions[line.name] / 1e3
+        force = np.linalg.norm(results.end_forces[line.name][1]) / 1e3
+        lines.append(f"  {line.name:<12} {line.start.to:>10} {tension[0]:13.3f} "
+                     f"{line.end.to:>10} {tension[1]:13.3f} {force:13.3f}")
+    for name, body in results.bodies.items():
+        diagonal = ", ".join(f"{v:.6g}" for v in np.diag(body.stiffness))
+        lines.append(f"  body {name}: stiffness diagonal (N/m x3, N m/rad x3) {diagonal}; "
+                     f"asymmetry {body.asymmetry:.2g}")
+    return lines
+
+
+def run_system(comm, system, settings, line_options, say, output=None, table=None,
+               text=None, notes=()):
+    """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
+    equilibrium (SystemSolver.solve), each body's stiffness, each line's record, the
+    result file and the tables when asked; the lines destroyed. Returns the
+    SystemResults. RodInputError for a system the checks refuse (exit 2),
+    RodDivergedError when no equilibrium was found (exit 4); nothing is written then.
+    Collective."""
+    on_every_rank(comm, system.check)
+    check_outputs(comm, system, output, table)
+    solver = SystemSolver(system, line_maker(system, line_options), comm,
+                          settings=settings)
+    try:
+        found = solver.solve()
+        stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+        records = gathered_lines(solver)
+        mpi = comm.tompi4py()
+        lines = {line.name: Results(records[k][0], records[k][2], True, mpi,
+                                    records[k][5], records[k][3])
+                 for k, line in enumerate(system.lines)}
+        bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
+                                     np.asarray(found.rotations[b.name]),
+                                     stiffness[b.name].matrix, stiffness[b.name].reference,
+                                     stiffness[b.name].moment, stiffness[b.name].asymmetry)
+                  for b in system.bodies}
+        names = [line.name for line in system.lines]
+        results = SystemResults(
+            dict(found.points), bodies,
+            {n: found.end_forces[k] for k, n in enumerate(names)},
+            {n: records[k][4] for k, n in enumerate(names)},
+            {n: bool(records[k][2]["converged"]) for k, n in enumerate(names)},
+            lines, found.load_factor == 1.0, found.iterations, found.halvings,
+            found.residual, found.load_factor)
+        check_finite(results)
+        for line in report_lines(system, results, comm.getSize()):
+            say(line)
+        if output:
+            write_file(comm, output, system, results, records, text, notes)
+        if table:
+            write_tables(comm, solver, table, system, results, records)
+        return results
+    finally:
+        solver.destroy()
+
+
+def solve_system(system, comm=None, output=None, say=None, options=None, table=None,
+                 notes=()):
+    """Solve ``system`` (api.System) on the ranks of ``comm`` (a PETSc communicator;
+    default PETSc.COMM_WORLD), each line on its group of ranks; collective.
+    ``output``: the system's result file (HDF5, docs/output.md) as -rod_output;
+    ``table``: FILE.csv, the tables FILE_<line>.csv and FILE_system.csv as -rod_table;
+    ``say(line)`` gets the command line's lines (None: silent), ``notes`` (the
+    reader's, read_moordyn's second value) said first; ``options`` {name without
+    ``rod_``: value}: 'system_steps' and every line's solver options (LINE_OPTIONS:
+    {'al_rtol': 1e-10}). Returns a SystemResults."""
+    from petsc4py import PETSc
+
+    comm = comm or PETSc.COMM_WORLD
+    say = say or (lambda line: None)
+    settings, line_options = on_every_rank(comm, split_options, options)
+    for note in notes:
+        say(f"petsc_rod: note: {note}")
+    return run_system(comm, system, settings, line_options, say, output, table,
+                      notes=notes)
