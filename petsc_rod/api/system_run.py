@@ -305,6 +305,18 @@ def report_lines(system, results, ranks):
     return lines
 
 
+def discard_tables(comm, table, system, say):
+    """After a system that found no equilibrium: no table is written, and the tables an
+    earlier run left at ``table``'s paths are removed (line_table.discard), said in one
+    line. Collective."""
+    paths = table_paths(table, system).values()
+    found = [path for path in paths if os.path.exists(path)]
+    for path in paths:
+        line_table.discard(path, comm, lambda line: None)
+    say(f"petsc_rod: no tables written (-rod_table {table}): no equilibrium"
+        + (f"; removed {len(found)} table(s) of an earlier run" if found else ""))
+
+
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
                text=None, notes=()):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
@@ -318,7 +330,12 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     solver = SystemSolver(system, line_maker(system, line_options), comm,
                           settings=settings)
     try:
-        found = solver.solve()
+        try:
+            found = solver.solve()
+        except RodDivergedError:
+            if table:
+                discard_tables(comm, table, system, say)
+            raise
         stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
         records = gathered_lines(solver)
         mpi = comm.tompi4py()

@@ -1,5 +1,5 @@
-"""A system on the command line (petsc_rod/cli_system.py, docs/systems.md "The command
-line"): ``python -m petsc_rod -rod_system FILE`` on a small MoorDyn deck (a free buoyant
+"""A system on the command line (petsc_rod/cli_system.py, docs/systems.md "Running a
+system"): ``python -m petsc_rod -rod_system FILE`` on a small MoorDyn deck (a free buoyant
 body on three 70 m chains in 30 m of water, tests/data/moordyn/small_free_body.dat),
 under a body load from the command line, on 1 and 2 ranks with the same numbers; its
 result file's groups and tables; the Python API's solve_system on the same file gives
@@ -162,3 +162,19 @@ def test_help_lists_the_system_options():
     for name in ("-rod_system ", "-rod_system_element_length ", "-rod_system_body_load ",
                  "-rod_system_steps ", "-rod_al_rtol "):
         assert name in process.stdout, name
+
+
+def test_no_equilibrium_writes_nothing_and_removes_old_tables(tmp_path):
+    """Lines that cannot converge (two iterations allowed): exit 4 in one line, no
+    result file, and the tables of an earlier run at the same paths removed."""
+    stale = [tmp_path / "t_Line1.csv", tmp_path / "t_system.csv"]
+    for path in stale:
+        path.write_text("an earlier run's\n")
+    out = tmp_path / "none.h5"
+    process = run_petsc_rod(["-rod_system", DECK, "-rod_al_max_it", "2", "-rod_output",
+                             str(out), "-rod_table", str(tmp_path / "t.csv")], 1, 120)
+    assert process.returncode == 4, describe(process)
+    errors = [line for line in process.stdout.splitlines() if "error" in line]
+    assert len(errors) == 1 and "did not converge" in errors[0], describe(process)
+    assert not out.exists() and not partial_files(out)
+    assert not any(path.exists() for path in stale)
