@@ -24,6 +24,7 @@ from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
@@ -111,7 +112,7 @@ def run(comm=None):
         PETSc.Sys.Print(text, comm=comm)
 
     try:
-        with AgreedFailures(comm):
+        with Interrupts(comm) as interrupts, AgreedFailures(comm):
             check_same_on_every_rank(comm)
             values, given = read_options()
             check_anderson_depth()
@@ -129,7 +130,7 @@ def run(comm=None):
                 say(f"petsc_rod: note: {note}")
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
-                                 text, notes)
+                                 text, notes, interrupts)
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)

@@ -14,7 +14,7 @@ import numpy as np
 from petsc_rod.api.results import Results
 from petsc_rod.cli.line_run import values_of
 from petsc_rod.cli.options import BY_NAME
-from petsc_rod.errors import RodDivergedError, RodInputError, on_every_rank
+from petsc_rod.errors import RodDivergedError, RodInputError, RodInterrupted, on_every_rank
 from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
@@ -318,10 +318,12 @@ def discard_tables(comm, table, system, say):
 
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
-               text=None, notes=()):
+               text=None, notes=(), interrupts=None):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, the
-    result file and the tables when asked; the lines destroyed. Returns the
+    result file and the tables when asked; the lines destroyed. ``interrupts``
+    (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
+    ends the run before anything is written (RodInterrupted). Returns the
     SystemResults. RodInputError for a system the checks refuse (exit 2),
     RodDivergedError when no equilibrium was found (exit 4); nothing is written then.
     Collective."""
@@ -336,6 +338,11 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
             if table:
                 discard_tables(comm, table, system, say)
             raise
+        number = 0 if interrupts is None else interrupts.received()
+        if number:
+            raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
+                                 "system's equilibrium was found; nothing written",
+                                 number)
         stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
         records = gathered_lines(solver)
         mpi = comm.tompi4py()

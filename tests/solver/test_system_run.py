@@ -76,3 +76,31 @@ def test_a_line_split_at_a_massless_free_point_is_the_unsplit_line():
     # J's balance: the two lines' forces on it cancel
     J = found.end_forces["lower"][1] + found.end_forces["upper"][0]
     assert np.abs(J).max() < 1e-6 * np.abs(found.end_forces["upper"]).max()
+
+
+class Signalled:
+    """An Interrupts (cli/signals.py) whose ranks received SIGTERM."""
+
+    def received(self):
+        return 15
+
+    @staticmethod
+    def name(number):
+        return "SIGTERM"
+
+
+def test_a_stop_signal_ends_the_run_before_anything_is_written(tmp_path):
+    import os
+
+    from petsc_rod.api.system_run import run_system
+    from petsc_rod.errors import RodInterrupted
+    from petsc_rod.system.equilibrium import Settings
+    system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
+                                      Connection("B")),),
+                    points=(Point("A", "fixed", ANCHOR), Point("B", "fixed", FAIRLEAD)))
+    out = str(tmp_path / "system.h5") if PETSc.COMM_WORLD.getSize() == 1 else None
+    with pytest.raises(RodInterrupted) as stopped:
+        run_system(PETSc.COMM_WORLD, system, Settings(), TIGHT, lambda line: None,
+                   output=out, interrupts=Signalled())
+    assert stopped.value.exit_code == 143 and "SIGTERM" in str(stopped.value)
+    assert out is None or not os.listdir(tmp_path)
