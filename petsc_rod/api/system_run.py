@@ -18,6 +18,7 @@ from petsc_rod.errors import RodDivergedError, RodInputError, RodInterrupted, on
 from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
+from petsc_rod.quantities import riser_numbers
 from petsc_rod.system.bodies import rotation
 from petsc_rod.system.equilibrium import Settings, SystemSolver
 from petsc_rod.system.held_line import HeldLine
@@ -137,8 +138,12 @@ def line_record(line):
                       stable=-1 if stable is None else int(stable), load_factor=1.0,
                       energy=problem.energy(), ranks=line.comm.getSize())
     tensions = np.array(_end_values(problem.mesh, vertex["effective_tension"]))
-    return (vertex, outputs.restart_state(problem), attributes, problem.units(), tensions,
-            problem.mesh.n_elements)
+    datasets, scalars = problem.units()
+    # final_record adds the effective tension of a plain rod, with the riser numbers' unit
+    datasets = {"effective_tension": riser_numbers.DATASET_UNITS["effective_tension"],
+                **datasets}
+    return (vertex, outputs.restart_state(problem), attributes, (datasets, scalars),
+            tensions, problem.mesh.n_elements)
 
 
 def _shapes(arrays):

@@ -33,13 +33,21 @@ def whole_line():
                        end=End.anchor(FAIRLEAD), options=TIGHT))
 
 
-def test_one_line_between_fixed_points_is_the_single_line():
+def test_one_line_between_fixed_points_is_the_single_line(tmp_path):
+    """Also its result file (on 2 ranks: the one line's group is both ranks): the line's
+    group holds the single line's centreline."""
+    import h5py
     system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
                                       Connection("B")),),
                     points=(Point("A", "fixed", ANCHOR), Point("B", "prescribed", FAIRLEAD)),
                     environment=Environment())
-    found = solve_system(system, options=TIGHT)
+    folder = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path))
+    found = solve_system(system, options=TIGHT, output=f"{folder}/one.h5")
     single = whole_line()
+    with h5py.File(f"{folder}/one.h5", "r") as f:
+        assert np.abs(f["lines/one/r"][()] - single.along_line(["r"])["r"]).max() < 1e-7
+        assert f["lines/one"].attrs["ranks"] == PETSc.COMM_WORLD.getSize()
+        assert f["lines/one/effective_tension"].attrs["units"] == "N"
     forces = found.end_forces["one"]
     assert forces[0] == pytest.approx(single.scalars["start_force"], rel=1e-9)
     assert forces[1] == pytest.approx(single.scalars["end_force"], rel=1e-9)
