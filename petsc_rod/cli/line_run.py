@@ -134,7 +134,7 @@ class BuiltLine:
     def __init__(self, comm, plan, path_of=None):
         self.comm, self.plan, self.path_of = comm, plan, path_of
         self.mesh = self.problem = self.solver = self.scene = None
-        self.notes, self.first_load_factor = [], 0.0
+        self.notes, self.first_load_factor, self.owned = [], 0.0, []
 
     def build(self, say=None):
         """Make the mesh, the problem and the solver (build_solver: a PETSc error while
@@ -175,8 +175,19 @@ class BuiltLine:
         return run_continuation(self.solver, path, say=say, writer=writer, options=options,
                                 interrupts=interrupts)
 
+    def own(self, made):
+        """Take ``made`` (a PETSc object's owner made on the built problem by a caller:
+        a held line's Newton solver, its Jacobian) to destroy before the solver, the
+        problem and the mesh; returns it."""
+        self.owned.append(made)
+        return made
+
     def destroy(self):
-        """Destroy what was built, in reverse order, skipping what was not. Collective."""
+        """Destroy what was built and what it was given to own (own), in reverse order,
+        skipping what was not made. Collective."""
+        for made in reversed(self.owned):
+            made.destroy()
+        self.owned = []
         for built in (self.solver, self.problem, self.mesh):
             if built is not None:
                 built.destroy()

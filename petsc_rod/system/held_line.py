@@ -258,15 +258,12 @@ class HeldLine:
         self.mesh, self.problem, self.solver = (self.built.mesh, self.built.problem,
                                                 self.built.solver)
         self.path = self.built.scene
-        self.newton = NewtonSolver(self.problem)
+        self.newton = self.built.own(NewtonSolver(self.problem))
 
     def _release(self):
-        for owned in (self.jacobian, self.newton):
-            if owned is not None:
-                owned.destroy()
-        self.jacobian = None
-        if self.built is not None:
+        if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
+        self.jacobian = None
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
@@ -397,7 +394,7 @@ class HeldLine:
                 vecs.append(shift)
             if hessian.resultants:
                 if self.jacobian is None:
-                    self.jacobian = NewtonJacobian(hessian)
+                    self.jacobian = self.built.own(NewtonJacobian(hessian))
                 self.jacobian.assemble()
                 solver = self.jacobian
             else:
