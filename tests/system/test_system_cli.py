@@ -178,3 +178,17 @@ def test_no_equilibrium_writes_nothing_and_removes_old_tables(tmp_path):
     assert len(errors) == 1 and "did not converge" in errors[0], describe(process)
     assert not out.exists() and not partial_files(out)
     assert not any(path.exists() for path in stale)
+
+
+def test_the_load_continuation_reaches_the_same_equilibrium(runs, tmp_path):
+    """-rod_system_steps 3: the body load in three steps (more Newton iterations), the
+    same pose and end forces as in one, to the lines' own accuracy (their end forces
+    converged to about 1e-8 of themselves over a stiffness of 8e3 N/m: 6e-8 m apart)."""
+    path, process = system_run(tmp_path, 1, "-rod_system_steps", "3")
+    assert process.returncode == 0, describe(process)
+    with h5py.File(runs[1][1], "r") as f, h5py.File(path, "r") as g:
+        assert g["system"].attrs["iterations"] > f["system"].attrs["iterations"]
+        assert np.abs(g["system/body_positions"][0, :3]
+                      - f["system/body_positions"][0, :3]).max() < 1e-6
+        assert np.abs(g["system/end_forces"][()] - f["system/end_forces"][()]).max() < (
+            1e-7 * np.abs(f["system/end_forces"][()]).max())
