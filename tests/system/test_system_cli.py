@@ -151,6 +151,13 @@ def test_bad_input_is_one_line_and_leaves_no_file(tmp_path):
                                          "Body7,1,0,0,0,0,0"])
     assert "no such file" in refused(tmp_path, ["-rod_system", str(tmp_path / "none.dat")],
                                      ranks=2)
+    copy = tmp_path / "deck.dat"
+    with open(DECK, encoding="utf-8") as source:
+        kept = source.read()
+    copy.write_text(kept)
+    process = run_petsc_rod(["-rod_system", str(copy), "-rod_output", str(copy)], 1, 120)
+    assert process.returncode == 2 and "-rod_output" in process.stdout, describe(process)
+    assert copy.read_text() == kept
     assert "-rod_system_steps" in refused(tmp_path, ["-options_file",
                                                      "options/cantilever.opts",
                                                      "-rod_system_steps", "2"])
