@@ -82,13 +82,13 @@ def split_options(options):
     if unknown:
         raise RodInputError(f"system option {unknown[0]!r}: not an option of a system; "
                             f"its options: {', '.join(SYSTEM_OPTIONS + LINE_OPTIONS)}")
-    steps = int(options.pop("system_steps", 1))
-    if steps < 1:
-        raise RodInputError(f"system_steps {steps}: at least 1 (the load continuation's "
-                            "first step is 1 / system_steps of the loads)")
-    line_options = {name: value for name, value in options.items()}
-    values_of(line_options)                 # a malformed value refused before any work
-    return Settings(load_steps=steps), line_options
+    steps = options.pop("system_steps", Settings().load_steps)
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise RodInputError(f"system_steps {steps!r}: a whole number of at least 1 (the "
+                            "load continuation's first step is 1 / system_steps of the "
+                            "loads)")
+    values_of(options)                      # a malformed value refused before any work
+    return Settings(load_steps=int(steps)), options
 
 
 def start_ends(system):

@@ -127,9 +127,10 @@ class BuiltLine:
     ``destroy`` (in reverse order, skipping what was not made); ``scene`` the scene the
     load path walks (the plan's, or a restart's walk from its file's scene) and
     ``notes`` the lines that say so; ``path_of(scene)``, when given, the load path the
-    problem walks instead (a held line's, system/held_line.HeldEnds). ``with BuiltLine(comm, plan) as built:`` builds and
-    destroys around the block; run_line calls build and destroy itself, so that the
-    ranks agree on a failure before the collective destroy."""
+    problem walks instead (a held line's, system/held_line.HeldEnds). ``with
+    BuiltLine(comm, plan) as built:`` builds and destroys around the block; run_line
+    calls build and destroy itself, so that the ranks agree on a failure before the
+    collective destroy."""
 
     def __init__(self, comm, plan, path_of=None):
         self.comm, self.plan, self.path_of = comm, plan, path_of

@@ -112,3 +112,16 @@ def test_a_stop_signal_ends_the_run_before_anything_is_written(tmp_path):
                    output=out, interrupts=Signalled())
     assert stopped.value.exit_code == 143 and "SIGTERM" in str(stopped.value)
     assert out is None or not os.listdir(tmp_path)
+
+
+def test_options_a_system_does_not_take_are_refused():
+    from petsc_rod.errors import RodInputError
+    system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
+                                      Connection("B")),),
+                    points=(Point("A", "fixed", ANCHOR), Point("B", "fixed", FAIRLEAD)))
+    with pytest.raises(RodInputError, match="'length': not an option of a system"):
+        solve_system(system, options={"length": 3.0})
+    with pytest.raises(RodInputError, match="system_steps 0"):
+        solve_system(system, options={"system_steps": 0})
+    with pytest.raises(RodInputError, match="-rod_al_rtol"):
+        solve_system(system, options={"al_rtol": "tight"})
