@@ -7,7 +7,7 @@ What it returns holds numpy arrays only (SystemResults); the lines' PETSc object
 made and destroyed here."""
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -125,12 +125,25 @@ def _end_values(mesh, values):
     return mesh.global_sum(np.asarray(first, float)), mesh.global_sum(np.asarray(last, float))
 
 
+@dataclass
+class LineRecord:
+    """A converged line's last step as a single line's result file holds it: this
+    rank's ``vertex`` datasets and restart ``state`` (outputs.restart_state), its
+    ``attributes`` and ``units`` ({dataset: unit}, {attribute: unit}), its end
+    ``tensions`` (2,), N (n.t at S = 0 and S = L), and its mesh's ``elements``."""
+
+    vertex: dict
+    state: dict
+    attributes: dict
+    units: tuple
+    tensions: np.ndarray
+    elements: int
+
+
 def line_record(line):
-    """(vertex datasets, restart state, attributes, units, end tensions (2,), elements) of a
-    converged HeldLine: what a single line's result file holds for its last step
-    (line_table.final_record: the terms' and reports' outputs, r absolute, the effective
-    tension), with its converged, iterations, stable, load factor and ranks. Collective
-    on the line's communicator."""
+    """The LineRecord of a converged HeldLine (line_table.final_record: the terms' and
+    reports' outputs, r absolute, the effective tension), with its converged,
+    iterations, stable, load factor and ranks. Collective on the line's communicator."""
     problem = line.problem
     vertex, attributes = line_table.final_record(problem)
     stable = line.stable()
@@ -142,8 +155,8 @@ def line_record(line):
     # final_record adds the effective tension of a plain rod, with the riser numbers' unit
     datasets = {"effective_tension": riser_numbers.DATASET_UNITS["effective_tension"],
                 **datasets}
-    return (vertex, outputs.restart_state(problem), attributes, (datasets, scalars),
-            tensions, problem.mesh.n_elements)
+    return LineRecord(vertex, outputs.restart_state(problem), attributes,
+                      (datasets, scalars), tensions, problem.mesh.n_elements)
 
 
 def _shapes(arrays):
@@ -157,15 +170,16 @@ def _empty(shapes):
 
 
 def gathered_lines(solver):
-    """{line index: (vertex, state, attributes, units, tensions, elements)} on every rank: this
-    rank's own rows of its group's lines, zero rows of the others' (their names and
-    shapes, attributes and units shared from the groups' roots). Collective."""
-    placement = solver.placement
+    """{line index: LineRecord} on every rank: this rank's own rows of its group's
+    lines, zero rows of the others' (their names and shapes, attributes, units and
+    tensions shared from the groups' roots). Collective."""
     mine = {k: line_record(line) for k, line in solver.lines.items()}
-    shared = placement.share({k: (_shapes(v[0]), _shapes(v[1])) + v[2:]
-                              for k, v in mine.items()})
-    return {k: ((mine[k][:2] if k in mine else (_empty(v[0]), _empty(v[1]))) + v[2:])
-            for k, v in shared.items()}
+    shared = solver.placement.share({k: replace(record, vertex=_shapes(record.vertex),
+                                                state=_shapes(record.state))
+                                     for k, record in mine.items()})
+    return {k: mine[k] if k in mine else replace(record, vertex=_empty(record.vertex),
+                                                 state=_empty(record.state))
+            for k, record in shared.items()}
 
 
 def check_finite(results):
@@ -228,8 +242,9 @@ def write_file(comm, output, system, results, records, text, notes):
     writer = SystemWriter(output, comm)
     try:
         for k, line in enumerate(system.lines):
-            vertex, state, attributes, units = records[k][:4]
-            writer.write_line(line.name, vertex, state, attributes, units)
+            record = records[k]
+            writer.write_line(line.name, record.vertex, record.state, record.attributes,
+                              record.units)
         data, units = system_datasets(system, results)
         attributes = {"converged": int(results.converged), "iterations": results.iterations,
                       "halvings": results.halvings, "residual": results.residual,
@@ -269,8 +284,9 @@ def write_tables(comm, solver, table, system, results, records):
     def write_all():
         for k, line in solver.lines.items():
             name = system.lines[k].name
-            vertex, _, attributes, units = records[k][:4]
-            line_table.write_tables(paths[name], line.comm, vertex, attributes, units)
+            record = records[k]
+            line_table.write_tables(paths[name], line.comm, record.vertex,
+                                    record.attributes, record.units)
         if comm.getRank() == 0:
             partial = paths["system"] + ".partial"
             line_table._write(paths["system"], partial, ends_rows(system, results))
@@ -351,8 +367,8 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
         stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
         records = gathered_lines(solver)
         mpi = comm.tompi4py()
-        lines = {line.name: Results(records[k][0], records[k][2], True, mpi,
-                                    records[k][5], records[k][3])
+        lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
+                                    records[k].elements, records[k].units)
                  for k, line in enumerate(system.lines)}
         bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
                                      np.asarray(found.rotations[b.name]),
@@ -363,8 +379,8 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
         results = SystemResults(
             dict(found.points), bodies,
             {n: found.end_forces[k] for k, n in enumerate(names)},
-            {n: records[k][4] for k, n in enumerate(names)},
-            {n: bool(records[k][2]["converged"]) for k, n in enumerate(names)},
+            {n: records[k].tensions for k, n in enumerate(names)},
+            {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
             lines, found.load_factor == 1.0, found.iterations, found.halvings,
             found.residual, found.load_factor)
         check_finite(results)
