@@ -93,8 +93,13 @@ def run(comm=None, texts=None):
 
 
 def check_system_options(given):
-    """Refuse a system's option given without -rod_system (a single line's run, where
-    it would be silently unused)."""
+    """Refuse a system's option in a single line's run, where it would be silently
+    unused: -rod_system itself (python -m petsc_rod hands a run with it to
+    cli_system.py; a sweep's cases, which come here, are single lines) and the system's
+    other options without it."""
+    if "rod_system" in given:
+        raise RodInputError("-rod_system: a system runs as python -m petsc_rod -rod_system "
+                            "FILE; a sweep's cases are single lines: drop it here")
     orphans = [name for name in ("rod_system_element_length", "rod_system_body_load",
                                  "rod_system_steps") if name in given]
     if orphans:

@@ -125,3 +125,14 @@ def test_options_a_system_does_not_take_are_refused():
         solve_system(system, options={"system_steps": 0})
     with pytest.raises(RodInputError, match="-rod_al_rtol"):
         solve_system(system, options={"al_rtol": "tight"})
+
+
+def test_a_single_line_run_refuses_a_system():
+    """cli.main.run (the single line's command line, a sweep's case) given -rod_system
+    or a system's option: exit 2 in one line, no default line run in its place."""
+    from petsc_rod.cli import main
+    try:
+        for texts in ({"rod_system": "spread.dat"}, {"rod_system_steps": "2"}):
+            assert main.run(PETSc.COMM_WORLD, texts) == 2
+    finally:
+        PETSc.Options().delValue("options_left")      # set by the refusal
