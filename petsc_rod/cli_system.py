@@ -1,8 +1,9 @@
 """``python -m petsc_rod -rod_system FILE``: a system of lines, points and bodies read
 from a MoorDyn version 2 input file, solved on the path the Python API's solve_system
 takes (api/system_run.py), with the command line's options, lines and exit codes
-(docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 4 no
-equilibrium or a PETSc error, 5 the result could not be written).
+(docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 3 no
+equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not be
+written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_steps), the outputs (-rod_output, -rod_table) and

@@ -14,7 +14,8 @@ import numpy as np
 from petsc_rod.api.results import Results
 from petsc_rod.cli.line_run import values_of
 from petsc_rod.cli.options import BY_NAME
-from petsc_rod.errors import RodDivergedError, RodInputError, RodInterrupted, on_every_rank
+from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
+                              RodNotConvergedError, on_every_rank)
 from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
@@ -346,7 +347,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
     ends the run before anything is written (RodInterrupted). Returns the
     SystemResults. RodInputError for a system the checks refuse (exit 2),
-    RodDivergedError when no equilibrium was found (exit 4); nothing is written then.
+    RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
+    RodDivergedError, its Newton or a line not converged after its halvings),
+    RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
     check_outputs(comm, system, output, table)
@@ -355,10 +358,12 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     try:
         try:
             found = solver.solve()
-        except RodDivergedError:
+        except RodDivergedError as error:
             if table:
                 discard_tables(comm, table, system, say)
-            raise
+            # a Newton or a line that did not converge, the halvings spent: the single
+            # line's exit 3, but no file (there is no equilibrium to write)
+            raise RodNotConvergedError(str(error)) from None
         number = 0 if interrupts is None else interrupts.received()
         if number:
             raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
