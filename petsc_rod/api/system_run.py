@@ -296,7 +296,8 @@ def write_tables(comm, solver, table, system, results, records):
 
 def report_lines(system, results, ranks):
     """The run's lines: the equilibrium's iterations and residual, a table of the
-    bodies' poses, the lines' end tensions, each body's stiffness diagonal."""
+    bodies' poses, the lines' end tensions and stability (a saddle in capitals), each
+    body's stiffness diagonal."""
     lines = [f"petsc_rod: system of {len(system.lines)} line(s), {len(system.points)} "
              f"point(s), {len(system.bodies)} body(ies) on {ranks} rank(s): equilibrium in "
              f"{results.iterations} Newton iteration(s) ({results.halvings} halving(s) of "
@@ -314,12 +315,14 @@ def report_lines(system, results, ranks):
         x = results.points[name]
         lines.append(f"  point {name}: ({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m")
     lines.append(f"  {'line':<12} {'start':>10} {'T start (kN)':>13} {'end':>10} "
-                 f"{'T end (kN)':>13} {'|F| end (kN)':>13}")
+                 f"{'T end (kN)':>13} {'|F| end (kN)':>13} {'stable':>7}")
+    verdicts = {1: "yes", 0: "SADDLE", -1: "-"}             # the file's stable codes
     for line in system.lines:
         tension = results.end_tensions[line.name] / 1e3
         force = np.linalg.norm(results.end_forces[line.name][1]) / 1e3
+        stable = verdicts[int(results.lines[line.name].scalars["stable"])]
         lines.append(f"  {line.name:<12} {line.start.to:>10} {tension[0]:13.3f} "
-                     f"{line.end.to:>10} {tension[1]:13.3f} {force:13.3f}")
+                     f"{line.end.to:>10} {tension[1]:13.3f} {force:13.3f} {stable:>7}")
     for name, body in results.bodies.items():
         diagonal = ", ".join(f"{v:.6g}" for v in np.diag(body.stiffness))
         lines.append(f"  body {name}: stiffness diagonal (N/m x3, N m/rad x3) {diagonal}; "

@@ -90,6 +90,9 @@ def test_the_result_file_and_the_tables(runs):
     assert table[0].startswith("S (m),x (m)") and len(table) == 72
     assert "petsc_rod: note: line type main: EI 0 in the file" in process.stdout
     assert "Body1" in process.stdout and "stiffness diagonal" in process.stdout
+    rows = [line.split() for line in process.stdout.splitlines()
+            if line.startswith("  Line")]
+    assert len(rows) == 3 and all(row[-1] == "yes" for row in rows), process.stdout
 
 
 def test_the_api_path_equals_the_file_path(runs, tmp_path):
