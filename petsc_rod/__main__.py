@@ -128,8 +128,13 @@ def main():
         sys.stderr.write(f"petsc_rod: error: {error}; an options file has one '-name value' "
                          "per line, '#' starts a comment\n")
         return 2
-    from petsc_rod.cli.main import run
+    from petsc4py import PETSc
+
     from petsc_rod.cli.signals import ignore_stop_signals
+    if PETSc.Options().hasName("rod_system"):     # a system of lines (docs/systems.md)
+        from petsc_rod.cli_system import run
+    else:
+        from petsc_rod.cli.main import run
     code = run()
     ignore_stop_signals()
     return end(code)

@@ -6,6 +6,7 @@ file (api/system.py, docs/systems.md).
 
     from petsc_rod.api import LineType, Line, End, Environment, Model, solve
     from petsc_rod.api import System, Point, Body, Connection, SystemLine, read_moordyn
+    from petsc_rod.api import solve_system       # -> SystemResults (api/system_run.py)
 """
 
 from petsc_rod.api.model import (Attachment, End, Environment, Line, LineType, Model,
@@ -14,7 +15,8 @@ from petsc_rod.api.results import Results
 from petsc_rod.api.run import scene_of, solve
 from petsc_rod.api.system import (Body, Connection, Point, System, SystemLine,
                                   read_moordyn)
+from petsc_rod.api.system_run import SystemResults, solve_system
 
 __all__ = ["Attachment", "Body", "Connection", "End", "Environment", "Line", "LineType",
            "Model", "Point", "Results", "System", "SystemLine", "UniformLine",
-           "read_moordyn", "scene_of", "solve"]
+           "SystemResults", "read_moordyn", "scene_of", "solve", "solve_system"]

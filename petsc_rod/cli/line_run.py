@@ -35,7 +35,8 @@ from petsc4py import PETSc
 
 from petsc_rod import resources
 from petsc_rod.cli import messages
-from petsc_rod.cli.options import BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value
+from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value,
+                                   parse_values)
 from petsc_rod.cli.modes import check_modes_inputs, report_modes, solve_for_run
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
                                          restart_path, rounded_down, settings_from_options)
@@ -81,6 +82,14 @@ class LinePlan:
     names: object = OPTION_NAMES
 
 
+def values_of(options):
+    """(values, given) of a solver's ``options`` {name without ``rod_``: value}: every
+    -rod_* option's value (options.parse_values: the rest their defaults) and the names
+    given, for a line a caller builds itself (system/held_line.py)."""
+    texts = {f"rod_{name}": str(value) for name, value in (options or {}).items()}
+    return parse_values(texts), set(texts)
+
+
 def plan_line(comm, model, values, given, names=OPTION_NAMES, mesh_named=None):
     """The LinePlan of ``model`` (model.Model) with the run's ``values`` and ``given``
     (module docstring), every refusal worded with ``names``: the scene compiled on every
@@ -118,14 +127,16 @@ class BuiltLine:
     and ``solver`` (UzawaSolver), made by ``build`` and destroyed together by
     ``destroy`` (in reverse order, skipping what was not made); ``scene`` the scene the
     load path walks (the plan's, or a restart's walk from its file's scene) and
-    ``notes`` the lines that say so. ``with BuiltLine(comm, plan) as built:`` builds and
-    destroys around the block; run_line calls build and destroy itself, so that the
-    ranks agree on a failure before the collective destroy."""
+    ``notes`` the lines that say so; ``path_of(scene)``, when given, the load path the
+    problem walks instead (a held line's, system/held_line.HeldEnds). ``with
+    BuiltLine(comm, plan) as built:`` builds and destroys around the block; run_line
+    calls build and destroy itself, so that the ranks agree on a failure before the
+    collective destroy."""
 
-    def __init__(self, comm, plan):
-        self.comm, self.plan = comm, plan
+    def __init__(self, comm, plan, path_of=None):
+        self.comm, self.plan, self.path_of = comm, plan, path_of
         self.mesh = self.problem = self.solver = self.scene = None
-        self.notes, self.first_load_factor = [], 0.0
+        self.notes, self.first_load_factor, self.owned = [], 0.0, []
 
     def build(self, say=None):
         """Make the mesh, the problem and the solver (build_solver: a PETSc error while
@@ -135,6 +146,8 @@ class BuiltLine:
         self.mesh = Mesh(self.comm, values["rod_elements"], plan.scene.length,
                          values["rod_mesh_grading"], plan.pieces)
         self.scene, self.notes = walked_scene(plan.scene, values, self.comm)
+        if self.path_of is not None:        # a caller's own load path over the scene
+            self.scene = self.path_of(self.scene)
         self.problem, self.solver = build_solver(self.mesh, self.scene, plan.settings,
                                                  say or _silent)
         check_stability_asked(values, plan.given, plan.scene, self.problem, plan.names,
@@ -166,8 +179,19 @@ class BuiltLine:
         return run_continuation(self.solver, path, say=say, writer=writer, options=options,
                                 interrupts=interrupts, before_finish=before_finish)
 
+    def own(self, made):
+        """Take ``made`` (a PETSc object's owner made on the built problem by a caller:
+        a held line's Newton solver, its Jacobian) to destroy before the solver, the
+        problem and the mesh; returns it."""
+        self.owned.append(made)
+        return made
+
     def destroy(self):
-        """Destroy what was built, in reverse order, skipping what was not. Collective."""
+        """Destroy what was built and what it was given to own (own), in reverse order,
+        skipping what was not made. Collective."""
+        for made in reversed(self.owned):
+            made.destroy()
+        self.owned = []
         for built in (self.solver, self.problem, self.mesh):
             if built is not None:
                 built.destroy()

@@ -60,6 +60,7 @@ def run(comm=None, texts=None):
                     values, given = read_options()
                 else:                       # the same on every rank: the sweep's
                     values, given = values_of(texts)
+                check_system_options(given)
                 check_anderson_depth()      # before any PETSc object is made
                 check_snes_type()
                 check_substructuring_switches()
@@ -90,6 +91,21 @@ def run(comm=None, texts=None):
             say(f"petsc_rod: error: {petsc_failure(error)}")
             database.setValue("options_left", "0")
             return RodDivergedError.exit_code
+
+
+def check_system_options(given):
+    """Refuse a system's option in a single line's run, where it would be silently
+    unused: -rod_system itself (python -m petsc_rod hands a run with it to
+    cli_system.py; a sweep's cases, which come here, are single lines) and the system's
+    other options without it."""
+    if "rod_system" in given:
+        raise RodInputError("-rod_system: a system runs as python -m petsc_rod -rod_system "
+                            "FILE; a sweep's cases are single lines: drop it here")
+    orphans = [name for name in ("rod_system_element_length", "rod_system_body_load",
+                                 "rod_system_steps") if name in given]
+    if orphans:
+        raise RodInputError(f"-{orphans[0]}: an option of a system, which needs "
+                            "-rod_system FILE; drop it for a single line")
 
 
 def check_inputs_kept(values, comm):

@@ -30,6 +30,7 @@ from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
 from petsc_rod.model.line import DEFAULT_ELEMENTS
+from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.values import MAX_MAGNITUDE  # noqa: F401 (the options' bound)
 from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
 from petsc_rod.scenes.scene import Scene
@@ -128,6 +129,12 @@ TOLERANCE = (lambda v: 1 / MAX_MAGNITUDE <= v < 1,
              "1 or more accepts any iterate")
 # The mesh's own default grading (Mesh's keyword).
 MESH_GRADING = inspect.signature(Mesh).parameters["grading"].default
+
+
+def default_of_function(function, name):
+    """The default of keyword ``name`` of ``function`` (the MoorDyn reader's element
+    length): an option's default is that of the code that uses it, read from there."""
+    return inspect.signature(function).parameters[name].default
 
 
 def default_of(owner, name):
@@ -325,6 +332,24 @@ OPTIONS = [
     Option("rod_modes_added_mass", _real, 1.0, "Ca",
            "the added-mass coefficient C_a of -rod_modes: C_a rho_w pi od^2 / 4 normal "
            "to the line, C_a rho_w V at an attachment", NON_NEGATIVE),
+    Option("rod_system", _string, None, "FILE",
+           "solve a system of lines, points and bodies read from FILE, a MoorDyn version 2 "
+           "input file (docs/systems.md): the coupled equilibrium, each body's 6 x 6 "
+           "mooring stiffness, every line's results; with -rod_output one HDF5 file (a "
+           "group per line, the group system), with -rod_table FILE.csv the tables "
+           "FILE_<line>.csv and FILE_system.csv", unit="text"),
+    Option("rod_system_element_length", _real, default_of_function(read_moordyn,
+                                                                   "element_length"),
+           "h", "with -rod_system: the lines' longest element, m (MoorDyn's segments finer "
+           "than it are kept)", SCALE, "m"),
+    Option("rod_system_body_load", _string, None, "NAME,fx,fy,fz,mx,my,mz[:NAME,...]",
+           "with -rod_system: a constant external load on body NAME, N and N m about its "
+           "reference point, global axes, added to the file's; several bodies separated "
+           "by ':'", unit="text"),
+    Option("rod_system_steps", _int, None, "n",
+           "with -rod_system: the load continuation's first step is 1/n of the bodies' "
+           "and points' loads (halved where it fails, doubled where it succeeds); default "
+           "the system solver's (1)", POSITIVE),
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "

@@ -562,8 +562,12 @@ class SystemSolver:
                 continue
             self.state, factor, step = state, to, 2.0 * step
         self.loads = target
-        # The lines may stand at the last trial; leave them at the solution.
-        self.evaluate(self.state)
+        # The lines may stand at the last trial; leave them at the solution, and report
+        # the end forces and stiffness of the lines as they are left (a re-solve from a
+        # trial differs by the lines' own tolerances).
+        solved = self.evaluate(self.state)
+        if solved[0]:
+            self.forces, self.stiffnesses = solved[1], solved[2]
         return self.result(factor, total, halvings)
 
     def replace(self, system):

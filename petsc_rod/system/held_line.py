@@ -65,17 +65,13 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
-from petsc_rod.cli.line_run import build_solver, check_mesh
-from petsc_rod.cli.options import parse_values
-from petsc_rod.cli.scene_options import checked_pieces, settings_from_options
+from petsc_rod.cli.line_run import BuiltLine, plan_line, values_of
 from petsc_rod.compile import compile_scene
 from petsc_rod.errors import NoCatenaryStart, RodError, RodInputError
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import NewtonSolver
-from petsc_rod.mesh.mesh import Mesh
-from petsc_rod.model.line import UniformLine
 from petsc_rod.model.end import End
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
@@ -220,9 +216,10 @@ class HeldLine:
                 raise RodInputError(f"HeldLine: the line's {which} is "
                                     f"{getattr(span, which).kind}; a line of a system is "
                                     "held at both ends (pin or clamp)")
-        self.values = parse_values({f"rod_{k}": str(v) for k, v in (options or {}).items()})
-        self.scene = self._compile(span.start.position, span.end.position)
-        self.mesh = self.problem = self.solver = self.newton = self.path = None
+        self.values, self.given = values_of(options)
+        self.scene = compile_scene(self._model(span.start.position, span.end.position),
+                                   FIELD_NAMES)
+        self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
         self.iterations = 0
         self.converged = False
@@ -246,50 +243,39 @@ class HeldLine:
         return cls(span, comm, environment, options)
 
     # --- building ----------------------------------------------------------------------
-    def _compile(self, start, end):
-        """The Scene of the line with its ends at ``start``, ``end`` (absolute, m)."""
+    def _model(self, start, end):
+        """The line's Model with its ends at ``start``, ``end`` (absolute, m)."""
         import dataclasses
         span = self.span
-        model = Model(span.line, dataclasses.replace(span.start, position=start),
-                      dataclasses.replace(span.end, position=end), self.environment,
-                      tuple(span.attachments))
-        return compile_scene(model, FIELD_NAMES)
+        return Model(span.line, dataclasses.replace(span.start, position=start),
+                     dataclasses.replace(span.end, position=end), self.environment,
+                     tuple(span.attachments))
 
     def _build(self, start, end):
-        """Mesh, problem, solver on the scene with the ends at ``start``, ``end``: its
-        frame's origin is ``start`` for the line's life. Collective."""
-        self.scene = scene = self._compile(start, end)
-        values = dict(self.values)
-        line = self.span.line
-        pieces = None
-        if isinstance(line, UniformLine):
-            values.update(rod_elements=int(line.elements), rod_length=float(line.length))
-            if line.grading is not None:
-                values["rod_mesh_grading"] = float(line.grading)
-        else:
-            pieces = checked_pieces(scene, line.element_counts(FIELD_NAMES),
-                                    FIELD_NAMES["sections"])
-            values["rod_elements"] = int(pieces.counts.sum())
-            values["rod_length"] = scene.length
-        check_mesh(self.comm, values)
-        settings = settings_from_options(values, scene, FIELD_NAMES)
-        self.origin = np.array(scene.start_position, dtype=float)
-        self.mesh = Mesh(self.comm, values["rod_elements"], scene.length,
-                         values["rod_mesh_grading"], pieces)
-        self.path = HeldEnds(scene)
-        self.problem, self.solver = build_solver(self.mesh, self.path, settings,
-                                                 lambda line: None)
-        self.newton = NewtonSolver(self.problem)
+        """The line's run built on the one path of a line (cli/line_run.py: plan_line,
+        BuiltLine: its mesh, problem and solver made and destroyed together) with the
+        ends at ``start``, ``end``, its problem walking HeldEnds: its frame's origin is
+        ``start`` for the line's life. Collective."""
+        plan = plan_line(self.comm, self._model(start, end), self.values, self.given,
+                         FIELD_NAMES)
+        self.built = BuiltLine(self.comm, plan, path_of=HeldEnds)
+        try:
+            self.built.build()
+        except BaseException:
+            self.built.destroy()
+            raise
+        self.scene = plan.scene
+        self.origin = np.array(plan.scene.start_position, dtype=float)
+        self.mesh, self.problem, self.solver = (self.built.mesh, self.built.problem,
+                                                self.built.solver)
+        self.path = self.built.scene
+        self.newton = self.built.own(NewtonSolver(self.problem))
 
     def _release(self):
-        for owned in (self.jacobian, self.newton):
-            if owned is not None:
-                owned.destroy()
+        if self.built is not None:          # its own objects and those it was given
+            self.built.destroy()
         self.jacobian = None
-        for built in (self.solver, self.problem, self.mesh):
-            if built is not None:
-                built.destroy()
-        self.mesh = self.problem = self.solver = self.newton = self.path = None
+        self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
     def solve(self, start_position, end_position):
@@ -465,7 +451,7 @@ class HeldLine:
                 vecs.append(shift)
             if hessian.resultants:
                 if self.jacobian is None:
-                    self.jacobian = NewtonJacobian(hessian)
+                    self.jacobian = self.built.own(NewtonJacobian(hessian))
                 self.jacobian.assemble()
                 solver = self.jacobian
             else:
@@ -549,7 +535,7 @@ class HeldLine:
                                 f"({loads}): no exact stiffness")
 
     def destroy(self):
-        """Free the line's PETSc objects (all made in _build). Collective."""
+        """Free the line's PETSc objects (its BuiltLine's, its Newton solver's). Collective."""
         self._release()
 
 

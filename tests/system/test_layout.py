@@ -29,6 +29,7 @@ sys.exit(code)
 SCENES = {
     "cantilever": ["-options_file", "options/cantilever.opts", "-rod_elements", "8"],
     "catenary start": ["-options_file", "options/catenary.opts", "-rod_elements", "100"],
+    "system": ["-rod_system", "tests/data/moordyn/small_spread.dat"],
 }
 
 

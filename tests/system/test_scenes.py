@@ -1,6 +1,7 @@
 """Every scene of options/ runs as a user runs it (``python -m petsc_rod -options_file
 options/<scene>.opts``, from the repository's root, on one rank) and converges, with a
-result file that says so and holds finite numbers. The scenes' own numbers are checked
+result file that says so and holds finite numbers (a system's scene, -rod_system, in
+each of its lines' groups). The scenes' own numbers are checked
 where they are named (docs/riser.md, tests/system/test_riser_cli.py); this keeps every
 scene runnable as the code changes."""
 
@@ -33,8 +34,12 @@ def test_every_scene_converges(scene, tmp_path):
     assert "petsc_rod: converged" in text and "warning" not in text, text
     with h5py.File(path, "r") as f:
         assert int(f.attrs["converged"]) == 1
-        for name in ("r", "n", "m", "u"):
-            assert np.all(np.isfinite(f[name][:])), name
+        # a system's scene (-rod_system): a group per line, each a line's result
+        groups = [f[f"lines/{name}"] for name in f["lines"]] if "system" in f else [f]
+        assert groups
+        for group in groups:
+            for name in ("r", "n", "m", "u"):
+                assert np.all(np.isfinite(group[name][:])), name
 
 
 def test_the_mooring_line_balances_its_weight_clumps_and_seabed(tmp_path):

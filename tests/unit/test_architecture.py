@@ -23,7 +23,8 @@ APPLICATION = ("environment", "quantities", "physics.nodal_load", "physics.seabe
                "physics.drag", "physics.surface", "physics.friction", "physics.slope_load")
 # The front ends, which drive the solver and which nothing below them imports; system/
 # (a system of lines solved together) drives lines as api/ does, at api/'s level.
-FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__", "system")
+FRONT_ENDS = ("cli", "api", "sweep", "report", "plots", "figures", "__main__", "system",
+              "cli_system")
 BELOW_FRONT_ENDS = CORE + ("physics", "environment", "quantities", "problem", "scenes", "io",
                            "frames.py", "errors.py", "tables.py", "resources.py", "model",
                            "compile.py")
@@ -241,16 +242,13 @@ def test_a_scene_is_made_whole_by_its_constructor():
 
 
 # The layer of a system's components (petsc_rod/system), at the level of the front
-# ends' helpers: it drives the solver as the Python API does, so of the front ends it
-# imports only the cli modules api/run.py imports from (its build and start helpers).
-SYSTEM_NOT = ("api", "sweep", "report", "plots", "figures", "__main__")
+# ends' helpers: it drives its lines as the Python API does, on the one run path of a
+# line, so of the front ends it imports cli/line_run.py alone (plan_line, BuiltLine,
+# values_of), never the options, the scene options or the session behind it.
+SYSTEM_NOT = ("api", "sweep", "report", "plots", "figures", "__main__", "cli_system")
 
 
-def test_the_system_layer_imports_what_the_api_builds_with():
-    run = imported(modules()[os.path.join("api", "run.py")])
-    allowed = {name for name in run if name.startswith("cli.")}
-    allowed |= {name for name in imported(modules()[os.path.join("cli", "line_run.py")])
-                if name.startswith("cli.")} | {"cli.line_run"}
+def test_the_system_layer_imports_only_the_run_path():
     found = 0
     for path, tree in modules().items():
         if folder_of(path) != "system":
@@ -259,7 +257,7 @@ def test_the_system_layer_imports_what_the_api_builds_with():
         names = imported(tree)
         front = sorted(name for name in names if name.split(".")[0] in SYSTEM_NOT)
         assert not front, f"{path} imports the front end {front}"
-        cli = sorted(name for name in names if name.startswith("cli.") and name not in allowed
-                     and not name.startswith("cli.line_run."))
-        assert not cli, f"{path} imports {cli}, which the run path does not"
+        cli = sorted(name for name in names if name.split(".")[0] == "cli"
+                     and name != "cli.line_run" and not name.startswith("cli.line_run."))
+        assert not cli, f"{path} imports {cli}: only the run path, cli/line_run.py"
     assert found >= 2                                       # the folder was read

@@ -1,0 +1,424 @@
+"""solve_system(system): a System (model/system.py, api/system.py) in its coupled static
+equilibrium (system/equilibrium.SystemSolver) with every line a HeldLine
+(system/held_line.py) on its group of ranks, each body's 6 x 6 mooring stiffness, every
+line's results as a single line has them, the result file and the CSV tables: the one
+path of a system's run, the Python API's and the command line's (cli_system.py).
+What it returns holds numpy arrays only (SystemResults); the lines' PETSc objects are
+made and destroyed here."""
+
+import os
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from petsc_rod.api.results import Results
+from petsc_rod.cli.line_run import values_of
+from petsc_rod.cli.options import BY_NAME
+from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
+                              RodNotConvergedError, on_every_rank)
+from petsc_rod.io import line_table, outputs
+from petsc_rod.io import results as io
+from petsc_rod.io.system_results import SystemWriter
+from petsc_rod.quantities import riser_numbers
+from petsc_rod.system.bodies import rotation
+from petsc_rod.system.equilibrium import Settings, SystemSolver
+from petsc_rod.system.held_line import HeldLine
+
+# The options of the system itself (not of its lines): the load continuation's first
+# step is 1 / system_steps of the bodies' loads (Settings.load_steps).
+SYSTEM_OPTIONS = ("system_steps",)
+# The options of a line that a system's lines take (every line the same): the
+# iteration's tolerances and switches (-rod_al_*), the halvings of a line's walk.
+LINE_OPTIONS = tuple(name.removeprefix("rod_") for name in BY_NAME
+                     if name.startswith("rod_al_")) + ("max_halvings",)
+
+
+@dataclass
+class BodyResult:
+    """A body at the equilibrium: ``position`` (6,) x, y, z (m), roll, pitch, yaw (rad);
+    ``rotation`` (3, 3), body axes to global; its mooring ``stiffness`` (6, 6) about
+    ``reference`` (3,), m (its reference point at the equilibrium), N/m, N, N m/rad, not
+    symmetrised, with ``asymmetry`` |K - K^T|_F / |K|_F and the lines' ``moment`` (3,),
+    N m, about the reference point, which is the rotational block's antisymmetric part
+    (docs/systems.md)."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+    stiffness: np.ndarray
+    reference: np.ndarray
+    moment: np.ndarray
+    asymmetry: float
+
+
+@dataclass
+class SystemResults:
+    """A system's equilibrium (solve_system), numpy only, the same on every rank:
+    ``points`` {name: (3,) m}; ``bodies`` {name: BodyResult}; ``end_forces`` {line:
+    (2, 3) N}, the force each line exerts ON its start's and its end's point or body;
+    ``end_tensions`` {line: (2,) N}, the end elements' tension along the line, n.t at
+    S = 0 and S = L; ``lines_converged`` {line: bool}; ``lines`` {line: api.Results}
+    (its arrays along S on this rank, none on a rank outside its group: along_line()
+    gathers them, collectively on the system's communicator); ``converged``,
+    ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
+    (the scaled norm), ``load_factor``."""
+
+    points: dict
+    bodies: dict
+    end_forces: dict
+    end_tensions: dict
+    lines_converged: dict
+    lines: dict
+    converged: bool
+    iterations: int
+    halvings: int
+    residual: float
+    load_factor: float
+
+
+def split_options(options):
+    """(system Settings, the lines' options) of ``options`` {name without ``rod_``:
+    value}; RodInputError naming one that neither takes."""
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(SYSTEM_OPTIONS) - set(LINE_OPTIONS))
+    if unknown:
+        raise RodInputError(f"system option {unknown[0]!r}: not an option of a system; "
+                            f"its options: {', '.join(SYSTEM_OPTIONS + LINE_OPTIONS)}")
+    steps = options.pop("system_steps", Settings().load_steps)
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise RodInputError(f"system_steps {steps!r}: a whole number of at least 1 (the "
+                            "load continuation's first step is 1 / system_steps of the "
+                            "loads)")
+    values_of(options)                      # a malformed value refused before any work
+    return Settings(load_steps=int(steps)), options
+
+
+def start_ends(system):
+    """{line name: (start (3,), end (3,))}, m: where the system's points and bodies put
+    each line's ends at the start (a body's local point through its start pose)."""
+    at = {p.name: np.asarray(p.position, dtype=float) for p in system.points}
+    poses = {b.name: np.asarray(b.position, dtype=float) for b in system.bodies}
+
+    def place(connection):
+        if connection.to in at:
+            return at[connection.to]
+        pose = poses[connection.to]
+        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
+
+    return {line.name: (place(line.start), place(line.end)) for line in system.lines}
+
+
+def line_maker(system, options):
+    """make_line(system_line, comm) of SystemSolver: the HeldLine of the line on its
+    group's communicator, every line with the same ``options``."""
+    ends = start_ends(system)
+
+    def make_line(line, comm):
+        return HeldLine.of_system_line(line, *ends[line.name], comm, system.environment,
+                                       options)
+    return make_line
+
+
+def _end_values(mesh, values):
+    """(values at vertex 0, values at the last vertex) of the owned ``values``, on every
+    rank of the mesh. Collective on the mesh's communicator."""
+    first = values[0] if mesh.on_lower_boundary else np.zeros(np.shape(values)[1:])
+    last = values[-1] if mesh.on_upper_boundary else np.zeros(np.shape(values)[1:])
+    return mesh.global_sum(np.asarray(first, float)), mesh.global_sum(np.asarray(last, float))
+
+
+@dataclass
+class LineRecord:
+    """A converged line's last step as a single line's result file holds it: this
+    rank's ``vertex`` datasets and restart ``state`` (outputs.restart_state), its
+    ``attributes`` and ``units`` ({dataset: unit}, {attribute: unit}), its end
+    ``tensions`` (2,), N (n.t at S = 0 and S = L), and its mesh's ``elements``."""
+
+    vertex: dict
+    state: dict
+    attributes: dict
+    units: tuple
+    tensions: np.ndarray
+    elements: int
+
+
+def line_record(line):
+    """The LineRecord of a converged HeldLine (line_table.final_record: the terms' and
+    reports' outputs, r absolute, the effective tension), with its converged,
+    iterations, stable, load factor and ranks. Collective on the line's communicator."""
+    problem = line.problem
+    vertex, attributes = line_table.final_record(problem)
+    stable = line.stable()
+    attributes.update(converged=1, stop_reason="converged", iterations=line.iterations,
+                      stable=-1 if stable is None else int(stable), load_factor=1.0,
+                      energy=problem.energy(), ranks=line.comm.getSize())
+    tensions = np.array(_end_values(problem.mesh, vertex["effective_tension"]))
+    datasets, scalars = problem.units()
+    # final_record adds the effective tension of a plain rod, with the riser numbers' unit
+    datasets = {"effective_tension": riser_numbers.DATASET_UNITS["effective_tension"],
+                **datasets}
+    return LineRecord(vertex, outputs.restart_state(problem), attributes,
+                      (datasets, scalars), tensions, problem.mesh.n_elements)
+
+
+def _shapes(arrays):
+    return {name: (np.shape(value)[1:], np.asarray(value).dtype.str)
+            for name, value in arrays.items()}
+
+
+def _empty(shapes):
+    return {name: np.zeros((0,) + tuple(shape), dtype=dtype)
+            for name, (shape, dtype) in shapes.items()}
+
+
+def gathered_lines(solver):
+    """{line index: LineRecord} on every rank: this rank's own rows of its group's
+    lines, zero rows of the others' (their names and shapes, attributes, units and
+    tensions shared from the groups' roots). Collective."""
+    mine = {k: line_record(line) for k, line in solver.lines.items()}
+    shared = solver.placement.share({k: replace(record, vertex=_shapes(record.vertex),
+                                                state=_shapes(record.state))
+                                     for k, record in mine.items()})
+    return {k: mine[k] if k in mine else replace(record, vertex=_empty(record.vertex),
+                                                 state=_empty(record.state))
+            for k, record in shared.items()}
+
+
+def check_finite(results):
+    """RodDivergedError unless every number of the equilibrium is finite: no NaN is
+    ever written or returned as a result."""
+    numbers = ([b.position for b in results.bodies.values()]
+               + [b.stiffness for b in results.bodies.values()]
+               + list(results.points.values()) + list(results.end_forces.values())
+               + list(results.end_tensions.values()))
+    if not all(np.all(np.isfinite(value)) for value in numbers):
+        raise RodDivergedError("system: the equilibrium holds non-finite numbers (NaN or "
+                               "inf); nothing is written")
+
+
+def table_paths(table, system):
+    """{line name or 'system': CSV path} of ``table`` (FILE.csv -> FILE_<line>.csv and
+    FILE_system.csv)."""
+    stem, extension = os.path.splitext(table)
+    names = [line.name for line in system.lines] + ["system"]
+    return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
+
+
+def check_outputs(comm, system, output, table):
+    """Refuse, before any work, a result file or a table that could not be written
+    (io/results.check_output_path, line_table.check_table_path). Collective."""
+    if output:
+        io.check_output_path(output, comm)
+    if table:
+        for path in table_paths(table, system).values():
+            line_table.check_table_path(path, output, comm)
+
+
+def system_datasets(system, results):
+    """({name: array}, {name: unit}) of the result file's ``system`` group."""
+    bodies = list(results.bodies.values())
+    lines = [line.name for line in system.lines]
+    data = {
+        "point_positions": np.array(list(results.points.values())).reshape(-1, 3),
+        "body_positions": np.array([b.position for b in bodies]).reshape(-1, 6),
+        "body_rotations": np.array([b.rotation for b in bodies]).reshape(-1, 3, 3),
+        "body_stiffness": np.array([b.stiffness for b in bodies]).reshape(-1, 6, 6),
+        "body_stiffness_reference": np.array([b.reference for b in bodies]).reshape(-1, 3),
+        "body_stiffness_moment": np.array([b.moment for b in bodies]).reshape(-1, 3),
+        "body_stiffness_asymmetry": np.array([b.asymmetry for b in bodies]),
+        "end_forces": np.array([results.end_forces[n] for n in lines]).reshape(-1, 2, 3),
+        "end_tensions": np.array([results.end_tensions[n] for n in lines]).reshape(-1, 2),
+        "line_converged": np.array([results.lines_converged[n] for n in lines], dtype=float),
+    }
+    units = {"point_positions": "m", "body_positions": "m, m, m, rad, rad, rad",
+             "body_rotations": "1", "body_stiffness": "N/m, N, N m/rad (rows F, M; "
+             "columns dX, dtheta)", "body_stiffness_reference": "m",
+             "body_stiffness_moment": "N m", "body_stiffness_asymmetry": "1",
+             "end_forces": "N", "end_tensions": "N", "line_converged": "1"}
+    return data, units
+
+
+def write_file(comm, output, system, results, records, text, notes):
+    """The system's result file (io/system_results.py): a group per line, the group
+    ``system``, the input file's text and the reader's notes. Collective."""
+    writer = SystemWriter(output, comm)
+    try:
+        for k, line in enumerate(system.lines):
+            record = records[k]
+            writer.write_line(line.name, record.vertex, record.state, record.attributes,
+                              record.units)
+        data, units = system_datasets(system, results)
+        attributes = {"converged": int(results.converged), "iterations": results.iterations,
+                      "halvings": results.halvings, "residual": results.residual,
+                      "load_factor": results.load_factor, "ranks": comm.getSize(),
+                      "point_names": ",".join(results.points),
+                      "body_names": ",".join(results.bodies),
+                      "line_names": ",".join(line.name for line in system.lines),
+                      "input_text": text or "", "notes": "\n".join(notes)}
+        units.update({"converged": "1", "iterations": "1", "halvings": "1",
+                      "residual": "1", "load_factor": "1", "ranks": "1",
+                      "point_names": "text", "body_names": "text", "line_names": "text",
+                      "input_text": "text", "notes": "text", "written": "text"})
+        writer.finish_system(data, attributes, units)
+        writer = None
+    finally:
+        if writer is not None:
+            writer.abort()
+
+
+def ends_rows(system, results):
+    """The text of FILE_system.csv: a row per line end."""
+    rows = ["line,end,to,force_x (N),force_y (N),force_z (N),tension (N)"]
+    for line in system.lines:
+        forces, tensions = results.end_forces[line.name], results.end_tensions[line.name]
+        for j, (which, connection) in enumerate((("start", line.start), ("end", line.end))):
+            rows.append(",".join([line.name, which, connection.to]
+                                 + [f"{v:.12g}" for v in forces[j]]
+                                 + [f"{tensions[j]:.12g}"]))
+    return "\n".join(rows) + "\n"
+
+
+def write_tables(comm, solver, table, system, results, records):
+    """FILE_<line>.csv (a single line's table, written by the line's group) for every
+    line and FILE_system.csv (rank 0). Collective on ``comm``."""
+    paths = table_paths(table, system)
+
+    def write_all():
+        for k, line in solver.lines.items():
+            name = system.lines[k].name
+            record = records[k]
+            line_table.write_tables(paths[name], line.comm, record.vertex,
+                                    record.attributes, record.units)
+        if comm.getRank() == 0:
+            partial = paths["system"] + ".partial"
+            line_table._write(paths["system"], partial, ends_rows(system, results))
+    on_every_rank(comm, write_all)
+
+
+def report_lines(system, results, ranks):
+    """The run's lines: the equilibrium's iterations and residual, a table of the
+    bodies' poses, the lines' end tensions and stability (a saddle in capitals), each
+    body's stiffness diagonal."""
+    lines = [f"petsc_rod: system of {len(system.lines)} line(s), {len(system.points)} "
+             f"point(s), {len(system.bodies)} body(ies) on {ranks} rank(s): equilibrium in "
+             f"{results.iterations} Newton iteration(s) ({results.halvings} halving(s) of "
+             f"the load step), scaled residual {results.residual:.3g}"]
+    if results.bodies:
+        lines.append(f"  {'body':<12} {'x (m)':>12} {'y (m)':>12} {'z (m)':>12} "
+                     f"{'roll (deg)':>11} {'pitch (deg)':>11} {'yaw (deg)':>11}")
+        for name, body in results.bodies.items():
+            x = body.position
+            angles = np.degrees(x[3:])
+            lines.append(f"  {name:<12} {x[0]:12.4f} {x[1]:12.4f} {x[2]:12.4f} "
+                         f"{angles[0]:11.5f} {angles[1]:11.5f} {angles[2]:11.5f}")
+    free = [p.name for p in system.points if p.kind == "free"]
+    for name in free:
+        x = results.points[name]
+        lines.append(f"  point {name}: ({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m")
+    lines.append(f"  {'line':<12} {'start':>10} {'T start (kN)':>13} {'end':>10} "
+                 f"{'T end (kN)':>13} {'|F| end (kN)':>13} {'stable':>7}")
+    verdicts = {1: "yes", 0: "SADDLE", -1: "-"}             # the file's stable codes
+    for line in system.lines:
+        tension = results.end_tensions[line.name] / 1e3
+        force = np.linalg.norm(results.end_forces[line.name][1]) / 1e3
+        stable = verdicts[int(results.lines[line.name].scalars["stable"])]
+        lines.append(f"  {line.name:<12} {line.start.to:>10} {tension[0]:13.3f} "
+                     f"{line.end.to:>10} {tension[1]:13.3f} {force:13.3f} {stable:>7}")
+    for name, body in results.bodies.items():
+        diagonal = ", ".join(f"{v:.6g}" for v in np.diag(body.stiffness))
+        lines.append(f"  body {name}: stiffness diagonal (N/m x3, N m/rad x3) {diagonal}; "
+                     f"asymmetry {body.asymmetry:.2g}")
+    return lines
+
+
+def discard_tables(comm, table, system, say):
+    """After a system that found no equilibrium: no table is written, and the tables an
+    earlier run left at ``table``'s paths are removed (line_table.discard), said in one
+    line. Collective."""
+    paths = table_paths(table, system).values()
+    found = [path for path in paths if os.path.exists(path)]
+    for path in paths:
+        line_table.discard(path, comm, lambda line: None)
+    say(f"petsc_rod: no tables written (-rod_table {table}): no equilibrium"
+        + (f"; removed {len(found)} table(s) of an earlier run" if found else ""))
+
+
+def run_system(comm, system, settings, line_options, say, output=None, table=None,
+               text=None, notes=(), interrupts=None):
+    """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
+    equilibrium (SystemSolver.solve), each body's stiffness, each line's record, the
+    result file and the tables when asked; the lines destroyed. ``interrupts``
+    (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
+    ends the run before anything is written (RodInterrupted). Returns the
+    SystemResults. RodInputError for a system the checks refuse (exit 2),
+    RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
+    RodDivergedError, its Newton or a line not converged after its halvings),
+    RodDivergedError for non-finite numbers (exit 4); nothing is written then.
+    Collective."""
+    on_every_rank(comm, system.check)
+    check_outputs(comm, system, output, table)
+    solver = SystemSolver(system, line_maker(system, line_options), comm,
+                          settings=settings)
+    try:
+        try:
+            found = solver.solve()
+        except RodDivergedError as error:
+            if table:
+                discard_tables(comm, table, system, say)
+            # a Newton or a line that did not converge, the halvings spent: the single
+            # line's exit 3, but no file (there is no equilibrium to write)
+            raise RodNotConvergedError(str(error)) from None
+        number = 0 if interrupts is None else interrupts.received()
+        if number:
+            raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
+                                 "system's equilibrium was found; nothing written",
+                                 number)
+        stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+        records = gathered_lines(solver)
+        mpi = comm.tompi4py()
+        lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
+                                    records[k].elements, records[k].units)
+                 for k, line in enumerate(system.lines)}
+        bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
+                                     np.asarray(found.rotations[b.name]),
+                                     stiffness[b.name].matrix, stiffness[b.name].reference,
+                                     stiffness[b.name].moment, stiffness[b.name].asymmetry)
+                  for b in system.bodies}
+        names = [line.name for line in system.lines]
+        results = SystemResults(
+            dict(found.points), bodies,
+            {n: found.end_forces[k] for k, n in enumerate(names)},
+            {n: records[k].tensions for k, n in enumerate(names)},
+            {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
+            lines, found.load_factor == 1.0, found.iterations, found.halvings,
+            found.residual, found.load_factor)
+        check_finite(results)
+        for line in report_lines(system, results, comm.getSize()):
+            say(line)
+        if output:
+            write_file(comm, output, system, results, records, text, notes)
+        if table:
+            write_tables(comm, solver, table, system, results, records)
+        return results
+    finally:
+        solver.destroy()
+
+
+def solve_system(system, comm=None, output=None, say=None, options=None, table=None,
+                 notes=()):
+    """Solve ``system`` (api.System) on the ranks of ``comm`` (a PETSc communicator;
+    default PETSc.COMM_WORLD), each line on its group of ranks; collective.
+    ``output``: the system's result file (HDF5, docs/output.md) as -rod_output;
+    ``table``: FILE.csv, the tables FILE_<line>.csv and FILE_system.csv as -rod_table;
+    ``say(line)`` gets the command line's lines (None: silent), ``notes`` (the
+    reader's, read_moordyn's second value) said first; ``options`` {name without
+    ``rod_``: value}: 'system_steps' and every line's solver options (LINE_OPTIONS:
+    {'al_rtol': 1e-10}). Returns a SystemResults."""
+    from petsc4py import PETSc
+
+    comm = comm or PETSc.COMM_WORLD
+    say = say or (lambda line: None)
+    settings, line_options = on_every_rank(comm, split_options, options)
+    for note in notes:
+        say(f"petsc_rod: note: {note}")
+    return run_system(comm, system, settings, line_options, say, output, table,
+                      notes=notes)

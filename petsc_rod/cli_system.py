@@ -1,0 +1,153 @@
+"""``python -m petsc_rod -rod_system FILE``: a system of lines, points and bodies read
+from a MoorDyn version 2 input file, solved on the path the Python API's solve_system
+takes (api/system_run.py), with the command line's options, lines and exit codes
+(docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 3 no
+equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not be
+written).
+
+Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
+-rod_system_body_load, -rod_system_steps), the outputs (-rod_output, -rod_table) and
+the line solver's (-rod_al_*, -rod_max_halvings: every line the same); every other
+-rod_* option describes a single line's scene or load path, which the file gives, and is
+refused in one line naming them. It sits above system/ and cli/ (it needs both: the
+option table, and the system's run), run by __main__.py when -rod_system is given."""
+
+import dataclasses
+import os
+import sys
+
+import numpy as np
+from petsc4py import PETSc
+
+from petsc_rod.api.system_run import LINE_OPTIONS, run_system
+from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
+from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
+                                   check_snes_type, check_substructuring_switches,
+                                   help_text, read_options, unused_options, whole_values)
+from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.signals import Interrupts
+from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
+from petsc_rod.io.same_file import replaced_input
+from petsc_rod.model.moordyn import read_moordyn
+from petsc_rod.system.equilibrium import Settings
+from petsc_rod.tables import read_text
+
+# What a system's run takes beside the line solver's options (LINE_OPTIONS).
+SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
+                  "rod_system_steps", "rod_output", "rod_table")
+
+
+def refused_options(given):
+    """The -rod_* options of ``given`` a system does not take (a single line's scene and
+    load path), in the table's order."""
+    taken = set(SYSTEM_OPTIONS) | {f"rod_{name}" for name in LINE_OPTIONS}
+    return [name for name in BY_NAME if name in given and name not in taken]
+
+
+def body_loads(text, system):
+    """``system`` with the loads of -rod_system_body_load ``text`` (NAME,fx,fy,fz,mx,my,mz
+    separated by ':') added to its bodies' own."""
+    bodies = {body.name: body for body in system.bodies}
+    for part in text.split(":"):
+        fields = [field.strip() for field in part.split(",")]
+        if len(fields) != 7:
+            raise RodInputError(f"-rod_system_body_load {part!r}: expected NAME,fx,fy,fz,"
+                                "mx,my,mz (N, N m), several separated by ':'")
+        name = fields[0]
+        if name not in bodies:
+            raise RodInputError(f"-rod_system_body_load {part!r}: no body {name!r} in the "
+                                f"system; its bodies: {', '.join(bodies) or 'none'}")
+        try:
+            load = np.array([float(v) for v in fields[1:]])
+        except ValueError:
+            raise RodInputError(f"-rod_system_body_load {part!r}: six numbers after the "
+                                "name (fx, fy, fz in N, mx, my, mz in N m)") from None
+        if not np.all(np.isfinite(load)):
+            raise RodInputError(f"-rod_system_body_load {part!r}: finite numbers only")
+        body = bodies[name]
+        bodies[name] = dataclasses.replace(body, load=tuple(np.add(body.load, load)))
+    return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
+
+
+def check_outputs_kept(values, comm):
+    """Refuse an output that names an input (the system file, an options file), which
+    writing it would replace. Collective: rank 0 decides."""
+    clash = None
+    if comm.getRank() == 0:
+        written = [("-rod_output", values["rod_output"]), ("-rod_table", values["rod_table"])]
+        read = [("-options_file", path) for path in every_options_file(sys.argv)]
+        read.append(("-rod_system", values["rod_system"]))
+        clash = replaced_input(written, read)
+    clash = comm.tompi4py().bcast(clash, root=0)
+    if clash:
+        raise RodInputError(clash)
+
+
+def prepared(values, given):
+    """(System, notes, the file's text, Settings, the lines' options) of the run's
+    option ``values``; RodInputError for what a system cannot take."""
+    refused = refused_options(given)
+    if refused:
+        raise RodInputError(f"{', '.join('-' + name for name in refused)}: option(s) of "
+                            "a single line's scene or load path, not of a system (the "
+                            f"-rod_system file {values['rod_system']} describes its lines); "
+                            "drop them")
+    path = values["rod_system"]
+    system, notes = read_moordyn(path, values["rod_system_element_length"])
+    if values["rod_system_body_load"]:
+        system = body_loads(values["rod_system_body_load"], system)
+    settings = Settings() if values["rod_system_steps"] is None else Settings(
+        load_steps=values["rod_system_steps"])
+    texts = whole_values()
+    options = {name.removeprefix("rod_"): texts[name] for name in given
+               if name.removeprefix("rod_") in LINE_OPTIONS}
+    return system, notes, read_text(path, "-rod_system"), settings, options
+
+
+def run(comm=None):
+    """The system's run on ``comm`` (default PETSc.COMM_WORLD); returns the exit code."""
+    comm = comm or PETSc.COMM_WORLD
+    database = PETSc.Options()
+
+    def say(text):
+        PETSc.Sys.Print(text, comm=comm)
+
+    try:
+        with Interrupts(comm) as interrupts, AgreedFailures(comm):
+            check_same_on_every_rank(comm)
+            values, given = read_options()
+            check_anderson_depth()
+            check_snes_type()
+            check_substructuring_switches()
+            if database.hasName("help"):
+                for line in help_text():
+                    say(line)
+            system, notes, text, settings, options = on_every_rank(comm, prepared, values,
+                                                                  given)
+            check_outputs_kept(values, comm)
+            if database.hasName("help"):
+                return 0
+            for note in notes:
+                say(f"petsc_rod: note: {note}")
+            output, table = values["rod_output"], values["rod_table"]
+            results = run_system(comm, system, settings, options, say, output, table,
+                                 text, notes, interrupts)
+            written = [f"result {output}"] if output else []
+            if table:
+                stem, extension = os.path.splitext(table)
+                written.append(f"tables {stem}_<line>{extension or '.csv'}, "
+                               f"{stem}_system{extension or '.csv'}")
+            say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
+                f"Newton iteration(s), residual {results.residual:.3g}"
+                + (f"; {'; '.join(written)}" if written else ""))
+            for name in unused_options():
+                say(f"petsc_rod: warning: option -{name} was set but not used")
+            return 0
+    except RodError as error:
+        say(f"petsc_rod: error: {error}")
+        database.setValue("options_left", "0")
+        return error.exit_code
+    except PETSc.Error as error:
+        say(f"petsc_rod: error: {petsc_failure(error)}")
+        database.setValue("options_left", "0")
+        return RodDivergedError.exit_code

@@ -1,0 +1,138 @@
+"""The system's run with real lines (api.solve_system: system/equilibrium.SystemSolver
+with every line a system/held_line.HeldLine, api/system_run.py), on one rank and on all
+(under ``mpiexec -n 2`` each line on its own rank, or one line over both), issue 49
+point 6:
+
+(a) a system of one line between fixed points is the single-line solver's line
+    (api.solve of the same Model): its end forces, end tensions and centreline;
+(b) a line split at a massless free point is the unsplit line: the point where the
+    unsplit line's vertex of that arc length is, and the same end forces.
+"""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import (Connection, End, Environment, Model, Point, System, SystemLine,
+                           UniformLine, solve, solve_system)
+
+pytestmark = pytest.mark.solver
+
+TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
+# an elastic catenary: 100 m of 10 N/m, EA 1e5 N, pins 80 m across and 20 m up
+ANCHOR, FAIRLEAD = (0.0, 0.0, 0.0), (80.0, 0.0, 20.0)
+
+
+def uniform(length, elements):
+    return UniformLine(length=length, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -10.0),
+                       axial_stiffness=1e5, elements=elements)
+
+
+def whole_line():
+    return solve(Model(line=uniform(100.0, 40), start=End.anchor(ANCHOR),
+                       end=End.anchor(FAIRLEAD), options=TIGHT))
+
+
+def test_one_line_between_fixed_points_is_the_single_line(tmp_path):
+    """Also its result file (on 2 ranks: the one line's group is both ranks): the line's
+    group holds the single line's centreline."""
+    import h5py
+    system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
+                                      Connection("B")),),
+                    points=(Point("A", "fixed", ANCHOR), Point("B", "prescribed", FAIRLEAD)),
+                    environment=Environment())
+    folder = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path))
+    found = solve_system(system, options=TIGHT, output=f"{folder}/one.h5")
+    single = whole_line()
+    with h5py.File(f"{folder}/one.h5", "r") as f:
+        assert np.abs(f["lines/one/r"][()] - single.along_line(["r"])["r"]).max() < 1e-7
+        assert f["lines/one"].attrs["ranks"] == PETSc.COMM_WORLD.getSize()
+        assert f["lines/one/effective_tension"].attrs["units"] == "N"
+    forces = found.end_forces["one"]
+    assert forces[0] == pytest.approx(single.scalars["start_force"], rel=1e-9)
+    assert forces[1] == pytest.approx(single.scalars["end_force"], rel=1e-9)
+    line = found.lines["one"]
+    along, reference = line.along_line(["r", "effective_tension"]), single.along_line()
+    assert np.abs(along["r"] - reference["r"]).max() < 1e-9 * 100.0
+    t = reference["d3"] / np.linalg.norm(reference["d3"], axis=1)[:, None]
+    tension = np.einsum("ij,ij->i", reference["n"], t)[[0, -1]]    # n.t at the ends
+    assert found.end_tensions["one"] == pytest.approx(tension, rel=1e-9)
+    assert along["effective_tension"][[0, -1]] == pytest.approx(tension, rel=1e-9)
+    assert found.converged and found.iterations == 0 and found.lines_converged["one"]
+
+
+def test_a_line_split_at_a_massless_free_point_is_the_unsplit_line():
+    """40 m + 60 m joined at a free point J (no mass, no volume), started 3 m off the
+    unsplit line: J where the unsplit line's vertex at S = 40 m is, the fairlead's force
+    the unsplit line's."""
+    system = System(lines=(SystemLine("lower", uniform(40.0, 16), Connection("A"),
+                                      Connection("J")),
+                           SystemLine("upper", uniform(60.0, 24), Connection("J"),
+                                      Connection("B"))),
+                    points=(Point("A", "fixed", ANCHOR), Point("J", "free", (30.0, 0.0, -12.0)),
+                            Point("B", "fixed", FAIRLEAD)),
+                    environment=Environment())
+    found = solve_system(system, options=TIGHT)
+    single = whole_line()
+    r = single.along_line(["r"])["r"]
+    assert found.converged and found.iterations >= 2
+    assert np.abs(found.points["J"] - r[16]).max() < 1e-6
+    assert found.end_forces["upper"][1] == pytest.approx(single.scalars["end_force"],
+                                                         rel=1e-7)
+    assert found.end_forces["lower"][0] == pytest.approx(single.scalars["start_force"],
+                                                         rel=1e-7)
+    # J's balance: the two lines' forces on it cancel
+    J = found.end_forces["lower"][1] + found.end_forces["upper"][0]
+    assert np.abs(J).max() < 1e-6 * np.abs(found.end_forces["upper"]).max()
+
+
+class Signalled:
+    """An Interrupts (cli/signals.py) whose ranks received SIGTERM."""
+
+    def received(self):
+        return 15
+
+    @staticmethod
+    def name(number):
+        return "SIGTERM"
+
+
+def test_a_stop_signal_ends_the_run_before_anything_is_written(tmp_path):
+    import os
+
+    from petsc_rod.api.system_run import run_system
+    from petsc_rod.errors import RodInterrupted
+    from petsc_rod.system.equilibrium import Settings
+    system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
+                                      Connection("B")),),
+                    points=(Point("A", "fixed", ANCHOR), Point("B", "fixed", FAIRLEAD)))
+    out = str(tmp_path / "system.h5") if PETSc.COMM_WORLD.getSize() == 1 else None
+    with pytest.raises(RodInterrupted) as stopped:
+        run_system(PETSc.COMM_WORLD, system, Settings(), TIGHT, lambda line: None,
+                   output=out, interrupts=Signalled())
+    assert stopped.value.exit_code == 143 and "SIGTERM" in str(stopped.value)
+    assert out is None or not os.listdir(tmp_path)
+
+
+def test_options_a_system_does_not_take_are_refused():
+    from petsc_rod.errors import RodInputError
+    system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),
+                                      Connection("B")),),
+                    points=(Point("A", "fixed", ANCHOR), Point("B", "fixed", FAIRLEAD)))
+    with pytest.raises(RodInputError, match="'length': not an option of a system"):
+        solve_system(system, options={"length": 3.0})
+    with pytest.raises(RodInputError, match="system_steps 0"):
+        solve_system(system, options={"system_steps": 0})
+    with pytest.raises(RodInputError, match="-rod_al_rtol"):
+        solve_system(system, options={"al_rtol": "tight"})
+
+
+def test_a_single_line_run_refuses_a_system():
+    """cli.main.run (the single line's command line, a sweep's case) given -rod_system
+    or a system's option: exit 2 in one line, no default line run in its place."""
+    from petsc_rod.cli import main
+    try:
+        for texts in ({"rod_system": "spread.dat"}, {"rod_system_steps": "2"}):
+            assert main.run(PETSc.COMM_WORLD, texts) == 2
+    finally:
+        PETSc.Options().delValue("options_left")      # set by the refusal
