@@ -79,6 +79,7 @@ from petsc_rod.model.line import UniformLine
 from petsc_rod.model.end import End
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
+from petsc_rod.model.system_check import connection_position
 from petsc_rod.quantities.riser_numbers import points_on_held_ends
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.scene import EndState
@@ -492,3 +493,22 @@ class HeldLine:
     def destroy(self):
         """Free the line's PETSc objects (all made in _build). Collective."""
         self._release()
+
+
+def held_lines(system, options=None):
+    """The ``make_line(system_line, comm)`` of system/equilibrium.SystemSolver for the
+    real lines of ``system`` (a model.system.System): each a HeldLine whose ends are
+    first where the system's points and bodies put its connections at their start
+    positions (system_check.connection_position), in the system's environment, tuned
+    by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
+    off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
+    line once at its equilibrium (SystemSolver.unstable_lines, HeldLine.stable)
+    instead of after each of its re-solves."""
+    options = {"al_stability": 0, **(options or {})}
+
+    def make_line(line, comm):
+        start, end = (connection_position(system.node(c.to), c)
+                      for c in (line.start, line.end))
+        return HeldLine.of_system_line(line, start, end, comm, system.environment, options)
+
+    return make_line
