@@ -10,8 +10,10 @@ elements, 4 m by default: 104 a line), makes the SystemSolver with real lines
 (system/held_line.held_lines; the lines dealt over the ranks by system/placement.py)
 and solves the coupled equilibrium under the file's steady loads; the time is the
 solver's making and its solve (the lines' first solves included; not the imports nor
-the reading). Prints every run as it ends, then the medians, the ratio of the
-medians and the load average before and after (the machine's other work slows both).
+the reading). Prints every run as it ends, with each rank's CPU time, then the medians,
+the ratio of the medians and the load average before and after: the machine's other
+work slows both; the CPU times' ratio it changes less (a rank waiting in MPI polls, so
+its waits count as CPU time too).
 """
 
 import json
@@ -35,16 +37,17 @@ def run(path, element_length):
     from petsc_rod.system.held_line import held_lines
     system, _ = read_moordyn(path, element_length=element_length)
     PETSc.COMM_WORLD.barrier()
-    clock = time.perf_counter()
+    clock, cpu = time.perf_counter(), time.process_time()
     solver = SystemSolver(system, held_lines(system), PETSc.COMM_WORLD)
     try:
         result = solver.solve()
     finally:
         solver.destroy()
     seconds = time.perf_counter() - clock
+    cpus = PETSc.COMM_WORLD.tompi4py().gather(time.process_time() - cpu)
     offsets = np.array([result.bodies[b.name][0] - b.position[0] for b in system.bodies])
     if PETSc.COMM_WORLD.rank == 0:
-        print(json.dumps({"ranks": PETSc.COMM_WORLD.size, "seconds": seconds,
+        print(json.dumps({"ranks": PETSc.COMM_WORLD.size, "seconds": seconds, "cpu": cpus,
                           "iterations": result.iterations, "lines": len(system.lines),
                           "elements": int(sum(l.line.sections[0][2] for l in system.lines)),
                           "surge": [float(offsets.min()), float(offsets.max())],
@@ -66,19 +69,24 @@ def main(pairs=2, element_length=4.0, path=FILE):
     before = os.getloadavg()
     print(f"{path}: load average {before[0]:.1f} {before[1]:.1f} {before[2]:.1f}, "
           f"{os.cpu_count()} cores", flush=True)
-    times = {1: [], 2: []}
+    times, cpus = {1: [], 2: []}, {1: [], 2: []}
     for pair in range(pairs):
         for ranks in ((1, 2) if pair % 2 == 0 else (2, 1)):
             result = launch(ranks, path, element_length)
             times[ranks].append(result["seconds"])
-            print(f"  {ranks} rank(s): {result['seconds']:.1f} s, Newton "
+            cpus[ranks].append(max(result["cpu"]))
+            print(f"  {ranks} rank(s): {result['seconds']:.1f} s (CPU of each rank "
+                  f"{', '.join(f'{c:.1f}' for c in result['cpu'])} s), Newton "
                   f"{result['iterations']}, {result['lines']} lines, {result['elements']} "
                   f"elements, surge {result['surge'][0]:.4f}-{result['surge'][1]:.4f} m, "
                   f"unstable {result['unstable']}, load {os.getloadavg()[0]:.1f}", flush=True)
     one, two = np.median(times[1]), np.median(times[2])
     after = os.getloadavg()
     print(f"median 1 rank {one:.1f} s, 2 ranks {two:.1f} s: 2 ranks {one / two:.2f} times as "
-          f"fast; load average after {after[0]:.1f} {after[1]:.1f} {after[2]:.1f}")
+          f"fast; load average after {after[0]:.1f} {after[1]:.1f} {after[2]:.1f}\n"
+          f"CPU (the busiest rank's) median 1 rank {np.median(cpus[1]):.1f} s, 2 ranks "
+          f"{np.median(cpus[2]):.1f} s: {np.median(cpus[1]) / np.median(cpus[2]):.2f} (what "
+          "an idle machine's ratio would be near, were the ranks not waiting on each other)")
 
 
 if __name__ == "__main__":

@@ -12,9 +12,9 @@ machine's load falls on all of them), each timed from the solver's making to its
 ``held`` the spar held where the deck puts it (the deck's coupled fairleads: the lines'
 equilibrium, then the 6 x 6); ``free`` the spar free on its lines at rest; ``thrust``
 the spar free under 800 kN of surge force at 90 m above its reference point. Prints
-each case's wall and CPU times, their median and lowest (the CPU time is what an
-idle machine's wall time would be, near enough, on one rank), the Newton iterations, the offset, the
-load average before and after.
+each case's wall and CPU times, their median and lowest (on one rank the CPU time is
+near what an idle machine's wall time would be), the Newton iterations, the offset, the
+stiffness's main entries, the lines found unstable, the load average before and after.
 """
 
 import os
