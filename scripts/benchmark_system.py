@@ -21,13 +21,16 @@ import os
 import sys
 import time
 
-import numpy as np
-from petsc4py import PETSc
+# one BLAS thread, as python -m petsc_rod runs: one rank does not borrow another core
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from petsc_rod.model.moordyn import read_moordyn
-from petsc_rod.system.equilibrium import SystemSolver
-from petsc_rod.system.held_line import held_lines
-from petsc_rod.validation.oc3_hywind import spar
+import numpy as np  # noqa: E402
+from petsc4py import PETSc  # noqa: E402
+
+from petsc_rod.model.moordyn import read_moordyn  # noqa: E402
+from petsc_rod.system.equilibrium import SystemSolver  # noqa: E402
+from petsc_rod.system.held_line import held_lines  # noqa: E402
+from petsc_rod.validation.oc3_hywind import spar  # noqa: E402
 
 DECK = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests",
                     "data", "moordyn", "OC3Hywind_MoorDyn.dat")
