@@ -110,3 +110,23 @@ def test_newton_stops_where_the_lines_forces_creep_below_the_floor():
     assert result.iterations <= 12 and result.halvings == 0         # measured 9
     assert result.residual < 1e-7
     assert result.bodies["floater"] == pytest.approx(exact.bodies["floater"], abs=1e-6)
+
+
+def test_the_free_oc3_spar_under_thrust_goes_where_the_catenarys_spar_goes():
+    """800 kN of surge force 90 m up (2 m elements): the spar goes where it goes on
+    elastic catenaries (28.2 m downwind, 0.1 rad of pitch) to 1 mm and 1e-6 rad
+    (measured 0.15 mm and 3e-8 rad: the seabed's compliance and the touchdown's
+    discretisation), and its lines' horizontal pull balances the force to the
+    residual's floor."""
+    thrust = 8e5
+    deck, _ = read_moordyn(DECK, element_length=2.0)
+    system = spar(deck, load=(thrust, 0.0, 0.0, 0.0, 90.0 * thrust, 0.0))
+    result, _ = solve_system(system, held_lines(system), stiffness=False)
+    closed, _ = solve_system(system, lambda line, comm: CatenaryLine(
+        line.line.sections[0][1], 698.094, 384.243e6, seabed=-320.0), stiffness=False)
+    pose, expected = result.bodies["spar"], closed.bodies["spar"]
+    assert expected[0] > 25.0 and expected[4] > 0.05
+    assert pose[:3] == pytest.approx(expected[:3], abs=1e-3)
+    assert pose[3:] == pytest.approx(expected[3:], abs=1e-6)
+    pull = result.end_forces[:, 1, :2].sum(axis=0)
+    assert pull == pytest.approx([-thrust, 0.0], abs=1e-7 * np.abs(result.end_forces).max())
