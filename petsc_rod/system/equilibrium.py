@@ -76,7 +76,8 @@ class Settings:
     force scale x the length scale)) that ends Newton; ``floor``: a scaled residual
     below it that no step of the line search reduces is the lines' own accuracy (their
     end forces are converged to their tolerances, not to round-off) and is accepted;
-    ``max_iterations`` per attempt; ``load_steps``: the continuation's first step is
+    ``max_iterations`` per attempt (below the floor, two Newton steps in a row that do
+    not halve the residual end it too: the same accuracy); ``load_steps``: the continuation's first step is
     1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
     Newton step."""
 
@@ -157,7 +158,8 @@ class Equilibrium:
     (x, y, z, roll, pitch, yaw) (6,)}, ``rotations`` {name: R (3, 3)}, ``end_forces``
     (n_lines, 2, 3), N, on each line's start and end, ``load_factor`` (1 when
     complete), ``iterations`` (Newton's, over the continuation), ``residual`` (the scaled
-    norm)."""
+    norm), ``unstable`` (the names of the lines whose own equilibrium is a saddle of
+    their energy: SystemSolver.unstable_lines)."""
 
     points: dict
     bodies: dict
@@ -167,6 +169,7 @@ class Equilibrium:
     iterations: int
     halvings: int
     residual: float
+    unstable: tuple = ()
 
 
 class Layout:
@@ -459,6 +462,7 @@ class SystemSolver:
             return None, 0
         r, J = self.residual(state, loads, forces, stiffness)
         norm = np.linalg.norm(r[free] / scale[free])
+        stalled = 0
         for iteration in range(settings.max_iterations + 1):
             self.forces, self.stiffnesses = forces, stiffness
             if norm <= settings.rtol:
@@ -495,8 +499,16 @@ class SystemSolver:
                 self.failure = (f"the line search found no decrease of the residual "
                                 f"{norm:.3g}{full}")
                 return None, iteration
+            stalled = stalled + 1 if t_norm > 0.5 * norm else 0
             state, forces, stiffness, r, J, norm = (trial, t_forces, t_stiffness, t_r,
                                                     t_J, t_norm)
+            if norm <= settings.floor and stalled >= 2:
+                # An exact Jacobian's step at least halves a residual that is not the
+                # lines' own error: two steps in a row that did not are at the lines'
+                # accuracy (a line re-solved after a tiny move takes one step of its
+                # own iteration, and its end forces creep).
+                self.forces, self.stiffnesses, self.norm = forces, stiffness, norm
+                return state, iteration + 1
         self.failure = (f"Newton did not converge in {settings.max_iterations} "
                         f"iterations (residual {norm:.3g})")
         return None, settings.max_iterations
@@ -568,7 +580,18 @@ class SystemSolver:
         solved = self.evaluate(self.state)
         if solved[0]:
             self.forces, self.stiffnesses = solved[1], solved[2]
-        return self.result(factor, total, halvings)
+        return self.result(factor, total, halvings, self.unstable_lines())
+
+    def unstable_lines(self):
+        """The names of the lines whose equilibrium, where they stand, is not stable
+        (line.stable() False: a saddle of its energy), in the system's order. The lines
+        may be solved with their own stability test off during the iterations (a third
+        of a warm re-solve) and tested here once. A line without ``stable`` (a mock) is
+        not tested. Collective."""
+        verdicts = self.placement.share({k: getattr(line, "stable", lambda: None)()
+                                         for k, line in self.lines.items()})
+        return tuple(self.system.lines[k].name for k in sorted(verdicts)
+                     if verdicts[k] is False)
 
     def replace(self, system):
         """Take ``system``'s loads: RodInputError unless it differs from the solver's
@@ -588,14 +611,14 @@ class SystemSolver:
                                 "new one for any other change")
         self.system = system
 
-    def result(self, factor, iterations, halvings):
+    def result(self, factor, iterations, halvings, unstable=()):
         state, names = self.state, [b.name for b in self.system.bodies]
         points = {p.name: state.points[i].copy() for i, p in enumerate(self.system.points)}
         return Equilibrium(points,
                            dict(zip(names, state.bodies.positions)),
                            dict(zip(names, state.bodies.R.copy())),
                            self.forces.copy(), factor, iterations, halvings,
-                           float(self.norm))
+                           float(self.norm), unstable)
 
     # -- the lines' own results -------------------------------------------------------------
 
