@@ -39,8 +39,9 @@ Newton system, so every rank has the same numbers on any number of ranks.
 A line is made by ``make_line(system_line, comm)`` (comm: its group's PETSc.Comm,
 collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces() ->
 (2, 3)`` (N, on its start and end points), ``stiffness() -> (6, 6)`` (d end_forces.ravel()
-/ d(start, end)) and ``destroy()``; a line with a clamped end at a body also
-``solve(start, end, start_frame, end_frame)`` (the clamp's frame turns with the body),
+/ d(start, end)) and ``destroy()``; a line with a clamped or flex end at a body also
+``solve(start, end, start_frame, end_frame)`` (the clamp's frame, or the frame a flex
+joint's axis turns with, turns with the body),
 ``end_moments() -> (2, 3)`` (N m, added to the body's moment) and ``end_stiffness() ->
 (12, 12)`` (forces and moments against positions and rotations of both ends), mapped
 through [T; 0 I] (Linearised, lines_part).
@@ -225,7 +226,8 @@ class Layout:
         self.body_end = np.full((n, 2), -1)
         self.point_end = np.full((n, 2), -1)
         self.local = np.zeros((n, 2, 3))
-        # a clamped end at a body: its frame turns with the body, its moment acts on it
+        # a clamped or flex end at a body: its frame (a flex joint's axis) turns with the
+        # body, its moment acts on it
         self.turned = np.zeros((n, 2), dtype=bool)
         for k, line in enumerate(system.lines):
             for j, connection in enumerate((line.start, line.end)):
@@ -235,7 +237,7 @@ class Layout:
                 self._check(line.name, ("start", "end")[j], connection, kind,
                             system.points[i].kind if kind == "point" else "body")
                 if kind == "body":
-                    self.turned[k, j] = connection.kind == "clamp"
+                    self.turned[k, j] = connection.kind in ("clamp", "flex")
                     self.body_end[k, j] = i
                     self.ends[k, j] = self.body_dofs[i]
                     self.local[k, j] = connection.local
@@ -256,12 +258,6 @@ class Layout:
                 f"line {line}: {which}: a {connection.kind} end at the free point "
                 f"{connection.to}, which has no rotation to hold the end's frame: use kind "
                 "'pin', or a body")
-        if node_kind == "body" and connection.kind == "flex":
-            raise RodInputError(
-                f"line {line}: {which}: a flex end at the body {connection.to}: the "
-                "coupled equilibrium takes pinned and clamped ends at bodies (a flex "
-                "joint's axis turning with the body is not linearised yet); use 'pin' "
-                "or 'clamp'")
         if kind == "point" and np.any(np.asarray(connection.local, dtype=float) != 0):
             raise RodInputError(f"line {line}: {which}: local {connection.local!r} at the "
                                 f"point {connection.to}, which has no axes: leave it zero")

@@ -65,7 +65,11 @@ conjugate of the clamp's rotation (they differ by O(h) terms, so dF/dtheta is no
 [M]x in the rotation block); the forces' position block is symmetric without a current
 (to 7e-8 of the largest entry with extensible clamps, whose stretch rule is not the
 energy's). A clamp in a current has no end_stiffness (its drag's Jacobian columns at
-the clamp are not taken).
+the clamp are not taken). A flex joint's support frame D given to solve turns its axis,
+a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient at its
+(free) node, solved for like a clamp's, and its moment on the support is the joint's,
+-k (theta / sin theta) d3 x a (not at an extensible end: the joint acts in the local
+step there).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged), a
@@ -88,7 +92,10 @@ from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.model.end import End
+from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
+                                         slope_factor)
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.system import Body
@@ -247,6 +254,25 @@ def _moment_jacobian(F, h, stiffness, e, unknowns):
     return out
 
 
+def _joint_moment(k, d, a):
+    """The moment a flex joint of stiffness k exerts on its support, N m: -dE/ddelta for
+    the support turned by delta (its axis a -> a + delta x a), E = k theta^2 / 2,
+    theta = angle(d, a); as E depends on d and a through their relative turn only, it is
+    dE/domega = d x dE/dd = -k (theta / sin theta) d x a (k theta about a x d)."""
+    return -k * slope_factor(joint_angle(d, a)) * np.cross(d, a)
+
+
+def _joint_jacobians(k, d, a):
+    """(J_d, J_a), (3, 3) each: d _joint_moment = J_d dd + J_a da for unit d, a:
+    dG = -k (-f'' dc v + (theta / sin theta) dv), v = d x a, c = d.a, f'' the joint's
+    curvature factor (sin theta - theta cos theta) / sin^3 theta."""
+    theta = joint_angle(d, a)
+    v = np.cross(d, a)
+    f2, s = curvature_factor(theta), slope_factor(theta)
+    return (-k * (-f2 * np.outer(v, a) - s * skew(a)),
+            -k * (-f2 * np.outer(v, d) + s * skew(d)))
+
+
 def _point(name, value):
     point = np.asarray(value, dtype=float)
     if point.shape != (3,) or not np.all(np.isfinite(point)):
@@ -259,12 +285,14 @@ class HeldLine:
     PETSc communicator: the line's own; collective on it alone).
 
     ``span``: a model.model.Span (or a model.Model, whose one span is taken) with both
-    ends held (pin or clamp; a clamp's frame is held as given); ``environment``: the
+    ends held (pin or clamp; a clamp's frame as given, or as solve turns it; a pin may
+    carry a flex joint, whose axis solve turns with its support); ``environment``: the
     sea (model.sea.Environment; a Model's own by default); ``options``: -rod_* options
     without ``rod_`` that tune the solver ({'al_rtol': 1e-10}).
 
-    solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
-    end_moments() -> (2, 3); stiffness() -> (6, 6); stable() -> bool or None;
+    solve(start_position, end_position, start_frame=None, end_frame=None) -> bool;
+    end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
+    end_stiffness() -> (12, 12); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
     destroy(). ``iterations``: those of the last solve."""
 
@@ -286,6 +314,7 @@ class HeldLine:
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
         self.frames = (None, None)          # the clamps' frames last asked for
+        self.axes = {}
         self.iterations = 0
         self.converged = False
 
@@ -295,8 +324,9 @@ class HeldLine:
         ``start`` and ``end`` ((3,), m, absolute: where the system's points and bodies
         put its connections): a 'pin' connection a pinned End, 'flex' a pinned End with
         the connection's rotational stiffness (its axis the line's start direction),
-        'clamp' a clamped End in the reference frame (the body's frame is not passed
-        yet)."""
+        'clamp' a clamped End in the reference frame at the start (a system then passes
+        the frame turned with its body to solve, and a flex joint's support frame
+        likewise)."""
         def end_of(connection, position):
             kind = "clamp" if connection.kind == "clamp" else "pin"
             stiffness = connection.stiffness if connection.kind == "flex" else None
@@ -314,7 +344,7 @@ class HeldLine:
         import dataclasses
 
         def at(end_, position, frame):
-            if frame is None:
+            if frame is None or end_.kind != "clamp":
                 return dataclasses.replace(end_, position=position)
             return dataclasses.replace(end_, position=position,
                                        frame=tuple(float(v) for v in np.ravel(frame)))
@@ -342,6 +372,9 @@ class HeldLine:
                                                 self.built.solver)
         self.path = self.built.scene
         self.newton = self.built.own(NewtonSolver(self.problem))
+        # each flex joint's neutral axis at the reference frame (turned by a frame given)
+        self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
+                     for t in self.problem.terms if isinstance(t, FlexJoint)}
 
     def _release(self):
         if self.built is not None:          # its own objects and those it was given
@@ -368,17 +401,26 @@ class HeldLine:
         if self.problem is None or not self.converged:
             self._release()
             self._build(a, b, frames)
+            self._turn_joints(frames)
             return self._first()
         return self._walk(a - self.origin, b - self.origin, frames)
+
+    def _turn_joints(self, frames):
+        """Each flex joint's axis turned with its support's frame D (rows d1, d2, d3):
+        a = D^T D_ref a_0, the rotation that takes the reference frame's rows to D's."""
+        for e, (term, axis) in self.axes.items():
+            if frames[e] is not None:
+                term.axis = frames[e].T @ REFERENCE_FRAME @ axis
 
     def _frame(self, which, frame):
         """A clamped end's frame (3, 3) checked (None passes), or RodInputError."""
         if frame is None:
             return None
-        if getattr(self.span, which).kind != "clamp":
+        end = getattr(self.span, which)
+        if end.kind != "clamp" and end.stiffness is None:
             raise RodInputError(f"HeldLine.solve: a {which}_frame for a "
-                                f"{getattr(self.span, which).kind} end: only a clamp "
-                                "holds a frame")
+                                f"{end.kind} end: only a clamp or a flex joint holds a "
+                                "frame")
         q = np.asarray(frame, dtype=float)
         if (q.shape != (3, 3) or not np.all(np.isfinite(q))
                 or np.abs(q @ q.T - np.eye(3)).max() > 1e-9 or np.linalg.det(q) < 0):
@@ -401,10 +443,14 @@ class HeldLine:
         state = self.problem.state
         saved = state.snapshot()
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
+        axes = {e: term.axis for e, (term, _) in self.axes.items()}
         self.path.move(a, b, *frames)
+        self._turn_joints(frames)
         if self._run(PathSettings(steps=1, track_link=False)):
             self.path.hold(a, b, *frames)
             return True
+        for e, (term, _) in self.axes.items():
+            term.axis = axes[e]
         state.restore(saved)
         self.path.hold(ends[0].position, ends[1].position, ends[0].frame, ends[1].frame)
         self.problem.prepare(1.0)
@@ -511,7 +557,22 @@ class HeldLine:
         self._check_solved()
         mesh = self.mesh
         m = vertex_fields(self.problem)["m"]
-        return np.array([_at_vertex(mesh, m, 0), -_at_vertex(mesh, m, mesh.n_elements)])
+        moments = np.array([_at_vertex(mesh, m, 0), -_at_vertex(mesh, m, mesh.n_elements)])
+        for e, d, term in self._joint_tangents(field=True):
+            moments[e] = _joint_moment(term.k, d, term.axis)
+        return moments
+
+    def _joint_tangents(self, field=False):
+        """[(end, d, term)] of the flex joints: the unit end tangent d (3,) on every rank
+        (the slope field's with ``field``, else tau3). Collective."""
+        out = []
+        last = 2 * self.mesh.n_elements
+        tangents = (self.problem.state.node_directors()[:, 2] if field
+                    else self.problem.state.tau[:, 2])
+        for e, (term, _) in sorted(self.axes.items()):
+            d = self._node_values([tangents], [(0, last)[e]])[0, 0]
+            out.append((e, d / np.linalg.norm(d), term))
+        return out
 
     def stiffness(self):
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
@@ -526,8 +587,8 @@ class HeldLine:
         """d(F_a, F_b, M_a, M_b)/d(x_a, x_b, theta_a, theta_b), (12, 12): the forces
         (end_forces, N) and moments (end_moments, N m) on both ends against the ends'
         positions (m) and small rotations theta of their clamps' frames (rad, global
-        axes: the frame Q turned to exp([theta]x) Q); a pinned end's theta columns are
-        zero (nothing of it turns). The first 6 x 6 is stiffness(). From the same
+        axes: the frame Q turned to exp([theta]x) Q; at a flex joint its support's frame,
+        which turns the joint's axis); a pinned end's theta columns are zero. The first 6 x 6 is stiffness(). From the same
         factored second variation (module docstring, "Rotations"). Collective."""
         return self._linearised(True)
 
@@ -560,6 +621,10 @@ class HeldLine:
             turned = hessian.full_columns([hessian.block * node + k for _, node, k
                                            in held_data[0]]) if clamps else []
             vecs.extend(turned)
+            flexed = self._flexed(hessian) if rotations else []
+            for entry in flexed:
+                turned.extend(entry[-1])
+                vecs.extend(entry[-1])
             recorder = _CurvatureRecorder(problem)
             for term in problem.terms:
                 if term.position_components:
@@ -586,7 +651,7 @@ class HeldLine:
             if rotations:
                 response = self._rotation_response(hessian, frames, columns, shift,
                                                    solved, recorder.heights, *held_data,
-                                                   response)
+                                                   response, flexed)
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -615,6 +680,35 @@ class HeldLine:
                 out[:, j] = [a[node - first] for a in arrays]
         return mesh.global_sum(out)
 
+    def _flexed(self, hessian):
+        """[(end, node, J_d, J_a, a, d, columns)] of the flex joints: turning the
+        support by delta turns the axis, a data change of the joint's gradient in its
+        node's rotation, G = _joint_moment (dE/domega): ``columns`` the three Vecs
+        J_a (e_k x a) on that node's rows (new Vecs). Collective."""
+        out = []
+        last = 2 * self.mesh.n_elements
+        for e, d, term in self._joint_tangents():
+            if term.local:
+                raise RodInputError("HeldLine.end_stiffness: a flex joint at an "
+                                    "extensible end acts in the local step: its turn is "
+                                    "not linearised yet")
+            node = (0, last)[e]
+            a = term.axis
+            J_d, J_a = _joint_jacobians(term.k, d, a)
+            columns = []
+            for k in range(3):
+                vec = hessian.matrix.createVecLeft()
+                vec.zeroEntries()
+                low, high = vec.getOwnershipRange()
+                rows = hessian.block * node + np.arange(3)
+                if low <= rows[0] < high:
+                    vec.setValues(rows.astype(PETSc.IntType),
+                                  J_a @ np.cross(np.eye(3)[k], a))
+                vec.assemble()
+                columns.append(vec)
+            out.append((e, node, J_d, J_a, a, d, columns))
+        return out
+
     def _held_data(self, hessian, clamps):
         """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
         rotation and 3 its stretch (an extensible line's clamped node, EA finite: held in
@@ -628,7 +722,7 @@ class HeldLine:
         return held, dict(zip([e for e, _ in clamps], axial))
 
     def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
-                           held, axial, response):
+                           held, axial, response, flexed=()):
         """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
 
         A clamp turned by theta holds its node's rotation at theta instead of 0: the
@@ -645,8 +739,8 @@ class HeldLine:
         by a complex step of that closed form, applied to dy at the free nodes and to
         the held data at a clamped one."""
         mesh, B, U = self.mesh, hessian.block, hessian.unknowns
-        n_h = len(held)
-        n_d = 10 + n_h - 3 * len(axial)                     # data: z, c, thetas, stretches
+        n_h = len(held) + 3 * len(flexed)
+        n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
         Y_C = solved[:3]
         Y_P = solved[3:4] if shift is not None else []
         Y_T = solved[3 + len(Y_P):]
@@ -658,6 +752,7 @@ class HeldLine:
             else:
                 data.append(10 + len(stretches))
                 stretches.append(e)
+        data += [4 + 3 * entry[0] + k for entry in flexed for k in range(3)]
         schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
         inverse = np.linalg.inv(schur)
         nodes_held = [node for _, node, _ in held]
@@ -668,6 +763,8 @@ class HeldLine:
         for j, (e, node, k) in enumerate(held):
             G[:, data[j]] = (-w[j] * skew(t[j])[:, k] if k < 3
                              else w[j] * t[j] / np.linalg.norm(t[j]))
+            CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
+        for j in range(len(held), n_h):                     # a flex joint's axis
             CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
         along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(3)
         dmu = -inverse @ (CY_T - G)
@@ -720,6 +817,12 @@ class HeldLine:
                     if node == ends[e][k]:
                         delta[slot, data[j]] += 1.0
                 moments[3 * e:3 * e + 3] += (1.0 if e == 0 else -1.0) * jac[:, k] @ delta
+        for e, node, J_d, J_a, a, d, _ in flexed:           # the joint's moment
+            v = values[:, 0 if e == 0 else 5]
+            delta = of_dy(v[:3].T, v[3] if Y_P else np.zeros(U),
+                          v[3 + len(Y_P):].T if n_h else np.zeros((U, 0)))
+            moments[3 * e:3 * e + 3] = J_d @ (-skew(d) @ delta[:3])
+            moments[3 * e:3 * e + 3, 4 + 3 * e:7 + 3 * e] += J_a @ (-skew(a))
         out = np.vstack([forces, moments])
         if not stretches:
             return out

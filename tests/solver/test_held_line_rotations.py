@@ -110,10 +110,38 @@ def test_a_frame_walk_is_the_fresh_solve():
         assert fresh.solve(*ENDS)
         assert np.abs(walked.end_moments() - fresh.end_moments()).max() < 1e-7
         assert np.abs(walked.end_forces() - fresh.end_forces()).max() < 1e-7
-        with pytest.raises(RodInputError, match="only a clamp holds a frame"):
+        with pytest.raises(RodInputError, match="only a clamp or a flex joint holds a frame"):
             walked.solve(*ENDS, None, REFERENCE)
         with pytest.raises(RodInputError, match="a rotation"):
             walked.solve(*ENDS, 2.0 * REFERENCE)
     finally:
         walked.destroy()
         fresh.destroy()
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+def test_a_flex_joints_end_stiffness_against_differences(comm):
+    """A flex joint's support turned turns its axis with it (a = D^T D_ref a_0): the
+    12 x 12 with the joint's moment on its support, -k (theta / sin theta) d3 x a,
+    against central differences (measured 5e-10); its rotation block's antisymmetric
+    part is -[M]x, M the joint's moment (left increments of a conservative joint)."""
+    line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
+                       elements=40)
+    model = Model(line=line, start=End(kind="pin", position=tuple(ENDS[0]), stiffness=200.0),
+                  end=End.anchor(tuple(ENDS[1])), environment=Environment())
+    flexed = HeldLine(model, COMMS[comm], options=TIGHT)
+    frames = [TURNED, None]
+    try:
+        assert flexed.solve(*ENDS, *frames)
+        moment = flexed.end_moments()[0]
+        assert np.abs(moment).max() > 10.0                  # the turned joint's moment
+        K = flexed.end_stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - differences(flexed, frames)).max() < 1e-6 * scale
+        skew_part = K[6:9, 6:9] - K[6:9, 6:9].T
+        assert np.abs(skew_part + np.array([[0.0, -moment[2], moment[1]],
+                                            [moment[2], 0.0, -moment[0]],
+                                            [-moment[1], moment[0], 0.0]])).max() \
+            < 1e-8 * scale
+    finally:
+        flexed.destroy()
