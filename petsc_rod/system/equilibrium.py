@@ -363,17 +363,17 @@ class SystemSolver:
             try:
                 ok = bool(line.solve(positions[k, 0], positions[k, 1], *frames[k]) if turned
                           else line.solve(positions[k, 0], positions[k, 1]))
+                if not ok:
+                    mine[k] = (False,)
+                elif turned:        # a refused end stiffness: below, on every rank
+                    mine[k] = (True, line.end_forces(), line.end_stiffness(),
+                               line.end_moments())
+                else:
+                    mine[k] = (True, line.end_forces(), line.stiffness())
             except RodInputError as error:      # raised below on every rank
                 mine[k] = (False, error)
-                continue
             except (RodError, np.linalg.LinAlgError):
-                ok = False
-            if not ok:
                 mine[k] = (False,)
-            elif turned:
-                mine[k] = (True, line.end_forces(), line.end_stiffness(), line.end_moments())
-            else:
-                mine[k] = (True, line.end_forces(), line.stiffness())
         self.last = None
         shared = self.placement.share(mine)
         refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]

@@ -119,3 +119,22 @@ def test_a_body_on_a_clamped_riser_balances_and_its_stiffness_is_the_derivative(
         assert np.abs(linearised.matrix[3, 6:9, 6:9]).max() > 1e3 * 1e-6 * scale
     finally:
         solver.destroy()
+
+
+def test_a_line_without_an_end_stiffness_is_refused_in_one_line_on_every_rank():
+    """A flex joint at an extensible end has no end stiffness yet (its joint acts in the
+    local step): the system's start says so on every rank, no traceback, no hang."""
+    import dataclasses
+
+    from petsc_rod.errors import RodInputError
+    system = moored("flex")
+    riser = system.lines[3]
+    stretched = dataclasses.replace(riser, line=dataclasses.replace(riser.line,
+                                                                    axial_stiffness=1e5))
+    system = dataclasses.replace(system, lines=system.lines[:3] + (stretched,))
+    solver = SystemSolver(system, factory(system), PETSc.COMM_WORLD)
+    try:
+        with pytest.raises(RodInputError, match="a flex joint at an extensible end"):
+            solver.solve()
+    finally:
+        solver.destroy()
