@@ -125,6 +125,9 @@ class SecondVariation:
                                if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
         self._reserved = not newton      # J's pattern in H (_assemble)
+        # global columns whose H e_j before the held rows are cleared a caller asks for
+        # at the next update (``full_columns``)
+        self.keep_columns, self.kept_columns = (), []
         self.constraint = []
         self._fill()
         self.mass = self._mass()
@@ -146,6 +149,9 @@ class SecondVariation:
         the factorisation and the constraint solves of the previous H are stale."""
         self._matrix_changed()
         self._assemble()
+        for vec in self.kept_columns:
+            vec.destroy()
+        self.kept_columns = [self._column(j) for j in self.keep_columns]
         self.matrix.zeroRowsColumns(self.held_rows, diag=1.0)
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.matrix.getDiagonal(self._diagonal)
@@ -156,6 +162,33 @@ class SecondVariation:
         # dependent; the second variation says nothing there (no constraint
         # qualification), and the state is the only one the ends allow
         self.decidable = len(self.constraint) == 3 or not self.problem.bordered
+
+    def full_columns(self, columns):
+        """H e_j for the global ``columns`` (held ones: a clamped node's rotation) as H
+        is before its held rows and columns become the identity, 0 on the held rows:
+        how the gradient of the free unknowns moves when a held unknown is moved (a
+        clamp's frame turned, system/held_line.py). New Vecs; assembles H again at the
+        current state. Collective."""
+        self.keep_columns = tuple(int(j) for j in columns)
+        try:
+            self.update()
+        finally:
+            self.keep_columns = ()
+        kept, self.kept_columns = self.kept_columns, []
+        return kept
+
+    def _column(self, j):
+        unit_vec = self.matrix.createVecRight()
+        unit_vec.zeroEntries()
+        low, high = unit_vec.getOwnershipRange()
+        if low <= j < high:
+            unit_vec.setValue(j, 1.0)
+        unit_vec.assemble()
+        column = self.matrix.createVecLeft()
+        self.matrix.mult(unit_vec, column)
+        unit_vec.destroy()
+        self._zero_clamped(column)
+        return column
 
     # --- assembly -------------------------------------------------------------------
     def _assemble(self):
@@ -281,14 +314,15 @@ class SecondVariation:
         for rows, columns, blocks in self.position_blocks(values, components, components):
             self._add_blocks(rows, columns, blocks)
 
-    def position_shift(self, values, component):
+    def position_shift(self, values, component, held=False):
         """The Vec sum_n values_n dx^c_n/dy of the owned nodes' ``values`` (n_nodes,)
         (a position energy's second derivative, N/m) times the derivative of component c
         of node n's position in the unknowns y: at a vertex its u^c, at a midpoint the
         row of u^c_e + h_e HALF.s^c_e (position_blocks). It is d(gradient)/d(shift):
         how the gradient of that energy moves when every position of component c is
-        shifted by 1 m (the held end moved, system/held_line.py); 0 on held rows.
-        Needs the chains of the last assembly. Collective."""
+        shifted by 1 m (the held end moved, system/held_line.py); 0 on held rows
+        (``held``: kept there, for a held unknown's share). Needs the chains of the last
+        assembly. Collective."""
         values = np.asarray(values, dtype=float)
         vec = self.matrix.createVecLeft()
         vec.zeroEntries()
@@ -304,7 +338,8 @@ class SecondVariation:
         vec.setValues(np.concatenate(rows).astype(PETSc.IntType), np.concatenate(entries),
                       addv=PETSc.InsertMode.ADD_VALUES)
         vec.assemble()
-        self._zero_clamped(vec)
+        if not held:
+            self._zero_clamped(vec)
         return vec
 
     def add_height_curvature(self, curvature):
@@ -517,5 +552,5 @@ class SecondVariation:
 
     def destroy(self):
         for obj in [self.matrix, self.mass, self._mass_or_one, self._work, self._diagonal,
-                    *self.constraint]:
+                    *self.constraint, *self.kept_columns]:
             obj.destroy()

@@ -39,7 +39,12 @@ Newton system, so every rank has the same numbers on any number of ranks.
 A line is made by ``make_line(system_line, comm)`` (comm: its group's PETSc.Comm,
 collective on it) and has ``solve(start (3,), end (3,)) -> bool``, ``end_forces() ->
 (2, 3)`` (N, on its start and end points), ``stiffness() -> (6, 6)`` (d end_forces.ravel()
-/ d(start, end)) and ``destroy()``.
+/ d(start, end)) and ``destroy()``; a line with a clamped or flex end at a body also
+``solve(start, end, start_frame, end_frame)`` (the clamp's frame, or the frame a flex
+joint's axis turns with, turns with the body),
+``end_moments() -> (2, 3)`` (N m, added to the body's moment) and ``end_stiffness() ->
+(12, 12)`` (forces and moments against positions and rotations of both ends), mapped
+through [T; 0 I] (Linearised, lines_part).
 """
 
 from dataclasses import dataclass, replace
@@ -48,6 +53,7 @@ from typing import Protocol
 import numpy as np
 
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
+from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
 
@@ -136,6 +142,21 @@ class Loads:
 
 
 @dataclass(frozen=True)
+class Linearised:
+    """The lines' end moments and stiffnesses at one evaluation: ``matrix`` (n, 12, 12),
+    d(F_a, F_b, M_a, M_b)/d(x_a, x_b, theta_a, theta_b) (HeldLine.end_stiffness; a
+    line with no clamp at a body: its 6 x 6 in the first block, the rest 0), ``moments``
+    (n, 2, 3), N m, each end's moment on its body (0 but at a clamp at a body)."""
+
+    matrix: np.ndarray
+    moments: np.ndarray
+
+
+# (F_a, M_a, F_b, M_b) of end_stiffness's rows and columns (F_a, F_b, M_a, M_b)
+BY_END = np.array([0, 1, 2, 6, 7, 8, 3, 4, 5, 9, 10, 11])
+
+
+@dataclass(frozen=True)
 class BodyStiffness:
     """The 6 x 6 mooring stiffness of a body, K = -d(F, M)/d(dX, dtheta) of the lines'
     loads about ``reference`` (the body's reference point, global axes; N/m, N, N m/rad),
@@ -208,6 +229,9 @@ class Layout:
         self.body_end = np.full((n, 2), -1)
         self.point_end = np.full((n, 2), -1)
         self.local = np.zeros((n, 2, 3))
+        # a clamped or flex end at a body: its frame (a flex joint's axis) turns with the
+        # body, its moment acts on it
+        self.turned = np.zeros((n, 2), dtype=bool)
         for k, line in enumerate(system.lines):
             for j, connection in enumerate((line.start, line.end)):
                 if connection.to not in where:
@@ -216,6 +240,7 @@ class Layout:
                 self._check(line.name, ("start", "end")[j], connection, kind,
                             system.points[i].kind if kind == "point" else "body")
                 if kind == "body":
+                    self.turned[k, j] = connection.kind in ("clamp", "flex")
                     self.body_end[k, j] = i
                     self.ends[k, j] = self.body_dofs[i]
                     self.local[k, j] = connection.local
@@ -231,11 +256,11 @@ class Layout:
 
     @staticmethod
     def _check(line, which, connection, kind, node_kind):
-        if node_kind in ("free", "body") and connection.kind != "pin":
+        if node_kind == "free" and connection.kind != "pin":
             raise RodInputError(
-                f"line {line}: {which}: a {connection.kind} end at the {node_kind} "
-                f"{'point ' if kind == 'point' else ''}{connection.to}: the coupled "
-                "equilibrium takes pinned ends at free points and bodies; use kind 'pin'")
+                f"line {line}: {which}: a {connection.kind} end at the free point "
+                f"{connection.to}, which has no rotation to hold the end's frame: use kind "
+                "'pin', or a body")
         if kind == "point" and np.any(np.asarray(connection.local, dtype=float) != 0):
             raise RodInputError(f"line {line}: {which}: local {connection.local!r} at the "
                                 f"point {connection.to}, which has no axes: leave it zero")
@@ -304,41 +329,81 @@ class SystemSolver:
             positions[on_body] += state.bodies.X[layout.body_end[on_body]]
         return positions
 
+    def end_frames(self, state):
+        """[(start frame, end frame)] per line: a clamp at a body's (3, 3), rows d1, d2,
+        d3, turning with it: the line's start frame (the reference, frames.REFERENCE_FRAME)
+        at the body's start rotation R0, so D = D_ref R0 R^T (each row d_i = R R0^T
+        d_i,ref); None elsewhere."""
+        layout, bodies = self.layout, state.bodies
+        out = []
+        for k in range(len(self.system.lines)):
+            out.append(tuple(
+                REFERENCE_FRAME @ bodies.R0[layout.body_end[k, j]]
+                @ bodies.R[layout.body_end[k, j]].T if layout.turned[k, j] else None
+                for j in (0, 1)))
+        return out
+
     def evaluate(self, state, strict=False):
-        """Solve every line at ``state``'s end positions (this rank's lines in turn) and
-        share the results: (converged, end forces (n, 2, 3), stiffnesses (n, 6, 6)).
-        A line that raises a solver's RodError has not converged; one that refuses its
-        ends (RodInputError: a span it cannot reach) has not either, except when
-        ``strict`` (the start, where the system itself is at fault): then its error
-        is raised on every rank. The ends of the last successful evaluation are not
-        solved again."""
+        """Solve every line at ``state``'s end positions (and a clamp's frame at a body:
+        end_frames) (this rank's lines in turn) and share the results: (converged, end
+        forces (n, 2, 3), Linearised). A line with a clamp at a body is asked for
+        solve(start, end, start_frame, end_frame), end_moments() and end_stiffness();
+        the others keep the four-method protocol. A line that raises a solver's RodError
+        has not converged; one that refuses its ends (RodInputError: a span it cannot
+        reach) has not either, except when ``strict`` (the start, where the system itself
+        is at fault): then its error is raised on every rank. The ends of the last
+        successful evaluation are not solved again."""
+        layout = self.layout
         positions = self.end_positions(state)
-        if self.last is not None and np.array_equal(positions, self.last[0]):
+        key = (positions, state.bodies.R)
+        if self.last is not None and all(np.array_equal(a, b)
+                                         for a, b in zip(key, self.last[0])):
             return self.last[1]                 # the lines stand there already
+        frames = self.end_frames(state)
         mine = {}
         for k, line in self.lines.items():
+            turned = bool(layout.turned[k].any())
             try:
-                ok = bool(line.solve(positions[k, 0], positions[k, 1]))
+                ok = bool(line.solve(positions[k, 0], positions[k, 1], *frames[k]) if turned
+                          else line.solve(positions[k, 0], positions[k, 1]))
+                if not ok:
+                    mine[k] = (False,)
+                elif turned:        # a refused end stiffness: below, on every rank
+                    mine[k] = (True, line.end_forces(), line.end_stiffness(),
+                               line.end_moments())
+                else:
+                    mine[k] = (True, line.end_forces(), line.stiffness())
             except RodInputError as error:      # raised below on every rank
                 mine[k] = (False, error)
-                continue
             except (RodError, np.linalg.LinAlgError):
-                ok = False
-            mine[k] = ((ok, line.end_forces(), line.stiffness()) if ok else (False,))
+                mine[k] = (False,)
         self.last = None
         shared = self.placement.share(mine)
         refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
         if refused and strict:
             raise refused[0]
-        failed = [k for k in range(len(self.system.lines)) if not shared[k][0]]
+        n = len(self.system.lines)
+        failed = [k for k in range(n) if not shared[k][0]]
         if failed:
             name, entry = self.system.lines[failed[0]].name, shared[failed[0]]
             self.failure = (f"line {name} refused its ends ({entry[1]})" if len(entry) == 2
                             else f"line {name} did not converge")
             return False, None, None
-        forces = np.array([shared[k][1] for k in range(len(shared))]).reshape(-1, 2, 3)
-        stiffness = np.array([shared[k][2] for k in range(len(shared))]).reshape(-1, 6, 6)
-        self.last = (positions, (True, forces, stiffness))
+        forces = np.array([shared[k][1] for k in range(n)]).reshape(-1, 2, 3)
+        matrix, moments = np.zeros((n, 12, 12)), np.zeros((n, 2, 3))
+        for k in range(n):
+            if len(shared[k]) == 4:
+                matrix[k] = shared[k][2]
+                moments[k] = shared[k][3]
+            else:
+                matrix[k, :6, :6] = shared[k][2]
+        # a pinned end's moment (of the discretisation, not a reaction) is not applied
+        off = ~layout.turned
+        moments[off] = 0.0
+        rows = np.zeros((n, 12), dtype=bool)
+        rows[:, 6:9], rows[:, 9:] = off[:, :1], off[:, 1:]
+        matrix[rows] = 0.0
+        self.last = (key, (True, forces, Linearised(matrix, moments)))
         return self.last[1]
 
     # -- residual and Jacobian ---------------------------------------------------------
@@ -346,17 +411,23 @@ class SystemSolver:
     def lines_part(self, state, forces, stiffness):
         """The lines' generalised forces r (size,) and their Jacobian J (size, size)
         (module docstring; the last row and column of the (size + 1)^2 work arrays
-        collect the held ends)."""
+        collect the held ends), from their end ``forces`` (n, 2, 3) and ``stiffness``
+        (Linearised): an end at a body moves by dx = T dq and a clamp there turns by
+        dtheta, so each end's (f, M) acts through [T; 0 I] (6 x 6)."""
         layout, n = self.layout, len(self.system.lines)
         arms = self.arms(state)
         T = lever_map(arms.reshape(-1, 3)).reshape(n, 2, 3, 6)
         on_point = layout.body_end < 0
         T[on_point, :, 3:] = 0.0                    # a point's end has no rotation
+        maps = np.zeros((n, 2, 6, 6))
+        maps[:, :, :3] = T
+        maps[:, :, 3:, 3:] = layout.turned[:, :, None, None] * np.eye(3)
+        loads = np.concatenate([forces, stiffness.moments], axis=2)      # (n, 2, 6)
         size = layout.size + 1
         r = np.zeros(size)
-        np.add.at(r, layout.ends, np.einsum("njia,nji->nja", T, forces))
-        K = stiffness.reshape(n, 2, 3, 2, 3)
-        blocks = np.einsum("niba,nibjc,njcd->nijad", T, K, T)           # (n, 2, 2, 6, 6)
+        np.add.at(r, layout.ends, np.einsum("njia,nji->nja", maps, loads))
+        K = stiffness.matrix[:, BY_END][:, :, BY_END].reshape(n, 2, 6, 2, 6)
+        blocks = np.einsum("niba,nibjc,njcd->nijad", maps, K, maps)     # (n, 2, 2, 6, 6)
         rows = np.broadcast_to(layout.ends[:, :, None, :, None], blocks.shape)
         cols = np.broadcast_to(layout.ends[:, None, :, None, :], blocks.shape)
         J = np.zeros((size, size))

@@ -46,11 +46,30 @@ contact is semi-smooth: an anchor exactly on the seabed has a one-sided vertical
 stiffness of its own (its node enters the contact when pressed in), and K gives the
 lifting side (its node counts as in contact only below the seabed).
 
-A clamped end holds the frame the model gives it: its moment is end_moments(), but a
-turn of the clamp's frame is no input yet (no rotational stiffness). On an extensible line the clamp's own node's stretch is held in
-H, as the Newton steps hold it (docs/method.md §12: it comes from the force balance),
-so there K misses that node's share: 7e-5 of the largest entry on a 40-element line,
-against 3e-9 inextensible.
+**Rotations.** A clamped end's frame is an input (solve(..., start_frame, end_frame),
+walked along the geodesic) and end_stiffness() gives the (12, 12) of the forces and the
+moments (end_moments) on both ends against the ends' positions and small rotations
+theta of the clamps' frames, Q -> exp([theta]x) Q. Turning a clamp moves a held
+unknown, its node's rotation, from 0 to theta: the free unknowns see the held columns
+of H times theta (SecondVariation.full_columns) and the chord moves by -w_n [t_n]x theta
+at that node; on an extensible line the clamped node's stretch, held in H and set by
+the force balance EA (k - 1) = n.d3 (docs/method.md §12), is one more such datum, solved
+for with the rest (so end_stiffness's forces against the positions are exact there too,
+where stiffness() misses that node's share: 7e-5 of the largest entry on a 40-element
+line, against 3e-9 inextensible). The moment at an end vertex is K u of the end
+element's three nodes' frames (io/outputs.vertex_fields); its derivative in those
+nodes' rotations and stretches is taken by a complex step of that closed form. Not
+symmetric: the moments are the constitutive K u at the vertex, not the energy's
+conjugate of the clamp's rotation (they differ by O(h) terms, so dF/dtheta is not
+(dM/dx)^T), and the rotations are increments on the left (a skew part of the order of
+[M]x in the rotation block); the forces' position block is symmetric without a current
+(to 7e-8 of the largest entry with extensible clamps, whose stretch rule is not the
+energy's). A clamp in a current has no end_stiffness (its drag's Jacobian columns at
+the clamp are not taken). A flex joint's support frame D given to solve turns its axis,
+a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient at its
+(free) node, solved for like a clamp's, and its moment on the support is the joint's,
+-k (theta / sin theta) d3 x a (not at an extensible end: the joint acts in the local
+step there).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged), a
@@ -65,6 +84,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
+from petsc_rod.analysis.second_variation import skew
 from petsc_rod.cli.line_run import BuiltLine, plan_line, values_of
 from petsc_rod.compile import compile_scene
 from petsc_rod.errors import NoCatenaryStart, RodError, RodInputError
@@ -72,13 +92,17 @@ from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.model.end import End
+from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
+                                         slope_factor)
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.system_check import connection_position
 from petsc_rod.quantities.riser_numbers import (_extreme, effective_tension,
                                              points_on_held_ends, top_end, touchdown)
 from petsc_rod.scenes import starts
+from petsc_rod.scenes.blend import blended_frame
 from petsc_rod.scenes.scene import EndState
 
 
@@ -99,22 +123,32 @@ class HeldEnds:
     def __init__(self, scene):
         self.scene = scene
         self.moves = None           # (a from, a to, b from, b to), (3,) each
+        self.turns = None           # the frames (a from, a to, b from, b to), (3, 3) each
 
     def __getattr__(self, name):
-        if name in ("scene", "moves"):
+        if name in ("scene", "moves", "turns"):
             raise AttributeError(name)
         return getattr(self.scene, name)
 
-    def move(self, start, end):
+    def move(self, start, end, start_frame=None, end_frame=None):
         """Walk from the ends at the path's end (s = 1) to ``start``, ``end`` (3,), m,
-        in the scene's frame."""
-        self.moves = (self.start_state(1.0).position, np.asarray(start, dtype=float),
-                      self.end_state(1.0).position, np.asarray(end, dtype=float))
+        in the scene's frame, and a clamped end's frame (3, 3) (rows d1, d2, d3) from
+        where it is to ``start_frame``, ``end_frame`` along the geodesic
+        (scenes/blend.blended_frame; None: held as it is)."""
+        a, b = self.start_state(1.0), self.end_state(1.0)
+        self.moves = (a.position, np.asarray(start, dtype=float),
+                      b.position, np.asarray(end, dtype=float))
+        self.turns = (a.frame, a.frame if start_frame is None else start_frame,
+                      b.frame, b.frame if end_frame is None else end_frame)
 
-    def hold(self, start, end):
+    def hold(self, start, end, start_frame=None, end_frame=None):
         """The ends held at ``start``, ``end`` (3,) all along the path (after a walk
-        that failed: back where they were)."""
+        that failed: back where they were), a clamp's frame at ``start_frame``,
+        ``end_frame`` (None: where it is)."""
+        a = self.start_state(1.0).frame if start_frame is None else start_frame
+        b = self.end_state(1.0).frame if end_frame is None else end_frame
         self.moves = (np.asarray(start, dtype=float),) * 2 + (np.asarray(end, dtype=float),) * 2
+        self.turns = (a, a, b, b)
 
     def _t(self, t):
         return 1.0 if self.moves is not None else t
@@ -155,7 +189,10 @@ class HeldEnds:
         if self.moves is None:
             return state
         old, new = self.moves[first], self.moves[first + 1]
-        return EndState(state.kind, (1.0 - s) * old + s * new, state.frame, state.force)
+        frame = state.frame
+        if state.kind == "clamp":
+            frame = blended_frame(self.turns[first], self.turns[first + 1], s)
+        return EndState(state.kind, (1.0 - s) * old + s * new, frame, state.force)
 
 
 class _CurvatureRecorder:
@@ -182,6 +219,59 @@ def _at_vertex(mesh, values, index):
     return mesh.global_sum(local)
 
 
+def _vertex_moment(F, h, stiffness, e):
+    """The moment K_i u_i d_i at the end vertex (e = 0: S = 0 of the first element; 1:
+    S = L of the last) from the frames F (3 nodes, 3 rows, 3) of that element, rows d1,
+    d2 and the slope (frames.strains' skew part of D'^T D^-T, P2 derivatives at the
+    vertex): io/outputs.vertex_fields' m, written for complex values."""
+    d = F[0] if e == 0 else F[2]
+    dd = ((-3.0 * F[0] + 4.0 * F[1] - F[2]) if e == 0 else (F[0] - 4.0 * F[1] + 3.0 * F[2])) / h
+    rate = dd.T @ np.linalg.inv(d.T)
+    omega = 0.5 * np.array([rate[2, 1] - rate[1, 2], rate[0, 2] - rate[2, 0],
+                            rate[1, 0] - rate[0, 1]])
+    u = d @ omega
+    return (stiffness * u) @ d
+
+
+def _moment_jacobian(F, h, stiffness, e, unknowns):
+    """d m / d(node k's rotation omega, and stretch on an extensible line), (3, 3 nodes,
+    unknowns): a rotation turns the node's rows, delta F_i = omega x F_i, a stretch the
+    slope, delta F_3 = delta_k F_3 / |F_3|; by a complex step of _vertex_moment (exact
+    to round-off)."""
+    step = 1e-30
+    out = np.zeros((3, 3, unknowns))
+    for k in range(3):
+        for j in range(unknowns):
+            change = np.zeros((3, 3))
+            if j < 3:
+                change = np.cross(np.eye(3)[j], F[k])
+            else:
+                change[2] = F[k, 2] / np.linalg.norm(F[k, 2])
+            G = F.astype(complex)
+            G[k] = G[k] + 1j * step * change
+            out[:, k, j] = _vertex_moment(G, h, stiffness, e).imag / step
+    return out
+
+
+def _joint_moment(k, d, a):
+    """The moment a flex joint of stiffness k exerts on its support, N m: -dE/ddelta for
+    the support turned by delta (its axis a -> a + delta x a), E = k theta^2 / 2,
+    theta = angle(d, a); as E depends on d and a through their relative turn only, it is
+    dE/domega = d x dE/dd = -k (theta / sin theta) d x a (k theta about a x d)."""
+    return -k * slope_factor(joint_angle(d, a)) * np.cross(d, a)
+
+
+def _joint_jacobians(k, d, a):
+    """(J_d, J_a), (3, 3) each: d _joint_moment = J_d dd + J_a da for unit d, a:
+    dG = -k (-f'' dc v + (theta / sin theta) dv), v = d x a, c = d.a, f'' the joint's
+    curvature factor (sin theta - theta cos theta) / sin^3 theta."""
+    theta = joint_angle(d, a)
+    v = np.cross(d, a)
+    f2, s = curvature_factor(theta), slope_factor(theta)
+    return (-k * (-f2 * np.outer(v, a) - s * skew(a)),
+            -k * (-f2 * np.outer(v, d) + s * skew(d)))
+
+
 def _point(name, value):
     point = np.asarray(value, dtype=float)
     if point.shape != (3,) or not np.all(np.isfinite(point)):
@@ -194,12 +284,14 @@ class HeldLine:
     PETSc communicator: the line's own; collective on it alone).
 
     ``span``: a model.model.Span (or a model.Model, whose one span is taken) with both
-    ends held (pin or clamp; a clamp's frame is held as given); ``environment``: the
+    ends held (pin or clamp; a clamp's frame as given, or as solve turns it; a pin may
+    carry a flex joint, whose axis solve turns with its support); ``environment``: the
     sea (model.sea.Environment; a Model's own by default); ``options``: -rod_* options
     without ``rod_`` that tune the solver ({'al_rtol': 1e-10}).
 
-    solve(start_position, end_position) -> bool; end_forces() -> (2, 3);
-    end_moments() -> (2, 3); stiffness() -> (6, 6); stable() -> bool or None;
+    solve(start_position, end_position, start_frame=None, end_frame=None) -> bool;
+    end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
+    end_stiffness() -> (12, 12); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
     destroy(). ``iterations``: those of the last solve."""
 
@@ -220,6 +312,8 @@ class HeldLine:
                                    FIELD_NAMES)
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
+        self.frames = (None, None)          # the clamps' frames last asked for
+        self.axes = {}
         self.iterations = 0
         self.converged = False
 
@@ -229,8 +323,9 @@ class HeldLine:
         ``start`` and ``end`` ((3,), m, absolute: where the system's points and bodies
         put its connections): a 'pin' connection a pinned End, 'flex' a pinned End with
         the connection's rotational stiffness (its axis the line's start direction),
-        'clamp' a clamped End in the reference frame (the body's frame is not passed
-        yet)."""
+        'clamp' a clamped End in the reference frame at the start (a system then passes
+        the frame turned with its body to solve, and a flex joint's support frame
+        likewise)."""
         def end_of(connection, position):
             kind = "clamp" if connection.kind == "clamp" else "pin"
             stiffness = connection.stiffness if connection.kind == "flex" else None
@@ -242,20 +337,27 @@ class HeldLine:
         return cls(span, comm, environment, options)
 
     # --- building ----------------------------------------------------------------------
-    def _model(self, start, end):
-        """The line's Model with its ends at ``start``, ``end`` (absolute, m)."""
+    def _model(self, start, end, frames=(None, None)):
+        """The line's Model with its ends at ``start``, ``end`` (absolute, m), a clamp's
+        frame at ``frames`` ((3, 3) or None: the span's)."""
         import dataclasses
+
+        def at(end_, position, frame):
+            if frame is None or end_.kind != "clamp":
+                return dataclasses.replace(end_, position=position)
+            return dataclasses.replace(end_, position=position,
+                                       frame=tuple(float(v) for v in np.ravel(frame)))
         span = self.span
-        return Model(span.line, dataclasses.replace(span.start, position=start),
-                     dataclasses.replace(span.end, position=end), self.environment,
+        return Model(span.line, at(span.start, start, frames[0]),
+                     at(span.end, end, frames[1]), self.environment,
                      tuple(span.attachments))
 
-    def _build(self, start, end):
+    def _build(self, start, end, frames=(None, None)):
         """The line's run built on the one path of a line (cli/line_run.py: plan_line,
         BuiltLine: its mesh, problem and solver made and destroyed together) with the
         ends at ``start``, ``end``, its problem walking HeldEnds: its frame's origin is
         ``start`` for the line's life. Collective."""
-        plan = plan_line(self.comm, self._model(start, end), self.values, self.given,
+        plan = plan_line(self.comm, self._model(start, end, frames), self.values, self.given,
                          FIELD_NAMES)
         self.built = BuiltLine(self.comm, plan, path_of=HeldEnds)
         try:
@@ -269,6 +371,9 @@ class HeldLine:
                                                 self.built.solver)
         self.path = self.built.scene
         self.newton = self.built.own(NewtonSolver(self.problem))
+        # each flex joint's neutral axis at the reference frame (turned by a frame given)
+        self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
+                     for t in self.problem.terms if isinstance(t, FlexJoint)}
 
     def _release(self):
         if self.built is not None:          # its own objects and those it was given
@@ -277,20 +382,50 @@ class HeldLine:
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
-    def solve(self, start_position, end_position):
+    def solve(self, start_position, end_position, start_frame=None, end_frame=None):
         """The line's equilibrium with its start held at ``start_position`` and its end
-        at ``end_position`` ((3,) each, m, absolute): the first time (and after a first
-        solve that failed) from the catenary start in one step, as the command line
-        starts; later walked in one step (halved where it fails, up to 4 times) from
-        the last converged equilibrium, the ends moved in straight lines. Returns
-        whether it converged; a failed walk leaves the last equilibrium as it was.
-        Collective."""
+        at ``end_position`` ((3,) each, m, absolute), a clamped end's frame at
+        ``start_frame``, ``end_frame`` ((3, 3), rows d1, d2, d3, global axes, as
+        model.End.frame; None: where it is, the model's at first): the first time (and
+        after a first solve that failed) from the catenary start in one step, as the
+        command line starts; later walked in one step (halved where it fails, up to 4
+        times) from the last converged equilibrium, the ends moved in straight lines and
+        the frames turned along the geodesic. Returns whether it converged; a failed
+        walk leaves the last equilibrium as it was. Collective."""
         a, b = _point("start_position", start_position), _point("end_position", end_position)
+        frames = tuple(given if given is not None else last for given, last in
+                       zip((self._frame("start", start_frame), self._frame("end", end_frame)),
+                           self.frames))
+        self.frames = frames
         if self.problem is None or not self.converged:
             self._release()
-            self._build(a, b)
+            self._build(a, b, frames)
+            self._turn_joints(frames)
             return self._first()
-        return self._walk(a - self.origin, b - self.origin)
+        return self._walk(a - self.origin, b - self.origin, frames)
+
+    def _turn_joints(self, frames):
+        """Each flex joint's axis turned with its support's frame D (rows d1, d2, d3):
+        a = D^T D_ref a_0, the rotation that takes the reference frame's rows to D's."""
+        for e, (term, axis) in self.axes.items():
+            if frames[e] is not None:
+                term.axis = frames[e].T @ REFERENCE_FRAME @ axis
+
+    def _frame(self, which, frame):
+        """A clamped end's frame (3, 3) checked (None passes), or RodInputError."""
+        if frame is None:
+            return None
+        end = getattr(self.span, which)
+        if end.kind != "clamp" and end.stiffness is None:
+            raise RodInputError(f"HeldLine.solve: a {which}_frame for a "
+                                f"{end.kind} end: only a clamp or a flex joint holds a "
+                                "frame")
+        q = np.asarray(frame, dtype=float)
+        if (q.shape != (3, 3) or not np.all(np.isfinite(q))
+                or np.abs(q @ q.T - np.eye(3)).max() > 1e-9 or np.linalg.det(q) < 0):
+            raise RodInputError(f"HeldLine.solve: {which}_frame: a rotation (3, 3), "
+                                "rows d1, d2, d3 orthonormal and right-handed")
+        return q
 
     def _first(self):
         problem = self.problem
@@ -303,16 +438,20 @@ class HeldLine:
         self.converged = self._run(PathSettings(steps=1, track_link=False))
         return self.converged
 
-    def _walk(self, a, b):
+    def _walk(self, a, b, frames):
         state = self.problem.state
         saved = state.snapshot()
-        old = (self.path.start_state(1.0).position, self.path.end_state(1.0).position)
-        self.path.move(a, b)
+        ends = (self.path.start_state(1.0), self.path.end_state(1.0))
+        axes = {e: term.axis for e, (term, _) in self.axes.items()}
+        self.path.move(a, b, *frames)
+        self._turn_joints(frames)
         if self._run(PathSettings(steps=1, track_link=False)):
-            self.path.hold(a, b)
+            self.path.hold(a, b, *frames)
             return True
+        for e, (term, _) in self.axes.items():
+            term.axis = axes[e]
         state.restore(saved)
-        self.path.hold(*old)
+        self.path.hold(ends[0].position, ends[1].position, ends[0].frame, ends[1].frame)
         self.problem.prepare(1.0)
         return False
 
@@ -417,7 +556,22 @@ class HeldLine:
         self._check_solved()
         mesh = self.mesh
         m = vertex_fields(self.problem)["m"]
-        return np.array([_at_vertex(mesh, m, 0), -_at_vertex(mesh, m, mesh.n_elements)])
+        moments = np.array([_at_vertex(mesh, m, 0), -_at_vertex(mesh, m, mesh.n_elements)])
+        for e, d, term in self._joint_tangents(field=True):
+            moments[e] = _joint_moment(term.k, d, term.axis)
+        return moments
+
+    def _joint_tangents(self, field=False):
+        """[(end, d, term)] of the flex joints: the unit end tangent d (3,) on every rank
+        (the slope field's with ``field``, else tau3). Collective."""
+        out = []
+        last = 2 * self.mesh.n_elements
+        tangents = (self.problem.state.node_directors()[:, 2] if field
+                    else self.problem.state.tau[:, 2])
+        for e, (term, _) in sorted(self.axes.items()):
+            d = self._node_values([tangents], [(0, last)[e]])[0, 0]
+            out.append((e, d / np.linalg.norm(d), term))
+        return out
 
     def stiffness(self):
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
@@ -426,9 +580,29 @@ class HeldLine:
         the line's factored second variation, or in a uniform current its Newton
         Jacobian (module docstring). Symmetric and negative semi-definite for a stable
         line without a current. Collective."""
+        return self._linearised(False)
+
+    def end_stiffness(self):
+        """d(F_a, F_b, M_a, M_b)/d(x_a, x_b, theta_a, theta_b), (12, 12): the forces
+        (end_forces, N) and moments (end_moments, N m) on both ends against the ends'
+        positions (m) and small rotations theta of their clamps' frames (rad, global
+        axes: the frame Q turned to exp([theta]x) Q; at a flex joint its support's frame,
+        which turns the joint's axis); a pinned end's theta columns are zero. The first 6 x 6 is stiffness(). From the same
+        factored second variation (module docstring, "Rotations"). Collective."""
+        return self._linearised(True)
+
+    def _clamp_nodes(self):
+        """[(end 0 or 1, global P2 node)] of the clamped ends."""
+        last = 2 * self.mesh.n_elements
+        return [(e, node) for e, (which, node) in enumerate((("start", 0), ("end", last)))
+                if getattr(self.span, which).kind == "clamp"]
+
+    def _linearised(self, rotations):
         self._check_solved()
         problem = self.problem
         self._check_exact()
+        clamps = self._clamp_nodes() if rotations else []
+        held_data = ([], {})
         state = problem.state
         saved = state.snapshot()
         frames = state.tau.copy()
@@ -438,6 +612,18 @@ class HeldLine:
         try:
             self.newton.lagrangian_gradient(frames, state.chord_multiplier.copy())
             hessian = problem.second_variation()
+            if clamps and hessian.resultants:
+                raise RodInputError("HeldLine.end_stiffness: a clamp's rotation in a "
+                                    "current is not linearised (its drag's Jacobian "
+                                    "columns at the clamp): no exact end stiffness")
+            held_data = self._held_data(hessian, clamps)
+            turned = hessian.full_columns([hessian.block * node + k for _, node, k
+                                           in held_data[0]]) if clamps else []
+            vecs.extend(turned)
+            flexed = self._flexed(hessian) if rotations else []
+            for entry in flexed:
+                turned.extend(entry[-1])
+                vecs.extend(entry[-1])
             recorder = _CurvatureRecorder(problem)
             for term in problem.terms:
                 if term.position_components:
@@ -456,10 +642,15 @@ class HeldLine:
             else:
                 hessian.factorise(0.0)
                 solver = hessian
-            solved = solver.solve_many(columns + ([] if shift is None else [shift]))
+            shifts = [] if shift is None else [shift]
+            solved = solver.solve_many(columns + shifts + turned)
             vecs.extend(solved)
-            response = self._response(hessian, columns, shift, solved,
+            response = self._response(hessian, columns, shift, solved[:3 + len(shifts)],
                                       recorder.heights)
+            if rotations:
+                response = self._rotation_response(hessian, frames, columns, shift,
+                                                   solved, recorder.heights, *held_data,
+                                                   response, flexed)
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -468,7 +659,194 @@ class HeldLine:
         chain[0, 2] = 1.0
         chain[1:, :3] = -np.eye(3)
         chain[1:, 3:] = np.eye(3)
-        return response @ chain
+        if not rotations:
+            return response @ chain
+        full = np.zeros((10, 12))                           # (z_a, c, th_a, th_b)
+        full[:4, :6] = chain
+        full[4:, 6:] = np.eye(6)
+        return response @ full
+
+    def _node_values(self, arrays, nodes):
+        """The values of the global P2 ``nodes`` of per-owned-node ``arrays`` (list of
+        (n_local_nodes, ...)), on every rank: (len(arrays), len(nodes), ...).
+        Collective."""
+        mesh = self.mesh
+        first = 2 * mesh.vertex_start
+        n_local = arrays[0].shape[0]
+        out = np.zeros((len(arrays), len(nodes)) + arrays[0].shape[1:])
+        for j, node in enumerate(nodes):
+            if first <= node < first + n_local:
+                out[:, j] = [a[node - first] for a in arrays]
+        return mesh.global_sum(out)
+
+    def _flexed(self, hessian):
+        """[(end, node, J_d, J_a, a, d, columns)] of the flex joints: turning the
+        support by delta turns the axis, a data change of the joint's gradient in its
+        node's rotation, G = _joint_moment (dE/domega): ``columns`` the three Vecs
+        J_a (e_k x a) on that node's rows (new Vecs). Collective."""
+        out = []
+        last = 2 * self.mesh.n_elements
+        for e, d, term in self._joint_tangents():
+            if term.local:
+                raise RodInputError("HeldLine.end_stiffness: a flex joint at an "
+                                    "extensible end acts in the local step: its turn is "
+                                    "not linearised yet")
+            node = (0, last)[e]
+            a = term.axis
+            J_d, J_a = _joint_jacobians(term.k, d, a)
+            columns = []
+            for k in range(3):
+                vec = hessian.matrix.createVecLeft()
+                vec.zeroEntries()
+                low, high = vec.getOwnershipRange()
+                rows = hessian.block * node + np.arange(3)
+                if low <= rows[0] < high:
+                    vec.setValues(rows.astype(PETSc.IntType),
+                                  J_a @ np.cross(np.eye(3)[k], a))
+                vec.assemble()
+                columns.append(vec)
+            out.append((e, node, J_d, J_a, a, d, columns))
+        return out
+
+    def _held_data(self, hessian, clamps):
+        """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
+        rotation and 3 its stretch (an extensible line's clamped node, EA finite: held in
+        H, set by the force balance, docs/method.md §12), with that node's EA (inf
+        where none). Collective."""
+        held = [(e, node, k) for e, node in clamps for k in range(3)]
+        axial = np.full(len(clamps), np.inf)
+        if hessian.stretch and clamps:
+            axial = self._node_values([self.problem.axial], [n for _, n in clamps])[0]
+            held += [(e, node, 3) for (e, node), ea in zip(clamps, axial) if np.isfinite(ea)]
+        return held, dict(zip([e for e, _ in clamps], axial))
+
+    def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
+                           held, axial, response, flexed=()):
+        """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
+
+        A clamp turned by theta holds its node's rotation at theta instead of 0: the
+        free unknowns see B theta on their right-hand side (B the held columns of H,
+        hessian.full_columns) and the chord moves by G theta, G = -w_n [t_n]x at the
+        clamped node; on an extensible line the clamped node's stretch k is held data
+        too (B its column, G = w_n t_n / |t_n|), fixed by the force balance
+        EA (k - 1) = n.d3 at that end. With the held data h (theta, and those
+        stretches), Y_T = A^-1 B:
+        dmu = -S^-1 (dc + C Y_P dz + (C Y_T - G) h), dy = -Y_P dz - Y_C dmu - Y_T h,
+        then dk = (dn.d3 + n.(theta x d3)) / EA solved for. The moment m at an end
+        vertex is K u of the end element's three nodes' frames
+        (io/outputs.vertex_fields): its derivative in each node's rotation and stretch
+        by a complex step of that closed form, applied to dy at the free nodes and to
+        the held data at a clamped one."""
+        mesh, B, U = self.mesh, hessian.block, hessian.unknowns
+        n_h = len(held) + 3 * len(flexed)
+        n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
+        Y_C = solved[:3]
+        Y_P = solved[3:4] if shift is not None else []
+        Y_T = solved[3 + len(Y_P):]
+        data = []                                           # the data column of each held
+        stretches = []
+        for e, node, k in held:
+            if k < 3:
+                data.append(4 + 3 * e + k)
+            else:
+                data.append(10 + len(stretches))
+                stretches.append(e)
+        data += [4 + 3 * entry[0] + k for entry in flexed for k in range(3)]
+        schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
+        inverse = np.linalg.inv(schur)
+        nodes_held = [node for _, node, _ in held]
+        w = self._node_values([self.problem.state.node_weights], nodes_held)[0]
+        t = self._node_values([frames[:, 2]], nodes_held)[0]
+        G = np.zeros((3, n_d))
+        CY_T = np.zeros((3, n_d))
+        for j, (e, node, k) in enumerate(held):
+            G[:, data[j]] = (-w[j] * skew(t[j])[:, k] if k < 3
+                             else w[j] * t[j] / np.linalg.norm(t[j]))
+            CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
+        for j in range(len(held), n_h):                     # a flex joint's axis
+            CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
+        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(3)
+        dmu = -inverse @ (CY_T - G)
+        dmu[:, 0] = -inverse @ along
+        dmu[:, 1:4] = -inverse
+
+        def of_dy(values_C, value_P, values_T):
+            """A linear functional of dy (its values on Y_C (.., 3), Y_P (..,) and the
+            Y_T (.., n_h)) as a function of the data."""
+            out = -np.multiply.outer(value_P, np.eye(n_d)[0]) - values_C @ dmu
+            for j, col in enumerate(data):
+                out[..., col] -= values_T[..., j]
+            return out
+
+        forces = np.zeros((6, n_d))
+        forces[3:] = dmu
+        forces[:3] = -dmu
+        forces[:3, :4] = response[:3]
+        if shift is not None:
+            moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]),
+                          np.array([shift.dot(y) for y in Y_T]))
+            full = hessian.position_shift(heights, 2, held=True)
+            try:
+                at = self._node_values([full.getArray(readonly=True).reshape(-1, B)[:, :U]],
+                                       nodes_held)[0]
+            finally:
+                full.destroy()
+            for j, (e, node, k) in enumerate(held):
+                moved[data[j]] += at[j, k]
+            forces[2, 4:] -= moved[4:]
+        # the moments: the three nodes of each end element
+        last = 2 * mesh.n_elements
+        ends = ([0, 1, 2], [last - 2, last - 1, last])
+        arrays = [y.getArray(readonly=True).reshape(-1, B)[:, :U] for y in solved]
+        values = self._node_values(arrays, ends[0] + ends[1])          # (vecs, 6, U)
+        fields = self._node_values([self.problem.state.node_directors()],
+                                   ends[0] + ends[1])[0]
+        S = np.array([_at_vertex(mesh, mesh.vertex_S, index) for index in
+                      (0, 1, mesh.n_elements - 1, mesh.n_elements)])
+        moments = np.zeros((6, n_d))
+        for e in (0, 1):
+            h = S[1] - S[0] if e == 0 else S[3] - S[2]
+            jac = _moment_jacobian(fields[3 * e:3 * e + 3], h,
+                                   self._end_stiffness_values(e, S), e, U)
+            for k in range(3):
+                v = values[:, 3 * e + k]                                # (vecs, U)
+                delta = of_dy(v[:3].T, v[3] if Y_P else np.zeros(U),
+                              v[3 + len(Y_P):].T if n_h else np.zeros((U, 0)))
+                for j, (end, node, slot) in enumerate(held):
+                    if node == ends[e][k]:
+                        delta[slot, data[j]] += 1.0
+                moments[3 * e:3 * e + 3] += (1.0 if e == 0 else -1.0) * jac[:, k] @ delta
+        for e, node, J_d, J_a, a, d, _ in flexed:           # the joint's moment
+            v = values[:, 0 if e == 0 else 5]
+            delta = of_dy(v[:3].T, v[3] if Y_P else np.zeros(U),
+                          v[3 + len(Y_P):].T if n_h else np.zeros((U, 0)))
+            moments[3 * e:3 * e + 3] = J_d @ (-skew(d) @ delta[:3])
+            moments[3 * e:3 * e + 3, 4 + 3 * e:7 + 3 * e] += J_a @ (-skew(a))
+        out = np.vstack([forces, moments])
+        if not stretches:
+            return out
+        # the clamps' stretches from their force balance: dk = rows @ (data, dk)
+        rows = np.zeros((len(stretches), n_d))
+        for i, e in enumerate(stretches):
+            d3 = t[data.index(10 + i)]
+            d3 = d3 / np.linalg.norm(d3)
+            force = self.end_forces()[e]
+            n = force - points_on_held_ends(self.problem)[e] if e == 0 else \
+                -(force - points_on_held_ends(self.problem)[e])
+            sign = 1.0 if e == 0 else -1.0                  # n(0) = F_a, n(L) = -F_b
+            rows[i] = sign * d3 @ out[3 * e:3 * e + 3] / axial[e]
+            rows[i, 4 + 3 * e:7 + 3 * e] += np.cross(d3, n) / axial[e]
+        own = rows[:, 10:]
+        solved_k = np.linalg.solve(np.eye(len(stretches)) - own, rows[:, :10])
+        return out[:, :10] + out[:, 10:] @ solved_k
+
+    def _end_stiffness_values(self, e, S):
+        """(K1, K2, K3) of the end element of end ``e`` at its end (vertex_fields')."""
+        scene = self.scene
+        if scene.uniform_stiffness:
+            return np.asarray(scene.stiffness, dtype=float)
+        at, inside = (S[0], 0.5 * (S[0] + S[1])) if e == 0 else (S[3], 0.5 * (S[2] + S[3]))
+        return scene.stiffness_at(np.array([at]), inside=np.array([inside]))[0]
 
     def _response(self, hessian, columns, shift, solved, heights):
         """d(F_a, F_b)/d(z_a, c), (6, 4), from the solves Y = A^-1 [C^T, P] (A: H, or

@@ -1,0 +1,147 @@
+"""A line of a system with clamped ends whose frames are inputs (petsc_rod/system/
+held_line.py): HeldLine.solve(start, end, start_frame, end_frame) walks a clamp's frame,
+and end_stiffness(), the (12, 12) of the forces and moments on both ends against the
+ends' positions and small rotations of the clamps' frames, from the factored second
+variation, agrees with central differences of re-solves with moved ends and turned
+frames, on an inextensible line (one clamp, the other end pinned) and an extensible one
+(both clamped: the clamped nodes' stretches held by their force balance), on one rank
+and on all."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import End, Environment, Model, UniformLine
+from petsc_rod.errors import RodInputError
+from petsc_rod.frames import rotations
+from petsc_rod.system.held_line import HeldLine
+
+pytestmark = pytest.mark.solver
+
+COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
+TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
+ENDS = (np.zeros(3), np.array([80.0, 0.0, 20.0]))
+REFERENCE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+# a clamp turned off the reference frame about a skew axis
+TURNED = REFERENCE @ rotations(np.array([0.1, -0.3, 0.2])).T
+
+
+def clamped_line(comm, extensible):
+    line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
+                       elements=40, axial_stiffness=1e5 if extensible else np.inf)
+    end = (End(kind="clamp", position=tuple(ENDS[1])) if extensible
+           else End.anchor(tuple(ENDS[1])))
+    model = Model(line=line, start=End(kind="clamp", position=tuple(ENDS[0])), end=end,
+                  environment=Environment())
+    held = HeldLine(model, comm, options=TIGHT)
+    frames = [TURNED, REFERENCE if extensible else None]
+    assert held.solve(*ENDS, *frames)
+    return held, frames
+
+
+def outputs(line):
+    return np.concatenate([line.end_forces().ravel(), line.end_moments().ravel()])
+
+
+def differences(line, frames, step=1e-4):
+    """(12, 12) central differences of (F_a, F_b, M_a, M_b) in (x_a, x_b, theta_a,
+    theta_b), a frame Q turned to exp([theta]x) Q (rows: Q exp(-[theta]x)); zero
+    columns for a pinned end's rotation."""
+    columns = []
+    for j in range(12):
+        e, k = divmod(j % 6, 3)
+        if j >= 6 and frames[e] is None:
+            columns.append(np.zeros(12))
+            continue
+        values = []
+        for sign in (1.0, -1.0):
+            x = [ENDS[0].copy(), ENDS[1].copy()]
+            turned = list(frames)
+            if j < 6:
+                x[e][k] += sign * step
+            else:
+                turned[e] = frames[e] @ rotations(sign * step * np.eye(3)[k]).T
+            assert line.solve(*x, *turned)
+            values.append(outputs(line))
+        columns.append((values[0] - values[1]) / (2 * step))
+    assert line.solve(*ENDS, *frames)
+    return np.array(columns).T
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("extensible", [False, True], ids=["inextensible", "extensible"])
+def test_end_stiffness_against_differences(comm, extensible):
+    line, frames = clamped_line(COMMS[comm], extensible)
+    try:
+        moments = line.end_moments()
+        assert abs(moments[0]).max() > 10.0                 # the turned clamp's reaction
+        K = line.end_stiffness()
+        assert K.shape == (12, 12)
+        scale = np.abs(K).max()
+        # measured: 1.5e-9 inextensible, 4e-8 extensible (the step's truncation)
+        assert np.abs(K - differences(line, frames)).max() < 1e-6 * scale
+        # the moment's rotation block carries the clamp's reaction
+        assert np.abs(K[6:9, 6:9]).max() > 0.5 * abs(moments[0]).max()
+        if not extensible:
+            # a pinned end turns nothing; the 6 x 6 is stiffness()'s
+            assert np.all(K[:, 9:] == 0.0)
+            assert np.abs(K[:6, :6] - line.stiffness()).max() < 1e-12 * scale
+        # the forces' position block is symmetric (conservative), except for the
+        # extensible clamp's stretch rule EA (k - 1) = n.d3, which is not the energy's
+        # (measured 7e-8 of the largest entry)
+        asymmetry = np.abs(K[:6, :6] - K[:6, :6].T).max() / scale
+        assert asymmetry < (1e-6 if extensible else 1e-12)
+    finally:
+        line.destroy()
+
+
+def test_a_frame_walk_is_the_fresh_solve():
+    """A clamp's frame walked from the reference is the line solved afresh with it."""
+    walked, frames = clamped_line(PETSc.COMM_WORLD, False)
+    line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
+                       elements=40)
+    model = Model(line=line, start=End(kind="clamp", position=tuple(ENDS[0]),
+                                       frame=tuple(TURNED.ravel())),
+                  end=End.anchor(tuple(ENDS[1])), environment=Environment())
+    fresh = HeldLine(model, PETSc.COMM_WORLD, options=TIGHT)
+    try:
+        assert walked.solve(*ENDS, REFERENCE)               # back to the reference ...
+        assert walked.solve(*ENDS, TURNED)                  # ... and turned again
+        assert fresh.solve(*ENDS)
+        assert np.abs(walked.end_moments() - fresh.end_moments()).max() < 1e-7
+        assert np.abs(walked.end_forces() - fresh.end_forces()).max() < 1e-7
+        with pytest.raises(RodInputError, match="only a clamp or a flex joint holds a frame"):
+            walked.solve(*ENDS, None, REFERENCE)
+        with pytest.raises(RodInputError, match="a rotation"):
+            walked.solve(*ENDS, 2.0 * REFERENCE)
+    finally:
+        walked.destroy()
+        fresh.destroy()
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+def test_a_flex_joints_end_stiffness_against_differences(comm):
+    """A flex joint's support turned turns its axis with it (a = D^T D_ref a_0): the
+    12 x 12 with the joint's moment on its support, -k (theta / sin theta) d3 x a,
+    against central differences (measured 5e-10); its rotation block's antisymmetric
+    part is -[M]x, M the joint's moment (left increments of a conservative joint)."""
+    line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
+                       elements=40)
+    model = Model(line=line, start=End(kind="pin", position=tuple(ENDS[0]), stiffness=200.0),
+                  end=End.anchor(tuple(ENDS[1])), environment=Environment())
+    flexed = HeldLine(model, COMMS[comm], options=TIGHT)
+    frames = [TURNED, None]
+    try:
+        assert flexed.solve(*ENDS, *frames)
+        moment = flexed.end_moments()[0]
+        assert np.abs(moment).max() > 10.0                  # the turned joint's moment
+        K = flexed.end_stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - differences(flexed, frames)).max() < 1e-6 * scale
+        skew_part = K[6:9, 6:9] - K[6:9, 6:9].T
+        assert np.abs(skew_part + np.array([[0.0, -moment[2], moment[1]],
+                                            [moment[2], 0.0, -moment[0]],
+                                            [-moment[1], moment[0], 0.0]])).max() \
+            < 1e-8 * scale
+    finally:
+        flexed.destroy()
