@@ -20,9 +20,8 @@ from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
 from petsc_rod.quantities import riser_numbers
-from petsc_rod.system.bodies import rotation
 from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import HeldLine
+from petsc_rod.system.held_line import held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
 # step is 1 / system_steps of the bodies' loads (Settings.load_steps).
@@ -90,32 +89,6 @@ def split_options(options):
                             "loads)")
     values_of(options)                      # a malformed value refused before any work
     return Settings(load_steps=int(steps)), options
-
-
-def start_ends(system):
-    """{line name: (start (3,), end (3,))}, m: where the system's points and bodies put
-    each line's ends at the start (a body's local point through its start pose)."""
-    at = {p.name: np.asarray(p.position, dtype=float) for p in system.points}
-    poses = {b.name: np.asarray(b.position, dtype=float) for b in system.bodies}
-
-    def place(connection):
-        if connection.to in at:
-            return at[connection.to]
-        pose = poses[connection.to]
-        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
-
-    return {line.name: (place(line.start), place(line.end)) for line in system.lines}
-
-
-def line_maker(system, options):
-    """make_line(system_line, comm) of SystemSolver: the HeldLine of the line on its
-    group's communicator, every line with the same ``options``."""
-    ends = start_ends(system)
-
-    def make_line(line, comm):
-        return HeldLine.of_system_line(line, *ends[line.name], comm, system.environment,
-                                       options)
-    return make_line
 
 
 def _end_values(mesh, values):
@@ -356,7 +329,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     Collective."""
     on_every_rank(comm, system.check)
     check_outputs(comm, system, output, table)
-    solver = SystemSolver(system, line_maker(system, line_options), comm,
+    solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
     try:
         try:

@@ -75,12 +75,11 @@ from petsc_rod.iteration.newton import NewtonSolver
 from petsc_rod.model.end import End
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
-from petsc_rod.model.system import Body
+from petsc_rod.model.system_check import connection_position
 from petsc_rod.quantities.riser_numbers import (_extreme, effective_tension,
                                              points_on_held_ends, top_end, touchdown)
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.scene import EndState
-from petsc_rod.system.bodies import rotation
 
 
 # The units of HeldLine.summary's numbers.
@@ -539,24 +538,14 @@ class HeldLine:
         self._release()
 
 
-def connection_position(system, connection):
-    """Where the model.system.Connection ``connection`` of ``system`` is at the start,
-    (3,), m, absolute: its point's position, or its body's X + R p (R from the body's
-    start angles, system/bodies.rotation)."""
-    node = system.node(connection.to)
-    if isinstance(node, Body):
-        pose = np.asarray(node.position, dtype=float)
-        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
-    return np.asarray(node.position, dtype=float)
-
-
 def held_lines(system, options=None):
     """The SystemSolver's ``make_line(system_line, comm)`` of ``system`` (a
     model.system.System): each line a HeldLine in the system's environment with its
-    ends first where the system's points and bodies put them (connection_position);
+    ends first where the system's points and bodies put them
+    (model.system_check.connection_position);
     ``options`` as HeldLine's."""
     def make_line(line, comm):
-        return HeldLine.of_system_line(line, connection_position(system, line.start),
-                                       connection_position(system, line.end), comm,
-                                       system.environment, options)
+        start, end = (connection_position(system.node(c.to), c)
+                      for c in (line.start, line.end))
+        return HeldLine.of_system_line(line, start, end, comm, system.environment, options)
     return make_line
