@@ -263,3 +263,29 @@ def test_the_load_continuation_reaches_the_same_equilibrium(runs, tmp_path):
                       - f["system/body_positions"][0, :3]).max() < 1e-6
         assert np.abs(g["system/end_forces"][()] - f["system/end_forces"][()]).max() < (
             1e-7 * np.abs(f["system/end_forces"][()]).max())
+
+
+def module(name, args):
+    import subprocess
+    import sys
+
+    from helpers import child_env
+    return subprocess.run([sys.executable, "-m", name, *args], cwd=REPO_ROOT,
+                          env=child_env(), capture_output=True, text=True, timeout=120,
+                          check=False)
+
+
+def test_the_plots_of_a_system_file(runs, tmp_path):
+    """python -m petsc_rod.plots on a system's file: the plan and elevation, the watch
+    circle and the load-excursion curves, each a drawn PNG, from the file alone."""
+    from helpers import png_summary
+    figure = tmp_path / "spread.png"
+    process = module("petsc_rod.plots", [str(runs[1][1]), str(figure)])
+    assert process.returncode == 0, describe(process)
+    for name, size in (("spread.png", (825, 1760)), ("spread_watch_circle.png", (605, 1760)),
+                       ("spread_excursion.png", (605, 1760))):
+        height, width, drawn = png_summary(tmp_path / name)
+        assert (height, width) == size and drawn > 0.01, name
+    # a figure that would replace the result file is refused in one line
+    process = module("petsc_rod.plots", [str(runs[1][1]), str(runs[1][1])])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
