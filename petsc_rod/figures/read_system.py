@@ -43,11 +43,13 @@ class SystemFile:
 
 
 def sweep(group):
-    """{name: array} of a sweep's group, with ``poses`` (k, 6), ``lines`` its lines'
+    """{name: array} of a sweep's group (its datasets over its attributes of the same
+    name), with ``poses`` (k, 6), ``lines`` its lines'
     names and the attributes; for the load-excursion curves also the (h, m) arrays
     ``grid_*`` (NaN where a case had no equilibrium: in memory, for a graph only)."""
-    found = {name: group[name][()] for name in group}
-    found.update({key: group.attrs[key] for key in group.attrs})
+    found = {key: group.attrs[key] for key in group.attrs}
+    found.update({name: group[name][()] for name in group})      # a row's load, not the
+    # watch circle's attribute of the same name
     found["poses"] = np.stack([found[k] for k in POSE], axis=1) if found["heading"].size \
         else np.zeros((0, 6))
     found["lines"] = _names(group.attrs["line_names"])
@@ -121,7 +123,7 @@ def figures(found):
     if circle is not None and circle["heading"].size:
         drawn["_watch_circle"] = watch_circle_figure(
             np.stack([circle["x_offset"], circle["y_offset"]], axis=1), circle["heading"],
-            circle["max_tension"], circle["min_grounded"], float(circle["load"]),
+            circle["max_tension"], circle["min_grounded"], float(circle["load"][0]),
             str(circle["body"]))
     curves = found.excursion
     if curves is not None and curves["heading"].size:

@@ -6,13 +6,16 @@ result file's groups and tables; the Python API's solve_system on the same file 
 the same numbers (issue 49 point 6, the MoorDyn-file path against the API path); bad
 input in one line, exit 2, no file left. Spawns processes: marked ``serial``."""
 
+import base64
 import os
+import re
 
 import h5py
 import numpy as np
 import pytest
 
 from helpers import REPO_ROOT, describe, partial_files, run_petsc_rod
+from test_sweep_cli import Page, run_module
 
 pytestmark = pytest.mark.serial
 
@@ -265,27 +268,67 @@ def test_the_load_continuation_reaches_the_same_equilibrium(runs, tmp_path):
             1e-7 * np.abs(f["system/end_forces"][()]).max())
 
 
-def module(name, args):
-    import subprocess
-    import sys
-
-    from helpers import child_env
-    return subprocess.run([sys.executable, "-m", name, *args], cwd=REPO_ROOT,
-                          env=child_env(), capture_output=True, text=True, timeout=120,
-                          check=False)
-
-
 def test_the_plots_of_a_system_file(runs, tmp_path):
     """python -m petsc_rod.plots on a system's file: the plan and elevation, the watch
     circle and the load-excursion curves, each a drawn PNG, from the file alone."""
     from helpers import png_summary
     figure = tmp_path / "spread.png"
-    process = module("petsc_rod.plots", [str(runs[1][1]), str(figure)])
+    process = run_module("petsc_rod.plots", [str(runs[1][1]), str(figure)])
     assert process.returncode == 0, describe(process)
     for name, size in (("spread.png", (825, 1760)), ("spread_watch_circle.png", (605, 1760)),
                        ("spread_excursion.png", (605, 1760))):
         height, width, drawn = png_summary(tmp_path / name)
         assert (height, width) == size and drawn > 0.01, name
     # a figure that would replace the result file is refused in one line
-    process = module("petsc_rod.plots", [str(runs[1][1]), str(runs[1][1])])
+    process = run_module("petsc_rod.plots", [str(runs[1][1]), str(runs[1][1])])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+
+
+def test_the_report_page_of_a_system_file(runs, tmp_path):
+    """python -m petsc_rod.report on a system's file: the bodies, the 6 x 6 stiffness,
+    a row a line with the file's end tensions, the watch circle's and excursion's
+    tables, the plan and elevation, the sweeps' graphs and each line's picture."""
+    output = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(runs[1][1]), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    text = output.read_text()
+    page = Page()
+    page.feed(text)
+    assert '<meta name="generator" content="petsc_rod.report">' in text
+    assert {"bodies", "points", "lines", "stiffness_Body1", "watch_circle",
+            "excursion"} <= set(page.tables)
+    with h5py.File(runs[1][1], "r") as f:
+        tensions = f["system/end_tensions"][()]
+        K = f["system/body_stiffness"][0]
+        circle = f["system/watch_circle/x_offset"][()]
+    lines = page.tables["lines"]
+    assert [row[0] for row in lines[1:]] == ["Line1", "Line2", "Line3"]
+    for k, row in enumerate(lines[1:]):
+        assert float(row[3]) == pytest.approx(tensions[k, 0] / 1e3, rel=1e-3)
+        assert float(row[4]) == pytest.approx(tensions[k, 1] / 1e3, rel=1e-3)
+        assert row[-1] == "yes" and float(row[8]) > 0
+    stiffness = np.array([[float(v) for v in row[1:]]
+                          for row in page.tables["stiffness_Body1"][1:]])
+    assert np.allclose(stiffness, K, rtol=1e-3, atol=1e-3 * np.abs(K).max())
+    rows = page.tables["watch_circle"]
+    assert len(rows) == 5 and float(rows[1][2]) == pytest.approx(circle[0], rel=1e-3)
+    assert len(page.tables["excursion"]) == 4
+    assert page.alts == ["plan and elevation", "watch circle", "load-excursion curves",
+                         "line Line1", "line Line2", "line Line3"]
+    encoded = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    assert len(encoded) == 6
+    assert all(base64.b64decode(e)[:8] == b"\x89PNG\r\n\x1a\n" for e in encoded)
+    assert "LINE TYPES" in page.folded and "384.243E6" in page.folded     # the MoorDyn text
+
+
+def test_the_report_refuses_a_broken_system_file(tmp_path):
+    """A system file without its datasets: one line, exit 2, no page."""
+    broken = tmp_path / "broken.h5"
+    with h5py.File(broken, "w") as f:
+        f.create_group("system").attrs["line_names"] = "Line1"
+    output = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(broken), "-o", str(output)])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+    assert process.stderr.startswith("petsc_rod.report: error: ") and not output.exists()
+    process = run_module("petsc_rod.plots", [str(broken), str(tmp_path / "x.png")])
     assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
