@@ -412,7 +412,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
 
 
 def solve_system(system, comm=None, output=None, say=None, options=None, table=None,
-                 notes=()):
+                 notes=(), sweeps=None):
     """Solve ``system`` (api.System) on the ranks of ``comm`` (a PETSc communicator;
     default PETSc.COMM_WORLD), each line on its group of ranks; collective.
     ``output``: the system's result file (HDF5, docs/output.md) as -rod_output;
@@ -420,7 +420,9 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     ``say(line)`` gets the command line's lines (None: silent), ``notes`` (the
     reader's, read_moordyn's second value) said first; ``options`` {name without
     ``rod_``: value}: 'system_steps' and every line's solver options (LINE_OPTIONS:
-    {'al_rtol': 1e-10}). Returns a SystemResults."""
+    {'al_rtol': 1e-10}); ``sweeps`` (api/system_sweeps.Sweeps: a watch circle, load-excursion
+    curves) run after the equilibrium, in ``SystemResults.sweeps``, the file and the
+    tables. Returns a SystemResults."""
     from petsc4py import PETSc
 
     comm = comm or PETSc.COMM_WORLD
@@ -429,4 +431,4 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,
-                      notes=notes)
+                      notes=notes, sweeps=sweeps or Sweeps())
