@@ -106,10 +106,12 @@ def sweep_html(kind, found):
     return _table(kind, head, rows) + note
 
 
-def line_png(path, name, seabed):
+def line_png(path, name, seabed, surface):
     """The base64 PNG of line ``name``'s picture (a single line's, of the file's group
-    lines/<name>)."""
+    lines/<name>), with the system's flat ``seabed`` and sea ``surface`` (m): a line's
+    group holds no sea of its own."""
     result = read_result(path, f"lines/{name}")
+    result.sea_surface = surface
     if result.seabed is None:
         result.seabed = seabed
     return png(riser_figure(result), CASE_DPI)
@@ -125,7 +127,8 @@ def build(path):
     pictured = [line["name"] for line in found.lines][:LINE_PICTURES] \
         if len(found.lines) <= LINE_PICTURES else []
     images = {suffix: png(figure) for suffix, figure in drawn.items()}
-    encoded = drawn_all([(line_png, (path, name, found.picture["seabed"]))
+    encoded = drawn_all([(line_png, (path, name, found.picture["seabed"],
+                                     found.picture["surface"]))
                          for name in pictured])
     parts = [f"<h1>{html.escape(title)}</h1>",
              f"<p>petsc_rod report, {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC. "
