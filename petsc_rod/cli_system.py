@@ -6,7 +6,8 @@ equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not
 written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
--rod_system_body_load, -rod_system_steps), the outputs (-rod_output, -rod_table) and
+-rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
+-rod_system_excursion), the outputs (-rod_output, -rod_table) and
 the line solver's (-rod_al_*, -rod_max_halvings: every line the same); every other
 -rod_* option describes a single line's scene or load path, which the file gives, and is
 refused in one line naming them. It sits above system/ and cli/ (it needs both: the
@@ -20,6 +21,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.api.system_run import LINE_OPTIONS, run_system
+from petsc_rod.api.system_sweeps import parse_sweeps
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
@@ -34,7 +36,8 @@ from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
-                  "rod_system_steps", "rod_output", "rod_table")
+                  "rod_system_steps", "rod_system_watch_circle", "rod_system_excursion",
+                  "rod_output", "rod_table")
 
 
 def refused_options(given):
@@ -84,8 +87,8 @@ def check_outputs_kept(values, comm):
 
 
 def prepared(values, given):
-    """(System, notes, the file's text, Settings, the lines' options) of the run's
-    option ``values``; RodInputError for what a system cannot take."""
+    """(System, notes, the file's text, Settings, the lines' options, the Sweeps) of
+    the run's option ``values``; RodInputError for what a system cannot take."""
     refused = refused_options(given)
     if refused:
         raise RodInputError(f"{', '.join('-' + name for name in refused)}: option(s) of "
@@ -101,7 +104,9 @@ def prepared(values, given):
     texts = whole_values()
     options = {name.removeprefix("rod_"): texts[name] for name in given
                if name.removeprefix("rod_") in LINE_OPTIONS}
-    return system, notes, read_text(path, "-rod_system"), settings, options
+    sweeps = parse_sweeps(values["rod_system_watch_circle"],
+                          values["rod_system_excursion"], system)
+    return system, notes, read_text(path, "-rod_system"), settings, options, sweeps
 
 
 def run(comm=None):
@@ -122,8 +127,8 @@ def run(comm=None):
             if database.hasName("help"):
                 for line in help_text():
                     say(line)
-            system, notes, text, settings, options = on_every_rank(comm, prepared, values,
-                                                                  given)
+            system, notes, text, settings, options, sweeps = on_every_rank(
+                comm, prepared, values, given)
             check_outputs_kept(values, comm)
             if database.hasName("help"):
                 return 0
@@ -131,12 +136,13 @@ def run(comm=None):
                 say(f"petsc_rod: note: {note}")
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
-                                 text, notes, interrupts)
+                                 text, notes, interrupts, sweeps)
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)
-                written.append(f"tables {stem}_<line>{extension or '.csv'}, "
-                               f"{stem}_system{extension or '.csv'}")
+                written.append("tables " + ", ".join(
+                    f"{stem}_{name}{extension or '.csv'}"
+                    for name in ["<line>", "system", *results.sweeps]))
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"
                 + (f"; {'; '.join(written)}" if written else ""))

@@ -3,6 +3,7 @@
     python -m petsc_rod.plots RESULT.h5 FIGURE.png [--min-bend-radius R]
     python -m petsc_rod.plots A.h5 B.h5 ... FIGURE.png      (the cases overlaid)
     python -m petsc_rod.plots MODES.csv FIGURE.png           (-rod_modes_table's modes)
+    python -m petsc_rod.plots SYSTEM.h5 FIGURE.png           (a system's file)
 
 For a plain rod: the centreline projected on the xy, xz and yz planes and the strains
 against S (the paper's Figures 1 and 3, docs/method.md §8). For a riser, a mooring line
@@ -10,7 +11,10 @@ or a cable (a file with a seabed, a current, line types or attachments): the ele
 and the plan with the sea surface, the seabed, the hang-off, the touchdown, the sections
 and the attachments, and against S the tension, the signed curvature against the
 allowable bend radius, the bending moment and the seabed reaction (petsc_rod/figures/,
-docs/output.md "Figures"). Two entry points return a matplotlib Figure:
+docs/output.md "Figures"). For a system's file (-rod_system): the plan and the elevation
+of the whole system to FIGURE.png and, where the file holds them, the watch circle to
+FIGURE_watch_circle.png and the load-excursion curves to FIGURE_excursion.png
+(figures/system.py, figures/read_system.py). Two entry points return a matplotlib Figure:
 ``result_figure(path)`` and ``sweep_figure(paths, labels)``.
 """
 
@@ -25,6 +29,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod.figures.modes import modes_figure  # noqa: E402
 from petsc_rod.figures.read import read_result  # noqa: E402
+from petsc_rod.figures.read_system import figures, is_system_file, read_system  # noqa: E402
 from petsc_rod.figures.riser import riser_figure, sweep_overlay  # noqa: E402
 from petsc_rod.figures.rod import rod_figure  # noqa: E402
 from petsc_rod.io.same_file import replaced_input, write_whole  # noqa: E402
@@ -55,6 +60,18 @@ def sweep_figure(paths, labels=None, min_bend_radius=None):
 def plot_result(path, output, min_bend_radius=None):
     """Write the figure of result file ``path`` to ``output`` (PNG)."""
     save(result_figure(path, min_bend_radius), output)
+
+
+def plot_system(path, output):
+    """Write the figures of system file ``path``: the plan and elevation to ``output``,
+    the sweeps' beside it (OUT_watch_circle.png, OUT_excursion.png); returns the paths
+    written."""
+    stem, extension = os.path.splitext(output)
+    written = []
+    for suffix, figure in figures(read_system(path)).items():
+        save(figure, f"{stem}{suffix}{extension}")
+        written.append(f"{stem}{suffix}{extension}")
+    return written
 
 
 def save(figure, output):
@@ -118,6 +135,16 @@ def main(argv):
             sys.stderr.write(f"petsc_rod.plots: error: {path}: {problem}\n")
             return 2
 
+    if len(inputs) == 1 and _system(inputs[0]):
+        stem, extension = os.path.splitext(output)
+        clash = replaced_input([("the figure", f"{stem}{suffix}{extension}")
+                                for suffix in ("_watch_circle", "_excursion")],
+                               [("result", inputs[0])])
+        if clash:
+            return parser.refuse(clash)
+        return drawn(lambda: plot_system(inputs[0], output), inputs,
+                     "a system's result file written with -rod_system ... -rod_output")
+
     def draw():
         if len(inputs) == 1:
             plot_result(inputs[0], output, radius)
@@ -125,6 +152,15 @@ def main(argv):
             labels = [os.path.basename(p).removesuffix(".h5") for p in inputs]
             save(sweep_figure(inputs, labels, radius), output)
     return drawn(draw, inputs, "result files written with -rod_output")
+
+
+def _system(path):
+    """Whether ``path`` is a system's result file (False for what h5py cannot open: the
+    single line's path then says why)."""
+    try:
+        return is_system_file(path)
+    except (OSError, KeyError, ValueError):
+        return False
 
 
 def drawn(draw, inputs, advice):

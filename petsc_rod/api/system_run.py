@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from petsc_rod.api.results import Results
+from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
 from petsc_rod.cli.line_run import values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
@@ -20,9 +21,8 @@ from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
 from petsc_rod.quantities import riser_numbers
-from petsc_rod.system.bodies import rotation
 from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import HeldLine
+from petsc_rod.system.held_line import held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
 # step is 1 / system_steps of the bodies' loads (Settings.load_steps).
@@ -60,7 +60,8 @@ class SystemResults:
     (its arrays along S on this rank, none on a rank outside its group: along_line()
     gathers them, collectively on the system's communicator); ``converged``,
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
-    (the scaled norm), ``load_factor``."""
+    (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
+    'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}."""
 
     points: dict
     bodies: dict
@@ -73,6 +74,7 @@ class SystemResults:
     halvings: int
     residual: float
     load_factor: float
+    sweeps: dict = None
 
 
 def split_options(options):
@@ -90,32 +92,6 @@ def split_options(options):
                             "loads)")
     values_of(options)                      # a malformed value refused before any work
     return Settings(load_steps=int(steps)), options
-
-
-def start_ends(system):
-    """{line name: (start (3,), end (3,))}, m: where the system's points and bodies put
-    each line's ends at the start (a body's local point through its start pose)."""
-    at = {p.name: np.asarray(p.position, dtype=float) for p in system.points}
-    poses = {b.name: np.asarray(b.position, dtype=float) for b in system.bodies}
-
-    def place(connection):
-        if connection.to in at:
-            return at[connection.to]
-        pose = poses[connection.to]
-        return pose[:3] + rotation(*pose[3:]) @ np.asarray(connection.local, dtype=float)
-
-    return {line.name: (place(line.start), place(line.end)) for line in system.lines}
-
-
-def line_maker(system, options):
-    """make_line(system_line, comm) of SystemSolver: the HeldLine of the line on its
-    group's communicator, every line with the same ``options``."""
-    ends = start_ends(system)
-
-    def make_line(line, comm):
-        return HeldLine.of_system_line(line, *ends[line.name], comm, system.environment,
-                                       options)
-    return make_line
 
 
 def _end_values(mesh, values):
@@ -195,21 +171,23 @@ def check_finite(results):
                                "inf); nothing is written")
 
 
-def table_paths(table, system):
-    """{line name or 'system': CSV path} of ``table`` (FILE.csv -> FILE_<line>.csv and
-    FILE_system.csv)."""
+def table_paths(table, system, sweeps=Sweeps()):
+    """{line name, 'system' or a sweep's name: CSV path} of ``table`` (FILE.csv ->
+    FILE_<line>.csv, FILE_system.csv, FILE_watch_circle.csv and FILE_excursion.csv
+    where ``sweeps`` asks for them)."""
     stem, extension = os.path.splitext(table)
-    names = [line.name for line in system.lines] + ["system"]
+    names = [line.name for line in system.lines] + ["system"] + [
+        name for name in ("watch_circle", "excursion") if getattr(sweeps, name) is not None]
     return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
 
 
-def check_outputs(comm, system, output, table):
+def check_outputs(comm, system, output, table, sweeps=Sweeps()):
     """Refuse, before any work, a result file or a table that could not be written
     (io/results.check_output_path, line_table.check_table_path). Collective."""
     if output:
         io.check_output_path(output, comm)
     if table:
-        for path in table_paths(table, system).values():
+        for path in table_paths(table, system, sweeps).values():
             line_table.check_table_path(path, output, comm)
 
 
@@ -237,6 +215,22 @@ def system_datasets(system, results):
     return data, units
 
 
+def picture_attributes(system):
+    """The ``system`` group's attributes a picture needs beside the datasets
+    (plots.py draws from the file alone): the points' kinds, each line's start's and
+    end's point or body (in ``line_names``' order), the flat seabed's height (left out
+    where there is none, or where it is sloped or profiled) and the sea surface's, m."""
+    environment = system.environment
+    found = {"point_kinds": ",".join(p.kind for p in system.points),
+             "line_starts": ",".join(line.start.to for line in system.lines),
+             "line_ends": ",".join(line.end.to for line in system.lines),
+             "surface": float(environment.surface or 0.0)}
+    if (environment.seabed is not None and not environment.seabed_slope
+            and environment.seabed_profile is None):
+        found["seabed"] = float(environment.seabed)
+    return found
+
+
 def write_file(comm, output, system, results, records, text, notes):
     """The system's result file (io/system_results.py): a group per line, the group
     ``system``, the input file's text and the reader's notes. Collective."""
@@ -253,12 +247,16 @@ def write_file(comm, output, system, results, records, text, notes):
                       "point_names": ",".join(results.points),
                       "body_names": ",".join(results.bodies),
                       "line_names": ",".join(line.name for line in system.lines),
-                      "input_text": text or "", "notes": "\n".join(notes)}
+                      "input_text": text or "", "notes": "\n".join(notes),
+                      **picture_attributes(system)}
         units.update({"converged": "1", "iterations": "1", "halvings": "1",
                       "residual": "1", "load_factor": "1", "ranks": "1",
                       "point_names": "text", "body_names": "text", "line_names": "text",
-                      "input_text": "text", "notes": "text", "written": "text"})
-        writer.finish_system(data, attributes, units)
+                      "input_text": "text", "notes": "text", "written": "text",
+                      "point_kinds": "text", "line_starts": "text", "line_ends": "text",
+                      "seabed": "m", "surface": "m"})
+        groups = {name: file_group(found) for name, found in results.sweeps.items()}
+        writer.finish_system(data, attributes, units, groups)
         writer = None
     finally:
         if writer is not None:
@@ -277,10 +275,11 @@ def ends_rows(system, results):
     return "\n".join(rows) + "\n"
 
 
-def write_tables(comm, solver, table, system, results, records):
+def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps()):
     """FILE_<line>.csv (a single line's table, written by the line's group) for every
-    line and FILE_system.csv (rank 0). Collective on ``comm``."""
-    paths = table_paths(table, system)
+    line, FILE_system.csv and the sweeps' FILE_watch_circle.csv, FILE_excursion.csv
+    (rank 0). Collective on ``comm``."""
+    paths = table_paths(table, system, sweeps)
 
     def write_all():
         for k, line in solver.lines.items():
@@ -291,6 +290,8 @@ def write_tables(comm, solver, table, system, results, records):
         if comm.getRank() == 0:
             partial = paths["system"] + ".partial"
             line_table._write(paths["system"], partial, ends_rows(system, results))
+            for name, found in results.sweeps.items():
+                line_table._write(paths[name], paths[name] + ".partial", table_text(found))
     on_every_rank(comm, write_all)
 
 
@@ -330,11 +331,11 @@ def report_lines(system, results, ranks):
     return lines
 
 
-def discard_tables(comm, table, system, say):
+def discard_tables(comm, table, system, say, sweeps=Sweeps()):
     """After a system that found no equilibrium: no table is written, and the tables an
     earlier run left at ``table``'s paths are removed (line_table.discard), said in one
     line. Collective."""
-    paths = table_paths(table, system).values()
+    paths = table_paths(table, system, sweeps).values()
     found = [path for path in paths if os.path.exists(path)]
     for path in paths:
         line_table.discard(path, comm, lambda line: None)
@@ -343,27 +344,29 @@ def discard_tables(comm, table, system, say):
 
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
-               text=None, notes=(), interrupts=None):
+               text=None, notes=(), interrupts=None, sweeps=Sweeps()):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, the
     result file and the tables when asked; the lines destroyed. ``interrupts``
     (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
-    ends the run before anything is written (RodInterrupted). Returns the
+    ends the run before anything is written (RodInterrupted). ``sweeps``
+    (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
+    after the equilibrium, in the results, the file and the tables. Returns the
     SystemResults. RodInputError for a system the checks refuse (exit 2),
     RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
     RodDivergedError, its Newton or a line not converged after its halvings),
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
-    check_outputs(comm, system, output, table)
-    solver = SystemSolver(system, line_maker(system, line_options), comm,
+    check_outputs(comm, system, output, table, sweeps)
+    solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
     try:
         try:
             found = solver.solve()
         except RodDivergedError as error:
             if table:
-                discard_tables(comm, table, system, say)
+                discard_tables(comm, table, system, say, sweeps)
             # a Newton or a line that did not converge, the halvings spent: the single
             # line's exit 3, but no file (there is no equilibrium to write)
             raise RodNotConvergedError(str(error)) from None
@@ -394,17 +397,22 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
         check_finite(results)
         for line in report_lines(system, results, comm.getSize()):
             say(line)
+        # after the records: the sweeps' warm re-solves leave the lines at rest again,
+        # but the equilibrium's numbers are those found before them
+        results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
+        for line in run_lines(results.sweeps):
+            say(line)
         if output:
             write_file(comm, output, system, results, records, text, notes)
         if table:
-            write_tables(comm, solver, table, system, results, records)
+            write_tables(comm, solver, table, system, results, records, sweeps)
         return results
     finally:
         solver.destroy()
 
 
 def solve_system(system, comm=None, output=None, say=None, options=None, table=None,
-                 notes=()):
+                 notes=(), sweeps=None):
     """Solve ``system`` (api.System) on the ranks of ``comm`` (a PETSc communicator;
     default PETSc.COMM_WORLD), each line on its group of ranks; collective.
     ``output``: the system's result file (HDF5, docs/output.md) as -rod_output;
@@ -412,7 +420,9 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     ``say(line)`` gets the command line's lines (None: silent), ``notes`` (the
     reader's, read_moordyn's second value) said first; ``options`` {name without
     ``rod_``: value}: 'system_steps' and every line's solver options (LINE_OPTIONS:
-    {'al_rtol': 1e-10}). Returns a SystemResults."""
+    {'al_rtol': 1e-10}); ``sweeps`` (api/system_sweeps.Sweeps: a watch circle, load-excursion
+    curves) run after the equilibrium, in ``SystemResults.sweeps``, the file and the
+    tables. Returns a SystemResults."""
     from petsc4py import PETSc
 
     comm = comm or PETSc.COMM_WORLD
@@ -421,4 +431,4 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,
-                      notes=notes)
+                      notes=notes, sweeps=sweeps or Sweeps())

@@ -350,6 +350,17 @@ OPTIONS = [
            "with -rod_system: the load continuation's first step is 1/n of the bodies' "
            "and points' loads (halved where it fails, doubled where it succeeds); default "
            "the system solver's (1)", POSITIVE),
+    Option("rod_system_watch_circle", _string, None, "BODY,LOAD[,N]",
+           "with -rod_system: after the equilibrium, body BODY's watch circle: its "
+           "position under a horizontal load LOAD (N) turned through N headings (default "
+           "24, every 15 deg), each equilibrium warm from the last; in the result file's "
+           "group system/watch_circle and the table FILE_watch_circle.csv", unit="text"),
+    Option("rod_system_excursion", _string, None, "BODY,LOADMAX[,N[,HEADING,...]]",
+           "with -rod_system: after the equilibrium, body BODY's load-excursion curves: "
+           "the restoring force against the offset under horizontal loads 0 to LOADMAX "
+           "(N) in N steps (default 10) along each heading (deg from +x towards +y, "
+           "default 0); in the result file's group system/excursion and the table "
+           "FILE_excursion.csv", unit="text"),
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "

@@ -65,9 +65,12 @@ def vector(attrs, key):
     return np.asarray(attrs[key], dtype=float)
 
 
-def read_result(path):
-    """The ``Result`` of result file ``path``."""
-    with h5py.File(path, "r") as f:
+def read_result(path, group=None):
+    """The ``Result`` of result file ``path``, or of its ``group`` holding what a
+    single line's file holds (a system's ``lines/<name>``, docs/output.md: named
+    ``FILE: name``)."""
+    with h5py.File(path, "r") as root:
+        f = root[group] if group else root
         a = f.attrs
         p = f["parameters"].attrs if "parameters" in f else {}
         S, r, u = f["S"][:], f["r"][:], f["u"][:]
@@ -78,7 +81,8 @@ def read_result(path):
                     if name in f}
         m, n = f["m"][:], f["n"][:]
         result = Result(
-            path=str(path), name=os.path.basename(str(path)).removesuffix(".h5"),
+            path=str(path), name=os.path.basename(str(path)).removesuffix(".h5")
+            + (f": {group.rsplit('/', 1)[-1]}" if group else ""),
             converged=bool(int(a["converged"])), stop_reason=text(a.get("stop_reason", "")),
             S=S, r=r, u=u,
             riser=("effective_tension" in f or "section_names" in a

@@ -37,16 +37,17 @@ class SystemWriter(ResultWriter):
         shapes everywhere), ``attributes`` and ``units`` the same on every rank."""
         self.write_step(f"lines/{name}", vertex, state, np.zeros((0, 3)), attributes, units)
 
-    def finish_system(self, datasets, attributes, units):
+    def finish_system(self, datasets, attributes, units, groups=None):
         """The group ``system`` with ``datasets`` {name: array} (the same on every rank,
-        written by rank 0) and its ``attributes``, the root's ``attributes`` too; then
-        the file closed and renamed to its path. ``units`` {name: unit} of both."""
+        written by rank 0) and its ``attributes``, the root's ``attributes`` too, and
+        its subgroups ``groups`` {name: (datasets, attributes, units)} alike (the
+        watch circle, the load-excursion curves); then the file closed and renamed to
+        its path. ``units`` {name: unit} of both."""
         attributes = self._shared(attributes)
-        self._collective(self._finish_system, datasets, attributes, units)
+        self._collective(self._finish_system, datasets, attributes, units, groups or {})
         self._collective(self._rename, self.path)
 
-    def _finish_system(self, datasets, attributes, units):
-        group = self.file.create_group("system")
+    def _group(self, group, datasets, attributes, units):
         for key, value in datasets.items():
             value = np.asarray(value, dtype=float)
             data = group.create_dataset(key, shape=value.shape, dtype="f8")
@@ -54,6 +55,12 @@ class SystemWriter(ResultWriter):
             if self.comm.Get_rank() == 0 and value.size:
                 data[...] = value
         _set_attributes(group, attributes, units)
+
+    def _finish_system(self, datasets, attributes, units, groups):
+        group = self.file.create_group("system")
+        self._group(group, datasets, attributes, units)
+        for name, (data, values, units_of) in groups.items():
+            self._group(group.create_group(name), data, values, units_of)
         _set_attributes(self.file, attributes, units)
         self.file.close()
         self.file = None

@@ -20,13 +20,13 @@ DOFS = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
 def rotation(roll, pitch, yaw):
-    """R = R_z(yaw) R_y(pitch) R_x(roll), (3, 3): body axes to global ones (angles in
-    rad), as Body.position gives them."""
+    """R = R_z(yaw) R_y(pitch) R_x(roll), (..., 3, 3): body axes to global ones (angles
+    in rad, scalars or arrays of one shape), as Body.position gives them."""
     cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
                               np.cos(yaw), np.sin(yaw))
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
+    return np.stack([np.stack([cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr], -1),
+                     np.stack([sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], -1),
+                     np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
 def connection_position(node, connection):

@@ -15,6 +15,8 @@ that an engineer attaches to a design note:
    named, the limits drawn (utilisation 1, the allowable bend radius when given);
 4. the pictures of each case, as ``petsc_rod.plots.result_figure`` draws them.
 
+A system's result file (-rod_system) has its own page (report/system_page.py).
+
 Units: kN, kN m, MPa, degrees, m, said once at the top; the page fits a 1400 px window
 (two range graphs a row, wide tables scroll inside their box).
 """
@@ -34,6 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod import plots  # noqa: E402
+from petsc_rod.figures.read_system import is_system_file  # noqa: E402
 from petsc_rod.io.same_file import write_text_whole  # noqa: E402
 from petsc_rod.report import envelopes, excursion, tables  # noqa: E402
 from petsc_rod.sweep import summary  # noqa: E402
@@ -266,5 +269,9 @@ def build(source, min_bend_radius=None):
 
 def write(source, output, min_bend_radius=None):
     """Write the page of ``source`` to ``output``, whole or not at all
-    (io.same_file.write_text_whole)."""
+    (io.same_file.write_text_whole): a system's result file's by report/system_page.py."""
+    if not os.path.isdir(source) and is_system_file(source):
+        from petsc_rod.report import system_page
+        write_text_whole(output, system_page.build(source))
+        return
     write_text_whole(output, build(source, min_bend_radius))

@@ -12,6 +12,8 @@ a force F (3,), N, and a moment M (3,), N m, about X, in global axes: the 6-vect
 
 import numpy as np
 
+from petsc_rod.model.system_check import rotation
+
 DOF_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
@@ -22,15 +24,6 @@ def skew(v):
     return np.stack([np.stack([zero, -v[..., 2], v[..., 1]], -1),
                      np.stack([v[..., 2], zero, -v[..., 0]], -1),
                      np.stack([-v[..., 1], v[..., 0], zero], -1)], -2)
-
-
-def rotation(roll, pitch, yaw):
-    """R = R_z(yaw) R_y(pitch) R_x(roll), (..., 3, 3) (model/system.Body's convention)."""
-    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
-                              np.cos(yaw), np.sin(yaw))
-    return np.stack([np.stack([cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr], -1),
-                     np.stack([sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], -1),
-                     np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
 def angles(R):

@@ -98,3 +98,32 @@ def test_the_report_loads_and_fits_a_1400_px_window(page, opened):
     for image in images:
         readable = 600 if image["alt"].startswith("range graph") else 1000
         assert readable <= image["width"] <= WIDTH, image
+
+
+@pytest.fixture(scope="module")
+def system_page(tmp_path_factory):
+    """The report of the small spread's system file with a watch circle of 3 headings:
+    its path."""
+    from helpers import run_petsc_rod
+    from test_system_cli import DECK
+    folder = tmp_path_factory.mktemp("system")
+    result = folder / "system.h5"
+    process = run_petsc_rod(["-rod_system", DECK, "-rod_system_watch_circle", "Body1,2e4,3",
+                             "-rod_output", str(result)], 1, 300)
+    assert process.returncode == 0, describe(process)
+    output = folder / "system.html"
+    process = run_module("petsc_rod.report", [str(result), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    return output
+
+
+def test_a_system_report_loads_and_fits_a_1400_px_window(system_page):
+    numbers = measure(system_page, True)
+    assert numbers["errors"] == [] and numbers["scroll"] <= WIDTH, numbers["scroll"]
+    ids = {table["id"] for table in numbers["tables"]}
+    assert {"bodies", "points", "lines", "stiffness_Body1", "watch_circle"} <= ids
+    assert all(table["boxRight"] <= WIDTH for table in numbers["tables"])
+    images = numbers["images"]
+    assert [image["alt"] for image in images] == ["plan and elevation", "watch circle",
+                                                  "line Line1", "line Line2", "line Line3"]
+    assert all(image["ok"] and 1000 <= image["width"] <= WIDTH for image in images), images

@@ -6,18 +6,25 @@ result file's groups and tables; the Python API's solve_system on the same file 
 the same numbers (issue 49 point 6, the MoorDyn-file path against the API path); bad
 input in one line, exit 2, no file left. Spawns processes: marked ``serial``."""
 
+import base64
 import os
+import re
 
 import h5py
 import numpy as np
 import pytest
 
 from helpers import REPO_ROOT, describe, partial_files, run_petsc_rod
+from test_sweep_cli import Page, run_module
 
 pytestmark = pytest.mark.serial
 
 DECK = os.path.join(REPO_ROOT, "tests", "data", "moordyn", "small_free_body.dat")
 LOAD = "Body1,10e3,2e3,0,0,0,5e3"
+# The sweeps of the shared runs: a watch circle of 4 headings, excursions in 2 steps at 90 deg.
+WATCH = ("Body1", 20e3, 4)
+SWEEPS = ["-rod_system_watch_circle", "Body1,20e3,4", "-rod_system_excursion",
+          "Body1,20e3,2,90"]
 SYSTEM_DATASETS = ("point_positions", "body_positions", "body_rotations", "body_stiffness",
                    "body_stiffness_reference", "body_stiffness_moment",
                    "body_stiffness_asymmetry", "end_forces", "end_tensions",
@@ -37,7 +44,7 @@ def runs(tmp_path_factory):
     found = {}
     for ranks in (1, 2):
         folder = tmp_path_factory.mktemp(f"ranks{ranks}")
-        found[ranks] = (folder,) + system_run(folder, ranks)
+        found[ranks] = (folder,) + system_run(folder, ranks, *SWEEPS)
     return found
 
 
@@ -53,6 +60,12 @@ def test_one_and_two_ranks_give_the_same_numbers(runs):
                                atol=1e-12 * np.abs(f["system"][name][()]).max()), name
         for line in ("Line1", "Line2", "Line3"):
             assert np.array_equal(f[f"lines/{line}/r"][()], g[f"lines/{line}/r"][()])
+        for sweep in ("watch_circle", "excursion"):
+            group = f[f"system/{sweep}"]
+            assert len(group["heading"]) > 0
+            for name in group:             # each line solved alike on its rank
+                assert np.array_equal(group[name][()], g[f"system/{sweep}"][name][()]), \
+                    (sweep, name)
 
 
 def test_the_result_file_and_the_tables(runs):
@@ -90,6 +103,24 @@ def test_the_result_file_and_the_tables(runs):
     assert table[0].startswith("S (m),x (m)") and len(table) == 72
     assert "petsc_rod: note: line type main: EI 0 in the file" in process.stdout
     assert "Body1" in process.stdout and "stiffness diagonal" in process.stdout
+    # the sweeps' tables: a row per case; their worst lines said in the run's lines
+    rows = (folder / "system_watch_circle.csv").read_text().splitlines()
+    assert rows[0].startswith("heading (deg),load (N),x_offset (m)") and len(rows) == 5
+    assert rows[1].split(",")[-1] in ("Line1", "Line2", "Line3")
+    rows = (folder / "system_excursion.csv").read_text().splitlines()
+    assert rows[0].startswith("heading (deg),load (N),offset (m),restoring (N)")
+    assert [float(row.split(",")[1]) for row in rows[1:]] == [0, 10e3, 20e3]
+    restoring = np.array([float(row.split(",")[3]) for row in rows[1:]])
+    # nothing else horizontal acts on the body: the restoring force is the load
+    assert np.abs(restoring - [0, 10e3, 20e3]).max() < 1e-2
+    with h5py.File(path, "r") as f:
+        excursion = f["system/excursion"]
+        assert excursion["restoring"].attrs["units"] == "N"
+        assert np.allclose(excursion["restoring"][()], restoring, rtol=1e-11, atol=1e-6)
+        assert "failed" in excursion.attrs and len(excursion["failed_heading"]) == 0
+    said = [line for line in process.stdout.splitlines() if "watch circle of Body1" in line]
+    assert len(said) == 1 and "largest tension" in said[0] and "smallest grounded" in said[0]
+    assert "load-excursion curves of Body1" in process.stdout
     rows = [line.split() for line in process.stdout.splitlines()
             if line.startswith("  Line")]
     assert len(rows) == 3 and all(row[-1] == "yes" for row in rows), process.stdout
@@ -111,11 +142,22 @@ system, notes = read_moordyn({DECK!r})
 body = system.bodies[0]
 load = np.add(body.load, [10e3, 2e3, 0, 0, 0, 5e3])
 system = dataclasses.replace(system, bodies=(dataclasses.replace(body, load=tuple(load)),))
-r = solve_system(system)
+from petsc_rod.api import Sweeps
+r = solve_system(system, sweeps=Sweeps(excursion=("Body1", [0.0, 2e4], [90.0])))
+from petsc4py import PETSc
+from petsc_rod.system.equilibrium import SystemSolver
+from petsc_rod.system.excursions import watch_circle
+from petsc_rod.system.held_line import held_lines
+solver = SystemSolver(system, held_lines(system, {{}}), PETSc.COMM_WORLD)
+solver.solve()
+circle = watch_circle(solver, "Body1", {WATCH[1]!r}, 360.0 * np.arange({WATCH[2]}) / {WATCH[2]})
+solver.destroy()
 np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffness,
          F=np.array([r.end_forces[n] for n in ("Line1", "Line2", "Line3")]),
          T=np.array([r.end_tensions[n] for n in ("Line1", "Line2", "Line3")]),
-         r=r.lines["Line2"].along_line(["r"])["r"])
+         r=r.lines["Line2"].along_line(["r"])["r"], offsets=circle.offsets,
+         poses=circle.poses, tension=circle.max_tension, grounded=circle.min_grounded,
+         excursion=r.sweeps["excursion"].offsets)
 """)
     process = subprocess.run([sys.executable, str(script)], cwd=REPO_ROOT, env=child_env(),
                              capture_output=True, text=True, timeout=300, check=False)
@@ -128,6 +170,25 @@ np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffne
         assert np.array_equal(api["F"], system["end_forces"][()])
         assert np.array_equal(api["T"], system["end_tensions"][()])
         assert np.array_equal(api["r"], f["lines/Line2/r"][()])
+        # the command line's watch circle is the library function's on the same system
+        circle = f["system/watch_circle"]
+        assert np.array_equal(circle["heading"][()], [0, 90, 180, 270])
+        assert np.array_equal(circle["load"][()], np.full(4, WATCH[1]))
+        offsets = np.stack([circle["x_offset"][()], circle["y_offset"][()]], axis=1)
+        assert np.abs(offsets - api["offsets"]).max() < 1e-9
+        poses = np.stack([circle[k][()] for k in ("x", "y", "z", "roll", "pitch", "yaw")], 1)
+        assert np.abs(poses - api["poses"]).max() < 1e-9
+        assert np.abs(circle["max_tension"][()] - api["tension"]).max() < 1e-9 * 1e5
+        assert np.abs(circle["min_grounded"][()] - api["grounded"]).max() < 1e-9
+        # under 20 kN the body moves about 2 to 3 m, downwind
+        assert 1.5 < np.linalg.norm(offsets, axis=1).min() < 3.5
+        assert circle["x_offset"][0] > 1.5 and circle["y_offset"][1] > 1.5
+        assert circle.attrs["largest_tension"] == circle["max_tension"][()].max()
+        # the API's sweeps: its curve (0 and 20 kN at 90 deg) the command line's (0, 10
+        # and 20 kN), to the lines' accuracy (another warm path)
+        offsets = f["system/excursion/offset"][()]
+        assert np.abs(api["excursion"][0] - offsets[[0, 2]]).max() < 1e-6
+        assert offsets[2] > 1.5
 
 
 def refused(tmp_path, args, ranks=1):
@@ -161,6 +222,11 @@ def test_bad_input_is_one_line_and_leaves_no_file(tmp_path):
     process = run_petsc_rod(["-rod_system", str(copy), "-rod_output", str(copy)], 1, 120)
     assert process.returncode == 2 and "-rod_output" in process.stdout, describe(process)
     assert copy.read_text() == kept
+    # the sweeps' options (the other refusals: tests/unit/test_system_sweeps.py)
+    for option, value, word in (("watch_circle", "Body7,1e3", "Body7"),
+                                ("excursion", "Body1,1e3,4,north", "north")):
+        assert word in refused(tmp_path, ["-rod_system", DECK,
+                                          f"-rod_system_{option}", value])
     assert "-rod_system_steps" in refused(tmp_path, ["-options_file",
                                                      "options/cantilever.opts",
                                                      "-rod_system_steps", "2"])
@@ -170,7 +236,8 @@ def test_help_lists_the_system_options():
     process = run_petsc_rod(["-rod_system", DECK, "-help"], 1, 120)
     assert process.returncode == 0, describe(process)
     for name in ("-rod_system ", "-rod_system_element_length ", "-rod_system_body_load ",
-                 "-rod_system_steps ", "-rod_al_rtol "):
+                 "-rod_system_steps ", "-rod_system_watch_circle ",
+                 "-rod_system_excursion ", "-rod_al_rtol "):
         assert name in process.stdout, name
 
 
@@ -203,3 +270,69 @@ def test_the_load_continuation_reaches_the_same_equilibrium(runs, tmp_path):
                       - f["system/body_positions"][0, :3]).max() < 1e-6
         assert np.abs(g["system/end_forces"][()] - f["system/end_forces"][()]).max() < (
             1e-7 * np.abs(f["system/end_forces"][()]).max())
+
+
+def test_the_plots_of_a_system_file(runs, tmp_path):
+    """python -m petsc_rod.plots on a system's file: the plan and elevation, the watch
+    circle and the load-excursion curves, each a drawn PNG, from the file alone."""
+    from helpers import png_summary
+    figure = tmp_path / "spread.png"
+    process = run_module("petsc_rod.plots", [str(runs[1][1]), str(figure)])
+    assert process.returncode == 0, describe(process)
+    for name, size in (("spread.png", (825, 1760)), ("spread_watch_circle.png", (605, 1760)),
+                       ("spread_excursion.png", (605, 1760))):
+        height, width, drawn = png_summary(tmp_path / name)
+        assert (height, width) == size and drawn > 0.01, name
+    # a figure that would replace the result file is refused in one line
+    process = run_module("petsc_rod.plots", [str(runs[1][1]), str(runs[1][1])])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+
+
+def test_the_report_page_of_a_system_file(runs, tmp_path):
+    """python -m petsc_rod.report on a system's file: the bodies, the 6 x 6 stiffness,
+    a row a line with the file's end tensions, the watch circle's and excursion's
+    tables, the plan and elevation, the sweeps' graphs and each line's picture."""
+    output = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(runs[1][1]), "-o", str(output)])
+    assert process.returncode == 0, describe(process)
+    text = output.read_text()
+    page = Page()
+    page.feed(text)
+    assert '<meta name="generator" content="petsc_rod.report">' in text
+    assert {"bodies", "points", "lines", "stiffness_Body1", "watch_circle",
+            "excursion"} <= set(page.tables)
+    with h5py.File(runs[1][1], "r") as f:
+        tensions = f["system/end_tensions"][()]
+        K = f["system/body_stiffness"][0]
+        circle = f["system/watch_circle/x_offset"][()]
+    lines = page.tables["lines"]
+    assert [row[0] for row in lines[1:]] == ["Line1", "Line2", "Line3"]
+    for k, row in enumerate(lines[1:]):
+        assert float(row[3]) == pytest.approx(tensions[k, 0] / 1e3, rel=1e-3)
+        assert float(row[4]) == pytest.approx(tensions[k, 1] / 1e3, rel=1e-3)
+        assert row[-1] == "yes" and float(row[8]) > 0
+    stiffness = np.array([[float(v) for v in row[1:]]
+                          for row in page.tables["stiffness_Body1"][1:]])
+    assert np.allclose(stiffness, K, rtol=1e-3, atol=1e-3 * np.abs(K).max())
+    rows = page.tables["watch_circle"]
+    assert len(rows) == 5 and float(rows[1][2]) == pytest.approx(circle[0], rel=1e-3)
+    assert len(page.tables["excursion"]) == 4
+    assert page.alts == ["plan and elevation", "watch circle", "load-excursion curves",
+                         "line Line1", "line Line2", "line Line3"]
+    encoded = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    assert len(encoded) == 6
+    assert all(base64.b64decode(e)[:8] == b"\x89PNG\r\n\x1a\n" for e in encoded)
+    assert "LINE TYPES" in page.folded and "384.243E6" in page.folded     # the MoorDyn text
+
+
+def test_the_report_refuses_a_broken_system_file(tmp_path):
+    """A system file without its datasets: one line, exit 2, no page."""
+    broken = tmp_path / "broken.h5"
+    with h5py.File(broken, "w") as f:
+        f.create_group("system").attrs["line_names"] = "Line1"
+    output = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(broken), "-o", str(output)])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+    assert process.stderr.startswith("petsc_rod.report: error: ") and not output.exists()
+    process = run_module("petsc_rod.plots", [str(broken), str(tmp_path / "x.png")])
+    assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)

@@ -1,0 +1,214 @@
+"""A system's sweeps after its equilibrium (docs/systems.md, "Excursions and the watch
+circle", "Running a system"): the watch circle (-rod_system_watch_circle) and the
+load-excursion curves (-rod_system_excursion) of system/excursions.py on the run's
+solver, their groups of the result file (``system/watch_circle``,
+``system/excursion``), their tables (FILE_watch_circle.csv, FILE_excursion.csv) and the
+run's lines.
+
+A case without an equilibrium is a gap: its row is left out of the file's group and
+of the table (the file lists it in ``failed_heading``, ``failed_load`` and the
+``failed`` attribute), so that no NaN is ever written as a result. The smallest
+grounded length's columns are left out when no line has a seabed."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from petsc_rod.errors import RodInputError
+from petsc_rod.system.excursions import TABLE_UNITS, load_excursion, watch_circle
+
+# The watch circle's headings when none are given: every 15 degrees.
+WATCH_HEADINGS = 24
+# The load-excursion curves' loads when none are given: 0 to LOADMAX in this many steps.
+EXCURSION_LOADS = 10
+# The columns naming a line (written as its index into the file's ``line_names``).
+LINE_COLUMNS = ("max_tension_line", "min_grounded_line")
+
+
+@dataclass(frozen=True)
+class Sweeps:
+    """What the run sweeps after the equilibrium: ``watch_circle`` (body, load N,
+    headings (h,) deg) and ``excursion`` (body, loads (m,) N, headings (h,) deg), each
+    or both None."""
+
+    watch_circle: tuple = None
+    excursion: tuple = None
+
+    def __bool__(self):
+        return self.watch_circle is not None or self.excursion is not None
+
+
+def _fields(option, text, least, most):
+    fields = [field.strip() for field in text.split(",")]
+    if not least <= len(fields) <= most:
+        raise RodInputError(f"-{option} {text!r}: expected {USAGE[option]}")
+    return fields
+
+
+def _number(option, text, value, what, positive=True):
+    try:
+        number = float(value)
+    except ValueError:
+        number = np.nan
+    if not np.isfinite(number) or (positive and number <= 0):
+        raise RodInputError(f"-{option} {text!r}: {value!r} is not {what}; expected "
+                            f"{USAGE[option]}")
+    return number
+
+
+def _count(option, text, value, what):
+    number = _number(option, text, value, what)
+    if number != int(number):
+        raise RodInputError(f"-{option} {text!r}: {value!r} is not {what}; expected "
+                            f"{USAGE[option]}")
+    return int(number)
+
+
+USAGE = {"rod_system_watch_circle": "BODY,LOAD[,N_HEADINGS] (a body's name, the load in "
+         "N, positive, the number of headings, default 24)",
+         "rod_system_excursion": "BODY,LOADMAX[,N_LOADS[,HEADING,...]] (a body's name, "
+         "the largest load in N, positive, the number of load steps, default 10, the "
+         "headings in degrees, default 0)"}
+
+
+def _body(option, text, name, system):
+    names = [body.name for body in system.bodies]
+    if name not in names:
+        raise RodInputError(f"-{option} {text!r}: no body {name!r} in the system; its "
+                            f"bodies: {', '.join(names) or 'none'}")
+    return name
+
+
+def parse_sweeps(watch_text, excursion_text, system):
+    """The Sweeps of the options' texts (None: not asked) on ``system``; RodInputError
+    in one line for a malformed one."""
+    circle = excursion = None
+    if watch_text:
+        option = "rod_system_watch_circle"
+        fields = _fields(option, watch_text, 2, 3)
+        body = _body(option, watch_text, fields[0], system)
+        load = _number(option, watch_text, fields[1], "a positive load in N")
+        count = (_count(option, watch_text, fields[2], "a whole number of headings")
+                 if len(fields) > 2 else WATCH_HEADINGS)
+        circle = (body, load, 360.0 * np.arange(count) / count)
+    if excursion_text:
+        option = "rod_system_excursion"
+        fields = _fields(option, excursion_text, 2, 2 + 360)
+        body = _body(option, excursion_text, fields[0], system)
+        largest = _number(option, excursion_text, fields[1], "a positive load in N")
+        count = (_count(option, excursion_text, fields[2], "a whole number of load steps")
+                 if len(fields) > 2 else EXCURSION_LOADS)
+        headings = np.array([_number(option, excursion_text, value, "a heading in degrees",
+                                     positive=False) for value in fields[3:]] or [0.0])
+        excursion = (body, largest * np.arange(count + 1) / count, headings)
+    return Sweeps(circle, excursion)
+
+
+def run_sweeps(solver, sweeps):
+    """{'watch_circle': WatchCircle, 'excursion': LoadExcursion} of those asked, on the
+    solved ``solver`` (system/excursions: warm re-solves, the solver left at rest).
+    Collective."""
+    found = {}
+    if sweeps.watch_circle is not None:
+        body, load, headings = sweeps.watch_circle
+        found["watch_circle"] = watch_circle(solver, body, load, headings)
+    if sweeps.excursion is not None:
+        body, loads, headings = sweeps.excursion
+        found["excursion"] = load_excursion(solver, body, loads, headings)
+    return found
+
+
+def solved_rows(result):
+    """{column: array} of ``result.table()`` with only the rows of the cases that
+    have an equilibrium, the lines as indices into ``result.lines``, and without the
+    grounded length's columns where no line has a seabed; (columns, {column: unit})."""
+    table = result.table()
+    keep = np.isfinite(np.asarray(result.poses, float).reshape(-1, 6)[:, 0])
+    index = {name: k for k, name in enumerate(result.lines)}
+    columns = {}
+    grounded = np.any(np.isfinite(result.min_grounded))
+    for name, values in table.items():
+        if name.startswith("min_grounded") and not grounded:
+            continue
+        values = np.asarray(values)[keep]
+        if name in LINE_COLUMNS:
+            values = np.array([index[v] for v in values], dtype=float)
+        columns[name] = np.asarray(values, dtype=float)
+    units = {name: ("index into line_names" if name in LINE_COLUMNS
+                    else TABLE_UNITS[name]) for name in columns}
+    return columns, units
+
+
+def file_group(result):
+    """(datasets, attributes, units) of the result file's group of ``result`` (a
+    WatchCircle or a LoadExcursion)."""
+    data, units = solved_rows(result)
+    failed = result.failed
+    data["failed_heading"] = np.array([f[0] for f in failed], dtype=float)
+    data["failed_load"] = np.array([f[1] for f in failed], dtype=float)
+    units.update(failed_heading="deg", failed_load="N")
+    tension, *_ = result.largest_tension
+    attributes = {"body": result.body, "line_names": ",".join(result.lines),
+                  "rest": np.asarray(result.rest, float),
+                  "failed": "\n".join(f"heading {h:g} deg, load {f:g} N: {why}"
+                                      for h, f, why in failed),
+                  "rows": "a case with an equilibrium; the cases without one are left out "
+                          "(failed_heading, failed_load, failed)"}
+    units_of = {"body": "text", "line_names": "text", "rest": "m, m, m, rad, rad, rad",
+                "failed": "text", "rows": "text"}
+    if np.isfinite(tension):
+        attributes["largest_tension"] = tension
+        units_of["largest_tension"] = "N"
+    grounded, *_ = result.smallest_grounded
+    if np.isfinite(grounded):
+        attributes["smallest_grounded"] = grounded
+        units_of["smallest_grounded"] = "m"
+    if hasattr(result, "load"):
+        attributes["load"] = result.load
+        units_of["load"] = "N"
+        if np.any(np.isfinite(result.offsets)):
+            attributes["largest_offset"] = result.largest_offset
+            units_of["largest_offset"] = "m"
+    units.update(units_of)
+    return data, attributes, units
+
+
+def table_text(result):
+    """The CSV text of ``result``'s table: a row per case with an equilibrium, the
+    lines by name."""
+    data, units = solved_rows(result)
+    header = ",".join(f"{name} ({units[name]})" if name not in LINE_COLUMNS and units[name]
+                      else name for name in data)
+    rows = [header]
+    for k in range(len(next(iter(data.values())))):
+        rows.append(",".join(result.lines[int(data[name][k])] if name in LINE_COLUMNS
+                             else f"{data[name][k] + 0.0:.12g}" for name in data))
+    return "\n".join(rows) + "\n"
+
+
+def run_lines(found):
+    """The run's lines about the sweeps ``found``."""
+    lines = []
+    for kind, result in found.items():
+        value, *where = result.largest_tension
+        grounded, *at = result.smallest_grounded
+        if kind == "watch_circle":
+            head = (f"petsc_rod: watch circle of {result.body} under {result.load:.6g} N "
+                    f"through {result.headings.size} heading(s)")
+            if np.any(np.isfinite(result.offsets)):
+                head += f": largest offset {result.largest_offset:.6g} m"
+            place = "heading {:g} deg, {}"
+        else:
+            head = (f"petsc_rod: load-excursion curves of {result.body}, loads up to "
+                    f"{result.loads.max():.6g} N in {result.loads.size - 1} step(s) at "
+                    f"heading(s) {', '.join(f'{h:g}' for h in result.headings)} deg")
+            place = "heading {:g} deg, load {:.6g} N, {}"
+        if np.isfinite(value):
+            head += f"; largest tension {value:.6g} N ({place.format(*where)})"
+        if np.isfinite(grounded):
+            head += f"; smallest grounded length {grounded:.6g} m ({place.format(*at)})"
+        lines.append(head)
+        for heading, load, why in result.failed:
+            lines.append(f"petsc_rod: warning: {kind.replace('_', ' ')}: no equilibrium at "
+                         f"heading {heading:g} deg, load {load:.6g} N (left out): {why}")
+    return lines

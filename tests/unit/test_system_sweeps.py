@@ -1,0 +1,93 @@
+"""The command line's sweeps of a system (petsc_rod/api/system_sweeps.py): the options'
+parsing and refusals, and a case without an equilibrium left out of the file's group and
+of the table (no NaN written), listed with its reason; figures/read_system.sweep puts
+the gap back in the curves' grid."""
+
+import h5py
+import numpy as np
+import pytest
+
+from petsc_rod.api.system_sweeps import file_group, parse_sweeps, run_lines, table_text
+from petsc_rod.errors import RodInputError
+from petsc_rod.figures.read_system import sweep
+from petsc_rod.model.moordyn import read_moordyn
+from petsc_rod.system.excursions import UNITS, LoadExcursion, WatchCircle
+
+LINES = ("Line1", "Line2", "Line3")
+
+
+def worst(shape, failed_index):
+    """Worst's arrays of ``shape``: NaN and -1 at the failed case ``failed_index``."""
+    tension = np.arange(1.0, np.prod(shape) + 1).reshape(shape) * 1e3
+    grounded = 50.0 - np.arange(np.prod(shape)).reshape(shape)
+    line = np.arange(np.prod(shape)).reshape(shape) % 3
+    tension[failed_index], grounded[failed_index] = np.nan, np.nan
+    line = np.where(np.isnan(tension), -1, line)
+    return dict(max_tension=tension, max_tension_line=line, min_grounded=grounded,
+                min_grounded_line=line.copy(), rest=np.zeros(6), lines=LINES, units=UNITS)
+
+
+def a_watch_circle():
+    headings = np.array([0.0, 120.0, 240.0])
+    poses = np.array([[2.0, 0, 0, 0, 0, 0], [np.nan] * 6, [-1.0, -1.7, 0, 0, 0, 0]])
+    return WatchCircle(body="Body1", headings=headings, poses=poses,
+                       failed=((120.0, 5e3, "line Line2 did not converge"),),
+                       **worst((3,), 1), load=5e3, offsets=poses[:, :2])
+
+
+def test_a_case_without_an_equilibrium_is_left_out_and_listed(tmp_path):
+    circle = a_watch_circle()
+    data, attributes, units = file_group(circle)
+    assert data["heading"].tolist() == [0.0, 240.0]
+    assert all(np.all(np.isfinite(value)) for value in data.values())
+    assert data["failed_heading"].tolist() == [120.0]
+    assert data["failed_load"].tolist() == [5e3]
+    assert "Line2 did not converge" in attributes["failed"]
+    assert data["max_tension_line"].tolist() == [0.0, 2.0]
+    assert attributes["largest_tension"] == 3e3 and attributes["smallest_grounded"] == 48.0
+    assert attributes["largest_offset"] == 2.0         # heading 0 (1.97 m at 240)
+    assert units["x_offset"] == "m" and units["max_tension"] == "N"
+    rows = table_text(circle).splitlines()
+    assert len(rows) == 3 and rows[2].startswith("240,5000,-1,-1.7,")
+    assert rows[1].split(",")[-1] == "Line1" and "nan" not in table_text(circle).lower()
+    said = run_lines({"watch_circle": circle})
+    assert "largest tension 3000 N (heading 240 deg, Line3)" in said[0]
+    assert said[1].startswith("petsc_rod: warning: watch circle: no equilibrium at heading "
+                              "120 deg")
+
+
+def test_the_curves_grid_gets_its_gap_back(tmp_path):
+    headings, loads = np.array([0.0, 90.0]), np.array([0.0, 1e3, 2e3])
+    poses = np.zeros((2, 3, 6))
+    poses[1, 2] = np.nan
+    offsets = np.array([[0.0, 1.0, 2.0], [0.0, 0.5, np.nan]])
+    curves = LoadExcursion(body="Body1", headings=headings, poses=poses,
+                           failed=((90.0, 2e3, "too far"),), **worst((2, 3), (1, 2)),
+                           loads=loads, offsets=offsets, restoring=offsets * 1e3)
+    data, attributes, units = file_group(curves)
+    assert data["offset"].size == 5 and "largest_offset" not in attributes
+    with h5py.File(tmp_path / "s.h5", "w") as f:
+        group = f.create_group("excursion")
+        for name, value in data.items():
+            group.create_dataset(name, data=value)
+        for name, value in attributes.items():
+            group.attrs[name] = value
+        found = sweep(group)
+    assert np.array_equal(found["grid_offset"], offsets, equal_nan=True)
+    assert found["grid_headings"].tolist() == [0.0, 90.0]
+
+
+def test_the_options_are_parsed_and_refused_in_one_line():
+    system, _ = read_moordyn("tests/data/moordyn/small_free_body.dat")
+    found = parse_sweeps("Body1,2e4", "Body1,3e4,3,0,90", system)
+    body, load, headings = found.watch_circle
+    assert (body, load, headings.size, headings[1]) == ("Body1", 2e4, 24, 15.0)
+    body, loads, headings = found.excursion
+    assert loads.tolist() == [0.0, 1e4, 2e4, 3e4] and headings.tolist() == [0.0, 90.0]
+    assert not parse_sweeps(None, None, system)
+    for circle, curves, word in (("Body2,1e3", None, "Body2"), ("Body1,0", None, "'0'"),
+                                 ("Body1,1e3,0", None, "'0'"), ("Body1", None, "LOAD"),
+                                 (None, "Body1,1e3,2,east", "'east'"),
+                                 (None, "Body1,inf", "'inf'")):
+        with pytest.raises(RodInputError, match=word):
+            parse_sweeps(circle, curves, system)
