@@ -154,7 +154,20 @@ def test_cli_modes_table(shared_tmp, capsys):
     assert np.allclose(table["period_s"], 1 / exact, rtol=1e-4)
     assert sorted(table["class"][:2]) == ["in-plane", "out-of-plane"]
     shapes = np.loadtxt(path.replace(".csv", "_shapes.csv"), delimiter=",", skiprows=1)
-    assert shapes.shape == (4 * 17, 8)
+    assert shapes.shape == (4 * 17, 11)
+    # the first mode's curvature at the vertices: the cantilever's phi''(S) / phi(L),
+    # phi = cosh bS - cos bS - s (sinh bS - sin bS), s = (cosh bL + cos bL) /
+    # (sinh bL + sin bL); the midpoints' values interpolated (the ends': their element's)
+    first = shapes[shapes[:, 0] == 1]
+    b = beta[0]
+    sigma = (np.cosh(b) + np.cos(b)) / (np.sinh(b) + np.sin(b))
+    phi = lambda x, k: b**k * (np.cosh(b * x) + (-1)**(k // 2 + 1) * np.cos(b * x)
+                               - sigma * (np.sinh(b * x) + (-1)**(k // 2 + 1) * np.sin(b * x)))
+    exact_curvature = np.abs(phi(first[:, 1], 2) / phi(1.0, 0))
+    bending = np.linalg.norm(first[:, 8:10], axis=1)
+    assert np.abs(bending - exact_curvature)[1:-1].max() < 3e-3 * exact_curvature.max()
+    assert np.abs(bending - exact_curvature).max() < 0.1 * exact_curvature.max()
+    assert np.abs(first[:, 10]).max() < 1e-6 * exact_curvature.max()      # no twist
     for k in range(1, 5):
         offsets = shapes[shapes[:, 0] == k][:, 2:5]
         assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
