@@ -203,3 +203,17 @@ def test_the_load_continuation_reaches_the_same_equilibrium(runs, tmp_path):
                       - f["system/body_positions"][0, :3]).max() < 1e-6
         assert np.abs(g["system/end_forces"][()] - f["system/end_forces"][()]).max() < (
             1e-7 * np.abs(f["system/end_forces"][()]).max())
+
+
+def test_modes_of_each_line_on_the_command_line(tmp_path):
+    """-rod_modes 3 on a system's run (2 ranks): a table per line in the run's lines and
+    the group lines/<name>/modes of the result file, its frequencies those said."""
+    path, process = system_run(tmp_path, 2, "-rod_modes", "3")
+    assert process.returncode == 0, describe(process)
+    assert "warning" not in process.stdout
+    with h5py.File(path, "r") as f:
+        for line in ("Line1", "Line2", "Line3"):
+            assert f"line {line} (ends held): modes: 3 lowest" in process.stdout
+            frequency = f[f"lines/{line}/modes/frequency"][()]
+            assert frequency.shape == (3,) and frequency[-1] > 0.1
+            assert f"{frequency[-1]:12.6g}" in process.stdout
