@@ -313,14 +313,22 @@ class Mesh:
         return received
 
     def global_min(self, value):
-        """Minimum of a float over all ranks."""
+        """Minimum of a float over all ranks (of an array: entry by entry)."""
         from mpi4py import MPI
-        return self.comm.tompi4py().allreduce(value, op=MPI.MIN)
+        return self._extreme(value, MPI.MIN)
 
     def global_max(self, value):
-        """Maximum of a float over all ranks."""
+        """Maximum of a float over all ranks (of an array: entry by entry)."""
         from mpi4py import MPI
-        return self.comm.tompi4py().allreduce(value, op=MPI.MAX)
+        return self._extreme(value, MPI.MAX)
+
+    def _extreme(self, value, op):
+        if np.ndim(value) == 0:
+            return self.comm.tompi4py().allreduce(value, op=op)
+        values = np.array(value, dtype=float)
+        from mpi4py import MPI
+        self.comm.tompi4py().Allreduce(MPI.IN_PLACE, values, op=op)
+        return values
 
     @property
     def smallest_element(self):
