@@ -194,7 +194,10 @@ class ModalOperators(SecondVariation):
                 R[c, :, c] = self._midpoint_rows[c][:, 0]
                 R[c, :, 3:] = self._midpoint_rows[c][:, 1:]
             middle = T[1:2 * ne:2]                                   # (ne, 3, 3)
-            blocks = np.einsum("eab,aei,bej->eij", middle, R, R)
+            R = R.transpose(1, 0, 2)                                 # (ne, 3, 3 + width)
+            # R^T T R per element as two batched products (a three-operand einsum
+            # does not pair them)
+            blocks = np.matmul(R.transpose(0, 2, 1), np.matmul(middle, R))
             triples.append((rows, blocks))
         return [t for t in triples if t[0].size]
 
