@@ -173,22 +173,39 @@ class ModalOperators(SecondVariation):
         mass.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return mass
 
+    def _add_chains(self, d):
+        """The chains (SecondVariation's), and M's translation pattern as zeros: K's
+        pattern then holds M's, so that K - sigma M is an axpy on K's pattern."""
+        super()._add_chains(d)
+        for rows in self._translation_rows():
+            self._add_blocks(rows, rows, np.zeros(rows.shape + rows.shape[1:]))
+
+    def _translation_rows(self):
+        """The rows of the translation blocks (_translation_blocks): the vertices' (u^x,
+        u^y, u^z) (n_v, 3) and, per element, (u^x_e, u^y_e, u^z_e, the element's
+        unknowns) (n_e, 3 + width); the empty ones left out."""
+        mesh, B = self.problem.mesh, self.block
+        vertices = self.first_row + B * np.arange(0, mesh.n_local_nodes, 2)
+        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
+        rows = [vertices[:, None] + slots]
+        if mesh.n_local_elements:
+            rows.append(np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
+                                       + [self._midpoint_index[0][:, 1:]], axis=1))
+        return [r for r in rows if r.size]
+
     def _translation_blocks(self):
         """The translation masses T_n (n, 3, 3) as (rows, blocks): at a vertex on its
         (u^x, u^y, u^z); at a midpoint, whose position component c is the row
         R_c = (1, h_e HALF.s^c_e) on (u^c_e, the element's unknowns), sum_ab T_ab R_a R_b^T
         on (u^x_e, u^y_e, u^z_e, the element's unknowns) in one block per element
         (position_blocks' entries, added at once)."""
-        mesh, B = self.problem.mesh, self.block
+        mesh = self.problem.mesh
         T = self.translation
-        vertices = self.first_row + B * np.arange(0, T.shape[0], 2)
-        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
-        triples = [(vertices[:, None] + slots, T[0::2])]
+        rows = self._translation_rows()
+        triples = [(rows[0], T[0::2])] if T.shape[0] else []
         ne = mesh.n_local_elements
         if ne:
             width = self._midpoint_rows[0].shape[1] - 1           # the element's unknowns
-            rows = np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
-                                  + [self._midpoint_index[0][:, 1:]], axis=1)
             R = np.zeros((3, ne, 3 + width))
             for c in (0, 1, 2):
                 R[c, :, c] = self._midpoint_rows[c][:, 0]
@@ -198,7 +215,7 @@ class ModalOperators(SecondVariation):
             # R^T T R per element as two batched products (a three-operand einsum
             # does not pair them)
             blocks = np.matmul(R.transpose(0, 2, 1), np.matmul(middle, R))
-            triples.append((rows, blocks))
+            triples.append((rows[-1], blocks))
         return [t for t in triples if t[0].size]
 
     def destroy(self):
@@ -249,7 +266,7 @@ def _solve_modes(problem, count, settings, SLEPc):
         operators = ModalOperators(problem, settings)
         K, M = operators.matrix, operators.mass_matrix
         shifted = K.duplicate(copy=True)
-        shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
     ksp = factor_ksp(shifted, factor)
