@@ -7,8 +7,10 @@ written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
--rod_system_excursion), the outputs (-rod_output, -rod_table) and
-the line solver's (-rod_al_*, -rod_max_halvings: every line the same); every other
+-rod_system_excursion), the outputs (-rod_output, -rod_table), the
+modes of each line with its ends held (-rod_modes N, -rod_modes_added_mass,
+-rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
+-rod_max_halvings: every line the same); every other
 -rod_* option describes a single line's scene or load path, which the file gives, and is
 refused in one line naming them. It sits above system/ and cli/ (it needs both: the
 option table, and the system's run), run by __main__.py when -rod_system is given."""
@@ -20,7 +22,7 @@ import sys
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.api.system_run import LINE_OPTIONS, run_system
+from petsc_rod.api.system_run import LINE_OPTIONS, MODES_OPTIONS, modes_request, run_system
 from petsc_rod.api.system_sweeps import parse_sweeps
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
@@ -37,7 +39,7 @@ from petsc_rod.tables import read_text
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
                   "rod_system_steps", "rod_system_watch_circle", "rod_system_excursion",
-                  "rod_output", "rod_table")
+                  "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 
 
 def refused_options(given):
@@ -87,8 +89,9 @@ def check_outputs_kept(values, comm):
 
 
 def prepared(values, given):
-    """(System, notes, the file's text, Settings, the lines' options, the Sweeps) of
-    the run's option ``values``; RodInputError for what a system cannot take."""
+    """(System, notes, the file's text, Settings, the lines' options, the Sweeps, the
+    modes' request: api/system_run.modes_request) of the run's option ``values``;
+    RodInputError for what a system cannot take."""
     refused = refused_options(given)
     if refused:
         raise RodInputError(f"{', '.join('-' + name for name in refused)}: option(s) of "
@@ -106,7 +109,9 @@ def prepared(values, given):
                if name.removeprefix("rod_") in LINE_OPTIONS}
     sweeps = parse_sweeps(values["rod_system_watch_circle"],
                           values["rod_system_excursion"], system)
-    return system, notes, read_text(path, "-rod_system"), settings, options, sweeps
+    modes = modes_request({name.removeprefix("rod_"): texts[name] for name in given
+                           if name.removeprefix("rod_") in MODES_OPTIONS})
+    return system, notes, read_text(path, "-rod_system"), settings, options, sweeps, modes
 
 
 def run(comm=None):
@@ -127,7 +132,7 @@ def run(comm=None):
             if database.hasName("help"):
                 for line in help_text():
                     say(line)
-            system, notes, text, settings, options, sweeps = on_every_rank(
+            system, notes, text, settings, options, sweeps, modes = on_every_rank(
                 comm, prepared, values, given)
             check_outputs_kept(values, comm)
             if database.hasName("help"):
@@ -136,7 +141,7 @@ def run(comm=None):
                 say(f"petsc_rod: note: {note}")
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
-                                 text, notes, interrupts, sweeps)
+                                 text, notes, interrupts, sweeps, modes)
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)

@@ -8,7 +8,8 @@ docs/modes.md): the kinetic energy
 of the node displacements u (m) and the sections' small rotations omega (rad), t the unit
 tangent of the static state: m the mass per length in air with the contents (kg/m; a
 line type's mass), m_a = C_a rho_w pi od^2 / 4 the water's added mass normal to the line
-(kg/m; none along it, C_a from -rod_modes_added_mass, default 1), J the polar and
+(kg/m; none along it; C_a a line type's ``ca`` where it gives one, else
+-rod_modes_added_mass, default 1), J the polar and
 I_b = J / 2 the bending mass moment of inertia of the section per length (kg m; a pipe:
 J = m (od^2 + id^2) / 8), and the attachments' mass m_p = rho_w V_p - F_z,p / g (from
 their dead force F and volume V) with their added mass C_a rho_w V_p at the nearest node.
@@ -40,7 +41,8 @@ def mass_known(scene, settings):
 
 @dataclass(frozen=True)
 class MassSettings:
-    """The modal analysis's inputs beyond the scene: the added-mass coefficient C_a (1),
+    """The modal analysis's inputs beyond the scene: the added-mass coefficient C_a (1;
+    of the attachments, and of the line types that give no ``ca``),
     and a uniform line's mass per length (kg/m; None: its load's magnitude / g) and
     polar mass moment of inertia per length (kg m)."""
 
@@ -57,7 +59,9 @@ def line_inertia(scene, S, settings):
         m = piecewise_constant(scene.sections, S, "mass")
         od = piecewise_constant(scene.sections, S, "od")
         inner = piecewise_constant(scene.sections, S, "id")
-        added = settings.added_mass * scene.water_density * np.pi * od**2 / 4
+        ca = piecewise_constant(scene.sections, S, "ca")
+        ca = np.where(np.isnan(ca), settings.added_mass, ca)
+        added = ca * scene.water_density * np.pi * od**2 / 4
         polar = m * (od**2 + inner**2) / 8
         return m, added, polar
     if not mass_known(scene, settings):
@@ -69,22 +73,36 @@ def line_inertia(scene, S, settings):
     return np.full(n, float(mass)), np.zeros(n), np.full(n, float(settings.inertia))
 
 
+def weighted_inertia(scene, mesh, settings):
+    """(w m, w m_a, w J) of the owned P2 nodes, (n,) each (kg, kg, kg m^2): each
+    element's Simpson weights h_e (1/6, 4/6, 1/6) times its own section's values (at its
+    midpoint), summed at the vertices, so that a vertex where the line type changes
+    takes each side's mass with that side's weight."""
+    left, right = mesh.vertex_sides()
+    S = mesh.vertex_S
+    sides = [np.asarray(line_inertia(scene, S + sign * h / 2, settings)) * h / 6
+             for sign, h in ((-1, left), (1, right))]
+    middle = np.asarray(line_inertia(scene, mesh.element_S + mesh.element_h / 2, settings))
+    weighted = np.empty((3, mesh.n_local_nodes))
+    weighted[:, 0::2] = sides[0] + sides[1]
+    weighted[:, 1::2] = middle * 4 * mesh.element_h / 6
+    return weighted
+
+
 def nodal_mass(scene, mesh, tangents, settings, submerged=None):
     """The lumped mass of the owned P2 nodes: (translation (n, 3, 3), kg; rotation (n, 3,
     3), kg m^2): w_n [m I + m_a (I - t t^T)] and w_n [J t t^T + J/2 (I - t t^T)], t the
     unit tangents (n, 3), plus the attachments' masses at their nearest nodes
     (point_masses); the added mass only at the ``submerged`` nodes (n,) bool, where
     given."""
-    S, w = mesh.node_S(), mesh.node_weights()
-    m, added, polar = line_inertia(scene, S, settings)
+    m, added, polar = weighted_inertia(scene, mesh, settings)
     if submerged is not None:
         added = np.where(submerged, added, 0.0)
     t = tangents / np.linalg.norm(tangents, axis=1)[:, None]
     along = np.einsum("nk,nl->nkl", t, t)
     normal = np.eye(3) - along
-    translation = w[:, None, None] * (m[:, None, None] * np.eye(3)
-                                      + added[:, None, None] * normal)
-    rotation = w[:, None, None] * polar[:, None, None] * (along + normal / 2)
+    translation = m[:, None, None] * np.eye(3) + added[:, None, None] * normal
+    rotation = polar[:, None, None] * (along + normal / 2)
     node, point = point_masses(scene, mesh, settings)
     np.add.at(translation, node, point[:, None, None] * np.eye(3))
     return translation, rotation

@@ -41,6 +41,11 @@ from petsc_rod.global_step.ksp import direct_factor
 from petsc_rod.scenes.boundary import is_held
 
 PREFIX = "rod_modes_"
+# The phases of solve_modes in -log_view: K and M, the factorisation of K - sigma M (and
+# its inertia), the eigensolver, the shapes.
+EVENTS = {name: PETSc.Log.Event(f"rod_modes_{name}")
+          for name in ("operators", "factor", "eps", "shapes")}
+STAGE = PETSc.Log.Stage("rod_modes")
 # sigma: omega^2 of the shift, rad^2/s^2, just below 0 so that a free rigid mode
 # (omega = 0) leaves K - sigma M nonsingular: the frequency 1e-4 Hz squared.
 SHIFT = -(2 * np.pi * 1e-4) ** 2
@@ -168,29 +173,49 @@ class ModalOperators(SecondVariation):
         mass.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return mass
 
+    def _add_chains(self, d):
+        """The chains (SecondVariation's), and M's translation pattern as zeros: K's
+        pattern then holds M's, so that K - sigma M is an axpy on K's pattern."""
+        super()._add_chains(d)
+        for rows in self._translation_rows():
+            self._add_blocks(rows, rows, np.zeros(rows.shape + rows.shape[1:]))
+
+    def _translation_rows(self):
+        """The rows of the translation blocks (_translation_blocks): the vertices' (u^x,
+        u^y, u^z) (n_v, 3) and, per element, (u^x_e, u^y_e, u^z_e, the element's
+        unknowns) (n_e, 3 + width); the empty ones left out."""
+        mesh, B = self.problem.mesh, self.block
+        vertices = self.first_row + B * np.arange(0, mesh.n_local_nodes, 2)
+        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
+        rows = [vertices[:, None] + slots]
+        if mesh.n_local_elements:
+            rows.append(np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
+                                       + [self._midpoint_index[0][:, 1:]], axis=1))
+        return [r for r in rows if r.size]
+
     def _translation_blocks(self):
         """The translation masses T_n (n, 3, 3) as (rows, blocks): at a vertex on its
         (u^x, u^y, u^z); at a midpoint, whose position component c is the row
         R_c = (1, h_e HALF.s^c_e) on (u^c_e, the element's unknowns), sum_ab T_ab R_a R_b^T
         on (u^x_e, u^y_e, u^z_e, the element's unknowns) in one block per element
         (position_blocks' entries, added at once)."""
-        mesh, B = self.problem.mesh, self.block
+        mesh = self.problem.mesh
         T = self.translation
-        vertices = self.first_row + B * np.arange(0, T.shape[0], 2)
-        slots = np.array([self.position_slot[c] for c in (0, 1, 2)])
-        triples = [(vertices[:, None] + slots, T[0::2])]
+        rows = self._translation_rows()
+        triples = [(rows[0], T[0::2])] if T.shape[0] else []
         ne = mesh.n_local_elements
         if ne:
             width = self._midpoint_rows[0].shape[1] - 1           # the element's unknowns
-            rows = np.concatenate([self._midpoint_index[c][:, :1] for c in (0, 1, 2)]
-                                  + [self._midpoint_index[0][:, 1:]], axis=1)
             R = np.zeros((3, ne, 3 + width))
             for c in (0, 1, 2):
                 R[c, :, c] = self._midpoint_rows[c][:, 0]
                 R[c, :, 3:] = self._midpoint_rows[c][:, 1:]
             middle = T[1:2 * ne:2]                                   # (ne, 3, 3)
-            blocks = np.einsum("eab,aei,bej->eij", middle, R, R)
-            triples.append((rows, blocks))
+            R = R.transpose(1, 0, 2)                                 # (ne, 3, 3 + width)
+            # R^T T R per element as two batched products (a three-operand einsum
+            # does not pair them)
+            blocks = np.matmul(R.transpose(0, 2, 1), np.matmul(middle, R))
+            triples.append((rows[-1], blocks))
         return [t for t in triples if t[0].size]
 
     def destroy(self):
@@ -228,17 +253,28 @@ def solve_modes(problem, count, settings=MassSettings()):
     from slepc4py import SLEPc
     if count < 1:
         raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
-    operators = ModalOperators(problem, settings)
-    K, M = operators.matrix, operators.mass_matrix
-    shifted = K.duplicate(copy=True)
-    shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    STAGE.push()
+    try:
+        return _solve_modes(problem, count, settings, SLEPc)
+    finally:
+        STAGE.pop()
+
+
+def _solve_modes(problem, count, settings, SLEPc):
+    """solve_modes in its -log_view stage."""
+    with EVENTS["operators"]:
+        operators = ModalOperators(problem, settings)
+        K, M = operators.matrix, operators.mass_matrix
+        shifted = K.duplicate(copy=True)
+        shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
     ksp = factor_ksp(shifted, factor)
     eps = SLEPc.EPS().create(comm=operators.comm)
     try:
-        factor.set_up(shifted)
-        negative = factor.negative_pivots() - operators.chain_constraints
+        with EVENTS["factor"]:
+            factor.set_up(shifted)
+            negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
             raise ModesRefused(int(negative))
         eps.setOperators(shifted, M)
@@ -254,8 +290,10 @@ def solve_modes(problem, count, settings=MassSettings()):
         st.setKSP(ksp)
         eps.setOptionsPrefix(PREFIX)
         eps.setFromOptions()
-        eps.solve()
-        return _modes(operators, eps, count)
+        with EVENTS["eps"]:
+            eps.solve()
+        with EVENTS["shapes"]:
+            return _modes(operators, eps, count)
     finally:
         eps.destroy()
         ksp.destroy()
@@ -268,55 +306,65 @@ def _modes(operators, eps, count):
     """The lowest ``count`` converged eigenpairs of ``eps`` as Modes. An eigenvalue below
     the shift is one of the massless unknowns' infinite ones that the spectral
     transformation returned with the wrong sign (the inertia proved there is none): left
-    out."""
+    out. The shapes are taken all at once (_shapes): their reductions over the ranks
+    are one per quantity, not one per mode."""
     converged = eps.getConverged()
     values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + SHIFT
     finite = np.flatnonzero(values >= SHIFT)
     order = finite[np.argsort(values[finite])][:count]
     vector = operators.mass_matrix.createVecRight()
     product = vector.duplicate()
-    parts = []
+    vectors, local_mass = [], []
     for i in order:
         eps.getEigenvector(int(i), vector)
-        parts.append(_shape(operators, vector, product))
+        operators.mass_matrix.mult(vector, product)
+        array = vector.getArray(readonly=True)
+        vectors.append(array.reshape(-1, operators.block).copy())
+        local_mass.append(float(product.getArray(readonly=True) @ array))
     vector.destroy()
     product.destroy()
     mesh = operators.problem.mesh
-    stack = [np.array([p[k] for p in parts]) if parts else np.zeros(0) for k in range(5)]
-    shares = stack[1].reshape(-1, len(CLASSES))
+    vectors = np.array(vectors).reshape(len(order), mesh.n_local_nodes, operators.block)
+    modal_mass, shares, offset, rotation, curvature = _shapes(
+        operators, vectors, np.asarray(mesh.global_sum(np.array(local_mass))))
     S_mid = mesh.element_S + mesh.element_h / 2
     omega2 = values[order]
-    return Modes(omega2, stack[0], shares, mesh.vertex_S, stack[2], stack[3], S_mid,
-                 stack[4], converged,
+    return Modes(omega2, modal_mass, shares, mesh.vertex_S, offset, rotation, S_mid,
+                 curvature, converged,
                  classify(shares, np.sqrt(np.maximum(omega2, 0.0)) / (2 * np.pi)))
 
 
-def _shape(operators, vector, product):
-    """(modal mass, shares (4,), offset (n_v, 3), rotation (n_v, 3), curvature (n_e, 3))
-    of one eigenvector, normalised to a largest offset of 1 (a torsional mode, at least
-    DOMINANT of its energy in the roll, to a largest rotation of 1 rad) with that
-    largest entry positive (the first along the line where several are)."""
+def _shapes(operators, vectors, masses):
+    """(modal masses (k,), shares (k, 4), offsets (k, n_v, 3), rotations (k, n_v, 3),
+    curvatures (k, n_e, 3)) of the eigenvectors ``vectors`` (k, n_nodes, block), whose
+    phi^T M phi are ``masses`` (k,): each normalised to a largest offset of 1 (a
+    torsional mode, at least DOMINANT of its energy in the roll, to a largest rotation
+    of 1 rad) with that largest entry positive (the first along the line where several
+    are). Collective."""
     problem, mesh = operators.problem, operators.problem.mesh
-    values = vector.getArray(readonly=True).reshape(-1, operators.block)
+    k = vectors.shape[0]
     slots = [operators.position_slot[c] for c in (0, 1, 2)]
-    offset = values[0::2, slots]
-    omega = values[:, :3]
-    shares = _shares(operators, offset, omega)
-    signed = omega if shares[CLASSES.index("torsional")] >= DOMINANT else offset
-    size = np.abs(signed).max(axis=1) if signed is omega else np.linalg.norm(signed, axis=1)
-    largest = mesh.global_max(float(size.max(initial=0.0)))
-    local = int(np.argmax(size)) if size.size else -1
-    here = size.size and size[local] >= largest * (1 - 1e-12)
+    offset = vectors[:, 0::2][:, :, slots]                     # (k, n_v, 3)
+    omega = vectors[:, :, :3]                                   # (k, n_nodes, 3)
+    shares = _shares(operators, offset, omega).reshape(k, len(CLASSES))
+    torsional = shares[:, CLASSES.index("torsional")] >= DOMINANT
+    sizes = [np.abs(omega[j]).max(axis=1) if torsional[j] else
+             np.linalg.norm(offset[j], axis=1) for j in range(k)]
+    signed = [omega[j] if torsional[j] else offset[j] for j in range(k)]
+    local_largest = np.array([size.max(initial=0.0) for size in sizes])
+    largest = mesh.global_max(local_largest)
+    local = np.array([int(np.argmax(size)) if size.size else -1 for size in sizes])
+    here = (local >= 0) & (local_largest >= largest * (1 - 1e-12))
     # rank order: 2 vertex_start + local increases along the line on either array
-    index = 2 * mesh.vertex_start + local if here else np.iinfo(np.int32).max
-    first = mesh.global_min(float(index))
-    entry = signed[local][np.argmax(np.abs(signed[local]))] if here and index == first else 0.0
-    sign = 1.0 if mesh.global_sum(float(entry)) >= 0 else -1.0
+    index = np.where(here, 2 * mesh.vertex_start + local, np.iinfo(np.int32).max)
+    first = mesh.global_min(index.astype(float))
+    entries = np.array([signed[j][local[j]][np.argmax(np.abs(signed[j][local[j]]))]
+                        if here[j] and index[j] == first[j] else 0.0 for j in range(k)])
+    sign = np.where(np.asarray(mesh.global_sum(entries)) >= 0, 1.0, -1.0)
     scale = sign / largest
-    operators.mass_matrix.mult(vector, product)
-    modal_mass = vector.dot(product) * scale**2
-    offset, omega = offset * scale, omega * scale
-    return modal_mass, shares, offset, omega[0::2], _curvature(problem, omega)
+    omega = omega * scale[:, None, None]
+    return (masses * scale**2, shares, offset * scale[:, None, None], omega[:, 0::2],
+            _curvature(problem, omega))
 
 
 def _plane_normal(problem):
@@ -335,10 +383,12 @@ def _plane_normal(problem):
 
 
 def _shares(operators, offset, omega):
-    """The shares of the kinetic energy (in-plane, out-of-plane, axial, torsional) of a
-    shape: the displacements at the vertices with their trapezoid masses, the rotations
-    at the P2 nodes with their rotary inertia; a rotation about the plane's normal is
-    in-plane bending, about the in-plane normal out-of-plane bending. Collective."""
+    """The shares of the kinetic energy (in-plane, out-of-plane, axial, torsional) of
+    shapes, (k, 4): offsets (k, n_v, 3) and rotations (k, n_nodes, 3); the
+    displacements at the vertices with their trapezoid masses, the rotations at the P2
+    nodes with their rotary inertia; a rotation about the plane's normal is in-plane
+    bending, about the in-plane normal out-of-plane bending. Collective (one reduction
+    for all k)."""
     problem, mesh = operators.problem, operators.problem.mesh
     normal = _plane_normal(problem)
     t = unit(problem.state.tau[:, 2])
@@ -346,30 +396,33 @@ def _shares(operators, offset, omega):
     S = mesh.vertex_S
     m, added, _ = line_inertia(problem.scene, S, operators.settings)
     vertex_w = 3 * mesh.node_weights()[0::2]      # (h_left + h_right) / 2
-    axial = np.einsum("nc,nc->n", offset, tv)
+    axial = np.einsum("knc,nc->kn", offset, tv)
     out = offset @ normal
-    inplane = np.maximum(np.sum(offset**2, axis=1) - axial**2 - out**2, 0.0)
+    inplane = np.maximum(np.sum(offset**2, axis=2) - axial**2 - out**2, 0.0)
     rotation = operators.rotation
-    torsion = np.einsum("nc,nc->n", omega, t)
+    torsion = np.einsum("knc,nc->kn", omega, t)
     about_normal = omega @ normal
     polar = np.einsum("nc,nck,nk->n", t, rotation, t)       # w J
-    energies = np.array([
-        np.sum(vertex_w * (m + added) * inplane) + np.sum(polar / 2 * about_normal**2),
-        np.sum(vertex_w * (m + added) * out**2)
-        + np.sum(polar / 2 * np.maximum(np.sum(omega**2, axis=1) - torsion**2
-                                        - about_normal**2, 0.0)),
-        np.sum(vertex_w * m * axial**2),
-        np.sum(polar * torsion**2)])
+    energies = np.stack([
+        inplane @ (vertex_w * (m + added)) + (about_normal**2) @ (polar / 2),
+        out**2 @ (vertex_w * (m + added))
+        + np.maximum(np.sum(omega**2, axis=2) - torsion**2 - about_normal**2, 0.0)
+        @ (polar / 2),
+        axial**2 @ (vertex_w * m),
+        torsion**2 @ polar], axis=1)
     energies = np.asarray(mesh.global_sum(energies))
-    return energies / max(energies.sum(), np.finfo(float).tiny)
+    return energies / np.maximum(energies.sum(axis=1, keepdims=True), np.finfo(float).tiny)
 
 
 def _curvature(problem, omega):
-    """(d1, d2, d3) . omega' at the owned elements' midpoints, (n_e, 3), 1/m: omega' of
-    the P2 field there, (omega_right - omega_left) / h."""
+    """(d1, d2, d3) . omega' at the owned elements' midpoints, (k, n_e, 3), 1/m, of the
+    rotations ``omega`` (k, n_nodes, 3): omega' of the P2 field there,
+    (omega_right - omega_left) / h. Collective (one exchange for all k)."""
     mesh = problem.mesh
     ne = mesh.n_local_elements
-    right = np.concatenate([omega[2::2], mesh.first_of_next_rank(omega)[None]])[:ne]
-    derivative = (right - omega[0:2 * ne:2]) / mesh.element_h[:, None]
+    vertices = np.moveaxis(omega[:, 0::2], 1, 0)                # (n_v, k, 3)
+    following = mesh.first_of_next_rank(np.ascontiguousarray(vertices))   # (k, 3)
+    right = np.concatenate([vertices[1:], following[None]])[:ne]          # (n_e, k, 3)
+    derivative = (right - vertices[:ne]) / mesh.element_h[:, None, None]
     d = problem.state.tau[1:2 * ne:2]                       # (n_e, 3 directors, 3)
-    return np.einsum("eic,ec->ei", d, derivative)
+    return np.einsum("eic,ekc->kei", d, derivative)

@@ -30,7 +30,7 @@ MODEL_OPTIONS = ("line_types", "sections", "length", "stiffness", "load", "load_
                  "current_profile")
 # The columns of a -rod_line_types table the export writes (model/line_type.py).
 COLUMNS = ("name", "od", "mass", "gj", "ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd",
-           "drag_d", "id", "smys", "stress_od")
+           "drag_d", "id", "smys", "stress_od", "ca")
 
 
 def _number(value):
@@ -56,7 +56,8 @@ def type_row(kind):
             + [_number(kind.ea), _number(kind.cd),
                blank if kind.drag_d is None else _number(kind.drag_d), _number(kind.id),
                blank if kind.smys is None else _number(kind.smys),
-               blank if kind.stress_od is None else _number(kind.stress_od)])
+               blank if kind.stress_od is None else _number(kind.stress_od),
+               blank if kind.ca is None else _number(kind.ca)])
 
 
 def line_types_table(types):

@@ -7,12 +7,16 @@ What it returns holds numpy arrays only (SystemResults); the lines' PETSc object
 made and destroyed here."""
 
 import os
-from dataclasses import dataclass, replace
+import time
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from petsc_rod.analysis.mass import MassSettings
+from petsc_rod.analysis.modes import ModesRefused, solve_modes
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
+from petsc_rod.cli.modes import table_lines
 from petsc_rod.cli.line_run import values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
@@ -27,6 +31,10 @@ from petsc_rod.system.held_line import held_lines
 # The options of the system itself (not of its lines): the load continuation's first
 # step is 1 / system_steps of the bodies' loads (Settings.load_steps).
 SYSTEM_OPTIONS = ("system_steps",)
+# The modes of each line with its ends held (docs/modes.md): their count and the mass's
+# settings (every line the same), the option names without ``rod_`` and MassSettings'.
+MODES_OPTIONS = {"modes": None, "modes_added_mass": "added_mass", "modes_mass": "mass",
+                 "modes_inertia": "inertia"}
 # The options of a line that a system's lines take (every line the same): the
 # iteration's tolerances and switches (-rod_al_*), the halvings of a line's walk.
 LINE_OPTIONS = tuple(name.removeprefix("rod_") for name in BY_NAME
@@ -61,7 +69,10 @@ class SystemResults:
     gathers them, collectively on the system's communicator); ``converged``,
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
     (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
-    'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}."""
+    'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}; with
+    modes asked, ``modes`` {line: analysis/modes.Modes or ModesRefused}, each line's
+    modes about its equilibrium in the system with its ends held (line_modes: the numbers per mode on every rank, the
+    shapes along the line on its group's ranks, zero rows on the others)."""
 
     points: dict
     bodies: dict
@@ -75,23 +86,82 @@ class SystemResults:
     residual: float
     load_factor: float
     sweeps: dict = None
+    modes: dict = field(default_factory=dict)
+
+
+def modes_request(options):
+    """(count, MassSettings) of the modes ``options`` {name without ``rod_``: value}
+    asks for (MODES_OPTIONS, parsed as the command line's -rod_modes*), None without
+    ``modes``; the options taken out of ``options``."""
+    texts = {name: options.pop(name) for name in list(options) if name in MODES_OPTIONS}
+    values, _ = values_of(texts)
+    if not values["rod_modes"]:
+        return None
+    return values["rod_modes"], MassSettings(
+        **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key})
 
 
 def split_options(options):
-    """(system Settings, the lines' options) of ``options`` {name without ``rod_``:
-    value}; RodInputError naming one that neither takes."""
+    """(system Settings, the lines' options, the modes' request (modes_request)) of
+    ``options`` {name without ``rod_``: value}; RodInputError naming one that none
+    takes."""
     options = dict(options or {})
-    unknown = sorted(set(options) - set(SYSTEM_OPTIONS) - set(LINE_OPTIONS))
+    taken = SYSTEM_OPTIONS + LINE_OPTIONS + tuple(MODES_OPTIONS)
+    unknown = sorted(set(options) - set(taken))
     if unknown:
         raise RodInputError(f"system option {unknown[0]!r}: not an option of a system; "
-                            f"its options: {', '.join(SYSTEM_OPTIONS + LINE_OPTIONS)}")
+                            f"its options: {', '.join(taken)}")
+    modes = modes_request(options)
     steps = options.pop("system_steps", Settings().load_steps)
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise RodInputError(f"system_steps {steps!r}: a whole number of at least 1 (the "
                             "load continuation's first step is 1 / system_steps of the "
                             "loads)")
     values_of(options)                      # a malformed value refused before any work
-    return Settings(load_steps=int(steps)), options
+    return Settings(load_steps=int(steps)), options, modes
+
+
+def line_modes(solver, count, settings):
+    """({line index: Modes or ModesRefused}, {line index: seconds}) on every rank: each
+    line's ``count`` lowest modes about its equilibrium with its ends held
+    (analysis/modes.solve_modes on the HeldLine's problem, collective on its group's
+    communicator: its ends are pinned there, so its modes are the held line's), the
+    shapes on the line's own ranks, zero rows of them on the others. Collective."""
+    mine, seconds = {}, {}
+    for k, line in solver.lines.items():
+        start = time.perf_counter()
+        try:
+            mine[k] = solve_modes(line.problem, count, settings)
+        except ModesRefused as refused:
+            mine[k] = refused
+        seconds[k] = line.mesh.global_max(time.perf_counter() - start)
+
+    def numbers(found):
+        if isinstance(found, ModesRefused):
+            return found.negative
+        n = len(found.omega2)
+        return replace(found, S=np.zeros(0), offset=np.zeros((n, 0, 3)),
+                       rotation=np.zeros((n, 0, 3)), S_mid=np.zeros(0),
+                       curvature=np.zeros((n, 0, 3)))
+    shared = solver.placement.share({k: (numbers(m), seconds[k]) for k, m in mine.items()})
+    found = {k: mine[k] if k in mine else
+             ModesRefused(value) if isinstance(value, (int, np.integer)) else value
+             for k, (value, _) in shared.items()}
+    return found, {k: time_ for k, (_, time_) in shared.items()}
+
+
+def modes_lines(system, modes, seconds):
+    """The run's lines of each line's modes (cli/modes.table_lines), or their refusal."""
+    lines = []
+    for k, line in enumerate(system.lines):
+        found = modes[k]
+        if isinstance(found, ModesRefused):
+            lines.append(f"line {line.name}: modes: refused: {found}")
+            continue
+        table = table_lines(found, seconds[k])
+        lines.append(f"line {line.name} (ends held): {table[0]}")
+        lines.extend(table[1:])
+    return lines
 
 
 def _end_values(mesh, values):
@@ -232,7 +302,8 @@ def picture_attributes(system):
 
 
 def write_file(comm, output, system, results, records, text, notes):
-    """The system's result file (io/system_results.py): a group per line, the group
+    """The system's result file (io/system_results.py): a group per line (with its
+    modes, ``lines/<name>/modes``, as a single line's file has them), the group
     ``system``, the input file's text and the reader's notes. Collective."""
     writer = SystemWriter(output, comm)
     try:
@@ -240,6 +311,9 @@ def write_file(comm, output, system, results, records, text, notes):
             record = records[k]
             writer.write_line(line.name, record.vertex, record.state, record.attributes,
                               record.units)
+            found = results.modes.get(line.name)
+            if found is not None and not isinstance(found, ModesRefused):
+                writer.write_modes(found, f"lines/{line.name}/modes")
         data, units = system_datasets(system, results)
         attributes = {"converged": int(results.converged), "iterations": results.iterations,
                       "halvings": results.halvings, "residual": results.residual,
@@ -344,10 +418,11 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps()):
 
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
-               text=None, notes=(), interrupts=None, sweeps=Sweeps()):
+               text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
-    equilibrium (SystemSolver.solve), each body's stiffness, each line's record, the
-    result file and the tables when asked; the lines destroyed. ``interrupts``
+    equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
+    line's modes with its ends held where ``modes`` (count, MassSettings) asks for
+    them (line_modes), the result file and the tables when asked; the lines destroyed. ``interrupts``
     (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
     ends the run before anything is written (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
@@ -397,6 +472,11 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
         check_finite(results)
         for line in report_lines(system, results, comm.getSize()):
             say(line)
+        if modes is not None:
+            found, seconds = line_modes(solver, *modes)
+            results.modes = {n: found[k] for k, n in enumerate(names)}
+            for line in modes_lines(system, found, seconds):
+                say(line)
         # after the records: the sweeps' warm re-solves leave the lines at rest again,
         # but the equilibrium's numbers are those found before them
         results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
@@ -422,13 +502,14 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     ``rod_``: value}: 'system_steps' and every line's solver options (LINE_OPTIONS:
     {'al_rtol': 1e-10}); ``sweeps`` (api/system_sweeps.Sweeps: a watch circle, load-excursion
     curves) run after the equilibrium, in ``SystemResults.sweeps``, the file and the
-    tables. Returns a SystemResults."""
+    tables; the modes of each line with its ends held are asked in ``options``
+    (MODES_OPTIONS: {'modes': 10, 'modes_added_mass': 1.0}). Returns a SystemResults."""
     from petsc4py import PETSc
 
     comm = comm or PETSc.COMM_WORLD
     say = say or (lambda line: None)
-    settings, line_options = on_every_rank(comm, split_options, options)
+    settings, line_options, modes = on_every_rank(comm, split_options, options)
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,
-                      notes=notes, sweeps=sweeps or Sweeps())
+                      notes=notes, sweeps=sweeps or Sweeps(), modes=modes)

@@ -17,7 +17,8 @@ from petsc_rod.io.results import check_output_path
 TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
                  "class", *(f"share_{name.replace('-', '_')}" for name in CLASSES))
 SHAPE_COLUMNS = ("mode", "S_m", "offset_x_m", "offset_y_m", "offset_z_m", "rotation_x_rad",
-                 "rotation_y_rad", "rotation_z_rad")
+                 "rotation_y_rad", "rotation_z_rad", "curvature_1_per_m",
+                 "curvature_2_per_m", "twist_per_m")
 
 
 def mass_settings(values):
@@ -85,6 +86,17 @@ def table_lines(modes, seconds):
     return lines
 
 
+def vertex_curvature(S, S_mid, curvature):
+    """The modes' curvature (n, n_e, 3) at the elements' midpoints S_mid (n_e,),
+    interpolated linearly in S to the vertices S (n_v,): (n, n_v, 3), 1/m per unit
+    largest offset; the end vertices take their element's value. (d1, d2, d3) . omega'
+    of the P2 rotations is exact at the midpoints, one-sided at a vertex."""
+    count = curvature.shape[0]
+    flat = curvature.transpose(0, 2, 1).reshape(-1, S_mid.size)
+    values = np.array([np.interp(S, S_mid, row) for row in flat])    # a row per mode
+    return values.reshape(count, 3, S.size).transpose(0, 2, 1)
+
+
 def write_tables(comm, modes, path, say):
     """The modes' table to ``path`` and their shapes (gathered in rank order) to
     shapes_path(path), by rank 0, each as a .partial file renamed when complete.
@@ -97,9 +109,14 @@ def write_tables(comm, modes, path, say):
         modes.offset.reshape(count, len(modes.S), 3),
         modes.rotation.reshape(count, len(modes.S), 3)], axis=2)
     pieces = mpi.gather(local, root=0)
+    middles = mpi.gather((modes.S_mid, modes.curvature), root=0)
     error = None
     if mpi.Get_rank() == 0:
-        rows = np.concatenate(pieces, axis=1).reshape(-1, len(SHAPE_COLUMNS))
+        vertices = np.concatenate(pieces, axis=1)
+        curvature = vertex_curvature(vertices[0, :, 1],
+                                     np.concatenate([m[0] for m in middles]),
+                                     np.concatenate([m[1] for m in middles], axis=1))
+        rows = np.concatenate([vertices, curvature], axis=2).reshape(-1, len(SHAPE_COLUMNS))
         partial = [f"{name}.{os.getpid()}.partial" for name in (path, shapes_path(path))]
         try:
             with open(partial[0], "w") as table:

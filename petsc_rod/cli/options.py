@@ -331,7 +331,8 @@ OPTIONS = [
            NON_NEGATIVE, "kg m"),
     Option("rod_modes_added_mass", _real, 1.0, "Ca",
            "the added-mass coefficient C_a of -rod_modes: C_a rho_w pi od^2 / 4 normal "
-           "to the line, C_a rho_w V at an attachment", NON_NEGATIVE),
+           "to the line where its line type gives no ca (a type's ca wins), C_a rho_w V "
+           "at an attachment", NON_NEGATIVE),
     Option("rod_system", _string, None, "FILE",
            "solve a system of lines, points and bodies read from FILE, a MoorDyn version 2 "
            "input file (docs/systems.md): the coupled equilibrium, each body's 6 x 6 "

@@ -19,7 +19,8 @@ def shapes_path(path):
 
 def read_modes(path):
     """(table, shapes): the modes' table of ``path`` (a structured array, a row per
-    mode) and the shapes' rows (n, 8: mode, S, offsets x y z, rotations x y z)."""
+    mode) and the shapes' rows (n, 11: mode, S, offsets x y z, rotations x y z, curvature
+    1 and 2, twist)."""
     table = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, dtype=None,
                                         encoding="utf-8"))
     shapes = np.loadtxt(shapes_path(path), delimiter=",", skiprows=1, ndmin=2)

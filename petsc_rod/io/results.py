@@ -352,8 +352,8 @@ class ResultWriter:
         _set_attributes(group, attributes, self.attribute_units)
         self.file.flush()
 
-    def write_modes(self, modes):
-        """The group ``modes`` (docs/modes.md, docs/output.md): per mode (m,)
+    def write_modes(self, modes, name="modes"):
+        """The group ``name`` (``modes``; docs/modes.md, docs/output.md): per mode (m,)
         ``frequency`` Hz, ``period`` s, ``omega2`` rad^2/s^2, ``modal_mass`` kg,
         ``shares`` (m, 4) and the attribute ``classes``; along the line, distributed by
         rows as the vertex datasets, ``S`` (n,), ``offset`` m and ``rotation`` rad (n, m,
@@ -367,10 +367,10 @@ class ResultWriter:
         nbytes = 8 * sum(int(np.prod(shape)) for shape, _, _ in layout.values())
         on_every_rank(self.comm, self._check_room_for_step,
                       SPACE_FACTOR * nbytes + SPACE_RESERVE)
-        self._collective(self._write_modes, modes, along, layout)
+        self._collective(self._write_modes, modes, along, layout, name)
 
-    def _write_modes(self, modes, along, layout):
-        group = self.file.require_group("modes")
+    def _write_modes(self, modes, along, layout, name):
+        group = self.file.require_group(name)
         for key, values, unit in (("frequency", modes.frequencies, "Hz"),
                                   ("period", modes.periods, "s"),
                                   ("omega2", modes.omega2, "rad^2/s^2"),

@@ -230,15 +230,21 @@ class Mesh:
         S[1::2] = self.element_S + self.element_h / 2
         return S
 
-    def node_weights(self):
-        """Simpson weights of the owned P2 nodes, (n_local_nodes,): h_e (1/6, 4/6, 1/6) per
-        element, summed at the vertices, so that sum_n w_n g(S_n) = int g dS exactly for
-        a piecewise cubic g (the quadrature of the constraint, docs/method.md §4)."""
+    def vertex_sides(self):
+        """The lengths (m) of the elements left and right of the owned vertices, each
+        (n_local_vertices,), 0 beyond the line's ends."""
         vertices = np.arange(self.vertex_start, self.vertex_end)
         lengths = self.element_lengths
         left = np.where(vertices > 0, lengths(np.maximum(vertices - 1, 0)), 0.0)
         right = np.where(vertices < self.n_elements,
                          lengths(np.minimum(vertices, self.n_elements - 1)), 0.0)
+        return left, right
+
+    def node_weights(self):
+        """Simpson weights of the owned P2 nodes, (n_local_nodes,): h_e (1/6, 4/6, 1/6) per
+        element, summed at the vertices, so that sum_n w_n g(S_n) = int g dS exactly for
+        a piecewise cubic g (the quadrature of the constraint, docs/method.md §4)."""
+        left, right = self.vertex_sides()
         w = np.empty(self.n_local_nodes)
         w[0::2] = (left + right) / 6
         w[1::2] = 4 * self.element_h / 6
@@ -307,14 +313,22 @@ class Mesh:
         return received
 
     def global_min(self, value):
-        """Minimum of a float over all ranks."""
+        """Minimum of a float over all ranks (of an array: entry by entry)."""
         from mpi4py import MPI
-        return self.comm.tompi4py().allreduce(value, op=MPI.MIN)
+        return self._extreme(value, MPI.MIN)
 
     def global_max(self, value):
-        """Maximum of a float over all ranks."""
+        """Maximum of a float over all ranks (of an array: entry by entry)."""
         from mpi4py import MPI
-        return self.comm.tompi4py().allreduce(value, op=MPI.MAX)
+        return self._extreme(value, MPI.MAX)
+
+    def _extreme(self, value, op):
+        if np.ndim(value) == 0:
+            return self.comm.tompi4py().allreduce(value, op=op)
+        values = np.array(value, dtype=float)
+        from mpi4py import MPI
+        self.comm.tompi4py().Allreduce(MPI.IN_PLACE, values, op=op)
+        return values
 
     @property
     def smallest_element(self):

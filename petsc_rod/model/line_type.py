@@ -27,7 +27,9 @@ class Section:
     normal Morison drag (0: none); od, id: outer and inner diameter, m (id 0: no bore);
     mass: kg/m in air; smys: the specified minimum yield stress of the pipe's wall, Pa
     (NaN: not given; quantities/stresses.py); stress_od: the outer diameter of the pipe's
-    wall, m, below a buoyancy jacket or coating (NaN: od; quantities/pressures.py).
+    wall, m, below a buoyancy jacket or coating (NaN: od; quantities/pressures.py);
+    ca: the added-mass coefficient normal to the line, 1, of the modes (analysis/mass.py;
+    NaN: not given, -rod_modes_added_mass's).
     """
 
     name: str
@@ -43,6 +45,7 @@ class Section:
     id: float = 0.0
     smys: float = np.nan
     stress_od: float = np.nan
+    ca: float = np.nan
 
     def __post_init__(self):
         self.stiffness_start = np.asarray(self.stiffness_start, dtype=float)
@@ -67,8 +70,9 @@ class LineType:
     ``ei`` (a bend stiffener), ``smys`` the wall's yield stress (Pa; None: no
     utilisation, quantities/stresses.py), ``stress_od`` the steel wall's outer diameter under
     a jacket or coating (m; None: the od: a buoyancy jacket or a coating has its own
-    larger od for weight and drag, but the external pressure on it is carried by it).
-    The submerged weight is (mass - rho_w pi od^2 / 4) g. The values' ranges are
+    larger od for weight and drag, but the external pressure on it is carried by it),
+    ``ca`` the added-mass coefficient normal to the line of the modes (1; None: not
+    given, -rod_modes_added_mass's, default 1; analysis/mass.py). The submerged weight is (mass - rho_w pi od^2 / 4) g. The values' ranges are
     checked with the line's (check_line_types)."""
 
     name: str
@@ -83,6 +87,7 @@ class LineType:
     ei_end: float = None
     smys: float = None
     stress_od: float = None
+    ca: float = None
 
     def __post_init__(self):
         owner = f"LineType {self.name!r}"
@@ -93,7 +98,7 @@ class LineType:
             real(f"{owner}.{name}", getattr(self, name))
         real(f"{owner}.ea", self.ea, allow_inf=True)
         bending = reals(f"{owner}.ei", self.ei, (1, 2))
-        for name in ("drag_d", "ei_end", "smys", "stress_od"):
+        for name in ("drag_d", "ei_end", "smys", "stress_od", "ca"):
             optional(f"{owner}.{name}", getattr(self, name), real)
         if self.ei_end is not None and bending.size != 1:
             raise RodInputError(f"line type {self.name}: a taper (ei_end) takes one ei")
@@ -126,13 +131,14 @@ class LineType:
                        np.array([0.0, 0.0, -self.submerged_weight(water_density, gravity)]),
                        0.5 * water_density * self.cd * drag_d, self.od, self.mass,
                        self.id, np.nan if self.smys is None else self.smys,
-                       self.od if self.stress_od is None else self.stress_od)
+                       self.od if self.stress_od is None else self.stress_od,
+                       np.nan if self.ca is None else self.ca)
 
 
 # The columns of a line-type table (-rod_line_types): required, and optional.
 LINE_TYPE_COLUMNS = ("name", "od", "mass", "gj")
 LINE_TYPE_OPTIONAL = ("ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd", "drag_d", "id",
-                      "smys", "stress_od")
+                      "smys", "stress_od", "ca")
 # The ways of giving the bending stiffness, one per line type (the others' columns left
 # blank, '-'): isotropic, anisotropic (about d1 and d2), and a linear taper along each
 # section of the type.
@@ -152,10 +158,11 @@ def table_columns(types):
         rows.append((kind.od, kind.mass, kind.gj) + bending
                     + (kind.ea, kind.cd, nan if kind.drag_d is None else kind.drag_d,
                        kind.id, nan if kind.smys is None else kind.smys,
-                       nan if kind.stress_od is None else kind.stress_od))
-    numbers = np.array(rows, dtype=float).reshape(len(types), 14)
+                       nan if kind.stress_od is None else kind.stress_od,
+                       nan if kind.ca is None else kind.ca))
+    numbers = np.array(rows, dtype=float).reshape(len(types), 15)
     names = ("od", "mass", "gj", "ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd",
-             "drag_d", "id", "smys", "stress_od")
+             "drag_d", "id", "smys", "stress_od", "ca")
     columns = {"name": [kind.name for kind in types]}
     columns.update({name: numbers[:, k] for k, name in enumerate(names)})
     return columns
@@ -242,19 +249,26 @@ def line_types_from_table(table, option, largest=np.inf):
         row = int(np.flatnonzero(~((cd >= 0) & np.isfinite(cd)))[0])
         raise RodInputError(f"{option}: line type {names[row]}: cd {cd[row]:g} must be a "
                             "finite number, 0 or more")
+    ca = column("ca", np.nan)
+    bad = ~np.isnan(ca) & ~((ca >= 0) & np.isfinite(ca))
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise RodInputError(f"{option}: line type {names[row]}: ca {ca[row]:g} must be a "
+                            "finite added-mass coefficient, 0 or more, or blank ('-')")
     bending = [start[i, 0] if form[i] != 1 else (start[i, 0], start[i, 1])
                for i in range(rows)]
     return {name: LineType(name, table["od"][i], table["mass"][i], bending[i],
                            table["gj"][i], ea[i], cd[i], drag_d[i], inner[i],
                            end[i, 0] if form[i] == 2 else None,
-                           None if np.isnan(smys[i]) else smys[i], wall[i])
+                           None if np.isnan(smys[i]) else smys[i], wall[i],
+                           None if np.isnan(ca[i]) else ca[i])
             for i, name in enumerate(names)}
 
 
 def _values(kind):
     """The numbers of a LineType, comparable."""
     return (kind.od, kind.mass, tuple(np.ravel(kind.ei)), kind.gj, kind.ea, kind.cd,
-            kind.drag_d, kind.id, kind.ei_end, kind.smys, kind.stress_od)
+            kind.drag_d, kind.id, kind.ei_end, kind.smys, kind.stress_od, kind.ca)
 
 
 def check_line_types(types, option, largest):

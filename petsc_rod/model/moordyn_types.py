@@ -59,7 +59,7 @@ def stiffness(where, column, text, notes):
 
 
 def type_row(row, place):
-    """{name, od, mass, ea, ei, cd} of one LINE TYPES row (tokens) at ``place``
+    """{name, od, mass, ea, ei, cd, ca} of one LINE TYPES row (tokens) at ``place``
     ('path:line'), notes of the viscoelastic forms said in row['notes']."""
     where = f"{place}: LINE TYPES: line type {row[0]}"
     if len(row) < len(TYPE_COLUMNS):
@@ -72,23 +72,25 @@ def type_row(row, place):
                   mass=number(where, "Mass/m", row[2]),
                   ea=stiffness(where, "EA", row[3], notes),
                   ei=stiffness(where, "EI", row[5], notes),
-                  cd=number(where, "Cd", row[6]), notes=notes)
+                  cd=number(where, "Cd", row[6]), ca=number(where, "Ca", row[7]),
+                  notes=notes)
     for column in ("od", "mass", "ea"):
         if not values[column] > 0:
             raise RodInputError(f"{where}: {dict(od='Diam', mass='Mass/m', ea='EA')[column]}"
                                 f" {values[column]:g} must be positive")
-    if values["ei"] < 0 or values["cd"] < 0:
-        raise RodInputError(f"{where}: EI and Cd must not be negative")
+    if values["ei"] < 0 or values["cd"] < 0 or values["ca"] < 0:
+        raise RodInputError(f"{where}: EI, Cd and Ca must not be negative")
     return values
 
 
 def line_types(rows, lines, depth, water_density, gravity, path):
-    """{name: LineType} of MoorDyn's line types ``rows`` ({name, od, mass, ea, ei, cd}),
+    """{name: LineType} of MoorDyn's line types ``rows`` ({name, od, mass, ea, ei, cd, ca}),
     and the notes of what was substituted. ``lines`` {type name: [(length m, element
     length m), ...]} of the lines of each type; ``depth`` (m; None: unknown, then the
     type's longest line stands for D). od and drag diameter: MoorDyn's Diam (the
     volume-equivalent diameter, so that the wet weight (mass - rho pi d^2 / 4) g is
-    MoorDyn's); Cd on d l as MoorDyn's; EA as given; EI as given, or the rule of the
+    MoorDyn's); Cd on d l as MoorDyn's; Ca, the transverse added-mass coefficient, for the
+    modes; EA as given; EI as given, or the rule of the
     module's docstring; GJ = EI / (1 + POISSON)."""
     types, notes = {}, []
     for row in rows:
@@ -113,7 +115,7 @@ def line_types(rows, lines, depth, water_density, gravity, path):
                 f"{'the water depth' if depth else 'its length'} {span:.4g} m), too "
                 "small to matter (docs/systems.md)")
         types[name] = LineType(name, row["od"], row["mass"], ei, ei / (1 + POISSON),
-                               row["ea"], row["cd"])
+                               row["ea"], row["cd"], ca=row["ca"])
     if types:
         notes.append(f"every line type: GJ = EI / {1 + POISSON:g} (a solid round section, "
                      f"Poisson's ratio {POISSON:g}): MoorDyn gives no torsional stiffness")

@@ -154,7 +154,20 @@ def test_cli_modes_table(shared_tmp, capsys):
     assert np.allclose(table["period_s"], 1 / exact, rtol=1e-4)
     assert sorted(table["class"][:2]) == ["in-plane", "out-of-plane"]
     shapes = np.loadtxt(path.replace(".csv", "_shapes.csv"), delimiter=",", skiprows=1)
-    assert shapes.shape == (4 * 17, 8)
+    assert shapes.shape == (4 * 17, 11)
+    # the first mode's curvature at the vertices: the cantilever's phi''(S) / phi(L),
+    # phi = cosh bS - cos bS - s (sinh bS - sin bS), s = (cosh bL + cos bL) /
+    # (sinh bL + sin bL); the midpoints' values interpolated (the ends': their element's)
+    first = shapes[shapes[:, 0] == 1]
+    b = beta[0]
+    sigma = (np.cosh(b) + np.cos(b)) / (np.sinh(b) + np.sin(b))
+    phi = lambda x, k: b**k * (np.cosh(b * x) + (-1)**(k // 2 + 1) * np.cos(b * x)
+                               - sigma * (np.sinh(b * x) + (-1)**(k // 2 + 1) * np.sin(b * x)))
+    exact_curvature = np.abs(phi(first[:, 1], 2) / phi(1.0, 0))
+    bending = np.linalg.norm(first[:, 8:10], axis=1)
+    assert np.abs(bending - exact_curvature)[1:-1].max() < 3e-3 * exact_curvature.max()
+    assert np.abs(bending - exact_curvature).max() < 0.1 * exact_curvature.max()
+    assert np.abs(first[:, 10]).max() < 1e-6 * exact_curvature.max()      # no twist
     for k in range(1, 5):
         offsets = shapes[shapes[:, 0] == k][:, 2:5]
         assert abs(np.linalg.norm(offsets, axis=1).max() - 1) < 1e-9     # 10 digits
@@ -204,6 +217,61 @@ def test_added_mass_of_a_line_type(added_mass):
              / np.sqrt(1 + (n * np.pi / L)**2 * (od**2 / 16) / (1 + added_mass)))
     assert modes.labels[0] == "rigid" and modes.shares[0, 3] > 0.999
     assert np.allclose(modes.frequencies[1:], exact, rtol=2e-4)
+
+
+def string_of_two_halves(mu, tension, half, count):
+    """The lowest ``count`` omega (rad/s) of a string pinned at both ends, of two halves of
+    length ``half`` (m) and masses per length mu (2,) (kg/m): on each half
+    y = sin(k_i x) from its pin, k_i = omega sqrt(mu_i / T), and the slope continuous at
+    the junction: k_1 cot(k_1 a) + k_2 cot(k_2 a) = 0 (the transfer matrix's), found by
+    bisection between the sign changes of sin(k_1 a) sin(k_2 a) times it. ``tension``
+    a function of omega: T - I_b omega^2 with the sections' rotary inertia I_b (kg m),
+    equal on both halves."""
+    def residual(omega):
+        k = omega * np.sqrt(mu / tension(omega))
+        return (k[0] * np.cos(k[0] * half) * np.sin(k[1] * half)
+                + k[1] * np.cos(k[1] * half) * np.sin(k[0] * half))
+    grid = np.linspace(1e-3, 2000.0, 200001)
+    values = np.array([residual(w) for w in grid])
+    roots = []
+    for i in np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:]))[:count]:
+        lo, hi = grid[i], grid[i + 1]
+        for _ in range(60):
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if np.sign(residual(mid)) == np.sign(residual(lo)) else (lo, mid)
+        roots.append((lo + hi) / 2)
+    return np.array(roots)
+
+
+def test_added_mass_per_line_type():
+    """A neutrally buoyant taut line (T = 100 N) of two halves of one diameter and mass
+    whose line types give C_a 0 and 3 (the column ``ca``): its transverse modes are those
+    of a string of masses m and 4 m per length on its halves (string_of_two_halves, of
+    the stretched line: m' = m / (1 + e), its tension lowered by the rotary inertia
+    I_b' omega^2, I_b = m od^2 / 16; EI 10^-6): within 6.6e-5 and 3.0e-4 from 16 elements
+    on (a plateau in n^2 that a uniform line of these line types shows as well, 5e-5 and
+    2e-4 against its closed form). The vertex at the junction takes each side's mass
+    with that side's weight (mass.weighted_inertia); -rod_modes_added_mass (5 here) is
+    the C_a of a line type without ``ca`` alone."""
+    from petsc_rod.model.line_type import LineType
+    rho, od, T, EA, EI, GJ = 1025.0, 0.2, 100.0, 1e6, 1e-6, 10.0
+    m = rho * np.pi * od**2 / 4
+    halves = [LineType(f"half{k}", od, m, EI, GJ, ea=EA, ca=ca).section(
+        0.5 * k, 0.5 * (k + 1), rho, G) for k, ca in enumerate((0.0, 3.0))]
+    e = T / EA
+    scene = dict(length=L, stiffness=(EI, EI, GJ), start="pin", end="pin",
+                 end_position=[L * (1 + e), 0.0, 0.0], sections=tuple(halves),
+                 axial_stiffness=EA, water_density=rho, load_values=[[0.0, 0.0, 0.0]])
+    modes = modes_of(scene, 16, 5, added_mass=5.0)
+    inertia = m * od**2 / 16 / (1 + e)
+    omega = string_of_two_halves(np.array([m, 4 * m]) / (1 + e),
+                                 lambda w: T - inertia * w**2, 0.5 * (1 + e), 2)
+    exact = np.repeat(omega / (2 * np.pi), 2)
+    assert modes.labels[0] == "rigid"
+    assert np.allclose(modes.frequencies[1:], exact, rtol=5e-4)
+    # the uniform line's closed form is far from it: the halves' masses matter
+    uniform = np.sqrt(T * (1 + e) / (2.5 * m)) / (2 * (1 + e))
+    assert abs(modes.frequencies[1] / uniform - 1) > 0.02
 
 
 def test_no_added_mass_above_the_sea():

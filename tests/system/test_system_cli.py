@@ -336,3 +336,15 @@ def test_the_report_refuses_a_broken_system_file(tmp_path):
     assert process.stderr.startswith("petsc_rod.report: error: ") and not output.exists()
     process = run_module("petsc_rod.plots", [str(broken), str(tmp_path / "x.png")])
     assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+def test_modes_of_each_line_on_the_command_line(tmp_path):
+    """-rod_modes 3 on a system's run (2 ranks): a table per line in the run's lines and
+    the group lines/<name>/modes of the result file, its frequencies those said."""
+    path, process = system_run(tmp_path, 2, "-rod_modes", "3")
+    assert process.returncode == 0, describe(process)
+    assert "warning" not in process.stdout
+    with h5py.File(path, "r") as f:
+        for line in ("Line1", "Line2", "Line3"):
+            assert f"line {line} (ends held): modes: 3 lowest" in process.stdout
+            frequency = f[f"lines/{line}/modes/frequency"][()]
+            assert frequency.shape == (3,) and frequency[-1] > 0.1
+            assert f"{frequency[-1]:12.6g}" in process.stdout

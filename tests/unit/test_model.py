@@ -146,3 +146,26 @@ def test_the_model_refuses_the_loads_it_derives_before_a_scene_is_compiled(model
     with pytest.raises(RodInputError) as compiled:
         compile_scene(model)
     assert str(compiled.value) == str(refused.value)
+
+
+def test_a_line_type_table_s_optional_ca():
+    """The column ca (the modes' added-mass coefficient): given, blank ('-', NaN: None,
+    -rod_modes_added_mass's) or absent (None); a negative one refused; the API's table
+    export keeps it."""
+    from petsc_rod.api.model import line_types_table
+    from petsc_rod.model import line_types_from_table
+    from petsc_rod.tables import read_table
+    from petsc_rod.model.line_type import LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL
+    base = {"name": ["a", "b"], "od": np.array([0.2, 0.3]), "mass": np.array([60.0, 70.0]),
+            "gj": np.array([8e4, 8e4]), "ei": np.array([1e5, 1e5])}
+    types = line_types_from_table(base, "t")
+    assert types["a"].ca is None and np.isnan(types["a"].section(0, 1, 1025, 9.8).ca)
+    types = line_types_from_table(dict(base, ca=np.array([0.7, np.nan])), "t")
+    assert types["a"].ca == 0.7 and types["b"].ca is None
+    assert types["a"].section(0, 1, 1025, 9.8).ca == 0.7
+    with pytest.raises(RodInputError, match="line type a: ca -1 must be a finite"):
+        line_types_from_table(dict(base, ca=np.array([-1.0, 1.0])), "t")
+    text = line_types_table(list(types.values()))
+    again = line_types_from_table(read_table(None, "t", LINE_TYPE_COLUMNS, LINE_TYPE_OPTIONAL,
+                                             content=text), "t")
+    assert again["a"].ca == 0.7 and again["b"].ca is None

@@ -256,3 +256,16 @@ def test_the_older_option_names_kb_and_cb_are_read():
                                                                                   "cb")))
     assert system.environment.seabed_stiffness == pytest.approx(3.0e6 * 0.09)
     assert "ignored: writeLog, dtM, cb," in " ".join(notes)
+
+
+def test_a_line_type_s_ca_is_its_added_mass_coefficient(tmp_path):
+    """MoorDyn's Ca (the transverse added-mass coefficient) is the line type's ca, the
+    modes' (analysis/mass.py); a negative one refused."""
+    text = open(os.path.join(DATA, "small_free_body.dat")).read()
+    path = tmp_path / "ca.dat"
+    path.write_text(text.replace("1.6    1.0    0.1", "1.6    0.8    0.1"))
+    system, _ = read_moordyn(str(path))
+    assert {line.line.sections[0][0].ca for line in system.lines} == {0.8}
+    path.write_text(text.replace("1.6    1.0    0.1", "1.6    -0.5   0.1"))
+    with pytest.raises(RodInputError, match="EI, Cd and Ca must not be negative"):
+        read_moordyn(str(path))

@@ -21,10 +21,11 @@ FAIRLEADS = ((5.2, 0.0, -70.0), (-2.6, 4.5, -70.0), (-2.6, -4.5, -70.0))
 def chain():
     """OC3-Hywind's line type, with the EI = 0 rule's bending stiffness (docs/systems.md):
     EI = (h / 10)^2 |w| D for 902.2 m in 903 elements of 1 m or less, D = 320 m, and
-    GJ = EI / 1.3."""
+    GJ = EI / 1.3; the file's Ca 1 as its ca."""
     weight = abs(77.7066 - 1025.0 * np.pi * 0.09 ** 2 / 4) * 9.80665
     ei = (0.1 * (902.2 / 903)) ** 2 * (weight * 320.0)
-    return LineType("main", od=0.09, mass=77.7066, ei=ei, gj=ei / 1.3, ea=384.243e6, cd=1.6)
+    return LineType("main", od=0.09, mass=77.7066, ei=ei, gj=ei / 1.3, ea=384.243e6, cd=1.6,
+                    ca=1.0)
 
 
 def spar_on_a_body():

@@ -1,0 +1,69 @@
+"""The modes of each line of a system with its ends held (-rod_modes on a system's run,
+api/system_run.line_modes, docs/modes.md): each line's modes about its equilibrium in
+the system are the single line's modes with its ends pinned where the system holds
+them; in the system's result file (lines/<name>/modes) and its run's lines."""
+
+import os
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from petsc_rod.api import End, Model, read_moordyn, solve, solve_system
+
+pytestmark = pytest.mark.solver
+pytest.importorskip("slepc4py")
+
+DECK = os.path.join(os.path.dirname(__file__), "..", "data", "moordyn", "small_free_body.dat")
+COUNT = 5
+
+
+def test_each_line_s_modes_are_the_held_single_line_s(shared_tmp):
+    """small_free_body.dat (three short chains to a free body): each line's COUNT lowest
+    modes in the system equal those of api.solve of the same line with its ends pinned
+    at the system's equilibrium positions (its first and last vertex) and
+    Model.options {'modes': COUNT}: frequencies to 10^-6 relative (the two equilibria
+    agree to the solvers' tolerance), modal masses and classes of the vibrations; the
+    system's file has them in lines/<name>/modes, its lines a table per line."""
+    import h5py
+    system, _ = read_moordyn(DECK)
+    path = os.path.join(shared_tmp, "system.h5")
+    said = []
+    results = solve_system(system, output=path, say=said.append, options={"modes": COUNT})
+    text = "\n".join(said)
+    for line in system.lines:
+        assert f"line {line.name} (ends held): modes: {COUNT} lowest" in text
+        found = results.modes[line.name]
+        ends = results.lines[line.name].along_line(["r"])["r"][[0, -1]]
+        single = os.path.join(shared_tmp, f"{line.name}.h5")
+        model = Model(line.line, End("pin", position=tuple(ends[0])),
+                      End("pin", position=tuple(ends[1])), system.environment,
+                      tuple(line.attachments), options={"modes": COUNT})
+        assert solve(model, output=single).converged
+        with h5py.File(single, "r") as f:
+            frequency = f["modes/frequency"][:]
+            modal_mass = f["modes/modal_mass"][:]
+            classes = f["modes"].attrs["classes"].split(",")
+        vibrations = frequency > 1e-3                  # the free roll's rigid mode aside
+        assert vibrations.sum() >= COUNT - 1
+        assert np.allclose(found.frequencies[vibrations], frequency[vibrations], rtol=1e-6)
+        assert np.allclose(found.frequencies[~vibrations], 0.0, atol=1e-4)
+        assert np.allclose(found.modal_mass[vibrations], modal_mass[vibrations], rtol=1e-5)
+        assert list(np.array(found.labels)[vibrations]) == \
+            list(np.array(classes)[vibrations])
+        with h5py.File(path, "r") as f:
+            group = f[f"lines/{line.name}/modes"]
+            assert np.array_equal(group["frequency"][:], found.frequencies)
+            vertices = f[f"lines/{line.name}/S"].shape[0]
+            assert group["offset"].shape == (vertices, COUNT, 3)
+            swaying = vibrations & (np.array(found.labels) != "torsional")
+            largest = np.linalg.norm(group["offset"][:][:, swaying], axis=2).max(axis=0)
+            assert np.allclose(largest, 1.0, atol=1e-9)     # normalised to 1 m
+
+
+def test_a_system_refuses_a_bad_modes_option():
+    """A malformed modes option: refused in one line before any work."""
+    from petsc_rod.errors import RodInputError
+    system, _ = read_moordyn(DECK)
+    with pytest.raises(RodInputError, match="-rod_modes"):
+        solve_system(system, options={"modes": "many"})
