@@ -3,6 +3,7 @@
 ``modes``), then said as the run's lines (a table of the modes) and written as the CSV
 files of -rod_modes_table: the modes' table and their shapes along the line."""
 
+import importlib.util
 import os
 import time
 
@@ -29,6 +30,9 @@ def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
     -rod_modes_mass, -rod_modes_table without -rod_modes, and a -rod_modes_table (or its
     shapes' file) that could not be written or names another output. Collective."""
+    if values["rod_modes"] and importlib.util.find_spec("slepc4py") is None:
+        raise RodInputError("-rod_modes needs slepc4py, which is not installed: install "
+                            "Debian's python3-slepc4py (scripts/setup.sh does)")
     path = values["rod_modes_table"]
     if path and not values["rod_modes"]:
         raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes)")

@@ -131,6 +131,24 @@ def test_modes_inputs_refused_before_the_run(options, message, capsys):
         assert message in out and "step 1" not in out
 
 
+def test_modes_without_slepc4py_refused(shared_tmp, monkeypatch, capsys):
+    """-rod_modes where slepc4py cannot be found: exit 2 with one line saying to
+    install it, before any step and with no result file."""
+    import importlib.util
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *rest: None if name == "slepc4py"
+                        else find_spec(name, *rest))
+    output = os.path.join(shared_tmp, "no_slepc.h5")
+    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
+                    "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "python3-slepc4py" in lines[0] and "step 1" not in out
+
+
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, the shapes'
