@@ -222,6 +222,20 @@ def factor_ksp(operator, factor):
     return ksp
 
 
+def check_options(comm):
+    """Set up, from the options database, an EPS with the modes' prefix (its ST a shift
+    and invert, as solve_modes's) and destroy it: a PETSc.Error for a bad
+    -rod_modes_eps_* or -rod_modes_st_* option, found before any work. Collective."""
+    from slepc4py import SLEPc
+    eps = SLEPc.EPS().create(comm=comm)
+    try:
+        eps.getST().setType(SLEPc.ST.Type.SINVERT)
+        eps.setOptionsPrefix(PREFIX)
+        eps.setFromOptions()
+    finally:
+        eps.destroy()
+
+
 def solve_modes(problem, count, settings=MassSettings()):
     """The ``count`` lowest modes (Modes) of the problem's converged state, or
     ModesRefused where the state is unstable. Collective."""

@@ -149,6 +149,20 @@ def test_modes_without_slepc4py_refused(shared_tmp, monkeypatch, capsys):
         assert len(lines) == 1 and "python3-slepc4py" in lines[0] and "step 1" not in out
 
 
+@pytest.mark.parametrize("option", ["rod_modes_eps_type", "rod_modes_st_type"])
+def test_bad_modes_solver_option_refused(option, shared_tmp, capsys):
+    """An unknown -rod_modes_eps_type or -rod_modes_st_type: exit 2 with one line naming
+    the modes' options, before any step and with no result file."""
+    output = os.path.join(shared_tmp, "bad_eps.h5")
+    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
+                    option: "nosuch", "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "-rod_modes_eps_*" in lines[0] and "step 1" not in out
+
+
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, the shapes'
