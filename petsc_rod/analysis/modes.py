@@ -242,15 +242,23 @@ def solve_modes(problem, count, settings=MassSettings()):
     from slepc4py import SLEPc
     if count < 1:
         raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
-    operators = ModalOperators(problem, settings)
-    K, M = operators.matrix, operators.mass_matrix
-    shifted = K.duplicate(copy=True)
-    shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
-    ksp = factor_ksp(shifted, factor)
-    eps = SLEPc.EPS().create(comm=operators.comm)
+    # what was made, destroyed in reverse order however far the set-up got
+    made = []
     try:
+        operators = ModalOperators(problem, settings)
+        made.append(operators)
+        K, M = operators.matrix, operators.mass_matrix
+        shifted = K.duplicate(copy=True)
+        made.append(shifted)
+        shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block,
+                               PREFIX + "st_")
+        made.append(factor)
+        ksp = factor_ksp(shifted, factor)
+        made.append(ksp)
+        eps = SLEPc.EPS().create(comm=operators.comm)
+        made.append(eps)
         factor.set_up(shifted)
         negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
@@ -271,11 +279,8 @@ def solve_modes(problem, count, settings=MassSettings()):
         eps.solve()
         return _modes(operators, eps, count)
     finally:
-        eps.destroy()
-        ksp.destroy()
-        factor.destroy()
-        shifted.destroy()
-        operators.destroy()
+        for thing in reversed(made):
+            thing.destroy()
 
 
 def _modes(operators, eps, count):

@@ -117,6 +117,38 @@ def test_unstable_state_refused():
     assert refused.value.negative > 0
 
 
+def test_failed_set_up_destroys_what_was_made(monkeypatch):
+    """The modes' set-up failing after the operators and the factor were made (here the
+    spectral transformation's KSP): both are destroyed, none left to leak."""
+    from petsc_rod.analysis import modes
+    destroyed = []
+    operators_destroy = modes.ModalOperators.destroy
+
+    def destroy_operators(self):
+        destroyed.append("operators")
+        operators_destroy(self)
+
+    def counted_factor(*args):
+        factor = made_factor(*args)
+        factor_destroy = factor.destroy
+
+        def destroy_factor():
+            destroyed.append("factor")
+            factor_destroy()
+        factor.destroy = destroy_factor
+        return factor
+
+    def failing_ksp(operator, factor):
+        raise PETSc.Error(73)
+    made_factor = modes.direct_factor
+    monkeypatch.setattr(modes.ModalOperators, "destroy", destroy_operators)
+    monkeypatch.setattr(modes, "direct_factor", counted_factor)
+    monkeypatch.setattr(modes, "factor_ksp", failing_ksp)
+    with pytest.raises(PETSc.Error):
+        modes_of(pinned(100.0, 1e6, 1e-6)[0], 8, 2, mass=1.0)
+    assert destroyed == ["factor", "operators"]
+
+
 @pytest.mark.parametrize("options, message", [
     ({"rod_modes": "3"}, "need its mass per length: give -rod_modes_mass"),
     ({"rod_modes_table": "modes.csv"}, "-rod_modes_table needs -rod_modes N"),
