@@ -247,6 +247,20 @@ def factor_ksp(operator, factor):
     return ksp
 
 
+def check_options(comm):
+    """Set up, from the options database, an EPS with the modes' prefix (its ST a shift
+    and invert, as solve_modes's) and destroy it: a PETSc.Error for a bad
+    -rod_modes_eps_* or -rod_modes_st_* option, found before any work. Collective."""
+    from slepc4py import SLEPc
+    eps = SLEPc.EPS().create(comm=comm)
+    try:
+        eps.getST().setType(SLEPc.ST.Type.SINVERT)
+        eps.setOptionsPrefix(PREFIX)
+        eps.setFromOptions()
+    finally:
+        eps.destroy()
+
+
 def solve_modes(problem, count, settings=MassSettings()):
     """The ``count`` lowest modes (Modes) of the problem's converged state, or
     ModesRefused where the state is unstable. Collective."""
@@ -262,16 +276,24 @@ def solve_modes(problem, count, settings=MassSettings()):
 
 def _solve_modes(problem, count, settings, SLEPc):
     """solve_modes in its -log_view stage."""
-    with EVENTS["operators"]:
-        operators = ModalOperators(problem, settings)
-        K, M = operators.matrix, operators.mass_matrix
-        shifted = K.duplicate(copy=True)
-        shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block, PREFIX + "st_")
-    ksp = factor_ksp(shifted, factor)
-    eps = SLEPc.EPS().create(comm=operators.comm)
+    # what was made, destroyed in reverse order however far the set-up got
+    made = []
     try:
+        with EVENTS["operators"]:
+            operators = ModalOperators(problem, settings)
+            made.append(operators)
+            K, M = operators.matrix, operators.mass_matrix
+            shifted = K.duplicate(copy=True)
+            made.append(shifted)
+            shifted.axpy(-SHIFT, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block,
+                               PREFIX + "st_")
+        made.append(factor)
+        ksp = factor_ksp(shifted, factor)
+        made.append(ksp)
+        eps = SLEPc.EPS().create(comm=operators.comm)
+        made.append(eps)
         with EVENTS["factor"]:
             factor.set_up(shifted)
             negative = factor.negative_pivots() - operators.chain_constraints
@@ -295,11 +317,8 @@ def _solve_modes(problem, count, settings, SLEPc):
         with EVENTS["shapes"]:
             return _modes(operators, eps, count)
     finally:
-        eps.destroy()
-        ksp.destroy()
-        factor.destroy()
-        shifted.destroy()
-        operators.destroy()
+        for thing in reversed(made):
+            thing.destroy()
 
 
 def _modes(operators, eps, count):

@@ -9,11 +9,17 @@ object: the run's are destroyed before it returns).
   m, ``r`` (n, 3) m, ``effective_tension`` (n,) N, ``u`` (n, 3) rad/m, ``m`` (n, 3)
   N m, ...): each rank holds its own vertices (``owned``); ``along_line()`` gathers the
   whole line on every rank (collective: every rank calls it);
-* ``units`` {name: unit} of both, as the result file has them (io/results.py).
+* ``units`` {name: unit} of both, as the result file has them (io/results.py);
+* ``modes`` of Model.options['modes'] (-rod_modes, docs/modes.md) about the converged
+  state: an analysis.modes.Modes (lowest first: ``frequencies`` Hz, ``periods`` s,
+  ``modal_mass`` kg, ``labels`` (their classes), ``shares`` (n, 4); this rank's
+  vertices' ``S``, ``offset`` and ``rotation``), None where none were asked or the run
+  did not converge; ``modes_refused`` why there are none (an unstable state), else None.
 """
 
 import numpy as np
 
+from petsc_rod.analysis.modes import ModesRefused
 from petsc_rod.cli.messages import summary
 from petsc_rod.io.results import ATTRIBUTE_UNITS, DATASET_UNITS
 
@@ -23,7 +29,10 @@ class Results:
     load factor 1 and converged; ``elements``: of the mesh; ``units``: ({dataset: unit},
     {attribute: unit}) of what the run's terms and reports wrote (RodProblem.units)."""
 
-    def __init__(self, owned, scalars, converged, comm, elements, units=None):
+    def __init__(self, owned, scalars, converged, comm, elements, units=None, modes=None):
+        refused = isinstance(modes, ModesRefused)
+        self.modes = None if refused else modes
+        self.modes_refused = str(modes) if refused else None
         self.owned = owned
         self.scalars = scalars
         self.converged = bool(converged)

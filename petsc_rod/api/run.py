@@ -178,7 +178,8 @@ def solve(model, comm=None, output=None, say=None):
     default PETSc.COMM_WORLD); collective. ``output``: a result file to write as well
     (HDF5, docs/output.md), as -rod_output; ``say(line)`` gets the command line's
     lines (None: silent). Returns an api.Results at the last load factor (its
-    ``converged`` says whether it is 1); RodInputError for a model the command line
+    ``converged`` says whether it is 1; its ``modes`` those of Model.options['modes'],
+    or ``modes_refused`` why there are none); RodInputError for a model the command line
     would refuse, RodDivergedError for a run that diverged."""
     from petsc4py import PETSc
 
@@ -194,4 +195,4 @@ def solve(model, comm=None, output=None, say=None):
                                                                   solver, start))
     last = run.last
     return Results(last.vertex, last.attributes, run.result.converged, comm.tompi4py(),
-                   run.elements, last.units)
+                   run.elements, last.units, run.modes)

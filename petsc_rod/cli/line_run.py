@@ -240,11 +240,14 @@ class LastStep:
 class LineRun:
     """How run_line's run ended: the ContinuationResult ``result`` (code, last report,
     iterations), the last step ``last`` (a LastStep: this rank's vertex arrays,
-    attributes and units; None unless asked) and the mesh's ``elements``."""
+    attributes and units; None unless asked), the mesh's ``elements`` and the modes of
+    -rod_modes about the converged state (analysis/modes.Modes, or the ModesRefused that
+    says why there are none; None unless asked and converged)."""
 
     result: object
     last: object
     elements: int
+    modes: object = None
 
 
 class AgreedFailures:
@@ -315,7 +318,8 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
                     report_modes(built.problem, values, modes[0], say)
             elif values["rod_table"]:       # none for this run: not an earlier run's either
                 line_table.discard(values["rod_table"], comm, say)
-            return LineRun(result, last, built.mesh.n_elements)
+            found = modes[0][0] if modes and result.code == 0 else None
+            return LineRun(result, last, built.mesh.n_elements, found)
     finally:
         if writer is not None:              # any failure before the file was finished
             writer.abort()

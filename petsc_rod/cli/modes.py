@@ -3,13 +3,15 @@
 ``modes``), then said as the run's lines (a table of the modes) and written as the CSV
 files of -rod_modes_table: the modes' table and their shapes along the line."""
 
+import importlib.util
 import os
 import time
 
 import numpy as np
+from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
-from petsc_rod.analysis.modes import CLASSES, ModesRefused, solve_modes
+from petsc_rod.analysis.modes import CLASSES, ModesRefused, check_options, solve_modes
 from petsc_rod.errors import RodInputError, RodIOError
 from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io.results import check_output_path
@@ -30,6 +32,16 @@ def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
     -rod_modes_mass, -rod_modes_table without -rod_modes, and a -rod_modes_table (or its
     shapes' file) that could not be written or names another output. Collective."""
+    if values["rod_modes"] and importlib.util.find_spec("slepc4py") is None:
+        raise RodInputError("-rod_modes needs slepc4py, which is not installed: install "
+                            "Debian's python3-slepc4py (scripts/setup.sh does)")
+    if values["rod_modes"]:
+        from petsc_rod.cli.line_run import petsc_message
+        try:
+            check_options(comm)
+        except PETSc.Error as error:
+            raise RodInputError(f"SLEPc refused the modes' options: {petsc_message(error)}; "
+                                "check the -rod_modes_eps_* and -rod_modes_st_* options") from None
     path = values["rod_modes_table"]
     if path and not values["rod_modes"]:
         raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes)")

@@ -311,3 +311,57 @@ def test_the_api_records_its_run_from_the_model_without_option_text(tmp_path, mo
     assert np.array_equal(recorded, lengths)
     assert table.shape[0] == 30 and np.array_equal(table[:, 0], S)
     assert table[-1, 3] == pytest.approx(-39.0 * 9.80665, rel=1e-12)
+
+
+def test_the_api_returns_the_modes_the_command_line_tabulates(tmp_path):
+    """Model.options['modes'] on a uniform cantilever: api.solve, with no result file,
+    returns the modes (Results.modes) the command line's -rod_modes_table gives for the
+    same line (frequencies, periods, modal masses to 10 digits, classes, shares), the
+    lowest the closed form's beta^2 / (2 pi L^2) sqrt(EI / m); no refusal."""
+    pytest.importorskip("slepc4py")
+    from helpers import run_cli
+
+    from petsc_rod.api import UniformLine
+    EI, m = 2.0, 3.0
+    cantilever = Model(UniformLine(length=1.0, stiffness=(EI, EI, EI), elements=16),
+                       start=End("clamp"), end=End("free"), initial_shape="straight",
+                       options={"modes": 4, "modes_mass": m})
+    results = solve(cantilever, comm=PETSc.COMM_WORLD)
+    modes = results.modes
+    assert results.modes_refused is None and len(modes.frequencies) == 4
+    folder = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path))
+    path = f"{folder}/modes.csv"
+    assert run_cli({"rod_length": "1", "rod_stiffness": f"{EI},{EI},{EI}",
+                    "rod_start": "clamp", "rod_end": "free", "rod_elements": "16",
+                    "rod_modes": "4", "rod_modes_mass": str(m),
+                    "rod_modes_table": path}) == 0
+    table = np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding=None)
+    assert np.allclose(modes.frequencies, table["frequency_Hz"], rtol=1e-9)
+    assert np.allclose(modes.periods, table["period_s"], rtol=1e-9)
+    assert np.allclose(modes.modal_mass, table["modal_mass_kg"], rtol=1e-9)
+    assert list(modes.labels) == list(table["class"])
+    shares = np.column_stack([table[name] for name in table.dtype.names
+                              if name.startswith("share_")])
+    assert np.allclose(modes.shares, shares, atol=1e-6)
+    assert modes.frequencies[0] == pytest.approx(
+        1.8751040687**2 / (2 * np.pi) * np.sqrt(EI / m), rel=1e-4)
+    assert modes.offset.shape == (4, len(results.owned["S"]), 3)
+
+
+def test_the_api_returns_why_the_modes_were_refused(monkeypatch):
+    """Modes refused (an unstable state, here its inertia's count stood in for): api.solve
+    with no say returns the reason (Results.modes_refused) and no modes."""
+    pytest.importorskip("slepc4py")
+    from petsc_rod.analysis.modes import ModesRefused
+    from petsc_rod.api import UniformLine
+    from petsc_rod.cli import modes
+
+    def refused(*args):
+        raise ModesRefused(2)
+    monkeypatch.setattr(modes, "solve_modes", refused)
+    cantilever = Model(UniformLine(length=1.0, stiffness=(2.0, 2.0, 2.0), elements=8),
+                       start=End("clamp"), end=End("free"), initial_shape="straight",
+                       options={"modes": 2, "modes_mass": 3.0})
+    results = solve(cantilever, comm=PETSc.COMM_WORLD)
+    assert results.modes is None
+    assert "unstable (2 negative eigenvalues" in results.modes_refused

@@ -117,6 +117,38 @@ def test_unstable_state_refused():
     assert refused.value.negative > 0
 
 
+def test_failed_set_up_destroys_what_was_made(monkeypatch):
+    """The modes' set-up failing after the operators and the factor were made (here the
+    spectral transformation's KSP): both are destroyed, none left to leak."""
+    from petsc_rod.analysis import modes
+    destroyed = []
+    operators_destroy = modes.ModalOperators.destroy
+
+    def destroy_operators(self):
+        destroyed.append("operators")
+        operators_destroy(self)
+
+    def counted_factor(*args):
+        factor = made_factor(*args)
+        factor_destroy = factor.destroy
+
+        def destroy_factor():
+            destroyed.append("factor")
+            factor_destroy()
+        factor.destroy = destroy_factor
+        return factor
+
+    def failing_ksp(operator, factor):
+        raise PETSc.Error(73)
+    made_factor = modes.direct_factor
+    monkeypatch.setattr(modes.ModalOperators, "destroy", destroy_operators)
+    monkeypatch.setattr(modes, "direct_factor", counted_factor)
+    monkeypatch.setattr(modes, "factor_ksp", failing_ksp)
+    with pytest.raises(PETSc.Error):
+        modes_of(pinned(100.0, 1e6, 1e-6)[0], 8, 2, mass=1.0)
+    assert destroyed == ["factor", "operators"]
+
+
 @pytest.mark.parametrize("options, message", [
     ({"rod_modes": "3"}, "need its mass per length: give -rod_modes_mass"),
     ({"rod_modes_table": "modes.csv"}, "-rod_modes_table needs -rod_modes N"),
@@ -129,6 +161,38 @@ def test_modes_inputs_refused_before_the_run(options, message, capsys):
     out = capsys.readouterr().out
     if PETSc.COMM_WORLD.getRank() == 0:
         assert message in out and "step 1" not in out
+
+
+def test_modes_without_slepc4py_refused(shared_tmp, monkeypatch, capsys):
+    """-rod_modes where slepc4py cannot be found: exit 2 with one line saying to
+    install it, before any step and with no result file."""
+    import importlib.util
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *rest: None if name == "slepc4py"
+                        else find_spec(name, *rest))
+    output = os.path.join(shared_tmp, "no_slepc.h5")
+    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
+                    "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "python3-slepc4py" in lines[0] and "step 1" not in out
+
+
+@pytest.mark.parametrize("option", ["rod_modes_eps_type", "rod_modes_st_type"])
+def test_bad_modes_solver_option_refused(option, shared_tmp, capsys):
+    """An unknown -rod_modes_eps_type or -rod_modes_st_type: exit 2 with one line naming
+    the modes' options, before any step and with no result file."""
+    output = os.path.join(shared_tmp, "bad_eps.h5")
+    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
+                    option: "nosuch", "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "-rod_modes_eps_*" in lines[0] and "step 1" not in out
 
 
 def test_cli_modes_table(shared_tmp, capsys):
