@@ -296,9 +296,11 @@ def string_of_two_halves(mu, tension, half, count):
         return (k[0] * np.cos(k[0] * half) * np.sin(k[1] * half)
                 + k[1] * np.cos(k[1] * half) * np.sin(k[0] * half))
     grid = np.linspace(1e-3, 2000.0, 200001)
-    values = np.array([residual(w) for w in grid])
+    with np.errstate(invalid="ignore"):     # no string beyond T - I_b omega^2 = 0
+        values = np.array([residual(w) for w in grid])
+    changes = (np.sign(values[:-1]) != np.sign(values[1:])) & np.isfinite(values[1:])
     roots = []
-    for i in np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:]))[:count]:
+    for i in np.flatnonzero(changes)[:count]:
         lo, hi = grid[i], grid[i + 1]
         for _ in range(60):
             mid = (lo + hi) / 2
