@@ -13,7 +13,7 @@ import numpy as np
 
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
-from petsc_rod.cli.line_run import values_of
+from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
                               RodNotConvergedError, on_every_rank)
@@ -362,53 +362,63 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
     try:
-        try:
-            found = solver.solve()
-        except RodDivergedError as error:
-            if table:
-                discard_tables(comm, table, system, say, sweeps)
-            # a Newton or a line that did not converge, the halvings spent: the single
-            # line's exit 3, but no file (there is no equilibrium to write)
-            raise RodNotConvergedError(str(error)) from None
-        number = 0 if interrupts is None else interrupts.received()
-        if number:
-            raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
-                                 "system's equilibrium was found; nothing written",
-                                 number)
-        stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
-        records = gathered_lines(solver)
-        mpi = comm.tompi4py()
-        lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
-                                    records[k].elements, records[k].units)
-                 for k, line in enumerate(system.lines)}
-        bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
-                                     np.asarray(found.rotations[b.name]),
-                                     stiffness[b.name].matrix, stiffness[b.name].reference,
-                                     stiffness[b.name].moment, stiffness[b.name].asymmetry)
-                  for b in system.bodies}
-        names = [line.name for line in system.lines]
-        results = SystemResults(
-            dict(found.points), bodies,
-            {n: found.end_forces[k] for k, n in enumerate(names)},
-            {n: records[k].tensions for k, n in enumerate(names)},
-            {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
-            lines, found.load_factor == 1.0, found.iterations, found.halvings,
-            found.residual, found.load_factor)
-        check_finite(results)
-        for line in report_lines(system, results, comm.getSize()):
-            say(line)
-        # after the records: the sweeps' warm re-solves leave the lines at rest again,
-        # but the equilibrium's numbers are those found before them
-        results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
-        for line in run_lines(results.sweeps):
-            say(line)
-        if output:
-            write_file(comm, output, system, results, records, text, notes)
-        if table:
-            write_tables(comm, solver, table, system, results, records, sweeps)
-        return results
+        # the ranks agree on a failure (one rank's alone ends every rank) before the
+        # lines' collective destroy
+        with AgreedFailures(comm):
+            return _solved(comm, solver, system, say, output, table, text, notes,
+                           interrupts, sweeps)
     finally:
         solver.destroy()
+
+
+def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps):
+    """run_system's work once its lines are built: the equilibrium, the records, the
+    sweeps, the file and the tables; SystemResults. Collective."""
+    try:
+        found = solver.solve()
+    except RodDivergedError as error:
+        if table:
+            discard_tables(comm, table, system, say, sweeps)
+        # a Newton or a line that did not converge, the halvings spent: the single
+        # line's exit 3, but no file (there is no equilibrium to write)
+        raise RodNotConvergedError(str(error)) from None
+    number = 0 if interrupts is None else interrupts.received()
+    if number:
+        raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
+                             "system's equilibrium was found; nothing written",
+                             number)
+    stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+    records = gathered_lines(solver)
+    mpi = comm.tompi4py()
+    lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
+                                records[k].elements, records[k].units)
+             for k, line in enumerate(system.lines)}
+    bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
+                                 np.asarray(found.rotations[b.name]),
+                                 stiffness[b.name].matrix, stiffness[b.name].reference,
+                                 stiffness[b.name].moment, stiffness[b.name].asymmetry)
+              for b in system.bodies}
+    names = [line.name for line in system.lines]
+    results = SystemResults(
+        dict(found.points), bodies,
+        {n: found.end_forces[k] for k, n in enumerate(names)},
+        {n: records[k].tensions for k, n in enumerate(names)},
+        {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
+        lines, found.load_factor == 1.0, found.iterations, found.halvings,
+        found.residual, found.load_factor)
+    check_finite(results)
+    for line in report_lines(system, results, comm.getSize()):
+        say(line)
+    # after the records: the sweeps' warm re-solves leave the lines at rest again,
+    # but the equilibrium's numbers are those found before them
+    results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
+    for line in run_lines(results.sweeps):
+        say(line)
+    if output:
+        write_file(comm, output, system, results, records, text, notes)
+    if table:
+        write_tables(comm, solver, table, system, results, records, sweeps)
+    return results
 
 
 def solve_system(system, comm=None, output=None, say=None, options=None, table=None,

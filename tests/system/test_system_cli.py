@@ -336,3 +336,36 @@ def test_the_report_refuses_a_broken_system_file(tmp_path):
     assert process.stderr.startswith("petsc_rod.report: error: ") and not output.exists()
     process = run_module("petsc_rod.plots", [str(broken), str(tmp_path / "x.png")])
     assert process.returncode == 2 and process.stderr.count("\n") == 1, describe(process)
+
+
+# rank 1 alone raises while the bodies' stiffness is computed (after the equilibrium)
+SYSTEM_ALONE = """
+from petsc_rod.system import equilibrium
+stiffness = equilibrium.SystemSolver.body_stiffness
+def body_stiffness(self, name):
+    if PETSc.COMM_WORLD.getRank() == 1:
+        raise FloatingPointError("injected on rank 1")
+    return stiffness(self, name)
+equilibrium.SystemSolver.body_stiffness = body_stiffness
+if sys.argv[1] == "api":
+    from petsc_rod.api import read_moordyn, solve_system
+    solve_system(read_moordyn(sys.argv[2])[0])
+else:
+    from petsc_rod import cli_system
+    sys.exit(cli_system.run())
+"""
+
+
+@pytest.mark.parametrize("path", ["api", "cli"])
+def test_one_rank_failing_alone_ends_the_system_run(tmp_path, path):
+    """A system's run (the API's solve_system and the command line's) in which rank 1
+    alone raises: every rank ends in the failing rank's one line, exit 4, no hang."""
+    from helpers import run_failing_on_rank_1
+
+    args = [path, DECK] if path == "api" else ["cli", "-rod_system", DECK]
+    done = run_failing_on_rank_1(tmp_path / "alone.py", SYSTEM_ALONE, args, timeout=90)
+    assert done.returncode == 4, describe(done)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
+    assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
+        describe(done)
+
