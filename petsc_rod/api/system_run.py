@@ -181,6 +181,21 @@ def table_paths(table, system, sweeps=Sweeps()):
     return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
 
 
+def written_paths(system, output, table, sweeps=Sweeps()):
+    """[(what names it, path)] of every file the run writes: the result file, each
+    line's table with its regions' and ends' tables, the system's and the sweeps'
+    tables; what a check that no output replaces an input compares."""
+    written = [("-rod_output", output)] if output else []
+    if table:
+        lines = {line.name for line in system.lines}
+        for name, path in table_paths(table, system, sweeps).items():
+            written.append((f"-rod_table {table}'s table", path))
+            if name in lines:
+                written += [(f"-rod_table {table}'s table", line_table.regions_path(path)),
+                            (f"-rod_table {table}'s table", line_table.ends_path(path))]
+    return written
+
+
 def check_outputs(comm, system, output, table, sweeps=Sweeps()):
     """Refuse, before any work, a result file or a table that could not be written
     (io/results.check_output_path, line_table.check_table_path). Collective."""

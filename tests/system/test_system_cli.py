@@ -369,3 +369,24 @@ def test_one_rank_failing_alone_ends_the_system_run(tmp_path, path):
     assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
         describe(done)
 
+
+
+def test_a_table_that_would_replace_the_system_file_is_refused(tmp_path):
+    """-rod_table X.dat with -rod_system X_system.dat (the system's table) or
+    X_Line1_ends.dat (a line's ends' table): exit 2 in one line naming -rod_table, the
+    input unchanged."""
+    import hashlib
+
+    with open(DECK, encoding="utf-8") as source:
+        kept = source.read()
+    for name in ("deck_system.dat", "deck_Line1_ends.dat"):
+        copy = tmp_path / name
+        copy.write_text(kept)
+        before = hashlib.md5(copy.read_bytes()).hexdigest()
+        process = run_petsc_rod(["-rod_system", str(copy), "-rod_table",
+                                 str(tmp_path / "deck.dat")], 1, 120)
+        assert process.returncode == 2, describe(process)
+        errors = [line for line in process.stdout.splitlines() if "error" in line]
+        assert len(errors) == 1 and "-rod_table" in errors[0] and name in errors[0], \
+            describe(process)
+        assert hashlib.md5(copy.read_bytes()).hexdigest() == before
