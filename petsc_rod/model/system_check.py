@@ -94,7 +94,7 @@ def check_names(system):
             owner = ("the system's" if line.name in RESERVED
                      else "another line's")
             raise RodInputError(f"line {line.name}: the name of {owner} table "
-                                f"(-rod_table FILE writes FILE_{line.name}.csv for it); "
+                                f"(the run's tables would share FILE_{line.name}.csv); "
                                 "rename the line")
 
 
