@@ -117,13 +117,13 @@ class LineRecord:
     elements: int
 
 
-def line_record(line):
+def line_record(line, stable):
     """The LineRecord of a converged HeldLine (line_table.final_record: the terms' and
     reports' outputs, r absolute, the effective tension), with its converged,
-    iterations, stable, load factor and ranks. Collective on the line's communicator."""
+    iterations, ``stable`` (the system's verdict, Equilibrium.stable: True, False or
+    None), load factor and ranks. Collective on the line's communicator."""
     problem = line.problem
     vertex, attributes = line_table.final_record(problem)
-    stable = line.stable()
     attributes.update(converged=1, stop_reason="converged", iterations=line.iterations,
                       stable=-1 if stable is None else int(stable), load_factor=1.0,
                       energy=problem.energy(), ranks=line.comm.getSize())
@@ -146,11 +146,13 @@ def _empty(shapes):
             for name, (shape, dtype) in shapes.items()}
 
 
-def gathered_lines(solver):
+def gathered_lines(solver, stable):
     """{line index: LineRecord} on every rank: this rank's own rows of its group's
     lines, zero rows of the others' (their names and shapes, attributes, units and
-    tensions shared from the groups' roots). Collective."""
-    mine = {k: line_record(line) for k, line in solver.lines.items()}
+    tensions shared from the groups' roots); ``stable`` {line name: verdict}
+    (Equilibrium.stable). Collective."""
+    names = [line.name for line in solver.system.lines]
+    mine = {k: line_record(line, stable[names[k]]) for k, line in solver.lines.items()}
     shared = solver.placement.share({k: replace(record, vertex=_shapes(record.vertex),
                                                 state=_shapes(record.state))
                                      for k, record in mine.items()})
@@ -403,7 +405,7 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
                              "system's equilibrium was found; nothing written",
                              number)
     stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
-    records = gathered_lines(solver)
+    records = gathered_lines(solver, found.stable)
     mpi = comm.tompi4py()
     lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
                                 records[k].elements, records[k].units)

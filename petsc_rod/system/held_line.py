@@ -931,7 +931,7 @@ def held_lines(system, options=None):
     positions (system_check.connection_position), in the system's environment, tuned
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
-    line once at its equilibrium (SystemSolver.unstable_lines, HeldLine.stable)
+    line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
     instead of after each of its re-solves."""
     options = {"al_stability": 0, **(options or {})}
 

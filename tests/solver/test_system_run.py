@@ -136,3 +136,29 @@ def test_a_single_line_run_refuses_a_system():
             assert main.run(PETSc.COMM_WORLD, texts) == 2
     finally:
         PETSc.Options().delValue("options_left")      # set by the refusal
+
+
+def test_each_line_is_tested_for_stability_once_at_the_equilibrium(monkeypatch):
+    """The lines solve with their own stability test off during the system's iterations
+    (held_lines) and are tested once each at its equilibrium (SystemSolver.line_verdicts),
+    the record reading that verdict: the test's calls over the ranks are one per line on
+    each rank of its group, and each line's verdict is in its results."""
+    import dataclasses
+    import os
+
+    from helpers import REPO_ROOT
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.model.moordyn import read_moordyn
+
+    calls = []
+    check = UzawaSolver.check_stability
+    monkeypatch.setattr(UzawaSolver, "check_stability",
+                        lambda self, *a, **k: calls.append(1) or check(self, *a, **k))
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    body = dataclasses.replace(system.bodies[0], load=(3e4, 1e4, 0, 0, 0, 0))
+    results = solve_system(dataclasses.replace(system, bodies=(body,)))
+    mpi = PETSc.COMM_WORLD.tompi4py()
+    ranks = sum(int(line.scalars["ranks"]) for line in results.lines.values())
+    assert mpi.allreduce(len(calls)) == ranks and len(results.lines) == 3
+    assert all(int(line.scalars["stable"]) == 1 for line in results.lines.values())
