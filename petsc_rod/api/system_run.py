@@ -56,9 +56,12 @@ class SystemResults:
     ``points`` {name: (3,) m}; ``bodies`` {name: BodyResult}; ``end_forces`` {line:
     (2, 3) N}, the force each line exerts ON its start's and its end's point or body;
     ``end_tensions`` {line: (2,) N}, the end elements' tension along the line, n.t at
-    S = 0 and S = L; ``lines_converged`` {line: bool}; ``lines`` {line: api.Results}
+    S = 0 and S = L; ``lines_converged`` {line: bool} (whether the line's last solve,
+    at the system's last evaluation, converged); ``lines`` {line: api.Results}
     (its arrays along S on this rank, none on a rank outside its group: along_line()
-    gathers them, collectively on the system's communicator); ``converged``,
+    gathers them, collectively on the system's communicator); ``converged`` (the load
+    continuation complete and every line converged: the solve raises when it finds no
+    equilibrium, so False only where a line's last re-solve failed),
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
     (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
     'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}."""
@@ -118,13 +121,17 @@ class LineRecord:
 
 
 def line_record(line, stable):
-    """The LineRecord of a converged HeldLine (line_table.final_record: the terms' and
-    reports' outputs, r absolute, the effective tension), with its converged,
+    """The LineRecord of a HeldLine (line_table.final_record: the terms' and reports'
+    outputs, r absolute, the effective tension), with its converged (whether its last
+    solve converged: the system's last evaluation may leave a line that did not),
     iterations, ``stable`` (the system's verdict, Equilibrium.stable: True, False or
     None), load factor and ranks. Collective on the line's communicator."""
     problem = line.problem
     vertex, attributes = line_table.final_record(problem)
-    attributes.update(converged=1, stop_reason="converged", iterations=line.iterations,
+    converged = bool(line.converged)
+    attributes.update(converged=int(converged),
+                      stop_reason="converged" if converged else "diverged",
+                      iterations=line.iterations,
                       stable=-1 if stable is None else int(stable), load_factor=1.0,
                       energy=problem.energy(), ranks=line.comm.getSize())
     tensions = np.array(_end_values(problem.mesh, vertex["effective_tension"]))
@@ -161,14 +168,18 @@ def gathered_lines(solver, stable):
             for k, record in shared.items()}
 
 
-def check_finite(results):
-    """RodDivergedError unless every number of the equilibrium is finite: no NaN is
-    ever written or returned as a result."""
+def check_finite(comm, results, records):
+    """RodDivergedError unless every number of the equilibrium is finite, the lines'
+    arrays along S (``records``' vertex datasets, on the ranks that hold them) too: no
+    NaN is ever written or returned as a result. Collective."""
     numbers = ([b.position for b in results.bodies.values()]
                + [b.stiffness for b in results.bodies.values()]
                + list(results.points.values()) + list(results.end_forces.values())
                + list(results.end_tensions.values()))
-    if not all(np.all(np.isfinite(value)) for value in numbers):
+    along = [value for record in records.values() for value in record.vertex.values()
+             if np.issubdtype(np.asarray(value).dtype, np.number)]
+    if not all(comm.tompi4py().allgather(
+            all(np.all(np.isfinite(value)) for value in numbers + along))):
         raise RodDivergedError("system: the equilibrium holds non-finite numbers (NaN or "
                                "inf); nothing is written")
 
@@ -421,9 +432,11 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
         {n: found.end_forces[k] for k, n in enumerate(names)},
         {n: records[k].tensions for k, n in enumerate(names)},
         {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
-        lines, found.load_factor == 1.0, found.iterations, found.halvings,
+        lines, found.load_factor == 1.0 and all(
+            bool(records[k].attributes["converged"]) for k in range(len(names))),
+        found.iterations, found.halvings,
         found.residual, found.load_factor)
-    check_finite(results)
+    check_finite(comm, results, records)
     for line in report_lines(system, results, comm.getSize()):
         say(line)
     # after the records: the sweeps' warm re-solves leave the lines at rest again,
