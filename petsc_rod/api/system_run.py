@@ -259,36 +259,35 @@ def picture_attributes(system):
     return found
 
 
-def write_file(comm, output, system, results, records, text, notes):
+def write_file(comm, output, system, results, records, text, notes, failures):
     """The system's result file (io/system_results.py): a group per line, the group
-    ``system``, the input file's text and the reader's notes. Collective."""
-    writer = SystemWriter(output, comm)
-    try:
-        for k, line in enumerate(system.lines):
-            record = records[k]
-            writer.write_line(line.name, record.vertex, record.state, record.attributes,
-                              record.units)
-        data, units = system_datasets(system, results)
-        attributes = {"converged": int(results.converged), "iterations": results.iterations,
-                      "halvings": results.halvings, "residual": results.residual,
-                      "load_factor": results.load_factor, "ranks": comm.getSize(),
-                      "point_names": ",".join(results.points),
-                      "body_names": ",".join(results.bodies),
-                      "line_names": ",".join(line.name for line in system.lines),
-                      "input_text": text or "", "notes": "\n".join(notes),
-                      **picture_attributes(system)}
-        units.update({"converged": "1", "iterations": "1", "halvings": "1",
-                      "residual": "1", "load_factor": "1", "ranks": "1",
-                      "point_names": "text", "body_names": "text", "line_names": "text",
-                      "input_text": "text", "notes": "text", "written": "text",
-                      "point_kinds": "text", "line_starts": "text", "line_ends": "text",
-                      "seabed": "m", "surface": "m"})
-        groups = {name: file_group(found) for name, found in results.sweeps.items()}
-        writer.finish_system(data, attributes, units, groups)
-        writer = None
-    finally:
-        if writer is not None:
-            writer.abort()
+    ``system``, the input file's text and the reader's notes. The open writer is
+    ``failures.writer`` (cli/line_run.AgreedFailures) until it is finished: the caller
+    aborts it once the ranks agree on a failure (its abort is collective), or a rank
+    failing alone removes its partial file. Collective."""
+    writer = failures.writer = SystemWriter(output, comm)
+    for k, line in enumerate(system.lines):
+        record = records[k]
+        writer.write_line(line.name, record.vertex, record.state, record.attributes,
+                          record.units)
+    data, units = system_datasets(system, results)
+    attributes = {"converged": int(results.converged), "iterations": results.iterations,
+                  "halvings": results.halvings, "residual": results.residual,
+                  "load_factor": results.load_factor, "ranks": comm.getSize(),
+                  "point_names": ",".join(results.points),
+                  "body_names": ",".join(results.bodies),
+                  "line_names": ",".join(line.name for line in system.lines),
+                  "input_text": text or "", "notes": "\n".join(notes),
+                  **picture_attributes(system)}
+    units.update({"converged": "1", "iterations": "1", "halvings": "1",
+                  "residual": "1", "load_factor": "1", "ranks": "1",
+                  "point_names": "text", "body_names": "text", "line_names": "text",
+                  "input_text": "text", "notes": "text", "written": "text",
+                  "point_kinds": "text", "line_starts": "text", "line_ends": "text",
+                  "seabed": "m", "surface": "m"})
+    groups = {name: file_group(found) for name, found in results.sweeps.items()}
+    writer.finish_system(data, attributes, units, groups)
+    failures.writer = None
 
 
 def ends_rows(system, results):
@@ -389,17 +388,21 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     check_outputs(comm, system, output, table, sweeps)
     solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
+    failures = AgreedFailures(comm)
     try:
         # the ranks agree on a failure (one rank's alone ends every rank) before the
-        # lines' collective destroy
-        with AgreedFailures(comm):
+        # result file's collective abort and the lines' collective destroy
+        with failures:
             return _solved(comm, solver, system, say, output, table, text, notes,
-                           interrupts, sweeps)
+                           interrupts, sweeps, failures)
     finally:
+        if failures.writer is not None:
+            failures.writer.abort()
         solver.destroy()
 
 
-def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps):
+def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps,
+            failures):
     """run_system's work once its lines are built: the equilibrium, the records, the
     sweeps, the file and the tables; SystemResults. Collective."""
     try:
@@ -445,7 +448,7 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
     for line in run_lines(results.sweeps):
         say(line)
     if output:
-        write_file(comm, output, system, results, records, text, notes)
+        write_file(comm, output, system, results, records, text, notes, failures)
     if table:
         write_tables(comm, solver, table, system, results, records, sweeps)
     return results

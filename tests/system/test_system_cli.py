@@ -390,3 +390,29 @@ def test_a_table_that_would_replace_the_system_file_is_refused(tmp_path):
         assert len(errors) == 1 and "-rod_table" in errors[0] and name in errors[0], \
             describe(process)
         assert hashlib.md5(copy.read_bytes()).hexdigest() == before
+
+
+# rank 1 alone raises while the system's result file is open
+WRITE_ALONE = """
+from petsc_rod.api import read_moordyn, solve_system, system_run
+def system_datasets(*args):
+    raise FloatingPointError("injected on rank 1")
+if PETSc.COMM_WORLD.getRank() == 1:
+    system_run.system_datasets = system_datasets
+solve_system(read_moordyn(sys.argv[1])[0], output=sys.argv[2])
+"""
+
+
+def test_one_rank_failing_alone_while_writing_leaves_no_file(tmp_path):
+    """solve_system with a result file, rank 1 alone raising while it is open: every
+    rank ends in one line, exit 4, and neither the file nor its partial file is left."""
+    from helpers import run_failing_on_rank_1
+
+    out = tmp_path / "sys.h5"
+    done = run_failing_on_rank_1(tmp_path / "write_alone.py", WRITE_ALONE,
+                                 [DECK, str(out)], timeout=90)
+    assert done.returncode == 4, describe(done)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
+    assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
+        describe(done)
+    assert not out.exists() and not partial_files(out)
