@@ -22,7 +22,8 @@ import sys
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.api.system_run import LINE_OPTIONS, MODES_OPTIONS, modes_request, run_system
+from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, modes_request, run_system,
+                                     written_paths)
 from petsc_rod.api.system_sweeps import parse_sweeps
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
@@ -74,12 +75,13 @@ def body_loads(text, system):
     return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
 
 
-def check_outputs_kept(values, comm):
+def check_outputs_kept(values, comm, system, sweeps):
     """Refuse an output that names an input (the system file, an options file), which
-    writing it would replace. Collective: rank 0 decides."""
+    writing it would replace: every file the run writes (written_paths: the result file,
+    the lines', the system's and the sweeps' tables). Collective: rank 0 decides."""
     clash = None
     if comm.getRank() == 0:
-        written = [("-rod_output", values["rod_output"]), ("-rod_table", values["rod_table"])]
+        written = written_paths(system, values["rod_output"], values["rod_table"], sweeps)
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
         read.append(("-rod_system", values["rod_system"]))
         clash = replaced_input(written, read)
@@ -134,7 +136,7 @@ def run(comm=None):
                     say(line)
             system, notes, text, settings, options, sweeps, modes = on_every_rank(
                 comm, prepared, values, given)
-            check_outputs_kept(values, comm)
+            check_outputs_kept(values, comm, system, sweeps)
             if database.hasName("help"):
                 return 0
             for note in notes:

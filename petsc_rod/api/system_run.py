@@ -17,7 +17,7 @@ from petsc_rod.analysis.modes import ModesRefused, solve_modes
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
 from petsc_rod.cli.modes import table_lines
-from petsc_rod.cli.line_run import values_of
+from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
                               RodNotConvergedError, on_every_rank)
@@ -64,9 +64,12 @@ class SystemResults:
     ``points`` {name: (3,) m}; ``bodies`` {name: BodyResult}; ``end_forces`` {line:
     (2, 3) N}, the force each line exerts ON its start's and its end's point or body;
     ``end_tensions`` {line: (2,) N}, the end elements' tension along the line, n.t at
-    S = 0 and S = L; ``lines_converged`` {line: bool}; ``lines`` {line: api.Results}
+    S = 0 and S = L; ``lines_converged`` {line: bool} (whether the line's last solve,
+    at the system's last evaluation, converged); ``lines`` {line: api.Results}
     (its arrays along S on this rank, none on a rank outside its group: along_line()
-    gathers them, collectively on the system's communicator); ``converged``,
+    gathers them, collectively on the system's communicator); ``converged`` (the load
+    continuation complete and every line converged: the solve raises when it finds no
+    equilibrium, so False only where a line's last re-solve failed),
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
     (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
     'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}; with
@@ -187,14 +190,18 @@ class LineRecord:
     elements: int
 
 
-def line_record(line):
-    """The LineRecord of a converged HeldLine (line_table.final_record: the terms' and
-    reports' outputs, r absolute, the effective tension), with its converged,
-    iterations, stable, load factor and ranks. Collective on the line's communicator."""
+def line_record(line, stable):
+    """The LineRecord of a HeldLine (line_table.final_record: the terms' and reports'
+    outputs, r absolute, the effective tension), with its converged (whether its last
+    solve converged: the system's last evaluation may leave a line that did not),
+    iterations, ``stable`` (the system's verdict, Equilibrium.stable: True, False or
+    None), load factor and ranks. Collective on the line's communicator."""
     problem = line.problem
     vertex, attributes = line_table.final_record(problem)
-    stable = line.stable()
-    attributes.update(converged=1, stop_reason="converged", iterations=line.iterations,
+    converged = bool(line.converged)
+    attributes.update(converged=int(converged),
+                      stop_reason="converged" if converged else "diverged",
+                      iterations=line.iterations,
                       stable=-1 if stable is None else int(stable), load_factor=1.0,
                       energy=problem.energy(), ranks=line.comm.getSize())
     tensions = np.array(_end_values(problem.mesh, vertex["effective_tension"]))
@@ -216,11 +223,13 @@ def _empty(shapes):
             for name, (shape, dtype) in shapes.items()}
 
 
-def gathered_lines(solver):
+def gathered_lines(solver, stable):
     """{line index: LineRecord} on every rank: this rank's own rows of its group's
     lines, zero rows of the others' (their names and shapes, attributes, units and
-    tensions shared from the groups' roots). Collective."""
-    mine = {k: line_record(line) for k, line in solver.lines.items()}
+    tensions shared from the groups' roots); ``stable`` {line name: verdict}
+    (Equilibrium.stable). Collective."""
+    names = [line.name for line in solver.system.lines]
+    mine = {k: line_record(line, stable[names[k]]) for k, line in solver.lines.items()}
     shared = solver.placement.share({k: replace(record, vertex=_shapes(record.vertex),
                                                 state=_shapes(record.state))
                                      for k, record in mine.items()})
@@ -229,14 +238,18 @@ def gathered_lines(solver):
             for k, record in shared.items()}
 
 
-def check_finite(results):
-    """RodDivergedError unless every number of the equilibrium is finite: no NaN is
-    ever written or returned as a result."""
+def check_finite(comm, results, records):
+    """RodDivergedError unless every number of the equilibrium is finite, the lines'
+    arrays along S (``records``' vertex datasets, on the ranks that hold them) too: no
+    NaN is ever written or returned as a result. Collective."""
     numbers = ([b.position for b in results.bodies.values()]
                + [b.stiffness for b in results.bodies.values()]
                + list(results.points.values()) + list(results.end_forces.values())
                + list(results.end_tensions.values()))
-    if not all(np.all(np.isfinite(value)) for value in numbers):
+    along = [value for record in records.values() for value in record.vertex.values()
+             if np.issubdtype(np.asarray(value).dtype, np.number)]
+    if not all(comm.tompi4py().allgather(
+            all(np.all(np.isfinite(value)) for value in numbers + along))):
         raise RodDivergedError("system: the equilibrium holds non-finite numbers (NaN or "
                                "inf); nothing is written")
 
@@ -249,6 +262,21 @@ def table_paths(table, system, sweeps=Sweeps()):
     names = [line.name for line in system.lines] + ["system"] + [
         name for name in ("watch_circle", "excursion") if getattr(sweeps, name) is not None]
     return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
+
+
+def written_paths(system, output, table, sweeps=Sweeps()):
+    """[(what names it, path)] of every file the run writes: the result file, each
+    line's table with its regions' and ends' tables, the system's and the sweeps'
+    tables; what a check that no output replaces an input compares."""
+    written = [("-rod_output", output)] if output else []
+    if table:
+        lines = {line.name for line in system.lines}
+        for name, path in table_paths(table, system, sweeps).items():
+            written.append((f"-rod_table {table}'s table", path))
+            if name in lines:
+                written += [(f"-rod_table {table}'s table", line_table.regions_path(path)),
+                            (f"-rod_table {table}'s table", line_table.ends_path(path))]
+    return written
 
 
 def check_outputs(comm, system, output, table, sweeps=Sweeps()):
@@ -301,40 +329,39 @@ def picture_attributes(system):
     return found
 
 
-def write_file(comm, output, system, results, records, text, notes):
-    """The system's result file (io/system_results.py): a group per line (with its
-    modes, ``lines/<name>/modes``, as a single line's file has them), the group
-    ``system``, the input file's text and the reader's notes. Collective."""
-    writer = SystemWriter(output, comm)
-    try:
-        for k, line in enumerate(system.lines):
-            record = records[k]
-            writer.write_line(line.name, record.vertex, record.state, record.attributes,
-                              record.units)
-            found = results.modes.get(line.name)
-            if found is not None and not isinstance(found, ModesRefused):
-                writer.write_modes(found, f"lines/{line.name}/modes")
-        data, units = system_datasets(system, results)
-        attributes = {"converged": int(results.converged), "iterations": results.iterations,
-                      "halvings": results.halvings, "residual": results.residual,
-                      "load_factor": results.load_factor, "ranks": comm.getSize(),
-                      "point_names": ",".join(results.points),
-                      "body_names": ",".join(results.bodies),
-                      "line_names": ",".join(line.name for line in system.lines),
-                      "input_text": text or "", "notes": "\n".join(notes),
-                      **picture_attributes(system)}
-        units.update({"converged": "1", "iterations": "1", "halvings": "1",
-                      "residual": "1", "load_factor": "1", "ranks": "1",
-                      "point_names": "text", "body_names": "text", "line_names": "text",
-                      "input_text": "text", "notes": "text", "written": "text",
-                      "point_kinds": "text", "line_starts": "text", "line_ends": "text",
-                      "seabed": "m", "surface": "m"})
-        groups = {name: file_group(found) for name, found in results.sweeps.items()}
-        writer.finish_system(data, attributes, units, groups)
-        writer = None
-    finally:
-        if writer is not None:
-            writer.abort()
+def write_file(comm, output, system, results, records, text, notes, failures):
+    """The system's result file (io/system_results.py): a group per line, the group
+    ``system`` (each line's group with its modes, ``lines/<name>/modes``, as a single
+    line's file has them), the input file's text and the reader's notes. The open writer is
+    ``failures.writer`` (cli/line_run.AgreedFailures) until it is finished: the caller
+    aborts it once the ranks agree on a failure (its abort is collective), or a rank
+    failing alone removes its partial file. Collective."""
+    writer = failures.writer = SystemWriter(output, comm)
+    for k, line in enumerate(system.lines):
+        record = records[k]
+        writer.write_line(line.name, record.vertex, record.state, record.attributes,
+                          record.units)
+        found = results.modes.get(line.name)
+        if found is not None and not isinstance(found, ModesRefused):
+            writer.write_modes(found, f"lines/{line.name}/modes")
+    data, units = system_datasets(system, results)
+    attributes = {"converged": int(results.converged), "iterations": results.iterations,
+                  "halvings": results.halvings, "residual": results.residual,
+                  "load_factor": results.load_factor, "ranks": comm.getSize(),
+                  "point_names": ",".join(results.points),
+                  "body_names": ",".join(results.bodies),
+                  "line_names": ",".join(line.name for line in system.lines),
+                  "input_text": text or "", "notes": "\n".join(notes),
+                  **picture_attributes(system)}
+    units.update({"converged": "1", "iterations": "1", "halvings": "1",
+                  "residual": "1", "load_factor": "1", "ranks": "1",
+                  "point_names": "text", "body_names": "text", "line_names": "text",
+                  "input_text": "text", "notes": "text", "written": "text",
+                  "point_kinds": "text", "line_starts": "text", "line_ends": "text",
+                  "seabed": "m", "surface": "m"})
+    groups = {name: file_group(found) for name, found in results.sweeps.items()}
+    writer.finish_system(data, attributes, units, groups)
+    failures.writer = None
 
 
 def ends_rows(system, results):
@@ -436,59 +463,75 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     check_outputs(comm, system, output, table, sweeps)
     solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
+    failures = AgreedFailures(comm)
     try:
-        try:
-            found = solver.solve()
-        except RodDivergedError as error:
-            if table:
-                discard_tables(comm, table, system, say, sweeps)
-            # a Newton or a line that did not converge, the halvings spent: the single
-            # line's exit 3, but no file (there is no equilibrium to write)
-            raise RodNotConvergedError(str(error)) from None
-        number = 0 if interrupts is None else interrupts.received()
-        if number:
-            raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
-                                 "system's equilibrium was found; nothing written",
-                                 number)
-        stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
-        records = gathered_lines(solver)
-        mpi = comm.tompi4py()
-        lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
-                                    records[k].elements, records[k].units)
-                 for k, line in enumerate(system.lines)}
-        bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
-                                     np.asarray(found.rotations[b.name]),
-                                     stiffness[b.name].matrix, stiffness[b.name].reference,
-                                     stiffness[b.name].moment, stiffness[b.name].asymmetry)
-                  for b in system.bodies}
-        names = [line.name for line in system.lines]
-        results = SystemResults(
-            dict(found.points), bodies,
-            {n: found.end_forces[k] for k, n in enumerate(names)},
-            {n: records[k].tensions for k, n in enumerate(names)},
-            {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
-            lines, found.load_factor == 1.0, found.iterations, found.halvings,
-            found.residual, found.load_factor)
-        check_finite(results)
-        for line in report_lines(system, results, comm.getSize()):
-            say(line)
-        if modes is not None:
-            found, seconds = line_modes(solver, *modes)
-            results.modes = {n: found[k] for k, n in enumerate(names)}
-            for line in modes_lines(system, found, seconds):
-                say(line)
-        # after the records: the sweeps' warm re-solves leave the lines at rest again,
-        # but the equilibrium's numbers are those found before them
-        results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
-        for line in run_lines(results.sweeps):
-            say(line)
-        if output:
-            write_file(comm, output, system, results, records, text, notes)
-        if table:
-            write_tables(comm, solver, table, system, results, records, sweeps)
-        return results
+        # the ranks agree on a failure (one rank's alone ends every rank) before the
+        # result file's collective abort and the lines' collective destroy
+        with failures:
+            return _solved(comm, solver, system, say, output, table, text, notes,
+                           interrupts, sweeps, modes, failures)
     finally:
+        if failures.writer is not None:
+            failures.writer.abort()
         solver.destroy()
+
+
+def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps,
+            modes, failures):
+    """run_system's work once its lines are built: the equilibrium, the records, the
+    lines' modes, the sweeps, the file and the tables; SystemResults. Collective."""
+    try:
+        found = solver.solve()
+    except RodDivergedError as error:
+        if table:
+            discard_tables(comm, table, system, say, sweeps)
+        # a Newton or a line that did not converge, the halvings spent: the single
+        # line's exit 3, but no file (there is no equilibrium to write)
+        raise RodNotConvergedError(str(error)) from None
+    number = 0 if interrupts is None else interrupts.received()
+    if number:
+        raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
+                             "system's equilibrium was found; nothing written",
+                             number)
+    stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+    records = gathered_lines(solver, found.stable)
+    mpi = comm.tompi4py()
+    lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
+                                records[k].elements, records[k].units)
+             for k, line in enumerate(system.lines)}
+    bodies = {b.name: BodyResult(np.asarray(found.bodies[b.name]),
+                                 np.asarray(found.rotations[b.name]),
+                                 stiffness[b.name].matrix, stiffness[b.name].reference,
+                                 stiffness[b.name].moment, stiffness[b.name].asymmetry)
+              for b in system.bodies}
+    names = [line.name for line in system.lines]
+    results = SystemResults(
+        dict(found.points), bodies,
+        {n: found.end_forces[k] for k, n in enumerate(names)},
+        {n: records[k].tensions for k, n in enumerate(names)},
+        {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
+        lines, found.load_factor == 1.0 and all(
+            bool(records[k].attributes["converged"]) for k in range(len(names))),
+        found.iterations, found.halvings,
+        found.residual, found.load_factor)
+    check_finite(comm, results, records)
+    for line in report_lines(system, results, comm.getSize()):
+        say(line)
+    if modes is not None:
+        found, seconds = line_modes(solver, *modes)
+        results.modes = {n: found[k] for k, n in enumerate(names)}
+        for line in modes_lines(system, found, seconds):
+            say(line)
+    # after the records: the sweeps' warm re-solves leave the lines at rest again,
+    # but the equilibrium's numbers are those found before them
+    results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
+    for line in run_lines(results.sweeps):
+        say(line)
+    if output:
+        write_file(comm, output, system, results, records, text, notes, failures)
+    if table:
+        write_tables(comm, solver, table, system, results, records, sweeps)
+    return results
 
 
 def solve_system(system, comm=None, output=None, say=None, options=None, table=None,

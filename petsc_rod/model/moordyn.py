@@ -184,6 +184,10 @@ def options(rows, path):
                 raise RodInputError(f"{path}:{line}: OPTIONS: WtrDpth {value}: a "
                                     "bathymetry file is not read; give the depth (m)")
             found[STATIC_OPTIONS[key]] = number(f"{path}:{line}: OPTIONS", data[1], value)
+            if key == "wtrdpth" and not found["depth"] > 0:
+                raise RodInputError(f"{path}:{line}: OPTIONS: WtrDpth {value}: the water "
+                                    "depth (m, the seabed at z = -WtrDpth) must be "
+                                    "positive")
         else:
             raise RodInputError(
                 f"{path}:{line}: OPTIONS: unknown option {data[1]!r}; petsc_rod reads "

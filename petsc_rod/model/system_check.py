@@ -70,9 +70,16 @@ def check_system(system, names):
     check_anchored(system)
 
 
+# The tables a system's run writes beside its lines' FILE_<line>.csv (api/system_run
+# table_paths): its own and its sweeps', and each line's regions' and ends'.
+RESERVED = ("system", "watch_circle", "excursion")
+SUFFIXES = ("_regions", "_ends")
+
+
 def check_names(system):
     """Names unique among the points and bodies (a Connection names one of them), and
-    among the lines."""
+    among the lines; no line named as one of the system's tables (RESERVED) or another
+    line's regions' or ends' table, whose FILE_<name>.csv it would share."""
     for what, items in (("points or bodies", (*system.points, *system.bodies)),
                         ("lines", system.lines)):
         seen = set()
@@ -81,6 +88,14 @@ def check_names(system):
                 raise RodInputError(f"two {what} are named {item.name}: give each a name "
                                     "of its own")
             seen.add(item.name)
+    tables = [f"{line.name}{suffix}" for line in system.lines for suffix in SUFFIXES]
+    for line in system.lines:
+        if line.name in RESERVED or line.name in tables:
+            owner = ("the system's" if line.name in RESERVED
+                     else "another line's")
+            raise RodInputError(f"line {line.name}: the name of {owner} table "
+                                f"(the run's tables would share FILE_{line.name}.csv); "
+                                "rename the line")
 
 
 def check_connections(line, nodes):

@@ -179,8 +179,9 @@ class Equilibrium:
     (x, y, z, roll, pitch, yaw) (6,)}, ``rotations`` {name: R (3, 3)}, ``end_forces``
     (n_lines, 2, 3), N, on each line's start and end, ``load_factor`` (1 when
     complete), ``iterations`` (Newton's, over the continuation), ``residual`` (the scaled
-    norm), ``unstable`` (the names of the lines whose own equilibrium is a saddle of
-    their energy: SystemSolver.unstable_lines)."""
+    norm), ``stable`` {line name: True a local minimiser of its energy, False a saddle,
+    None undecided} (SystemSolver.line_verdicts: each line tested once, here), and
+    ``unstable`` the names of the lines whose verdict is False, in the system's order."""
 
     points: dict
     bodies: dict
@@ -191,6 +192,7 @@ class Equilibrium:
     halvings: int
     residual: float
     unstable: tuple = ()
+    stable: dict = None
 
 
 class Layout:
@@ -651,18 +653,18 @@ class SystemSolver:
         solved = self.evaluate(self.state)
         if solved[0]:
             self.forces, self.stiffnesses = solved[1], solved[2]
-        return self.result(factor, total, halvings, self.unstable_lines())
+        return self.result(factor, total, halvings, self.line_verdicts())
 
-    def unstable_lines(self):
-        """The names of the lines whose equilibrium, where they stand, is not stable
-        (line.stable() False: a saddle of its energy), in the system's order. The lines
-        may be solved with their own stability test off during the iterations (a third
-        of a warm re-solve) and tested here once. A line without ``stable`` (a mock) is
-        not tested. Collective."""
+    def line_verdicts(self):
+        """{line name: line.stable()} of every line where it stands, in the system's
+        order, on every rank: True a local minimiser of its energy, False a saddle, None
+        undecided. The lines may be solved with their own stability test off during the
+        iterations (a third of a warm re-solve) and are tested here once; the run's
+        records read these verdicts. A line without ``stable`` (a mock) is not tested
+        (None). Collective."""
         verdicts = self.placement.share({k: getattr(line, "stable", lambda: None)()
                                          for k, line in self.lines.items()})
-        return tuple(self.system.lines[k].name for k in sorted(verdicts)
-                     if verdicts[k] is False)
+        return {self.system.lines[k].name: verdicts[k] for k in sorted(verdicts)}
 
     def replace(self, system):
         """Take ``system``'s loads: RodInputError unless it differs from the solver's
@@ -682,14 +684,16 @@ class SystemSolver:
                                 "new one for any other change")
         self.system = system
 
-    def result(self, factor, iterations, halvings, unstable=()):
+    def result(self, factor, iterations, halvings, stable=None):
         state, names = self.state, [b.name for b in self.system.bodies]
         points = {p.name: state.points[i].copy() for i, p in enumerate(self.system.points)}
         return Equilibrium(points,
                            dict(zip(names, state.bodies.positions)),
                            dict(zip(names, state.bodies.R.copy())),
                            self.forces.copy(), factor, iterations, halvings,
-                           float(self.norm), unstable)
+                           float(self.norm),
+                           tuple(name for name, verdict in (stable or {}).items()
+                                 if verdict is False), dict(stable or {}))
 
     # -- the lines' own results -------------------------------------------------------------
 

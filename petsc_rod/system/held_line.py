@@ -316,6 +316,7 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
+        self.name = "the line"              # how a refusal names it (of_system_line)
 
     @classmethod
     def of_system_line(cls, line, start, end, comm, environment, options=None):
@@ -334,7 +335,9 @@ class HeldLine:
 
         span = Span(line.line, end_of(line.start, start), end_of(line.end, end),
                     tuple(line.attachments))
-        return cls(span, comm, environment, options)
+        held = cls(span, comm, environment, options)
+        held.name = f"line {line.name}"
+        return held
 
     # --- building ----------------------------------------------------------------------
     def _model(self, start, end, frames=(None, None)):
@@ -358,7 +361,7 @@ class HeldLine:
         ends at ``start``, ``end``, its problem walking HeldEnds: its frame's origin is
         ``start`` for the line's life. Collective."""
         plan = plan_line(self.comm, self._model(start, end, frames), self.values, self.given,
-                         FIELD_NAMES)
+                         FIELD_NAMES, self._mesh_named)
         self.built = BuiltLine(self.comm, plan, path_of=HeldEnds)
         try:
             self.built.build()
@@ -374,6 +377,11 @@ class HeldLine:
         # each flex joint's neutral axis at the reference frame (turned by a frame given)
         self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
                      for t in self.problem.terms if isinstance(t, FlexJoint)}
+
+    def _mesh_named(self, pieces, elements):
+        """How a mesh too large for the machine names the line's element count."""
+        return (f"{self.name}: {elements} elements (its sections' counts: a MoorDyn "
+                "line's NumSegs, or its length over the system's element length)")
 
     def _release(self):
         if self.built is not None:          # its own objects and those it was given
@@ -923,7 +931,7 @@ def held_lines(system, options=None):
     positions (system_check.connection_position), in the system's environment, tuned
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
-    line once at its equilibrium (SystemSolver.unstable_lines, HeldLine.stable)
+    line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
     instead of after each of its re-solves."""
     options = {"al_stability": 0, **(options or {})}
 

@@ -9,6 +9,8 @@ point 6:
     unsplit line's vertex of that arc length is, and the same end forces.
 """
 
+import os
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
@@ -136,3 +138,92 @@ def test_a_single_line_run_refuses_a_system():
             assert main.run(PETSc.COMM_WORLD, texts) == 2
     finally:
         PETSc.Options().delValue("options_left")      # set by the refusal
+
+
+def test_each_line_is_tested_for_stability_once_at_the_equilibrium(monkeypatch):
+    """The lines solve with their own stability test off during the system's iterations
+    (held_lines) and are tested once each at its equilibrium (SystemSolver.line_verdicts),
+    the record reading that verdict: the test's calls over the ranks are one per line on
+    each rank of its group, and each line's verdict is in its results."""
+    import dataclasses
+    import os
+
+    from helpers import REPO_ROOT
+    from petsc_rod.iteration.driver import UzawaSolver
+    from petsc_rod.model.moordyn import read_moordyn
+
+    calls = []
+    check = UzawaSolver.check_stability
+    monkeypatch.setattr(UzawaSolver, "check_stability",
+                        lambda self, *a, **k: calls.append(1) or check(self, *a, **k))
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    body = dataclasses.replace(system.bodies[0], load=(3e4, 1e4, 0, 0, 0, 0))
+    results = solve_system(dataclasses.replace(system, bodies=(body,)))
+    mpi = PETSc.COMM_WORLD.tompi4py()
+    ranks = sum(int(line.scalars["ranks"]) for line in results.lines.values())
+    assert mpi.allreduce(len(calls)) == ranks and len(results.lines) == 3
+    assert all(int(line.scalars["stable"]) == 1 for line in results.lines.values())
+
+
+def free_body_system():
+    import dataclasses
+    import os
+
+    from helpers import REPO_ROOT
+    from petsc_rod.model.moordyn import read_moordyn
+
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    body = dataclasses.replace(system.bodies[0], load=(3e4, 1e4, 0, 0, 0, 0))
+    return dataclasses.replace(system, bodies=(body,))
+
+
+def test_a_line_whose_last_solve_failed_is_not_converged(monkeypatch, tmp_path):
+    """Line2's last solve left unconverged (as the system's last evaluation may): its
+    converged is 0 in the results, its group and the file's line_converged, and the
+    system's converged is 0."""
+    import h5py
+
+    from petsc_rod.system.equilibrium import SystemSolver
+
+    solve = SystemSolver.solve
+
+    def failed_last(self):
+        found = solve(self)
+        for k, line in self.lines.items():
+            if self.system.lines[k].name == "Line2":
+                line.converged = False
+        return found
+    monkeypatch.setattr(SystemSolver, "solve", failed_last)
+    path = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path / "sys.h5"))
+    results = solve_system(free_body_system(), output=path)
+    assert results.lines_converged == {"Line1": True, "Line2": False, "Line3": True}
+    assert not results.converged
+    assert int(results.lines["Line2"].scalars["converged"]) == 0
+    with h5py.File(path, "r") as f:
+        assert list(f["system/line_converged"][()]) == [1.0, 0.0, 1.0]
+        assert int(f["system"].attrs["converged"]) == 0
+        assert int(f["lines/Line2"].attrs["converged"]) == 0
+        assert int(f["lines/Line1"].attrs["converged"]) == 1
+
+
+def test_a_nan_along_a_line_is_never_written(monkeypatch, tmp_path):
+    """A NaN in a line's positions along S (on the ranks that hold it), which no end
+    force or tension carries: RodDivergedError on every rank before anything is
+    written."""
+    from petsc_rod.errors import RodDivergedError
+    from petsc_rod.io import line_table
+
+    record = line_table.final_record
+
+    def with_nan(problem):
+        vertex, attributes = record(problem)
+        if len(vertex["r"]):        # not an end's number: only along the line
+            vertex["r"][0, 2] = np.nan
+        return vertex, attributes
+    monkeypatch.setattr(line_table, "final_record", with_nan)
+    path = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path / "sys.h5"))
+    with pytest.raises(RodDivergedError, match="non-finite"):
+        solve_system(free_body_system(), output=path, table=path[:-3] + ".csv")
+    assert not [name for name in os.listdir(os.path.dirname(path))]

@@ -348,3 +348,82 @@ def test_modes_of_each_line_on_the_command_line(tmp_path):
             frequency = f[f"lines/{line}/modes/frequency"][()]
             assert frequency.shape == (3,) and frequency[-1] > 0.1
             assert f"{frequency[-1]:12.6g}" in process.stdout
+
+
+# rank 1 alone raises while the bodies' stiffness is computed (after the equilibrium)
+SYSTEM_ALONE = """
+from petsc_rod.system import equilibrium
+stiffness = equilibrium.SystemSolver.body_stiffness
+def body_stiffness(self, name):
+    if PETSc.COMM_WORLD.getRank() == 1:
+        raise FloatingPointError("injected on rank 1")
+    return stiffness(self, name)
+equilibrium.SystemSolver.body_stiffness = body_stiffness
+if sys.argv[1] == "api":
+    from petsc_rod.api import read_moordyn, solve_system
+    solve_system(read_moordyn(sys.argv[2])[0])
+else:
+    from petsc_rod import cli_system
+    sys.exit(cli_system.run())
+"""
+
+
+@pytest.mark.parametrize("path", ["api", "cli"])
+def test_one_rank_failing_alone_ends_the_system_run(tmp_path, path):
+    """A system's run (the API's solve_system and the command line's) in which rank 1
+    alone raises: every rank ends in the failing rank's one line, exit 4, no hang."""
+    from helpers import run_failing_on_rank_1
+
+    args = [path, DECK] if path == "api" else ["cli", "-rod_system", DECK]
+    done = run_failing_on_rank_1(tmp_path / "alone.py", SYSTEM_ALONE, args, timeout=90)
+    assert done.returncode == 4, describe(done)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
+    assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
+        describe(done)
+
+
+def test_a_table_that_would_replace_the_system_file_is_refused(tmp_path):
+    """-rod_table X.dat with -rod_system X_system.dat (the system's table) or
+    X_Line1_ends.dat (a line's ends' table): exit 2 in one line naming -rod_table, the
+    input unchanged."""
+    import hashlib
+
+    with open(DECK, encoding="utf-8") as source:
+        kept = source.read()
+    for name in ("deck_system.dat", "deck_Line1_ends.dat"):
+        copy = tmp_path / name
+        copy.write_text(kept)
+        before = hashlib.md5(copy.read_bytes()).hexdigest()
+        process = run_petsc_rod(["-rod_system", str(copy), "-rod_table",
+                                 str(tmp_path / "deck.dat")], 1, 120)
+        assert process.returncode == 2, describe(process)
+        errors = [line for line in process.stdout.splitlines() if "error" in line]
+        assert len(errors) == 1 and "-rod_table" in errors[0] and name in errors[0], \
+            describe(process)
+        assert hashlib.md5(copy.read_bytes()).hexdigest() == before
+
+
+# rank 1 alone raises while the system's result file is open
+WRITE_ALONE = """
+from petsc_rod.api import read_moordyn, solve_system, system_run
+def system_datasets(*args):
+    raise FloatingPointError("injected on rank 1")
+if PETSc.COMM_WORLD.getRank() == 1:
+    system_run.system_datasets = system_datasets
+solve_system(read_moordyn(sys.argv[1])[0], output=sys.argv[2])
+"""
+
+
+def test_one_rank_failing_alone_while_writing_leaves_no_file(tmp_path):
+    """solve_system with a result file, rank 1 alone raising while it is open: every
+    rank ends in one line, exit 4, and neither the file nor its partial file is left."""
+    from helpers import run_failing_on_rank_1
+
+    out = tmp_path / "sys.h5"
+    done = run_failing_on_rank_1(tmp_path / "write_alone.py", WRITE_ALONE,
+                                 [DECK, str(out)], timeout=90)
+    assert done.returncode == 4, describe(done)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("petsc_rod: error")]
+    assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
+        describe(done)
+    assert not out.exists() and not partial_files(out)

@@ -269,3 +269,24 @@ def test_a_line_type_s_ca_is_its_added_mass_coefficient(tmp_path):
     path.write_text(text.replace("1.6    1.0    0.1", "1.6    -0.5   0.1"))
     with pytest.raises(RodInputError, match="EI, Cd and Ca must not be negative"):
         read_moordyn(str(path))
+
+
+@pytest.mark.parametrize("depth", ["0", "-5"])
+def test_a_water_depth_not_positive_is_refused_naming_it(depth):
+    message = refused(text(lambda s: s.replace("320           WtrDpth",
+                                               f"{depth}           WtrDpth")))
+    assert message == (f"case.dat:32: OPTIONS: WtrDpth {depth}: the water depth (m, the "
+                       "seabed at z = -WtrDpth) must be positive")
+
+
+def test_a_numsegs_too_large_to_mesh_is_refused_naming_it():
+    from petsc_rod.api import solve_system
+
+    system, _ = parse_moordyn(text(lambda s: s.replace("902.2     20 ",
+                                                       "902.2     4000000000 ")), "case.dat")
+    with pytest.raises(RodInputError) as error:
+        solve_system(system)
+    message = str(error.value)
+    assert message.startswith("line Line1: 4000000000 elements (its sections' counts: a "
+                              "MoorDyn line's NumSegs"), message
+    assert "-rod_elements" not in message

@@ -59,6 +59,17 @@ def test_names_are_unique_among_points_and_bodies_and_among_lines():
         "two lines are named L1: give each a name of its own")
 
 
+def test_a_line_named_as_a_table_of_the_system_is_refused():
+    """FILE_system.csv, the sweeps' tables and a line's _regions / _ends tables are
+    written beside FILE_<line>.csv: a line of one of those names would share its file."""
+    system = spread()
+    for name in ("system", "watch_circle", "excursion"):
+        message = refused(with_line(system, 0, name=name))
+        assert message.startswith(f"line {name}: the name of the system's table")
+        assert "rename the line" in message
+    assert "another line's table" in refused(with_line(system, 1, name="L1_ends"))
+
+
 def with_line(system, index, **change):
     lines = list(system.lines)
     lines[index] = dataclasses.replace(lines[index], **change)
