@@ -38,12 +38,11 @@ def petsc_error(report):
 
 def start_slepc(argv):
     """Initialise SLEPc (the modal analysis, analysis/modes.py) with the same ``argv`` as
-    PETSc, where slepc4py is installed; without it the modes are refused when asked
-    for (analysis/modes.py)."""
-    try:
-        import slepc4py
-    except ImportError:
+    PETSc, where slepc4py is installed (find_module: Debian's, found without
+    SLEPC_DIR); without it the modes are refused when asked for (cli/modes.py)."""
+    if not find_module("slepc4py", DEBIAN_SLEPC4PY):
         return
+    import slepc4py
     slepc4py.init(argv)
 
 
@@ -78,29 +77,43 @@ def end(code):
     os._exit(code)
 
 
-# Where Debian's python3-petsc4py puts the module: under PETSC_DIR, which its own .pth
-# file expects in the environment (or the /usr/lib/petsc link of the -dev package).
+# Where Debian's python3-petsc4py and python3-slepc4py put the modules: under PETSC_DIR
+# and SLEPC_DIR, which their own .pth files expect in the environment (or the
+# /usr/lib/petsc and /usr/lib/slepc links of the -dev packages).
 DEBIAN_PETSC4PY = "/usr/lib/petscdir/petsc3.*/*-real/lib/python3/dist-packages"
+DEBIAN_SLEPC4PY = "/usr/lib/slepcdir/slepc3.*/*-real/lib/python3/dist-packages"
 
 
-def find_petsc4py():
-    """Whether petsc4py imports, after adding Debian's newest real-scalar petsc4py to the
-    path when it does not on its own (a venv made by `pip install .`, no PETSC_DIR)."""
+def find_module(name, pattern):
+    """Whether module ``name`` imports, after adding the newest of Debian's folders
+    matching ``pattern`` to the path when it does not on its own (a venv made by
+    `pip install .`, no PETSC_DIR or SLEPC_DIR in the environment)."""
+    import importlib
     try:
-        import petsc4py  # noqa: F401
+        importlib.import_module(name)
         return True
     except ImportError:
         pass
     import glob
-    import importlib
     import re
 
     def version(path):
         return [int(part) for part in re.findall(r"\d+", path)]
 
-    found = sorted(glob.glob(DEBIAN_PETSC4PY), key=version)
+    found = sorted(glob.glob(pattern), key=version)
     if not found:
         return False
+    sys.path.append(found[-1])
+    try:
+        importlib.import_module(name)
+        return True
+    except ImportError:
+        return False
+
+
+def find_petsc4py():
+    """Whether petsc4py imports (find_module: Debian's, found without PETSC_DIR)."""
+    return find_module("petsc4py", DEBIAN_PETSC4PY)
     sys.path.append(found[-1])
     try:
         importlib.import_module("petsc4py")
