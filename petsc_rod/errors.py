@@ -2,6 +2,11 @@
 agreement of all ranks on whether one was raised."""
 
 
+def petsc_message(error):
+    """The last line of a PETSc.Error's report (PETSc's own message), without its rank."""
+    return str(error).strip().splitlines()[-1].split("] ", 1)[-1]
+
+
 class RodError(Exception):
     """Base class: ``str(error)`` is the one-line message shown to the user."""
 

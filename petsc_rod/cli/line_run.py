@@ -43,7 +43,8 @@ from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, ch
 from petsc_rod.cli.session import run_continuation
 from petsc_rod.compile import compile_scene
 from petsc_rod.environment.profiles import read_seabed_profile
-from petsc_rod.errors import NoCatenaryStart, RodDivergedError, RodInputError, on_every_rank
+from petsc_rod.errors import (NoCatenaryStart, RodDivergedError, RodInputError, on_every_rank,
+                              petsc_message)
 from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
@@ -329,11 +330,6 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
 def default_record(plan, solver, start):
     """run_record of the plan's values: the record of the command line's run."""
     return run_record(plan.values, solver, start)
-
-
-def petsc_message(error):
-    """The last line of a PETSc.Error's report (PETSc's own message), without its rank."""
-    return str(error).strip().splitlines()[-1].split("] ", 1)[-1]
 
 
 def petsc_failure(error):

@@ -12,7 +12,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import CLASSES, ModesRefused, check_options, solve_modes
-from petsc_rod.errors import RodInputError, RodIOError
+from petsc_rod.errors import RodInputError, RodIOError, petsc_message
 from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io.results import check_output_path
 
@@ -36,7 +36,6 @@ def check_modes_inputs(values, scene, comm):
         raise RodInputError("-rod_modes needs slepc4py, which is not installed: install "
                             "Debian's python3-slepc4py (scripts/setup.sh does)")
     if values["rod_modes"]:
-        from petsc_rod.cli.line_run import petsc_message
         try:
             check_options(comm)
         except PETSc.Error as error:

@@ -53,9 +53,14 @@ def main(argv=None):
     if clash:
         sys.stderr.write(f"petsc_rod.report: error: {clash}\n")
         return 2
-    from petsc_rod.report import page
+    from petsc_rod.figures.read_system import is_system_file
+    from petsc_rod.io.same_file import write_text_whole
+    from petsc_rod.report import page, system_page
     try:
-        page.write(source, args.output, args.min_bend_radius)
+        if not os.path.isdir(source) and is_system_file(source):
+            write_text_whole(args.output, system_page.build(source))
+        else:
+            page.write(source, args.output, args.min_bend_radius)
     except OSError as error:
         sys.stderr.write(f"petsc_rod.report: error: {args.output}: {error.strerror or error}\n")
         return 2

@@ -36,7 +36,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from petsc_rod import plots  # noqa: E402
-from petsc_rod.figures.read_system import is_system_file  # noqa: E402
 from petsc_rod.io.same_file import write_text_whole  # noqa: E402
 from petsc_rod.report import envelopes, excursion, tables  # noqa: E402
 from petsc_rod.sweep import summary  # noqa: E402
@@ -269,9 +268,6 @@ def build(source, min_bend_radius=None):
 
 def write(source, output, min_bend_radius=None):
     """Write the page of ``source`` to ``output``, whole or not at all
-    (io.same_file.write_text_whole): a system's result file's by report/system_page.py."""
-    if not os.path.isdir(source) and is_system_file(source):
-        from petsc_rod.report import system_page
-        write_text_whole(output, system_page.build(source))
-        return
+    (io.same_file.write_text_whole); a system's result file has its own
+    (report/system_page.py, chosen by report/__main__.py)."""
     write_text_whole(output, build(source, min_bend_radius))

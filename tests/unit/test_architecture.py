@@ -93,6 +93,18 @@ def test_no_loop_between_folders():
     assert graph["problem"] and graph["iteration"]       # the graph was read
 
 
+def test_no_two_modules_of_a_folder_import_each_other():
+    """A pair of modules that import each other (at the top or inside a function) is a
+    circle inside a folder: what both need belongs in one of them or below them."""
+    dotted = {path.removesuffix(".py").replace(os.sep, "."): tree
+              for path, tree in modules().items()}
+    uses = {name: {other for other in imported(tree) if other in dotted and other != name}
+            for name, tree in dotted.items()}
+    circles = sorted((a, b) for a in uses for b in uses[a] if a < b and a in uses[b])
+    assert not circles, f"modules that import each other: {circles}"
+    assert uses["cli.main"]                                 # the imports were read
+
+
 def test_the_core_never_imports_an_application():
     for path, tree in modules().items():
         if path.startswith(CORE):
