@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from petsc_rod.errors import RodInputError
+from petsc_rod.frames import rotation_about, tait_bryan_zyx
 from petsc_rod.model.line import Line
 from petsc_rod.model.moordyn_types import line_types, number, type_row
 from petsc_rod.model.sea import GRAVITY, WATER_DENSITY, Environment
@@ -209,6 +210,17 @@ def triple(where, column, text):
     return tuple(values)
 
 
+def moordyn_angles(r0, p0, y0):
+    """(roll, pitch, yaw), rad, of a Body (R = R_z(yaw) R_y(pitch) R_x(roll)) turned as
+    MoorDyn turns a body given r0, p0, y0 (rad): R = R_x(r0) R_y(p0) R_z(y0), its
+    Euler2Quat (rotations about the axes X, then the turned Y, then the turned Z). The
+    two orders agree for one angle at a time; MoorPy composes R_z R_y R_x and so places
+    a body given two or three angles elsewhere than MoorDyn."""
+    turned = (rotation_about((1.0, 0.0, 0.0), r0) @ rotation_about((0.0, 1.0, 0.0), p0)
+              @ rotation_about((0.0, 0.0, 1.0), y0))
+    return tuple(float(a) for a in tait_bryan_zyx(turned))
+
+
 def body_rows(rows, path):
     """{'Body<ID>': Body's fields} of the BODIES rows: ID Attachment X0 Y0 Z0 r0 p0 y0
     (deg) Mass CG* I* Volume CdA* Ca*; the inertia and hydrodynamic coefficients are
@@ -226,7 +238,7 @@ def body_rows(rows, path):
         place = [number(where, c, v) for c, v in zip(("X0", "Y0", "Z0", "r0", "p0", "y0"),
                                                       data[2:8])]
         bodies[f"Body{int(number(where, 'ID', data[0]))}"] = dict(
-            position=tuple(place[:3]) + tuple(float(a) for a in np.radians(place[3:])),
+            position=tuple(place[:3]) + moordyn_angles(*np.radians(place[3:])),
             mass=number(where, "Mass", data[8]), cog=triple(where, "CG", data[9]),
             volume=number(where, "Volume", data[11]), held=held)
     return bodies

@@ -12,6 +12,7 @@ a force F (3,), N, and a moment M (3,), N m, about X, in global axes: the 6-vect
 
 import numpy as np
 
+from petsc_rod.frames import tait_bryan_zyx
 from petsc_rod.model.system_check import rotation
 
 DOF_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
@@ -24,14 +25,6 @@ def skew(v):
     return np.stack([np.stack([zero, -v[..., 2], v[..., 1]], -1),
                      np.stack([v[..., 2], zero, -v[..., 0]], -1),
                      np.stack([-v[..., 1], v[..., 0], zero], -1)], -2)
-
-
-def angles(R):
-    """(..., 3): (roll, pitch, yaw), rad, of R = R_z(yaw) R_y(pitch) R_x(roll) (pitch
-    in [-pi/2, pi/2])."""
-    pitch = np.arcsin(np.clip(-R[..., 2, 0], -1.0, 1.0))
-    return np.stack([np.arctan2(R[..., 2, 1], R[..., 2, 2]), pitch,
-                     np.arctan2(R[..., 1, 0], R[..., 0, 0])], -1)
 
 
 def _series(angle, small, exact, limit, slope):
@@ -118,7 +111,7 @@ class Bodies:
     @property
     def positions(self):
         """(x, y, z, roll, pitch, yaw) (n, 6)."""
-        return np.concatenate([self.X, angles(self.R)], axis=1)
+        return np.concatenate([self.X, tait_bryan_zyx(self.R)], axis=1)
 
     def own_loads(self, loads):
         """(loads (n, 6), d loads / d(dX, dtheta) (n, 6, 6)) of the bodies' weight at

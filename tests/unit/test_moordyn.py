@@ -11,6 +11,7 @@ import pytest
 from helpers import REPO_ROOT
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.moordyn import parse_moordyn, read_moordyn
+from petsc_rod.model.system_check import rotation
 
 pytestmark = pytest.mark.unit
 
@@ -290,3 +291,28 @@ def test_a_numsegs_too_large_to_mesh_is_refused_naming_it():
     assert message.startswith("line Line1: 4000000000 elements (its sections' counts: a "
                               "MoorDyn line's NumSegs"), message
     assert "-rod_elements" not in message
+
+
+def test_a_body_turned_by_three_angles_is_placed_as_moordyn_places_it(tmp_path):
+    """MoorDyn turns a body by R = R_x(r0) R_y(p0) R_z(y0) (rotations about X, the turned
+    Y, the turned Z); the Body read must take its local points where that R does."""
+    r0, p0, y0 = np.radians([10.0, 20.0, 30.0])
+    c, s = np.cos, np.sin
+    rx = np.array([[1, 0, 0], [0, c(r0), -s(r0)], [0, s(r0), c(r0)]])
+    ry = np.array([[c(p0), 0, s(p0)], [0, 1, 0], [-s(p0), 0, c(p0)]])
+    rz = np.array([[c(y0), -s(y0), 0], [s(y0), c(y0), 0], [0, 0, 1]])
+    path = tmp_path / "turned.dat"
+    path.write_text(SEMI.replace("0       0      10    1e6", "10      20     30    1e6"),
+                    encoding="utf-8")
+    (body,) = read_moordyn(path)[0].bodies
+    turned = rotation(*body.position[3:])
+    assert np.abs(turned - rx @ ry @ rz).max() < 1e-15
+    assert np.abs(turned - rz @ ry @ rx).max() > 0.05     # not MoorPy's order
+
+
+def test_one_angle_alone_is_read_as_given(tmp_path):
+    path = tmp_path / "pitched.dat"
+    path.write_text(SEMI.replace("0       0      10    1e6", "0       7      0     1e6"),
+                    encoding="utf-8")
+    (body,) = read_moordyn(path)[0].bodies
+    assert body.position[3:] == pytest.approx((0.0, np.radians(7.0), 0.0), abs=1e-15)
