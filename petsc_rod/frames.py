@@ -59,14 +59,6 @@ def rotation_about(axis, angle):
     return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
 
 
-def tait_bryan_zyx(R):
-    """(..., 3): (roll, pitch, yaw), rad, of R = R_z(yaw) R_y(pitch) R_x(roll) (pitch in
-    [-pi/2, pi/2]): the angles a Body's position holds."""
-    pitch = np.arcsin(np.clip(-R[..., 2, 0], -1.0, 1.0))
-    return np.stack([np.arctan2(R[..., 2, 1], R[..., 2, 2]), pitch,
-                     np.arctan2(R[..., 1, 0], R[..., 0, 0])], -1)
-
-
 def rotations(omega):
     """Rotation matrices exp([omega]x) of rotation vectors omega (..., 3) (Rodrigues):
     I + sin(a) [k]x + (1 - cos a) [k]x^2 with a = |omega|, k = omega / a. (..., 3, 3)."""

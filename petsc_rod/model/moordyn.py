@@ -14,11 +14,11 @@ import math
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.frames import rotation_about, tait_bryan_zyx
 from petsc_rod.model.line import Line
 from petsc_rod.model.moordyn_types import line_types, number, type_row
 from petsc_rod.model.sea import GRAVITY, WATER_DENSITY, Environment
 from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
+from petsc_rod.model.system_check import rotation, tait_bryan_zyx
 from petsc_rod.tables import is_number, read_text
 
 # The longest element petsc_rod meshes a MoorDyn line with (m): a line gets
@@ -216,8 +216,7 @@ def moordyn_angles(r0, p0, y0):
     Euler2Quat (rotations about the axes X, then the turned Y, then the turned Z). The
     two orders agree for one angle at a time; MoorPy composes R_z R_y R_x and so places
     a body given two or three angles elsewhere than MoorDyn."""
-    turned = (rotation_about((1.0, 0.0, 0.0), r0) @ rotation_about((0.0, 1.0, 0.0), p0)
-              @ rotation_about((0.0, 0.0, 1.0), y0))
+    turned = rotation(r0, 0.0, 0.0) @ rotation(0.0, p0, 0.0) @ rotation(0.0, 0.0, y0)
     return tuple(float(a) for a in tait_bryan_zyx(turned))
 
 

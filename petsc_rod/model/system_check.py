@@ -29,6 +29,14 @@ def rotation(roll, pitch, yaw):
                      np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
+def tait_bryan_zyx(R):
+    """(..., 3): (roll, pitch, yaw), rad, of R = R_z(yaw) R_y(pitch) R_x(roll) (pitch in
+    [-pi/2, pi/2]): the angles a Body's position holds."""
+    pitch = np.arcsin(np.clip(-R[..., 2, 0], -1.0, 1.0))
+    return np.stack([np.arctan2(R[..., 2, 1], R[..., 2, 2]), pitch,
+                     np.arctan2(R[..., 1, 0], R[..., 0, 0])], -1)
+
+
 def connection_position(node, connection):
     """Where ``connection`` is, (3,), m, global, with its Point or Body ``node`` at its
     start position: the point's position, or the body's reference point plus its

@@ -12,8 +12,7 @@ a force F (3,), N, and a moment M (3,), N m, about X, in global axes: the 6-vect
 
 import numpy as np
 
-from petsc_rod.frames import tait_bryan_zyx
-from petsc_rod.model.system_check import rotation
+from petsc_rod.model.system_check import rotation, tait_bryan_zyx
 
 DOF_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
 
