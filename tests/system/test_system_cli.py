@@ -427,3 +427,32 @@ def test_one_rank_failing_alone_while_writing_leaves_no_file(tmp_path):
     assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
         describe(done)
     assert not out.exists() and not partial_files(out)
+
+
+def test_the_system_modes_in_the_lines_the_file_and_the_table(tmp_path):
+    """-rod_system_modes: the bodies' modes about the equilibrium in the run's lines
+    (said to be with the lines quasi-static), the file's group system/modes and the
+    table FILE_system_modes.csv, the same on 1 and 2 ranks; refused without -rod_system."""
+    found = {}
+    for ranks in (1, 2):
+        folder = tmp_path / f"r{ranks}"
+        folder.mkdir()
+        out, process = system_run(folder, ranks, "-rod_system_modes", "1",
+                                  "-rod_system_modes_line_mass", "1")
+        assert process.returncode == 0, describe(process)
+        assert "the lines quasi-static" in process.stdout
+        assert "the lines' mass lumped half at each end" in process.stdout
+        with h5py.File(out, "r") as f:
+            group = f["system/modes"]
+            frequencies = group["frequencies"][()]
+            assert group.attrs["dofs"].startswith("Body1 x,Body1 y,Body1 z")
+            assert int(group.attrs["line_mass"]) == 1
+        rows = np.genfromtxt(folder / "system_system_modes.csv", delimiter=",",
+                             names=True, dtype=None, encoding="utf-8")
+        assert np.allclose(rows["frequency_Hz"], frequencies, rtol=1e-9)
+        # the lines' mass at the fairleads gives the rotations inertia: six modes
+        assert len(frequencies) == 6 and np.all(np.diff(frequencies) >= 0)
+        found[ranks] = frequencies
+    assert np.allclose(found[1], found[2], rtol=1e-9)
+    assert "-rod_system_modes" in refused(tmp_path, ["-options_file", "options/cantilever.opts",
+                                                     "-rod_system_modes", "1"])
