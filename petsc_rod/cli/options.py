@@ -318,6 +318,10 @@ OPTIONS = [
            "(undamped: no drag; SLEPc, options -rod_modes_eps_*; docs/modes.md): "
            "frequencies, periods, modal masses and classes in the run's lines; 0 none",
            NON_NEGATIVE),
+    Option("rod_modes_range", _string, None, "FMIN,FMAX",
+           "after the last step, every natural mode with a frequency in [FMIN, FMAX] Hz "
+           "(their number counted by the inertia of K - omega^2 M at both ends; "
+           "docs/modes.md), in place of -rod_modes N", unit="text"),
     Option("rod_modes_table", _string, None, "FILE.csv",
            "write the modes' table (one row per mode) to FILE, and their shapes along "
            "the line (one row per vertex and mode) to FILE's stem + _shapes.csv",

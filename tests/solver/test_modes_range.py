@@ -1,0 +1,70 @@
+"""-rod_modes_range FMIN,FMAX (analysis/modes.solve_modes with a band): every mode in a
+frequency band, counted by the inertia of K - sigma M at both ends and found by
+shift-and-invert about the band's middle; a taut string's modes in a band are its
+closed form's list; a bad band refused in one line. Serially and on 2 ranks."""
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import continuation, destroy, make_solver, run_cli
+
+from test_modes import pinned
+
+pytest.importorskip("slepc4py")
+
+
+def string_modes(band=None, count=0, n_elements=32):
+    from petsc_rod.analysis.mass import MassSettings
+    from petsc_rod.analysis.modes import solve_modes
+    scene, _, _ = pinned(100.0, 1e6, 1e-6)
+    mesh, solver = make_solver(PETSc.COMM_WORLD, n_elements, scene, 1e2)
+    try:
+        continuation(solver)
+        return solve_modes(solver.problem, count, MassSettings(mass=1.0), band=band)
+    finally:
+        destroy(mesh, solver)
+
+
+def closed_form(n):
+    _, length, m = pinned(100.0, 1e6, 1e-6)
+    return n / (2 * length) * np.sqrt(100.0 / m)
+
+
+def test_a_taut_string_s_modes_in_a_band_are_the_closed_form_s():
+    """f_n = n / (2 L') sqrt(T / m') = 5.0 n Hz, a pair (in and out of the plane) each:
+    [7, 16] Hz holds n = 2, 3, four modes; the band's ends leave out n = 1 and 4."""
+    modes = string_modes(band=(7.0, 16.0))
+    assert modes.band == (7.0, 16.0, 4)
+    exact = closed_form(np.array([2, 2, 3, 3]))
+    assert np.allclose(modes.frequencies, exact, rtol=1e-5)
+    lowest = string_modes(count=6)
+    assert np.allclose(modes.frequencies, lowest.frequencies[2:], rtol=1e-9)
+    assert np.allclose(modes.modal_mass, lowest.modal_mass[2:], rtol=1e-6)
+    every = PETSc.COMM_WORLD.tompi4py().allgather(modes.frequencies)
+    assert all(np.allclose(every[0], f, rtol=1e-10) for f in every)
+
+
+def test_a_band_from_zero_and_a_band_without_modes():
+    below = string_modes(band=(0.0, 11.0))
+    assert below.band[2] == 4
+    assert np.allclose(below.frequencies, closed_form(np.array([1, 1, 2, 2])), rtol=1e-5)
+    empty = string_modes(band=(5.5, 9.5))
+    assert empty.band == (5.5, 9.5, 0) and len(empty.omega2) == 0
+
+
+@pytest.mark.parametrize("text", ["5,1", "abc", "-1,2", "1,2,3", "1,inf", "3,3"])
+def test_a_bad_band_is_refused_in_one_line(text, capsys):
+    assert run_cli({"rod_length": "1", "rod_modes_mass": "1", "rod_modes_range": text}) == 2
+    out = capsys.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "-rod_modes_range" in lines[0] and "step 1" not in out
+
+
+def test_a_band_beside_a_count_is_refused(capsys):
+    assert run_cli({"rod_length": "1", "rod_modes_mass": "1", "rod_modes": "3",
+                    "rod_modes_range": "1,2"}) == 2
+    out = capsys.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        assert "give one" in out
