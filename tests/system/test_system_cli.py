@@ -237,7 +237,8 @@ def test_help_lists_the_system_options():
     assert process.returncode == 0, describe(process)
     for name in ("-rod_system ", "-rod_system_element_length ", "-rod_system_body_load ",
                  "-rod_system_steps ", "-rod_system_watch_circle ",
-                 "-rod_system_excursion ", "-rod_al_rtol "):
+                 "-rod_system_excursion ", "-rod_al_rtol ", "-rod_system_modes ",
+                 "-rod_system_modes_line_mass "):
         assert name in process.stdout, name
 
 
