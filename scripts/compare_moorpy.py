@@ -18,7 +18,7 @@ markdown table.
 
 the spar's natural periods on its moorings (docs/modes.md, "The coupled system's
 modes"): the spar free, with the OC3 definition's mass properties and a strip-theory
-added mass (SPAR_INERTIA, added_mass below), petsc_rod's system modes
+added mass (validation/oc3_hywind.free_spar), petsc_rod's system modes
 (system/body_modes.py) against the same eigenproblem with MoorPy's mooring stiffness
 (the same mass and hydrostatics) and the published periods.
 """
@@ -36,7 +36,8 @@ from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.system.body_modes import rigid_mass, system_modes
 from petsc_rod.system.equilibrium import SystemSolver, solve_system
 from petsc_rod.system.held_line import held_lines
-from petsc_rod.validation.oc3_hywind import GRAVITY_DEPTH, catenaries, spar
+from petsc_rod.validation.oc3_hywind import (GRAVITY_DEPTH, PUBLISHED_FREQUENCIES, catenaries,
+                                             free_spar, spar, spar_inertia)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DECK = os.path.join(HERE, os.pardir, "tests", "data", "moordyn", "OC3Hywind_MoorDyn.dat")
@@ -48,23 +49,6 @@ MOORPY = "MoorPy==1.3.0"
 # as quoted (docs/systems.md says where they were and were not checked).
 PUBLISHED = {(0, 0): 41180.0, (1, 1): 41180.0, (2, 2): 11940.0, (3, 3): 311.1e6,
              (4, 4): 311.1e6, (5, 5): 11.56e6, (0, 4): -2.821e6, (1, 3): 2.821e6}
-
-# The OC3-Hywind system's parts (Jonkman 2010, as commonly quoted; not read from the
-# report here): (mass kg, height of its centre of mass m, its own inertia about it
-# (roll = pitch, yaw) kg m^2): the platform; the tower (87.6 m from 10 m, as a thin
-# tube: m L^2 / 12); the rotor-nacelle assembly as a point mass at the hub, 90 m.
-PARTS = ((7466330.0, -89.9155, 4229230000.0, 164230000.0),
-         (249718.0, 43.4, 249718.0 * 77.6**2 / 12, 0.0),
-         (350000.0, 90.0, 0.0, 0.0))
-# The spar's radius against depth, m: 6.5 m diameter to 4 m down, a taper to 9.4 m at
-# 12 m, 9.4 m to the keel at 120 m.
-PROFILE = ((0.0, 3.25), (4.0, 3.25), (12.0, 4.7), (120.0, 4.7))
-# Published natural frequencies of the whole system (Hz), as commonly quoted from the
-# OC3 phase IV code comparison (Jonkman and Musial, NREL/TP-5000-48191, 2010; not at
-# hand here to check the digits); the pitch value is the full system's by an
-# eigenanalysis of the linearised matrices (J. Jonkman on NREL's forum, "OC3 Spar
-# natural frequency").
-PUBLISHED_FREQUENCIES = {"surge": 0.0080, "heave": 0.0324, "pitch": 0.0343, "yaw": 0.1210}
 
 CHILD = r"""
 import json, sys
@@ -102,46 +86,6 @@ def moorpy(deck, sea):
                           str(sea.water_density), str(sea.gravity)],
                          capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
-
-
-def spar_inertia():
-    """(mass, cog height, inertia (3, 3) about the cog) of the whole system (PARTS)."""
-    parts = np.array(PARTS)
-    mass = parts[:, 0].sum()
-    z = parts[:, 0] @ parts[:, 1] / mass
-    pitch = parts[:, 2].sum() + parts[:, 0] @ (parts[:, 1] - z) ** 2
-    return mass, z, np.diag([pitch, pitch, parts[:, 3].sum()])
-
-
-def added_mass(rho, steps=12000):
-    """(6, 6) strip-theory added mass of the spar about its reference point at the
-    surface, C_a = 1 on every section: rho pi r^2 per metre across (A11 = A22), its
-    first and second moments in z (A15 = -A24 = rho int a z dz, A44 = A55 = rho int a
-    z^2 dz) and, in heave, the keel's disc, rho D^3 / 6 (half a disc's in an infinite
-    fluid)."""
-    depth = np.linspace(0.0, PROFILE[-1][0], steps + 1)
-    radius = np.interp(depth, *np.array(PROFILE).T)
-    z = -0.5 * (depth[1:] + depth[:-1])
-    area = np.pi * (0.5 * (radius[1:] + radius[:-1])) ** 2 * np.diff(depth)
-    A = np.zeros((6, 6))
-    A[0, 0] = A[1, 1] = rho * area.sum()
-    A[0, 4] = A[4, 0] = rho * area @ z
-    A[1, 3] = A[3, 1] = -rho * area @ z
-    A[3, 3] = A[4, 4] = rho * area @ z**2
-    A[2, 2] = rho * (2 * radius[-1]) ** 3 / 6
-    return A
-
-
-def free_spar(deck):
-    """The spar free at rest with the whole system's inertia and the strip theory's
-    added mass (its mass stays validation/oc3_hywind's, balancing the lines, and its
-    cog GRAVITY_DEPTH down)."""
-    from dataclasses import replace
-    system = spar(deck)
-    _, _, inertia = spar_inertia()
-    body = replace(system.bodies[0], inertia=tuple(inertia.ravel()),
-                   added_mass=tuple(added_mass(deck.environment.water_density).ravel()))
-    return replace(system, bodies=(body,))
 
 
 def periods(K, M):

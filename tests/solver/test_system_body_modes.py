@@ -154,3 +154,42 @@ def test_an_unstable_equilibrium_is_refused():
             system_modes(solver)
     finally:
         solver.destroy()
+
+
+def test_the_oc3_spar_s_periods_on_its_real_lines():
+    """OC3-Hywind's spar free on its deck's three chains (real lines, 2 m elements),
+    the definition's mass properties and a strip-theory added mass
+    (validation/oc3_hywind.free_spar): its surge, heave, pitch and yaw periods equal
+    those of the same spar on elastic catenaries (a rigid frictionless seabed; their
+    stiffness by central differences) within the touchdown's discretisation, and the
+    published surge, heave and pitch periods within the added mass's approximation
+    (docs/modes.md)."""
+    from petsc_rod.model.moordyn import read_moordyn
+    from petsc_rod.system.held_line import held_lines
+    from petsc_rod.validation.oc3_hywind import PUBLISHED_FREQUENCIES, free_spar
+    from test_system_equilibrium import CatenaryLine
+    from test_system_oc3 import DECK
+    deck, _ = read_moordyn(DECK, element_length=2.0)
+    system = free_spar(deck)
+    found = {}
+    for name, make in (("rod", held_lines(system)),
+                       ("catenary", lambda line, comm: CatenaryLine(902.2, 698.094, 384.243e6,
+                                                                    seabed=-320.0))):
+        solver = SystemSolver(system, make, PETSc.COMM_WORLD)
+        try:
+            solver.solve()
+            found[name] = system_modes(solver)
+        finally:
+            solver.destroy()
+    rod, catenary = found["rod"], found["catenary"]
+    for modes in (rod, catenary):           # the pairs in either order: degenerate
+        assert {modes.labels[0], modes.labels[1]} == {"spar x", "spar y"}
+        assert {modes.labels[3], modes.labels[4]} == {"spar roll", "spar pitch"}
+        assert modes.labels[2] == "spar z" and modes.labels[5] == "spar yaw"
+    assert np.allclose(rod.periods[:2], catenary.periods[:2], rtol=3e-3)
+    assert np.allclose(rod.periods[2:], catenary.periods[2:], rtol=5e-4)
+    published = {name: 1 / f for name, f in PUBLISHED_FREQUENCIES.items()}
+    assert rod.periods[0] == pytest.approx(published["surge"], rel=0.01)
+    assert rod.periods[2] == pytest.approx(published["heave"], rel=0.02)
+    assert rod.periods[4] == pytest.approx(published["pitch"], rel=0.04)
+    same_on_every_rank(rod.omega2)
