@@ -193,3 +193,30 @@ def test_the_oc3_spar_s_periods_on_its_real_lines():
     assert rod.periods[2] == pytest.approx(published["heave"], rel=0.02)
     assert rod.periods[4] == pytest.approx(published["pitch"], rel=0.04)
     same_on_every_rank(rod.omega2)
+
+
+def test_a_constant_yaw_moment_makes_complex_modes_and_is_refused():
+    """The three-spring spread of test_system_equilibrium under a constant (global)
+    yaw moment of 2 MN m: the lines' moment about the reference point makes the
+    rotational stiffness unsymmetric, [M]x / 2 coupling the equal roll and pitch (and
+    through them surge and sway): complex eigenvalues of M^-1 K, refused; without the
+    moment the same body has six real modes."""
+    from dataclasses import replace
+    from test_system_equilibrium import spread
+    found = {}
+    for moment in (0.0, 2e6):
+        system = spread(load=(0.0,) * 5 + (moment,))
+        system = replace(system, bodies=(replace(system.bodies[0],
+                                                 inertia=(5e8, 5e8, 8e8)),))
+        solver = solved(system)
+        try:
+            found[moment] = system_modes(solver)
+        except SystemModesRefused as refused:
+            found[moment] = refused
+        finally:
+            solver.destroy()
+    assert len(found[0.0].omega2) == 6 and found[0.0].imaginary < 1e-12
+    refused = found[2e6]
+    assert isinstance(refused, SystemModesRefused)
+    assert refused.complex == 4 and refused.negative == 0
+    assert "complex eigenvalues" in str(refused)
