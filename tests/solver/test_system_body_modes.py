@@ -220,3 +220,24 @@ def test_a_constant_yaw_moment_makes_complex_modes_and_is_refused():
     assert isinstance(refused, SystemModesRefused)
     assert refused.complex == 4 and refused.negative == 0
     assert "complex eigenvalues" in str(refused)
+
+
+def test_the_lines_mass_lumped_half_at_each_end():
+    """With line_mass: each spring's mass (its UniformLine's load over g times its
+    length) half at each end, the fixed ends' halves held: the point carries one half
+    of each, omega^2 = 2k / (m (1 + ca) + w L0 / g) along the line; without it, none."""
+    from dataclasses import replace
+    k, span, rest, mass, ca, w = 3e4, 20.0, 18.0, 500.0, 0.8, 400.0
+    system = point_between(k, span, rest, mass, ca)
+    heavy = tuple(replace(line, line=replace(line.line, load=((0.0, 0.0, -w),)))
+                  for line in system.lines)
+    solver = solved(replace(system, lines=heavy))
+    try:
+        lumped, bare = system_modes(solver, line_mass=True), system_modes(solver)
+    finally:
+        solver.destroy()
+    assert lumped.line_mass and not bare.line_mass
+    along = dict(zip(lumped.labels, lumped.omega2))["mid x"]
+    assert along == pytest.approx(2 * k / (mass * (1 + ca) + w * rest / G), rel=1e-12)
+    assert dict(zip(bare.labels, bare.omega2))["mid x"] == pytest.approx(
+        2 * k / (mass * (1 + ca)), rel=1e-12)
