@@ -9,7 +9,7 @@ Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_l
 -rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
 -rod_system_excursion, -rod_system_modes, -rod_system_modes_line_mass), the outputs
 (-rod_output, -rod_table), the
-modes of each line with its ends held (-rod_modes N, -rod_modes_added_mass,
+modes of each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
 -rod_max_halvings: every line the same); every other
 -rod_* option describes a single line's scene or load path, which the file gives, and is

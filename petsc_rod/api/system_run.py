@@ -16,7 +16,7 @@ from petsc_rod.analysis.mass import MassSettings
 from petsc_rod.analysis.modes import ModesRefused, solve_modes
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
-from petsc_rod.cli.modes import table_lines
+from petsc_rod.cli.modes import modes_band, table_lines
 from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
@@ -36,7 +36,8 @@ from petsc_rod.system.held_line import held_lines
 SYSTEM_OPTIONS = ("system_steps", "system_modes", "system_modes_line_mass")
 # The modes of each line with its ends held (docs/modes.md): their count and the mass's
 # settings (every line the same), the option names without ``rod_`` and MassSettings'.
-MODES_OPTIONS = {"modes": None, "modes_added_mass": "added_mass", "modes_mass": "mass",
+MODES_OPTIONS = {"modes": None, "modes_range": None, "modes_added_mass": "added_mass",
+                 "modes_mass": "mass",
                  "modes_inertia": "inertia"}
 # The options of a line that a system's lines take (every line the same): the
 # iteration's tolerances and switches (-rod_al_*), the halvings of a line's walk.
@@ -114,15 +115,21 @@ def body_modes_request(options):
 
 
 def modes_request(options):
-    """(count, MassSettings) of the modes ``options`` {name without ``rod_``: value}
-    asks for (MODES_OPTIONS, parsed as the command line's -rod_modes*), None without
-    ``modes``; the options taken out of ``options``."""
+    """(count, MassSettings, band) of the modes ``options`` {name without ``rod_``:
+    value} asks for (MODES_OPTIONS, parsed as the command line's -rod_modes*: the
+    ``modes`` lowest, or every mode in the band ``modes_range`` 'FMIN,FMAX' Hz, band
+    then (fmin, fmax), else None), None without either; the options taken out of
+    ``options``."""
     texts = {name: options.pop(name) for name in list(options) if name in MODES_OPTIONS}
     values, _ = values_of(texts)
-    if not values["rod_modes"]:
+    band = modes_band(values["rod_modes_range"])
+    if values["rod_modes"] and band is not None:
+        raise RodInputError("modes and modes_range: give one (the N lowest modes, or "
+                            "every mode in a band)")
+    if not values["rod_modes"] and band is None:
         return None
     return values["rod_modes"], MassSettings(
-        **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key})
+        **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key}), band
 
 
 def split_options(options):
@@ -146,9 +153,10 @@ def split_options(options):
     return Settings(load_steps=int(steps)), options, modes, body_modes
 
 
-def line_modes(solver, count, settings):
+def line_modes(solver, count, settings, band=None):
     """({line index: Modes or ModesRefused}, {line index: seconds}) on every rank: each
-    line's ``count`` lowest modes about its equilibrium with its ends held
+    line's ``count`` lowest modes (every mode in ``band``, Hz, where given) about its
+    equilibrium with its ends held
     (analysis/modes.solve_modes on the HeldLine's problem, collective on its group's
     communicator: its ends are pinned there, so its modes are the held line's), the
     shapes on the line's own ranks, zero rows of them on the others. Collective."""
@@ -156,7 +164,7 @@ def line_modes(solver, count, settings):
     for k, line in solver.lines.items():
         start = time.perf_counter()
         try:
-            mine[k] = solve_modes(line.problem, count, settings)
+            mine[k] = solve_modes(line.problem, count, settings, band)
         except ModesRefused as refused:
             mine[k] = refused
         seconds[k] = line.mesh.global_max(time.perf_counter() - start)
