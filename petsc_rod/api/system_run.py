@@ -454,7 +454,8 @@ def ends_rows(system, results):
 def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps()):
     """FILE_<line>.csv (a single line's table, written by the line's group) for every
     line, FILE_system.csv, the sweeps' FILE_watch_circle.csv, FILE_excursion.csv and
-    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused).
+    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused,
+    and an earlier run's removed).
     Collective on ``comm``."""
     paths = table_paths(table, system, sweeps, results.body_modes is not None)
 
@@ -472,6 +473,8 @@ def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps())
             if isinstance(results.body_modes, SystemModes):
                 line_table._write(paths["system_modes"], paths["system_modes"] + ".partial",
                                   body_modes_table(results.body_modes))
+            elif results.body_modes is not None and os.path.exists(paths["system_modes"]):
+                os.remove(paths["system_modes"])        # an earlier run's: none this time
     on_every_rank(comm, write_all)
 
 

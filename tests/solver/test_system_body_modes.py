@@ -241,3 +241,40 @@ def test_the_lines_mass_lumped_half_at_each_end():
     assert along == pytest.approx(2 * k / (mass * (1 + ca) + w * rest / G), rel=1e-12)
     assert dict(zip(bare.labels, bare.omega2))["mid x"] == pytest.approx(
         2 * k / (mass * (1 + ca)), rel=1e-12)
+
+
+def test_refused_modes_in_the_file_and_no_table(shared_tmp):
+    """small_free_body.dat's body (given an inertia) under a constant yaw moment of
+    200 kN m: its modes refused as complex, in the run's lines and the file's
+    system/modes (the attribute ``refused``, no dataset), and an earlier run's
+    FILE_system_modes.csv removed, no table written."""
+    import dataclasses
+    import os
+
+    import h5py
+
+    from petsc_rod.api import read_moordyn, solve_system
+    from helpers import REPO_ROOT
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    body = dataclasses.replace(system.bodies[0], load=(0.0,) * 5 + (2e5,),
+                               inertia=(1e5, 1e5, 1e5))
+    system = dataclasses.replace(system, bodies=(body,))
+    output, table = (os.path.join(shared_tmp, name) for name in ("refused.h5", "refused.csv"))
+    stale = os.path.join(shared_tmp, "refused_system_modes.csv")
+    if PETSc.COMM_WORLD.getRank() == 0:
+        with open(stale, "w") as f:
+            f.write("an earlier run's\n")
+    PETSc.COMM_WORLD.tompi4py().barrier()
+    said = []
+    results = solve_system(system, output=output, table=table, say=said.append,
+                           options={"system_modes": True})
+    assert isinstance(results.body_modes, SystemModesRefused)
+    refused = results.body_modes
+    assert refused.complex >= 2 and refused.complex % 2 == 0 and refused.negative == 0
+    assert any(line.startswith("system modes: refused: the system's equilibrium is "
+                               f"unstable ({refused.complex} complex") for line in said)
+    assert not os.path.exists(stale)
+    with h5py.File(output, "r") as f:
+        group = f["system/modes"]
+        assert "complex eigenvalues" in group.attrs["refused"] and len(group) == 0
