@@ -455,5 +455,12 @@ def test_the_system_modes_in_the_lines_the_file_and_the_table(tmp_path):
         assert len(frequencies) == 6 and np.all(np.diff(frequencies) >= 0)
         found[ranks] = frequencies
     assert np.allclose(found[1], found[2], rtol=1e-9)
+    page = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(tmp_path / "r1" / "system.h5"), "-o",
+                                              str(page)])
+    assert process.returncode == 0, describe(process)
+    text = page.read_text(encoding="utf-8")
+    assert "Natural modes of the bodies and free points" in text and 'id="modes"' in text
+    assert f"{1 / found[1][0]:.4g}"[:4] in text             # the first period, in s
     assert "-rod_system_modes" in refused(tmp_path, ["-options_file", "options/cantilever.opts",
                                                      "-rod_system_modes", "1"])
