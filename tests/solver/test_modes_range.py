@@ -60,6 +60,7 @@ def test_a_bad_band_is_refused_in_one_line(text, capsys):
     if PETSc.COMM_WORLD.getRank() == 0:
         lines = [line for line in out.splitlines() if "error" in line]
         assert len(lines) == 1 and "-rod_modes_range" in lines[0] and "step 1" not in out
+        assert "expected FMIN,FMAX" in lines[0]
 
 
 def test_a_band_beside_a_count_is_refused(capsys):
