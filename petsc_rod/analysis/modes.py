@@ -371,8 +371,9 @@ def _modes(operators, eps, count, shift=SHIFT, window=(SHIFT, np.inf)):
     """The lowest ``count`` converged eigenpairs of ``eps`` (its operator K - shift M)
     in ``window`` (omega^2 from, to) as Modes. An eigenvalue below SHIFT is one of the
     massless unknowns' infinite ones that the spectral transformation returned with the
-    wrong sign (the inertia proved there is none): left out. The shapes are taken all at once (_shapes): their reductions over the ranks
-    are one per quantity, not one per mode."""
+    wrong sign (the inertia proved there is none): left out. The shapes are taken all
+    at once (_shapes): their reductions over the ranks are one per quantity, not one
+    per mode."""
     converged = eps.getConverged()
     values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + shift
     finite = np.flatnonzero((values >= window[0]) & (values <= window[1]))

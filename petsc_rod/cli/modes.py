@@ -158,10 +158,14 @@ def write_tables(comm, modes, path, say):
     error = None
     if mpi.Get_rank() == 0:
         vertices = np.concatenate(pieces, axis=1)
-        curvature = vertex_curvature(vertices[0, :, 1],
-                                     np.concatenate([m[0] for m in middles]),
-                                     np.concatenate([m[1] for m in middles], axis=1))
-        rows = np.concatenate([vertices, curvature], axis=2).reshape(-1, len(SHAPE_COLUMNS))
+        # a band without modes (-rod_modes_range): the tables' headers alone
+        rows = np.zeros((0, len(SHAPE_COLUMNS)))
+        if count:
+            curvature = vertex_curvature(vertices[0, :, 1],
+                                         np.concatenate([m[0] for m in middles]),
+                                         np.concatenate([m[1] for m in middles], axis=1))
+            rows = np.concatenate([vertices, curvature], axis=2).reshape(-1,
+                                                                         len(SHAPE_COLUMNS))
         partial = [f"{name}.{os.getpid()}.partial" for name in (path, shapes_path(path))]
         try:
             with open(partial[0], "w") as table:

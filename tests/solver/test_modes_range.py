@@ -92,3 +92,23 @@ def test_the_api_and_the_command_line_take_a_band(tmp_path):
     assert run_cli({f"rod_{name}": str(value) for name, value in given.items()}) == 0
     assert np.allclose(modes.frequencies, np.loadtxt(path, delimiter=",", skiprows=1,
                                                      usecols=1), rtol=1e-9)
+
+
+def test_a_band_without_modes_writes_the_tables_headers(shared_tmp, capsys):
+    """A band above every mode of the 8-element string (1000-1001 Hz): the run
+    converges, says the inertia counts 0, and -rod_modes_table writes both tables'
+    header lines alone (no row), the result file's group with zero modes."""
+    import h5py
+    import os
+    path, output = (os.path.join(shared_tmp, name) for name in ("empty.csv", "empty.h5"))
+    given = {"length": 1, "modes_mass": 1, "modes_range": "1000,1001", "elements": 8,
+             "modes_table": path, "output": output}
+    assert run_cli({f"rod_{name}": str(value) for name, value in given.items()}) == 0
+    out = capsys.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        assert "modes: 0 in 1000-1001 Hz (the inertia counts 0)" in out
+        for name in (path, path.replace(".csv", "_shapes.csv")):
+            with open(name) as table:
+                assert len(table.read().splitlines()) == 1
+        with h5py.File(output, "r") as f:
+            assert f["modes/frequency"].shape == (0,)
