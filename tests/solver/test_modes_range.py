@@ -112,3 +112,4 @@ def test_a_band_without_modes_writes_the_tables_headers(shared_tmp, capsys):
                 assert len(table.read().splitlines()) == 1
         with h5py.File(output, "r") as f:
             assert f["modes/frequency"].shape == (0,)
+            assert list(f["modes"].attrs["band"]) == [1000.0, 1001.0, 0.0]
