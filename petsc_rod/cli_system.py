@@ -7,8 +7,9 @@ written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
--rod_system_excursion), the outputs (-rod_output, -rod_table), the
-modes of each line with its ends held (-rod_modes N, -rod_modes_added_mass,
+-rod_system_excursion, -rod_system_modes, -rod_system_modes_line_mass), the outputs
+(-rod_output, -rod_table), the
+modes of each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
 -rod_max_halvings: every line the same); every other
 -rod_* option describes a single line's scene or load path, which the file gives, and is
@@ -22,8 +23,8 @@ import sys
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, modes_request, run_system,
-                                     written_paths)
+from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, body_modes_request,
+                                     modes_request, run_system, written_paths)
 from petsc_rod.api.system_sweeps import parse_sweeps
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
@@ -34,12 +35,14 @@ from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
+from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
 from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
                   "rod_system_steps", "rod_system_watch_circle", "rod_system_excursion",
+                  "rod_system_modes", "rod_system_modes_line_mass",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 
 
@@ -75,13 +78,14 @@ def body_loads(text, system):
     return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
 
 
-def check_outputs_kept(values, comm, system, sweeps):
+def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
     """Refuse an output that names an input (the system file, an options file), which
     writing it would replace: every file the run writes (written_paths: the result file,
     the lines', the system's and the sweeps' tables). Collective: rank 0 decides."""
     clash = None
     if comm.getRank() == 0:
-        written = written_paths(system, values["rod_output"], values["rod_table"], sweeps)
+        written = written_paths(system, values["rod_output"], values["rod_table"], sweeps,
+                                body_modes is not None)
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
         read.append(("-rod_system", values["rod_system"]))
         clash = replaced_input(written, read)
@@ -92,7 +96,8 @@ def check_outputs_kept(values, comm, system, sweeps):
 
 def prepared(values, given):
     """(System, notes, the file's text, Settings, the lines' options, the Sweeps, the
-    modes' request: api/system_run.modes_request) of the run's option ``values``;
+    modes' request: api/system_run.modes_request, the system's modes' request:
+    body_modes_request) of the run's option ``values``;
     RodInputError for what a system cannot take."""
     refused = refused_options(given)
     if refused:
@@ -113,7 +118,11 @@ def prepared(values, given):
                           values["rod_system_excursion"], system)
     modes = modes_request({name.removeprefix("rod_"): texts[name] for name in given
                            if name.removeprefix("rod_") in MODES_OPTIONS})
-    return system, notes, read_text(path, "-rod_system"), settings, options, sweeps, modes
+    body_modes = body_modes_request({"system_modes": values["rod_system_modes"],
+                                     "system_modes_line_mass":
+                                         values["rod_system_modes_line_mass"]})
+    return (system, notes, read_text(path, "-rod_system"), settings, options, sweeps, modes,
+            body_modes)
 
 
 def run(comm=None):
@@ -134,22 +143,24 @@ def run(comm=None):
             if database.hasName("help"):
                 for line in help_text():
                     say(line)
-            system, notes, text, settings, options, sweeps, modes = on_every_rank(
+            system, notes, text, settings, options, sweeps, modes, body_modes = on_every_rank(
                 comm, prepared, values, given)
-            check_outputs_kept(values, comm, system, sweeps)
+            check_outputs_kept(values, comm, system, sweeps, body_modes)
             if database.hasName("help"):
                 return 0
             for note in notes:
                 say(f"petsc_rod: note: {note}")
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
-                                 text, notes, interrupts, sweeps, modes)
+                                 text, notes, interrupts, sweeps, modes, body_modes)
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)
                 written.append("tables " + ", ".join(
                     f"{stem}_{name}{extension or '.csv'}"
-                    for name in ["<line>", "system", *results.sweeps]))
+                    for name in ["<line>", "system", *results.sweeps,
+                                 *(["system_modes"] if isinstance(results.body_modes,
+                                                                  SystemModes) else [])]))
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"
                 + (f"; {'; '.join(written)}" if written else ""))

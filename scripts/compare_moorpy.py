@@ -13,6 +13,14 @@ prints its numbers as JSON. The deck's coupled fairleads go on one body held at 
 there); MoorPy's stiffness is its analytical one (Body.getStiffnessA, lines only), with
 the water depth (320 m), density and gravity petsc_rod reads or takes. Prints a
 markdown table.
+
+    python scripts/compare_moorpy.py --modes [deck] [element_length]
+
+the spar's natural periods on its moorings (docs/modes.md, "The coupled system's
+modes"): the spar free, with the OC3 definition's mass properties and a strip-theory
+added mass (validation/oc3_hywind.free_spar), petsc_rod's system modes
+(system/body_modes.py) against the same eigenproblem with MoorPy's mooring stiffness
+(the same mass and hydrostatics) and the published periods.
 """
 
 import json
@@ -25,9 +33,11 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.model.moordyn import read_moordyn
-from petsc_rod.system.equilibrium import solve_system
+from petsc_rod.system.body_modes import rigid_mass, system_modes
+from petsc_rod.system.equilibrium import SystemSolver, solve_system
 from petsc_rod.system.held_line import held_lines
-from petsc_rod.validation.oc3_hywind import catenaries, spar
+from petsc_rod.validation.oc3_hywind import (GRAVITY_DEPTH, PUBLISHED_FREQUENCIES, catenaries,
+                                             free_spar, spar, spar_inertia)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DECK = os.path.join(HERE, os.pardir, "tests", "data", "moordyn", "OC3Hywind_MoorDyn.dat")
@@ -78,6 +88,52 @@ def moorpy(deck, sea):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def periods(K, M):
+    """Sorted natural periods (s) of K x = omega^2 M x and each mode's largest-share
+    degree of freedom (M's diagonal)."""
+    values, vectors = np.linalg.eig(np.linalg.solve(M, K))
+    order = np.argsort(values.real)
+    shares = vectors.real[:, order] ** 2 * np.diag(M)[:, None]
+    return 2 * np.pi / np.sqrt(values.real[order]), np.argmax(shares, axis=0)
+
+
+def compare_modes(deck=DECK, element_length=1.0):
+    say = PETSc.Sys.Print
+    system, _ = read_moordyn(deck, element_length=element_length)
+    free = free_spar(system)
+    clock = time.perf_counter()
+    solver = SystemSolver(free, held_lines(free))
+    try:
+        solver.solve()
+        modes = system_modes(solver)
+        own = -solver.own_part(solver.state, solver.loads)[1]
+    finally:
+        solver.destroy()
+    seconds = time.perf_counter() - clock
+    theirs = moorpy(deck, system.environment)
+    body = free.bodies[0]
+    M = rigid_mass(body.mass, body.cog, np.reshape(body.inertia, (3, 3)),
+                   np.reshape(body.added_mass, (6, 6)), np.eye(3))
+    T_mp, dof_mp = periods(np.array(theirs["K"]) + own, M)
+    names = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+    mass, z, inertia = spar_inertia()
+    say(f"OC3-Hywind free on {deck} ({element_length:g} m elements, {seconds:.1f} s): "
+        f"mass {body.mass:.6g} kg (the definition's {mass:.6g}), cog {-GRAVITY_DEPTH} m "
+        f"(the parts' {z:.2f} m), I_pitch {inertia[0, 0]:.4g} kg m^2 about it, strip "
+        f"theory's A11 {body.added_mass[0]:.4g} kg, A33 {body.added_mass[14]:.4g} kg, "
+        f"A55 {body.added_mass[28]:.4g} kg m^2, A15 {body.added_mass[4]:.4g} kg m\n")
+    say("| mode | petsc_rod T (s) | MoorPy's K, T (s) | published T (s) | petsc_rod / MoorPy - 1 |")
+    say("|---|---|---|---|---|")
+    dof = [names[["x", "y", "z", "roll", "pitch", "yaw"].index(label.split()[1])]
+           for label in modes.labels]
+    for k, (T, name) in enumerate(zip(modes.periods, dof)):
+        j = [i for i in range(6) if names[dof_mp[i]] == name]
+        other = T_mp[j[0]] if j else np.nan
+        published = PUBLISHED_FREQUENCIES.get(name)
+        shown = f"{1 / published:.1f}" if published else ""
+        say(f"| {k + 1} {name} | {T:.2f} | {other:.2f} | {shown} | {T / other - 1:.1e} |")
+
+
 def main(deck=DECK, element_length=1.0):
     say = PETSc.Sys.Print
     system, _ = read_moordyn(deck, element_length=element_length)
@@ -112,5 +168,7 @@ def main(deck=DECK, element_length=1.0):
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:2], **({"element_length": float(sys.argv[2])} if len(sys.argv) > 2
-                            else {}))
+    arguments = [a for a in sys.argv[1:] if a != "--modes"]
+    run = compare_modes if "--modes" in sys.argv[1:] else main
+    run(*arguments[:1], **({"element_length": float(arguments[1])} if len(arguments) > 1
+                           else {}))

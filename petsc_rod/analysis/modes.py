@@ -92,6 +92,8 @@ class Modes:
     curvature: np.ndarray
     converged: int = 0
     labels: list = field(default_factory=list)
+    # a band's (fmin, fmax, the count of its modes by the inertia), Hz; None: the lowest
+    band: tuple = None
 
     @property
     def frequencies(self):
@@ -261,20 +263,36 @@ def check_options(comm):
         eps.destroy()
 
 
-def solve_modes(problem, count, settings=MassSettings()):
+def solve_modes(problem, count, settings=MassSettings(), band=None):
     """The ``count`` lowest modes (Modes) of the problem's converged state, or
-    ModesRefused where the state is unstable. Collective."""
+    ModesRefused where the state is unstable. With ``band`` (fmin, fmax), Hz, every
+    mode in it instead (``count`` unused): the inertia of K - sigma M at both ends
+    counts them (Sylvester: the eigenvalues below sigma), and the eigensolver, shifted
+    to the band's middle omega^2, finds that many nearest to it, which are the band's
+    (every other eigenvalue is farther from the middle). Collective."""
     from slepc4py import SLEPc
-    if count < 1:
+    if band is None and count < 1:
         raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
     STAGE.push()
     try:
-        return _solve_modes(problem, count, settings, SLEPc)
+        return _solve_modes(problem, count, settings, SLEPc, band)
     finally:
         STAGE.pop()
 
 
-def _solve_modes(problem, count, settings, SLEPc):
+def band_shifts(band):
+    """(sigma_low, sigma_high), rad^2/s^2, of a band (fmin, fmax), Hz: (2 pi f)^2, and
+    SHIFT for fmin = 0 (a free rigid mode at omega = 0 counts in the band)."""
+    return tuple((2 * np.pi * f) ** 2 if f > 0 else SHIFT for f in band)
+
+
+def _shift_to(shifted, K, M, sigma):
+    """shifted = K - sigma M, on K's pattern."""
+    K.copy(shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+    shifted.axpy(-sigma, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+
+
+def _solve_modes(problem, count, settings, SLEPc, band=None):
     """solve_modes in its -log_view stage."""
     # what was made, destroyed in reverse order however far the set-up got
     made = []
@@ -299,6 +317,22 @@ def _solve_modes(problem, count, settings, SLEPc):
             negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
             raise ModesRefused(int(negative))
+        shift, window = SHIFT, (SHIFT, np.inf)
+        if band is not None:
+            window = band_shifts(band)
+            below = []
+            for sigma in window:
+                with EVENTS["factor"]:
+                    _shift_to(shifted, K, M, sigma)
+                    factor.set_up(shifted)
+                    below.append(factor.negative_pivots() - operators.chain_constraints)
+            count = int(below[1] - below[0])
+            if count == 0:
+                return _empty_modes(problem.mesh, band)
+            shift = 0.5 * (window[0] + window[1])
+            with EVENTS["factor"]:
+                _shift_to(shifted, K, M, shift)
+                factor.set_up(shifted)
         eps.setOperators(shifted, M)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
         eps.setDimensions(count, count + max(SUBSPACE, count // 2))
@@ -315,21 +349,34 @@ def _solve_modes(problem, count, settings, SLEPc):
         with EVENTS["eps"]:
             eps.solve()
         with EVENTS["shapes"]:
-            return _modes(operators, eps, count)
+            modes = _modes(operators, eps, count, shift, window)
+        if band is not None:
+            modes.band = (band[0], band[1], count)
+        return modes
     finally:
         for thing in reversed(made):
             thing.destroy()
 
 
-def _modes(operators, eps, count):
-    """The lowest ``count`` converged eigenpairs of ``eps`` as Modes. An eigenvalue below
-    the shift is one of the massless unknowns' infinite ones that the spectral
-    transformation returned with the wrong sign (the inertia proved there is none): left
-    out. The shapes are taken all at once (_shapes): their reductions over the ranks
-    are one per quantity, not one per mode."""
+def _empty_modes(mesh, band):
+    """The Modes of a band without any (band[2] = 0)."""
+    n_v, n_e = len(mesh.vertex_S), mesh.n_local_elements
+    return Modes(np.zeros(0), np.zeros(0), np.zeros((0, len(CLASSES))), mesh.vertex_S,
+                 np.zeros((0, n_v, 3)), np.zeros((0, n_v, 3)),
+                 mesh.element_S + mesh.element_h / 2, np.zeros((0, n_e, 3)), 0, [],
+                 (band[0], band[1], 0))
+
+
+def _modes(operators, eps, count, shift=SHIFT, window=(SHIFT, np.inf)):
+    """The lowest ``count`` converged eigenpairs of ``eps`` (its operator K - shift M)
+    in ``window`` (omega^2 from, to) as Modes. An eigenvalue below SHIFT is one of the
+    massless unknowns' infinite ones that the spectral transformation returned with the
+    wrong sign (the inertia proved there is none): left out. The shapes are taken all
+    at once (_shapes): their reductions over the ranks are one per quantity, not one
+    per mode."""
     converged = eps.getConverged()
-    values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + SHIFT
-    finite = np.flatnonzero(values >= SHIFT)
+    values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + shift
+    finite = np.flatnonzero((values >= window[0]) & (values <= window[1]))
     order = finite[np.argsort(values[finite])][:count]
     vector = operators.mass_matrix.createVecRight()
     product = vector.duplicate()

@@ -16,7 +16,7 @@ from petsc_rod.analysis.mass import MassSettings
 from petsc_rod.analysis.modes import ModesRefused, solve_modes
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
-from petsc_rod.cli.modes import table_lines
+from petsc_rod.cli.modes import modes_band, table_lines
 from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
@@ -25,15 +25,19 @@ from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
 from petsc_rod.quantities import riser_numbers
+from petsc_rod.system.body_modes import SystemModes, SystemModesRefused, system_modes
+from petsc_rod.system.body_modes import table_lines as body_modes_lines
 from petsc_rod.system.equilibrium import Settings, SystemSolver
 from petsc_rod.system.held_line import held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
-# step is 1 / system_steps of the bodies' loads (Settings.load_steps).
-SYSTEM_OPTIONS = ("system_steps",)
+# step is 1 / system_steps of the bodies' loads (Settings.load_steps); the modes of the
+# bodies and free points (system/body_modes.py), the lines' mass lumped at their ends.
+SYSTEM_OPTIONS = ("system_steps", "system_modes", "system_modes_line_mass")
 # The modes of each line with its ends held (docs/modes.md): their count and the mass's
 # settings (every line the same), the option names without ``rod_`` and MassSettings'.
-MODES_OPTIONS = {"modes": None, "modes_added_mass": "added_mass", "modes_mass": "mass",
+MODES_OPTIONS = {"modes": None, "modes_range": None, "modes_added_mass": "added_mass",
+                 "modes_mass": "mass",
                  "modes_inertia": "inertia"}
 # The options of a line that a system's lines take (every line the same): the
 # iteration's tolerances and switches (-rod_al_*), the halvings of a line's walk.
@@ -75,7 +79,9 @@ class SystemResults:
     'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}; with
     modes asked, ``modes`` {line: analysis/modes.Modes or ModesRefused}, each line's
     modes about its equilibrium in the system with its ends held (line_modes: the numbers per mode on every rank, the
-    shapes along the line on its group's ranks, zero rows on the others)."""
+    shapes along the line on its group's ranks, zero rows on the others); with the
+    system's modes asked, ``body_modes`` (system/body_modes.SystemModes of the bodies
+    and free points, or SystemModesRefused), else None."""
 
     points: dict
     bodies: dict
@@ -90,24 +96,46 @@ class SystemResults:
     load_factor: float
     sweeps: dict = None
     modes: dict = field(default_factory=dict)
+    body_modes: object = None
+
+
+def body_modes_request(options):
+    """{'line_mass': bool} of the system's modes ``options`` asks for ('system_modes',
+    'system_modes_line_mass'), None without 'system_modes'; the two taken out of
+    ``options``."""
+    asked, lumped = (options.pop(name, False) for name in ("system_modes",
+                                                           "system_modes_line_mass"))
+    for name, value in (("system_modes", asked), ("system_modes_line_mass", lumped)):
+        if not isinstance(value, (bool, np.bool_, int, np.integer)) or value not in (0, 1):
+            raise RodInputError(f"{name} {value!r}: True or False")
+    if lumped and not asked:
+        raise RodInputError("system_modes_line_mass needs system_modes (the system's "
+                            "modes it lumps the lines' mass for)")
+    return {"line_mass": bool(lumped)} if asked else None
 
 
 def modes_request(options):
-    """(count, MassSettings) of the modes ``options`` {name without ``rod_``: value}
-    asks for (MODES_OPTIONS, parsed as the command line's -rod_modes*), None without
-    ``modes``; the options taken out of ``options``."""
+    """(count, MassSettings, band) of the modes ``options`` {name without ``rod_``:
+    value} asks for (MODES_OPTIONS, parsed as the command line's -rod_modes*: the
+    ``modes`` lowest, or every mode in the band ``modes_range`` 'FMIN,FMAX' Hz, band
+    then (fmin, fmax), else None), None without either; the options taken out of
+    ``options``."""
     texts = {name: options.pop(name) for name in list(options) if name in MODES_OPTIONS}
     values, _ = values_of(texts)
-    if not values["rod_modes"]:
+    band = modes_band(values["rod_modes_range"])
+    if values["rod_modes"] and band is not None:
+        raise RodInputError("modes and modes_range: give one (the N lowest modes, or "
+                            "every mode in a band)")
+    if not values["rod_modes"] and band is None:
         return None
     return values["rod_modes"], MassSettings(
-        **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key})
+        **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key}), band
 
 
 def split_options(options):
-    """(system Settings, the lines' options, the modes' request (modes_request)) of
-    ``options`` {name without ``rod_``: value}; RodInputError naming one that none
-    takes."""
+    """(system Settings, the lines' options, the modes' request (modes_request), the
+    system's modes' request (body_modes_request)) of ``options`` {name without
+    ``rod_``: value}; RodInputError naming one that none takes."""
     options = dict(options or {})
     taken = SYSTEM_OPTIONS + LINE_OPTIONS + tuple(MODES_OPTIONS)
     unknown = sorted(set(options) - set(taken))
@@ -115,18 +143,20 @@ def split_options(options):
         raise RodInputError(f"system option {unknown[0]!r}: not an option of a system; "
                             f"its options: {', '.join(taken)}")
     modes = modes_request(options)
+    body_modes = body_modes_request(options)
     steps = options.pop("system_steps", Settings().load_steps)
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise RodInputError(f"system_steps {steps!r}: a whole number of at least 1 (the "
                             "load continuation's first step is 1 / system_steps of the "
                             "loads)")
     values_of(options)                      # a malformed value refused before any work
-    return Settings(load_steps=int(steps)), options, modes
+    return Settings(load_steps=int(steps)), options, modes, body_modes
 
 
-def line_modes(solver, count, settings):
+def line_modes(solver, count, settings, band=None):
     """({line index: Modes or ModesRefused}, {line index: seconds}) on every rank: each
-    line's ``count`` lowest modes about its equilibrium with its ends held
+    line's ``count`` lowest modes (every mode in ``band``, Hz, where given) about its
+    equilibrium with its ends held
     (analysis/modes.solve_modes on the HeldLine's problem, collective on its group's
     communicator: its ends are pinned there, so its modes are the held line's), the
     shapes on the line's own ranks, zero rows of them on the others. Collective."""
@@ -134,7 +164,7 @@ def line_modes(solver, count, settings):
     for k, line in solver.lines.items():
         start = time.perf_counter()
         try:
-            mine[k] = solve_modes(line.problem, count, settings)
+            mine[k] = solve_modes(line.problem, count, settings, band)
         except ModesRefused as refused:
             mine[k] = refused
         seconds[k] = line.mesh.global_max(time.perf_counter() - start)
@@ -254,24 +284,26 @@ def check_finite(comm, results, records):
                                "inf); nothing is written")
 
 
-def table_paths(table, system, sweeps=Sweeps()):
-    """{line name, 'system' or a sweep's name: CSV path} of ``table`` (FILE.csv ->
-    FILE_<line>.csv, FILE_system.csv, FILE_watch_circle.csv and FILE_excursion.csv
-    where ``sweeps`` asks for them)."""
+def table_paths(table, system, sweeps=Sweeps(), body_modes=False):
+    """{line name, 'system', a sweep's name or 'system_modes': CSV path} of ``table``
+    (FILE.csv -> FILE_<line>.csv, FILE_system.csv, FILE_watch_circle.csv and
+    FILE_excursion.csv where ``sweeps`` asks for them, FILE_system_modes.csv where
+    ``body_modes``)."""
     stem, extension = os.path.splitext(table)
     names = [line.name for line in system.lines] + ["system"] + [
         name for name in ("watch_circle", "excursion") if getattr(sweeps, name) is not None]
+    names += ["system_modes"] if body_modes else []
     return {name: f"{stem}_{name}{extension or '.csv'}" for name in names}
 
 
-def written_paths(system, output, table, sweeps=Sweeps()):
+def written_paths(system, output, table, sweeps=Sweeps(), body_modes=False):
     """[(what names it, path)] of every file the run writes: the result file, each
     line's table with its regions' and ends' tables, the system's and the sweeps'
     tables; what a check that no output replaces an input compares."""
     written = [("-rod_output", output)] if output else []
     if table:
         lines = {line.name for line in system.lines}
-        for name, path in table_paths(table, system, sweeps).items():
+        for name, path in table_paths(table, system, sweeps, body_modes).items():
             written.append((f"-rod_table {table}'s table", path))
             if name in lines:
                 written += [(f"-rod_table {table}'s table", line_table.regions_path(path)),
@@ -279,13 +311,13 @@ def written_paths(system, output, table, sweeps=Sweeps()):
     return written
 
 
-def check_outputs(comm, system, output, table, sweeps=Sweeps()):
+def check_outputs(comm, system, output, table, sweeps=Sweeps(), body_modes=False):
     """Refuse, before any work, a result file or a table that could not be written
     (io/results.check_output_path, line_table.check_table_path). Collective."""
     if output:
         io.check_output_path(output, comm)
     if table:
-        for path in table_paths(table, system, sweeps).values():
+        for path in table_paths(table, system, sweeps, body_modes).values():
             line_table.check_table_path(path, output, comm)
 
 
@@ -360,8 +392,51 @@ def write_file(comm, output, system, results, records, text, notes, failures):
                   "point_kinds": "text", "line_starts": "text", "line_ends": "text",
                   "seabed": "m", "surface": "m"})
     groups = {name: file_group(found) for name, found in results.sweeps.items()}
+    if results.body_modes is not None:
+        groups["modes"] = body_modes_group(results.body_modes)
     writer.finish_system(data, attributes, units, groups)
     failures.writer = None
+
+
+def body_modes_group(found):
+    """(datasets, attributes, units) of the result file's group ``system/modes``: the
+    system's modes (system/body_modes.SystemModes), or the reason there are none."""
+    if isinstance(found, SystemModesRefused):
+        return {}, {"refused": str(found)}, {"refused": "text"}
+    data = {"frequencies": found.frequencies, "periods": found.periods,
+            "omega2": found.omega2, "modal_mass": found.modal_mass,
+            "shapes": found.shapes, "shares": found.shares,
+            "stiffness": found.stiffness, "mass": found.mass}
+    attributes = {"dofs": ",".join(f"{n} {d}" for n, d in found.dofs),
+                  "labels": ",".join(found.labels),
+                  "condensed": found.condensed,
+                  "line_mass": int(found.line_mass), "imaginary": found.imaginary,
+                  "lines": "quasi-static: their static stiffness at the equilibrium"}
+    units = {"frequencies": "Hz", "periods": "s", "omega2": "rad^2/s^2",
+             "modal_mass": "kg (kg m^2 where the dominant unknown is a rotation)",
+             "shapes": "m, rad (per unit dominant unknown; columns: dofs)",
+             "shares": "1", "stiffness": "N/m, N, N m/rad (rows and columns: dofs)",
+             "mass": "kg, kg m, kg m^2 (rows and columns: dofs)", "dofs": "text",
+             "labels": "text", "condensed": "1", "line_mass": "1", "imaginary": "1",
+             "lines": "text"}
+    return data, attributes, units
+
+
+def body_modes_table(found):
+    """The text of FILE_system_modes.csv: a row per mode, its frequency, period,
+    omega, modal mass, dominant unknown, then its shares and its shape per unknown."""
+    columns = [f"{n}_{d}" for n, d in found.dofs]
+    rows = [",".join(["mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass",
+                      "dominant"] + [f"share_{c}" for c in columns]
+                     + [f"shape_{c}" for c in columns])]
+    for k in range(len(found.omega2)):
+        rows.append(",".join(
+            [str(k + 1)] + [f"{v:.10g}" for v in (found.frequencies[k], found.periods[k],
+                                                   np.sqrt(found.omega2[k]),
+                                                   found.modal_mass[k])]
+            + [found.labels[k].replace(" ", "_")]
+            + [f"{v:.6f}" for v in found.shares[k]] + [f"{v:.10g}" for v in found.shapes[k]]))
+    return "\n".join(rows) + "\n"
 
 
 def ends_rows(system, results):
@@ -378,9 +453,11 @@ def ends_rows(system, results):
 
 def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps()):
     """FILE_<line>.csv (a single line's table, written by the line's group) for every
-    line, FILE_system.csv and the sweeps' FILE_watch_circle.csv, FILE_excursion.csv
-    (rank 0). Collective on ``comm``."""
-    paths = table_paths(table, system, sweeps)
+    line, FILE_system.csv, the sweeps' FILE_watch_circle.csv, FILE_excursion.csv and
+    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused,
+    and an earlier run's removed).
+    Collective on ``comm``."""
+    paths = table_paths(table, system, sweeps, results.body_modes is not None)
 
     def write_all():
         for k, line in solver.lines.items():
@@ -393,6 +470,11 @@ def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps())
             line_table._write(paths["system"], partial, ends_rows(system, results))
             for name, found in results.sweeps.items():
                 line_table._write(paths[name], paths[name] + ".partial", table_text(found))
+            if isinstance(results.body_modes, SystemModes):
+                line_table._write(paths["system_modes"], paths["system_modes"] + ".partial",
+                                  body_modes_table(results.body_modes))
+            elif results.body_modes is not None and os.path.exists(paths["system_modes"]):
+                os.remove(paths["system_modes"])        # an earlier run's: none this time
     on_every_rank(comm, write_all)
 
 
@@ -432,11 +514,11 @@ def report_lines(system, results, ranks):
     return lines
 
 
-def discard_tables(comm, table, system, say, sweeps=Sweeps()):
+def discard_tables(comm, table, system, say, sweeps=Sweeps(), body_modes=False):
     """After a system that found no equilibrium: no table is written, and the tables an
     earlier run left at ``table``'s paths are removed (line_table.discard), said in one
     line. Collective."""
-    paths = table_paths(table, system, sweeps).values()
+    paths = table_paths(table, system, sweeps, body_modes).values()
     found = [path for path in paths if os.path.exists(path)]
     for path in paths:
         line_table.discard(path, comm, lambda line: None)
@@ -445,11 +527,14 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps()):
 
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
-               text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None):
+               text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None,
+               body_modes=None):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
     line's modes with its ends held where ``modes`` (count, MassSettings) asks for
-    them (line_modes), the result file and the tables when asked; the lines destroyed. ``interrupts``
+    them (line_modes), the bodies' and free points' modes where ``body_modes``
+    ({'line_mass': bool}) asks for them (system/body_modes.system_modes), the result
+    file and the tables when asked; the lines destroyed. ``interrupts``
     (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
     ends the run before anything is written (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
@@ -460,7 +545,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
-    check_outputs(comm, system, output, table, sweeps)
+    check_outputs(comm, system, output, table, sweeps, body_modes is not None)
     solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
     failures = AgreedFailures(comm)
@@ -469,7 +554,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
         # result file's collective abort and the lines' collective destroy
         with failures:
             return _solved(comm, solver, system, say, output, table, text, notes,
-                           interrupts, sweeps, modes, failures)
+                           interrupts, sweeps, modes, failures, body_modes)
     finally:
         if failures.writer is not None:
             failures.writer.abort()
@@ -477,14 +562,15 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
 
 
 def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps,
-            modes, failures):
+            modes, failures, body_modes=None):
     """run_system's work once its lines are built: the equilibrium, the records, the
-    lines' modes, the sweeps, the file and the tables; SystemResults. Collective."""
+    lines' modes, the system's modes, the sweeps, the file and the tables;
+    SystemResults. Collective."""
     try:
         found = solver.solve()
     except RodDivergedError as error:
         if table:
-            discard_tables(comm, table, system, say, sweeps)
+            discard_tables(comm, table, system, say, sweeps, body_modes is not None)
         # a Newton or a line that did not converge, the halvings spent: the single
         # line's exit 3, but no file (there is no equilibrium to write)
         raise RodNotConvergedError(str(error)) from None
@@ -494,6 +580,13 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
                              "system's equilibrium was found; nothing written",
                              number)
     stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
+    # at the equilibrium, before the sweeps move the solver (numpy: every rank the same)
+    coupled = None
+    if body_modes is not None:
+        try:
+            coupled = system_modes(solver, **body_modes)
+        except SystemModesRefused as refused:
+            coupled = refused
     records = gathered_lines(solver, found.stable)
     mpi = comm.tompi4py()
     lines = {line.name: Results(records[k].vertex, records[k].attributes, True, mpi,
@@ -522,6 +615,11 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
         results.modes = {n: found[k] for k, n in enumerate(names)}
         for line in modes_lines(system, found, seconds):
             say(line)
+    if coupled is not None:
+        results.body_modes = coupled
+        for line in (body_modes_lines(coupled) if isinstance(coupled, SystemModes) else
+                     [f"system modes: refused: {coupled}"]):
+            say(line)
     # after the records: the sweeps' warm re-solves leave the lines at rest again,
     # but the equilibrium's numbers are those found before them
     results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
@@ -546,13 +644,16 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     {'al_rtol': 1e-10}); ``sweeps`` (api/system_sweeps.Sweeps: a watch circle, load-excursion
     curves) run after the equilibrium, in ``SystemResults.sweeps``, the file and the
     tables; the modes of each line with its ends held are asked in ``options``
-    (MODES_OPTIONS: {'modes': 10, 'modes_added_mass': 1.0}). Returns a SystemResults."""
+    (MODES_OPTIONS: {'modes': 10, 'modes_added_mass': 1.0}), the bodies' and free
+    points' modes too ({'system_modes': True, 'system_modes_line_mass': False}:
+    SystemResults.body_modes). Returns a SystemResults."""
     from petsc4py import PETSc
 
     comm = comm or PETSc.COMM_WORLD
     say = say or (lambda line: None)
-    settings, line_options, modes = on_every_rank(comm, split_options, options)
+    settings, line_options, modes, body_modes = on_every_rank(comm, split_options, options)
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,
-                      notes=notes, sweeps=sweeps or Sweeps(), modes=modes)
+                      notes=notes, sweeps=sweeps or Sweeps(), modes=modes,
+                      body_modes=body_modes)

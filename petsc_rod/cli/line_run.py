@@ -37,7 +37,7 @@ from petsc_rod import resources
 from petsc_rod.cli import messages
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value,
                                    parse_values)
-from petsc_rod.cli.modes import check_modes_inputs, report_modes, solve_for_run
+from petsc_rod.cli.modes import check_modes_inputs, modes_asked, report_modes, solve_for_run
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
                                          restart_path, rounded_down, settings_from_options)
 from petsc_rod.cli.session import run_continuation
@@ -311,7 +311,7 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
                 modes.append(solve_for_run(built.problem, values, writer))
             result = built.run(path, say=say, writer=last or writer, options=options,
                                interrupts=interrupts,
-                               before_finish=find_modes if values["rod_modes"] else None)
+                               before_finish=find_modes if modes_asked(values) else None)
             writer = failures.writer = None             # finished
             if result.code == 0:            # the CSV table of the converged result
                 line_table.finish_run(built.problem, values["rod_table"], say)

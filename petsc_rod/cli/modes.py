@@ -28,22 +28,49 @@ def mass_settings(values):
                         mass=values["rod_modes_mass"], inertia=values["rod_modes_inertia"])
 
 
+def modes_band(text):
+    """(fmin, fmax), Hz, of -rod_modes_range ``text`` 'FMIN,FMAX' (None: none);
+    RodInputError unless 0 <= FMIN < FMAX, both finite."""
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        band = tuple(float(part) for part in parts)
+    except ValueError:
+        band = ()
+    if len(band) != 2 or not np.all(np.isfinite(band)) or not 0 <= band[0] < band[1]:
+        raise RodInputError(f"-rod_modes_range {text}: expected FMIN,FMAX, two frequencies "
+                            "in Hz with 0 <= FMIN < FMAX (e.g. 0.05,0.5)")
+    return band
+
+
+def modes_asked(values):
+    """Whether the run asks for modes: -rod_modes N or -rod_modes_range."""
+    return bool(values["rod_modes"] or values["rod_modes_range"])
+
+
 def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
-    -rod_modes_mass, -rod_modes_table without -rod_modes, and a -rod_modes_table (or its
-    shapes' file) that could not be written or names another output. Collective."""
-    if values["rod_modes"] and importlib.util.find_spec("slepc4py") is None:
+    -rod_modes_mass, -rod_modes_range malformed or beside -rod_modes, -rod_modes_table
+    without either, and a -rod_modes_table (or its shapes' file) that could not be
+    written or names another output. Collective."""
+    modes_band(values["rod_modes_range"])
+    if values["rod_modes"] and values["rod_modes_range"]:
+        raise RodInputError("-rod_modes and -rod_modes_range: give one (the N lowest "
+                            "modes, or every mode in a band)")
+    if modes_asked(values) and importlib.util.find_spec("slepc4py") is None:
         raise RodInputError("-rod_modes needs slepc4py, which is not installed: install "
                             "Debian's python3-slepc4py (scripts/setup.sh does)")
-    if values["rod_modes"]:
+    if modes_asked(values):
         try:
             check_options(comm)
         except PETSc.Error as error:
             raise RodInputError(f"SLEPc refused the modes' options: {petsc_message(error)}; "
                                 "check the -rod_modes_eps_* and -rod_modes_st_* options") from None
     path = values["rod_modes_table"]
-    if path and not values["rod_modes"]:
-        raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes)")
+    if path and not modes_asked(values):
+        raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes) "
+                            "or -rod_modes_range FMIN,FMAX")
     if path:
         others = [values["rod_output"], values["rod_table"]]
         for name in (path, shapes_path(path)):
@@ -52,7 +79,7 @@ def check_modes_inputs(values, scene, comm):
                 raise RodInputError(f"-rod_modes_table {path}: it (or its shapes' file "
                                     f"{name}) is another output of the run; name another file")
             check_output_path(name, comm, "-rod_modes_table")
-    if values["rod_modes"] and not mass_known(scene, mass_settings(values)):
+    if modes_asked(values) and not mass_known(scene, mass_settings(values)):
         raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
 
 
@@ -61,7 +88,8 @@ def solve_for_run(problem, values, writer):
     the modes written into the result file where there is one (``writer``). Collective."""
     start = time.perf_counter()
     try:
-        modes = solve_modes(problem, values["rod_modes"], mass_settings(values))
+        modes = solve_modes(problem, values["rod_modes"], mass_settings(values),
+                            modes_band(values["rod_modes_range"]))
     except ModesRefused as refused:
         return refused, problem.mesh.global_max(time.perf_counter() - start)
     seconds = problem.mesh.global_max(time.perf_counter() - start)
@@ -86,7 +114,9 @@ def report_modes(problem, values, found, say):
 def table_lines(modes, seconds):
     """The run's lines of the modes: one per mode, lowest first; ``seconds`` the time
     they took."""
-    lines = [f"modes: {len(modes.omega2)} lowest about the static state in {seconds:.3g} s "
+    which = "lowest" if modes.band is None else \
+        f"in {modes.band[0]:g}-{modes.band[1]:g} Hz (the inertia counts {modes.band[2]})"
+    lines = [f"modes: {len(modes.omega2)} {which} about the static state in {seconds:.3g} s "
              "(undamped, no drag; shares of the kinetic energy in plane / out of plane / "
              "axial / torsional)",
              f"  {'mode':>4} {'f (Hz)':>12} {'T (s)':>12} {'modal mass (kg)':>16}  class"]
@@ -94,6 +124,10 @@ def table_lines(modes, seconds):
             modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
         fractions = " / ".join(f"{share:.2f}" for share in shares)
         lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
+    if modes.band is not None and modes.band[2] != len(modes.omega2):
+        lines.append(f"modes: warning: {len(modes.omega2)} of the band's {modes.band[2]} "
+                     "modes converged: a larger -rod_modes_eps_ncv or -rod_modes_eps_max_it "
+                     "finds the others")
     return lines
 
 
@@ -124,10 +158,14 @@ def write_tables(comm, modes, path, say):
     error = None
     if mpi.Get_rank() == 0:
         vertices = np.concatenate(pieces, axis=1)
-        curvature = vertex_curvature(vertices[0, :, 1],
-                                     np.concatenate([m[0] for m in middles]),
-                                     np.concatenate([m[1] for m in middles], axis=1))
-        rows = np.concatenate([vertices, curvature], axis=2).reshape(-1, len(SHAPE_COLUMNS))
+        # a band without modes (-rod_modes_range): the tables' headers alone
+        rows = np.zeros((0, len(SHAPE_COLUMNS)))
+        if count:
+            curvature = vertex_curvature(vertices[0, :, 1],
+                                         np.concatenate([m[0] for m in middles]),
+                                         np.concatenate([m[1] for m in middles], axis=1))
+            rows = np.concatenate([vertices, curvature], axis=2).reshape(-1,
+                                                                         len(SHAPE_COLUMNS))
         partial = [f"{name}.{os.getpid()}.partial" for name in (path, shapes_path(path))]
         try:
             with open(partial[0], "w") as table:

@@ -318,6 +318,10 @@ OPTIONS = [
            "(undamped: no drag; SLEPc, options -rod_modes_eps_*; docs/modes.md): "
            "frequencies, periods, modal masses and classes in the run's lines; 0 none",
            NON_NEGATIVE),
+    Option("rod_modes_range", _string, None, "FMIN,FMAX",
+           "after the last step, every natural mode with a frequency in [FMIN, FMAX] Hz "
+           "(their number counted by the inertia of K - omega^2 M at both ends; "
+           "docs/modes.md), in place of -rod_modes N", unit="text"),
     Option("rod_modes_table", _string, None, "FILE.csv",
            "write the modes' table (one row per mode) to FILE, and their shapes along "
            "the line (one row per vertex and mode) to FILE's stem + _shapes.csv",
@@ -362,6 +366,15 @@ OPTIONS = [
            "(N) in N steps (default 10) along each heading (deg from +x towards +y, "
            "default 0); in the result file's group system/excursion and the table "
            "FILE_excursion.csv", unit="text"),
+    Option("rod_system_modes", _bool, False, "bool",
+           "with -rod_system: the natural modes of the bodies and free points about the "
+           "equilibrium, K x = omega^2 (M + A) x over their free degrees of freedom "
+           "(the lines quasi-static: their static stiffness; docs/modes.md): periods, "
+           "frequencies, each mode's shares per body and degree of freedom; in the run's "
+           "lines, the group system/modes, the table FILE_system_modes.csv"),
+    Option("rod_system_modes_line_mass", _bool, False, "bool",
+           "with -rod_system_modes: each line's mass in air lumped half at each of its "
+           "ends (default: left out, the lines' dynamics being in their own modes)"),
     Option("rod_al_penalty", _real, None, "R",
            "augmented-Lagrangian penalty R, N; default the largest of 100 sqrt(min(K) "
            "max(K)) / L^2, half the applied force int |f| dS + |end forces|, and 2 M^2 / "

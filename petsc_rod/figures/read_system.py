@@ -19,7 +19,8 @@ def is_system_file(path):
         return "system" in f and "line_names" in f["system"].attrs
 
 
-def _names(text):
+def names_of(text):
+    """The names of a comma-separated text (empty parts dropped)."""
     return [name for name in str(text).split(",") if name]
 
 
@@ -30,7 +31,8 @@ class SystemFile:
     reference (3,), moment (3,), asymmetry}]; ``lines`` [{name, start, end,
     end_tensions (2,), end_forces (2, 3), max_tension, grounded_length (NaN: none),
     stable}]; ``watch_circle``, ``excursion``: the sweep's arrays (``sweep``) or None;
-    ``attributes`` the group ``system``'s."""
+    ``attributes`` the group ``system``'s; ``modes`` the group ``system/modes``'s
+    arrays and attributes (the bodies' and free points' modes), or None."""
 
     path: str
     name: str
@@ -40,6 +42,7 @@ class SystemFile:
     watch_circle: dict
     excursion: dict
     attributes: dict
+    modes: dict = None
 
 
 def sweep(group):
@@ -52,7 +55,7 @@ def sweep(group):
     # watch circle's attribute of the same name
     found["poses"] = np.stack([found[k] for k in POSE], axis=1) if found["heading"].size \
         else np.zeros((0, 6))
-    found["lines"] = _names(group.attrs["line_names"])
+    found["lines"] = names_of(group.attrs["line_names"])
     if "min_grounded" not in found:
         found["min_grounded"] = np.full(found["heading"].shape, np.nan)
     if "offset" in found:                           # the load-excursion curves
@@ -73,16 +76,16 @@ def read_system(path):
     with h5py.File(path, "r") as f:
         system = f["system"]
         attributes = {key: system.attrs[key] for key in system.attrs}
-        names = _names(attributes["line_names"])
-        starts = _names(attributes.get("line_starts", ""))
-        ends = _names(attributes.get("line_ends", ""))
+        names = names_of(attributes["line_names"])
+        starts = names_of(attributes.get("line_starts", ""))
+        ends = names_of(attributes.get("line_ends", ""))
         centrelines = {name: f[f"lines/{name}/r"][()] for name in names}
-        point_names = _names(attributes["point_names"])
-        kinds = _names(attributes.get("point_kinds", "")) or ["fixed"] * len(point_names)
+        point_names = names_of(attributes["point_names"])
+        kinds = names_of(attributes.get("point_kinds", "")) or ["fixed"] * len(point_names)
         points = [(name, kind, position) for name, kind, position
                   in zip(point_names, kinds, system["point_positions"][()])]
         bodies, drawn = [], []
-        for k, name in enumerate(_names(attributes["body_names"])):
+        for k, name in enumerate(names_of(attributes["body_names"])):
             fairleads = [centrelines[line][0] for line, to in zip(names, starts) if to == name]
             fairleads += [centrelines[line][-1] for line, to in zip(names, ends) if to == name]
             position = system["body_positions"][k]
@@ -108,9 +111,12 @@ def read_system(path):
                    "surface": float(attributes.get("surface", 0.0))}
         sweeps = {name: sweep(system[name]) if name in system else None
                   for name in ("watch_circle", "excursion")}
+        modes = ({**{key: group[key][()] for key in group},
+                  **{key: group.attrs[key] for key in group.attrs}}
+                 if (group := system.get("modes")) is not None else None)
     name = os.path.basename(path).removesuffix(".h5")
     return SystemFile(path, name, picture, bodies, lines, sweeps["watch_circle"],
-                      sweeps["excursion"], attributes)
+                      sweeps["excursion"], attributes, modes)
 
 
 def figures(found):

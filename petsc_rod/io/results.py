@@ -358,8 +358,9 @@ class ResultWriter:
         ``shares`` (m, 4) and the attribute ``classes``; along the line, distributed by
         rows as the vertex datasets, ``S`` (n,), ``offset`` m and ``rotation`` rad (n, m,
         3) of the shapes normalised to a largest offset of 1 m, and at the elements'
-        midpoints ``S_mid`` (n_e,) and ``curvature`` (n_e, m, 3) 1/m. ``modes``:
-        analysis/modes.Modes (this rank's rows)."""
+        midpoints ``S_mid`` (n_e,) and ``curvature`` (n_e, m, 3) 1/m; of a band
+        (-rod_modes_range) the attribute ``band`` (fmin, fmax Hz, the inertia's
+        count). ``modes``: analysis/modes.Modes (this rank's rows)."""
         along = {"S": modes.S, "offset": np.moveaxis(modes.offset, 0, 1),
                  "rotation": np.moveaxis(modes.rotation, 0, 1), "S_mid": modes.S_mid,
                  "curvature": np.moveaxis(modes.curvature, 0, 1)}
@@ -390,6 +391,8 @@ class ResultWriter:
                 data[start:start + rows] = local
         group.attrs["classes"] = ",".join(modes.labels)
         group.attrs["share_columns"] = "in-plane,out-of-plane,axial,torsional"
+        if modes.band is not None:
+            group.attrs["band"] = np.asarray(modes.band, dtype=float)
         self.file.flush()
 
     def finish(self, last_group, attributes, name=None):

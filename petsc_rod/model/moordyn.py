@@ -141,8 +141,9 @@ def parse_moordyn(text, path="<MoorDyn text>", element_length=ELEMENT_LENGTH):
         lines=tuple(SystemLine(name, Line([(types[kind], length, count)]), start, end)
                     for name, kind, length, count, start, end in lines),
         points=tuple(Point(name, p["kind"], p["position"], p["mass"], p["volume"],
-                           p["force"], p["cda"]) for name, p in points.items()),
-        bodies=tuple(Body(name, **fields) for name, fields in bodies.items()),
+                           p["force"], p["cda"], p["ca"]) for name, p in points.items()),
+        bodies=tuple(Body(name, **body_fields(fields, sea["rho"]))
+                     for name, fields in bodies.items()),
         environment=environment)
     system.check()
     return system, tuple(notes)
@@ -222,8 +223,10 @@ def moordyn_angles(r0, p0, y0):
 
 def body_rows(rows, path):
     """{'Body<ID>': Body's fields} of the BODIES rows: ID Attachment X0 Y0 Z0 r0 p0 y0
-    (deg) Mass CG* I* Volume CdA* Ca*; the inertia and hydrodynamic coefficients are
-    dynamic and not read. Buoyancy acts at the reference point (MoorDyn's)."""
+    (deg) Mass CG* I* Volume CdA* Ca*: I (one number for all three, or Ix|Iy|Iz, about
+    the cog, body axes) and Ca (one or three numbers) for the system's modes
+    (body_fields); CdA is dynamic and not read. Buoyancy acts at the reference point
+    (MoorDyn's)."""
     bodies = {}
     for line, data in rows:
         where = f"{path}:{line}: BODIES: body {data[0]}"
@@ -236,11 +239,36 @@ def body_rows(rows, path):
                                 f"{', '.join(BODY_HELD)}")
         place = [number(where, c, v) for c, v in zip(("X0", "Y0", "Z0", "r0", "p0", "y0"),
                                                       data[2:8])]
+        inertia = [number(where, "I", v) for v in data[10].split("|")]
+        if len(inertia) not in (1, 3):
+            raise RodInputError(f"{where}: I {data[10]!r}: one number or three, Ix|Iy|Iz")
+        ca = ([number(where, "Ca", v) for v in data[13].split("|")]
+              if len(data) > 13 else [0.0])
+        if len(ca) not in (1, 3):
+            raise RodInputError(f"{where}: Ca {data[13]!r}: one number or three, "
+                                "Ca_x|Ca_y|Ca_z (the translations' added mass Ca rho V)")
         bodies[f"Body{int(number(where, 'ID', data[0]))}"] = dict(
             position=tuple(place[:3]) + moordyn_angles(*np.radians(place[3:])),
             mass=number(where, "Mass", data[8]), cog=triple(where, "CG", data[9]),
-            volume=number(where, "Volume", data[11]), held=held)
+            volume=number(where, "Volume", data[11]), held=held,
+            inertia=np.diag(np.broadcast_to(inertia, 3)).astype(float),
+            ca=np.broadcast_to(ca, 3).astype(float))
     return bodies
+
+
+def body_fields(fields, rho):
+    """A body's Body fields from body_rows' (and add_to_body's): its inertia tensor
+    about the cog (None where zero) and the added mass of MoorDyn's Ca, rho V Ca in the
+    translations at the reference point (where MoorDyn's buoyancy acts; none in the
+    rotations), body axes."""
+    fields = dict(fields)
+    inertia, ca = fields.pop("inertia"), fields.pop("ca")
+    volume = fields.pop("own_volume", fields["volume"])
+    fields["inertia"] = tuple(inertia.ravel().tolist()) if np.any(inertia) else None
+    added = np.zeros((6, 6))
+    added[:3, :3] = np.diag(rho * volume * ca)
+    fields["added_mass"] = tuple(added.ravel().tolist()) if np.any(ca) else None
+    return fields
 
 
 def point_rows(rows, bodies, path):
@@ -273,8 +301,9 @@ def point_rows(rows, bodies, path):
         if kind is None:
             raise RodInputError(f"{where}: attachment {data[1]!r}: use Fixed, Free, "
                                 "Coupled (or Anchor, Connect, Vessel) or Body<N>")
+        ca = number(where, "Ca", data[8]) if len(data) > 8 else 0.0
         points[f"Point{ident}"] = dict(kind=kind, position=(x, y, z), mass=mass,
-                                       volume=volume, force=(0.0, 0.0, 0.0), cda=cda)
+                                       volume=volume, force=(0.0, 0.0, 0.0), cda=cda, ca=ca)
         attached[ident] = Connection(f"Point{ident}")
     return points, attached
 
@@ -287,12 +316,20 @@ def numbered(word, stem):
 
 def add_to_body(body, local, mass, volume):
     """Add a point's ``mass`` (kg) and ``volume`` (m^3) at ``local`` (body axes, m) to a
-    body's fields: the mass at the combined centre of gravity, the volume's buoyancy
-    at the combined centre of buoyancy (the body's own at its reference point)."""
+    body's fields: the mass at the combined centre of gravity, its inertia about it
+    (parallel axes: the body's inertia moved to the new cog, the point's m |d|^2 I -
+    m d d^T), the volume's buoyancy at the combined centre of buoyancy (the body's own
+    at its reference point)."""
+    body.setdefault("own_volume", body["volume"])
     if mass:
         total = body["mass"] + mass
-        body["cog"] = tuple(float(v) for v in (body["mass"] * np.asarray(body["cog"])
-                                               + mass * local) / total)
+        cog = (body["mass"] * np.asarray(body["cog"]) + mass * local) / total
+
+        def moved(m, d):
+            return m * (d @ d * np.eye(3) - np.outer(d, d))
+        body["inertia"] = (body["inertia"] + moved(body["mass"], np.asarray(body["cog"]) - cog)
+                           + moved(mass, local - cog))
+        body["cog"] = tuple(float(v) for v in cog)
         body["mass"] = total
     if volume:
         total = body["volume"] + volume

@@ -40,8 +40,9 @@ class Point:
     """A point of the system, named ``name``: ``kind`` in POINT_KINDS; ``position``
     (3,), m, absolute (a free point's: where its equilibrium is sought from); ``mass``
     (kg) in air and displaced ``volume`` (m^3) (a clump weight, a buoy); ``force`` (3,),
-    N, a constant external force; ``cda`` = C_d A (m^2), its drag area in a current. Its
-    dead force is force + (rho_w volume - mass) g e_z."""
+    N, a constant external force; ``cda`` = C_d A (m^2), its drag area in a current;
+    ``ca`` its added-mass coefficient (the system's modes: added mass ca rho_w volume,
+    kg, in every direction). Its dead force is force + (rho_w volume - mass) g e_z."""
 
     name: str
     kind: str = "fixed"
@@ -50,6 +51,7 @@ class Point:
     volume: float = 0.0
     force: tuple = (0.0, 0.0, 0.0)
     cda: float = 0.0
+    ca: float = 0.0
 
     def __post_init__(self):
         _name("Point.name", self.name)
@@ -58,10 +60,26 @@ class Point:
                                 f"{', '.join(POINT_KINDS)}")
         reals(f"Point {self.name}: position", self.position, (3,))
         reals(f"Point {self.name}: force", self.force, (3,))
-        for name in ("mass", "volume", "cda"):
+        for name in ("mass", "volume", "cda", "ca"):
             if real(f"Point {self.name}: {name}", getattr(self, name)) < 0:
                 raise RodInputError(f"Point {self.name}: {name} {getattr(self, name)!r}: "
                                     "must not be negative")
+
+
+def check_inertia(owner, inertia, added_mass):
+    """Refuse an inertia (3 or 9 numbers) or an added mass (36) that is not symmetric
+    and positive semi-definite: a mass matrix is."""
+    for name, value, sizes in (("inertia", inertia, (3, 9)), ("added_mass", added_mass,
+                                                               (36,))):
+        if value is None:
+            continue
+        array = reals(f"{owner} {name}", value, sizes)
+        matrix = np.diag(array) if array.size == 3 else array.reshape(round(array.size**0.5), -1)
+        scale = max(float(np.abs(matrix).max()), np.finfo(float).tiny)
+        if (np.abs(matrix - matrix.T).max() > 1e-9 * scale
+                or np.linalg.eigvalsh(matrix).min() < -1e-9 * scale):
+            raise RodInputError(f"{owner} {name} {value!r}: a mass matrix is symmetric "
+                                "and has no negative eigenvalue")
 
 
 @dataclass(frozen=True)
@@ -76,7 +94,12 @@ class Body:
     (N/m, N, N m/rad about the reference point at its start position, in place of
     the volume's and waterplane's own); ``load`` (6,): a constant external force (N)
     and moment (N m) about the reference point, global axes (wind, current, wave
-    drift); ``held`` (6,) bools: the degrees of freedom held at ``position``."""
+    drift); ``held`` (6,) bools: the degrees of freedom held at ``position``. For the
+    system's modes only (system/body_modes.py): ``inertia``, the mass moments of
+    inertia about the cog in body axes, kg m^2: (Ixx, Iyy, Izz) or the whole tensor (9
+    numbers; None: none, the rotations then massless but for the mass's own m |cog|^2);
+    ``added_mass`` (6, 6): the hydrodynamic added mass about the reference point in body
+    axes (kg, kg m, kg m^2; rows and columns x, y, z, roll, pitch, yaw; None: none)."""
 
     name: str
     position: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -89,6 +112,8 @@ class Body:
     hydrostatic: tuple = None
     load: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     held: tuple = (False,) * 6
+    inertia: tuple = None
+    added_mass: tuple = None
 
     def __post_init__(self):
         _name("Body.name", self.name)
@@ -99,6 +124,7 @@ class Body:
             reals(f"{owner} {name}", getattr(self, name), (3,))
         reals(f"{owner} waterplane_moments", self.waterplane_moments, (2,))
         optional(f"{owner} hydrostatic", self.hydrostatic, reals, (36,))
+        check_inertia(owner, self.inertia, self.added_mass)
         for name in ("mass", "volume", "waterplane_area"):
             if real(f"{owner} {name}", getattr(self, name)) < 0:
                 raise RodInputError(f"{owner} {name} {getattr(self, name)!r}: must not be "

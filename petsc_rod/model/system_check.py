@@ -79,8 +79,8 @@ def check_system(system, names):
 
 
 # The tables a system's run writes beside its lines' FILE_<line>.csv (api/system_run
-# table_paths): its own and its sweeps', and each line's regions' and ends'.
-RESERVED = ("system", "watch_circle", "excursion")
+# table_paths): its own, its sweeps' and its modes', and each line's regions' and ends'.
+RESERVED = ("system", "watch_circle", "excursion", "system_modes")
 SUFFIXES = ("_regions", "_ends")
 
 

@@ -8,7 +8,8 @@ self-contained HTML file with
    rotational block's antisymmetric part, said), the points, and a row a line of its
    end tensions, end forces, largest tension, grounded length and stability;
 3. the plan and the elevation of the whole system, and where the file holds them the
-   watch circle and the load-excursion curves (figures/system.py) with their tables;
+   watch circle and the load-excursion curves (figures/system.py) with their tables,
+   and the bodies' and free points' natural modes (their periods and shares);
 4. each line's own picture as a single line's page draws it (plots.riser_figure of the
    file's group ``lines/<name>``), for up to LINE_PICTURES lines; beyond, the lines are
    listed (their arrays are in the file).
@@ -21,7 +22,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from petsc_rod.figures.read import read_result
-from petsc_rod.figures.read_system import figures, read_system
+from petsc_rod.figures.read_system import figures, names_of, read_system
 from petsc_rod.figures.riser import riser_figure
 from petsc_rod.report.page import CASE_DPI, STYLE, drawn_all, img, png
 from petsc_rod.report.tables import number_text
@@ -106,6 +107,27 @@ def sweep_html(kind, found):
     return _table(kind, head, rows) + note
 
 
+def modes_html(modes):
+    """The section of the bodies' and free points' modes (the file's system/modes): a
+    row per mode, its frequency, period, dominant unknown and the shares over 0.05; or
+    why they were refused."""
+    head = ("<h2>Natural modes of the bodies and free points</h2><p>About the "
+            "equilibrium, undamped, the lines quasi-static (their static stiffness; the "
+            "lines' mass " + ("lumped half at each end" if int(modes.get("line_mass", 0))
+                              else "left out") + "; their own dynamics in their modes "
+            "with the ends held).</p>")
+    if "refused" in modes:
+        return head + f"<p id=\"modes_refused\">Refused: {html.escape(str(modes['refused']))}</p>"
+    dofs, labels = names_of(modes["dofs"]), names_of(modes["labels"])
+    rows = []
+    for k, shares in enumerate(np.atleast_2d(modes["shares"])):
+        big = [i for i in np.argsort(-shares) if shares[i] >= 0.05]
+        rows.append([k + 1.0, float(modes["frequencies"][k]), float(modes["periods"][k]),
+                     labels[k], ", ".join(f"{dofs[i]} {shares[i]:.2f}" for i in big)])
+    return head + _table("modes", ["mode", "f (Hz)", "T (s)", "dominant",
+                                   "shares of the kinetic energy"], rows)
+
+
 def line_png(path, name, seabed, surface):
     """The base64 PNG of line ``name``'s picture (a single line's, of the file's group
     lines/<name>), with the system's flat ``seabed`` and sea ``surface`` (m): a line's
@@ -167,6 +189,8 @@ def build(path):
         if suffix in images:
             parts.append(img(heading.lower(), images[suffix]))
         parts.append(sweep_html(kind, sweep))
+    if found.modes is not None:
+        parts.append(modes_html(found.modes))
     parts.append("<h2>Each line</h2>")
     if pictured:
         for name, encoded_line in zip(pictured, encoded):

@@ -15,7 +15,8 @@ from petsc_rod.errors import RodDivergedError, RodInputError
 from petsc_rod.model.line import UniformLine
 from petsc_rod.model.sea import Environment
 from petsc_rod.model.system import Body, Connection, Point, System, SystemLine
-from petsc_rod.system.bodies import angles, exp_rotation, log_rotation, skew
+from petsc_rod.system.bodies import exp_rotation, log_rotation, skew
+from petsc_rod.model.system_check import tait_bryan_zyx
 from petsc_rod.system.equilibrium import Loads, Settings, SystemSolver, solve_system
 from petsc_rod.validation.elastic_catenary import elastic_catenary
 
@@ -230,7 +231,8 @@ def equilibrium(system, comm=PETSc.COMM_SELF):
 def lines_on_body(system, pose_X, pose_R, name="floater"):
     """The lines' (F, M) on the body held at (X, R), the free points re-equilibrated."""
     body = system.bodies[0]
-    moved = Body(body.name, position=tuple(pose_X) + tuple(angles(pose_R)), held=(True,) * 6)
+    moved = Body(body.name, position=tuple(pose_X) + tuple(tait_bryan_zyx(pose_R)),
+                 held=(True,) * 6)
     held = System(lines=system.lines, points=system.points, bodies=(moved,),
                   environment=system.environment)
     solver = SystemSolver(held, spring, PETSc.COMM_SELF, settings=Settings(rtol=1e-14))

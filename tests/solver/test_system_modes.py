@@ -67,3 +67,22 @@ def test_a_system_refuses_a_bad_modes_option():
     system, _ = read_moordyn(DECK)
     with pytest.raises(RodInputError, match="-rod_modes"):
         solve_system(system, options={"modes": "many"})
+
+
+def test_each_line_s_modes_in_a_band():
+    """Options {'modes_range': '0.2,0.4'} on the same system: each line's modes in the
+    band, counted by the inertia, are those of its 8 lowest that lie in it (which
+    reach beyond 0.4 Hz; frequencies to 1e-9), and the run's lines say the band and
+    the count."""
+    system, _ = read_moordyn(DECK)
+    said = []
+    band = solve_system(system, say=said.append, options={"modes_range": "0.2,0.4"})
+    lowest = solve_system(system, options={"modes": 8})
+    for line in system.lines:
+        assert lowest.modes[line.name].frequencies[-1] > 0.4
+        found, every = band.modes[line.name], lowest.modes[line.name].frequencies
+        inside = every[(every >= 0.2) & (every <= 0.4)]
+        assert found.band[2] == len(found.frequencies) == len(inside) > 0
+        assert np.allclose(found.frequencies, inside, rtol=1e-9)
+        assert f"line {line.name} (ends held): modes: {len(inside)} in 0.2-0.4 Hz" in \
+            "\n".join(said)

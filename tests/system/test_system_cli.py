@@ -237,7 +237,8 @@ def test_help_lists_the_system_options():
     assert process.returncode == 0, describe(process)
     for name in ("-rod_system ", "-rod_system_element_length ", "-rod_system_body_load ",
                  "-rod_system_steps ", "-rod_system_watch_circle ",
-                 "-rod_system_excursion ", "-rod_al_rtol "):
+                 "-rod_system_excursion ", "-rod_al_rtol ", "-rod_system_modes ",
+                 "-rod_system_modes_line_mass "):
         assert name in process.stdout, name
 
 
@@ -427,3 +428,39 @@ def test_one_rank_failing_alone_while_writing_leaves_no_file(tmp_path):
     assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
         describe(done)
     assert not out.exists() and not partial_files(out)
+
+
+def test_the_system_modes_in_the_lines_the_file_and_the_table(tmp_path):
+    """-rod_system_modes: the bodies' modes about the equilibrium in the run's lines
+    (said to be with the lines quasi-static), the file's group system/modes and the
+    table FILE_system_modes.csv, the same on 1 and 2 ranks; refused without -rod_system."""
+    found = {}
+    for ranks in (1, 2):
+        folder = tmp_path / f"r{ranks}"
+        folder.mkdir()
+        out, process = system_run(folder, ranks, "-rod_system_modes", "1",
+                                  "-rod_system_modes_line_mass", "1")
+        assert process.returncode == 0, describe(process)
+        assert "the lines quasi-static" in process.stdout
+        assert "the lines' mass lumped half at each end" in process.stdout
+        with h5py.File(out, "r") as f:
+            group = f["system/modes"]
+            frequencies = group["frequencies"][()]
+            assert group.attrs["dofs"].startswith("Body1 x,Body1 y,Body1 z")
+            assert int(group.attrs["line_mass"]) == 1
+        rows = np.genfromtxt(folder / "system_system_modes.csv", delimiter=",",
+                             names=True, dtype=None, encoding="utf-8")
+        assert np.allclose(rows["frequency_Hz"], frequencies, rtol=1e-9)
+        # the lines' mass at the fairleads gives the rotations inertia: six modes
+        assert len(frequencies) == 6 and np.all(np.diff(frequencies) >= 0)
+        found[ranks] = frequencies
+    assert np.allclose(found[1], found[2], rtol=1e-9)
+    page = tmp_path / "page.html"
+    process = run_module("petsc_rod.report", [str(tmp_path / "r1" / "system.h5"), "-o",
+                                              str(page)])
+    assert process.returncode == 0, describe(process)
+    text = page.read_text(encoding="utf-8")
+    assert "Natural modes of the bodies and free points" in text and 'id="modes"' in text
+    assert f"{1 / found[1][0]:.4g}"[:4] in text             # the first period, in s
+    assert "-rod_system_modes" in refused(tmp_path, ["-options_file", "options/cantilever.opts",
+                                                     "-rod_system_modes", "1"])

@@ -316,3 +316,27 @@ def test_one_angle_alone_is_read_as_given(tmp_path):
                     encoding="utf-8")
     (body,) = read_moordyn(path)[0].bodies
     assert body.position[3:] == pytest.approx((0.0, np.radians(7.0), 0.0), abs=1e-15)
+
+
+def test_a_body_s_inertia_and_added_mass_are_read(tmp_path):
+    """I about the cog (one number: all three), moved to the cog the body's point mass
+    shifts (parallel axes), and Ca as rho V Ca in the translations, for the system's
+    modes; a point's Ca."""
+    path = tmp_path / "semi.dat"
+    row = "1     free        0     0      -5     0       0      10    1e6  -2|0|-8  1e8   1100    0      0"
+    assert row in SEMI
+    path.write_text(SEMI.replace(row, row[:-1] + "0.5|0.5|1.0"), encoding="utf-8")
+    system, _ = read_moordyn(path)
+    (body,) = system.bodies
+    cog = np.array(body.cog)
+    d_body, d_point = np.array([-2.0, 0.0, -8.0]) - cog, np.array([-20.0, 0.0, -10.0]) - cog
+
+    def moved(m, d):
+        return m * (d @ d * np.eye(3) - np.outer(d, d))
+    expected = 1e8 * np.eye(3) + moved(1e6, d_body) + moved(100.0, d_point)
+    assert np.allclose(np.reshape(body.inertia, (3, 3)), expected, rtol=1e-13, atol=0)
+    added = np.reshape(body.added_mass, (6, 6))
+    assert np.allclose(np.diag(added), [1025.0 * 1100 * 0.5] * 2 + [1025.0 * 1100] + [0] * 3)
+    assert np.count_nonzero(added - np.diag(np.diag(added))) == 0
+    assert read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                     "small_free_body.dat"))[0].bodies[0].inertia is None

@@ -229,3 +229,35 @@ def test_a_group_of_points_and_bodies_with_nothing_holding_it_is_refused():
         system, bodies=system.bodies + (steered,), lines=system.lines + clump,
         points=system.points + (Point("clump", "free", (0.0, 0.0, -51.0), mass=1e3),)
     )).startswith("nothing holds clump, float2 in x, y: no fixed or prescribed point")
+
+
+@pytest.mark.parametrize("fields, words", [
+    ({"inertia": (1.0, -2.0, 3.0)}, "inertia (1.0, -2.0, 3.0): a mass matrix is symmetric"),
+    ({"inertia": (1, 2, 0, 0, 1, 0, 0, 0, 1)}, "a mass matrix is symmetric"),
+    ({"inertia": (1.0, 2.0)}, "expected 3 or 9 numbers"),
+    ({"added_mass": (1.0,) * 35}, "expected 36 numbers"),
+    ({"added_mass": tuple(-np.eye(6).ravel())}, "no negative eigenvalue"),
+])
+def test_a_body_s_inertia_and_added_mass_are_mass_matrices(fields, words):
+    with pytest.raises(RodInputError, match=r"Body hull: ") as refused:
+        Body("hull", **fields)
+    assert words in str(refused.value)
+
+
+def test_a_point_s_added_mass_coefficient_is_not_negative():
+    with pytest.raises(RodInputError, match="Point p: ca -0.5: must not be negative"):
+        Point("p", "free", ca=-0.5)
+
+
+def test_the_system_modes_options_of_the_api():
+    from petsc_rod.api.system_run import split_options
+    assert split_options({"system_modes": True})[3] == {"line_mass": False}
+    assert split_options({"system_modes": 1, "system_modes_line_mass": 1})[3] == {
+        "line_mass": True}
+    assert split_options({})[3] is None
+    with pytest.raises(RodInputError, match="system_modes_line_mass needs system_modes"):
+        split_options({"system_modes_line_mass": True})
+    with pytest.raises(RodInputError, match="system_modes 'yes': True or False"):
+        split_options({"system_modes": "yes"})
+    with pytest.raises(RodInputError, match="modes and modes_range: give one"):
+        split_options({"modes": 3, "modes_range": "1,2"})
