@@ -234,6 +234,9 @@ class Layout:
         # a clamped or flex end at a body: its frame (a flex joint's axis) turns with the
         # body, its moment acts on it
         self.turned = np.zeros((n, 2), dtype=bool)
+        # the line's end frame a clamp or flex joint holds, body axes (Connection.
+        # line_frame); None: the reference frame at the body's start pose
+        self.frames = [[None, None] for _ in range(n)]
         for k, line in enumerate(system.lines):
             for j, connection in enumerate((line.start, line.end)):
                 if connection.to not in where:
@@ -243,6 +246,7 @@ class Layout:
                             system.points[i].kind if kind == "point" else "body")
                 if kind == "body":
                     self.turned[k, j] = connection.kind in ("clamp", "flex")
+                    self.frames[k][j] = connection.line_frame(j == 1)
                     self.body_end[k, j] = i
                     self.ends[k, j] = self.body_dofs[i]
                     self.local[k, j] = connection.local
@@ -333,16 +337,25 @@ class SystemSolver:
 
     def end_frames(self, state):
         """[(start frame, end frame)] per line: a clamp at a body's (3, 3), rows d1, d2,
-        d3, turning with it: the line's start frame (the reference, frames.REFERENCE_FRAME)
-        at the body's start rotation R0, so D = D_ref R0 R^T (each row d_i = R R0^T
-        d_i,ref); None elsewhere."""
+        d3, turning with it, D = D_b R^T (each row d_i = R d_i,b), D_b the line's end
+        frame in the body's axes (Connection.line_frame), or where the connection gives
+        none the line's start frame (the reference, frames.REFERENCE_FRAME) at the
+        body's start rotation R0, D_b = D_ref R0; None elsewhere. A flex joint's axis
+        turns with the same D (held_line.HeldLine: a = D^T D_ref a_0)."""
         layout, bodies = self.layout, state.bodies
         out = []
         for k in range(len(self.system.lines)):
-            out.append(tuple(
-                REFERENCE_FRAME @ bodies.R0[layout.body_end[k, j]]
-                @ bodies.R[layout.body_end[k, j]].T if layout.turned[k, j] else None
-                for j in (0, 1)))
+            ends = []
+            for j in (0, 1):
+                body = layout.body_end[k, j]
+                if not layout.turned[k, j]:
+                    ends.append(None)
+                    continue
+                frame = layout.frames[k][j]
+                if frame is None:
+                    frame = REFERENCE_FRAME @ bodies.R0[body]
+                ends.append(frame @ bodies.R[body].T)
+            out.append(tuple(ends))
         return out
 
     def evaluate(self, state, strict=False):
