@@ -6,7 +6,7 @@ equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not
 written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
--rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
+-rod_system_body_load, -rod_system_offset, -rod_system_steps, -rod_system_watch_circle,
 -rod_system_excursion), the outputs (-rod_output, -rod_table), the
 modes of each line with its ends held (-rod_modes N, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
@@ -39,7 +39,8 @@ from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
-                  "rod_system_steps", "rod_system_watch_circle", "rod_system_excursion",
+                  "rod_system_offset", "rod_system_steps", "rod_system_watch_circle",
+                  "rod_system_excursion",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 
 
@@ -50,29 +51,82 @@ def refused_options(given):
     return [name for name in BY_NAME if name in given and name not in taken]
 
 
+def named_rows(option, text, names, fields):
+    """[(name, numbers (n,))] of ``option``'s ``text``: NAME,v1,...,vn parts separated by
+    ':', each NAME one of ``names`` (a dict or a list), n = len(``fields``) finite
+    numbers (``fields``: the words of the numbers, 'fx in N'); RodInputError naming the
+    part that is not."""
+    rows = []
+    for part in text.split(":"):
+        words = [word.strip() for word in part.split(",")]
+        form = f"NAME,{','.join(f.split()[0] for f in fields)}"
+        if len(words) != len(fields) + 1:
+            raise RodInputError(f"-{option} {part!r}: expected {form} ({', '.join(fields)}), "
+                                "several separated by ':'")
+        if words[0] not in names:
+            raise RodInputError(f"-{option} {part!r}: no {'/'.join(names.kinds)} "
+                                f"{words[0]!r} in the system; its names: "
+                                f"{', '.join(names) or 'none'}")
+        try:
+            values = np.array([float(v) for v in words[1:]])
+        except ValueError:
+            raise RodInputError(f"-{option} {part!r}: {len(fields)} numbers after the "
+                                f"name ({', '.join(fields)})") from None
+        if not np.all(np.isfinite(values)):
+            raise RodInputError(f"-{option} {part!r}: finite numbers only")
+        rows.append((words[0], values))
+    return rows
+
+
+class _Names(dict):
+    """{name: item} that says what kinds of things it names (named_rows' message)."""
+
+    def __init__(self, items, kinds):
+        super().__init__((item.name, item) for item in items)
+        self.kinds = kinds
+
+
 def body_loads(text, system):
     """``system`` with the loads of -rod_system_body_load ``text`` (NAME,fx,fy,fz,mx,my,mz
     separated by ':') added to its bodies' own."""
-    bodies = {body.name: body for body in system.bodies}
-    for part in text.split(":"):
-        fields = [field.strip() for field in part.split(",")]
-        if len(fields) != 7:
-            raise RodInputError(f"-rod_system_body_load {part!r}: expected NAME,fx,fy,fz,"
-                                "mx,my,mz (N, N m), several separated by ':'")
-        name = fields[0]
-        if name not in bodies:
-            raise RodInputError(f"-rod_system_body_load {part!r}: no body {name!r} in the "
-                                f"system; its bodies: {', '.join(bodies) or 'none'}")
-        try:
-            load = np.array([float(v) for v in fields[1:]])
-        except ValueError:
-            raise RodInputError(f"-rod_system_body_load {part!r}: six numbers after the "
-                                "name (fx, fy, fz in N, mx, my, mz in N m)") from None
-        if not np.all(np.isfinite(load)):
-            raise RodInputError(f"-rod_system_body_load {part!r}: finite numbers only")
+    bodies = _Names(system.bodies, ("body",))
+    for name, load in named_rows("rod_system_body_load", text, bodies,
+                                 ("fx in N", "fy in N", "fz in N", "mx in N m", "my in N m",
+                                  "mz in N m")):
         body = bodies[name]
         bodies[name] = dataclasses.replace(body, load=tuple(np.add(body.load, load)))
     return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
+
+
+def offsets(text, system):
+    """``system`` with the offsets of -rod_system_offset ``text`` (NAME,dx,dy,dz separated
+    by ':', m, global axes) added to the positions of its fixed or prescribed points and
+    of its bodies in their held translations; RodInputError for a free point, or a body
+    moved in a direction it is free in (its equilibrium decides where it is there)."""
+    nodes = _Names((*system.points, *system.bodies), ("point", "body"))
+    for name, move in named_rows("rod_system_offset", text, nodes,
+                                 ("dx in m", "dy in m", "dz in m")):
+        node = nodes[name]
+        if hasattr(node, "kind"):
+            if node.kind == "free":
+                raise RodInputError(f"-rod_system_offset {name}: a free point, whose "
+                                    "equilibrium decides where it is; offset a fixed or "
+                                    "prescribed point or a held body")
+            nodes[name] = dataclasses.replace(node, position=tuple(np.add(node.position,
+                                                                          move)))
+            continue
+        free = [axis for axis, d, held in zip("xyz", move, node.held) if d != 0 and not held]
+        if free:
+            raise RodInputError(f"-rod_system_offset {name}: body {name} is free in "
+                                f"{', '.join(free)}, where its equilibrium decides where it "
+                                "is; hold it there (Fixed or Coupled in the file) or move "
+                                "it by a load (-rod_system_body_load)")
+        position = np.array(node.position, dtype=float)
+        position[:3] += move
+        nodes[name] = dataclasses.replace(node, position=tuple(position))
+    return dataclasses.replace(
+        system, points=tuple(nodes[p.name] for p in system.points),
+        bodies=tuple(nodes[b.name] for b in system.bodies))
 
 
 def check_outputs_kept(values, comm, system, sweeps):
@@ -104,6 +158,8 @@ def prepared(values, given):
     system, notes = read_moordyn(path, values["rod_system_element_length"])
     if values["rod_system_body_load"]:
         system = body_loads(values["rod_system_body_load"], system)
+    if values["rod_system_offset"]:
+        system = offsets(values["rod_system_offset"], system)
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()

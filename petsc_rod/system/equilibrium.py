@@ -112,33 +112,37 @@ class State:
 @dataclass(frozen=True)
 class Loads:
     """What the continuation moves: the bodies' external loads (n_bodies, 6), the free
-    points' forces (n_free, 3) and the held points' positions (n_points, 3) (the free
-    points' rows unused)."""
+    points' forces (n_free, 3), the held points' positions (n_points, 3) (the free
+    points' rows unused) and the bodies' reference points (n_bodies, 3) (their held
+    components: a body held in x, y or z moved to an offset)."""
 
     bodies: np.ndarray
     forces: np.ndarray
     held: np.ndarray
+    places: np.ndarray
 
     @classmethod
     def of(cls, system, layout):
         return cls(np.array([b.load for b in system.bodies], dtype=float).reshape(-1, 6),
                    np.array([system.points[i].force for i in layout.point_index],
                             dtype=float).reshape(-1, 3),
-                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3))
+                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3),
+                   np.array([b.position[:3] for b in system.bodies],
+                            dtype=float).reshape(-1, 3))
+
+    def _pairs(self, other):
+        return ((self.bodies, other.bodies), (self.forces, other.forces),
+                (self.held, other.held), (self.places, other.places))
 
     def towards(self, other, factor):
         """self + factor (other - self)."""
-        return Loads(*(a + factor * (b - a) for a, b in
-                       ((self.bodies, other.bodies), (self.forces, other.forces),
-                        (self.held, other.held))))
+        return Loads(*(a + factor * (b - a) for a, b in self._pairs(other)))
 
     def unloaded(self):
-        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held)
+        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held, self.places)
 
     def same(self, other):
-        return all(np.array_equal(a, b) for a, b in ((self.bodies, other.bodies),
-                                                     (self.forces, other.forces),
-                                                     (self.held, other.held)))
+        return all(np.array_equal(a, b) for a, b in self._pairs(other))
 
 
 @dataclass(frozen=True)
@@ -217,6 +221,7 @@ class Layout:
         self.point_dofs = np.arange(3 * n_free)
         self.body_dofs = 3 * n_free + np.arange(6 * n_bodies).reshape(n_bodies, 6)
         held = np.array([b.held for b in system.bodies], dtype=bool).reshape(-1, 6)
+        self.held_places = held[:, :3]
         self.free = np.concatenate([self.point_dofs, self.body_dofs[~held]])
         self.free.sort()
         self.names = ([(system.points[i].name, DOF_NAMES[k]) for i in self.point_index
@@ -270,6 +275,13 @@ class Layout:
         if kind == "point" and np.any(np.asarray(connection.local, dtype=float) != 0):
             raise RodInputError(f"line {line}: {which}: local {connection.local!r} at the "
                                 f"point {connection.to}, which has no axes: leave it zero")
+
+
+def _moved_where_held(new, old):
+    """Whether Body ``new`` is at ``old``'s position but in its held translations."""
+    moved = np.asarray(new.position, dtype=float) != np.asarray(old.position, dtype=float)
+    return not np.any(moved & ~np.concatenate([np.asarray(old.held[:3], dtype=bool),
+                                                np.zeros(3, dtype=bool)]))
 
 
 class SystemSolver:
@@ -541,7 +553,8 @@ class SystemSolver:
         put at its positions), or (None, its iterations) with self.failure saying why.
         self.forces/stiffnesses: the lines' at the returned state."""
         settings, free, held = self.settings, self.layout.free, self.layout.held_points
-        state = State(state.points.copy(), state.bodies)
+        state = State(state.points.copy(),
+                      state.bodies.placed(loads.places, self.layout.held_places))
         state.points[held] = loads.held[held]
         ok, forces, stiffness = self.evaluate(state)
         if not ok:
@@ -681,20 +694,23 @@ class SystemSolver:
 
     def replace(self, system):
         """Take ``system``'s loads: RodInputError unless it differs from the solver's
-        only in the bodies' loads, the points' forces and the held points' positions."""
+        only in the bodies' loads, the points' forces, the held points' positions and
+        the bodies' reference points in their held translations."""
         old = self.system
         same = (repr(system.lines) == repr(old.lines)
                 and repr(system.environment) == repr(old.environment)
                 and len(system.points) == len(old.points)
                 and len(system.bodies) == len(old.bodies)
-                and all(replace(new, load=b.load) == b
+                and all(replace(new, load=b.load, position=b.position) == b
+                        and _moved_where_held(new, b)
                         for new, b in zip(system.bodies, old.bodies))
                 and all(replace(new, force=p.force, position=p.position) == p
                         for new, p in zip(system.points, old.points)))
         if not same:
             raise RodInputError("system: a solver re-solves its system under other body "
-                                "loads, point forces or held points' positions only; make a "
-                                "new one for any other change")
+                                "loads, point forces or held points' positions (and "
+                                "bodies' positions in their held translations) only; make "
+                                "a new one for any other change")
         self.system = system
 
     def result(self, factor, iterations, halvings, stable=None):
