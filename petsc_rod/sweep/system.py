@@ -93,8 +93,10 @@ def make_cases(settings, system):
             headings = tuple(sweep_cases.numbers(",".join(settings.headings),
                                                  "-sweep_headings (deg, with -rod_system)"))
         offsets = offset_cases(settings.offsets, headings, settings.offset_of)
-    listed = (sweep_cases.read_cases(settings.cases, known_case_option) if settings.cases
-              else None)
+    listed = (sweep_cases.read_cases(
+        settings.cases, known_case_option, "an option a system's case sets (rod_system_"
+        "body_load, rod_system_offset; a line's length or type changes the system's "
+        "lines: a sweep of its own)") if settings.cases else None)
     made = sweep_cases.product(listed, offsets)
     sweep_cases.check_unique(made, "the sweep")
     return made

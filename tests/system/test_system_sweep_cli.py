@@ -122,8 +122,11 @@ def test_a_case_file_of_body_loads(tmp_path):
     (["-sweep_offsets", "1", "-sweep_offset_of", "Body1", "-sweep_headings", "far"],
      "-sweep_headings"),
     (["-sweep_current_headings", "0"], "a system's current is its file's"),
+    (["-sweep_cases", "lengths.txt"], "column rod_length is not an option a system's case"),
 ])
 def test_bad_system_sweep_input_is_one_line_and_exit_2(tmp_path, args, message):
+    (tmp_path / "lengths.txt").write_text("name rod_length\nlong 80\n")
+    args = [str(tmp_path / arg) if arg == "lengths.txt" else arg for arg in args]
     process = sweep(tmp_path / "out", HELD, 1, *args)
     assert process.returncode == 2, describe(process)
     lines = process.stdout.strip().splitlines()
