@@ -6,7 +6,8 @@ equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not
 written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
--rod_system_body_load, -rod_system_offset, -rod_system_steps, -rod_system_watch_circle,
+-rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
+-rod_system_watch_circle,
 -rod_system_excursion), the outputs (-rod_output, -rod_table), the
 modes of each line with its ends held (-rod_modes N, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
@@ -39,7 +40,8 @@ from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
-                  "rod_system_offset", "rod_system_steps", "rod_system_watch_circle",
+                  "rod_system_offset", "rod_system_line_length", "rod_system_steps",
+                  "rod_system_watch_circle",
                   "rod_system_excursion",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 
@@ -129,6 +131,27 @@ def offsets(text, system):
         bodies=tuple(nodes[b.name] for b in system.bodies))
 
 
+def line_lengths(text, system, element_length):
+    """``system`` with the lengths of -rod_system_line_length ``text`` (NAME,L separated by
+    ':', m): line NAME's sections scaled by L over its length, each meshed with its
+    elements or more, none longer than ``element_length`` (m)."""
+    lines = _Names(system.lines, ("line",))
+    for name, (length,) in named_rows("rod_system_line_length", text, lines,
+                                      ("L in m",)):
+        if not length > 0:
+            raise RodInputError(f"-rod_system_line_length {name},{length:g}: a positive "
+                                "length (m)")
+        line = lines[name]
+        scale = length / float(np.sum(line.line.lengths))
+        sections = [(entry[0], float(entry[1]) * scale,
+                     max(int(entry[2]) if len(entry) > 2 else 1,
+                         int(np.ceil(float(entry[1]) * scale / element_length))))
+                    for entry in line.line.sections]
+        lines[name] = dataclasses.replace(line, line=dataclasses.replace(
+            line.line, sections=tuple(sections)))
+    return dataclasses.replace(system, lines=tuple(lines[line.name] for line in system.lines))
+
+
 def check_outputs_kept(values, comm, system, sweeps):
     """Refuse an output that names an input (the system file, an options file), which
     writing it would replace: every file the run writes (written_paths: the result file,
@@ -160,6 +183,9 @@ def prepared(values, given):
         system = body_loads(values["rod_system_body_load"], system)
     if values["rod_system_offset"]:
         system = offsets(values["rod_system_offset"], system)
+    if values["rod_system_line_length"]:
+        system = line_lengths(values["rod_system_line_length"], system,
+                              values["rod_system_element_length"])
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()

@@ -5,13 +5,14 @@
 Each case is the system's run (api/system_run.run_system, the path of
 ``python -m petsc_rod -rod_system FILE``) with the base options and the case's own over
 them; a case sets what tells one load case of a system from another (CASE_OPTIONS): the
-bodies' external loads (-rod_system_body_load) and the offsets of fixed or prescribed
-points and held bodies (-rod_system_offset; -sweep_offsets makes them along headings).
-The cases run one after the other on one SystemSolver: each is the solver's warm
-re-solve from the last converged case's equilibrium (SystemSolver.replace: the held
-points and bodies walked, the loads continued, every line warm from its own last
-state), or with -sweep_start scene a solver made afresh per case; a warm case that
-fails runs again on a fresh solver (-sweep_retry). Each case writes DIR/<case>.h5 (the
+bodies' external loads (-rod_system_body_load), the offsets of fixed or prescribed
+points and held bodies (-rod_system_offset; -sweep_offsets makes them along headings)
+and the lines' lengths (-rod_system_line_length). The cases run one after the other on
+one SystemSolver: each is the solver's warm re-solve from the last converged case's
+equilibrium (SystemSolver.replace: the held points and bodies walked, the loads
+continued, every line warm from its own last state), or with -sweep_start scene, or
+where the case's lines differ from the last case's (a length), a solver made afresh; a
+warm case that fails runs again on a fresh solver (-sweep_retry). Each case writes DIR/<case>.h5 (the
 system's result file); after each, DIR/summary.csv, DIR/summary.md and DIR/sweep.json
 are rewritten on rank 0 with a row per case: the bodies' positions, each line's
 fairlead tension and the largest tension over the lines.
@@ -40,7 +41,7 @@ from petsc_rod.system.equilibrium import SystemSolver
 from petsc_rod.system.held_line import held_lines
 
 # What a case of a system's sweep may set: what SystemSolver.replace re-solves warm.
-CASE_OPTIONS = ("rod_system_body_load", "rod_system_offset")
+CASE_OPTIONS = ("rod_system_body_load", "rod_system_offset", "rod_system_line_length")
 
 
 def known_case_option(name):
@@ -94,9 +95,8 @@ def make_cases(settings, system):
                                                  "-sweep_headings (deg, with -rod_system)"))
         offsets = offset_cases(settings.offsets, headings, settings.offset_of)
     listed = (sweep_cases.read_cases(
-        settings.cases, known_case_option, "an option a system's case sets (rod_system_"
-        "body_load, rod_system_offset; a line's length or type changes the system's "
-        "lines: a sweep of its own)") if settings.cases else None)
+        settings.cases, known_case_option, "an option a system's case sets: "
+        f"{', '.join(CASE_OPTIONS)}") if settings.cases else None)
     made = sweep_cases.product(listed, offsets)
     sweep_cases.check_unique(made, "the sweep")
     return made
@@ -176,12 +176,17 @@ class SystemSweep(Sweep):
             self.say(f"petsc_rod: error: {error}")
             return record
         warm = self.solver is not None and self.settings.start != "scene"
+        # other lines (a length) are a new solver's: the kept one re-solves loads and
+        # held positions only (SystemSolver.replace)
+        relined = warm and repr(made[0].lines) != repr(self.solver.system.lines)
+        warm = warm and not relined
         self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}"
                  + ("; warm from the last converged case" if warm else ""))
         if not warm:
             self.drop_solver()
         code, results = self._run(case, made)
-        start = "from the last case" if warm else "own start"
+        start = ("from the last case" if warm else
+                 "own start (its lines differ)" if relined else "own start")
         if warm and code in (3, 4, FAILED) and self.settings.retry:
             self.say(f"sweep: case {case.name}: the warm start ended with exit {code}; "
                      "again from the case's own start")

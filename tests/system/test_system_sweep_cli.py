@@ -1,7 +1,7 @@
 """Sweeps of a system (petsc_rod/sweep/system.py, docs/sweeps.md "Sweeps of a system"):
 ``python -m petsc_rod.sweep -rod_system FILE`` over offsets of a held body
-(-sweep_offsets, -sweep_offset_of, headings in degrees) and over a case file of the
-bodies' loads, on 1 and 2 ranks with the same numbers; each case warm from the last is
+(-sweep_offsets, -sweep_offset_of, headings in degrees) and over case files of the
+bodies' loads and the lines' lengths, on 1 and 2 ranks with the same numbers; each case warm from the last is
 the case run alone (``python -m petsc_rod -rod_system FILE`` with the case's option);
 the summary's columns (the body's position, each line's fairlead tension, the largest
 tension); bad sweep input in one line, exit 2. Small decks of tests/data/moordyn with
@@ -116,6 +116,26 @@ def test_a_case_file_of_body_loads(tmp_path):
     assert summary_rows(tmp_path / "bad")["moved"]["exit"] == "2"
 
 
+def test_a_case_file_of_line_lengths(tmp_path):
+    """A line's length per case: the case whose lines differ from the last case's gets a
+    solver of its own; a longer Line1 (its anchor at +x) lets the pushed body sit
+    nearer its rest."""
+    cases = tmp_path / "lengths.txt"
+    cases.write_text("name rod_system_line_length\n"
+                     "short Line1,69\n"
+                     "long Line1,71\n")
+    folder = tmp_path / "lengths"
+    process = sweep(folder, FREE, 1, "-sweep_cases", str(cases), "-rod_system_body_load",
+                    "Body1,20e3,0,0,0,0,0")
+    assert process.returncode == 0, describe(process)
+    rows = summary_rows(folder)
+    assert rows["long"]["start"] == "own start (its lines differ)"
+    assert float(rows["long"]["Body1 x (m)"]) < float(rows["short"]["Body1 x (m)"]) - 0.5
+    with h5py.File(folder / "long.h5", "r") as f:
+        assert f["lines/Line1/S"][-1] == pytest.approx(71.0, rel=1e-12)
+        assert f["lines/Line2/S"][-1] == pytest.approx(70.0, rel=1e-12)
+
+
 @pytest.mark.parametrize("args, message", [
     (["-sweep_offsets", "1"], "-sweep_offsets and -sweep_offset_of NAME go together"),
     (["-sweep_offsets", "1", "-sweep_offset_of", "Body9"], "no point or body of that name"),
@@ -123,6 +143,8 @@ def test_a_case_file_of_body_loads(tmp_path):
      "-sweep_headings"),
     (["-sweep_current_headings", "0"], "a system's current is its file's"),
     (["-sweep_cases", "lengths.txt"], "column rod_length is not an option a system's case"),
+    (["-rod_system_line_length", "Line1,-3", "-sweep_offsets", "1", "-sweep_offset_of", "Body1"],
+     "a positive length"),
 ])
 def test_bad_system_sweep_input_is_one_line_and_exit_2(tmp_path, args, message):
     (tmp_path / "lengths.txt").write_text("name rod_length\nlong 80\n")
