@@ -134,6 +134,14 @@ def test_a_case_file_of_line_lengths(tmp_path):
     with h5py.File(folder / "long.h5", "r") as f:
         assert f["lines/Line1/S"][-1] == pytest.approx(71.0, rel=1e-12)
         assert f["lines/Line2/S"][-1] == pytest.approx(70.0, rel=1e-12)
+    # the report of a system's sweep is not made yet: one line, exit 2, no page
+    page = tmp_path / "page.html"
+    report = run_module("petsc_rod.report", [str(folder), "-o", str(page)])
+    assert report.returncode == 2 and not page.exists(), describe(report)
+    assert report.stderr.strip().splitlines() == [
+        f"petsc_rod.report: error: {folder}: a system's sweep, whose page is not made "
+        f"yet: report one of its cases' files ({folder / '<case>.h5'}), or read its "
+        "summary.md"]
 
 
 @pytest.mark.parametrize("args, message", [
