@@ -16,9 +16,8 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.api import (Body, Connection, End, Environment, Model, Point, System,
-                           SystemLine, UniformLine, solve, solve_system)
+                           SystemLine, UniformLine, clamp_frame, solve, solve_system)
 from petsc_rod.errors import RodInputError
-from petsc_rod.model.system import clamp_frame
 from petsc_rod.model.system_check import rotation
 from petsc_rod.system.equilibrium import Settings, SystemSolver
 from petsc_rod.system.held_line import held_lines
