@@ -6,10 +6,10 @@ equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not
 written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
--rod_system_body_load, -rod_system_steps, -rod_system_watch_circle,
--rod_system_excursion, -rod_system_modes, -rod_system_modes_line_mass), the outputs
-(-rod_output, -rod_table), the
-modes of each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
+-rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
+-rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
+-rod_system_modes_line_mass), the outputs (-rod_output, -rod_table), the modes of
+each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
 -rod_max_halvings: every line the same); every other
 -rod_* option describes a single line's scene or load path, which the file gives, and is
@@ -41,7 +41,8 @@ from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
-                  "rod_system_steps", "rod_system_watch_circle", "rod_system_excursion",
+                  "rod_system_offset", "rod_system_line_length", "rod_system_steps",
+                  "rod_system_watch_circle", "rod_system_excursion",
                   "rod_system_modes", "rod_system_modes_line_mass",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 
@@ -53,29 +54,103 @@ def refused_options(given):
     return [name for name in BY_NAME if name in given and name not in taken]
 
 
+def named_rows(option, text, names, fields):
+    """[(name, numbers (n,))] of ``option``'s ``text``: NAME,v1,...,vn parts separated by
+    ':', each NAME one of ``names`` (a dict or a list), n = len(``fields``) finite
+    numbers (``fields``: the words of the numbers, 'fx in N'); RodInputError naming the
+    part that is not."""
+    rows = []
+    for part in text.split(":"):
+        words = [word.strip() for word in part.split(",")]
+        form = f"NAME,{','.join(f.split()[0] for f in fields)}"
+        if len(words) != len(fields) + 1:
+            raise RodInputError(f"-{option} {part!r}: expected {form} ({', '.join(fields)}), "
+                                "several separated by ':'")
+        if words[0] not in names:
+            raise RodInputError(f"-{option} {part!r}: no {'/'.join(names.kinds)} "
+                                f"{words[0]!r} in the system; its names: "
+                                f"{', '.join(names) or 'none'}")
+        try:
+            values = np.array([float(v) for v in words[1:]])
+        except ValueError:
+            raise RodInputError(f"-{option} {part!r}: {len(fields)} numbers after the "
+                                f"name ({', '.join(fields)})") from None
+        if not np.all(np.isfinite(values)):
+            raise RodInputError(f"-{option} {part!r}: finite numbers only")
+        rows.append((words[0], values))
+    return rows
+
+
+class _Names(dict):
+    """{name: item} that says what kinds of things it names (named_rows' message)."""
+
+    def __init__(self, items, kinds):
+        super().__init__((item.name, item) for item in items)
+        self.kinds = kinds
+
+
 def body_loads(text, system):
     """``system`` with the loads of -rod_system_body_load ``text`` (NAME,fx,fy,fz,mx,my,mz
     separated by ':') added to its bodies' own."""
-    bodies = {body.name: body for body in system.bodies}
-    for part in text.split(":"):
-        fields = [field.strip() for field in part.split(",")]
-        if len(fields) != 7:
-            raise RodInputError(f"-rod_system_body_load {part!r}: expected NAME,fx,fy,fz,"
-                                "mx,my,mz (N, N m), several separated by ':'")
-        name = fields[0]
-        if name not in bodies:
-            raise RodInputError(f"-rod_system_body_load {part!r}: no body {name!r} in the "
-                                f"system; its bodies: {', '.join(bodies) or 'none'}")
-        try:
-            load = np.array([float(v) for v in fields[1:]])
-        except ValueError:
-            raise RodInputError(f"-rod_system_body_load {part!r}: six numbers after the "
-                                "name (fx, fy, fz in N, mx, my, mz in N m)") from None
-        if not np.all(np.isfinite(load)):
-            raise RodInputError(f"-rod_system_body_load {part!r}: finite numbers only")
+    bodies = _Names(system.bodies, ("body",))
+    for name, load in named_rows("rod_system_body_load", text, bodies,
+                                 ("fx in N", "fy in N", "fz in N", "mx in N m", "my in N m",
+                                  "mz in N m")):
         body = bodies[name]
         bodies[name] = dataclasses.replace(body, load=tuple(np.add(body.load, load)))
     return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
+
+
+def offsets(text, system):
+    """``system`` with the offsets of -rod_system_offset ``text`` (NAME,dx,dy,dz separated
+    by ':', m, global axes) added to the positions of its fixed or prescribed points and
+    of its bodies in their held translations; RodInputError for a free point, or a body
+    moved in a direction it is free in (its equilibrium decides where it is there)."""
+    nodes = _Names((*system.points, *system.bodies), ("point", "body"))
+    for name, move in named_rows("rod_system_offset", text, nodes,
+                                 ("dx in m", "dy in m", "dz in m")):
+        node = nodes[name]
+        if hasattr(node, "kind"):
+            if node.kind == "free":
+                raise RodInputError(f"-rod_system_offset {name}: a free point, whose "
+                                    "equilibrium decides where it is; offset a fixed or "
+                                    "prescribed point or a held body")
+            nodes[name] = dataclasses.replace(node, position=tuple(np.add(node.position,
+                                                                          move)))
+            continue
+        free = [axis for axis, d, held in zip("xyz", move, node.held) if d != 0 and not held]
+        if free:
+            raise RodInputError(f"-rod_system_offset {name}: body {name} is free in "
+                                f"{', '.join(free)}, where its equilibrium decides where it "
+                                "is; hold it there (Fixed or Coupled in the file) or move "
+                                "it by a load (-rod_system_body_load)")
+        position = np.array(node.position, dtype=float)
+        position[:3] += move
+        nodes[name] = dataclasses.replace(node, position=tuple(position))
+    return dataclasses.replace(
+        system, points=tuple(nodes[p.name] for p in system.points),
+        bodies=tuple(nodes[b.name] for b in system.bodies))
+
+
+def line_lengths(text, system, element_length):
+    """``system`` with the lengths of -rod_system_line_length ``text`` (NAME,L separated by
+    ':', m): line NAME's sections scaled by L over its length, each meshed with its
+    elements or more, none longer than ``element_length`` (m)."""
+    lines = _Names(system.lines, ("line",))
+    for name, (length,) in named_rows("rod_system_line_length", text, lines,
+                                      ("L in m",)):
+        if not length > 0:
+            raise RodInputError(f"-rod_system_line_length {name},{length:g}: a positive "
+                                "length (m)")
+        line = lines[name]
+        scale = length / float(np.sum(line.line.lengths))
+        sections = [(entry[0], float(entry[1]) * scale,
+                     max(int(entry[2]) if len(entry) > 2 else 1,
+                         int(np.ceil(float(entry[1]) * scale / element_length))))
+                    for entry in line.line.sections]
+        lines[name] = dataclasses.replace(line, line=dataclasses.replace(
+            line.line, sections=tuple(sections)))
+    return dataclasses.replace(system, lines=tuple(lines[line.name] for line in system.lines))
 
 
 def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
@@ -109,6 +184,11 @@ def prepared(values, given):
     system, notes = read_moordyn(path, values["rod_system_element_length"])
     if values["rod_system_body_load"]:
         system = body_loads(values["rod_system_body_load"], system)
+    if values["rod_system_offset"]:
+        system = offsets(values["rod_system_offset"], system)
+    if values["rod_system_line_length"]:
+        system = line_lengths(values["rod_system_line_length"], system,
+                              values["rod_system_element_length"])
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()

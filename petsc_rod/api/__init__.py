@@ -14,10 +14,11 @@ from petsc_rod.api.model import (Attachment, End, Environment, Line, LineType, M
 from petsc_rod.api.results import Results
 from petsc_rod.api.run import scene_of, solve
 from petsc_rod.api.system import (Body, Connection, Point, System, SystemLine,
-                                  read_moordyn)
+                                  clamp_frame, read_moordyn)
 from petsc_rod.api.system_run import SystemResults, solve_system
 from petsc_rod.api.system_sweeps import Sweeps
 
 __all__ = ["Attachment", "Body", "Connection", "End", "Environment", "Line", "LineType",
            "Model", "Point", "Results", "System", "SystemLine", "UniformLine",
-           "SystemResults", "Sweeps", "read_moordyn", "scene_of", "solve", "solve_system"]
+           "SystemResults", "Sweeps", "clamp_frame", "read_moordyn", "scene_of", "solve",
+           "solve_system"]

@@ -528,7 +528,7 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps(), body_modes=False):
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
                text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None,
-               body_modes=None):
+               body_modes=None, solver=None):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
     line's modes with its ends held where ``modes`` (count, MassSettings) asks for
@@ -539,15 +539,23 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     ends the run before anything is written (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
     after the equilibrium, in the results, the file and the tables. Returns the
-    SystemResults. RodInputError for a system the checks refuse (exit 2),
+    SystemResults. ``solver``: a SystemSolver of a system that differs from ``system``
+    only in what SystemSolver.replace takes (loads, held points' and bodies'
+    positions), re-solved warm from where it stands and left to its caller (a sweep's
+    cases); None: one made for the run and destroyed after it.
+    RodInputError for a system the checks refuse (exit 2),
     RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
     RodDivergedError, its Newton or a line not converged after its halvings),
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
     check_outputs(comm, system, output, table, sweeps, body_modes is not None)
-    solver = SystemSolver(system, held_lines(system, line_options), comm,
-                          settings=settings)
+    own = solver is None
+    if own:
+        solver = SystemSolver(system, held_lines(system, line_options), comm,
+                              settings=settings)
+    else:
+        on_every_rank(comm, solver.replace, system)
     failures = AgreedFailures(comm)
     try:
         # the ranks agree on a failure (one rank's alone ends every rank) before the
@@ -558,7 +566,8 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     finally:
         if failures.writer is not None:
             failures.writer.abort()
-        solver.destroy()
+        if own:
+            solver.destroy()
 
 
 def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps,

@@ -351,6 +351,14 @@ OPTIONS = [
            "with -rod_system: a constant external load on body NAME, N and N m about its "
            "reference point, global axes, added to the file's; several bodies separated "
            "by ':'", unit="text"),
+    Option("rod_system_offset", _string, None, "NAME,dx,dy,dz[:NAME,...]",
+           "with -rod_system: move the fixed or prescribed point NAME, or the body NAME "
+           "held in each moved direction, by (dx, dy, dz), m, global axes, from the "
+           "file's position (a vessel's offset); several separated by ':'", unit="text"),
+    Option("rod_system_line_length", _string, None, "NAME,L[:NAME,...]",
+           "with -rod_system: line NAME's unstretched length L, m, its sections' lengths "
+           "scaled to it (their elements at most -rod_system_element_length long); "
+           "several separated by ':'", unit="text"),
     Option("rod_system_steps", _int, None, "n",
            "with -rod_system: the load continuation's first step is 1/n of the bodies' "
            "and points' loads (halved where it fails, doubled where it succeeds); default "

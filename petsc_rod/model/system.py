@@ -139,12 +139,23 @@ class Body:
 class Connection:
     """Where a line's end is fixed: to the Point or Body named ``to``; ``local`` (3,),
     m, the point in the body's axes (a fairlead; zero on a point); ``kind`` in
-    CONNECTION_KINDS, with ``stiffness`` (N m/rad) for a flex joint."""
+    CONNECTION_KINDS, with ``stiffness`` (N m/rad) for a flex joint.
+
+    ``direction`` (3,), body axes, any length but not zero: at a clamp or a flex joint
+    on a body, the line's tangent at this end pointing INTO the line from the body (a
+    riser hanging down from its hang-off: (0, 0, -1)); a flex joint's neutral axis.
+    ``twist`` (rad): at a clamp, the roll of the clamp's d1 about ``direction`` from
+    its untwisted place (clamp_frame). None: the line's reference frame (d3 along +x)
+    at the body's start pose, as it turns with the body (a flex joint: the line's
+    direction in its start shape). A pin holds no frame and takes neither; a flex joint
+    holds no roll and takes no twist (System.check)."""
 
     to: str
     local: tuple = (0.0, 0.0, 0.0)
     kind: str = "pin"
     stiffness: float = None
+    direction: tuple = None
+    twist: float = None
 
     def __post_init__(self):
         _name("Connection.to", self.to)
@@ -153,6 +164,45 @@ class Connection:
             raise RodInputError(f"Connection to {self.to}: kind {self.kind!r}: use one of "
                                 f"{', '.join(CONNECTION_KINDS)}")
         optional(f"Connection to {self.to}: stiffness", self.stiffness, real)
+        optional(f"Connection to {self.to}: direction", self.direction, reals, (3,))
+        optional(f"Connection to {self.to}: twist", self.twist, real)
+        if self.direction is not None and not np.linalg.norm(
+                np.asarray(self.direction, dtype=float)) > 0:
+            raise RodInputError(f"Connection to {self.to}: direction "
+                                f"{tuple(self.direction)}: the zero vector has no direction; "
+                                "give the line's tangent into the line, body axes")
+
+    def line_frame(self, at_end):
+        """The line's end frame this connection holds, body axes, (3, 3) rows d1, d2,
+        d3, or None (no ``direction``): clamp_frame(direction, twist) at the line's
+        start (S = 0, d3 into the line); at its end (S = L, ``at_end``), where the
+        line's d3 points out of it into the body, that frame turned by pi about its d1,
+        rows (d1, -d2, -d3)."""
+        if self.direction is None:
+            return None
+        frame = clamp_frame(self.direction, self.twist or 0.0)
+        return frame * np.array([[1.0], [-1.0], [-1.0]]) if at_end else frame
+
+
+def clamp_frame(direction, twist=0.0):
+    """The frame (3, 3), rows d1, d2, d3, of a clamp whose d3 is ``direction`` (3,),
+    normalised, turned by ``twist`` (rad) about it; axes those of ``direction``.
+
+    Untwisted, d2 is the axes' +z projected normal to d3 and d1 = d2 x d3: the
+    reference frame (rows e_y, e_z, e_x) for d3 = e_x. With d3 = (sin b cos a,
+    sin b sin a, cos b) (a the azimuth from +x towards +y, b the declination from +z),
+    the rows are d1 = (-sin a, cos a, 0), d2 = (-cos b cos a, -cos b sin a, sin b), also
+    for a vertical d3 (a = atan2(y, x) of its zero horizontal part, 0). These are
+    OrcaFlex's end axes (E = R_z(a) R_y(b) R_z(gamma), twist = gamma) as d1 = E_y,
+    d2 = -E_x, d3 = E_z."""
+    d3 = np.asarray(direction, dtype=float)
+    d3 = d3 / np.linalg.norm(d3)
+    a = np.arctan2(d3[1], d3[0])
+    b = np.arctan2(np.hypot(d3[0], d3[1]), d3[2])
+    d1 = np.array([-np.sin(a), np.cos(a), 0.0])
+    d2 = np.array([-np.cos(b) * np.cos(a), -np.cos(b) * np.sin(a), np.sin(b)])
+    c, s = np.cos(twist), np.sin(twist)
+    return np.array([c * d1 + s * d2, -s * d1 + c * d2, d3])
 
 
 @dataclass(frozen=True)

@@ -47,6 +47,17 @@ def connection_position(node, connection):
     return place[:3] + rotation(*place[3:]) @ np.asarray(connection.local, dtype=float)
 
 
+def connection_frame(node, connection, at_end):
+    """The line's end frame ``connection`` holds, (3, 3) rows d1, d2, d3, global axes,
+    with its Body ``node`` at its start pose: D_b R^T (D_b = Connection.line_frame,
+    body axes; ``at_end``: the line's end S = L); None where the connection gives no
+    direction."""
+    frame = connection.line_frame(at_end)
+    if frame is None:
+        return None
+    return frame @ rotation(*np.asarray(node.position, dtype=float)[3:]).T
+
+
 def is_held(node):
     """Whether a Point or Body is held where it is: a fixed or prescribed point, a body
     held in all six degrees of freedom."""
@@ -108,7 +119,8 @@ def check_names(system):
 
 def check_connections(line, nodes):
     """Each end of ``line`` names an existing point or body; a point takes a pin at
-    itself (no local point, no clamp: a point has no frame); a flex joint has a
+    itself (no local point, no clamp: a point has no frame); a pin takes no direction
+    nor twist, a flex joint no twist, a twist needs a direction; a flex joint has a
     stiffness >= 0 and only a flex joint has one; the two ends are not one point."""
     for which in ("start", "end"):
         connection = getattr(line, which)
@@ -133,6 +145,18 @@ def check_connections(line, nodes):
                                               and connection.stiffness >= 0):
             raise RodInputError(f"{owner}: a flex joint needs Connection.stiffness >= 0 "
                                 "(N m/rad)")
+        if connection.kind == "pin" and (connection.direction is not None
+                                         or connection.twist is not None):
+            raise RodInputError(f"{owner}: Connection.direction or twist at a pin: a pin "
+                                "holds no frame; give kind 'clamp' (or 'flex' for a "
+                                "direction) or drop them")
+        if connection.kind == "flex" and connection.twist is not None:
+            raise RodInputError(f"{owner}: Connection.twist at a flex joint: the joint "
+                                "holds no roll about the line; drop the twist or give "
+                                "kind 'clamp'")
+        if connection.twist is not None and connection.direction is None:
+            raise RodInputError(f"{owner}: Connection.twist without a direction: the "
+                                "twist turns the clamp about its direction; give both")
         if connection.kind != "flex" and connection.stiffness is not None:
             raise RodInputError(f"{owner}: Connection.stiffness is a flex joint's; give "
                                 f"kind 'flex' or drop the stiffness (the end is a "

@@ -12,6 +12,17 @@ from petsc_rod.plots import OneLineParser
 from petsc_rod.tables import file_problem
 
 
+def system_sweep(folder):
+    """Whether the sweep in ``folder`` is a system's (its sweep.json says so:
+    sweep/system.py); a record that cannot be read is left to the page's checks."""
+    import json
+    try:
+        with open(os.path.join(folder, "sweep.json"), encoding="utf-8") as f:
+            return json.load(f).get("system") is True
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def main(argv=None):
     parser = OneLineParser(prog="python -m petsc_rod.report",
                            description="one self-contained HTML page of a result file or a "
@@ -33,6 +44,11 @@ def main(argv=None):
         return 2
     if not os.path.exists(source):
         sys.stderr.write(f"petsc_rod.report: error: {source}: no such file or folder\n")
+        return 2
+    if os.path.isdir(source) and system_sweep(source):
+        sys.stderr.write(f"petsc_rod.report: error: {source}: a system's sweep, whose page "
+                         "is not made yet: report one of its cases' files "
+                         f"({os.path.join(source, '<case>.h5')}), or read its summary.md\n")
         return 2
     problem = "" if os.path.isdir(source) else file_problem(source)
     if problem:                         # a FIFO would block h5py for ever

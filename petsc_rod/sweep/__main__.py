@@ -1,7 +1,8 @@
 """``mpiexec -n 2 python -m petsc_rod.sweep -options_file options/<scene>.opts
 -sweep_output DIR (-sweep_cases FILE | -sweep_offsets ... | -sweep_current_headings ...)``:
 the start of petsc_rod's own entry (petsc_rod/__main__.py: the options files checked,
-petsc4py found and started), then the sweep (sweep/runner.py)."""
+petsc4py found and started), then the sweep (sweep/runner.py; with -rod_system FILE a
+system's, sweep/system.py)."""
 
 import sys
 
@@ -26,9 +27,12 @@ def main():
         sys.stderr.write(f"petsc_rod.sweep: error: {error}; an options file has one "
                          "'-name value' per line, '#' starts a comment\n")
         return 2
+    from petsc4py import PETSc
+
     from petsc_rod.cli.signals import ignore_stop_signals
     from petsc_rod.sweep.runner import run_sweep
-    code = run_sweep()
+    from petsc_rod.sweep.system import run_system_sweep
+    code = run_system_sweep() if PETSc.Options().hasName("rod_system") else run_sweep()
     ignore_stop_signals()
     return entry.end(code)
 

@@ -47,11 +47,13 @@ def check_name(name, where):
                             " (it names the case's result file)")
 
 
-def read_cases(path, known):
+def read_cases(path, known, what="a petsc_rod option; name options without the dash, "
+                                  "e.g. rod_end_position"):
     """The cases of file ``path``: whitespace-separated columns (quotes group, '#' starts
     a comment), a header row naming options without the dash (``rod_end_position``) and
     optionally ``name``, then one row per case; a value ``-`` leaves that option as the
-    base options give it. ``known(name)`` says whether an option name exists."""
+    base options give it. ``known(name)`` says whether an option name exists (a
+    column it refuses is not ``what``)."""
     check_input_file(path, "-sweep_cases")
     try:
         with open(path, encoding="utf-8") as f:
@@ -84,8 +86,7 @@ def read_cases(path, known):
             close = difflib.get_close_matches(column, [o for o in known.names], n=1) \
                 if hasattr(known, "names") else []
             hint = f" (did you mean {close[0]}?)" if close else ""
-            raise RodInputError(f"{where}: column {column} is not a petsc_rod option{hint}; "
-                                "name options without the dash, e.g. rod_end_position")
+            raise RodInputError(f"{where}: column {column} is not {what}{hint}")
     if len(set(header)) != len(header):
         raise RodInputError(f"{where}: a column is repeated")
     cases = []

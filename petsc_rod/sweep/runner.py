@@ -64,6 +64,7 @@ class SweepSettings:
     start: str = "auto"          # -sweep_start auto|nearest|scene
     warm_steps: int = 1          # -sweep_warm_steps K
     retry: bool = True           # -sweep_retry: a failed warm start again from the scene
+    offset_of: str = ""          # -sweep_offset_of NAME: a system's point or body offset
 
 
 SWEEP_OPTIONS = {
@@ -81,6 +82,8 @@ SWEEP_OPTIONS = {
     "sweep_warm_steps": "K: steps of the walk from the nearest case's scene (1)",
     "sweep_retry": "bool: a warm start that fails is run again from the case's own start "
                    "(true)",
+    "sweep_offset_of": "NAME: with -rod_system, the point or held body the offsets move "
+                       "(-sweep_headings then in deg anticlockwise from +x, default 0)",
 }
 
 
@@ -126,7 +129,11 @@ def read_settings():
         else sweep_cases.HEADINGS,
         current_headings=numbers("sweep_current_headings"),
         current_speed=speed[0] if speed else None, start=start, warm_steps=int(steps),
-        retry=retry not in ("0", "false", "no", "off"))
+        retry=retry not in ("0", "false", "no", "off"), offset_of=text("sweep_offset_of"))
+    if settings.offset_of and not database.hasName("rod_system"):
+        raise RodInputError("-sweep_offset_of names a point or body of a system: give "
+                            "-rod_system FILE, or drop it (a single line's offsets move its "
+                            "hang-off)")
     if not (settings.cases or settings.offsets or settings.current_headings):
         raise RodInputError("a sweep needs cases: -sweep_cases FILE, -sweep_offsets d1,... "
                             "or -sweep_current_headings deg,...")
@@ -454,27 +461,42 @@ class Sweep:
         try:
             return with_options(self.comm, solvers, lambda: run(self.comm, texts))
         except Exception as error:          # noqa: BLE001 (any failure is the case's)
-            words = f"{type(error).__name__}: {error}".splitlines()[0]
-            if not every_rank_failed(self._failures):
-                abort_alone(self.comm, f"sweep case {case.name}: {words}")
-            self.say(f"petsc_rod.sweep: case {case.name} failed: {words}")
-            self._error = words
-            return FAILED
+            return self.failed(case, error)
+
+    def failed(self, case, error):
+        """FAILED for ``case``, whose run raised ``error``, its words kept for the record,
+        once every rank has failed (a rank failing alone ends the sweep: _run).
+        Collective."""
+        words = f"{type(error).__name__}: {error}".splitlines()[0]
+        if not every_rank_failed(self._failures):
+            abort_alone(self.comm, f"sweep case {case.name}: {words}")
+        self.say(f"petsc_rod.sweep: case {case.name} failed: {words}")
+        self._error = words
+        return FAILED
 
     def destroy(self):
         self._failures.Free()
+
+    # what the summary's title says the cases are of, and the record's own entries
+    of = ""
+    record_entries = {}
+
+    def table(self):
+        """(header, rows) of the summary (summary.table)."""
+        return summary.table(self.records, self.varied)
 
     def write(self):
         """Rewrite the summary and the record (rank 0)."""
         if self.comm.getRank() != 0:
             return None
-        header, rows = summary.table(self.records, self.varied)
+        header, rows = self.table()
         folder = self.settings.output
         summary.write_csv(os.path.join(folder, "summary.csv"), header, rows)
         summary.write_markdown(os.path.join(folder, "summary.md"), header, rows,
-                               title=f"Sweep of {len(self.cases)} case(s)")
+                               title=f"Sweep of {len(self.cases)} case(s){self.of}")
         summary.write_record(os.path.join(folder, "sweep.json"), {
             "base_options": self.base, "varied": self.varied, "cases": self.records,
+            **self.record_entries,
             "settings": {k: list(v) if isinstance(v, tuple) else v
                          for k, v in vars(self.settings).items()}})
         return summary.markdown(header, rows)
@@ -506,17 +528,37 @@ def run_sweep(comm=None):
         say(f"petsc_rod.sweep: error: {error}")
         database.setValue("options_left", "0")
         return error.exit_code
-    base = {name: ("" if value is None else value) for name, value in database.getAll().items()
-            if name.startswith("rod_")}
-    base.pop("rod_output", None)
-    sweep = Sweep(comm, settings, made, base)
+    sweep = Sweep(comm, settings, made, base_options())
     say(f"petsc_rod.sweep: {len(made)} case(s) varying "
         f"{', '.join('-' + v for v in sweep.varied) or 'nothing'}, into {settings.output}")
+    return run_cases(comm, sweep, settings, lock)
+
+
+def base_options():
+    """{name: text} of the -rod_* options of PETSc's database, the cases' base (the
+    sweep sets each case's -rod_output)."""
+    base = {name: ("" if value is None else value)
+            for name, value in PETSc.Options().getAll().items() if name.startswith("rod_")}
+    base.pop("rod_output", None)
+    return base
+
+
+def run_cases(comm, sweep, settings, lock):
+    """Run ``sweep``'s cases in turn (a Sweep, or a system's: sweep/system.py; its
+    ``interrupts`` set to the run's cli/signals.Interrupts), its summary written before
+    the first and after each, its lines said; the folder's ``lock`` closed; returns the
+    exit code (module docstring)."""
+    made = sweep.cases
+
+    def say(text):
+        PETSc.Sys.Print(text, comm=comm)
+
     sweep.write()           # the folder is this sweep's from the start
     stopped = None
     # a stop signal between two cases (each run records its own: cli/signals.py) ends
     # the sweep before the next, as one during a case ends it after that one
     with Interrupts(comm) as interrupts:
+        sweep.interrupts = interrupts
         for number, case in enumerate(made, start=1):
             received = interrupts.received()
             if received:
@@ -539,7 +581,7 @@ def run_sweep(comm=None):
         f"converged" + (f"; not: {', '.join(failed)}" if failed else "")
         + (f"; {len(made) - len(sweep.records)} not run" if stopped is not None else "")
         + f"; summary in {os.path.join(settings.output, 'summary.md')}")
-    database.setValue("options_left", "0")
+    PETSc.Options().setValue("options_left", "0")
     if lock is not None:    # else released when the process ends
         os.close(lock)
     if stopped is not None:

@@ -107,6 +107,19 @@ class Bodies:
         other.R = exp_rotation(steps[:, 3:]) @ self.R
         return other
 
+    def placed(self, places, held):
+        """The poses with the reference points' ``held`` components ((n, 3) bools) at
+        ``places`` (n, 3), m, and the hydrostatic reference X0 with them (as a body
+        made at that position has it); self where nothing changes."""
+        if not np.any(held) or np.array_equal(self.X[held], places[held]):
+            return self
+        other = object.__new__(Bodies)
+        other.__dict__.update(self.__dict__)
+        other.X, other.X0 = self.X.copy(), self.X0.copy()
+        other.X[held] = places[held]
+        other.X0[held] = places[held]
+        return other
+
     @property
     def positions(self):
         """(x, y, z, roll, pitch, yaw) (n, 6)."""

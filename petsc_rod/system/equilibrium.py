@@ -112,33 +112,37 @@ class State:
 @dataclass(frozen=True)
 class Loads:
     """What the continuation moves: the bodies' external loads (n_bodies, 6), the free
-    points' forces (n_free, 3) and the held points' positions (n_points, 3) (the free
-    points' rows unused)."""
+    points' forces (n_free, 3), the held points' positions (n_points, 3) (the free
+    points' rows unused) and the bodies' reference points (n_bodies, 3) (their held
+    components: a body held in x, y or z moved to an offset)."""
 
     bodies: np.ndarray
     forces: np.ndarray
     held: np.ndarray
+    places: np.ndarray
 
     @classmethod
     def of(cls, system, layout):
         return cls(np.array([b.load for b in system.bodies], dtype=float).reshape(-1, 6),
                    np.array([system.points[i].force for i in layout.point_index],
                             dtype=float).reshape(-1, 3),
-                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3))
+                   np.array([p.position for p in system.points], dtype=float).reshape(-1, 3),
+                   np.array([b.position[:3] for b in system.bodies],
+                            dtype=float).reshape(-1, 3))
+
+    def _pairs(self, other):
+        return ((self.bodies, other.bodies), (self.forces, other.forces),
+                (self.held, other.held), (self.places, other.places))
 
     def towards(self, other, factor):
         """self + factor (other - self)."""
-        return Loads(*(a + factor * (b - a) for a, b in
-                       ((self.bodies, other.bodies), (self.forces, other.forces),
-                        (self.held, other.held))))
+        return Loads(*(a + factor * (b - a) for a, b in self._pairs(other)))
 
     def unloaded(self):
-        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held)
+        return Loads(0.0 * self.bodies, 0.0 * self.forces, self.held, self.places)
 
     def same(self, other):
-        return all(np.array_equal(a, b) for a, b in ((self.bodies, other.bodies),
-                                                     (self.forces, other.forces),
-                                                     (self.held, other.held)))
+        return all(np.array_equal(a, b) for a, b in self._pairs(other))
 
 
 @dataclass(frozen=True)
@@ -217,6 +221,7 @@ class Layout:
         self.point_dofs = np.arange(3 * n_free)
         self.body_dofs = 3 * n_free + np.arange(6 * n_bodies).reshape(n_bodies, 6)
         held = np.array([b.held for b in system.bodies], dtype=bool).reshape(-1, 6)
+        self.held_places = held[:, :3]
         self.free = np.concatenate([self.point_dofs, self.body_dofs[~held]])
         self.free.sort()
         self.names = ([(system.points[i].name, DOF_NAMES[k]) for i in self.point_index
@@ -234,6 +239,9 @@ class Layout:
         # a clamped or flex end at a body: its frame (a flex joint's axis) turns with the
         # body, its moment acts on it
         self.turned = np.zeros((n, 2), dtype=bool)
+        # the line's end frame a clamp or flex joint holds, body axes (Connection.
+        # line_frame); None: the reference frame at the body's start pose
+        self.frames = [[None, None] for _ in range(n)]
         for k, line in enumerate(system.lines):
             for j, connection in enumerate((line.start, line.end)):
                 if connection.to not in where:
@@ -243,6 +251,7 @@ class Layout:
                             system.points[i].kind if kind == "point" else "body")
                 if kind == "body":
                     self.turned[k, j] = connection.kind in ("clamp", "flex")
+                    self.frames[k][j] = connection.line_frame(j == 1)
                     self.body_end[k, j] = i
                     self.ends[k, j] = self.body_dofs[i]
                     self.local[k, j] = connection.local
@@ -266,6 +275,13 @@ class Layout:
         if kind == "point" and np.any(np.asarray(connection.local, dtype=float) != 0):
             raise RodInputError(f"line {line}: {which}: local {connection.local!r} at the "
                                 f"point {connection.to}, which has no axes: leave it zero")
+
+
+def _moved_where_held(new, old):
+    """Whether Body ``new`` is at ``old``'s position but in its held translations."""
+    moved = np.asarray(new.position, dtype=float) != np.asarray(old.position, dtype=float)
+    return not np.any(moved & ~np.concatenate([np.asarray(old.held[:3], dtype=bool),
+                                                np.zeros(3, dtype=bool)]))
 
 
 class SystemSolver:
@@ -333,16 +349,25 @@ class SystemSolver:
 
     def end_frames(self, state):
         """[(start frame, end frame)] per line: a clamp at a body's (3, 3), rows d1, d2,
-        d3, turning with it: the line's start frame (the reference, frames.REFERENCE_FRAME)
-        at the body's start rotation R0, so D = D_ref R0 R^T (each row d_i = R R0^T
-        d_i,ref); None elsewhere."""
+        d3, turning with it, D = D_b R^T (each row d_i = R d_i,b), D_b the line's end
+        frame in the body's axes (Connection.line_frame), or where the connection gives
+        none the line's start frame (the reference, frames.REFERENCE_FRAME) at the
+        body's start rotation R0, D_b = D_ref R0; None elsewhere. A flex joint's axis
+        turns with the same D (held_line.HeldLine: a = D^T D_ref a_0)."""
         layout, bodies = self.layout, state.bodies
         out = []
         for k in range(len(self.system.lines)):
-            out.append(tuple(
-                REFERENCE_FRAME @ bodies.R0[layout.body_end[k, j]]
-                @ bodies.R[layout.body_end[k, j]].T if layout.turned[k, j] else None
-                for j in (0, 1)))
+            ends = []
+            for j in (0, 1):
+                body = layout.body_end[k, j]
+                if not layout.turned[k, j]:
+                    ends.append(None)
+                    continue
+                frame = layout.frames[k][j]
+                if frame is None:
+                    frame = REFERENCE_FRAME @ bodies.R0[body]
+                ends.append(frame @ bodies.R[body].T)
+            out.append(tuple(ends))
         return out
 
     def evaluate(self, state, strict=False):
@@ -528,7 +553,8 @@ class SystemSolver:
         put at its positions), or (None, its iterations) with self.failure saying why.
         self.forces/stiffnesses: the lines' at the returned state."""
         settings, free, held = self.settings, self.layout.free, self.layout.held_points
-        state = State(state.points.copy(), state.bodies)
+        state = State(state.points.copy(),
+                      state.bodies.placed(loads.places, self.layout.held_places))
         state.points[held] = loads.held[held]
         ok, forces, stiffness = self.evaluate(state)
         if not ok:
@@ -668,20 +694,23 @@ class SystemSolver:
 
     def replace(self, system):
         """Take ``system``'s loads: RodInputError unless it differs from the solver's
-        only in the bodies' loads, the points' forces and the held points' positions."""
+        only in the bodies' loads, the points' forces, the held points' positions and
+        the bodies' reference points in their held translations."""
         old = self.system
         same = (repr(system.lines) == repr(old.lines)
                 and repr(system.environment) == repr(old.environment)
                 and len(system.points) == len(old.points)
                 and len(system.bodies) == len(old.bodies)
-                and all(replace(new, load=b.load) == b
+                and all(replace(new, load=b.load, position=b.position) == b
+                        and _moved_where_held(new, b)
                         for new, b in zip(system.bodies, old.bodies))
                 and all(replace(new, force=p.force, position=p.position) == p
                         for new, p in zip(system.points, old.points)))
         if not same:
             raise RodInputError("system: a solver re-solves its system under other body "
-                                "loads, point forces or held points' positions only; make a "
-                                "new one for any other change")
+                                "loads, point forces or held points' positions (and "
+                                "bodies' positions in their held translations) only; make "
+                                "a new one for any other change")
         self.system = system
 
     def result(self, factor, iterations, halvings, stable=None):

@@ -98,7 +98,7 @@ from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_ang
                                          slope_factor)
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
-from petsc_rod.model.system_check import connection_position
+from petsc_rod.model.system_check import connection_frame, connection_position
 from petsc_rod.quantities.riser_numbers import (_extreme, effective_tension,
                                              points_on_held_ends, top_end, touchdown)
 from petsc_rod.scenes import starts
@@ -319,22 +319,29 @@ class HeldLine:
         self.name = "the line"              # how a refusal names it (of_system_line)
 
     @classmethod
-    def of_system_line(cls, line, start, end, comm, environment, options=None):
+    def of_system_line(cls, line, start, end, comm, environment, options=None,
+                       frames=(None, None)):
         """The HeldLine of a model.system.SystemLine ``line`` whose ends are first at
         ``start`` and ``end`` ((3,), m, absolute: where the system's points and bodies
         put its connections): a 'pin' connection a pinned End, 'flex' a pinned End with
-        the connection's rotational stiffness (its axis the line's start direction),
-        'clamp' a clamped End in the reference frame at the start (a system then passes
-        the frame turned with its body to solve, and a flex joint's support frame
-        likewise)."""
-        def end_of(connection, position):
+        the connection's rotational stiffness (its axis the line's start direction, or
+        with a Connection.direction the reference d3 e_x, which the support's frame
+        given to solve turns: a = D^T D_ref e_x, D's d3), 'clamp' a clamped End in
+        ``frames`` ((3, 3) global, or None: the reference frame) at the start (a system
+        then passes the frame turned with its body to solve, and a flex joint's support
+        frame likewise)."""
+        def end_of(connection, position, frame):
             kind = "clamp" if connection.kind == "clamp" else "pin"
             stiffness = connection.stiffness if connection.kind == "flex" else None
+            axis = (tuple(REFERENCE_FRAME[2]) if stiffness is not None
+                    and connection.direction is not None else None)
+            frame = (tuple(float(v) for v in np.ravel(frame))
+                     if kind == "clamp" and frame is not None else None)
             return End(kind=kind, position=tuple(float(v) for v in position),
-                       stiffness=stiffness)
+                       stiffness=stiffness, axis=axis, frame=frame)
 
-        span = Span(line.line, end_of(line.start, start), end_of(line.end, end),
-                    tuple(line.attachments))
+        span = Span(line.line, end_of(line.start, start, frames[0]),
+                    end_of(line.end, end, frames[1]), tuple(line.attachments))
         held = cls(span, comm, environment, options)
         held.name = f"line {line.name}"
         return held
@@ -928,7 +935,9 @@ def held_lines(system, options=None):
     """The ``make_line(system_line, comm)`` of system/equilibrium.SystemSolver for the
     real lines of ``system`` (a model.system.System): each a HeldLine whose ends are
     first where the system's points and bodies put its connections at their start
-    positions (system_check.connection_position), in the system's environment, tuned
+    positions (system_check.connection_position), a clamp's frame where its
+    Connection.direction puts it at its body's start pose (connection_frame), in the
+    system's environment, tuned
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
@@ -938,6 +947,10 @@ def held_lines(system, options=None):
     def make_line(line, comm):
         start, end = (connection_position(system.node(c.to), c)
                       for c in (line.start, line.end))
-        return HeldLine.of_system_line(line, start, end, comm, system.environment, options)
+        frames = tuple(connection_frame(system.node(c.to), c, e == 1)
+                       if c.kind == "clamp" and not hasattr(system.node(c.to), "kind")
+                       else None for e, c in enumerate((line.start, line.end)))
+        return HeldLine.of_system_line(line, start, end, comm, system.environment, options,
+                                       frames)
 
     return make_line

@@ -26,10 +26,11 @@ COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
 TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
 
 
-def moored(kind="clamp"):
+def moored(kind="clamp", framed=False):
     """A small buoyant body (1 t, 1.2 m^3) under a load, on three springs at 120
     degrees and a 100 m riser of 10 N/m and EI 50 N m^2 hanging from it (``kind`` at the
-    body) to an anchor 80 m away and 21 m down."""
+    body; ``framed``: its Connection's direction (0.3, 0.2, -1) in the body's axes, a
+    clamp twisted by 0.3 rad about it) to an anchor 80 m away and 21 m down."""
     headings = np.radians([90.0, 210.0, 330.0])
     out = np.stack([np.cos(headings), np.sin(headings), np.zeros(3)], axis=1)
     points = [Point(f"anchor{i}", "fixed", tuple(25.0 * out[i] + (0, 0, -10.0)))
@@ -38,8 +39,10 @@ def moored(kind="clamp"):
                   end_local=tuple(out[i] + (0, 0, -1.0))) for i in range(3)]
     riser = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
                         elements=40)
+    frame = ({"direction": (0.3, 0.2, -1.0), "twist": 0.3 if kind == "clamp" else None}
+             if framed else {})
     lines.append(SystemLine("riser", riser, Connection(
-        "buoy", (0.0, 0.0, -1.0), kind, 200.0 if kind == "flex" else None),
+        "buoy", (0.0, 0.0, -1.0), kind, 200.0 if kind == "flex" else None, **frame),
         Connection("foot")))
     body = Body("buoy", mass=1000.0, cog=(0.0, 0.0, -0.5), volume=1.2, cob=(0.0, 0.0, -0.3),
                 waterplane_area=1.0, waterplane_moments=(1.0, 1.0),
@@ -58,8 +61,10 @@ def factory(system):
 
 @pytest.mark.parametrize("comm", list(COMMS))
 @pytest.mark.parametrize("kind", ["clamp", "flex"])
-def test_a_body_on_a_clamped_riser_balances_and_its_stiffness_is_the_derivative(comm, kind):
-    system = moored(kind)
+@pytest.mark.parametrize("framed", [False, True], ids=["reference frame", "given frame"])
+def test_a_body_on_a_clamped_riser_balances_and_its_stiffness_is_the_derivative(comm, kind,
+                                                                               framed):
+    system = moored(kind, framed)
     solver = SystemSolver(system, factory(system), COMMS[comm], settings=Settings(rtol=1e-12))
     try:
         result = solver.solve()
