@@ -104,3 +104,25 @@ def test_the_liftings_are_the_unconstrained_products(solver_factory, comm):
         assert total >= 2
         for obj in (full, x, lift):
             obj.destroy()
+
+
+def test_strains_of_many_points_hold_no_array_of_their_size_but_the_answer():
+    import tracemalloc
+
+    from petsc_rod.frames import strains
+    rng = np.random.default_rng(3)
+    n = 40000
+    d, dd = rng.normal(size=(n, 3, 3)), rng.normal(size=(n, 3, 3))
+    d[7] = 0.0                                  # a singular frame: the pseudo-inverse
+    tracemalloc.start()
+    try:
+        u = strains(d, dd)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    # the answer (n, 3) and blocks of points; at once: inverses, rates (n, 3, 3) each
+    assert peak < u.nbytes + d.nbytes
+    # each point's strains are its own: the same bits as the points one block apart
+    assert np.array_equal(u[1:2], strains(d[1:2], dd[1:2]))
+    assert np.array_equal(u[-3:], strains(d[-3:], dd[-3:]))
+    assert np.all(np.isfinite(u))
