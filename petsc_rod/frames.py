@@ -9,6 +9,8 @@ import numpy as np
 REFERENCE_FRAME = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 # |det D| below which strains() takes the pseudo-inverse of a frame
 SINGULAR_FRAME = 1e-12
+# Points whose strains strains() computes at once.
+STRAIN_BLOCK = 8192
 
 
 def strains(d, dd):
@@ -28,6 +30,18 @@ def strains(d, dd):
     shape = np.shape(d)
     d = np.asarray(d, dtype=float).reshape(-1, 3, 3)
     dd = np.asarray(dd, dtype=float).reshape(-1, 3, 3)
+    u = np.empty((d.shape[0], 3))
+    # in blocks of points: the inverses and rates of a long line's points at once were
+    # several arrays of its size beside the run's (docs/performance.md, "Memory for
+    # long lines"); each point's value is its own
+    for start in range(0, d.shape[0], STRAIN_BLOCK):
+        block = slice(start, start + STRAIN_BLOCK)
+        u[block] = _strains(d[block], dd[block])
+    return u.reshape(shape[:-1])
+
+
+def _strains(d, dd):
+    """strains of (n, 3, 3) frames d and their derivatives dd, (n, 3)."""
     transposed = np.swapaxes(d, -1, -2)
     inverse = np.empty_like(d)
     regular = np.abs(np.linalg.det(d)) > SINGULAR_FRAME
@@ -36,7 +50,7 @@ def strains(d, dd):
     rate = np.einsum("nji,njk->nik", dd, inverse)
     omega = 0.5 * np.stack([rate[:, 2, 1] - rate[:, 1, 2], rate[:, 0, 2] - rate[:, 2, 0],
                             rate[:, 1, 0] - rate[:, 0, 1]], axis=-1)
-    return np.einsum("nic,nc->ni", d, omega).reshape(shape[:-1])
+    return np.einsum("nic,nc->ni", d, omega)
 
 
 def split_coefficients(stiffness):

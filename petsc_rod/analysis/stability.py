@@ -66,42 +66,51 @@ class StabilityTest(SecondVariation):
     def _create_solver(self):
         """One LDL^T (global_step/ksp.direct_factor: MUMPS's, by substructuring on several
         ranks) for H - shift M at every shift: the symbolic factorisation is made once,
-        the numeric one per shift. With a follower load the factored matrix leaves out
-        the resultants' identity rows (``_kept``): they are decoupled from the rest with
-        eigenvalue 1 (nothing to count), and they made MUMPS's analysis on several ranks
-        slow (docs/performance.md)."""
-        self._kept = self._kept_mass = self._kept_rows = None
+        the numeric one per shift. H itself is factored, its diagonal shifted for the
+        factorisation and put back after it (M is diagonal): no copy of H is kept beside
+        the factor (docs/performance.md, "Memory for long lines"). With a follower load
+        the factored matrix is a submatrix that leaves out the resultants' identity rows
+        (``_kept``): they are decoupled from the rest with eigenvalue 1 (nothing to
+        count), and they made MUMPS's analysis on several ranks slow
+        (docs/performance.md)."""
+        self._kept = self._kept_mass = self._kept_rows = self.shifted = None
         if self.resultants:
             start, end = self.matrix.getOwnershipRange()
             kept = np.setdiff1d(np.arange(start, end), self.resultant_rows)
             self._kept_rows = kept - start          # local rows of the factored matrix
             self._kept = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=self.comm)
             self.shifted = self.matrix.createSubMatrix(self._kept, self._kept)
+            self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             view = self.mass.getSubVector(self._kept)
             self._kept_mass = view.copy()
             self.mass.restoreSubVector(self._kept, view)
+            self._shift_work = self.shifted.createVecLeft()
         else:
-            self.shifted = self.matrix.duplicate(copy=True)
-        self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        self._shift_work = self.shifted.createVecLeft()
+            self._shift_work = self.matrix.createVecLeft()
+        self._unshifted = self._shift_work.duplicate()      # the diagonal put back
         # the factored rows come node by node: block less the resultants' three
         kept_block = self.block - 3 * int(self.resultants)
-        self.solver = direct_factor(self.shifted, PETSc.PC.Type.CHOLESKY, kept_block,
-                                    INERTIA_PREFIX)
+        self.solver = direct_factor(self.shifted or self.matrix, PETSc.PC.Type.CHOLESKY,
+                                    kept_block, INERTIA_PREFIX)
 
     def factorise(self, shift):
         """Factor H - shift M (the constraint solves of the previous factorisation are
-        dropped)."""
+        dropped); H is as it was afterwards."""
         self._drop_constraint_solves()
         if self._kept is None:
-            self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            factored = self.matrix
             self.mass.copy(self._shift_work)
         else:
-            self.matrix.createSubMatrix(self._kept, self._kept, submat=self.shifted)
+            factored = self.matrix.createSubMatrix(self._kept, self._kept, submat=self.shifted)
             self._kept_mass.copy(self._shift_work)
+        factored.getDiagonal(self._unshifted)
         self._shift_work.scale(-shift)
-        self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
-        self.solver.set_up(self.shifted)
+        factored.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
+        try:
+            self.solver.set_up(factored)
+        finally:
+            if factored is self.matrix:
+                factored.setDiagonal(self._unshifted)
         self._factored = True
 
     def solve(self, rhs):
@@ -232,7 +241,8 @@ class StabilityTest(SecondVariation):
 
     def destroy(self):
         self._drop_constraint_solves()
-        for obj in [self.solver, self.shifted, self._shift_work,
-                    *[obj for obj in (self._kept, self._kept_mass) if obj is not None]]:
+        for obj in [self.solver, self._shift_work, self._unshifted,
+                    *[obj for obj in (self.shifted, self._kept, self._kept_mass)
+                      if obj is not None]]:
             obj.destroy()
         super().destroy()

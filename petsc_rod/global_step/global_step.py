@@ -97,6 +97,15 @@ class GlobalStep:
             term.build(matrices[2], penalty)
         EVENTS["assembly"].end()
 
+    def unconstrained_slope_matrix(self):
+        """The slope problem's matrix as build assembles it, before its prescribed rows
+        and columns are cleared (the problems keep only the constrained one): a new Mat,
+        the caller's to destroy (validation/roundoff.py)."""
+        matrices = self.coefficients.global_step_matrices(2, self.penalty)
+        for term in self.terms:
+            term.add_slope_matrices(matrices)
+        return assemble_matrix(self.mesh, matrices)
+
     def ksps(self):
         """Every KSP of the global step: d1, d2, the slope, and the terms' (the height's
         with a seabed)."""

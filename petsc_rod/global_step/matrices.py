@@ -48,24 +48,22 @@ class ScalarProblem:
         self.mesh = mesh
         self.name = prefix
         self._rows = element_rows(mesh)
-        self.full = assemble_matrix(mesh, element_matrices)
-        self.constrained = self.full.duplicate(copy=True)
-        start, end = self.full.getOwnershipRange()
+        self.constrained = assemble_matrix(mesh, element_matrices)
+        start, end = self.constrained.getOwnershipRange()
         self.fixed_rows = np.array([2 * v + s for v, s, _ in prescribed], dtype=PETSc.IntType)
         self._owned = (self.fixed_rows >= start) & (self.fixed_rows < end)
-        self.constrained.zeroRowsColumns(self.fixed_rows[self._owned], diag=1.0)
-        self.constrained.setOption(PETSc.Mat.Option.SPD, True)
         self._local_rows = self.fixed_rows[self._owned] - start
         self._fixed_values = np.zeros((int(self._owned.sum()), 3))
-        self._lift = [self.full.createVecLeft() for _ in range(3)]
-        self._work = self.full.createVecLeft()
+        self._couplings(start)
+        self.constrained.zeroRowsColumns(self.fixed_rows[self._owned], diag=1.0)
+        self.constrained.setOption(PETSc.Mat.Option.SPD, True)
         self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
         self.ksp.setUp()
         self._report_failed_factorisation()
         self._factor, self._columns = self._direct_solver()
         self._blocks = []           # dense right-hand sides and solutions for MatMatSolve
         if self._factor is not None:
-            sizes = [(end - start, self.full.getSize()[0]), (3, 3)]
+            sizes = [(end - start, self.constrained.getSize()[0]), (3, 3)]
             self._blocks = [PETSc.Mat().createDense(sizes, comm=mesh.comm) for _ in range(2)]
             for block in self._blocks:
                 block.setUp()
@@ -105,7 +103,7 @@ class ScalarProblem:
         correction x - mu w keeps the prescribed values), and c.w = c0^T A^-1 c0 > 0.
         ``element_integrals`` (ne, 3) are the element contributions int_e phi_k dS.
         """
-        c = self.full.createVecLeft()
+        c = self.constrained.createVecLeft()
         c.setValues(self._rows.ravel(), np.ravel(element_integrals),
                     addv=PETSc.InsertMode.ADD_VALUES)
         c.assemble()
@@ -119,19 +117,42 @@ class ScalarProblem:
         self._border = [c, w]
         self._c_dot_w = c.dot(w)
 
+    def _couplings(self, start):
+        """The columns of the unconstrained matrix at the prescribed dofs, A e_j, on the
+        owned rows they reach (``_coupled_rows``, local; ``_coupling`` (rows, prescribed
+        dofs)), before its prescribed rows and columns are cleared: all the lifting
+        needs of it, so that the matrix is not kept twice. Collective."""
+        matrix = self.constrained
+        unit, column = matrix.createVecs()
+        columns = []
+        try:
+            for j in self.fixed_rows:
+                unit.zeroEntries()
+                if start <= j < start + unit.getLocalSize():
+                    unit.getArray()[j - start] = 1.0
+                matrix.mult(unit, column)
+                columns.append(column.getArray(readonly=True).copy())
+        finally:
+            unit.destroy()
+            column.destroy()
+        columns = np.array(columns).reshape(len(self.fixed_rows), -1).T
+        self._coupled_rows = np.flatnonzero(np.any(columns != 0.0, axis=1))
+        self._coupling = columns[self._coupled_rows]
+
     def set_prescribed(self, prescribed):
-        """New prescribed values (same rows); computes the lifting A_full x_bc once, kept
-        sparse: it is nonzero only on the rows coupled to a prescribed one."""
-        self._fixed_values = np.array([value for _, _, value in prescribed]).reshape(-1, 3)[
-            self._owned]
-        for c, lift in enumerate(self._lift):
-            self._work.zeroEntries()
-            self._work.getArray()[self._local_rows] = self._fixed_values[:, c]
-            self.full.mult(self._work, lift)
-            lift.getArray()[self._local_rows] = 0.0
-        lifts = np.stack([lift.getArray(readonly=True) for lift in self._lift], axis=1)
-        self._lift_rows = np.flatnonzero(np.any(lifts != 0.0, axis=1))
-        self._lift_values = lifts[self._lift_rows]
+        """New prescribed values (same rows); computes the lifting A_full x_bc, kept
+        sparse: it is nonzero only on the rows coupled to a prescribed one. Summed over
+        the prescribed dofs in the order of their rows, as a product with A_full would
+        sum them."""
+        values = np.array([value for _, _, value in prescribed]).reshape(-1, 3)
+        self._fixed_values = values[self._owned]
+        lifts = np.zeros((len(self._coupled_rows), 3))
+        for j in np.argsort(self.fixed_rows, kind="stable"):
+            lifts += self._coupling[:, j, None] * values[j]
+        lifts[np.isin(self._coupled_rows, self._local_rows)] = 0.0
+        nonzero = np.any(lifts != 0.0, axis=1)
+        self._lift_rows = self._coupled_rows[nonzero]
+        self._lift_values = lifts[nonzero]
 
     def solve(self, rhs, solution, components=(0, 1, 2)):
         """Solve for the given components (x, y, z by default): rhs, solution are
@@ -204,7 +225,7 @@ class ScalarProblem:
     def _report_failed_factorisation(self):
         """One solve with a zero right-hand side: KSPSolve is what reports a failed set-up
         (this petsc4py has no PCGetFailedReason), and the MatMatSolve path skips it."""
-        zero = self.full.createVecLeft()
+        zero = self.constrained.createVecLeft()
         solution = zero.duplicate()
         try:
             self._solve_one(zero, solution)
@@ -217,8 +238,7 @@ class ScalarProblem:
         check_solved(self.ksp, self.name)
 
     def destroy(self):
-        for obj in [self.ksp, self.full, self.constrained, self._work] + self._blocks \
-                + self._lift + self._border:
+        for obj in [self.ksp, self.constrained] + self._blocks + self._border:
             obj.destroy()
 
 

@@ -118,6 +118,9 @@ class UzawaSolver:
                     # one iteration before, showed it stable
                     step.stability_tested(True)
                     break
+                # the iteration's work is not needed while H is factored: its memory
+                # goes to the factorisation (the next solve sets the SNES up again)
+                self.release_work()
                 try:
                     stable, direction = self.check_stability()
                 except np.linalg.LinAlgError:
@@ -225,6 +228,16 @@ class UzawaSolver:
             angle = step.escape_angle(early=True)
             if angle is not None:
                 self._turn(angle, direction)
+
+    def release_work(self):
+        """Free the SNES's work vectors, Anderson's history among them (2 m + 5 vectors
+        of the node state, 576 bytes per element per unit of depth m, and five more:
+        docs/performance.md, "Memory for long lines"), until its next solve sets it up
+        again. Each solve starts its history empty, so the iterates are the same."""
+        self.snes.reset()
+        # SNESReset drops the residual vector with the rest: give it back, so that the
+        # next set-up does not make another
+        self.snes.setFunction(self._fixed_point_residual, self._f)
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state: the verdict of the

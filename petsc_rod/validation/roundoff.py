@@ -51,7 +51,7 @@ def centreline_solve_error(problem, t=1.0):
     The right-hand side is A slope* (+ mu int g), with A the full slope matrix; the
     solve is the run's (GlobalStep.solve_centreline). Overwrites the problem's state.
     """
-    mesh, slope_problem = problem.mesh, problem.global_step.slope_problem
+    mesh = problem.mesh
     problem.prepare(t)
     start, end = problem.start_state, problem.end_state
     nodal = quadratic_slope(mesh.length, start, end)
@@ -67,8 +67,10 @@ def centreline_solve_error(problem, t=1.0):
     contributions = element_integrals(mesh.element_h)[:, :, None] * bordered
     problem.global_step.rhs[2].add_ghosted(scatter_element_vectors(
         mesh.ghost_end - mesh.ghost_start, mesh.element_local, P2, contributions))
+    full = problem.global_step.unconstrained_slope_matrix()
     for x, b in zip(problem.state.slope.components, problem.global_step.rhs[2].components):
-        slope_problem.full.multAdd(x, b, b)
+        full.multAdd(x, b, b)
+    full.destroy()
     problem.global_step.solve_centreline(problem.state)
     exact = exact_centreline(mesh.length, nodal, start, end, S)
     error = mesh.global_max(float(np.abs(problem.state.r.owned()[:, 0] - exact).max(initial=0.0)))
