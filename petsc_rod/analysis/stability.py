@@ -192,9 +192,13 @@ class StabilityTest(SecondVariation):
         return self.problem.mesh.global_min(float(bound.min(initial=0.0)))
 
     def descent_direction(self):
-        """A unit rotation-vector field of negative curvature, (n_nodes, 3) (on an
-        extensible line (n_nodes, 4): the rotation vector and the stretch k), or None when
-        H has no eigenvalue below -tolerance() on the constraint set. The lowest
+        """A unit rotation-vector field along the mode of H's lowest eigenvalue, (n_nodes,
+        3) (on an extensible line (n_nodes, 4): the rotation vector and the stretch k), or
+        None when H has no eigenvalue below -tolerance() on the constraint set. The field
+        is an escape direction, not the eigenvector: the iteration solves without the
+        chord constraint and the last projection onto it adds a node-to-node zigzag, so
+        its own curvature can be positive while it lies mostly along the mode
+        (docs/stability.md, "The direction at a saddle"). The lowest
         eigenvalue is bracketed by bisection on the inertia between the Gershgorin bound
         and -tolerance to within a factor 2, and inverse iteration at the lower end
         converges to its eigenvector at a rate of at most 1/2 per step."""
