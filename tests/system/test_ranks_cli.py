@@ -1,0 +1,44 @@
+"""The command line on two ranks with a short line run whole on rank 0
+(-rod_ranks_split auto, cli/ranks.py): the lines of the one-rank run, said once, the
+same result file and table, and a bad value refused in one line with exit 2."""
+
+import re
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import describe, run_petsc_rod
+
+pytestmark = pytest.mark.serial
+
+# options/cantilever.opts on 16 elements: below the cost model's crossover
+SHORT = ["-options_file", "options/cantilever.opts", "-rod_elements", "16"]
+CLOCK = re.compile(r"in [0-9.e+-]+ s")
+
+
+def test_a_short_line_on_two_ranks_says_and_writes_what_one_rank_does(tmp_path):
+    runs = {}
+    for ranks in (1, 2):
+        output, table = tmp_path / f"r{ranks}.h5", tmp_path / f"r{ranks}.csv"
+        done = run_petsc_rod(SHORT + ["-rod_output", str(output), "-rod_table", str(table)],
+                             ranks=ranks)
+        assert done.returncode == 0, describe(done)
+        assert done.stderr.strip() == "", describe(done)
+        lines = [CLOCK.sub("in T s", line).replace(f"r{ranks}.", "r.")
+                 for line in done.stdout.splitlines()]
+        runs[ranks] = lines, output, table
+    (one, file_one, table_one), (two, file_two, table_two) = runs[1], runs[2]
+    assert two == one
+    assert table_two.read_text() == table_one.read_text()
+    with h5py.File(file_one, "r") as f, h5py.File(file_two, "r") as g:
+        for name in ("r", "d1", "d2", "d3", "state/tau", "state/lambda"):
+            assert np.array_equal(f[name][:], g[name][:]), name
+        assert int(g.attrs["iterations"]) == int(f.attrs["iterations"])
+
+
+def test_a_bad_placement_exits_2_in_one_line():
+    done = run_petsc_rod(SHORT + ["-rod_ranks_split", "halves"])
+    assert done.returncode == 2, describe(done)
+    assert done.stdout.splitlines() == [
+        "petsc_rod: error: -rod_ranks_split halves: expected one of auto|whole|split"]
