@@ -5,13 +5,18 @@ waits for a failure of rank 0 as one. Serially both runs are one rank's; under
 ``mpiexec -n 2`` the second rank waits while the first runs the line."""
 
 import os
+import signal
+import time
 
 import h5py
 import numpy as np
+import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from petsc_rod.cli import main
+from petsc_rod.cli.ranks import run_whole
+from petsc_rod.errors import RodError, RodInterrupted, RodIOError
 
 # a clamped-pinned rod of 12 elements, two steps (under a second of solve)
 ROD = {"rod_length": "1", "rod_stiffness": "1,1.3,0.9", "rod_start": "clamp",
@@ -89,3 +94,46 @@ def test_a_bad_placement_is_refused_in_one_line(capfd):
     lines = capfd.readouterr().out.splitlines()
     expected = ["petsc_rod: error: -rod_ranks_split half: expected one of auto|whole|split"]
     assert lines == (expected if PETSc.COMM_WORLD.getRank() == 0 else [])
+
+
+class Recorded:
+    """A run's signals.Interrupts as the handler leaves it: ``signal_number``."""
+
+    def __init__(self, number):
+        self.signal_number = number
+
+    @staticmethod
+    def name(number):
+        return str(number)
+
+
+def test_a_stop_signal_of_the_last_rank_reaches_the_whole_run():
+    """The last rank received SIGUSR1 (rank 0 itself on one rank): rank 0's work asks
+    for a signal and gets it; every rank returns what the work returned."""
+    world = PETSc.COMM_WORLD
+    last = world.getRank() == world.getSize() - 1
+    interrupts = Recorded(signal.SIGUSR1 if last else 0)
+
+    def work(line_comm, stops):
+        assert line_comm.getSize() == 1
+        deadline = time.monotonic() + 20.0
+        while time.monotonic() < deadline:
+            if stops.received():
+                return stops.received()
+            time.sleep(0.001)
+        return 0
+
+    assert run_whole(world, work, interrupts) == signal.SIGUSR1
+
+
+@pytest.mark.parametrize("raised, code", [
+    (RodInterrupted("interrupted by SIGTERM", signal.SIGTERM), 128 + signal.SIGTERM),
+    (RodIOError("the disk is full"), 5)])
+def test_the_whole_run_s_error_is_raised_on_every_rank(raised, code):
+    def work(line_comm, stops):
+        raise raised
+
+    with pytest.raises(RodError) as error:
+        run_whole(PETSc.COMM_WORLD, work, Recorded(0))
+    assert error.value.exit_code == code and str(error.value) == str(raised)
+    assert getattr(error.value, "signal_number", 0) == getattr(raised, "signal_number", 0)
