@@ -11,9 +11,13 @@ error (a RodError's, a PETSc error's as exit 4, anything else raised on every ra
 when every rank fails), and a stop signal that any rank receives stops the run: a waiting
 rank hands its signal to rank 0, which asks for it after every iteration
 (WholeInterrupts). The waiting ranks sleep between polls, so they leave their cores to
-other work.
+other work, and rank 0 may run on any core of the job's ranks while it works alone
+(job_cores: mpiexec binds each rank to a core of its own, where a one-rank run may move
+to the less busy core).
 """
 
+import contextlib
+import os
 import time
 
 from mpi4py import MPI
@@ -64,11 +68,38 @@ def run_whole(comm, work, interrupts=None):
     signals.Interrupts (None: none asked). Collective."""
     channel = comm.tompi4py().Dup()
     try:
+        cores = channel.allgather(_cores())
         if channel.Get_rank() == 0:
-            return _lead(channel, work, interrupts)
+            with job_cores(set().union(*cores)):
+                return _lead(channel, work, interrupts)
         return _wait(channel, interrupts)
     finally:
         channel.Free()
+
+
+def _cores():
+    """The cores this process may run on (empty where the system does not say)."""
+    with contextlib.suppress(AttributeError, OSError):
+        return set(os.sched_getaffinity(0))
+    return set()
+
+
+@contextlib.contextmanager
+def job_cores(cores):
+    """Within the block this process may run on any of ``cores`` (the job's ranks'),
+    its own affinity put back after it; nothing where the system cannot set it."""
+    own = _cores()
+    widened = False
+    if own and cores - own:
+        with contextlib.suppress(OSError):
+            os.sched_setaffinity(0, cores)
+            widened = True
+    try:
+        yield
+    finally:
+        if widened:
+            with contextlib.suppress(OSError):
+                os.sched_setaffinity(0, own)
 
 
 def _lead(channel, work, interrupts):
