@@ -411,6 +411,9 @@ OPTIONS = [
            "text"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
+# Options of how a run is made, not of what it solves: a result file's parameters
+# without them are not an older version's (cli/line_run.walked_scene).
+HOW_RUN = ("rod_ranks_split",)
 
 
 def read_options():

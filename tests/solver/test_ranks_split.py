@@ -137,3 +137,21 @@ def test_the_whole_run_s_error_is_raised_on_every_rank(raised, code):
         run_whole(PETSc.COMM_WORLD, work, Recorded(0))
     assert error.value.exit_code == code and str(error.value) == str(raised)
     assert getattr(error.value, "signal_number", 0) == getattr(raised, "signal_number", 0)
+
+
+def test_a_file_without_the_placement_still_walks_its_restart(shared_tmp, capfd):
+    """A result file written before -rod_ranks_split (its parameters without it) is not
+    taken for an older version's: a restart under another end force walks from its
+    scene."""
+    path = os.path.join(shared_tmp, "before.h5")
+    assert main.run(PETSc.COMM_WORLD, {**ROD, "rod_output": path}) == 0
+    if PETSc.COMM_WORLD.getRank() == 0:
+        with h5py.File(path, "r+") as f:
+            del f["parameters"].attrs["ranks_split"]
+    PETSc.COMM_WORLD.tompi4py().Barrier()
+    capfd.readouterr()
+    moved = {**ROD, "rod_end_position": "0.6,0.5,0.3", "rod_initial": path}
+    assert main.run(PETSc.COMM_WORLD, moved) == 0
+    out = capfd.readouterr().out
+    if PETSc.COMM_WORLD.getRank() == 0:
+        assert "restart: walks from the file's scene" in out and "lack" not in out, out
