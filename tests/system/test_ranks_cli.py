@@ -42,3 +42,29 @@ def test_a_bad_placement_exits_2_in_one_line():
     assert done.returncode == 2, describe(done)
     assert done.stdout.splitlines() == [
         "petsc_rod: error: -rod_ranks_split halves: expected one of auto|whole|split"]
+
+
+def test_the_scenes_benchmark_times_each_scene_on_one_and_two_ranks():
+    """scripts/benchmark_scenes.py on two rods, one pair, with --fit: a row a scene with
+    its elements, auto's placement, the times and the pairs' ratio; the constants
+    fitted; no file written with --only."""
+    import subprocess
+    import sys
+
+    from helpers import REPO_ROOT, child_env
+
+    done = subprocess.run([sys.executable, "scripts/benchmark_scenes.py", "--only", "twist",
+                           "cantilever", "--pairs", "1", "--fit"], cwd=REPO_ROOT,
+                          env=child_env(), capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, describe(done)
+    rows = [line.split(" | ") for line in done.stdout.splitlines()
+            if line.startswith(("| twist", "| cantilever"))]
+    assert [(row[0], row[1], row[2]) for row in rows] == [("| cantilever", "64", "whole"),
+                                                        ("| twist", "32", "whole")]
+    for row in rows:
+        one, two, ratio = (float(cell) for cell in row[3:6])
+        assert one > 0 and two > 0 and ratio == pytest.approx(two / one, rel=0.02)
+        first, second = row[6].rstrip(" |").split(" / ")
+        assert int(first) == int(second) > 0        # whole on 2 ranks: the 1-rank run
+    assert "WHOLE = IterationCost(fixed=" in done.stdout and "N* = " in done.stdout
+    assert "load average" in done.stdout
