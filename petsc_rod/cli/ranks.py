@@ -11,9 +11,9 @@ error (a RodError's, a PETSc error's as exit 4, anything else raised on every ra
 when every rank fails), and a stop signal that any rank receives stops the run: a waiting
 rank hands its signal to rank 0, which asks for it after every iteration
 (WholeInterrupts). The waiting ranks sleep between polls, so they leave their cores to
-other work, and rank 0 may run on any core of the job's ranks while it works alone
-(job_cores: mpiexec binds each rank to a core of its own, where a one-rank run may move
-to the less busy core).
+other work, and rank 0 may run on any core of the job's ranks on its machine while it
+works alone (job_cores: mpiexec binds each rank to a core of its own, where a one-rank
+run may move to the less busy core).
 """
 
 import contextlib
@@ -68,9 +68,9 @@ def run_whole(comm, work, interrupts=None):
     signals.Interrupts (None: none asked). Collective."""
     channel = comm.tompi4py().Dup()
     try:
-        cores = channel.allgather(_cores())
-        if channel.Get_rank() == 0:
-            with job_cores(set().union(*cores)):
+        cores = channel.allgather((MPI.Get_processor_name(), _cores()))
+        if channel.Get_rank() == 0:         # the cores of the ranks on rank 0's machine
+            with job_cores(set().union(*(own for host, own in cores if host == cores[0][0]))):
                 return _lead(channel, work, interrupts)
         return _wait(channel, interrupts)
     finally:
