@@ -143,6 +143,7 @@ def main():
     parser.add_argument("--out", default=str(ROOT / "docs" / "scenes_benchmark.md"))
     arguments = parser.parse_args()
     before, started = load(), datetime.datetime.now(datetime.timezone.utc)
+    measured = commit()                 # the code the runs import, at their start
     rows, fitted = [], []
     for path in scenes(arguments.only):
         elements, runs = measure(path, arguments.pairs, arguments.fit)
@@ -157,7 +158,7 @@ def main():
         print(" | ".join(row), flush=True)
         if arguments.fit and elements:
             fitted.append((elements, per_iteration(runs["one"]), per_iteration(runs["split"])))
-    lines = [f"Measured {started:%Y-%m-%d %H:%M} UTC at commit {commit()}, {arguments.pairs} "
+    lines = [f"Measured {started:%Y-%m-%d %H:%M} UTC at commit {measured}, {arguments.pairs} "
              f"alternated pair(s) a scene; load average (1, 5, 15 min) {before} before, "
              f"{load()} after.", "",
              "| scene | elements | on 2 ranks (auto) | 1 rank (s) | 2 ranks (s) | "

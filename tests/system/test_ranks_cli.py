@@ -68,3 +68,28 @@ def test_the_scenes_benchmark_times_each_scene_on_one_and_two_ranks():
         assert int(first) == int(second) > 0        # whole on 2 ranks: the 1-rank run
     assert "WHOLE = IterationCost(fixed=" in done.stdout and "N* = " in done.stdout
     assert "load average" in done.stdout
+
+
+def test_a_sweep_of_a_short_line_on_two_ranks_runs_each_case_whole(tmp_path):
+    """python -m petsc_rod.sweep under mpiexec -n 2: each case of a 16-element cantilever
+    runs whole on rank 0 (its file says 1 rank), the summary is the 1-rank sweep's."""
+    import subprocess
+    import sys
+
+    from helpers import REPO_ROOT, child_env, mpiexec
+
+    cases = tmp_path / "cases.txt"
+    cases.write_text("rod_end_force\n0,-3,0\n0,-4,0\n")
+    summaries = {}
+    for ranks in (1, 2):
+        folder = tmp_path / f"sweep{ranks}"
+        done = subprocess.run(mpiexec(ranks) + [sys.executable, "-m", "petsc_rod.sweep"]
+                              + SHORT + ["-sweep_cases", str(cases), "-sweep_output",
+                                         str(folder)], cwd=REPO_ROOT, env=child_env(),
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, describe(done)
+        summaries[ranks] = (folder / "summary.csv").read_text()
+        for case in ("case1", "case2"):
+            with h5py.File(folder / f"{case}.h5", "r") as f:
+                assert int(f.attrs["ranks"]) == 1
+    assert summaries[2] == summaries[1]
