@@ -35,8 +35,8 @@ from petsc4py import PETSc
 
 from petsc_rod import resources
 from petsc_rod.cli import messages
-from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value,
-                                   parse_values)
+from petsc_rod.cli.options import (BY_NAME, HOW_RUN, OPTIONS, SOLVER_PREFIXES,
+                                   format_value, parse_values)
 from petsc_rod.cli.modes import check_modes_inputs, modes_asked, report_modes, solve_for_run
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
                                          restart_path, rounded_down, settings_from_options)
@@ -483,8 +483,8 @@ def walked_scene(scene, values, comm):
             f"-rod_initial {path}: written part way along a restart's walk from another "
             f"scene (s = {t_file:.6g}), its state is the equilibrium of a scene between the "
             "two; restart from the file that walk started from")
-    missing = [option.name for option in OPTIONS
-               if option.name.removeprefix("rod_") not in parameters]
+    missing = [option.name for option in OPTIONS if option.name not in HOW_RUN
+               and option.name.removeprefix("rod_") not in parameters]
     if missing:
         return scene, [f"petsc_rod: restart: the file's parameters lack -{missing[0]}"
                        f"{' and more' if len(missing) > 1 else ''}; its scene is taken as "

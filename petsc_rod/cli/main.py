@@ -16,6 +16,7 @@ from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, values_of)
 from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.ranks import run_placed
 from petsc_rod.cli.scene_options import model_from_options
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
@@ -73,8 +74,8 @@ def run(comm=None, texts=None):
                 if database.hasName("help"):
                     run_line(comm, plan, say, check_only=True)
                     return 0
-                code = run_line(comm, plan, say, options=options_record(texts),
-                                interrupts=interrupts).result.code
+                code = run_placed(comm, plan, say, options=options_record(texts),
+                                  interrupts=interrupts)
                 for name in unused_options():
                     say(f"petsc_rod: warning: option -{name} was set but not used")
                 return code

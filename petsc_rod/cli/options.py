@@ -29,6 +29,7 @@ from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_S
 from petsc_rod.iteration.driver import DEFAULT_SNES, FUNCTION_ONLY_SNES
 from petsc_rod.iteration.stopping import Settings
 from petsc_rod.mesh.mesh import Mesh
+from petsc_rod.mesh.ranks import MODES as RANKS_MODES
 from petsc_rod.model.line import DEFAULT_ELEMENTS
 from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.values import MAX_MAGNITUDE  # noqa: F401 (the options' bound)
@@ -421,8 +422,19 @@ OPTIONS = [
            f"raise R {ADAPT_FACTOR:g} times, refactoring the matrices, while it is below "
            f"{ADAPT_BELOW:g} of the default and the constraint residual stays above "
            f"{ADAPT_PROGRESS:g} of its value {ADAPT_WINDOW} iterations before"),
+    Option("rod_ranks_split", _string, "auto", "|".join(RANKS_MODES),
+           "on several ranks, the line's run split over them (split) or done whole on "
+           "the first while the others wait (whole: the answers of one rank); auto: "
+           "whole where the cost model of mesh/ranks.py, measured by "
+           "scripts/benchmark_scenes.py, predicts an iteration faster on one rank (the "
+           "short lines), split elsewhere",
+           (lambda v: v in RANKS_MODES, f"expected one of {'|'.join(RANKS_MODES)}"),
+           "text"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
+# Options of how a run is made, not of what it solves: a result file's parameters
+# without them are not an older version's (cli/line_run.walked_scene).
+HOW_RUN = ("rod_ranks_split",)
 
 
 def read_options():

@@ -295,7 +295,8 @@ def test_two_ranks_write_the_same_result(cantilever, folder):
     path, first = cantilever
     assert first.returncode == 0, describe(first)
     out = folder / "c_np2.h5"
-    process = run(cantilever_args() + ["-rod_output", str(out)], ranks=2)
+    process = run(cantilever_args() + ["-rod_output", str(out), "-rod_ranks_split", "split"],
+                  ranks=2)
     assert process.returncode == 0, describe(process)
     with h5py.File(path, "r") as f, h5py.File(out, "r") as g:
         assert int(g.attrs["ranks"]) == 2

@@ -365,7 +365,8 @@ def test_an_exception_on_one_rank_alone_ends_the_run_without_a_file(tmp_path):
     one line and exit 4, and neither the result nor its partial file is left."""
     path = tmp_path / "out.h5"
     done = run_failing_on_rank_1(tmp_path / "one_rank_fails.py", CLI_RUN,
-                                 CANTILEVER + ["-rod_output", str(path)])
+                                 CANTILEVER + ["-rod_output", str(path),
+                                               "-rod_ranks_split", "split"])
     assert_one_line_and_nothing_left(done.returncode, done.stdout, 4,
                                      ["rank 1 failed alone", "FloatingPointError",
                                       "injected on rank 1"], path)

@@ -1,0 +1,57 @@
+"""The choice between a line split over the ranks and whole on one (mesh/ranks.py):
+its decisions against its cost model, and what the measured constants decide for the
+scenes of options/."""
+
+import math
+
+import pytest
+
+from petsc_rod.mesh import ranks
+from petsc_rod.mesh.ranks import IterationCost, choose, crossover, predicted
+
+# a model with round numbers: 1 ms + 1 us an element whole, 3 ms + 0.5 us split over 2
+WHOLE = IterationCost(1e-3, 1e-6)
+SPLIT = IterationCost(3e-3, 0.5e-6)
+
+
+def test_the_crossover_is_where_the_predicted_times_meet():
+    n = crossover(2, WHOLE, SPLIT)
+    assert n == pytest.approx(4000.0)
+    below, above = predicted(n - 1, 2, WHOLE, SPLIT), predicted(n + 1, 2, WHOLE, SPLIT)
+    assert below[0] < below[1] and above[1] < above[0]
+    assert choose("auto", 3999, 2, WHOLE, SPLIT) == "whole"
+    assert choose("auto", 4001, 2, WHOLE, SPLIT) == "split"
+
+
+def test_more_ranks_split_shorter_lines():
+    assert crossover(4, WHOLE, SPLIT) == pytest.approx(2e-3 / 0.75e-6)
+    assert choose("auto", 3000, 4, WHOLE, SPLIT) == "split"
+
+
+def test_a_split_that_never_pays_and_one_that_always_does():
+    assert crossover(2, WHOLE, IterationCost(3e-3, 1e-6)) == math.inf
+    assert choose("auto", 10**9, 2, WHOLE, IterationCost(3e-3, 1e-6)) == "whole"
+    assert crossover(2, WHOLE, IterationCost(0.5e-3, 0.5e-6)) == 0.0
+
+
+def test_one_rank_is_whole_and_the_forced_modes_hold():
+    assert choose("split", 10**6, 1) == "whole"
+    assert choose("whole", 10**6, 2) == "whole"
+    assert choose("split", 8, 2) == "split"
+    with pytest.raises(ValueError, match="auto|whole|split"):
+        choose("half", 80, 2)
+
+
+# the element counts of options/ (cable_80m the shortest cable, 340 elements)
+@pytest.mark.parametrize("elements", [16, 32, 64, 80])
+def test_the_measured_model_runs_the_rods_of_options_whole(elements):
+    assert choose("auto", elements, 2) == "whole"
+
+
+@pytest.mark.parametrize("elements", [340, 707, 850, 1800, 2000, 2400, 2741, 3000, 18000])
+def test_the_measured_model_splits_the_long_lines(elements):
+    """The cables and risers of options/ (cable_80m's 340 elements the fewest),
+    cable_800m, riser_catenary, the 18 000-element riser: split, where a second rank
+    gains today."""
+    assert choose("auto", elements, 2) == "split"
+    assert ranks.WHOLE.per_element > ranks.SPLIT.per_element
