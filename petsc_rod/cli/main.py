@@ -11,7 +11,6 @@ import sys
 from petsc4py import PETSc
 
 from petsc_rod.cli.line_run import (AgreedFailures, petsc_failure, plan_line, run_line)
-from petsc_rod.cli.modes import shapes_path
 from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, values_of)
@@ -19,6 +18,7 @@ from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.scene_options import model_from_options
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
+from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io import line_table
 from petsc_rod.io.same_file import replaced_input
 

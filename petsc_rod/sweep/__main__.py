@@ -3,12 +3,14 @@
 the start of petsc_rod's own entry (petsc_rod/__main__.py: the options files checked,
 petsc4py found and started), then the sweep (sweep/runner.py)."""
 
+import os
 import sys
 
 from petsc_rod import __main__ as entry
 
 
 def main():
+    os.environ.update(entry.open_mpi_defaults(os.environ))
     error = entry.options_file_error(sys.argv)
     if error:
         if entry.launcher_rank() == 0:
