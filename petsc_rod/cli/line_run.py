@@ -35,6 +35,7 @@ from petsc4py import PETSc
 
 from petsc_rod import resources
 from petsc_rod.cli import messages
+from petsc_rod.cli.phases import OUTPUT, SETUP, STEPS
 from petsc_rod.cli.options import (BY_NAME, OPTIONS, SOLVER_PREFIXES, format_value,
                                    parse_values)
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
@@ -301,10 +302,11 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
     built, writer = BuiltLine(comm, plan), None
     try:
         with AgreedFailures(comm) as failures:
-            built.build(say)
-            if check_only:
-                return None
-            path = built.start(say)
+            with SETUP:
+                built.build(say)
+                if check_only:
+                    return None
+                path = built.start(say)
             if values["rod_output"]:
                 made = (record or default_record)(plan, built.solver, built.first_load_factor)
                 writer = failures.writer = io.ResultWriter(
@@ -316,16 +318,18 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
 
             def find_modes(writer):
                 modes.append(modes_of_run().solve_for_run(built.problem, values, writer))
-            result = built.run(path, say=say, writer=last or writer, options=options,
-                               interrupts=interrupts,
-                               before_finish=find_modes if values["rod_modes"] else None)
+            with STEPS:
+                result = built.run(path, say=say, writer=last or writer, options=options,
+                                   interrupts=interrupts,
+                                   before_finish=find_modes if values["rod_modes"] else None)
             writer = failures.writer = None             # finished
-            if result.code == 0:            # the CSV table of the converged result
-                line_table.finish_run(built.problem, values["rod_table"], say)
-                if modes:
-                    modes_of_run().report_modes(built.problem, values, modes[0], say)
-            elif values["rod_table"]:       # none for this run: not an earlier run's either
-                line_table.discard(values["rod_table"], comm, say)
+            with OUTPUT:
+                if result.code == 0:            # the CSV table of the converged result
+                    line_table.finish_run(built.problem, values["rod_table"], say)
+                    if modes:
+                        modes_of_run().report_modes(built.problem, values, modes[0], say)
+                elif values["rod_table"]:   # none for this run: not an earlier run's either
+                    line_table.discard(values["rod_table"], comm, say)
             found = modes[0][0] if modes and result.code == 0 else None
             return LineRun(result, last, built.mesh.n_elements, found)
     finally:

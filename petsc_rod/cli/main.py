@@ -15,6 +15,7 @@ from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, values_of)
 from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.phases import SETUP
 from petsc_rod.cli.scene_options import model_from_options
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
@@ -67,8 +68,9 @@ def run(comm=None, texts=None):
                 if database.hasName("help"):
                     for line in help_text():
                         say(line)
-                plan = plan_line(comm, model_from_options(values, given), values, given,
-                                 mesh_named=sections_named)
+                with SETUP:
+                    plan = plan_line(comm, model_from_options(values, given), values, given,
+                                     mesh_named=sections_named)
                 check_inputs_kept(values, comm)
                 if database.hasName("help"):
                     run_line(comm, plan, say, check_only=True)

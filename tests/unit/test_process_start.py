@@ -73,3 +73,21 @@ def test_the_command_line_imports_no_module_it_does_not_use():
                           text=True, check=False)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "[]"
+
+
+def test_log_view_names_each_phase():
+    """-log_view's stages rod_setup, rod_steps and rod_output, and the stability test's
+    event rod_stability, each with a time."""
+    done = subprocess.run(
+        [sys.executable, "-m", "petsc_rod", "-options_file", "options/cantilever.opts",
+         "-rod_elements", "8", "-rod_steps", "1", "-rod_al_newton", "0", "-log_view"],
+        cwd=REPO_ROOT, capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split(":") for line in done.stdout.splitlines() if ":" in line]
+    stages = {row[1].strip(): float(row[2].split()[0]) for row in rows
+              if row[0].strip().isdigit()}
+    assert {"rod_setup", "rod_steps", "rod_output"} <= stages.keys()
+    assert all(stages[name] > 0 for name in ("rod_setup", "rod_steps", "rod_output"))
+    events = [line.split() for line in done.stdout.splitlines()
+              if line.startswith("rod_stability ")]
+    assert len(events) == 1 and int(events[0][1]) == 1 and float(events[0][3]) > 0
