@@ -10,7 +10,8 @@ import sys
 # are busy (docs/performance.md, "Per-iteration overhead").
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from petsc_rod.cli.options_files import options_file_error  # noqa: E402  (no PETSc)
+from petsc_rod.cli.options_files import (  # noqa: E402  (no PETSc)
+    every_options_file, options_file_error)
 
 
 # Open MPI's fastest start where it cannot change what the ranks can reach: one process
@@ -63,6 +64,22 @@ def open_mpi_defaults(environ):
     if not launched and not chosen & set(SINGLETON_DEFAULTS):
         defaults.update(SINGLETON_DEFAULTS)
     return {f"OMPI_MCA_{name}": value for name, value in defaults.items()}
+
+
+def may_write_a_result(argv, environ=None):
+    """Whether the run may write a result file, whose record names the checkout's commit
+    (io/provenance.py: git, run before MPI starts): an option with 'output' in its name
+    where PETSc reads options (the command line, PETSC_OPTIONS, the options files). A run
+    without one runs no git."""
+    environ = os.environ if environ is None else environ
+    texts = [" ".join(argv[1:]), environ.get("PETSC_OPTIONS", "")]
+    for path in every_options_file(argv, environ):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as handle:
+                texts.append(handle.read())
+        except OSError:
+            return True
+    return any("output" in text for text in texts)
 
 
 def launcher_rank():
@@ -185,8 +202,9 @@ def main():
             f"({sys.executable}); install Debian's python3-petsc4py (or run scripts/setup.sh "
             "once, then `source .venv/bin/activate`)\n")
         return 2
-    from petsc_rod.io.provenance import commit
-    commit()                          # git runs before MPI starts (provenance)
+    if may_write_a_result(sys.argv):
+        from petsc_rod.io.provenance import commit
+        commit()                      # git runs before MPI starts (provenance)
     error = start_petsc(sys.argv)
     if error:
         sys.stderr.write(f"petsc_rod: error: {error}; an options file has one '-name value' "

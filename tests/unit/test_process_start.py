@@ -7,7 +7,7 @@ import sys
 
 from helpers import REPO_ROOT
 
-from petsc_rod.__main__ import open_mpi_defaults
+from petsc_rod.__main__ import may_write_a_result, open_mpi_defaults
 
 FAST = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self,vader",
         "OMPI_MCA_ess_singleton_isolated": "1"}
@@ -91,3 +91,18 @@ def test_log_view_names_each_phase():
     events = [line.split() for line in done.stdout.splitlines()
               if line.startswith("rod_stability ")]
     assert len(events) == 1 and int(events[0][1]) == 1 and float(events[0][3]) > 0
+
+
+def test_git_runs_only_for_a_run_that_may_write_a_result(tmp_path):
+    """The result file's record names the commit (git, run before MPI starts); a run
+    whose options name no output anywhere runs no git."""
+    scene = tmp_path / "scene.opts"
+    scene.write_text("-rod_length 2\n")
+    writes = tmp_path / "writes.opts"
+    writes.write_text("-options_file scene.opts\n-rod_output run.h5\n".replace(
+        "scene.opts", str(scene)))
+    assert not may_write_a_result(["petsc_rod", "-options_file", str(scene)], {})
+    assert may_write_a_result(["petsc_rod", "-options_file", str(scene), "-rod_output",
+                               "x.h5"], {})
+    assert may_write_a_result(["petsc_rod", "-options_file", str(writes)], {})
+    assert may_write_a_result(["petsc_rod"], {"PETSC_OPTIONS": "-rod_output x.h5"})
