@@ -5,7 +5,7 @@ user chose nothing, and nothing imported that the run does not use."""
 import subprocess
 import sys
 
-from helpers import REPO_ROOT
+from helpers import REPO_ROOT, child_env
 
 from petsc_rod.__main__ import may_write_a_result, open_mpi_defaults
 
@@ -69,8 +69,8 @@ def test_the_command_line_imports_no_module_it_does_not_use():
         "'petsc_rod.figures.rod', 'petsc_rod.figures.riser')\n"
         "print(sorted({name.split('.')[0] if name.startswith('h5py') else name\n"
         "              for name in sys.modules if name.startswith(unused)}))\n")
-    done = subprocess.run([sys.executable, "-c", script], cwd=REPO_ROOT, capture_output=True,
-                          text=True, check=False)
+    done = subprocess.run([sys.executable, "-c", script], cwd=REPO_ROOT, env=child_env(),
+                          capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "[]"
 
@@ -81,7 +81,7 @@ def test_log_view_names_each_phase():
     done = subprocess.run(
         [sys.executable, "-m", "petsc_rod", "-options_file", "options/cantilever.opts",
          "-rod_elements", "8", "-rod_steps", "1", "-rod_al_newton", "0", "-log_view"],
-        cwd=REPO_ROOT, capture_output=True, text=True, check=False)
+        cwd=REPO_ROOT, env=child_env(), capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     rows = [line.split(":") for line in done.stdout.splitlines() if ":" in line]
     stages = {row[1].strip(): float(row[2].split()[0]) for row in rows
