@@ -1,7 +1,7 @@
 """The whole command against its solve: what a user waits for beyond the iterations.
 
     python scripts/benchmark_process.py [SCENE ...] [--runs N] [--ranks R]
-        [--tree DIR ...] [--args "-rod_output x.h5 ..."]
+        [--tree DIR ...] [--args "-rod_output x.h5 ..."] [--breakdown]
 
 Runs ``python -m petsc_rod -options_file options/SCENE.opts`` (``mpiexec -n R`` for R > 1)
 N times (default 5) per scene (default cable_800m) as a user runs it, and prints for each
@@ -10,7 +10,11 @@ the median of the whole process's wall time, of the solve's (the run's own line
 test's last report, the output and the exit) and of their difference, with the load
 average before and after. With several ``--tree`` checkouts (another commit's worktree,
 say) their runs are alternated, so that each sees the shared machine in the same states:
-the comparison of a change. The environment is the caller's (run it after
+the comparison of a change. ``--breakdown`` says where the difference goes, each the
+median of N: the interpreter alone, with numpy, with MPI and PETSc started (with
+``python -m petsc_rod``'s Open MPI defaults), and the run's ``-log_view`` stages (the
+Main Stage: the imports after PETSc started, the options, the exit's share PETSc sees)
+against its whole time. The environment is the caller's (run it after
 ``source scripts/setup.sh``), so the Open MPI defaults of ``python -m petsc_rod`` apply as
 they do for a user (docs/performance.md, "Where the remaining time goes").
 """
@@ -45,6 +49,43 @@ def one_run(tree, scene, ranks, extra):
     return whole, float(found[-1])
 
 
+STAGE_LINE = re.compile(r"^ *\d+: +(.+?): +(\S+) ", re.MULTILINE)
+STARTS = {"python": "pass", "python + numpy": "import numpy",
+          "python + numpy + MPI + PETSc": "import petsc4py; petsc4py.init(); "
+                                          "from petsc4py import PETSc"}
+
+
+def wall(command, env=None):
+    """Wall time of ``command`` (s) and its stdout."""
+    started = time.perf_counter()
+    done = subprocess.run(command, cwd=ROOT, env=env, capture_output=True, text=True,
+                          check=True)
+    return time.perf_counter() - started, done.stdout
+
+
+def breakdown(scene, runs, extra):
+    """Print the medians of the start-ups and of the run's -log_view stages."""
+    sys.path.insert(0, str(ROOT))
+    from petsc_rod.__main__ import open_mpi_defaults
+    env = {**os.environ, **open_mpi_defaults(os.environ)}
+    rows = {}
+    for _ in range(runs):
+        for name, code in STARTS.items():
+            rows.setdefault(name, []).append(wall([sys.executable, "-c", code], env)[0])
+        whole, out = wall([sys.executable, "-m", "petsc_rod", "-options_file",
+                           str(ROOT / "options" / f"{scene}.opts"), "-log_view", *extra])
+        rows.setdefault("whole command (-log_view)", []).append(whole)
+        rows.setdefault("solve line", []).append(float(SOLVE_LINE.findall(out)[-1]))
+        stages = dict(STAGE_LINE.findall(out))
+        for name, seconds in stages.items():
+            rows.setdefault(f"stage {name}", []).append(float(seconds))
+        rows.setdefault("before and after PETSc's clock",
+                        []).append(whole - sum(map(float, stages.values())))
+    print(f"{scene}, medians of {runs} (load {os.getloadavg()[0]:.2f}):")
+    for name, values in rows.items():
+        print(f"  {name:<36} {statistics.median(values):7.3f} s")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scenes", nargs="*", default=["cable_800m"])
@@ -53,9 +94,15 @@ def main():
     parser.add_argument("--tree", action="append", default=None,
                         help="a checkout to run (repeatable: alternated); default this one")
     parser.add_argument("--args", default="", help="more options for every run")
+    parser.add_argument("--breakdown", action="store_true",
+                        help="the start-ups and -log_view's stages of this checkout")
     args = parser.parse_args()
     trees = [str(Path(tree).resolve()) for tree in (args.tree or [ROOT])]
     extra = shlex.split(args.args)
+    if args.breakdown:
+        for scene in args.scenes:
+            breakdown(scene, args.runs, extra)
+        return
     print(f"{'scene':<16} {'tree':<28} {'whole (s)':>9} {'solve (s)':>9} "
           f"{'whole - solve':>13} {'load before, after':>19}")
     for scene in args.scenes:
