@@ -56,8 +56,8 @@ def test_mpiexec_on_one_node_and_on_several(tmp_path):
 
 def test_the_command_line_imports_no_module_it_does_not_use():
     """A run without a result file, modes or pictures imports neither h5py, SLEPc
-    (slepc4py's package, which only says where it is, may be), matplotlib, scipy nor the
-    modes', report's and sweep's modules."""
+    (slepc4py's package, which only says where it is, may be), matplotlib, scipy, the
+    modes', report's and sweep's modules nor subprocess (git runs for a result file)."""
     script = (
         "import sys; sys.argv = ['petsc_rod', '-options_file', 'options/cantilever.opts', "
         "'-rod_elements', '8', '-rod_steps', '1']\n"
@@ -66,7 +66,7 @@ def test_the_command_line_imports_no_module_it_does_not_use():
         "unused = ('h5py', 'slepc4py.SLEPc', 'slepc4py.lib', 'matplotlib', 'scipy', "
         "'petsc_rod.analysis.modes', 'petsc_rod.cli.modes', "
         "'petsc_rod.report', 'petsc_rod.sweep', 'petsc_rod.system', 'petsc_rod.plots', "
-        "'petsc_rod.figures.rod', 'petsc_rod.figures.riser')\n"
+        "'petsc_rod.figures.rod', 'petsc_rod.figures.riser', 'subprocess')\n"
         "print(sorted({name.split('.')[0] if name.startswith('h5py') else name\n"
         "              for name in sys.modules if name.startswith(unused)}))\n")
     done = subprocess.run([sys.executable, "-c", script], cwd=REPO_ROOT, env=child_env(),
