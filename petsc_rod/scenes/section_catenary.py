@@ -107,12 +107,13 @@ def end_points(ends, weights, H, grounded, V0):
     rises = np.cumsum(weights * lengths, axis=-1)
     V = V0 + np.concatenate([np.zeros_like(rises[..., :1]), rises[..., :-1]], axis=-1)
     dx, dz = advance(H, V, weights, lengths)
-    return grounded[..., 0] + np.cumsum(dx, axis=-1)[..., -1], np.cumsum(dz, axis=-1)[..., -1]
+    return (grounded[..., 0] + np.cumsum(dx, axis=-1)[..., -1],
+            np.cumsum(dz, axis=-1)[..., -1])
 
 
 def _bracketed(function, lower, upper):
-    """Whether function(lower) < 0 < function(upper), a row each (catenary.increasing_roots's
-    precondition; rows and points as it has them)."""
+    """Whether function(lower) < 0 < function(upper), a row each (the precondition of
+    catenary.increasing_roots; rows and points as it has them)."""
     values = function(np.arange(np.size(lower)), np.stack([lower, upper], axis=1))
     return (values[:, 0] < 0.0) & (0.0 < values[:, 1])
 
