@@ -10,7 +10,76 @@ import sys
 # are busy (docs/performance.md, "Per-iteration overhead").
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from petsc_rod.cli.options_files import options_file_error  # noqa: E402  (no PETSc)
+from petsc_rod.cli.options_files import (  # noqa: E402  (no PETSc)
+    every_options_file, options_file_error)
+
+
+# Open MPI's fastest start where it cannot change what the ranks can reach: one process
+# alone (a singleton) or every rank on this node talks through shared memory (ob1 with
+# the self and vader transports), and a singleton starts no helper daemon (isolated). A
+# start without them probes the network transports (UCX) and, alone, forks an orted
+# (docs/performance.md, "Where the remaining time goes").
+TRANSPORT_DEFAULTS = {"pml": "ob1", "btl": "self,vader"}
+SINGLETON_DEFAULTS = {"ess_singleton_isolated": "1"}
+# What says a launcher started the process (Open MPI's mpiexec, PMIx or PMI as srun's
+# or MPICH's): then it is no singleton, and its ranks may be on other nodes.
+LAUNCHER_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "PMI_FD",
+                      "SLURM_STEP_NUM_TASKS")
+
+
+def user_mca_names(environ):
+    """The MCA parameters the user's parameter files set (OMPI_MCA_mca_base_param_files,
+    ':'-separated, or $HOME/.openmpi/mca-params.conf, which Open MPI reads unless told
+    otherwise): 'name = value' lines. A value set there is the user's choice, which an
+    environment variable would override."""
+    own = os.path.join(environ.get("HOME", "~"), ".openmpi", "mca-params.conf")
+    paths = environ.get("OMPI_MCA_mca_base_param_files", own).split(":")
+    names = set()
+    for path in paths:
+        try:
+            with open(os.path.expanduser(path), encoding="utf-8") as lines:
+                names.update(line.split("=", 1)[0].strip() for line in lines
+                             if "=" in line and not line.lstrip().startswith("#"))
+        except OSError:
+            continue
+    return names
+
+
+def open_mpi_defaults(environ):
+    """{variable: value}: the OMPI_MCA_* settings to add to ``environ`` before MPI starts
+    (TRANSPORT_DEFAULTS, SINGLETON_DEFAULTS). None where the user (the environment,
+    mpiexec's --mca or -x, a parameter file) chose a transport (pml, btl or mtl) or the
+    singleton's start; the transports only as a singleton or under Open MPI's mpiexec
+    with every rank on this node (OMPI_COMM_WORLD_LOCAL_SIZE == OMPI_COMM_WORLD_SIZE),
+    the isolated start only as a singleton."""
+    chosen = user_mca_names(environ) | {name.removeprefix("OMPI_MCA_") for name in environ
+                                        if name.startswith("OMPI_MCA_")}
+    launched = any(name in environ for name in LAUNCHER_VARIABLES)
+    size = environ.get("OMPI_COMM_WORLD_SIZE")
+    one_node = not launched or (size is not None
+                                and environ.get("OMPI_COMM_WORLD_LOCAL_SIZE") == size)
+    defaults = {}
+    if one_node and not chosen & {"pml", "btl", "mtl"}:
+        defaults.update(TRANSPORT_DEFAULTS)
+    if not launched and not chosen & set(SINGLETON_DEFAULTS):
+        defaults.update(SINGLETON_DEFAULTS)
+    return {f"OMPI_MCA_{name}": value for name, value in defaults.items()}
+
+
+def may_write_a_result(argv, environ=None):
+    """Whether the run may write a result file, whose record names the checkout's commit
+    (io/provenance.py: git, run before MPI starts): an option with 'output' in its name
+    where PETSc reads options (the command line, PETSC_OPTIONS, the options files). A run
+    without one runs no git."""
+    environ = os.environ if environ is None else environ
+    texts = [" ".join(argv[1:]), environ.get("PETSC_OPTIONS", "")]
+    for path in every_options_file(argv, environ):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as handle:
+                texts.append(handle.read())
+        except OSError:
+            return True
+    return any("output" in text for text in texts)
 
 
 def launcher_rank():
@@ -36,14 +105,12 @@ def petsc_error(report):
     return message[-1] if message else ""
 
 
-def start_slepc(argv):
-    """Initialise SLEPc (the modal analysis, analysis/modes.py) with the same ``argv`` as
-    PETSc, where slepc4py is installed (find_module: Debian's, found without
-    SLEPC_DIR); without it the modes are refused when asked for (cli/modes.py)."""
-    if not find_module("slepc4py", DEBIAN_SLEPC4PY):
-        return
-    import slepc4py
-    slepc4py.init(argv)
+def find_slepc4py():
+    """Make slepc4py importable where it is installed (find_module: Debian's, found
+    without SLEPC_DIR); without it the modes are refused when asked for (cli/modes.py).
+    SLEPc itself starts only when the modes import it (analysis/modes.py), on PETSc's
+    running options database: a run without modes does not load it."""
+    find_module("slepc4py", DEBIAN_SLEPC4PY)
 
 
 def start_petsc(argv):
@@ -53,10 +120,10 @@ def start_petsc(argv):
     import petsc4py
 
     from petsc_rod.io.capture import stderr_captured
+    find_slepc4py()
     with stderr_captured() as report:
         try:
             petsc4py.init(argv)         # PETSc starts and reads the options here
-            start_slepc(argv)
         except Exception:               # petsc4py.PETSc.Error, not importable before
             return petsc_error(report()) or "PETSc could not start with these options"
         printed = report()
@@ -123,6 +190,7 @@ def find_petsc4py():
 
 
 def main():
+    os.environ.update(open_mpi_defaults(os.environ))
     error = options_file_error(sys.argv)
     if error:
         if launcher_rank() == 0:        # one line, not one per rank
@@ -134,8 +202,9 @@ def main():
             f"({sys.executable}); install Debian's python3-petsc4py (or run scripts/setup.sh "
             "once, then `source .venv/bin/activate`)\n")
         return 2
-    from petsc_rod.io.provenance import commit
-    commit()                          # git runs before MPI starts (provenance)
+    if may_write_a_result(sys.argv):
+        from petsc_rod.io.provenance import commit
+        commit()                      # git runs before MPI starts (provenance)
     error = start_petsc(sys.argv)
     if error:
         sys.stderr.write(f"petsc_rod: error: {error}; an options file has one '-name value' "

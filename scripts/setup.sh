@@ -53,5 +53,10 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 ACTIVATE
 fi
+# The package byte-compiled: Python does it on a first import unless PYTHONDONTWRITEBYTECODE
+# is set, and then compiles every module again at each start (docs/performance.md, "Where
+# the remaining time goes"). Only what changed is compiled again; a read-only checkout
+# just starts slower.
+"$VENV/bin/python" -m compileall -q "$ROOT/petsc_rod" >/dev/null 2>&1 || true
 # shellcheck disable=SC1091
 source "$VENV/bin/activate"

@@ -35,9 +35,9 @@ from petsc4py import PETSc
 
 from petsc_rod import resources
 from petsc_rod.cli import messages
+from petsc_rod.cli.phases import OUTPUT, SETUP, STEPS
 from petsc_rod.cli.options import (BY_NAME, HOW_RUN, OPTIONS, SOLVER_PREFIXES,
-                                   format_value, parse_values)
-from petsc_rod.cli.modes import check_modes_inputs, modes_asked, report_modes, solve_for_run
+                                   format_value, modes_asked, parse_values)
 from petsc_rod.cli.scene_options import (OPTION_NAMES, check_stability_asked, checked_pieces,
                                          restart_path, rounded_down, settings_from_options)
 from petsc_rod.cli.session import run_continuation
@@ -115,7 +115,8 @@ def plan_line(comm, model, values, given, names=OPTION_NAMES, mesh_named=None):
     check_mesh(comm, values, resources.bytes_per_element(
         scene.seabed is not None and (settings.newton or settings.check_stability)),
         None if mesh_named is None else mesh_named(pieces, values["rod_elements"]))
-    check_modes_inputs(values, scene, comm)
+    if modes_asked(values) or values["rod_modes_table"]:
+        modes_of_run().check_modes_inputs(values, scene, comm)
     if values["rod_output"]:
         io.check_output_path(values["rod_output"], comm)
     if values["rod_table"]:
@@ -277,6 +278,13 @@ class AgreedFailures:
         return False
 
 
+def modes_of_run():
+    """cli/modes.py, imported here: only a run with -rod_modes or -rod_modes_table loads
+    the modes' modules (analysis/modes.py and SLEPc)."""
+    from petsc_rod.cli import modes
+    return modes
+
+
 def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
              interrupts=None, check_only=False):
     """Run the LinePlan ``plan`` on ``comm``: build its line (BuiltLine), start it, run
@@ -294,10 +302,11 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
     built, writer = BuiltLine(comm, plan), None
     try:
         with AgreedFailures(comm) as failures:
-            built.build(say)
-            if check_only:
-                return None
-            path = built.start(say)
+            with SETUP:
+                built.build(say)
+                if check_only:
+                    return None
+                path = built.start(say)
             if values["rod_output"]:
                 made = (record or default_record)(plan, built.solver, built.first_load_factor)
                 writer = failures.writer = io.ResultWriter(
@@ -308,17 +317,19 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
             modes = []                      # -rod_modes: found before the file is finished
 
             def find_modes(writer):
-                modes.append(solve_for_run(built.problem, values, writer))
-            result = built.run(path, say=say, writer=last or writer, options=options,
-                               interrupts=interrupts,
-                               before_finish=find_modes if modes_asked(values) else None)
+                modes.append(modes_of_run().solve_for_run(built.problem, values, writer))
+            with STEPS:
+                result = built.run(path, say=say, writer=last or writer, options=options,
+                                   interrupts=interrupts,
+                                   before_finish=find_modes if modes_asked(values) else None)
             writer = failures.writer = None             # finished
-            if result.code == 0:            # the CSV table of the converged result
-                line_table.finish_run(built.problem, values["rod_table"], say)
-                if modes:
-                    report_modes(built.problem, values, modes[0], say)
-            elif values["rod_table"]:       # none for this run: not an earlier run's either
-                line_table.discard(values["rod_table"], comm, say)
+            with OUTPUT:
+                if result.code == 0:            # the CSV table of the converged result
+                    line_table.finish_run(built.problem, values["rod_table"], say)
+                    if modes:
+                        modes_of_run().report_modes(built.problem, values, modes[0], say)
+                elif values["rod_table"]:   # none for this run: not an earlier run's either
+                    line_table.discard(values["rod_table"], comm, say)
             found = modes[0][0] if modes and result.code == 0 else None
             return LineRun(result, last, built.mesh.n_elements, found)
     finally:

@@ -11,15 +11,16 @@ import sys
 from petsc4py import PETSc
 
 from petsc_rod.cli.line_run import (AgreedFailures, petsc_failure, plan_line, run_line)
-from petsc_rod.cli.modes import shapes_path
 from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
                                    help_text, read_options, unused_options, values_of)
 from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.phases import SETUP
 from petsc_rod.cli.ranks import run_placed
 from petsc_rod.cli.scene_options import model_from_options
 from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError
+from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io import line_table
 from petsc_rod.io.same_file import replaced_input
 
@@ -68,8 +69,9 @@ def run(comm=None, texts=None):
                 if database.hasName("help"):
                     for line in help_text():
                         say(line)
-                plan = plan_line(comm, model_from_options(values, given), values, given,
-                                 mesh_named=sections_named)
+                with SETUP:
+                    plan = plan_line(comm, model_from_options(values, given), values, given,
+                                     mesh_named=sections_named)
                 check_inputs_kept(values, comm)
                 if database.hasName("help"):
                     run_line(comm, plan, say, check_only=True)

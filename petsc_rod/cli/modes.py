@@ -13,6 +13,7 @@ from petsc4py import PETSc
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import CLASSES, ModesRefused, check_options, solve_modes
 from petsc_rod.errors import RodInputError, RodIOError, petsc_message
+from petsc_rod.cli.options import modes_asked
 from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io.results import check_output_path
 
@@ -42,11 +43,6 @@ def modes_band(text):
         raise RodInputError(f"-rod_modes_range {text}: expected FMIN,FMAX, two frequencies "
                             "in Hz with 0 <= FMIN < FMAX (e.g. 0.05,0.5)")
     return band
-
-
-def modes_asked(values):
-    """Whether the run asks for modes: -rod_modes N or -rod_modes_range."""
-    return bool(values["rod_modes"] or values["rod_modes_range"])
 
 
 def check_modes_inputs(values, scene, comm):

@@ -630,3 +630,8 @@ def unused_options():
         if used(None, name.encode(), ctypes.byref(flag)) == 0 and not flag.value:
             unused.append(name)
     return unused
+
+
+def modes_asked(values):
+    """Whether the run asks for modes: -rod_modes N or -rod_modes_range."""
+    return bool(values["rod_modes"] or values["rod_modes_range"])

@@ -6,6 +6,7 @@ line, the scripts and the tests call run_continuation."""
 from dataclasses import dataclass
 
 from petsc_rod.cli import messages
+from petsc_rod.cli.phases import OUTPUT
 from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedError
 from petsc_rod.io import outputs
 from petsc_rod.iteration import events
@@ -61,15 +62,17 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
             raises = []
         elif isinstance(event, events.StepEnded):
             group = f"steps/{event.number}"
-            record = record_step(
-                problem, event.report, event.t, writer, group, wall_time=event.wall_time,
-                options=options, halvings=event.halvings, total_halvings=event.total_halvings,
-                asked_penalty=solver.settings.asked_penalty,
-                total_iterations=event.total_iterations,
-                undone_iterations=event.undone_iterations)
-            say(messages.step_line(event, record))
-            if verbose:
-                say(messages.step_details(event, record))
+            with OUTPUT:
+                record = record_step(
+                    problem, event.report, event.t, writer, group,
+                    wall_time=event.wall_time, options=options, halvings=event.halvings,
+                    total_halvings=event.total_halvings,
+                    asked_penalty=solver.settings.asked_penalty,
+                    total_iterations=event.total_iterations,
+                    undone_iterations=event.undone_iterations)
+                say(messages.step_line(event, record))
+                if verbose:
+                    say(messages.step_details(event, record))
             if raises:
                 say(messages.raised(event.label, raises, problem.scale))
             raises = []
@@ -88,12 +91,13 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
         elif isinstance(event, events.RunFinished):
             if before_finish is not None and event.converged and last is not None:
                 before_finish(writer)
-            if writer is not None:
-                writer.finish(*last)
-            if event.converged and last is not None:
-                for line in messages.summary(last[1]):
-                    say(line)
-            say(messages.finished(event, solver.settings, problem.scale))
+            with OUTPUT:
+                if writer is not None:
+                    writer.finish(*last)
+                if event.converged and last is not None:
+                    for line in messages.summary(last[1]):
+                        say(line)
+                say(messages.finished(event, solver.settings, problem.scale))
             code = 0 if event.converged else RodNotConvergedError.exit_code
             return ContinuationResult(code, event.report, event.iterations)
     raise RuntimeError("the continuation ended without a final event")

@@ -6,7 +6,6 @@ since forking a process under MPI is not safe everywhere.
 
 import functools
 import os
-import subprocess
 
 from petsc_rod import __version__
 
@@ -22,6 +21,8 @@ def commit():
     """The commit of the checkout the package runs from, with '+modified' when tracked
     files differ from it; 'unknown' outside a git checkout of its own (e.g. installed
     into another repository's tree) or without git."""
+    import subprocess               # here: a run without a result file runs no git
+
     def git(*args):
         return subprocess.run(["git", "-C", REPOSITORY, *args], capture_output=True,
                               text=True, timeout=20, check=True).stdout.strip()

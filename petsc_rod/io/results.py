@@ -34,7 +34,6 @@ import stat
 import sys
 from dataclasses import dataclass
 
-import h5py
 import numpy as np
 
 from petsc_rod.io.capture import stderr_captured
@@ -209,6 +208,7 @@ def minimum_bytes(mesh, state, steps):
 
 
 def _open(path, mode, comm):
+    import h5py                     # with the first file: a run without one loads no HDF5
     if h5py.get_config().mpi and comm.size > 1:
         return h5py.File(path, mode, driver="mpio", comm=comm)
     if comm.size > 1:
@@ -477,6 +477,7 @@ def read_restart(path, mesh, state_templates):
 
 
 def _read_restart(path, mesh, layout):
+    import h5py                     # with the first file: a run without one loads no HDF5
     def refuse(what):
         raise RodInputError(f"-rod_initial {path}: {what}")
 
@@ -526,6 +527,7 @@ def read_parameters(path, comm):
 
 def _parameters(path):
     """read_parameters on one process."""
+    import h5py                     # with the first file: a run without one loads no HDF5
     if file_problem(path):                  # _read_restart says what; a FIFO would block
         return None
     try:
@@ -544,6 +546,7 @@ def _parameters(path):
 def _read_slice(f, key, shape, start, rows, refuse):
     """Rows [start, start + rows) of dataset ``key``, checked: present, of global
     ``shape``, numbers, finite."""
+    import h5py                     # with the first file: a run without one loads no HDF5
     try:
         dataset = f.get(key)
     except (KeyError, TypeError, ValueError, OSError):     # e.g. 'state' not a group

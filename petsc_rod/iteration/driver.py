@@ -28,6 +28,8 @@ DEFAULT_SNES = "anderson"
 FUNCTION_ONLY_SNES = ("anderson", "nrichardson", "ngmres", "qn", "ncg")
 SNES_REASONS = {getattr(PETSc.SNES.ConvergedReason, name): name.lower()
                 for name in dir(PETSc.SNES.ConvergedReason) if not name.startswith("_")}
+# -log_view's event of the stability test of a converged step (§10).
+STABILITY_EVENT = PETSc.Log.Event("rod_stability")
 
 
 def default_anderson_depth(mesh):
@@ -241,8 +243,10 @@ class UzawaSolver:
 
     def check_stability(self):
         """(stable, direction) of the current (converged) state: the verdict of the
-        stability test (analysis/stability.StabilityTest.verdict)."""
-        return self.problem.second_variation().verdict()
+        stability test (analysis/stability.StabilityTest.verdict), in -log_view's event
+        rod_stability."""
+        with STABILITY_EVENT:
+            return self.problem.second_variation().verdict()
 
     # --- the SNES's view of the iteration -----------------------------------------------
     def _fixed_point_residual(self, snes, x, f):

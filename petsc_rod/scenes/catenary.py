@@ -24,6 +24,47 @@ def increasing_root(function, lower, upper):
             upper = middle
 
 
+def increasing_roots(function, lower, upper, depth=5, refusal=None):
+    """increasing_root of many increasing functions at once: ``function(rows, points)``
+    maps rows (indices, (r,)) and points (r, k) to values (r, k), row i's by function
+    i; ``lower``, ``upper`` (n,) bracket each root (function(lower) < 0 <
+    function(upper)). Each row visits the midpoints increasing_root visits, so its root
+    is the same double; ``depth`` halvings are evaluated in one call (the 2**depth - 1
+    midpoints they may need), so that a root takes about 60 / depth calls. A NaN on a
+    row's path is taken as above the root, as increasing_root does, or raises
+    ValueError(``refusal``) where given (the function has no value there)."""
+    lower, upper = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    roots = np.full(lower.shape, np.nan)
+    open_rows = np.arange(lower.size)
+    while open_rows.size:
+        # the ends of the 2**depth intervals of depth halvings, in order: the midpoints of
+        # level l are every 2**(depth - l)-th from the 2**(depth - l - 1)-th
+        ends = np.stack([lower[open_rows], upper[open_rows]], axis=1)
+        for _ in range(depth):
+            finer = np.empty((open_rows.size, 2 * ends.shape[1] - 1))
+            finer[:, ::2], finer[:, 1::2] = ends, 0.5 * (ends[:, :-1] + ends[:, 1:])
+            ends = finer
+        values = np.full(ends.shape, np.nan)
+        values[:, 1:-1] = function(open_rows, ends[:, 1:-1])
+        ends, values = ends.ravel(), values.ravel()
+        low = np.arange(open_rows.size) * (2 ** depth + 1)      # positions in ends
+        high = low + 2 ** depth
+        going = np.ones(open_rows.size, bool)
+        for _ in range(depth):
+            at = (low + high) // 2
+            middle = ends[at]
+            done = going & ~((ends[low] < middle) & (middle < ends[high]))
+            roots[open_rows[done]] = middle[done]
+            going &= ~done
+            if refusal is not None and np.any(going & np.isnan(values[at])):
+                raise ValueError(refusal)
+            below = values[at] < 0.0
+            low, high = np.where(below, at, low), np.where(below, high, at)
+        lower[open_rows], upper[open_rows] = ends[low], ends[high]
+        open_rows = open_rows[going]
+    return roots
+
+
 def catenary_axes(length, chord, load):
     """The unit vectors (e_v, e_h) of a catenary's plane: up (against the load) and along
     the horizontal part of the chord. ValueError when there is no catenary: a length or

@@ -18,24 +18,28 @@ with V(a) = 0). H makes the span X for a given V(0) or a (x(L) grows with H), an
 rise Z fixes the other: z(L) grows with V(0), and falls as a grows where the weight at
 the touchdown w(a) is positive (dz(L)/da = -w(a) det / (dx(L)/dH), det >= 0 by
 Cauchy-Schwarz). Both are bracketed and bisected to adjacent doubles
-(catenary.increasing_root). A line that rests on the seabed must leave it going up and
+(catenary.increasing_roots). A line that rests on the seabed must leave it going up and
 stay above it: a touchdown on a buoyant or weightless piece, or a suspended part that
 dips below the seabed (a sag bend after a buoyant arch in shallow water), is refused. A
 uniform weight gives the catenary and the catenary with touchdown of catenary.py and
 touchdown.py.
 """
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
-from petsc_rod.scenes.catenary import increasing_root
+from petsc_rod.scenes.catenary import increasing_roots
 
 # A piece whose weight changes V by less than this fraction of |n| is taken as straight
 # in dx (the error is of its square).
 STRAIGHT_PIECE = 1e-8
-# The most doublings of a bracket before the scene is said to have no catenary.
+# The most doublings of a bracket before the scene is said to have no catenary, and how
+# many are tried in one call.
 MAX_DOUBLINGS = 200
+CHUNK = 8
+INNER_DEPTH, OUTER_DEPTH = 4, 4
 
 
 @dataclass(frozen=True)
@@ -92,31 +96,76 @@ def advance(H, V0, w, dS):
     return np.where(straight, H * dS / middle, curved), dz
 
 
-def _root(function, lower, upper):
-    """catenary.increasing_root, with its precondition function(lower) < 0 <
-    function(upper) checked (ValueError: no catenary)."""
-    if not function(lower) < 0.0 < function(upper):
-        raise ValueError("section catenary: no catenary of these weights between the ends")
-    return increasing_root(function, lower, upper)
+def end_points(ends, weights, H, grounded, V0):
+    """(x(L), z(L)) of many lines of the same pieces (ends (m + 1,), weights (m,)), m:
+    line i has the horizontal force H[i] (N), the grounded length grounded[i] (m) and
+    V(0) V0[i] (N), arrays that broadcast. SectionCatenary.end_point's numbers, to the
+    bit: a piece on the seabed is one of length 0, which adds exact zeros."""
+    H, grounded, V0 = (np.asarray(v, dtype=float)[..., None] for v in (H, grounded, V0))
+    starts = np.maximum(ends[:-1], grounded)
+    lengths = np.maximum(ends[1:], grounded) - starts
+    rises = np.cumsum(weights * lengths, axis=-1)
+    V = V0 + np.concatenate([np.zeros_like(rises[..., :1]), rises[..., :-1]], axis=-1)
+    dx, dz = advance(H, V, weights, lengths)
+    return (grounded[..., 0] + np.cumsum(dx, axis=-1)[..., -1],
+            np.cumsum(dz, axis=-1)[..., -1])
 
 
-def _bracket_above(function, start):
-    """The first of start, 2 start, 4 start, ... where ``function`` > 0; ValueError when
-    none is within MAX_DOUBLINGS."""
-    value = start
-    for _ in range(MAX_DOUBLINGS):
-        if function(value) > 0:
-            return value
-        value *= 2
-    raise ValueError("section catenary: no bracket")
+def _bracketed(function, lower, upper):
+    """Whether function(lower) < 0 < function(upper), a row each (the precondition of
+    catenary.increasing_roots; rows and points as it has them)."""
+    values = function(np.arange(np.size(lower)), np.stack([lower, upper], axis=1))
+    return (values[:, 0] < 0.0) & (0.0 < values[:, 1])
+
+
+def _brackets_above(function, start, refusal=None):
+    """For each row, the first of start, 2 start, 4 start, ... where ``function`` > 0
+    (rows and points as catenary.increasing_roots's), CHUNK doublings a call; NaN
+    where there is none within MAX_DOUBLINGS. A NaN value before it raises
+    ValueError(``refusal``) where given (as increasing_roots)."""
+    start = np.asarray(start, dtype=float)
+    found = np.full(start.shape, np.nan)
+    left = np.arange(start.size)
+    for first in range(0, MAX_DOUBLINGS, CHUNK):
+        if not left.size:
+            break
+        points = start[left, None] * 2.0 ** np.arange(first, min(first + CHUNK,
+                                                                  MAX_DOUBLINGS))
+        values = function(left, points)
+        stop = (values > 0) | (np.isnan(values) if refusal is not None else False)
+        hit = stop.any(axis=1)
+        at = np.argmax(stop[hit], axis=1)
+        if np.isnan(values[hit, at]).any():
+            raise ValueError(refusal)
+        found[left[hit]] = points[hit, at]
+        left = left[~hit]
+    return found
+
+
+NO_CATENARY = "section catenary: no catenary of these weights between the ends"
 
 
 def solve(ends, weights, span, rise, on_seabed):
     """The SectionCatenary through (span, rise) from the origin (module docstring);
     ``on_seabed``: the start lies on the seabed, so the line may rest on it. ValueError
     where there is none: the ends L or more apart, on one vertical, or (on the seabed)
-    too much line to lie taut between them."""
-    ends, weights = np.asarray(ends, dtype=float), np.asarray(weights, dtype=float)
+    too much line to lie taut between them. Solved once for its arguments (a run asks
+    for its start twice: the penalty's tension scale and the start itself)."""
+    return _solved(tuple(map(float, ends)), tuple(map(float, weights)), float(span),
+                   float(rise), bool(on_seabed))
+
+
+@functools.lru_cache(maxsize=16)
+@np.errstate(over="ignore", invalid="ignore")
+def _solved(ends, weights, span, rise, on_seabed):
+    """solve, its arguments as hashable numbers. The nested roots of the module
+    docstring, each bisected to adjacent doubles, many lines at once: every point the
+    outer bisection may visit (a or V(0)) with the inner one (H) of each. A line
+    without an H (NaN) is refused where the outer bisection visits it; the points it
+    does not visit may overflow (an H of 1e-300 under a V(0) far from the root) without
+    a warning."""
+    ends, weights = np.array(ends), np.array(weights)
+    ends.flags.writeable = weights.flags.writeable = False     # shared by the cache's users
     length = ends[-1]
     if not (np.hypot(span, rise) < length and span > 1e-9 * length):
         raise ValueError("section catenary: the ends must be less than L apart and not on "
@@ -125,31 +174,63 @@ def solve(ends, weights, span, rise, on_seabed):
     if scale == 0.0:
         raise ValueError("section catenary: the line has no weight")
 
-    def line(H, grounded, V0):
-        return SectionCatenary(H, grounded, V0, ends, weights)
-
     def spanned(grounded, V0):
-        """The line of the given a, V(0) whose H makes the span."""
-        def excess(H):
-            return line(H, grounded, V0).end_point()[0] - span
-        upper = _bracket_above(excess, scale)
-        return line(_root(excess, 1e-300, upper), grounded, V0)
+        """H (n,) of the lines of grounded lengths and V(0) (n,) that make the span; NaN
+        where none is bracketed."""
+        def excess(rows, H):
+            return end_points(ends, weights, H, grounded[rows, None], V0[rows, None])[0] - span
+        H = np.full(grounded.shape, np.nan)
+        upper = _brackets_above(excess, np.full(grounded.shape, scale))
+        lower = np.full(grounded.shape, 1e-300)
+        found = np.flatnonzero(~np.isnan(upper))
+        found = found[_bracketed(lambda rows, H: excess(found[rows], H), lower[found],
+                                 upper[found])]
+        H[found] = increasing_roots(lambda rows, H: excess(found[rows], H), lower[found],
+                                    upper[found], depth=INNER_DEPTH)
+        return H
 
-    def climb(V0):                                  # z(L) - Z, increasing in V(0)
-        return spanned(0.0, V0).end_point()[1] - rise
+    def end_heights(grounded, V0):
+        """z(L) of the spanned lines of grounded lengths and V(0) (any one shape)."""
+        grounded, V0 = np.broadcast_arrays(grounded, V0)
+        flat = grounded.ravel(), V0.ravel()
+        return end_points(ends, weights, spanned(*flat), *flat)[1].reshape(grounded.shape)
 
-    if on_seabed and climb(0.0) >= 0.0:
+    def climb(rows, V0):                            # z(L) - Z, increasing in V(0)
+        return end_heights(0.0, V0) - rise
+
+    def sink(rows, grounded):                       # increasing in a
+        return rise - end_heights(grounded, 0.0)
+
+    def at(function, point):
+        value = function(None, np.full((1, 1), point))[0, 0]
+        if np.isnan(value):                         # no H at this a or V(0)
+            raise ValueError(NO_CATENARY)
+        return value
+
+    def root(function, lower, upper):
+        if not _bracketed(function, [lower], [upper])[0]:
+            raise ValueError(NO_CATENARY)
+        return float(increasing_roots(function, [lower], [upper], depth=OUTER_DEPTH,
+                                      refusal=NO_CATENARY)[0])
+
+    def first_above(function):
+        found = float(_brackets_above(function, [scale], refusal=NO_CATENARY)[0])
+        if np.isnan(found):
+            raise ValueError("section catenary: no bracket")
+        return found
+
+    if on_seabed and at(climb, 0.0) >= 0.0:
         # too much rise with V(0) = 0: the line rests on the seabed up to a
-        def sink(grounded):                         # increasing in a
-            return rise - spanned(grounded, 0.0).end_point()[1]
-        if sink(span * (1 - 1e-12)) <= 0.0:
+        if at(sink, span * (1 - 1e-12)) <= 0.0:
             raise ValueError("section catenary: the line is too long to lie taut on the "
                              "seabed between its ends")
-        solved = spanned(_root(sink, 0.0, span * (1 - 1e-12)), 0.0)
+        grounded, V0 = root(sink, 0.0, span * (1 - 1e-12)), 0.0
     else:
-        upper = _bracket_above(climb, scale)
-        lower = 0.0 if on_seabed else -_bracket_above(lambda v: -climb(-v), scale)
-        solved = spanned(0.0, _root(climb, lower, upper))
+        upper = first_above(climb)
+        lower = 0.0 if on_seabed else -first_above(lambda rows, v: -climb(rows, -v))
+        grounded, V0 = 0.0, root(climb, lower, upper)
+    H = float(spanned(np.array([grounded]), np.array([V0]))[0])
+    solved = SectionCatenary(H, grounded, V0, ends, weights)
     if on_seabed:
         _check_above_seabed(solved, length)
     return solved

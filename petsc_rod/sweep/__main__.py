@@ -4,12 +4,14 @@ the start of petsc_rod's own entry (petsc_rod/__main__.py: the options files che
 petsc4py found and started), then the sweep (sweep/runner.py; with -rod_system FILE a
 system's, sweep/system.py)."""
 
+import os
 import sys
 
 from petsc_rod import __main__ as entry
 
 
 def main():
+    os.environ.update(entry.open_mpi_defaults(os.environ))
     error = entry.options_file_error(sys.argv)
     if error:
         if entry.launcher_rank() == 0:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from petsc_rod.scenes import section_catenary
-from petsc_rod.scenes.catenary import catenary
+from petsc_rod.scenes.catenary import catenary, increasing_root, increasing_roots
 from petsc_rod.scenes.touchdown import grounded_catenary
 
 # the 80 m lazy-wave cable of options/cable_80m.opts (N/m, > 0 down)
@@ -93,3 +93,40 @@ def test_a_buoyant_first_section_that_would_dip_under_the_seabed_is_refused():
     line = section_catenary.solve([0.0, 50.0, 130.0], [-50.0, 200.0], 100.0, 60.0, True)
     assert line.grounded == 0.0 and line.V0 > 0.0
     assert line.at(np.linspace(0.0, 130.0, 4097))[1].min() >= 0.0
+
+
+def test_many_roots_at_once_are_the_doubles_of_one_bisection_each():
+    """catenary.increasing_roots: each row the same double as increasing_root's
+    bisection, on functions whose rounding makes them step near the root."""
+    targets = np.array([1e-7, 0.3, 2.0, 1234.5678, 7.0e5])
+    scales = np.array([1.0, 3.0, 1e-3, 1e4, 0.7])
+
+    def one(k):
+        return lambda x: ((x * scales[k]) ** 3 - (targets[k] * scales[k]) ** 3) * 1e12
+
+    expected = [increasing_root(one(k), 0.0, 1e6) for k in range(targets.size)]
+    for depth in (1, 4, 6):
+        found = increasing_roots(lambda rows, x: ((x * scales[rows, None]) ** 3 - (
+            targets[rows, None] * scales[rows, None]) ** 3) * 1e12,
+            np.zeros(5), np.full(5, 1e6), depth=depth)
+        assert found.tolist() == expected
+
+
+def test_the_start_of_a_cable_is_solved_once_in_few_evaluations(monkeypatch):
+    """The 800 m cable's catenary (options/cable_800m.opts) evaluates its pieces in
+    fewer than 500 calls (the nested bisections batched; 3 650 one line at a time), and
+    a second solve of the same line is the first's (a run asks twice)."""
+    calls = []
+    advance = section_catenary.advance
+
+    def counted(*args):
+        calls.append(1)
+        return advance(*args)
+
+    monkeypatch.setattr(section_catenary, "advance", counted)
+    ends, weights = [0.0, 597.981, 997.981, 1370.43], [157.8003, -83.6829, 157.8003]
+    line = section_catenary.solve(ends, weights, 800.0 + 1e-6, 786.0, True)
+    assert 0 < len(calls) < 500
+    assert np.allclose(line.end_point(), (800.0 + 1e-6, 786.0), rtol=0, atol=1e-9)
+    again = section_catenary.solve(np.array(ends), weights, 800.0 + 1e-6, 786.0, True)
+    assert again is line and len(calls) < 500
