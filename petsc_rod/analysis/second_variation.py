@@ -125,6 +125,11 @@ class SecondVariation:
                                if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
         self._reserved = not newton      # J's pattern in H (_assemble)
+        # whether H's pattern is made (the first assembly): zeroEntries keeps it, so an
+        # update adds no block of zeros (_add_blocks) and sets the resultants' identity
+        # through the diagonal (_assemble)
+        self._patterned = False
+        self._identity = None
         # global columns whose H e_j before the held rows are cleared a caller asks for
         # at the next update (``full_columns``)
         self.keep_columns, self.kept_columns = (), []
@@ -229,7 +234,7 @@ class SecondVariation:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
         if self.positions:
             self._add_chains(d)
-        if self.resultants:
+        if self.resultants and not self._patterned:
             self._add_blocks(self.resultant_rows[:, None], self.resultant_rows[:, None],
                              np.ones((self.resultant_rows.size, 1, 1)))
         for term in problem.terms:
@@ -243,6 +248,20 @@ class SecondVariation:
                                      np.zeros(rows.shape + columns.shape[1:]))
             self._reserved = True
         self.matrix.assemble()
+        if self.resultants and self._patterned:
+            # the resultants' identity rows by the diagonal of the assembled matrix, in
+            # place: one pass, where the same ones by blocks cost a search in each row
+            self.matrix.setDiagonal(self._resultant_identity(),
+                                    addv=PETSc.InsertMode.ADD_VALUES)
+        self._patterned = True
+
+    def _resultant_identity(self):
+        """A Vec of 1 on the resultants' rows and 0 elsewhere (made once)."""
+        if self._identity is None:
+            self._identity = self.matrix.createVecLeft()
+            self._identity.zeroEntries()
+            self._identity.getArray()[self.resultant_rows - self.first_row] = 1.0
+        return self._identity
 
     # --- the positions' chains (module docstring, analysis/positions.py) -----------------
     def _add_chains(self, d):
@@ -279,6 +298,16 @@ class SecondVariation:
                 self._add_blocks(multiplier, multiplier, np.zeros((ne, 1, 1)))
 
     def _add_blocks(self, rows, columns, values):
+        """Add ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
+        ``columns`` (k, c). Once the pattern is made a block of zeros adds nothing and is
+        left out (the seabed's curvature off the contact, the zeros that only reserve
+        places): MatSetValues searches each of a block's rows."""
+        if self._patterned:
+            kept = np.any(values != 0.0, axis=(1, 2))
+            if not kept.all():
+                rows, columns, values = rows[kept], columns[kept], values[kept]
+            if not len(rows):
+                return
         self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
                                  values, addv=PETSc.InsertMode.ADD_VALUES)
 
@@ -552,5 +581,6 @@ class SecondVariation:
 
     def destroy(self):
         for obj in [self.matrix, self.mass, self._mass_or_one, self._work, self._diagonal,
-                    *self.constraint, *self.kept_columns]:
+                    *self.constraint, *self.kept_columns,
+                    *([self._identity] if self._identity is not None else [])]:
             obj.destroy()
