@@ -9,12 +9,16 @@ off the contact.
 (a) H assembled again at the same state (SecondVariation.update) is the same matrix bit
     for bit, its pattern kept; the update hands MatSetValues no block of zeros (the
     places they reserve are in the pattern since the first assembly) and not the
-    resultants' identity (added through the diagonal).
+    resultants' identity (added through the diagonal);
+(b) the drag's entries of the Newton Jacobian come in one block per element and kind of
+    row (the frames' rows, the resultants' chain): each of those rows is searched once.
 """
 
 import numpy as np
 import pytest
 from petsc4py import PETSc
+
+from petsc_rod.analysis.jacobian import NewtonJacobian
 
 from petsc_rod.environment.current import Current
 from petsc_rod.environment.seabed import Seabed
@@ -49,6 +53,19 @@ class CountingMatrix:
         return getattr(self._matrix, name)
 
 
+def counted(owner, work):
+    """The blocks handed to ``owner.matrix``'s setValuesRCV while ``work()`` runs (the
+    matrix stood in for by a CountingMatrix meanwhile)."""
+    real = owner.matrix
+    counting = CountingMatrix(real)
+    owner.matrix = counting
+    try:
+        work()
+    finally:
+        owner.matrix = real
+    return counting.blocks
+
+
 def diagonal_places(rows, columns, targets):
     """How many places of blocks at ``rows`` (k, r) and ``columns`` (k, c) are on the
     diagonal in a row of ``targets``."""
@@ -61,31 +78,44 @@ def local_csr(matrix):
     return indptr.copy(), indices.copy(), values.copy()
 
 
-def test_an_update_adds_no_zeros_and_gives_the_same_matrix(comm, solver_factory):
+def riser_hessian(comm, solver_factory):
+    """(mesh, H) of RISER at an iterate from its catenary start."""
     mesh, solver = solver_factory(comm, 60, RISER, 1e6)
     problem = solver.problem
     problem.state.set_from_curve(catenary_start(Scene(**dict(RISER, current=None)), 1.0))
     problem.prepare(1.0)
     problem.iterate()                   # multipliers of an iterate, the heights' contact
-    hessian = problem.second_variation()
+    return mesh, problem.second_variation()
+
+
+def test_an_update_adds_no_zeros_and_gives_the_same_matrix(comm, solver_factory):
+    mesh, hessian = riser_hessian(comm, solver_factory)
     assert hessian.resultants and hessian.positions
     before = local_csr(hessian.matrix)
-    real = hessian.matrix
-    counting = CountingMatrix(real)
-    hessian.matrix = counting
-    try:
-        hessian.update()
-    finally:
-        hessian.matrix = real
-    after = local_csr(real)
+    blocks = counted(hessian, hessian.update)
+    after = local_csr(hessian.matrix)
     same = all(np.array_equal(a, b) for a, b in zip(before, after))
     assert mesh.global_min(int(same)) == 1
     # part of the line rests on the seabed, part hangs: the seabed's curvature is zero
     # on some nodes and not on others
     zero_blocks = sum(int(np.sum(~np.any(values != 0.0, axis=(1, 2))))
-                      for _, _, values in counting.blocks)
+                      for _, _, values in blocks)
     assert mesh.global_sum(zero_blocks) == 0
     on_identity = sum(diagonal_places(rows, columns, hessian.resultant_rows)
-                      for rows, columns, _ in counting.blocks)
+                      for rows, columns, _ in blocks)
     assert mesh.global_sum(on_identity) == 0
-    assert mesh.global_sum(sum(len(values) for _, _, values in counting.blocks)) > 0
+    assert mesh.global_sum(sum(len(values) for _, _, values in blocks)) > 0
+
+
+def test_the_drags_entries_come_in_one_block_per_kind_of_row(comm, solver_factory):
+    mesh, hessian = riser_hessian(comm, solver_factory)
+    jacobian = NewtonJacobian(hessian)
+    try:
+        jacobian.assemble()
+        blocks = counted(jacobian, jacobian._add_terms)
+    finally:
+        jacobian.destroy()
+    searched = sum(rows.size for rows, _, _ in blocks)
+    # the frames' rows of the element's three nodes and the chain's three rows
+    rows = mesh.n_local_elements * (3 * hessian.unknowns + 3)
+    assert mesh.global_sum(searched) == mesh.global_sum(rows) > 0
