@@ -217,8 +217,8 @@ class SecondVariation:
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
         tau, lam, w = problem.state.tau, problem.state.lam, problem.state.node_weights
-        outer = np.einsum("nik,nil->nkl", lam, tau)
-        dots = np.einsum("nik,nik->n", lam, tau)
+        outer = np.matmul(lam.transpose(0, 2, 1), tau)        # sum_i lambda_i d_i^T
+        dots = np.trace(outer, axis1=1, axis2=2)
         local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
                                      - dots[:, None, None] * np.eye(3))
         if self.stretch:
@@ -382,26 +382,22 @@ class SecondVariation:
         """The element blocks of the bending and torsion part of H, (ne, 3, 3, 3, 3)
         indexed (node a, component s, node b, component t):
         sum_i weights_i K_ab ([d_a,i]x^T [d_b,i]x)_st with [u]x^T [v]x = (u.v) I - v u^T,
-        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3),
-        written out in broadcast products (cheaper than an einsum over the cross-product
-        matrices: docs/performance.md). Element matrices (3, ne, 3, 3), one K_i per field
-        (a stiffness varying along the line): sum_i weights_i K_i,ab (...)_st."""
+        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3):
+        with P_ab = sum_i weights_i d_b,i d_a,i^T (3 x 3, one batched product of the
+        nodes' director matrices), K_ab (tr(P_ab) I - P_ab) (cheaper than an einsum over
+        the cross-product matrices, and than a broadcast product per director:
+        docs/performance.md). Element matrices (3, ne, 3, 3), one K_i per field (a
+        stiffness varying along the line): sum_i weights_i K_i,ab (...)_st."""
         if np.ndim(stiffness) == 4:
             return sum(SecondVariation._element_blocks(d[:, :, i:i + 1], weights[i:i + 1],
                                                        stiffness[i]) for i in range(3))
-        ne = d.shape[0]
-        blocks = np.zeros((ne, 3, 3, 3, 3))
-        product = np.empty_like(blocks)
-        dots = np.zeros((ne, 3, 3))
-        for i, weight in enumerate(weights):
-            di = d[:, :, i, :]                                       # (ne, node, 3)
-            # product[e, a, s, b, t] = d_a,i[t] d_b,i[s]
-            np.multiply(di[:, :, None, None, :], di.transpose(0, 2, 1)[:, None, :, :, None],
-                        out=product)
-            blocks -= weight * product
-            dots += weight * np.matmul(di, di.transpose(0, 2, 1))   # (ne, a, b)
+        weighted = d * np.asarray(weights, dtype=float)[None, None, :, None]
+        # P[e, a, b, s, t] = sum_i weights_i d_b,i[s] d_a,i[t]
+        products = np.matmul(weighted.transpose(0, 1, 3, 2)[:, None], d[:, :, None])
+        traces = np.trace(products, axis1=3, axis2=4)                    # (ne, a, b)
+        blocks = np.negative(products.transpose(0, 1, 3, 2, 4))           # (ne, a, s, b, t)
         for s in range(3):
-            blocks[:, :, s, :, s] += dots
+            blocks[:, :, s, :, s] += traces
         blocks *= stiffness[:, :, None, :, None]
         return blocks
 

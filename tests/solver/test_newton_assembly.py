@@ -11,7 +11,11 @@ off the contact.
     places they reserve are in the pattern since the first assembly) and not the
     resultants' identity (added through the diagonal);
 (b) the drag's entries of the Newton Jacobian come in one block per element and kind of
-    row (the frames' rows, the resultants' chain): each of those rows is searched once.
+    row (the frames' rows, the resultants' chain): each of those rows is searched once;
+(c) the element blocks of the bending and torsion part of H (one batched product of the
+    nodes' director matrices) against their definition by cross-product matrices,
+    sum_i w_i K_ab [d_a,i]x^T [d_b,i]x, for directors that are not rotations (an
+    iterate's fields), one stiffness and one per field.
 """
 
 import numpy as np
@@ -19,6 +23,7 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.analysis.jacobian import NewtonJacobian
+from petsc_rod.analysis.second_variation import SecondVariation, skew
 
 from petsc_rod.environment.current import Current
 from petsc_rod.environment.seabed import Seabed
@@ -119,3 +124,21 @@ def test_the_drags_entries_come_in_one_block_per_kind_of_row(comm, solver_factor
     # the frames' rows of the element's three nodes and the chain's three rows
     rows = mesh.n_local_elements * (3 * hessian.unknowns + 3)
     assert mesh.global_sum(searched) == mesh.global_sum(rows) > 0
+
+
+@pytest.mark.parametrize("per_field", [False, True])
+def test_element_blocks_are_those_of_the_cross_product_matrices(per_field):
+    rng = np.random.default_rng(7)
+    ne = 5
+    d = rng.standard_normal((ne, 3, 3, 3))                 # (element, node, director, 3)
+    weights = np.array([2.0, 3.0, 0.5])
+    stiffness = rng.standard_normal((3, ne, 3, 3) if per_field else (ne, 3, 3))
+    crossed = skew(d)                                       # (ne, node, i, 3, 3)
+    expected = np.zeros((ne, 3, 3, 3, 3))
+    for i in range(3):
+        K = stiffness[i] if per_field else stiffness
+        # [d_a,i]x^T [d_b,i]x, (ne, a, s, b, t)
+        pair = np.einsum("eaks,ebkt->easbt", crossed[:, :, i], crossed[:, :, i])
+        expected += weights[i] * K[:, :, None, :, None] * pair
+    blocks = SecondVariation._element_blocks(d, weights, stiffness)
+    assert np.allclose(blocks, expected, rtol=0.0, atol=1e-13 * np.abs(expected).max())
