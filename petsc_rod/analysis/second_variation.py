@@ -125,6 +125,11 @@ class SecondVariation:
                                if self.resultants else np.zeros(0, dtype=int))
         self._diagonal = self.matrix.createVecLeft()
         self._reserved = not newton      # J's pattern in H (_assemble)
+        # whether H's pattern is made (the first assembly): zeroEntries keeps it, so an
+        # update adds no block of zeros (_add_blocks) and sets the resultants' identity
+        # through the diagonal (_assemble)
+        self._patterned = False
+        self._identity = None
         # global columns whose H e_j before the held rows are cleared a caller asks for
         # at the next update (``full_columns``)
         self.keep_columns, self.kept_columns = (), []
@@ -212,8 +217,8 @@ class SecondVariation:
                                      addv=PETSc.InsertMode.ADD_VALUES)
         # the curvature of the constraint set: -w_n sum_i [sym(lambda_i d_i^T) - lambda_i.d_i I]
         tau, lam, w = problem.state.tau, problem.state.lam, problem.state.node_weights
-        outer = np.einsum("nik,nil->nkl", lam, tau)
-        dots = np.einsum("nik,nik->n", lam, tau)
+        outer = np.matmul(lam.transpose(0, 2, 1), tau)        # sum_i lambda_i d_i^T
+        dots = np.trace(outer, axis1=1, axis2=2)
         local = -w[:, None, None] * (0.5 * (outer + outer.transpose(0, 2, 1))
                                      - dots[:, None, None] * np.eye(3))
         if self.stretch:
@@ -229,7 +234,7 @@ class SecondVariation:
             self.matrix.setValuesRCV(rows, rows, local, addv=PETSc.InsertMode.ADD_VALUES)
         if self.positions:
             self._add_chains(d)
-        if self.resultants:
+        if self.resultants and not self._patterned:
             self._add_blocks(self.resultant_rows[:, None], self.resultant_rows[:, None],
                              np.ones((self.resultant_rows.size, 1, 1)))
         for term in problem.terms:
@@ -243,6 +248,20 @@ class SecondVariation:
                                      np.zeros(rows.shape + columns.shape[1:]))
             self._reserved = True
         self.matrix.assemble()
+        if self.resultants and self._patterned:
+            # the resultants' identity rows by the diagonal of the assembled matrix, in
+            # place: one pass, where the same ones by blocks cost a search in each row
+            self.matrix.setDiagonal(self._resultant_identity(),
+                                    addv=PETSc.InsertMode.ADD_VALUES)
+        self._patterned = True
+
+    def _resultant_identity(self):
+        """A Vec of 1 on the resultants' rows and 0 elsewhere (made once)."""
+        if self._identity is None:
+            self._identity = self.matrix.createVecLeft()
+            self._identity.zeroEntries()
+            self._identity.getArray()[self.resultant_rows - self.first_row] = 1.0
+        return self._identity
 
     # --- the positions' chains (module docstring, analysis/positions.py) -----------------
     def _add_chains(self, d):
@@ -279,6 +298,16 @@ class SecondVariation:
                 self._add_blocks(multiplier, multiplier, np.zeros((ne, 1, 1)))
 
     def _add_blocks(self, rows, columns, values):
+        """Add ``values`` (k, len rows, len columns) at global ``rows`` (k, r) and
+        ``columns`` (k, c). Once the pattern is made a block of zeros adds nothing and is
+        left out (the seabed's curvature off the contact, the zeros that only reserve
+        places): MatSetValues searches each of a block's rows."""
+        if self._patterned:
+            kept = np.any(values != 0.0, axis=(1, 2))
+            if not kept.all():
+                rows, columns, values = rows[kept], columns[kept], values[kept]
+            if not len(rows):
+                return
         self.matrix.setValuesRCV(rows.astype(PETSc.IntType), columns.astype(PETSc.IntType),
                                  values, addv=PETSc.InsertMode.ADD_VALUES)
 
@@ -353,26 +382,22 @@ class SecondVariation:
         """The element blocks of the bending and torsion part of H, (ne, 3, 3, 3, 3)
         indexed (node a, component s, node b, component t):
         sum_i weights_i K_ab ([d_a,i]x^T [d_b,i]x)_st with [u]x^T [v]x = (u.v) I - v u^T,
-        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3),
-        written out in broadcast products (cheaper than an einsum over the cross-product
-        matrices: docs/performance.md). Element matrices (3, ne, 3, 3), one K_i per field
-        (a stiffness varying along the line): sum_i weights_i K_i,ab (...)_st."""
+        for directors d (ne, node, director i, 3) and element matrices K (ne, 3, 3):
+        with P_ab = sum_i weights_i d_b,i d_a,i^T (3 x 3, one batched product of the
+        nodes' director matrices), K_ab (tr(P_ab) I - P_ab) (cheaper than an einsum over
+        the cross-product matrices, and than a broadcast product per director:
+        docs/performance.md). Element matrices (3, ne, 3, 3), one K_i per field (a
+        stiffness varying along the line): sum_i weights_i K_i,ab (...)_st."""
         if np.ndim(stiffness) == 4:
             return sum(SecondVariation._element_blocks(d[:, :, i:i + 1], weights[i:i + 1],
                                                        stiffness[i]) for i in range(3))
-        ne = d.shape[0]
-        blocks = np.zeros((ne, 3, 3, 3, 3))
-        product = np.empty_like(blocks)
-        dots = np.zeros((ne, 3, 3))
-        for i, weight in enumerate(weights):
-            di = d[:, :, i, :]                                       # (ne, node, 3)
-            # product[e, a, s, b, t] = d_a,i[t] d_b,i[s]
-            np.multiply(di[:, :, None, None, :], di.transpose(0, 2, 1)[:, None, :, :, None],
-                        out=product)
-            blocks -= weight * product
-            dots += weight * np.matmul(di, di.transpose(0, 2, 1))   # (ne, a, b)
+        weighted = d * np.asarray(weights, dtype=float)[None, None, :, None]
+        # P[e, a, b, s, t] = sum_i weights_i d_b,i[s] d_a,i[t]
+        products = np.matmul(weighted.transpose(0, 1, 3, 2)[:, None], d[:, :, None])
+        traces = np.trace(products, axis1=3, axis2=4)                    # (ne, a, b)
+        blocks = np.negative(products.transpose(0, 1, 3, 2, 4))           # (ne, a, s, b, t)
         for s in range(3):
-            blocks[:, :, s, :, s] += dots
+            blocks[:, :, s, :, s] += traces
         blocks *= stiffness[:, :, None, :, None]
         return blocks
 
@@ -552,5 +577,6 @@ class SecondVariation:
 
     def destroy(self):
         for obj in [self.matrix, self.mass, self._mass_or_one, self._work, self._diagonal,
-                    *self.constraint, *self.kept_columns]:
+                    *self.constraint, *self.kept_columns,
+                    *([self._identity] if self._identity is not None else [])]:
             obj.destroy()

@@ -305,7 +305,8 @@ class NewtonSolver:
                     if frames is None:
                         break
                 else:
-                    frames = np.einsum("nkl,nil->nik", rotations(omega), frames)
+                    # d_i <- R d_i for each row d_i: frames R^T, one batched product
+                    frames = np.matmul(frames, rotations(omega).transpose(0, 2, 1))
                 mu = mu + dmu
                 # what is compared with STEP_TOLERANCE: an exact step's turn (the error
                 # it leaves is about its square), a chord step's geometric rest

@@ -128,7 +128,6 @@ class DragTerm(NodalLoadTerm):
         if not ne:
             return
         U = hessian.unknowns
-        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
         tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
         h = mesh.element_h
         r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
@@ -146,20 +145,33 @@ class DragTerm(NodalLoadTerm):
             rows_map = np.concatenate([rows_map, -unit[:, :, None, :]], axis=2)  # (ne, a, 4, 3)
         integrals = element_integrals(h)                                         # (ne, 3)
         tails = self.drag.tail_integrals                                         # (ne, a, b)
-        jacobian.add(x_rows, psi[:, 1],
-                     (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3))
-        # rows_map_a tails_ab G_b for each node pair (a, b) of an element, (ne, a, b, U,
-        # 3), by a batched matmul (a three-operand einsum loops over every index:
-        # docs/performance.md), then in the order of the rows (a, U) and columns (b, 3)
+        # the frames' rows on the element's turns and on the far vertex's resultants, in
+        # one block per element (the columns of _jacobian_blocks): rows_map_a tails_ab
+        # G_b for each node pair (a, b), (ne, a, b, U, 3), by a batched matmul (a
+        # three-operand einsum loops over every index: docs/performance.md), then in the
+        # order of the rows (a, U) and columns (b, 3)
         coupling = np.matmul(rows_map[:, :, None], G[:, None])
         coupling *= tails[:, :, :, None, None]
-        jacobian.add(x_rows, turns, coupling.transpose(0, 1, 3, 2, 4).reshape(ne, 3 * U, 9))
+        (frame_rows, frame_columns), (chain_rows, chain_columns) = \
+            self._jacobian_blocks(hessian)
+        jacobian.add(frame_rows, frame_columns, np.concatenate(
+            [coupling.transpose(0, 1, 3, 2, 4).reshape(ne, 3 * U, 9),
+             (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3)], axis=2))
         # the chain: Psi_e - Psi_e+1 - sum_l I_l G_l omega_l = 0 in Psi_e's row from a
         # held start, its negative in Psi_e+1's from a held end (the diagonal 1 is H's)
         sign = -1.0 if is_held(self.start_state) else 1.0
-        jacobian.add(row, other, np.broadcast_to(-np.eye(3), (ne, 3, 3)))
         chain = sign * np.einsum("eb,ebjk->ejbk", integrals, G).reshape(ne, 3, 9)
-        jacobian.add(row, turns, chain)
+        jacobian.add(chain_rows, chain_columns, np.concatenate(
+            [chain, np.broadcast_to(-np.eye(3), (ne, 3, 3))], axis=2))
+
+    def _jacobian_blocks(self, hessian):
+        """add_jacobian's (rows, columns) per owned element: the frames' rows (ne, 3 U)
+        on the element's turns and the far vertex's resultants (ne, 12), and the chain's
+        rows (ne, 3) on the turns and the other vertex's resultants (ne, 12). One block
+        each, not one per kind of column: MatSetValues searches each row of a block."""
+        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
+        return [(x_rows, np.concatenate([turns, psi[:, 1]], axis=1)),
+                (row, np.concatenate([turns, other], axis=1))]
 
     def _jacobian_indices(self, hessian):
         """The global rows and columns of add_jacobian's blocks, per owned element (ne):
@@ -181,8 +193,7 @@ class DragTerm(NodalLoadTerm):
         """add_jacobian's blocks (Term.jacobian_pattern)."""
         if not self.mesh.n_local_elements:
             return []
-        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
-        return [(x_rows, psi[:, 1]), (x_rows, turns), (row, other), (row, turns)]
+        return self._jacobian_blocks(hessian)
 
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""
