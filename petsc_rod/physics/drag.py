@@ -25,6 +25,9 @@ unsymmetric Newton Jacobian through the resultants' chain (analysis/jacobian.py)
 
 import numpy as np
 
+from petsc4py import PETSc
+
+from petsc_rod.analysis.positions import HEIGHT
 from petsc_rod.analysis.second_variation import skew
 from petsc_rod.global_step.nodal_loads import NodalLoad
 from petsc_rod.global_step.seabed_contact import node_rows
@@ -60,6 +63,21 @@ def drag_jacobian(tangent, velocity, drag):
     return stiffness @ turn @ skew(t)
 
 
+def drag_height_derivative(tangent, velocity, rate, drag):
+    """df/dz, (n, 3) N/m^2: the derivative of normal_drag in the height of its node,
+    through the current's rate dv/dz ``rate`` (n, 3) 1/s (Current.height_derivative):
+    c (|v_n| I + v_n v_n^T / |v_n|) (I - t t^T) dv/dz, for tangents (n, 3) (normalised
+    here), velocities (n, 3) m/s and c = ``drag`` (n,) kg/m^2."""
+    t = _unit(tangent)
+    normal = velocity - np.einsum("nc,nc->n", velocity, t)[:, None] * t
+    speed = np.sqrt(_squares(normal))
+    dv_n = rate - np.einsum("nc,nc->n", rate, t)[:, None] * t
+    along = np.divide(np.einsum("nc,nc->n", normal, dv_n), speed, out=np.zeros_like(speed),
+                      where=speed > 0)
+    return np.asarray(drag, dtype=float).reshape(-1)[:, None] * (
+        speed[:, None] * dv_n + along[:, None] * normal)
+
+
 def _unit(tangent):
     """The unit tangents of rows (n, 3), 0 where a row is 0: a node that the stretched
     local step compressed to a point (k = 0, docs/method.md §12) has no direction, and
@@ -91,6 +109,10 @@ class DragTerm(NodalLoadTerm):
         self.surface = surface
         self.drag = NodalLoad(mesh, self._nodes)
         self._node_S = mesh.node_S()            # where each node's section's drag applies
+        # a current that varies with depth: its drag reads the heights, whose chain the
+        # Newton Jacobian then carries (add_jacobian)
+        self.jacobian_positions = ((HEIGHT,) if any(c.depths.size > 1 for _, c
+                                                     in scene.drag_loads(1.0)) else ())
 
     def node_loads(self, state, tangents=None):
         """sum_k w_k c_k |v_n,k| v_n,k at the owned nodes (N/m), (n_nodes, 3), over the
@@ -119,33 +141,15 @@ class DragTerm(NodalLoadTerm):
     def add_jacobian(self, jacobian):
         """The drag's entries of J (analysis/jacobian.py module docstring): the frames'
         rows on the resultants and on the element's turns, and the resultants' chain, at
-        the fields' tangents and heights. The depth derivative of a current profile is
-        left out (J is then inexact on a sheared current: the steps converge linearly,
-        fast where the shear over a step's height change is small)."""
-        mesh, hessian = self.mesh, jacobian.hessian
-        state = jacobian.problem.state
-        ne = mesh.n_local_elements
-        if not ne:
+        the fields' tangents and heights; in a current that varies with depth, the same
+        rows on the heights' chain too (delta f_l = (df/dz)_l dz_l, dz_l a vertex's u or
+        a midpoint's u_e + h_e HALF.s_e: analysis/positions.py), so that J is exact on a
+        sheared current."""
+        parts = self._linearisation(jacobian.hessian, jacobian.problem.state)
+        if parts is None:
             return
-        U = hessian.unknowns
-        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
-        tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
-        h = mesh.element_h
-        r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
-        z = np.einsum("enk,ek->en", node_rows(h),
-                      np.concatenate(mesh.element_ends(r), axis=1))      # (ne, 3 nodes)
-        S = mesh.element_S[:, None] + h[:, None] * np.array([0.0, 0.5, 1.0])
-        flat_t = tangents.reshape(-1, 3)
-        G = sum(w * drag_jacobian(flat_t, c.velocity(z.ravel()),
-                                  self.scene.drag_at(S.ravel(), c))
-                for w, c in self.scene.drag_loads(self.t)).reshape(ne, 3, 3, 3)
-        # the frames' rows of -delta b: -[t]x on omega, -t/|t| on the stretch
-        rows_map = -skew(tangents)                                               # (ne, a, 3, 3)
-        if U == 4:
-            unit = tangents / np.linalg.norm(tangents, axis=2, keepdims=True)
-            rows_map = np.concatenate([rows_map, -unit[:, :, None, :]], axis=2)  # (ne, a, 4, 3)
-        integrals = element_integrals(h)                                         # (ne, 3)
-        tails = self.drag.tail_integrals                                         # (ne, a, b)
+        x_rows, turns, psi, row, other, rows_map, integrals, tails, G, heights = parts
+        ne, U = len(x_rows), jacobian.hessian.unknowns
         jacobian.add(x_rows, psi[:, 1],
                      (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3))
         # rows_map_a tails_ab G_b for each node pair (a, b) of an element, (ne, a, b, U,
@@ -160,6 +164,91 @@ class DragTerm(NodalLoadTerm):
         jacobian.add(row, other, np.broadcast_to(-np.eye(3), (ne, 3, 3)))
         chain = sign * np.einsum("eb,ebjk->ejbk", integrals, G).reshape(ne, 3, 9)
         jacobian.add(row, turns, chain)
+        if heights is not None:
+            columns, frames_rows, chain_rows, Z = heights
+            jacobian.add(x_rows, columns, np.matmul(frames_rows, Z))
+            jacobian.add(row, columns, np.matmul(chain_rows, Z))
+
+    def add_hessian(self, hessian):
+        """No curvature (the drag has no energy); where the heights' chain is for the
+        drag's Jacobian alone, zeros on its diagonal, so that a shift of H
+        (analysis/stability.py) meets no new nonzero there."""
+        if self.jacobian_positions and HEIGHT in hessian.position_slot:
+            hessian.add_height_curvature(np.zeros(self.mesh.n_local_nodes))
+
+    def height_shift(self, hessian, state):
+        """The Vec d(residual)/dz_0 of the drag: every node's height raised by 1 m (the
+        held start moved up, system/held_line.py), delta f_l = (df/dz)_l on the frames'
+        rows and the resultants' chain as in add_jacobian; None where the current does
+        not vary with depth. Collective."""
+        if not self.jacobian_positions:
+            return None
+        parts = self._linearisation(hessian, state)
+        vec = hessian.matrix.createVecLeft()
+        vec.zeroEntries()
+        if parts is not None:
+            x_rows, row, heights = parts[0], parts[3], parts[-1]
+            _, frames_rows, chain_rows, _ = heights
+            vec.setValues(np.concatenate([x_rows.ravel(), row.ravel()]).astype(PETSc.IntType),
+                          np.concatenate([frames_rows.sum(axis=2).ravel(),
+                                          chain_rows.sum(axis=2).ravel()]),
+                          addv=PETSc.InsertMode.ADD_VALUES)
+        vec.assemble()
+        hessian.zero_held(vec)
+        return vec
+
+    def _linearisation(self, hessian, state):
+        """The pieces of add_jacobian at ``state`` on ``hessian``'s layout, per owned
+        element (None where this rank owns none): its indices (_jacobian_indices), the
+        frames' rows of -delta b (ne, 3, U, 3), the node integrals I (ne, 3), the tails
+        T (ne, 3, 3), the turns' G (ne, 3, 3, 3), and in a sheared current the heights'
+        (columns (ne, 2 + 3 U): u_e, u_e+1, the element's unknowns; the frames' rows
+        sum_b tails_ab rows_map_a (df/dz)_b (ne, 3 U, 3 nodes); the chain's
+        sign I_b (df/dz)_b (ne, 3, 3 nodes); Z (ne, 3 nodes, 2 + 3 U) each node's height
+        as a row on those columns), else None."""
+        mesh = self.mesh
+        ne = mesh.n_local_elements
+        if not ne:
+            return None
+        U = hessian.unknowns
+        x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
+        tangents = element_dofs(state.slope.ghosted(), mesh.element_local, P2)   # (ne, 3, 3)
+        h = mesh.element_h
+        r = state.r.ghosted()[:, :, 2]                     # Hermite (z, z') at the vertices
+        z = np.einsum("enk,ek->en", node_rows(h),
+                      np.concatenate(mesh.element_ends(r), axis=1))      # (ne, 3 nodes)
+        S = mesh.element_S[:, None] + h[:, None] * np.array([0.0, 0.5, 1.0])
+        flat_t = tangents.reshape(-1, 3)
+        currents = self.scene.drag_loads(self.t)
+        G = sum(w * drag_jacobian(flat_t, c.velocity(z.ravel()),
+                                  self.scene.drag_at(S.ravel(), c))
+                for w, c in currents).reshape(ne, 3, 3, 3)
+        # the frames' rows of -delta b: -[t]x on omega, -t/|t| on the stretch
+        rows_map = -skew(tangents)                                               # (ne, a, 3, 3)
+        if U == 4:
+            unit = tangents / np.linalg.norm(tangents, axis=2, keepdims=True)
+            rows_map = np.concatenate([rows_map, -unit[:, :, None, :]], axis=2)  # (ne, a, 4, 3)
+        integrals = element_integrals(h)                                         # (ne, 3)
+        tails = self.drag.tail_integrals                                         # (ne, a, b)
+        heights = None
+        if self.jacobian_positions:
+            D = sum(w * drag_height_derivative(flat_t, c.velocity(z.ravel()),
+                                               c.height_derivative(z.ravel()),
+                                               self.scene.drag_at(S.ravel(), c))
+                    for w, c in currents).reshape(ne, 3, 3)                     # (ne, b, 3)
+            sign = -1.0 if is_held(self.start_state) else 1.0
+            # rows_map_a (df/dz)_b tails_ab: (ne, a, U, b)
+            frames_rows = (np.matmul(rows_map, D.transpose(0, 2, 1)[:, None])
+                           * tails[:, :, None, :]).reshape(ne, 3 * U, 3)
+            chain_rows = sign * (integrals[:, None, :] * D.transpose(0, 2, 1))  # (ne, 3, b)
+            slot = hessian.position_slot[HEIGHT]
+            middle = hessian.midpoint_row(HEIGHT)                               # (ne, 1 + 3 U)
+            Z = np.zeros((ne, 3, 2 + 3 * U))
+            Z[:, 0, 0] = Z[:, 2, 1] = 1.0
+            Z[:, 1, 0] = middle[:, 0]
+            Z[:, 1, 2:] = middle[:, 1:]
+            heights = (self._height_columns(x_rows, slot, U), frames_rows, chain_rows, Z)
+        return x_rows, turns, psi, row, other, rows_map, integrals, tails, G, heights
 
     def _jacobian_indices(self, hessian):
         """The global rows and columns of add_jacobian's blocks, per owned element (ne):
@@ -177,12 +266,25 @@ class DragTerm(NodalLoadTerm):
             (psi[:, 1], psi[:, 0])
         return x_rows, turns, psi, row, other
 
+    @staticmethod
+    def _height_columns(x_rows, slot, unknowns):
+        """The columns of the heights' entries per element, (ne, 2 + 3 U): u at its
+        two vertices (their first row plus the heights' ``slot``), then its nodes'
+        unknowns (``x_rows``)."""
+        first = x_rows[:, ::unknowns]                       # each node's first row
+        return np.concatenate([first[:, [0, 2]] + slot, x_rows], axis=1)
+
     def jacobian_pattern(self, hessian):
         """add_jacobian's blocks (Term.jacobian_pattern)."""
         if not self.mesh.n_local_elements:
             return []
         x_rows, turns, psi, row, other = self._jacobian_indices(hessian)
-        return [(x_rows, psi[:, 1]), (x_rows, turns), (row, other), (row, turns)]
+        blocks = [(x_rows, psi[:, 1]), (x_rows, turns), (row, other), (row, turns)]
+        if self.jacobian_positions:
+            columns = self._height_columns(x_rows, hessian.position_slot[HEIGHT],
+                                           hessian.unknowns)
+            blocks += [(x_rows, columns), (row, columns)]
+        return blocks
 
     def add_iterate_load(self, rhs, state):
         """Add the drag's int F.g to the slope problem's right-hand side."""

@@ -28,7 +28,8 @@ c = x_b - x_a and the start's height z_a: with A the matrix of the Newton system
 equilibrium (H, the second variation, analysis/second_variation.py; in a current the
 Newton Jacobian J, analysis/jacobian.py), C^T the chord forms (3 columns) and
 P = dgrad L/dz_a (the seabed's curvature times each node's height row,
-SecondVariation.position_shift), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3, 3):
+SecondVariation.position_shift; in a sheared current plus the drag's columns on the
+heights summed, DragTerm.height_shift: the line raised meets another current), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3, 3):
 
     dmu = -S^-1 (dc + C Y_P dz_a),   dy = -Y_P dz_a - Y_C dmu,
     dF_b = dmu,   dF_a = dPsi_0 - (P.dy + sum_n k w_n dz_a) e_z - dmu,
@@ -72,13 +73,14 @@ a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient 
 step there).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged), a
-sheared current (the depth derivative of its drag is not in J), and any load outside
-the Newton system (the sea surface's wet and dry parts, attachments that reach it).
+seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged),
+and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
 """
+
+import dataclasses
 
 import numpy as np
 from petsc4py import PETSc
@@ -343,8 +345,6 @@ class HeldLine:
     def _model(self, start, end, frames=(None, None)):
         """The line's Model with its ends at ``start``, ``end`` (absolute, m), a clamp's
         frame at ``frames`` ((3, 3) or None: the span's)."""
-        import dataclasses
-
         def at(end_, position, frame):
             if frame is None or end_.kind != "clamp":
                 return dataclasses.replace(end_, position=position)
@@ -585,8 +585,8 @@ class HeldLine:
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
         derivative of force component i (0-2 on the start, 3-5 on the end) in position
         component j (0-2 of the start, 3-5 of the end), at the last equilibrium, from
-        the line's factored second variation, or in a uniform current its Newton
-        Jacobian (module docstring). Symmetric and negative semi-definite for a stable
+        the line's factored second variation, or in a current its Newton Jacobian
+        (module docstring). Symmetric and negative semi-definite for a stable
         line without a current. Collective."""
         return self._linearised(False)
 
@@ -642,6 +642,18 @@ class HeldLine:
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
+            # a sheared current: the start raised moves the drag of every node too
+            pushes = [v for v in (term.height_shift(hessian, state) for term in problem.terms
+                                  if term.jacobian_positions) if v is not None]
+            vecs.extend(pushes)
+            lift = shift
+            if pushes:
+                lift = pushes[0].duplicate()
+                vecs.append(lift)
+                lift.zeroEntries()
+                lift.maxpy([1.0] * len(pushes), pushes)
+                if shift is not None:
+                    lift.axpy(1.0, shift)
             if hessian.resultants:
                 if self.jacobian is None:
                     self.jacobian = self.built.own(NewtonJacobian(hessian))
@@ -650,7 +662,7 @@ class HeldLine:
             else:
                 hessian.factorise(0.0)
                 solver = hessian
-            shifts = [] if shift is None else [shift]
+            shifts = [] if lift is None else [lift]
             solved = solver.solve_many(columns + shifts + turned)
             vecs.extend(solved)
             response = self._response(hessian, columns, shift, solved[:3 + len(shifts)],
@@ -658,7 +670,7 @@ class HeldLine:
             if rotations:
                 response = self._rotation_response(hessian, frames, columns, shift,
                                                    solved, recorder.heights, *held_data,
-                                                   response, flexed)
+                                                   response, flexed, lifted=bool(shifts))
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -729,7 +741,7 @@ class HeldLine:
         return held, dict(zip([e for e, _ in clamps], axial))
 
     def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
-                           held, axial, response, flexed=()):
+                           held, axial, response, flexed=(), lifted=False):
         """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
 
         A clamp turned by theta holds its node's rotation at theta instead of 0: the
@@ -749,7 +761,7 @@ class HeldLine:
         n_h = len(held) + 3 * len(flexed)
         n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
         Y_C = solved[:3]
-        Y_P = solved[3:4] if shift is not None else []
+        Y_P = solved[3:4] if lifted else []
         Y_T = solved[3 + len(Y_P):]
         data = []                                           # the data column of each held
         stretches = []
@@ -900,11 +912,6 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        current = scene.current
-        if current is not None and np.ptp(current.velocities, axis=0).max() > 0:
-            raise RodInputError("HeldLine.stiffness: a current profile's depth derivative "
-                                "is not in the Newton Jacobian: no exact stiffness in a "
-                                "sheared current (a uniform one has one)")
         if scene.seabed is not None and scene.seabed.friction is not None:
             raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
                                 "exact stiffness of a line with friction")
@@ -932,12 +939,18 @@ def held_lines(system, options=None):
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
-    instead of after each of its re-solves."""
+    instead of after each of its re-solves. A current profile's depths are below the
+    system's sea surface, z = 0 where the Environment gives none (as the free points'
+    drag, system/equilibrium.py), not below each line's higher end as for a single
+    line: the lines and points of a system share one sea."""
     options = {"al_stability": 0, **(options or {})}
+    environment = system.environment
+    if environment.profile() is not None and environment.surface is None:
+        environment = dataclasses.replace(environment, surface=0.0)
 
     def make_line(line, comm):
         start, end = (connection_position(system.node(c.to), c)
                       for c in (line.start, line.end))
-        return HeldLine.of_system_line(line, start, end, comm, system.environment, options)
+        return HeldLine.of_system_line(line, start, end, comm, environment, options)
 
     return make_line

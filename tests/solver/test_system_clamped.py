@@ -56,6 +56,25 @@ def factory(system):
     return make_line
 
 
+def body_differences(solver, h=(1e-4,) * 3 + (1e-5,) * 3):
+    """-d(the lines' share of the first body's residual)/d(its pose), central
+    differences of the lines re-solved at moved and turned poses, (6, 6)."""
+    state, layout = solver.state, solver.layout
+    numeric = np.empty((6, 6))
+    for j in range(6):
+        sides = []
+        for sign in (1.0, -1.0):
+            step = np.zeros(layout.size)
+            step[layout.body_dofs[0][j]] = sign * h[j]
+            moved = state.moved(step, layout)
+            ok, f, lin = solver.evaluate(moved)
+            assert ok
+            r, _ = solver.lines_part(moved, f, lin)
+            sides.append(r[layout.body_dofs[0]])
+        numeric[:, j] = -(sides[0] - sides[1]) / (2 * h[j])
+    return numeric
+
+
 @pytest.mark.parametrize("comm", list(COMMS))
 @pytest.mark.parametrize("kind", ["clamp", "flex"])
 def test_a_body_on_a_clamped_riser_balances_and_its_stiffness_is_the_derivative(comm, kind):
@@ -84,19 +103,7 @@ def test_a_body_on_a_clamped_riser_balances_and_its_stiffness_is_the_derivative(
         # the 6 x 6 against central differences of the lines re-solved at the body's
         # moved and turned poses
         K = solver.body_stiffness("buoy").matrix
-        h = np.array([1e-4] * 3 + [1e-5] * 3)
-        numeric = np.empty((6, 6))
-        for j in range(6):
-            sides = []
-            for sign in (1.0, -1.0):
-                step = np.zeros(layout.size)
-                step[layout.body_dofs[0][j]] = sign * h[j]
-                moved = state.moved(step, layout)
-                ok, f, lin = solver.evaluate(moved)
-                assert ok
-                r, _ = solver.lines_part(moved, f, lin)
-                sides.append(r[layout.body_dofs[0]])
-            numeric[:, j] = -(sides[0] - sides[1]) / (2 * h[j])
+        numeric = body_differences(solver)
         scale = np.abs(K).max()
         error = np.abs(K - numeric).max() / scale
         print(f"balance {np.abs(total[:3]).max():.3g} N, {np.abs(total[3:]).max():.3g} N m; "
