@@ -450,8 +450,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
     line's modes with its ends held where ``modes`` (count, MassSettings) asks for
     them (line_modes), the result file and the tables when asked; the lines destroyed. ``interrupts``
-    (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
-    ends the run before anything is written (RodInterrupted). ``sweeps``
+    (cli/signals.Interrupts) asked before every iteration of the system's Newton (and
+    so of its sweeps) and once the equilibrium is found: a stop signal then ends the
+    run before anything is written (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
     after the equilibrium, in the results, the file and the tables. Returns the
     SystemResults. RodInputError for a system the checks refuse (exit 2),
@@ -463,6 +464,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     check_outputs(comm, system, output, table, sweeps)
     solver = SystemSolver(system, held_lines(system, line_options), comm,
                           settings=settings)
+    solver.interrupts = interrupts
     failures = AgreedFailures(comm)
     try:
         # the ranks agree on a failure (one rank's alone ends every rank) before the

@@ -427,3 +427,33 @@ def test_one_rank_failing_alone_while_writing_leaves_no_file(tmp_path):
     assert len(errors) == 1 and "rank 1 failed alone (FloatingPointError" in errors[0], \
         describe(done)
     assert not out.exists() and not partial_files(out)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_stop_signal_during_the_newton_ends_the_run_there(tmp_path, ranks):
+    """SIGTERM sent once the run has said its notes (before its lines are solved) stops
+    it at the next iteration of the system's Newton, not once the equilibrium is found:
+    one line naming the load factor and the iteration, 128 + 15 (mpiexec: 1), no file."""
+    import signal
+    import subprocess
+
+    from helpers import child_env, petsc_rod_command
+    out = tmp_path / "system.h5"
+    process = subprocess.Popen(
+        petsc_rod_command(["-rod_system", DECK, "-rod_system_body_load", LOAD,
+                           "-rod_output", str(out), *SWEEPS], ranks),
+        cwd=REPO_ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        text=True)
+    try:
+        first = process.stdout.readline()
+        assert first.startswith("petsc_rod: note"), first
+        process.send_signal(signal.SIGTERM)
+        output, _ = process.communicate(timeout=300)
+    finally:
+        process.kill()
+    errors = [line for line in output.splitlines() if line.startswith("petsc_rod: error")]
+    assert process.returncode == (143 if ranks == 1 else 1), output
+    assert len(errors) == 1, output
+    assert "stopped by SIGTERM during the system's Newton (load factor" in errors[0]
+    assert "Traceback" not in output and "equilibrium in" not in output
+    assert not out.exists() and not partial_files(out)
