@@ -197,6 +197,35 @@ class DragTerm(NodalLoadTerm):
         hessian.zero_held(vec)
         return vec
 
+    def turn_columns(self, hessian, state, columns):
+        """The drag's entries of J in the global ``columns`` (a held node's rotation:
+        a clamp's, which its turn moves, system/held_line.py), one new Vec each, 0 on
+        the held rows: the frames' rows' coupling and the resultants' chain of
+        add_jacobian in those columns. Collective."""
+        parts = self._linearisation(hessian, state)
+        vecs = []
+        for column in columns:
+            vec = hessian.matrix.createVecLeft()
+            vec.zeroEntries()
+            if parts is not None:
+                x_rows, turns, _, row, _, rows_map, integrals, tails, G, _ = parts
+                ne, U = len(x_rows), hessian.unknowns
+                elements, slots = np.nonzero(turns == column)
+                for e, slot in zip(elements, slots):
+                    b, k = divmod(int(slot), 3)
+                    # rows_map_a tails_ab G_b e_k on the frames' rows, and the chain's
+                    # sign I_b G_b e_k (add_jacobian)
+                    frames = (np.matmul(rows_map[e], G[e, b][:, k]) * tails[e, :, b, None])
+                    sign = -1.0 if is_held(self.start_state) else 1.0
+                    chain = sign * integrals[e, b] * G[e, b][:, k]
+                    vec.setValues(np.concatenate([x_rows[e], row[e]]).astype(PETSc.IntType),
+                                  np.concatenate([frames.reshape(3 * U), chain]),
+                                  addv=PETSc.InsertMode.ADD_VALUES)
+            vec.assemble()
+            hessian.zero_held(vec)
+            vecs.append(vec)
+        return vecs
+
     def _linearisation(self, hessian, state):
         """The pieces of add_jacobian at ``state`` on ``hessian``'s layout, per owned
         element (None where this rank owns none): its indices (_jacobian_indices), the

@@ -65,8 +65,9 @@ conjugate of the clamp's rotation (they differ by O(h) terms, so dF/dtheta is no
 (dM/dx)^T), and the rotations are increments on the left (a skew part of the order of
 [M]x in the rotation block); the forces' position block is symmetric without a current
 (to 7e-8 of the largest entry with extensible clamps, whose stretch rule is not the
-energy's). A clamp in a current has no end_stiffness (its drag's Jacobian columns at
-the clamp are not taken). A flex joint's support frame D given to solve turns its axis,
+energy's). In a current the drag at the clamped node turns with the clamp: J's columns
+at its held rotation are H's (full_columns) plus the drag's (DragTerm.turn_columns), and
+the start's force moves with the drag's resultant Psi_0 in every datum. A flex joint's support frame D given to solve turns its axis,
 a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient at its
 (free) node, solved for like a clamp's, and its moment on the support is the joint's,
 -k (theta / sin theta) d3 x a (not at an extensible end: the joint acts in the local
@@ -620,14 +621,14 @@ class HeldLine:
         try:
             self.newton.lagrangian_gradient(frames, state.chord_multiplier.copy())
             hessian = problem.second_variation()
-            if clamps and hessian.resultants:
-                raise RodInputError("HeldLine.end_stiffness: a clamp's rotation in a "
-                                    "current is not linearised (its drag's Jacobian "
-                                    "columns at the clamp): no exact end stiffness")
             held_data = self._held_data(hessian, clamps)
             turned = hessian.full_columns([hessian.block * node + k for _, node, k
                                            in held_data[0]]) if clamps else []
             vecs.extend(turned)
+            if clamps and hessian.resultants:
+                # J's columns at the clamps' rotations: the drag at the clamped node
+                # turns with it (DragTerm.turn_columns)
+                self._add_turn_columns(hessian, held_data[0], turned, vecs)
             flexed = self._flexed(hessian) if rotations else []
             for entry in flexed:
                 turned.extend(entry[-1])
@@ -728,6 +729,19 @@ class HeldLine:
             out.append((e, node, J_d, J_a, a, d, columns))
         return out
 
+    def _add_turn_columns(self, hessian, held, turned, vecs):
+        """Add the followers' entries of J (DragTerm.turn_columns) to H's columns
+        ``turned`` at the held rotations of ``held`` [(end, node, slot)]; the new Vecs
+        go to ``vecs`` to be freed. Collective."""
+        rotated = [j for j, (_, _, k) in enumerate(held) if k < 3]
+        columns = [hessian.block * held[j][1] + held[j][2] for j in rotated]
+        for term in self.problem.terms:
+            if term.follower:
+                extra = term.turn_columns(hessian, self.problem.state, columns)
+                vecs.extend(extra)
+                for j, vec in zip(rotated, extra):
+                    turned[j].axpy(1.0, vec)
+
     def _held_data(self, hessian, clamps):
         """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
         rotation and 3 its stretch (an extensible line's clamped node, EA finite: held in
@@ -801,6 +815,13 @@ class HeldLine:
         forces = np.zeros((6, n_d))
         forces[3:] = dmu
         forces[:3] = -dmu
+        if hessian.resultants:                              # the drag's resultant Psi_0
+            slot = hessian.resultant_slot
+            first = mesh.global_sum(np.array(
+                [y.getArray(readonly=True).reshape(-1, B)[0, slot:slot + 3]
+                 if mesh.on_lower_boundary else np.zeros(3) for y in solved]))
+            forces[:3] += of_dy(first[:3].T, first[3] if Y_P else np.zeros(3),
+                                first[3 + len(Y_P):3 + len(Y_P) + n_h].T)
         forces[:3, :4] = response[:3]
         if shift is not None:
             moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]),

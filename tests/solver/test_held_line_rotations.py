@@ -26,13 +26,14 @@ REFERENCE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 TURNED = REFERENCE @ rotations(np.array([0.1, -0.3, 0.2])).T
 
 
-def clamped_line(comm, extensible):
+def clamped_line(comm, extensible, current=None):
     line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
-                       elements=40, axial_stiffness=1e5 if extensible else np.inf)
+                       elements=40, axial_stiffness=1e5 if extensible else np.inf,
+                       drag=None if current is None else (1025.0, 1.2, 0.1))
     end = (End(kind="clamp", position=tuple(ENDS[1])) if extensible
            else End.anchor(tuple(ENDS[1])))
     model = Model(line=line, start=End(kind="clamp", position=tuple(ENDS[0])), end=end,
-                  environment=Environment())
+                  environment=Environment(current=current))
     held = HeldLine(model, comm, options=TIGHT)
     frames = [TURNED, REFERENCE if extensible else None]
     assert held.solve(*ENDS, *frames)
@@ -91,6 +92,25 @@ def test_end_stiffness_against_differences(comm, extensible):
         # (measured 7e-8 of the largest entry)
         asymmetry = np.abs(K[:6, :6] - K[:6, :6].T).max() / scale
         assert asymmetry < (1e-6 if extensible else 1e-12)
+    finally:
+        line.destroy()
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("extensible", [False, True], ids=["inextensible", "extensible"])
+def test_end_stiffness_in_a_current_against_differences(comm, extensible):
+    """A clamp in a current: turning it turns the drag at the clamped node (the drag's
+    Jacobian columns at the clamp's rotation) and moves the drag's resultant on the
+    start; unsymmetric."""
+    line, frames = clamped_line(COMMS[comm], extensible, current=(0.2, 0.5, 0.0))
+    try:
+        assert line.end_forces()[:, 1].sum() > 50.0             # the current's push
+        K = line.end_stiffness()
+        scale = np.abs(K).max()
+        found = differences(line, frames)
+        print("ERR", np.abs(K - found).max() / scale)
+        assert np.abs(K - found).max() < 1e-6 * scale
+        assert np.abs(K[6:9, 6:9]).max() > 0.5 * abs(line.end_moments()[0]).max()
     finally:
         line.destroy()
 
