@@ -67,11 +67,12 @@ conjugate of the clamp's rotation (they differ by O(h) terms, so dF/dtheta is no
 (to 7e-8 of the largest entry with extensible clamps, whose stretch rule is not the
 energy's). In a current the drag at the clamped node turns with the clamp: J's columns
 at its held rotation are H's (full_columns) plus the drag's (DragTerm.turn_columns), and
-the start's force moves with the drag's resultant Psi_0 in every datum. A flex joint's support frame D given to solve turns its axis,
-a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient at its
-(free) node, solved for like a clamp's, and its moment on the support is the joint's,
--k (theta / sin theta) d3 x a (not at an extensible end: the joint acts in the local
-step there).
+the start's force moves with the drag's resultant Psi_0 in every datum. A flex joint's
+support frame D given to solve turns its axis, a = D^T D_ref a_0; turning it by delta is
+a data change of the joint's gradient at its (free) node, solved for like a clamp's, and
+its moment on the support is the joint's, -k (theta / sin theta) d3 x a; at an
+extensible end too, where the joint acts in the local step (its gradient in rotations,
+of the tangent's direction only, is the same function of d3 and a).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged),
@@ -708,10 +709,6 @@ class HeldLine:
         out = []
         last = 2 * self.mesh.n_elements
         for e, d, term in self._joint_tangents():
-            if term.local:
-                raise RodInputError("HeldLine.end_stiffness: a flex joint at an "
-                                    "extensible end acts in the local step: its turn is "
-                                    "not linearised yet")
             node = (0, last)[e]
             a = term.axis
             J_d, J_a = _joint_jacobians(term.k, d, a)

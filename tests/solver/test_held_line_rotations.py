@@ -140,13 +140,15 @@ def test_a_frame_walk_is_the_fresh_solve():
 
 
 @pytest.mark.parametrize("comm", list(COMMS))
-def test_a_flex_joints_end_stiffness_against_differences(comm):
+@pytest.mark.parametrize("extensible", [False, True], ids=["inextensible", "extensible"])
+def test_a_flex_joints_end_stiffness_against_differences(comm, extensible):
     """A flex joint's support turned turns its axis with it (a = D^T D_ref a_0): the
     12 x 12 with the joint's moment on its support, -k (theta / sin theta) d3 x a,
     against central differences (measured 5e-10); its rotation block's antisymmetric
-    part is -[M]x, M the joint's moment (left increments of a conservative joint)."""
+    part is -[M]x, M the joint's moment (left increments of a conservative joint); at an
+    extensible end too, where the joint acts in the local step."""
     line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
-                       elements=40)
+                       elements=40, axial_stiffness=1e5 if extensible else np.inf)
     model = Model(line=line, start=End(kind="pin", position=tuple(ENDS[0]), stiffness=200.0),
                   end=End.anchor(tuple(ENDS[1])), environment=Environment())
     flexed = HeldLine(model, COMMS[comm], options=TIGHT)
