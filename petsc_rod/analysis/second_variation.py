@@ -102,7 +102,9 @@ class SecondVariation:
         # energies read (and ``positions``: the modes' mass, analysis/modes.py), one slot
         # each after the node's unknowns
         self.positions = tuple(sorted({c for term in problem.terms
-                                       for c in term.position_components} | set(positions)))
+                                       for c in term.position_components
+                                       + (term.jacobian_positions if newton else ())}
+                                      | set(positions)))
         self.position_slot = {c: self.unknowns + i for i, c in enumerate(self.positions)}
         # the resultants' chain of a load that follows the line (analysis/jacobian.py):
         # three slots per node, identity rows here (H is the frozen load's); not where H
@@ -336,6 +338,12 @@ class SecondVariation:
                                     * self._midpoint_rows[b][:, None, :]))
         return [t for t in triples if t[0].size]
 
+    def midpoint_row(self, component):
+        """The midpoint's position of ``component`` as a row on (u_e, the element's
+        unknowns), (ne, 1 + 3 U), per owned element: u_e + h_e HALF.s_e at the last
+        assembly (a term's Jacobian entries in the positions, physics/drag.py)."""
+        return self._midpoint_rows[component]
+
     def add_position_curvature(self, values, components):
         """Add a position energy's second derivative (module docstring of positions.py),
         ``values`` (n_nodes, m, m) in the ``components`` (m,) of the owned nodes' positions,
@@ -553,6 +561,11 @@ class SecondVariation:
     def from_vec(self, vec):
         """The nodes' unknowns (n_nodes, unknowns) of a Vec (u, nu left out), a copy."""
         return vec.getArray(readonly=True).reshape(-1, self.block)[:, :self.unknowns].copy()
+
+    def zero_held(self, vec):
+        """``vec`` set to 0 on the held rows (J's identity rows drop a term's entries
+        there too)."""
+        self._zero_clamped(vec)
 
     def _zero_clamped(self, vec):
         local = self.held_rows - self.first_row

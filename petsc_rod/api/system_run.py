@@ -535,8 +535,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     them (line_modes), the bodies' and free points' modes where ``body_modes``
     ({'line_mass': bool}) asks for them (system/body_modes.system_modes), the result
     file and the tables when asked; the lines destroyed. ``interrupts``
-    (cli/signals.Interrupts) asked once the equilibrium is found: a stop signal then
-    ends the run before anything is written (RodInterrupted). ``sweeps``
+    (cli/signals.Interrupts) asked before every iteration of the system's Newton (and
+    so of its sweeps) and once the equilibrium is found: a stop signal then ends the
+    run before anything is written (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
     after the equilibrium, in the results, the file and the tables. Returns the
     SystemResults. ``solver``: a SystemSolver of a system that differs from ``system``
@@ -556,6 +557,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
                               settings=settings)
     else:
         on_every_rank(comm, solver.replace, system)
+    solver.interrupts = interrupts
     failures = AgreedFailures(comm)
     try:
         # the ranks agree on a failure (one rank's alone ends every rank) before the

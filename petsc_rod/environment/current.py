@@ -46,6 +46,21 @@ class Current:
         return np.stack([np.interp(depth, self.depths, self.velocities[:, c])
                          for c in range(3)], axis=-1)
 
+    def height_derivative(self, z):
+        """dv/dz at heights z (n,), (n, 3), 1/s: minus the slope of ``velocity`` in the
+        depth, that of the rows' segment holding the depth (the deeper one at a row), 0
+        beyond the first and last rows and for a uniform current."""
+        depth = self.surface - np.asarray(z, dtype=float)
+        out = np.zeros(depth.shape + (3,))
+        if self.depths.size < 2:
+            return out
+        k = np.clip(np.searchsorted(self.depths, depth, side="right") - 1, 0,
+                    self.depths.size - 2)
+        slope = np.diff(self.velocities, axis=0) / np.diff(self.depths)[:, None]
+        inside = (depth >= self.depths[0]) & (depth < self.depths[-1])
+        out[inside] = -slope[k[inside]]
+        return out
+
     def largest_drag(self):
         """c max |v|^2 (N/m): the largest drag per metre the current can exert."""
         return float(self.drag * np.max(np.sum(self.velocities**2, axis=1)))

@@ -68,6 +68,11 @@ class Term:
     # Newton system and the stability test then carry their chains
     # (analysis/positions.py), and add_hessian may call hessian.add_position_curvature
     position_components = ()
+    # the components of the node positions the term's load reads without an energy (the
+    # drag of a current that varies with depth: the heights): the Newton system carries
+    # their chains (analysis/positions.py) for the Jacobian's columns in them
+    # (add_jacobian), and nothing else changes (no curvature, no stability test)
+    jacobian_positions = ()
     # the term's load follows the line and has no potential (the drag): the resultants'
     # chain of analysis/jacobian.py carries its linearisation
     follower = False

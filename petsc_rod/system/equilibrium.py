@@ -52,7 +52,8 @@ from typing import Protocol
 
 import numpy as np
 
-from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
+from petsc_rod.errors import (RodDivergedError, RodError, RodInputError, RodInterrupted,
+                              on_every_rank)
 from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
@@ -317,6 +318,10 @@ class SystemSolver:
             raise
         self.forces = self.stiffnesses = None
         self.failure, self.checked, self.last = "", False, None
+        # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
+        # asked before every Newton iteration; None: not asked
+        self.interrupts = None
+        self.factor = 0.0                       # the load factor the Newton works at
         self.loads = Loads.of(system, self.layout).unloaded()
 
     def destroy(self):
@@ -564,6 +569,7 @@ class SystemSolver:
         stalled = 0
         for iteration in range(settings.max_iterations + 1):
             self.forces, self.stiffnesses = forces, stiffness
+            self.check_interrupted(iteration)
             if norm <= settings.rtol:
                 self.norm = norm
                 return state, iteration
@@ -612,6 +618,16 @@ class SystemSolver:
                         f"iterations (residual {norm:.3g})")
         return None, settings.max_iterations
 
+    def check_interrupted(self, iteration):
+        """RodInterrupted when a rank received a stop signal (``interrupts``): asked by
+        every rank at the same iteration (the Newton's steps are the same on every
+        rank), so that all stop together, nothing written. Collective."""
+        number = 0 if self.interrupts is None else self.interrupts.received()
+        if number:
+            raise RodInterrupted(f"stopped by {self.interrupts.name(number)} during the "
+                                 f"system's Newton (load factor {self.factor:.6g}, "
+                                 f"iteration {iteration}); nothing written", number)
+
     def check_restoring(self):
         """RodInputError naming a body's or a point's degree of freedom that nothing
         restores (the Jacobian at the start is singular in it)."""
@@ -650,6 +666,7 @@ class SystemSolver:
         target = Loads.of(self.system, self.layout)
         factor, step, halvings, total = ((1.0, 0.0, 0, 0) if self.loads.same(target) else
                                          (0.0, 1.0 / settings.load_steps, 0, 0))
+        self.factor = factor
         state, iterations = self.newton(self.state, self.loads.towards(target, factor),
                                         scale)
         total += iterations
@@ -658,7 +675,7 @@ class SystemSolver:
                                    f"{self.failure}")
         self.state = state
         while factor < 1.0:
-            to = min(1.0, factor + step)
+            to = self.factor = min(1.0, factor + step)
             state, iterations = self.newton(self.state, self.loads.towards(target, to),
                                             scale)
             total += iterations

@@ -28,7 +28,8 @@ c = x_b - x_a and the start's height z_a: with A the matrix of the Newton system
 equilibrium (H, the second variation, analysis/second_variation.py; in a current the
 Newton Jacobian J, analysis/jacobian.py), C^T the chord forms (3 columns) and
 P = dgrad L/dz_a (the seabed's curvature times each node's height row,
-SecondVariation.position_shift), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3, 3):
+SecondVariation.position_shift; in a sheared current plus the drag's columns on the
+heights summed, DragTerm.height_shift: the line raised meets another current), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3, 3):
 
     dmu = -S^-1 (dc + C Y_P dz_a),   dy = -Y_P dz_a - Y_C dmu,
     dF_b = dmu,   dF_a = dPsi_0 - (P.dy + sum_n k w_n dz_a) e_z - dmu,
@@ -64,21 +65,24 @@ conjugate of the clamp's rotation (they differ by O(h) terms, so dF/dtheta is no
 (dM/dx)^T), and the rotations are increments on the left (a skew part of the order of
 [M]x in the rotation block); the forces' position block is symmetric without a current
 (to 7e-8 of the largest entry with extensible clamps, whose stretch rule is not the
-energy's). A clamp in a current has no end_stiffness (its drag's Jacobian columns at
-the clamp are not taken). A flex joint's support frame D given to solve turns its axis,
-a = D^T D_ref a_0; turning it by delta is a data change of the joint's gradient at its
-(free) node, solved for like a clamp's, and its moment on the support is the joint's,
--k (theta / sin theta) d3 x a (not at an extensible end: the joint acts in the local
-step there).
+energy's). In a current the drag at the clamped node turns with the clamp: J's columns
+at its held rotation are H's (full_columns) plus the drag's (DragTerm.turn_columns), and
+the start's force moves with the drag's resultant Psi_0 in every datum. A flex joint's
+support frame D given to solve turns its axis, a = D^T D_ref a_0; turning it by delta is
+a data change of the joint's gradient at its (free) node, solved for like a clamp's, and
+its moment on the support is the joint's, -k (theta / sin theta) d3 x a; at an
+extensible end too, where the joint acts in the local step (its gradient in rotations,
+of the tangent's direction only, is the same function of d3 and a).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged), a
-sheared current (the depth derivative of its drag is not in J), and any load outside
-the Newton system (the sea surface's wet and dry parts, attachments that reach it).
+seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged),
+and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
 """
+
+import dataclasses
 
 import numpy as np
 from petsc4py import PETSc
@@ -350,8 +354,6 @@ class HeldLine:
     def _model(self, start, end, frames=(None, None)):
         """The line's Model with its ends at ``start``, ``end`` (absolute, m), a clamp's
         frame at ``frames`` ((3, 3) or None: the span's)."""
-        import dataclasses
-
         def at(end_, position, frame):
             if frame is None or end_.kind != "clamp":
                 return dataclasses.replace(end_, position=position)
@@ -592,8 +594,8 @@ class HeldLine:
         """d(end_forces)/d(start position, end position), (6, 6), N/m: K[i, j] the
         derivative of force component i (0-2 on the start, 3-5 on the end) in position
         component j (0-2 of the start, 3-5 of the end), at the last equilibrium, from
-        the line's factored second variation, or in a uniform current its Newton
-        Jacobian (module docstring). Symmetric and negative semi-definite for a stable
+        the line's factored second variation, or in a current its Newton Jacobian
+        (module docstring). Symmetric and negative semi-definite for a stable
         line without a current. Collective."""
         return self._linearised(False)
 
@@ -627,14 +629,14 @@ class HeldLine:
         try:
             self.newton.lagrangian_gradient(frames, state.chord_multiplier.copy())
             hessian = problem.second_variation()
-            if clamps and hessian.resultants:
-                raise RodInputError("HeldLine.end_stiffness: a clamp's rotation in a "
-                                    "current is not linearised (its drag's Jacobian "
-                                    "columns at the clamp): no exact end stiffness")
             held_data = self._held_data(hessian, clamps)
             turned = hessian.full_columns([hessian.block * node + k for _, node, k
                                            in held_data[0]]) if clamps else []
             vecs.extend(turned)
+            if clamps and hessian.resultants:
+                # J's columns at the clamps' rotations: the drag at the clamped node
+                # turns with it (DragTerm.turn_columns)
+                self._add_turn_columns(hessian, held_data[0], turned, vecs)
             flexed = self._flexed(hessian) if rotations else []
             for entry in flexed:
                 turned.extend(entry[-1])
@@ -649,6 +651,18 @@ class HeldLine:
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
+            # a sheared current: the start raised moves the drag of every node too
+            pushes = [v for v in (term.height_shift(hessian, state) for term in problem.terms
+                                  if term.jacobian_positions) if v is not None]
+            vecs.extend(pushes)
+            lift = shift
+            if pushes:
+                lift = pushes[0].duplicate()
+                vecs.append(lift)
+                lift.zeroEntries()
+                lift.maxpy([1.0] * len(pushes), pushes)
+                if shift is not None:
+                    lift.axpy(1.0, shift)
             if hessian.resultants:
                 if self.jacobian is None:
                     self.jacobian = self.built.own(NewtonJacobian(hessian))
@@ -657,7 +671,7 @@ class HeldLine:
             else:
                 hessian.factorise(0.0)
                 solver = hessian
-            shifts = [] if shift is None else [shift]
+            shifts = [] if lift is None else [lift]
             solved = solver.solve_many(columns + shifts + turned)
             vecs.extend(solved)
             response = self._response(hessian, columns, shift, solved[:3 + len(shifts)],
@@ -665,7 +679,7 @@ class HeldLine:
             if rotations:
                 response = self._rotation_response(hessian, frames, columns, shift,
                                                    solved, recorder.heights, *held_data,
-                                                   response, flexed)
+                                                   response, flexed, lifted=bool(shifts))
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -702,10 +716,6 @@ class HeldLine:
         out = []
         last = 2 * self.mesh.n_elements
         for e, d, term in self._joint_tangents():
-            if term.local:
-                raise RodInputError("HeldLine.end_stiffness: a flex joint at an "
-                                    "extensible end acts in the local step: its turn is "
-                                    "not linearised yet")
             node = (0, last)[e]
             a = term.axis
             J_d, J_a = _joint_jacobians(term.k, d, a)
@@ -723,6 +733,19 @@ class HeldLine:
             out.append((e, node, J_d, J_a, a, d, columns))
         return out
 
+    def _add_turn_columns(self, hessian, held, turned, vecs):
+        """Add the followers' entries of J (DragTerm.turn_columns) to H's columns
+        ``turned`` at the held rotations of ``held`` [(end, node, slot)]; the new Vecs
+        go to ``vecs`` to be freed. Collective."""
+        rotated = [j for j, (_, _, k) in enumerate(held) if k < 3]
+        columns = [hessian.block * held[j][1] + held[j][2] for j in rotated]
+        for term in self.problem.terms:
+            if term.follower:
+                extra = term.turn_columns(hessian, self.problem.state, columns)
+                vecs.extend(extra)
+                for j, vec in zip(rotated, extra):
+                    turned[j].axpy(1.0, vec)
+
     def _held_data(self, hessian, clamps):
         """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
         rotation and 3 its stretch (an extensible line's clamped node, EA finite: held in
@@ -736,7 +759,7 @@ class HeldLine:
         return held, dict(zip([e for e, _ in clamps], axial))
 
     def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
-                           held, axial, response, flexed=()):
+                           held, axial, response, flexed=(), lifted=False):
         """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
 
         A clamp turned by theta holds its node's rotation at theta instead of 0: the
@@ -756,7 +779,7 @@ class HeldLine:
         n_h = len(held) + 3 * len(flexed)
         n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
         Y_C = solved[:3]
-        Y_P = solved[3:4] if shift is not None else []
+        Y_P = solved[3:4] if lifted else []
         Y_T = solved[3 + len(Y_P):]
         data = []                                           # the data column of each held
         stretches = []
@@ -796,6 +819,13 @@ class HeldLine:
         forces = np.zeros((6, n_d))
         forces[3:] = dmu
         forces[:3] = -dmu
+        if hessian.resultants:                              # the drag's resultant Psi_0
+            slot = hessian.resultant_slot
+            first = mesh.global_sum(np.array(
+                [y.getArray(readonly=True).reshape(-1, B)[0, slot:slot + 3]
+                 if mesh.on_lower_boundary else np.zeros(3) for y in solved]))
+            forces[:3] += of_dy(first[:3].T, first[3] if Y_P else np.zeros(3),
+                                first[3 + len(Y_P):3 + len(Y_P) + n_h].T)
         forces[:3, :4] = response[:3]
         if shift is not None:
             moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]),
@@ -907,11 +937,6 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        current = scene.current
-        if current is not None and np.ptp(current.velocities, axis=0).max() > 0:
-            raise RodInputError("HeldLine.stiffness: a current profile's depth derivative "
-                                "is not in the Newton Jacobian: no exact stiffness in a "
-                                "sheared current (a uniform one has one)")
         if scene.seabed is not None and scene.seabed.friction is not None:
             raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
                                 "exact stiffness of a line with friction")
@@ -941,8 +966,14 @@ def held_lines(system, options=None):
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
-    instead of after each of its re-solves."""
+    instead of after each of its re-solves. A current profile's depths are below the
+    system's sea surface, z = 0 where the Environment gives none (as the free points'
+    drag, system/equilibrium.py), not below each line's higher end as for a single
+    line: the lines and points of a system share one sea."""
     options = {"al_stability": 0, **(options or {})}
+    environment = system.environment
+    if environment.profile() is not None and environment.surface is None:
+        environment = dataclasses.replace(environment, surface=0.0)
 
     def make_line(line, comm):
         start, end = (connection_position(system.node(c.to), c)
@@ -950,7 +981,7 @@ def held_lines(system, options=None):
         frames = tuple(connection_frame(system.node(c.to), c, e == 1)
                        if c.kind == "clamp" and not hasattr(system.node(c.to), "kind")
                        else None for e, c in enumerate((line.start, line.end)))
-        return HeldLine.of_system_line(line, start, end, comm, system.environment, options,
+        return HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
 
     return make_line

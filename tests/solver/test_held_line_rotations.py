@@ -26,13 +26,14 @@ REFERENCE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 TURNED = REFERENCE @ rotations(np.array([0.1, -0.3, 0.2])).T
 
 
-def clamped_line(comm, extensible):
+def clamped_line(comm, extensible, current=None):
     line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
-                       elements=40, axial_stiffness=1e5 if extensible else np.inf)
+                       elements=40, axial_stiffness=1e5 if extensible else np.inf,
+                       drag=None if current is None else (1025.0, 1.2, 0.1))
     end = (End(kind="clamp", position=tuple(ENDS[1])) if extensible
            else End.anchor(tuple(ENDS[1])))
     model = Model(line=line, start=End(kind="clamp", position=tuple(ENDS[0])), end=end,
-                  environment=Environment())
+                  environment=Environment(current=current))
     held = HeldLine(model, comm, options=TIGHT)
     frames = [TURNED, REFERENCE if extensible else None]
     assert held.solve(*ENDS, *frames)
@@ -95,6 +96,25 @@ def test_end_stiffness_against_differences(comm, extensible):
         line.destroy()
 
 
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("extensible", [False, True], ids=["inextensible", "extensible"])
+def test_end_stiffness_in_a_current_against_differences(comm, extensible):
+    """A clamp in a current: turning it turns the drag at the clamped node (the drag's
+    Jacobian columns at the clamp's rotation) and moves the drag's resultant on the
+    start; unsymmetric."""
+    line, frames = clamped_line(COMMS[comm], extensible, current=(0.2, 0.5, 0.0))
+    try:
+        assert line.end_forces()[:, 1].sum() > 50.0             # the current's push
+        K = line.end_stiffness()
+        scale = np.abs(K).max()
+        found = differences(line, frames)
+        print("ERR", np.abs(K - found).max() / scale)
+        assert np.abs(K - found).max() < 1e-6 * scale
+        assert np.abs(K[6:9, 6:9]).max() > 0.5 * abs(line.end_moments()[0]).max()
+    finally:
+        line.destroy()
+
+
 def test_a_frame_walk_is_the_fresh_solve():
     """A clamp's frame walked from the reference is the line solved afresh with it."""
     walked, frames = clamped_line(PETSc.COMM_WORLD, False)
@@ -120,13 +140,15 @@ def test_a_frame_walk_is_the_fresh_solve():
 
 
 @pytest.mark.parametrize("comm", list(COMMS))
-def test_a_flex_joints_end_stiffness_against_differences(comm):
+@pytest.mark.parametrize("extensible", [False, True], ids=["inextensible", "extensible"])
+def test_a_flex_joints_end_stiffness_against_differences(comm, extensible):
     """A flex joint's support turned turns its axis with it (a = D^T D_ref a_0): the
     12 x 12 with the joint's moment on its support, -k (theta / sin theta) d3 x a,
     against central differences (measured 5e-10); its rotation block's antisymmetric
-    part is -[M]x, M the joint's moment (left increments of a conservative joint)."""
+    part is -[M]x, M the joint's moment (left increments of a conservative joint); at an
+    extensible end too, where the joint acts in the local step."""
     line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
-                       elements=40)
+                       elements=40, axial_stiffness=1e5 if extensible else np.inf)
     model = Model(line=line, start=End(kind="pin", position=tuple(ENDS[0]), stiffness=200.0),
                   end=End.anchor(tuple(ENDS[1])), environment=Environment())
     flexed = HeldLine(model, COMMS[comm], options=TIGHT)

@@ -116,6 +116,41 @@ def test_a_stop_signal_ends_the_run_before_anything_is_written(tmp_path):
     assert out is None or not os.listdir(tmp_path)
 
 
+class SignalledLater(Signalled):
+    """An Interrupts whose ranks received SIGTERM from its ``calls``-th question on."""
+
+    def __init__(self, calls):
+        self.calls, self.asked = calls, 0
+
+    def received(self):
+        self.asked += 1
+        return 15 if self.asked >= self.calls else 0
+
+
+def test_a_stop_signal_is_acted_on_between_the_newton_s_iterations(tmp_path):
+    """A signal received during the system's Newton (a free point to find: several
+    iterations) ends the run at the next iteration, not once the equilibrium is found;
+    nothing written."""
+    from petsc_rod.api.system_run import run_system
+    from petsc_rod.errors import RodInterrupted
+    from petsc_rod.system.equilibrium import Settings
+    system = System(lines=(SystemLine("lower", uniform(40.0, 16), Connection("A"),
+                                      Connection("J")),
+                           SystemLine("upper", uniform(60.0, 24), Connection("J"),
+                                      Connection("B"))),
+                    points=(Point("A", "fixed", ANCHOR), Point("J", "free", (30.0, 0.0, 5.0)),
+                            Point("B", "fixed", FAIRLEAD)))
+    out = str(tmp_path / "system.h5") if PETSc.COMM_WORLD.getSize() == 1 else None
+    interrupts = SignalledLater(3)
+    with pytest.raises(RodInterrupted) as stopped:
+        run_system(PETSc.COMM_WORLD, system, Settings(), TIGHT, lambda line: None,
+                   output=out, interrupts=interrupts)
+    assert stopped.value.exit_code == 143
+    assert "during the system's Newton (load factor 1, iteration 2)" in str(stopped.value)
+    assert interrupts.asked == 3
+    assert out is None or not os.listdir(tmp_path)
+
+
 def test_options_a_system_does_not_take_are_refused():
     from petsc_rod.errors import RodInputError
     system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),

@@ -464,3 +464,33 @@ def test_the_system_modes_in_the_lines_the_file_and_the_table(tmp_path):
     assert f"{1 / found[1][0]:.4g}"[:4] in text             # the first period, in s
     assert "-rod_system_modes" in refused(tmp_path, ["-options_file", "options/cantilever.opts",
                                                      "-rod_system_modes", "1"])
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_stop_signal_during_the_newton_ends_the_run_there(tmp_path, ranks):
+    """SIGTERM sent once the run has said its notes (before its lines are solved) stops
+    it at the next iteration of the system's Newton, not once the equilibrium is found:
+    one line naming the load factor and the iteration, 128 + 15 (mpiexec: 1), no file."""
+    import signal
+    import subprocess
+
+    from helpers import child_env, petsc_rod_command
+    out = tmp_path / "system.h5"
+    process = subprocess.Popen(
+        petsc_rod_command(["-rod_system", DECK, "-rod_system_body_load", LOAD,
+                           "-rod_output", str(out), *SWEEPS], ranks),
+        cwd=REPO_ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        text=True)
+    try:
+        first = process.stdout.readline()
+        assert first.startswith("petsc_rod: note"), first
+        process.send_signal(signal.SIGTERM)
+        output, _ = process.communicate(timeout=300)
+    finally:
+        process.kill()
+    errors = [line for line in output.splitlines() if line.startswith("petsc_rod: error")]
+    assert process.returncode == (143 if ranks == 1 else 1), output
+    assert len(errors) == 1, output
+    assert "stopped by SIGTERM during the system's Newton (load factor" in errors[0]
+    assert "Traceback" not in output and "equilibrium in" not in output
+    assert not out.exists() and not partial_files(out)
