@@ -606,6 +606,15 @@ class HeldLine:
         factored second variation (module docstring, "Rotations"). Collective."""
         return self._linearised(True)
 
+    def _settle(self):
+        """Newton's steps from where the line stands to its stationary point (to
+        iteration/newton.py's STEP_TOLERANCE), kept where they converge: the second
+        variation is the stiffness at a stationary point only, and a walk stopped by the
+        iteration's tolerances (a change per iteration below rtol after a small move)
+        may leave |grad L| large enough to matter where the line is nearly singular in
+        bending (a chain's small EI: docs/systems.md, "Symmetry"). Collective."""
+        self.newton.run()
+
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
         last = 2 * self.mesh.n_elements
@@ -616,6 +625,7 @@ class HeldLine:
         self._check_solved()
         problem = self.problem
         self._check_exact()
+        self._settle()
         clamps = self._clamp_nodes() if rotations else []
         held_data = ([], {})
         state = problem.state
