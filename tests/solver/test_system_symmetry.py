@@ -6,7 +6,9 @@ exactly, and the same deck turned by 30 degrees about the vertical:
 (a) Kxx = Kyy and no coupling of the translations with the yaw (the spread's planar
     stiffness is isotropic for three equally spaced lines);
 (b) turning the deck turns K: K' = T K T^T, T the turn of the translations and the
-    rotations, the yaw stiffness and Kxx + Kyy unchanged.
+    rotations, the yaw stiffness and Kxx + Kyy unchanged;
+(c) one of its lines held (HeldLine) and walked to its ends after a 0.1 mm move has
+    the stiffness of the line solved there from its start.
 
 A line walked to its ends by the iteration's tolerances after a small move of the body
 was linearised short of its stationary point: its transverse stiffness 45 % off and
@@ -17,9 +19,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from petsc4py import PETSc
 
 from petsc_rod.api.system_run import solve_system
 from petsc_rod.model.moordyn import parse_moordyn
+from petsc_rod.system.held_line import HeldLine
 
 pytestmark = pytest.mark.solver
 
@@ -72,3 +76,22 @@ def test_turned_spread_turns_the_stiffness(stiffnesses):
     assert np.abs(turned - T @ K @ T.T).max() < 1e-6 * np.abs(K).max()
     assert turned[5, 5] == pytest.approx(K[5, 5], rel=1e-7)
     assert turned[0, 0] + turned[1, 1] == pytest.approx(K[0, 0] + K[1, 1], rel=1e-7)
+
+
+def test_walked_line_has_the_fresh_stiffness():
+    system, _ = parse_moordyn(turned_deck(0.0))
+    anchor, fairlead = np.array([65.0, 0.0, -30.0]), np.array([5.0, 0.0, -3.35])
+    moved = fairlead + [0.0, 0.0, -1e-4]
+    lines = [HeldLine.of_system_line(system.lines[0], anchor, fairlead, PETSc.COMM_SELF,
+                                     system.environment, {"al_stability": 0})
+             for _ in range(2)]
+    try:
+        walked, fresh = lines
+        assert walked.solve(anchor, fairlead) and walked.solve(anchor, moved)
+        assert fresh.solve(anchor, moved)
+        K, K_fresh = walked.stiffness(), fresh.stiffness()
+        assert K_fresh[4, 4] == pytest.approx(-23893.9 / 60.0, rel=1e-3)   # T_h / span
+        assert np.abs(K - K_fresh).max() < 1e-6 * np.abs(K_fresh).max()
+    finally:
+        for line in lines:
+            line.destroy()
