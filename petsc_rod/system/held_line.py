@@ -36,7 +36,10 @@ SecondVariation.position_shift), with Y_C = A^-1 C^T, Y_P = A^-1 P, S = C Y_C (3
 Psi_0 the resultant at S = 0 of a load that follows the line (the drag: a row of the
 Jacobian's unknowns, so dPsi_0 a row of dy), sum_n over the nodes in contact. One
 factorisation of A (the stability test's LDL^T of H unshifted, or J's LU; by
-substructuring on several ranks) and four solves: no finite differences. Without a
+substructuring on several ranks) and four solves: no finite differences. All of it holds at
+a stationary point of L: where the last solve ended by the iteration's tolerances and not
+in Newton's steps, settle() takes those steps first (a walk after a small move leaves
+|grad L| that a grounded line's sideways stiffness feels). Without a
 current K = -Hess Phi: symmetric, and negative semi-definite for a stable line (moving
 an end outward pulls it back: the restoring stiffness of a point is -K); without a
 seabed K_aa = K_bb = -K_ab = -S^-1 (a translation of the whole line changes nothing).
