@@ -375,7 +375,7 @@ class SystemSolver:
             out.append(tuple(ends))
         return out
 
-    def evaluate(self, state, strict=False):
+    def evaluate(self, state, strict=False, settle=False):
         """Solve every line at ``state``'s end positions (and a clamp's frame at a body:
         end_frames) (this rank's lines in turn) and share the results: (converged, end
         forces (n, 2, 3), Linearised). A line with a clamp at a body is asked for
@@ -384,20 +384,25 @@ class SystemSolver:
         has not converged; one that refuses its ends (RodInputError: a span it cannot
         reach) has not either, except when ``strict`` (the start, where the system itself
         is at fault): then its error is raised on every rank. The ends of the last
-        successful evaluation are not solved again."""
+        successful evaluation are not solved again. ``settle``: each line that can
+        (HeldLine.settle) first taken to its stationary point, for the stiffness a
+        system reports (the iterations' Jacobian needs only the lines' tolerances)."""
         layout = self.layout
         positions = self.end_positions(state)
         key = (positions, state.bodies.R)
-        if self.last is not None and all(np.array_equal(a, b)
-                                         for a, b in zip(key, self.last[0])):
+        there = self.last is not None and all(np.array_equal(a, b)
+                                              for a, b in zip(key, self.last[0]))
+        if there and not settle:
             return self.last[1]                 # the lines stand there already
         frames = self.end_frames(state)
         mine = {}
         for k, line in self.lines.items():
             turned = bool(layout.turned[k].any())
             try:
-                ok = bool(line.solve(positions[k, 0], positions[k, 1], *frames[k]) if turned
-                          else line.solve(positions[k, 0], positions[k, 1]))
+                ok = there or bool(line.solve(positions[k, 0], positions[k, 1], *frames[k])
+                                   if turned else line.solve(positions[k, 0], positions[k, 1]))
+                if ok and settle and hasattr(line, "settle"):
+                    line.settle()
                 if not ok:
                     mine[k] = (False,)
                 elif turned:        # a refused end stiffness: below, on every rank
@@ -693,7 +698,7 @@ class SystemSolver:
         # The lines may stand at the last trial; leave them at the solution, and report
         # the end forces and stiffness of the lines as they are left (a re-solve from a
         # trial differs by the lines' own tolerances).
-        solved = self.evaluate(self.state)
+        solved = self.evaluate(self.state, settle=True)
         if solved[0]:
             self.forces, self.stiffnesses = solved[1], solved[2]
         return self.result(factor, total, halvings, self.line_verdicts())

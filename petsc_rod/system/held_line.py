@@ -37,7 +37,10 @@ heights summed, DragTerm.height_shift: the line raised meets another current), w
 Psi_0 the resultant at S = 0 of a load that follows the line (the drag: a row of the
 Jacobian's unknowns, so dPsi_0 a row of dy), sum_n over the nodes in contact. One
 factorisation of A (the stability test's LDL^T of H unshifted, or J's LU; by
-substructuring on several ranks) and four solves: no finite differences. Without a
+substructuring on several ranks) and four solves: no finite differences. All of it holds at
+a stationary point of L: where the last solve ended by the iteration's tolerances and not
+in Newton's steps, settle() takes those steps first (a walk after a small move leaves
+|grad L| that a grounded line's sideways stiffness feels). Without a
 current K = -Hess Phi: symmetric, and negative semi-definite for a stable line (moving
 an end outward pulls it back: the restoring stiffness of a point is -K); without a
 seabed K_aa = K_bb = -K_ab = -S^-1 (a translation of the whole line changes nothing).
@@ -95,7 +98,7 @@ from petsc_rod.errors import NoCatenaryStart, RodError, RodInputError
 from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
-from petsc_rod.iteration.newton import NewtonSolver
+from petsc_rod.iteration.newton import CONVERGED, NewtonSolver
 from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
@@ -295,7 +298,7 @@ class HeldLine:
 
     solve(start_position, end_position, start_frame=None, end_frame=None) -> bool;
     end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
-    end_stiffness() -> (12, 12); stable() -> bool or None;
+    end_stiffness() -> (12, 12); settle(); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
     destroy(). ``iterations``: those of the last solve."""
 
@@ -320,6 +323,8 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
+        self.settled = False                # the last solve ended in Newton's convergence
+        self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
     @classmethod
@@ -476,8 +481,11 @@ class HeldLine:
         """The continuation on ``path``: whether it converged (a divergence, a PETSc
         error of its solves, is a failure). Collective."""
         self.iterations = 0
+        self.settled = False
         try:
             for event in continuation(self.solver, path):
+                if isinstance(event, events.NewtonAttempt):
+                    self.settled = event.outcome == CONVERGED
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
                     return bool(event.converged)
@@ -608,6 +616,25 @@ class HeldLine:
         factored second variation (module docstring, "Rotations"). Collective."""
         return self._linearised(True)
 
+    def settle(self):
+        """Newton's steps from where the line stands to its stationary point (to
+        iteration/newton.py's STEP_TOLERANCE), kept where they converge, unless the last
+        solve ended in Newton's convergence: the second variation is the stiffness at a
+        stationary point only, and a walk stopped by the iteration's tolerances (its
+        change per iteration below rtol after a small move) leaves |grad L| far above
+        Newton's, which a grounded line's sideways stiffness feels (docs/systems.md,
+        "The stiffness at the lines' stationary points"). stiffness() and
+        end_stiffness() call it first where ``settles`` (a system's lines: only for the
+        stiffness it reports, SystemSolver.evaluate). Nothing where the stiffness is not
+        exact (_check_exact: the friction's state is its history). Collective."""
+        self._check_solved()
+        try:
+            self._check_exact()
+        except RodInputError:
+            return
+        if not self.settled:
+            self.settled = self.newton.run() == CONVERGED
+
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
         last = 2 * self.mesh.n_elements
@@ -618,6 +645,8 @@ class HeldLine:
         self._check_solved()
         problem = self.problem
         self._check_exact()
+        if self.settles:
+            self.settle()
         clamps = self._clamp_nodes() if rotations else []
         held_data = ([], {})
         state = problem.state
@@ -966,7 +995,9 @@ def held_lines(system, options=None):
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
-    instead of after each of its re-solves. A current profile's depths are below the
+    instead of after each of its re-solves; and they are settled at their stationary
+    points (HeldLine.settle) for the stiffness the system reports only, not for its
+    iterations' Jacobian. A current profile's depths are below the
     system's sea surface, z = 0 where the Environment gives none (as the free points'
     drag, system/equilibrium.py), not below each line's higher end as for a single
     line: the lines and points of a system share one sea."""
@@ -981,7 +1012,9 @@ def held_lines(system, options=None):
         frames = tuple(connection_frame(system.node(c.to), c, e == 1)
                        if c.kind == "clamp" and not hasattr(system.node(c.to), "kind")
                        else None for e, c in enumerate((line.start, line.end)))
-        return HeldLine.of_system_line(line, start, end, comm, environment, options,
+        held = HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
+        held.settles = False                # SystemSolver.evaluate settles it when it reports
+        return held
 
     return make_line

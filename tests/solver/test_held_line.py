@@ -211,7 +211,9 @@ def test_stiffness_in_a_sheared_current(comm, ends, seabed):
         scale = np.abs(K).max()
         # the shear makes a vertical translation of the whole line matter
         assert abs(K[1, 2] + K[1, 5]) > 1e-3 * scale
-        found = differences(line, ends, 1e-4 if seabed else 1e-3)
+        # the same step on the seabed: at 1e-4 m a node's contact edge can fall between
+        # the two re-solves of a column (a kink, not the stiffness: 2e-5 at that column)
+        found = differences(line, ends, 1e-3)
         mask = np.ones((6, 6), dtype=bool)
         if seabed is not None:              # the anchor on the seabed: one-sided (above)
             mask[2, 2] = False
