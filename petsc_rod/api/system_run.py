@@ -284,6 +284,10 @@ def check_finite(comm, results, records):
                                "inf); nothing is written")
 
 
+# the system's tables that a run writes only when asked (write_tables, stale_paths)
+OPTIONAL_TABLES = ("watch_circle", "excursion", "system_modes")
+
+
 def table_paths(table, system, sweeps=Sweeps(), body_modes=False):
     """{line name, 'system', a sweep's name or 'system_modes': CSV path} of ``table``
     (FILE.csv -> FILE_<line>.csv, FILE_system.csv, FILE_watch_circle.csv and
@@ -454,8 +458,8 @@ def ends_rows(system, results):
 def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps()):
     """FILE_<line>.csv (a single line's table, written by the line's group) for every
     line, FILE_system.csv, the sweeps' FILE_watch_circle.csv, FILE_excursion.csv and
-    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused,
-    and an earlier run's removed).
+    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused);
+    an earlier run's optional tables that this run did not write removed (stale_paths).
     Collective on ``comm``."""
     paths = table_paths(table, system, sweeps, results.body_modes is not None)
 
@@ -473,9 +477,21 @@ def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps())
             if isinstance(results.body_modes, SystemModes):
                 line_table._write(paths["system_modes"], paths["system_modes"] + ".partial",
                                   body_modes_table(results.body_modes))
-            elif results.body_modes is not None and os.path.exists(paths["system_modes"]):
-                os.remove(paths["system_modes"])        # an earlier run's: none this time
+            written = set(results.sweeps) | (
+                {"system_modes"} if isinstance(results.body_modes, SystemModes) else set())
+            for path in stale_paths(table, system, written):
+                os.remove(path)
     on_every_rank(comm, write_all)
+
+
+def stale_paths(table, system, written):
+    """The existing FILE_watch_circle.csv, FILE_excursion.csv and FILE_system_modes.csv
+    of ``table`` whose names are not in ``written`` (this run wrote no such table): an
+    earlier run's, which would otherwise stand beside this run's tables as if its
+    own."""
+    every = table_paths(table, system, Sweeps(watch_circle=True, excursion=True), True)
+    return [every[name] for name in OPTIONAL_TABLES
+            if name not in written and os.path.exists(every[name])]
 
 
 def report_lines(system, results, ranks):

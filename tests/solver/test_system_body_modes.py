@@ -278,3 +278,29 @@ def test_refused_modes_in_the_file_and_no_table(shared_tmp):
     with h5py.File(output, "r") as f:
         group = f["system/modes"]
         assert "complex eigenvalues" in group.attrs["refused"] and len(group) == 0
+
+
+def test_a_run_removes_the_optional_tables_it_did_not_write(shared_tmp):
+    """small_free_body.dat solved with -rod_table but neither the system's modes nor a
+    sweep: an earlier run's FILE_system_modes.csv, FILE_watch_circle.csv and
+    FILE_excursion.csv are removed (they stood beside the new tables as if this run's),
+    FILE_system.csv written."""
+    import os
+
+    from petsc_rod.api import read_moordyn, solve_system
+    from helpers import REPO_ROOT
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    table = os.path.join(shared_tmp, "stale.csv")
+    stale = [os.path.join(shared_tmp, f"stale_{name}.csv")
+             for name in ("system_modes", "watch_circle", "excursion")]
+    if PETSc.COMM_WORLD.getRank() == 0:
+        for path in stale:
+            with open(path, "w") as f:
+                f.write("an earlier run's\n")
+    PETSc.COMM_WORLD.tompi4py().barrier()
+    results = solve_system(system, table=table, say=lambda line: None)
+    assert results.body_modes is None
+    PETSc.COMM_WORLD.tompi4py().barrier()
+    assert [os.path.exists(path) for path in stale] == [False] * 3
+    assert os.path.exists(os.path.join(shared_tmp, "stale_system.csv"))
