@@ -67,6 +67,10 @@ RESIDUAL = 1e-3
 # SLICE_DEPTH halvings (_slice)
 SLICE_SPAN = 1e4
 SLICE_DEPTH = 12
+# the pairs a sub-band's solve asks for beyond its count: the eigensolver stops once it
+# has as many as asked, and a free rigid mode of little mass can converge after the
+# nearest vibration (those outside the sub-band are left out)
+EXTRA = 4
 
 
 class ModesRefused(Exception):
@@ -328,8 +332,8 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
                                                  SHIFT, (SHIFT, np.inf)))
             return modes
         window = band_shifts(band)
-        ends = [_below(operators, shifted, factor, sigma) for sigma in window]
-        found, failed = _slice(operators, shifted, factor, SLEPc, window, ends, 0)
+        ends = [_below(operators, shifted, sigma) for sigma in window]
+        found, failed = _slice(operators, shifted, SLEPc, window, ends, 0)
         if len(found[0]) == 0:
             modes = _empty_modes(problem.mesh, band)
             modes.converged = found[3]
@@ -352,17 +356,35 @@ def _empty_modes(mesh, band):
                  (band[0], band[1], 0))
 
 
-def _below(operators, shifted, factor, sigma):
+def _below(operators, shifted, sigma):
     """The eigenvalues of K - omega^2 M below ``sigma`` (rad^2/s^2): the negative pivots
-    of the LDL^T of K - sigma M (left in ``shifted`` and ``factor``) less the chains'
-    constraints (Sylvester). Collective."""
+    of the LDL^T of K - sigma M (left in ``shifted``) less the chains' constraints
+    (Sylvester). Collective."""
+    factor = _factored(operators, shifted, sigma)
+    try:
+        return int(factor.negative_pivots() - operators.chain_constraints)
+    finally:
+        factor.destroy()
+
+
+def _factored(operators, shifted, sigma):
+    """A new factorisation (direct_factor) of ``shifted`` = K - sigma M: its own
+    analysis at sigma, as MUMPS's ordering and pivoting of a matrix analysed at a
+    far other shift (M's entries at a sigma far above the modes) lose the digits of
+    the factor's solves and inertia. Collective; the caller destroys it."""
     with EVENTS["factor"]:
         _shift_to(shifted, operators.matrix, operators.mass_matrix, sigma)
-        factor.set_up(shifted)
-        return int(factor.negative_pivots() - operators.chain_constraints)
+        factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block,
+                               PREFIX + "st_")
+        try:
+            factor.set_up(shifted)
+        except Exception:
+            factor.destroy()
+            raise
+        return factor
 
 
-def _slice(operators, shifted, factor, SLEPc, window, ends, depth):
+def _slice(operators, shifted, SLEPc, window, ends, depth):
     """The verified pairs (_pairs' tuple) of every eigenvalue in ``window`` (omega^2 from,
     to), which the inertia counts ``ends`` (below each end) hold, and the sub-bands
     (omega^2 from, to) left short: unverified at the depth SLICE_DEPTH, or where the
@@ -370,7 +392,8 @@ def _slice(operators, shifted, factor, SLEPc, window, ends, depth):
     than SLICE_SPAN apart in omega^2 (from RIGID's omega^2 where it starts at 0), or
     whose solve about its middle verifies fewer pairs than it holds, is cut at its
     geometric middle (the inertia there counts each half's): one shift at the middle of
-    a wide band keeps none of the low eigenvalues' digits in sigma + 1/theta. An empty
+    a wide band keeps none of the low eigenvalues' digits in sigma + 1/theta. A
+    sub-band is solved about its middle, or about SHIFT where it starts at 0. An empty
     one costs no solve. Collective."""
     count = ends[1] - ends[0]
     if count < 0:
@@ -382,11 +405,16 @@ def _slice(operators, shifted, factor, SLEPc, window, ends, depth):
     low = max(window[0], (2 * np.pi * RIGID) ** 2)
     wide = window[1] > SLICE_SPAN * low
     if not wide:
-        shift = 0.5 * (window[0] + window[1])
-        with EVENTS["factor"]:
-            _shift_to(shifted, operators.matrix, operators.mass_matrix, shift)
-            factor.set_up(shifted)
-        found = _pairs(operators, shifted, factor, SLEPc, count, shift, window)
+        # from the band's start at 0 the lowest ``count`` above SHIFT are the
+        # sub-band's (the stable state has none below): the free rigid modes, whose
+        # small mass the Krylov space misses about a shift above them, found as
+        # without a band
+        shift = SHIFT if window[0] <= SHIFT else 0.5 * (window[0] + window[1])
+        factor = _factored(operators, shifted, shift)
+        try:
+            found = _pairs(operators, shifted, factor, SLEPc, count, shift, window, EXTRA)
+        finally:
+            factor.destroy()
         if len(found[0]) == count:
             return found, []
         if depth >= SLICE_DEPTH:
@@ -394,10 +422,10 @@ def _slice(operators, shifted, factor, SLEPc, window, ends, depth):
     if depth >= SLICE_DEPTH:
         return _no_pairs(operators), [window]
     middle = np.sqrt(low * window[1])
-    inside = _below(operators, shifted, factor, middle)
-    lower, failed_lower = _slice(operators, shifted, factor, SLEPc, (window[0], middle),
+    inside = _below(operators, shifted, middle)
+    lower, failed_lower = _slice(operators, shifted, SLEPc, (window[0], middle),
                                  (ends[0], inside), depth + 1)
-    upper, failed_upper = _slice(operators, shifted, factor, SLEPc, (middle, window[1]),
+    upper, failed_upper = _slice(operators, shifted, SLEPc, (middle, window[1]),
                                  (inside, ends[1]), depth + 1)
     return (tuple(np.concatenate([a, b]) for a, b in zip(lower[:3], upper[:3]))
             + (lower[3] + upper[3],)), failed_lower + failed_upper
@@ -409,15 +437,16 @@ def _no_pairs(operators):
     return np.zeros(0), np.zeros((0, n, operators.block)), np.zeros(0), 0
 
 
-def _pairs(operators, shifted, factor, SLEPc, count, shift, window):
+def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
     """(omega2 (k,), vectors (k, n_nodes, block), phi^T M phi (k,), converged) of the
     lowest ``count`` verified eigenpairs of K phi = omega^2 M phi in ``window`` (omega^2
     from, to), found by shift-and-invert about ``shift`` (``shifted`` = K - shift M,
-    factored in ``factor``). omega^2 is each vector's Rayleigh quotient
-    phi^T K phi / phi^T M phi (the eigensolver's shift + 1/theta loses the digits of an
-    eigenvalue far below the shift); a pair is kept where its relative residual
-    ||K phi - omega^2 M phi|| / (||K phi|| + omega^2 ||M phi||) is below RESIDUAL (or,
-    for a rigid mode, ||K phi|| below RESIDUAL ||K||_inf ||phi||), phi^T M phi > 0 and
+    factored in ``factor``), ``extra`` more asked of the eigensolver. omega^2 is each
+    vector's Rayleigh quotient phi^T K phi / phi^T M phi (the eigensolver's
+    shift + 1/theta loses the digits of an eigenvalue far below the shift); a pair is
+    kept where its relative residual ||K phi - omega^2 M phi|| / (||K phi|| +
+    omega^2 ||M phi||) is below RESIDUAL (or, for a rigid mode, ||K phi|| and the
+    residual below RESIDUAL ||K||_inf ||phi||), phi^T M phi > 0 and
     omega^2 in the window. An eigenvalue below SHIFT is one of the massless unknowns'
     infinite ones that the spectral transformation returned with the wrong sign: left
     out. Collective."""
@@ -428,7 +457,7 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window):
     try:
         eps.setOperators(shifted, M)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count, count + max(SUBSPACE, count // 2))
+        eps.setDimensions(count + extra, count + extra + max(SUBSPACE, count // 2))
         # the purification's solves (one per vector) change no shape: the massless
         # unknowns' components it removes are not read (u and omega are)
         eps.setPurify(False)
@@ -464,7 +493,8 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window):
                 continue
             values.append(value)
             masses.append(mass)
-            vectors.append(vector.getArray(readonly=True).reshape(-1, operators.block).copy())
+            vectors.append(vector.getArray(readonly=True).reshape(-1, operators.block)
+                           .copy())
         order = np.argsort(values)[:count]
         n = operators.problem.mesh.n_local_nodes
         return (np.array(values)[order].reshape(-1),

@@ -128,10 +128,9 @@ def table_lines(modes, seconds):
     if modes.band is not None and (modes.slices or modes.band[2] != len(modes.omega2)):
         short = ", ".join(f"{low:.4g}-{high:.4g} Hz" for low, high in modes.slices)
         lines.append(f"modes: warning: {len(modes.omega2)} verified modes, the inertia counts "
-                     f"{modes.band[2]}; left short: {short or 'none'} (a sub-band whose "
-                     "inertia decreases lies above the discretisation's frequencies): a "
-                     "-rod_modes_range below them, or a larger -rod_modes_eps_ncv, finds "
-                     "the others")
+                     f"{modes.band[2]}; left short: {short or 'none'}: a larger "
+                     "-rod_modes_eps_ncv, or -rod_modes_range split there, finds the "
+                     "others (none reported is unverified)")
     elif modes.band is not None:
         lines.append(f"modes: every mode of the band verified (relative residual below "
                      f"{RESIDUAL:g}), as many as the inertia counts")

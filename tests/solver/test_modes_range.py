@@ -124,13 +124,18 @@ def cantilever_band(band):
 
 
 def test_a_wide_band_gives_the_narrow_band_s_frequencies():
-    """The cantilever (EI 2, m 3, 16 elements) in [0, 1e7] Hz: one shift at the band's
-    middle lost the low modes' digits (mode 1 came out far above 1.0237 Hz); the band
-    cut into sub-bands with verified pairs gives the lowest four of [0, 10] Hz to 1e-9
+    """The cantilever (EI 2, m 3, 16 elements) in [0, 1e7] and [0, 1e30] Hz: one shift
+    at the band's middle lost the low modes' digits (mode 1 came out far above 1.0237
+    Hz); the band cut into sub-bands gives as many verified pairs as the inertia counts
+    (every mode of the discretisation in the second), the lowest six of [0, 10] Hz to 1e-9
     (closed form beta_n L = 1.8751, 4.6941, a pair each), every frequency in the band
     and increasing, on 1 and 2 ranks alike."""
     narrow = cantilever_band("0,10")
     wide = cantilever_band("0,1e7")
+    whole = cantilever_band("0,1e30")
+    assert wide.band[2] == len(wide.omega2) and not wide.slices
+    assert whole.band[2] == len(whole.omega2) and not whole.slices
+    assert np.allclose(whole.frequencies[:6], narrow.frequencies, rtol=1e-9)
     exact = np.repeat(np.array([1.8751, 4.6941]) ** 2 / (2 * np.pi) * np.sqrt(2.0 / 3.0), 2)
     assert np.allclose(narrow.frequencies[:4], exact, rtol=1e-3)
     assert len(wide.omega2) >= len(narrow.omega2) == 6
