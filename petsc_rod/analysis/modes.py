@@ -104,6 +104,8 @@ class Modes:
     labels: list = field(default_factory=list)
     # a band's (fmin, fmax, the count of its modes by the inertia), Hz; None: the lowest
     band: tuple = None
+    # the modes asked for without a band (fewer where fewer converged and verified)
+    asked: int = 0
     # the band's sub-bands (fmin, fmax), Hz, whose pairs did not all verify or whose
     # inertia decreased (their modes left out)
     slices: list = field(default_factory=list)
@@ -330,6 +332,7 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
         if band is None:
             modes = _assemble(operators, *_pairs(operators, shifted, factor, SLEPc, count,
                                                  SHIFT, (SHIFT, np.inf)))
+            modes.asked = count
             return modes
         window = band_shifts(band)
         ends = [_below(operators, shifted, sigma) for sigma in window]

@@ -125,6 +125,10 @@ def table_lines(modes, seconds):
             modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
         fractions = " / ".join(f"{share:.2f}" for share in shares)
         lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
+    if modes.band is None and len(modes.omega2) < modes.asked:
+        lines.append(f"modes: warning: {len(modes.omega2)} of the {modes.asked} asked "
+                     "converged and verified (none reported is unverified): a larger "
+                     "-rod_modes_eps_ncv or -rod_modes_eps_max_it finds the others")
     if modes.band is not None and (modes.slices or modes.band[2] != len(modes.omega2)):
         short = ", ".join(f"{low:.4g}-{high:.4g} Hz" for low, high in modes.slices)
         lines.append(f"modes: warning: {len(modes.omega2)} verified modes, the inertia counts "

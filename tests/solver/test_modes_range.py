@@ -144,3 +144,15 @@ def test_a_wide_band_gives_the_narrow_band_s_frequencies():
     assert np.all(wide.modal_mass > 0)
     every = PETSc.COMM_WORLD.tompi4py().allgather(wide.frequencies[:6])
     assert all(np.allclose(every[0], f, rtol=1e-10) for f in every)
+
+
+def test_fewer_verified_modes_than_asked_are_said():
+    """The lowest modes without a band: the run's lines warn where fewer than asked
+    converged and verified (a pair that does not verify is never reported)."""
+    from petsc_rod.cli.modes import table_lines
+    modes = string_modes(count=2)
+    assert modes.asked == 2 and len(modes.omega2) == 2
+    assert not any("warning" in line for line in table_lines(modes, 1.0))
+    modes.asked = 3
+    assert any(line.startswith("modes: warning: 2 of the 3 asked converged and verified")
+               for line in table_lines(modes, 1.0))
