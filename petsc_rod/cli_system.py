@@ -200,7 +200,7 @@ def prepared(values, given):
                            if name.removeprefix("rod_") in MODES_OPTIONS})
     body_modes = body_modes_request({"system_modes": values["rod_system_modes"],
                                      "system_modes_line_mass":
-                                         values["rod_system_modes_line_mass"]})
+                                         values["rod_system_modes_line_mass"]}, cli=True)
     return (system, notes, read_text(path, "-rod_system"), settings, options, sweeps, modes,
             body_modes)
 
@@ -232,7 +232,8 @@ def run(comm=None):
                 say(f"petsc_rod: note: {note}")
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
-                                 text, notes, interrupts, sweeps, modes, body_modes)
+                                 text, notes, interrupts, sweeps, modes, body_modes,
+                                 line_mass_option="-rod_system_modes_line_mass")
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)

@@ -61,6 +61,16 @@ DOMINANT = 0.6
 # vibrations are faster, and the free roll of sections with polar inertia between pins
 # has omega = 0 to round-off
 RIGID = 1e-3
+# a pair is reported only with its relative residual below RESIDUAL (_pairs)
+RESIDUAL = 1e-3
+# a band is cut where its ends (omega^2) are more than SLICE_SPAN apart, to at most
+# SLICE_DEPTH halvings (_slice)
+SLICE_SPAN = 1e4
+SLICE_DEPTH = 12
+# the pairs a sub-band's solve asks for beyond its count: the eigensolver stops once it
+# has as many as asked, and a free rigid mode of little mass can converge after the
+# nearest vibration (those outside the sub-band are left out)
+EXTRA = 4
 
 
 class ModesRefused(Exception):
@@ -94,6 +104,11 @@ class Modes:
     labels: list = field(default_factory=list)
     # a band's (fmin, fmax, the count of its modes by the inertia), Hz; None: the lowest
     band: tuple = None
+    # the modes asked for without a band (fewer where fewer converged and verified)
+    asked: int = 0
+    # the band's sub-bands (fmin, fmax), Hz, whose pairs did not all verify or whose
+    # inertia decreased (their modes left out)
+    slices: list = field(default_factory=list)
 
     @property
     def frequencies(self):
@@ -267,9 +282,10 @@ def solve_modes(problem, count, settings=MassSettings(), band=None):
     """The ``count`` lowest modes (Modes) of the problem's converged state, or
     ModesRefused where the state is unstable. With ``band`` (fmin, fmax), Hz, every
     mode in it instead (``count`` unused): the inertia of K - sigma M at both ends
-    counts them (Sylvester: the eigenvalues below sigma), and the eigensolver, shifted
-    to the band's middle omega^2, finds that many nearest to it, which are the band's
-    (every other eigenvalue is farther from the middle). Collective."""
+    counts them (Sylvester: the eigenvalues below sigma), and the band is sliced into
+    sub-bands (_slice), each solved about its middle omega^2 for the many its inertia
+    counts (every other eigenvalue is farther from the middle); ``Modes.slices`` names
+    those left short. Every pair is verified (_pairs). Collective."""
     from slepc4py import SLEPc
     if band is None and count < 1:
         raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
@@ -308,50 +324,26 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
         factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block,
                                PREFIX + "st_")
         made.append(factor)
-        ksp = factor_ksp(shifted, factor)
-        made.append(ksp)
-        eps = SLEPc.EPS().create(comm=operators.comm)
-        made.append(eps)
         with EVENTS["factor"]:
             factor.set_up(shifted)
             negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
             raise ModesRefused(int(negative))
-        shift, window = SHIFT, (SHIFT, np.inf)
-        if band is not None:
-            window = band_shifts(band)
-            below = []
-            for sigma in window:
-                with EVENTS["factor"]:
-                    _shift_to(shifted, K, M, sigma)
-                    factor.set_up(shifted)
-                    below.append(factor.negative_pivots() - operators.chain_constraints)
-            count = int(below[1] - below[0])
-            if count == 0:
-                return _empty_modes(problem.mesh, band)
-            shift = 0.5 * (window[0] + window[1])
-            with EVENTS["factor"]:
-                _shift_to(shifted, K, M, shift)
-                factor.set_up(shifted)
-        eps.setOperators(shifted, M)
-        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count, count + max(SUBSPACE, count // 2))
-        # the purification's solves (one per vector) change no shape: the massless
-        # unknowns' components it removes are not read (u and omega are)
-        eps.setPurify(False)
-        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-        eps.setTarget(0.0)
-        st = eps.getST()
-        st.setType(SLEPc.ST.Type.SINVERT)
-        st.setKSP(ksp)
-        eps.setOptionsPrefix(PREFIX)
-        eps.setFromOptions()
-        with EVENTS["eps"]:
-            eps.solve()
-        with EVENTS["shapes"]:
-            modes = _modes(operators, eps, count, shift, window)
-        if band is not None:
-            modes.band = (band[0], band[1], count)
+        if band is None:
+            modes = _assemble(operators, *_pairs(operators, shifted, factor, SLEPc, count,
+                                                 SHIFT, (SHIFT, np.inf)))
+            modes.asked = count
+            return modes
+        window = band_shifts(band)
+        ends = [_below(operators, shifted, sigma) for sigma in window]
+        found, failed = _slice(operators, shifted, SLEPc, window, ends, 0)
+        if len(found[0]) == 0:
+            modes = _empty_modes(problem.mesh, band)
+            modes.converged = found[3]
+        else:
+            modes = _assemble(operators, *found)
+        modes.band = (band[0], band[1], int(ends[1] - ends[0]))
+        modes.slices = [tuple(np.sqrt(np.maximum(w, 0.0)) / (2 * np.pi)) for w in failed]
         return modes
     finally:
         for thing in reversed(made):
@@ -367,34 +359,163 @@ def _empty_modes(mesh, band):
                  (band[0], band[1], 0))
 
 
-def _modes(operators, eps, count, shift=SHIFT, window=(SHIFT, np.inf)):
-    """The lowest ``count`` converged eigenpairs of ``eps`` (its operator K - shift M)
-    in ``window`` (omega^2 from, to) as Modes. An eigenvalue below SHIFT is one of the
-    massless unknowns' infinite ones that the spectral transformation returned with the
-    wrong sign (the inertia proved there is none): left out. The shapes are taken all
-    at once (_shapes): their reductions over the ranks are one per quantity, not one
-    per mode."""
-    converged = eps.getConverged()
-    values = np.array([eps.getEigenvalue(i).real for i in range(converged)]) + shift
-    finite = np.flatnonzero((values >= window[0]) & (values <= window[1]))
-    order = finite[np.argsort(values[finite])][:count]
-    vector = operators.mass_matrix.createVecRight()
-    product = vector.duplicate()
-    vectors, local_mass = [], []
-    for i in order:
-        eps.getEigenvector(int(i), vector)
-        operators.mass_matrix.mult(vector, product)
-        array = vector.getArray(readonly=True)
-        vectors.append(array.reshape(-1, operators.block).copy())
-        local_mass.append(float(product.getArray(readonly=True) @ array))
-    vector.destroy()
-    product.destroy()
+def _below(operators, shifted, sigma):
+    """The eigenvalues of K - omega^2 M below ``sigma`` (rad^2/s^2): the negative pivots
+    of the LDL^T of K - sigma M (left in ``shifted``) less the chains' constraints
+    (Sylvester). Collective."""
+    factor = _factored(operators, shifted, sigma)
+    try:
+        return int(factor.negative_pivots() - operators.chain_constraints)
+    finally:
+        factor.destroy()
+
+
+def _factored(operators, shifted, sigma):
+    """A new factorisation (direct_factor) of ``shifted`` = K - sigma M: its own
+    analysis at sigma, as MUMPS's ordering and pivoting of a matrix analysed at a
+    far other shift (M's entries at a sigma far above the modes) lose the digits of
+    the factor's solves and inertia. Collective; the caller destroys it."""
+    with EVENTS["factor"]:
+        _shift_to(shifted, operators.matrix, operators.mass_matrix, sigma)
+        factor = direct_factor(shifted, PETSc.PC.Type.CHOLESKY, operators.block,
+                               PREFIX + "st_")
+        try:
+            factor.set_up(shifted)
+        except Exception:
+            factor.destroy()
+            raise
+        return factor
+
+
+def _slice(operators, shifted, SLEPc, window, ends, depth):
+    """The verified pairs (_pairs' tuple) of every eigenvalue in ``window`` (omega^2 from,
+    to), which the inertia counts ``ends`` (below each end) hold, and the sub-bands
+    (omega^2 from, to) left short: unverified at the depth SLICE_DEPTH, or where the
+    inertia decreases. A sub-band whose ends are more
+    than SLICE_SPAN apart in omega^2 (from RIGID's omega^2 where it starts at 0), or
+    whose solve about its middle verifies fewer pairs than it holds, is cut at its
+    geometric middle (the inertia there counts each half's): one shift at the middle of
+    a wide band keeps none of the low eigenvalues' digits in sigma + 1/theta. A
+    sub-band is solved about its middle, or about SHIFT where it starts at 0. An empty
+    one costs no solve. Collective."""
+    count = ends[1] - ends[0]
+    if count < 0:
+        # the inertia decreases: K - sigma M lost its digits at a sigma far above the
+        # discretisation's eigenvalues; nothing in the sub-band can be counted
+        return _no_pairs(operators), [window]
+    if count == 0:
+        return _no_pairs(operators), []
+    low = max(window[0], (2 * np.pi * RIGID) ** 2)
+    wide = window[1] > SLICE_SPAN * low
+    if not wide:
+        # from the band's start at 0 the lowest ``count`` above SHIFT are the
+        # sub-band's (the stable state has none below): the free rigid modes, whose
+        # small mass the Krylov space misses about a shift above them, found as
+        # without a band
+        shift = SHIFT if window[0] <= SHIFT else 0.5 * (window[0] + window[1])
+        factor = _factored(operators, shifted, shift)
+        try:
+            found = _pairs(operators, shifted, factor, SLEPc, count, shift, window, EXTRA)
+        finally:
+            factor.destroy()
+        if len(found[0]) == count:
+            return found, []
+        if depth >= SLICE_DEPTH:
+            return found, [window]
+    if depth >= SLICE_DEPTH:
+        return _no_pairs(operators), [window]
+    middle = np.sqrt(low * window[1])
+    inside = _below(operators, shifted, middle)
+    lower, failed_lower = _slice(operators, shifted, SLEPc, (window[0], middle),
+                                 (ends[0], inside), depth + 1)
+    upper, failed_upper = _slice(operators, shifted, SLEPc, (middle, window[1]),
+                                 (inside, ends[1]), depth + 1)
+    return (tuple(np.concatenate([a, b]) for a, b in zip(lower[:3], upper[:3]))
+            + (lower[3] + upper[3],)), failed_lower + failed_upper
+
+
+def _no_pairs(operators):
+    """_pairs' tuple without any pair."""
+    n = operators.problem.mesh.n_local_nodes
+    return np.zeros(0), np.zeros((0, n, operators.block)), np.zeros(0), 0
+
+
+def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
+    """(omega2 (k,), vectors (k, n_nodes, block), phi^T M phi (k,), converged) of the
+    lowest ``count`` verified eigenpairs of K phi = omega^2 M phi in ``window`` (omega^2
+    from, to), found by shift-and-invert about ``shift`` (``shifted`` = K - shift M,
+    factored in ``factor``), ``extra`` more asked of the eigensolver. omega^2 is each
+    vector's Rayleigh quotient phi^T K phi / phi^T M phi (the eigensolver's
+    shift + 1/theta loses the digits of an eigenvalue far below the shift); a pair is
+    kept where its relative residual ||K phi - omega^2 M phi|| / (||K phi|| +
+    omega^2 ||M phi||) is below RESIDUAL (or, for a rigid mode, ||K phi|| and the
+    residual below RESIDUAL ||K||_inf ||phi||), phi^T M phi > 0 and
+    omega^2 in the window. An eigenvalue below SHIFT is one of the massless unknowns'
+    infinite ones that the spectral transformation returned with the wrong sign: left
+    out. Collective."""
+    ksp = factor_ksp(shifted, factor)
+    eps = SLEPc.EPS().create(comm=operators.comm)
+    K, M = operators.matrix, operators.mass_matrix
+    vector, Kx, Mx = M.createVecRight(), M.createVecRight(), M.createVecRight()
+    try:
+        eps.setOperators(shifted, M)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(count + extra, count + extra + max(SUBSPACE, count // 2))
+        # the purification's solves (one per vector) change no shape: the massless
+        # unknowns' components it removes are not read (u and omega are)
+        eps.setPurify(False)
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+        eps.setTarget(0.0)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        st.setKSP(ksp)
+        eps.setOptionsPrefix(PREFIX)
+        eps.setFromOptions()
+        with EVENTS["eps"]:
+            eps.solve()
+        converged = eps.getConverged()
+        scale = K.norm(PETSc.NormType.INFINITY)
+        values, vectors, masses = [], [], []
+        for i in range(converged):
+            if eps.getEigenvalue(i).real + shift < SHIFT:
+                continue
+            eps.getEigenvector(i, vector)
+            K.mult(vector, Kx)
+            M.mult(vector, Mx)
+            mass = vector.dot(Mx)
+            if not mass > 0:
+                continue
+            value = vector.dot(Kx) / mass
+            stiffness, inertia = Kx.norm(), Mx.norm()
+            Kx.axpy(-value, Mx)
+            residual = Kx.norm()
+            rigid = residual <= RESIDUAL * scale * vector.norm() and \
+                stiffness <= RESIDUAL * scale * vector.norm()
+            if not (residual <= RESIDUAL * (stiffness + abs(value) * inertia) or rigid) \
+                    or not window[0] <= value <= window[1]:
+                continue
+            values.append(value)
+            masses.append(mass)
+            vectors.append(vector.getArray(readonly=True).reshape(-1, operators.block)
+                           .copy())
+        order = np.argsort(values)[:count]
+        n = operators.problem.mesh.n_local_nodes
+        return (np.array(values)[order].reshape(-1),
+                np.array(vectors).reshape(-1, n, operators.block)[order],
+                np.array(masses)[order].reshape(-1), converged)
+    finally:
+        for thing in (vector, Kx, Mx, eps, ksp):
+            thing.destroy()
+
+
+def _assemble(operators, omega2, vectors, masses, converged):
+    """Modes of verified pairs (_pairs), lowest first; their shapes taken all at once
+    (_shapes: one reduction over the ranks per quantity, not per mode)."""
     mesh = operators.problem.mesh
-    vectors = np.array(vectors).reshape(len(order), mesh.n_local_nodes, operators.block)
-    modal_mass, shares, offset, rotation, curvature = _shapes(
-        operators, vectors, np.asarray(mesh.global_sum(np.array(local_mass))))
+    order = np.argsort(omega2, kind="stable")
+    omega2, vectors, masses = omega2[order], vectors[order], masses[order]
+    modal_mass, shares, offset, rotation, curvature = _shapes(operators, vectors, masses)
     S_mid = mesh.element_S + mesh.element_h / 2
-    omega2 = values[order]
     return Modes(omega2, modal_mass, shares, mesh.vertex_S, offset, rotation, S_mid,
                  curvature, converged,
                  classify(shares, np.sqrt(np.maximum(omega2, 0.0)) / (2 * np.pi)))

@@ -25,7 +25,8 @@ from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
 from petsc_rod.quantities import riser_numbers
-from petsc_rod.system.body_modes import SystemModes, SystemModesRefused, system_modes
+from petsc_rod.system.body_modes import (SystemModes, SystemModesRefused, check_line_masses,
+                                         system_modes)
 from petsc_rod.system.body_modes import table_lines as body_modes_lines
 from petsc_rod.system.equilibrium import Settings, SystemSolver
 from petsc_rod.system.held_line import held_lines
@@ -99,18 +100,20 @@ class SystemResults:
     body_modes: object = None
 
 
-def body_modes_request(options):
+def body_modes_request(options, cli=False):
     """{'line_mass': bool} of the system's modes ``options`` asks for ('system_modes',
     'system_modes_line_mass'), None without 'system_modes'; the two taken out of
-    ``options``."""
+    ``options``. ``cli``: a refusal names the command line's options
+    (-rod_system_modes 1), else the API's."""
     asked, lumped = (options.pop(name, False) for name in ("system_modes",
                                                            "system_modes_line_mass"))
     for name, value in (("system_modes", asked), ("system_modes_line_mass", lumped)):
         if not isinstance(value, (bool, np.bool_, int, np.integer)) or value not in (0, 1):
             raise RodInputError(f"{name} {value!r}: True or False")
     if lumped and not asked:
-        raise RodInputError("system_modes_line_mass needs system_modes (the system's "
-                            "modes it lumps the lines' mass for)")
+        needs = ("-rod_system_modes_line_mass needs -rod_system_modes 1" if cli else
+                 "system_modes_line_mass needs system_modes")
+        raise RodInputError(f"{needs} (the system's modes it lumps the lines' mass for)")
     return {"line_mass": bool(lumped)} if asked else None
 
 
@@ -284,6 +287,10 @@ def check_finite(comm, results, records):
                                "inf); nothing is written")
 
 
+# the system's tables that a run writes only when asked (write_tables, stale_paths)
+OPTIONAL_TABLES = ("watch_circle", "excursion", "system_modes")
+
+
 def table_paths(table, system, sweeps=Sweeps(), body_modes=False):
     """{line name, 'system', a sweep's name or 'system_modes': CSV path} of ``table``
     (FILE.csv -> FILE_<line>.csv, FILE_system.csv, FILE_watch_circle.csv and
@@ -454,8 +461,8 @@ def ends_rows(system, results):
 def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps()):
     """FILE_<line>.csv (a single line's table, written by the line's group) for every
     line, FILE_system.csv, the sweeps' FILE_watch_circle.csv, FILE_excursion.csv and
-    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused,
-    and an earlier run's removed).
+    the system's modes' FILE_system_modes.csv (rank 0; none where they were refused);
+    an earlier run's optional tables that this run did not write removed (stale_paths).
     Collective on ``comm``."""
     paths = table_paths(table, system, sweeps, results.body_modes is not None)
 
@@ -473,9 +480,21 @@ def write_tables(comm, solver, table, system, results, records, sweeps=Sweeps())
             if isinstance(results.body_modes, SystemModes):
                 line_table._write(paths["system_modes"], paths["system_modes"] + ".partial",
                                   body_modes_table(results.body_modes))
-            elif results.body_modes is not None and os.path.exists(paths["system_modes"]):
-                os.remove(paths["system_modes"])        # an earlier run's: none this time
+            written = set(results.sweeps) | (
+                {"system_modes"} if isinstance(results.body_modes, SystemModes) else set())
+            for path in stale_paths(table, system, written):
+                os.remove(path)
     on_every_rank(comm, write_all)
+
+
+def stale_paths(table, system, written):
+    """The existing FILE_watch_circle.csv, FILE_excursion.csv and FILE_system_modes.csv
+    of ``table`` whose names are not in ``written`` (this run wrote no such table): an
+    earlier run's, which would otherwise stand beside this run's tables as if its
+    own."""
+    every = table_paths(table, system, Sweeps(watch_circle=True, excursion=True), True)
+    return [every[name] for name in OPTIONAL_TABLES
+            if name not in written and os.path.exists(every[name])]
 
 
 def report_lines(system, results, ranks):
@@ -528,7 +547,7 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps(), body_modes=False):
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
                text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None,
-               body_modes=None, solver=None):
+               body_modes=None, solver=None, line_mass_option="system_modes_line_mass"):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
     line's modes with its ends held where ``modes`` (count, MassSettings) asks for
@@ -550,6 +569,8 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
+    if body_modes is not None and body_modes["line_mass"]:
+        on_every_rank(comm, check_line_masses, system, line_mass_option)
     check_outputs(comm, system, output, table, sweeps, body_modes is not None)
     own = solver is None
     if own:

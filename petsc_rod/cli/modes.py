@@ -11,7 +11,8 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
-from petsc_rod.analysis.modes import CLASSES, ModesRefused, check_options, solve_modes
+from petsc_rod.analysis.modes import (CLASSES, RESIDUAL, ModesRefused, check_options,
+                                      solve_modes)
 from petsc_rod.errors import RodInputError, RodIOError, petsc_message
 from petsc_rod.cli.options import modes_asked
 from petsc_rod.figures.modes import shapes_path
@@ -120,10 +121,19 @@ def table_lines(modes, seconds):
             modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
         fractions = " / ".join(f"{share:.2f}" for share in shares)
         lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
-    if modes.band is not None and modes.band[2] != len(modes.omega2):
-        lines.append(f"modes: warning: {len(modes.omega2)} of the band's {modes.band[2]} "
-                     "modes converged: a larger -rod_modes_eps_ncv or -rod_modes_eps_max_it "
-                     "finds the others")
+    if modes.band is None and len(modes.omega2) < modes.asked:
+        lines.append(f"modes: warning: {len(modes.omega2)} of the {modes.asked} asked "
+                     "converged and verified (none reported is unverified): a larger "
+                     "-rod_modes_eps_ncv or -rod_modes_eps_max_it finds the others")
+    if modes.band is not None and (modes.slices or modes.band[2] != len(modes.omega2)):
+        short = ", ".join(f"{low:.4g}-{high:.4g} Hz" for low, high in modes.slices)
+        lines.append(f"modes: warning: {len(modes.omega2)} verified modes, the inertia counts "
+                     f"{modes.band[2]}; left short: {short or 'none'}: a larger "
+                     "-rod_modes_eps_ncv, or -rod_modes_range split there, finds the "
+                     "others (none reported is unverified)")
+    elif modes.band is not None:
+        lines.append(f"modes: every mode of the band verified (relative residual below "
+                     f"{RESIDUAL:g}), as many as the inertia counts")
     return lines
 
 

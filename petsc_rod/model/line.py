@@ -192,7 +192,10 @@ class UniformLine:
     piecewise-constant dead ``load`` ((m, 3) N/m) changing at ``load_breaks`` ((m - 1,)
     m), of axial stiffness ``axial_stiffness`` (EA, N; inf: inextensible) and, in a
     current, the normal drag ``drag`` (rho kg/m^3, Cd, D m; None: none), meshed with
-    ``elements`` elements graded by ``grading`` (None: the mesh's default)."""
+    ``elements`` elements graded by ``grading`` (None: the mesh's default); ``mass``
+    its mass per length in air, kg/m, of a system's modes with the lines' mass
+    (system/body_modes.line_masses; None: not given: the load is a weight in water,
+    not a mass)."""
 
     length: float = 1.0
     stiffness: object = (1.0, 1.0, 1.0)
@@ -202,9 +205,14 @@ class UniformLine:
     drag: object = None
     elements: int = DEFAULT_ELEMENTS
     grading: float = None
+    mass: float = None
 
     def __post_init__(self):
         real("UniformLine.length", self.length)
+        optional("UniformLine.mass", self.mass, real)
+        if self.mass is not None and not self.mass >= 0:
+            raise RodInputError(f"UniformLine.mass {self.mass!r}: a mass per length in "
+                                "air, kg/m, at least 0")
         reals("UniformLine.stiffness", self.stiffness, (3,))
         real("UniformLine.axial_stiffness", self.axial_stiffness, allow_inf=True)
         optional("UniformLine.drag", self.drag, reals, (3,))

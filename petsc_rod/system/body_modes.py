@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from petsc_rod.analysis.modes import Modes
+from petsc_rod.errors import RodInputError
 from petsc_rod.model.line import UniformLine
 from petsc_rod.system.bodies import lever_map, skew
 
@@ -111,21 +112,25 @@ def inertia_tensor(body):
 
 
 def line_masses(system):
-    """(n_lines,): each line's mass in air, kg: its sections' mass per length times
-    their lengths (a UniformLine: its load's magnitude over g)."""
-    g = system.environment.gravity
-    out = []
+    """(n_lines,): each line's mass in air, kg: its sections' line types' mass per
+    length times their lengths, a UniformLine's ``mass`` times its length (its load is
+    a weight in water: check_line_masses refuses one without a mass)."""
+    check_line_masses(system)
+    return np.array([float(line.line.mass * line.line.length)
+                     if isinstance(line.line, UniformLine) else
+                     float(sum(entry[0].mass * float(entry[1])
+                               for entry in line.line.sections))
+                     for line in system.lines])
+
+
+def check_line_masses(system, option="system_modes_line_mass"):
+    """RodInputError where a line's mass in air is not known for ``option`` (the lines'
+    mass lumped at their ends): a UniformLine without ``mass``."""
     for line in system.lines:
-        model = line.line
-        if isinstance(model, UniformLine):
-            load = np.linalg.norm(model.load_values, axis=1)
-            breaks = np.concatenate([[0.0], np.asarray(model.load_breaks, float),
-                                     [model.length]])
-            out.append(float(load @ np.diff(breaks)) / g)
-        else:
-            out.append(float(sum(entry[0].mass * float(entry[1])
-                                 for entry in model.sections)))
-    return np.array(out)
+        if isinstance(line.line, UniformLine) and line.line.mass is None:
+            raise RodInputError(f"{option}: line {line.name} is a UniformLine without a "
+                                "mass in air (its load is a weight in water, not a mass): "
+                                "give UniformLine.mass (kg/m) or sections of line types")
 
 
 def mass_matrix(solver, line_mass=False):

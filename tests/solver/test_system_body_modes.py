@@ -223,13 +223,14 @@ def test_a_constant_yaw_moment_makes_complex_modes_and_is_refused():
 
 
 def test_the_lines_mass_lumped_half_at_each_end():
-    """With line_mass: each spring's mass (its UniformLine's load over g times its
-    length) half at each end, the fixed ends' halves held: the point carries one half
+    """With line_mass: each spring's mass (its UniformLine's mass in air, here its load
+    over g, times its length) half at each end, the fixed ends' halves held: the point carries one half
     of each, omega^2 = 2k / (m (1 + ca) + w L0 / g) along the line; without it, none."""
     from dataclasses import replace
     k, span, rest, mass, ca, w = 3e4, 20.0, 18.0, 500.0, 0.8, 400.0
     system = point_between(k, span, rest, mass, ca)
-    heavy = tuple(replace(line, line=replace(line.line, load=((0.0, 0.0, -w),)))
+    heavy = tuple(replace(line, line=replace(line.line, load=((0.0, 0.0, -w),),
+                                             mass=w / G))
                   for line in system.lines)
     solver = solved(replace(system, lines=heavy))
     try:
@@ -278,3 +279,53 @@ def test_refused_modes_in_the_file_and_no_table(shared_tmp):
     with h5py.File(output, "r") as f:
         group = f["system/modes"]
         assert "complex eigenvalues" in group.attrs["refused"] and len(group) == 0
+
+
+def test_a_run_removes_the_optional_tables_it_did_not_write(shared_tmp):
+    """small_free_body.dat solved with -rod_table but neither the system's modes nor a
+    sweep: an earlier run's FILE_system_modes.csv, FILE_watch_circle.csv and
+    FILE_excursion.csv are removed (they stood beside the new tables as if this run's),
+    FILE_system.csv written."""
+    import os
+
+    from petsc_rod.api import read_moordyn, solve_system
+    from helpers import REPO_ROOT
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "small_free_body.dat"))
+    table = os.path.join(shared_tmp, "stale.csv")
+    stale = [os.path.join(shared_tmp, f"stale_{name}.csv")
+             for name in ("system_modes", "watch_circle", "excursion")]
+    if PETSc.COMM_WORLD.getRank() == 0:
+        for path in stale:
+            with open(path, "w") as f:
+                f.write("an earlier run's\n")
+    PETSc.COMM_WORLD.tompi4py().barrier()
+    results = solve_system(system, table=table, say=lambda line: None)
+    assert results.body_modes is None
+    PETSc.COMM_WORLD.tompi4py().barrier()
+    assert [os.path.exists(path) for path in stale] == [False] * 3
+    assert os.path.exists(os.path.join(shared_tmp, "stale_system.csv"))
+
+
+def test_the_lines_mass_is_their_mass_in_air():
+    """line_masses: a Line of a line type of 80 kg/m in air and 0.3 m od (its weight
+    in water (80 - 1025 pi 0.3^2 / 4) g, 63 % of its weight in air) weighs 80 L, and a
+    UniformLine under 400 N/m given 50 kg/m its 50 L, not |w| L / g; a UniformLine
+    without a mass is refused in one line (its load is a weight in water), never
+    taken as |w| / g."""
+    from dataclasses import replace
+    from petsc_rod.model.line import Line
+    from petsc_rod.model.line_type import LineType
+    from petsc_rod.system.body_modes import line_masses
+    from petsc_rod.errors import RodInputError
+    system = point_between()
+    chain = LineType("chain", od=0.3, mass=80.0, ei=(1e3, 1e3), gj=1e3, ea=1e8)
+    typed = replace(system.lines[0], line=Line(((chain, 18.0),)))
+    uniform = replace(system.lines[1], line=replace(system.lines[1].line,
+                                                    load=((0.0, 0.0, -400.0),), mass=50.0))
+    masses = line_masses(replace(system, lines=(typed, uniform)))
+    assert masses == pytest.approx([80.0 * 18.0, 50.0 * 18.0], rel=1e-14)
+    wet = replace(uniform, line=replace(uniform.line, mass=None))
+    with pytest.raises(RodInputError, match="system_modes_line_mass: line b is a "
+                                            "UniformLine without a mass in air"):
+        line_masses(replace(system, lines=(typed, wet)))

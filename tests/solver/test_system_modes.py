@@ -86,3 +86,19 @@ def test_each_line_s_modes_in_a_band():
         assert np.allclose(found.frequencies, inside, rtol=1e-9)
         assert f"line {line.name} (ends held): modes: {len(inside)} in 0.2-0.4 Hz" in \
             "\n".join(said)
+
+
+def test_each_line_s_modes_in_a_band_wider_than_its_spectrum():
+    """Options {'modes_range': '0,1e30'}: each line's every mode, as many verified as
+    the inertia counts, its lowest 8 (a free roll at 0 Hz first) those of {'modes': 8}
+    to 1e-9 (one shift at the band's middle gave 7e29 Hz and negative modal masses)."""
+    system, _ = read_moordyn(DECK)
+    said = []
+    wide = solve_system(system, say=said.append, options={"modes_range": "0,1e30"})
+    lowest = solve_system(system, options={"modes": 8})
+    for line in system.lines:
+        found, every = wide.modes[line.name], lowest.modes[line.name]
+        assert found.band[2] == len(found.frequencies) > 8 and not found.slices
+        assert np.all(found.modal_mass > 0)
+        assert np.allclose(found.frequencies[:8], every.frequencies, rtol=1e-9, atol=1e-6)
+    assert "every mode of the band verified" in "\n".join(said)

@@ -261,3 +261,13 @@ def test_the_system_modes_options_of_the_api():
         split_options({"system_modes": "yes"})
     with pytest.raises(RodInputError, match="modes and modes_range: give one"):
         split_options({"modes": 3, "modes_range": "1,2"})
+
+
+def test_the_system_modes_options_are_named_as_the_caller_gave_them():
+    """The API's wording for the API; the command line's names its options."""
+    from petsc_rod.api.system_run import body_modes_request
+    with pytest.raises(RodInputError, match="^system_modes_line_mass needs system_modes "):
+        body_modes_request({"system_modes_line_mass": True})
+    with pytest.raises(RodInputError, match="^-rod_system_modes_line_mass needs "
+                                            "-rod_system_modes 1 "):
+        body_modes_request({"system_modes_line_mass": True}, cli=True)
