@@ -35,6 +35,7 @@ from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
+from petsc_rod.model.system_check import check_reach
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
 from petsc_rod.tables import read_text
@@ -58,7 +59,8 @@ def named_rows(option, text, names, fields):
     """[(name, numbers (n,))] of ``option``'s ``text``: NAME,v1,...,vn parts separated by
     ':', each NAME one of ``names`` (a dict or a list), n = len(``fields``) finite
     numbers (``fields``: the words of the numbers, 'fx in N'); RodInputError naming the
-    part that is not."""
+    part that is not, and a NAME given twice (whose parts would otherwise add or
+    overwrite without a word)."""
     rows = []
     for part in text.split(":"):
         words = [word.strip() for word in part.split(",")]
@@ -77,6 +79,10 @@ def named_rows(option, text, names, fields):
                                 f"name ({', '.join(fields)})") from None
         if not np.all(np.isfinite(values)):
             raise RodInputError(f"-{option} {part!r}: finite numbers only")
+        if words[0] in (name for name, _ in rows):
+            raise RodInputError(f"-{option}: {words[0]} is given twice; give each "
+                                f"{'/'.join(names.kinds)} once, its values in one part "
+                                f"{form}")
         rows.append((words[0], values))
     return rows
 
@@ -101,29 +107,35 @@ def body_loads(text, system):
     return dataclasses.replace(system, bodies=tuple(bodies[b.name] for b in system.bodies))
 
 
+def check_movable(node, move, option, hint):
+    """Refuse to move the Point or Body ``node`` by ``move`` ((3,), m: the directions a
+    sweep moves it in, or one offset) where its equilibrium decides where it is: a free
+    point, or a body free in a moved direction; ``option`` names what moves it, ``hint``
+    how else to move a free body (a load)."""
+    if hasattr(node, "kind"):
+        if node.kind == "free":
+            raise RodInputError(f"{option} {node.name}: a free point, whose equilibrium "
+                                "decides where it is; offset a fixed or prescribed point "
+                                "or a held body")
+        return
+    free = [axis for axis, d, held in zip("xyz", move, node.held) if d != 0 and not held]
+    if free:
+        raise RodInputError(f"{option} {node.name}: body {node.name} is free in "
+                            f"{', '.join(free)}, where its equilibrium decides where it "
+                            "is; hold it there (Fixed or Coupled in the file) or move it "
+                            f"by a load ({hint})")
+
+
 def offsets(text, system):
     """``system`` with the offsets of -rod_system_offset ``text`` (NAME,dx,dy,dz separated
     by ':', m, global axes) added to the positions of its fixed or prescribed points and
     of its bodies in their held translations; RodInputError for a free point, or a body
-    moved in a direction it is free in (its equilibrium decides where it is there)."""
+    moved in a direction it is free in (check_movable)."""
     nodes = _Names((*system.points, *system.bodies), ("point", "body"))
     for name, move in named_rows("rod_system_offset", text, nodes,
                                  ("dx in m", "dy in m", "dz in m")):
         node = nodes[name]
-        if hasattr(node, "kind"):
-            if node.kind == "free":
-                raise RodInputError(f"-rod_system_offset {name}: a free point, whose "
-                                    "equilibrium decides where it is; offset a fixed or "
-                                    "prescribed point or a held body")
-            nodes[name] = dataclasses.replace(node, position=tuple(np.add(node.position,
-                                                                          move)))
-            continue
-        free = [axis for axis, d, held in zip("xyz", move, node.held) if d != 0 and not held]
-        if free:
-            raise RodInputError(f"-rod_system_offset {name}: body {name} is free in "
-                                f"{', '.join(free)}, where its equilibrium decides where it "
-                                "is; hold it there (Fixed or Coupled in the file) or move "
-                                "it by a load (-rod_system_body_load)")
+        check_movable(node, move, "-rod_system_offset", "-rod_system_body_load")
         position = np.array(node.position, dtype=float)
         position[:3] += move
         nodes[name] = dataclasses.replace(node, position=tuple(position))
@@ -169,11 +181,52 @@ def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
         raise RodInputError(clash)
 
 
-def prepared(values, given):
+def _names(text):
+    """The NAMEs of an option's NAME,... parts separated by ':' (named_rows' form)."""
+    return [part.split(",")[0].strip() for part in text.split(":")]
+
+
+def changed(system, values, case):
+    """``system`` (the file's) with the run's -rod_system_body_load, -rod_system_offset
+    and -rod_system_line_length (``values``), then a sweep case's (``case``: {option
+    name: text}) over them, as each option acts on the file's: a case's loads and
+    offsets add to the base's, per name (each is a change: the base's of the file's, the
+    case's of the base's); a case's lengths replace the base's for the lines it names,
+    the base's others kept. Checked again where a point or body moved or a line's length
+    changed (System.check: a line that cannot reach its held ends), and every line for
+    its start (system_check.check_reach: longer than its ends' distance), the messages
+    naming the option that moved or lengthened them."""
+    element_length = values["rod_system_element_length"]
+    for option, change in (("rod_system_body_load", body_loads),
+                           ("rod_system_offset", offsets)):
+        for text in (values[option], case.get(option)):
+            if text:
+                system = change(text, system)
+    base, own = values["rod_system_line_length"], case.get("rod_system_line_length")
+    if base and own:
+        kept = set(_names(own))
+        base = ":".join([part for part in base.split(":") if _names(part)[0] not in kept]
+                        + [own])
+    lengths = base or own
+    if lengths:
+        system = line_lengths(lengths, system, element_length)
+    made_by = {("line", name): "-rod_system_line_length" for name in
+               _names(lengths or "")}
+    made_by.update({("node", name): "-rod_system_offset" for text in
+                    (values["rod_system_offset"], case.get("rod_system_offset")) if text
+                    for name in _names(text)})
+    if made_by:
+        system.check(made_by=made_by)
+    check_reach(system, made_by)
+    return system
+
+
+def prepared(values, given, case=None):
     """(System, notes, the file's text, Settings, the lines' options, the Sweeps, the
     modes' request: api/system_run.modes_request, the system's modes' request:
-    body_modes_request) of the run's option ``values``;
-    RodInputError for what a system cannot take."""
+    body_modes_request) of the run's option ``values`` (a sweep's base options) with a
+    sweep case's ``case`` ({option name: text} of sweep/system.CASE_OPTIONS) over them
+    (changed); RodInputError for what a system cannot take."""
     refused = refused_options(given)
     if refused:
         raise RodInputError(f"{', '.join('-' + name for name in refused)}: option(s) of "
@@ -182,13 +235,7 @@ def prepared(values, given):
                             "drop them")
     path = values["rod_system"]
     system, notes = read_moordyn(path, values["rod_system_element_length"])
-    if values["rod_system_body_load"]:
-        system = body_loads(values["rod_system_body_load"], system)
-    if values["rod_system_offset"]:
-        system = offsets(values["rod_system_offset"], system)
-    if values["rod_system_line_length"]:
-        system = line_lengths(values["rod_system_line_length"], system,
-                              values["rod_system_element_length"])
+    system = changed(system, values, case or {})
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()

@@ -248,12 +248,14 @@ class System:
         if not isinstance(self.environment, Environment):
             raise RodInputError("System.environment: expected an Environment")
 
-    def check(self, names=FIELD_NAMES):
+    def check(self, names=FIELD_NAMES, made_by=None):
         """Raise RodInputError on a system no equilibrium can be sought for
         (system_check.check_system): names, connections, each line's own checks worded
-        with ``names`` (names.Names), held points a line cannot span, a point without a
-        line, a body's degree of freedom nothing restores."""
-        check_system(self, names)
+        with ``names`` (names.Names), held points a line cannot span, a line too short
+        for its ends where it starts, a point without a line, a body's degree of freedom
+        nothing restores; ``made_by``: what moved points or changed lines' lengths, for
+        the messages (check_system)."""
+        check_system(self, names, made_by)
 
     def node(self, name):
         """The Point or Body named ``name``."""

@@ -64,10 +64,12 @@ def is_held(node):
     return node.kind != "free" if hasattr(node, "kind") else bool(np.all(node.held))
 
 
-def check_system(system, names):
+def check_system(system, names, made_by=None):
     """Raise RodInputError on a System no equilibrium can be sought for; the single
     line's checks word their messages with ``names`` (names.Names), prefixed by the
-    line's name."""
+    line's name; ``made_by`` {("line", name) or ("node", name): what}: what changed a
+    line's length or moved a point or body from the model's (a command line's option),
+    named in the messages of the spans it changed."""
     if not system.lines:
         raise RodInputError("System.lines: a system needs at least one line (SystemLine)")
     check_names(system)
@@ -76,7 +78,7 @@ def check_system(system, names):
         check_connections(line, nodes)
     check_lines(system, names)
     check_points(system)
-    check_held_spans(system, nodes)
+    check_held_spans(system, nodes, made_by or {})
     check_seabed_under(system)
     sea = system.environment
     for body in system.bodies:
@@ -250,7 +252,22 @@ def needed_strain(lengths, eas, chord):
     return np.inf if compliance == 0 else excess / compliance / float(eas.min())
 
 
-def check_held_spans(system, nodes):
+def ends_distance(line, nodes):
+    """The distance (m) between ``line``'s ends with their points and bodies
+    (``nodes`` by name) at their start positions."""
+    return float(np.linalg.norm(connection_position(nodes[line.end.to], line.end)
+                                - connection_position(nodes[line.start.to], line.start)))
+
+
+def changed_by(line, made_by):
+    """' (OPTION, ...)': what changed ``line``'s length or moved its ends (made_by of
+    check_system), '' for the model's own."""
+    found = [made_by[key] for key in (("line", line.name), ("node", line.start.to),
+                                      ("node", line.end.to)) if key in made_by]
+    return f" ({', '.join(dict.fromkeys(found))})" if found else ""
+
+
+def check_held_spans(system, nodes, made_by):
     """A line between two held points (or bodies held in all degrees of freedom) must
     reach across them: an inextensible one no shorter than their distance, an extensible
     one within MAX_STRAIN of it (the bound of the single line's model of stretch)."""
@@ -258,8 +275,7 @@ def check_held_spans(system, nodes):
         start, end = nodes[line.start.to], nodes[line.end.to]
         if not (is_held(start) and is_held(end)):
             continue
-        chord = float(np.linalg.norm(connection_position(end, line.end)
-                                     - connection_position(start, line.start)))
+        chord = ends_distance(line, nodes)
         model = line.line
         if hasattr(model, "sections"):
             lengths, eas = model.lengths, [entry[0].ea for entry in model.sections]
@@ -269,16 +285,45 @@ def check_held_spans(system, nodes):
         if strain == np.inf:
             raise RodInputError(
                 f"line {line.name}: {line.start.to} and {line.end.to} are held "
-                f"{chord:.6g} m apart, {chord - float(np.sum(lengths)):.3g} m more than "
+                f"{chord:.6g} m apart{changed_by(line, made_by)}, "
+                f"{chord - float(np.sum(lengths)):.3g} m more than "
                 f"its length {float(np.sum(lengths)):.6g} m (inextensible); lengthen the "
                 "line, move the points closer, or give its line types an EA")
         if strain > MAX_STRAIN:
             raise RodInputError(
                 f"line {line.name}: {line.start.to} and {line.end.to} are held "
-                f"{chord:.6g} m apart: its length {float(np.sum(lengths)):.6g} m must "
+                f"{chord:.6g} m apart{changed_by(line, made_by)}: its length "
+                f"{float(np.sum(lengths)):.6g} m must "
                 f"stretch by {100 * strain:.3g} % or more to reach, above "
                 f"{100 * MAX_STRAIN:g} %, where the linear stretch models no line "
                 "material; lengthen the line, move the points closer, or check its EA (N)")
+
+
+def check_reach(system, made_by=None):
+    """A line of one load piece (one section, or a uniform line of one load) with an end
+    at a free point or body must be longer than the distance between its ends where the
+    run starts (the free one at its start position): its first solve starts from the
+    inextensible catenary between them (scenes/starts.catenary_start), which a line as
+    long as its chord or shorter does not have. A line of several pieces starts straight
+    where its catenary cannot be drawn (HeldLine); one between held ends is
+    check_held_spans'. Not part of check_system: a model's free points may stand
+    anywhere (a MoorDyn file's are guesses); the run refuses them before it starts
+    (cli_system.changed). ``made_by``: check_system's."""
+    made_by = made_by or {}
+    nodes = {item.name: item for item in (*system.points, *system.bodies)}
+    for line in system.lines:
+        if is_held(nodes[line.start.to]) and is_held(nodes[line.end.to]):
+            continue
+        model = line.line
+        pieces = (len(model.sections) if hasattr(model, "sections")
+                  else len(model.load_values))
+        length, chord = float(model.length), ends_distance(line, nodes)
+        if pieces == 1 and not chord < length:
+            raise RodInputError(
+                f"line {line.name}: its length {length:.6g} m is not longer than its "
+                f"ends' distance {chord:.6g} m, {line.start.to} to {line.end.to} where the "
+                f"run starts{changed_by(line, made_by)}; its start hangs it between them "
+                "as a catenary: lengthen the line or move its ends closer")
 
 
 def check_seabed_under(system):

@@ -4,10 +4,12 @@
 
 Each case is the system's run (api/system_run.run_system, the path of
 ``python -m petsc_rod -rod_system FILE``) with the base options and the case's own over
-them; a case sets what tells one load case of a system from another (CASE_OPTIONS): the
-bodies' external loads (-rod_system_body_load), the offsets of fixed or prescribed
-points and held bodies (-rod_system_offset; -sweep_offsets makes them along headings)
-and the lines' lengths (-rod_system_line_length). The cases run one after the other on
+them (cli_system.changed: a case's loads and offsets add to the base's per name, its
+lines' lengths replace the base's); a case sets what tells one load case of a system
+from another (CASE_OPTIONS): the bodies' external loads (-rod_system_body_load), the
+offsets of fixed or prescribed points and held bodies (-rod_system_offset;
+-sweep_offsets makes them along headings) and the lines' lengths
+(-rod_system_line_length). The cases run one after the other on
 one SystemSolver: each is the solver's warm re-solve from the last converged case's
 equilibrium (SystemSolver.replace: the held points and bodies walked, the loads
 continued, every line warm from its own last state), or with -sweep_start scene, or
@@ -30,7 +32,7 @@ from petsc4py import PETSc
 from petsc_rod.api.system_run import run_system
 from petsc_rod.cli.options import check_same_on_every_rank, read_options, values_of
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.cli_system import prepared
+from petsc_rod.cli_system import check_movable, prepared
 from petsc_rod.errors import RodError, RodInputError, on_every_rank
 from petsc_rod.sweep import cases as sweep_cases
 from petsc_rod.sweep import summary
@@ -74,8 +76,9 @@ def offset_cases(offsets, headings, name):
 
 def make_cases(settings, system):
     """The cases of a system's sweep (``system``: the base System, whose names the
-    offsets' point or body must be one of): the product of the case file's rows and the
-    offsets."""
+    offsets' point or body must be one of, a fixed or prescribed point or a body held
+    in every direction the offsets move it: cli_system.check_movable): the product of
+    the case file's rows and the offsets."""
     if settings.current_headings:
         raise RodInputError("-sweep_current_headings turns a single line's current; a "
                             "system's current is its file's: give -sweep_cases or "
@@ -94,6 +97,11 @@ def make_cases(settings, system):
             headings = tuple(sweep_cases.numbers(",".join(settings.headings),
                                                  "-sweep_headings (deg, with -rod_system)"))
         offsets = offset_cases(settings.offsets, headings, settings.offset_of)
+        # the directions some case moves it in, as the cases give them
+        moves = np.array([case.options["rod_system_offset"].split(",")[1:]
+                          for case in offsets], dtype=float)
+        check_movable(system.node(settings.offset_of), np.any(moves != 0, axis=0),
+                      "-sweep_offset_of", "-sweep_cases of rod_system_body_load")
     listed = (sweep_cases.read_cases(
         settings.cases, known_case_option, "an option a system's case sets: "
         f"{', '.join(CASE_OPTIONS)}") if settings.cases else None)
@@ -164,13 +172,14 @@ class SystemSweep(Sweep):
     def run_case(self, number, case):
         """Prepare and run one case (warm on the kept solver, then afresh if that fails
         and -sweep_retry); returns its record."""
-        texts = {**self.base, **case.options}
+        texts = {**self.base, **case.options}       # the summary's varied columns
         shown = " ".join(f"-{k} {v}" for k, v in case.options.items()) or "(the base options)"
         record = {"name": case.name, "options": {n: texts[n] for n in self.varied
                                                  if n in texts},
                   "set": case.options, "code": 2, "start": "", "file": None}
         try:
-            made = on_every_rank(self.comm, lambda: prepared(*values_of(texts)))
+            made = on_every_rank(self.comm, lambda: prepared(*values_of(self.base),
+                                                             case=case.options))
         except RodInputError as error:
             self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}")
             self.say(f"petsc_rod: error: {error}")

@@ -232,6 +232,32 @@ def test_bad_input_is_one_line_and_leaves_no_file(tmp_path):
                                                      "-rod_system_steps", "2"])
 
 
+def test_a_line_too_short_after_the_options_names_them(tmp_path):
+    """A line that cannot reach its ends once -rod_system_line_length or
+    -rod_system_offset changed it: the line, its length, its ends' distance and the
+    option, not a single line's -rod_initial_shape message (Line1: Point1 at (65, 0,
+    -30) to Body1's fairlead at (5, 0, -5), 65 m)."""
+    line = refused(tmp_path, ["-rod_system", DECK, "-rod_system_line_length", "Line1,10"])
+    assert line == ("petsc_rod: error: line Line1: its length 10 m is not longer than its "
+                    "ends' distance 65 m, Point1 to Body1 where the run starts "
+                    "(-rod_system_line_length); its start hangs it between them as a "
+                    "catenary: lengthen the line or move its ends closer")
+    line = refused(tmp_path, ["-rod_system", DECK, "-rod_system_offset", "Point1,1e9,0,0"])
+    assert "line Line1: its length 70 m is not longer than its ends' distance 1e+09 m" in line
+    assert "(-rod_system_offset)" in line and "-rod_initial_shape" not in line
+
+
+@pytest.mark.parametrize("option, value, kinds, form", [
+    ("offset", "Point1,1,0,0:Point1,2,0,0", "point/body", "NAME,dx,dy,dz"),
+    ("line_length", "Line1,71:Line1,72", "line", "NAME,L"),
+    ("body_load", "Body1,1,0,0,0,0,0:Body1,2,0,0,0,0,0", "body", "NAME,fx,fy,fz,mx,my,mz")])
+def test_a_name_given_twice_in_one_option_is_refused(tmp_path, option, value, kinds, form):
+    name = value.split(",")[0]
+    assert refused(tmp_path, ["-rod_system", DECK, f"-rod_system_{option}", value]) == (
+        f"petsc_rod: error: -rod_system_{option}: {name} is given twice; give each "
+        f"{kinds} once, its values in one part {form}")
+
+
 def test_help_lists_the_system_options():
     process = run_petsc_rod(["-rod_system", DECK, "-help"], 1, 120)
     assert process.returncode == 0, describe(process)

@@ -144,6 +144,59 @@ def test_a_case_file_of_line_lengths(tmp_path):
         "summary.md"]
 
 
+def test_a_case_s_options_act_on_the_base_s(tmp_path):
+    """The base's -rod_system_offset, -rod_system_line_length and -rod_system_body_load
+    kept under a case's (the base's Point2 offset under the sweep's offsets of Point1):
+    a case's offsets and loads add to the base's per name, its lengths replace the
+    base's for the lines it names; the warm case is the plain run with the sums."""
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_system_line_length rod_system_body_load\n"
+                     "more Line1,70.5 Body1,5e3,0,0,0,0,0\n")
+    folder = tmp_path / "over"
+    process = sweep(folder, FREE, 1, "-rod_system_offset", "Point2,10,0,0:Point1,1,0,0",
+                    "-rod_system_line_length", "Line3,70.5:Line1,69",
+                    "-rod_system_body_load", "Body1,5e3,0,0,0,0,0", "-sweep_cases",
+                    str(cases), "-sweep_offsets", "0,2", "-sweep_offset_of", "Point1")
+    assert process.returncode == 0, describe(process)
+    assert set(summary_rows(folder)) == {"more_offset0", "more_heading0_offset2"}
+    alone = tmp_path / "alone.h5"
+    single = run_petsc_rod(["-rod_system", FREE, *COARSE, "-rod_system_offset",
+                            "Point2,10,0,0:Point1,3,0,0", "-rod_system_line_length",
+                            "Line3,70.5:Line1,70.5", "-rod_system_body_load",
+                            "Body1,10e3,0,0,0,0,0", "-rod_output", str(alone)], 1, 120)
+    assert single.returncode == 0, describe(single)
+    with h5py.File(folder / "more_heading0_offset2.h5", "r") as f, h5py.File(alone, "r") as g:
+        for line, length in (("Line1", 70.5), ("Line2", 70.0), ("Line3", 70.5)):
+            assert f[f"lines/{line}/S"][-1] == pytest.approx(length, rel=1e-12)
+        assert np.array_equal(f["system/point_positions"][()], g["system/point_positions"][()])
+        assert np.abs(f["system/body_positions"][()] - g["system/body_positions"][()]
+                      ).max() < 1e-6
+    with h5py.File(folder / "more_offset0.h5", "r") as f:
+        assert f["system/point_positions"][0, 0] == pytest.approx(65.0 + 1.0, abs=1e-12)
+        assert f["system/point_positions"][1, 0] == pytest.approx(-32.5 + 10.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["Body1", "Point2"])
+def test_offsets_of_a_free_body_or_point_are_refused_before_any_case(tmp_path, name):
+    """The free body of small_free_body.dat (x only: heading 0), or a point made free:
+    one line, exit 2, no folder."""
+    deck = tmp_path / "deck.dat"
+    with open(FREE, encoding="utf-8") as source:
+        deck.write_text(source.read().replace("2     Fixed       -32.5",
+                                              "2     Free        -32.5"))
+    process = sweep(tmp_path / "out", str(deck), 1, "-sweep_offsets", "0,5",
+                    "-sweep_offset_of", name)
+    assert process.returncode == 2, describe(process)
+    lines = process.stdout.strip().splitlines()
+    assert lines == [f"petsc_rod.sweep: error: -sweep_offset_of {name}: " + (
+        "body Body1 is free in x, where its equilibrium decides where it is; hold it there "
+        "(Fixed or Coupled in the file) or move it by a load (-sweep_cases of "
+        "rod_system_body_load)" if name == "Body1" else
+        "a free point, whose equilibrium decides where it is; offset a fixed or "
+        "prescribed point or a held body")], describe(process)
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("args, message", [
     (["-sweep_offsets", "1"], "-sweep_offsets and -sweep_offset_of NAME go together"),
     (["-sweep_offsets", "1", "-sweep_offset_of", "Body9"], "no point or body of that name"),

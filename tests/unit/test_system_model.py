@@ -9,7 +9,7 @@ import pytest
 from petsc_rod.errors import RodInputError
 from petsc_rod.model import (Body, Connection, Environment, Line, LineType, Point, System,
                              SystemLine)
-from petsc_rod.model.system_check import needed_strain, rotation
+from petsc_rod.model.system_check import check_reach, needed_strain, rotation
 
 pytestmark = pytest.mark.unit
 
@@ -129,6 +129,28 @@ def test_a_line_too_short_for_its_held_points_is_refused():
     assert refused(held_pair(soft, 100.0, 250.0)).startswith(
         "line tie: a and b are held 250 m apart: its length 100 m must stretch by 150 % or "
         "more to reach, above 100 %")
+
+
+def test_a_line_to_a_free_point_too_short_for_its_start_is_refused_by_the_run():
+    """check_reach, the run's (not System.check's: a free point's position is a guess):
+    a line of one piece whose end is free must be longer than its ends' distance where
+    the run starts, which its catenary start needs; the option that made it named."""
+    system = held_pair(CHAIN, 100.0, 100.0)
+    free = dataclasses.replace(system, points=(system.points[0],
+                                               Point("b", "free", (100.0, 0.0, -50.0))))
+    free.check()
+    message = ("line tie: its length 100 m is not longer than its ends' distance 100 m, "
+               "a to b where the run starts; its start hangs it between them as a "
+               "catenary: lengthen the line or move its ends closer")
+    with pytest.raises(RodInputError) as error:
+        check_reach(free)
+    assert str(error.value) == message
+    with pytest.raises(RodInputError) as error:
+        check_reach(free, {("node", "b"): "-rod_system_offset", ("line", "b"): "-x"})
+    assert "where the run starts (-rod_system_offset);" in str(error.value)
+    check_reach(held_pair(CHAIN, 100.0, 100.0))            # held ends: check_held_spans'
+    check_reach(dataclasses.replace(free, points=(
+        system.points[0], Point("b", "free", (99.9, 0.0, -50.0)))))
 
 
 def test_the_needed_strain_of_sections_in_series():
