@@ -12,7 +12,7 @@ exactly, and the same deck turned by 30 degrees about the vertical:
 
 A line walked to its ends by the iteration's tolerances after a small move of the body
 was linearised short of its stationary point: its transverse stiffness 45 % off and
-different for each line (docs/systems.md, "Symmetry").
+different for each line (docs/systems.md, "The stiffness at the lines' stationary points").
 """
 
 from pathlib import Path

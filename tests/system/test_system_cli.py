@@ -503,7 +503,10 @@ def test_a_stop_signal_during_the_newton_ends_the_run_there(tmp_path, ranks):
     from helpers import child_env, petsc_rod_command
     out = tmp_path / "system.h5"
     process = subprocess.Popen(
+        # 0.2 m elements: a Newton long enough that the signal, forwarded by mpiexec,
+        # lands inside it on a fast machine too
         petsc_rod_command(["-rod_system", DECK, "-rod_system_body_load", LOAD,
+                           "-rod_system_element_length", "0.2",
                            "-rod_output", str(out), *SWEEPS], ranks),
         cwd=REPO_ROOT, env=child_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
         text=True)
