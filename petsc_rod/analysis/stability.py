@@ -66,11 +66,14 @@ class StabilityTest(SecondVariation):
     def _create_solver(self):
         """One LDL^T (global_step/ksp.direct_factor: MUMPS's, by substructuring on several
         ranks) for H - shift M at every shift: the symbolic factorisation is made once,
-        the numeric one per shift. H itself is factored, its diagonal shifted for the
-        factorisation and put back after it (M is diagonal): no copy of H is kept beside
-        the factor (docs/performance.md, "Memory for long lines"). With a follower load
-        the factored matrix is a submatrix that leaves out the resultants' identity rows
-        (``_kept``): they are decoupled from the rest with eigenvalue 1 (nothing to
+        the numeric one per shift. The factored matrix is a copy of H (``shifted``), its
+        diagonal shifted: H itself is not factored in place, because each update of H
+        takes its held rows out of its pattern and puts them back (zeroRowsColumns), a
+        new nonzero pattern to PETSc, whose set-up of MUMPS again on a changed pattern
+        fails in PETSc 3.18 ("Ordering type cannot be null",
+        tests/solver/test_seabed_newton.py); the copy keeps one pattern. With a follower
+        load the factored matrix is a submatrix that leaves out the resultants' identity
+        rows (``_kept``): they are decoupled from the rest with eigenvalue 1 (nothing to
         count), and they made MUMPS's analysis on several ranks slow
         (docs/performance.md)."""
         self._kept = self._kept_mass = self._kept_rows = self.shifted = None
@@ -84,33 +87,28 @@ class StabilityTest(SecondVariation):
             view = self.mass.getSubVector(self._kept)
             self._kept_mass = view.copy()
             self.mass.restoreSubVector(self._kept, view)
-            self._shift_work = self.shifted.createVecLeft()
         else:
-            self._shift_work = self.matrix.createVecLeft()
-        self._unshifted = self._shift_work.duplicate()      # the diagonal put back
+            self.shifted = self.matrix.duplicate(copy=True)
+        self.shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self._shift_work = self.shifted.createVecLeft()
         # the factored rows come node by node: block less the resultants' three
         kept_block = self.block - 3 * int(self.resultants)
-        self.solver = direct_factor(self.shifted or self.matrix, PETSc.PC.Type.CHOLESKY,
-                                    kept_block, INERTIA_PREFIX)
+        self.solver = direct_factor(self.shifted, PETSc.PC.Type.CHOLESKY, kept_block,
+                                    INERTIA_PREFIX)
 
     def factorise(self, shift):
         """Factor H - shift M (the constraint solves of the previous factorisation are
         dropped); H is as it was afterwards."""
         self._drop_constraint_solves()
         if self._kept is None:
-            factored = self.matrix
+            self.matrix.copy(self.shifted, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self.mass.copy(self._shift_work)
         else:
-            factored = self.matrix.createSubMatrix(self._kept, self._kept, submat=self.shifted)
+            self.matrix.createSubMatrix(self._kept, self._kept, submat=self.shifted)
             self._kept_mass.copy(self._shift_work)
-        factored.getDiagonal(self._unshifted)
         self._shift_work.scale(-shift)
-        factored.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
-        try:
-            self.solver.set_up(factored)
-        finally:
-            if factored is self.matrix:
-                factored.setDiagonal(self._unshifted)
+        self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
+        self.solver.set_up(self.shifted)
         self._factored = True
 
     def solve(self, rhs):
@@ -245,8 +243,7 @@ class StabilityTest(SecondVariation):
 
     def destroy(self):
         self._drop_constraint_solves()
-        for obj in [self.solver, self._shift_work, self._unshifted,
-                    *[obj for obj in (self.shifted, self._kept, self._kept_mass)
-                      if obj is not None]]:
+        for obj in [self.solver, self.shifted, self._shift_work,
+                    *[obj for obj in (self._kept, self._kept_mass) if obj is not None]]:
             obj.destroy()
         super().destroy()
