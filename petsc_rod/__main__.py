@@ -27,22 +27,41 @@ LAUNCHER_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE
                       "SLURM_STEP_NUM_TASKS")
 
 
+# The parameter files Open MPI reads unless OMPI_MCA_mca_base_param_files names others
+# (`ompi_info --param mca base --level 9`): the user's, then the installation's.
+SYSTEM_MCA_FILE = "/etc/openmpi/openmpi-mca-params.conf"
+
+
 def user_mca_names(environ):
-    """The MCA parameters the user's parameter files set (OMPI_MCA_mca_base_param_files,
-    ':'-separated, or $HOME/.openmpi/mca-params.conf, which Open MPI reads unless told
-    otherwise): 'name = value' lines. A value set there is the user's choice, which an
-    environment variable would override."""
+    """The MCA parameters the parameter files choose: 'name = value' lines of
+    OMPI_MCA_mca_base_param_files (a ','-separated list; ':' taken too) or of
+    $HOME/.openmpi/mca-params.conf and SYSTEM_MCA_FILE. A value there is the user's or
+    the administrator's choice, which an environment variable would override; a value
+    that only excludes components (``^ucx``) none of which TRANSPORT_DEFAULTS uses is
+    no choice against them (Debian's own file excludes UCX and OFI so)."""
     own = os.path.join(environ.get("HOME", "~"), ".openmpi", "mca-params.conf")
-    paths = environ.get("OMPI_MCA_mca_base_param_files", own).split(":")
+    listed = environ.get("OMPI_MCA_mca_base_param_files")
+    paths = listed.replace(":", ",").split(",") if listed else [own, SYSTEM_MCA_FILE]
     names = set()
     for path in paths:
         try:
-            with open(os.path.expanduser(path), encoding="utf-8") as lines:
-                names.update(line.split("=", 1)[0].strip() for line in lines
-                             if "=" in line and not line.lstrip().startswith("#"))
+            with open(os.path.expanduser(path.strip()), encoding="utf-8") as lines:
+                settings = [line.split("=", 1) for line in lines
+                            if "=" in line and not line.lstrip().startswith("#")]
         except OSError:
             continue
+        names.update(name.strip() for name, value in settings
+                     if not _excludes_none_of_ours(name.strip(), value.strip()))
     return names
+
+
+def _excludes_none_of_ours(name, value):
+    """Whether ``value`` of MCA parameter ``name`` only excludes components (^a,b) and
+    none that TRANSPORT_DEFAULTS[name] uses."""
+    if not value.startswith("^"):
+        return False
+    ours = set(TRANSPORT_DEFAULTS.get(name, "").split(","))
+    return not ours & {part.strip() for part in value[1:].split(",")}
 
 
 def open_mpi_defaults(environ):
@@ -181,12 +200,6 @@ def find_module(name, pattern):
 def find_petsc4py():
     """Whether petsc4py imports (find_module: Debian's, found without PETSC_DIR)."""
     return find_module("petsc4py", DEBIAN_PETSC4PY)
-    sys.path.append(found[-1])
-    try:
-        importlib.import_module("petsc4py")
-        return True
-    except ImportError:
-        return False
 
 
 def main():

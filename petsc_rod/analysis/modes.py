@@ -489,7 +489,11 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
             stiffness, inertia = Kx.norm(), Mx.norm()
             Kx.axpy(-value, Mx)
             residual = Kx.norm()
-            rigid = residual <= RESIDUAL * scale * vector.norm() and \
+            # a zero-frequency mode (a free roll) is checked against K's size, as its
+            # own Kx vanishes; a vibration always against its own K x and M x, however
+            # small they are beside K's norm (a stiff line's low modes)
+            rigid = value < (2 * np.pi * RIGID) ** 2 and \
+                residual <= RESIDUAL * scale * vector.norm() and \
                 stiffness <= RESIDUAL * scale * vector.norm()
             if not (residual <= RESIDUAL * (stiffness + abs(value) * inertia) or rigid) \
                     or not window[0] <= value <= window[1]:

@@ -5,13 +5,21 @@ user chose nothing, and nothing imported that the run does not use."""
 import subprocess
 import sys
 
+import pytest
 from helpers import REPO_ROOT, child_env
 
+import petsc_rod.__main__
 from petsc_rod.__main__ import may_write_a_result, open_mpi_defaults
 
 FAST = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self,vader",
         "OMPI_MCA_ess_singleton_isolated": "1"}
 ONE_NODE = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self,vader"}
+
+
+@pytest.fixture(autouse=True)
+def no_installation_file(tmp_path, monkeypatch):
+    """The installation's parameter file of the machine the tests run on is not read."""
+    monkeypatch.setattr(petsc_rod.__main__, "SYSTEM_MCA_FILE", str(tmp_path / "none.conf"))
 
 
 def test_a_singleton_starts_isolated_on_shared_memory(tmp_path):
@@ -106,3 +114,23 @@ def test_git_runs_only_for_a_run_that_may_write_a_result(tmp_path):
                                "x.h5"], {})
     assert may_write_a_result(["petsc_rod", "-options_file", str(writes)], {})
     assert may_write_a_result(["petsc_rod"], {"PETSC_OPTIONS": "-rod_output x.h5"})
+
+
+def test_the_installation_s_file_and_a_comma_separated_list_are_read(tmp_path, monkeypatch):
+    """Open MPI reads the user's file and then the installation's, and a list of files
+    separated by commas: a transport chosen in any of them is kept; a value that only
+    excludes components none of ours (Debian's pml = ^ucx) is no choice against them."""
+    system = tmp_path / "openmpi-mca-params.conf"
+    monkeypatch.setattr(petsc_rod.__main__, "SYSTEM_MCA_FILE", str(system))
+    home = {"HOME": str(tmp_path)}
+    system.write_text("mtl = ^ofi\nbtl = ^uct,openib,ofi\npml = ^ucx\n")
+    assert open_mpi_defaults(home) == FAST
+    system.write_text("pml = ^ob1\n")
+    assert open_mpi_defaults(home) == {"OMPI_MCA_ess_singleton_isolated": "1"}
+    system.write_text("btl = self,tcp\n")
+    assert open_mpi_defaults(home) == {"OMPI_MCA_ess_singleton_isolated": "1"}
+    first, second = tmp_path / "a.conf", tmp_path / "b.conf"
+    first.write_text("# nothing of ours\n")
+    second.write_text("mtl = psm2\n")
+    assert open_mpi_defaults({"HOME": "/nonexistent", "OMPI_MCA_mca_base_param_files":
+                              f"{first},{second}"}) == {"OMPI_MCA_ess_singleton_isolated": "1"}
