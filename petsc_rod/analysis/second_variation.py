@@ -250,12 +250,24 @@ class SecondVariation:
                                      np.zeros(rows.shape + columns.shape[1:]))
             self._reserved = True
         self.matrix.assemble()
+        if not self._patterned:
+            self._compact()
         if self.resultants and self._patterned:
             # the resultants' identity rows by the diagonal of the assembled matrix, in
             # place: one pass, where the same ones by blocks cost a search in each row
             self.matrix.setDiagonal(self._resultant_identity(),
                                     addv=PETSc.InsertMode.ADD_VALUES)
         self._patterned = True
+
+    def _compact(self):
+        """H in storage of its own pattern after the first assembly: the preallocation is
+        a bound (every unknown of the 5 nodes of a node's elements, each slot a row),
+        which PETSc keeps allocated beside the entries used, and the pattern is fixed
+        from here on (``update``)."""
+        compact = self.matrix.duplicate(copy=True)
+        compact.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        self.matrix.destroy()
+        self.matrix = compact
 
     def _resultant_identity(self):
         """A Vec of 1 on the resultants' rows and 0 elsewhere (made once)."""

@@ -164,6 +164,9 @@ class UzawaSolver:
                 return
             if decision.action is control.Action.TRY_NEWTON:
                 step.resume()
+                # the history is not read by the attempt, and the next solve starts its
+                # own: its memory goes to the attempt's factorisations
+                self.release_work()
                 self._try_newton(step)
                 if step.finished:       # converged in Newton's terms, or the observer
                     return

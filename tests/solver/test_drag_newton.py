@@ -131,6 +131,47 @@ def test_jacobian_against_finite_differences(comm, solver_factory, line):
 
 
 # --- (b) Newton steps in a current -----------------------------------------------------------
+def test_h_is_stored_in_its_own_pattern(comm, solver_factory):
+    """H (with the heights' chain, the resultants and the drag's places in J) holds no
+    storage beyond the entries its first assembly made: its preallocation (every unknown
+    of a node's 5 nodes, each row) is only a bound, about 2.7 times the entries on the
+    18 000-element riser, and PETSc keeps the rest allocated; J is made from it. The
+    entries stay those of the pattern at the next assembly."""
+    mesh, solver, report = converged(solver_factory, comm, LINES["catenary"], newton=True,
+                                     n_elements=20)
+    problem = solver.problem
+    hessian = problem.second_variation()
+    used = stored_entries(hessian.matrix, "nz_used")
+    assert used > 0
+    assert stored_entries(hessian.matrix, "nz_allocated") == used
+    hessian.update()
+    assert stored_entries(hessian.matrix, "nz_allocated") == used
+    assert stored_entries(hessian.matrix, "nz_used") == used
+
+
+def test_the_attempt_runs_without_andersons_history(comm, solver_factory, monkeypatch):
+    """Anderson's history (2 m vectors of the node state, 311 MB on the 18 000-element
+    riser at m = 30) is freed before each Newton attempt, which does not read it (the
+    next solve of the map starts its own), so the attempt's factorisations take its
+    memory; the run still converges by Newton steps."""
+    mesh, solver = solver_factory(comm, 20, LINES["catenary"], 200.0, rtol=1e-12,
+                                  ctol=1e-12, max_it=20000, newton=True)
+    problem = solver.problem
+    problem.state.set_from_curve(catenary_start(
+        type(problem.scene)(**dict(LINES["catenary"], current=None)), 1.0))
+    events = []
+    release, attempt = solver.release_work, solver.newton.run
+    monkeypatch.setattr(solver, "release_work",
+                        lambda: (events.append("release"), release())[1])
+    monkeypatch.setattr(solver.newton, "run",
+                        lambda *args: (events.append("attempt"), attempt(*args))[1])
+    report = solver.solve_step(1.0)
+    assert report.converged and report.newton_steps > 0
+    attempts = [i for i, event in enumerate(events) if event == "attempt"]
+    assert attempts
+    assert all(i > 0 and events[i - 1] == "release" for i in attempts)
+
+
 def test_newton_in_a_current_reaches_the_iterations_state(comm, solver_factory):
     """The catenary of (a) in the current across its plane, at 20 elements from its
     catenary, with and without Newton steps: the same state to the tolerance, in a
