@@ -614,7 +614,10 @@ class HeldLine:
         positions (m) and small rotations theta of their clamps' frames (rad, global
         axes: the frame Q turned to exp([theta]x) Q; at a flex joint its support's frame,
         which turns the joint's axis); a pinned end's theta columns are zero. The first 6 x 6 is stiffness(). From the same
-        factored second variation (module docstring, "Rotations"). Collective."""
+        factored second variation (module docstring, "Rotations"), but without the free
+        roll's constraint of stiffness()'s solves (_response): where one rank's LU keeps
+        that roll's pivot (round sections, nothing clamped, in a current) the first 6 x 6
+        carries what round-off puts there (docs/systems.md). Collective."""
         return self._linearised(True)
 
     def settle(self):
