@@ -185,6 +185,12 @@ class NewtonSolver:
         # convergence in Newton's terms (run)
         self.solved_norms = None
 
+    @property
+    def free_roll(self):
+        """Whether every section is round and nothing is clamped: one roll of every
+        section about its tangent is a null vector of H (the steps leave it out)."""
+        return self._free_roll
+
     def _untwisting_roll(self, frames):
         """The roll (rad, (n_local_nodes,)) of each node's frame about its tangent that
         leaves no twist between neighbouring nodes (frames.roll_between of the rolled

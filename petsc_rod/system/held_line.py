@@ -100,6 +100,7 @@ from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import CONVERGED, NewtonSolver
 from petsc_rod.frames import REFERENCE_FRAME
+from petsc_rod.global_step.chain_factor import NULL_PIVOT
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
                                          slope_factor)
@@ -613,7 +614,10 @@ class HeldLine:
         positions (m) and small rotations theta of their clamps' frames (rad, global
         axes: the frame Q turned to exp([theta]x) Q; at a flex joint its support's frame,
         which turns the joint's axis); a pinned end's theta columns are zero. The first 6 x 6 is stiffness(). From the same
-        factored second variation (module docstring, "Rotations"). Collective."""
+        factored second variation (module docstring, "Rotations"), but without the free
+        roll's constraint of stiffness()'s solves (_response): where one rank's LU keeps
+        that roll's pivot (round sections, nothing clamped, in a current) the first 6 x 6
+        carries what round-off puts there (docs/systems.md). Collective."""
         return self._linearised(True)
 
     def settle(self):
@@ -675,6 +679,13 @@ class HeldLine:
                 if term.position_components:
                     term.add_hessian(recorder)
             columns = hessian.chord_forms(frames[:, 2])
+            if self.newton.free_roll and hessian.resultants and not rotations:
+                # round sections, nothing clamped: one roll of every section about its
+                # tangent is a null vector of J (the drag has no entries along it); an
+                # LU that keeps its pivot gives the solves whatever round-off puts
+                # there, which moves the stiffness; held by a constraint, its
+                # multiplier dropped, as in the Newton steps (_response)
+                columns.append(hessian.roll_form(frames[:, 2]))
             vecs.extend(columns)
             shift = None
             if recorder.heights is not None:
@@ -703,8 +714,9 @@ class HeldLine:
             shifts = [] if lift is None else [lift]
             solved = solver.solve_many(columns + shifts + turned)
             vecs.extend(solved)
-            response = self._response(hessian, columns, shift, solved[:3 + len(shifts)],
-                                      recorder.heights)
+            response = self._response(hessian, columns, shift,
+                                      solved[:len(columns) + len(shifts)], recorder.heights,
+                                      solver)
             if rotations:
                 response = self._rotation_response(hessian, frames, columns, shift,
                                                    solved, recorder.heights, *held_data,
@@ -922,36 +934,45 @@ class HeldLine:
         at, inside = (S[0], 0.5 * (S[0] + S[1])) if e == 0 else (S[3], 0.5 * (S[2] + S[3]))
         return scene.stiffness_at(np.array([at]), inside=np.array([inside]))[0]
 
-    def _response(self, hessian, columns, shift, solved, heights):
+    def _response(self, hessian, columns, shift, solved, heights, solver=None):
         """d(F_a, F_b)/d(z_a, c), (6, 4), from the solves Y = A^-1 [C^T, P] (A: H, or
         J in a current): dmu = -S^-1 (dc + C Y_P dz), dy = -Y_P dz - Y_C dmu, F_b = mu,
         F_a = W + Psi_0 + R_s e_z - mu with Psi_0 the load's resultant at S = 0 that
         follows the shape (the drag's, a row of dy) and R_s the seabed's whole reaction,
-        dR_s = -(P.dy + sum k w_n dz). Collective."""
+        dR_s = -(P.dy + sum k w_n dz). A fourth column, the free roll's form r (held at 0,
+        its multiplier dropped), is held only where the factor of J kept the roll's
+        null pivot: r.A^-1 r above r.r / (NULL_PIVOT |A|_inf) (where the factor dropped
+        that direction itself, the substructured interface's pseudo-inverse, the
+        roll's Schur entry is of the matrix's own size). Collective."""
         mesh = self.mesh
-        Y_C, Y_P = solved[:3], solved[3:]
+        n_c = len(columns)                  # the chord's three, and the roll's (held 0)
+        Y_C, Y_P = solved[:n_c], solved[n_c:]
         schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
         if not np.all(np.isfinite(schur)):
             raise np.linalg.LinAlgError("the line's second variation could not be "
                                         "factored at its equilibrium")
+        if n_c == 4 and abs(schur[3, 3]) * solver.matrix.norm(PETSc.NormType.INFINITY) \
+                < columns[3].dot(columns[3]) / NULL_PIVOT:
+            n_c, columns, Y_C, schur = 3, columns[:3], Y_C[:3], schur[:3, :3]
         inverse = np.linalg.inv(schur)
-        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(3)
-        dmu = np.zeros((3, 4))                              # d mu / d(z_a, c)
-        dmu[:, 0] = -inverse @ along
-        dmu[:, 1:] = -inverse
+        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(n_c)
+        multipliers = np.zeros((n_c, 4))                    # d (mu, roll's) / d(z_a, c)
+        multipliers[:, 0] = -inverse @ along
+        multipliers[:, 1:] = -inverse[:, :3]
+        dmu = multipliers[:3]
 
         def of_dy(values_C, value_P):
             """A linear functional of dy (values on Y_C (.., 3) and on Y_P (..,))
             as a function of (z_a, c)."""
-            return -np.multiply.outer(value_P, [1.0, 0.0, 0.0, 0.0]) - values_C @ dmu
+            return -np.multiply.outer(value_P, [1.0, 0.0, 0.0, 0.0]) - values_C @ multipliers
 
         start = -dmu.copy()
         if hessian.resultants:
             slot = hessian.resultant_slot
             first = [y.getArray(readonly=True).reshape(-1, hessian.block)[0, slot:slot + 3]
-                     if mesh.on_lower_boundary else np.zeros(3) for y in solved]
-            first = mesh.global_sum(np.array(first))        # (3 or 4, 3): Psi_0 of each Y
-            start += of_dy(first[:3].T, first[3] if Y_P else np.zeros(3))
+                     if mesh.on_lower_boundary else np.zeros(3) for y in Y_C + Y_P]
+            first = mesh.global_sum(np.array(first))        # (n_c [+ 1], 3): Psi_0 of each Y
+            start += of_dy(first[:n_c].T, first[n_c] if Y_P else np.zeros(3))
         if shift is not None:
             moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]))
             moved[0] += mesh.global_sum(float(heights.sum()))

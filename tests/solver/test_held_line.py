@@ -339,3 +339,38 @@ def test_a_line_of_sections_on_the_seabed():
         assert np.abs(K - found)[mask].max() < 1e-5 * scale
     finally:
         sections.destroy()
+
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("current", [(0.0, 0.3, 0.0), (0.3, 0.0, 0.0)],
+                         ids=["across the ends' plane", "in it"])
+def test_stiffness_on_the_seabed_in_a_uniform_current(comm, current):
+    """A mooring line partly grounded in a uniform current, across the plane of its ends
+    and in it, walked to its ends (the iteration's own tolerances end the walk short of
+    the stationary point): the stiffness, taken at the stationary point, against central
+    differences of re-solves; and again after the differences' walks (round sections,
+    nothing clamped: one roll of every section is a null vector of J, whose pivot one
+    rank's LU keeps: the stiffness's solves hold it)."""
+    model = line_model(MOORING, seabed=-30.0, current=current, elements=50)
+    line = HeldLine(model, COMMS[comm])
+    try:
+        assert line.solve(MOORING[0], MOORING[1] + np.array([-3.0, 2.0, 0.0]))
+        assert line.solve(*MOORING)
+        assert solve(model, comm=line.comm).scalars["touchdown_S"] > 30.0
+        K = line.stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K - K.T).max() > 1e-3 * scale          # the drag: no energy
+        found = differences(line, MOORING, 1e-3)
+        assert but_the_anchors_lift(K - found) < 1e-6 * scale
+        assert but_the_anchors_lift(line.stiffness() - found) < 1e-6 * scale
+    finally:
+        line.destroy()
+
+
+def but_the_anchors_lift(error):
+    """The largest |error| of a (6, 6) stiffness but its [2, 2]: the anchor on the seabed
+    has a one-sided vertical stiffness (lifting it), which central differences miss."""
+    mask = np.ones((6, 6), dtype=bool)
+    mask[2, 2] = False
+    return np.abs(error)[mask].max()
