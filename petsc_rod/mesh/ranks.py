@@ -42,8 +42,8 @@ class IterationCost:
 
 # An iteration as the run counts it (the map's, or a Newton step's), over the scenes of
 # options/; how they were measured: docs/performance.md, "Two ranks or one".
-WHOLE = IterationCost(fixed=3.1e-3, per_element=31e-6)
-SPLIT = IterationCost(fixed=5.4e-3, per_element=18e-6)
+WHOLE = IterationCost(fixed=0.80e-3, per_element=6.42e-6)
+SPLIT = IterationCost(fixed=1.52e-3, per_element=4.35e-6)
 
 
 def predicted(elements, ranks, whole=WHOLE, split=SPLIT):
