@@ -613,11 +613,12 @@ class HeldLine:
         (end_forces, N) and moments (end_moments, N m) on both ends against the ends'
         positions (m) and small rotations theta of their clamps' frames (rad, global
         axes: the frame Q turned to exp([theta]x) Q; at a flex joint its support's frame,
-        which turns the joint's axis); a pinned end's theta columns are zero. The first 6 x 6 is stiffness(). From the same
-        factored second variation (module docstring, "Rotations"), but without the free
-        roll's constraint of stiffness()'s solves (_response): where one rank's LU keeps
-        that roll's pivot (round sections, nothing clamped, in a current) the first 6 x 6
-        carries what round-off puts there (docs/systems.md). Collective."""
+        which turns the joint's axis); a pinned end's theta columns are zero. The first
+        6 x 6 is stiffness(). From the same factored second variation (module docstring,
+        "Rotations"), its solves with J holding the free roll (round sections, nothing
+        clamped, in a current: flex joints and pins at the ends) where the factor kept
+        that roll's null pivot, as stiffness()'s do (_held_forms; docs/systems.md).
+        Collective."""
         return self._linearised(True)
 
     def settle(self):
@@ -679,12 +680,13 @@ class HeldLine:
                 if term.position_components:
                     term.add_hessian(recorder)
             columns = hessian.chord_forms(frames[:, 2])
-            if self.newton.free_roll and hessian.resultants and not rotations:
-                # round sections, nothing clamped: one roll of every section about its
-                # tangent is a null vector of J (the drag has no entries along it); an
-                # LU that keeps its pivot gives the solves whatever round-off puts
-                # there, which moves the stiffness; held by a constraint, its
-                # multiplier dropped, as in the Newton steps (_response)
+            if self.newton.free_roll and hessian.resultants:
+                # round sections, nothing clamped (a flex joint holds no roll): one roll
+                # of every section about its tangent is a null vector of J (the drag
+                # has no entries along it); an LU that keeps its pivot gives the solves
+                # whatever round-off puts there, which moves the stiffness; held by a
+                # constraint, its multiplier dropped, as in the Newton steps
+                # (_held_forms)
                 columns.append(hessian.roll_form(frames[:, 2]))
             vecs.extend(columns)
             shift = None
@@ -720,7 +722,8 @@ class HeldLine:
             if rotations:
                 response = self._rotation_response(hessian, frames, columns, shift,
                                                    solved, recorder.heights, *held_data,
-                                                   response, flexed, lifted=bool(shifts))
+                                                   response, flexed, lifted=bool(shifts),
+                                                   solver=solver)
         finally:
             for vec in vecs:
                 vec.destroy()
@@ -800,7 +803,7 @@ class HeldLine:
         return held, dict(zip([e for e, _ in clamps], axial))
 
     def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
-                           held, axial, response, flexed=(), lifted=False):
+                           held, axial, response, flexed=(), lifted=False, solver=None):
         """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
 
         A clamp turned by theta holds its node's rotation at theta instead of 0: the
@@ -815,13 +818,18 @@ class HeldLine:
         vertex is K u of the end element's three nodes' frames
         (io/outputs.vertex_fields): its derivative in each node's rotation and stretch
         by a complex step of that closed form, applied to dy at the free nodes and to
-        the held data at a clamped one."""
+        the held data at a clamped one. The free roll's form, a fourth of ``columns``
+        (held at 0 by every datum, its multiplier dropped), as in _response
+        (_held_forms)."""
         mesh, B, U = self.mesh, hessian.block, hessian.unknowns
         n_h = len(held) + 3 * len(flexed)
         n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
-        Y_C = solved[:3]
-        Y_P = solved[3:4] if lifted else []
-        Y_T = solved[3 + len(Y_P):]
+        n_s = len(columns)                                  # the solves of the forms
+        Y_P = solved[n_s:n_s + 1] if lifted else []
+        Y_T = solved[n_s + len(Y_P):]
+        columns, Y_C, schur = self._held_forms(columns, solved[:n_s], solver)
+        n_c = len(columns)
+        used = Y_C + Y_P + Y_T                              # the solves the response reads
         data = []                                           # the data column of each held
         stretches = []
         for e, node, k in held:
@@ -831,28 +839,28 @@ class HeldLine:
                 data.append(10 + len(stretches))
                 stretches.append(e)
         data += [4 + 3 * entry[0] + k for entry in flexed for k in range(3)]
-        schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
         inverse = np.linalg.inv(schur)
         nodes_held = [node for _, node, _ in held]
         w = self._node_values([self.problem.state.node_weights], nodes_held)[0]
         t = self._node_values([frames[:, 2]], nodes_held)[0]
-        G = np.zeros((3, n_d))
-        CY_T = np.zeros((3, n_d))
+        G = np.zeros((n_c, n_d))                            # the roll's row: held at 0
+        CY_T = np.zeros((n_c, n_d))
         for j, (e, node, k) in enumerate(held):
-            G[:, data[j]] = (-w[j] * skew(t[j])[:, k] if k < 3
-                             else w[j] * t[j] / np.linalg.norm(t[j]))
+            G[:3, data[j]] = (-w[j] * skew(t[j])[:, k] if k < 3
+                              else w[j] * t[j] / np.linalg.norm(t[j]))
             CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
         for j in range(len(held), n_h):                     # a flex joint's axis
             CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
-        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(3)
-        dmu = -inverse @ (CY_T - G)
-        dmu[:, 0] = -inverse @ along
-        dmu[:, 1:4] = -inverse
+        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(n_c)
+        multipliers = -inverse @ (CY_T - G)                 # d (mu, roll's) / d(data)
+        multipliers[:, 0] = -inverse @ along
+        multipliers[:, 1:4] = -inverse[:, :3]
+        dmu = multipliers[:3]
 
         def of_dy(values_C, value_P, values_T):
-            """A linear functional of dy (its values on Y_C (.., 3), Y_P (..,) and the
+            """A linear functional of dy (its values on Y_C (.., n_c), Y_P (..,) and the
             Y_T (.., n_h)) as a function of the data."""
-            out = -np.multiply.outer(value_P, np.eye(n_d)[0]) - values_C @ dmu
+            out = -np.multiply.outer(value_P, np.eye(n_d)[0]) - values_C @ multipliers
             for j, col in enumerate(data):
                 out[..., col] -= values_T[..., j]
             return out
@@ -864,9 +872,9 @@ class HeldLine:
             slot = hessian.resultant_slot
             first = mesh.global_sum(np.array(
                 [y.getArray(readonly=True).reshape(-1, B)[0, slot:slot + 3]
-                 if mesh.on_lower_boundary else np.zeros(3) for y in solved]))
-            forces[:3] += of_dy(first[:3].T, first[3] if Y_P else np.zeros(3),
-                                first[3 + len(Y_P):3 + len(Y_P) + n_h].T)
+                 if mesh.on_lower_boundary else np.zeros(3) for y in used]))
+            forces[:3] += of_dy(first[:n_c].T, first[n_c] if Y_P else np.zeros(3),
+                                first[n_c + len(Y_P):].T)
         forces[:3, :4] = response[:3]
         if shift is not None:
             moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]),
@@ -883,7 +891,7 @@ class HeldLine:
         # the moments: the three nodes of each end element
         last = 2 * mesh.n_elements
         ends = ([0, 1, 2], [last - 2, last - 1, last])
-        arrays = [y.getArray(readonly=True).reshape(-1, B)[:, :U] for y in solved]
+        arrays = [y.getArray(readonly=True).reshape(-1, B)[:, :U] for y in used]
         values = self._node_values(arrays, ends[0] + ends[1])          # (vecs, 6, U)
         fields = self._node_values([self.problem.state.node_directors()],
                                    ends[0] + ends[1])[0]
@@ -896,16 +904,16 @@ class HeldLine:
                                    self._end_stiffness_values(e, S), e, U)
             for k in range(3):
                 v = values[:, 3 * e + k]                                # (vecs, U)
-                delta = of_dy(v[:3].T, v[3] if Y_P else np.zeros(U),
-                              v[3 + len(Y_P):].T if n_h else np.zeros((U, 0)))
+                delta = of_dy(v[:n_c].T, v[n_c] if Y_P else np.zeros(U),
+                              v[n_c + len(Y_P):].T if n_h else np.zeros((U, 0)))
                 for j, (end, node, slot) in enumerate(held):
                     if node == ends[e][k]:
                         delta[slot, data[j]] += 1.0
                 moments[3 * e:3 * e + 3] += (1.0 if e == 0 else -1.0) * jac[:, k] @ delta
         for e, node, J_d, J_a, a, d, _ in flexed:           # the joint's moment
             v = values[:, 0 if e == 0 else 5]
-            delta = of_dy(v[:3].T, v[3] if Y_P else np.zeros(U),
-                          v[3 + len(Y_P):].T if n_h else np.zeros((U, 0)))
+            delta = of_dy(v[:n_c].T, v[n_c] if Y_P else np.zeros(U),
+                          v[n_c + len(Y_P):].T if n_h else np.zeros((U, 0)))
             moments[3 * e:3 * e + 3] = J_d @ (-skew(d) @ delta[:3])
             moments[3 * e:3 * e + 3, 4 + 3 * e:7 + 3 * e] += J_a @ (-skew(a))
         out = np.vstack([forces, moments])
@@ -934,26 +942,37 @@ class HeldLine:
         at, inside = (S[0], 0.5 * (S[0] + S[1])) if e == 0 else (S[3], 0.5 * (S[2] + S[3]))
         return scene.stiffness_at(np.array([at]), inside=np.array([inside]))[0]
 
+    @staticmethod
+    def _held_forms(columns, solved, solver):
+        """(forms, their solves, S) of the constraints the Schur solve holds: the chord's
+        three forms C^T, and a fourth, the free roll's r, only where the factor of A
+        kept the roll's null pivot: r.A^-1 r above r.r / (NULL_PIVOT |A|_inf) (where the
+        factor dropped that direction itself, the substructured interface's
+        pseudo-inverse, the roll's Schur entry is of the matrix's own size); S = C Y_C
+        (n_c, n_c) of the forms kept. LinAlgError where S is not finite (A not
+        factored). Collective."""
+        schur = np.array([[c.dot(y) for y in solved] for c in columns])
+        if not np.all(np.isfinite(schur)):
+            raise np.linalg.LinAlgError("the line's second variation could not be "
+                                        "factored at its equilibrium")
+        if len(columns) == 4 and abs(schur[3, 3]) \
+                * solver.matrix.norm(PETSc.NormType.INFINITY) \
+                < columns[3].dot(columns[3]) / NULL_PIVOT:
+            return columns[:3], solved[:3], schur[:3, :3]
+        return list(columns), list(solved), schur
+
     def _response(self, hessian, columns, shift, solved, heights, solver=None):
         """d(F_a, F_b)/d(z_a, c), (6, 4), from the solves Y = A^-1 [C^T, P] (A: H, or
         J in a current): dmu = -S^-1 (dc + C Y_P dz), dy = -Y_P dz - Y_C dmu, F_b = mu,
         F_a = W + Psi_0 + R_s e_z - mu with Psi_0 the load's resultant at S = 0 that
         follows the shape (the drag's, a row of dy) and R_s the seabed's whole reaction,
-        dR_s = -(P.dy + sum k w_n dz). A fourth column, the free roll's form r (held at 0,
-        its multiplier dropped), is held only where the factor of J kept the roll's
-        null pivot: r.A^-1 r above r.r / (NULL_PIVOT |A|_inf) (where the factor dropped
-        that direction itself, the substructured interface's pseudo-inverse, the
-        roll's Schur entry is of the matrix's own size). Collective."""
+        dR_s = -(P.dy + sum k w_n dz). A fourth column, the free roll's form, held at 0
+        with its multiplier dropped where the factor kept its pivot (_held_forms).
+        Collective."""
         mesh = self.mesh
+        Y_P = solved[len(columns):]
+        columns, Y_C, schur = self._held_forms(columns, solved[:len(columns)], solver)
         n_c = len(columns)                  # the chord's three, and the roll's (held 0)
-        Y_C, Y_P = solved[:n_c], solved[n_c:]
-        schur = np.array([[c.dot(y) for y in Y_C] for c in columns])
-        if not np.all(np.isfinite(schur)):
-            raise np.linalg.LinAlgError("the line's second variation could not be "
-                                        "factored at its equilibrium")
-        if n_c == 4 and abs(schur[3, 3]) * solver.matrix.norm(PETSc.NormType.INFINITY) \
-                < columns[3].dot(columns[3]) / NULL_PIVOT:
-            n_c, columns, Y_C, schur = 3, columns[:3], Y_C[:3], schur[:3, :3]
         inverse = np.linalg.inv(schur)
         along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(n_c)
         multipliers = np.zeros((n_c, 4))                    # d (mu, roll's) / d(z_a, c)

@@ -44,10 +44,10 @@ def outputs(line):
     return np.concatenate([line.end_forces().ravel(), line.end_moments().ravel()])
 
 
-def differences(line, frames, step=1e-4):
+def differences(line, frames, step=1e-4, ends=ENDS):
     """(12, 12) central differences of (F_a, F_b, M_a, M_b) in (x_a, x_b, theta_a,
-    theta_b), a frame Q turned to exp([theta]x) Q (rows: Q exp(-[theta]x)); zero
-    columns for a pinned end's rotation."""
+    theta_b) about the ends at ``ends``, a frame Q turned to exp([theta]x) Q (rows:
+    Q exp(-[theta]x)); zero columns for a pinned end's rotation."""
     columns = []
     for j in range(12):
         e, k = divmod(j % 6, 3)
@@ -56,7 +56,7 @@ def differences(line, frames, step=1e-4):
             continue
         values = []
         for sign in (1.0, -1.0):
-            x = [ENDS[0].copy(), ENDS[1].copy()]
+            x = [ends[0].copy(), ends[1].copy()]
             turned = list(frames)
             if j < 6:
                 x[e][k] += sign * step
@@ -65,7 +65,7 @@ def differences(line, frames, step=1e-4):
             assert line.solve(*x, *turned)
             values.append(outputs(line))
         columns.append((values[0] - values[1]) / (2 * step))
-    assert line.solve(*ENDS, *frames)
+    assert line.solve(*ends, *frames)
     return np.array(columns).T
 
 
@@ -165,5 +165,39 @@ def test_a_flex_joints_end_stiffness_against_differences(comm, extensible):
                                             [moment[2], 0.0, -moment[0]],
                                             [-moment[1], moment[0], 0.0]])).max() \
             < 1e-8 * scale
+    finally:
+        flexed.destroy()
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+def test_a_flex_joints_end_stiffness_on_the_seabed_in_a_current(comm):
+    """A cable partly grounded in a uniform current across the plane of its ends, its
+    fairlead on a flex joint (its support in the reference frame), walked to its ends:
+    the 12 x 12 against central differences of re-solves, and again after the
+    differences' walks. Round sections and nothing clamped (a flex joint holds no
+    roll): one roll of every section about its tangent is a null vector of J, whose
+    pivot one rank's LU keeps; end_stiffness's solves hold it, as stiffness()'s do."""
+    ends = (np.array([0.0, 0.0, -30.0]), np.array([85.0, 0.0, 0.0]))
+    line = UniformLine(length=100.0, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -10.0),
+                       axial_stiffness=1e5, elements=50, drag=(1025.0, 1.2, 0.1))
+    model = Model(line=line, start=End.anchor(tuple(ends[0])),
+                  end=End(kind="pin", position=tuple(ends[1]), stiffness=5.0),
+                  environment=Environment(seabed=-30.0, current=(0.0, 0.3, 0.0)))
+    flexed = HeldLine(model, COMMS[comm])
+    frames = [None, REFERENCE]
+    try:
+        assert flexed.solve(ends[0], ends[1] + np.array([-3.0, 2.0, 0.0]), *frames)
+        assert flexed.solve(*ends, *frames)
+        assert np.abs(flexed.end_moments()[1]).max() > 1.0      # the joint's
+        K = flexed.end_stiffness()
+        scale = np.abs(K).max()
+        found = differences(flexed, frames, 1e-3, ends)
+        # the anchor on the seabed: its vertical stiffness one-sided (lifting it)
+        mask = np.ones((12, 12), dtype=bool)
+        mask[2, 2] = False
+        assert np.abs(K - found)[mask].max() < 1e-6 * scale
+        for _ in range(3):                  # each Newton run moves round-off's roll
+            assert np.abs(flexed.end_stiffness() - found)[mask].max() < 1e-6 * scale
+            flexed.newton.run()
     finally:
         flexed.destroy()
