@@ -324,7 +324,7 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
-        self.settled = False                # settle() ran since the last solve
+        self.settled = False                # the last solve ended in Newton's convergence
         self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
@@ -485,6 +485,8 @@ class HeldLine:
         self.settled = False
         try:
             for event in continuation(self.solver, path):
+                if isinstance(event, events.NewtonAttempt):
+                    self.settled = event.outcome == CONVERGED
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
                     return bool(event.converged)
@@ -621,10 +623,8 @@ class HeldLine:
 
     def settle(self):
         """Newton's steps from where the line stands to its stationary point (to
-        iteration/newton.py's STEP_TOLERANCE), kept where they converge, once after each
-        solve (a Newton attempt that converged inside the solve does not say the solve
-        ended there: the map may iterate on, or the step be halved, after it): the
-        second variation is the stiffness at a
+        iteration/newton.py's STEP_TOLERANCE), kept where they converge, unless the last
+        solve ended in Newton's convergence: the second variation is the stiffness at a
         stationary point only, and a walk stopped by the iteration's tolerances (its
         change per iteration below rtol after a small move) leaves |grad L| far above
         Newton's, which a grounded line's sideways stiffness feels (docs/systems.md,

@@ -374,28 +374,3 @@ def but_the_anchors_lift(error):
     mask = np.ones((6, 6), dtype=bool)
     mask[2, 2] = False
     return np.abs(error)[mask].max()
-
-
-def test_settle_takes_newton_s_steps_once_after_every_solve(monkeypatch):
-    """Whatever the solve's own Newton attempts did (one can converge and the map iterate
-    on after it, or the step be halved), settle() runs Newton once after each solve
-    before the stiffness is taken, and not again until the next solve: a mooring line
-    whose walk ends in a converged Newton attempt."""
-    line = held(line_model(MOORING, seabed=-30.0), PETSc.COMM_WORLD, MOORING)
-    calls = []
-    run = line.newton.run
-
-    def counted():
-        calls.append(1)
-        return run()
-    monkeypatch.setattr(line.newton, "run", counted)
-    try:
-        assert line.solve(MOORING[0], MOORING[1] + np.array([2.0, 0.0, 1.0]))
-        line.settle()
-        line.settle()
-        assert len(calls) == 1
-        assert line.solve(*MOORING)
-        line.settle()
-        assert len(calls) == 2
-    finally:
-        line.destroy()
