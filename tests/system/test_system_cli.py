@@ -521,5 +521,9 @@ def test_a_stop_signal_during_the_newton_ends_the_run_there(tmp_path, ranks):
     assert process.returncode == (143 if ranks == 1 else 1), output
     assert len(errors) == 1, output
     assert "stopped by SIGTERM during the system's Newton (load factor" in errors[0]
-    assert "Traceback" not in output and "equilibrium in" not in output
+    assert "Traceback" not in output
+    if ranks == 1:
+        # under mpiexec the first line reaches the test through its forwarding, late: the
+        # signal may land in a later Newton of the run (the watch circle's), as said above
+        assert "equilibrium in" not in output
     assert not out.exists() and not partial_files(out)
