@@ -25,6 +25,10 @@ LOAD = "Body1,10e3,2e3,0,0,0,5e3"
 WATCH = ("Body1", 20e3, 4)
 SWEEPS = ["-rod_system_watch_circle", "Body1,20e3,4", "-rod_system_excursion",
           "Body1,20e3,2,90"]
+# The scaled residual a system's Newton accepts as its lines' own accuracy
+# (system/equilibrium.py's Settings.floor): two runs of the same system whose round-off
+# differs agree to it, relative to each quantity's largest entry.
+FLOOR = 1e-7
 SYSTEM_DATASETS = ("point_positions", "body_positions", "body_rotations", "body_stiffness",
                    "body_stiffness_reference", "body_stiffness_moment",
                    "body_stiffness_asymmetry", "end_forces", "end_tensions",
@@ -128,7 +132,12 @@ def test_the_result_file_and_the_tables(runs):
 
 def test_the_api_path_equals_the_file_path(runs, tmp_path):
     """solve_system on the System read from the same file, the load added in Python:
-    the command line's numbers."""
+    the command line's numbers, to the system's accuracy (FLOOR). Not bit for bit: the
+    two processes' heaps differ, and OpenBLAS's AVX-512 kernels group a sum by its
+    buffer's address mod 64 (OpenBLAS issues 317 and 5972), so the line solves' last bits
+    and with them where each iteration stops differ; swapping OpenBLAS's kernels
+    (OPENBLAS_CORETYPE Haswell, Sandybridge, Nehalem, Prescott) moved these numbers by at
+    most 1.4e-7 of their largest entry (the grounded length), 4e-8 the others."""
     import subprocess
     import sys
 
@@ -163,23 +172,31 @@ np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffne
                              capture_output=True, text=True, timeout=300, check=False)
     assert process.returncode == 0, describe(process)
     api = np.load(out)
+
+    def same(ours, theirs, rtol=FLOOR):
+        """Within the system's accepted accuracy, relative to the largest entry."""
+        ours, theirs = np.asarray(ours), np.asarray(theirs)
+        return ours.shape == theirs.shape and \
+            np.abs(ours - theirs).max() <= rtol * np.abs(theirs).max()
+
     with h5py.File(runs[1][1], "r") as f:
         system = f["system"]
-        assert np.array_equal(api["x"], system["body_positions"][0])
-        assert np.array_equal(api["K"], system["body_stiffness"][0])
-        assert np.array_equal(api["F"], system["end_forces"][()])
-        assert np.array_equal(api["T"], system["end_tensions"][()])
-        assert np.array_equal(api["r"], f["lines/Line2/r"][()])
+        assert same(api["x"], system["body_positions"][0])
+        assert same(api["K"], system["body_stiffness"][0])
+        assert same(api["F"], system["end_forces"][()])
+        assert same(api["T"], system["end_tensions"][()])
+        assert same(api["r"], f["lines/Line2/r"][()])
         # the command line's watch circle is the library function's on the same system
         circle = f["system/watch_circle"]
         assert np.array_equal(circle["heading"][()], [0, 90, 180, 270])
         assert np.array_equal(circle["load"][()], np.full(4, WATCH[1]))
         offsets = np.stack([circle["x_offset"][()], circle["y_offset"][()]], axis=1)
-        assert np.abs(offsets - api["offsets"]).max() < 1e-9
+        assert same(api["offsets"], offsets)
         poses = np.stack([circle[k][()] for k in ("x", "y", "z", "roll", "pitch", "yaw")], 1)
-        assert np.abs(poses - api["poses"]).max() < 1e-9
-        assert np.abs(circle["max_tension"][()] - api["tension"]).max() < 1e-9 * 1e5
-        assert np.abs(circle["min_grounded"][()] - api["grounded"]).max() < 1e-9
+        assert same(api["poses"], poses)
+        assert same(api["tension"], circle["max_tension"][()])
+        # the touchdown point, interpolated between nodes: ten times looser
+        assert same(api["grounded"], circle["min_grounded"][()], 10 * FLOOR)
         # under 20 kN the body moves about 2 to 3 m, downwind
         assert 1.5 < np.linalg.norm(offsets, axis=1).min() < 3.5
         assert circle["x_offset"][0] > 1.5 and circle["y_offset"][1] > 1.5
