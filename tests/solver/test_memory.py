@@ -38,6 +38,16 @@ def test_the_iteration_work_is_freed_while_h_is_factored(solver_factory, comm, m
     # a set-up SNES holds x as its solution; SNESReset (release_work) lets it go with
     # Anderson's history, and the next step's solve takes it again
     assert testing and max(testing) < min(iterating)
+    # and the run goes on to the same answer, bit for bit, as with the work kept
+    monkeypatch.undo()
+    _, kept = solver_factory(comm, 24, PAPER, 400.0, 1e-3, 1e-3, 5000, newton=False)
+    monkeypatch.setattr(type(kept), "release_work", lambda self: None)
+    kept_report = continuation(kept, steps=2)
+    assert kept_report.converged and kept_report.iterations == report.iterations
+    freed, held = solver.problem.state.snapshot(), kept.problem.state.snapshot()
+    assert set(freed) == set(held) and "r" in freed
+    for name in freed:
+        assert np.array_equal(freed[name], held[name]), name
 
 
 def csr(matrix):
