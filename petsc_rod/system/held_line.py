@@ -287,6 +287,27 @@ def _point(name, value):
     return point
 
 
+def _refine(solver, rights, solved):
+    """One step of iterative refinement of the solves x_j = J^-1 b_j (``solved``, of the
+    Vecs ``rights``), in place: x_j <- x_j + J^-1 (b_j - J x_j), with the factored
+    NewtonJacobian ``solver``'s own matrix. Where the factor kept the free roll's null
+    pivot at the size of round-off (the substructured factor's interface may keep it or
+    drop it, as round-off of the state falls: _held_forms), its solves carry errors
+    beyond the roll's direction, which the Schur step holding the roll's form does not
+    remove and this step does. Returns the work Vecs, the caller's to destroy.
+    Collective."""
+    residuals = []
+    for b, x in zip(rights, solved):
+        residual = b.duplicate()
+        solver.matrix.mult(x, residual)
+        residual.aypx(-1.0, b)                      # b - J x
+        residuals.append(residual)
+    corrections = solver.solve_many(residuals)
+    for x, dx in zip(solved, corrections):
+        x.axpy(1.0, dx)
+    return residuals + corrections
+
+
 def _ends_at_newton(event, newton_at):
     """Whether the attempt that ``event`` ends (a StepEnded; a StepHalved undoes it)
     leaves the state where its last Newton run converged, at iteration ``newton_at``
@@ -733,8 +754,11 @@ class HeldLine:
                 hessian.factorise(0.0)
                 solver = hessian
             shifts = [] if lift is None else [lift]
-            solved = solver.solve_many(columns + shifts + turned)
+            rights = columns + shifts + turned
+            solved = solver.solve_many(rights)
             vecs.extend(solved)
+            if solver is self.jacobian:
+                vecs.extend(_refine(solver, rights, solved))
             response = self._response(hessian, columns, shift,
                                       solved[:len(columns) + len(shifts)], recorder.heights,
                                       solver)

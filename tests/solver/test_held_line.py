@@ -412,3 +412,23 @@ def test_a_converged_newton_run_of_an_undone_attempt_does_not_settle_the_line(mo
         assert but_the_anchors_lift(K - found) < 1e-5 * scale
     finally:
         line.destroy()
+
+
+def test_the_stiffness_after_further_newton_runs_in_a_sheared_current():
+    """Newton runs from the converged state move it by round-off only (a roll of every
+    section, the free roll, and round-off of the positions and the chord's multiplier),
+    which on two ranks decides whether the substructured factor keeps the free roll's
+    null pivot or drops it: the stiffness (its solves with J refined once) is the same
+    either way, against central differences of re-solves as in
+    test_stiffness_in_a_sheared_current, after each of two runs."""
+    line = held(sheared_model(MOORING, -30.0), PETSc.COMM_WORLD, MOORING)
+    try:
+        stiffnesses = []
+        for _ in range(2):
+            assert line.newton.run() == CONVERGED
+            stiffnesses.append(line.stiffness())
+        found = differences(line, MOORING, 1e-3)
+        for K in stiffnesses:
+            assert but_the_anchors_lift(K - found) < 1e-6 * np.abs(K).max()
+    finally:
+        line.destroy()
