@@ -287,6 +287,39 @@ def _point(name, value):
     return point
 
 
+def _refine(solver, rights, solved):
+    """One step of iterative refinement of the solves x_j = J^-1 b_j (``solved``, of the
+    Vecs ``rights``), in place: x_j <- x_j + J^-1 (b_j - J x_j), with the factored
+    NewtonJacobian ``solver``'s own matrix. Where the factor kept the free roll's null
+    pivot at the size of round-off (the substructured factor's interface may keep it or
+    drop it, as round-off of the state falls: _held_forms), its solves carry errors
+    beyond the roll's direction, which the Schur step holding the roll's form does not
+    remove and this step does. Returns the work Vecs, the caller's to destroy.
+    Collective."""
+    residuals = []
+    for b, x in zip(rights, solved):
+        residual = b.duplicate()
+        solver.matrix.mult(x, residual)
+        residual.aypx(-1.0, b)                      # b - J x
+        residuals.append(residual)
+    corrections = solver.solve_many(residuals)
+    for x, dx in zip(solved, corrections):
+        x.axpy(1.0, dx)
+    return residuals + corrections
+
+
+def _ends_at_newton(event, newton_at):
+    """Whether the attempt that ``event`` ends (a StepEnded; a StepHalved undoes it)
+    leaves the state where its last Newton run converged, at iteration ``newton_at``
+    (None: no such run, or the frames turned after it): the step ended at that run or
+    at the iteration after it, which moves a Newton state by the map's round-off only
+    (iteration/driver.py, controller.verified_by_newton). A later step of the path, a
+    halved attempt's retry, or more iterations after the run (the map iterating on
+    after a hand-over at the round-off floor, an escape) end elsewhere."""
+    return (isinstance(event, events.StepEnded) and newton_at is not None
+            and event.report.iterations - newton_at in (0, 1))
+
+
 class HeldLine:
     """A line of the typed model held at its two ends, on the ranks of ``comm`` (a
     PETSc communicator: the line's own; collective on it alone).
@@ -324,7 +357,7 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
-        self.settled = False                # the last solve ended in Newton's convergence
+        self.settled = False                # the last solve ended at Newton's convergence
         self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
@@ -483,10 +516,16 @@ class HeldLine:
         error of its solves, is a failure). Collective."""
         self.iterations = 0
         self.settled = False
+        newton_at = None        # the iteration of the attempt's last converged Newton run
         try:
             for event in continuation(self.solver, path):
                 if isinstance(event, events.NewtonAttempt):
-                    self.settled = event.outcome == CONVERGED
+                    newton_at = event.iteration if event.outcome == CONVERGED else None
+                elif isinstance(event, events.SaddleLeft):
+                    newton_at = None            # the frames turned off Newton's state
+                elif isinstance(event, (events.StepHalved, events.StepEnded)):
+                    self.settled = _ends_at_newton(event, newton_at)
+                    newton_at = None
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
                     return bool(event.converged)
@@ -624,7 +663,8 @@ class HeldLine:
     def settle(self):
         """Newton's steps from where the line stands to its stationary point (to
         iteration/newton.py's STEP_TOLERANCE), kept where they converge, unless the last
-        solve ended in Newton's convergence: the second variation is the stiffness at a
+        solve ended at Newton's convergence (its last step at a converged Newton run, or
+        one iteration after it: _ends_at_newton): the second variation is the stiffness at a
         stationary point only, and a walk stopped by the iteration's tolerances (its
         change per iteration below rtol after a small move) leaves |grad L| far above
         Newton's, which a grounded line's sideways stiffness feels (docs/systems.md,
@@ -714,8 +754,11 @@ class HeldLine:
                 hessian.factorise(0.0)
                 solver = hessian
             shifts = [] if lift is None else [lift]
-            solved = solver.solve_many(columns + shifts + turned)
+            rights = columns + shifts + turned
+            solved = solver.solve_many(rights)
             vecs.extend(solved)
+            if solver is self.jacobian:
+                vecs.extend(_refine(solver, rights, solved))
             response = self._response(hessian, columns, shift,
                                       solved[:len(columns) + len(shifts)], recorder.heights,
                                       solver)

@@ -19,12 +19,17 @@ parallel run):
     derivative in the Jacobian), alone and on the seabed.
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 from petsc4py import PETSc
 
 from petsc_rod.api import End, Environment, Model, UniformLine, solve
 from petsc_rod.errors import RodInputError
+from petsc_rod.iteration.events import NewtonAttempt
+from petsc_rod.iteration.newton import CONVERGED
+from petsc_rod.iteration.stopping import STOP_UNTESTED
 from petsc_rod.system.held_line import HeldLine
 from petsc_rod.validation.elastic_catenary import elastic_catenary
 
@@ -374,3 +379,56 @@ def but_the_anchors_lift(error):
     mask = np.ones((6, 6), dtype=bool)
     mask[2, 2] = False
     return np.abs(error)[mask].max()
+
+
+def test_a_converged_newton_run_of_an_undone_attempt_does_not_settle_the_line(monkeypatch):
+    """A walk whose first attempt converged in Newton's steps and was then failed (as
+    the stability test's failed factorisation fails it: STOP_UNTESTED) is halved, and
+    its two half steps end by the iteration's (default) tolerances before any Newton
+    run: the state is not Newton's stationary point, so the stiffness settles it first
+    (a grounded line's sideways stiffness feels the difference). The mooring line's
+    stiffness after a 2 cm sideways move of its fairlead against central differences of
+    re-solves."""
+    line = HeldLine(line_model(MOORING, seabed=-30.0), PETSc.COMM_WORLD)
+    ends = (MOORING[0], MOORING[1] + np.array([0.0, 0.02, 0.0]))
+    assert line.solve(*MOORING)
+    solve_step, failed = line.solver.solve_step, []
+
+    def untested_once(t, label="", observer=None):
+        report = solve_step(t, label=label, observer=observer)
+        if failed:
+            return report
+        failed.append(report)
+        return dataclasses.replace(report, converged=False, reason=STOP_UNTESTED)
+    try:
+        monkeypatch.setattr(line.solver, "solve_step", untested_once)
+        assert line.solve(*ends)
+        monkeypatch.undo()
+        newton = [e for e in failed[0].events if isinstance(e, NewtonAttempt)]
+        assert newton and newton[-1].outcome == CONVERGED
+        K = line.stiffness()
+        scale = np.abs(K).max()
+        found = differences(line, ends, 1e-3)
+        assert but_the_anchors_lift(K - found) < 1e-5 * scale
+    finally:
+        line.destroy()
+
+
+def test_the_stiffness_after_further_newton_runs_in_a_sheared_current():
+    """Newton runs from the converged state move it by round-off only (a roll of every
+    section, the free roll, and round-off of the positions and the chord's multiplier),
+    which on two ranks decides whether the substructured factor keeps the free roll's
+    null pivot or drops it: the stiffness (its solves with J refined once) is the same
+    either way, against central differences of re-solves as in
+    test_stiffness_in_a_sheared_current, after each of two runs."""
+    line = held(sheared_model(MOORING, -30.0), PETSc.COMM_WORLD, MOORING)
+    try:
+        stiffnesses = []
+        for _ in range(2):
+            assert line.newton.run() == CONVERGED
+            stiffnesses.append(line.stiffness())
+        found = differences(line, MOORING, 1e-3)
+        for K in stiffnesses:
+            assert but_the_anchors_lift(K - found) < 1e-6 * np.abs(K).max()
+    finally:
+        line.destroy()
