@@ -293,7 +293,8 @@ def changed_by(line, made_by):
 def check_held_spans(system, nodes, made_by):
     """A line between two held points (or bodies held in all degrees of freedom) must
     reach across them: an inextensible one no shorter than their distance, an extensible
-    one within MAX_STRAIN of it (the bound of the single line's model of stretch)."""
+    one within MAX_STRAIN of it (the bound of the single line's model of stretch); and
+    not be folded on one vertical (check_not_folded)."""
     for line in system.lines:
         start, end = nodes[line.start.to], nodes[line.end.to]
         if not (is_held(start) and is_held(end)):
@@ -330,7 +331,8 @@ def check_reach(system, made_by=None):
     inextensible catenary between them (scenes/starts.catenary_start), which a line as
     long as its chord or shorter does not have. A line of several pieces starts straight
     where its catenary cannot be drawn (HeldLine); one between held ends is
-    check_held_spans'. Not part of check_system: a model's free points may stand
+    check_held_spans'. Neither may a line with a free end be folded on one vertical
+    (check_not_folded). Not part of check_system: a model's free points may stand
     anywhere (a MoorDyn file's are guesses); the run refuses them before it starts
     (cli_system.changed). ``made_by``: check_system's."""
     made_by = made_by or {}
