@@ -271,15 +271,21 @@ def gathered_lines(solver, stable):
             for k, record in shared.items()}
 
 
+# datasets along S where +inf is a value: the bend radius of a straight piece
+# (quantities/line_results.bend_radius), a taut line's everywhere
+UNBOUNDED = ("bend_radius",)
+
+
 def check_finite(comm, results, records):
     """RodDivergedError unless every number of the equilibrium is finite, the lines'
-    arrays along S (``records``' vertex datasets, on the ranks that hold them) too: no
-    NaN is ever written or returned as a result. Collective."""
+    arrays along S (``records``' vertex datasets, on the ranks that hold them) too, +inf
+    allowed in UNBOUNDED's: no NaN is ever written or returned as a result. Collective."""
     numbers = ([b.position for b in results.bodies.values()]
                + [b.stiffness for b in results.bodies.values()]
                + list(results.points.values()) + list(results.end_forces.values())
                + list(results.end_tensions.values()))
-    along = [value for record in records.values() for value in record.vertex.values()
+    along = [np.where(value == np.inf, 0.0, value) if name in UNBOUNDED else value
+             for record in records.values() for name, value in record.vertex.items()
              if np.issubdtype(np.asarray(value).dtype, np.number)]
     if not all(comm.tompi4py().allgather(
             all(np.all(np.isfinite(value)) for value in numbers + along))):

@@ -12,6 +12,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.end import End
+from petsc_rod.model.derived import TAUT_GAP
 from petsc_rod.model.model import Span, check_pipe, check_sea, check_span
 from petsc_rod.model.values import MAX_STRAIN
 
@@ -252,11 +253,33 @@ def needed_strain(lengths, eas, chord):
     return np.inf if compliance == 0 else excess / compliance / float(eas.min())
 
 
-def ends_distance(line, nodes):
-    """The distance (m) between ``line``'s ends with their points and bodies
+def ends_chord(line, nodes):
+    """The vector (3,) from ``line``'s start to its end, m, with their points and bodies
     (``nodes`` by name) at their start positions."""
-    return float(np.linalg.norm(connection_position(nodes[line.end.to], line.end)
-                                - connection_position(nodes[line.start.to], line.start)))
+    return (connection_position(nodes[line.end.to], line.end)
+            - connection_position(nodes[line.start.to], line.start))
+
+
+def ends_distance(line, nodes):
+    """The distance (m) between ``line``'s ends at their start positions (ends_chord)."""
+    return float(np.linalg.norm(ends_chord(line, nodes)))
+
+
+def check_not_folded(line, nodes, made_by):
+    """A line whose ends lie on one vertical (their horizontal distance below 1e-9 of
+    its length) must be no longer than their distance (to TAUT_GAP): a taut line (a
+    tendon) is straight between them, tension linear in height, and starts so
+    (scenes/starts.chord_start); a longer one has no catenary and, weighed down,
+    would fold on itself."""
+    chord = ends_chord(line, nodes)
+    length, distance = float(line.line.length), float(np.linalg.norm(chord))
+    if np.hypot(chord[0], chord[1]) <= 1e-9 * length and distance < length * (1 - TAUT_GAP):
+        raise RodInputError(
+            f"line {line.name}: its ends {line.start.to} and {line.end.to} lie on one "
+            f"vertical {distance:.6g} m apart where the run starts{changed_by(line, made_by)}"
+            f", and its length {length:.6g} m is longer, so it has no catenary and would "
+            "fold on itself; shorten it to at most their distance (a taut tendon; "
+            "-rod_system_line_length) or move an end sideways (-rod_system_offset)")
 
 
 def changed_by(line, made_by):
@@ -270,11 +293,13 @@ def changed_by(line, made_by):
 def check_held_spans(system, nodes, made_by):
     """A line between two held points (or bodies held in all degrees of freedom) must
     reach across them: an inextensible one no shorter than their distance, an extensible
-    one within MAX_STRAIN of it (the bound of the single line's model of stretch)."""
+    one within MAX_STRAIN of it (the bound of the single line's model of stretch); and
+    not be folded on one vertical (check_not_folded)."""
     for line in system.lines:
         start, end = nodes[line.start.to], nodes[line.end.to]
         if not (is_held(start) and is_held(end)):
             continue
+        check_not_folded(line, nodes, made_by)
         chord = ends_distance(line, nodes)
         model = line.line
         if hasattr(model, "sections"):
@@ -306,7 +331,8 @@ def check_reach(system, made_by=None):
     inextensible catenary between them (scenes/starts.catenary_start), which a line as
     long as its chord or shorter does not have. A line of several pieces starts straight
     where its catenary cannot be drawn (HeldLine); one between held ends is
-    check_held_spans'. Not part of check_system: a model's free points may stand
+    check_held_spans'. Neither may a line with a free end be folded on one vertical
+    (check_not_folded). Not part of check_system: a model's free points may stand
     anywhere (a MoorDyn file's are guesses); the run refuses them before it starts
     (cli_system.changed). ``made_by``: check_system's."""
     made_by = made_by or {}
@@ -317,6 +343,7 @@ def check_reach(system, made_by=None):
         model = line.line
         pieces = (len(model.sections) if hasattr(model, "sections")
                   else len(model.load_values))
+        check_not_folded(line, nodes, made_by)
         length, chord = float(model.length), ends_distance(line, nodes)
         if pieces == 1 and not chord < length:
             raise RodInputError(

@@ -15,6 +15,7 @@ from petsc_rod.scenes.boundary import is_held
 from petsc_rod.scenes.catenary import catenary, catenary_axes
 from petsc_rod.errors import NoCatenaryStart, RodInputError
 from petsc_rod.frames import REFERENCE_FRAME
+from petsc_rod.model.derived import TAUT_GAP
 from petsc_rod.scenes.touchdown import seabed_shape
 
 SHAPES = ("straight", "catenary")
@@ -64,6 +65,59 @@ def catenary_start(scene, t):
 
     if scene.seabed is not None:        # resting on the seabed where it reaches it
         shape = seabed_shape(scene, chord, load, shape)
+
+    return planar_curve(shape, normal, start.position)
+
+
+def lies_straight(scene, t):
+    """Whether the line is held at both ends at least its length less TAUT_GAP
+    (relative) apart at load factor t: taut, with no catenary (catenary_axes), and the
+    straight start along its chord (chord_start) its natural start."""
+    start, end = scene.start_state(t), scene.end_state(t)
+    chord = float(np.linalg.norm(end.position - start.position))
+    return (is_held(start) and is_held(end)
+            and chord >= scene.length * (1.0 - TAUT_GAP))
+
+
+def chord_start(scene, t):
+    """The straight line along the chord c between the held ends at load factor t, for
+    a taut line (lies_straight), stretched uniformly: r = r_a + (S / L) c, d3 = e =
+    c / |c|, d1 normal to the plane of e and the load's resultant (e_y projected
+    normal to e where they are parallel or there is no load), d2 = d3 x d1. The force
+    is that of a straight line under the load f(S) (N/m), n' + f = 0 along e:
+
+        n(S) = (T + e . (F(S) - <F>)) e,   F(S) = int_S^L f dS,   <F> its mean over S,
+        T = (|c| - L) / int_0^L dS / EA      (N, the mean tension of the stretch),
+
+    the equilibrium of a line whose load is along the chord (a vertical tendon: the
+    tension linear in height), the start of a taut one whose load sags it a little;
+    T = 0 for an inextensible line (its tension is the solve's)."""
+    start, end = scene.start_state(t), scene.end_state(t)
+    chord = end.position - start.position
+    along = chord / np.linalg.norm(chord)
+    ends = scene.load_piece_ends
+    loads = t * np.asarray(scene.load_values, dtype=float)
+    # <F> = (1/L) int_0^L F dS = (1/L) int_0^L S f(S) dS, exact for pieces of constant f
+    mean_beyond = (0.5 * (ends[1:] ** 2 - ends[:-1] ** 2)) @ loads / scene.length
+    pieces = np.concatenate([[0.0], scene.stiffness_breaks, [scene.length]])
+    compliance = float(np.sum(np.diff(pieces)
+                              / scene.axial_stiffness_at(0.5 * (pieces[1:] + pieces[:-1]))))
+    excess = float(np.linalg.norm(chord)) - scene.length
+    tension = excess / compliance if compliance > 0 else 0.0
+    resultant = loads.sum(axis=0)
+    normal = np.cross(-resultant, along)
+    if np.linalg.norm(normal) <= 1e-9 * np.linalg.norm(resultant):     # also no load
+        normal = REFERENCE_FRAME[0] - (REFERENCE_FRAME[0] @ along) * along
+        if np.linalg.norm(normal) < 0.5:
+            normal = REFERENCE_FRAME[1] - (REFERENCE_FRAME[1] @ along) * along
+    normal = normal / np.linalg.norm(normal)
+
+    def shape(S):
+        S = np.asarray(S, dtype=float)
+        r = (S / scene.length)[..., None] * chord
+        axial = tension + (scene.load_beyond(S, t) - mean_beyond) @ along
+        tangent = np.broadcast_to(along, S.shape + (3,))
+        return r, tangent, axial[..., None] * along
 
     return planar_curve(shape, normal, start.position)
 

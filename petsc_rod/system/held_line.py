@@ -485,12 +485,15 @@ class HeldLine:
 
     def _first(self):
         problem = self.problem
-        try:
-            curve = starts.catenary_start(self.path, 1.0)
-        except NoCatenaryStart:
-            problem.state.set_straight()
+        if starts.lies_straight(self.path, 1.0):        # taut: no catenary
+            problem.state.set_from_curve(starts.chord_start(self.path, 1.0))
         else:
-            problem.state.set_from_curve(curve)
+            try:
+                curve = starts.catenary_start(self.path, 1.0)
+            except NoCatenaryStart:
+                problem.state.set_straight()
+            else:
+                problem.state.set_from_curve(curve)
         self.converged = self._run(PathSettings(steps=1, track_link=False))
         return self.converged
 

@@ -176,14 +176,20 @@ def test_a_flex_joints_end_stiffness_on_the_seabed_in_a_current(comm):
     the 12 x 12 against central differences of re-solves, and again after the
     differences' walks. Round sections and nothing clamped (a flex joint holds no
     roll): one roll of every section about its tangent is a null vector of J, whose
-    pivot one rank's LU keeps; end_stiffness's solves hold it, as stiffness()'s do."""
+    pivot one rank's LU keeps; end_stiffness's solves hold it, as stiffness()'s do.
+    The re-solves stop at TIGHT's tolerances: at the iteration's default each walk
+    stops short of the equilibrium by an amount that does not cancel between the two
+    sides, a bias of the differences (in the joint's support rotation) that grows with
+    the tolerance and as 1/step; the step 2e-3 balances their O(step^2) truncation
+    against the re-solves' remaining noise at the grounded anchor's entries (the
+    tolerance and step studies: docs/systems.md)."""
     ends = (np.array([0.0, 0.0, -30.0]), np.array([85.0, 0.0, 0.0]))
     line = UniformLine(length=100.0, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -10.0),
                        axial_stiffness=1e5, elements=50, drag=(1025.0, 1.2, 0.1))
     model = Model(line=line, start=End.anchor(tuple(ends[0])),
                   end=End(kind="pin", position=tuple(ends[1]), stiffness=5.0),
                   environment=Environment(seabed=-30.0, current=(0.0, 0.3, 0.0)))
-    flexed = HeldLine(model, COMMS[comm])
+    flexed = HeldLine(model, COMMS[comm], options=TIGHT)
     frames = [None, REFERENCE]
     try:
         assert flexed.solve(ends[0], ends[1] + np.array([-3.0, 2.0, 0.0]), *frames)
@@ -191,13 +197,13 @@ def test_a_flex_joints_end_stiffness_on_the_seabed_in_a_current(comm):
         assert np.abs(flexed.end_moments()[1]).max() > 1.0      # the joint's
         K = flexed.end_stiffness()
         scale = np.abs(K).max()
-        found = differences(flexed, frames, 1e-3, ends)
+        found = differences(flexed, frames, 2e-3, ends)
         # the anchor on the seabed: its vertical stiffness one-sided (lifting it)
         mask = np.ones((12, 12), dtype=bool)
         mask[2, 2] = False
-        assert np.abs(K - found)[mask].max() < 1e-6 * scale
+        assert np.abs(K - found)[mask].max() < 1e-7 * scale
         for _ in range(3):                  # each Newton run moves round-off's roll
-            assert np.abs(flexed.end_stiffness() - found)[mask].max() < 1e-6 * scale
+            assert np.abs(flexed.end_stiffness() - found)[mask].max() < 1e-7 * scale
             flexed.newton.run()
     finally:
         flexed.destroy()

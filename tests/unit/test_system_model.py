@@ -131,6 +131,28 @@ def test_a_line_too_short_for_its_held_points_is_refused():
         "more to reach, above 100 %")
 
 
+def test_a_line_folded_on_one_vertical_is_refused_and_a_taut_one_passes():
+    """check_not_folded: ends on one vertical (the prescribed point 50 m above the fixed
+    one), a line longer than their distance refused by System.check (held ends) and by
+    check_reach (a free end); as long as the distance, or stretched, it passes."""
+    def vertical(length, kind="prescribed"):
+        system = held_pair(CHAIN, length, 0.0)
+        return dataclasses.replace(system, points=(system.points[0],
+                                                   Point("b", kind, (0.0, 0.0, 0.0))))
+    message = ("line tie: its ends a and b lie on one vertical 50 m apart where the run "
+               "starts, and its length 60 m is longer, so it has no catenary and would "
+               "fold on itself; shorten it to at most their distance (a taut tendon; "
+               "-rod_system_line_length) or move an end sideways (-rod_system_offset)")
+    assert refused(vertical(60.0)) == message
+    free = vertical(60.0, "free")
+    free.check()
+    with pytest.raises(RodInputError) as error:
+        check_reach(free)
+    assert str(error.value) == message
+    vertical(50.0).check()
+    vertical(49.9).check()
+
+
 def test_a_line_to_a_free_point_too_short_for_its_start_is_refused_by_the_run():
     """check_reach, the run's (not System.check's: a free point's position is a guess):
     a line of one piece whose end is free must be longer than its ends' distance where
