@@ -3,6 +3,8 @@ checks name the model's fields, or the options a front end gives in their names;
 seabed, the current and the pipe's pressures are resolved in the compile, in the
 solver's frame."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -146,6 +148,21 @@ def test_the_model_refuses_the_loads_it_derives_before_a_scene_is_compiled(model
     with pytest.raises(RodInputError) as compiled:
         compile_scene(model)
     assert str(compiled.value) == str(refused.value)
+
+
+def test_a_seabed_under_a_line_with_no_load_is_not_bounded_by_its_load():
+    """The seabed's largest stiffness is scaled by the line's load (model/sea.py): a
+    line with no load has none, and was refused with 'the largest accepted is nan'."""
+    model = Model(UniformLine(**dict(ROPE, load=(0.0, 0.0, 0.0))),
+                  End.anchor((0.0, 0.0, -30.0)), End.anchor((60.0, 0.0, -10.0)),
+                  Environment(seabed=-30.0, seabed_stiffness=1e4))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model.check()
+    with pytest.raises(RodInputError, match="the largest accepted is 100 N/m"):
+        Model(UniformLine(**dict(ROPE, load=(0.0, 0.0, -1e-10))),
+              End.anchor((0.0, 0.0, -30.0)), End.anchor((60.0, 0.0, -10.0)),
+              Environment(seabed=-30.0, seabed_stiffness=1e4)).check()
 
 
 def test_a_line_type_table_s_optional_ca():
