@@ -61,6 +61,13 @@ class Seabed:
         """The plane z = height (no shape)."""
         return self.shape is None
 
+    @property
+    def plane(self):
+        """A sloping plane (bathymetry.Plane): one normal everywhere, so its energy is
+        a quadratic of the normal penetration with a constant Hessian on the contact
+        (position_derivatives)."""
+        return self.shape is not None and hasattr(self.shape, "slope_vector")
+
     def heights(self, x, y):
         """z_b at horizontal positions (x, y), m, the shape of x."""
         if self.shape is None:
@@ -119,6 +126,20 @@ class Seabed:
         gap = self.height - z
         spring = self.stiffness * weights * (gap > 0)
         return -spring * gap, spring
+
+    def position_derivatives(self, r, weights):
+        """(dE/dr_n, d2E/dr_n^2) of E = k/2 sum_n w_n (N.(r_b - r_n))_+^2 on a sloping plane
+        (plane) at node positions r (n, 3) with weights w_n (n,), m; N the unit normal
+        (-g, 1) / sqrt(1 + |g|^2) and N.(r_b - r_n) = (z_b(x_n, y_n) - z_n) cos(theta)
+        the normal penetration d_n: -k w_n d_n N (N, (n, 3)) and k w_n N N^T on the
+        nodes with d_n > 0 (N/m, (n, 3, 3)). The flat seabed's height_derivatives with
+        N = e_z; the energy is energy()'s, k_v/2 p^2 = k/2 d^2."""
+        g = self.shape.gradient(r[:, 0], r[:, 1])
+        normal = self.shape.normal(r[:, 0], r[:, 1])
+        depth = (self.shape.height(r[:, 0], r[:, 1]) - r[:, 2]) / self.slope_factor(g)
+        spring = self.stiffness * weights * (depth > 0)
+        return ((-spring * depth)[:, None] * normal,
+                spring[:, None, None] * normal[:, :, None] * normal[:, None, :])
 
     def energy(self, r, weights):
         """sum_n w_n k_v,n / 2 p_n^2 (J) at node positions r (n, 3) with weights w_n (n,),

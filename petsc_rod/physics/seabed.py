@@ -34,7 +34,11 @@ class SeabedTerm(NodalLoadTerm):
     def __init__(self, mesh, seabed):
         super().__init__(mesh, "seabed")
         self.seabed = seabed
+        if seabed.plane:
+            # a sloping plane's penetration is along its normal: all three components
+            self.position_components = (0, 1, HEIGHT)
         self.vertical = self.contact = None
+        self._solved = None         # the z slope of the contact's last solve (node_loads)
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -60,6 +64,7 @@ class SeabedTerm(NodalLoadTerm):
         start = (state.r.ghosted() if self.contact.active is None and self.seabed.flat
                  else None)
         self.contact.solve(rhs.components[2], state.slope.components[2], start)
+        self._solved = state.slope.components[2].getArray(readonly=True).copy()
         if bordered:
             state.chord_multiplier[2] = self.vertical.end_residual()
 
@@ -78,14 +83,28 @@ class SeabedTerm(NodalLoadTerm):
                                                              state.node_weights)))
 
     def add_gradient(self, g, state):
-        """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; the
-        state's r is that of its fields (RodProblem.energy_gradient). Collective."""
+        """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; on a
+        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives).
+        The state's r is that of its fields (RodProblem.energy_gradient). Collective."""
+        if self.seabed.plane:
+            gradient = self._plane_derivatives(state)[0]
+            self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
+            return
         self.add_position_gradient(g, state, {HEIGHT: self._height_derivatives(state)[0]})
 
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
-        its gradient gives through the multipliers)."""
+        its gradient gives through the multipliers); on a sloping plane k w_n N N^T on
+        the nodes' three position components."""
+        if self.seabed.plane:
+            hessian.add_position_curvature(self._plane_derivatives(hessian.problem.state)[1],
+                                           self.position_components)
+            return
         hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
+
+    def _plane_derivatives(self, state):
+        """Seabed.position_derivatives at the owned nodes of the state's centreline."""
+        return self.seabed.position_derivatives(state.node_positions(), state.node_weights)
 
     def pressure(self, z):
         """The seabed's upward force per metre (N/m) at heights z."""
@@ -93,11 +112,23 @@ class SeabedTerm(NodalLoadTerm):
 
     def node_loads(self, state):
         loads = np.zeros((self.mesh.n_local_nodes, 3))
-        if self.seabed.flat or self.contact.solution is None:
+        if self.seabed.flat or not self.contact_solved(state):
             loads[:, 2] = self.seabed.force(state.node_positions())[:, 2]
         else:                           # a slope: the reaction the vertical problem carried
             loads[:, 2] = self.contact.node_force()[:, 2]
         return loads
+
+    def contact_solved(self, state):
+        """Whether the state's z slope is the one the contact's last vertical solve set:
+        then the outputs read its reaction (the reaction the iteration carried, which
+        does not amplify the positions' tolerance by k); after Newton steps on a sloping
+        plane, which moved the state and not the contact, the state's own force
+        (Seabed.force, as on the flat seabed). Collective."""
+        if self.contact.solution is None or self._solved is None:
+            return False
+        same = np.array_equal(state.slope.components[2].getArray(readonly=True),
+                              self._solved)
+        return self.mesh.global_min(int(same)) == 1
 
     def _destroy_vertical(self):
         if self.vertical is not None:

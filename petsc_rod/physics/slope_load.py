@@ -9,20 +9,28 @@ implicit in the vertical problem, the horizontal part
 
     f_h,n = -k_n p_n g_n    (N/m; N tan(theta) down the slope, N = k_n p_n / cos(theta))
 
-enters the slope problem's right-hand side like the drag (nodal_load.NodalLoadTerm), from
-the positions of the last global step. Why lagged, and why that is stable: its
+enters the slope problem's right-hand side as its work on the nodes' positions (the
+energy's form, add_iterate_load), from the positions of the last global step. Why
+lagged, and why that is stable: its
 sensitivity to the iterate is that of the reaction k_n p_n, which the vertical problem
 fixes from the line's equilibrium rather than from k, times tan(theta); an error dx of
 the horizontal positions returns as about tan(theta)^2 dx, small for the moderate slopes
 of the seabed data (docs/riser.md §3a).
 
 Not a term of the energy: the energy of the seabed term (k_n/2 sum w_n p_n^2) is the
-potential of the whole force on a plane, but the Newton steps and the stability test
-would need its derivatives in x and y, which they do not have: the term says so
-(``conservative``, ``in_newton`` False), so the run takes neither.
+potential of the whole force on a plane. On a sloping plane that term's derivatives
+carry all three components of the positions (Seabed.position_derivatives: k w_n N N^T
+on the contact, the flat seabed's with N for e_z), so the Newton steps and the
+stability test have the whole force from it and this term adds nothing to them
+(``in_newton``, ``conservative``). Its outputs (the internal force's share) are the
+last vertical solve's reaction where the state is that solve's, and the force at the
+state's positions after Newton steps (SeabedTerm.contact_solved). On a profile, whose slope turns
+smoothly at its rows, the Newton steps would need the curvature of z_b as well: the
+term says so (``conservative``, ``in_newton`` False), so the run takes neither.
 """
 
-from petsc_rod.global_step.nodal_loads import NodalLoad
+import numpy as np
+
 from petsc_rod.physics.nodal_load import NodalLoadTerm
 
 
@@ -37,23 +45,46 @@ class SeabedSlopeLoad(NodalLoadTerm):
         super().__init__(mesh, "seabed_slope")
         self.contact = contact                  # the SeabedTerm (seabed.py)
         self.seabed = contact.seabed            # environment.Seabed, not flat
-        self.load = NodalLoad(mesh, self._nodes)
+        # on a plane the seabed term's energy holds the whole force (module docstring)
+        self.conservative = self.in_newton = self.seabed.plane
 
     def node_loads(self, state):
         """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of
-        the last vertical solve (seabed_contact.SeabedContact.node_force). Zero before the first
-        solve: the start's own penetration (a straight start under a rising seabed:
-        metres) is not a reaction, and k times it would throw the first iterate far away.
-        Collective."""
+        the last vertical solve (seabed_contact.SeabedContact.node_force), or after
+        Newton steps on a plane the force at the state's positions
+        (SeabedTerm.contact_solved). Zero before the first solve: the start's own
+        penetration (a straight start under a rising seabed: metres) is not a reaction,
+        and k times it would throw the first iterate far away. Collective."""
+        if self.contact.contact.solution is not None \
+                and not self.contact.contact_solved(state):
+            force = self.seabed.force(state.node_positions())
+            force[:, 2] = 0.0
+            return force
+        return self._iterate_loads()
+
+    def _iterate_loads(self):
+        """f_h of the last vertical solve, z component 0 (the global step's lagged push;
+        zero before the first solve). Collective."""
         force = self.contact.contact.node_force()
         force[:, 2] = 0.0
         return force
 
     def add_iterate_load(self, rhs, state):
-        """Add int F.g of f_h to the slope problem's right-hand side, then move the
+        """Add the work of f_h to the slope problem's right-hand side, then move the
         seabed's heights and springs under the nodes of the last global step for this
         step's vertical solve (seabed_contact.SeabedContact.follow; this term is built after the
-        seabed's, and add_iterate_load comes before every solve of the global step)."""
-        self.load.set(self.node_loads(state))
-        self.add_to_rhs(rhs, self.load)
+        seabed's, and add_iterate_load comes before every solve of the global step).
+
+        The work is the energy's form, sum_n w_n f_h,n . x_n with the nodes' positions
+        the chain's (positions.position_gradient: its adjoint in the slopes), not
+        int F.g of f_h's P2 interpolant: the two differ by O(h^2 tan(theta)), and in the
+        energy's form the global step's fixed point on a plane is the stationary point
+        of the Newton steps, whose seabed energy sums over the nodes with the same
+        weights (seabed.py). Collective."""
+        work = self._iterate_loads() * state.node_weights[:, None]
+        n = work.shape[0]
+        gradient = np.zeros((n, 3, 3))
+        self.add_position_gradient(gradient, state, {c: -work[:, c] for c in (0, 1)})
+        for c in (0, 1):
+            rhs.components[c].getArray()[:n] -= gradient[:, 2, c]
         self.contact.contact.follow(state.r.ghosted())

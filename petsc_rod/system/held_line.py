@@ -12,7 +12,9 @@ reads the positions: analysis/positions.py), the equilibrium with the ends at x_
 F the energy with the work of the loads, C(q) = int r' dS the chord and mu its
 multiplier (iteration/newton.py). The loads per metre do not depend on where the line
 is, so F depends on x_a only through the positions' terms: on a flat seabed through the
-start's height z_a (a node's height is z_a plus the integral of the slope). With
+start's height z_a (a node's height is z_a plus the integral of the slope); on a sloping
+plane through the whole x_a (its energy reads the normal penetration), and the data
+below are (x_a, c) with one P per component (_plane_response). With
 G(z_a, c) = F at the equilibrium of chord c, the line's potential as a function of its
 ends is Phi(x_a, x_b) = G(z_a, x_b - x_a) - W . x_a, W the load's resultant.
 
@@ -78,7 +80,8 @@ extensible end too, where the joint acts in the local step (its gradient in rota
 of the tangent's direction only, is the same function of d3 and a).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction (it dissipates), a sloping or profiled seabed (its contact lagged),
+seabed's friction (it dissipates), a seabed profile (its contact lagged), a clamp or flex
+joint on a sloping plane (end_stiffness),
 and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -210,13 +213,16 @@ class _CurvatureRecorder:
     def __init__(self, problem):
         self.problem = problem
         self.heights = None
+        self.positions = None       # a sloping plane's k w_n N N^T (n_nodes, 3, 3)
 
     def add_height_curvature(self, curvature):
         self.heights = np.asarray(curvature, dtype=float)
 
     def add_position_curvature(self, values, components):
-        raise RodInputError("a line whose energy reads its horizontal positions (the "
-                            "seabed's friction) has no exact stiffness here")
+        if tuple(components) != (0, 1, 2):
+            raise RodInputError("a line whose energy reads its horizontal positions (the "
+                                "seabed's friction) has no exact stiffness here")
+        self.positions = np.asarray(values, dtype=float)
 
 
 def _at_vertex(mesh, values, index):
@@ -722,6 +728,11 @@ class HeldLine:
             for term in problem.terms:
                 if term.position_components:
                     term.add_hessian(recorder)
+            if recorder.positions is not None and rotations:
+                raise RodInputError(
+                    "HeldLine.end_stiffness: no exact stiffness of a clamped or "
+                    "flex-jointed end on a sloping seabed; pin the line's ends or make "
+                    "the seabed flat")
             columns = hessian.chord_forms(frames[:, 2])
             if self.newton.free_roll and hessian.resultants:
                 # round sections, nothing clamped (a flex joint holds no roll): one roll
@@ -736,6 +747,11 @@ class HeldLine:
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
+            planes = []
+            if recorder.positions is not None:
+                planes = self._plane_shifts(hessian, recorder.positions)
+                vecs.extend(planes)
+                shift = planes[2]
             # a sheared current: the start raised moves the drag of every node too
             pushes = [v for v in (term.height_shift(hessian, state) for term in problem.terms
                                   if term.jacobian_positions) if v is not None]
@@ -757,11 +773,18 @@ class HeldLine:
                 hessian.factorise(0.0)
                 solver = hessian
             shifts = [] if lift is None else [lift]
+            if planes:
+                shifts = planes[:2] + shifts
             rights = columns + shifts + turned
             solved = solver.solve_many(rights)
             vecs.extend(solved)
             if solver is self.jacobian:
                 vecs.extend(_refine(solver, rights, solved))
+            if planes:
+                response = self._plane_response(hessian, columns, planes,
+                                                solved, recorder.positions, solver)
+                return response @ np.block([[np.eye(3), np.zeros((3, 3))],
+                                            [-np.eye(3), np.eye(3)]])
             response = self._response(hessian, columns, shift,
                                       solved[:len(columns) + len(shifts)], recorder.heights,
                                       solver)
@@ -1044,6 +1067,60 @@ class HeldLine:
             start[2] -= moved                               # P.dy + sum k w_n dz
         return np.vstack([start, dmu])
 
+    @staticmethod
+    def _plane_shifts(hessian, curvature):
+        """P_j = sum_c sum_n H_n[c, j] dx^c_n/dy, j = x, y, z (three new Vecs): how the
+        gradient moves when every node is shifted by 1 m along axis j (the start moved),
+        H_n = k w_n N N^T the sloping plane's curvature at the owned nodes
+        (n_nodes, 3, 3) (SecondVariation.position_shift per component). Collective."""
+        out = []
+        for j in range(3):
+            total = hessian.position_shift(curvature[:, 0, j], 0)
+            for c in (1, 2):
+                part = hessian.position_shift(curvature[:, c, j], c)
+                total.axpy(1.0, part)
+                part.destroy()
+            out.append(total)
+        return out
+
+    def _plane_response(self, hessian, columns, planes, solved, curvature, solver):
+        """d(F_a, F_b)/d(x_a, c), (6, 6), on a sloping plane: _response with the start's
+        whole position as data. With Y_C = A^-1 C^T and Y_j = A^-1 L_j (L_j = P_j, the
+        sheared drag's height columns added to L_z): dmu = -S^-1 (dc + C Y_j dx_a,j),
+        dy = -Y_j dx_a,j - Y_C dmu, F_b = mu, F_a = W + Psi_0 + R_s - mu with R_s the
+        seabed's whole reaction, dR_s,i = -(P_i.dy + sum_n H_n[i, j] dx_a,j).
+        Collective."""
+        mesh = self.mesh
+        n_all = len(columns)
+        Y_P = solved[n_all:n_all + 3]
+        columns, Y_C, schur = self._held_forms(columns, solved[:n_all], solver)
+        n_c = len(columns)
+        inverse = np.linalg.inv(schur)
+        along = np.array([[c.dot(y) for y in Y_P] for c in columns])     # (n_c, 3)
+        multipliers = np.zeros((n_c, 6))                    # d (mu, roll's) / d(x_a, c)
+        multipliers[:, :3] = -inverse @ along
+        multipliers[:, 3:] = -inverse[:, :3]
+        dmu = multipliers[:3]
+
+        def of_dy(values_C, values_P):
+            """A linear functional of dy (its values on Y_C (.., n_c) and on the Y_j
+            (.., 3)) as a function of (x_a, c)."""
+            return -np.concatenate([values_P, np.zeros(values_P.shape[:-1] + (3,))],
+                                   axis=-1) - values_C @ multipliers
+
+        start = -dmu.copy()
+        if hessian.resultants:
+            slot = hessian.resultant_slot
+            first = [y.getArray(readonly=True).reshape(-1, hessian.block)[0, slot:slot + 3]
+                     if mesh.on_lower_boundary else np.zeros(3) for y in Y_C + Y_P]
+            first = mesh.global_sum(np.array(first))        # (n_c + 3, 3): Psi_0 of each Y
+            start += of_dy(first[:n_c].T, first[n_c:].T)
+        moved = of_dy(np.array([[p.dot(y) for y in Y_C] for p in planes]),
+                      np.array([[p.dot(y) for y in Y_P] for p in planes]))
+        moved[:, :3] += mesh.global_sum(curvature.sum(axis=0))
+        start -= moved                                      # P_i.dy + sum_n H_n dx_a
+        return np.vstack([start, dmu])
+
     def _check_solved(self):
         if self.problem is None or not self.converged:
             raise RodInputError("HeldLine: no converged equilibrium yet (solve first, and "
@@ -1055,9 +1132,10 @@ class HeldLine:
         if scene.seabed is not None and scene.seabed.friction is not None:
             raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
                                 "exact stiffness of a line with friction")
-        if scene.seabed is not None and not scene.seabed.flat:
-            raise RodInputError("HeldLine.stiffness: exact on a flat seabed only (a "
-                                "sloping or profiled one's contact is lagged)")
+        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
+            raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
+                                "seabed profile (its contact is lagged in the line's "
+                                "iterations); give a flat or uniformly sloping seabed")
         loose = [term for term in self.problem.terms if not term.in_newton
                  or not (term.conservative or term.follower)]
         if loose:

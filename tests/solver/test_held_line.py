@@ -414,6 +414,43 @@ def test_a_converged_newton_run_of_an_undone_attempt_does_not_settle_the_line(mo
         line.destroy()
 
 
+# the mooring over a plane rising 3 degrees towards azimuth 30 degrees, 0.2 m below
+# the anchor there: its chain grounded on the slope and pushed across it
+SLOPE = {"seabed": -30.2, "seabed_slope": 3.0, "seabed_direction": 30.0,
+         "seabed_origin": (0.0, 0.0)}
+
+
+def sloped_model(elements=40, drag=None, **sea):
+    line = UniformLine(length=LENGTH, stiffness=(1e-2, 1e-2, 1e-2), load=(0, 0, -WEIGHT),
+                       axial_stiffness=EA, elements=elements, drag=drag)
+    return Model(line=line, start=End.anchor(tuple(MOORING[0])),
+                 end=End.anchor(tuple(MOORING[1])), environment=Environment(**sea))
+
+
+def against_differences(line, K, step=1e-4):
+    """max |K - central differences of re-solves (``step`` m)| / max |K| of the
+    mooring."""
+    error = np.abs(K - differences(line, MOORING, step)).max() / np.abs(K).max()
+    print(f"K against differences {error:.3g} of {np.abs(K).max():.6g}")
+    return error
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+def test_stiffness_on_a_sloping_seabed(comm):
+    """The plane's contact k w_n N N^T in the Newton system (Seabed.position_derivatives):
+    the (6, 6) against central differences of re-solves, every entry (the anchor is off
+    the plane, so no node's contact is one-sided)."""
+    line = held(sloped_model(**SLOPE), COMMS[comm], MOORING)
+    try:
+        forces = line.end_forces()
+        assert abs(forces[0, 1]) > 1.0                  # pushed across the slope
+        K = line.stiffness()
+        assert np.abs(K - K.T).max() < 1e-10 * np.abs(K).max()
+        assert against_differences(line, K) < 1e-6
+    finally:
+        line.destroy()
+
+
 def test_the_stiffness_after_further_newton_runs_in_a_sheared_current():
     """Newton runs from the converged state move it by round-off only (a roll of every
     section, the free roll, and round-off of the positions and the chord's multiplier),
@@ -430,5 +467,41 @@ def test_the_stiffness_after_further_newton_runs_in_a_sheared_current():
         found = differences(line, MOORING, 1e-3)
         for K in stiffnesses:
             assert but_the_anchors_lift(K - found) < 1e-6 * np.abs(K).max()
+    finally:
+        line.destroy()
+
+
+def test_stiffness_on_a_sloping_seabed_in_a_current():
+    """A uniform current across the slope: the drag's Jacobian with the plane's
+    contact, against central differences of re-solves."""
+    line = held(sloped_model(drag=(1025.0, 1.2, 0.1), current=(0.0, 0.3, 0.0), **SLOPE),
+                PETSc.COMM_WORLD, MOORING)
+    try:
+        K = line.stiffness()
+        assert np.abs(K - K.T).max() > 1e-3 * np.abs(K).max()    # the drag: not symmetric
+        # the steps of the flat seabed's case in a current (above): its re-solves' noise
+        assert against_differences(line, K, 1e-3) < 1e-6
+    finally:
+        line.destroy()
+
+
+def test_a_slope_of_zero_is_the_flat_seabed_bit_for_bit():
+    numbers = []
+    for sea in ({**SLOPE, "seabed_slope": 0.0}, {"seabed": SLOPE["seabed"]}):
+        line = held(sloped_model(**sea), PETSc.COMM_SELF, MOORING)
+        try:
+            numbers.append((line.end_forces(), line.stiffness()))
+        finally:
+            line.destroy()
+    assert np.array_equal(numbers[0][0], numbers[1][0])
+    assert np.array_equal(numbers[0][1], numbers[1][1])
+
+
+def test_a_seabed_profile_is_refused_in_one_line():
+    profile = ((-100.0, -30.2), (40.0, -30.2), (200.0, -25.0))
+    line = held(sloped_model(seabed_profile=profile), PETSc.COMM_SELF, MOORING)
+    try:
+        with pytest.raises(RodInputError, match="seabed profile.*flat or uniformly sloping"):
+            line.stiffness()
     finally:
         line.destroy()

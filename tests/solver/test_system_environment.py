@@ -32,14 +32,15 @@ def in_the_sea(environment, drag=(1025.0, 1.2, 0.2), kind="pin"):
         dataclasses.replace(riser, line=line),), environment=environment)
 
 
-def assert_exact_body_stiffness(system, comm):
-    """The system solved; its body's 6 x 6 against central differences of the lines
-    re-solved at moved and turned poses, to 1e-6 of its largest entry. Returns the
-    solver (destroyed by the caller)."""
-    solver = SystemSolver(system, factory(system), COMMS[comm], settings=Settings(rtol=1e-12))
+def assert_exact_body_stiffness(system, comm, make_line=None, body="buoy"):
+    """The system solved (its lines from ``make_line``; None: factory's); its ``body``'s
+    6 x 6 against central differences of the lines re-solved at moved and turned poses,
+    to 1e-6 of its largest entry. Returns the solver (destroyed by the caller)."""
+    solver = SystemSolver(system, make_line or factory(system), COMMS[comm],
+                          settings=Settings(rtol=1e-12))
     try:
         assert solver.solve().load_factor == 1.0
-        K = solver.body_stiffness("buoy").matrix
+        K = solver.body_stiffness(body).matrix
         numeric = body_differences(solver)
         scale = np.abs(K).max()
         error = np.abs(K - numeric).max() / scale

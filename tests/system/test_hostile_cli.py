@@ -609,7 +609,7 @@ CATENARY_RISER = ["-options_file", "options/riser_catenary.opts", "-rod_elements
     (CATENARY_RISER + ["-rod_seabed", "0.30000000000000004", "-rod_start_position", "0,0,0.3"],
      18),
     (["-options_file", "options/steel_catenary_riser_slope.opts", "-rod_seabed", "1e-12",
-      "-rod_sections", "scr10:2400:400"], 36)])
+      "-rod_sections", "scr10:2400:400"], 40)])
 def test_an_anchor_on_the_seabed_to_round_off_is_on_it(tmp_path, args, iterations):
     """An anchor 1e-12 m below the seabed, flat or sloping (or 0.1 + 0.2 against 0.3),
     was accepted, then diverged at iteration 1 of every halving (exit 4): it is on the

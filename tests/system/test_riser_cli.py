@@ -426,18 +426,37 @@ def test_a_current_drags_only_the_line_under_the_surface(tmp_path):
       "-rod_current", "0,1,0"], ["-rod_current", "a current has none", "drop -rod_al_stability"]),
     (["-options_file", "options/mooring_chain.opts", "-rod_seabed_friction", "0.5"],
      ["-rod_seabed_friction", "friction has none", "drop -rod_al_stability"]),
-    (["-options_file", "options/steel_catenary_riser_slope.opts"],
+    (["-options_file", "{profiled}"],
      ["-rod_al_stability 1", "loads without one", "a seabed that is not flat",
       "drop -rod_al_stability"]),
-], ids=["current", "friction", "slope"])
+], ids=["current", "friction", "profile"])
 def test_a_stability_test_asked_for_a_scene_without_energy_is_refused(tmp_path, args,
                                                                        words, ranks):
-    """-rod_al_stability 1 given with a current or seabed friction (loads without an
-    energy, which the test cannot take) is refused in one line, not left out in silence."""
+    """-rod_al_stability 1 given with a current, seabed friction or a seabed profile
+    (loads without an energy, which the test cannot take) is refused in one line, not
+    left out in silence. (A sloping plane has one: test_a_stability_test_on_a_slope.)"""
     path = tmp_path / "out.h5"
+    # steel_catenary_riser_slope.opts's plane as a profile of two rows
+    profile = tmp_path / "profile.txt"
+    profile.write_text("".join(f"{d:g} {d * np.tan(np.radians(3.0)):.17g}\n"
+                               for d in (-100.0, 5000.0)))
+    profiled = tmp_path / "profiled.opts"
+    profiled.write_text("".join(
+        row + "\n" for row in open("options/steel_catenary_riser.opts").read().splitlines()
+        if not row.startswith("-rod_seabed ")) + f"-rod_seabed_profile {profile}\n")
+    args = [str(profiled) if a == "{profiled}" else a for a in args]
     done = run(args + ["-rod_al_stability", "1", "-rod_output", str(path)], ranks)
     assert_one_line_and_nothing_left(done.returncode, done.stdout + done.stderr, 2, words,
                                      path)
+
+
+def test_a_stability_test_on_a_slope(tmp_path):
+    """A sloping plane's contact has an energy (docs/riser.md §3a): -rod_al_stability 1
+    runs, and the equilibrium is stable."""
+    done = run(["-options_file", "options/steel_catenary_riser_slope.opts",
+                "-rod_sections", "scr10:2400:400", "-rod_al_stability", "1"])
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "stable" in done.stdout and "UNSTABLE" not in done.stdout
 
 
 def test_a_current_without_a_stability_switch_still_runs(tmp_path):
