@@ -93,10 +93,19 @@ FLOOR_TURN = 1e-7
 # FROZEN_SHRINK of the previous one is taken again with fresh factors (above FLOOR_TURN;
 # at the floor the state is handed over, as after any step that does not shrink). Such a
 # problem has no energy: the inertia test is its steps' safeguard, not a stability
-# verdict, and it was passed at most about FREEZE_TURN rad from the result. A
-# conservative problem's steps stay exact.
+# verdict, and it was passed at most about FREEZE_TURN + INERTIA_TURN rad from the
+# result. A conservative problem's steps stay exact.
 FREEZE_TURN = 1e-4
 FROZEN_SHRINK = 0.1
+# On such a problem an exact step after a step of at most INERTIA_TURN rad whose H passed
+# the inertia test is taken without the test (no LDL^T of H: its solves are J's): the
+# inertia on the constraint set changes between two states only where an eigenvalue
+# crosses zero, and H's entries (smooth in the frames and the multipliers) move by about
+# the turn times their derivatives between the two, so the test, like a chord step's
+# reuse of the factors, is trusted at most about INERTIA_TURN rad from where it was made.
+# The next exact step after a chord step or an untested one tests again. A conservative
+# problem tests every exact step: its last test is the stability verdict (``verified``).
+INERTIA_TURN = 1e-3
 # A chord step converges linearly, by the factor theta = turn / previous turn (at most
 # FROZEN_SHRINK): the error it leaves is about theta / (1 - theta) times its turn (the
 # geometric rest), and a chord step whose rest is below STEP_TOLERANCE rad is the last
@@ -154,6 +163,8 @@ class NewtonSolver:
         self._near = False
         # the last exact step's KKT pieces, for the chord steps (_keep_kkt)
         self._kkt = None
+        # the next step is exact and taken without the inertia test (run, INERTIA_TURN)
+        self._trusted = False
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
         # of the Newton system, which LU turns into a step of round-off's size); the
@@ -177,7 +188,8 @@ class NewtonSolver:
                 int(np.any(~self._free & np.isfinite(problem.axial)))))
         # whether the last step's H was tested on the constraint set (decidable) and found
         # positive definite, with the state's own curvature: the stability test's verdict,
-        # at 1e-10 rad from the result (a chord step, FREEZE_TURN, tests nothing)
+        # at 1e-10 rad from the result (a chord step, FREEZE_TURN, tests nothing, nor an
+        # exact one after a small tested step, INERTIA_TURN)
         self.verified = False
         # the stopping quantities (state.Norms, §6) of the last step of an attempt whose
         # steps converged (below STEP_TOLERANCE) on the whole problem; None after any
@@ -236,6 +248,7 @@ class NewtonSolver:
         start_norm = np.inf               # |grad L| of the last step's start (all)
         outcome = FAILED
         regularised = False
+        tested = False                    # the last step's H passed the inertia test
         try:
             self._agree(self._usable(frames))
             for _ in range(MAX_STEPS):
@@ -250,13 +263,20 @@ class NewtonSolver:
                 chord = (self.unsymmetric and previous <= FREEZE_TURN
                          and self._kkt is not None)
                 self._near = previous <= ROLL_TURN
+                # an exact step without the inertia test (INERTIA_TURN); a step taken
+                # again below is tested
+                self._trusted = (self.unsymmetric and not chord and tested
+                                 and previous <= INERTIA_TURN)
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, chord)
+                tested = not (chord or self._trusted)
+                self._trusted = False
                 if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
                     # a chord step that did not contract: fresh factors (at the round-off
                     # floor the shrink test below hands the state over instead)
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
+                    tested = True
                 if omega is None and curvature is None and self.reads_positions:
                     # H indefinite after a step on a line whose heights enter: the step
                     # again with the iteration's curvature, as the first (_newton_step),
@@ -264,6 +284,7 @@ class NewtonSolver:
                     curvature = start_lam
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
+                    tested = True
                 if omega is None:
                     outcome = INDEFINITE
                     break
@@ -297,6 +318,7 @@ class NewtonSolver:
                     regularised = True
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised)
+                    tested = True
                     if omega is None:
                         outcome = INDEFINITE
                         break
@@ -333,6 +355,7 @@ class NewtonSolver:
         finally:
             # the kept KKT pieces serve this attempt's chord steps only
             self._drop_kkt()
+            self._trusted = False
             EVENT.end()
 
     # --- the pieces of a step ---------------------------------------------------------
@@ -433,7 +456,8 @@ class NewtonSolver:
         docs/method.md §11), which ``run`` takes again with the iteration's curvature.
         ``frozen``: a chord step, with the matrices and factors of the last exact step,
         and its chord forms' solves (FREEZE_TURN, _keep_kkt; ``run`` takes one only
-        where they are kept)."""
+        where they are kept). Where ``_trusted`` is set (``run``: INERTIA_TURN, a problem
+        that solves with J) an exact step is taken without the inertia test."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         self._agree(np.isfinite(self._residual_norm))        # the same sum on every rank
@@ -445,7 +469,9 @@ class NewtonSolver:
         vecs = []                   # every Vec made here, destroyed on the way out
         held = False
         try:
-            if not frozen:
+            if self._trusted and not frozen:
+                self.verified = False
+            elif not frozen:
                 if not self._positive_definite(hessian, regularised):
                     if not self._free_roll or (self.reads_positions and curvature is None):
                         # (where the heights enter, ``run`` first takes the step again

@@ -312,3 +312,44 @@ def test_a_chord_step_solves_one_right_hand_side_and_ends_by_its_rest(comm, solv
     assert turns[-1] > newton_module.STEP_TOLERANCE
     assert rests[-1] < newton_module.STEP_TOLERANCE <= min(rests[:-1])
     assert np.abs(r - exact_r).max() < 1e-9
+
+
+def test_an_exact_step_after_a_small_tested_one_is_taken_without_the_inertia_test(
+        comm, solver_factory, monkeypatch):
+    """The catenary of (d) with exact steps only (FREEZE_TURN = 0; measured turns 0.39,
+    0.15, 1.8e-3, 9.8e-6 rad, then one below STEP_TOLERANCE): the step after the tested
+    one of 9.8e-6 rad (at most INERTIA_TURN) is taken without H's inertia test (its
+    solves are J's), so H is tested at one step fewer than J is factored; the others
+    are tested, the first steps' turns being above INERTIA_TURN. The state is that of
+    the attempt that tests every step (INERTIA_TURN = 0), to round-off."""
+    from petsc_rod.analysis.jacobian import NewtonJacobian
+    from petsc_rod.iteration import newton as newton_module
+    events = []
+    assemble = NewtonJacobian.assemble
+    positive_definite = NewtonSolver._positive_definite
+
+    def factored(self):
+        events.append("J")
+        assemble(self)
+
+    def tested(hessian, regularised=False):
+        events.append("H")
+        return positive_definite(hessian, regularised)
+
+    monkeypatch.setattr(NewtonJacobian, "assemble", factored)
+    monkeypatch.setattr(NewtonSolver, "_positive_definite", staticmethod(tested))
+    monkeypatch.setattr(newton_module, "FREEZE_TURN", 0.0)
+    scene = dict(LINES["catenary"], stiffness=(1e-1, 2e-1, 1e-1))
+    runs = []
+    for inertia_turn in (newton_module.INERTIA_TURN, 0.0):
+        monkeypatch.setattr(newton_module, "INERTIA_TURN", inertia_turn)
+        events.clear()
+        _, solver, report = converged(solver_factory, comm, scene, newton=True)
+        assert report.converged and report.newton_steps >= 4
+        runs.append((events.count("H"), events.count("J"),
+                     solver.problem.state.r.owned().copy()))
+    (tests, factorisations, r), (all_tests, all_factorisations, all_r) = runs
+    assert factorisations == all_factorisations >= 4
+    assert all_tests == all_factorisations
+    assert tests == factorisations - 1
+    assert np.abs(r - all_r).max() < 1e-12
