@@ -99,7 +99,7 @@ from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import CONVERGED, NewtonSolver
-from petsc_rod.frames import REFERENCE_FRAME
+from petsc_rod.frames import REFERENCE_FRAME, rotations
 from petsc_rod.global_step.chain_factor import NULL_PIVOT
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
@@ -113,6 +113,12 @@ from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import blended_frame
 from petsc_rod.scenes.scene import EndState
 
+
+# A predicted state that turns a section by more than this (rad) is not used: the
+# tangent at the last equilibrium holds the seabed's contact as it was, and beyond this
+# the walk from the old state with its ends moved starts nearer (docs/systems.md, "The
+# lines' predictor").
+PREDICTED_TURN = 1e-2
 
 # The units of HeldLine.summary's numbers.
 SUMMARY_UNITS = {"max_tension": "N", "max_tension_S": "m", "max_tension_position": "m",
@@ -325,6 +331,10 @@ class HeldLine:
         self.iterations = 0
         self.converged = False
         self.settled = False                # the last solve ended in Newton's convergence
+        self.solves = 0                     # the state's changes (solves, settlings)
+        self.tangent = None                 # (dy/d(z_a, c), dmu/d(z_a, c), at solves)
+        self.predicts = False               # walks start from the predictor (_predict)
+        self.predicted = False              # the last walk started from the predictor
         self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
@@ -402,6 +412,7 @@ class HeldLine:
         if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
         self.jacobian = None
+        self.tangent = None
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
@@ -466,11 +477,25 @@ class HeldLine:
         saved = state.snapshot()
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
         axes = {e: term.axis for e, (term, _) in self.axes.items()}
+        turned = any(given is not None and not np.array_equal(given, end.frame)
+                     for given, end in zip(frames, ends))
         self.path.move(a, b, *frames)
         self._turn_joints(frames)
+        self.predicted = not turned and self._predict(a - ends[0].position,
+                                                       b - ends[1].position)
         if self._run(PathSettings(steps=1, track_link=False)):
             self.path.hold(a, b, *frames)
             return True
+        if self.predicted:
+            # the walk from the old state with only its ends moved
+            state.restore(saved)
+            self.predicted = False
+            iterations = self.iterations
+            done = self._run(PathSettings(steps=1, track_link=False))
+            self.iterations += iterations
+            if done:
+                self.path.hold(a, b, *frames)
+                return True
         for e, (term, _) in self.axes.items():
             term.axis = axes[e]
         state.restore(saved)
@@ -478,11 +503,70 @@ class HeldLine:
         self.problem.prepare(1.0)
         return False
 
+    def _predict(self, da, db):
+        """Start the walk from the first-order predictor: the state at the last
+        equilibrium moved by its tangent in the ends' motion (``da``, ``db`` (3,), m),
+        dy = (dy/dz_a) da_z + (dy/dc) (db - da) and dmu likewise (the solves
+        A^-1 [C^T, P] of the last stiffness, _response; docs/systems.md, "The lines'
+        predictor"), the frames turned through the Newton step's exponential map,
+        d_n <- exp([omega_n]x) d_n (and k_n += dk_n on an extensible line), tau and
+        lambda handed over as the Uzawa fixed point at those frames (the loads at the
+        moved ends). A walk without it (no tangent of this state, a clamp or a joint
+        turned) starts from the old state with its ends moved. Returns whether the
+        state was predicted; where the prediction is not finite the state is as it was.
+        Collective."""
+        if not self.predicts or self.tangent is None or self.tangent[2] != self.solves:
+            return False
+        tangent, dmu, _ = self.tangent
+        change = np.concatenate([[da[2]], db - da])
+        problem, newton = self.problem, self.newton
+        state = problem.state
+        saved = state.snapshot()
+        frames = state.tau.copy()
+        held = ~problem.free_nodes
+        frames[held] = state.node_directors()[held]
+        omega = tangent @ change
+        ok = bool(self.mesh.global_min(int(np.all(np.isfinite(omega)))))
+        if ok:
+            # each section's roll about its tangent: a chain's torsion is next to free
+            # (GJ over the line), and the solves carry whatever of it round-off puts
+            # there; the ends' forces do not see it, the frames do
+            tangents = frames[:, 2] / np.linalg.norm(frames[:, 2], axis=1)[:, None]
+            omega[:, :3] -= np.einsum("nc,nc->n", omega[:, :3], tangents)[:, None] * tangents
+            ok = bool(self.mesh.global_max(float(np.abs(omega[:, :3]).max(initial=0.0)))
+                      <= PREDICTED_TURN)
+        if ok and newton.stretch:
+            frames = newton._stretched(frames, omega)
+            ok = frames is not None
+        elif ok:
+            frames = np.matmul(frames, rotations(omega[:, :3]).transpose(0, 2, 1))
+        if self.mesh.global_min(int(ok)):
+            problem.prepare(1.0)
+            newton._hand_over(frames, state.chord_multiplier + dmu @ change)
+            if self.mesh.global_min(int(np.all(np.isfinite(state.tau))
+                                        and np.all(np.isfinite(state.lam)))):
+                return True
+        state.restore(saved)
+        return False
+
+    def _newton(self):
+        """Newton's steps from the predicted state (iteration/newton.py): whether they
+        converged, to the stationary point (``iterations`` their number); otherwise the
+        state is the predicted one. Collective."""
+        steps = []
+        self.solves += 1
+        self.settled = self.converged = self.newton.run(record=steps.append) == CONVERGED
+        self.iterations = len(steps)
+        if self.converged:
+            self.problem.accept_step()
+        return self.converged
+
     def _run(self, path):
         """The continuation on ``path``: whether it converged (a divergence, a PETSc
         error of its solves, is a failure). Collective."""
         self.iterations = 0
         self.settled = False
+        self.solves += 1
         try:
             for event in continuation(self.solver, path):
                 if isinstance(event, events.NewtonAttempt):
@@ -639,6 +723,7 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
+            self.solves += 1
 
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
@@ -979,6 +1064,12 @@ class HeldLine:
         multipliers[:, 0] = -inverse @ along
         multipliers[:, 1:] = -inverse[:, :3]
         dmu = multipliers[:3]
+        # the state's tangent in (z_a, c): dy = -Y_P dz - Y_C dmu (the predictor, predict)
+        tangent = -np.einsum("inu,ij->nuj", np.array([hessian.from_vec(y) for y in Y_C]),
+                             multipliers)
+        if Y_P:
+            tangent[..., 0] -= hessian.from_vec(Y_P[0])
+        self.tangent = (tangent, dmu.copy(), self.solves)
 
         def of_dy(values_C, value_P):
             """A linear functional of dy (values on Y_C (.., 3) and on Y_P (..,))
@@ -1055,6 +1146,7 @@ def held_lines(system, options=None):
         held = HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
         held.settles = False                # SystemSolver.evaluate settles it when it reports
+        held.predicts = True                # its stiffness is asked after every solve
         return held
 
     return make_line
