@@ -307,7 +307,9 @@ class HeldLine:
     end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
     end_stiffness() -> (12, 12); settle(); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
-    destroy(). ``iterations``: those of the last solve."""
+    destroy(). ``iterations``: those of the last solve; ``predicts``: a walk starts
+    from the last equilibrium moved by its tangent where the last stiffness gave it
+    (_predict; a system's lines, held_lines)."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -511,10 +513,10 @@ class HeldLine:
         predictor"), the frames turned through the Newton step's exponential map,
         d_n <- exp([omega_n]x) d_n (and k_n += dk_n on an extensible line), tau and
         lambda handed over as the Uzawa fixed point at those frames (the loads at the
-        moved ends). A walk without it (no tangent of this state, a clamp or a joint
-        turned) starts from the old state with its ends moved. Returns whether the
-        state was predicted; where the prediction is not finite the state is as it was.
-        Collective."""
+        moved ends). A walk without it (not ``predicts``, no tangent of this state, a
+        clamp or a joint turned, a predicted turn above PREDICTED_TURN) starts from the
+        old state with its ends moved. Returns whether the state was predicted; where
+        it was not (or not finite) the state is as it was. Collective."""
         if not self.predicts or self.tangent is None or self.tangent[2] != self.solves:
             return False
         tangent, dmu, _ = self.tangent
@@ -528,11 +530,10 @@ class HeldLine:
         omega = tangent @ change
         ok = bool(self.mesh.global_min(int(np.all(np.isfinite(omega)))))
         if ok:
-            # each section's roll about its tangent: a chain's torsion is next to free
-            # (GJ over the line), and the solves carry whatever of it round-off puts
-            # there; the ends' forces do not see it, the frames do
-            tangents = frames[:, 2] / np.linalg.norm(frames[:, 2], axis=1)[:, None]
-            omega[:, :3] -= np.einsum("nc,nc->n", omega[:, :3], tangents)[:, None] * tangents
+            if newton.free_roll:
+                # round sections, nothing clamped: the solves carry whatever of the
+                # free roll (a null vector of H) round-off puts there
+                newton._without_roll(omega, frames)
             ok = bool(self.mesh.global_max(float(np.abs(omega[:, :3]).max(initial=0.0)))
                       <= PREDICTED_TURN)
         if ok and newton.stretch:
@@ -1126,9 +1127,11 @@ def held_lines(system, options=None):
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
-    instead of after each of its re-solves; and they are settled at their stationary
+    instead of after each of its re-solves; they are settled at their stationary
     points (HeldLine.settle) for the stiffness the system reports only, not for its
-    iterations' Jacobian. A current profile's depths are below the
+    iterations' Jacobian; and a small move of their ends is walked from the
+    first-order predictor (HeldLine.predicts: their stiffness is asked after every
+    solve). A current profile's depths are below the
     system's sea surface, z = 0 where the Environment gives none (as the free points'
     drag, system/equilibrium.py), not below each line's higher end as for a single
     line: the lines and points of a system share one sea."""
