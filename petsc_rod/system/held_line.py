@@ -99,7 +99,7 @@ from petsc_rod.io.outputs import vertex_fields
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import CONVERGED, NewtonSolver
-from petsc_rod.frames import REFERENCE_FRAME, rotations
+from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.global_step.chain_factor import NULL_PIVOT
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
@@ -113,12 +113,6 @@ from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import blended_frame
 from petsc_rod.scenes.scene import EndState
 
-
-# A predicted state that turns a section by more than this (rad) is not used: the
-# tangent at the last equilibrium holds the seabed's contact as it was, and beyond this
-# the walk from the old state with its ends moved starts nearer (docs/systems.md, "The
-# lines' predictor").
-PREDICTED_TURN = 1e-2
 
 # The units of HeldLine.summary's numbers.
 SUMMARY_UNITS = {"max_tension": "N", "max_tension_S": "m", "max_tension_position": "m",
@@ -307,9 +301,7 @@ class HeldLine:
     end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
     end_stiffness() -> (12, 12); settle(); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
-    destroy(). ``iterations``: those of the last solve; ``predicts``: a walk starts
-    from the last equilibrium moved by its tangent where the last stiffness gave it
-    (_predict; a system's lines, held_lines)."""
+    destroy(). ``iterations``: those of the last solve."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -333,10 +325,6 @@ class HeldLine:
         self.iterations = 0
         self.converged = False
         self.settled = False                # the last solve ended in Newton's convergence
-        self.solves = 0                     # the state's changes (solves, settlings)
-        self.tangent = None                 # (dy/d(z_a, c), dmu/d(z_a, c), at solves)
-        self.predicts = False               # walks start from the predictor (_predict)
-        self.predicted = False              # the last walk started from the predictor
         self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
@@ -414,7 +402,6 @@ class HeldLine:
         if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
         self.jacobian = None
-        self.tangent = None
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
@@ -479,25 +466,11 @@ class HeldLine:
         saved = state.snapshot()
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
         axes = {e: term.axis for e, (term, _) in self.axes.items()}
-        turned = any(given is not None and not np.array_equal(given, end.frame)
-                     for given, end in zip(frames, ends))
         self.path.move(a, b, *frames)
         self._turn_joints(frames)
-        self.predicted = not turned and self._predict(a - ends[0].position,
-                                                       b - ends[1].position)
         if self._run(PathSettings(steps=1, track_link=False)):
             self.path.hold(a, b, *frames)
             return True
-        if self.predicted:
-            # the walk from the old state with only its ends moved
-            state.restore(saved)
-            self.predicted = False
-            iterations = self.iterations
-            done = self._run(PathSettings(steps=1, track_link=False))
-            self.iterations += iterations
-            if done:
-                self.path.hold(a, b, *frames)
-                return True
         for e, (term, _) in self.axes.items():
             term.axis = axes[e]
         state.restore(saved)
@@ -505,69 +478,11 @@ class HeldLine:
         self.problem.prepare(1.0)
         return False
 
-    def _predict(self, da, db):
-        """Start the walk from the first-order predictor: the state at the last
-        equilibrium moved by its tangent in the ends' motion (``da``, ``db`` (3,), m),
-        dy = (dy/dz_a) da_z + (dy/dc) (db - da) and dmu likewise (the solves
-        A^-1 [C^T, P] of the last stiffness, _response; docs/systems.md, "The lines'
-        predictor"), the frames turned through the Newton step's exponential map,
-        d_n <- exp([omega_n]x) d_n (and k_n += dk_n on an extensible line), tau and
-        lambda handed over as the Uzawa fixed point at those frames (the loads at the
-        moved ends). A walk without it (not ``predicts``, no tangent of this state, a
-        clamp or a joint turned, a predicted turn above PREDICTED_TURN) starts from the
-        old state with its ends moved. Returns whether the state was predicted; where
-        it was not (or not finite) the state is as it was. Collective."""
-        if not self.predicts or self.tangent is None or self.tangent[2] != self.solves:
-            return False
-        tangent, dmu, _ = self.tangent
-        change = np.concatenate([[da[2]], db - da])
-        problem, newton = self.problem, self.newton
-        state = problem.state
-        saved = state.snapshot()
-        frames = state.tau.copy()
-        held = ~problem.free_nodes
-        frames[held] = state.node_directors()[held]
-        omega = tangent @ change
-        ok = bool(self.mesh.global_min(int(np.all(np.isfinite(omega)))))
-        if ok:
-            if newton.free_roll:
-                # round sections, nothing clamped: the solves carry whatever of the
-                # free roll (a null vector of H) round-off puts there
-                newton._without_roll(omega, frames)
-            ok = bool(self.mesh.global_max(float(np.abs(omega[:, :3]).max(initial=0.0)))
-                      <= PREDICTED_TURN)
-        if ok and newton.stretch:
-            frames = newton._stretched(frames, omega)
-            ok = frames is not None
-        elif ok:
-            frames = np.matmul(frames, rotations(omega[:, :3]).transpose(0, 2, 1))
-        if self.mesh.global_min(int(ok)):
-            problem.prepare(1.0)
-            newton._hand_over(frames, state.chord_multiplier + dmu @ change)
-            if self.mesh.global_min(int(np.all(np.isfinite(state.tau))
-                                        and np.all(np.isfinite(state.lam)))):
-                return True
-        state.restore(saved)
-        return False
-
-    def _newton(self):
-        """Newton's steps from the predicted state (iteration/newton.py): whether they
-        converged, to the stationary point (``iterations`` their number); otherwise the
-        state is the predicted one. Collective."""
-        steps = []
-        self.solves += 1
-        self.settled = self.converged = self.newton.run(record=steps.append) == CONVERGED
-        self.iterations = len(steps)
-        if self.converged:
-            self.problem.accept_step()
-        return self.converged
-
     def _run(self, path):
         """The continuation on ``path``: whether it converged (a divergence, a PETSc
         error of its solves, is a failure). Collective."""
         self.iterations = 0
         self.settled = False
-        self.solves += 1
         try:
             for event in continuation(self.solver, path):
                 if isinstance(event, events.NewtonAttempt):
@@ -724,7 +639,6 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
-            self.solves += 1
 
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
@@ -1065,12 +979,6 @@ class HeldLine:
         multipliers[:, 0] = -inverse @ along
         multipliers[:, 1:] = -inverse[:, :3]
         dmu = multipliers[:3]
-        # the state's tangent in (z_a, c): dy = -Y_P dz - Y_C dmu (the predictor, predict)
-        tangent = -np.einsum("inu,ij->nuj", np.array([hessian.from_vec(y) for y in Y_C]),
-                             multipliers)
-        if Y_P:
-            tangent[..., 0] -= hessian.from_vec(Y_P[0])
-        self.tangent = (tangent, dmu.copy(), self.solves)
 
         def of_dy(values_C, value_P):
             """A linear functional of dy (values on Y_C (.., 3) and on Y_P (..,))
@@ -1127,11 +1035,9 @@ def held_lines(system, options=None):
     by ``options`` (-rod_* options without ``rod_``). The lines' own stability test is
     off ({'al_stability': 0} unless ``options`` says otherwise): the system tests each
     line once at its equilibrium (SystemSolver.line_verdicts, HeldLine.stable)
-    instead of after each of its re-solves; they are settled at their stationary
+    instead of after each of its re-solves; and they are settled at their stationary
     points (HeldLine.settle) for the stiffness the system reports only, not for its
-    iterations' Jacobian; and a small move of their ends is walked from the
-    first-order predictor (HeldLine.predicts: their stiffness is asked after every
-    solve). A current profile's depths are below the
+    iterations' Jacobian. A current profile's depths are below the
     system's sea surface, z = 0 where the Environment gives none (as the free points'
     drag, system/equilibrium.py), not below each line's higher end as for a single
     line: the lines and points of a system share one sea."""
@@ -1149,7 +1055,6 @@ def held_lines(system, options=None):
         held = HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
         held.settles = False                # SystemSolver.evaluate settles it when it reports
-        held.predicts = True                # its stiffness is asked after every solve
         return held
 
     return make_line

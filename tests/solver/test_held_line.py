@@ -154,34 +154,6 @@ def test_stiffness_on_an_elastic_seabed(mooring):
     assert K[2, 2] == pytest.approx(lifted[2, 2], rel=1e-4)
 
 
-@pytest.mark.parametrize("comm", list(COMMS.values()), ids=list(COMMS))
-def test_a_small_move_starts_from_the_predictor(comm):
-    """A system's line (``predicts``: its stiffness asked after each solve) walks a small
-    move of its ends from its last equilibrium moved by its tangent, dy/d(ends) . (the
-    ends' move): a few iterations instead of a walk's (its 15 before Newton), the same
-    forces to the lines' tolerances; a move whose predicted turn is above PREDICTED_TURN
-    walks as before."""
-    move = (MOORING[0], MOORING[1] + np.array([2e-4, 0.0, 1e-4]))
-    lines = [HeldLine(line_model(MOORING, seabed=-30.0, elements=50), comm)
-             for _ in range(2)]
-    try:
-        assert all(line.solve(*MOORING) for line in lines)
-        old, new = lines
-        new.predicts = True
-        for line in lines:
-            line.stiffness()
-            assert line.solve(*move)
-        assert new.predicted and not old.predicted
-        assert new.iterations <= 3 < 10 <= old.iterations
-        assert new.end_forces() == pytest.approx(old.end_forces(), rel=1e-8)
-        new.stiffness()
-        assert new.solve(MOORING[0], MOORING[1] + np.array([10.0, 0.0, 0.0]))
-        assert not new.predicted
-    finally:
-        for line in lines:
-            line.destroy()
-
-
 def test_one_rank_and_all_agree(mooring):
     alone = held(line_model(MOORING, seabed=-30.0, elements=50), PETSc.COMM_SELF, MOORING)
     try:
