@@ -318,6 +318,7 @@ class SystemSolver:
             raise
         self.forces = self.stiffnesses = None
         self.failure, self.checked, self.last = "", False, None
+        self.mine = {}                          # this rank's lines' last results
         # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
         # asked before every Newton iteration; None: not asked
         self.interrupts = None
@@ -389,7 +390,9 @@ class SystemSolver:
         system reports (the iterations' Jacobian needs only the lines' tolerances).
         Without ``linearise`` the lines' stiffnesses are left out (Linearised.matrix
         None: a trial whose Jacobian no step may need); asked again at the same ends
-        with it, they are added without solving the lines again."""
+        with it, they are added without solving the lines again. A line that stands
+        there at its stationary point already (``settled``) keeps its last results
+        (settling it changes nothing, nor its stiffness)."""
         layout = self.layout
         positions = self.end_positions(state)
         key = (positions, state.bodies.R)
@@ -399,8 +402,12 @@ class SystemSolver:
             return self.last[1]                 # the lines stand there already
         frames = self.end_frames(state)
         mine = {}
+        linearised = there and self.last[1][2].matrix is not None
         for k, line in self.lines.items():
             turned = bool(layout.turned[k].any())
+            if linearised and getattr(line, "settled", False) and self.mine[k][0]:
+                mine[k] = self.mine[k]
+                continue
             try:
                 ok = there or bool(line.solve(positions[k, 0], positions[k, 1], *frames[k])
                                    if turned else line.solve(positions[k, 0], positions[k, 1]))
@@ -420,6 +427,7 @@ class SystemSolver:
             except (RodError, np.linalg.LinAlgError):
                 mine[k] = (False,)
         self.last = None
+        self.mine = mine
         shared = self.placement.share(mine)
         refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
         if refused and strict:

@@ -444,6 +444,38 @@ def test_each_line_is_linearised_once_a_step_and_once_for_the_report(load):
         solver.destroy()
 
 
+class SettledLine(CountingLine):
+    """A counting spring that says it stands at its stationary point (HeldLine's
+    ``settled``): settling it changes nothing."""
+
+    settled = True
+
+    def settle(self):
+        pass
+
+
+def settled(line, comm):
+    return SettledLine(line.line.stiffness[0], line.line.length, comm,
+                       limit=line.line.stiffness[1])
+
+
+@pytest.mark.parametrize("held", [True, False])
+def test_a_settled_line_is_not_linearised_again_where_it_stands(held):
+    """The equilibrium reported where the lines were last linearised (a held body: the
+    start) takes the settled lines' stiffnesses as they were: once each in all."""
+    SpringLine.made = []
+    solver = SystemSolver(spread(held=(held,) * 6), settled, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-13))
+    try:
+        result = solver.solve()
+        K = solver.body_stiffness("floater").matrix
+        assert np.all(np.isfinite(K)) and np.abs(K).max() > 0.0
+        assert [line.linearised for line in SpringLine.made] == \
+            [result.iterations + 1] * 3
+    finally:
+        solver.destroy()
+
+
 def test_a_residual_at_the_lines_accuracy_is_accepted_below_the_floor():
     system = spread(load=(1e6, 0, 0, 0, 0, 0))
     noisy = lambda line, comm: NoisyLine(line.line.stiffness[0], line.line.length, comm)
