@@ -318,6 +318,7 @@ class SystemSolver:
             raise
         self.forces = self.stiffnesses = None
         self.failure, self.checked, self.last = "", False, None
+        self.mine = {}                          # this rank's lines' last results
         # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
         # asked before every Newton iteration; None: not asked
         self.interrupts = None
@@ -375,7 +376,7 @@ class SystemSolver:
             out.append(tuple(ends))
         return out
 
-    def evaluate(self, state, strict=False, settle=False):
+    def evaluate(self, state, strict=False, settle=False, linearise=True):
         """Solve every line at ``state``'s end positions (and a clamp's frame at a body:
         end_frames) (this rank's lines in turn) and share the results: (converged, end
         forces (n, 2, 3), Linearised). A line with a clamp at a body is asked for
@@ -386,18 +387,27 @@ class SystemSolver:
         is at fault): then its error is raised on every rank. The ends of the last
         successful evaluation are not solved again. ``settle``: each line that can
         (HeldLine.settle) first taken to its stationary point, for the stiffness a
-        system reports (the iterations' Jacobian needs only the lines' tolerances)."""
+        system reports (the iterations' Jacobian needs only the lines' tolerances).
+        Without ``linearise`` the lines' stiffnesses are left out (Linearised.matrix
+        None: a trial whose Jacobian no step may need); asked again at the same ends
+        with it, they are added without solving the lines again. A line that stands
+        there at its stationary point already (``settled``) keeps its last results
+        (settling it changes nothing, nor its stiffness)."""
         layout = self.layout
         positions = self.end_positions(state)
         key = (positions, state.bodies.R)
         there = self.last is not None and all(np.array_equal(a, b)
                                               for a, b in zip(key, self.last[0]))
-        if there and not settle:
+        if there and not settle and (self.last[1][2].matrix is not None or not linearise):
             return self.last[1]                 # the lines stand there already
         frames = self.end_frames(state)
         mine = {}
+        linearised = there and self.last[1][2].matrix is not None
         for k, line in self.lines.items():
             turned = bool(layout.turned[k].any())
+            if linearised and getattr(line, "settled", False) and self.mine[k][0]:
+                mine[k] = self.mine[k]
+                continue
             try:
                 ok = there or bool(line.solve(positions[k, 0], positions[k, 1], *frames[k])
                                    if turned else line.solve(positions[k, 0], positions[k, 1]))
@@ -406,15 +416,18 @@ class SystemSolver:
                 if not ok:
                     mine[k] = (False,)
                 elif turned:        # a refused end stiffness: below, on every rank
-                    mine[k] = (True, line.end_forces(), line.end_stiffness(),
+                    mine[k] = (True, line.end_forces(),
+                               line.end_stiffness() if linearise else None,
                                line.end_moments())
                 else:
-                    mine[k] = (True, line.end_forces(), line.stiffness())
+                    mine[k] = (True, line.end_forces(),
+                               line.stiffness() if linearise else None)
             except RodInputError as error:      # raised below on every rank
                 mine[k] = (False, error)
             except (RodError, np.linalg.LinAlgError):
                 mine[k] = (False,)
         self.last = None
+        self.mine = mine
         shared = self.placement.share(mine)
         refused = [shared[k][1] for k in sorted(shared) if len(shared[k]) == 2]
         if refused and strict:
@@ -430,9 +443,10 @@ class SystemSolver:
         matrix, moments = np.zeros((n, 12, 12)), np.zeros((n, 2, 3))
         for k in range(n):
             if len(shared[k]) == 4:
-                matrix[k] = shared[k][2]
                 moments[k] = shared[k][3]
-            else:
+            if linearise and len(shared[k]) == 4:
+                matrix[k] = shared[k][2]
+            elif linearise:
                 matrix[k, :6, :6] = shared[k][2]
         # a pinned end's moment (of the discretisation, not a reaction) is not applied
         off = ~layout.turned
@@ -440,7 +454,7 @@ class SystemSolver:
         rows = np.zeros((n, 12), dtype=bool)
         rows[:, 6:9], rows[:, 9:] = off[:, :1], off[:, 1:]
         matrix[rows] = 0.0
-        self.last = (key, (True, forces, Linearised(matrix, moments)))
+        self.last = (key, (True, forces, Linearised(matrix if linearise else None, moments)))
         return self.last[1]
 
     # -- residual and Jacobian ---------------------------------------------------------
@@ -450,7 +464,8 @@ class SystemSolver:
         (module docstring; the last row and column of the (size + 1)^2 work arrays
         collect the held ends), from their end ``forces`` (n, 2, 3) and ``stiffness``
         (Linearised): an end at a body moves by dx = T dq and a clamp there turns by
-        dtheta, so each end's (f, M) acts through [T; 0 I] (6 x 6)."""
+        dtheta, so each end's (f, M) acts through [T; 0 I] (6 x 6). J is None where the
+        stiffnesses were left out (evaluate's ``linearise``)."""
         layout, n = self.layout, len(self.system.lines)
         arms = self.arms(state)
         T = lever_map(arms.reshape(-1, 3)).reshape(n, 2, 3, 6)
@@ -463,6 +478,8 @@ class SystemSolver:
         size = layout.size + 1
         r = np.zeros(size)
         np.add.at(r, layout.ends, np.einsum("njia,nji->nja", maps, loads))
+        if stiffness.matrix is None:
+            return r[:-1], None
         K = stiffness.matrix[:, BY_END][:, :, BY_END].reshape(n, 2, 6, 2, 6)
         blocks = np.einsum("niba,nibjc,njcd->nijad", maps, K, maps)     # (n, 2, 2, 6, 6)
         rows = np.broadcast_to(layout.ends[:, :, None, :, None], blocks.shape)
@@ -539,7 +556,7 @@ class SystemSolver:
     def residual(self, state, loads, forces, stiffness):
         r_lines, J_lines = self.lines_part(state, forces, stiffness)
         r_own, J_own = self.own_part(state, loads)
-        return r_lines + r_own, J_lines + J_own
+        return r_lines + r_own, None if J_lines is None else J_lines + J_own
 
     # -- Newton, continuation ------------------------------------------------------------
 
@@ -566,7 +583,7 @@ class SystemSolver:
         state = State(state.points.copy(),
                       state.bodies.placed(loads.places, self.layout.held_places))
         state.points[held] = loads.held[held]
-        ok, forces, stiffness = self.evaluate(state)
+        ok, forces, stiffness = self.evaluate(state, linearise=False)
         if not ok:
             return None, 0
         r, J = self.residual(state, loads, forces, stiffness)
@@ -580,6 +597,14 @@ class SystemSolver:
                 return state, iteration
             if iteration == settings.max_iterations:
                 break
+            if J is None:
+                # the lines' stiffnesses, left out of the evaluation until a step needs
+                # them (the last one's never is: solve's settled evaluation gives them)
+                ok, forces, stiffness = self.evaluate(state)
+                if not ok:
+                    return None, iteration
+                self.stiffnesses = stiffness
+                r, J = self.residual(state, loads, forces, stiffness)
             step = np.zeros(self.layout.size)
             try:
                 step[free] = -np.linalg.solve(J[np.ix_(free, free)], r[free])
@@ -593,7 +618,7 @@ class SystemSolver:
             alpha, full = 1.0, ""
             for _ in range(settings.line_search + 1):
                 trial = state.moved(alpha * step, self.layout)
-                ok, t_forces, t_stiffness = self.evaluate(trial)
+                ok, t_forces, t_stiffness = self.evaluate(trial, linearise=False)
                 full = full or ("" if ok or alpha < 1.0 else f" ({self.failure} at the "
                                                              "full step)")
                 if ok:
@@ -699,6 +724,8 @@ class SystemSolver:
         # the end forces and stiffness of the lines as they are left (a re-solve from a
         # trial differs by the lines' own tolerances).
         solved = self.evaluate(self.state, settle=True)
+        if not solved[0] and self.stiffnesses.matrix is None:
+            solved = self.evaluate(self.state)
         if solved[0]:
             self.forces, self.stiffnesses = solved[1], solved[2]
         return self.result(factor, total, halvings, self.line_verdicts())

@@ -413,6 +413,69 @@ class NoisyLine(SpringLine):
         return super().end_forces() * (1.0 + 1e-9 * np.sin(self.solves))
 
 
+class CountingLine(SpringLine):
+    """A spring that counts its stiffness's evaluations."""
+
+    def stiffness(self):
+        self.linearised = getattr(self, "linearised", 0) + 1
+        return super().stiffness()
+
+
+def counting(line, comm):
+    return CountingLine(line.line.stiffness[0], line.line.length, comm,
+                        limit=line.line.stiffness[1])
+
+
+@pytest.mark.parametrize("load", [(4e5, -2e5, 1e5, 3e6, -2e6, 5e6), (0.0,) * 6])
+def test_each_line_is_linearised_once_a_step_and_once_for_the_report(load):
+    """A trial's stiffness is asked only where a step reads it: each line's once for each
+    Newton step (the start's serves the first) and once at the equilibrium reported,
+    not at the last step's trial too."""
+    SpringLine.made = []
+    solver = SystemSolver(spread(load=load), counting, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-13))
+    try:
+        result = solver.solve()
+        K = solver.body_stiffness("floater").matrix
+        assert result.iterations > 0 and np.all(np.isfinite(K))
+        assert [line.linearised for line in SpringLine.made] == \
+            [result.iterations + 1] * 3
+    finally:
+        solver.destroy()
+
+
+class SettledLine(CountingLine):
+    """A counting spring that says it stands at its stationary point (HeldLine's
+    ``settled``): settling it changes nothing."""
+
+    settled = True
+
+    def settle(self):
+        pass
+
+
+def settled(line, comm):
+    return SettledLine(line.line.stiffness[0], line.line.length, comm,
+                       limit=line.line.stiffness[1])
+
+
+@pytest.mark.parametrize("held", [True, False])
+def test_a_settled_line_is_not_linearised_again_where_it_stands(held):
+    """The equilibrium reported where the lines were last linearised (a held body: the
+    start) takes the settled lines' stiffnesses as they were: once each in all."""
+    SpringLine.made = []
+    solver = SystemSolver(spread(held=(held,) * 6), settled, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-13))
+    try:
+        result = solver.solve()
+        K = solver.body_stiffness("floater").matrix
+        assert np.all(np.isfinite(K)) and np.abs(K).max() > 0.0
+        assert [line.linearised for line in SpringLine.made] == \
+            [result.iterations + 1] * 3
+    finally:
+        solver.destroy()
+
+
 def test_a_residual_at_the_lines_accuracy_is_accepted_below_the_floor():
     system = spread(load=(1e6, 0, 0, 0, 0, 0))
     noisy = lambda line, comm: NoisyLine(line.line.stiffness[0], line.line.length, comm)
