@@ -505,7 +505,7 @@ class HeldLine:
 
     def _walk(self, a, b, frames):
         state = self.problem.state
-        saved = state.snapshot()
+        saved, settled = state.snapshot(), self.settled
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
         axes = {e: term.axis for e, (term, _) in self.axes.items()}
         self.path.move(a, b, *frames)
@@ -516,6 +516,7 @@ class HeldLine:
         for e, (term, _) in self.axes.items():
             term.axis = axes[e]
         state.restore(saved)
+        self.settled = settled                  # the restored equilibrium's
         self.path.hold(ends[0].position, ends[1].position, ends[0].frame, ends[1].frame)
         self.problem.prepare(1.0)
         return False
@@ -537,11 +538,13 @@ class HeldLine:
                     newton_at = None
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
+                    self.settled = self.settled and bool(event.converged)
                     return bool(event.converged)
                 if isinstance(event, events.RunDiverged):
-                    return False
+                    break
         except (RodError, PETSc.Error, FloatingPointError):
-            return False
+            pass
+        self.settled = False                    # a failed run's state is no equilibrium
         return False
 
     # --- what it gives the system --------------------------------------------------------

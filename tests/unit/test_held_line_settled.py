@@ -9,6 +9,7 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.api import End, Environment, Model, UniformLine
+from petsc_rod.errors import RodDivergedError
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.newton import CONVERGED, FAILED
@@ -57,3 +58,31 @@ def test_settled_only_where_the_last_step_ends_at_newton(name, monkeypatch):
                         lambda solver, path: iter(script + [FINISHED]))
     assert line._run(PathSettings(steps=1, track_link=False))
     assert line.settled is settled
+
+
+def diverging(script):
+    """The continuation of ``script`` that then raises a divergence, as a solve's
+    failure inside an attempt does."""
+    yield from script
+    raise RodDivergedError("diverged")
+
+
+FAILURES = {
+    "a divergence after a settled half step": lambda: iter(
+        [newton(20), ended(20, 0.5), events.RunDiverged(RodDivergedError("x"), 0.75, 1)]),
+    "an error raised after a settled half step": lambda: diverging(
+        [newton(20), ended(20, 0.5)]),
+}
+
+
+@pytest.mark.parametrize("name", list(FAILURES))
+def test_a_failed_run_is_not_settled(name, monkeypatch):
+    """A run that fails after a half step that ended at Newton (the review: the flag
+    stayed true, and a walk's restored equilibrium then skipped its settling)."""
+    line = HeldLine(Model(UniformLine(length=10.0, stiffness=(1.0, 1.0, 1.0),
+                                      load=(0, 0, -1.0), elements=4),
+                          End.anchor((0.0, 0.0, 0.0)), End.anchor((8.0, 0.0, 0.0)),
+                          Environment()), PETSc.COMM_SELF)
+    monkeypatch.setattr(held_line, "continuation", lambda solver, path: FAILURES[name]())
+    assert not line._run(PathSettings(steps=1, track_link=False))
+    assert line.settled is False
