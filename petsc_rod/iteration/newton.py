@@ -97,8 +97,9 @@ FLOOR_TURN = 1e-7
 # result. A conservative problem's steps stay exact.
 FREEZE_TURN = 1e-4
 FROZEN_SHRINK = 0.1
-# On such a problem an exact step after a step of at most INERTIA_TURN rad whose H passed
-# the inertia test is taken without the test (no LDL^T of H: its solves are J's): the
+# On such a problem an exact step after a step of at most INERTIA_TURN rad whose own H
+# (not one with the iteration's curvature, nor with the roll held) passed the inertia
+# test is taken without the test (no LDL^T of H: its solves are J's): the
 # inertia on the constraint set changes between two states only where an eigenvalue
 # crosses zero, and H's entries (smooth in the frames and the multipliers) move by about
 # the turn times their derivatives between the two, so the test, like a chord step's
@@ -165,6 +166,7 @@ class NewtonSolver:
         self._kkt = None
         # the next step is exact and taken without the inertia test (run, INERTIA_TURN)
         self._trusted = False
+        self._own_test = False          # the last _newton_step passed its own H's test
         # the free roll: where K1 = K2 all along and no frame is clamped, turning every
         # cross-section by one angle about its own tangent changes nothing (a null vector
         # of the Newton system, which LU turns into a step of round-off's size); the
@@ -248,7 +250,7 @@ class NewtonSolver:
         start_norm = np.inf               # |grad L| of the last step's start (all)
         outcome = FAILED
         regularised = False
-        tested = False                    # the last step's H passed the inertia test
+        tested = False                    # the last step passed the test of its own H
         try:
             self._agree(self._usable(frames))
             for _ in range(MAX_STEPS):
@@ -268,7 +270,7 @@ class NewtonSolver:
                 self._trusted = (self.unsymmetric and not chord and tested
                                  and previous <= INERTIA_TURN)
                 omega, dmu = self._newton_step(frames, g, mu, regularised, curvature, chord)
-                tested = not (chord or self._trusted)
+                tested = self._own_test
                 self._trusted = False
                 if (chord and previous > FLOOR_TURN
                         and not self._largest(omega) <= FROZEN_SHRINK * previous):
@@ -276,7 +278,7 @@ class NewtonSolver:
                     # floor the shrink test below hands the state over instead)
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
-                    tested = True
+                    tested = self._own_test
                 if omega is None and curvature is None and self.reads_positions:
                     # H indefinite after a step on a line whose heights enter: the step
                     # again with the iteration's curvature, as the first (_newton_step),
@@ -284,7 +286,7 @@ class NewtonSolver:
                     curvature = start_lam
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised, curvature)
-                    tested = True
+                    tested = self._own_test
                 if omega is None:
                     outcome = INDEFINITE
                     break
@@ -318,7 +320,7 @@ class NewtonSolver:
                     regularised = True
                     chord = False
                     omega, dmu = self._newton_step(frames, g, mu, regularised)
-                    tested = True
+                    tested = self._own_test
                     if omega is None:
                         outcome = INDEFINITE
                         break
@@ -469,6 +471,7 @@ class NewtonSolver:
         vecs = []                   # every Vec made here, destroyed on the way out
         held = False
         try:
+            self._own_test = False
             if self._trusted and not frozen:
                 self.verified = False
             elif not frozen:
@@ -491,6 +494,10 @@ class NewtonSolver:
                 # on one with the roll held (H itself was found indefinite: the
                 # stability test decides)
                 self.verified = hessian.decidable and curvature is None and not held
+                # what a trusted step next to this one may lean on (INERTIA_TURN): the
+                # test of the state's own H, not of one with the iteration's curvature
+                # nor with the roll held
+                self._own_test = curvature is None and not held
             # the Jacobian with the followers' linearisation, else H's factor
             solver = (self._jacobian if frozen else self._jacobian_of(hessian)) \
                 if self.unsymmetric else hessian

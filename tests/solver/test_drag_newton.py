@@ -353,3 +353,37 @@ def test_an_exact_step_after_a_small_tested_one_is_taken_without_the_inertia_tes
     assert all_tests == all_factorisations
     assert tests == factorisations - 1
     assert np.abs(r - all_r).max() < 1e-12
+
+
+def test_a_first_step_with_the_iterations_curvature_vouches_for_no_trusted_step(
+        comm, solver_factory, monkeypatch):
+    """A line whose heights enter (the catenary of (d) on a seabed at its start): its
+    first step's inertia test is of H with the iteration's multipliers, not of the
+    state's own H, so the next exact step is tested even where every turn would allow a
+    trusted one (INERTIA_TURN = 1 rad): an H test between the first two factorisations
+    of J (the review found the state's own H indefinite at such a trusted step)."""
+    from petsc_rod.analysis.jacobian import NewtonJacobian
+    from petsc_rod.environment.seabed import Seabed
+    from petsc_rod.iteration import newton as newton_module
+    events = []
+    assemble = NewtonJacobian.assemble
+    positive_definite = NewtonSolver._positive_definite
+
+    def factored(self):
+        events.append("J")
+        assemble(self)
+
+    def tested(hessian, regularised=False):
+        events.append("H")
+        return positive_definite(hessian, regularised)
+
+    monkeypatch.setattr(NewtonJacobian, "assemble", factored)
+    monkeypatch.setattr(NewtonSolver, "_positive_definite", staticmethod(tested))
+    monkeypatch.setattr(newton_module, "FREEZE_TURN", 0.0)
+    monkeypatch.setattr(newton_module, "INERTIA_TURN", 1.0)
+    scene = dict(LINES["catenary"], seabed=Seabed(0.0, 1e3))
+    _, solver, report = converged(solver_factory, comm, scene, newton=True)
+    assert report.converged and solver.newton.reads_positions
+    assert events.count("J") >= 3
+    first, second = [k for k, event in enumerate(events) if event == "J"][:2]
+    assert "H" in events[:first] and "H" in events[first:second]
