@@ -314,16 +314,10 @@ def test_a_chord_step_solves_one_right_hand_side_and_ends_by_its_rest(comm, solv
     assert np.abs(r - exact_r).max() < 1e-9
 
 
-def test_an_exact_step_after_a_small_tested_one_is_taken_without_the_inertia_test(
-        comm, solver_factory, monkeypatch):
-    """The catenary of (d) with exact steps only (FREEZE_TURN = 0; measured turns 0.39,
-    0.15, 1.8e-3, 9.8e-6 rad, then one below STEP_TOLERANCE): the step after the tested
-    one of 9.8e-6 rad (at most INERTIA_TURN) is taken without H's inertia test (its
-    solves are J's), so H is tested at one step fewer than J is factored; the others
-    are tested, the first steps' turns being above INERTIA_TURN. The state is that of
-    the attempt that tests every step (INERTIA_TURN = 0), to round-off."""
+def recorded_steps(monkeypatch):
+    """The list to which each assembly (and LU) of the Newton Jacobian appends "J" and
+    each inertia test of H "H", in order, while ``monkeypatch`` holds."""
     from petsc_rod.analysis.jacobian import NewtonJacobian
-    from petsc_rod.iteration import newton as newton_module
     events = []
     assemble = NewtonJacobian.assemble
     positive_definite = NewtonSolver._positive_definite
@@ -338,6 +332,19 @@ def test_an_exact_step_after_a_small_tested_one_is_taken_without_the_inertia_tes
 
     monkeypatch.setattr(NewtonJacobian, "assemble", factored)
     monkeypatch.setattr(NewtonSolver, "_positive_definite", staticmethod(tested))
+    return events
+
+
+def test_an_exact_step_after_a_small_tested_one_is_taken_without_the_inertia_test(
+        comm, solver_factory, monkeypatch):
+    """The catenary of (d) with exact steps only (FREEZE_TURN = 0; measured turns 0.39,
+    0.15, 1.8e-3, 9.8e-6 rad, then one below STEP_TOLERANCE): the step after the tested
+    one of 9.8e-6 rad (at most INERTIA_TURN) is taken without H's inertia test (its
+    solves are J's), so H is tested at one step fewer than J is factored; the others
+    are tested, the first steps' turns being above INERTIA_TURN. The state is that of
+    the attempt that tests every step (INERTIA_TURN = 0), to round-off."""
+    from petsc_rod.iteration import newton as newton_module
+    events = recorded_steps(monkeypatch)
     monkeypatch.setattr(newton_module, "FREEZE_TURN", 0.0)
     scene = dict(LINES["catenary"], stiffness=(1e-1, 2e-1, 1e-1))
     runs = []
@@ -362,23 +369,9 @@ def test_a_first_step_with_the_iterations_curvature_vouches_for_no_trusted_step(
     state's own H, so the next exact step is tested even where every turn would allow a
     trusted one (INERTIA_TURN = 1 rad): an H test between the first two factorisations
     of J (the review found the state's own H indefinite at such a trusted step)."""
-    from petsc_rod.analysis.jacobian import NewtonJacobian
     from petsc_rod.environment.seabed import Seabed
     from petsc_rod.iteration import newton as newton_module
-    events = []
-    assemble = NewtonJacobian.assemble
-    positive_definite = NewtonSolver._positive_definite
-
-    def factored(self):
-        events.append("J")
-        assemble(self)
-
-    def tested(hessian, regularised=False):
-        events.append("H")
-        return positive_definite(hessian, regularised)
-
-    monkeypatch.setattr(NewtonJacobian, "assemble", factored)
-    monkeypatch.setattr(NewtonSolver, "_positive_definite", staticmethod(tested))
+    events = recorded_steps(monkeypatch)
     monkeypatch.setattr(newton_module, "FREEZE_TURN", 0.0)
     monkeypatch.setattr(newton_module, "INERTIA_TURN", 1.0)
     scene = dict(LINES["catenary"], seabed=Seabed(0.0, 1e3))
