@@ -728,6 +728,11 @@ class SystemSolver:
             solved = self.evaluate(self.state)
         if solved[0]:
             self.forces, self.stiffnesses = solved[1], solved[2]
+        if self.stiffnesses.matrix is None:
+            # the lines' stiffness failed at the equilibrium itself (the iterations
+            # ended at a trial, which takes none): no stiffness to report
+            raise RodDivergedError(f"system: the lines' stiffness at the equilibrium "
+                                   f"failed: {self.failure}")
         return self.result(factor, total, halvings, self.line_verdicts())
 
     def line_verdicts(self):

@@ -444,6 +444,45 @@ def test_each_line_is_linearised_once_a_step_and_once_for_the_report(load):
         solver.destroy()
 
 
+class BreakingLine(CountingLine):
+    """A counting spring whose stiffness fails (a LinAlgError, as a line's Schur solve
+    may) from its ``works + 1``-th evaluation on."""
+
+    works = 0
+
+    def stiffness(self):
+        if getattr(self, "linearised", 0) >= self.works:
+            raise np.linalg.LinAlgError("singular")
+        return super().stiffness()
+
+
+def test_a_stiffness_that_fails_at_the_equilibrium_is_a_failed_solve():
+    """The Newton steps converge, but the lines' stiffness at the equilibrium (asked for
+    the report: the iterations ended at a trial, which takes none) fails: the solve fails
+    with one line's message (a RodDivergedError), not a traceback when the body's
+    stiffness is read (the review)."""
+    load = (4e5, -2e5, 1e5, 3e6, -2e6, 5e6)
+    SpringLine.made = []
+    solver = SystemSolver(spread(load=load), counting, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-13))
+    try:
+        steps = solver.solve().iterations
+    finally:
+        solver.destroy()
+    BreakingLine.works = steps
+
+    def breaking(line, comm):
+        return BreakingLine(line.line.stiffness[0], line.line.length, comm,
+                            limit=line.line.stiffness[1])
+    solver = SystemSolver(spread(load=load), breaking, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-13))
+    try:
+        with pytest.raises(RodDivergedError, match="stiffness at the equilibrium failed"):
+            solver.solve()
+    finally:
+        solver.destroy()
+
+
 class SettledLine(CountingLine):
     """A counting spring that says it stands at its stationary point (HeldLine's
     ``settled``): settling it changes nothing."""
