@@ -99,6 +99,24 @@ def global_max(comm, value):
     return mpi.allreduce(float(value), op=MPI.MAX)
 
 
+def zero_slope_planes(monkeypatch):
+    """Make a seabed slope of 0 degrees a bathymetry.Plane (its slope vector zero) for
+    as long as ``monkeypatch`` holds, instead of the flat seabed the compile makes of it
+    (compile.seabed_shape): the plane's own path (its contact on the x, y, z position
+    chains, HeldLine's plane response) on the flat seabed's geometry."""
+    from petsc_rod import compile as compile_module
+    from petsc_rod.environment.bathymetry import Plane
+
+    made = compile_module.seabed_shape
+
+    def shape(sea, height, origin, n):
+        if sea.seabed_slope == 0 and sea.seabed_profile is None:
+            start = sea.seabed_origin if sea.seabed_origin is not None else (0.0, 0.0)
+            return Plane.sloping(start, height, 0.0, compile_module.seabed_direction(sea)).moved(origin)
+        return made(sea, height, origin, n)
+    monkeypatch.setattr(compile_module, "seabed_shape", shape)
+
+
 def run_cli(options):
     """cli.main.run on COMM_WORLD with ``options`` {name: text} in PETSc's options
     database, removed afterwards; the exit code."""
