@@ -527,6 +527,7 @@ class HeldLine:
         self.iterations = 0
         self.settled = False
         newton_at = None        # the iteration of the attempt's last converged Newton run
+        converged = False
         try:
             for event in continuation(self.solver, path):
                 if isinstance(event, events.NewtonAttempt):
@@ -538,14 +539,16 @@ class HeldLine:
                     newton_at = None
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
-                    self.settled = self.settled and bool(event.converged)
-                    return bool(event.converged)
+                    converged = bool(event.converged)
+                    break
                 if isinstance(event, events.RunDiverged):
                     break
         except (RodError, PETSc.Error, FloatingPointError):
             pass
-        self.settled = False                    # a failed run's state is no equilibrium
-        return False
+        finally:
+            if not converged:
+                self.settled = False            # a failed run's state is no equilibrium
+        return converged
 
     # --- what it gives the system --------------------------------------------------------
     def positions(self):

@@ -86,3 +86,23 @@ def test_a_failed_run_is_not_settled(name, monkeypatch):
     monkeypatch.setattr(held_line, "continuation", lambda solver, path: FAILURES[name]())
     assert not line._run(PathSettings(steps=1, track_link=False))
     assert line.settled is False
+
+
+def test_a_failed_walk_puts_back_the_restored_equilibriums_flag(monkeypatch):
+    """A walk that fails restores the last equilibrium (and the line stays converged):
+    its settled flag comes back with it, not the failed run's (whose half step ended at
+    a converged Newton run)."""
+    line = HeldLine(Model(UniformLine(length=10.0, stiffness=(1.0, 1.0, 1.0),
+                                      load=(0, 0, -1.0), elements=4),
+                          End.anchor((0.0, 0.0, 0.0)), End.anchor((8.0, 0.0, 0.0)),
+                          Environment()), PETSc.COMM_SELF)
+    try:
+        assert line.solve((0.0, 0.0, 0.0), (8.0, 0.0, 0.0))
+        line.settled = False                # as a solve ended by the tolerances leaves it
+        monkeypatch.setattr(held_line, "continuation",
+                            lambda solver, path: FAILURES["a divergence after a settled "
+                                                          "half step"]())
+        assert not line.solve((0.0, 0.0, 0.0), (8.5, 0.0, 0.0))
+        assert line.converged and line.settled is False
+    finally:
+        line.destroy()
