@@ -254,7 +254,8 @@ def check_seabed_stiffness(loads, n):
     """Refuse a seabed stiffer than sea.largest_stiffness (given, or the default
     w / 1 mm of a long line), naming the field and the largest stiffness accepted. A
     line with no load at all (a weightless line in still water, no force) has no such
-    bound: nothing presses it into the seabed, and the bound, scaled by its load, is 0."""
+    bound: nothing presses it into the seabed, and the bound, scaled by its load, is 0
+    (the model's range check still refuses a stiffness above MAX_MAGNITUDE)."""
     if not loads.sea.has_seabed:
         return
     force = float(sum(loads.applied_forces().values()))

@@ -3,6 +3,7 @@ checks name the model's fields, or the options a front end gives in their names;
 seabed, the current and the pipe's pressures are resolved in the compile, in the
 solver's frame."""
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -159,6 +160,10 @@ def test_a_seabed_under_a_line_with_no_load_is_not_bounded_by_its_load():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         model.check()
+    # the bound of the model's numbers still holds (its range check)
+    with pytest.raises(RodInputError, match="seabed_stiffness 1e\\+300: out of range"):
+        dataclasses.replace(model, environment=Environment(
+            seabed=-30.0, seabed_stiffness=1e300)).check()
     with pytest.raises(RodInputError, match="the largest accepted is 100 N/m"):
         Model(UniformLine(**dict(ROPE, load=(0.0, 0.0, -1e-10))),
               End.anchor((0.0, 0.0, -30.0)), End.anchor((60.0, 0.0, -10.0)),
