@@ -4,7 +4,8 @@ line's Newton system, Seabed.position_derivatives): tests/data/moordyn/small_fre
 plane rising 2 degrees along +x under the anchor at x = 65 m (0.2 m below it; the
 other two anchors 3.4 m above it), its chains grounded on it. The body's 6 x 6 against
 central differences of the lines re-solved at moved and turned poses, serially and on
-all ranks; a slope of zero gives the flat seabed's numbers bit for bit."""
+all ranks; a plane of slope zero (the plane's own path) gives the flat seabed's numbers
+to the lines' accuracy."""
 
 import dataclasses
 from pathlib import Path
