@@ -278,8 +278,8 @@ def check_not_folded(line, nodes, made_by):
             f"line {line.name}: its ends {line.start.to} and {line.end.to} lie on one "
             f"vertical {distance:.6g} m apart where the run starts{changed_by(line, made_by)}"
             f", and its length {length:.6g} m is longer, so it has no catenary and would "
-            "fold on itself; shorten it to at most their distance (a taut tendon; "
-            "-rod_system_line_length) or move an end sideways (-rod_system_offset)")
+            "fold on itself; shorten it to at most their distance (a taut tendon) or "
+            "move an end sideways")
 
 
 def changed_by(line, made_by):

@@ -102,4 +102,4 @@ def test_a_vertical_line_longer_than_its_ends_distance_is_refused(tmp_path, kind
         "petsc_rod: error: line Line1: its ends Point1 and Point2 lie on one vertical 25 m "
         f"apart where the run starts{made}, and its length 26 m is longer, so it has no "
         "catenary and would fold on itself; shorten it to at most their distance (a taut "
-        "tendon; -rod_system_line_length) or move an end sideways (-rod_system_offset)")
+        "tendon) or move an end sideways")

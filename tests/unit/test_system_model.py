@@ -141,8 +141,8 @@ def test_a_line_folded_on_one_vertical_is_refused_and_a_taut_one_passes():
                                                    Point("b", kind, (0.0, 0.0, 0.0))))
     message = ("line tie: its ends a and b lie on one vertical 50 m apart where the run "
                "starts, and its length 60 m is longer, so it has no catenary and would "
-               "fold on itself; shorten it to at most their distance (a taut tendon; "
-               "-rod_system_line_length) or move an end sideways (-rod_system_offset)")
+               "fold on itself; shorten it to at most their distance (a taut tendon) or "
+               "move an end sideways")
     assert refused(vertical(60.0)) == message
     free = vertical(60.0, "free")
     free.check()
