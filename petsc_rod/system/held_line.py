@@ -13,7 +13,7 @@ F the energy with the work of the loads, C(q) = int r' dS the chord and mu its
 multiplier (iteration/newton.py). The loads per metre do not depend on where the line
 is, so F depends on x_a only through the positions' terms: on a flat seabed through the
 start's height z_a (a node's height is z_a plus the integral of the slope); on a sloping
-plane through the whole x_a (its energy reads the normal penetration), and the data
+plane or a profile through the whole x_a (its energy reads the normal penetration), and the data
 below are (x_a, c) with one P per component (_plane_response). With
 G(z_a, c) = F at the equilibrium of chord c, the line's potential as a function of its
 ends is Phi(x_a, x_b) = G(z_a, x_b - x_a) - W . x_a, W the load's resultant.
@@ -1138,10 +1138,10 @@ class HeldLine:
         if scene.seabed is not None and scene.seabed.friction is not None:
             raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
                                 "exact stiffness of a line with friction")
-        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
+        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.exact):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
-                                "seabed profile (its contact is lagged in the line's "
-                                "iterations); give a flat or uniformly sloping seabed")
+                                "seabed grid (its contact is lagged in the line's "
+                                "iterations); give a flat or sloping seabed or a profile")
         loose = [term for term in self.problem.terms if not term.in_newton
                  or not (term.conservative or term.follower)]
         if loose:

@@ -427,19 +427,20 @@ def test_a_current_drags_only_the_line_under_the_surface(tmp_path):
     (["-options_file", "options/mooring_chain.opts", "-rod_seabed_friction", "0.5"],
      ["-rod_seabed_friction", "friction has none", "drop -rod_al_stability"]),
     (["-options_file", "{profiled}"],
-     ["-rod_al_stability 1", "loads without one", "a seabed that is not flat",
+     ["-rod_al_stability 1", "loads without one", "a seabed grid",
       "drop -rod_al_stability"]),
-], ids=["current", "friction", "profile"])
+], ids=["current", "friction", "grid"])
 def test_a_stability_test_asked_for_a_scene_without_energy_is_refused(tmp_path, args,
                                                                        words, ranks):
-    """-rod_al_stability 1 given with a current, seabed friction or a seabed profile
+    """-rod_al_stability 1 given with a current, seabed friction or a seabed grid
     (loads without an energy, which the test cannot take) is refused in one line, not
-    left out in silence. (A sloping plane has one: test_a_stability_test_on_a_slope.)"""
+    left out in silence. (A sloping plane and a profile have one:
+    test_a_stability_test_on_a_slope, test_a_stability_test_on_a_profile.)"""
     path = tmp_path / "out.h5"
-    # steel_catenary_riser_slope.opts's plane as a profile of two rows
+    # steel_catenary_riser_slope.opts's plane as a grid of two by two rows
     profile = tmp_path / "profile.txt"
-    profile.write_text("".join(f"{d:g} {d * np.tan(np.radians(3.0)):.17g}\n"
-                               for d in (-100.0, 5000.0)))
+    profile.write_text("".join(f"{d:g} {y:g} {d * np.tan(np.radians(3.0)):.17g}\n"
+                               for d in (-100.0, 5000.0) for y in (-100.0, 100.0)))
     profiled = tmp_path / "profiled.opts"
     profiled.write_text("".join(
         row + "\n" for row in open("options/steel_catenary_riser.opts").read().splitlines()
