@@ -28,8 +28,9 @@ seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
   a node there between the two pushes, has a fixed point (docs/riser.md §3a).
   ``covers`` tells whether a point lies within the rows.
 * ``Grid``: bilinear in each cell of a rectangular grid, its gradient the secant over
-  SMOOTHING times the closest grid lines' spacing along x and along y, for the same
-  reason.
+  SMOOTHING times the closest grid lines' spacing along x and along y, for the lagged
+  push's fixed point; its height is not smoothed, so that secant is not its
+  derivative: it has no ``hessian``, and its push stays lagged (no Newton steps).
 
 The unit normal pointing up out of the seabed is (-g, 1) / sqrt(1 + |g|^2), and the
 local slope atan |g|. Heights in m, in whichever frame the shape was made in

@@ -88,7 +88,7 @@ class SeabedTerm(NodalLoadTerm):
         (Seabed.position_derivatives).
         The state's r is that of its fields (RodProblem.energy_gradient). Collective."""
         if self.seabed.exact:
-            gradient = self._plane_derivatives(state)[0]
+            gradient = self._shape_derivatives(state)[0]
             self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
             return
         self.add_position_gradient(g, state, {HEIGHT: self._height_derivatives(state)[0]})
@@ -99,13 +99,14 @@ class SeabedTerm(NodalLoadTerm):
         the nodes' three position components, on a profile with its curvature's terms
         (Seabed.position_derivatives)."""
         if self.seabed.exact:
-            hessian.add_position_curvature(self._plane_derivatives(hessian.problem.state)[1],
+            hessian.add_position_curvature(self._shape_derivatives(hessian.problem.state)[1],
                                            self.position_components)
             return
         hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
 
-    def _plane_derivatives(self, state):
-        """Seabed.position_derivatives at the owned nodes of the state's centreline."""
+    def _shape_derivatives(self, state):
+        """Seabed.position_derivatives (a plane's or a profile's) at the owned nodes of
+        the state's centreline."""
         return self.seabed.position_derivatives(state.node_positions(), state.node_weights)
 
     def pressure(self, z):
