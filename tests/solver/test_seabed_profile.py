@@ -8,7 +8,8 @@ docs/riser.md §3a), on one rank (PETSc.COMM_SELF) and on all (PETSc.COMM_WORLD:
     contact): with Newton steps it converges in fewer iterations than the plain
     iteration, to the same state, and is tested stable; the same on one rank and all;
 (b) its HeldLine.stiffness (the profile's contact and curvature in the line's Newton
-    system) against central differences of re-solves, every entry;
+    system) against central differences of re-solves, every entry; and with the turn
+    at 55 m, where the touchdown lies within the row's rounding;
 (c) tests/data/moordyn/small_free_body.dat's body moored over a profile with a row under
     each chain's grounded part: its 6 x 6 against central differences of the
     equilibrium (test_system_environment.assert_exact_body_stiffness).
@@ -69,11 +70,17 @@ def test_newton_on_a_kinked_profile_converges_to_the_plain_iteration_s_state():
     assert every["stable"] == 1
 
 
+# the same turn at 55 m: the touchdown (56.3 m) within the row's rounding (delta = 14.5 m)
+AT_THE_TOUCHDOWN = ((-100.0, -30.2), (55.0, -30.2), (200.0, -30.2 + 145.0 * RISE))
+
+
+@pytest.mark.parametrize("rows", [KINKED, AT_THE_TOUCHDOWN], ids=["grounded", "touchdown"])
 @pytest.mark.parametrize("comm", list(COMMS))
-def test_stiffness_on_a_kinked_profile(comm):
-    """The (6, 6) against central differences of re-solves (measured 5.6e-8 on one
-    rank, 2.3e-8 on two; 1.0e-2 with the curvature's terms left out)."""
-    line = held(sloped_model(seabed_profile=KINKED), COMMS[comm], MOORING)
+def test_stiffness_on_a_kinked_profile(comm, rows):
+    """The (6, 6) against central differences of re-solves (measured 5.6e-8 and 3.4e-9
+    on one rank, 2.3e-8 and 5.5e-9 on two; 1.0e-2 and 3.4e-3 with the curvature's terms
+    left out)."""
+    line = held(sloped_model(seabed_profile=rows), COMMS[comm], MOORING)
     try:
         assert grounded_at_the_row(line) >= 5
         K = line.stiffness()
