@@ -107,6 +107,7 @@ from petsc_rod.global_step.chain_factor import NULL_PIVOT
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
                                          slope_factor)
+from petsc_rod.physics.friction import FrictionTerm
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.system_check import connection_frame, connection_position
@@ -223,6 +224,21 @@ class _CurvatureRecorder:
             raise RodInputError("a line whose energy reads its horizontal positions (the "
                                 "seabed's friction) has no exact stiffness here")
         self.positions = np.asarray(values, dtype=float)
+
+    def add_friction(self, terms):
+        """The frictional line's whole position block H_n (n_nodes, 3, 3), rows the
+        gradient's components, columns the positions': the friction's rows (x, y) of
+        FrictionTerm.position_derivatives (unsymmetric: its z column, the limit mu R
+        following the contact), the seabed's k w_n at (z, z); the heights' own record
+        folded in (the response then takes the start's three position data, as on a
+        sloping plane)."""
+        state = self.problem.state
+        block = np.zeros((state.node_weights.shape[0], 3, 3))
+        if self.heights is not None:
+            block[:, 2, 2] = self.heights
+        for term in terms:
+            block[:, :2] += term.position_derivatives(state)
+        self.positions, self.heights = block, None
 
 
 def _at_vertex(mesh, values, index):
@@ -359,6 +375,7 @@ class HeldLine:
                                    FIELD_NAMES)
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
+        self.friction = []                  # the FrictionTerm, its anchors held
         self.frames = (None, None)          # the clamps' frames last asked for
         self.axes = {}
         self.iterations = 0
@@ -431,6 +448,11 @@ class HeldLine:
         # each flex joint's neutral axis at the reference frame (turned by a frame given)
         self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
                      for t in self.problem.terms if isinstance(t, FlexJoint)}
+        # the friction's anchors: the first solve's start (the line as laid), held for
+        # the line's life (module docstring, "Friction")
+        self.friction = [t for t in self.problem.terms if isinstance(t, FrictionTerm)]
+        for term in self.friction:
+            term.hold_anchors = True
 
     def _mesh_named(self, pieces, elements):
         """How a mesh too large for the machine names the line's element count."""
@@ -441,6 +463,7 @@ class HeldLine:
         if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
         self.jacobian = None
+        self.friction = []
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
@@ -694,6 +717,8 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
+            for term in self.friction:      # the end forces read the settled state's
+                term.follow_state(self.problem.state)
 
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
@@ -732,15 +757,23 @@ class HeldLine:
                 vecs.extend(entry[-1])
             recorder = _CurvatureRecorder(problem)
             for term in problem.terms:
-                if term.position_components:
+                if term.position_components and term not in self.friction:
                     term.add_hessian(recorder)
+            if self.friction and rotations:
+                raise RodInputError(
+                    f"HeldLine.end_stiffness: {self.name}: no exact stiffness of a "
+                    "clamped or flex-jointed end of a line with seabed friction; pin "
+                    "the line's ends")
             if recorder.positions is not None and rotations:
                 raise RodInputError(
                     "HeldLine.end_stiffness: no exact stiffness of a clamped or "
                     "flex-jointed end on a sloping seabed; pin the line's ends or make "
                     "the seabed flat")
+            if self.friction:
+                recorder.add_friction(self.friction)
+            unsymmetric = hessian.resultants or bool(self.friction)
             columns = hessian.chord_forms(frames[:, 2])
-            if self.newton.free_roll and hessian.resultants:
+            if self.newton.free_roll and unsymmetric:
                 # round sections, nothing clamped (a flex joint holds no roll): one roll
                 # of every section about its tangent is a null vector of J (the drag
                 # has no entries along it); an LU that keeps its pivot gives the solves
@@ -753,11 +786,15 @@ class HeldLine:
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
-            planes = []
+            planes = readers = []
             if recorder.positions is not None:
-                planes = self._plane_shifts(hessian, recorder.positions)
+                planes = readers = self._plane_shifts(hessian, recorder.positions)
                 vecs.extend(planes)
                 shift = planes[2]
+                if self.friction:       # unsymmetric: the forces read its transpose
+                    readers = self._plane_shifts(
+                        hessian, recorder.positions.transpose(0, 2, 1))
+                    vecs.extend(readers)
             # a sheared current: the start raised moves the drag of every node too
             pushes = [v for v in (term.height_shift(hessian, state) for term in problem.terms
                                   if term.jacobian_positions) if v is not None]
@@ -770,7 +807,7 @@ class HeldLine:
                 lift.maxpy([1.0] * len(pushes), pushes)
                 if shift is not None:
                     lift.axpy(1.0, shift)
-            if hessian.resultants:
+            if unsymmetric:
                 if self.jacobian is None:
                     self.jacobian = self.built.own(NewtonJacobian(hessian))
                 self.jacobian.assemble()
@@ -787,7 +824,7 @@ class HeldLine:
             if solver is self.jacobian:
                 vecs.extend(_refine(solver, rights, solved))
             if planes:
-                response = self._plane_response(hessian, columns, planes,
+                response = self._plane_response(hessian, columns, readers,
                                                 solved, recorder.positions, solver)
                 return response @ np.block([[np.eye(3), np.zeros((3, 3))],
                                             [-np.eye(3), np.eye(3)]])
@@ -1094,8 +1131,11 @@ class HeldLine:
         whole position as data. With Y_C = A^-1 C^T and Y_j = A^-1 L_j (L_j = P_j, the
         sheared drag's height columns added to L_z): dmu = -S^-1 (dc + C Y_j dx_a,j),
         dy = -Y_j dx_a,j - Y_C dmu, F_b = mu, F_a = W + Psi_0 + R_s - mu with R_s the
-        seabed's whole reaction, dR_s,i = -(P_i.dy + sum_n H_n[i, j] dx_a,j).
-        Collective."""
+        seabed's whole reaction, dR_s,i = -(Q_i.dy + sum_n H_n[i, j] dx_a,j), the
+        functionals ``planes`` Q_i = sum_j sum_n H_n[i, j] dx^j_n/dy: P_i where H_n is
+        symmetric (the plane), the shifts of H_n's transpose with the friction (its
+        force on the line, part of R_s, reads the heights; the gradient's x and y rows
+        do not move the contact). Collective."""
         mesh = self.mesh
         n_all = len(columns)
         Y_P = solved[n_all:n_all + 3]
@@ -1135,15 +1175,17 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if scene.seabed is not None and scene.seabed.friction is not None:
-            raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
-                                "exact stiffness of a line with friction")
+        if any(not term.in_newton for term in self.friction):
+            raise RodInputError(f"HeldLine.stiffness: {self.name}: its seabed friction "
+                                "takes no Newton steps (two coefficients, or a seabed that "
+                                "is not flat), so no exact stiffness: give the friction "
+                                "one coefficient on a flat seabed")
         if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
                                 "seabed profile (its contact is lagged in the line's "
                                 "iterations); give a flat or uniformly sloping seabed")
         loose = [term for term in self.problem.terms if not term.in_newton
-                 or not (term.conservative or term.follower)]
+                 or not (term.conservative or term.follower or term in self.friction)]
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))
