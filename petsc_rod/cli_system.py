@@ -38,6 +38,7 @@ from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.system_check import check_reach
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
+from petsc_rod.system.held_line import friction_notes
 from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
@@ -236,6 +237,7 @@ def prepared(values, given, case=None):
     path = values["rod_system"]
     system, notes = read_moordyn(path, values["rod_system_element_length"])
     system = changed(system, values, case or {})
+    notes = tuple(notes) + friction_notes(system)
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()

@@ -29,7 +29,7 @@ from petsc_rod.system.body_modes import (SystemModes, SystemModesRefused, check_
                                          system_modes)
 from petsc_rod.system.body_modes import table_lines as body_modes_lines
 from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import held_lines
+from petsc_rod.system.held_line import friction_notes, held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
 # step is 1 / system_steps of the bodies' loads (Settings.load_steps); the modes of the
@@ -690,6 +690,7 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     comm = comm or PETSc.COMM_WORLD
     say = say or (lambda line: None)
     settings, line_options, modes, body_modes = on_every_rank(comm, split_options, options)
+    notes = tuple(notes) + friction_notes(system)
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,

@@ -21,7 +21,8 @@ Friction depends on the path: the anchors are the nodes' positions where the run
 (its start shape, or the file of a restart: the line as laid), and at the end of every
 accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
 a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
-carries none).
+carries none). A line of a system holds its anchors where its first solve started
+(``hold_anchors``, system/held_line.py): its equilibrium is a function of its ends.
 
 In the global step the friction is implicit, like the seabed: x and y are solved in
 Hermite dofs (global_step/hermite.py), where a spring on a node's position is banded, in place of

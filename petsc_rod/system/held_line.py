@@ -79,9 +79,25 @@ its moment on the support is the joint's, -k (theta / sin theta) d3 x a; at an
 extensible end too, where the joint acts in the local step (its gradient in rotations,
 of the tangent's direction only, is the same function of d3 and a).
 
+**Friction.** The seabed's friction (physics/friction.py) holds each grounded node to
+an anchor. A held line's anchors are its nodes where its first solve starts (the line as
+laid: its catenary between the ends' first positions, in the line's frame, whose origin
+is fixed for its life) and stay there (FrictionTerm.hold_anchors: no return map at the
+end of a step): its equilibrium is then a function of its ends alone, whatever walks,
+halvings and trials reached them (OrcaFlex's statics within one load step). Its gradient
+reads every node's horizontal position, so the data are the start's whole x_a, as on a
+plane (_plane_response), with the position block H_n of the friction's Newton steps
+(FrictionTerm.position_derivatives: stick k_s w I, slide the secant block and the z
+column of the limit mu R following the contact) and the seabed's k w_n: unsymmetric,
+so A is J (its LU), and the forces read the block through its transpose. A sliding
+node's stiffness is the loading tangent (the slip continued); unloading it would stick.
+Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
+pinned ends only.
+
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction (it dissipates), a seabed profile (its contact lagged), a clamp or flex
-joint on a sloping plane (end_stiffness),
+seabed's friction with two coefficients or on a seabed that is not flat (no Newton
+steps), or at a clamped or flex-jointed end (end_stiffness), a seabed profile (its
+contact lagged), a clamp or flex joint on a sloping plane (end_stiffness),
 and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -708,8 +724,9 @@ class HeldLine:
         Newton's, which a grounded line's sideways stiffness feels (docs/systems.md,
         "The stiffness at the lines' stationary points"). stiffness() and
         end_stiffness() call it first where ``settles`` (a system's lines: only for the
-        stiffness it reports, SystemSolver.evaluate). Nothing where the stiffness is not
-        exact (_check_exact: the friction's state is its history). Collective."""
+        stiffness it reports, SystemSolver.evaluate); the friction's force then
+        recorded at the settled state (FrictionTerm.follow_state), which the end forces
+        read. Nothing where the stiffness is not exact (_check_exact). Collective."""
         self._check_solved()
         try:
             self._check_exact()
@@ -1195,6 +1212,17 @@ class HeldLine:
     def destroy(self):
         """Free the line's PETSc objects (its BuiltLine's, its Newton solver's). Collective."""
         self._release()
+
+
+def friction_notes(system):
+    """The run's note on a system whose seabed has friction (a tuple of one line, or
+    none): what its friction is measured from (module docstring, "Friction")."""
+    if system.environment.seabed_friction is None:
+        return ()
+    return ("seabed friction measured from the lines' as-laid shapes: each line's "
+            "friction anchors are its nodes where its first solve starts (the catenary "
+            "between its ends' start positions), held through the whole solve, its load "
+            "steps, sweeps and cases (docs/systems.md, \"Seabed friction\")",)
 
 
 def held_lines(system, options=None):

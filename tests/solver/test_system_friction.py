@@ -14,7 +14,8 @@ one-sided) with friction mu:
 (c) the answer does not depend on the trials: the equilibrium reached in one load step,
     by a continuation, and after a detour through another load, the same to the floor;
 (d) a friction so large that every grounded node sticks: the pose does not depend on
-    mu; a friction that vanishes: the frictionless system's pose.
+    mu; a friction that vanishes: the frictionless system's pose;
+(e) two coefficients (no Newton steps) refused in one line naming the line.
 """
 
 import dataclasses
@@ -25,8 +26,9 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.api import read_moordyn
+from petsc_rod.errors import RodInputError
 from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import HeldLine, held_lines
+from petsc_rod.system.held_line import HeldLine, friction_notes, held_lines
 
 from test_held_line import differences
 from test_system_clamped import COMMS, body_differences
@@ -217,3 +219,25 @@ def test_a_vanishing_friction_is_the_frictionless_system():
     slip = np.abs(pose(solved_once(1e-12)) - pose(solved_once(None))).max()
     print(f"vanishing friction's pose from the frictionless one {slip:.3g}")
     assert slip < 1e-9
+
+
+def test_two_coefficients_are_refused_in_one_line_naming_the_line():
+    """mu_a != mu_l takes no Newton steps (physics/friction.py): no exact stiffness;
+    the refusal names the line and what to change. The run says once what the
+    friction is measured from."""
+    system = frictional((0.5, 0.8))
+    ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
+    line = HeldLine.of_system_line(system.lines[1], *ends, PETSc.COMM_SELF,
+                                   system.environment, {"al_stability": 0})
+    try:
+        assert line.solve(*ends)
+        with pytest.raises(RodInputError) as refused:
+            line.stiffness()
+    finally:
+        line.destroy()
+    message = str(refused.value)
+    assert "\n" not in message
+    assert f"line {system.lines[1].name}" in message and "one coefficient" in message
+    assert friction_notes(frictional(None)) == ()
+    (note,) = friction_notes(system)
+    assert "as-laid" in note
