@@ -392,6 +392,9 @@ class HeldLine:
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
         self.friction = []                  # the FrictionTerm, its anchors held
+        # where a frictional line is laid, (start, end) absolute (None: where its first
+        # solve asks): the first solve starts there and walks to its ends
+        self.laid = None
         self.frames = (None, None)          # the clamps' frames last asked for
         self.axes = {}
         self.iterations = 0
@@ -491,8 +494,10 @@ class HeldLine:
         after a first solve that failed) from the catenary start in one step, as the
         command line starts; later walked in one step (halved where it fails, up to 4
         times) from the last converged equilibrium, the ends moved in straight lines and
-        the frames turned along the geodesic. Returns whether it converged; a failed
-        walk leaves the last equilibrium as it was. Collective."""
+        the frames turned along the geodesic. Where the line is ``laid`` elsewhere
+        (a frictional line of a system moved by an offset), its first solve is there
+        and walks to these ends. Returns whether it converged; a failed walk leaves the
+        last equilibrium as it was. Collective."""
         a, b = _point("start_position", start_position), _point("end_position", end_position)
         frames = tuple(given if given is not None else last for given, last in
                        zip((self._frame("start", start_frame), self._frame("end", end_frame)),
@@ -500,9 +505,11 @@ class HeldLine:
         self.frames = frames
         if self.problem is None or not self.converged:
             self._release()
-            self._build(a, b, frames)
+            laid = (a, b) if self.laid is None else self.laid
+            self._build(*laid, frames)
             self._turn_joints(frames)
-            return self._first()
+            if not self._first() or self.laid is None:
+                return self.converged
         return self._walk(a - self.origin, b - self.origin, frames)
 
     def _turn_joints(self, frames):
@@ -1221,11 +1228,12 @@ def friction_notes(system):
         return ()
     return ("seabed friction measured from the lines' as-laid shapes: each line's "
             "friction anchors are its nodes where its first solve starts (the catenary "
-            "between its ends' start positions), held through the whole solve, its load "
-            "steps, sweeps and cases (docs/systems.md, \"Seabed friction\")",)
+            "between its ends' start positions, before any offset), held through the "
+            "whole solve, its load steps, sweeps and cases "
+            '(docs/systems.md, "Seabed friction")',)
 
 
-def held_lines(system, options=None):
+def held_lines(system, options=None, laid=None):
     """The ``make_line(system_line, comm)`` of system/equilibrium.SystemSolver for the
     real lines of ``system`` (a model.system.System): each a HeldLine whose ends are
     first where the system's points and bodies put its connections at their start
@@ -1240,7 +1248,11 @@ def held_lines(system, options=None):
     iterations' Jacobian. A current profile's depths are below the
     system's sea surface, z = 0 where the Environment gives none (as the free points'
     drag, system/equilibrium.py), not below each line's higher end as for a single
-    line: the lines and points of a system share one sea."""
+    line: the lines and points of a system share one sea. ``laid``: a System with the
+    same points and bodies (the system file's, before a run's or a sweep case's
+    offsets) whose start positions lay each frictional line (HeldLine.laid: its
+    friction's anchors; None: ``system``'s own), so that every case measures its
+    friction from the same laid lines."""
     options = {"al_stability": 0, **(options or {})}
     environment = system.environment
     if environment.profile() is not None and environment.surface is None:
@@ -1254,6 +1266,11 @@ def held_lines(system, options=None):
                        else None for e, c in enumerate((line.start, line.end)))
         held = HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
+        if laid is not None and environment.seabed_friction is not None:
+            ends = tuple(connection_position(laid.node(c.to), c)
+                         for c in (line.start, line.end))
+            if not (np.array_equal(ends[0], start) and np.array_equal(ends[1], end)):
+                held.laid = tuple(np.asarray(e, dtype=float) for e in ends)
         held.settles = False                # SystemSolver.evaluate settles it when it reports
         return held
 

@@ -241,3 +241,37 @@ def test_two_coefficients_are_refused_in_one_line_naming_the_line():
     assert friction_notes(frictional(None)) == ()
     (note,) = friction_notes(system)
     assert "as-laid" in note
+
+
+def test_a_line_laid_elsewhere_is_measured_from_where_it_was_laid():
+    """A sweep's cases (offsets of held points) on a fresh solver or warm from another
+    case: a frictional line is laid where the system file puts its ends (held_lines'
+    ``laid``) and walked to the case's; so its equilibrium at an offset is the same
+    whether it came there directly or through another offset. Laid at the offset
+    itself instead, its anchors (and its forces) differ."""
+    base = frictional(0.5)
+    moved = dataclasses.replace(base, points=tuple(
+        dataclasses.replace(p, position=tuple(np.add(p.position, (3.0, -2.0, 0.0))))
+        if p.name == "Point2" else p for p in base.points))
+    line = moved.lines[1]
+    assert line.start.to == "Point2"
+    start, end = np.array(moved.node("Point2").position), np.array([-2.5, 4.33, -5.0])
+    detour = start + np.array([-6.0, 1.0, 0.0])
+    make = held_lines(moved, TIGHT, laid=base)
+    lines = [make(line, PETSc.COMM_SELF) for _ in range(2)]
+    plain = held_lines(moved, TIGHT)(line, PETSc.COMM_SELF)
+    try:
+        assert lines[0].laid is not None and plain.laid is None
+        assert lines[0].solve(detour, end) and lines[0].solve(start, end)
+        assert lines[1].solve(start, end)
+        assert plain.solve(start, end)
+        forces = [held.end_forces() for held in lines + [plain]]
+        scale = np.abs(forces[0]).max()
+        same = np.abs(forces[0] - forces[1]).max() / scale
+        other = np.abs(forces[2] - forces[1]).max() / scale
+        print(f"through a detour {same:.3g}, laid at the offset {other:.3g} of {scale:.6g} N")
+        assert same < 1e-9
+        assert other > 1e-4
+    finally:
+        for held in lines + [plain]:
+            held.destroy()
