@@ -741,8 +741,8 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
-            for term in self.friction:      # the end forces read the settled state's
-                term.follow_state(self.problem.state)
+            for term in self.friction if self.settled else ():
+                term.follow_state(self.problem.state)   # the end forces read its
 
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
