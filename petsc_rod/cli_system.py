@@ -38,6 +38,7 @@ from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.system_check import check_reach
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
+from petsc_rod.system.held_line import friction_notes
 from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
@@ -221,6 +222,15 @@ def changed(system, values, case):
     return system
 
 
+def laid_system(values, system):
+    """The System whose start positions lay ``system``'s frictional lines: the -rod_system
+    file's, before the run's and a sweep case's offsets (held_line.held_lines), or None
+    where its seabed has no friction."""
+    if system.environment.seabed_friction is None:
+        return None
+    return read_moordyn(values["rod_system"], values["rod_system_element_length"])[0]
+
+
 def prepared(values, given, case=None):
     """(System, notes, the file's text, Settings, the lines' options, the Sweeps, the
     modes' request: api/system_run.modes_request, the system's modes' request:
@@ -236,6 +246,7 @@ def prepared(values, given, case=None):
     path = values["rod_system"]
     system, notes = read_moordyn(path, values["rod_system_element_length"])
     system = changed(system, values, case or {})
+    notes = tuple(notes) + friction_notes(system)
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])
     texts = whole_values()
@@ -280,7 +291,8 @@ def run(comm=None):
             output, table = values["rod_output"], values["rod_table"]
             results = run_system(comm, system, settings, options, say, output, table,
                                  text, notes, interrupts, sweeps, modes, body_modes,
-                                 line_mass_option="-rod_system_modes_line_mass")
+                                 line_mass_option="-rod_system_modes_line_mass",
+                                 laid=on_every_rank(comm, laid_system, values, system))
             written = [f"result {output}"] if output else []
             if table:
                 stem, extension = os.path.splitext(table)

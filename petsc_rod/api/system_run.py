@@ -29,7 +29,7 @@ from petsc_rod.system.body_modes import (SystemModes, SystemModesRefused, check_
                                          system_modes)
 from petsc_rod.system.body_modes import table_lines as body_modes_lines
 from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import held_lines
+from petsc_rod.system.held_line import friction_notes, held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
 # step is 1 / system_steps of the bodies' loads (Settings.load_steps); the modes of the
@@ -553,7 +553,8 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps(), body_modes=False):
 
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
                text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None,
-               body_modes=None, solver=None, line_mass_option="system_modes_line_mass"):
+               body_modes=None, solver=None, line_mass_option="system_modes_line_mass",
+               laid=None):
     """The system's run on ``comm`` (PETSc.Comm): its lines built on their groups, the
     equilibrium (SystemSolver.solve), each body's stiffness, each line's record, each
     line's modes with its ends held where ``modes`` (count, MassSettings) asks for
@@ -568,7 +569,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     SystemResults. ``solver``: a SystemSolver of a system that differs from ``system``
     only in what SystemSolver.replace takes (loads, held points' and bodies'
     positions), re-solved warm from where it stands and left to its caller (a sweep's
-    cases); None: one made for the run and destroyed after it.
+    cases); None: one made for the run and destroyed after it, its frictional lines
+    laid where ``laid`` (a System: the file's, before the run's offsets) puts them
+    (held_line.held_lines).
     RodInputError for a system the checks refuse (exit 2),
     RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
     RodDivergedError, its Newton or a line not converged after its halvings),
@@ -580,7 +583,7 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     check_outputs(comm, system, output, table, sweeps, body_modes is not None)
     own = solver is None
     if own:
-        solver = SystemSolver(system, held_lines(system, line_options), comm,
+        solver = SystemSolver(system, held_lines(system, line_options, laid), comm,
                               settings=settings)
     else:
         on_every_rank(comm, solver.replace, system)
@@ -690,6 +693,7 @@ def solve_system(system, comm=None, output=None, say=None, options=None, table=N
     comm = comm or PETSc.COMM_WORLD
     say = say or (lambda line: None)
     settings, line_options, modes, body_modes = on_every_rank(comm, split_options, options)
+    notes = tuple(notes) + friction_notes(system)
     for note in notes:
         say(f"petsc_rod: note: {note}")
     return run_system(comm, system, settings, line_options, say, output, table,

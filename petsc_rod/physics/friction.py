@@ -21,7 +21,8 @@ Friction depends on the path: the anchors are the nodes' positions where the run
 (its start shape, or the file of a restart: the line as laid), and at the end of every
 accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
 a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
-carries none).
+carries none). A line of a system holds its anchors where its first solve started
+(``hold_anchors``, system/held_line.py): its equilibrium is a function of its ends.
 
 In the global step the friction is implicit, like the seabed: x and y are solved in
 Hermite dofs (global_step/hermite.py), where a spring on a node's position is banded, in place of
@@ -151,6 +152,10 @@ class FrictionTerm(NodalLoadTerm):
         # (solve_slope; after an attempt that failed, those of the restored state, the
         # last solve's)
         self._springs_stale = False
+        # the anchors stay where the first solve put them (accept_step moves none): a
+        # line of a system, whose equilibrium is then a function of its ends alone
+        # (system/held_line.py)
+        self.hold_anchors = False
 
     @property
     def in_newton(self):
@@ -248,11 +253,16 @@ class FrictionTerm(NodalLoadTerm):
         positions = self.load.element_values[..., :2].copy()
         self.load.set(state.node_directors()[:, 2])
         tangents = self.load.element_values[..., :2].copy()
+        self._springs_from_positions(positions, tangents, reaction)
+        self._springs_stale = False
+
+    def _springs_from_positions(self, positions, tangents, reaction):
+        """The secant springs (ne, 3) of the element nodes' horizontal ``positions``
+        (ne, 3, 2), ``tangents`` (ne, 3, 2) and reactions ``reaction`` (ne, 3)."""
         trial = -self.friction.stiffness * (positions - self.anchors)
         size = elliptic_norm(trial, tangents, self.friction)
         self.spring = self.friction.stiffness * np.divide(
             reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
-        self._springs_stale = False
 
     @property
     def stick(self):
@@ -352,12 +362,40 @@ class FrictionTerm(NodalLoadTerm):
                 rest, self.position_components, self.position_components + (HEIGHT,)):
             jacobian.add(rows, columns, blocks)
 
+    def position_derivatives(self, state):
+        """The whole derivative of -w_n f_n (the friction's share of the gradient on the
+        horizontal positions) in the node's position (x, y, z), (n_nodes, 2, 3), N/m, at
+        the owned nodes of the state's centreline: the Newton system's block (module
+        docstring) with its z column (a line's end stiffness, system/held_line.py:
+        the gradient's move when the whole line is shifted over fixed anchors)."""
+        _, in_x, in_z = self._newton_law(state)
+        return np.concatenate([in_x, in_z[:, :, None]], axis=2)
+
+    def follow_state(self, state):
+        """Record the friction of the state's own positions (the law of the Newton
+        steps at fixed anchors) as if a global step had solved them: after Newton steps
+        that no global step follows (HeldLine.settle), the internal force and the end
+        forces read the friction of the state they stand at. Flat seabed only (the
+        Newton steps' case). Collective (a ghost exchange)."""
+        if self.anchors is None:
+            return
+        self.load.set(state.node_positions())
+        positions = self.load.element_values[..., :2].copy()
+        heights = self.load.element_values[..., 2].copy()
+        self.load.set(state.node_directors()[:, 2])
+        tangents = self.load.element_values[..., :2].copy()
+        reaction = self.seabed_term.seabed.push(heights.ravel()).reshape(heights.shape)
+        self._springs_from_positions(positions, tangents, reaction)
+        force = -self.spring[..., None] * (positions - self.anchors)
+        self._record(force, positions, tangents, reaction, None)
+
     # --- the load path --------------------------------------------------------------
     def accept_step(self, state):
         """At the end of an accepted load step: every anchor to x_n + f_n / k_s of the
         last solve (the return map: a sticking node keeps its anchor, a sliding one's
-        follows it, a node off the seabed has its own position)."""
-        if self.positions is not None:
+        follows it, a node off the seabed has its own position); none where the anchors
+        are held (``hold_anchors``)."""
+        if self.positions is not None and not self.hold_anchors:
             self.anchors = self.positions + self.force[..., :2] / self.friction.stiffness
 
     # --- outputs --------------------------------------------------------------------

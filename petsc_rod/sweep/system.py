@@ -32,7 +32,7 @@ from petsc4py import PETSc
 from petsc_rod.api.system_run import run_system
 from petsc_rod.cli.options import check_same_on_every_rank, read_options, values_of
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.cli_system import check_movable, prepared
+from petsc_rod.cli_system import check_movable, laid_system, prepared
 from petsc_rod.errors import RodError, RodInputError, on_every_rank
 from petsc_rod.sweep import cases as sweep_cases
 from petsc_rod.sweep import summary
@@ -219,8 +219,10 @@ class SystemSweep(Sweep):
         self._error = None
         try:
             if self.solver is None:
-                self.solver = SystemSolver(system, held_lines(system, options), self.comm,
-                                           settings=settings)
+                laid = on_every_rank(self.comm, laid_system, values_of(self.base)[0],
+                                     system)
+                self.solver = SystemSolver(system, held_lines(system, options, laid),
+                                           self.comm, settings=settings)
             results = run_system(self.comm, system, settings, options, self.say,
                                  self.file(case), None, text, notes, self.interrupts,
                                  sweeps, modes, body_modes, solver=self.solver)

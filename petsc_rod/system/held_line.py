@@ -79,9 +79,25 @@ its moment on the support is the joint's, -k (theta / sin theta) d3 x a; at an
 extensible end too, where the joint acts in the local step (its gradient in rotations,
 of the tangent's direction only, is the same function of d3 and a).
 
+**Friction.** The seabed's friction (physics/friction.py) holds each grounded node to
+an anchor. A held line's anchors are its nodes where its first solve starts (the line as
+laid: its catenary between the ends' first positions, in the line's frame, whose origin
+is fixed for its life) and stay there (FrictionTerm.hold_anchors: no return map at the
+end of a step): its equilibrium is then a function of its ends alone, whatever walks,
+halvings and trials reached them (OrcaFlex's statics within one load step). Its gradient
+reads every node's horizontal position, so the data are the start's whole x_a, as on a
+plane (_plane_response), with the position block H_n of the friction's Newton steps
+(FrictionTerm.position_derivatives: stick k_s w I, slide the secant block and the z
+column of the limit mu R following the contact) and the seabed's k w_n: unsymmetric,
+so A is J (its LU), and the forces read the block through its transpose. A sliding
+node's stiffness is the loading tangent (the slip continued); unloading it would stick.
+Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
+pinned ends only.
+
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction (it dissipates), a seabed profile (its contact lagged), a clamp or flex
-joint on a sloping plane (end_stiffness),
+seabed's friction with two coefficients or on a seabed that is not flat (no Newton
+steps), or at a clamped or flex-jointed end (end_stiffness), a seabed profile (its
+contact lagged), a clamp or flex joint on a sloping plane (end_stiffness),
 and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -107,6 +123,7 @@ from petsc_rod.global_step.chain_factor import NULL_PIVOT
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
                                          slope_factor)
+from petsc_rod.physics.friction import FrictionTerm
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.system_check import connection_frame, connection_position
@@ -223,6 +240,21 @@ class _CurvatureRecorder:
             raise RodInputError("a line whose energy reads its horizontal positions (the "
                                 "seabed's friction) has no exact stiffness here")
         self.positions = np.asarray(values, dtype=float)
+
+    def add_friction(self, terms):
+        """The frictional line's whole position block H_n (n_nodes, 3, 3), rows the
+        gradient's components, columns the positions': the friction's rows (x, y) of
+        FrictionTerm.position_derivatives (unsymmetric: its z column, the limit mu R
+        following the contact), the seabed's k w_n at (z, z); the heights' own record
+        folded in (the response then takes the start's three position data, as on a
+        sloping plane)."""
+        state = self.problem.state
+        block = np.zeros((state.node_weights.shape[0], 3, 3))
+        if self.heights is not None:
+            block[:, 2, 2] = self.heights
+        for term in terms:
+            block[:, :2] += term.position_derivatives(state)
+        self.positions, self.heights = block, None
 
 
 def _at_vertex(mesh, values, index):
@@ -359,6 +391,10 @@ class HeldLine:
                                    FIELD_NAMES)
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
+        self.friction = []                  # the FrictionTerm, its anchors held
+        # where a frictional line is laid, (start, end) absolute (None: where its first
+        # solve asks): the first solve starts there and walks to its ends
+        self.laid = None
         self.frames = (None, None)          # the clamps' frames last asked for
         self.axes = {}
         self.iterations = 0
@@ -431,6 +467,11 @@ class HeldLine:
         # each flex joint's neutral axis at the reference frame (turned by a frame given)
         self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
                      for t in self.problem.terms if isinstance(t, FlexJoint)}
+        # the friction's anchors: the first solve's start (the line as laid), held for
+        # the line's life (module docstring, "Friction")
+        self.friction = [t for t in self.problem.terms if isinstance(t, FrictionTerm)]
+        for term in self.friction:
+            term.hold_anchors = True
 
     def _mesh_named(self, pieces, elements):
         """How a mesh too large for the machine names the line's element count."""
@@ -441,6 +482,7 @@ class HeldLine:
         if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
         self.jacobian = None
+        self.friction = []
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
     # --- solving -----------------------------------------------------------------------
@@ -452,8 +494,10 @@ class HeldLine:
         after a first solve that failed) from the catenary start in one step, as the
         command line starts; later walked in one step (halved where it fails, up to 4
         times) from the last converged equilibrium, the ends moved in straight lines and
-        the frames turned along the geodesic. Returns whether it converged; a failed
-        walk leaves the last equilibrium as it was. Collective."""
+        the frames turned along the geodesic. Where the line is ``laid`` elsewhere
+        (a frictional line of a system moved by an offset), its first solve is there
+        and walks to these ends. Returns whether it converged; a failed walk leaves the
+        last equilibrium as it was. Collective."""
         a, b = _point("start_position", start_position), _point("end_position", end_position)
         frames = tuple(given if given is not None else last for given, last in
                        zip((self._frame("start", start_frame), self._frame("end", end_frame)),
@@ -461,9 +505,11 @@ class HeldLine:
         self.frames = frames
         if self.problem is None or not self.converged:
             self._release()
-            self._build(a, b, frames)
+            laid = (a, b) if self.laid is None else self.laid
+            self._build(*laid, frames)
             self._turn_joints(frames)
-            return self._first()
+            if not self._first() or self.laid is None:
+                return self.converged
         return self._walk(a - self.origin, b - self.origin, frames)
 
     def _turn_joints(self, frames):
@@ -685,8 +731,9 @@ class HeldLine:
         Newton's, which a grounded line's sideways stiffness feels (docs/systems.md,
         "The stiffness at the lines' stationary points"). stiffness() and
         end_stiffness() call it first where ``settles`` (a system's lines: only for the
-        stiffness it reports, SystemSolver.evaluate). Nothing where the stiffness is not
-        exact (_check_exact: the friction's state is its history). Collective."""
+        stiffness it reports, SystemSolver.evaluate); the friction's force then
+        recorded at the settled state (FrictionTerm.follow_state), which the end forces
+        read. Nothing where the stiffness is not exact (_check_exact). Collective."""
         self._check_solved()
         try:
             self._check_exact()
@@ -694,6 +741,8 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
+            for term in self.friction if self.settled else ():
+                term.follow_state(self.problem.state)   # the end forces read its
 
     def _clamp_nodes(self):
         """[(end 0 or 1, global P2 node)] of the clamped ends."""
@@ -732,15 +781,23 @@ class HeldLine:
                 vecs.extend(entry[-1])
             recorder = _CurvatureRecorder(problem)
             for term in problem.terms:
-                if term.position_components:
+                if term.position_components and term not in self.friction:
                     term.add_hessian(recorder)
+            if self.friction and rotations:
+                raise RodInputError(
+                    f"HeldLine.end_stiffness: {self.name}: no exact stiffness of a "
+                    "clamped or flex-jointed end of a line with seabed friction; pin "
+                    "the line's ends")
             if recorder.positions is not None and rotations:
                 raise RodInputError(
                     "HeldLine.end_stiffness: no exact stiffness of a clamped or "
                     "flex-jointed end on a sloping seabed; pin the line's ends or make "
                     "the seabed flat")
+            if self.friction:
+                recorder.add_friction(self.friction)
+            unsymmetric = hessian.resultants or bool(self.friction)
             columns = hessian.chord_forms(frames[:, 2])
-            if self.newton.free_roll and hessian.resultants:
+            if self.newton.free_roll and unsymmetric:
                 # round sections, nothing clamped (a flex joint holds no roll): one roll
                 # of every section about its tangent is a null vector of J (the drag
                 # has no entries along it); an LU that keeps its pivot gives the solves
@@ -753,11 +810,15 @@ class HeldLine:
             if recorder.heights is not None:
                 shift = hessian.position_shift(recorder.heights, 2)
                 vecs.append(shift)
-            planes = []
+            planes = readers = []
             if recorder.positions is not None:
-                planes = self._plane_shifts(hessian, recorder.positions)
+                planes = readers = self._plane_shifts(hessian, recorder.positions)
                 vecs.extend(planes)
                 shift = planes[2]
+                if self.friction:       # unsymmetric: the forces read its transpose
+                    readers = self._plane_shifts(
+                        hessian, recorder.positions.transpose(0, 2, 1))
+                    vecs.extend(readers)
             # a sheared current: the start raised moves the drag of every node too
             pushes = [v for v in (term.height_shift(hessian, state) for term in problem.terms
                                   if term.jacobian_positions) if v is not None]
@@ -770,7 +831,7 @@ class HeldLine:
                 lift.maxpy([1.0] * len(pushes), pushes)
                 if shift is not None:
                     lift.axpy(1.0, shift)
-            if hessian.resultants:
+            if unsymmetric:
                 if self.jacobian is None:
                     self.jacobian = self.built.own(NewtonJacobian(hessian))
                 self.jacobian.assemble()
@@ -787,7 +848,7 @@ class HeldLine:
             if solver is self.jacobian:
                 vecs.extend(_refine(solver, rights, solved))
             if planes:
-                response = self._plane_response(hessian, columns, planes,
+                response = self._plane_response(hessian, columns, readers,
                                                 solved, recorder.positions, solver)
                 return response @ np.block([[np.eye(3), np.zeros((3, 3))],
                                             [-np.eye(3), np.eye(3)]])
@@ -1094,8 +1155,11 @@ class HeldLine:
         whole position as data. With Y_C = A^-1 C^T and Y_j = A^-1 L_j (L_j = P_j, the
         sheared drag's height columns added to L_z): dmu = -S^-1 (dc + C Y_j dx_a,j),
         dy = -Y_j dx_a,j - Y_C dmu, F_b = mu, F_a = W + Psi_0 + R_s - mu with R_s the
-        seabed's whole reaction, dR_s,i = -(P_i.dy + sum_n H_n[i, j] dx_a,j).
-        Collective."""
+        seabed's whole reaction, dR_s,i = -(Q_i.dy + sum_n H_n[i, j] dx_a,j), the
+        functionals ``planes`` Q_i = sum_j sum_n H_n[i, j] dx^j_n/dy: P_i where H_n is
+        symmetric (the plane), the shifts of H_n's transpose with the friction (its
+        force on the line, part of R_s, reads the heights; the gradient's x and y rows
+        do not move the contact). Collective."""
         mesh = self.mesh
         n_all = len(columns)
         Y_P = solved[n_all:n_all + 3]
@@ -1135,15 +1199,17 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if scene.seabed is not None and scene.seabed.friction is not None:
-            raise RodInputError("HeldLine.stiffness: the seabed's friction dissipates: no "
-                                "exact stiffness of a line with friction")
+        if any(not term.in_newton for term in self.friction):
+            raise RodInputError(f"HeldLine.stiffness: {self.name}: its seabed friction "
+                                "takes no Newton steps (two coefficients, or a seabed that "
+                                "is not flat), so no exact stiffness: give the friction "
+                                "one coefficient on a flat seabed")
         if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.exact):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
                                 "seabed grid (its contact is lagged in the line's "
                                 "iterations); give a flat or sloping seabed or a profile")
         loose = [term for term in self.problem.terms if not term.in_newton
-                 or not (term.conservative or term.follower)]
+                 or not (term.conservative or term.follower or term in self.friction)]
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))
@@ -1155,7 +1221,19 @@ class HeldLine:
         self._release()
 
 
-def held_lines(system, options=None):
+def friction_notes(system):
+    """The run's note on a system whose seabed has friction (a tuple of one line, or
+    none): what its friction is measured from (module docstring, "Friction")."""
+    if system.environment.seabed_friction is None:
+        return ()
+    return ("seabed friction measured from the lines' as-laid shapes: each line's "
+            "friction anchors are its nodes where its first solve starts (the catenary "
+            "between its ends' start positions, before any offset), held through the "
+            "whole solve, its load steps, sweeps and cases "
+            '(docs/systems.md, "Seabed friction")',)
+
+
+def held_lines(system, options=None, laid=None):
     """The ``make_line(system_line, comm)`` of system/equilibrium.SystemSolver for the
     real lines of ``system`` (a model.system.System): each a HeldLine whose ends are
     first where the system's points and bodies put its connections at their start
@@ -1170,7 +1248,11 @@ def held_lines(system, options=None):
     iterations' Jacobian. A current profile's depths are below the
     system's sea surface, z = 0 where the Environment gives none (as the free points'
     drag, system/equilibrium.py), not below each line's higher end as for a single
-    line: the lines and points of a system share one sea."""
+    line: the lines and points of a system share one sea. ``laid``: a System with the
+    same points and bodies (the system file's, before a run's or a sweep case's
+    offsets) whose start positions lay each frictional line (HeldLine.laid: its
+    friction's anchors; None: ``system``'s own), so that every case measures its
+    friction from the same laid lines."""
     options = {"al_stability": 0, **(options or {})}
     environment = system.environment
     if environment.profile() is not None and environment.surface is None:
@@ -1184,6 +1266,11 @@ def held_lines(system, options=None):
                        else None for e, c in enumerate((line.start, line.end)))
         held = HeldLine.of_system_line(line, start, end, comm, environment, options,
                                        frames)
+        if laid is not None and environment.seabed_friction is not None:
+            ends = tuple(connection_position(laid.node(c.to), c)
+                         for c in (line.start, line.end))
+            if not (np.array_equal(ends[0], start) and np.array_equal(ends[1], end)):
+                held.laid = tuple(np.asarray(e, dtype=float) for e in ends)
         held.settles = False                # SystemSolver.evaluate settles it when it reports
         return held
 
