@@ -334,7 +334,7 @@ def check_reach(system, made_by=None):
     be folded on one vertical (check_not_folded). A line shorter than its ends' distance
     (to TAUT_GAP) is taut: it starts straight along its chord (scenes/starts.chord_start),
     stretched to it, so it must be able to stretch that far (needed_strain: extensible,
-    within MAX_STRAIN). A line at least as long hangs as its catenary start. A free node
+    within MAX_STRAIN). A longer line hangs as its catenary start. A free node
     whose lines are all taut must be pulled away along one of them at least (pulled):
     else they would all be in compression. Not part of check_system: a model's free
     points may stand anywhere (a MoorDyn file's are guesses); the run refuses them before
@@ -389,8 +389,8 @@ def own_force(node, water_density, gravity):
 
 
 def pulled(node, lines, water_density, gravity, made_by):
-    """A free point or body whose lines are all taut (``lines``: (SystemLine, unit
-    vector from its other end to this node), Body's and Point's) and whose translation
+    """A free point or body whose lines are all taut (``lines``: [(SystemLine, unit
+    vector from its other end to this node)]) and whose translation
     nothing else holds (a held translation, a hydrostatic term) must be pulled along one
     of them at least: its own force F (own_force) with F . e > 0 for some e. A taut
     line holds its node only by its tension, so with F . e <= 0 for all (a TLP's hull
