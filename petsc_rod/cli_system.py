@@ -8,7 +8,9 @@ written).
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
 -rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
--rod_system_modes_line_mass), the outputs (-rod_output, -rod_table), the modes of
+-rod_system_modes_line_mass), the seabed's plane (-rod_seabed_slope,
+-rod_seabed_direction, -rod_seabed_origin: a MoorDyn file carries none), the outputs
+(-rod_output, -rod_table), the modes of
 each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
 -rod_max_halvings: every line the same); every other
@@ -35,6 +37,7 @@ from petsc_rod.cli.signals import Interrupts
 from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
+from petsc_rod.model.names import FIELD_NAMES, Names
 from petsc_rod.model.system_check import check_reach
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
@@ -47,12 +50,18 @@ SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_lo
                   "rod_system_watch_circle", "rod_system_excursion",
                   "rod_system_modes", "rod_system_modes_line_mass",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
+# The single line's options of a sloping seabed a system file's sea takes: a MoorDyn file
+# gives the seabed's depth (WtrDpth) only, which is the plane's height at its origin.
+SEABED_OPTIONS = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin")
+SEABED_NAMES = Names({**{name.removeprefix("rod_"): f"-{name}" for name in SEABED_OPTIONS},
+                      "seabed": "seabed (the file's WtrDpth)"}, FIELD_NAMES.__getitem__)
 
 
 def refused_options(given):
     """The -rod_* options of ``given`` a system does not take (a single line's scene and
     load path), in the table's order."""
-    taken = set(SYSTEM_OPTIONS) | {f"rod_{name}" for name in LINE_OPTIONS}
+    taken = (set(SYSTEM_OPTIONS) | set(SEABED_OPTIONS)
+             | {f"rod_{name}" for name in LINE_OPTIONS})
     return [name for name in BY_NAME if name in given and name not in taken]
 
 
@@ -166,6 +175,21 @@ def line_lengths(text, system, element_length):
     return dataclasses.replace(system, lines=tuple(lines[line.name] for line in system.lines))
 
 
+def sloped(values, given, system):
+    """``system`` with its seabed the plane of -rod_seabed_slope, -rod_seabed_direction
+    and -rod_seabed_origin (``values`` of those ``given``; Environment.seabed_slope,
+    seabed_direction, seabed_origin: through the file's seabed height at the origin),
+    checked again (System.check) with those options named in the refusals."""
+    fields = {name.removeprefix("rod_"): values[name] for name in SEABED_OPTIONS
+              if name in given}
+    if not fields:
+        return system
+    system = dataclasses.replace(system, environment=dataclasses.replace(
+        system.environment, **fields))
+    system.check(SEABED_NAMES)
+    return system
+
+
 def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
     """Refuse an output that names an input (the system file, an options file), which
     writing it would replace: every file the run writes (written_paths: the result file,
@@ -245,7 +269,7 @@ def prepared(values, given, case=None):
                             "drop them")
     path = values["rod_system"]
     system, notes = read_moordyn(path, values["rod_system_element_length"])
-    system = changed(system, values, case or {})
+    system = changed(sloped(values, given, system), values, case or {})
     notes = tuple(notes) + friction_notes(system)
     settings = Settings() if values["rod_system_steps"] is None else Settings(
         load_steps=values["rod_system_steps"])

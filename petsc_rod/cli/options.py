@@ -255,7 +255,8 @@ OPTIONS = [
     Option("rod_seabed_slope", _real, None, "deg",
            "the seabed a plane rising at this angle (degrees above the horizontal, "
            "negative: falling) along -rod_seabed_direction, through the height -rod_seabed "
-           "at -rod_seabed_origin; the contact acts normal to it", SLOPE, "deg"),
+           "at -rod_seabed_origin (with -rod_system: the file's seabed height there); the "
+           "contact acts normal to it", SLOPE, "deg"),
     Option("rod_seabed_direction", _reals(), None, "azimuth|dx,dy",
            "direction of the seabed's slope (upward) or profile: an azimuth, degrees from "
            "+x toward +y (anticlockwise seen from above), or a horizontal vector; default "

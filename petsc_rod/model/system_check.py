@@ -253,6 +253,14 @@ def needed_strain(lengths, eas, chord):
     return np.inf if compliance == 0 else excess / compliance / float(eas.min())
 
 
+def sections_stretch(model):
+    """The lengths (m) and axial stiffnesses EA (N, inf: inextensible) of a Line's
+    sections, or a UniformLine's one, as needed_strain takes them."""
+    if hasattr(model, "sections"):
+        return model.lengths, [entry[0].ea for entry in model.sections]
+    return [model.length], [model.axial_stiffness]
+
+
 def ends_chord(line, nodes):
     """The vector (3,) from ``line``'s start to its end, m, with their points and bodies
     (``nodes`` by name) at their start positions."""
@@ -301,11 +309,7 @@ def check_held_spans(system, nodes, made_by):
             continue
         check_not_folded(line, nodes, made_by)
         chord = ends_distance(line, nodes)
-        model = line.line
-        if hasattr(model, "sections"):
-            lengths, eas = model.lengths, [entry[0].ea for entry in model.sections]
-        else:
-            lengths, eas = [model.length], [model.axial_stiffness]
+        lengths, eas = sections_stretch(line.line)
         strain = needed_strain(lengths, eas, chord)
         if strain == np.inf:
             raise RodInputError(
@@ -325,32 +329,91 @@ def check_held_spans(system, nodes, made_by):
 
 
 def check_reach(system, made_by=None):
-    """A line of one load piece (one section, or a uniform line of one load) with an end
-    at a free point or body must be longer than the distance between its ends where the
-    run starts (the free one at its start position): its first solve starts from the
-    inextensible catenary between them (scenes/starts.catenary_start), which a line as
-    long as its chord or shorter does not have. A line of several pieces starts straight
-    where its catenary cannot be drawn (HeldLine); one between held ends is
-    check_held_spans'. Neither may a line with a free end be folded on one vertical
-    (check_not_folded). Not part of check_system: a model's free points may stand
-    anywhere (a MoorDyn file's are guesses); the run refuses them before it starts
-    (cli_system.changed). ``made_by``: check_system's."""
+    """The lines with an end at a free point or body, where the run starts (the free
+    one at its start position); a line between held ends is check_held_spans'. None may
+    be folded on one vertical (check_not_folded). A line shorter than its ends' distance
+    (to TAUT_GAP) is taut: it starts straight along its chord (scenes/starts.chord_start),
+    stretched to it, so it must be able to stretch that far (needed_strain: extensible,
+    within MAX_STRAIN). A longer line hangs as its catenary start. A free node
+    whose lines are all taut must be pulled away along one of them at least (pulled):
+    else they would all be in compression. Not part of check_system: a model's free
+    points may stand anywhere (a MoorDyn file's are guesses); the run refuses them before
+    it starts (cli_system.changed). ``made_by``: check_system's."""
     made_by = made_by or {}
     nodes = {item.name: item for item in (*system.points, *system.bodies)}
+    taut, slack = {}, set()
     for line in system.lines:
         if is_held(nodes[line.start.to]) and is_held(nodes[line.end.to]):
             continue
-        model = line.line
-        pieces = (len(model.sections) if hasattr(model, "sections")
-                  else len(model.load_values))
         check_not_folded(line, nodes, made_by)
-        length, chord = float(model.length), ends_distance(line, nodes)
-        if pieces == 1 and not chord < length:
-            raise RodInputError(
-                f"line {line.name}: its length {length:.6g} m is not longer than its "
-                f"ends' distance {chord:.6g} m, {line.start.to} to {line.end.to} where the "
-                f"run starts{changed_by(line, made_by)}; its start hangs it between them "
-                "as a catenary: lengthen the line or move its ends closer")
+        chord = ends_chord(line, nodes)
+        distance, length = float(np.linalg.norm(chord)), float(line.line.length)
+        ends = [(line.start.to, -chord), (line.end.to, chord)]
+        if distance < length * (1 - TAUT_GAP):
+            slack.update(name for name, _ in ends)
+            continue
+        check_stretch(line, distance, made_by)
+        for name, outward in ends:
+            if line.start.to != line.end.to and not is_held(nodes[name]):
+                taut.setdefault(name, []).append((line, outward / distance))
+    sea = system.environment
+    for name, lines in taut.items():
+        if name not in slack:
+            pulled(nodes[name], lines, sea.water_density, sea.gravity, made_by)
+
+
+def check_stretch(line, distance, made_by):
+    """A taut line (ends ``distance`` m apart, at least its length) with a free end must
+    stretch to its chord: extensible, with a strain (needed_strain) within MAX_STRAIN."""
+    lengths, eas = sections_stretch(line.line)
+    strain = needed_strain(lengths, eas, distance)
+    length = float(np.sum(lengths))
+    head = (f"line {line.name}: its length {length:.6g} m is shorter than its ends' "
+            f"distance {distance:.6g} m, {line.start.to} to {line.end.to} where the run "
+            f"starts{changed_by(line, made_by)}")
+    if strain == np.inf:
+        raise RodInputError(f"{head}, and it is inextensible: lengthen the line, move its "
+                            "ends closer, or give its line types an EA")
+    if strain > MAX_STRAIN:
+        raise RodInputError(f"{head}: it must stretch by {100 * strain:.3g} % or more to "
+                            f"reach, above {100 * MAX_STRAIN:g} %, where the linear stretch "
+                            "models no line material; lengthen the line or move its ends "
+                            "closer")
+
+
+def own_force(node, water_density, gravity):
+    """The force (3,), N, global, on a Point or Body of its own at its start: buoyancy
+    less weight, (rho V - m) g e_z, and its constant force or load."""
+    load = np.asarray(node.force if hasattr(node, "kind") else node.load[:3], dtype=float)
+    return load + np.array([0.0, 0.0, (water_density * node.volume - node.mass) * gravity])
+
+
+def pulled(node, lines, water_density, gravity, made_by):
+    """A free point or body whose lines are all taut (``lines``: [(SystemLine, unit
+    vector from its other end to this node)]) and whose translation
+    nothing else holds (a held translation, a hydrostatic term) must be pulled along one
+    of them at least: its own force F (own_force) with F . e > 0 for some e. A taut
+    line holds its node only by its tension, so with F . e <= 0 for all (a TLP's hull
+    heavier than its buoyancy, a weightless point on a straight line) the tendons'
+    equilibrium would need compression."""
+    if not hasattr(node, "kind") and (
+            np.any(np.asarray(node.held, dtype=bool)[:3])
+            or np.any(restoring_by_hydrostatics(node, water_density, gravity)[:3] > 0)):
+        return
+    force = own_force(node, water_density, gravity)
+    directions = np.array([outward for _, outward in lines])
+    scale = 1e-12 * max(float(np.linalg.norm(force)), 1.0)
+    if np.max(directions @ force) > scale:
+        return
+    line = lines[0][0]
+    shown = ", ".join(f"{value:.6g}" for value in force)
+    raise RodInputError(
+        f"line {line.name}: taut between {line.start.to} and {line.end.to} where the run "
+        f"starts{changed_by(line, made_by)}, as are all lines at {node.name}, and nothing "
+        f"pulls them: {node.name}'s buoyancy less weight and load, ({shown}) N, pulls it "
+        "along none of them away from their other ends, so they would be in compression; "
+        f"give {node.name} more buoyancy than weight (a tension leg platform), or lengthen "
+        "a line so it hangs slack")
 
 
 def check_seabed_under(system):

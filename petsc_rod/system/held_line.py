@@ -94,10 +94,14 @@ node's stiffness is the loading tangent (the slip continued); unloading it would
 Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
 pinned ends only.
 
+On a sloping plane or a profile the rotations' response takes the seabed's data (x_a, c): three
+solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
+by the held data through P_i's held rows (_rotation_response).
+
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients or on a seabed that is not flat (no Newton
-steps), or at a clamped or flex-jointed end (end_stiffness), a seabed profile (its
-contact lagged), a clamp or flex joint on a sloping plane (end_stiffness),
+steps), or at a clamped or flex-jointed end (end_stiffness), a seabed grid (its contact
+lagged),
 and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -788,11 +792,6 @@ class HeldLine:
                     f"HeldLine.end_stiffness: {self.name}: no exact stiffness of a "
                     "clamped or flex-jointed end of a line with seabed friction; pin "
                     "the line's ends")
-            if recorder.positions is not None and rotations:
-                raise RodInputError(
-                    "HeldLine.end_stiffness: no exact stiffness of a clamped or "
-                    "flex-jointed end on a sloping seabed; pin the line's ends or make "
-                    "the seabed flat")
             if self.friction:
                 recorder.add_friction(self.friction)
             unsymmetric = hessian.resultants or bool(self.friction)
@@ -849,30 +848,36 @@ class HeldLine:
                 vecs.extend(_refine(solver, rights, solved))
             if planes:
                 response = self._plane_response(hessian, columns, readers,
-                                                solved, recorder.positions, solver)
-                return response @ np.block([[np.eye(3), np.zeros((3, 3))],
-                                            [-np.eye(3), np.eye(3)]])
-            response = self._response(hessian, columns, shift,
-                                      solved[:len(columns) + len(shifts)], recorder.heights,
-                                      solver)
+                                                solved[:len(columns) + len(shifts)],
+                                                recorder.positions, solver)
+                seabed = [(i, planes[i], self._plane_held_shift(hessian, recorder.positions,
+                                                                i)) for i in range(3)]
+            else:
+                response = self._response(hessian, columns, shift,
+                                          solved[:len(columns) + len(shifts)],
+                                          recorder.heights, solver)
+                seabed = [] if shift is None else [(2, shift, self._height_held_shift(
+                    hessian, recorder.heights))]
             if rotations:
-                response = self._rotation_response(hessian, frames, columns, shift,
-                                                   solved, recorder.heights, *held_data,
-                                                   response, flexed, lifted=bool(shifts),
-                                                   solver=solver)
+                response = self._rotation_response(hessian, frames, columns, solved,
+                                                   *held_data, response, flexed,
+                                                   len(shifts), seabed, solver=solver)
         finally:
             for vec in vecs:
                 vec.destroy()
             state.restore(saved)
-        chain = np.zeros((4, 6))                            # (z_a, c) of (x_a, x_b)
-        chain[0, 2] = 1.0
-        chain[1:, :3] = -np.eye(3)
-        chain[1:, 3:] = np.eye(3)
+        if planes:                                          # (x_a, c) of (x_a, x_b)
+            chain = np.block([[np.eye(3), np.zeros((3, 3))], [-np.eye(3), np.eye(3)]])
+        else:                                               # (z_a, c) of (x_a, x_b)
+            chain = np.zeros((4, 6))
+            chain[0, 2] = 1.0
+            chain[1:, :3] = -np.eye(3)
+            chain[1:, 3:] = np.eye(3)
         if not rotations:
             return response @ chain
-        full = np.zeros((10, 12))                           # (z_a, c, th_a, th_b)
-        full[:4, :6] = chain
-        full[4:, 6:] = np.eye(6)
+        full = np.zeros((chain.shape[0] + 6, 12))           # (data, th_a, th_b)
+        full[:-6, :6] = chain
+        full[-6:, 6:] = np.eye(6)
         return response @ full
 
     def _node_values(self, arrays, nodes):
@@ -938,9 +943,11 @@ class HeldLine:
             held += [(e, node, 3) for (e, node), ea in zip(clamps, axial) if np.isfinite(ea)]
         return held, dict(zip([e for e, _ in clamps], axial))
 
-    def _rotation_response(self, hessian, frames, columns, shift, solved, heights,
-                           held, axial, response, flexed=(), lifted=False, solver=None):
-        """d(F_a, F_b, M_a, M_b)/d(z_a, c, theta_a, theta_b), (12, 10).
+    def _rotation_response(self, hessian, frames, columns, solved, held, axial, response,
+                           flexed=(), shifts=0, seabed=(), solver=None):
+        """d(F_a, F_b, M_a, M_b)/d(s, c, theta_a, theta_b), (12, p + 9): s the start's
+        data of ``response`` ((6, p + 3), d(F_a, F_b)/d(s, c): _response's, s = z_a,
+        p = 1, or on a sloping plane _plane_response's, s = x_a, p = 3).
 
         A clamp turned by theta holds its node's rotation at theta instead of 0: the
         free unknowns see B theta on their right-hand side (B the held columns of H,
@@ -956,13 +963,19 @@ class HeldLine:
         by a complex step of that closed form, applied to dy at the free nodes and to
         the held data at a clamped one. The free roll's form, a fourth of ``columns``
         (held at 0 by every datum, its multiplier dropped), as in _response
-        (_held_forms)."""
+        (_held_forms). ``shifts``: the solves Y_P = A^-1 P of the start's data (0, 1:
+        P for z_a, 3: P_j for x_a), after the forms' in ``solved``; ``seabed``: [(row,
+        P_i, P_i with its held rows)] of the seabed's reaction on the start, dR_s,i =
+        -(P_i.dy + the held data's share), row i of F_a."""
         mesh, B, U = self.mesh, hessian.block, hessian.unknowns
+        p = response.shape[1] - 3                           # the start's data: 1 or 3
+        base = p + 3                                        # the first rotation's column
         n_h = len(held) + 3 * len(flexed)
-        n_d = 10 + sum(k == 3 for _, _, k in held)          # data: z, c, thetas, stretches
+        n_d = base + 6 + sum(k == 3 for _, _, k in held)    # data: s, c, thetas, stretches
         n_s = len(columns)                                  # the solves of the forms
-        Y_P = solved[n_s:n_s + 1] if lifted else []
+        Y_P = solved[n_s:n_s + shifts]
         Y_T = solved[n_s + len(Y_P):]
+        n_p = len(Y_P)
         columns, Y_C, schur = self._held_forms(columns, solved[:n_s], solver)
         n_c = len(columns)
         used = Y_C + Y_P + Y_T                              # the solves the response reads
@@ -970,11 +983,11 @@ class HeldLine:
         stretches = []
         for e, node, k in held:
             if k < 3:
-                data.append(4 + 3 * e + k)
+                data.append(base + 3 * e + k)
             else:
-                data.append(10 + len(stretches))
+                data.append(base + 6 + len(stretches))
                 stretches.append(e)
-        data += [4 + 3 * entry[0] + k for entry in flexed for k in range(3)]
+        data += [base + 3 * entry[0] + k for entry in flexed for k in range(3)]
         inverse = np.linalg.inv(schur)
         nodes_held = [node for _, node, _ in held]
         w = self._node_values([self.problem.state.node_weights], nodes_held)[0]
@@ -987,16 +1000,18 @@ class HeldLine:
             CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
         for j in range(len(held), n_h):                     # a flex joint's axis
             CY_T[:, data[j]] = [c.dot(Y_T[j]) for c in columns]
-        along = np.array([c.dot(Y_P[0]) for c in columns]) if Y_P else np.zeros(n_c)
+        along = np.array([[c.dot(y) for y in Y_P] for c in columns]).reshape(n_c, n_p)
         multipliers = -inverse @ (CY_T - G)                 # d (mu, roll's) / d(data)
-        multipliers[:, 0] = -inverse @ along
-        multipliers[:, 1:4] = -inverse[:, :3]
+        multipliers[:, :p] = 0.0
+        multipliers[:, :n_p] = -inverse @ along
+        multipliers[:, p:base] = -inverse[:, :3]
         dmu = multipliers[:3]
+        onto = np.eye(n_p, n_d)                             # Y_P onto the start's data
 
-        def of_dy(values_C, value_P, values_T):
-            """A linear functional of dy (its values on Y_C (.., n_c), Y_P (..,) and the
-            Y_T (.., n_h)) as a function of the data."""
-            out = -np.multiply.outer(value_P, np.eye(n_d)[0]) - values_C @ multipliers
+        def of_dy(values_C, values_P, values_T):
+            """A linear functional of dy (its values on Y_C (.., n_c), the Y_P (..,
+            n_p) and the Y_T (.., n_h)) as a function of the data."""
+            out = -values_P @ onto - values_C @ multipliers
             for j, col in enumerate(data):
                 out[..., col] -= values_T[..., j]
             return out
@@ -1009,13 +1024,14 @@ class HeldLine:
             first = mesh.global_sum(np.array(
                 [y.getArray(readonly=True).reshape(-1, B)[0, slot:slot + 3]
                  if mesh.on_lower_boundary else np.zeros(3) for y in used]))
-            forces[:3] += of_dy(first[:n_c].T, first[n_c] if Y_P else np.zeros(3),
-                                first[n_c + len(Y_P):].T)
-        forces[:3, :4] = response[:3]
-        if shift is not None:
-            moved = of_dy(np.array([shift.dot(y) for y in Y_C]), shift.dot(Y_P[0]),
+            forces[:3] += of_dy(first[:n_c].T, first[n_c:n_c + n_p].T,
+                                first[n_c + n_p:].T)
+        forces[:3, :base] = response[:3]
+        for row, shift, held_shift in seabed:
+            moved = of_dy(np.array([shift.dot(y) for y in Y_C]),
+                          np.array([shift.dot(y) for y in Y_P]),
                           np.array([shift.dot(y) for y in Y_T]))
-            full = hessian.position_shift(heights, 2, held=True)
+            full = held_shift()
             try:
                 at = self._node_values([full.getArray(readonly=True).reshape(-1, B)[:, :U]],
                                        nodes_held)[0]
@@ -1023,7 +1039,7 @@ class HeldLine:
                 full.destroy()
             for j, (e, node, k) in enumerate(held):
                 moved[data[j]] += at[j, k]
-            forces[2, 4:] -= moved[4:]
+            forces[row, base:] -= moved[base:]
         # the moments: the three nodes of each end element
         last = 2 * mesh.n_elements
         ends = ([0, 1, 2], [last - 2, last - 1, last])
@@ -1040,35 +1056,35 @@ class HeldLine:
                                    self._end_stiffness_values(e, S), e, U)
             for k in range(3):
                 v = values[:, 3 * e + k]                                # (vecs, U)
-                delta = of_dy(v[:n_c].T, v[n_c] if Y_P else np.zeros(U),
-                              v[n_c + len(Y_P):].T if n_h else np.zeros((U, 0)))
+                delta = of_dy(v[:n_c].T, v[n_c:n_c + n_p].T,
+                              v[n_c + n_p:].T if n_h else np.zeros((U, 0)))
                 for j, (end, node, slot) in enumerate(held):
                     if node == ends[e][k]:
                         delta[slot, data[j]] += 1.0
                 moments[3 * e:3 * e + 3] += (1.0 if e == 0 else -1.0) * jac[:, k] @ delta
         for e, node, J_d, J_a, a, d, _ in flexed:           # the joint's moment
             v = values[:, 0 if e == 0 else 5]
-            delta = of_dy(v[:n_c].T, v[n_c] if Y_P else np.zeros(U),
-                          v[n_c + len(Y_P):].T if n_h else np.zeros((U, 0)))
+            delta = of_dy(v[:n_c].T, v[n_c:n_c + n_p].T,
+                          v[n_c + n_p:].T if n_h else np.zeros((U, 0)))
             moments[3 * e:3 * e + 3] = J_d @ (-skew(d) @ delta[:3])
-            moments[3 * e:3 * e + 3, 4 + 3 * e:7 + 3 * e] += J_a @ (-skew(a))
+            moments[3 * e:3 * e + 3, base + 3 * e:base + 3 + 3 * e] += J_a @ (-skew(a))
         out = np.vstack([forces, moments])
         if not stretches:
             return out
         # the clamps' stretches from their force balance: dk = rows @ (data, dk)
         rows = np.zeros((len(stretches), n_d))
         for i, e in enumerate(stretches):
-            d3 = t[data.index(10 + i)]
+            d3 = t[data.index(base + 6 + i)]
             d3 = d3 / np.linalg.norm(d3)
             force = self.end_forces()[e]
             n = force - points_on_held_ends(self.problem)[e] if e == 0 else \
                 -(force - points_on_held_ends(self.problem)[e])
             sign = 1.0 if e == 0 else -1.0                  # n(0) = F_a, n(L) = -F_b
             rows[i] = sign * d3 @ out[3 * e:3 * e + 3] / axial[e]
-            rows[i, 4 + 3 * e:7 + 3 * e] += np.cross(d3, n) / axial[e]
-        own = rows[:, 10:]
-        solved_k = np.linalg.solve(np.eye(len(stretches)) - own, rows[:, :10])
-        return out[:, :10] + out[:, 10:] @ solved_k
+            rows[i, base + 3 * e:base + 3 + 3 * e] += np.cross(d3, n) / axial[e]
+        own = rows[:, base + 6:]
+        solved_k = np.linalg.solve(np.eye(len(stretches)) - own, rows[:, :base + 6])
+        return out[:, :base + 6] + out[:, base + 6:] @ solved_k
 
     def _end_stiffness_values(self, e, S):
         """(K1, K2, K3) of the end element of end ``e`` at its end (vertex_fields')."""
@@ -1133,6 +1149,26 @@ class HeldLine:
             moved[0] += mesh.global_sum(float(heights.sum()))
             start[2] -= moved                               # P.dy + sum k w_n dz
         return np.vstack([start, dmu])
+
+    @staticmethod
+    def _height_held_shift(hessian, heights):
+        """A function giving P = d(grad L)/dz_a with its held rows kept (a new Vec):
+        the held data's share of the flat seabed's reaction (_rotation_response)."""
+        return lambda: hessian.position_shift(heights, 2, held=True)
+
+    @staticmethod
+    def _plane_held_shift(hessian, curvature, j):
+        """A function giving P_j (_plane_shifts) with its held rows kept (a new Vec):
+        the held data's share of the plane's reaction along axis j
+        (_rotation_response)."""
+        def shift():
+            total = hessian.position_shift(curvature[:, 0, j], 0, held=True)
+            for c in (1, 2):
+                part = hessian.position_shift(curvature[:, c, j], c, held=True)
+                total.axpy(1.0, part)
+                part.destroy()
+            return total
+        return shift
 
     @staticmethod
     def _plane_shifts(hessian, curvature):

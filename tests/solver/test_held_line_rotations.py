@@ -207,3 +207,62 @@ def test_a_flex_joints_end_stiffness_on_the_seabed_in_a_current(comm):
             flexed.newton.run()
     finally:
         flexed.destroy()
+
+
+# the mooring over a plane rising 3 degrees towards azimuth 30 degrees, 0.2 m below its
+# anchor (test_held_line.SLOPE): its chain grounded on the slope and pushed across it
+MOORING = (np.array([0.0, 0.0, -30.0]), np.array([85.0, 0.0, 0.0]))
+SLOPE = dict(seabed=-30.2, seabed_slope=3.0, seabed_direction=30.0, seabed_origin=(0.0, 0.0))
+
+
+def dipping_frame(dip):
+    """A clamp's frame (rows d1, d2, d3) whose d3 points along +x and down by ``dip``
+    (the slope's tangent), d1 horizontal."""
+    d3 = np.array([1.0, 0.0, -dip]) / np.hypot(1.0, dip)
+    d1 = np.cross([0.0, 0.0, 1.0], d3)
+    d1 /= np.linalg.norm(d1)
+    return np.array([d1, np.cross(d3, d1), d3])
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("end", ["clamp", "flex"])
+def test_end_stiffness_on_a_sloping_seabed_against_differences(comm, end):
+    """A clamped or flex-jointed end on a sloping plane: the plane's reaction on the
+    start moves with the whole start position and with the held data (the clamp's
+    rotation, the joint's support), _rotation_response on _plane_response's (x_a, c):
+    the 12 x 12 against central differences of re-solves. The clamp at the anchor (an
+    inextensible line: an extensible clamp's stretch rule does not start on a seabed),
+    pointing 0.3 down so that its first element's far vertex lies on the plane: the
+    clamp's rotation moves that contact (without its share the error is of the order of
+    K itself); the flex joint at the fairlead of an extensible line, its support in
+    the reference frame."""
+    line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
+                       elements=40, axial_stiffness=np.inf if end == "clamp" else 1e5)
+    if end == "clamp":
+        ends = (End(kind="clamp", position=tuple(MOORING[0])), End.anchor(tuple(MOORING[1])))
+        frames = [dipping_frame(0.3), None]
+    else:
+        ends = (End.anchor(tuple(MOORING[0])),
+                End(kind="pin", position=tuple(MOORING[1]), stiffness=200.0))
+        frames = [None, REFERENCE]
+    model = Model(line=line, start=ends[0], end=ends[1], environment=Environment(**SLOPE))
+    held = HeldLine(model, COMMS[comm], options=TIGHT)
+    try:
+        assert held.solve(*MOORING, *frames)
+        assert abs(held.end_forces()[0, 1]) > 1.0           # pushed across the slope
+        e = 0 if end == "clamp" else 1
+        assert np.abs(held.end_moments()[e]).max() > 1.0    # the clamp's, the joint's
+        K = held.end_stiffness()
+        scale = np.abs(K).max()
+        error = np.abs(K - differences(held, frames, 1e-4, MOORING)).max() / scale
+        print(f"end stiffness on the slope ({end}) against differences {error:.3g}")
+        assert error < 1e-6
+        if end == "clamp":                                  # its first vertex grounded
+            second = held.centreline()
+            if second is not None:
+                assert held.scene.seabed.gap(second[1] - held.origin) < 0.0
+        else:       # the pinned start: stiffness()'s 6 x 6 (after the differences'
+            # re-solves, which move the state by round-off: 1.1e-12 on 2 ranks)
+            assert np.abs(K[:6, :6] - held.stiffness()).max() < 1e-10 * scale
+    finally:
+        held.destroy()

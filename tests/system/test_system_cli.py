@@ -259,16 +259,18 @@ def test_bad_input_is_one_line_and_leaves_no_file(tmp_path):
 
 def test_a_line_too_short_after_the_options_names_them(tmp_path):
     """A line that cannot reach its ends once -rod_system_line_length or
-    -rod_system_offset changed it: the line, its length, its ends' distance and the
-    option, not a single line's -rod_initial_shape message (Line1: Point1 at (65, 0,
+    -rod_system_offset changed it (a strain above any line type's to stretch to them):
+    the line, its length, its ends' distance and the option, not a single line's
+    -rod_initial_shape message (Line1: Point1 at (65, 0,
     -30) to Body1's fairlead at (5, 0, -5), 65 m)."""
     line = refused(tmp_path, ["-rod_system", DECK, "-rod_system_line_length", "Line1,10"])
-    assert line == ("petsc_rod: error: line Line1: its length 10 m is not longer than its "
+    assert line == ("petsc_rod: error: line Line1: its length 10 m is shorter than its "
                     "ends' distance 65 m, Point1 to Body1 where the run starts "
-                    "(-rod_system_line_length); its start hangs it between them as a "
-                    "catenary: lengthen the line or move its ends closer")
+                    "(-rod_system_line_length): it must stretch by 550 % or more to reach, "
+                    "above 100 %, where the linear stretch models no line material; "
+                    "lengthen the line or move its ends closer")
     line = refused(tmp_path, ["-rod_system", DECK, "-rod_system_offset", "Point1,1e9,0,0"])
-    assert "line Line1: its length 70 m is not longer than its ends' distance 1e+09 m" in line
+    assert "line Line1: its length 70 m is shorter than its ends' distance 1e+09 m" in line
     assert "(-rod_system_offset)" in line and "-rod_initial_shape" not in line
 
 

@@ -2,14 +2,18 @@
 apart has no catenary and starts straight along its chord (scenes/starts.chord_start);
 its equilibrium against the closed forms of a straight elastic line. A vertical line
 longer than its ends' distance is refused in one line naming it, not with a single
-line's -rod_initial_shape message.
+line's -rod_initial_shape message. A tension-leg platform (options/tlp.dat): tendons
+shorter than their ends' distance to a free hull that pulls them, and refused where the
+hull is heavier than its buoyancy.
 """
+
+import os
 
 import numpy as np
 import h5py
 import pytest
 
-from helpers import describe, run_petsc_rod
+from helpers import REPO_ROOT, describe, run_petsc_rod
 from test_system_cli import refused
 
 EA, DIAMETER, WATER, GRAVITY = 384.243e6, 0.09, 1025.0, 9.80665
@@ -103,3 +107,42 @@ def test_a_vertical_line_longer_than_its_ends_distance_is_refused(tmp_path, kind
         f"apart where the run starts{made}, and its length 26 m is longer, so it has no "
         "catenary and would fold on itself; shorten it to at most their distance (a taut "
         "tendon) or move an end sideways")
+
+
+TLP = os.path.join(REPO_ROOT, "options", "tlp.dat")
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_tension_leg_platform_runs_from_its_file(tmp_path, ranks):
+    """options/tlp.dat: a free hull, 2.2e6 kg of net buoyancy, on four 94.96 m tendons
+    95 m long between anchor and fairlead (check_reach refused them: shorter than their
+    ends' distance): the hull rises 2.48 mm to where each tendon's top tension is
+    (B - W) / 4 (tests/solver/test_system_tlp.py's closed forms), the same on 1 and 2
+    ranks."""
+    out = tmp_path / "tlp.h5"
+    process = run_petsc_rod(["-rod_system", TLP, "-rod_output", str(out)], ranks, 120)
+    assert process.returncode == 0, describe(process)
+    assert "petsc_rod: converged" in process.stdout and "warning" not in process.stdout
+    net = (WATER * 8000.0 - 6.0e6) * GRAVITY
+    wet = (450.0 - WATER * np.pi * 0.7 ** 2 / 4) * GRAVITY
+    chord = 94.96 + 94.96 * (net / 4 - wet * 94.96 / 2) / 1.2e10
+    with h5py.File(out, "r") as result:
+        pose = result["system/body_positions"][0]
+        assert pose[2] == pytest.approx(-120.0 + chord + 25.0, abs=1e-9)
+        assert np.abs(pose[[0, 1, 3, 4, 5]]).max() < 1e-9
+        # the command line's default line tolerances: the system's accuracy, 1e-7
+        assert np.allclose(result["system/end_tensions"][:, 1], net / 4, rtol=1e-7)
+
+
+def test_a_tension_leg_platform_heavier_than_its_buoyancy_is_refused(tmp_path):
+    """Its tendons, all taut, would be in compression: one line naming the hull's net
+    force, no file."""
+    with open(TLP, encoding="utf-8") as source:
+        text = source.read()
+    heavy = tmp_path / "heavy.dat"
+    heavy.write_text(text.replace("6.0E6   0        0        8000", "6.0E6   0        0        5000"))
+    line = refused(tmp_path, ["-rod_system", str(heavy)])
+    assert line.startswith("petsc_rod: error: line Line1: taut between Point1 and Body1 "
+                           "where the run starts, as are all lines at Body1, and nothing "
+                           "pulls them: Body1's buoyancy less weight and load, (0, 0, "
+                           "-8.58082e+06) N")

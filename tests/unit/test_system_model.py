@@ -153,26 +153,73 @@ def test_a_line_folded_on_one_vertical_is_refused_and_a_taut_one_passes():
     vertical(49.9).check()
 
 
-def test_a_line_to_a_free_point_too_short_for_its_start_is_refused_by_the_run():
-    """check_reach, the run's (not System.check's: a free point's position is a guess):
-    a line of one piece whose end is free must be longer than its ends' distance where
-    the run starts, which its catenary start needs; the option that made it named."""
+def test_a_taut_line_to_a_free_point_runs_where_it_is_pulled_and_can_stretch():
+    """check_reach, the run's (not System.check's: a free point's position is a guess): a
+    line with a free end, as long as its ends' distance or shorter, starts straight along
+    its chord (a tendon): refused where nothing pulls the free end along it (a weightless
+    point, a hull heavier than its buoyancy: the taut lines would be in compression) or
+    where it cannot stretch to it; passed where the free end's buoyancy pulls it; the
+    option that made it named."""
     system = held_pair(CHAIN, 100.0, 100.0)
     free = dataclasses.replace(system, points=(system.points[0],
                                                Point("b", "free", (100.0, 0.0, -50.0))))
     free.check()
-    message = ("line tie: its length 100 m is not longer than its ends' distance 100 m, "
-               "a to b where the run starts; its start hangs it between them as a "
-               "catenary: lengthen the line or move its ends closer")
+    message = ("line tie: taut between a and b where the run starts, as are all lines at "
+               "b, and nothing pulls them: b's buoyancy less weight and load, (0, 0, 0) N, "
+               "pulls it along none of them away from their other ends, so they would be "
+               "in compression; give b more buoyancy than weight (a tension leg platform), "
+               "or lengthen a line so it hangs slack")
     with pytest.raises(RodInputError) as error:
         check_reach(free)
     assert str(error.value) == message
     with pytest.raises(RodInputError) as error:
         check_reach(free, {("node", "b"): "-rod_system_offset", ("line", "b"): "-x"})
-    assert "where the run starts (-rod_system_offset);" in str(error.value)
+    assert "where the run starts (-rod_system_offset), as" in str(error.value)
     check_reach(held_pair(CHAIN, 100.0, 100.0))            # held ends: check_held_spans'
     check_reach(dataclasses.replace(free, points=(
         system.points[0], Point("b", "free", (99.9, 0.0, -50.0)))))
+
+    def tendon(line_type, length, volume=2.0, mass=1000.0, force=(0.0, 0.0, 0.0)):
+        """A 100 m vertical line from a to a free buoy b right above it."""
+        return dataclasses.replace(held_pair(line_type, length, 0.0), points=(
+            Point("a", "fixed", (0.0, 0.0, -150.0)),
+            Point("b", "free", (0.0, 0.0, -50.0), mass=mass, volume=volume, force=force)))
+    check_reach(tendon(CHAIN, 99.9))                    # 1025 kg of buoyancy net
+    check_reach(tendon(CHAIN, 100.0))
+    check_reach(tendon(CHAIN, 99.9, volume=0.0, mass=0.0, force=(0.0, 0.0, 1.0)))
+    heavy = refused_reach(tendon(CHAIN, 99.9, volume=0.5))
+    assert heavy.startswith("line tie: taut between a and b where the run starts, as are "
+                            "all lines at b, and nothing pulls them: b's buoyancy less "
+                            "weight and load, (0, 0, -4780.74) N, pulls it along none")
+    assert refused_reach(tendon(ROPE, 99.9)) == (
+        "line tie: its length 99.9 m is shorter than its ends' distance 100 m, a to b "
+        "where the run starts, and it is inextensible: lengthen the line, move its ends "
+        "closer, or give its line types an EA")
+    check_reach(tendon(ROPE, 100.0))                    # as long as the distance
+    soft = dataclasses.replace(CHAIN, ea=50.0)
+    assert refused_reach(tendon(soft, 40.0)).startswith(
+        "line tie: its length 40 m is shorter than its ends' distance 100 m, a to b where "
+        "the run starts: it must stretch by 150 % or more to reach, above 100 %")
+    # a hull held down by four tendons: buoyancy above its weight passes, below refused
+    legs = [(x, y, -20.0) for x, y in ((10, 0), (0, 10), (-10, 0), (0, -10))]
+
+    def platform(volume):
+        return System(
+            points=tuple(Point(f"A{k}", "fixed", (x, y, -200.0))
+                         for k, (x, y, _) in enumerate(legs)),
+            bodies=(Body("hull", mass=1e6, volume=volume),),
+            lines=tuple(SystemLine(f"T{k}", Line([(CHAIN, 179.9)], element_length=10.0),
+                                   Connection(f"A{k}"), Connection("hull", leg))
+                        for k, leg in enumerate(legs)))
+    check_reach(platform(1200.0))
+    assert refused_reach(platform(900.0)).startswith(
+        "line T0: taut between A0 and hull where the run starts, as are all lines at hull")
+
+
+def refused_reach(system):
+    with pytest.raises(RodInputError) as error:
+        check_reach(system)
+    return str(error.value)
 
 
 def test_the_needed_strain_of_sections_in_series():

@@ -1,0 +1,113 @@
+"""A tension-leg platform (options/tlp.dat, docs/systems.md "A tension-leg platform"): a
+free hull whose buoyancy B exceeds its weight W, held down by four vertical tendons
+shorter than the distance from their anchors to its fairleads (check_reach: a taut line
+to a free body starts straight along its chord), against the closed forms of a taut
+string: heave where the tendons' top tensions add up to B - W, each tension linear in
+height, the surge stiffness the tendons' pendulum stiffness, heave 4 EA / L; the 6 x 6
+against central differences of the equilibrium re-solved under small loads. Serially
+and under mpiexec -n 2 (the tendons split over the ranks)."""
+
+import dataclasses
+import os
+
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from helpers import REPO_ROOT
+from petsc_rod.api import read_moordyn, solve_system
+from petsc_rod.system.bodies import log_rotation
+from petsc_rod.system.equilibrium import SystemSolver
+from petsc_rod.system.held_line import held_lines
+
+pytestmark = pytest.mark.solver
+
+DECK = os.path.join(REPO_ROOT, "options", "tlp.dat")
+TIGHT = {"al_rtol": 1e-12, "al_ctol": 1e-12}
+RHO, G = 1025.0, 9.80665
+# the deck's numbers: hull, tendon type, geometry
+MASS, VOLUME = 6.0e6, 8000.0
+EA, MASS_PER_M, DIAMETER, LENGTH = 1.2e10, 450.0, 0.7, 94.96
+ANCHOR_Z, FAIRLEAD_Z = -120.0, -25.0
+NET = (RHO * VOLUME - MASS) * G                             # B - W, N
+WET = (MASS_PER_M - RHO * np.pi * DIAMETER ** 2 / 4) * G    # N/m
+
+
+def closed_form():
+    """Each tendon's top and bottom tensions (N), the hull's heave (m) and the pendulum
+    surge stiffness of the four (N/m) of an extensible string under its wet weight w:
+    top T_1 = (B - W) / 4, bottom T_0 = T_1 - w L; stretched to the chord
+    c = L + L (T_1 - w L / 2) / EA (the mean tension's stretch); a sideways force H on
+    the top moves it by H (int dS / T + L / EA), int dS / T = ln(T_1 / T_0) / w."""
+    top = NET / 4
+    bottom = top - WET * LENGTH
+    chord = LENGTH + LENGTH * (top - WET * LENGTH / 2) / EA
+    surge = 4.0 / (np.log(top / bottom) / WET + LENGTH / EA)
+    return top, bottom, ANCHOR_Z + chord - FAIRLEAD_Z, surge
+
+
+def test_the_tlp_settles_where_its_tendons_hold_its_net_buoyancy():
+    system, _ = read_moordyn(DECK)
+    found = solve_system(system, options=TIGHT)
+    top, bottom, heave, surge = closed_form()
+    body = found.bodies["Body1"]
+    assert body.position[2] == pytest.approx(heave, abs=1e-10)
+    assert body.position[2] > 1e-3                  # the start was 2.5 mm too deep
+    assert np.abs(body.position[[0, 1, 3, 4, 5]]).max() < 1e-9
+    for name in ("Line1", "Line2", "Line3", "Line4"):
+        assert found.end_tensions[name] == pytest.approx([bottom, top], rel=1e-9)
+        along = found.lines[name].along_line(["S", "axial_tension", "r"])
+        expected = top - WET * (LENGTH - along["S"])
+        assert np.abs(along["axial_tension"] - expected).max() < 1e-8 * top
+        assert np.abs(along["r"][:, :2] - along["r"][0, :2]).max() < 1e-9
+    K = body.stiffness
+    # the pendulum's (the string's, its tension varying along it; the tendons stay
+    # straight, so their bending stiffness adds nothing); tension over length (T_total /
+    # L, a weightless string's) only to 1 %
+    assert K[0, 0] == pytest.approx(surge, rel=1e-9)
+    assert K[1, 1] == pytest.approx(surge, rel=1e-9)
+    assert K[0, 0] == pytest.approx(NET / LENGTH, rel=1e-2)
+    assert K[0, 0] != pytest.approx(NET / LENGTH, rel=1e-3)
+    assert K[2, 2] == pytest.approx(4 * EA / LENGTH, rel=1e-9)
+    # the fairleads 25 m below the reference point and 15 m from its axis: surge-pitch
+    # and sway-roll through that lever, yaw the pendulums' at 15 m
+    arm = FAIRLEAD_Z
+    assert K[0, 4] == pytest.approx(arm * surge, rel=1e-9)
+    assert K[1, 3] == pytest.approx(-arm * surge, rel=1e-9)
+    assert K[5, 5] == pytest.approx(15.0 ** 2 * surge, rel=1e-9)
+    assert body.asymmetry < 1e-9
+
+
+def test_the_tlp_stiffness_is_the_derivative_of_re_solved_equilibria():
+    """K dq = dF: each column of K^-1 against the pose's central difference under loads
+    +-dF_j on the hull (dF_j = K_jj h_j, h 1 mm and 1e-5 rad)."""
+    system, _ = read_moordyn(DECK)
+    solver = SystemSolver(system, held_lines(system, TIGHT), PETSc.COMM_WORLD)
+    try:
+        base = solver.solve()
+        K = solver.body_stiffness("Body1").matrix
+        X, R = base.bodies["Body1"][:3], base.rotations["Body1"]
+        body = system.bodies[0]
+        h = np.array([1e-3] * 3 + [1e-5] * 3)
+        numeric = np.empty((6, 6))
+        for j in range(6):
+            poses = []
+            for sign in (1.0, -1.0):
+                load = np.zeros(6)
+                load[j] = sign * K[j, j] * h[j]
+                loaded = dataclasses.replace(system, bodies=(dataclasses.replace(
+                    body, load=tuple(np.add(body.load, load))),))
+                found = solver.solve(loaded)
+                poses.append((found.bodies["Body1"][:3], found.rotations["Body1"]))
+            (xp, Rp), (xm, Rm) = poses
+            numeric[:3, j] = (xp - xm) / (2 * K[j, j] * h[j])
+            numeric[3:, j] = log_rotation(Rp @ Rm.T) / (2 * K[j, j] * h[j])
+    finally:
+        solver.destroy()
+    compliance = np.linalg.inv(K)
+    for rows in (slice(0, 3), slice(3, 6)):
+        for columns in (slice(0, 3), slice(3, 6)):
+            block = compliance[rows, columns]
+            scale = np.abs(compliance[rows, rows]).max() ** 0.5 * np.abs(
+                compliance[columns, columns]).max() ** 0.5
+            assert np.abs(numeric[rows, columns] - block).max() < 1e-6 * scale, (rows, columns)
