@@ -14,10 +14,11 @@ rank hands its signal to rank 0, which asks for it after every iteration
 other work, and while they wait they run on rank 0's cores (on_cores; those on its
 machine): Linux's group scheduling (a session's autogroup, a cgroup) gives the job's
 processes one weight, shared among the cores in proportion to each core's recent load
-(PELT, a 32 ms half-life), and a waiting rank's load of its own start-up, left on a core
-of its own, would take about half of it from rank 0's core for the first tens of
-milliseconds of the solve, which a short line's whole solve is. Rank 0 keeps mpiexec's
-binding, so that the scheduler does not move it away from the waiting ranks' load.
+(PELT, a 32 ms half-life): a waiting rank's load of its own start-up, left on a core of
+its own, would take about half of it from rank 0's core during the first tens of
+milliseconds of the solve, all of a short line's. Rank 0 keeps mpiexec's binding, so
+that the scheduler does not move it away from the waiting ranks' load
+(docs/performance.md, "Where a whole run lost its time").
 """
 
 import contextlib
