@@ -11,9 +11,14 @@ error (a RodError's, a PETSc error's as exit 4, anything else raised on every ra
 when every rank fails), and a stop signal that any rank receives stops the run: a waiting
 rank hands its signal to rank 0, which asks for it after every iteration
 (WholeInterrupts). The waiting ranks sleep between polls, so they leave their cores to
-other work, and rank 0 may run on any core of the job's ranks on its machine while it
-works alone (job_cores: mpiexec binds each rank to a core of its own, where a one-rank
-run may move to the less busy core).
+other work, and while they wait they run on rank 0's cores (on_cores; those on its
+machine): Linux's group scheduling (a session's autogroup, a cgroup) gives the job's
+processes one weight, shared among the cores in proportion to each core's recent load
+(PELT, a 32 ms half-life): a waiting rank's load of its own start-up, left on a core of
+its own, would take about half of it from rank 0's core during the first tens of
+milliseconds of the solve, all of a short line's. Rank 0 keeps mpiexec's binding, so
+that the scheduler does not move it away from the waiting ranks' load
+(docs/performance.md, "Where a whole run lost its time").
 """
 
 import contextlib
@@ -63,16 +68,16 @@ class WholeInterrupts:
 
 def run_whole(comm, work, interrupts=None):
     """``work(line_comm, line_interrupts)`` on rank 0 of ``comm`` alone, on
-    PETSc.COMM_SELF, the other ranks waiting; returns its value on every rank, or raises
-    on every rank what it raised (module docstring). ``interrupts``: the run's
-    signals.Interrupts (None: none asked). Collective."""
+    PETSc.COMM_SELF, the other ranks waiting on rank 0's cores; returns its value on
+    every rank, or raises on every rank what it raised (module docstring).
+    ``interrupts``: the run's signals.Interrupts (None: none asked). Collective."""
     channel = comm.tompi4py().Dup()
     try:
-        cores = channel.allgather((MPI.Get_processor_name(), _cores()))
-        if channel.Get_rank() == 0:         # the cores of the ranks on rank 0's machine
-            with job_cores(set().union(*(own for host, own in cores if host == cores[0][0]))):
-                return _lead(channel, work, interrupts)
-        return _wait(channel, interrupts)
+        host, cores = channel.bcast((MPI.Get_processor_name(), _cores()), root=0)
+        if channel.Get_rank() == 0:
+            return _lead(channel, work, interrupts)
+        with on_cores(cores if host == MPI.Get_processor_name() else set()):
+            return _wait(channel, interrupts)
     finally:
         channel.Free()
 
@@ -85,19 +90,19 @@ def _cores():
 
 
 @contextlib.contextmanager
-def job_cores(cores):
-    """Within the block this process may run on any of ``cores`` (the job's ranks'),
-    its own affinity put back after it; nothing where the system cannot set it."""
+def on_cores(cores):
+    """Within the block this process runs on ``cores`` only, its own affinity put back
+    after it; nothing where ``cores`` is empty or the system cannot set it."""
     own = _cores()
-    widened = False
-    if own and cores - own:
+    moved = False
+    if own and cores and cores != own:
         with contextlib.suppress(OSError):
             os.sched_setaffinity(0, cores)
-            widened = True
+            moved = True
     try:
         yield
     finally:
-        if widened:
+        if moved:
             with contextlib.suppress(OSError):
                 os.sched_setaffinity(0, own)
 

@@ -126,6 +126,33 @@ def test_a_stop_signal_of_the_last_rank_reaches_the_whole_run():
     assert run_whole(world, work, interrupts) == signal.SIGUSR1
 
 
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="no CPU affinity here")
+def test_the_waiting_ranks_wait_on_rank_0_s_cores_and_rank_0_keeps_its_own():
+    """While rank 0 works, every waiting rank on its machine may run on rank 0's cores
+    only (so that the scheduler counts the job's load on rank 0's cores), rank 0 on its
+    own cores as before; each rank's own cores are put back after the run."""
+    world = PETSc.COMM_WORLD.tompi4py()
+    own = os.sched_getaffinity(0)
+    ranks = world.allgather((MPI.Get_processor_name(), os.getpid(), sorted(own)))
+
+    def work(line_comm, stops):
+        # the waiting ranks move once they have rank 0's cores: a moment after it starts
+        deadline = time.monotonic() + 2.0
+        while True:
+            seen = [(sorted(os.sched_getaffinity(pid)), host == ranks[0][0])
+                    for host, pid, _ in ranks]
+            if time.monotonic() > deadline or all(cores == ranks[0][2]
+                                                  for cores, local in seen if local):
+                return seen
+            time.sleep(0.001)
+
+    during = run_whole(PETSc.COMM_WORLD, work, Recorded(0))
+    assert during[0][0] == ranks[0][2]
+    assert [cores for cores, local in during[1:] if local] == \
+        [ranks[0][2]] * sum(local for _, local in during[1:])
+    assert os.sched_getaffinity(0) == own
+
+
 @pytest.mark.parametrize("raised, code", [
     (RodInterrupted("interrupted by SIGTERM", signal.SIGTERM), 128 + signal.SIGTERM),
     (RodIOError("the disk is full"), 5)])
