@@ -83,7 +83,9 @@ PREFIXES = ("rod_x_", "rod_y_")
 # Units of the datasets and attributes this module adds to the result file.
 DATASET_UNITS = {"friction_force": "N/m", "friction_state": "1"}
 ATTRIBUTE_UNITS = {"friction_stick_length": "m", "friction_slide_length": "m",
-                   "friction_max_force": "N/m", "friction_max_use": "1"}
+                   "friction_max_force": "N/m", "friction_max_use": "1",
+                   "friction_stick_nodes": "1", "friction_slide_nodes": "1",
+                   "friction_stick_max_use": "1", "friction_band": "m"}
 
 # friction_state at a vertex: off the seabed, sticking, sliding
 OFF, STICK, SLIDE = 0, 1, 2
@@ -366,10 +368,31 @@ class FrictionTerm(NodalLoadTerm):
         (n_nodes, 3), for the internal force (NodalLoadTerm.force_beyond)."""
         return owned_nodes(self.mesh, self.force)
 
+    def path_numbers(self):
+        """How far the equilibrium is one of many (docs/riser.md §3b, "The path"): a
+        sticking node balances anywhere within |k_s (x_n - a_n)|_mu <= R_n of its anchor,
+        so another load path from the as-laid line could leave it elsewhere in that
+        band. Returns (sticking P2 nodes, sliding P2 nodes, the largest use
+        |f|_mu / R_n of a sticking node (its mobilisation, 1 at the slide), the largest
+        band max(mu_a, mu_l) R_n / k_s of a sticking node, m), over the whole line (0
+        where nothing sticks). Collective."""
+        mesh = self.mesh
+        grounded = owned_nodes(mesh, self.reaction) > 0
+        stick = (owned_nodes(mesh, self.stick) > 0) & grounded
+        counts = mesh.global_sum(np.array([np.count_nonzero(stick),
+                                           np.count_nonzero(grounded & ~stick)], dtype=float))
+        use = owned_nodes(mesh, self.use)[stick]
+        band = (max(self.friction.axial, self.friction.lateral) / self.friction.stiffness
+                * owned_nodes(mesh, self.reaction)[stick])
+        return (int(counts[0]), int(counts[1]),
+                mesh.global_max(float(use.max(initial=0.0))),
+                mesh.global_max(float(band.max(initial=0.0))))
+
     def outputs(self, problem, vertex):
         """The friction force and state (off, stick, slide) at the vertices; the grounded
         lengths that stick and slide (Simpson weights of the P2 nodes), the largest
-        friction per metre and the largest use |f|_mu / R. Collective."""
+        friction per metre, the largest use |f|_mu / R and the path's numbers
+        (path_numbers). Collective."""
         mesh = self.mesh
         grounded = self.reaction > 0
         stick = self.stick & grounded
@@ -378,12 +401,15 @@ class FrictionTerm(NodalLoadTerm):
         size = np.linalg.norm(self.force, axis=2)
         largest = mesh.global_max(float(size.max()) if size.size else 0.0)
         use = mesh.global_max(float(self.use.max()) if self.use.size else 0.0)
+        stick_nodes, slide_nodes, stick_use, band = self.path_numbers()
         state = np.where(grounded, np.where(self.stick, STICK, SLIDE), OFF)
         vertices = owned_nodes(mesh, np.stack([self.force[..., c] for c in range(3)] + [state],
                                               axis=2))[0::2]
         attributes = {"friction_stick_length": float(lengths[0]),
                       "friction_slide_length": float(lengths[1]),
-                      "friction_max_force": largest, "friction_max_use": use}
+                      "friction_max_force": largest, "friction_max_use": use,
+                      "friction_stick_nodes": stick_nodes, "friction_slide_nodes": slide_nodes,
+                      "friction_stick_max_use": stick_use, "friction_band": band}
         text = (f"friction: {lengths[0]:.6g} m stick, {lengths[1]:.6g} m slide, largest "
                 f"{largest:.4g} N/m")
         return TermOutput({"friction_force": vertices[:, :3],
