@@ -37,14 +37,14 @@ global step's vertical solve (the seabed term comes first). Why implicit: an exp
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (global_step/seabed_contact.py).
 
-In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed
-or a sloping plane and with one coefficient (mu_a = mu_l): within a load step the anchors are fixed, and the
-law above is a function of the node
-positions, f_n(x_n, z_n), through d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work
-enters the gradient like the seabed's energy, -w_n f_n on the horizontal positions,
-carried by their chains (analysis/positions.py; ``position_components`` (0, 1)), and its
-derivative -w_n df_n is the Newton system's block of the friction (a semi-smooth Newton
-step: stick, slide and off the seabed those of the iterate):
+In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed or
+a sloping plane and with one coefficient (mu_a = mu_l): within a load step the anchors
+are fixed, and the law above is a function of the node positions, f_n(x_n, z_n), through
+d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work enters the gradient like the
+seabed's energy, -w_n f_n on the horizontal positions, carried by their chains
+(analysis/positions.py; ``position_components`` (0, 1)), and its derivative -w_n df_n is
+the Newton system's block of the friction (a semi-smooth Newton step: stick, slide and
+off the seabed those of the iterate):
 
     stick:  w_n k_s I,
     slide:  w_n R_n / |d_n|_mu (I - d_n (M_n d_n)^T / |d_n|_mu^2)   on x_n,
