@@ -123,6 +123,23 @@ def friction_text(attributes):
             + (f", touchdown {offset:.4g} m off the ends' plane" if offset == offset else ""))
 
 
+def friction_path_text(attributes):
+    """The line that says a frictional equilibrium is one of many (physics/friction.py
+    FrictionTerm.path_numbers): how many grounded nodes stick and slide, the largest
+    mobilisation of a sticking node and the band mu R / k_s within which another load
+    path from the as-laid line could leave a sticking node; '' where no node sticks (a
+    sliding node's force is the limit, whatever the path)."""
+    a = attributes
+    if a.get("friction_stick_nodes", 0) <= 0:
+        return ""
+    return (f"seabed friction depends on the path from the as-laid line (the start): "
+            f"{a['friction_stick_nodes']} grounded nodes stick and "
+            f"{a['friction_slide_nodes']} slide; a sticking node uses at most "
+            f"{a['friction_stick_max_use']:.4g} of its limit mu R and could lie anywhere "
+            f"within mu R / k_s = {a['friction_band'] * 1e3:.3g} mm of its anchor after "
+            "another load path (this equilibrium is one of that set)")
+
+
 def step_line(event, record):
     """The line of a StepEnded event with its io.outputs.StepRecord: load factor,
     iterations (Newton steps), converged, stable or a saddle, the linking number where
@@ -200,6 +217,8 @@ def summary(attributes):
         out += end_force_lines(a)
     if "friction_stick_length" in a:
         out.append("  seabed" + friction_text(a)[1:])
+        if friction_path_text(a):
+            out.append("  " + friction_path_text(a))
     if "module_pitch" in a:
         out.append(f"  buoyancy modules, over the module pitch {a['module_pitch']:.4g} m: "
                    + "; ".join(f"global {kind} bend radius "

@@ -251,6 +251,7 @@ class NewtonSolver:
         outcome = FAILED
         regularised = False
         tested = False                    # the last step passed the test of its own H
+        curved = False                    # the last exact step took the iteration's curvature
         try:
             self._agree(self._usable(frames))
             for _ in range(MAX_STEPS):
@@ -261,9 +262,11 @@ class NewtonSolver:
                 # the first step's curvature from the iteration's multipliers where the
                 # heights enter (see _newton_step)
                 curvature = start_lam if first and self.reads_positions else None
-                # a chord step (FREEZE_TURN) from the last exact step's KKT matrix
+                # a chord step (FREEZE_TURN) from the last exact step's KKT matrix, not
+                # from one made with the iteration's curvature: that matrix is not J, and
+                # its chord steps left |grad L| where it was (docs/riser.md §3b)
                 chord = (self.unsymmetric and previous <= FREEZE_TURN
-                         and self._kkt is not None)
+                         and self._kkt is not None and not curved)
                 self._near = previous <= ROLL_TURN
                 # an exact step without the inertia test (INERTIA_TURN); a step taken
                 # again below is tested
@@ -290,6 +293,8 @@ class NewtonSolver:
                 if omega is None:
                     outcome = INDEFINITE
                     break
+                if not chord:
+                    curved = curvature is not None
                 if self.unsymmetric:
                     # no energy to descend: the residual must fall at every step, but at
                     # the round-off floor (the last turn below FLOOR_TURN, as below);

@@ -38,14 +38,14 @@ global step's vertical solve (the seabed term comes first). Why implicit: an exp
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (global_step/seabed_contact.py).
 
-In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed
-and with one coefficient (mu_a = mu_l): within a load step the anchors are fixed, and the
-law above is a function of the node
-positions, f_n(x_n, z_n), through d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work
-enters the gradient like the seabed's energy, -w_n f_n on the horizontal positions,
-carried by their chains (analysis/positions.py; ``position_components`` (0, 1)), and its
-derivative -w_n df_n is the Newton system's block of the friction (a semi-smooth Newton
-step: stick, slide and off the seabed those of the iterate):
+In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed or
+a sloping plane and with one coefficient (mu_a = mu_l): within a load step the anchors
+are fixed, and the law above is a function of the node positions, f_n(x_n, z_n), through
+d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work enters the gradient like the
+seabed's energy, -w_n f_n on the horizontal positions, carried by their chains
+(analysis/positions.py; ``position_components`` (0, 1)), and its derivative -w_n df_n is
+the Newton system's block of the friction (a semi-smooth Newton step: stick, slide and
+off the seabed those of the iterate):
 
     stick:  w_n k_s I,
     slide:  w_n R_n / |d_n|_mu (I - d_n (M_n d_n)^T / |d_n|_mu^2)   on x_n,
@@ -59,8 +59,23 @@ stability test see the friction with its limit held at its current value); the z
 unsymmetric, its symmetric part indefinite where the slip is oblique to the line, and
 the turn of the axes a, l with the tangent, left out, is of the order of R: the steps
 failed there (docs/riser.md §3b), so such a run takes none (``in_newton``); nor on a
-seabed that is not flat (slope_load.py). Not conservative: friction dissipates, so the run
-gives no stability verdict (as with the drag).
+seabed profile (its curvature is not in the Newton steps, slope_load.py).
+
+On a sloping plane z_b = z_0 + g.x (g constant) the force is F_n = (f_n, g.f_n) on
+(x_n, z_n), its size |d|_G = sqrt(d^T G d) / mu with G = I + g g^T (the tangent-plane
+norm above), and the limit R_n = k cos(theta) (z_b(x_n) - z_n)_+ follows x_n as well as
+z_n (_plane_law): -w dF/d(x, z) has rows (I; g^T) times
+
+    stick:  w_n k_s I                                                     on x_n,
+    slide:  w_n [R_n / |d|_G (I - d (G d)^T / (mu^2 |d|_G^2))
+                 + k cos(theta) d g^T / |d|_G]                            on x_n,
+            -w_n k cos(theta) d / |d|_G                                   on z_n.
+
+H takes the limit held and the slip's turn in the horizontal plane,
+w_n R_n / |d|_G (I - d d^T / |d|^2), which is positive semidefinite; J the rest. The
+global step carries g.f as its work through the heights' chain (add_iterate_load), so
+that its fixed point is the Newton steps' stationary point. Not conservative: friction
+dissipates, so the run gives no stability verdict (as with the drag).
 """
 
 import numpy as np
@@ -84,7 +99,9 @@ PREFIXES = ("rod_x_", "rod_y_")
 # Units of the datasets and attributes this module adds to the result file.
 DATASET_UNITS = {"friction_force": "N/m", "friction_state": "1"}
 ATTRIBUTE_UNITS = {"friction_stick_length": "m", "friction_slide_length": "m",
-                   "friction_max_force": "N/m", "friction_max_use": "1"}
+                   "friction_max_force": "N/m", "friction_max_use": "1",
+                   "friction_stick_nodes": "1", "friction_slide_nodes": "1",
+                   "friction_stick_max_use": "1", "friction_band": "m"}
 
 # friction_state at a vertex: off the seabed, sticking, sliding
 OFF, STICK, SLIDE = 0, 1, 2
@@ -126,7 +143,7 @@ class FrictionTerm(NodalLoadTerm):
     # the recorded force, reactions and use are the last global step's (_record): a
     # step that Newton steps finish ends at the iteration after them (Term)
     outputs_of_state = False
-    newton_gap = ("seabed friction with two coefficients or on a seabed that is not flat "
+    newton_gap = ("seabed friction with two coefficients or on a seabed profile "
                   "(docs/riser.md §3b)")
 
     def __init__(self, mesh, seabed_term):
@@ -156,11 +173,13 @@ class FrictionTerm(NodalLoadTerm):
         # line of a system, whose equilibrium is then a function of its ends alone
         # (system/held_line.py)
         self.hold_anchors = False
+        self._held = None           # H's share on a plane of the last _plane_law (n, 2, 2)
 
     @property
     def in_newton(self):
-        """On a flat seabed with one coefficient (module docstring)."""
-        return (self.seabed_term.seabed.flat
+        """On a flat seabed or a sloping plane, with one coefficient (module docstring)."""
+        seabed = self.seabed_term.seabed
+        return ((seabed.flat or seabed.plane)
                 and self.friction.axial == self.friction.lateral)
 
     # --- the global step --------------------------------------------------------------
@@ -184,14 +203,22 @@ class FrictionTerm(NodalLoadTerm):
 
     def add_iterate_load(self, rhs, state):
         """On a seabed that is not flat: the friction's vertical part g.f of the last
-        solve, a nodal load on the slope's right-hand side (its z part, which the
-        seabed's vertical problem solves; lagged like the slope's push, slope_load.py)."""
+        solve on the slope's right-hand side (its z part, which the seabed's vertical
+        problem solves; lagged like the slope's push, slope_load.py), as its work
+        sum_n w_n (g.f)_n z_n through the heights' chain: the form of the Newton steps'
+        gradient, so that the global step's fixed point is their stationary point (the
+        P2 interpolant's int F.g differs by O(h^2)). Collective."""
         if self.seabed_term.seabed.flat:
             return
-        vertical = np.zeros((self.mesh.n_local_nodes, 3))
-        vertical[:, 2] = owned_nodes(self.mesh, self.force[..., 2])
-        self.load.set(vertical)
-        self.add_to_rhs(rhs, self.load)
+        if self._springs_stale and self.seabed_term.seabed.plane:
+            # after Newton steps: the friction at their positions (the last solve's is
+            # that of the state before them)
+            work = -self._newton_law(state)[0][:, 2]
+        else:
+            work = owned_nodes(self.mesh, self.force[..., 2]) * state.node_weights
+        gradient = np.zeros((work.shape[0], 3, 3))
+        self.add_position_gradient(gradient, state, {HEIGHT: -work})
+        rhs.components[HEIGHT].getArray()[:work.shape[0]] -= gradient[:, 2, HEIGHT]
 
     def solve_slope(self, rhs, state, bordered):
         """x' and y' from the Hermite problems with the friction (module docstring): the
@@ -260,7 +287,8 @@ class FrictionTerm(NodalLoadTerm):
         """The secant springs (ne, 3) of the element nodes' horizontal ``positions``
         (ne, 3, 2), ``tangents`` (ne, 3, 2) and reactions ``reaction`` (ne, 3)."""
         trial = -self.friction.stiffness * (positions - self.anchors)
-        size = elliptic_norm(trial, tangents, self.friction)
+        size = (elliptic_norm(trial, tangents, self.friction)
+                * tangent_factor(trial, self.seabed_term.contact.gradients))
         self.spring = self.friction.stiffness * np.divide(
             reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
 
@@ -297,15 +325,18 @@ class FrictionTerm(NodalLoadTerm):
     # --- the Newton steps (module docstring) -------------------------------------------
     def _newton_law(self, state):
         """The law at the state's centreline (the frames' integral: the Newton steps), at
-        the owned nodes: (-w_n f_n (n, 2), N, the derivative of -w f in x (n, 2, 2) and
-        in z (n, 2), N/m)."""
+        the owned nodes: (-w_n F_n (n, m), N, the derivative of -w F in x (n, m, 2) and
+        in z (n, m), N/m), F = f (m = 2) on a flat seabed, (f, g.f) (m = 3) on a sloping
+        plane (module docstring)."""
         seabed = self.seabed_term.seabed
         r = state.node_positions().copy()
         tangents = state.node_directors()[:, 2, :2].copy()
         w = state.node_weights
         d = r[:, :2] - owned_nodes(self.mesh, self.anchors)
-        reaction = seabed.push(r[:, 2])
         stiffness = self.friction.stiffness
+        if not seabed.flat:
+            return self._plane_law(r, d, w)
+        reaction = seabed.push(r[:, 2])
         norm = elliptic_norm(d, tangents, self.friction)                  # |d|_mu
         slide = (reaction > 0) & (stiffness * norm > reaction)
         stick = (reaction > 0) & ~slide
@@ -327,6 +358,51 @@ class FrictionTerm(NodalLoadTerm):
                                              where=slide[:, None])
         return -w[:, None] * force, w[:, None, None] * in_x, w[:, None] * in_z
 
+    def _plane_law(self, r, d, w):
+        """_newton_law on a sloping plane z_b = z_0 + g.x with one coefficient mu: the
+        norm of the whole force |d|_G = sqrt(d^T G d) / mu, G = I + g g^T, and the limit
+        R = k cos(theta) (z_b - z)_+ (Seabed.reaction), whose derivatives in x and z are
+        k cos(theta) g and -k cos(theta) on the contact. Stick f = -k_s d; slide
+        f = -R d / |d|_G, whose derivative in x is
+        -R / |d|_G (I - d (G d)^T / (mu^2 |d|_G^2)) - d (k cos(theta) g)^T / |d|_G and in
+        z d k cos(theta) / |d|_G; the vertical part g.f has g^T times them. Returns
+        (-w F (n, 3), -w dF/dx (n, 3, 2), -w dF/dz (n, 3)), N and N/m."""
+        seabed = self.seabed_term.seabed
+        mu, stiffness = self.friction.lateral, self.friction.stiffness
+        g = seabed.gradients(r[:, 0], r[:, 1])                            # (n, 2)
+        cosine = 1.0 / seabed.slope_factor(g)
+        reaction = seabed.reaction(r)
+        contact = reaction > 0
+        metric = d + g * np.einsum("nc,nc->n", g, d)[:, None]              # G d
+        norm = np.sqrt(np.einsum("nc,nc->n", d, metric)) / mu             # |d|_G
+        slide = contact & (stiffness * norm > reaction)
+        stick = contact & ~slide
+        force = np.where(stick[:, None], -stiffness * d, 0.0)
+        scale = np.divide(reaction, norm, out=np.zeros_like(norm), where=slide)
+        force[slide] = -(scale[:, None] * d)[slide]
+        squared = np.where(slide, mu**2 * norm**2, 1.0)
+        limit = np.divide(seabed.stiffness * cosine, norm, out=np.zeros_like(norm),
+                          where=slide)                                    # k cos / |d|_G
+        in_x = ((stick * stiffness)[:, None, None] * np.eye(2)
+                + scale[:, None, None] * (np.eye(2) - d[:, :, None] * metric[:, None, :]
+                                          / squared[:, None, None])
+                + limit[:, None, None] * d[:, :, None] * g[:, None, :])
+        in_z = -limit[:, None] * d
+        # H's share, the limit held and the slip's turn measured in the horizontal plane:
+        # positive semidefinite (the symmetric part of in_x is not: the d g^T of the
+        # limit and G's oblique projection); J carries the rest (add_jacobian)
+        length = np.where(slide, np.einsum("nc,nc->n", d, d), 1.0)
+        self._held = w[:, None, None] * (
+            (stick * stiffness)[:, None, None] * np.eye(2)
+            + scale[:, None, None] * (np.eye(2) - d[:, :, None] * d[:, None, :]
+                                      / length[:, None, None]))
+        rise = np.einsum("nc,nc->n", g, force)
+        return (-w[:, None] * np.concatenate([force, rise[:, None]], axis=1),
+                w[:, None, None] * np.concatenate([in_x, np.einsum("nc,ncj->nj", g, in_x)[:, None]],
+                                                  axis=1),
+                w[:, None] * np.concatenate([in_z, np.einsum("nc,nc->n", g, in_z)[:, None]],
+                                            axis=1))
+
     def add_gradient(self, g, state):
         """-w_n f_n on the horizontal positions, into g's d3 x and y rows through their
         chains (NodalLoadTerm.add_position_gradient), at the state's centreline (the
@@ -336,30 +412,37 @@ class FrictionTerm(NodalLoadTerm):
             return
         derivative = self._newton_law(state)[0]
         self.add_position_gradient(g, state, {c: derivative[:, c]
-                                              for c in self.position_components})
+                                              for c in range(derivative.shape[1])})
 
     def add_hessian(self, hessian):
         """The symmetric part of -w_n df_n/dx_n on the horizontal positions (module
         docstring)."""
         if self.anchors is None:
             return
-        in_x = self._newton_law(hessian.problem.state)[1]
-        hessian.add_position_curvature(0.5 * (in_x + in_x.transpose(0, 2, 1)),
-                                       self.position_components)
+        in_x = self._newton_law(hessian.problem.state)[1][:, :2]
+        held = (self._held if not self.seabed_term.seabed.flat
+                else 0.5 * (in_x + in_x.transpose(0, 2, 1)))
+        hessian.add_position_curvature(held, self.position_components)
 
     def add_jacobian(self, jacobian):
-        """J beyond H: the antisymmetric part of -w_n df_n/dx_n (zero with one
-        coefficient, the only case in the Newton steps) and its column on the heights
-        (the limit mu R following the contact reaction), which the seabed's chain
-        carries (the seabed term reads them)."""
+        """J beyond H: the antisymmetric part of -w_n df_n/dx_n (zero on a flat seabed
+        with one coefficient) and its column on the heights (the limit mu R following
+        the contact reaction), which the seabed's chain carries (the seabed term reads
+        them); on a sloping plane all of -w dF/d(x, z) but H's share (_plane_law), with
+        the rows of the heights (the vertical part g.f)."""
         if self.anchors is None:
             return
         hessian = jacobian.hessian
         _, in_x, in_z = self._newton_law(hessian.problem.state)
-        rest = np.concatenate([0.5 * (in_x - in_x.transpose(0, 2, 1)), in_z[:, :, None]],
-                              axis=2)
+        rest = np.concatenate([in_x, in_z[:, :, None]], axis=2)
+        horizontal = in_x[:, :2]
+        if self.seabed_term.seabed.flat:
+            rest[:, :2, :2] = 0.5 * (horizontal - horizontal.transpose(0, 2, 1))
+        else:
+            rest[:, :2, :2] -= self._held
+        rows = self.position_components + ((HEIGHT,) if rest.shape[1] == 3 else ())
         for rows, columns, blocks in hessian.position_blocks(
-                rest, self.position_components, self.position_components + (HEIGHT,)):
+                rest, rows, self.position_components + (HEIGHT,)):
             jacobian.add(rows, columns, blocks)
 
     def position_derivatives(self, state):
@@ -404,10 +487,31 @@ class FrictionTerm(NodalLoadTerm):
         (n_nodes, 3), for the internal force (NodalLoadTerm.force_beyond)."""
         return owned_nodes(self.mesh, self.force)
 
+    def path_numbers(self):
+        """How far the equilibrium is one of many (docs/riser.md §3b, "The path"): a
+        sticking node balances anywhere within |k_s (x_n - a_n)|_mu <= R_n of its anchor,
+        so another load path from the as-laid line could leave it elsewhere in that
+        band. Returns (sticking P2 nodes, sliding P2 nodes, the largest use
+        |f|_mu / R_n of a sticking node (its mobilisation, 1 at the slide), the largest
+        band max(mu_a, mu_l) R_n / k_s of a sticking node, m), over the whole line (0
+        where nothing sticks). Collective."""
+        mesh = self.mesh
+        grounded = owned_nodes(mesh, self.reaction) > 0
+        stick = (owned_nodes(mesh, self.stick) > 0) & grounded
+        counts = mesh.global_sum(np.array([np.count_nonzero(stick),
+                                           np.count_nonzero(grounded & ~stick)], dtype=float))
+        use = owned_nodes(mesh, self.use)[stick]
+        band = (max(self.friction.axial, self.friction.lateral) / self.friction.stiffness
+                * owned_nodes(mesh, self.reaction)[stick])
+        return (int(counts[0]), int(counts[1]),
+                mesh.global_max(float(use.max(initial=0.0))),
+                mesh.global_max(float(band.max(initial=0.0))))
+
     def outputs(self, problem, vertex):
         """The friction force and state (off, stick, slide) at the vertices; the grounded
         lengths that stick and slide (Simpson weights of the P2 nodes), the largest
-        friction per metre and the largest use |f|_mu / R. Collective."""
+        friction per metre, the largest use |f|_mu / R and the path's numbers
+        (path_numbers). Collective."""
         mesh = self.mesh
         grounded = self.reaction > 0
         stick = self.stick & grounded
@@ -416,12 +520,15 @@ class FrictionTerm(NodalLoadTerm):
         size = np.linalg.norm(self.force, axis=2)
         largest = mesh.global_max(float(size.max()) if size.size else 0.0)
         use = mesh.global_max(float(self.use.max()) if self.use.size else 0.0)
+        stick_nodes, slide_nodes, stick_use, band = self.path_numbers()
         state = np.where(grounded, np.where(self.stick, STICK, SLIDE), OFF)
         vertices = owned_nodes(mesh, np.stack([self.force[..., c] for c in range(3)] + [state],
                                               axis=2))[0::2]
         attributes = {"friction_stick_length": float(lengths[0]),
                       "friction_slide_length": float(lengths[1]),
-                      "friction_max_force": largest, "friction_max_use": use}
+                      "friction_max_force": largest, "friction_max_use": use,
+                      "friction_stick_nodes": stick_nodes, "friction_slide_nodes": slide_nodes,
+                      "friction_stick_max_use": stick_use, "friction_band": band}
         text = (f"friction: {lengths[0]:.6g} m stick, {lengths[1]:.6g} m slide, largest "
                 f"{largest:.4g} N/m")
         return TermOutput({"friction_force": vertices[:, :3],

@@ -74,7 +74,10 @@ class SeabedSlopeLoad(NodalLoadTerm):
         return force
 
     def add_iterate_load(self, rhs, state):
-        """Add the work of f_h to the slope problem's right-hand side, then move the
+        """Add the work of f_h (node_loads: the last vertical solve's, or after Newton
+        steps on a plane, which moved the state and not the contact, the force at the
+        state's positions, whose global step then keeps their fixed point) to the slope
+        problem's right-hand side, then move the
         seabed's heights and springs under the nodes of the last global step for this
         step's vertical solve (seabed_contact.SeabedContact.follow; this term is built after the
         seabed's, and add_iterate_load comes before every solve of the global step).
@@ -85,7 +88,7 @@ class SeabedSlopeLoad(NodalLoadTerm):
         energy's form the global step's fixed point on a plane is the stationary point
         of the Newton steps, whose seabed energy sums over the nodes with the same
         weights (seabed.py). Collective."""
-        work = self._iterate_loads() * state.node_weights[:, None]
+        work = self.node_loads(state) * state.node_weights[:, None]
         n = work.shape[0]
         gradient = np.zeros((n, 3, 3))
         self.add_position_gradient(gradient, state, {c: -work[:, c] for c in (0, 1)})

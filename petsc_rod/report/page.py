@@ -195,6 +195,16 @@ def range_graphs(images, min_bend_radius):
                else "") + ").</p>" + '<div class="graphs">' + "".join(images) + "</div>")
 
 
+def summary_column(header, rows, attribute):
+    """The numbers of the summary's column of ``attribute`` (its unit in the header),
+    blanks left out; [] without that column."""
+    column = next((k for k, name in enumerate(header)
+                   if name.split(" (")[0] == attribute), None)
+    if column is None:
+        return []
+    return [row[column] for row in rows if isinstance(row[column], (int, float))]
+
+
 def build(source, min_bend_radius=None):
     """The HTML page of ``source``: a result file or a sweep's folder; ``min_bend_radius``
     (m): the allowable bend radius drawn as a limit."""
@@ -228,6 +238,14 @@ def build(source, min_bend_radius=None):
     parts.append('<div class="scroll">' + tables.key_results(header, rows, codes) + "</div>")
     parts.append("<p>'-': a case that did not converge (its state is no equilibrium of the "
                  "case) or a number the case does not have.</p>")
+    if any(value > 0 for value in summary_column(header, rows, "friction_stick_nodes")):
+        parts.append("<p>Seabed friction: where grounded nodes stick "
+                     "(<code>friction_stick_nodes</code>) the equilibrium depends on the load "
+                     "path from the as-laid line (the run's start). A sticking node could "
+                     "lie anywhere within <code>friction_band</code> (&mu;R / k<sub>s</sub>) "
+                     "of its anchor after another path; "
+                     "<code>friction_stick_max_use</code> is how much of its limit "
+                     "&mu;R a sticking node uses (docs/riser.md &sect;3b).</p>")
     regions = tables.region_rows([r["file"] for r in done], [r["name"] for r in done])
     if regions:
         parts.append("<h3>Regions</h3><p>Each region's extremes over the converged cases "

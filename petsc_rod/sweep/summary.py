@@ -61,6 +61,10 @@ NUMBERS = [
     ("local_sag_bend_radius", "local_sag_bend_radius", "m"),
     ("max_wall_tension", "max_wall_tension", "N"),
     ("max_wall_tension_S", "max_wall_tension_S", "m"),
+    ("friction_stick_nodes", "friction_stick_nodes", "1"),
+    ("friction_slide_nodes", "friction_slide_nodes", "1"),
+    ("friction_stick_max_use", "friction_stick_max_use", "1"),
+    ("friction_band", "friction_band", "m"),
 ]
 # Other root attributes shown when present and scalar.
 EXTRA_PREFIXES = ("max_", "min_", "top_")

@@ -29,6 +29,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import make_solver
+from petsc_rod.environment.bathymetry import Plane
 from petsc_rod.environment.seabed import Friction, Seabed
 from petsc_rod.iteration.events import NewtonAttempt
 from petsc_rod.iteration.newton import NewtonSolver
@@ -37,6 +38,7 @@ from petsc_rod.physics.seabed import SeabedTerm
 from test_seabed_newton import moved, random_direction
 
 COMMS = {"one rank": PETSc.COMM_SELF, "all ranks": PETSc.COMM_WORLD}
+SLOPE = Plane.sloping(np.zeros(2), 0.0, 5.0, np.array([np.cos(np.pi / 6), np.sin(np.pi / 6)]))
 
 
 @pytest.fixture(scope="module", params=list(COMMS))
@@ -64,6 +66,14 @@ LINES = {
                                       -100.0 * np.cos(np.radians(35.0))]],
                         axial_stiffness=1e6,
                         seabed=Seabed(0.0, 1e6, None, Friction(0.5, 0.5, 1e6))), 1e6),
+    # the line pushed across on a plane rising at 5 deg toward 30 deg from x: the
+    # friction in the tangent plane (its vertical part g.f, the norm of the whole
+    # force, the limit's columns on x, y and z)
+    "pushed across a slope": (dict(length=10.0, stiffness=(1e-1, 1e-1, 1e-1), start="pin",
+                                   end="pin", end_position=(7.0, 0.0, 1.0),
+                                   load_values=[[0.0, 0.3, -1.0]],
+                                   seabed=Seabed(0.0, 1e3, SLOPE, Friction(0.5, 0.5, 1e2))),
+                              50.0),
 }
 
 
@@ -77,10 +87,14 @@ def converged(comm, line, newton, n_elements=40):
 
 def position_derivatives(problem, friction, seabed):
     """dE/dx at the owned nodes (n_nodes, 3): the friction's -w f on x, y and the
-    seabed's on z, at the state's centreline."""
+    seabed's on z, at the state's centreline; on a sloping plane the seabed's on x, y,
+    z and the friction's -w (f, g.f)."""
     state = problem.state
     values = np.zeros((problem.mesh.n_local_nodes, 3))
-    values[:, :2] = friction._newton_law(state)[0]
+    law = friction._newton_law(state)[0]
+    values[:, :law.shape[1]] = law
+    if seabed.seabed.plane:
+        return values + seabed._plane_derivatives(state)[0]
     values[:, 2] = seabed._height_derivatives(state)[0]
     return values
 
@@ -108,6 +122,11 @@ def sets(friction, state):
 
 @pytest.mark.parametrize("line", list(LINES))
 def test_jacobian_against_finite_differences(comm, line):
+    if line == "pushed across a slope" and comm.getSize() > 1:
+        # the plain iteration split over two ranks did not reach rtol 1e-10 in 20 000
+        # iterations (change 8.8e-6, measured); the plane's block on two ranks is
+        # test_seabed_friction's Newton steps on the contour line
+        pytest.skip("the sloping line's plain iteration on one rank only")
     mesh, solver, report = converged(comm, line, newton=False)
     assert report.converged
     problem = solver.problem
@@ -256,8 +275,8 @@ def test_newton_steps_take_friction_of_one_coefficient(comm):
             assert problem.in_newton is expected and solver.uses_newton is expected
             gaps = [term.newton_gap for term in problem.terms if not term.in_newton]
             assert gaps == ([] if expected else
-                            ["seabed friction with two coefficients or on a seabed that is "
-                             "not flat (docs/riser.md §3b)"])
+                            ["seabed friction with two coefficients or on a seabed "
+                             "profile (docs/riser.md §3b)"])
         finally:
             solver.destroy()
             problem.destroy()

@@ -94,6 +94,23 @@ def test_pulled_line_converges_as_the_stick_stiffens(pulled_runs):
     assert 0.4 < order < 0.6
 
 
+def test_pulled_line_says_how_its_sticking_part_depends_on_the_path(pulled_runs):
+    """The path's numbers (FrictionTerm.path_numbers) of the pulled line at k_s = 1e5
+    N/m^2, 200 elements: the 401 P2 nodes but the free end's lie on the seabed, those
+    behind the stick-slip front (S < L - F / (mu w) = 100 m, the front 3.5 m on by the
+    stick's elastic zone as above) stick, the others slide; the band mu R / k_s = mu w /
+    k_s = 0.5 mm; the sticking node next to the front uses between exp(-h / (2 l)) and 1
+    of its limit, the stick's displacement falling as exp((S - S_front) / l) with
+    l = sqrt(EA / k_s) = 3.16 m (0.951 measured)."""
+    attributes = pulled_runs[1e5][2]
+    h = LENGTH / 200
+    stick, slide = attributes["friction_stick_nodes"], attributes["friction_slide_nodes"]
+    assert stick + slide == 400
+    assert 2 * 100.0 / h <= stick <= 2 * 103.5 / h
+    assert abs(attributes["friction_band"] - MU * WEIGHT / 1e5) < 1e-3 * MU * WEIGHT / 1e5
+    assert np.exp(-h / (2 * np.sqrt(1e6 / 1e5))) < attributes["friction_stick_max_use"] < 1.0
+
+
 INCLINE_LENGTH = 100.0
 
 
@@ -121,6 +138,13 @@ def test_line_on_an_incline_sticks_below_and_slides_above_mu(theta):
     if np.tan(t) < MU:
         assert attributes["friction_slide_length"] < 0.02 * INCLINE_LENGTH
         assert anchor < 0.02 * drive
+        # the path's numbers: every grounded node but the anchor's sticks, the block's
+        # mobilisation tan(theta) / mu and band mu w cos(theta) / k_s (k_s = 1e6 N/m^2),
+        # to 1e-3 (2e-4 and 6e-4 measured)
+        assert attributes["friction_stick_nodes"] == 200
+        assert attributes["friction_slide_nodes"] == 0
+        assert abs(attributes["friction_stick_max_use"] / (np.tan(t) / MU) - 1) < 1e-3
+        assert abs(attributes["friction_band"] / (MU * WEIGHT * np.cos(t) / 1e6) - 1) < 1e-3
     else:
         assert attributes["friction_stick_length"] < 0.05 * INCLINE_LENGTH
         exact = INCLINE_LENGTH * WEIGHT * (np.sin(t) - MU * np.cos(t))
@@ -154,6 +178,33 @@ def test_line_along_a_sloping_seabed_is_held_by_friction():
     assert np.abs(use - np.tan(theta) / MU).max() < 1e-3
     assert attributes["friction_max_use"] < 1.0
     assert np.abs(fields["r"][:, 1]).max() < MU * w / 1e6
+
+
+def test_line_along_a_sloping_seabed_in_newton_steps():
+    """The contour line above with Newton steps (friction's block in the tangent plane of
+    a sloping plane, physics/friction.py): it takes them and converges in 23 iterations
+    (741 without, measured), to the block's friction as above, and one rank and all
+    ranks reach the same line to 1e-9 m and the same friction to 1e-6 w."""
+    theta = np.radians(10.0)
+    shape = Plane.sloping(np.zeros(2), 0.0, 10.0, np.array([0.0, 1.0]))
+    scene = dict(length=INCLINE_LENGTH, stiffness=(100.0, 100.0, 100.0), start="pin",
+                 end="free", load_values=[[0.0, 0.0, -WEIGHT]], axial_stiffness=1e6,
+                 seabed=seabed(1e6, shape=shape))
+    runs = [solve(comm, 40, scene, rtol=1e-10, newton=True)
+            for comm in (PETSc.COMM_SELF, PETSc.COMM_WORLD)]
+    w = WEIGHT
+    for report, fields, attributes in runs:
+        assert report.converged
+        assert report.newton_steps > 0
+        assert report.iterations < 100
+        inner = (fields["S"] > 20.0) & (fields["S"] < INCLINE_LENGTH - 5.0)
+        force = fields["friction_force"][inner]
+        assert np.abs(force[:, 1] - w * np.sin(theta) * np.cos(theta)).max() < 1e-3 * w
+        assert np.abs(force[:, 2] - w * np.sin(theta)**2).max() < 1e-3 * w
+        assert np.all(fields["friction_state"][inner] == 1)
+    (_, one, _), (_, all_, _) = runs
+    assert np.abs(one["r"] - all_["r"]).max() < 1e-9
+    assert np.abs(one["friction_force"] - all_["friction_force"]).max() < 1e-6 * w
 
 
 @pytest.mark.parametrize("newton", [False, True], ids=["plain", "Newton"])

@@ -102,12 +102,22 @@ def test_friction_holds_the_riser_under_a_cross_current(tmp_path):
         assert np.all(force[reaction > 0] <= MU * reaction[reaction > 0] * (1 + 1e-6))
         assert b.attrs["friction_stick_length"] + b.attrs["friction_slide_length"] == \
             pytest.approx(b.attrs["grounded_length"], abs=3.0)
+        # the path's numbers (FrictionTerm.path_numbers) at the P2 nodes, of which the
+        # vertices are every other: their sticking vertices within them
+        assert b.attrs["friction_stick_nodes"] >= stick.sum()
+        assert b.attrs["friction_slide_nodes"] >= (state == 2).sum()
+        band = MU * reaction[stick].max() / stiffness
+        assert band * (1 - 1e-9) <= b.attrs["friction_band"] <= 1.05 * band
+        assert np.abs(r[stick, 1]).max() <= b.attrs["friction_band"] * 1.01
+        assert 0.0 < b.attrs["friction_stick_max_use"] <= 1.0
         with h5py.File(plain, "r") as c:
             assert np.abs(c["r"][:] - r).max() < 1e-4
             assert np.array_equal(c["friction_state"][:], state)
             assert abs(c.attrs["touchdown_offset"] - offset) < 1e-4
     assert "m stick" in text and "m slide" in text and "off the ends' plane" in text
     assert "no Newton steps" not in text
+    # the summary says the answer is one of many, with the band
+    assert "depends on the path from the as-laid line" in text and "mu R / k_s" in text
 
     def iterations(output):
         return int(re.search(r"converged in (\d+) iterations", output).group(1))
