@@ -1235,11 +1235,14 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if any(not term.in_newton for term in self.friction):
-            raise RodInputError(f"HeldLine.stiffness: {self.name}: its seabed friction "
-                                "takes no Newton steps (two coefficients, or a seabed that "
-                                "is not flat), so no exact stiffness: give the friction "
-                                "one coefficient on a flat seabed")
+        if self.friction and (scene.seabed is None or not scene.seabed.flat
+                              or any(not term.in_newton for term in self.friction)):
+            # a sloping plane's friction is in the line's Newton steps, but its block
+            # (n, 3, 3) and the state it follows are not written into this response
+            raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
+                                "its seabed friction with two coefficients or on a seabed "
+                                "that is not flat: give the friction one coefficient on a "
+                                "flat seabed")
         if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.exact):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
                                 "seabed grid (its contact is lagged in the line's "

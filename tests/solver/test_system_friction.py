@@ -221,14 +221,22 @@ def test_a_vanishing_friction_is_the_frictionless_system():
     assert slip < 1e-9
 
 
-def test_two_coefficients_are_refused_in_one_line_naming_the_line():
-    """mu_a != mu_l takes no Newton steps (physics/friction.py): no exact stiffness;
-    the refusal names the line and what to change. The run says once what the
-    friction is measured from."""
+@pytest.mark.parametrize("case", ["two coefficients", "a sloping plane"])
+def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
+    """mu_a != mu_l takes no Newton steps (physics/friction.py), and a sloping plane's
+    friction block is not in the end stiffness: no exact stiffness; the refusal names
+    the line and what to change. The run says once what the friction is measured
+    from."""
     system = frictional((0.5, 0.8))
+    environment = system.environment
+    if case == "a sloping plane":
+        system = frictional(0.5)
+        environment = dataclasses.replace(system.environment, seabed_slope=2.0,
+                                          seabed_direction=30.0,
+                                          seabed_origin=(-32.5, 56.292))
     ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
     line = HeldLine.of_system_line(system.lines[1], *ends, PETSc.COMM_SELF,
-                                   system.environment, {"al_stability": 0})
+                                   environment, {"al_stability": 0})
     try:
         assert line.solve(*ends)
         with pytest.raises(RodInputError) as refused:
