@@ -8,29 +8,19 @@ seabed, a direction e = (cos beta, sin beta), beta the azimuth from +x toward +y
 
 * ``Plane``: z_b = z0 + tan(alpha) d, alpha the largest upward slope (rad; negative:
   the seabed falls along e), constant across e. gradient g = tan(alpha) e.
-* ``Profile``: the rows (d_i, z_i), d_i strictly increasing, and z(d) their linear
-  interpolant, constant across e and beyond the first and last rows. Its height is z
-  box-smoothed over a width delta = SMOOTHING times the closest rows' spacing,
-
-      h_s(d) = (1/delta) int_{d - delta/2}^{d + delta/2} z(t) dt
-             = z(d) + J_i (delta/2 - |d - d_i|)_+^2 / (2 delta),
-
-  J_i the jump of z's slope at row i (at the first and last rows from or to level),
-  at most one row within delta/2 of any d. Its gradient is the secant
-  h_s' = (z(d + delta/2) - z(d - delta/2)) / delta e: the segment's slope away from the
-  rows, turning linearly from one segment's to the next over delta about a row; its
-  curvature h_s'' = J_i / delta within delta/2 of row i, 0 elsewhere. h_s = z farther
-  than delta/2 from every row, and within it differs from z by at most |J_i| delta / 8
-  (at the row). Why smoothed: the contact's energy k/2 (h_s - z)_+^2 / (1 + h_s'^2) then
-  has a gradient continuous in the position and a Hessian, so the Newton steps and a
-  system's stiffness hold it exactly (environment/seabed.py position_derivatives), and
-  the lagged push of the line's iterations, which with a slope jumping at a row flipped
-  a node there between the two pushes, has a fixed point (docs/riser.md §3a).
+* ``Profile``: z_b = the linear interpolant of the rows (d_i, z_i), d_i strictly
+  increasing, constant across e and beyond the first and last rows. Its gradient is
+  the secant over a width delta = SMOOTHING times the closest rows' spacing,
+  g = (z_b(d + delta/2) - z_b(d - delta/2)) / delta e: the segment's slope away from the
+  rows, and turning linearly from one segment's to the next over delta about a row
+  (and to 0 about the first and last). Why: the contact's horizontal push is lagged
+  (physics/slope_load.py), and with the slope jumping at a row a node there flips between the
+  two pushes from one iteration to the next and the iteration never settles
+  (docs/riser.md §3a); a gradient continuous in the position gives it a fixed point.
   ``covers`` tells whether a point lies within the rows.
 * ``Grid``: bilinear in each cell of a rectangular grid, its gradient the secant over
-  SMOOTHING times the closest grid lines' spacing along x and along y, for the lagged
-  push's fixed point; its height is not smoothed, so that secant is not its
-  derivative: it has no ``hessian``, and its push stays lagged (no Newton steps).
+  SMOOTHING times the closest grid lines' spacing along x and along y, for the same
+  reason.
 
 The unit normal pointing up out of the seabed is (-g, 1) / sqrt(1 + |g|^2), and the
 local slope atan |g|. Heights in m, in whichever frame the shape was made in
@@ -79,10 +69,6 @@ class Plane:
         """dz_b/d(x, y), (shape of x) + (2,)."""
         return np.broadcast_to(self.slope_vector, np.shape(x) + (2,)).copy()
 
-    def hessian(self, x, y):
-        """d2z_b/d(x, y)^2 = 0, (shape of x) + (2, 2)."""
-        return np.zeros(np.shape(x) + (2, 2))
-
     def normal(self, x, y):
         """The unit normal up out of the seabed, (shape of x) + (3,)."""
         return unit_normal(self.gradient(x, y))
@@ -112,49 +98,17 @@ class Profile:
         return ((np.asarray(x, dtype=float) - self.origin[0]) * self.direction[0]
                 + (np.asarray(y, dtype=float) - self.origin[1]) * self.direction[1])
 
-    def _half_width(self):
-        """delta / 2 = SMOOTHING / 2 times the closest rows' spacing, m."""
-        return 0.5 * SMOOTHING * np.min(np.diff(self.distances))
-
-    def _near_row(self, d):
-        """(J, u): the slope jump J_i of the row nearest each distance d and u = d - d_i
-        (m), the shape of d; J = 0 where no row lies within delta / 2 (module
-        docstring)."""
-        slopes = np.diff(self.heights) / np.diff(self.distances)
-        jumps = np.diff(np.concatenate([[0.0], slopes, [0.0]]))          # (rows,)
-        rows = np.clip(np.searchsorted(self.distances, d), 1, self.distances.size - 1)
-        nearer = np.where(np.abs(d - self.distances[rows - 1])
-                          <= np.abs(d - self.distances[rows]), rows - 1, rows)
-        u = d - self.distances[nearer]
-        return np.where(np.abs(u) < self._half_width(), jumps[nearer], 0.0), u
-
     def height(self, x, y):
-        """h_s, z box-smoothed over delta (module docstring), m, the shape of x."""
-        d = self.along(x, y)
-        half = self._half_width()
-        jump, u = self._near_row(d)
-        rounding = np.maximum(half - np.abs(u), 0.0)**2 / (4.0 * half)
-        return np.interp(d, self.distances, self.heights) + jump * rounding
+        return np.interp(self.along(x, y), self.distances, self.heights)
 
     def gradient(self, x, y):
-        """dh_s/d(x, y): the secant slope over delta along e (module docstring),
-        (shape of x) + (2,)."""
+        """The secant slope over SMOOTHING times the closest rows' spacing along e
+        (module docstring), (shape of x) + (2,)."""
         d = self.along(x, y)
-        half = self._half_width()
+        half = 0.5 * SMOOTHING * np.min(np.diff(self.distances))
         slope = (np.interp(d + half, self.distances, self.heights)
                  - np.interp(d - half, self.distances, self.heights)) / (2 * half)
         return slope[..., None] * self.direction
-
-    def curvature(self, x, y):
-        """d2h_s/dd2 = J_i / delta within delta/2 of row i, else 0 (module docstring),
-        1/m, the shape of x."""
-        jump, _ = self._near_row(self.along(x, y))
-        return jump / (2.0 * self._half_width())
-
-    def hessian(self, x, y):
-        """d2h_s/d(x, y)^2 = h_s'' e e^T, 1/m, (shape of x) + (2, 2)."""
-        e = self.direction
-        return self.curvature(x, y)[..., None, None] * np.outer(e, e)
 
     def normal(self, x, y):
         return unit_normal(self.gradient(x, y))

@@ -68,22 +68,6 @@ class Seabed:
         (position_derivatives)."""
         return self.shape is not None and hasattr(self.shape, "slope_vector")
 
-    @property
-    def exact(self):
-        """A shape whose contact energy has the Hessian position_derivatives gives (a
-        plane, or a profile whose height is smoothed to have a curvature): the Newton
-        steps and a line's stiffness hold it; a grid's push stays lagged."""
-        return self.shape is not None and hasattr(self.shape, "hessian")
-
-    def bends(self, x, y):
-        """H g (..., 2), 1/m: the shape's Hessian d2z_b/d(x, y)^2 times its gradient,
-        where k_v changes along the seabed (zero on a plane, on the flat seabed and
-        on a grid, whose push is lagged as it was)."""
-        if not self.exact:
-            return np.zeros(np.shape(x) + (2,))
-        return np.einsum("...ij,...j->...i", self.shape.hessian(x, y),
-                         self.shape.gradient(x, y))
-
     def heights(self, x, y):
         """z_b at horizontal positions (x, y), m, the shape of x."""
         if self.shape is None:
@@ -129,16 +113,11 @@ class Seabed:
         metre is k_v p sqrt(1 + |g|^2) = k p cos(theta)."""
         return np.sqrt(1.0 + np.sum(gradient**2, axis=-1))
 
-    def normal_force(self, push, gradient, bend=None):
-        """The seabed's force per metre (N/m), (..., 3), from its vertical part ``push``
-        (...,) = k_v p (push) and the gradients g (..., 2): k_v p (-g, 1), minus the
-        gradient of the energy k_v/2 p^2 where k_v is constant; where it is not (a
-        profile's row, ``bend`` = H g (..., 2), bends) the energy's gradient adds
-        -p^2/2 grad k_v = k p^2 H g / (1 + |g|^2)^2 = push^2 H g / k horizontally."""
-        horizontal = -push[..., None] * gradient
-        if bend is not None:
-            horizontal = horizontal + push[..., None]**2 * bend / self.stiffness
-        return np.concatenate([horizontal, push[..., None]], axis=-1)
+    @staticmethod
+    def normal_force(push, gradient):
+        """k_v p (-g, 1) (N/m), (..., 3): the force along the seabed's normal from its
+        vertical part ``push`` (...,) (push) and the gradients g (..., 2)."""
+        return np.concatenate([-push[..., None] * gradient, push[..., None]], axis=-1)
 
     def height_derivatives(self, z, weights):
         """(dE/dz_n, d2E/dz_n^2) of E = k/2 sum_n w_n (z_b - z_n)_+^2 on the flat seabed at
@@ -149,41 +128,18 @@ class Seabed:
         return -spring * gap, spring
 
     def position_derivatives(self, r, weights):
-        """(dE/dr_n, d2E/dr_n^2) of E = k/2 sum_n w_n F_n, F = p^2 / q, p = (z_b - z)_+,
-        q = 1 + |g|^2 (the energy of energy(): k_v/2 p^2 = k/2 d^2, d = p / sqrt(q) the
-        normal penetration), on a seabed with a Hessian H = d2z_b/d(x, y)^2 (exact: a
-        plane, H = 0; a profile, H piecewise constant) at node positions r (n, 3) with
-        weights w_n (n,), m. With h the horizontal components, on p > 0:
-
-            F_h = 2 p g / q - 2 p^2 H g / q^2,   F_z = -2 p / q,
-            F_zz = 2 / q,   F_zh = -2 g / q + 4 p H g / q^2,
-            F_hh = 2 g g^T / q + 2 p H / q - 4 p (g (Hg)^T + (Hg) g^T) / q^2
-                   - 2 p^2 H H / q^2 + 8 p^2 (Hg)(Hg)^T / q^3;
-
-        returns k w_n / 2 times them: (n, 3), N, and (n, 3, 3), N/m. On a plane the
-        first is -k w_n d_n N and the second k w_n N N^T (N the unit normal
-        (-g, 1) / sqrt(q)); on a profile the terms in p H are the seabed's curvature."""
-        x, y = r[:, 0], r[:, 1]
-        g = self.shape.gradient(x, y)
-        H = self.shape.hessian(x, y)
-        p = self.penetration(r[:, 2], self.shape.height(x, y))
-        q = 1.0 + np.sum(g**2, axis=-1)
-        Hg = np.einsum("nij,nj->ni", H, g)
-        half = 0.5 * self.stiffness * weights * (p > 0)
-        first = np.empty((r.shape[0], 3))
-        first[:, :2] = (2 * p / q)[:, None] * g - (2 * p**2 / q**2)[:, None] * Hg
-        first[:, 2] = -2 * p / q
-        second = np.empty((r.shape[0], 3, 3))
-        outer = np.einsum("ni,nj->nij", g, Hg)
-        second[:, :2, :2] = (2 / q)[:, None, None] * np.einsum("ni,nj->nij", g, g) \
-            + (2 * p / q)[:, None, None] * H \
-            - (4 * p / q**2)[:, None, None] * (outer + outer.transpose(0, 2, 1)) \
-            - (2 * p**2 / q**2)[:, None, None] * np.einsum("nij,njk->nik", H, H) \
-            + (8 * p**2 / q**3)[:, None, None] * np.einsum("ni,nj->nij", Hg, Hg)
-        second[:, 2, 2] = 2 / q
-        second[:, :2, 2] = second[:, 2, :2] = (-2 / q)[:, None] * g \
-            + (4 * p / q**2)[:, None] * Hg
-        return half[:, None] * first, half[:, None, None] * second
+        """(dE/dr_n, d2E/dr_n^2) of E = k/2 sum_n w_n (N.(r_b - r_n))_+^2 on a sloping plane
+        (plane) at node positions r (n, 3) with weights w_n (n,), m; N the unit normal
+        (-g, 1) / sqrt(1 + |g|^2) and N.(r_b - r_n) = (z_b(x_n, y_n) - z_n) cos(theta)
+        the normal penetration d_n: -k w_n d_n N (N, (n, 3)) and k w_n N N^T on the
+        nodes with d_n > 0 (N/m, (n, 3, 3)). The flat seabed's height_derivatives with
+        N = e_z; the energy is energy()'s, k_v/2 p^2 = k/2 d^2."""
+        g = self.shape.gradient(r[:, 0], r[:, 1])
+        normal = self.shape.normal(r[:, 0], r[:, 1])
+        depth = (self.shape.height(r[:, 0], r[:, 1]) - r[:, 2]) / self.slope_factor(g)
+        spring = self.stiffness * weights * (depth > 0)
+        return ((-spring * depth)[:, None] * normal,
+                spring[:, None, None] * normal[:, :, None] * normal[:, None, :])
 
     def energy(self, r, weights):
         """sum_n w_n k_v,n / 2 p_n^2 (J) at node positions r (n, 3) with weights w_n (n,),
@@ -201,8 +157,7 @@ class Seabed:
             return force
         g = self.shape.gradient(r[:, 0], r[:, 1])
         return self.normal_force(self.push(r[:, 2], self.shape.height(r[:, 0], r[:, 1]),
-                                           self.vertical_stiffness(g)), g,
-                                 self.bends(r[:, 0], r[:, 1]))
+                                           self.vertical_stiffness(g)), g)
 
     def reaction(self, r):
         """|force| (N/m) at positions r (n, 3): k times the normal penetration,

@@ -78,7 +78,6 @@ class SeabedContact:
         # z_b and k at the nodes: the flat seabed's numbers, else (ne, 3) arrays (follow)
         self.base, self.stiffness = seabed.height, seabed.stiffness
         self.gradients = None                                       # (ne, 3, 2), follow
-        self.bends = None                                           # (ne, 3, 2), follow
         self.solution = None                # the Hermite dofs y of the last solve (a Vec)
         self.solves = 0                                             # since the last reset
         self._local = mesh.da.createLocalVec()
@@ -130,7 +129,6 @@ class SeabedContact:
             self.stiffness != stiffness)
         self.base, self.stiffness = self.seabed.heights(x, y), stiffness
         self.gradients = self.seabed.gradients(x, y)                       # (ne, 3, 2)
-        self.bends = self.seabed.bends(x, y)                               # (ne, 3, 2)
         if self.active is None:
             return
         if self.mesh.global_sum(int(changed)):
@@ -180,16 +178,14 @@ class SeabedContact:
 
     def node_force(self):
         """k_n (z_b,n - z_n)_+ (-g_n, 1) at the owned P2 nodes (N/m), (n_nodes, 3), of a
-        seabed that is not flat (on a profile's rows with the energy's term in the
-        change of k_n, environment.Seabed.normal_force): the normal force with the penetration of the last
+        seabed that is not flat: the normal force with the penetration of the last
         vertical solve's heights z_n under the z_b,n, k_n, g_n it was solved with (the
         ``follow`` before it), so that it is the reaction that problem carried
         (physics/slope_load.py). Collective. Zero before a solve after the first ``follow`` (the
         start; a contact rebuilt at a penalty raise: one iteration without the push)."""
         if self.gradients is None or self.solution is None:
             return np.zeros((self.mesh.n_local_nodes, 3))
-        force = self.seabed.normal_force(self._push(), self.gradients, self.bends)
-        return owned_nodes(self.mesh, force)
+        return owned_nodes(self.mesh, self.seabed.normal_force(self._push(), self.gradients))
 
     def reaction(self):
         """R = k (z_b,n - z_n)_+ cos(theta_n) at the element nodes (ne, 3), N/m: the

@@ -34,8 +34,8 @@ class SeabedTerm(NodalLoadTerm):
     def __init__(self, mesh, seabed):
         super().__init__(mesh, "seabed")
         self.seabed = seabed
-        if seabed.exact:
-            # a plane's or profile's penetration is along its normal: all three components
+        if seabed.plane:
+            # a sloping plane's penetration is along its normal: all three components
             self.position_components = (0, 1, HEIGHT)
         self.vertical = self.contact = None
         self._solved = None         # the z slope of the contact's last solve (node_loads)
@@ -84,11 +84,10 @@ class SeabedTerm(NodalLoadTerm):
 
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; on a
-        sloping plane or a profile dE_s/dr' of all three components
-        (Seabed.position_derivatives).
+        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives).
         The state's r is that of its fields (RodProblem.energy_gradient). Collective."""
-        if self.seabed.exact:
-            gradient = self._shape_derivatives(state)[0]
+        if self.seabed.plane:
+            gradient = self._plane_derivatives(state)[0]
             self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
             return
         self.add_position_gradient(g, state, {HEIGHT: self._height_derivatives(state)[0]})
@@ -96,17 +95,15 @@ class SeabedTerm(NodalLoadTerm):
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
         its gradient gives through the multipliers); on a sloping plane k w_n N N^T on
-        the nodes' three position components, on a profile with its curvature's terms
-        (Seabed.position_derivatives)."""
-        if self.seabed.exact:
-            hessian.add_position_curvature(self._shape_derivatives(hessian.problem.state)[1],
+        the nodes' three position components."""
+        if self.seabed.plane:
+            hessian.add_position_curvature(self._plane_derivatives(hessian.problem.state)[1],
                                            self.position_components)
             return
         hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
 
-    def _shape_derivatives(self, state):
-        """Seabed.position_derivatives (a plane's or a profile's) at the owned nodes of
-        the state's centreline."""
+    def _plane_derivatives(self, state):
+        """Seabed.position_derivatives at the owned nodes of the state's centreline."""
         return self.seabed.position_derivatives(state.node_positions(), state.node_weights)
 
     def pressure(self, z):

@@ -24,12 +24,9 @@ on the contact, the flat seabed's with N for e_z), so the Newton steps and the
 stability test have the whole force from it and this term adds nothing to them
 (``in_newton``, ``conservative``). Its outputs (the internal force's share) are the
 last vertical solve's reaction where the state is that solve's, and the force at the
-state's positions after Newton steps (SeabedTerm.contact_solved). A profile, whose
-height is smoothed at its rows (bathymetry.Profile), is the same: the energy's Hessian
-holds its curvature (Seabed.position_derivatives), and the push here is the energy's
-gradient with the lagged p, g and curvature (Seabed.normal_force). On a grid the Newton
-steps would need its curvature as well: the term says so (``conservative``,
-``in_newton`` False), so the run takes neither.
+state's positions after Newton steps (SeabedTerm.contact_solved). On a profile, whose slope turns
+smoothly at its rows, the Newton steps would need the curvature of z_b as well: the
+term says so (``conservative``, ``in_newton`` False), so the run takes neither.
 """
 
 import numpy as np
@@ -42,15 +39,14 @@ class SeabedSlopeLoad(NodalLoadTerm):
 
     conservative = False
     in_newton = False
-    newton_gap = "a seabed grid (docs/riser.md §3a)"
+    newton_gap = "a seabed that is not flat (docs/riser.md §3a)"
 
     def __init__(self, mesh, contact):
         super().__init__(mesh, "seabed_slope")
         self.contact = contact                  # the SeabedTerm (seabed.py)
         self.seabed = contact.seabed            # environment.Seabed, not flat
-        # on a plane or a profile the seabed term's energy holds the whole force
-        # (module docstring)
-        self.conservative = self.in_newton = self.seabed.exact
+        # on a plane the seabed term's energy holds the whole force (module docstring)
+        self.conservative = self.in_newton = self.seabed.plane
 
     def node_loads(self, state):
         """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of

@@ -13,7 +13,7 @@ F the energy with the work of the loads, C(q) = int r' dS the chord and mu its
 multiplier (iteration/newton.py). The loads per metre do not depend on where the line
 is, so F depends on x_a only through the positions' terms: on a flat seabed through the
 start's height z_a (a node's height is z_a plus the integral of the slope); on a sloping
-plane or a profile through the whole x_a (its energy reads the normal penetration), and the data
+plane through the whole x_a (its energy reads the normal penetration), and the data
 below are (x_a, c) with one P per component (_plane_response). With
 G(z_a, c) = F at the equilibrium of chord c, the line's potential as a function of its
 ends is Phi(x_a, x_b) = G(z_a, x_b - x_a) - W . x_a, W the load's resultant.
@@ -94,14 +94,14 @@ node's stiffness is the loading tangent (the slip continued); unloading it would
 Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
 pinned ends only.
 
-On a sloping plane or a profile the rotations' response takes the seabed's data (x_a, c): three
+On a sloping plane the rotations' response takes the plane's data (x_a, c): three
 solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
 by the held data through P_i's held rows (_rotation_response).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients or on a seabed that is not flat (no Newton
-steps), or at a clamped or flex-jointed end (end_stiffness), a seabed grid (its contact
-lagged),
+steps), or at a clamped or flex-jointed end (end_stiffness), a seabed profile or grid
+(its contact lagged),
 and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -1243,10 +1243,10 @@ class HeldLine:
                                 "its seabed friction with two coefficients or on a seabed "
                                 "that is not flat: give the friction one coefficient on a "
                                 "flat seabed")
-        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.exact):
+        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
-                                "seabed grid (its contact is lagged in the line's "
-                                "iterations); give a flat or sloping seabed or a profile")
+                                "seabed profile (its contact is lagged in the line's "
+                                "iterations); give a flat or uniformly sloping seabed")
         loose = [term for term in self.problem.terms if not term.in_newton
                  or not (term.conservative or term.follower or term in self.friction)]
         if loose:

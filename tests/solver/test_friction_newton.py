@@ -94,7 +94,7 @@ def position_derivatives(problem, friction, seabed):
     law = friction._newton_law(state)[0]
     values[:, :law.shape[1]] = law
     if seabed.seabed.plane:
-        return values + seabed._shape_derivatives(state)[0]
+        return values + seabed._plane_derivatives(state)[0]
     values[:, 2] = seabed._height_derivatives(state)[0]
     return values
 

@@ -159,9 +159,7 @@ def trench_line(S):
 
 
 def test_a_span_over_a_trench_is_a_free_span_not_grounded(comm):
-    """Regions of the line over the trench (profile rows 3.01 | 3.02 and 4.98 | 4.99,
-    off the vertices: the profile's height rounds each corner by |J| delta / 8 = 12.5 mm,
-    more than the line's 1 mm penetration, within 0.5 mm of the row): grounded
+    """Regions of the line over the trench (profile rows 3 | 3.01 and 4.99 | 5): grounded
     from the touchdown (x = 6) to the trench's far edge, a free span over the trench,
     grounded again to the anchor. In contact is a gap below the largest penetration
     (1 mm): the bounds are where the gap crosses it, within the 1 cm steps. Before, the
@@ -169,7 +167,7 @@ def test_a_span_over_a_trench_is_a_free_span_not_grounded(comm):
     from petsc_rod.environment.bathymetry import Profile
 
     profile = Profile(np.zeros(2), np.array([1.0, 0.0]),
-                      np.array([-1.0, 3.01, 3.02, 4.98, 4.99, 20.0]),
+                      np.array([-1.0, 3.0, 3.01, 4.99, 5.0, 20.0]),
                       np.array([0.0, 0.0, -TRENCH_DEPTH, -TRENCH_DEPTH, 0.0, 0.0]))
     length = FLAT + 4.0
     top = trench_line(np.array([length]))[0][0]

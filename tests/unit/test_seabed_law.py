@@ -5,7 +5,7 @@ the reaction the global step's contact computes from its lagged k_v is the seabe
 import numpy as np
 import pytest
 
-from petsc_rod.environment.bathymetry import Plane, Profile
+from petsc_rod.environment.bathymetry import Plane
 from petsc_rod.environment.seabed import Seabed
 
 K = 1e4
@@ -58,37 +58,3 @@ def test_on_a_slope_the_contact_s_reaction_from_its_lagged_spring_is_the_seabed_
                        atol=0)
     assert seabed.reaction(r)[0] == pytest.approx(K * 0.02 * np.cos(slope), rel=1e-14)
     assert seabed.reaction(r)[2] == 0.0
-
-
-@pytest.mark.parametrize("direction", [(1.0, 0.0), (0.6, -0.8)])
-def test_on_a_profile_the_position_derivatives_are_those_of_the_energy(direction):
-    """Seabed.position_derivatives on a profile (its height smoothed at the rows, the
-    curvature's terms in the Hessian) against central differences of energy(); the
-    force the seabed reports (the lagged push's law, normal_force with the bend) is
-    minus the energy's gradient per metre, also where k_v changes along a row."""
-    e = np.array(direction)
-    profile = Profile(np.zeros(2), e, np.array([-10.0, 0.0, 10.0]),
-                      np.array([0.0, 1.0, 4.0]))            # slope jump 0.2 at d = 0
-    seabed = Seabed(0.0, K, profile)
-    d = np.array([-0.3, -0.1, 0.05, 0.4, 3.0, 9.9, 10.2])  # within delta/2 = 0.5 of rows
-    across = np.array([-e[1], e[0]]) * 2.0
-    r = np.stack([d * e[0] + across[0], d * e[1] + across[1],
-                  seabed.heights(d * e[0], d * e[1]) - 0.05], axis=1)
-    r[-1, 2] += 0.5                                         # one node above the seabed
-    weights = np.linspace(0.2, 0.5, d.size)
-    first, second = seabed.position_derivatives(r, weights)
-    assert np.any(np.abs(profile.curvature(r[:, 0], r[:, 1])) > 0.1)
-    step = 1e-6
-    for c in range(3):
-        shift = np.zeros_like(r)
-        shift[:, c] = step
-        energies = [np.array([seabed.energy(r[n:n + 1] + s * shift[n:n + 1],
-                                            weights[n:n + 1]) for n in range(d.size)])
-                    for s in (1.0, -1.0)]
-        numeric = (energies[0] - energies[1]) / (2 * step)
-        assert np.allclose(first[:, c], numeric, rtol=1e-6, atol=1e-9 * K)
-        grads = [seabed.position_derivatives(r + s * shift, weights)[0] for s in (1.0, -1.0)]
-        assert np.allclose(second[:, :, c], (grads[0] - grads[1]) / (2 * step),
-                           rtol=1e-6, atol=1e-7 * K)
-    assert np.allclose(seabed.force(r) * weights[:, None], -first, rtol=1e-12,
-                       atol=1e-12 * K)
