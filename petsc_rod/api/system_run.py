@@ -582,8 +582,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     Collective."""
     on_every_rank(comm, system.check)
     if solver is None:
-        # where the run starts: every line able to start (the command line has checked
-        # it already, naming the options that moved its ends; a sweep's cases too)
+        # every line able to start where the run starts (the command line checked it
+        # first, naming the options that moved its ends; a sweep's cases, re-solved on
+        # a kept solver, are checked by the command line alone)
         on_every_rank(comm, check_reach, system)
     if body_modes is not None and body_modes["line_mass"]:
         on_every_rank(comm, check_line_masses, system, line_mass_option)
