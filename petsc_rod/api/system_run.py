@@ -24,6 +24,7 @@ from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
 from petsc_rod.io import line_table, outputs
 from petsc_rod.io import results as io
 from petsc_rod.io.system_results import SystemWriter
+from petsc_rod.model.system_check import check_reach
 from petsc_rod.quantities import riser_numbers
 from petsc_rod.system.body_modes import (SystemModes, SystemModesRefused, check_line_masses,
                                          system_modes)
@@ -572,12 +573,19 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     cases); None: one made for the run and destroyed after it, its frictional lines
     laid where ``laid`` (a System: the file's, before the run's offsets) puts them
     (held_line.held_lines).
-    RodInputError for a system the checks refuse (exit 2),
+    RodInputError for a system the checks refuse (exit 2: System.check, and
+    system_check.check_reach where the run starts: a line that cannot start, taut lines
+    that nothing pulls),
     RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
     RodDivergedError, its Newton or a line not converged after its halvings),
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
+    if solver is None:
+        # every line able to start where the run starts (the command line checked it
+        # first, naming the options that moved its ends; a sweep's cases, re-solved on
+        # a kept solver, are checked by the command line alone)
+        on_every_rank(comm, check_reach, system)
     if body_modes is not None and body_modes["line_mass"]:
         on_every_rank(comm, check_line_masses, system, line_mass_option)
     check_outputs(comm, system, output, table, sweeps, body_modes is not None)

@@ -95,6 +95,7 @@ class GlobalStep:
         self._set_prescribed()
         for term in self.terms:
             term.build(matrices[2], penalty)
+            term.set_clamp_stretch(*self.clamp_stretch)
         EVENTS["assembly"].end()
 
     def unconstrained_slope_matrix(self):
@@ -146,13 +147,17 @@ class GlobalStep:
 
     def set_clamp_stretch(self, start, end):
         """1 + eps at a clamped start and end (1 at an end that is not clamped): the
-        slope prescribed there becomes (1 + eps) d3 (docs/method.md §12). The same values
-        on every rank; the slope's lifting is recomputed where they changed."""
+        slope prescribed there becomes (1 + eps) d3 (docs/method.md §12), in the P2 slope
+        problem and in the terms' that solve slope components (the seabed's z, the
+        friction's x and y). The same values on every rank; the slope's lifting is
+        recomputed where they changed."""
         stretch = (float(start), float(end))
         if stretch != self.clamp_stretch:
             self.clamp_stretch = stretch
             if self.problems:
                 self.problems[2].set_prescribed(self._prescribed(2))
+                for term in self.terms:
+                    term.set_clamp_stretch(*stretch)
 
     def solve(self, state):
         """Solve for d1, d2, r' and r of ``state`` (problem/state.py) from its tau and

@@ -77,6 +77,9 @@ class HermiteProblem:
         self.rhs, self.solution, self.bc, self._work, self._product = (
             self.base.createVecLeft() for _ in range(5))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
+        self._ends = None               # the last set_end_states' (start, end)
+        # 1 + eps at a clamped start and end of an extensible line (set_clamp_stretch)
+        self.clamp_stretch = (1.0, 1.0)
         self._added = None              # the last set_added's (matrices, vectors)
         # the slope problem's solver and defaults: the natural order on one rank, in
         # which the chain is a band matrix without fill
@@ -97,23 +100,46 @@ class HermiteProblem:
 
     def set_end_states(self, start, end):
         """Essential conditions from the end states: the coordinate at a held end, its
-        slope at a clamp (d3's component; a clamped end of an extensible line is not
-        stretched here)."""
+        slope at a clamp, d3's component times the clamp's 1 + eps (clamp_stretch)."""
+        self._ends = (start, end)
+        fixed = self._fixed_rows()
+        start_row, end_row = self.base.getOwnershipRange()
+        self.fixed = np.array([r for r, _ in fixed], dtype=PETSc.IntType)
+        self._local_fixed = np.array([r - start_row for r, _ in fixed
+                                      if start_row <= r < end_row], dtype=np.int64)
+        self._set_fixed_values()
+        self._constrain()
+
+    def set_clamp_stretch(self, start, end):
+        """1 + eps at a clamped start and end (docs/method.md §12): the slope prescribed
+        there becomes (1 + eps) d3's component, as in the P2 slope problem
+        (GlobalStep.set_clamp_stretch). The fixed rows stay, so only their values and
+        the lifting change (no refactorisation)."""
+        stretch = (float(start), float(end))
+        if stretch != self.clamp_stretch:
+            self.clamp_stretch = stretch
+            if self._ends is not None:
+                self._set_fixed_values()
+
+    def _fixed_rows(self):
+        """[(row, value)] of the essential conditions of the last end states."""
         last = 2 * self.mesh.n_elements
         fixed = []
-        for row, state in ((0, start), (last, end)):
+        for row, state, stretch in zip((0, last), self._ends, self.clamp_stretch):
             if is_held(state):
                 fixed.append((row, state.position[self.component]))
             if state.kind == "clamp":
-                fixed.append((row + 1, state.frame[2, self.component]))
+                fixed.append((row + 1, stretch * state.frame[2, self.component]))
+        return fixed
+
+    def _set_fixed_values(self):
+        """The owned fixed rows' values (_fixed_rows) into bc, the lifting's vector, and
+        _fixed_values."""
         start_row, end_row = self.base.getOwnershipRange()
-        self.fixed = np.array([r for r, _ in fixed], dtype=PETSc.IntType)
-        owned = [(r - start_row, v) for r, v in fixed if start_row <= r < end_row]
-        self._local_fixed = np.array([r for r, _ in owned], dtype=np.int64)
-        self._fixed_values = np.array([v for _, v in owned], dtype=float)
+        self._fixed_values = np.array([v for r, v in self._fixed_rows()
+                                       if start_row <= r < end_row], dtype=float)
         self.bc.zeroEntries()
         self.bc.getArray()[self._local_fixed] = self._fixed_values
-        self._constrain()
 
     def set_added(self, element_matrices, element_vectors):
         """Add sum_e element_matrices (ne, 4, 4) to the matrix and sum_e element_vectors

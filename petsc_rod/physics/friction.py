@@ -196,6 +196,10 @@ class FrictionTerm(NodalLoadTerm):
     def ksps(self):
         return [problem.ksp for problem in self.problems]
 
+    def set_clamp_stretch(self, start, end):
+        for problem in self.problems:
+            problem.set_clamp_stretch(start, end)
+
     def prepare(self, t, start, end):
         super().prepare(t, start, end)
         for problem in self.problems:

@@ -52,6 +52,9 @@ class SeabedTerm(NodalLoadTerm):
     def ksps(self):
         return [self.vertical.ksp]
 
+    def set_clamp_stretch(self, start, end):
+        self.vertical.set_clamp_stretch(start, end)
+
     def prepare(self, t, start, end):
         super().prepare(t, start, end)
         self.vertical.set_end_states(start, end)

@@ -131,6 +131,12 @@ class Term:
         ``slope_components`` of state.slope from the right-hand side ``rhs``; with both
         ends held (``bordered``) also their part of state.chord_multiplier."""
 
+    def set_clamp_stretch(self, start, end):
+        """1 + eps at a clamped start and end of an extensible line (docs/method.md §12;
+        1 at an end that is not clamped), after every build and whenever they change: a
+        term that solves slope components (solve_slope) prescribes (1 + eps) d3 there,
+        as the P2 slope problem does (GlobalStep.set_clamp_stretch)."""
+
     def ksps(self):
         """The KSPs the term made (their types go to the result file)."""
         return []

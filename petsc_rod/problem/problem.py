@@ -264,8 +264,11 @@ class RodProblem:
         """At a clamped end the slope is prescribed, r' = (1 + eps) d3, and the local
         step's multiplier there meets no equation: eps is taken from the force balance,
         EA eps = n.d3 with n the internal force of the last global step at that end
-        (one iteration behind; docs/method.md §12). Sets the clamped nodes' targets
-        (1 + eps) tau3 and the prescribed slope of the next global step. Collective."""
+        (one iteration behind; docs/method.md §12), 1 + eps >= 0. Sets the clamped
+        nodes' targets (1 + eps) tau3, tau3 = tau1 x tau2 (the local step's stretch there
+        may be 0, its tau3 row then zero), and the prescribed slope of the next global
+        step, in the P2 problem and in the seabed's and the friction's Hermite problems.
+        Collective."""
         mesh, state = self.mesh, self.state
         force = self.internal_force()
         ends = ((self.start_state, 0, mesh.on_lower_boundary),
@@ -274,11 +277,13 @@ class RodProblem:
         for j, (end, index, owner) in enumerate(ends):
             if end.kind == "clamp" and owner and np.isfinite(self.axial[index]):
                 strain[j] = force[index] @ end.frame[2] / self.axial[index]
-        stretch = 1.0 + mesh.global_sum(strain)
+        # k >= 0, as in the local step (a line is not turned inside out)
+        stretch = np.maximum(1.0 + mesh.global_sum(strain), 0.0)
         for j, (end, index, owner) in enumerate(ends):
             if end.kind == "clamp" and owner:
-                tangent = state.tau[index, 2]
-                tangent *= stretch[j] / np.linalg.norm(tangent)
+                # tau3 = tau1 x tau2: the local step's stretch there may be 0
+                targets = state.tau[index]
+                targets[2] = stretch[j] * np.cross(targets[0], targets[1])
         self.global_step.set_clamp_stretch(*stretch)
 
     def end_strains(self, elements):

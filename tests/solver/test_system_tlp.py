@@ -16,6 +16,7 @@ from petsc4py import PETSc
 
 from helpers import REPO_ROOT
 from petsc_rod.api import read_moordyn, solve_system
+from petsc_rod.errors import RodInputError
 from petsc_rod.system.bodies import log_rotation
 from petsc_rod.system.equilibrium import SystemSolver
 from petsc_rod.system.held_line import held_lines
@@ -111,3 +112,21 @@ def test_the_tlp_stiffness_is_the_derivative_of_re_solved_equilibria():
             scale = np.abs(compliance[rows, rows]).max() ** 0.5 * np.abs(
                 compliance[columns, columns]).max() ** 0.5
             assert np.abs(numeric[rows, columns] - block).max() < 1e-6 * scale, (rows, columns)
+
+
+def test_the_api_refuses_a_tlp_heavier_than_its_buoyancy():
+    """solve_system checks where the run starts as the command line does
+    (system_check.check_reach): a hull of 5000 m^3, 8.58e6 N heavier than its buoyancy,
+    on tendons all taut, is refused in one line naming its net force, before any solve
+    (it returned the tendons in compression, -2.1 MN, at a saddle)."""
+    system, _ = read_moordyn(DECK)
+    heavy = dataclasses.replace(system, bodies=tuple(
+        dataclasses.replace(body, volume=5000.0) for body in system.bodies))
+    with pytest.raises(RodInputError) as refused:
+        solve_system(heavy, options=TIGHT)
+    message = str(refused.value)
+    assert "\n" not in message
+    assert message.startswith("line Line1: taut between Point1 and Body1 where the run "
+                              "starts, as are all lines at Body1, and nothing pulls them: "
+                              "Body1's buoyancy less weight and load, (0, 0, "
+                              "-8.58082e+06) N")
