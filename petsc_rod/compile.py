@@ -98,25 +98,12 @@ def pressures_of(line, sea, origin):
     return fields
 
 
-def seabed_direction(sea):
-    """The unit horizontal vector of the seabed's direction (an azimuth in degrees, or
-    a vector dx,dy; checked by Model.check), default +x."""
-    given = sea.seabed_direction
-    if given is None:
-        return np.array([1.0, 0.0])
-    given = np.atleast_1d(np.asarray(given, dtype=float))
-    if given.size == 1:
-        angle = np.radians(given[0])
-        return np.array([np.cos(angle), np.sin(angle)])
-    return given / float(np.hypot(*given))
-
-
 def seabed_shape(sea, height, origin, n):
     """The bathymetry.Plane, Profile or Grid of the sea's seabed in the scene's frame (its
     origin at ``origin`` (3,), absolute), or None for a flat seabed (no slope, or a
     slope of 0: the plane z = ``height``, bit for bit); ``height`` the seabed's absolute
     height."""
-    direction = seabed_direction(sea)
+    direction = sea.seabed_unit_direction()
     seabed_origin = np.asarray(sea.seabed_origin if sea.seabed_origin is not None
                                else (0.0, 0.0), dtype=float)
     if sea.seabed_profile is not None:

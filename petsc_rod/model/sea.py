@@ -90,6 +90,32 @@ class Environment:
         """Whether there is a seabed (a height or a profile)."""
         return self.seabed is not None or self.seabed_profile is not None
 
+    def seabed_unit_direction(self):
+        """The unit horizontal vector (2,) of the seabed's direction (an azimuth in
+        degrees, or a vector dx,dy), default +x."""
+        given = self.seabed_direction
+        if given is None:
+            return np.array([1.0, 0.0])
+        given = np.atleast_1d(np.asarray(given, dtype=float))
+        if given.size == 1:
+            angle = np.radians(given[0])
+            return np.array([np.cos(angle), np.sin(angle)])
+        return given / float(np.hypot(*given))
+
+    def plane_height(self, x, y):
+        """The seabed's height (m) at the horizontal position (x, y), m, of a flat or
+        sloping plane: z_b = seabed + tan(slope) ((x, y) - origin).e; None without a
+        seabed or with a profile or grid."""
+        if self.seabed is None or self.seabed_profile is not None:
+            return None
+        if not self.seabed_slope:
+            return float(self.seabed)
+        origin = np.asarray(self.seabed_origin if self.seabed_origin is not None
+                            else (0.0, 0.0), dtype=float)
+        along = float(np.dot(np.array([x, y], dtype=float) - origin,
+                             self.seabed_unit_direction()))
+        return float(self.seabed) + float(np.tan(np.radians(self.seabed_slope))) * along
+
     def profile(self):
         """(depths (m,), velocities (m, 3)) of a current profile, None for a uniform
         current or none."""

@@ -80,7 +80,7 @@ def check_system(system, names, made_by=None):
     check_lines(system, names)
     check_points(system)
     check_held_spans(system, nodes, made_by or {})
-    check_seabed_under(system)
+    check_seabed_under(system, names)
     sea = system.environment
     for body in system.bodies:
         # a line from the body to itself (a bridle) holds nothing against its motion
@@ -416,19 +416,28 @@ def pulled(node, lines, water_density, gravity, made_by):
         "a line so it hangs slack")
 
 
-def check_seabed_under(system):
-    """No held point below a flat seabed (to round-off of the lines' length)."""
+def check_seabed_under(system, names=None):
+    """No held point below a flat or sloping seabed (to round-off of the lines' length),
+    the plane's options named through ``names`` (names.Names; None: the model's
+    fields)."""
     sea = system.environment
-    if sea.seabed is None or sea.seabed_slope is not None:
-        return
     scale = 1e-12 * max(float(sum(line.line.length for line in system.lines)), 1.0)
     for point in system.points:
-        depth = sea.seabed - float(point.position[2])
-        if point.kind != "free" and depth > scale:
+        x, y, z = (float(value) for value in point.position)
+        height = sea.plane_height(x, y)
+        if point.kind == "free" or height is None or height - z <= scale:
+            continue
+        if not sea.seabed_slope:
             raise RodInputError(
-                f"point {point.name} ({point.kind}) is held at z = {point.position[2]:.6g} "
-                f"m, {depth:.3g} m below the seabed (Environment.seabed {sea.seabed:g}); "
+                f"point {point.name} ({point.kind}) is held at z = {z:.6g} m, "
+                f"{height - z:.3g} m below the seabed (Environment.seabed {sea.seabed:g}); "
                 "hold it on or above it")
+        given = ", ".join(names[field] if names is not None else f"Environment.{field}"
+                          for field in ("seabed_slope", "seabed_direction", "seabed_origin"))
+        raise RodInputError(
+            f"point {point.name} ({point.kind}) is held at z = {z:.6g} m, {height - z:.3g} "
+            f"m below the sloping seabed there (z = {height:.6g} m: the plane of {given}); "
+            "hold it on or above it, or move the plane's origin or change its slope")
 
 
 def restoring_by_hydrostatics(body, water_density, gravity):

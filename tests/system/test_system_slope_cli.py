@@ -101,3 +101,15 @@ def test_the_slope_options_are_listed_and_checked(tmp_path):
     line = refused(tmp_path, ["-rod_system", DECK, "-rod_seabed_slope", "2",
                               "-rod_seabed_direction", "0,0"])
     assert line.startswith("petsc_rod: error: ") and "-rod_seabed_direction" in line
+
+
+def test_a_held_point_below_the_plane_is_refused_naming_it_and_the_options(tmp_path):
+    """The plane through the file's seabed (z = -30) at the default origin (0, 0),
+    rising 2 degrees along +x, is 2.27 m above the anchor Point1 at x = 65 m: refused
+    before the run, naming the point, the plane's height there and its options (the
+    single line's check named neither the point nor an option)."""
+    assert refused(tmp_path, ["-rod_system", DECK, "-rod_seabed_slope", "2"]) == (
+        "petsc_rod: error: point Point1 (fixed) is held at z = -30 m, 2.27 m below the "
+        "sloping seabed there (z = -27.7301 m: the plane of -rod_seabed_slope, "
+        "-rod_seabed_direction, -rod_seabed_origin); hold it on or above it, or move the "
+        "plane's origin or change its slope")

@@ -362,3 +362,25 @@ def test_the_system_modes_options_are_named_as_the_caller_gave_them():
     with pytest.raises(RodInputError, match="^-rod_system_modes_line_mass needs "
                                             "-rod_system_modes 1 "):
         body_modes_request({"system_modes_line_mass": True}, cli=True)
+
+
+def test_a_held_point_below_a_sloping_seabed_is_refused():
+    """System.check: a fixed point under the plane (its height at the point from the
+    slope, direction and origin) is refused naming the point, the height there and the
+    Environment's fields; on the plane or above it passes."""
+    system = held_pair(CHAIN, 100.0, 100.0)
+    sea = dataclasses.replace(system.environment, seabed=-50.0, seabed_slope=1.0,
+                              seabed_origin=(0.0, 0.0))    # through a, rising toward b
+    below = dataclasses.replace(system, environment=sea)
+    with pytest.raises(RodInputError) as error:
+        below.check()
+    message = str(error.value)
+    assert "\n" not in message and message.startswith("point ")
+    assert "below the sloping seabed there" in message
+    assert message == (
+        "point b (prescribed) is held at z = -50 m, 1.75 m below the sloping seabed there "
+        "(z = -48.2545 m: the plane of Environment.seabed_slope, "
+        "Environment.seabed_direction, Environment.seabed_origin); hold it on or above "
+        "it, or move the plane's origin or change its slope")
+    level = dataclasses.replace(sea, seabed_slope=-1.0)    # falling toward b: passes
+    dataclasses.replace(system, environment=level).check()
