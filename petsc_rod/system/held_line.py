@@ -99,10 +99,11 @@ solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of i
 by the held data through P_i's held rows (_rotation_response).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a seabed that is not flat (no Newton
-steps), or at a clamped or flex-jointed end (end_stiffness), a seabed profile or grid
-(its contact lagged),
-and any load outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
+seabed's friction with two coefficients or on a profile (no Newton steps), on a sloping
+plane (its Newton block, all three components, not written into this response), or at a
+clamped or flex-jointed end (end_stiffness); a seabed profile or grid (its contact
+lagged); any load outside the Newton system (the sea surface's wet and dry parts,
+attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
