@@ -392,10 +392,12 @@ def pulled(node, lines, water_density, gravity, made_by):
     """A free point or body whose lines are all taut (``lines``: [(SystemLine, unit
     vector from its other end to this node)]) and whose translation
     nothing else holds (a held translation, a hydrostatic term) must be pulled along one
-    of them at least: its own force F (own_force) with F . e > 0 for some e. A taut
-    line holds its node only by its tension, so with F . e <= 0 for all (a TLP's hull
-    heavier than its buoyancy, a weightless point on a straight line) the tendons'
-    equilibrium would need compression."""
+    of them at least, its own force F (own_force) with F . e > 0 for some e, or be held
+    between them (balanced: opposing lines whose tensions balance, whatever F; it moves
+    until they take F). A taut line holds its node only by its tension, so with
+    F . e <= 0 for all and no opposing lines (a TLP's hull heavier than its buoyancy, a
+    weightless point at the end of one straight line) the tendons' equilibrium would
+    need compression."""
     if not hasattr(node, "kind") and (
             np.any(np.asarray(node.held, dtype=bool)[:3])
             or np.any(restoring_by_hydrostatics(node, water_density, gravity)[:3] > 0)):
@@ -403,7 +405,7 @@ def pulled(node, lines, water_density, gravity, made_by):
     force = own_force(node, water_density, gravity)
     directions = np.array([outward for _, outward in lines])
     scale = 1e-12 * max(float(np.linalg.norm(force)), 1.0)
-    if np.max(directions @ force) > scale:
+    if np.max(directions @ force) > scale or balanced(directions):
         return
     line = lines[0][0]
     shown = ", ".join(f"{value:.6g}" for value in force)
@@ -414,6 +416,36 @@ def pulled(node, lines, water_density, gravity, made_by):
         "along none of them away from their other ends, so they would be in compression; "
         f"give {node.name} more buoyancy than weight (a tension leg platform), or lengthen "
         "a line so it hangs slack")
+
+
+def balanced(directions, tolerance=1e-9):
+    """Whether tensions T_i >= 0, not all zero, balance along the unit ``directions``
+    (n, 3): sum T_i e_i = 0, i.e. 0 lies in their convex hull (a node held between
+    opposing taut lines: a buoy on a level pretensioned line, a connector between two
+    tendons), so their own tensions hold it whatever its own force. By Caratheodory's
+    theorem in 3-D, 0 lies in the hull of at most four of them: each subset of two to
+    four is tried for barycentric weights w >= 0, sum w = 1, with E^T w = 0 (least
+    squares, the residual within ``tolerance``). A node's lines are few (the subsets of
+    twelve lines are 781)."""
+    count = len(directions)
+    for size in range(2, min(count, 4) + 1):
+        for subset in _subsets(count, size):
+            rows = np.vstack([np.asarray(directions)[list(subset)].T, np.ones(size)])
+            weights, *_ = np.linalg.lstsq(rows, np.r_[np.zeros(3), 1.0], rcond=None)
+            residual = rows @ weights - np.r_[np.zeros(3), 1.0]
+            if np.all(weights >= -tolerance) and np.linalg.norm(residual) <= tolerance:
+                return True
+    return False
+
+
+def _subsets(count, size, first=0):
+    """The index tuples of ``size`` of range(first, count), increasing (combinations)."""
+    if size == 0:
+        yield ()
+        return
+    for index in range(first, count - size + 1):
+        for rest in _subsets(count, size - 1, index + 1):
+            yield (index,) + rest
 
 
 def check_seabed_under(system, names=None):

@@ -130,3 +130,39 @@ def test_the_api_refuses_a_tlp_heavier_than_its_buoyancy():
                               "starts, as are all lines at Body1, and nothing pulls them: "
                               "Body1's buoyancy less weight and load, (0, 0, "
                               "-8.58082e+06) N")
+
+
+def test_a_buoy_between_two_taut_lines_rises_where_their_tensions_hold_it():
+    """tests/data/moordyn/buoy_level.dat: a buoy whose net buoyancy B - W = 90.7 kN
+    pulls it along neither of its two level tendons where the run starts (its own force
+    is across both), but it is held between them (system_check.balanced: their tensions
+    balance): check_reach passes it (it refused it as tendons in compression), and it
+    rises by h where the taut strings' closed form puts it: each tendon, its chord
+    c = sqrt(50^2 + h^2) nearly level, sags by s = w c^2 / 8T under its wet weight w, so
+    its stretched length L (1 + T / EA) is the chord and the sag's 8 s^2 / 3c (1.7e-4 m
+    of the 12.7 mm stretch), and 2 T h / c = B - W - w L (the buoy carries half of each
+    tendon's wet weight); the strings' neglected terms are of the order (w L / T)^2."""
+    deck = os.path.join(REPO_ROOT, "tests", "data", "moordyn", "buoy_level.dat")
+    system, _ = read_moordyn(deck)
+    found = solve_system(system, options=TIGHT)
+    position = np.asarray(found.points["Point2"], dtype=float)
+    net, length = (RHO * 10.0 - 1000.0) * G, 49.99
+
+    def tension(chord):
+        """T of the sagging string spanning ``chord`` (fixed point of the length's
+        equation, from the straight string's)."""
+        value = EA * (chord - length) / length
+        for _ in range(50):
+            value = EA * ((chord + WET ** 2 * chord ** 3 / (24 * value ** 2)) / length - 1)
+        return value
+
+    def unbalanced(h):
+        chord = np.hypot(50.0, h)
+        return 2 * tension(chord) * h / chord - (net - WET * length)
+
+    low, high = 0.1, 1.0                    # bisection of the closed form's root
+    for _ in range(100):
+        middle = (low + high) / 2
+        low, high = (low, middle) if unbalanced(middle) > 0 else (middle, high)
+    assert position[2] + 50.0 == pytest.approx(low, rel=1e-4)
+    assert abs(position[0] - 50.0) < 1e-9 and abs(position[1]) < 1e-9    # symmetric

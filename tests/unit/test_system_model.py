@@ -9,7 +9,7 @@ import pytest
 from petsc_rod.errors import RodInputError
 from petsc_rod.model import (Body, Connection, Environment, Line, LineType, Point, System,
                              SystemLine)
-from petsc_rod.model.system_check import check_reach, needed_strain, rotation
+from petsc_rod.model.system_check import balanced, check_reach, needed_strain, rotation
 
 pytestmark = pytest.mark.unit
 
@@ -384,3 +384,27 @@ def test_a_held_point_below_a_sloping_seabed_is_refused():
         "it, or move the plane's origin or change its slope")
     level = dataclasses.replace(sea, seabed_slope=-1.0)    # falling toward b: passes
     dataclasses.replace(system, environment=level).check()
+
+
+def test_a_node_held_between_opposing_taut_lines_passes_whatever_its_own_force():
+    """check_reach's pulled: a buoy on a level pretensioned line (its buoyancy across
+    both taut lines), a weightless connector between two taut lines, three taut lines at
+    120 degrees in a plane: held between them (balanced), passed; a weightless point at
+    the end of one straight line, or a hull heavier than its buoyancy above its tendons,
+    is still refused (the test above)."""
+    def between(directions, mass=0.0, volume=0.0):
+        ends = [Point(f"a{k}", "fixed", tuple(50.0 * np.asarray(d))) for k, d in
+                enumerate(directions)]
+        return System(points=(*ends, Point("b", "free", (0.0, 0.0, 0.0), mass=mass,
+                                            volume=volume)),
+                      lines=tuple(SystemLine(f"t{k}", Line([(CHAIN, 49.99)],
+                                                            element_length=5.0),
+                                             Connection(f"a{k}"), Connection("b"))
+                                  for k in range(len(directions))))
+    level = [(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0)]
+    check_reach(between(level, mass=1000.0, volume=10.0))       # buoyant, across both
+    check_reach(between([(0.0, 0.0, 1.0), (0.0, 0.0, -1.0)]))  # weightless, vertical
+    third = [(np.cos(a), np.sin(a), 0.0) for a in np.radians([90.0, 210.0, 330.0])]
+    check_reach(between(third, mass=500.0))
+    assert balanced(np.array(third)) and not balanced(np.array(third[:2]))
+    assert refused_reach(between(level[:1])).startswith("line t0: taut between a0 and b")
