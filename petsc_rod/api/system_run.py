@@ -395,11 +395,12 @@ def write_file(comm, output, system, results, records, text, notes, failures):
         if found is not None and not isinstance(found, ModesRefused):
             writer.write_modes(found, f"lines/{line.name}/modes")
     data, units = system_datasets(system, results)
+    verdict = results.verdict
     attributes = {"converged": int(results.converged), "iterations": results.iterations,
                   "halvings": results.halvings, "residual": results.residual,
                   "load_factor": results.load_factor, "ranks": comm.getSize(),
-                  "system_stable": -1 if results.verdict is None else results.verdict.code(),
-                  "system_verdict": "" if results.verdict is None else results.verdict.text(),
+                  "system_stable": -1 if verdict is None else verdict.code(),
+                  "system_verdict": "" if verdict is None else verdict.text(),
                   "point_names": ",".join(results.points),
                   "body_names": ",".join(results.bodies),
                   "line_names": ",".join(line.name for line in system.lines),

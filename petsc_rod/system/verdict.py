@@ -1,9 +1,10 @@
 """The system's own stability at its equilibrium (docs/systems.md, "The system's
 verdict"): each line is tested with its ends held (HeldLine.stable), but a Newton on
 the points' and bodies' unknowns can land on a saddle of the system whose lines are
-each stable (a hull pushed down on taut tendons: each tendon a minimiser with its ends
-held, the hull a saddle in surge). Numpy only; every rank computes the same numbers
-from the solver's small arrays.
+each stable (a body whose cog stands high above its moorings' restoring, upright by
+symmetry: each line a minimiser with its ends held, the body a saddle in roll and
+pitch). Numpy only; every rank computes the same numbers from the solver's small
+arrays.
 
     K = -dR/dq          over the free unknowns q of system/equilibrium.Layout
 
@@ -61,8 +62,8 @@ class SystemVerdict:
         if self.stable is None:
             return f"no verdict: {self.reason}"
         if self.stable:
-            return (f"stable (the lowest eigenvalue of its stiffness {self.lowest:.6g} N/m, "
-                    f"mostly in {self.dof[0]} {self.dof[1]})")
+            return (f"stable (the lowest eigenvalue of its stiffness {self.lowest:.6g} "
+                    f"N/m, mostly in {self.dof[0]} {self.dof[1]})")
         return (f"a saddle of the system: its stiffness has {self.negative} negative "
                 f"eigenvalue(s), the lowest {self.lowest:.6g} N/m, mostly in {self.dof[0]} "
                 f"{self.dof[1]}")

@@ -91,8 +91,8 @@ def test_a_top_heavy_body_on_stable_lines_is_a_saddle_of_the_system(tmp_path):
 
 def test_a_tlp_heavier_than_its_buoyancy_is_a_saddle_of_the_system():
     """check_reach refuses it up front; past it, the solver converges with the tendons
-    in compression (-2.2 MN at the anchors): the hull's surge and sway stiffness is
-    the tendons' pendulum's, negative, and so is its yaw's."""
+    in compression (pushing each anchor down by 2.2 MN): the hull's surge and sway
+    stiffness is the tendons' pendulum's, negative, and so is its yaw's."""
     system, _ = read_moordyn(TLP)
     heavy = dataclasses.replace(system, bodies=tuple(
         dataclasses.replace(body, volume=5000.0) for body in system.bodies))
