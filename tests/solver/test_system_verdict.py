@@ -111,3 +111,36 @@ def test_a_system_in_a_current_has_no_verdict():
     found, _ = solved(system)
     assert found.verdict.stable is None and found.verdict.code() == -1
     assert found.verdict.text().startswith("no verdict: a current: its drag")
+
+
+def test_the_systems_stiffness_is_symmetric_at_a_conservative_equilibrium():
+    """The reason the symmetric part is tested (docs/systems.md "The system's verdict"):
+    under a force of (10, 2, 0) kN at the reference point the lines' 6 x 6 is
+    unsymmetric by 1e-2 (their moment about X), but the system's K = -dR/dq, the
+    weight's and buoyancy's arms with it, is symmetric to round-off (the moments sum to
+    0); a moment of 50 kN m fixed in space leaves it unsymmetric (-[M_load]x) and has no
+    verdict."""
+    system, _ = read_moordyn(SMALL)
+    asymmetry = {}
+    for name, load in (("force", (1e4, 2e3, 0.0, 0.0, 0.0, 0.0)),
+                       ("moment", (1e4, 2e3, 0.0, 0.0, 0.0, 5e4))):
+        loaded = dataclasses.replace(system, bodies=(dataclasses.replace(
+            system.bodies[0], load=load),))
+        solver = SystemSolver(loaded, held_lines(loaded, TIGHT), PETSc.COMM_WORLD)
+        try:
+            found = solver.solve()
+            _, J = solver.residual(solver.state, solver.loads, solver.forces,
+                                   solver.stiffnesses)
+            D = np.diag([1.0] * 3 + [1.0 / solver.length] * 3)
+            K = -D @ J @ D
+            asymmetry[name] = (np.linalg.norm(K - K.T) / np.linalg.norm(K),
+                               solver.body_stiffness("Body1").asymmetry, found.verdict)
+        finally:
+            solver.destroy()
+    system_part, lines_part, verdict = asymmetry["force"]
+    assert lines_part > 5e-3 and system_part < 1e-12
+    assert verdict.stable is True
+    assert verdict.lowest == pytest.approx(6556.18, rel=1e-5)
+    system_part, _, verdict = asymmetry["moment"]
+    assert system_part > 1e-2
+    assert verdict.stable is None and "has a moment, fixed in space" in verdict.reason
