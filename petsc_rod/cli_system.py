@@ -34,7 +34,8 @@ from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
-from petsc_rod.errors import RodDivergedError, RodError, RodInputError, on_every_rank
+from petsc_rod.errors import (RodDivergedError, RodError, RodInputError,
+                              RodNotConvergedError, on_every_rank)
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.names import FIELD_NAMES, Names
@@ -325,6 +326,13 @@ def run(comm=None):
                     for name in ["<line>", "system", *results.sweeps,
                                  *(["system_modes"] if isinstance(results.body_modes,
                                                                   SystemModes) else [])]))
+            if results.verdict is not None and results.verdict.stable is False:
+                # a single line's saddle: exit 3, the file written with converged = 0
+                say(f"petsc_rod: error: the system's equilibrium is "
+                    f"{results.verdict.text()}: an equilibrium that is not a minimiser "
+                    "(check the bodies' weight against their buoyancy and the loads)"
+                    + (f"; result {output}, which says converged = 0" if output else ""))
+                return RodNotConvergedError.exit_code
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"
                 + (f"; {'; '.join(written)}" if written else ""))

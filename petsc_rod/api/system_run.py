@@ -76,6 +76,7 @@ class SystemResults:
     gathers them, collectively on the system's communicator); ``converged`` (the load
     continuation complete and every line converged: the solve raises when it finds no
     equilibrium, so False only where a line's last re-solve failed),
+    False too at a saddle of the system (``verdict``),
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
     (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
     'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}; with
@@ -83,7 +84,9 @@ class SystemResults:
     modes about its equilibrium in the system with its ends held (line_modes: the numbers per mode on every rank, the
     shapes along the line on its group's ranks, zero rows on the others); with the
     system's modes asked, ``body_modes`` (system/body_modes.SystemModes of the bodies
-    and free points, or SystemModesRefused), else None."""
+    and free points, or SystemModesRefused), else None; ``verdict`` the system's own
+    stability in its free unknowns (system/verdict.SystemVerdict: stable True, False a
+    saddle of the system, None no verdict)."""
 
     points: dict
     bodies: dict
@@ -99,6 +102,7 @@ class SystemResults:
     sweeps: dict = None
     modes: dict = field(default_factory=dict)
     body_modes: object = None
+    verdict: object = None
 
 
 def body_modes_request(options, cli=False):
@@ -391,15 +395,19 @@ def write_file(comm, output, system, results, records, text, notes, failures):
         if found is not None and not isinstance(found, ModesRefused):
             writer.write_modes(found, f"lines/{line.name}/modes")
     data, units = system_datasets(system, results)
+    verdict = results.verdict
     attributes = {"converged": int(results.converged), "iterations": results.iterations,
                   "halvings": results.halvings, "residual": results.residual,
                   "load_factor": results.load_factor, "ranks": comm.getSize(),
+                  "system_stable": -1 if verdict is None else verdict.code(),
+                  "system_verdict": "" if verdict is None else verdict.text(),
                   "point_names": ",".join(results.points),
                   "body_names": ",".join(results.bodies),
                   "line_names": ",".join(line.name for line in system.lines),
                   "input_text": text or "", "notes": "\n".join(notes),
                   **picture_attributes(system)}
     units.update({"converged": "1", "iterations": "1", "halvings": "1",
+                  "system_stable": "1", "system_verdict": "text",
                   "residual": "1", "load_factor": "1", "ranks": "1",
                   "point_names": "text", "body_names": "text", "line_names": "text",
                   "input_text": "text", "notes": "text", "written": "text",
@@ -537,6 +545,8 @@ def report_lines(system, results, ranks):
         diagonal = ", ".join(f"{v:.6g}" for v in np.diag(body.stiffness))
         lines.append(f"  body {name}: stiffness diagonal (N/m x3, N m/rad x3) {diagonal}; "
                      f"asymmetry {body.asymmetry:.2g}")
+    if results.verdict is not None:
+        lines.append(f"  the system's equilibrium: {results.verdict.text()}")
     return lines
 
 
@@ -652,10 +662,12 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
         {n: found.end_forces[k] for k, n in enumerate(names)},
         {n: records[k].tensions for k, n in enumerate(names)},
         {n: bool(records[k].attributes["converged"]) for k, n in enumerate(names)},
+        # a saddle of the system is not converged, as a single line's saddle is not
         lines, found.load_factor == 1.0 and all(
-            bool(records[k].attributes["converged"]) for k in range(len(names))),
+            bool(records[k].attributes["converged"]) for k in range(len(names)))
+        and (found.verdict is None or found.verdict.stable is not False),
         found.iterations, found.halvings,
-        found.residual, found.load_factor)
+        found.residual, found.load_factor, verdict=found.verdict)
     check_finite(comm, results, records)
     for line in report_lines(system, results, comm.getSize()):
         say(line)

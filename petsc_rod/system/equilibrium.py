@@ -57,6 +57,7 @@ from petsc_rod.errors import (RodDivergedError, RodError, RodInputError, RodInte
 from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
+from petsc_rod.system.verdict import system_verdict
 
 
 class HeldLine(Protocol):
@@ -186,7 +187,9 @@ class Equilibrium:
     complete), ``iterations`` (Newton's, over the continuation), ``residual`` (the scaled
     norm), ``stable`` {line name: True a local minimiser of its energy, False a saddle,
     None undecided} (SystemSolver.line_verdicts: each line tested once, here), and
-    ``unstable`` the names of the lines whose verdict is False, in the system's order."""
+    ``unstable`` the names of the lines whose verdict is False, in the system's order;
+    ``verdict`` the system's own stability in its free unknowns (system/verdict.py:
+    SystemVerdict, stable True, False a saddle of the system, None not conservative)."""
 
     points: dict
     bodies: dict
@@ -198,6 +201,7 @@ class Equilibrium:
     residual: float
     unstable: tuple = ()
     stable: dict = None
+    verdict: object = None
 
 
 class Layout:
@@ -733,7 +737,8 @@ class SystemSolver:
             # ended at a trial, which takes none): no stiffness to report
             raise RodDivergedError(f"system: the lines' stiffness at the equilibrium "
                                    f"failed: {self.failure}")
-        return self.result(factor, total, halvings, self.line_verdicts())
+        return self.result(factor, total, halvings, self.line_verdicts(),
+                           system_verdict(self))
 
     def line_verdicts(self):
         """{line name: line.stable()} of every line where it stands, in the system's
@@ -767,7 +772,9 @@ class SystemSolver:
                                 "a new one for any other change")
         self.system = system
 
-    def result(self, factor, iterations, halvings, stable=None):
+    def result(self, factor, iterations, halvings, stable=None, own=None):
+        """The Equilibrium at the solver's state: ``stable`` the lines' verdicts, ``own``
+        the system's (SystemVerdict)."""
         state, names = self.state, [b.name for b in self.system.bodies]
         points = {p.name: state.points[i].copy() for i, p in enumerate(self.system.points)}
         return Equilibrium(points,
@@ -776,7 +783,7 @@ class SystemSolver:
                            self.forces.copy(), factor, iterations, halvings,
                            float(self.norm),
                            tuple(name for name, verdict in (stable or {}).items()
-                                 if verdict is False), dict(stable or {}))
+                                 if verdict is False), dict(stable or {}), own)
 
     # -- the lines' own results -------------------------------------------------------------
 
