@@ -335,8 +335,8 @@ def check_reach(system, made_by=None):
     (to TAUT_GAP) is taut: it starts straight along its chord (scenes/starts.chord_start),
     stretched to it, so it must be able to stretch that far (needed_strain: extensible,
     within MAX_STRAIN). A longer line hangs as its catenary start. A free node
-    whose lines are all taut must be pulled away along one of them at least (pulled):
-    else they would all be in compression. Not part of check_system: a model's free
+    whose lines are all taut must be pulled away along one of them at least, or be held
+    between opposing ones (pulled): else they would all be in compression. Not part of check_system: a model's free
     points may stand anywhere (a MoorDyn file's are guesses); the run refuses them before
     it starts (cli_system.changed). ``made_by``: check_system's."""
     made_by = made_by or {}
