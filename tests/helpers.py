@@ -112,7 +112,7 @@ def zero_slope_planes(monkeypatch):
     def shape(sea, height, origin, n):
         if sea.seabed_slope == 0 and sea.seabed_profile is None:
             start = sea.seabed_origin if sea.seabed_origin is not None else (0.0, 0.0)
-            return Plane.sloping(start, height, 0.0, compile_module.seabed_direction(sea)).moved(origin)
+            return Plane.sloping(start, height, 0.0, sea.seabed_unit_direction()).moved(origin)
         return made(sea, height, origin, n)
     monkeypatch.setattr(compile_module, "seabed_shape", shape)
 
