@@ -1159,33 +1159,29 @@ class HeldLine:
 
     @staticmethod
     def _plane_held_shift(hessian, curvature, j):
-        """A function giving P_j (_plane_shifts) with its held rows kept (a new Vec):
+        """A function giving P_j (_plane_shift) with its held rows kept (a new Vec):
         the held data's share of the plane's reaction along axis j
         (_rotation_response)."""
-        def shift():
-            total = hessian.position_shift(curvature[:, 0, j], 0, held=True)
-            for c in (1, 2):
-                part = hessian.position_shift(curvature[:, c, j], c, held=True)
-                total.axpy(1.0, part)
-                part.destroy()
-            return total
-        return shift
+        return lambda: HeldLine._plane_shift(hessian, curvature, j, held=True)
+
+    @staticmethod
+    def _plane_shift(hessian, curvature, j, held=False):
+        """P_j = sum_c sum_n H_n[c, j] dx^c_n/dy (a new Vec): how the gradient moves when
+        every node is shifted by 1 m along axis j (the start moved), H_n = k w_n N N^T
+        the sloping plane's curvature at the owned nodes (n_nodes, 3, 3)
+        (SecondVariation.position_shift per component; ``held``: its held rows kept).
+        Collective."""
+        total = hessian.position_shift(curvature[:, 0, j], 0, held=held)
+        for c in (1, 2):
+            part = hessian.position_shift(curvature[:, c, j], c, held=held)
+            total.axpy(1.0, part)
+            part.destroy()
+        return total
 
     @staticmethod
     def _plane_shifts(hessian, curvature):
-        """P_j = sum_c sum_n H_n[c, j] dx^c_n/dy, j = x, y, z (three new Vecs): how the
-        gradient moves when every node is shifted by 1 m along axis j (the start moved),
-        H_n = k w_n N N^T the sloping plane's curvature at the owned nodes
-        (n_nodes, 3, 3) (SecondVariation.position_shift per component). Collective."""
-        out = []
-        for j in range(3):
-            total = hessian.position_shift(curvature[:, 0, j], 0)
-            for c in (1, 2):
-                part = hessian.position_shift(curvature[:, c, j], c)
-                total.axpy(1.0, part)
-                part.destroy()
-            out.append(total)
-        return out
+        """[P_x, P_y, P_z] (_plane_shift; three new Vecs). Collective."""
+        return [HeldLine._plane_shift(hessian, curvature, j) for j in range(3)]
 
     def _plane_response(self, hessian, columns, planes, solved, curvature, solver):
         """d(F_a, F_b)/d(x_a, c), (6, 6), on a sloping plane: _response with the start's
