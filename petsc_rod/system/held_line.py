@@ -363,6 +363,12 @@ def _ends_at_newton(event, newton_at):
             and event.report.iterations - newton_at in (0, 1))
 
 
+def _verified(newton):
+    """Whether ``newton``'s (a NewtonSolver's, None without Newton steps) last run's
+    last H passed the inertia test on the constraint set (NewtonSolver.verified)."""
+    return newton is not None and bool(newton.verified)
+
+
 class HeldLine:
     """A line of the typed model held at its two ends, on the ranks of ``comm`` (a
     PETSc communicator: the line's own; collective on it alone).
@@ -405,6 +411,9 @@ class HeldLine:
         self.iterations = 0
         self.converged = False
         self.settled = False                # the last solve ended at Newton's convergence
+        # ... and that Newton run's last H was positive definite on the constraint set
+        # (NewtonSolver.verified): the stability test's own criterion (stable)
+        self.verified = False
         self.settles = True                 # stiffness() first settles the line (settle)
         self.name = "the line"              # how a refusal names it (of_system_line)
 
@@ -556,7 +565,7 @@ class HeldLine:
 
     def _walk(self, a, b, frames):
         state = self.problem.state
-        saved, settled = state.snapshot(), self.settled
+        saved, settled, verified = state.snapshot(), self.settled, self.verified
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
         axes = {e: term.axis for e, (term, _) in self.axes.items()}
         self.path.move(a, b, *frames)
@@ -567,7 +576,7 @@ class HeldLine:
         for e, (term, _) in self.axes.items():
             term.axis = axes[e]
         state.restore(saved)
-        self.settled = settled                  # the restored equilibrium's
+        self.settled, self.verified = settled, verified     # the restored equilibrium's
         self.path.hold(ends[0].position, ends[1].position, ends[0].frame, ends[1].frame)
         self.problem.prepare(1.0)
         return False
@@ -576,7 +585,7 @@ class HeldLine:
         """The continuation on ``path``: whether it converged (a divergence, a PETSc
         error of its solves, is a failure). Collective."""
         self.iterations = 0
-        self.settled = False
+        self.settled = self.verified = False
         newton_at = None        # the iteration of the attempt's last converged Newton run
         converged = False
         try:
@@ -587,6 +596,9 @@ class HeldLine:
                     newton_at = None            # the frames turned off Newton's state
                 elif isinstance(event, (events.StepHalved, events.StepEnded)):
                     self.settled = _ends_at_newton(event, newton_at)
+                    # the run was the iteration's own Newton's
+                    self.verified = self.settled and _verified(getattr(self.solver, "newton",
+                                                                       None))
                     newton_at = None
                 if isinstance(event, events.RunFinished):
                     self.iterations = event.iterations
@@ -598,7 +610,8 @@ class HeldLine:
             pass
         finally:
             if not converged:
-                self.settled = False            # a failed run's state is no equilibrium
+                # a failed run's state is no equilibrium
+                self.settled = self.verified = False
         return converged
 
     # --- what it gives the system --------------------------------------------------------
@@ -670,10 +683,16 @@ class HeldLine:
         True a local minimiser, False a saddle, None undecided or a line whose loads
         have no energy (a current). A system may solve its lines with the test off
         (options {'al_stability': 0}: a third of a small warm re-solve's time) and ask
-        this once at its own equilibrium. Collective."""
+        this once at its own equilibrium. Where the line is settled by a Newton run
+        whose last H passed the inertia test on the constraint set (``verified``),
+        that test is the verdict, True, without a factorisation of its own, as a
+        single line's step that ends at Newton takes it (iteration/driver.py).
+        Collective."""
         self._check_solved()
         if not self.problem.conservative:
             return None
+        if self.settled and self.verified:
+            return True
         try:
             return self.solver.check_stability()[0]
         except np.linalg.LinAlgError:
@@ -746,6 +765,7 @@ class HeldLine:
             return
         if not self.settled:
             self.settled = self.newton.run() == CONVERGED
+            self.verified = self.settled and _verified(self.newton)
             for term in self.friction if self.settled else ():
                 term.follow_state(self.problem.state)   # the end forces read its
 

@@ -132,6 +132,45 @@ def test_a_small_move_is_warm_started(hanging):
     untested.destroy()
 
 
+def asking(line, monkeypatch):
+    """The calls of ``line``'s stability test (appended to the list returned), the
+    test itself run as before; and the test."""
+    asked, test = [], line.solver.check_stability
+    monkeypatch.setattr(line.solver, "check_stability", lambda: asked.append(1) or test())
+    return asked, test
+
+
+def test_a_line_settled_by_newton_takes_its_inertia_test_for_the_verdict(monkeypatch):
+    """stable() of a line settled by a Newton run whose last H passed the inertia test
+    on the constraint set (settle, or a walk that ends at Newton) is True without the
+    stability test's own factorisation, which agrees; a line not settled is tested."""
+    plain = HeldLine(line_model(HANGING), PETSc.COMM_WORLD,
+                     options={**TIGHT, "al_stability": 0, "al_newton": 0})
+    try:
+        assert plain.solve(*HANGING)
+        assert plain.solve(HANGING[0], HANGING[1] + np.array([0.05, 0.0, 0.0]))
+        assert not plain.settled                # the iteration's own tests ended it
+        asked, test = asking(plain, monkeypatch)
+        assert plain.stable() is True and asked == [1]
+        plain.settle()
+        assert plain.settled and plain.verified
+        assert plain.stable() is True and asked == [1]
+        assert test()[0] is True
+    finally:
+        plain.destroy()
+    walked = HeldLine(line_model(MOORING, seabed=-30.0), PETSc.COMM_WORLD,
+                      options={**TIGHT, "al_stability": 0})
+    try:
+        assert walked.solve(*MOORING)
+        assert walked.solve(MOORING[0], MOORING[1] + np.array([0.05, 0.0, 0.0]))
+        assert walked.settled and walked.verified       # the walk ended at Newton
+        asked, test = asking(walked, monkeypatch)
+        assert walked.stable() is True and asked == []
+        assert test()[0] is True
+    finally:
+        walked.destroy()
+
+
 @pytest.fixture(scope="module", params=list(COMMS))
 def mooring(request):
     line = held(line_model(MOORING, seabed=-30.0, elements=50), COMMS[request.param],
