@@ -2,8 +2,8 @@
 from a MoorDyn version 2 input file, solved on the path the Python API's solve_system
 takes (api/system_run.py), with the command line's options, lines and exit codes
 (docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 3 no
-equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not be
-written).
+equilibrium found or a saddle of the system, at rest or at a case of a sweep (the file
+written), 4 non-finite numbers or a PETSc error, 5 the result could not be written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
@@ -27,7 +27,7 @@ from petsc4py import PETSc
 
 from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, body_modes_request,
                                      modes_request, run_system, written_paths)
-from petsc_rod.api.system_sweeps import parse_sweeps
+from petsc_rod.api.system_sweeps import parse_sweeps, sweep_saddles
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
@@ -332,6 +332,17 @@ def run(comm=None):
                     f"{results.verdict.text()}: an equilibrium that is not a minimiser "
                     "(check the bodies' weight against their buoyancy and the loads)"
                     + (f"; result {output}, which says converged = 0" if output else ""))
+                return RodNotConvergedError.exit_code
+            saddles = sweep_saddles(results.sweeps)
+            if saddles:
+                # a sweep's saddle as the rest's: its case kept and marked, exit 3
+                say(f"petsc_rod: error: {saddles}: equilibria that are not minimisers, "
+                    "kept and marked saddle (check the bodies' weight against their "
+                    "buoyancy, the lines' layout and the loads)"
+                    + (f"; result {output}, whose "
+                       + ", ".join(f"system/{kind}" for kind, found in results.sweeps.items()
+                                   if found.saddles())
+                       + " says converged = 0" if output else ""))
                 return RodNotConvergedError.exit_code
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"
