@@ -102,6 +102,11 @@ class Worst:
         """[(heading deg, load N)] of every case, in the arrays' order (raveled)."""
         raise NotImplementedError
 
+    @staticmethod
+    def where(cases):
+        """The words of ``cases`` [(heading deg, load N)]: the subclasses'."""
+        raise NotImplementedError
+
     def saddles(self):
         """[(heading deg, load N)] of the cases that are saddles of the system."""
         cases = self.cases()
@@ -110,7 +115,7 @@ class Worst:
     def verdict_text(self):
         """The verdicts over the cases with an equilibrium in words: 'all stable', or
         '; '-separated 'N saddle(s) of the system: headings 90, 105 deg' (the curves':
-        'heading 0 deg under 5e+04, 6e+04 N'), 'N stable', 'M without a verdict: why'
+        'heading 180 deg under 60000, 80000 N'), 'N stable', 'M without a verdict: why'
         ('no verdict: why' where no case has one)."""
         solved = np.isfinite(self.poses.reshape(-1, 6)[:, 0])
         codes = self.stable.ravel()[solved]
