@@ -5,8 +5,10 @@ says "all stable" and exits 0; the body with Line1 crossed under it
 under 60 kN towards -x: its load-excursion curve (0 and 60 kN at heading 180 deg) keeps
 the saddle's row, marked ``saddle`` in the table and 0 in the file's ``verdict``, says
 it in the run's lines and exits 3 as a saddle at rest does, the sweep's group with
-converged = 0 (the rest's ``system`` group converged = 1), on 1 and 2 ranks. Spawns
-processes: marked ``serial``."""
+converged = 0 (the rest's ``system`` group converged = 1), on 1 and 2 ranks; a case of
+a system's sweep (python -m petsc_rod.sweep -rod_system) whose equilibrium is that
+saddle exits 3 as its run alone does, its file written. Spawns processes: marked
+``serial``."""
 
 import os
 
@@ -14,6 +16,7 @@ import h5py
 import pytest
 
 from helpers import REPO_ROOT, describe, run_petsc_rod
+from test_sweep_cli import run_module
 
 pytestmark = pytest.mark.serial
 
@@ -66,3 +69,20 @@ def test_a_saddle_in_the_curves_exits_3_with_its_row_marked(tmp_path, ranks):
         group = f["system/excursion"]
         assert group["verdict"][()].tolist() == [1.0, 0.0]
         assert int(group.attrs["converged"]) == 0 and int(group.attrs["saddles"]) == 1
+
+
+def test_a_system_sweeps_case_at_a_saddle_exits_3(tmp_path):
+    cases = tmp_path / "cases.txt"
+    cases.write_text("name rod_system_body_load\npushed Body1,-6e4,0,0,0,0,0\n")
+    folder = tmp_path / "sweep"
+    process = run_module("petsc_rod.sweep", [
+        "-rod_system", os.path.join(DATA, "crossed_line.dat"),
+        "-rod_system_element_length", "2", "-sweep_cases", str(cases),
+        "-sweep_output", str(folder)], 1)
+    assert process.returncode == 3, describe(process)
+    assert ("petsc_rod: error: the system's equilibrium is a saddle of the system: its "
+            "stiffness has 1 negative eigenvalue(s)") in process.stdout
+    assert "0 of 1 case(s) converged; not: pushed" in process.stdout
+    with h5py.File(folder / "pushed.h5", "r") as f:
+        assert int(f["system"].attrs["system_stable"]) == 0
+        assert int(f["system"].attrs["converged"]) == 0
