@@ -6,8 +6,8 @@ same load solved directly; the same body with Line1 crossed under it
 (tests/data/moordyn/crossed_line.dat: its fairlead at x = -5 m, its anchor at x = 55 m)
 stable at rest but a saddle in yaw under 60 kN towards -x (the crossed line, taut,
 pulls its fairlead across the body: turning the body shortens it), its watch circle's
-case reported as a saddle in the table, the file's group and the run's lines. Serially and under mpiexec -n 2
-(the lines split over the ranks)."""
+case reported as a saddle in the table, the file's group and the run's lines. Serially
+and under mpiexec -n 2 (the lines split over the ranks)."""
 
 import os
 
