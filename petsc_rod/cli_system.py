@@ -2,8 +2,8 @@
 from a MoorDyn version 2 input file, solved on the path the Python API's solve_system
 takes (api/system_run.py), with the command line's options, lines and exit codes
 (docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 3 no
-equilibrium found, 4 non-finite numbers or a PETSc error, 5 the result could not be
-written).
+equilibrium found or a saddle of the system, at rest or at a case of a sweep (the file
+written), 4 non-finite numbers or a PETSc error, 5 the result could not be written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
@@ -27,7 +27,7 @@ from petsc4py import PETSc
 
 from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, body_modes_request,
                                      modes_request, run_system, written_paths)
-from petsc_rod.api.system_sweeps import parse_sweeps
+from petsc_rod.api.system_sweeps import parse_sweeps, sweep_saddles
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
@@ -288,6 +288,28 @@ def prepared(values, given, case=None):
             body_modes)
 
 
+def saddle_error(results, output=None):
+    """The error line (without 'petsc_rod: error: ') of a system's run whose results
+    (api/system_run.SystemResults) hold a saddle of the system, '' where none does:
+    at rest (a single line's saddle: exit 3, the file written with converged = 0), or
+    else at a case of its watch circle or load-excursion curves (the case kept and
+    marked, the sweep's group converged = 0). ``output``: the result file, named."""
+    if results.verdict is not None and results.verdict.stable is False:
+        return (f"the system's equilibrium is {results.verdict.text()}: an equilibrium "
+                "that is not a minimiser (check the bodies' weight against their "
+                "buoyancy and the loads)"
+                + (f"; result {output}, which says converged = 0" if output else ""))
+    saddles = sweep_saddles(results.sweeps)
+    if not saddles:
+        return ""
+    groups = ", ".join(f"system/{kind}" for kind, found in results.sweeps.items()
+                       if found.saddles())
+    return (f"{saddles}: equilibria that are not minimisers, kept and marked saddle "
+            "(check the bodies' weight against their buoyancy, the lines' layout and the "
+            "loads)" + (f"; result {output}, whose {groups} says converged = 0"
+                        if output else ""))
+
+
 def run(comm=None):
     """The system's run on ``comm`` (default PETSc.COMM_WORLD); returns the exit code."""
     comm = comm or PETSc.COMM_WORLD
@@ -326,12 +348,9 @@ def run(comm=None):
                     for name in ["<line>", "system", *results.sweeps,
                                  *(["system_modes"] if isinstance(results.body_modes,
                                                                   SystemModes) else [])]))
-            if results.verdict is not None and results.verdict.stable is False:
-                # a single line's saddle: exit 3, the file written with converged = 0
-                say(f"petsc_rod: error: the system's equilibrium is "
-                    f"{results.verdict.text()}: an equilibrium that is not a minimiser "
-                    "(check the bodies' weight against their buoyancy and the loads)"
-                    + (f"; result {output}, which says converged = 0" if output else ""))
+            saddle = saddle_error(results, output)
+            if saddle:
+                say(f"petsc_rod: error: {saddle}")
                 return RodNotConvergedError.exit_code
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"

@@ -79,7 +79,9 @@ class SystemResults:
     False too at a saddle of the system (``verdict``),
     ``iterations`` (Newton's), ``halvings`` (of the load continuation), ``residual``
     (the scaled norm), ``load_factor``; ``sweeps`` {'watch_circle': WatchCircle,
-    'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}; with
+    'excursion': LoadExcursion} of those asked (api/system_sweeps.py), else {}, each
+    case with the system's verdict (``stable``, ``saddles()``: a saddle at a case
+    leaves ``converged``, the rest's, as it is; the command line exits 3); with
     modes asked, ``modes`` {line: analysis/modes.Modes or ModesRefused}, each line's
     modes about its equilibrium in the system with its ends held (line_modes: the numbers per mode on every rank, the
     shapes along the line on its group's ranks, zero rows on the others); with the

@@ -8,14 +8,22 @@ run's lines.
 A case without an equilibrium is a gap: its row is left out of the file's group and
 of the table (the file lists it in ``failed_heading``, ``failed_load`` and the
 ``failed`` attribute), so that no NaN is ever written as a result. The smallest
-grounded length's columns are left out when no line has a seabed."""
+grounded length's columns are left out when no line has a seabed, the lowest
+eigenvalue's when a case has none (a system that is not conservative).
+
+Each case carries the system's verdict (system/excursions.py): the table's ``verdict``
+(stable, saddle, none; the file's codes 1, 0, -1 of ``system_stable``) and
+``lowest_eigenvalue``; a saddle's row is kept and marked, the group's ``converged`` is
+0 where a case is a saddle (as the system group's at a saddle at rest), and the run
+says the verdicts in one line a sweep and exits 3 (cli_system.py)."""
 
 from dataclasses import dataclass
 
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.system.excursions import TABLE_UNITS, load_excursion, watch_circle
+from petsc_rod.system.excursions import (TABLE_UNITS, VERDICT_WORDS, load_excursion,
+                                         watch_circle)
 
 # The watch circle's headings when none are given: every 15 degrees.
 WATCH_HEADINGS = 24
@@ -23,6 +31,12 @@ WATCH_HEADINGS = 24
 EXCURSION_LOADS = 10
 # The columns naming a line (written as its index into the file's ``line_names``).
 LINE_COLUMNS = ("max_tension_line", "min_grounded_line")
+# The file's codes of the table's ``verdict`` words (the system group's system_stable).
+VERDICT_CODES = {word: code for code, word in VERDICT_WORDS.items()}
+VERDICT_UNIT = "1 stable, 0 a saddle of the system, -1 no verdict (system_stable's codes)"
+# The run's words of a sweep (run_lines) and what it counts.
+SWEEP_WORDS = {"watch_circle": ("watch circle", "heading"),
+               "excursion": ("load-excursion curves", "case")}
 
 
 @dataclass(frozen=True)
@@ -120,22 +134,29 @@ def run_sweeps(solver, sweeps):
 
 def solved_rows(result):
     """{column: array} of ``result.table()`` with only the rows of the cases that
-    have an equilibrium, the lines as indices into ``result.lines``, and without the
-    grounded length's columns where no line has a seabed; (columns, {column: unit})."""
+    have an equilibrium, the lines as indices into ``result.lines``, the verdicts as
+    their codes (VERDICT_CODES), without the grounded length's columns where no line
+    has a seabed and the lowest eigenvalue's where a case has none; (columns, {column:
+    unit})."""
     table = result.table()
     keep = np.isfinite(np.asarray(result.poses, float).reshape(-1, 6)[:, 0])
     index = {name: k for k, name in enumerate(result.lines)}
     columns = {}
-    grounded = np.any(np.isfinite(result.min_grounded))
+    left_out = {"min_grounded": not np.any(np.isfinite(result.min_grounded)),
+                "lowest_eigenvalue": not np.all(np.isfinite(
+                    table["lowest_eigenvalue"][keep]))}
     for name, values in table.items():
-        if name.startswith("min_grounded") and not grounded:
+        if any(name.startswith(prefix) and out for prefix, out in left_out.items()):
             continue
         values = np.asarray(values)[keep]
         if name in LINE_COLUMNS:
             values = np.array([index[v] for v in values], dtype=float)
+        if name == "verdict":
+            values = np.array([VERDICT_CODES[v] for v in values], dtype=float)
         columns[name] = np.asarray(values, dtype=float)
-    units = {name: ("index into line_names" if name in LINE_COLUMNS
-                    else TABLE_UNITS[name]) for name in columns}
+    units = {name: ("index into line_names" if name in LINE_COLUMNS else
+                    VERDICT_UNIT if name == "verdict" else TABLE_UNITS[name])
+             for name in columns}
     return columns, units
 
 
@@ -148,14 +169,18 @@ def file_group(result):
     data["failed_load"] = np.array([f[1] for f in failed], dtype=float)
     units.update(failed_heading="deg", failed_load="N")
     tension, *_ = result.largest_tension
+    saddles = len(result.saddles())
     attributes = {"body": result.body, "line_names": ",".join(result.lines),
                   "rest": np.asarray(result.rest, float),
                   "failed": "\n".join(f"heading {h:g} deg, load {f:g} N: {why}"
                                       for h, f, why in failed),
                   "rows": "a case with an equilibrium; the cases without one are left out "
-                          "(failed_heading, failed_load, failed)"}
+                          "(failed_heading, failed_load, failed)",
+                  "converged": int(saddles == 0), "saddles": saddles,
+                  "system_verdict": result.verdict_text()}
     units_of = {"body": "text", "line_names": "text", "rest": "m, m, m, rad, rad, rad",
-                "failed": "text", "rows": "text"}
+                "failed": "text", "rows": "text", "converged": "1", "saddles": "1",
+                "system_verdict": "text"}
     if np.isfinite(tension):
         attributes["largest_tension"] = tension
         units_of["largest_tension"] = "N"
@@ -177,11 +202,12 @@ def table_text(result):
     """The CSV text of ``result``'s table: a row per case with an equilibrium, the
     lines by name."""
     data, units = solved_rows(result)
-    header = ",".join(f"{name} ({units[name]})" if name not in LINE_COLUMNS and units[name]
-                      else name for name in data)
+    header = ",".join(f"{name} ({units[name]})" if name not in (*LINE_COLUMNS, "verdict")
+                      and units[name] else name for name in data)
     rows = [header]
     for k in range(len(next(iter(data.values())))):
         rows.append(",".join(result.lines[int(data[name][k])] if name in LINE_COLUMNS
+                             else VERDICT_WORDS[int(data[name][k])] if name == "verdict"
                              else f"{data[name][k] + 0.0:.12g}" for name in data))
     return "\n".join(rows) + "\n"
 
@@ -211,4 +237,20 @@ def run_lines(found):
         for heading, load, why in result.failed:
             lines.append(f"petsc_rod: warning: {kind.replace('_', ' ')}: no equilibrium at "
                          f"heading {heading:g} deg, load {load:.6g} N (left out): {why}")
+        what, unit = SWEEP_WORDS[kind]
+        solved = int(np.count_nonzero(np.isfinite(result.poses.reshape(-1, 6)[:, 0])))
+        total = result.poses.reshape(-1, 6).shape[0]
+        lines.append(f"petsc_rod: {what}: {solved} {unit}(s)"
+                     + (f" of {total} with an equilibrium" if solved < total else "")
+                     + f", the system's verdict: {result.verdict_text()}")
     return lines
+
+
+def sweep_saddles(found):
+    """'the watch circle of Body1 has 2 saddle(s) of the system: headings 90, 105 deg'
+    (the sweeps of ``found`` with a saddle, joined by '; '), '' where none has one:
+    the command line's exit 3 (cli_system.py), as at a saddle at rest."""
+    return "; ".join(f"the {SWEEP_WORDS[kind][0]} of {result.body} "
+                     f"{'have' if kind == 'excursion' else 'has'} {len(saddles)} saddle(s) "
+                     f"of the system: {result.where(saddles)}"
+                     for kind, result in found.items() if (saddles := result.saddles()))

@@ -63,7 +63,9 @@ def sweep(group):
         loads = np.unique(np.concatenate([found["load"], found["failed_load"]]))
         h = np.searchsorted(headings, found["heading"])
         m = np.searchsorted(loads, found["load"])
-        for name in ("offset", "restoring", "max_tension", "min_grounded"):
+        for name in ("offset", "restoring", "max_tension", "min_grounded", "verdict"):
+            if name not in found:       # a file written before the sweeps' verdicts
+                continue
             grid = np.full((headings.size, loads.size), np.nan)
             grid[h, m] = found[name]
             found[f"grid_{name}"] = grid
@@ -130,10 +132,17 @@ def figures(found):
         drawn["_watch_circle"] = watch_circle_figure(
             np.stack([circle["x_offset"], circle["y_offset"]], axis=1), circle["heading"],
             circle["max_tension"], circle["min_grounded"], float(circle["load"][0]),
-            str(circle["body"]))
+            str(circle["body"]), saddle=_saddle(circle.get("verdict")))
     curves = found.excursion
     if curves is not None and curves["heading"].size:
         drawn["_excursion"] = excursion_figure(
             curves["grid_offset"], curves["grid_restoring"], curves["grid_headings"],
-            curves["grid_max_tension"], curves["grid_min_grounded"], str(curves["body"]))
+            curves["grid_max_tension"], curves["grid_min_grounded"], str(curves["body"]),
+            saddle=_saddle(curves.get("grid_verdict")))
     return drawn
+
+
+def _saddle(verdict):
+    """The cases whose ``verdict`` (the file's codes; None: a file without them) says
+    a saddle of the system (0), or None."""
+    return None if verdict is None else np.asarray(verdict) == 0

@@ -11,6 +11,9 @@ plain arrays (system/outputs.picture, system/excursions' results):
   offset along each heading, and the largest tension and the smallest grounded length
   against the offset.
 
+In both, a case that is a saddle of the system (system/excursions.py's verdict) is
+marked with a red cross.
+
 Each is laid out at fixed margins (a figure of SIZE inches), as the riser's figure."""
 
 import matplotlib.pyplot as plt
@@ -30,6 +33,7 @@ POINT_MARKS = {"fixed": ("s", style.END, "anchor (fixed point)"),
                "free": ("D", style.ATTACHMENT, "free point"),
                "prescribed": ("^", style.END, "prescribed point")}
 BODY = (0.0, 0.45, 0.25)            # the bodies' reference points and fairleads
+SADDLE = (0.85, 0.1, 0.1)           # a sweep's case that is a saddle of the system
 
 
 def _row(size, columns, ratios=None):
@@ -131,18 +135,30 @@ def system_figure(lines, points=(), bodies=(), seabed=None, surface=0.0, title=N
     return figure
 
 
+def _saddles(axis, x, y, saddle):
+    """Mark the cases ``saddle`` (a bool array of ``x``'s shape, or None) of the
+    curves (``x``, ``y``) on ``axis``: saddles of the system, kept in the results."""
+    if saddle is None or not np.any(saddle):
+        return
+    saddle = np.asarray(saddle, bool)
+    axis.plot(np.asarray(x, float)[saddle], np.asarray(y, float)[saddle], "X",
+              color=SADDLE, ms=11, ls="none", label="saddle of the system")
+
+
 def watch_circle_figure(offsets, headings, max_tension, min_grounded, load, body="",
-                        title=None):
+                        title=None, saddle=None):
     """The watch circle of ``body`` under a horizontal ``load`` (N) turned through
     ``headings`` (h,), deg: the reference point's horizontal ``offsets`` (h, 2), m, from
     its rest; the lines' largest tension (h,), N, and smallest grounded length (h,), m
-    (all NaN: no seabed, not drawn), against the heading."""
+    (all NaN: no seabed, not drawn), against the heading; ``saddle`` (h,) bool, the
+    headings whose equilibrium is a saddle of the system, marked (None: none)."""
     offsets = np.asarray(offsets, float).reshape(-1, 2)
     headings = np.asarray(headings, float)
     figure, (circle, tension, grounded) = _row(CURVES_SIZE, 3, ratios=[1.0, 1.2, 1.2])
     closed = np.vstack([offsets, offsets[:1]]) if len(offsets) > 2 else offsets
     circle.plot(closed[:, 0], closed[:, 1], "-", color=style.LINE, lw=1.8)
     circle.plot(offsets[:, 0], offsets[:, 1], "o", color=style.LINE, ms=4)
+    _saddles(circle, offsets[:, 0], offsets[:, 1], saddle)
     circle.plot([0.0], [0.0], "P", color=BODY, ms=10, label="at rest")
     reach = max(float(np.abs(offsets).max(initial=0.0)), 1e-9)
     for angle in np.radians(headings):       # the load's direction at each heading
@@ -187,11 +203,12 @@ def _grounded(axis, x, grounded, label):
 
 
 def excursion_figure(offsets, restoring, headings, max_tension, min_grounded, body="",
-                     title=None):
+                     title=None, saddle=None):
     """The load-excursion curves of ``body``: for each of ``headings`` (h,), deg, the
     restoring force ``restoring`` (h, m), N, against the ``offsets`` (h, m), m, along
     the heading; the lines' largest tension (h, m), N, and smallest grounded length
-    (h, m), m, against the offset."""
+    (h, m), m, against the offset; ``saddle`` (h, m) bool, the cases whose equilibrium
+    is a saddle of the system, marked (None: none)."""
     offsets, restoring = np.asarray(offsets, float), np.asarray(restoring, float)
     figure, (force, tension, grounded) = _row(CURVES_SIZE, 3)
     (f_divisor, f_unit), (t_divisor, t_unit) = _scale(restoring), _scale(max_tension)
@@ -201,6 +218,7 @@ def excursion_figure(offsets, restoring, headings, max_tension, min_grounded, bo
                    label=f"{heading:g} deg")
         tension.plot(offsets[k], np.asarray(max_tension, float)[k] / t_divisor, "o-",
                      color=colour, ms=4)
+    _saddles(force, offsets, restoring / f_divisor, saddle)
     force.set_xlabel("offset along the heading (m)")
     force.set_ylabel(f"restoring force ({f_unit})")
     force.set_title("restoring force against offset", fontsize=10)

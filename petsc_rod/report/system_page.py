@@ -81,10 +81,11 @@ def lines_html(lines):
 
 
 def sweep_html(kind, found):
-    """The table of a sweep's cases (its rows with an equilibrium) and its failed
-    cases."""
+    """The table of a sweep's cases (its rows with an equilibrium; the system's verdict
+    at each, SADDLE in capitals, where the file has it) and its failed cases."""
     names = found["lines"]
     grounded = "min_grounded_line" in found
+    verdicts = found.get("verdict")
     rows = []
     for k in range(found["heading"].size):
         row = [float(found["heading"][k]), float(found["load"][k]) / 1e3]
@@ -95,15 +96,22 @@ def sweep_html(kind, found):
                 names[int(found["max_tension_line"][k])]]
         if grounded:
             row += [float(found["min_grounded"][k]), names[int(found["min_grounded_line"][k])]]
+        if verdicts is not None:
+            row.append(STABLE.get(int(verdicts[k]), "-"))
         rows.append(row)
     head = ["heading (deg)", "load (kN)"] + (["x offset (m)", "y offset (m)"]
                                              if kind == "watch_circle" else
                                              ["offset (m)", "restoring (kN)"])
     head += ["largest tension (kN)", "line"] + (["smallest grounded (m)", "line"]
                                                  if grounded else [])
+    head += ["stable"] if verdicts is not None else []
     failed = str(found.get("failed", ""))
     note = (f"<p>Cases without an equilibrium, left out: {html.escape(failed)}</p>"
             if failed else "")
+    if "system_verdict" in found:
+        note += (f"<p>The system's verdict at its cases: "
+                 f"{html.escape(str(found['system_verdict']))} (a saddle: an equilibrium "
+                 "that is not a minimiser, kept and marked).</p>")
     return _table(kind, head, rows) + note
 
 

@@ -19,8 +19,10 @@ system's result file); after each, DIR/summary.csv, DIR/summary.md and DIR/sweep
 are rewritten on rank 0 with a row per case: the bodies' positions, each line's
 fairlead tension and the largest tension over the lines.
 
-Exit code as runner.run_sweep's: 0 every case converged, 3 some did not, 2 bad sweep
-input before any run, 128 + n a stop signal.
+Exit code as runner.run_sweep's: 0 every case converged, 3 some did not (a case whose
+equilibrium, or a case of its watch circle or load-excursion curves, is a saddle of the
+system is such a case: exit 3 as its run alone, cli_system.saddle_error, its file
+written), 2 bad sweep input before any run, 128 + n a stop signal.
 """
 
 import os
@@ -32,8 +34,8 @@ from petsc4py import PETSc
 from petsc_rod.api.system_run import run_system
 from petsc_rod.cli.options import check_same_on_every_rank, read_options, values_of
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.cli_system import check_movable, laid_system, prepared
-from petsc_rod.errors import RodError, RodInputError, on_every_rank
+from petsc_rod.cli_system import check_movable, laid_system, prepared, saddle_error
+from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError, on_every_rank
 from petsc_rod.sweep import cases as sweep_cases
 from petsc_rod.sweep import summary
 from petsc_rod.sweep.runner import (FAILED, Sweep, base_options, check_file_names,
@@ -226,6 +228,11 @@ class SystemSweep(Sweep):
             results = run_system(self.comm, system, settings, options, self.say,
                                  self.file(case), None, text, notes, self.interrupts,
                                  sweeps, modes, body_modes, solver=self.solver)
+            saddle = saddle_error(results, self.file(case))
+            if saddle:
+                # the case's run alone would exit 3 (cli_system.run): its file kept
+                self.say(f"petsc_rod: error: {saddle}")
+                return RodNotConvergedError.exit_code, results
             return 0, results
         except RodError as error:
             self.say(f"petsc_rod: error: {error}")

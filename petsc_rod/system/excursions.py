@@ -21,6 +21,13 @@ pitch). The slope d restoring / d offset at F = 0 is the inverse of the complian
 hydrostatics'), K_xx itself when the body's other degrees of freedom are held or
 uncoupled.
 
+At each equilibrium, the system's own verdict (SystemSolver.solve's
+Equilibrium.verdict, system/verdict.py: computed by every solve, so recorded here at no
+cost): ``stable`` 1 a strict local minimiser of the system's potential, 0 a saddle of
+the system (a warm Newton under a large load can land on one: its numbers are kept and
+the case is marked), -1 no verdict (not conservative, or neutral to round-off), and
+the lowest eigenvalue of its scaled stiffness, N/m (NaN where there is none).
+
 A case no equilibrium is found for (the solver's RodDivergedError: a line that cannot
 reach, a load beyond what the lines hold) is a gap in the results (NaN, its reason in
 ``failed``), and the next case starts from the last equilibrium found.
@@ -31,7 +38,7 @@ so that the solver's ``system``, which the loads are added to, is the same base 
 for the next call.
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,13 +47,18 @@ from petsc_rod.system.outputs import line_summaries
 
 # Units of the results' arrays.
 UNITS = {"headings": "deg", "loads": "N", "load": "N", "poses": "m, rad",
-         "offsets": "m", "restoring": "N", "max_tension": "N", "min_grounded": "m"}
+         "offsets": "m", "restoring": "N", "max_tension": "N", "min_grounded": "m",
+         "stable": "1", "lowest_eigenvalue": "N/m"}
 # Units of the columns of the results' tables (``table()``).
 TABLE_UNITS = {"heading": "deg", "load": "N", "offset": "m", "restoring": "N",
                "x_offset": "m", "y_offset": "m", "x": "m", "y": "m", "z": "m",
                "roll": "rad", "pitch": "rad", "yaw": "rad", "max_tension": "N",
-               "max_tension_line": "", "min_grounded": "m", "min_grounded_line": ""}
+               "max_tension_line": "", "min_grounded": "m", "min_grounded_line": "",
+               "verdict": "", "lowest_eigenvalue": "N/m"}
 POSE = ("x", "y", "z", "roll", "pitch", "yaw")
+# The table's ``verdict`` words of the ``stable`` codes (SystemVerdict.code: the result
+# file's system_stable).
+VERDICT_WORDS = {1: "stable", 0: "saddle", -1: "none"}
 
 
 @dataclass(frozen=True)
@@ -59,7 +71,10 @@ class Worst:
     pitch, yaw rad); ``units`` of the arrays; ``failed`` ((heading deg, load N,
     why), ...) the cases no equilibrium was found for (RodDivergedError's message),
     NaN in every array (and -1 in the line indices), the next case solved from the
-    last equilibrium."""
+    last equilibrium; the system's verdict at each equilibrium (module docstring):
+    ``stable`` 1, 0 a saddle, -1 none (and at a failed case), ``lowest_eigenvalue``
+    N/m (NaN: none), ``no_verdict`` why a case has none ('' where each has one; default
+    for all three: no verdict)."""
 
     body: str
     headings: np.ndarray
@@ -72,6 +87,56 @@ class Worst:
     rest: np.ndarray
     lines: tuple
     units: dict
+    stable: np.ndarray = field(default=None, kw_only=True)
+    lowest_eigenvalue: np.ndarray = field(default=None, kw_only=True)
+    no_verdict: str = field(default="", kw_only=True)
+
+    def __post_init__(self):
+        shape = np.shape(self.max_tension)
+        if self.stable is None:
+            object.__setattr__(self, "stable", np.full(shape, -1))
+        if self.lowest_eigenvalue is None:
+            object.__setattr__(self, "lowest_eigenvalue", np.full(shape, np.nan))
+
+    def cases(self):
+        """[(heading deg, load N)] of every case, in the arrays' order (raveled)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def where(cases):
+        """The words of ``cases`` [(heading deg, load N)]: the subclasses'."""
+        raise NotImplementedError
+
+    def saddles(self):
+        """[(heading deg, load N)] of the cases that are saddles of the system."""
+        cases = self.cases()
+        return [cases[k] for k in np.flatnonzero(self.stable.ravel() == 0)]
+
+    def verdict_text(self):
+        """The verdicts over the cases with an equilibrium in words: 'all stable', or
+        '; '-separated 'N saddle(s) of the system: headings 90, 105 deg' (the curves':
+        'heading 180 deg under 60000, 80000 N'), 'N stable', 'M without a verdict: why'
+        ('no verdict: why' where no case has one)."""
+        solved = np.isfinite(self.poses.reshape(-1, 6)[:, 0])
+        codes = self.stable.ravel()[solved]
+        if not codes.size:
+            return "no equilibrium"
+        if np.all(codes == 1):
+            return "all stable"
+        parts = []
+        saddles = self.saddles()
+        if saddles:
+            parts.append(f"{len(saddles)} saddle(s) of the system: "
+                         f"{self.where(saddles)}")
+        stable = int(np.count_nonzero(codes == 1))
+        if stable:
+            parts.append(f"{stable} stable")
+        none = int(np.count_nonzero(codes == -1))
+        if none:
+            parts.append(("no verdict" if none == codes.size else
+                          f"{none} without a verdict")
+                         + (f": {self.no_verdict}" if self.no_verdict else ""))
+        return "; ".join(parts)
 
     def _worst(self, values, lines, pick):
         """(value, index into the arrays, line name) of ``pick`` (np.nanargmax or
@@ -82,12 +147,17 @@ class Worst:
         return float(values[index]), index, self.lines[int(lines[index])]
 
     def _table(self, first):
-        """{column: (k,) array}: the columns ``first`` then the pose and the worst
-        lines' numbers, a row per case (TABLE_UNITS; a line's name, "" where none)."""
+        """{column: (k,) array}: the columns ``first`` then the pose, the system's
+        verdict (``verdict`` stable, saddle or none: VERDICT_WORDS) and its lowest
+        eigenvalue, and the worst lines' numbers, a row per case (TABLE_UNITS; a
+        line's name, "" where none)."""
         names = np.array(list(self.lines) + [""], dtype=object)
         table = dict(first)
         table.update(zip(POSE, self.poses.reshape(-1, 6).T))
-        table.update(max_tension=self.max_tension.ravel(),
+        table.update(verdict=np.array([VERDICT_WORDS[int(c)] for c in self.stable.ravel()],
+                                      dtype=object),
+                     lowest_eigenvalue=self.lowest_eigenvalue.ravel(),
+                     max_tension=self.max_tension.ravel(),
                      max_tension_line=names[self.max_tension_line.ravel()],
                      min_grounded=self.min_grounded.ravel(),
                      min_grounded_line=names[self.min_grounded_line.ravel()])
@@ -116,6 +186,17 @@ class LoadExcursion(Worst):
         if index is None:
             return value, np.nan, np.nan, None
         return value, float(self.headings[index[0]]), float(self.loads[index[1]]), line
+
+    def cases(self):
+        return [(float(h), float(f)) for h in self.headings for f in self.loads]
+
+    @staticmethod
+    def where(cases):
+        """'heading 180 deg under 60000, 80000 N; ...' of ``cases``, by heading."""
+        headings = list(dict.fromkeys(h for h, _ in cases))
+        return "; ".join(f"heading {h:g} deg under "
+                         + ", ".join(f"{f:.6g}" for g, f in cases if g == h) + " N"
+                         for h in headings)
 
     @property
     def largest_tension(self):
@@ -154,6 +235,15 @@ class WatchCircle(Worst):
 
     def _at(self, value, index, line):
         return value, (np.nan if index is None else float(self.headings[index[0]])), line
+
+    def cases(self):
+        return [(float(h), self.load) for h in self.headings]
+
+    @staticmethod
+    def where(cases):
+        """'headings 90, 105 deg' of ``cases``."""
+        return (f"heading{'s' if len(cases) > 1 else ''} "
+                + ", ".join(f"{h:g}" for h, _ in cases) + " deg")
 
     @property
     def largest_tension(self):
@@ -207,7 +297,8 @@ def _direction(heading):
 def _cases(solver, body, cases):
     """Solve ``cases`` [(heading deg, magnitude N)] in order, after the rest: (rest
     pose (6,), poses (k, 6), lines' force on the body (k, 3) and at rest (3,),
-    extremes (k, 4))."""
+    extremes (k, 4), failed, verdicts: each case's SystemVerdict, None where it
+    failed)."""
     base = solver.system
     names = [b.name for b in base.bodies]
     if body not in names:
@@ -216,7 +307,7 @@ def _cases(solver, body, cases):
     index = names.index(body)
     rest = solver.solve(base).bodies[body].copy()
     rest_force = lines_force(solver, index)
-    poses, forces, worst, failed = [], [], [], []
+    poses, forces, worst, failed, verdicts = [], [], [], [], []
     for heading, magnitude in cases:
         saved = solver.state
         try:
@@ -228,13 +319,15 @@ def _cases(solver, body, cases):
             poses.append(np.full(6, np.nan))
             forces.append(np.full(3, np.nan))
             worst.append((np.nan, -1, np.nan, -1))
+            verdicts.append(None)
             continue
         poses.append(result.bodies[body].copy())
         forces.append(lines_force(solver, index))
         worst.append(extremes(line_summaries(solver)))
+        verdicts.append(result.verdict)
     solver.solve(base)
     return rest, np.array(poses).reshape(-1, 6), np.array(forces).reshape(-1, 3), \
-        rest_force, np.array(worst, dtype=float).reshape(-1, 4), tuple(failed)
+        rest_force, np.array(worst, dtype=float).reshape(-1, 4), tuple(failed), verdicts
 
 
 def load_excursion(solver, body, loads, headings=(0.0,)):
@@ -245,14 +338,15 @@ def load_excursion(solver, body, loads, headings=(0.0,)):
     loads = np.asarray(loads, dtype=float).ravel()
     headings = np.asarray(headings, dtype=float).ravel()
     cases = [(h, f) for h in headings for f in loads]
-    rest, poses, forces, rest_force, worst, failed = _cases(solver, body, cases)
+    rest, poses, forces, rest_force, worst, failed, verdicts = _cases(solver, body,
+                                                                        cases)
     shape = (headings.size, loads.size)
     e = np.array([_direction(h) for h in headings])                  # (h, 3)
     poses = poses.reshape(shape + (6,))
     offsets = np.einsum("hmi,hi->hm", poses[..., :3] - rest[:3], e)
     restoring = -np.einsum("hmi,hi->hm", forces.reshape(shape + (3,)) - rest_force, e)
     return LoadExcursion(**_worst(solver, body, headings, poses, rest,
-                                  worst.reshape(shape + (4,)), failed),
+                                  worst.reshape(shape + (4,)), failed, verdicts, shape),
                          loads=loads, offsets=offsets, restoring=restoring)
 
 
@@ -261,15 +355,23 @@ def watch_circle(solver, body, load, headings=np.arange(0.0, 360.0, 15.0)):
     through ``headings`` (deg), one after the next (each equilibrium warm from the
     last), after the rest. Collective."""
     headings = np.asarray(headings, dtype=float).ravel()
-    rest, poses, _, _, worst, failed = _cases(solver, body,
-                                              [(h, float(load)) for h in headings])
-    return WatchCircle(**_worst(solver, body, headings, poses, rest, worst, failed),
+    rest, poses, _, _, worst, failed, verdicts = _cases(
+        solver, body, [(h, float(load)) for h in headings])
+    return WatchCircle(**_worst(solver, body, headings, poses, rest, worst, failed,
+                                verdicts, headings.shape),
                        load=float(load), offsets=poses[:, :2] - rest[:2])
 
 
-def _worst(solver, body, headings, poses, rest, worst, failed):
-    """Worst's fields from the extremes ``worst`` (..., 4)."""
+def _worst(solver, body, headings, poses, rest, worst, failed, verdicts, shape):
+    """Worst's fields from the extremes ``worst`` (..., 4) and the cases' ``verdicts``
+    (SystemVerdict or None, raveled; ``shape`` the cases')."""
+    reasons = [v.reason for v in verdicts if v is not None and v.stable is None]
     return dict(body=body, headings=headings, poses=poses, failed=failed,
+                stable=np.array([-1 if v is None else v.code() for v in verdicts],
+                                dtype=int).reshape(shape),
+                lowest_eigenvalue=np.array([np.nan if v is None else v.lowest
+                                            for v in verdicts], dtype=float).reshape(shape),
+                no_verdict=reasons[0] if reasons else "",
                 max_tension=worst[..., 0],
                 max_tension_line=worst[..., 1].astype(int), min_grounded=worst[..., 2],
                 min_grounded_line=worst[..., 3].astype(int), rest=rest,

@@ -155,8 +155,8 @@ def test_the_watch_circle_turns_with_the_spread(solver, circle):
     assert circle.largest_offset == pytest.approx(np.linalg.norm(offsets[0]), rel=1e-7)
     table = circle.table()
     assert list(table) == ["heading", "load", "x_offset", "y_offset", "x", "y", "z", "roll",
-                           "pitch", "yaw", "max_tension", "max_tension_line",
-                           "min_grounded", "min_grounded_line"]
+                           "pitch", "yaw", "verdict", "lowest_eigenvalue", "max_tension",
+                           "max_tension_line", "min_grounded", "min_grounded_line"]
     assert table["yaw"] == pytest.approx(circle.poses[:, 5])
     assert list(table["max_tension_line"]) == [circle.lines[k]
                                                for k in circle.max_tension_line]

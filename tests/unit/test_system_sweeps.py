@@ -91,3 +91,58 @@ def test_the_options_are_parsed_and_refused_in_one_line():
                                  (None, "Body1,inf", "'inf'")):
         with pytest.raises(RodInputError, match=word):
             parse_sweeps(circle, curves, system)
+
+
+def test_a_saddle_case_is_marked_in_the_file_the_figure_and_the_page(tmp_path):
+    """The curves' case at heading 90 deg, 1 kN, a saddle of the system: kept in the
+    file's group (verdict 0, converged 0), crossed in red on the restoring force's
+    graph at its point, SADDLE in the report page's table, its words under it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from petsc_rod.figures.read_system import figures
+    from petsc_rod.figures.read_system import SystemFile
+    from petsc_rod.report.system_page import sweep_html
+
+    headings, loads = np.array([0.0, 90.0]), np.array([0.0, 1e3, 2e3])
+    poses = np.zeros((2, 3, 6))
+    poses[1, 2] = np.nan
+    offsets = np.array([[0.0, 1.0, 2.0], [0.0, 0.5, np.nan]])
+    stable = np.array([[1, 1, 1], [1, 0, -1]])
+    lowest = np.array([[9.0, 8.0, 7.0], [9.0, -2.0, np.nan]])
+    curves = LoadExcursion(body="Body1", headings=headings, poses=poses,
+                           failed=((90.0, 2e3, "too far"),), **worst((2, 3), (1, 2)),
+                           loads=loads, offsets=offsets, restoring=offsets * 1e3,
+                           stable=stable, lowest_eigenvalue=lowest)
+    assert curves.saddles() == [(90.0, 1e3)]
+    data, attributes, units = file_group(curves)
+    assert data["verdict"].tolist() == [1, 1, 1, 1, 0]
+    assert data["lowest_eigenvalue"].tolist() == [9.0, 8.0, 7.0, 9.0, -2.0]
+    assert attributes["converged"] == 0 and attributes["saddles"] == 1
+    assert attributes["system_verdict"] == ("1 saddle(s) of the system: heading 90 deg "
+                                            "under 1000 N; 4 stable")
+    rows = table_text(curves).splitlines()
+    assert rows[5].split(",")[10:12] == ["saddle", "-2"]
+    with h5py.File(tmp_path / "s.h5", "w") as f:
+        group = f.create_group("excursion")
+        group.attrs.update(attributes)
+        for name, value in data.items():
+            group[name] = value
+        found = sweep(group)
+    assert np.array_equal(found["grid_verdict"], [[1, 1, 1], [1, 0, np.nan]],
+                          equal_nan=True)
+    drawn = figures(SystemFile("s.h5", "s", {"lines": {}, "points": [], "bodies": [],
+                                             "seabed": None, "surface": 0.0},
+                               [], [], None, found, {}))
+    marks = [line for line in drawn["_excursion"].axes[0].get_lines()
+             if line.get_label() == "saddle of the system"]
+    assert len(marks) == 1
+    assert marks[0].get_xdata().tolist() == [0.5]
+    assert marks[0].get_ydata().tolist() == [0.5]                      # kN
+    for figure in drawn.values():
+        plt.close(figure)
+    page = sweep_html("excursion", found)
+    assert "<th>stable</th>" in page and page.count("SADDLE") == 1
+    assert "1 saddle(s) of the system: heading 90 deg under 1000 N" in page
