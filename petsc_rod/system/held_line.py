@@ -247,18 +247,23 @@ class _CurvatureRecorder:
         self.positions = np.asarray(values, dtype=float)
 
     def add_friction(self, terms):
-        """The frictional line's whole position block H_n (n_nodes, 3, 3), rows the
-        gradient's components, columns the positions': the friction's rows (x, y) of
-        FrictionTerm.position_derivatives (unsymmetric: its z column, the limit mu R
-        following the contact), the seabed's k w_n at (z, z); the heights' own record
-        folded in (the response then takes the start's three position data, as on a
-        sloping plane)."""
+        """The frictional line's whole position block H_n (n_nodes, 3, 3) at the owned
+        nodes, rows the gradient's components, columns the positions': the seabed's
+        (k w_n at (z, z) on a flat seabed, the heights' own record folded in; on a
+        sloping plane its k w_n N N^T) plus the friction's
+        FrictionTerm.position_derivatives (unsymmetric: rows (x, y) on a flat seabed,
+        its z column the limit mu R following the contact; on a plane all three rows,
+        the vertical part g.f, and the limit following x as well). The response then
+        takes the start's three position data (_plane_response)."""
         state = self.problem.state
         block = np.zeros((state.node_weights.shape[0], 3, 3))
+        if self.positions is not None:
+            block += self.positions
         if self.heights is not None:
             block[:, 2, 2] = self.heights
         for term in terms:
-            block[:, :2] += term.position_derivatives(state)
+            rows = term.position_derivatives(state)
+            block[:, :rows.shape[1]] += rows
         self.positions, self.heights = block, None
 
 
@@ -1232,14 +1237,11 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if self.friction and (scene.seabed is None or not scene.seabed.flat
-                              or any(not term.in_newton for term in self.friction)):
-            # a sloping plane's friction is in the line's Newton steps, but its block
-            # (n, 3, 3) and the state it follows are not written into this response
+        if self.friction and any(not term.in_newton for term in self.friction):
             raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
                                 "its seabed friction with two coefficients or on a seabed "
-                                "that is not flat: give the friction one coefficient on a "
-                                "flat seabed")
+                                "profile: give the friction one coefficient on a flat or "
+                                "uniformly sloping seabed")
         if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
                                 "seabed profile (its contact is lagged in the line's "
