@@ -86,21 +86,24 @@ is fixed for its life) and stay there (FrictionTerm.hold_anchors: no return map 
 end of a step): its equilibrium is then a function of its ends alone, whatever walks,
 halvings and trials reached them (OrcaFlex's statics within one load step). Its gradient
 reads every node's horizontal position, so the data are the start's whole x_a, as on a
-plane (_plane_response), with the position block H_n of the friction's Newton steps
-(FrictionTerm.position_derivatives: stick k_s w I, slide the secant block and the z
-column of the limit mu R following the contact) and the seabed's k w_n: unsymmetric,
-so A is J (its LU), and the forces read the block through its transpose. A sliding
-node's stiffness is the loading tangent (the slip continued); unloading it would stick.
-Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
-pinned ends only.
+plane (_plane_response), with the position block H_n (n_nodes, 3, 3) at the owned
+nodes: the seabed's (k w_n at (z, z); on a sloping plane k w_n N N^T) plus the
+friction's Newton block (FrictionTerm.position_derivatives: stick k_s w I, slide the
+secant block and the z column of the limit mu R following the contact; on a plane all
+three rows, the friction's vertical part g.f = g^T times its horizontal rows, and the
+limit following x as well, k cos(theta) d g^T): unsymmetric, so A is J (its LU), and
+the forces read the block through its transpose. A sliding node's stiffness is the
+loading tangent (the slip continued); unloading it would stick. On a flat seabed or a
+sloping plane with one coefficient only (the friction's Newton steps: ``in_newton``);
+pinned ends only. settle() records the friction of the settled state
+(FrictionTerm.follow_state), which the end forces read.
 
 On a sloping plane the rotations' response takes the plane's data (x_a, c): three
 solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
 by the held data through P_i's held rows (_rotation_response).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a profile (no Newton steps), on a sloping
-plane (its Newton block, all three components, not written into this response), or at a
+seabed's friction with two coefficients or on a profile (no Newton steps), or at a
 clamped or flex-jointed end (end_stiffness); a seabed profile or grid (its contact
 lagged); any load outside the Newton system (the sea surface's wet and dry parts,
 attachments that reach it).
