@@ -1199,8 +1199,8 @@ class HeldLine:
         seabed's whole reaction, dR_s,i = -(Q_i.dy + sum_n H_n[i, j] dx_a,j), the
         functionals ``planes`` Q_i = sum_j sum_n H_n[i, j] dx^j_n/dy: P_i where H_n is
         symmetric (the plane), the shifts of H_n's transpose with the friction (its
-        force on the line, part of R_s, reads the heights; the gradient's x and y rows
-        do not move the contact). Collective."""
+        force on the line, part of R_s, reads the heights, and on a plane the
+        horizontal positions through the limit: H_n is not symmetric). Collective."""
         mesh = self.mesh
         n_all = len(columns)
         Y_P = solved[n_all:n_all + 3]
