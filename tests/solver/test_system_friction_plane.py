@@ -123,14 +123,17 @@ def on_a_plane(mu=0.5):
     return dataclasses.replace(system, environment=environment, points=points)
 
 
+# the body's equilibrium on one rank (the one-rank spread's, or solved for the test)
+_ALONE = {}
+
+
 @pytest.fixture(scope="module", params=list(COMMS))
 def spread(request):
     solver, result = solved(on_a_plane(), COMMS[request.param])
+    if request.param == "one rank":
+        _ALONE["alone"] = result
     yield solver, result
     solver.destroy()
-
-
-_ALONE = {}
 
 
 def test_a_body_on_frictional_lines_on_a_plane(spread):
