@@ -462,19 +462,22 @@ class FrictionTerm(NodalLoadTerm):
         """Record the friction of the state's own positions (the law of the Newton
         steps at fixed anchors) as if a global step had solved them: after Newton steps
         that no global step follows (HeldLine.settle), the internal force and the end
-        forces read the friction of the state they stand at. Flat seabed only (the
-        Newton steps' case). Collective (a ghost exchange)."""
+        forces read the friction of the state they stand at. A flat seabed or a sloping
+        plane (the Newton steps' cases): the reaction of each node's whole position,
+        k (z_b - z)_+ cos(theta) (Seabed.reaction), and the vertical part g.f.
+        Collective (a ghost exchange)."""
         if self.anchors is None:
             return
+        seabed = self.seabed_term.seabed
         self.load.set(state.node_positions())
-        positions = self.load.element_values[..., :2].copy()
-        heights = self.load.element_values[..., 2].copy()
+        nodes = self.load.element_values.copy()                     # (ne, 3, 3)
         self.load.set(state.node_directors()[:, 2])
         tangents = self.load.element_values[..., :2].copy()
-        reaction = self.seabed_term.seabed.push(heights.ravel()).reshape(heights.shape)
-        self._springs_from_positions(positions, tangents, reaction)
-        force = -self.spring[..., None] * (positions - self.anchors)
-        self._record(force, positions, tangents, reaction, None)
+        reaction = seabed.reaction(nodes.reshape(-1, 3)).reshape(nodes.shape[:2])
+        gradients = None if seabed.flat else seabed.gradients(nodes[..., 0], nodes[..., 1])
+        self._springs_from_positions(nodes[..., :2], tangents, reaction)
+        force = -self.spring[..., None] * (nodes[..., :2] - self.anchors)
+        self._record(force, nodes[..., :2], tangents, reaction, gradients)
 
     # --- the load path --------------------------------------------------------------
     def accept_step(self, state):

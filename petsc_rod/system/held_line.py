@@ -86,21 +86,24 @@ is fixed for its life) and stay there (FrictionTerm.hold_anchors: no return map 
 end of a step): its equilibrium is then a function of its ends alone, whatever walks,
 halvings and trials reached them (OrcaFlex's statics within one load step). Its gradient
 reads every node's horizontal position, so the data are the start's whole x_a, as on a
-plane (_plane_response), with the position block H_n of the friction's Newton steps
-(FrictionTerm.position_derivatives: stick k_s w I, slide the secant block and the z
-column of the limit mu R following the contact) and the seabed's k w_n: unsymmetric,
-so A is J (its LU), and the forces read the block through its transpose. A sliding
-node's stiffness is the loading tangent (the slip continued); unloading it would stick.
-Flat seabed and one coefficient only (the friction's Newton steps: ``in_newton``);
-pinned ends only.
+plane (_plane_response), with the position block H_n (n_nodes, 3, 3) at the owned
+nodes: the seabed's (k w_n at (z, z); on a sloping plane k w_n N N^T) plus the
+friction's Newton block (FrictionTerm.position_derivatives: stick k_s w I, slide the
+secant block and the z column of the limit mu R following the contact; on a plane all
+three rows, the friction's vertical part g.f = g^T times its horizontal rows, and the
+limit following x as well, k cos(theta) d g^T): unsymmetric, so A is J (its LU), and
+the forces read the block through its transpose. A sliding node's stiffness is the
+loading tangent (the slip continued); unloading it would stick. On a flat seabed or a
+sloping plane with one coefficient only (the friction's Newton steps: ``in_newton``);
+pinned ends only. settle() records the friction of the settled state
+(FrictionTerm.follow_state), which the end forces read.
 
 On a sloping plane the rotations' response takes the plane's data (x_a, c): three
 solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
 by the held data through P_i's held rows (_rotation_response).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a profile (no Newton steps), on a sloping
-plane (its Newton block, all three components, not written into this response), or at a
+seabed's friction with two coefficients or on a profile (no Newton steps), or at a
 clamped or flex-jointed end (end_stiffness); a seabed profile or grid (its contact
 lagged); any load outside the Newton system (the sea surface's wet and dry parts,
 attachments that reach it).
@@ -247,18 +250,23 @@ class _CurvatureRecorder:
         self.positions = np.asarray(values, dtype=float)
 
     def add_friction(self, terms):
-        """The frictional line's whole position block H_n (n_nodes, 3, 3), rows the
-        gradient's components, columns the positions': the friction's rows (x, y) of
-        FrictionTerm.position_derivatives (unsymmetric: its z column, the limit mu R
-        following the contact), the seabed's k w_n at (z, z); the heights' own record
-        folded in (the response then takes the start's three position data, as on a
-        sloping plane)."""
+        """The frictional line's whole position block H_n (n_nodes, 3, 3) at the owned
+        nodes, rows the gradient's components, columns the positions': the seabed's
+        (k w_n at (z, z) on a flat seabed, the heights' own record folded in; on a
+        sloping plane its k w_n N N^T) plus the friction's
+        FrictionTerm.position_derivatives (unsymmetric: rows (x, y) on a flat seabed,
+        its z column the limit mu R following the contact; on a plane all three rows,
+        the vertical part g.f, and the limit following x as well). The response then
+        takes the start's three position data (_plane_response)."""
         state = self.problem.state
         block = np.zeros((state.node_weights.shape[0], 3, 3))
+        if self.positions is not None:
+            block += self.positions
         if self.heights is not None:
             block[:, 2, 2] = self.heights
         for term in terms:
-            block[:, :2] += term.position_derivatives(state)
+            rows = term.position_derivatives(state)
+            block[:, :rows.shape[1]] += rows
         self.positions, self.heights = block, None
 
 
@@ -1211,8 +1219,8 @@ class HeldLine:
         seabed's whole reaction, dR_s,i = -(Q_i.dy + sum_n H_n[i, j] dx_a,j), the
         functionals ``planes`` Q_i = sum_j sum_n H_n[i, j] dx^j_n/dy: P_i where H_n is
         symmetric (the plane), the shifts of H_n's transpose with the friction (its
-        force on the line, part of R_s, reads the heights; the gradient's x and y rows
-        do not move the contact). Collective."""
+        force on the line, part of R_s, reads the heights, and on a plane the
+        horizontal positions through the limit: H_n is not symmetric). Collective."""
         mesh = self.mesh
         n_all = len(columns)
         Y_P = solved[n_all:n_all + 3]
@@ -1252,14 +1260,11 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         scene = self.scene
-        if self.friction and (scene.seabed is None or not scene.seabed.flat
-                              or any(not term.in_newton for term in self.friction)):
-            # a sloping plane's friction is in the line's Newton steps, but its block
-            # (n, 3, 3) and the state it follows are not written into this response
+        if self.friction and any(not term.in_newton for term in self.friction):
             raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
                                 "its seabed friction with two coefficients or on a seabed "
-                                "that is not flat: give the friction one coefficient on a "
-                                "flat seabed")
+                                "profile: give the friction one coefficient on a flat or "
+                                "uniformly sloping seabed")
         if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
                                 "seabed profile (its contact is lagged in the line's "

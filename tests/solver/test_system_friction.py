@@ -15,7 +15,9 @@ one-sided) with friction mu:
     by a continuation, and after a detour through another load, the same to the floor;
 (d) a friction so large that every grounded node sticks: the pose does not depend on
     mu; a friction that vanishes: the frictionless system's pose;
-(e) two coefficients (no Newton steps) refused in one line naming the line.
+(e) two coefficients (no Newton steps) refused in one line naming the line, on a flat
+    seabed and on a sloping plane (one coefficient on a plane:
+    test_system_friction_plane.py).
 """
 
 import dataclasses
@@ -151,8 +153,9 @@ def solved_once(mu, load=SIDE):
     return _FRICTIONLESS[key][0]
 
 
-def test_the_body_stiffness_is_the_derivative(spread):
-    solver, _ = spread
+def assert_body_stiffness_is_the_derivative(solver):
+    """The body's 6 x 6 against central differences of the lines re-solved at moved
+    and turned poses, to 1e-6 of its largest entry."""
     K = solver.body_stiffness("Body1").matrix
     scale = np.abs(K).max()
     error = np.abs(K - body_differences(solver)).max() / scale
@@ -160,14 +163,22 @@ def test_the_body_stiffness_is_the_derivative(spread):
     assert error < 1e-6
 
 
-def test_one_rank_and_all_agree(spread):
-    _, result = spread
-    alone = solved_once(0.5)
+def assert_same_pose(result, alone):
+    """The pose of ``result`` and ``alone`` to the floor, their lines' end forces to
+    the floor of the largest."""
     difference = np.abs(pose(result) - pose(alone)).max()
     print(f"pose difference {difference:.3g}")
     assert difference < FLOOR
     assert np.abs(result.end_forces - alone.end_forces).max() \
         < FLOOR * np.abs(alone.end_forces).max()
+
+
+def test_the_body_stiffness_is_the_derivative(spread):
+    assert_body_stiffness_is_the_derivative(spread[0])
+
+
+def test_one_rank_and_all_agree(spread):
+    assert_same_pose(spread[1], solved_once(0.5))
 
 
 def test_a_continuation_reaches_the_one_step_equilibrium():
@@ -221,31 +232,38 @@ def test_a_vanishing_friction_is_the_frictionless_system():
     assert slip < 1e-9
 
 
-@pytest.mark.parametrize("case", ["two coefficients", "a sloping plane"])
-def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
-    """mu_a != mu_l takes no Newton steps (physics/friction.py), and a sloping plane's
-    friction block is not in the end stiffness: no exact stiffness; the refusal names
-    the line and what to change. The run says once what the friction is measured
-    from."""
-    system = frictional((0.5, 0.8))
-    environment = system.environment
-    if case == "a sloping plane":
-        system = frictional(0.5)
-        environment = dataclasses.replace(system.environment, seabed_slope=2.0,
-                                          seabed_direction=30.0,
-                                          seabed_origin=(-32.5, 56.292))
-    ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
-    line = HeldLine.of_system_line(system.lines[1], *ends, PETSc.COMM_SELF,
-                                   environment, {"al_stability": 0})
+def refusal(system_line, environment, ends, ask):
+    """The message of the RodInputError that ``ask`` (a HeldLine's method) raises on
+    ``system_line`` solved on one rank between ``ends`` in ``environment``: one line,
+    naming the line."""
+    line = HeldLine.of_system_line(system_line, *ends, PETSc.COMM_SELF, environment,
+                                   {"al_stability": 0})
     try:
         assert line.solve(*ends)
         with pytest.raises(RodInputError) as refused:
-            line.stiffness()
+            ask(line)
     finally:
         line.destroy()
     message = str(refused.value)
     assert "\n" not in message
-    assert f"line {system.lines[1].name}" in message and "one coefficient" in message
+    assert f"line {system_line.name}" in message
+    return message
+
+
+@pytest.mark.parametrize("case", ["two coefficients", "two coefficients on a sloping plane"])
+def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
+    """mu_a != mu_l takes no Newton steps (physics/friction.py), on a flat seabed or a
+    sloping plane: no exact stiffness; the refusal names the line and what to change.
+    The run says once what the friction is measured from."""
+    system = frictional((0.5, 0.8))
+    environment = system.environment
+    if case == "two coefficients on a sloping plane":
+        environment = dataclasses.replace(system.environment, seabed_slope=2.0,
+                                          seabed_direction=30.0,
+                                          seabed_origin=(-32.5, 56.292))
+    ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
+    message = refusal(system.lines[1], environment, ends, HeldLine.stiffness)
+    assert "one coefficient" in message
     assert friction_notes(frictional(None)) == ()
     (note,) = friction_notes(system)
     assert "as-laid" in note
