@@ -296,6 +296,20 @@ class FrictionTerm(NodalLoadTerm):
         self.spring = self.friction.stiffness * np.divide(
             reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
 
+    def snapshot(self):
+        """Copies of what the last solve left: the springs, the recorded force,
+        positions, reactions and use (``_record``), so that a state restored to an
+        earlier one (a held line's walk that failed, HeldLine._walk) reads its own
+        friction, not the failed solve's (``restore``)."""
+        return (self.spring.copy(), self.force.copy(),
+                None if self.positions is None else self.positions.copy(),
+                self.reaction.copy(), self.use.copy(), self._springs_stale)
+
+    def restore(self, saved):
+        """Put back what ``snapshot`` copied."""
+        (self.spring, self.force, self.positions, self.reaction, self.use,
+         self._springs_stale) = saved
+
     @property
     def stick(self):
         """The nodes whose spring is the stick stiffness (ne, 3): grounded and within

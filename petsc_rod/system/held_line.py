@@ -574,6 +574,7 @@ class HeldLine:
     def _walk(self, a, b, frames):
         state = self.problem.state
         saved, settled, verified = state.snapshot(), self.settled, self.verified
+        frictions = [term.snapshot() for term in self.friction]
         ends = (self.path.start_state(1.0), self.path.end_state(1.0))
         axes = {e: term.axis for e, (term, _) in self.axes.items()}
         self.path.move(a, b, *frames)
@@ -584,6 +585,8 @@ class HeldLine:
         for e, (term, _) in self.axes.items():
             term.axis = axes[e]
         state.restore(saved)
+        for term, record in zip(self.friction, frictions):
+            term.restore(record)                # its end forces read the friction's
         self.settled, self.verified = settled, verified     # the restored equilibrium's
         self.path.hold(ends[0].position, ends[1].position, ends[0].frame, ends[1].frame)
         self.problem.prepare(1.0)

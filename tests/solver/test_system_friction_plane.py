@@ -162,3 +162,32 @@ def test_a_clamped_frictional_line_on_a_plane_is_refused_in_one_line():
     message = refusal(line, on_the_plane(system, 4.0, 0.0, tuple(ANCHOR[:2])),
                       (ANCHOR, FAIRLEAD), HeldLine.end_stiffness)
     assert "pin the line's ends" in message
+
+
+@pytest.mark.parametrize("slope", [0.0, 4.0])
+def test_a_walk_that_fails_keeps_the_friction_of_the_last_equilibrium(slope):
+    """A walk that fails restores the line's state and its friction's record (the
+    springs, the force the end forces read): its end forces are the last equilibrium's,
+    on a flat seabed to round-off and on the plane to the solve's tolerance (there the
+    restored state's seabed force is its own, Seabed.force, where the equilibrium's was
+    the reaction its last vertical solve carried: SeabedTerm.contact_solved), on all
+    ranks. The friction of the failed walk left in the record moved them by about
+    1e-2."""
+    system = frictional(0.5)
+    environment = (on_the_plane(system, slope, 0.0, tuple(ANCHOR[:2])) if slope
+                   else system.environment)
+    line = HeldLine.of_system_line(system.lines[1], ANCHOR, FAIRLEAD, PETSc.COMM_WORLD,
+                                   environment, {**TIGHT, "al_stability": 0})
+    moved = FAIRLEAD + np.array([4.0, 0.0, 0.0])
+    try:
+        assert line.solve(ANCHOR, FAIRLEAD) and line.solve(ANCHOR, moved)
+        before = line.end_forces()
+        # a budget no walk of 4 m can keep to (the controller reads it every step)
+        line.solver.settings.max_it = 2
+        assert not line.solve(ANCHOR, moved + np.array([4.0, 2.0, 0.0]))
+        assert line.end_forces() == pytest.approx(before, rel=1e-9 if slope else 1e-12)
+        line.solver.settings.max_it = 2000
+        assert line.solve(ANCHOR, moved)
+        assert line.end_forces() == pytest.approx(before, rel=1e-9)
+    finally:
+        line.destroy()
