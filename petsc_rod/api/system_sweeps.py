@@ -14,8 +14,9 @@ eigenvalue's when a case has none (a system that is not conservative).
 Each case carries the system's verdict (system/excursions.py): the table's ``verdict``
 (stable, saddle, none; the file's codes 1, 0, -1 of ``system_stable``) and
 ``lowest_eigenvalue``; a saddle's row is kept and marked, the group's ``converged`` is
-0 where a case is a saddle (as the system group's at a saddle at rest), and the run
-says the verdicts in one line a sweep and exits 3 (cli_system.py)."""
+0 where a case is a saddle (as the system group's at a saddle at rest) or has no
+equilibrium, and the run says the verdicts in one line a sweep and exits 3 at a saddle
+(cli_system.py)."""
 
 from dataclasses import dataclass
 
@@ -176,7 +177,7 @@ def file_group(result):
                                       for h, f, why in failed),
                   "rows": "a case with an equilibrium; the cases without one are left out "
                           "(failed_heading, failed_load, failed)",
-                  "converged": int(saddles == 0), "saddles": saddles,
+                  "converged": int(saddles == 0 and not failed), "saddles": saddles,
                   "system_verdict": result.verdict_text()}
     units_of = {"body": "text", "line_names": "text", "rest": "m, m, m, rad, rad, rad",
                 "failed": "text", "rows": "text", "converged": "1", "saddles": "1",

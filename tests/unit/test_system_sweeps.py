@@ -43,6 +43,8 @@ def test_a_case_without_an_equilibrium_is_left_out_and_listed(tmp_path):
     assert data["failed_heading"].tolist() == [120.0]
     assert data["failed_load"].tolist() == [5e3]
     assert "Line2 did not converge" in attributes["failed"]
+    # a sweep with a case left without an equilibrium did not converge as a whole
+    assert attributes["converged"] == 0 and attributes["saddles"] == 0
     assert data["max_tension_line"].tolist() == [0.0, 2.0]
     assert attributes["largest_tension"] == 3e3 and attributes["smallest_grounded"] == 48.0
     assert attributes["largest_offset"] == 2.0         # heading 0 (1.97 m at 240)
