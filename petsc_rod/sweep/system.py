@@ -144,6 +144,8 @@ def table(records, varied):
     rows = []
     for record in records:
         status = summary.exit_reason(record["code"])
+        if record.get("saddle"):
+            status = "not converged (saddle)"
         if record.get("error"):
             status = f"failed ({record['error']})"
         numbers = dict(record.get("numbers", ()))
@@ -207,9 +209,14 @@ class SystemSweep(Sweep):
         if code != 0:
             self.drop_solver()
         record.update(code=code, start=start if code != 2 else "")
-        if code == 0:
+        if code == 0 or (code == 3 and results is not None):
+            # a saddle of the system's file is written, converged = 0 there (a single
+            # line's exit 3 likewise: runner.Sweep.run_case)
             record["file"] = os.path.abspath(self.file(case))
+        if code == 0:
             record["numbers"] = case_numbers(made[0], results)
+        elif code == 3 and results is not None:
+            record["saddle"] = True
         if code == FAILED and self._error:
             record["error"] = self._error
         return record

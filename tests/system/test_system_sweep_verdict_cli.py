@@ -10,6 +10,7 @@ a system's sweep (python -m petsc_rod.sweep -rod_system) whose equilibrium is th
 saddle exits 3 as its run alone does, its file written. Spawns processes: marked
 ``serial``."""
 
+import json
 import os
 
 import h5py
@@ -83,6 +84,10 @@ def test_a_system_sweeps_case_at_a_saddle_exits_3(tmp_path):
     assert ("petsc_rod: error: the system's equilibrium is a saddle of the system: its "
             "stiffness has 1 negative eigenvalue(s)") in process.stdout
     assert "0 of 1 case(s) converged; not: pushed" in process.stdout
+    # the summary says why it did not converge and the record names the saddle's file
+    assert "not converged (saddle)" in (folder / "summary.csv").read_text()
+    (record,) = json.loads((folder / "sweep.json").read_text())["cases"]
+    assert record["file"] == str(folder / "pushed.h5")
     with h5py.File(folder / "pushed.h5", "r") as f:
         assert int(f["system"].attrs["system_stable"]) == 0
         assert int(f["system"].attrs["converged"]) == 0
