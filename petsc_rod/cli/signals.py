@@ -40,9 +40,12 @@ class Interrupts:
                 signal.signal(stop, handler)
         return False
 
-    def received(self):
-        """The stop signal a rank received (the largest number if several), else 0."""
-        return self.comm.allreduce(self.signal_number, op=MPI.MAX)
+    def received(self, comm=None):
+        """The stop signal a rank received (the largest number if several), else 0;
+        collective on ``comm`` (a PETSc communicator: a system's line asks on its own,
+        system/held_line.py), by default the run's."""
+        on = self.comm if comm is None else comm.tompi4py()
+        return on.allreduce(self.signal_number, op=MPI.MAX)
 
     @staticmethod
     def name(number):

@@ -324,7 +324,8 @@ class SystemSolver:
         self.failure, self.checked, self.last = "", False, None
         self.mine = {}                          # this rank's lines' last results
         # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
-        # asked before every Newton iteration; None: not asked
+        # asked before every Newton iteration and after a failed one, and handed to the
+        # lines, which ask after every iteration of their walks; None: not asked
         self.interrupts = None
         self.factor = 0.0                       # the load factor the Newton works at
         self.loads = Loads.of(system, self.layout).unloaded()
@@ -412,6 +413,8 @@ class SystemSolver:
             if linearised and getattr(line, "settled", False) and self.mine[k][0]:
                 mine[k] = self.mine[k]
                 continue
+            if hasattr(line, "interrupts"):
+                line.interrupts = self.interrupts   # a walk stops at a stop signal
             try:
                 ok = there or bool(line.solve(positions[k, 0], positions[k, 1], *frames[k])
                                    if turned else line.solve(positions[k, 0], positions[k, 1]))
@@ -652,15 +655,17 @@ class SystemSolver:
                         f"iterations (residual {norm:.3g})")
         return None, settings.max_iterations
 
-    def check_interrupted(self, iteration):
+    def check_interrupted(self, iteration=None):
         """RodInterrupted when a rank received a stop signal (``interrupts``): asked by
         every rank at the same iteration (the Newton's steps are the same on every
-        rank), so that all stop together, nothing written. Collective."""
+        rank), so that all stop together, nothing written; without ``iteration``
+        after a failure (a line's walk stopped by the signal). Collective."""
         number = 0 if self.interrupts is None else self.interrupts.received()
         if number:
+            where = "" if iteration is None else f", iteration {iteration}"
             raise RodInterrupted(f"stopped by {self.interrupts.name(number)} during the "
-                                 f"system's Newton (load factor {self.factor:.6g}, "
-                                 f"iteration {iteration}); nothing written", number)
+                                 f"system's Newton (load factor {self.factor:.6g}{where}); "
+                                 "nothing written", number)
 
     def check_restoring(self):
         """RodInputError naming a body's or a point's degree of freedom that nothing
@@ -689,7 +694,15 @@ class SystemSolver:
         lines as they stand): Newton where the last equilibrium was (the first time:
         the system unloaded), then the continuation of the loads towards the new ones,
         each failing step halved up to ``max_halvings`` times; RodDivergedError saying
-        why when that did not help. Leaves the lines at the solution."""
+        why when that did not help, RodInterrupted where a stop signal ended it (the
+        lines' walks stop at one and fail). Leaves the lines at the solution."""
+        try:
+            return self._solve(system)
+        except RodDivergedError:
+            self.check_interrupted()
+            raise
+
+    def _solve(self, system):
         settings = self.settings
         if system is not None:
             self.replace(system)

@@ -418,6 +418,10 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
+        # the run's stop signals (cli/signals.Interrupts), asked on the line's
+        # communicator after every iteration of its solves (a walk stops at once, a
+        # failure); None: not asked (the system's solver sets it: SystemSolver.evaluate)
+        self.interrupts = None
         self.settled = False                # the last solve ended at Newton's convergence
         # ... and that Newton run's last H was positive definite on the constraint set
         # (NewtonSolver.verified): the stability test's own criterion (stable)
@@ -600,7 +604,7 @@ class HeldLine:
         newton_at = None        # the iteration of the attempt's last converged Newton run
         converged = False
         try:
-            for event in continuation(self.solver, path):
+            for event in continuation(self.solver, path, stop=self._stop()):
                 if isinstance(event, events.NewtonAttempt):
                     newton_at = event.iteration if event.outcome == CONVERGED else None
                 elif isinstance(event, events.SaddleLeft):
@@ -624,6 +628,14 @@ class HeldLine:
                 # a failed run's state is no equilibrium
                 self.settled = self.verified = False
         return converged
+
+    def _stop(self):
+        """continuation's ``stop``: whether a rank of the line received a stop signal
+        (``interrupts``; collective on the line's communicator), None without them."""
+        interrupts = self.interrupts
+        if interrupts is None:
+            return None
+        return lambda: bool(interrupts.received(self.comm))
 
     # --- what it gives the system --------------------------------------------------------
     def positions(self):

@@ -295,6 +295,35 @@ def test_a_walk_that_fails_keeps_the_last_equilibrium():
         line.destroy()
 
 
+class Signalled:
+    """An Interrupts (cli/signals.py) whose ranks received SIGTERM, counting the
+    questions asked on a line's communicator."""
+
+    def __init__(self):
+        self.asked = 0
+
+    def received(self, comm=None):
+        self.asked += comm is not None
+        return 15
+
+
+def test_a_walk_stops_at_a_stop_signal_and_keeps_the_last_equilibrium():
+    """A line given the run's stop signals (HeldLine.interrupts, as the system's solver
+    hands them) asks after every iteration of a walk: a signal ends the walk at its
+    first iteration, a failure, the last equilibrium kept."""
+    line = held(line_model(HANGING), PETSc.COMM_WORLD, HANGING)
+    try:
+        before = line.end_forces()
+        line.interrupts = Signalled()
+        assert not line.solve(HANGING[0], HANGING[1] - np.array([20.0, 0.0, 0.0]))
+        assert line.interrupts.asked == 1
+        assert line.end_forces() == pytest.approx(before, rel=1e-12)
+        line.interrupts = None
+        assert line.solve(HANGING[0], HANGING[1] - np.array([20.0, 0.0, 0.0]))
+    finally:
+        line.destroy()
+
+
 def test_stiffness_with_a_clamped_start():
     """A clamp holds its frame as the model gives it; an inextensible line's stiffness
     in the ends' positions is as exact as a pinned one's."""

@@ -91,7 +91,7 @@ def test_a_line_split_at_a_massless_free_point_is_the_unsplit_line():
 class Signalled:
     """An Interrupts (cli/signals.py) whose ranks received SIGTERM."""
 
-    def received(self):
+    def received(self, comm=None):
         return 15
 
     @staticmethod
@@ -117,20 +117,35 @@ def test_a_stop_signal_ends_the_run_before_anything_is_written(tmp_path):
 
 
 class SignalledLater(Signalled):
-    """An Interrupts whose ranks received SIGTERM from its ``calls``-th question on."""
+    """An Interrupts whose ranks received SIGTERM from the system's ``calls``-th
+    question on (the lines' questions, on their communicators, not counted)."""
 
     def __init__(self, calls):
         self.calls, self.asked = calls, 0
 
-    def received(self):
-        self.asked += 1
+    def received(self, comm=None):
+        if comm is None:
+            self.asked += 1
         return 15 if self.asked >= self.calls else 0
 
 
-def test_a_stop_signal_is_acted_on_between_the_newton_s_iterations(tmp_path):
-    """A signal received during the system's Newton (a free point to find: several
-    iterations) ends the run at the next iteration, not once the equilibrium is found;
-    nothing written."""
+class SignalledInAWalk(Signalled):
+    """An Interrupts whose ranks received SIGTERM at a line's ``calls``-th question
+    (a line asks on its communicator after every iteration of its walks)."""
+
+    def __init__(self, calls):
+        self.calls, self.line_asked = calls, 0
+
+    def received(self, comm=None):
+        if comm is not None:
+            self.line_asked += 1
+        return 15 if self.line_asked >= self.calls else 0
+
+
+def interrupted_joined_lines(tmp_path, interrupts):
+    """The message of the RodInterrupted that run_system raises on two lines joined at
+    a free point (a Newton of several iterations) given ``interrupts``, its exit code
+    143 and no file written."""
     from petsc_rod.api.system_run import run_system
     from petsc_rod.errors import RodInterrupted
     from petsc_rod.system.equilibrium import Settings
@@ -141,14 +156,35 @@ def test_a_stop_signal_is_acted_on_between_the_newton_s_iterations(tmp_path):
                     points=(Point("A", "fixed", ANCHOR), Point("J", "free", (30.0, 0.0, 5.0)),
                             Point("B", "fixed", FAIRLEAD)))
     out = str(tmp_path / "system.h5") if PETSc.COMM_WORLD.getSize() == 1 else None
-    interrupts = SignalledLater(3)
     with pytest.raises(RodInterrupted) as stopped:
         run_system(PETSc.COMM_WORLD, system, Settings(), TIGHT, lambda line: None,
                    output=out, interrupts=interrupts)
     assert stopped.value.exit_code == 143
-    assert "during the system's Newton (load factor 1, iteration 2)" in str(stopped.value)
-    assert interrupts.asked == 3
     assert out is None or not os.listdir(tmp_path)
+    return str(stopped.value)
+
+
+def test_a_stop_signal_is_acted_on_between_the_newton_s_iterations(tmp_path):
+    """A signal received during the system's Newton (a free point to find: several
+    iterations) ends the run at the next iteration, not once the equilibrium is found;
+    nothing written."""
+    interrupts = SignalledLater(3)
+    stopped = interrupted_joined_lines(tmp_path, interrupts)
+    assert "during the system's Newton (load factor 1, iteration 2)" in stopped
+    assert interrupts.asked == 3
+
+
+def test_a_stop_signal_during_a_line_s_walk_ends_the_walk_and_the_run(tmp_path):
+    """A signal received while a line walks (a watch circle's case under a load no
+    line can hold spends minutes in its lines' iterations and halvings) stops the walk
+    at the iteration it arrived in and the run there, nothing written: the lines ask
+    after every iteration (HeldLine.interrupts). Before, the lines never asked and the
+    run went on to the end."""
+    interrupts = SignalledInAWalk(5)
+    assert "SIGTERM" in interrupted_joined_lines(tmp_path, interrupts)
+    # the walk that received it stopped at once, the other line's (on this rank) at
+    # its first iteration
+    assert 5 <= interrupts.line_asked <= 6
 
 
 def test_options_a_system_does_not_take_are_refused():
@@ -177,27 +213,33 @@ def test_a_single_line_run_refuses_a_system():
 
 def test_each_line_is_tested_for_stability_once_at_the_equilibrium(monkeypatch):
     """The lines solve with their own stability test off during the system's iterations
-    (held_lines) and are tested once each at its equilibrium (SystemSolver.line_verdicts),
-    the record reading that verdict: the test's calls over the ranks are one per line on
-    each rank of its group, and each line's verdict is in its results."""
+    (held_lines) and are asked once each at its equilibrium (SystemSolver.line_verdicts),
+    the record reading that verdict: the verdict's calls over the ranks are one per line
+    on each rank of its group; the test runs for each line not settled by a Newton run
+    whose last H passed the inertia test (HeldLine.verified, which is the verdict), and
+    each line's verdict is in its results."""
     import dataclasses
     import os
 
     from helpers import REPO_ROOT
     from petsc_rod.iteration.driver import UzawaSolver
     from petsc_rod.model.moordyn import read_moordyn
+    from petsc_rod.system.held_line import HeldLine
 
-    calls = []
-    check = UzawaSolver.check_stability
+    calls, asked = [], []
+    check, stable = UzawaSolver.check_stability, HeldLine.stable
     monkeypatch.setattr(UzawaSolver, "check_stability",
                         lambda self, *a, **k: calls.append(1) or check(self, *a, **k))
+    monkeypatch.setattr(HeldLine, "stable", lambda self: asked.append(
+        int(self.settled and self.verified)) or stable(self))
     system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
                                           "small_free_body.dat"))
     body = dataclasses.replace(system.bodies[0], load=(3e4, 1e4, 0, 0, 0, 0))
     results = solve_system(dataclasses.replace(system, bodies=(body,)))
     mpi = PETSc.COMM_WORLD.tompi4py()
     ranks = sum(int(line.scalars["ranks"]) for line in results.lines.values())
-    assert mpi.allreduce(len(calls)) == ranks and len(results.lines) == 3
+    assert mpi.allreduce(len(asked)) == ranks and len(results.lines) == 3
+    assert mpi.allreduce(len(calls)) == ranks - mpi.allreduce(sum(asked))
     assert all(int(line.scalars["stable"]) == 1 for line in results.lines.values())
 
 
