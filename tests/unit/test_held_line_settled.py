@@ -55,7 +55,7 @@ def test_settled_only_where_the_last_step_ends_at_newton(name, monkeypatch):
                           End.anchor((0.0, 0.0, 0.0)), End.anchor((8.0, 0.0, 0.0)),
                           Environment()), PETSc.COMM_SELF)
     monkeypatch.setattr(held_line, "continuation",
-                        lambda solver, path: iter(script + [FINISHED]))
+                        lambda solver, path, stop=None: iter(script + [FINISHED]))
     assert line._run(PathSettings(steps=1, track_link=False))
     assert line.settled is settled
 
@@ -83,7 +83,8 @@ def test_a_failed_run_is_not_settled(name, monkeypatch):
                                       load=(0, 0, -1.0), elements=4),
                           End.anchor((0.0, 0.0, 0.0)), End.anchor((8.0, 0.0, 0.0)),
                           Environment()), PETSc.COMM_SELF)
-    monkeypatch.setattr(held_line, "continuation", lambda solver, path: FAILURES[name]())
+    monkeypatch.setattr(held_line, "continuation",
+                        lambda solver, path, stop=None: FAILURES[name]())
     assert not line._run(PathSettings(steps=1, track_link=False))
     assert line.settled is False
 
@@ -100,8 +101,8 @@ def test_a_failed_walk_puts_back_the_restored_equilibriums_flag(monkeypatch):
         assert line.solve((0.0, 0.0, 0.0), (8.0, 0.0, 0.0))
         line.settled = False                # as a solve ended by the tolerances leaves it
         monkeypatch.setattr(held_line, "continuation",
-                            lambda solver, path: FAILURES["a divergence after a settled "
-                                                          "half step"]())
+                            lambda solver, path, stop=None: FAILURES[
+                                "a divergence after a settled half step"]())
         assert not line.solve((0.0, 0.0, 0.0), (8.5, 0.0, 0.0))
         assert line.converged and line.settled is False
     finally:
