@@ -111,8 +111,9 @@ class SeabedTerm(NodalLoadTerm):
 
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; on a
-        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives).
-        The state's r is that of its fields (RodProblem.energy_gradient). Collective."""
+        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives), on
+        a linearised profile -w_n f_n's (Seabed.profile_derivatives). The state's r is
+        that of its fields (RodProblem.energy_gradient). Collective."""
         if self.seabed.plane or self.profiled:
             gradient = self._plane_derivatives(state)[0]
             self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
@@ -122,7 +123,8 @@ class SeabedTerm(NodalLoadTerm):
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
         its gradient gives through the multipliers); on a sloping plane k w_n N N^T on
-        the nodes' three position components."""
+        the nodes' three position components; on a linearised profile the symmetric part
+        of its block B_n there."""
         if self.seabed.plane or self.profiled:
             block = self._plane_derivatives(hessian.problem.state)[1]
             if self.profiled:                   # J carries the rest (add_jacobian)
