@@ -16,7 +16,10 @@ parallel run):
 (e) the same numbers on one rank and on all;
 (f) in a current (the drag follows the line) the stiffness from the Newton Jacobian
     against central differences, unsymmetric: uniform, and sheared (the drag's depth
-    derivative in the Jacobian), alone and on the seabed.
+    derivative in the Jacobian), alone and on the seabed;
+(g) on a seabed profile (the fixed point of the line's lagged iteration, its contact's
+    block per node) against central differences, with and without grounded nodes in
+    the secant's turn about a row; a seabed grid refused in one line.
 """
 
 import dataclasses
