@@ -8,8 +8,9 @@ written), 4 non-finite numbers or a PETSc error, 5 the result could not be writt
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
 -rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
--rod_system_modes_line_mass), the seabed's plane (-rod_seabed_slope,
--rod_seabed_direction, -rod_seabed_origin: a MoorDyn file carries none), the outputs
+-rod_system_modes_line_mass), the seabed's plane or profile (-rod_seabed_slope,
+-rod_seabed_direction, -rod_seabed_origin, -rod_seabed_profile: a MoorDyn file carries
+none), the outputs
 (-rod_output, -rod_table), the modes of
 each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
 -rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
@@ -34,12 +35,14 @@ from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
+from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import (RodDivergedError, RodError, RodInputError,
                               RodNotConvergedError, on_every_rank)
 from petsc_rod.io.same_file import replaced_input
 from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.names import FIELD_NAMES, Names
 from petsc_rod.model.system_check import check_reach
+from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
 from petsc_rod.system.held_line import friction_notes
@@ -51,9 +54,11 @@ SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_lo
                   "rod_system_watch_circle", "rod_system_excursion",
                   "rod_system_modes", "rod_system_modes_line_mass",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
-# The single line's options of a sloping seabed a system file's sea takes: a MoorDyn file
-# gives the seabed's depth (WtrDpth) only, which is the plane's height at its origin.
-SEABED_OPTIONS = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin")
+# The single line's options of a sloping or profiled seabed a system file's sea takes: a
+# MoorDyn file gives the seabed's depth (WtrDpth) only, which is the plane's height at
+# its origin; a profile's rows give the heights themselves, in place of the depth.
+SEABED_OPTIONS = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin",
+                  "rod_seabed_profile")
 SEABED_NAMES = Names({**{name.removeprefix("rod_"): f"-{name}" for name in SEABED_OPTIONS},
                       "seabed": "seabed (the file's WtrDpth)"}, FIELD_NAMES.__getitem__)
 
@@ -180,11 +185,17 @@ def sloped(values, given, system):
     """``system`` with its seabed the plane of -rod_seabed_slope, -rod_seabed_direction
     and -rod_seabed_origin (``values`` of those ``given``; Environment.seabed_slope,
     seabed_direction, seabed_origin: through the file's seabed height at the origin),
+    or the profile or grid of -rod_seabed_profile's rows (Environment.seabed_profile,
+    along -rod_seabed_direction from -rod_seabed_origin; the file's depth dropped),
     checked again (System.check) with those options named in the refusals."""
     fields = {name.removeprefix("rod_"): values[name] for name in SEABED_OPTIONS
               if name in given}
     if not fields:
         return system
+    if "seabed_profile" in fields:
+        fields["seabed_profile"] = read_seabed_profile(fields["seabed_profile"],
+                                                       MAX_MAGNITUDE)
+        fields.setdefault("seabed", None)
     system = dataclasses.replace(system, environment=dataclasses.replace(
         system.environment, **fields))
     system.check(SEABED_NAMES)

@@ -104,11 +104,38 @@ class Profile:
     def gradient(self, x, y):
         """The secant slope over SMOOTHING times the closest rows' spacing along e
         (module docstring), (shape of x) + (2,)."""
+        return self._secant(self.along(x, y))[..., None] * self.direction
+
+    def _half_width(self):
+        """delta / 2, m: half the width SMOOTHING times the closest rows' spacing."""
+        return 0.5 * SMOOTHING * np.min(np.diff(self.distances))
+
+    def _secant(self, d):
+        """g(d) = (z_b(d + delta/2) - z_b(d - delta/2)) / delta, the slope along e of
+        ``gradient`` at distances d (any shape)."""
+        half = self._half_width()
+        return (np.interp(d + half, self.distances, self.heights)
+                - np.interp(d - half, self.distances, self.heights)) / (2 * half)
+
+    def _rise(self, d):
+        """z_b'(d): the slope of the segment that holds d (the one after a row at a
+        row), 0 before the first row and from the last one on, at distances d."""
+        segments = np.diff(self.heights) / np.diff(self.distances)
+        index = np.searchsorted(self.distances, d, side="right") - 1
+        inside = (index >= 0) & (index < segments.size)
+        return np.where(inside, segments[np.clip(index, 0, segments.size - 1)], 0.0)
+
+    def slopes(self, x, y):
+        """(z_b', g, g') at (x, y), each the shape of x, along e: the interpolant's own
+        slope z_b'(d) (what moves a point's penetration), the secant g(d) of
+        ``gradient`` (what turns its push) and g'(d) = (z_b'(d + delta/2)
+        - z_b'(d - delta/2)) / delta, the secant's rate, 1/m: 0 farther than delta/2
+        from every row, where g = z_b' (a line's exact stiffness on the profile,
+        Seabed.profile_derivatives)."""
         d = self.along(x, y)
-        half = 0.5 * SMOOTHING * np.min(np.diff(self.distances))
-        slope = (np.interp(d + half, self.distances, self.heights)
-                 - np.interp(d - half, self.distances, self.heights)) / (2 * half)
-        return slope[..., None] * self.direction
+        half = self._half_width()
+        return (self._rise(d), self._secant(d),
+                (self._rise(d + half) - self._rise(d - half)) / (2 * half))
 
     def normal(self, x, y):
         return unit_normal(self.gradient(x, y))

@@ -141,6 +141,34 @@ class Seabed:
         return ((-spring * depth)[:, None] * normal,
                 spring[:, None, None] * normal[:, :, None] * normal[:, None, :])
 
+    def profile_derivatives(self, r, weights):
+        """(G, B) of a profile (bathymetry.Profile) at node positions r (n, 3) with
+        weights w_n (n,), m: G_n = -w_n f_n, the share of the gradient of the force
+        f_n = k_v p_n (-g_n e, 1) (force; p_n = (z_b(d_n) - z_n)_+, g_n the secant
+        gradient along e, k_v = k / (1 + g_n^2): the force of the line's lagged
+        iteration at its fixed point, physics/slope_load.py), N, (n, 3); and
+        B_n = dG_n/dr_n, N/m, (n, 3, 3), rows G's components, columns the position's:
+        with a = (g e, -1), E = (e, 0) and z_b' the interpolant's slope,
+
+            B_n = w_n [a (k_v (z_b' e, -1) + p dk_v/dg g' E)^T + k_v p g' E E^T],
+
+        dk_v/dg = -2 g k_v^2 / k, g' the secant's rate (Profile.slopes), on the nodes
+        with p_n > 0. Not symmetric where g != z_b' (within delta/2 of a row); farther
+        from the rows g' = 0 and B_n = k w_n N N^T, a plane's (position_derivatives)
+        with the node's own normal."""
+        x, y = r[:, 0], r[:, 1]
+        rise, g, rate = self.shape.slopes(x, y)
+        e = np.append(self.shape.direction, 0.0)
+        p = self.penetration(r[:, 2], self.shape.height(x, y))
+        k_v = self.stiffness / (1.0 + g**2)
+        a = g[:, None] * e - np.array([0.0, 0.0, 1.0])
+        moved = (k_v[:, None] * (rise[:, None] * e - np.array([0.0, 0.0, 1.0]))
+                 + (p * rate * (-2.0 * g * k_v**2 / self.stiffness))[:, None] * e)
+        block = (a[:, :, None] * moved[:, None, :]
+                 + (k_v * p * rate)[:, None, None] * np.outer(e, e))
+        spring = weights * (p > 0)
+        return ((weights * k_v * p)[:, None] * a, spring[:, None, None] * block)
+
     def energy(self, r, weights):
         """sum_n w_n k_v,n / 2 p_n^2 (J) at node positions r (n, 3) with weights w_n (n,),
         m, z_b and k_v under each node (this rank's part of the energy)."""

@@ -11,9 +11,16 @@ node heights, so its gradient in the slopes is the adjoint of their integral
 (analysis/positions.position_gradient) and its curvature k w_n on the active nodes enters
 the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
 semi-smooth Newton step, the active set that of the iterate.
+
+On a seabed profile the run takes no Newton steps (physics/slope_load.py). A line of a
+system asks for its fixed point's linearisation (linearise_profile, for its stiffness
+only): the force at the state's positions in the gradient, and its whole derivative
+B_n (Seabed.profile_derivatives, unsymmetric near a row) on the x, y, z chains, H its
+symmetric part and the Newton Jacobian the rest (add_jacobian).
 """
 
 import numpy as np
+from petsc4py import PETSc
 
 from petsc_rod.analysis.positions import HEIGHT
 from petsc_rod.global_step.hermite import HermiteProblem
@@ -39,6 +46,23 @@ class SeabedTerm(NodalLoadTerm):
             self.position_components = (0, 1, HEIGHT)
         self.vertical = self.contact = None
         self._solved = None         # the z slope of the contact's last solve (node_loads)
+        # a profile's contact in the Newton system (linearise_profile): a held line's
+        # exact stiffness only; a line's own run leaves it lagged
+        self.profiled = False
+
+    def linearise_profile(self):
+        """On a seabed profile, put the contact's force at the state's positions and its
+        whole derivative (Seabed.profile_derivatives) into the gradient, H and J: the
+        derivative of the lagged iteration's fixed point (physics/slope_load.py), which
+        a line of a system takes for its exact stiffness (system/held_line.py). The
+        run's iterations are unchanged: the slope load still keeps the run out of
+        Newton's steps (its ``in_newton``). Nothing on another seabed. Call it before
+        the problem's second variation and Newton solver are made."""
+        if self.seabed.flat or self.seabed.plane or not hasattr(self.seabed.shape,
+                                                                 "slopes"):
+            return
+        self.profiled = self.unsymmetric = True
+        self.position_components = (0, 1, HEIGHT)
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -87,9 +111,10 @@ class SeabedTerm(NodalLoadTerm):
 
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; on a
-        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives).
-        The state's r is that of its fields (RodProblem.energy_gradient). Collective."""
-        if self.seabed.plane:
+        sloping plane dE_s/dr' of all three components (Seabed.position_derivatives), on
+        a linearised profile -w_n f_n's (Seabed.profile_derivatives). The state's r is
+        that of its fields (RodProblem.energy_gradient). Collective."""
+        if self.seabed.plane or self.profiled:
             gradient = self._plane_derivatives(state)[0]
             self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
             return
@@ -98,15 +123,65 @@ class SeabedTerm(NodalLoadTerm):
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
         its gradient gives through the multipliers); on a sloping plane k w_n N N^T on
-        the nodes' three position components."""
-        if self.seabed.plane:
-            hessian.add_position_curvature(self._plane_derivatives(hessian.problem.state)[1],
-                                           self.position_components)
+        the nodes' three position components; on a linearised profile the symmetric part
+        of its block B_n there."""
+        if self.seabed.plane or self.profiled:
+            block = self._plane_derivatives(hessian.problem.state)[1]
+            if self.profiled:                   # J carries the rest (add_jacobian)
+                block = 0.5 * (block + block.transpose(0, 2, 1))
+            hessian.add_position_curvature(block, self.position_components)
             return
         hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
 
+    def add_jacobian(self, jacobian):
+        """On a linearised profile (linearise_profile): the antisymmetric part of its
+        block B_n, which H leaves out, into the Newton Jacobian."""
+        if not self.profiled:
+            return
+        hessian = jacobian.hessian
+        block = self._plane_derivatives(hessian.problem.state)[1]
+        rest = 0.5 * (block - block.transpose(0, 2, 1))
+        for rows, columns, blocks in hessian.position_blocks(
+                rest, self.position_components, self.position_components):
+            jacobian.add(rows, columns, blocks)
+
+    def turn_columns(self, hessian, state, columns):
+        """add_jacobian's entries in the global ``columns`` (held unknowns: a clamp's
+        rotation or stretch, which moves its element's positions; system/held_line.py),
+        one new Vec each, 0 on the held rows: with H's held columns
+        (SecondVariation.full_columns) J's. Collective."""
+        block = self._plane_derivatives(state)[1]
+        triples = hessian.position_blocks(0.5 * (block - block.transpose(0, 2, 1)),
+                                          self.position_components,
+                                          self.position_components)
+        vecs = []
+        for column in columns:
+            vec = hessian.matrix.createVecLeft()
+            vec.zeroEntries()
+            for rows, places, blocks in triples:
+                at, slot = np.nonzero(places == column)
+                if at.size:
+                    vec.setValues(rows[at].ravel().astype(PETSc.IntType),
+                                  blocks[at, :, slot].ravel(),
+                                  addv=PETSc.InsertMode.ADD_VALUES)
+            vec.assemble()
+            hessian.zero_held(vec)
+            vecs.append(vec)
+        return vecs
+
+    def position_derivatives(self, state):
+        """The whole block B_n (n_nodes, 3, 3), N/m, of a linearised profile at the
+        owned nodes of the state's centreline (Seabed.profile_derivatives): rows the
+        gradient's components, columns the positions' (a line's end stiffness,
+        system/held_line.py)."""
+        return self._plane_derivatives(state)[1]
+
     def _plane_derivatives(self, state):
-        """Seabed.position_derivatives at the owned nodes of the state's centreline."""
+        """Seabed.position_derivatives at the owned nodes of the state's centreline
+        (Seabed.profile_derivatives on a linearised profile)."""
+        if self.profiled:
+            return self.seabed.profile_derivatives(state.node_positions(),
+                                                   state.node_weights)
         return self.seabed.position_derivatives(state.node_positions(), state.node_weights)
 
     def pressure(self, z):

@@ -26,7 +26,10 @@ stability test have the whole force from it and this term adds nothing to them
 last vertical solve's reaction where the state is that solve's, and the force at the
 state's positions after Newton steps (SeabedTerm.contact_solved). On a profile, whose slope turns
 smoothly at its rows, the Newton steps would need the curvature of z_b as well: the
-term says so (``conservative``, ``in_newton`` False), so the run takes neither.
+term says so (``conservative``, ``in_newton`` False), so the run takes neither. A line
+of a system has the fixed point's exact linearisation all the same, for its stiffness
+alone: the seabed term then carries this push's derivative (SeabedTerm
+.linearise_profile, system/held_line.py).
 """
 
 import numpy as np

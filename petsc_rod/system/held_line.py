@@ -102,11 +102,26 @@ On a sloping plane the rotations' response takes the plane's data (x_a, c): thre
 solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
 by the held data through P_i's held rows (_rotation_response).
 
+**Seabed profile.** The line's equilibrium on a profile is the fixed point of its lagged
+iteration (physics/slope_load.py; its run takes no Newton steps and is not changed
+here): a node's penetration reads the interpolant's height z_b(d), its push the secant
+gradient g(d), with k_v = k / (1 + g^2). Its derivative in the ends is the full
+linearisation there, per grounded node the block B_n = d(-w_n f_n)/dr_n of
+Seabed.profile_derivatives (z_b', g, its rate g' and k_v's turn with g), which the
+seabed term puts into the Newton system for this line alone
+(SeabedTerm.linearise_profile, _linearised_profile: H its symmetric part, J the rest):
+unsymmetric within delta / 2 of a row, where g != z_b', so A is J (its LU), the
+data are (x_a, c) as on a plane with the block per node, and the forces read it
+through its transpose (as the friction's); a clamp's or a joint's held columns of J
+take the block's antisymmetric part too (SeabedTerm.turn_columns). Away from the rows
+B_n is the plane's k w_n N N^T with the node's own normal. settle() takes Newton's
+steps on that system: their stationary point is the iteration's fixed point.
+
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients or on a profile (no Newton steps), or at a
-clamped or flex-jointed end (end_stiffness); a seabed profile or grid (its contact
-lagged); any load outside the Newton system (the sea surface's wet and dry parts,
-attachments that reach it).
+clamped or flex-jointed end (end_stiffness); a seabed grid (its contact lagged, its
+secant's derivative not written); any load outside the Newton system (the sea surface's
+wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -411,6 +426,7 @@ class HeldLine:
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
         self.friction = []                  # the FrictionTerm, its anchors held
+        self.profile = None                 # the SeabedTerm of a profile, linearised
         # where a frictional line is laid, (start, end) absolute (None: where its first
         # solve asks): the first solve starts there and walks to its ends
         self.laid = None
@@ -489,6 +505,7 @@ class HeldLine:
         self.mesh, self.problem, self.solver = (self.built.mesh, self.built.problem,
                                                 self.built.solver)
         self.path = self.built.scene
+        self.profile = self._linearised_profile()           # before the Newton solver
         self.newton = self.built.own(NewtonSolver(self.problem))
         # each flex joint's neutral axis at the reference frame (turned by a frame given)
         self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
@@ -507,7 +524,7 @@ class HeldLine:
     def _release(self):
         if self.built is not None:          # its own objects and those it was given
             self.built.destroy()
-        self.jacobian = None
+        self.jacobian = self.profile = None
         self.friction = []
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
 
@@ -823,6 +840,7 @@ class HeldLine:
                 # J's columns at the clamps' rotations: the drag at the clamped node
                 # turns with it (DragTerm.turn_columns)
                 self._add_turn_columns(hessian, held_data[0], turned, vecs)
+            self._add_profile_columns(hessian, held_data[0], turned, vecs)
             flexed = self._flexed(hessian) if rotations else []
             for entry in flexed:
                 turned.extend(entry[-1])
@@ -838,7 +856,9 @@ class HeldLine:
                     "the line's ends")
             if self.friction:
                 recorder.add_friction(self.friction)
-            unsymmetric = hessian.resultants or bool(self.friction)
+            self._record_profile(recorder)
+            unsymmetric = (hessian.resultants or bool(self.friction)
+                           or self.profile is not None)
             columns = hessian.chord_forms(frames[:, 2])
             if self.newton.free_roll and unsymmetric:
                 # round sections, nothing clamped (a flex joint holds no roll): one roll
@@ -858,7 +878,8 @@ class HeldLine:
                 planes = readers = self._plane_shifts(hessian, recorder.positions)
                 vecs.extend(planes)
                 shift = planes[2]
-                if self.friction:       # unsymmetric: the forces read its transpose
+                if self.friction or self.profile is not None:
+                    # unsymmetric: the forces read its transpose
                     readers = self._plane_shifts(
                         hessian, recorder.positions.transpose(0, 2, 1))
                     vecs.extend(readers)
@@ -894,8 +915,8 @@ class HeldLine:
                 response = self._plane_response(hessian, columns, readers,
                                                 solved[:len(columns) + len(shifts)],
                                                 recorder.positions, solver)
-                seabed = [(i, planes[i], self._plane_held_shift(hessian, recorder.positions,
-                                                                i)) for i in range(3)]
+                seabed = [(i, readers[i], self._plane_held_shift(
+                    hessian, recorder.positions.transpose(0, 2, 1), i)) for i in range(3)]
             else:
                 response = self._response(hessian, columns, shift,
                                           solved[:len(columns) + len(shifts)],
@@ -974,6 +995,19 @@ class HeldLine:
                 vecs.extend(extra)
                 for j, vec in zip(rotated, extra):
                     turned[j].axpy(1.0, vec)
+
+    def _add_profile_columns(self, hessian, held, turned, vecs):
+        """On a seabed profile, add J's entries beyond H (SeabedTerm.turn_columns: the
+        block's antisymmetric part) to H's columns ``turned`` at the held unknowns of
+        ``held`` [(end, node, slot)], rotations and stretches; the new Vecs go to
+        ``vecs`` to be freed. Collective."""
+        if self.profile is None or not held:
+            return
+        extra = self.profile.turn_columns(hessian, self.problem.state,
+                                          [hessian.block * node + k for _, node, k in held])
+        vecs.extend(extra)
+        for column, vec in zip(turned, extra):
+            column.axpy(1.0, vec)
 
     def _held_data(self, hessian, clamps):
         """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
@@ -1267,6 +1301,23 @@ class HeldLine:
         start -= moved                                      # P_i.dy + sum_n H_n dx_a
         return np.vstack([start, dmu])
 
+    def _linearised_profile(self):
+        """The SeabedTerm of a seabed profile, its contact put into the Newton system
+        (SeabedTerm.linearise_profile: the stiffness's, before the Newton solver is
+        made), or None on another seabed or none."""
+        for term in self.problem.terms:
+            if hasattr(term, "linearise_profile"):
+                term.linearise_profile()
+                return term if term.profiled else None
+        return None
+
+    def _record_profile(self, recorder):
+        """On a seabed profile, the recorder's block the profile's whole B_n
+        (SeabedTerm.position_derivatives), unsymmetric near a row, where its
+        add_hessian gave H's symmetric part."""
+        if self.profile is not None:
+            recorder.positions = self.profile.position_derivatives(self.problem.state)
+
     def _check_solved(self):
         if self.problem is None or not self.converged:
             raise RodInputError("HeldLine: no converged equilibrium yet (solve first, and "
@@ -1280,12 +1331,19 @@ class HeldLine:
                                 "its seabed friction with two coefficients or on a seabed "
                                 "profile: give the friction one coefficient on a flat or "
                                 "uniformly sloping seabed")
-        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane):
+        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane) \
+                and self.profile is None:
             raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
-                                "seabed profile (its contact is lagged in the line's "
-                                "iterations); give a flat or uniformly sloping seabed")
-        loose = [term for term in self.problem.terms if not term.in_newton
-                 or not (term.conservative or term.follower or term in self.friction)]
+                                "seabed grid (its contact is lagged in the line's "
+                                "iterations); give a flat, uniformly sloping or profiled "
+                                "seabed")
+        # a profile's lagged push: its linearisation is the seabed term's
+        # (SeabedTerm.linearise_profile)
+        lagged = {term for term in self.problem.terms if self.profile is not None
+                  and getattr(term, "contact", None) is self.profile}
+        loose = [term for term in self.problem.terms if term not in lagged and (
+            not term.in_newton
+            or not (term.conservative or term.follower or term in self.friction))]
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))

@@ -16,7 +16,10 @@ parallel run):
 (e) the same numbers on one rank and on all;
 (f) in a current (the drag follows the line) the stiffness from the Newton Jacobian
     against central differences, unsymmetric: uniform, and sheared (the drag's depth
-    derivative in the Jacobian), alone and on the seabed.
+    derivative in the Jacobian), alone and on the seabed;
+(g) on a seabed profile (the fixed point of the line's lagged iteration, its contact's
+    block per node) against central differences, with and without grounded nodes in
+    the secant's turn about a row; a seabed grid refused in one line.
 """
 
 import dataclasses
@@ -576,11 +579,79 @@ def test_a_plane_of_slope_zero_is_the_flat_seabed(monkeypatch):
     assert np.abs(K - flat_K).max() <= 1e-10 * np.abs(flat_K).max()
 
 
-def test_a_seabed_profile_is_refused_in_one_line():
-    profile = ((-100.0, -30.2), (40.0, -30.2), (200.0, -25.0))
-    line = held(sloped_model(seabed_profile=profile), PETSc.COMM_SELF, MOORING)
+# seabed profiles under the mooring along +x from the anchor, level at
+# its seabed up to a row at 20 m and rising 1.7 degrees beyond: the chain's grounded
+# part (to about 50 m) spans the row. NARROW adds two rows 1 m apart far away, so the
+# secant turns over delta = 0.1 m only and no grounded node meets its turn; WIDE's
+# rows are 120 m apart at the closest (delta = 12 m: eight grounded nodes within
+# delta / 2 of the row, where g' enters and the block is not symmetric).
+NARROW = ((-100.0, -30.2), (20.0, -30.2), (200.0, -25.0), (300.0, -25.0), (301.0, -25.0))
+WIDE = ((-100.0, -30.2), (20.0, -30.2), (200.0, -25.0))
+
+
+def turning_nodes(line):
+    """How many grounded nodes of the line meet the secant's turn (g' != 0), on every
+    rank."""
+    seabed = line.scene.seabed
+    r = line.problem.state.node_positions()
+    rate = seabed.shape.slopes(r[:, 0], r[:, 1])[2]
+    return line.mesh.global_sum(int(np.sum((seabed.gap(r) < 0) & (rate != 0))))
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("rows", [NARROW, WIDE], ids=["away from the turn", "in the turn"])
+def test_stiffness_on_a_seabed_profile(comm, rows):
+    """The profile's contact in the Newton system at the fixed point of the line's
+    lagged iteration (Seabed.profile_derivatives: the penetration's z_b', the push's
+    secant g and its rate g', k_v's turn with g): the (6, 6) against central differences
+    of re-solves, every entry; symmetric where no grounded node meets the secant's turn,
+    not quite where some do."""
+    line = held(sloped_model(seabed_profile=rows), COMMS[comm],
+                MOORING)
     try:
-        with pytest.raises(RodInputError, match="seabed profile.*flat or uniformly sloping"):
+        summary = line.summary()
+        assert 30.0 < summary["touchdown_S"] < 70.0 and summary["grounded_length"] > 30.0
+        K = line.stiffness()
+        assert line.settled                 # Newton's steps reached the fixed point
+        turning = turning_nodes(line)
+        assert (turning == 0) if rows is NARROW else (turning >= 4)
+        asymmetry = np.abs(K - K.T).max() / np.abs(K).max()
+        print(f"K - K^T {asymmetry:.3g}")
+        assert (asymmetry < 1e-12) if rows is NARROW else (asymmetry > 1e-7)
+        assert against_differences(line, K) < 1e-7
+    finally:
+        line.destroy()
+
+
+def test_the_secant_turn_matters_on_a_profile(monkeypatch):
+    """WIDE's stiffness with the secant's rate g' dropped from the block misses the
+    differences by 3.6e-3 of its largest entry: its terms are what makes the stiffness
+    exact near a row."""
+    from petsc_rod.environment.bathymetry import Profile
+
+    line = held(sloped_model(seabed_profile=WIDE), PETSc.COMM_SELF,
+                MOORING)
+    try:
+        found = differences(line, MOORING, 1e-4)
+        exact = line.stiffness()
+        slopes = Profile.slopes
+        monkeypatch.setattr(Profile, "slopes",
+                            lambda self, x, y: slopes(self, x, y)[:2] + (0.0,))
+        rough = line.stiffness()
+        scale = np.abs(exact).max()
+        assert np.abs(exact - found).max() < 1e-7 * scale
+        assert np.abs(rough - found).max() > 1e-3 * scale
+    finally:
+        line.destroy()
+
+
+def test_a_seabed_grid_is_refused_in_one_line():
+    grid = tuple((x, y, -30.2 + 0.02 * max(x - 20.0, 0.0)) for x in (-100.0, 20.0, 200.0)
+                 for y in (-100.0, 100.0))
+    line = held(sloped_model(seabed_profile=grid), PETSc.COMM_SELF, MOORING)
+    try:
+        with pytest.raises(RodInputError, match="seabed grid.*flat, uniformly sloping or "
+                                                "profiled"):
             line.stiffness()
     finally:
         line.destroy()

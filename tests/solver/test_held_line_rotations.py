@@ -224,8 +224,15 @@ def dipping_frame(dip):
     return np.array([d1, np.cross(d3, d1), d3])
 
 
+# a seabed profile along +x, level 0.05 m below the anchor up to a row at 1.5 m, rising
+# 1.5 degrees beyond: the clamp's first midpoint grounded within delta / 2 = 5.1 m of
+# the row, where the profile's block is not symmetric and the midpoint's position reads
+# the clamp's rotation: J's held columns take the block's antisymmetric part
+# (SeabedTerm.turn_columns; without it 3.2e-2 of K off the differences)
+PROFILE = dict(seabed_profile=((-100.0, -30.05), (1.5, -30.05), (200.0, -25.0)))
 CASES = {"clamp": (False, SLOPE), "extensible clamp": (True, SLOPE),
-         "flex": (True, SLOPE), "extensible fairlead clamp": (True, SLOPE)}
+         "flex": (True, SLOPE), "extensible fairlead clamp": (True, SLOPE),
+         "clamp on a profile": (False, PROFILE)}
 # a fairlead clamp's frame: d3 rising at 0.8 along +x (d3's z not zero: the seabed's
 # vertical problem prescribes the stretched slope there too)
 RISING = dipping_frame(-0.8)
@@ -245,6 +252,11 @@ def test_end_stiffness_on_a_sloping_seabed_against_differences(comm, end):
     itself); the flex joint at the fairlead of an extensible line, its support in the
     reference frame; a clamp there, rising at 0.8."""
     extensible, sea = CASES[end]
+    if "seabed_profile" in sea and (comm == "one rank" or PETSc.COMM_WORLD.getSize() > 1):
+        # its 24 re-solves by the profile's lagged iteration take a minute on one rank
+        # and 20 on two loaded ones; run once, serially (a profile's stiffness on two
+        # ranks: test_held_line.test_stiffness_on_a_seabed_profile, test_system_profile)
+        pytest.skip("the clamp on a profile: serially, once")
     line = UniformLine(length=100.0, stiffness=(50.0, 50.0, 50.0), load=(0, 0, -10.0),
                        elements=40, axial_stiffness=1e5 if extensible else np.inf)
     clamped = end not in ("flex", "extensible fairlead clamp")
@@ -262,15 +274,26 @@ def test_end_stiffness_on_a_sloping_seabed_against_differences(comm, end):
     held = HeldLine(model, COMMS[comm], options=TIGHT)
     try:
         assert held.solve(*MOORING, *frames)
-        assert abs(held.end_forces()[0, 1]) > 1.0           # pushed across the slope
+        if "seabed_slope" in sea:
+            assert abs(held.end_forces()[0, 1]) > 1.0       # pushed across the slope
         e = 0 if clamped else 1
         assert np.abs(held.end_moments()[e]).max() > 1.0    # the clamp's, the joint's
         K = held.end_stiffness()
         scale = np.abs(K).max()
-        error = np.abs(K - differences(held, frames, 1e-4, MOORING)).max() / scale
+        # a profile's re-solves (its lagged iteration, no Newton steps) are noisier:
+        # 1e-3 rad and m (8.6e-7 of K with 1e-4 in the moments' rows, on a profile
+        # whose turn the clamp's element does not meet)
+        step = 1e-3 if "seabed_profile" in sea else 1e-4
+        error = np.abs(K - differences(held, frames, step, MOORING)).max() / scale
         print(f"end stiffness on the slope ({end}) against differences {error:.3g}")
         assert error < 1e-6
-        if clamped:             # its first vertex grounded
+        if "seabed_profile" in sea:     # its first midpoint grounded in the turn
+            r = held.problem.state.node_positions()[1:2]
+            if held.mesh.vertex_start == 0:
+                seabed = held.scene.seabed
+                assert seabed.gap(r)[0] < 0.0
+                assert seabed.shape.slopes(r[:, 0], r[:, 1])[2][0] != 0.0
+        elif clamped:             # its first vertex grounded
             second = held.centreline()
             if second is not None:
                 seabed, r = held.scene.seabed, second[1:3] - held.origin

@@ -96,7 +96,7 @@ def test_the_slope_options_are_listed_and_checked(tmp_path):
         assert name in process.stdout, name
     assert refused(tmp_path, ["-rod_system", DECK, "-rod_seabed_direction", "30"]) == (
         "petsc_rod: error: -rod_seabed_direction needs -rod_seabed_slope or "
-        "Environment.seabed_profile (the flat seabed (the file's WtrDpth) has no direction "
+        "-rod_seabed_profile (the flat seabed (the file's WtrDpth) has no direction "
         "or origin); give one of them, or drop -rod_seabed_direction")
     line = refused(tmp_path, ["-rod_system", DECK, "-rod_seabed_slope", "2",
                               "-rod_seabed_direction", "0,0"])
