@@ -13,28 +13,21 @@ rotation and stretch beyond H's), serially and on all ranks:
 (b) an extensible line clamped at its anchor pointing 0.3 down, 5 cm above a frictional
     seabed, its clamp turned so that the grounded nodes beside it slide: the friction's
     entries of J at the clamp's rotation and stretch matter (without them the error is
-    of the order of K), the 12 x 12 against differences;
-(c) the small body on its three frictional chains, one clamped at the body: converged,
-    balanced, its 6 x 6 against central differences of the lines re-solved at moved and
-    turned poses, the same pose on one rank and on all.
+    of the order of K), the 12 x 12 against differences.
 """
 
 import dataclasses
 
 import numpy as np
 import pytest
-from petsc4py import PETSc
 
 from petsc_rod.api import End, Environment, Model, UniformLine
 from petsc_rod.frames import REFERENCE_FRAME, rotations
-from petsc_rod.model.system import Connection
 from petsc_rod.system.held_line import HeldLine
 
 from test_held_line_rotations import differences, dipping_frame
 from test_system_clamped import COMMS
-from test_system_friction import (TIGHT, assert_body_stiffness_is_the_derivative,
-                                  assert_same_pose, frictional, friction_states, pose,
-                                  solved)
+from test_system_friction import TIGHT, frictional
 
 pytestmark = pytest.mark.solver
 
@@ -165,44 +158,3 @@ def test_a_clamp_whose_grounded_neighbours_slide(comm):
         assert error < 1e-6
     finally:
         held.destroy()
-
-
-def clamped_at_the_body():
-    """frictional(0.5) with its second chain clamped at the body, along the laid
-    chain's top (the direction into the line from the body, body axes)."""
-    system = frictional(0.5)
-    lines = list(system.lines)
-    lines[1] = dataclasses.replace(lines[1], end=Connection(
-        lines[1].end.to, lines[1].end.local, "clamp", direction=tuple(-TOP)))
-    return dataclasses.replace(system, lines=tuple(lines))
-
-
-_ALONE = {}
-
-
-@pytest.fixture(scope="module", params=list(COMMS))
-def spread(request):
-    solver, result = solved(clamped_at_the_body(), COMMS[request.param])
-    if request.param == "one rank":
-        _ALONE["alone"] = result
-    yield solver, result
-    solver.destroy()
-
-
-def test_a_body_on_frictional_chains_one_clamped(spread):
-    """Converged; every chain's grounded nodes partly stick, partly slide; the clamp's
-    moment on the body; the 6 x 6 against central differences."""
-    solver, result = spread
-    assert result.residual <= 1e-12
-    states = friction_states(solver)
-    print(f"states {states}")
-    assert all(0 < stick < grounded for stick, grounded in states)
-    assert_body_stiffness_is_the_derivative(solver)
-
-
-def test_one_rank_and_all_give_the_clamped_body_the_same_pose(spread):
-    if "alone" not in _ALONE:
-        solver, _ALONE["alone"] = solved(clamped_at_the_body(), PETSc.COMM_SELF)
-        solver.destroy()
-    print(f"pose {pose(_ALONE['alone'])}")
-    assert_same_pose(spread[1], _ALONE["alone"])
