@@ -109,9 +109,8 @@ by the held data through P_i's held rows (_rotation_response).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients or on a profile (no Newton steps); a seabed
-profile or grid (its contact
-lagged); any load outside the Newton system (the sea surface's wet and dry parts,
-attachments that reach it).
+profile or grid (its contact lagged); any load outside the Newton system (the sea
+surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -1027,7 +1026,8 @@ class HeldLine:
         (_held_forms). ``shifts``: the solves Y_P = A^-1 P of the start's data (0, 1:
         P for z_a, 3: P_j for x_a), after the forms' in ``solved``; ``seabed``: [(row,
         P_i, P_i with its held rows)] of the seabed's reaction on the start, dR_s,i =
-        -(P_i.dy + the held data's share), row i of F_a."""
+        -(P_i.dy + the held data's share), row i of F_a (with the friction the shifts of
+        H_n's transpose, _plane_response's Q_i)."""
         mesh, B, U = self.mesh, hessian.block, hessian.unknowns
         p = response.shape[1] - 3                           # the start's data: 1 or 3
         base = p + 3                                        # the first rotation's column
