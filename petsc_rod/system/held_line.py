@@ -94,9 +94,14 @@ three rows, the friction's vertical part g.f = g^T times its horizontal rows, an
 limit following x as well, k cos(theta) d g^T): unsymmetric, so A is J (its LU), and
 the forces read the block through its transpose. A sliding node's stiffness is the
 loading tangent (the slip continued); unloading it would stick. On a flat seabed or a
-sloping plane with one coefficient only (the friction's Newton steps: ``in_newton``);
-pinned ends only. settle() records the friction of the settled state
-(FrictionTerm.follow_state), which the end forces read.
+sloping plane with one coefficient only (the friction's Newton steps: ``in_newton``).
+settle() records the friction of the settled state (FrictionTerm.follow_state), which
+the end forces read. At a clamped or flex-jointed end the rotations' response takes the
+same block: the seabed's reaction on the start read through H_n's transpose in the
+free unknowns and in the held data's rows alike, and the held data's right-hand sides
+J's columns, not H's: the friction's entries of J beyond H (the limit following the
+contact, on a sliding node of the clamped node's element) read off the assembled J
+(_add_jacobian_columns).
 
 On a sloping plane the rotations' response takes the plane's data (x_a, c): three
 solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of its rows
@@ -118,10 +123,9 @@ B_n is the plane's k w_n N N^T with the node's own normal. settle() takes Newton
 steps on that system: their stationary point is the iteration's fixed point.
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a profile (no Newton steps), or at a
-clamped or flex-jointed end (end_stiffness); a seabed grid (its contact lagged, its
-secant's derivative not written); any load outside the Newton system (the sea surface's
-wet and dry parts, attachments that reach it).
+seabed's friction with two coefficients or on a profile (no Newton steps); a seabed
+grid (its contact lagged, its secant's derivative not written); any load outside the
+Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -836,7 +840,7 @@ class HeldLine:
             turned = hessian.full_columns([hessian.block * node + k for _, node, k
                                            in held_data[0]]) if clamps else []
             vecs.extend(turned)
-            if clamps and hessian.resultants:
+            if clamps and hessian.resultants and not self.friction:
                 # J's columns at the clamps' rotations: the drag at the clamped node
                 # turns with it (DragTerm.turn_columns)
                 self._add_turn_columns(hessian, held_data[0], turned, vecs)
@@ -849,11 +853,6 @@ class HeldLine:
             for term in problem.terms:
                 if term.position_components and term not in self.friction:
                     term.add_hessian(recorder)
-            if self.friction and rotations:
-                raise RodInputError(
-                    f"HeldLine.end_stiffness: {self.name}: no exact stiffness of a "
-                    "clamped or flex-jointed end of a line with seabed friction; pin "
-                    "the line's ends")
             if self.friction:
                 recorder.add_friction(self.friction)
             self._record_profile(recorder)
@@ -900,6 +899,10 @@ class HeldLine:
                     self.jacobian = self.built.own(NewtonJacobian(hessian))
                 self.jacobian.assemble()
                 solver = self.jacobian
+                if clamps and self.friction:
+                    # J's columns at the held data beyond H's: the friction's (and a
+                    # drag's) entries there, read off the assembled J
+                    self._add_jacobian_columns(hessian, held_data[0], turned, vecs)
             else:
                 hessian.factorise(0.0)
                 solver = hessian
@@ -915,6 +918,8 @@ class HeldLine:
                 response = self._plane_response(hessian, columns, readers,
                                                 solved[:len(columns) + len(shifts)],
                                                 recorder.positions, solver)
+                # the reaction's rows read H_n's transpose (readers; with the friction
+                # or a profile's block unsymmetric, else the same)
                 seabed = [(i, readers[i], self._plane_held_shift(
                     hessian, recorder.positions.transpose(0, 2, 1), i)) for i in range(3)]
             else:
@@ -1009,6 +1014,31 @@ class HeldLine:
         for column, vec in zip(turned, extra):
             column.axpy(1.0, vec)
 
+    def _add_jacobian_columns(self, hessian, held, turned, vecs):
+        """Add J's entries beyond H's in the held data's columns (a clamp's rotation
+        and stretch, [(end, node, slot)] ``held``) to H's columns ``turned``, read off the
+        assembled Newton Jacobian: J is H with its held columns cleared plus the
+        unsymmetric terms' entries (Term.add_jacobian), which keep those columns, with
+        identity rows at the held unknowns, so J e_j with the held rows cleared is the
+        terms' share of d(gradient)/d(held datum j): the friction's block through the
+        clamped node's slope in its first element's midpoint (and a drag's turn,
+        DragTerm.turn_columns). The new Vecs go to ``vecs`` to be freed. Collective."""
+        matrix = self.jacobian.matrix
+        unit_vec = matrix.createVecRight()
+        vecs.append(unit_vec)
+        low, high = unit_vec.getOwnershipRange()
+        for j, (_, node, slot) in enumerate(held):
+            column = hessian.block * node + slot
+            unit_vec.zeroEntries()
+            if low <= column < high:
+                unit_vec.setValue(column, 1.0)
+            unit_vec.assemble()
+            extra = matrix.createVecLeft()
+            vecs.append(extra)
+            matrix.mult(unit_vec, extra)
+            hessian.zero_held(extra)
+            turned[j].axpy(1.0, extra)
+
     def _held_data(self, hessian, clamps):
         """The held unknowns a clamp's data moves: [(end, node, slot)], slot 0-2 its
         rotation and 3 its stretch (an extensible line's clamped node, EA finite: held in
@@ -1044,7 +1074,8 @@ class HeldLine:
         (_held_forms). ``shifts``: the solves Y_P = A^-1 P of the start's data (0, 1:
         P for z_a, 3: P_j for x_a), after the forms' in ``solved``; ``seabed``: [(row,
         P_i, P_i with its held rows)] of the seabed's reaction on the start, dR_s,i =
-        -(P_i.dy + the held data's share), row i of F_a."""
+        -(P_i.dy + the held data's share), row i of F_a (with the friction the shifts of
+        H_n's transpose, _plane_response's Q_i)."""
         mesh, B, U = self.mesh, hessian.block, hessian.unknowns
         p = response.shape[1] - 3                           # the start's data: 1 or 3
         base = p + 3                                        # the first rotation's column

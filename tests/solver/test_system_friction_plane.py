@@ -13,7 +13,8 @@ chains) read by the API, friction mu = 0.5:
     toward 45 degrees, under a side load: converged, every chain sticks and slides, the
     body's 6 x 6 against central differences of the lines re-solved at moved and turned
     poses, the same pose on one rank and on all;
-(c) a clamped frictional chain on the plane: its end stiffness refused in one line.
+(c) a clamped frictional chain on the plane: its 12 x 12 end stiffness against central
+    differences of re-solves.
 """
 
 import dataclasses
@@ -22,13 +23,16 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
+from petsc_rod.frames import rotations
 from petsc_rod.system.held_line import HeldLine
 
 from test_held_line import differences
+from test_held_line_rotations import differences as rotation_differences
 from test_system_clamped import COMMS
 from test_system_friction import (TIGHT, assert_body_stiffness_is_the_derivative,
                                   assert_same_pose, frictional, friction_states, pose,
-                                  refusal, solved)
+                                  solved)
+from test_system_friction_clamped import TOP, frame_along
 
 pytestmark = pytest.mark.solver
 
@@ -155,13 +159,36 @@ def test_one_rank_and_all_give_the_body_the_same_pose(spread):
     assert_same_pose(spread[1], _ALONE["alone"])
 
 
-def test_a_clamped_frictional_line_on_a_plane_is_refused_in_one_line():
+def test_a_clamped_frictional_line_on_a_plane_has_the_exact_end_stiffness():
+    """The deck's chain clamped at its fairlead (its frame along the laid chain's top,
+    then turned 0.1 rad), on the plane rising 4 degrees along +x, laid and its fairlead
+    moved 4 m along x: the 12 x 12 against central differences of re-solves (before,
+    refused: "pin the line's ends")."""
     system = frictional(0.5)
-    line = system.lines[1]
-    line = dataclasses.replace(line, end=dataclasses.replace(line.end, kind="clamp"))
-    message = refusal(line, on_the_plane(system, 4.0, 0.0, tuple(ANCHOR[:2])),
-                      (ANCHOR, FAIRLEAD), HeldLine.end_stiffness)
-    assert "pin the line's ends" in message
+    chain = system.lines[1]
+    chain = dataclasses.replace(chain, end=dataclasses.replace(chain.end, kind="clamp"))
+    laid = (None, frame_along(TOP))
+    turned = [None, laid[1] @ rotations(np.array([0.0, 0.0, 0.1])).T]
+    line = HeldLine.of_system_line(chain, ANCHOR, FAIRLEAD, PETSc.COMM_SELF,
+                                   on_the_plane(system, 4.0, 0.0, tuple(ANCHOR[:2])),
+                                   {**TIGHT, "al_stability": 0}, frames=laid)
+    try:
+        assert line.solve(ANCHOR, FAIRLEAD, *laid)
+        moved = (ANCHOR, FAIRLEAD + np.array([4.0, 0.0, 0.0]))
+        assert line.solve(*moved, *turned)
+        term = line.friction[0]
+        grounded = term.reaction > 0
+        stick = float(np.sum(term.stick & grounded))
+        assert 5 <= stick <= np.sum(grounded) - 5
+        K = line.end_stiffness()
+        scale = np.abs(K).max()
+        assert np.abs(K[:, 9:]).max() > 1e-3 * scale        # the clamp's rotations
+        error = np.abs(K - rotation_differences(line, turned, 3e-5, moved)).max() / scale
+        print(f"{stick:g} of {np.sum(grounded):g} grounded nodes stick; the 12 x 12 "
+              f"against differences {error:.3g} of {scale:.6g}")
+        assert error < 1e-6
+    finally:
+        line.destroy()
 
 
 @pytest.mark.parametrize("slope", [0.0, 4.0])
