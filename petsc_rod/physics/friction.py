@@ -138,6 +138,7 @@ class FrictionTerm(NodalLoadTerm):
     attribute_units = ATTRIBUTE_UNITS
 
     slope_components = position_components = (0, 1)
+    chains_from_end = True
     conservative = False
     unsymmetric = True
     # the recorded force, reactions and use are the last global step's (_record): a
