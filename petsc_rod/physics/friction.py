@@ -17,8 +17,10 @@ its tangent plane: its horizontal part is f, its vertical part g.f (g = grad z_b
 the norm is that of the whole force, |f|_mu sqrt(1 + (g.f)^2 / |f|^2) (so a block on an
 incline of angle theta sticks up to tan(theta) = mu).
 
-Friction depends on the path: the anchors are the nodes' positions where the run starts
-(its start shape, or the file of a restart: the line as laid), and at the end of every
+Friction depends on the path: the anchors are the line as laid, the catenary between
+the ends at the first step's load factor whatever the start shape (lay_anchors, from
+cli/line_run.lay_friction_anchors), or the file of a restart, or where no catenary can be
+drawn the nodes' positions where the run starts; and at the end of every
 accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
 a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
 carries none). A line of a system holds its anchors where its first solve started
@@ -296,6 +298,15 @@ class FrictionTerm(NodalLoadTerm):
                 * tangent_factor(trial, self.seabed_term.contact.gradients))
         self.spring = self.friction.stiffness * np.divide(
             reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
+
+    def lay_anchors(self, curve):
+        """The anchors at the line as laid along ``curve`` (S -> (r, frame, force),
+        scenes/starts.py), at every P2 node of the owned elements: its horizontal
+        positions there (a run's start, cli/line_run.lay_friction_anchors)."""
+        mesh = self.mesh
+        S = mesh.element_S[:, None] + np.array([0.0, 0.5, 1.0]) * mesh.element_h[:, None]
+        positions = curve(S.ravel())[0]
+        self.anchors = positions[:, :2].reshape(S.shape + (2,)).copy()
 
     @property
     def stick(self):

@@ -59,3 +59,19 @@ def test_a_line_given_from_its_fairlead_is_the_mirror_of_one_given_from_its_anch
     assert tension[-1] > 35e3
     # as few iterations as the forward line (23 measured, 7 of them Newton steps)
     assert reversed_["iterations"] <= forward["iterations"] + 5
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_straight_start_lays_the_anchors_on_the_catenary(tmp_path, ranks):
+    """The friction's anchors are the catenary between the ends whatever the start shape
+    (cli/line_run.lay_friction_anchors): from the straight start (a line along x, 70 m
+    past the anchor, which made every grounded node slide and compressed the chain) the
+    reversed line reaches the catenary start's equilibrium."""
+    r_straight, tension, straight = solved(
+        tmp_path, "straight", REVERSED + ["-rod_initial_shape", "straight"], ranks)
+    r_catenary, _, catenary = solved(
+        tmp_path, "catenary", REVERSED + ["-rod_initial_shape", "catenary"], ranks)
+    assert straight["converged"] == 1
+    assert np.max(np.abs(r_straight - r_catenary)) < 1e-6
+    assert straight["anchor_tension"] == pytest.approx(catenary["anchor_tension"], rel=1e-6)
+    assert tension[-1] > 35e3
