@@ -54,7 +54,7 @@ from petsc4py import PETSc
 from petsc_rod.analysis.positions import HALF, HEIGHT, SIMPSON, slope_rows
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import element_dofs
-from petsc_rod.scenes.boundary import is_held
+from petsc_rod.global_step.centreline import chains_from_start
 
 # A negative eigenvalue of H / M counts when it is below -TOLERANCE max_i |H_ii| / M_ii
 # (SecondVariation.tolerance): far above round-off, far below a buckling mode's.
@@ -460,9 +460,10 @@ class SecondVariation:
             held = np.flatnonzero(~np.isfinite(self.problem.axial) & self.problem.free_nodes)
             rows = np.sort(np.concatenate([rows, self.first_row + B * held + 3]))
         if self.positions:
-            # the position at the held end (the start's, else the end's) is held: u_a = 0
-            mesh = self.problem.mesh
-            if is_held(self.problem.start_state):
+            # the position at the chains' origin (the start's, else the end's:
+            # centreline.chains_from_start) is held: u_a = 0
+            mesh, problem = self.problem.mesh, self.problem
+            if chains_from_start(problem.state, problem.start_state, problem.end_state):
                 anchor = [0] if mesh.on_lower_boundary else []
             else:
                 anchor = [mesh.n_local_nodes - 1] if mesh.on_upper_boundary else []

@@ -22,6 +22,13 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.second_variation import SecondVariation
 from petsc_rod.global_step.ksp import INERTIA_PREFIX, direct_factor, solve_vecs
+from petsc_rod.petsc_defaults import defaults_in_effect
+
+# MUMPS's threshold of a null pivot (CNTL 3; negative: absolute) where the chains run
+# from a line's end (centreline.chains_from_start): there its default, relative to the
+# matrix's norm, took one of the chains' pivots for null and the count of negative
+# eigenvalues came out one short of the chains' own (docs/riser.md §3b, "The path").
+NULL_PIVOT = -1e-300
 
 # Inverse-iteration steps for the direction of negative curvature.
 INVERSE_STEPS = 8
@@ -108,7 +115,10 @@ class StabilityTest(SecondVariation):
             self._kept_mass.copy(self._shift_work)
         self._shift_work.scale(-shift)
         self.shifted.setDiagonal(self._shift_work, addv=PETSc.InsertMode.ADD_VALUES)
-        self.solver.set_up(self.shifted)
+        pivots = ({f"{INERTIA_PREFIX}mat_mumps_cntl_3": str(NULL_PIVOT)}
+                  if self.problem.state.chains_from_end else {})
+        with defaults_in_effect(pivots):
+            self.solver.set_up(self.shifted)
         self._factored = True
 
     def solve(self, rhs):

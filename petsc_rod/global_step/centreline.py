@@ -39,14 +39,33 @@ def anchor_work(start, end, total_load):
     return float(anchor.position @ applied)
 
 
-def positions_from_increments(mesh, increments, start, end):
+def chains_from_start(state, start, end):
+    """Whether the centreline, and the Newton steps' chains of the positions
+    (analysis/positions.py), run from the start: where it is held, but not where the
+    state's line runs them from its end (``RodState.chains_from_end``, lower_end_first)."""
+    return is_held(start) and not getattr(state, "chains_from_end", False)
+
+
+def lower_end_first(start, end):
+    """Whether a line held at both ends, ``start`` and ``end`` its end states at the
+    full load, has its end the lower (an anchor given as the end, the fairlead as the
+    start): where a term reads the grounded positions horizontally (the seabed's
+    friction) its centreline and chains then run from that end, and its grounded part
+    hangs from the end it lies at, as a line given from its anchor hangs from its start:
+    an iterate's errors in angle over the suspended part, and its chord's error, are
+    then no errors of the grounded positions (docs/riser.md §3b, "The path")."""
+    return is_held(start) and is_held(end) and end.position[2] < start.position[2]
+
+
+def positions_from_increments(mesh, increments, start, end, from_start=None):
     """r at the owned vertices from int_e slope dS of the owned elements (ne, 3): across
     ranks the running sum is a prefix sum (Mesh.prefix_sum). From a held start,
-    r_i = r(0) + sum_{e < i} int_e slope; from a held end (free start),
-    r_i = r(L) - sum_{e >= i} int_e slope. Returns (n_owned, 3).
+    r_i = r(0) + sum_{e < i} int_e slope; from a held end (free start, or
+    ``from_start`` False: chains_from_start), r_i = r(L) - sum_{e >= i} int_e slope.
+    Returns (n_owned, 3).
     """
     before = mesh.prefix_sum(increments)
-    if is_held(start):
+    if is_held(start) if from_start is None else from_start:
         return start.position + before
     return end.position - mesh.global_sum(increments.sum(axis=0)) + before
 

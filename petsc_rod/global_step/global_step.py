@@ -24,7 +24,7 @@ components itself (solve_slope: the seabed's z).
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.global_step.centreline import positions_from_increments
+from petsc_rod.global_step.centreline import chains_from_start, positions_from_increments
 from petsc_rod.global_step.coefficients import ENERGY, LAGGED
 from petsc_rod.global_step.matrices import ScalarProblem, assemble_matrix
 from petsc_rod.mesh.elements import element_integrals
@@ -257,8 +257,9 @@ class GlobalStep:
             column = np.multiply(self._integrals[0], left, out=increments[c])
             column += np.multiply(self._integrals[1], middle, out=work)
             column += np.multiply(self._integrals[2], right, out=work)
-        positions = positions_from_increments(mesh, increments.T, self.start_state,
-                                              self.end_state)
+        positions = positions_from_increments(
+            mesh, increments.T, self.start_state, self.end_state,
+            chains_from_start(state, self.start_state, self.end_state))
         for c, (r, slope) in enumerate(zip(state.r.components, state.slope.components)):
             values = r.getArray()
             values[0::2] = positions[:, c]

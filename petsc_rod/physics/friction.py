@@ -17,8 +17,10 @@ its tangent plane: its horizontal part is f, its vertical part g.f (g = grad z_b
 the norm is that of the whole force, |f|_mu sqrt(1 + (g.f)^2 / |f|^2) (so a block on an
 incline of angle theta sticks up to tan(theta) = mu).
 
-Friction depends on the path: the anchors are the nodes' positions where the run starts
-(its start shape, or the file of a restart: the line as laid), and at the end of every
+Friction depends on the path: the anchors are the line as laid, the catenary between
+the ends at the first step's load factor whatever the start shape (lay_anchors, from
+cli/line_run.lay_friction_anchors), or the file of a restart, or where no catenary can be
+drawn the nodes' positions where the run starts; and at the end of every
 accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
 a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
 carries none). A line of a system holds its anchors where its first solve started
@@ -138,6 +140,7 @@ class FrictionTerm(NodalLoadTerm):
     attribute_units = ATTRIBUTE_UNITS
 
     slope_components = position_components = (0, 1)
+    chains_from_end = True
     conservative = False
     unsymmetric = True
     # the recorded force, reactions and use are the last global step's (_record): a
@@ -309,6 +312,15 @@ class FrictionTerm(NodalLoadTerm):
         """Put back what ``snapshot`` copied."""
         (self.spring, self.force, self.positions, self.reaction, self.use,
          self._springs_stale) = saved
+
+    def lay_anchors(self, curve):
+        """The anchors at the line as laid along ``curve`` (S -> (r, frame, force),
+        scenes/starts.py), at every P2 node of the owned elements: its horizontal
+        positions there (a run's start, cli/line_run.lay_friction_anchors)."""
+        mesh = self.mesh
+        S = mesh.element_S[:, None] + np.array([0.0, 0.5, 1.0]) * mesh.element_h[:, None]
+        positions = curve(S.ravel())[0]
+        self.anchors = positions[:, :2].reshape(S.shape + (2,)).copy()
 
     @property
     def stick(self):

@@ -5,6 +5,7 @@ the seabed (seabed.py), the drag (drag.py), the sea surface (surface.py), the fr
 import numpy as np
 
 from petsc_rod.analysis.positions import position_gradient
+from petsc_rod.global_step.centreline import chains_from_start
 from petsc_rod.global_step.nodal_loads import NodalLoad
 from petsc_rod.mesh.elements import P2
 from petsc_rod.mesh.fields import VectorField, scatter_element_vectors
@@ -65,7 +66,7 @@ class NodalLoadTerm(Term):
         (positions.position_gradient), the element vectors summed into the nodes by one
         ghost update. Collective."""
         mesh = self.mesh
-        held_start = is_held(self.start_state)
+        held_start = chains_from_start(state, self.start_state, self.end_state)
         element = np.zeros((mesh.n_local_elements, 3, 3))
         factors = {}
         for c, derivative in derivatives.items():

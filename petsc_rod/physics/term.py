@@ -73,6 +73,11 @@ class Term:
     # their chains (analysis/positions.py) for the Jacobian's columns in them
     # (add_jacobian), and nothing else changes (no curvature, no stability test)
     jacobian_positions = ()
+    # the centreline and the positions' chains of a line held at both ends run from its
+    # lower end (global_step/centreline.chains_from_start): the term reads grounded
+    # positions horizontally (the friction), whose errors from the other end are the
+    # iterate's chord error and its errors in angle over the suspended part
+    chains_from_end = False
     # the term's load follows the line and has no potential (the drag): the resultants'
     # chain of analysis/jacobian.py carries its linearisation
     follower = False

@@ -17,6 +17,7 @@ from petsc4py import PETSc
 from petsc_rod.analysis.link import FULLER_MARGIN, link_integrands
 from petsc_rod.analysis.stability import StabilityTest
 from petsc_rod.frames import roll_between, strains
+from petsc_rod.global_step.centreline import lower_end_first
 from petsc_rod.global_step.coefficients import FieldCoefficients
 from petsc_rod.global_step.global_step import GlobalStep
 from petsc_rod.local_step.projection import (ITERATION_PASSES, nearest_rotation,
@@ -63,6 +64,9 @@ class RodProblem:
                     if term.node is not None:
                         self._local_joints.append(term)
         self.state = RodState(mesh)
+        self.state.chains_from_end = (
+            any(term.chains_from_end for term in self.terms)
+            and lower_end_first(scene.start_state(1.0), scene.end_state(1.0)))
         try:
             self.global_step = GlobalStep(mesh, scene, self.coefficients, float(penalty),
                                           self.terms)

@@ -48,6 +48,9 @@ class RodState:
 
     def __init__(self, mesh):
         self.mesh = mesh
+        # the centreline from the lower end of a line held at both ends
+        # (centreline.chains_from_start): set where a term asks for it
+        self.chains_from_end = False
         self.d1, self.d2, self.slope, self.r = (VectorField(mesh, n)
                                                 for n in ("d1", "d2", "slope", "r"))
         shape = (mesh.n_local_nodes, 3, 3)

@@ -519,6 +519,8 @@ class HeldLine:
         self.friction = [t for t in self.problem.terms if isinstance(t, FrictionTerm)]
         for term in self.friction:
             term.hold_anchors = True
+        # the end stiffness reads the positions from the start (add_friction)
+        self.problem.state.chains_from_end = False
 
     def _mesh_named(self, pieces, elements):
         """How a mesh too large for the machine names the line's element count."""

@@ -1,0 +1,77 @@
+"""A mooring line with seabed friction given either way round (docs/riser.md §3b, "The
+path"): from its anchor to its fairlead, and from its fairlead to its anchor (End A at
+the vessel, as OrcaFlex users give it). The reversed line is the same line, so it must
+reach the mirror image of the forward one's equilibrium, with the anchor's chain in
+tension. Before the chains of the positions ran from the lower end
+(global_step/centreline.chains_from_start) the reversed line's Newton steps found H
+indefinite and its halved path ended with the chain compressed at the anchor. Spawns
+processes: marked ``serial``."""
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import describe, run_petsc_rod
+
+pytestmark = pytest.mark.serial
+
+TIMEOUT = 300
+# 500 m of the fairlead's 850 m grounded at mu = 0.5 (the lead's measured case: 108 m
+# stick, 392 m slide, the anchor holds +39.04 kN)
+LINE = ["-rod_line_types", "options/line_types/mooring_chain.txt",
+        "-rod_sections", "chain120:850:170", "-rod_seabed_friction", "0.5",
+        "-rod_start", "pin", "-rod_end", "pin"]
+FORWARD = LINE + ["-rod_end_position", "780,0,186", "-rod_seabed", "0",
+                  "-rod_sea_surface", "200"]
+REVERSED = LINE + ["-rod_end_position", "780,0,-186", "-rod_seabed", "-186",
+                   "-rod_sea_surface", "14"]
+FAIRLEAD = np.array([780.0, 0.0, 186.0])
+
+
+def solved(tmp_path, name, args, ranks):
+    """(r (n, 3), effective tension (n,), the file's attributes) of a converged run."""
+    path = tmp_path / f"{name}.h5"
+    done = run_petsc_rod(args + ["-rod_output", str(path)], ranks, TIMEOUT)
+    assert done.returncode == 0, describe(done)
+    with h5py.File(path, "r") as f:
+        return f["r"][()], f["effective_tension"][()], dict(f.attrs)
+
+
+def mirrored(r):
+    """The forward line's r as the reversed line's: its nodes from the fairlead, which
+    is at the origin, and the anchor toward +x."""
+    image = r[::-1] - FAIRLEAD
+    image[:, 0] *= -1.0
+    return image
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_line_given_from_its_fairlead_is_the_mirror_of_one_given_from_its_anchor(
+        tmp_path, ranks):
+    shape = ["-rod_initial_shape", "catenary"]
+    r_forward, _, forward = solved(tmp_path, "forward", FORWARD + shape, ranks)
+    r_reversed, tension, reversed_ = solved(tmp_path, "reversed", REVERSED + shape, ranks)
+    assert forward["converged"] == 1 and reversed_["converged"] == 1
+    assert np.max(np.abs(r_reversed - mirrored(r_forward))) < 1e-6
+    assert reversed_["anchor_tension"] == pytest.approx(39.04e3, rel=2e-3)
+    assert reversed_["anchor_tension"] == pytest.approx(forward["anchor_tension"], rel=1e-6)
+    # the chain pulls on its anchor (the compressed answer had -37.2 kN there)
+    assert tension[-1] > 35e3
+    # as few iterations as the forward line (23 measured, 7 of them Newton steps)
+    assert reversed_["iterations"] <= forward["iterations"] + 5
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_straight_start_lays_the_anchors_on_the_catenary(tmp_path, ranks):
+    """The friction's anchors are the catenary between the ends whatever the start shape
+    (cli/line_run.lay_friction_anchors): from the straight start (a line along x, 70 m
+    past the anchor, which made every grounded node slide and compressed the chain) the
+    reversed line reaches the catenary start's equilibrium."""
+    r_straight, tension, straight = solved(
+        tmp_path, "straight", REVERSED + ["-rod_initial_shape", "straight"], ranks)
+    r_catenary, _, catenary = solved(
+        tmp_path, "catenary", REVERSED + ["-rod_initial_shape", "catenary"], ranks)
+    assert straight["converged"] == 1
+    assert np.max(np.abs(r_straight - r_catenary)) < 1e-6
+    assert straight["anchor_tension"] == pytest.approx(catenary["anchor_tension"], rel=1e-6)
+    assert tension[-1] > 35e3
