@@ -148,3 +148,26 @@ def test_a_saddle_case_is_marked_in_the_file_the_figure_and_the_page(tmp_path):
     page = sweep_html("excursion", found)
     assert "<th>stable</th>" in page and page.count("SADDLE") == 1
     assert "1 saddle(s) of the system: heading 90 deg under 1000 N" in page
+
+
+def test_a_case_without_a_lowest_eigenvalue_keeps_the_column():
+    """One case with an equilibrium but no lowest eigenvalue (its verdict none) among
+    cases with one, and a case without an equilibrium: the column kept for every row,
+    NaN in the file's dataset and an empty cell in the table at that case; left out
+    only where no case has one."""
+    circle = a_watch_circle()
+    stable, lowest = np.array([1, -1, -1]), np.array([7.5, np.nan, np.nan])
+    circle = WatchCircle(body="Body1", headings=circle.headings, poses=circle.poses,
+                         failed=circle.failed, **worst((3,), 1), load=5e3,
+                         offsets=circle.offsets, stable=stable, lowest_eigenvalue=lowest)
+    data, _, units = file_group(circle)
+    assert data["lowest_eigenvalue"][0] == 7.5 and np.isnan(data["lowest_eigenvalue"][1])
+    assert units["lowest_eigenvalue"] == "N/m"
+    rows = [row.split(",") for row in table_text(circle).splitlines()]
+    column = rows[0].index("lowest_eigenvalue (N/m)")
+    assert [row[column] for row in rows[1:]] == ["7.5", ""]
+    assert [row[column - 1] for row in rows[1:]] == ["stable", "none"]
+    none = WatchCircle(body="Body1", headings=circle.headings, poses=circle.poses,
+                       failed=circle.failed, **worst((3,), 1), load=5e3,
+                       offsets=circle.offsets)
+    assert "lowest_eigenvalue" not in file_group(none)[0]
