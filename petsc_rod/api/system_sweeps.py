@@ -259,3 +259,15 @@ def sweep_saddles(found):
                      f"{'have' if kind == 'excursion' else 'has'} {len(saddles)} saddle(s) "
                      f"of the system: {result.where(saddles)}"
                      for kind, result in found.items() if (saddles := result.saddles()))
+
+
+def sweep_gaps(found):
+    """'the watch circle of Body1 has no equilibrium at 1 of its 24 cases: heading 120
+    deg' (the sweeps of ``found`` with a case left without one, joined by '; '), ''
+    where every case has one: the command line's exit 3 (cli_system.py), the result
+    incomplete."""
+    return "; ".join(f"the {SWEEP_WORDS[kind][0]} of {result.body} "
+                     f"{'have' if kind == 'excursion' else 'has'} no equilibrium at "
+                     f"{len(result.failed)} of {len(result.cases())} case(s): "
+                     f"{result.where([(h, f) for h, f, _ in result.failed])}"
+                     for kind, result in found.items() if result.failed)
