@@ -3,7 +3,8 @@ from a MoorDyn version 2 input file, solved on the path the Python API's solve_s
 takes (api/system_run.py), with the command line's options, lines and exit codes
 (docs/systems.md, "Running a system"; docs/errors.md: 0 converged, 2 bad input, 3 no
 equilibrium found or a saddle of the system, at rest or at a case of a sweep (the file
-written), 4 non-finite numbers or a PETSc error, 5 the result could not be written).
+written; at a sweep's case without an equilibrium, with the other cases), 4
+non-finite numbers or a PETSc error, 5 the result could not be written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
@@ -28,7 +29,7 @@ from petsc4py import PETSc
 
 from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, body_modes_request,
                                      modes_request, run_system, written_paths)
-from petsc_rod.api.system_sweeps import parse_sweeps, sweep_saddles
+from petsc_rod.api.system_sweeps import parse_sweeps, sweep_gaps, sweep_saddles
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
                                    check_snes_type, check_substructuring_switches,
@@ -321,6 +322,35 @@ def saddle_error(results, output=None):
                         if output else ""))
 
 
+def gap_error(results, output=None):
+    """The error line (without 'petsc_rod: error: ') of a system's run whose watch circle
+    or load-excursion curves left cases without an equilibrium (each solve's
+    RodDivergedError: their rows left out, listed in the sweep's group), '' where
+    none did: the result is incomplete, exit 3 as a system without an equilibrium at
+    rest (api/system_run.run_system). ``output``: the result file, named."""
+    gaps = sweep_gaps(results.sweeps)
+    if not gaps:
+        return ""
+    groups = ", ".join(f"system/{kind}" for kind, found in results.sweeps.items()
+                       if found.failed)
+    return (f"{gaps}: the sweep is incomplete (its other cases written"
+            + (f" in {output}, whose {groups} lists the failed ones and says converged = 0"
+               if output else "") + "; a smaller load or more -rod_system_steps may "
+            "reach them)")
+
+
+def finished_error(results, say, output=None):
+    """The exit code of a system's run with ``results`` after its saddles and gaps
+    (saddle_error, gap_error) are said as its last lines, the saddle's first: 0 with
+    neither, else RodNotConvergedError's 3 (its file written: converged = 0 in the
+    system's or the sweep's group). Collective."""
+    said = [line for line in (saddle_error(results, output), gap_error(results, output))
+            if line]
+    for line in said:
+        say(f"petsc_rod: error: {line}")
+    return RodNotConvergedError.exit_code if said else 0
+
+
 def run(comm=None):
     """The system's run on ``comm`` (default PETSc.COMM_WORLD); returns the exit code."""
     comm = comm or PETSc.COMM_WORLD
@@ -359,10 +389,9 @@ def run(comm=None):
                     for name in ["<line>", "system", *results.sweeps,
                                  *(["system_modes"] if isinstance(results.body_modes,
                                                                   SystemModes) else [])]))
-            saddle = saddle_error(results, output)
-            if saddle:
-                say(f"petsc_rod: error: {saddle}")
-                return RodNotConvergedError.exit_code
+            code = finished_error(results, say, output)
+            if code:
+                return code
             say(f"petsc_rod: converged: the system's equilibrium in {results.iterations} "
                 f"Newton iteration(s), residual {results.residual:.3g}"
                 + (f"; {'; '.join(written)}" if written else ""))

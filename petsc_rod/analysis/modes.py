@@ -73,14 +73,30 @@ SLICE_DEPTH = 12
 EXTRA = 4
 
 
-class ModesRefused(Exception):
-    """The static state has eigenvalues of K - omega^2 M below 0: unstable, no modes."""
+def symmetrised_text(symmetrised):
+    """The words of ``symmetrised`` (count, ratio) of ModalOperators: '' where K is the
+    terms' whole derivative, else where and how much K is their symmetric part only."""
+    count, ratio = symmetrised
+    if not count:
+        return ""
+    return (f"K takes the symmetric part of the seabed contact's stiffness at {count} "
+            f"grounded node{'s' if count != 1 else ''} within delta/2 of a seabed profile's "
+            f"row (its antisymmetric part up to {ratio:.3g} of it there: the lagged push "
+            "turns over delta about a row and has no energy; docs/riser.md §3a), so the "
+            "modes are approximate there")
 
-    def __init__(self, negative):
+
+class ModesRefused(Exception):
+    """The static state has eigenvalues of K - omega^2 M below 0: unstable, no modes;
+    ``symmetrised`` as Modes'."""
+
+    def __init__(self, negative, symmetrised=(0, 0.0)):
+        note = symmetrised_text(symmetrised)
         super().__init__(f"the static state is unstable ({negative} negative eigenvalue"
                          f"{'s' if negative != 1 else ''} of K - omega^2 M): no vibration "
-                         "modes about it")
+                         "modes about it" + (f" ({note})" if note else ""))
         self.negative = negative
+        self.symmetrised = symmetrised
 
 
 @dataclass
@@ -109,6 +125,10 @@ class Modes:
     # the band's sub-bands (fmin, fmax), Hz, whose pairs did not all verify or whose
     # inertia decreased (their modes left out)
     slices: list = field(default_factory=list)
+    # (count, ratio): the grounded nodes where K holds only the symmetric part of the
+    # seabed's contact stiffness (a profile's rows; Term.symmetrised_nodes) and the
+    # largest |B - B^T| / |B| there; (0, 0.0): K is exact
+    symmetrised: tuple = (0, 0.0)
 
     @property
     def frequencies(self):
@@ -158,6 +178,10 @@ class ModalOperators(SecondVariation):
                 and mesh.global_max(float(np.abs(polar).max(initial=0.0))) == 0.0:
             self.hold_roll(tangents)
         self.mass_matrix = self._mass_matrix()
+        found = np.array([term.symmetrised_nodes(problem.state) for term in problem.terms]
+                         or [(0, 0.0)], dtype=float)
+        self.symmetrised = (int(mesh.global_sum(found[:, 0].sum())),
+                            float(mesh.global_max(found[:, 1].max())))
 
     def _clamped_rows(self):
         rows = super()._clamped_rows()
@@ -328,11 +352,12 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
             factor.set_up(shifted)
             negative = factor.negative_pivots() - operators.chain_constraints
         if negative > 0:
-            raise ModesRefused(int(negative))
+            raise ModesRefused(int(negative), operators.symmetrised)
         if band is None:
             modes = _assemble(operators, *_pairs(operators, shifted, factor, SLEPc, count,
                                                  SHIFT, (SHIFT, np.inf)))
             modes.asked = count
+            modes.symmetrised = operators.symmetrised
             return modes
         window = band_shifts(band)
         ends = [_below(operators, shifted, sigma) for sigma in window]
@@ -344,6 +369,7 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
             modes = _assemble(operators, *found)
         modes.band = (band[0], band[1], int(ends[1] - ends[0]))
         modes.slices = [tuple(np.sqrt(np.maximum(w, 0.0)) / (2 * np.pi)) for w in failed]
+        modes.symmetrised = operators.symmetrised
         return modes
     finally:
         for thing in reversed(made):

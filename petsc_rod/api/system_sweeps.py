@@ -9,7 +9,10 @@ A case without an equilibrium is a gap: its row is left out of the file's group 
 of the table (the file lists it in ``failed_heading``, ``failed_load`` and the
 ``failed`` attribute), so that no NaN is ever written as a result. The smallest
 grounded length's columns are left out when no line has a seabed, the lowest
-eigenvalue's when a case has none (a system that is not conservative).
+eigenvalue's when no case has one (a system that is not conservative); a case with an
+equilibrium but without a lowest eigenvalue (its verdict none: a stiffness that is not
+finite) keeps its row, NaN in the file's ``lowest_eigenvalue`` and an empty cell in the
+table.
 
 Each case carries the system's verdict (system/excursions.py): the table's ``verdict``
 (stable, saddle, none; the file's codes 1, 0, -1 of ``system_stable``) and
@@ -137,14 +140,14 @@ def solved_rows(result):
     """{column: array} of ``result.table()`` with only the rows of the cases that
     have an equilibrium, the lines as indices into ``result.lines``, the verdicts as
     their codes (VERDICT_CODES), without the grounded length's columns where no line
-    has a seabed and the lowest eigenvalue's where a case has none; (columns, {column:
-    unit})."""
+    has a seabed and the lowest eigenvalue's where no case has one (NaN at a case
+    without one); (columns, {column: unit})."""
     table = result.table()
     keep = np.isfinite(np.asarray(result.poses, float).reshape(-1, 6)[:, 0])
     index = {name: k for k, name in enumerate(result.lines)}
     columns = {}
     left_out = {"min_grounded": not np.any(np.isfinite(result.min_grounded)),
-                "lowest_eigenvalue": not np.all(np.isfinite(
+                "lowest_eigenvalue": not np.any(np.isfinite(
                     table["lowest_eigenvalue"][keep]))}
     for name, values in table.items():
         if any(name.startswith(prefix) and out for prefix, out in left_out.items()):
@@ -201,7 +204,7 @@ def file_group(result):
 
 def table_text(result):
     """The CSV text of ``result``'s table: a row per case with an equilibrium, the
-    lines by name."""
+    lines by name, an empty cell where a case has no lowest eigenvalue."""
     data, units = solved_rows(result)
     header = ",".join(f"{name} ({units[name]})" if name not in (*LINE_COLUMNS, "verdict")
                       and units[name] else name for name in data)
@@ -209,6 +212,7 @@ def table_text(result):
     for k in range(len(next(iter(data.values())))):
         rows.append(",".join(result.lines[int(data[name][k])] if name in LINE_COLUMNS
                              else VERDICT_WORDS[int(data[name][k])] if name == "verdict"
+                             else "" if np.isnan(data[name][k])
                              else f"{data[name][k] + 0.0:.12g}" for name in data))
     return "\n".join(rows) + "\n"
 
@@ -255,3 +259,15 @@ def sweep_saddles(found):
                      f"{'have' if kind == 'excursion' else 'has'} {len(saddles)} saddle(s) "
                      f"of the system: {result.where(saddles)}"
                      for kind, result in found.items() if (saddles := result.saddles()))
+
+
+def sweep_gaps(found):
+    """'the watch circle of Body1 has no equilibrium at 1 of its 24 cases: heading 120
+    deg' (the sweeps of ``found`` with a case left without one, joined by '; '), ''
+    where every case has one: the command line's exit 3 (cli_system.py), the result
+    incomplete."""
+    return "; ".join(f"the {SWEEP_WORDS[kind][0]} of {result.body} "
+                     f"{'have' if kind == 'excursion' else 'has'} no equilibrium at "
+                     f"{len(result.failed)} of {len(result.cases())} case(s): "
+                     f"{result.where([(h, f) for h, f, _ in result.failed])}"
+                     for kind, result in found.items() if result.failed)

@@ -49,10 +49,10 @@ from petsc_rod.io import line_table, outputs, provenance
 from petsc_rod.io import results as io
 from petsc_rod.iteration.continuation import PathSettings
 from petsc_rod.iteration.driver import UzawaSolver
-from petsc_rod.physics.friction import FrictionTerm
 from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
                                  fewest_elements, largest_grading)
 from petsc_rod.model import UniformLine
+from petsc_rod.problem.build import lay_friction_anchors
 from petsc_rod.problem.problem import RodProblem
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import BlendedPath
@@ -476,27 +476,6 @@ def start_from(problem, values, given, say):
         problem.state.set_straight()
     lay_friction_anchors(problem, curve, values["rod_steps"], say)
     return 0.0
-
-
-def lay_friction_anchors(problem, curve, steps, say):
-    """The seabed friction's anchors (physics/friction.py), the line as laid, from the
-    catenary between the ends at the first step's load factor (starts.catenary_start,
-    ``curve`` where the start drew it), whatever the start shape: the straight start is
-    no line as laid, and its anchors, a line along x, made every grounded node slide
-    (docs/riser.md §3b, "The path"). Where no catenary can be drawn the anchors are the
-    start's positions (the first global step's), said in one line."""
-    terms = [term for term in problem.terms if isinstance(term, FrictionTerm)]
-    if not terms:
-        return
-    if curve is None:
-        try:
-            curve = starts.catenary_start(problem.scene, 1.0 / steps)
-        except RodInputError as reason:     # NoCatenaryStart included
-            say(f"petsc_rod: seabed friction: no catenary between the ends ({reason}); its "
-                "anchors are the start's positions")
-            return
-    for term in terms:
-        term.lay_anchors(curve)
 
 
 def walked_scene(scene, values, comm):

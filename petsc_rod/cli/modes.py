@@ -12,7 +12,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import (CLASSES, RESIDUAL, ModesRefused, check_options,
-                                      solve_modes)
+                                      solve_modes, symmetrised_text)
 from petsc_rod.errors import RodInputError, RodIOError, petsc_message
 from petsc_rod.cli.options import modes_asked
 from petsc_rod.figures.modes import shapes_path
@@ -48,7 +48,8 @@ def modes_band(text):
 
 def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
-    -rod_modes_mass, -rod_modes_range malformed or beside -rod_modes, -rod_modes_table
+    -rod_modes_mass or on a seabed grid, -rod_modes_range malformed or beside -rod_modes,
+    -rod_modes_table
     without either, and a -rod_modes_table (or its shapes' file) that could not be
     written or names another output. Collective."""
     modes_band(values["rod_modes_range"])
@@ -78,6 +79,15 @@ def check_modes_inputs(values, scene, comm):
             check_output_path(name, comm, "-rod_modes_table")
     if modes_asked(values) and not mass_known(scene, mass_settings(values)):
         raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
+    seabed = scene.seabed
+    if modes_asked(values) and seabed is not None and not seabed.flat \
+            and not seabed.plane and not hasattr(seabed.shape, "slopes"):
+        # K holds a shaped seabed's contact through its linearisation
+        # (SeabedTerm.profile): a grid has none
+        raise RodInputError("-rod_modes on a seabed grid (-rod_seabed_profile with x y z "
+                            "rows): K has no stiffness of its contact along its normal, "
+                            "and the modes would be a flat seabed's; give the seabed as a "
+                            "profile (distance height rows) or a plane (-rod_seabed_slope)")
 
 
 def solve_for_run(problem, values, writer):
@@ -121,6 +131,8 @@ def table_lines(modes, seconds):
             modes.frequencies, modes.periods, modes.modal_mass, modes.labels, modes.shares)):
         fractions = " / ".join(f"{share:.2f}" for share in shares)
         lines.append(f"  {k + 1:>4} {f:12.6g} {T:12.6g} {mass:16.6g}  {label} ({fractions})")
+    if modes.symmetrised[0]:
+        lines.append(f"modes: warning: {symmetrised_text(modes.symmetrised)}")
     if modes.band is None and len(modes.omega2) < modes.asked:
         lines.append(f"modes: warning: {len(modes.omega2)} of the {modes.asked} asked "
                      "converged and verified (none reported is unverified): a larger "

@@ -360,7 +360,9 @@ class ResultWriter:
         3) of the shapes normalised to a largest offset of 1 m, and at the elements'
         midpoints ``S_mid`` (n_e,) and ``curvature`` (n_e, m, 3) 1/m; of a band
         (-rod_modes_range) the attribute ``band`` (fmin, fmax Hz, the inertia's
-        count). ``modes``: analysis/modes.Modes (this rank's rows)."""
+        count); where K holds only the symmetric part of the seabed's contact stiffness
+        (Modes.symmetrised: a profile's rows) the attributes ``symmetrised_nodes`` and
+        ``symmetrised_ratio``. ``modes``: analysis/modes.Modes (this rank's rows)."""
         along = {"S": modes.S, "offset": np.moveaxis(modes.offset, 0, 1),
                  "rotation": np.moveaxis(modes.rotation, 0, 1), "S_mid": modes.S_mid,
                  "curvature": np.moveaxis(modes.curvature, 0, 1)}
@@ -393,6 +395,9 @@ class ResultWriter:
         group.attrs["share_columns"] = "in-plane,out-of-plane,axial,torsional"
         if modes.band is not None:
             group.attrs["band"] = np.asarray(modes.band, dtype=float)
+        if modes.symmetrised[0]:
+            group.attrs["symmetrised_nodes"] = int(modes.symmetrised[0])
+            group.attrs["symmetrised_ratio"] = float(modes.symmetrised[1])
         self.file.flush()
 
     def finish(self, last_group, attributes, name=None):

@@ -17,6 +17,7 @@ from petsc_rod.iteration import controller as control
 from petsc_rod.iteration import events, newton, stopping
 from petsc_rod.petsc_defaults import set_from_options_with_defaults
 from petsc_rod.problem import penalty as penalty_policy
+from petsc_rod.problem.build import lay_friction_anchors
 from petsc_rod.problem.problem import RodProblem
 from petsc_rod.resources import anderson_depth, ranks_on_this_machine
 
@@ -321,12 +322,18 @@ def _rows(frames):
     return rows
 
 
-def solver_for(mesh, scene, settings):
+def solver_for(mesh, scene, settings, steps=1, say=None):
     """The UzawaSolver of a new RodProblem of ``scene`` on ``mesh`` at the asked penalty
-    of ``settings`` (what a script or a test makes). The caller destroys both:
-    ``solver.destroy(); solver.problem.destroy()``."""
+    of ``settings`` (what a script or a test makes), the seabed friction's anchors laid
+    as the command line and the API lay them (problem/build.lay_friction_anchors: the
+    catenary at the first of ``steps`` load steps' load factor, whatever start the
+    caller sets), its line where none can be drawn said by ``say`` (default: printed on
+    the mesh's rank 0). The caller destroys both: ``solver.destroy();
+    solver.problem.destroy()``. Collective."""
     problem = RodProblem(mesh, scene, settings.asked_penalty)
     try:
+        lay_friction_anchors(problem, None, steps,
+                             say or (lambda text: PETSc.Sys.Print(text, comm=mesh.comm)))
         return UzawaSolver(problem, settings)
     except Exception:
         problem.destroy()

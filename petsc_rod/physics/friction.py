@@ -19,7 +19,7 @@ incline of angle theta sticks up to tan(theta) = mu).
 
 Friction depends on the path: the anchors are the line as laid, the catenary between
 the ends at the first step's load factor whatever the start shape (lay_anchors, from
-cli/line_run.lay_friction_anchors), or the file of a restart, or where no catenary can be
+problem/build.lay_friction_anchors), or the file of a restart, or where no catenary can be
 drawn the nodes' positions where the run starts; and at the end of every
 accepted load step each anchor moves to x_n + f_n / k_s (the return map of plasticity:
 a sticking node keeps its anchor, a sliding one drags it along, a node off the seabed
@@ -316,7 +316,7 @@ class FrictionTerm(NodalLoadTerm):
     def lay_anchors(self, curve):
         """The anchors at the line as laid along ``curve`` (S -> (r, frame, force),
         scenes/starts.py), at every P2 node of the owned elements: its horizontal
-        positions there (a run's start, cli/line_run.lay_friction_anchors)."""
+        positions there (a run's start, problem/build.lay_friction_anchors)."""
         mesh = self.mesh
         S = mesh.element_S[:, None] + np.array([0.0, 0.5, 1.0]) * mesh.element_h[:, None]
         positions = curve(S.ravel())[0]

@@ -16,7 +16,10 @@ On a seabed profile the run takes no Newton steps (physics/slope_load.py). A lin
 system asks for its fixed point's linearisation (linearise_profile, for its stiffness
 only): the force at the state's positions in the gradient, and its whole derivative
 B_n (Seabed.profile_derivatives, unsymmetric near a row) on the x, y, z chains, H its
-symmetric part and the Newton Jacobian the rest (add_jacobian).
+symmetric part and the Newton Jacobian the rest (add_jacobian). H on a profile is that
+symmetric part whether linearised or not (the modes' K, analysis/modes.py): farther
+than delta/2 from every row B_n = k w_n N N^T, a plane's with the node's own normal, so
+K is exact there; nearer, symmetrised_nodes says where it is not.
 """
 
 import numpy as np
@@ -29,6 +32,10 @@ from petsc_rod.physics.nodal_load import NodalLoadTerm
 
 # The KSP options prefix of the vertical (seabed) problem.
 VERTICAL_PREFIX = "rod_z_"
+# A profile's block B_n is unsymmetric where |B_n - B_n^T| exceeds this fraction of
+# |B_n| (symmetrised_nodes): far above the round-off of k_v a a^T formed as a product,
+# far below the slope change of a row (|g - z_b'| of order the slopes).
+ASYMMETRY = 1e-8
 
 
 class SeabedTerm(NodalLoadTerm):
@@ -41,14 +48,22 @@ class SeabedTerm(NodalLoadTerm):
     def __init__(self, mesh, seabed):
         super().__init__(mesh, "seabed")
         self.seabed = seabed
-        if seabed.plane:
-            # a sloping plane's penetration is along its normal: all three components
+        if seabed.plane or self.profile:
+            # a sloping plane's or a profile's penetration is along its normal: all
+            # three components
             self.position_components = (0, 1, HEIGHT)
         self.vertical = self.contact = None
         self._solved = None         # the z slope of the contact's last solve (node_loads)
         # a profile's contact in the Newton system (linearise_profile): a held line's
         # exact stiffness only; a line's own run leaves it lagged
         self.profiled = False
+
+    @property
+    def profile(self):
+        """Whether the seabed is a profile whose contact has a linearisation
+        (Seabed.profile_derivatives: bathymetry.Profile)."""
+        return (not self.seabed.flat and not self.seabed.plane
+                and hasattr(self.seabed.shape, "slopes"))
 
     def linearise_profile(self):
         """On a seabed profile, put the contact's force at the state's positions and its
@@ -58,11 +73,9 @@ class SeabedTerm(NodalLoadTerm):
         run's iterations are unchanged: the slope load still keeps the run out of
         Newton's steps (its ``in_newton``). Nothing on another seabed. Call it before
         the problem's second variation and Newton solver are made."""
-        if self.seabed.flat or self.seabed.plane or not hasattr(self.seabed.shape,
-                                                                 "slopes"):
+        if not self.profile:
             return
         self.profiled = self.unsymmetric = True
-        self.position_components = (0, 1, HEIGHT)
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -123,15 +136,30 @@ class SeabedTerm(NodalLoadTerm):
     def add_hessian(self, hessian):
         """k w_n at the active nodes on their heights (the seabed's curvature, beyond what
         its gradient gives through the multipliers); on a sloping plane k w_n N N^T on
-        the nodes' three position components; on a linearised profile the symmetric part
-        of its block B_n there."""
-        if self.seabed.plane or self.profiled:
+        the nodes' three position components; on a profile the symmetric part of its
+        block B_n there (Seabed.profile_derivatives: k w_n N N^T with the node's own
+        normal farther than delta/2 from every row; nearer, unsymmetric:
+        symmetrised_nodes)."""
+        if self.seabed.plane or self.profile:
             block = self._plane_derivatives(hessian.problem.state)[1]
-            if self.profiled:                   # J carries the rest (add_jacobian)
+            if self.profile:        # a linearised one's J carries the rest (add_jacobian)
                 block = 0.5 * (block + block.transpose(0, 2, 1))
             hessian.add_position_curvature(block, self.position_components)
             return
         hessian.add_height_curvature(self._height_derivatives(hessian.problem.state)[1])
+
+    def symmetrised_nodes(self, state):
+        """(count, ratio) of Term.symmetrised_nodes: on a profile the owned grounded
+        nodes whose block B_n has |B_n - B_n^T| above ASYMMETRY |B_n| (max-norms; within
+        delta/2 of a row whose slopes differ), the largest ratio among them."""
+        if not self.profile:
+            return 0, 0.0
+        block = self._plane_derivatives(state)[1]
+        size = np.abs(block).max(axis=(1, 2))
+        ratio = (np.abs(block - block.transpose(0, 2, 1)).max(axis=(1, 2))
+                 / np.where(size > 0, size, 1.0))
+        unsymmetric = ratio > ASYMMETRY
+        return int(unsymmetric.sum()), float(ratio.max(initial=0.0))
 
     def add_jacobian(self, jacobian):
         """On a linearised profile (linearise_profile): the antisymmetric part of its
@@ -178,8 +206,8 @@ class SeabedTerm(NodalLoadTerm):
 
     def _plane_derivatives(self, state):
         """Seabed.position_derivatives at the owned nodes of the state's centreline
-        (Seabed.profile_derivatives on a linearised profile)."""
-        if self.profiled:
+        (Seabed.profile_derivatives on a profile)."""
+        if self.profile:
             return self.seabed.profile_derivatives(state.node_positions(),
                                                    state.node_weights)
         return self.seabed.position_derivatives(state.node_positions(), state.node_weights)

@@ -167,6 +167,14 @@ class Term:
         gives through the multipliers (§10), to the SecondVariation ``hessian`` before it
         is assembled (a term linear in the directors adds nothing)."""
 
+    def symmetrised_nodes(self, state):
+        """(count, ratio): the owned nodes where add_hessian holds only the symmetric
+        part of the term's derivative, which is not symmetric there (a seabed profile's
+        contact near a row, seabed.py), and the largest |B - B^T| / |B| of their blocks
+        (max-norm); (0, 0.0) where H is the term's whole derivative. The modes say it
+        (analysis/modes.py): their K is then symmetrised, not exact."""
+        return 0, 0.0
+
     def add_jacobian(self, jacobian):
         """An unsymmetric term's entries of the Newton Jacobian beyond H
         (analysis/jacobian.py NewtonJacobian, before assembly): a follower's load's

@@ -9,8 +9,12 @@ Its reports (quantities/report.py), held beside the terms: the riser numbers
 (quantities/riser_numbers.py) where it has a seabed or a current; the sections' numbers,
 pressures and, with an inner diameter, the pipe's stresses on a line of line types; the
 results along the line (quantities/line_results.py) always; its regions
-(quantities/regions.py) on a riser-like scene (a seabed, a current or line types)."""
+(quantities/regions.py) on a riser-like scene (a seabed, a current or line types).
 
+And where a run's seabed friction is anchored: lay_friction_anchors, the command line's,
+the API's and iteration/driver.solver_for's (scripts' and tests')."""
+
+from petsc_rod.errors import RodInputError
 from petsc_rod.physics.dead_loads import DeadLoads
 from petsc_rod.physics.drag import DragTerm
 from petsc_rod.physics.flex_joint import FlexJoint
@@ -27,6 +31,7 @@ from petsc_rod.quantities.regions import LineRegions
 from petsc_rod.quantities.riser_numbers import RiserNumbers
 from petsc_rod.quantities.section_numbers import SectionNumbers
 from petsc_rod.quantities.stresses import PipeStresses
+from petsc_rod.scenes import starts
 from petsc_rod.scenes.boundary import is_held
 
 
@@ -75,3 +80,24 @@ def scene_reports(scene, terms):
     if seabed is not None or drag or scene.sections:
         reports.append(LineRegions(seabed))
     return reports
+
+
+def lay_friction_anchors(problem, curve, steps, say):
+    """The seabed friction's anchors (physics/friction.py), the line as laid, from the
+    catenary between the ends at the first step's load factor (starts.catenary_start,
+    ``curve`` where the start drew it), whatever the start shape: the straight start is
+    no line as laid, and its anchors, a line along x, made every grounded node slide
+    (docs/riser.md §3b, "The path"). Where no catenary can be drawn the anchors are the
+    start's positions (the first global step's), said in one line."""
+    terms = [term for term in problem.terms if isinstance(term, FrictionTerm)]
+    if not terms:
+        return
+    if curve is None:
+        try:
+            curve = starts.catenary_start(problem.scene, 1.0 / steps)
+        except RodInputError as reason:     # NoCatenaryStart included
+            say(f"petsc_rod: seabed friction: no catenary between the ends ({reason}); its "
+                "anchors are the start's positions")
+            return
+    for term in terms:
+        term.lay_anchors(curve)

@@ -22,7 +22,8 @@ fairlead tension and the largest tension over the lines.
 Exit code as runner.run_sweep's: 0 every case converged, 3 some did not (a case whose
 equilibrium, or a case of its watch circle or load-excursion curves, is a saddle of the
 system is such a case: exit 3 as its run alone, cli_system.saddle_error, its file
-written), 2 bad sweep input before any run, 128 + n a stop signal.
+written; so is one whose watch circle or curves left a case without an equilibrium,
+cli_system.gap_error), 2 bad sweep input before any run, 128 + n a stop signal.
 """
 
 import os
@@ -34,8 +35,9 @@ from petsc4py import PETSc
 from petsc_rod.api.system_run import run_system
 from petsc_rod.cli.options import check_same_on_every_rank, read_options, values_of
 from petsc_rod.cli.options_files import every_options_file
-from petsc_rod.cli_system import check_movable, laid_system, prepared, saddle_error
-from petsc_rod.errors import RodError, RodInputError, RodNotConvergedError, on_every_rank
+from petsc_rod.cli_system import (check_movable, finished_error, laid_system, prepared,
+                                  saddle_error)
+from petsc_rod.errors import RodError, RodInputError, on_every_rank
 from petsc_rod.sweep import cases as sweep_cases
 from petsc_rod.sweep import summary
 from petsc_rod.sweep.runner import (FAILED, Sweep, base_options, check_file_names,
@@ -146,6 +148,8 @@ def table(records, varied):
         status = summary.exit_reason(record["code"])
         if record.get("saddle"):
             status = "not converged (saddle)"
+        if record.get("gaps"):
+            status = "not converged (a sweep's case without an equilibrium)"
         if record.get("error"):
             status = f"failed ({record['error']})"
         numbers = dict(record.get("numbers", ()))
@@ -209,14 +213,15 @@ class SystemSweep(Sweep):
         if code != 0:
             self.drop_solver()
         record.update(code=code, start=start if code != 2 else "")
-        if code == 0 or (code == 3 and results is not None):
-            # a saddle of the system's file is written, converged = 0 there (a single
-            # line's exit 3 likewise: runner.Sweep.run_case)
+        if results is not None:
+            # a saddle of the system's or an incomplete sweep's file is written,
+            # converged = 0 there (a single line's exit 3 likewise:
+            # runner.Sweep.run_case)
             record["file"] = os.path.abspath(self.file(case))
         if code == 0:
             record["numbers"] = case_numbers(made[0], results)
         elif code == 3 and results is not None:
-            record["saddle"] = True
+            record["saddle" if saddle_error(results) else "gaps"] = True
         if code == FAILED and self._error:
             record["error"] = self._error
         return record
@@ -235,12 +240,9 @@ class SystemSweep(Sweep):
             results = run_system(self.comm, system, settings, options, self.say,
                                  self.file(case), None, text, notes, self.interrupts,
                                  sweeps, modes, body_modes, solver=self.solver)
-            saddle = saddle_error(results, self.file(case))
-            if saddle:
-                # the case's run alone would exit 3 (cli_system.run): its file kept
-                self.say(f"petsc_rod: error: {saddle}")
-                return RodNotConvergedError.exit_code, results
-            return 0, results
+            # a saddle or a sweep's gap: the case's run alone's exit 3 (cli_system.run),
+            # its file kept
+            return finished_error(results, self.say, self.file(case)), results
         except RodError as error:
             self.say(f"petsc_rod: error: {error}")
             return error.exit_code, None

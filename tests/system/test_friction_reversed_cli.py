@@ -64,7 +64,7 @@ def test_a_line_given_from_its_fairlead_is_the_mirror_of_one_given_from_its_anch
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_the_straight_start_lays_the_anchors_on_the_catenary(tmp_path, ranks):
     """The friction's anchors are the catenary between the ends whatever the start shape
-    (cli/line_run.lay_friction_anchors): from the straight start (a line along x, 70 m
+    (problem/build.lay_friction_anchors): from the straight start (a line along x, 70 m
     past the anchor, which made every grounded node slide and compressed the chain) the
     reversed line reaches the catenary start's equilibrium."""
     r_straight, tension, straight = solved(
@@ -75,3 +75,38 @@ def test_the_straight_start_lays_the_anchors_on_the_catenary(tmp_path, ranks):
     assert np.max(np.abs(r_straight - r_catenary)) < 1e-6
     assert straight["anchor_tension"] == pytest.approx(catenary["anchor_tension"], rel=1e-6)
     assert tension[-1] > 35e3
+
+
+def test_solver_for_lays_the_anchors_as_the_command_line(tmp_path):
+    """iteration/driver.solver_for (the scripts' and tests' entry) lays the friction's
+    anchors on the catenary through the command line's function
+    (problem/build.lay_friction_anchors): the reversed line from the straight start
+    reaches the command line's anchor force to 1e-6. Before, its anchors were the
+    straight start's own positions, and the chain ended compressed at the anchor
+    (-37.2 kN)."""
+    from petsc4py import PETSc
+
+    from helpers import continuation, destroy
+    from petsc_rod.cli.options import parse_values
+    from petsc_rod.cli.scene_options import scene_from_options, settings_from_options
+    from petsc_rod.io.outputs import vertex_fields
+    from petsc_rod.iteration.driver import solver_for
+    from petsc_rod.mesh.mesh import Mesh
+
+    args = REVERSED + ["-rod_initial_shape", "straight"]
+    _, _, cli = solved(tmp_path, "straight", args, 1)
+    texts = dict(zip((a[1:] for a in args[0::2]), args[1::2]))
+    values = parse_values(texts)
+    scene = scene_from_options(values, set(texts))
+    mesh = Mesh(PETSc.COMM_SELF, 170, scene.length)
+    solver = solver_for(mesh, scene, settings_from_options(values, scene),
+                        steps=values["rod_steps"])
+    try:
+        assert continuation(solver, values["rod_steps"]).converged
+        attributes = {}
+        for output in solver.problem.outputs(vertex_fields(solver.problem)):
+            attributes.update(output.attributes)
+    finally:
+        destroy(mesh, solver)
+    assert cli["anchor_tension"] > 35e3
+    assert attributes["anchor_tension"] == pytest.approx(cli["anchor_tension"], rel=1e-6)

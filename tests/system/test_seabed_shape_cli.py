@@ -50,6 +50,9 @@ BAD = {
                               ["-rod_seabed_profile", "the grid covers x from 0 to 5 m", "extend"]),
     "grid with a direction": (["-rod_seabed_profile", "{grid}", "-rod_seabed_direction", "30"],
                               ["-rod_seabed_direction", "drop the direction"]),
+    "modes on a grid": (["-rod_seabed_profile", "{grid}", "-rod_modes", "3",
+                         "-rod_modes_mass", "1"],
+                        ["-rod_modes on a seabed grid", "a flat seabed's", "profile"]),
     "rows of 2 and 3 numbers": (["-rod_seabed_profile", "{mixed}"],
                                 ["-rod_seabed_profile", "line 2", "the same in every row"]),
     "profile and height": (["-rod_seabed", "0", "-rod_seabed_profile", "{plane}"],
@@ -177,3 +180,26 @@ def test_vertices_beyond_a_profile_are_counted_and_said(tmp_path):
         y = f["r"][:, 1]
     assert beyond == int(np.sum(np.abs(y) > 0.01)) > 10
     assert f"{beyond} vertices beyond the seabed profile's rows" in text
+
+
+def test_modes_on_a_profile_say_where_their_stiffness_is_symmetrised(tmp_path):
+    """-rod_modes on a profile whose slope turns under the grounded part (5 to 2 degrees
+    at 2 m): the run's warning and the modes group's attributes give the same count of
+    grounded nodes where K is the contact's symmetric part; the same line on the plane
+    has neither."""
+    t = np.tan(np.radians(5.0))
+    kink = write(tmp_path, "kink.txt", f"-5 {-5 * t:.17g}\n2 {2 * t:.17g}\n"
+                 f"20 {2 * t + 18 * np.tan(np.radians(2.0)):.17g}\n")
+    modes = ["-rod_end_position", "8,0,4", "-rod_modes", "3", "-rod_modes_mass", "0.1"]
+    path, text = solved(tmp_path, "kink", modes + ["-rod_seabed_profile", kink])
+    with h5py.File(path, "r") as f:
+        count = int(f["modes"].attrs["symmetrised_nodes"])
+        assert 0 < f["modes"].attrs["symmetrised_ratio"] < 1
+    assert count > 0
+    assert (f"modes: warning: K takes the symmetric part of the seabed contact's "
+            f"stiffness at {count} grounded nodes") in text
+    plane, text = solved(tmp_path, "plane", modes + ["-rod_seabed", "0", "-rod_seabed_slope",
+                                                     "5"])
+    with h5py.File(plane, "r") as f:
+        assert "symmetrised_nodes" not in f["modes"].attrs
+    assert "modes: warning" not in text

@@ -148,3 +148,64 @@ def test_a_saddle_case_is_marked_in_the_file_the_figure_and_the_page(tmp_path):
     page = sweep_html("excursion", found)
     assert "<th>stable</th>" in page and page.count("SADDLE") == 1
     assert "1 saddle(s) of the system: heading 90 deg under 1000 N" in page
+
+
+def test_a_case_without_a_lowest_eigenvalue_keeps_the_column():
+    """One case with an equilibrium but no lowest eigenvalue (its verdict none) among
+    cases with one, and a case without an equilibrium: the column kept for every row,
+    NaN in the file's dataset and an empty cell in the table at that case; left out
+    only where no case has one."""
+    circle = a_watch_circle()
+    stable, lowest = np.array([1, -1, -1]), np.array([7.5, np.nan, np.nan])
+    circle = WatchCircle(body="Body1", headings=circle.headings, poses=circle.poses,
+                         failed=circle.failed, **worst((3,), 1), load=5e3,
+                         offsets=circle.offsets, stable=stable, lowest_eigenvalue=lowest)
+    data, _, units = file_group(circle)
+    assert data["lowest_eigenvalue"][0] == 7.5 and np.isnan(data["lowest_eigenvalue"][1])
+    assert units["lowest_eigenvalue"] == "N/m"
+    rows = [row.split(",") for row in table_text(circle).splitlines()]
+    column = rows[0].index("lowest_eigenvalue (N/m)")
+    assert [row[column] for row in rows[1:]] == ["7.5", ""]
+    assert [row[column - 1] for row in rows[1:]] == ["stable", "none"]
+    none = WatchCircle(body="Body1", headings=circle.headings, poses=circle.poses,
+                       failed=circle.failed, **worst((3,), 1), load=5e3,
+                       offsets=circle.offsets)
+    assert "lowest_eigenvalue" not in file_group(none)[0]
+
+
+def test_a_sweep_with_a_case_without_an_equilibrium_exits_3():
+    """The command line's end of a system's run (cli_system.finished_error): a watch
+    circle with a heading left without an equilibrium is an incomplete result, exit 3
+    (a system without an equilibrium at rest: RodNotConvergedError's) with the last
+    line naming the case and the file; with a saddle as well, the saddle's line first,
+    exit 3; complete and stable, 0. Before, such a run exited 0 with 'petsc_rod:
+    converged'."""
+    from types import SimpleNamespace
+
+    from petsc_rod.cli_system import finished_error
+    from petsc_rod.errors import RodNotConvergedError
+
+    circle = a_watch_circle()
+    said = []
+    results = SimpleNamespace(verdict=None, sweeps={"watch_circle": circle})
+    assert finished_error(results, said.append, "out.h5") == \
+        RodNotConvergedError.exit_code == 3
+    assert said == ["petsc_rod: error: the watch circle of Body1 has no equilibrium at 1 of "
+                    "3 case(s): heading 120 deg: the sweep is incomplete (its other cases "
+                    "written in out.h5, whose system/watch_circle lists the failed ones and "
+                    "says converged = 0; a smaller load or more -rod_system_steps may "
+                    "reach them)"]
+    saddle = WatchCircle(body="Body1", headings=circle.headings, poses=circle.poses,
+                         failed=circle.failed, **worst((3,), 1), load=5e3,
+                         offsets=circle.offsets, stable=np.array([0, -1, 1]))
+    said.clear()
+    results = SimpleNamespace(verdict=None, sweeps={"watch_circle": saddle})
+    assert finished_error(results, said.append) == 3
+    assert len(said) == 2 and "saddle" in said[0] and "no equilibrium" in said[1]
+    complete = WatchCircle(body="Body1", headings=circle.headings[[0, 2]],
+                           poses=circle.poses[[0, 2]], failed=(), **worst((2,), 0),
+                           load=5e3, offsets=circle.offsets[[0, 2]],
+                           stable=np.array([1, 1]))
+    said.clear()
+    results = SimpleNamespace(verdict=None, sweeps={"watch_circle": complete})
+    assert finished_error(results, said.append) == 0 and said == []
