@@ -12,11 +12,11 @@ node heights, so its gradient in the slopes is the adjoint of their integral
 the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
 semi-smooth Newton step, the active set that of the iterate.
 
-On a seabed profile the run takes no Newton steps (physics/slope_load.py). A line of a
-system asks for its fixed point's linearisation (linearise_profile, for its stiffness
-only): the force at the state's positions in the gradient, and its whole derivative
-B_n (Seabed.profile_derivatives, unsymmetric near a row) on the x, y, z chains, H its
-symmetric part and the Newton Jacobian the rest (add_jacobian).
+On a seabed profile or grid the run takes no Newton steps (physics/slope_load.py). A
+line of a system asks for its fixed point's linearisation (linearise_profile, for its
+stiffness only): the force at the state's positions in the gradient, and its whole
+derivative B_n (Seabed.profile_derivatives, unsymmetric near a row or grid line) on the
+x, y, z chains, H its symmetric part and the Newton Jacobian the rest (add_jacobian).
 """
 
 import numpy as np
@@ -51,15 +51,14 @@ class SeabedTerm(NodalLoadTerm):
         self.profiled = False
 
     def linearise_profile(self):
-        """On a seabed profile, put the contact's force at the state's positions and its
-        whole derivative (Seabed.profile_derivatives) into the gradient, H and J: the
-        derivative of the lagged iteration's fixed point (physics/slope_load.py), which
-        a line of a system takes for its exact stiffness (system/held_line.py). The
-        run's iterations are unchanged: the slope load still keeps the run out of
+        """On a seabed profile or grid, put the contact's force at the state's positions
+        and its whole derivative (Seabed.profile_derivatives) into the gradient, H and
+        J: the derivative of the lagged iteration's fixed point (physics/slope_load.py),
+        which a line of a system takes for its exact stiffness (system/held_line.py).
+        The run's iterations are unchanged: the slope load still keeps the run out of
         Newton's steps (its ``in_newton``). Nothing on another seabed. Call it before
         the problem's second variation and Newton solver are made."""
-        if self.seabed.flat or self.seabed.plane or not hasattr(self.seabed.shape,
-                                                                 "slopes"):
+        if self.seabed.flat or self.seabed.plane:
             return
         self.profiled = self.unsymmetric = True
         self.position_components = (0, 1, HEIGHT)
