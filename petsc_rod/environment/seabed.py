@@ -175,10 +175,10 @@ class Seabed:
         rise, g, rate = self.plan_slopes(x, y)
         p = self.penetration(r[:, 2], self.shape.height(x, y))
         k_v = self.vertical_stiffness(g)
-        down = np.array([0.0, 0.0, 1.0])
-        a = np.append(g, np.zeros((g.shape[0], 1)), axis=1) - down
+        e_z = np.array([0.0, 0.0, 1.0])
+        a = np.append(g, np.zeros((g.shape[0], 1)), axis=1) - e_z
         turn = np.einsum("nij,ni->nj", rate, (-2.0 * k_v**2 / self.stiffness)[:, None] * g)
-        moved = (k_v[:, None] * (np.append(rise, np.zeros((g.shape[0], 1)), axis=1) - down)
+        moved = (k_v[:, None] * (np.append(rise, np.zeros((g.shape[0], 1)), axis=1) - e_z)
                  + np.append(p[:, None] * turn, np.zeros((g.shape[0], 1)), axis=1))
         block = a[:, :, None] * moved[:, None, :]
         block[:, :2, :2] += (k_v * p)[:, None, None] * rate

@@ -2,9 +2,10 @@
 docs/systems.md "Running a system"): -rod_seabed_profile FILE of x, y, height rows
 gives the system's seabed in place of the MoorDyn file's depth.
 tests/data/moordyn/small_free_body.dat on the grid of tests/solver/test_system_grid.py
-(sloping in x and y, falling beyond a grid line at x = 55 m): the command line on 1 and
-2 ranks equals the Python API with Environment.seabed_profile on the same rows, to the
-system's accuracy (test_system_cli.FLOOR). Spawns processes: marked ``serial``."""
+(level to x = -20 m, sloping in x and y beyond, falling more beyond a grid line at
+x = 55 m): the command line on 1 and 2 ranks equals the Python API with
+Environment.seabed_profile on the same rows, to the system's accuracy
+(test_system_cli.FLOOR). Spawns processes: marked ``serial``."""
 
 import pytest
 
@@ -14,8 +15,8 @@ pytestmark = pytest.mark.serial
 
 # test_system_grid.GRID (a solver test's module, which this process does not import)
 XS, YS = (-100.0, -20.0, 55.0, 95.0, 200.0), (-100.0, 30.0, 100.0)
-ROWS = tuple((x, y, -30.4 - 0.004 * x + 0.002 * y - 0.03 * max(x - 55.0, 0.0))
-             for x in XS for y in YS)
+ROWS = tuple((x, y, -30.2 + max(x + 20.0, 0.0) * (-0.004 + 3e-5 * y)
+                - 0.03 * max(x - 55.0, 0.0)) for x in XS for y in YS)
 
 
 @pytest.fixture(scope="module")
