@@ -31,8 +31,9 @@ class Friction:
 
 @dataclass(frozen=True)
 class Seabed:
-    """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the plane z = ``height`` (m), or, with a ``shape``
-    (environment/bathymetry.py: a sloping Plane, a Profile or a Grid), the surface z = z_b(x, y), its
+    """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the
+    plane z = ``height`` (m), or, with a ``shape`` (environment/bathymetry.py: a
+    sloping Plane, a Profile or a Grid), the surface z = z_b(x, y), its
     ``height`` then z_b under the scene's origin. It pushes a line below it out along
     its unit normal N = (-g, 1) / sqrt(1 + |g|^2) (g = grad z_b) with k times the normal
     penetration per metre of line, k = ``stiffness`` (N/m per m of line per m of

@@ -116,9 +116,10 @@ SLOPED_GRID = Grid(np.array([1.0, -2.0]), np.array([-20.0, -6.0, 0.0, 9.0, 20.0]
 
 
 def grid_points(grid, near):
-    """Points (x, y) of the grid's inside: ``near`` False farther than 0.1 m beyond
-    the secant's reach from every grid line (in the cell 0 < x < 9, -5 < y < 5); True within delta / 2 of the grid line
-    x = 0 and of y = 5 (the secant turning there), away from the kinks of Dg."""
+    """Points (x, y) of the grid's inside: ``near`` False in the cell 0 < x < 9,
+    -5 < y < 5, farther than 0.1 m beyond the secant's reach from its grid lines; True
+    within delta / 2 of the grid line x = 0 and of y = 5 (the secant turning there),
+    away from the kinks of Dg."""
     rng = np.random.default_rng(11)
     hx, hy = grid._half_widths()
     if near:
