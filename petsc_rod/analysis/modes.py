@@ -81,7 +81,7 @@ def symmetrised_text(symmetrised):
         return ""
     return (f"K takes the symmetric part of the seabed contact's stiffness at {count} "
             f"grounded node{'s' if count != 1 else ''} within delta/2 of a seabed profile's "
-            f"row (its antisymmetric part up to {ratio:.3g} of it there: the lagged push "
+            f"row or grid line (its antisymmetric part up to {ratio:.3g} of it there: the lagged push "
             "turns over delta about a row and has no energy; docs/riser.md §3a), so the "
             "modes are approximate there")
 

@@ -48,7 +48,7 @@ def modes_band(text):
 
 def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
-    -rod_modes_mass or on a seabed grid, -rod_modes_range malformed or beside -rod_modes,
+    -rod_modes_mass, -rod_modes_range malformed or beside -rod_modes,
     -rod_modes_table
     without either, and a -rod_modes_table (or its shapes' file) that could not be
     written or names another output. Collective."""
@@ -79,15 +79,6 @@ def check_modes_inputs(values, scene, comm):
             check_output_path(name, comm, "-rod_modes_table")
     if modes_asked(values) and not mass_known(scene, mass_settings(values)):
         raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
-    seabed = scene.seabed
-    if modes_asked(values) and seabed is not None and not seabed.flat \
-            and not seabed.plane and not hasattr(seabed.shape, "slopes"):
-        # K holds a shaped seabed's contact through its linearisation
-        # (SeabedTerm.profile): a grid has none
-        raise RodInputError("-rod_modes on a seabed grid (-rod_seabed_profile with x y z "
-                            "rows): K has no stiffness of its contact along its normal, "
-                            "and the modes would be a flat seabed's; give the seabed as a "
-                            "profile (distance height rows) or a plane (-rod_seabed_slope)")
 
 
 def solve_for_run(problem, values, writer):

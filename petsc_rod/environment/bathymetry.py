@@ -184,15 +184,55 @@ class Grid:
         return ((1 - s) * (1 - t) * z[i, j] + s * (1 - t) * z[i + 1, j]
                 + (1 - s) * t * z[i, j + 1] + s * t * z[i + 1, j + 1])
 
+    def _half_widths(self):
+        """(hx, hy), m: half the widths SMOOTHING times the closest grid lines' spacing
+        along x and along y."""
+        return (0.5 * SMOOTHING * np.min(np.diff(self.xs)),
+                0.5 * SMOOTHING * np.min(np.diff(self.ys)))
+
     def gradient(self, x, y):
         """The secant slopes over SMOOTHING times the closest grid lines' spacing along
         x and y (module docstring), (shape of x) + (2,)."""
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        hx = 0.5 * SMOOTHING * np.min(np.diff(self.xs))
-        hy = 0.5 * SMOOTHING * np.min(np.diff(self.ys))
+        hx, hy = self._half_widths()
         gx = (self.height(x + hx, y) - self.height(x - hx, y)) / (2 * hx)
         gy = (self.height(x, y + hy) - self.height(x, y - hy)) / (2 * hy)
         return np.stack([gx, gy], axis=-1)
+
+    def _rise(self, x, y):
+        """grad z_b of the bilinear interpolant, (shape of x) + (2,): in the cell that
+        holds (x, y) (the one after a grid line on it),
+        dz_b/dx = ((1-t)(z10 - z00) + t (z11 - z01)) / dx and
+        dz_b/dy = ((1-s)(z01 - z00) + s (z11 - z10)) / dy; beyond an edge the component
+        across it 0 (level there), the one along it the edge's."""
+        u = np.asarray(x, dtype=float) - self.origin[0]
+        v = np.asarray(y, dtype=float) - self.origin[1]
+        i, j, s, t = self._cell(x, y)
+        z = self.heights
+        zx = (((1 - t) * (z[i + 1, j] - z[i, j]) + t * (z[i + 1, j + 1] - z[i, j + 1]))
+              / (self.xs[i + 1] - self.xs[i]))
+        zy = (((1 - s) * (z[i, j + 1] - z[i, j]) + s * (z[i + 1, j + 1] - z[i + 1, j]))
+              / (self.ys[j + 1] - self.ys[j]))
+        zx = np.where((u >= self.xs[0]) & (u < self.xs[-1]), zx, 0.0)
+        zy = np.where((v >= self.ys[0]) & (v < self.ys[-1]), zy, 0.0)
+        return np.stack([zx, zy], axis=-1)
+
+    def slopes(self, x, y):
+        """(grad z_b, g, Dg) at (x, y): the interpolant's own slope (..., 2) (what moves
+        a point's penetration), the secant gradient g (..., 2) of ``gradient`` (what
+        turns its push) and its derivative Dg_ij = dg_i/dx_j (..., 2, 2), 1/m, exact
+        for the piecewise-bilinear z_b: with hx, hy the secant's half widths,
+        Dg_xj = (d_j z_b(x + hx, y) - d_j z_b(x - hx, y)) / (2 hx) and
+        Dg_yj = (d_j z_b(x, y + hy) - d_j z_b(x, y - hy)) / (2 hy) (a line's exact
+        stiffness on the grid, Seabed.profile_derivatives). Within a cell and farther
+        than hx, hy from its edges g = grad z_b and Dg is the bilinear form's own
+        Hessian (0 on its diagonal)."""
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        hx, hy = self._half_widths()
+        rate = np.stack([(self._rise(x + hx, y) - self._rise(x - hx, y)) / (2 * hx),
+                         (self._rise(x, y + hy) - self._rise(x, y - hy)) / (2 * hy)],
+                        axis=-2)
+        return self._rise(x, y), self.gradient(x, y), rate
 
     def normal(self, x, y):
         return unit_normal(self.gradient(x, y))

@@ -31,8 +31,9 @@ class Friction:
 
 @dataclass(frozen=True)
 class Seabed:
-    """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the plane z = ``height`` (m), or, with a ``shape``
-    (environment/bathymetry.py: a sloping Plane or a Profile), the surface z = z_b(x, y), its
+    """An elastic seabed, frictionless unless it has a ``friction`` (Friction): the
+    plane z = ``height`` (m), or, with a ``shape`` (environment/bathymetry.py: a
+    sloping Plane, a Profile or a Grid), the surface z = z_b(x, y), its
     ``height`` then z_b under the scene's origin. It pushes a line below it out along
     its unit normal N = (-g, 1) / sqrt(1 + |g|^2) (g = grad z_b) with k times the normal
     penetration per metre of line, k = ``stiffness`` (N/m per m of line per m of
@@ -141,31 +142,47 @@ class Seabed:
         return ((-spring * depth)[:, None] * normal,
                 spring[:, None, None] * normal[:, :, None] * normal[:, None, :])
 
+    def plan_slopes(self, x, y):
+        """(grad z_b, g, Dg) of a profile or grid at (x, y) (n,), in the plan: the
+        interpolant's own slope (n, 2), the secant gradient (n, 2) and its derivative
+        dg_i/dx_j (n, 2, 2), 1/m (bathymetry.Grid.slopes); a profile's slopes along its
+        direction e (Profile.slopes: z_b', g, g') as z_b' e, g e and g' e e^T."""
+        slopes = self.shape.slopes(x, y)
+        if not hasattr(self.shape, "direction"):
+            return slopes
+        rise, g, rate = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in slopes))
+        e = self.shape.direction
+        return rise[:, None] * e, g[:, None] * e, rate[:, None, None] * np.outer(e, e)
+
     def profile_derivatives(self, r, weights):
-        """(G, B) of a profile (bathymetry.Profile) at node positions r (n, 3) with
-        weights w_n (n,), m: G_n = -w_n f_n, the share of the gradient of the force
-        f_n = k_v p_n (-g_n e, 1) (force; p_n = (z_b(d_n) - z_n)_+, g_n the secant
-        gradient along e, k_v = k / (1 + g_n^2): the force of the line's lagged
+        """(G, B) of a profile or grid (bathymetry.Profile, Grid) at node positions r
+        (n, 3) with weights w_n (n,), m: G_n = -w_n f_n, the share of the gradient of the
+        force f_n = k_v p_n (-g_n, 1) (force; p_n = (z_b(x_n, y_n) - z_n)_+, g_n the
+        secant gradient (2,), k_v = k / (1 + |g_n|^2): the force of the line's lagged
         iteration at its fixed point, physics/slope_load.py), N, (n, 3); and
-        B_n = dG_n/dr_n, N/m, (n, 3, 3), rows G's components, columns the position's:
-        with a = (g e, -1), E = (e, 0) and z_b' the interpolant's slope,
+        B_n = dG_n/dr_n, N/m, (n, 3, 3), rows G's components, columns the position's.
+        With a = (g, -1), grad z_b the interpolant's own slope and Dg = dg/d(x, y)
+        (plan_slopes), G_n = w_n k_v p a and dp/dr = (grad z_b, -1),
+        dk_v/dr = (Dg^T dk_v/dg, 0), dk_v/dg = -2 g k_v^2 / k, da/dr = [[Dg, 0], [0, 0]]:
 
-            B_n = w_n [a (k_v (z_b' e, -1) + p dk_v/dg g' E)^T + k_v p g' E E^T],
+            B_n = w_n [a (k_v (grad z_b, -1) + p (Dg^T dk_v/dg, 0))^T
+                       + k_v p [[Dg, 0], [0, 0]]]
 
-        dk_v/dg = -2 g k_v^2 / k, g' the secant's rate (Profile.slopes), on the nodes
-        with p_n > 0. Not symmetric where g != z_b' (within delta/2 of a row); farther
-        from the rows g' = 0 and B_n = k w_n N N^T, a plane's (position_derivatives)
-        with the node's own normal."""
+        on the nodes with p_n > 0 (a profile's Dg = g' e e^T). Not symmetric where
+        g != grad z_b (within delta/2 of a row or grid line); farther from them on a
+        profile Dg = 0 and B_n = k w_n N N^T, a plane's (position_derivatives) with the
+        node's own normal."""
         x, y = r[:, 0], r[:, 1]
-        rise, g, rate = self.shape.slopes(x, y)
-        e = np.append(self.shape.direction, 0.0)
+        rise, g, rate = self.plan_slopes(x, y)
         p = self.penetration(r[:, 2], self.shape.height(x, y))
-        k_v = self.stiffness / (1.0 + g**2)
-        a = g[:, None] * e - np.array([0.0, 0.0, 1.0])
-        moved = (k_v[:, None] * (rise[:, None] * e - np.array([0.0, 0.0, 1.0]))
-                 + (p * rate * (-2.0 * g * k_v**2 / self.stiffness))[:, None] * e)
-        block = (a[:, :, None] * moved[:, None, :]
-                 + (k_v * p * rate)[:, None, None] * np.outer(e, e))
+        k_v = self.vertical_stiffness(g)
+        e_z = np.array([0.0, 0.0, 1.0])
+        a = np.append(g, np.zeros((g.shape[0], 1)), axis=1) - e_z
+        turn = np.einsum("nij,ni->nj", rate, (-2.0 * k_v**2 / self.stiffness)[:, None] * g)
+        moved = (k_v[:, None] * (np.append(rise, np.zeros((g.shape[0], 1)), axis=1) - e_z)
+                 + np.append(p[:, None] * turn, np.zeros((g.shape[0], 1)), axis=1))
+        block = a[:, :, None] * moved[:, None, :]
+        block[:, :2, :2] += (k_v * p)[:, None, None] * rate
         spring = weights * (p > 0)
         return ((weights * k_v * p)[:, None] * a, spring[:, None, None] * block)
 

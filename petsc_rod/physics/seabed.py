@@ -12,14 +12,15 @@ node heights, so its gradient in the slopes is the adjoint of their integral
 the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
 semi-smooth Newton step, the active set that of the iterate.
 
-On a seabed profile the run takes no Newton steps (physics/slope_load.py). A line of a
-system asks for its fixed point's linearisation (linearise_profile, for its stiffness
-only): the force at the state's positions in the gradient, and its whole derivative
-B_n (Seabed.profile_derivatives, unsymmetric near a row) on the x, y, z chains, H its
-symmetric part and the Newton Jacobian the rest (add_jacobian). H on a profile is that
-symmetric part whether linearised or not (the modes' K, analysis/modes.py): farther
-than delta/2 from every row B_n = k w_n N N^T, a plane's with the node's own normal, so
-K is exact there; nearer, symmetrised_nodes says where it is not.
+On a seabed profile or grid the run takes no Newton steps (physics/slope_load.py). A
+line of a system asks for its fixed point's linearisation (linearise_profile, for its
+stiffness only): the force at the state's positions in the gradient, and its whole
+derivative B_n (Seabed.profile_derivatives, unsymmetric near a row or grid line) on the
+x, y, z chains, H its symmetric part and the Newton Jacobian the rest (add_jacobian). H
+on a profile or grid is that symmetric part whether linearised or not (the modes' K,
+analysis/modes.py): farther than delta/2 from every row B_n = k w_n N N^T, a plane's
+with the node's own normal, so K is exact there; nearer, symmetrised_nodes says where
+it is not.
 """
 
 import numpy as np
@@ -60,17 +61,17 @@ class SeabedTerm(NodalLoadTerm):
 
     @property
     def profile(self):
-        """Whether the seabed is a profile whose contact has a linearisation
-        (Seabed.profile_derivatives: bathymetry.Profile)."""
+        """Whether the seabed is a profile or a grid, whose contact has a linearisation
+        (Seabed.profile_derivatives: bathymetry.Profile, bathymetry.Grid)."""
         return (not self.seabed.flat and not self.seabed.plane
                 and hasattr(self.seabed.shape, "slopes"))
 
     def linearise_profile(self):
-        """On a seabed profile, put the contact's force at the state's positions and its
-        whole derivative (Seabed.profile_derivatives) into the gradient, H and J: the
-        derivative of the lagged iteration's fixed point (physics/slope_load.py), which
-        a line of a system takes for its exact stiffness (system/held_line.py). The
-        run's iterations are unchanged: the slope load still keeps the run out of
+        """On a seabed profile or grid, put the contact's force at the state's positions
+        and its whole derivative (Seabed.profile_derivatives) into the gradient, H and
+        J: the derivative of the lagged iteration's fixed point (physics/slope_load.py),
+        which a line of a system takes for its exact stiffness (system/held_line.py).
+        The run's iterations are unchanged: the slope load still keeps the run out of
         Newton's steps (its ``in_newton``). Nothing on another seabed. Call it before
         the problem's second variation and Newton solver are made."""
         if not self.profile:

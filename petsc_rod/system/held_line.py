@@ -120,12 +120,13 @@ data are (x_a, c) as on a plane with the block per node, and the forces read it
 through its transpose (as the friction's); a clamp's or a joint's held columns of J
 take the block's antisymmetric part too (SeabedTerm.turn_columns). Away from the rows
 B_n is the plane's k w_n N N^T with the node's own normal. settle() takes Newton's
-steps on that system: their stationary point is the iteration's fixed point.
+steps on that system: their stationary point is the iteration's fixed point. A seabed
+grid the same way, its slopes vectors in the plan (Grid.slopes: grad z_b, g and
+Dg = dg/d(x, y)), B_n unsymmetric within delta / 2 of a grid line.
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a profile (no Newton steps); a seabed
-grid (its contact lagged, its secant's derivative not written); any load outside the
-Newton system (the sea surface's wet and dry parts, attachments that reach it).
+seabed's friction with two coefficients or on a profile (no Newton steps); any load
+outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -1358,19 +1359,12 @@ class HeldLine:
 
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
-        scene = self.scene
         if self.friction and any(not term.in_newton for term in self.friction):
             raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
                                 "its seabed friction with two coefficients or on a seabed "
                                 "profile: give the friction one coefficient on a flat or "
                                 "uniformly sloping seabed")
-        if scene.seabed is not None and not (scene.seabed.flat or scene.seabed.plane) \
-                and self.profile is None:
-            raise RodInputError("HeldLine.stiffness: no exact stiffness of a line on a "
-                                "seabed grid (its contact is lagged in the line's "
-                                "iterations); give a flat, uniformly sloping or profiled "
-                                "seabed")
-        # a profile's lagged push: its linearisation is the seabed term's
+        # a profile's or grid's lagged push: its linearisation is the seabed term's
         # (SeabedTerm.linearise_profile)
         lagged = {term for term in self.problem.terms if self.profile is not None
                   and getattr(term, "contact", None) is self.profile}

@@ -19,7 +19,8 @@ parallel run):
     derivative in the Jacobian), alone and on the seabed;
 (g) on a seabed profile (the fixed point of the line's lagged iteration, its contact's
     block per node) against central differences, with and without grounded nodes in
-    the secant's turn about a row; a seabed grid refused in one line.
+    the secant's turn about a row; the same on a seabed grid, the line heading along
+    no grid axis.
 """
 
 import dataclasses
@@ -645,13 +646,112 @@ def test_the_secant_turn_matters_on_a_profile(monkeypatch):
         line.destroy()
 
 
-def test_a_seabed_grid_is_refused_in_one_line():
-    grid = tuple((x, y, -30.2 + 0.02 * max(x - 20.0, 0.0)) for x in (-100.0, 20.0, 200.0)
-                 for y in (-100.0, 100.0))
-    line = held(sloped_model(seabed_profile=grid), PETSc.COMM_SELF, MOORING)
+# seabed grids under the mooring turned 30 degrees off +x (its heading along no grid
+# axis): heights -30.2 m at the anchor rising 0.01 along x and 0.015 along y with a
+# twist, and 0.02 more along x beyond a grid line x = kink; AWAY_GRID's kink at
+# 120 m, no grid line within 15 m of the grounded part (the secant turning over
+# hx = 4 m at the lines), NEAR_GRID's at 20 m across it (hx = 5 m: grounded nodes
+# within delta / 2 of it, where g != grad z_b and the block is not symmetric). The
+# lagged iteration on these grids stalls short of TIGHT's tolerance: each solve and
+# re-solve ends at a looser one, settled by Newton's steps at the fixed point
+# (HeldLine.settle) before its forces are read.
+HEADING = np.radians(30.0)
+TURNED = (MOORING[0], np.array([85.0 * np.cos(HEADING), 85.0 * np.sin(HEADING), 0.0]))
+GRID_TOLERANCE = {"al_rtol": 1e-8, "al_ctol": 1e-8}
+GRID_STEP = 1e-4
+
+
+def settled_differences(line, ends, step):
+    """differences' (6, 6) with each re-solve settled (HeldLine.settle)."""
+    solve = line.solve
+
+    def settled(*args):
+        ok = solve(*args)
+        line.settle()
+        assert line.settled
+        return ok
+
+    line.solve = settled
     try:
-        with pytest.raises(RodInputError, match="seabed grid.*flat, uniformly sloping or "
-                                                "profiled"):
-            line.stiffness()
+        return differences(line, ends, step)
+    finally:
+        del line.solve
+
+
+def grid_rows(xs, kink, ys=(-100.0, 100.0, 200.0)):
+    return tuple((x, y, -30.2 + 0.01 * x + 0.015 * y + 1e-4 * x * y
+                  + 0.02 * max(x - kink, 0.0)) for x in xs for y in ys)
+
+
+AWAY_GRID = grid_rows((-100.0, -20.0, 120.0, 300.0), 120.0)
+NEAR_GRID = grid_rows((-100.0, 20.0, 120.0, 300.0), 20.0)
+
+
+def grid_turning_nodes(line):
+    """How many grounded nodes of the line meet the secant's turn at a grid line
+    (g != grad z_b), on every rank."""
+    seabed = line.scene.seabed
+    r = line.problem.state.node_positions()
+    rise, g, _ = seabed.shape.slopes(r[:, 0], r[:, 1])
+    turning = (seabed.gap(r) < 0) & (np.abs(g - rise).max(axis=1) > 1e-12)
+    return line.mesh.global_sum(int(np.sum(turning)))
+
+
+@pytest.mark.parametrize("comm", list(COMMS))
+@pytest.mark.parametrize("rows", [AWAY_GRID, NEAR_GRID],
+                         ids=["away from the grid lines", "at a grid line"])
+def test_stiffness_on_a_seabed_grid(comm, rows):
+    """The grid's contact in the Newton system (Seabed.profile_derivatives with
+    Grid.slopes' grad z_b, g and Dg in the plan), the line heading 30 degrees off the
+    grid's x axis: the (6, 6) against central differences of re-solves, every entry;
+    not symmetric where grounded nodes meet the secant's turn."""
+    line = HeldLine(sloped_model(seabed_profile=rows), COMMS[comm], options=GRID_TOLERANCE)
+    assert line.solve(*TURNED)
+    try:
+        summary = line.summary()
+        assert 30.0 < summary["touchdown_S"] < 70.0 and summary["grounded_length"] > 30.0
+        forces = line.end_forces()
+        assert abs(forces[0, 0] * np.sin(HEADING) - forces[0, 1] * np.cos(HEADING)) > 1.0
+        K = line.stiffness()
+        assert line.settled
+        turning = grid_turning_nodes(line)
+        assert (turning == 0) if rows is AWAY_GRID else (turning >= 4)
+        asymmetry = np.abs(K - K.T).max() / np.abs(K).max()
+        print(f"K - K^T {asymmetry:.3g}")
+        if rows is NEAR_GRID:
+            assert asymmetry > 1e-7
+        error = (np.abs(K - settled_differences(line, TURNED, GRID_STEP)).max()
+                 / np.abs(K).max())
+        print(f"K against differences {error:.3g} of {np.abs(K).max():.6g}")
+        assert error < 1e-7
+    finally:
+        line.destroy()
+
+
+def test_the_secant_turn_matters_on_a_grid(monkeypatch):
+    """NEAR_GRID's stiffness with the secant's derivative Dg dropped from the block
+    misses the settled differences by 3.9e-3 of its largest entry: Dg's terms are what
+    makes the stiffness exact near a grid line."""
+    from petsc_rod.environment.bathymetry import Grid
+
+    line = HeldLine(sloped_model(seabed_profile=NEAR_GRID), PETSc.COMM_SELF,
+                    options=GRID_TOLERANCE)
+    try:
+        assert line.solve(*TURNED)
+        exact = line.stiffness()
+        found = settled_differences(line, TURNED, GRID_STEP)
+        slopes = Grid.slopes
+
+        def without_turn(self, x, y):
+            rise, g, rate = slopes(self, x, y)
+            return rise, g, np.zeros_like(rate)
+
+        monkeypatch.setattr(Grid, "slopes", without_turn)
+        rough = line.stiffness()
+        scale = np.abs(exact).max()
+        print(f"exact {np.abs(exact - found).max() / scale:.3g}, "
+              f"without Dg {np.abs(rough - found).max() / scale:.3g}")
+        assert np.abs(exact - found).max() < 1e-7 * scale
+        assert np.abs(rough - found).max() > 1e-3 * scale
     finally:
         line.destroy()

@@ -10,7 +10,7 @@ import pytest
 from petsc4py import PETSc
 
 from helpers import destroy, make_solver
-from petsc_rod.environment.bathymetry import Plane, Profile
+from petsc_rod.environment.bathymetry import Grid, Plane, Profile
 from petsc_rod.environment.seabed import Seabed
 from petsc_rod.problem.penalty import default_penalty
 from petsc_rod.scenes.scene import Scene
@@ -65,6 +65,19 @@ def test_a_profile_that_is_the_plane_has_the_planes_modes():
     assert "in-plane" in plane.labels
     assert plane.symmetrised == (0, 0.0) and profile.symmetrised[0] == 0
     assert not any("warning" in line for line in table_lines(profile, 0.0))
+
+
+def test_a_grid_that_is_the_plane_has_the_planes_modes():
+    """A 3 x 3 grid of the plane's heights (bilinear: the plane itself), a grid line
+    at x = 2 m under the grounded part: the COUNT lowest frequencies those of the plane
+    to 1e-6 (the grid's contact linearised as a profile's, Grid.slopes)."""
+    plane, _ = modes_on(Plane.sloping(np.zeros(2), 0.0, DEG, np.array([1.0, 0.0])))
+    xs, ys = np.array([-5.0, 2.0, 20.0]), np.array([-3.0, 0.5, 3.0])
+    heights = np.tan(np.radians(DEG)) * xs[:, None] + 0.0 * ys[None, :]
+    grid, _ = modes_on(Grid(np.zeros(2), xs, ys, heights))
+    assert len(grid.omega2) == COUNT
+    assert np.abs(grid.frequencies / plane.frequencies - 1).max() < 1e-6
+    assert grid.labels == plane.labels
 
 
 def test_a_row_under_the_grounded_part_is_said():

@@ -31,18 +31,16 @@ def rows_file(tmp_path_factory):
     return path
 
 
-@pytest.fixture(scope="module")
-def api(tmp_path_factory):
-    """The API's body pose and stiffness of the deck on the profile, in a process of
-    its own."""
-    tmp_path = tmp_path_factory.mktemp("api")
+def api_numbers(tmp_path, sea):
+    """The API's body pose and stiffness of the deck with its environment's fields
+    ``sea`` (a dict's text, Environment's fields) and no flat seabed, in a process of
+    its own: {"x", "K"}."""
     script, out = tmp_path / "api.py", tmp_path / "api.npz"
     script.write_text(f"""
 import dataclasses, numpy as np
 from petsc_rod.api import read_moordyn, solve_system
 system, notes = read_moordyn({DECK!r})
-sea = dataclasses.replace(system.environment, seabed=None, seabed_profile={ROWS!r},
-                          seabed_direction=0.0, seabed_origin=(0.0, 0.0))
+sea = dataclasses.replace(system.environment, seabed=None, **{sea})
 r = solve_system(dataclasses.replace(system, environment=sea))
 np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffness)
 """)
@@ -52,9 +50,17 @@ np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffne
     return np.load(out)
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
-def test_the_file_on_a_profile_equals_the_api_on_a_profile(api, rows_file, tmp_path, ranks):
-    out = tmp_path / f"profile{ranks}.h5"
+@pytest.fixture(scope="module")
+def api(tmp_path_factory):
+    """The API's body pose and stiffness of the deck on the profile."""
+    return api_numbers(tmp_path_factory.mktemp("api"),
+                       f"dict(seabed_profile={ROWS!r}, seabed_direction=0.0, "
+                       "seabed_origin=(0.0, 0.0))")
+
+
+def file_numbers(rows_file, out, ranks):
+    """The command line's body pose and stiffness of the deck on the seabed of
+    ``rows_file`` (-rod_seabed_profile) on ``ranks`` ranks, its result ``out``."""
     process = run_petsc_rod(["-rod_system", DECK, "-rod_seabed_profile", str(rows_file),
                              "-rod_output", str(out)], ranks, 600)
     assert process.returncode == 0, describe(process)
@@ -62,11 +68,23 @@ def test_the_file_on_a_profile_equals_the_api_on_a_profile(api, rows_file, tmp_p
     with h5py.File(out, "r") as f:
         x, K = f["system"]["body_positions"][0], f["system"]["body_stiffness"][0]
     print("body", x)
-    assert x[0] > 1e-3                  # toward the anchor beyond the row, as the API's
+    return x, K
+
+
+def assert_same(x, K, api):
+    """The pose's positions and rotations, and each 3 x 3 block of the stiffness, the
+    API's to the system's accuracy (same)."""
     assert same(x[:3], api["x"][:3]) and same(x[3:], api["x"][3:])
     for rows in (slice(0, 3), slice(3, 6)):       # N/m, N/rad; N, N m/rad
         for columns in (slice(0, 3), slice(3, 6)):
             assert same(K[rows, columns], api["K"][rows, columns])
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_file_on_a_profile_equals_the_api_on_a_profile(api, rows_file, tmp_path, ranks):
+    x, K = file_numbers(rows_file, tmp_path / f"profile{ranks}.h5", ranks)
+    assert x[0] > 1e-3                  # toward the anchor beyond the row, as the API's
+    assert_same(x, K, api)
 
 
 def test_a_profile_with_a_slope_is_refused_naming_both(rows_file, tmp_path):

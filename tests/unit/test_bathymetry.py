@@ -104,3 +104,58 @@ def test_the_incline_catenary_reaches_its_top_and_balances_the_slope(deg, top):
     assert n[2, 1] / n[2, 0] == pytest.approx(np.tan(alpha), rel=1e-12)
     with pytest.raises(ValueError, match="taut"):
         incline_catenary(10.0, 1.0, np.radians(5.0), 7.0, 4.0)    # compressed at the anchor
+
+
+# a grid of uneven spacing with heights sloping in x and y and a bilinear twist in
+# every cell: the secant's half widths hx = 0.3 m, hy = 0.5 m
+SLOPED_GRID = Grid(np.array([1.0, -2.0]), np.array([-20.0, -6.0, 0.0, 9.0, 20.0]),
+                   np.array([-20.0, -5.0, 5.0, 20.0]),
+                   np.random.default_rng(5).uniform(-0.8, 0.8, size=(5, 4))
+                   + 0.05 * np.array([-20.0, -6.0, 0.0, 9.0, 20.0])[:, None]
+                   - 0.03 * np.array([-20.0, -5.0, 5.0, 20.0])[None, :])
+
+
+def grid_points(grid, near):
+    """Points (x, y) of the grid's inside: ``near`` False in the cell 0 < x < 9,
+    -5 < y < 5, farther than 0.1 m beyond the secant's reach from its grid lines; True
+    within delta / 2 of the grid line x = 0 and of y = 5 (the secant turning there),
+    away from the kinks of Dg."""
+    rng = np.random.default_rng(11)
+    hx, hy = grid._half_widths()
+    if near:
+        u = rng.uniform(-0.9 * hx, 0.9 * hx, 40)
+        v = 5.0 + rng.uniform(-0.9 * hy, 0.9 * hy, 40)
+        u, v = np.concatenate([u, u]), np.concatenate([v, rng.uniform(-3.0, 3.0, 40)])
+    else:
+        u, v = rng.uniform(0.5, 8.5, 40), rng.uniform(-4.3, 4.3, 40)
+        assert np.all(np.abs(v) < 5.0 - hy - 0.1)
+    return u + grid.origin[0], v + grid.origin[1]
+
+
+@pytest.mark.parametrize("near", [False, True], ids=["in the cells", "at grid lines"])
+def test_a_grid_s_slopes_are_the_differences_of_its_heights_and_its_secant(near):
+    """Grid.slopes: grad z_b the interpolant's slope, g the secant gradient, Dg its
+    derivative, each against central differences (1e-6 m) of what it is the slope of;
+    away from the grid lines g = grad z_b, near one the secant turns (Dg's off the
+    cell's own)."""
+    grid = SLOPED_GRID
+    x, y = grid_points(grid, near)
+    rise, g, rate = grid.slopes(x, y)
+    assert rise.shape == g.shape == (80 if near else 40, 2) and rate.shape == g.shape + (2,)
+    step = 1e-6
+    height = np.stack([(grid.height(x + step, y) - grid.height(x - step, y)),
+                       (grid.height(x, y + step) - grid.height(x, y - step))], -1) / (2 * step)
+    turn = np.stack([(grid.gradient(x + step, y) - grid.gradient(x - step, y)),
+                     (grid.gradient(x, y + step) - grid.gradient(x, y - step))], -1) / (2 * step)
+    assert np.abs(rise - height).max() < 1e-8
+    assert np.array_equal(g, grid.gradient(x, y))
+    assert np.abs(rate - turn).max() < 1e-7 * np.abs(rate).max()
+    if near:
+        assert np.abs(g - rise).max() > 1e-2                  # the secant turns there
+        assert np.abs(rate[:, 0, 0]).max() > 1e-2 and np.abs(rate[:, 1, 1]).max() > 1e-2
+    else:
+        assert np.abs(g - rise).max() < 1e-12
+        assert np.abs(rate[:, 0, 0]).max() < 1e-12 and np.abs(rate[:, 1, 0]).max() > 1e-3
+    # beyond the edges level across them: the slope across an edge 0, along it the edge's
+    beyond = grid.slopes(np.array([30.0]), np.array([0.0]))
+    assert beyond[0][0, 0] == 0.0 and beyond[0][0, 1] != 0.0

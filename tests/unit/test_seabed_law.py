@@ -58,3 +58,52 @@ def test_on_a_slope_the_contact_s_reaction_from_its_lagged_spring_is_the_seabed_
                        atol=0)
     assert seabed.reaction(r)[0] == pytest.approx(K * 0.02 * np.cos(slope), rel=1e-14)
     assert seabed.reaction(r)[2] == 0.0
+
+
+def profile_blocks_against_differences(seabed, x, y):
+    """max |B_n - dG_n/dr_n by central differences (1e-6 m)| / max |B| of
+    Seabed.profile_derivatives at nodes 1 to 10 cm below the seabed at (x, y), and B."""
+    z = seabed.heights(x, y) - np.linspace(0.01, 0.1, x.size)
+    r = np.stack([x, y, z], axis=1)
+    weights = np.linspace(0.5, 1.5, x.size)
+    _, B = seabed.profile_derivatives(r, weights)
+    step, found = 1e-6, np.zeros_like(B)
+    for j in range(3):                              # the three columns of every block
+        move = np.zeros(3)
+        move[j] = step
+        found[:, :, j] = (seabed.profile_derivatives(r + move, weights)[0]
+                          - seabed.profile_derivatives(r - move, weights)[0]) / (2 * step)
+    return np.abs(B - found).max() / np.abs(B).max(), B
+
+
+@pytest.mark.parametrize("near", [False, True], ids=["in the cells", "at grid lines"])
+def test_a_grid_s_block_is_the_derivative_of_its_force(near):
+    """On a grid (test_bathymetry.SLOPED_GRID: slopes in x and y) B_n = dG_n/dr_n with
+    grad z_b, g and Dg vectors (Grid.slopes), against central differences of G; not
+    symmetric near a grid line (g != grad z_b there), in a cell only by the terms of
+    order p of its twist's turn of k_v."""
+    from test_bathymetry import SLOPED_GRID, grid_points
+
+    seabed = Seabed(0.0, 1e5, SLOPED_GRID)
+    error, B = profile_blocks_against_differences(seabed, *grid_points(SLOPED_GRID, near))
+    print(f"B against differences {error:.3g}")
+    assert error < 1e-7
+    asymmetry = np.abs(B - B.transpose(0, 2, 1)).max() / np.abs(B).max()
+    print(f"B - B^T {asymmetry:.3g}")
+    assert (asymmetry > 1e-3) if near else (1e-8 < asymmetry < 1e-3)
+
+
+def test_a_profile_s_block_is_the_derivative_of_its_force():
+    """A profile along (0.6, 0.8) with nodes within delta / 2 of a row and away from it:
+    its B_n (Profile.slopes' z_b', g, g' as vectors in the plan) against central
+    differences of G, as the grid's."""
+    from petsc_rod.environment.bathymetry import Profile
+
+    e = np.array([0.6, 0.8])
+    profile = Profile(np.zeros(2), e, np.array([0.0, 10.0, 30.0]), np.array([1.0, 3.0, 2.0]))
+    d = np.concatenate([10.0 + np.linspace(-0.45, 0.45, 6), np.linspace(2.0, 8.0, 5)])
+    seabed = Seabed(0.0, 1e5, profile)
+    error, _ = profile_blocks_against_differences(seabed, d * e[0] - 3.0 * e[1],
+                                                  d * e[1] + 3.0 * e[0])
+    print(f"B against differences {error:.3g}")
+    assert error < 1e-7
