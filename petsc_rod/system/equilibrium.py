@@ -89,7 +89,8 @@ class Settings:
     1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
     Newton step; ``predictor``: a solver's first solve starts where the system's
     catenaries settle (system/predictor.py) when its lines allow it (``make_line``'s
-    ``predictable``); False: always the continuation from the unloaded system."""
+    ``predictable``) and ``load_steps`` is 1; False: always the continuation from the
+    unloaded system."""
 
     rtol: float = 1e-10
     floor: float = 1e-7
@@ -312,7 +313,9 @@ class SystemSolver:
         self.make_line = make_line
         # the catenary predictor (_predicted): whether the first solve tries it, and
         # what it did (None: not tried; "used"; else why not, or why it failed)
-        self.predictable = settings.predictor and getattr(make_line, "predictable", False)
+        # (not where a continuation in load steps is asked for: Settings.load_steps)
+        self.predictable = (settings.predictor and settings.load_steps == 1
+                            and getattr(make_line, "predictable", False))
         self.prediction = None
         self.lines = {}
         # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
