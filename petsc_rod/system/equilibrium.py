@@ -787,6 +787,7 @@ class SystemSolver:
         except RodInterrupted:
             raise
         except RodError as error:
+            self.check_interrupted()            # a stop signal failed the lines: stop
             self.prediction = f"failed ({error}); solved from the unloaded system"
             self._drop_lines()
             self._start(self.first)
