@@ -41,7 +41,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from petsc_rod.errors import RodDivergedError, RodError
+from petsc_rod.errors import RodError
 from petsc_rod.model.line import Line
 
 # The largest bending length sqrt(EI / (w L)) of a line a catenary stands in for, as a
@@ -134,7 +134,7 @@ def _solve2(D, b):
 class CatenaryLine:
     """A system line as an elastic catenary (module docstring), with the HeldLine
     protocol of system/equilibrium.py: solve(start, end) -> bool, end_forces() (2, 3),
-    stiffness() (6, 6), destroy(). ``seabed``: the flat seabed's height (m) or None."""
+    stiffness() (6, 6), destroy(); ``seabed`` the flat seabed's height (m) or None."""
 
     def __init__(self, line, environment):
         model = line.line
@@ -147,6 +147,9 @@ class CatenaryLine:
         self.forces = self.K = None
 
     def solve(self, start, end):
+        """The catenary between ``start`` and ``end`` (3,), m, from the last one's (H, V);
+        False where it has none: the ends on one vertical, the lower end below the
+        seabed, Newton failing, a hanging line through the seabed."""
         start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         flip = end[2] < start[2]
         a, b = (end, start) if flip else (start, end)
@@ -154,18 +157,16 @@ class CatenaryLine:
         l, h = float(np.hypot(chord[0], chord[1])), float(chord[2])
         if not l > 1e-9 * self.L:
             return False                    # on one vertical: no catenary's H
-        if self.seabed is None:
-            grounded_ok = False
-        else:
-            lying = abs(a[2] - self.seabed) <= 1e-6 * self.L
-            if a[2] < self.seabed - 1e-6 * self.L or not lying and not self._clear(a, l, h):
+        grounded_ok = False
+        if self.seabed is not None:
+            if a[2] < self.seabed - 1e-6 * self.L:
                 return False
-            grounded_ok = lying
+            grounded_ok = abs(a[2] - self.seabed) <= 1e-6 * self.L
         found = self._solve(l, h, grounded_ok)
         if found is None:
             return False
         H, V, D, grounded = found
-        if not grounded and self.seabed is not None and not self._clear(a, l, h, H, V):
+        if not grounded and self.seabed is not None and not self._clear(a[2], H, V):
             return False
         e = np.array([chord[0] / l, chord[1] / l, 0.0])
         z = np.array([0.0, 0.0, 1.0])
@@ -189,17 +190,15 @@ class CatenaryLine:
         self.HV = (H, V)
         return True
 
-    def _clear(self, a, l, h, H=None, V=None):
-        """Whether the hanging catenary from ``a`` stays above the seabed (without
-        (H, V): whether ``a`` is above it)."""
-        if H is None:
-            return a[2] >= self.seabed
+    def _clear(self, height, H, V):
+        """Whether the hanging catenary of (H, V) from a lower end at ``height`` (m)
+        stays above the seabed."""
         Va = V - self.w * self.L
         if Va >= 0.0:
             return True                     # rising all along from a
         # its lowest point, where the vertical tension vanishes (inextensible sag)
         sag = H / self.w * (np.sqrt(1.0 + (Va / H) ** 2) - 1.0)
-        return a[2] - sag >= self.seabed - 1e-6 * self.L
+        return height - sag >= self.seabed - 1e-6 * self.L
 
     def _solve(self, l, h, grounded_ok):
         """(H, V, D, grounded) of the span (l, h), None where Newton fails."""
@@ -281,7 +280,7 @@ def predict(system, settings):
             return None, (f"the catenaries' ends move {float(np.max(moves / lengths)):.2g} "
                           f"of their lengths, less than {NEAR:g}: solved from the start")
         return solver.state, None
-    except (RodError, RodDivergedError) as error:
+    except RodError as error:
         return None, f"the catenaries' system: {error}"
     finally:
         solver.destroy()
