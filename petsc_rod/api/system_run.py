@@ -635,6 +635,9 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
         # a Newton or a line that did not converge, the halvings spent: the single
         # line's exit 3, but no file (there is no equilibrium to write)
         raise RodNotConvergedError(str(error)) from None
+    if solver.prediction is not None and not solver.prediction.startswith("not used"):
+        # the first solve started from the catenaries' equilibrium (system/predictor.py)
+        say(f"petsc_rod: note: the system's catenary predictor {solver.prediction}")
     number = 0 if interrupts is None else interrupts.received()
     if number:
         raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "

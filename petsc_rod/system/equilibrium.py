@@ -87,7 +87,10 @@ class Settings:
     ``max_iterations`` per attempt (below the floor, two Newton steps in a row that do
     not halve the residual end it too: the same accuracy); ``load_steps``: the continuation's first step is
     1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
-    Newton step."""
+    Newton step; ``predictor``: a solver's first solve starts where the system's
+    catenaries settle (system/predictor.py) when its lines allow it (``make_line``'s
+    ``predictable``) and ``load_steps`` is 1; False: always the continuation from the
+    unloaded system."""
 
     rtol: float = 1e-10
     floor: float = 1e-7
@@ -95,6 +98,7 @@ class Settings:
     load_steps: int = 1
     max_halvings: int = 12
     line_search: int = 10
+    predictor: bool = True
 
 
 @dataclass
@@ -301,40 +305,56 @@ class SystemSolver:
         self.layout = Layout(system)
         environment = system.environment
         self.rho, self.g = environment.water_density, environment.gravity
-        self.state = State(np.array([p.position for p in system.points],
-                                    dtype=float).reshape(-1, 3),
-                           Bodies(system.bodies, self.rho, self.g))
         self.length = max([1.0] + [float(np.abs(np.asarray(v, float)).max()) for b in
                                    system.bodies for v in (b.cog, b.cob)]
                           + [float(np.abs(self.layout.local).max(initial=0.0))])
         sizes = [line_elements(line) for line in system.lines] if sizes is None else sizes
         self.placement = Placement.make(comm or PETSc.COMM_WORLD, sizes)
+        self.make_line = make_line
+        # the catenary predictor (_predicted): whether the first solve tries it, and
+        # what it did (None: not tried; "used"; else why not, or why it failed)
+        # (not where a continuation in load steps is asked for: Settings.load_steps)
+        self.predictable = (settings.predictor and settings.load_steps == 1
+                            and getattr(make_line, "predictable", False))
+        self.prediction = None
         self.lines = {}
+        # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
+        # asked before every Newton iteration and after a failed one, and handed to the
+        # lines, which ask after every iteration of their walks; None: not asked
+        self.interrupts = None
+        self.first = system
+        self._start(system)
+
+    def _start(self, system):
+        """The lines made (collective) and the solver at ``system``'s start, unloaded."""
 
         def make_mine():
             for k in self.placement.mine:
-                self.lines[int(k)] = make_line(system.lines[k], self.placement.line_comm)
+                self.lines[int(k)] = self.make_line(system.lines[k],
+                                                    self.placement.line_comm)
 
         try:                                    # a line refused on one group, on all
             on_every_rank(self.placement.mpi, make_mine)
         except BaseException:
             self.destroy()
             raise
+        self.state = State(np.array([p.position for p in system.points],
+                                    dtype=float).reshape(-1, 3),
+                           Bodies(system.bodies, self.rho, self.g))
         self.forces = self.stiffnesses = None
         self.failure, self.checked, self.last = "", False, None
         self.mine = {}                          # this rank's lines' last results
-        # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
-        # asked before every Newton iteration and after a failed one, and handed to the
-        # lines, which ask after every iteration of their walks; None: not asked
-        self.interrupts = None
         self.factor = 0.0                       # the load factor the Newton works at
         self.loads = Loads.of(system, self.layout).unloaded()
 
     def destroy(self):
+        self._drop_lines()
+        self.placement.destroy()
+
+    def _drop_lines(self):
         for line in self.lines.values():
             line.destroy()
         self.lines = {}
-        self.placement.destroy()
 
     # -- the lines --------------------------------------------------------------------
 
@@ -706,6 +726,10 @@ class SystemSolver:
         settings = self.settings
         if system is not None:
             self.replace(system)
+        if not self.checked and self.predictable:
+            predicted = self._predicted()
+            if predicted is not None:
+                return predicted
         if not self.checked:
             self.check_restoring()
             self.checked = True
@@ -737,6 +761,43 @@ class SystemSolver:
                 continue
             self.state, factor, step = state, to, 2.0 * step
         self.loads = target
+        return self._finish(factor, total, halvings)
+
+    def _predicted(self):
+        """The first solve from the catenaries' equilibrium (system/predictor.py): the
+        lines' first solves at the ends it puts them, then Newton under the full loads;
+        None where no catenary stands in for a line, the catenaries have no
+        equilibrium, or that Newton fails: the solver is then as made (its lines made
+        again), for the continuation from the unloaded system. ``prediction`` says
+        which. Collective (every rank predicts the same state alone)."""
+        from petsc_rod.system.predictor import predict
+        self.predictable = False                # the first solve's only
+        state, why = predict(self.system, self.settings)
+        if state is None:
+            self.prediction = f"not used: {why}"
+            return None
+        target = Loads.of(self.system, self.layout)
+        try:
+            self.state = State(state.points, state.bodies)
+            self.check_restoring()              # the lines' first solves, there
+            self.checked, self.factor = True, 1.0
+            solved, iterations = self.newton(self.state, target, self.scales())
+            if solved is None:
+                raise RodDivergedError(self.failure)
+        except RodInterrupted:
+            raise
+        except RodError as error:
+            self.check_interrupted()            # a stop signal failed the lines: stop
+            self.prediction = f"failed ({error}); solved from the unloaded system"
+            self._drop_lines()
+            self._start(self.first)
+            return None
+        self.prediction = "used"
+        self.state, self.loads = solved, target
+        return self._finish(1.0, iterations, 0)
+
+    def _finish(self, factor, total, halvings):
+        """The Equilibrium at the solver's state (solve), the lines left there."""
         # The lines may stand at the last trial; leave them at the solution, and report
         # the end forces and stiffness of the lines as they are left (a re-solve from a
         # trial differs by the lines' own tolerances).

@@ -1435,4 +1435,5 @@ def held_lines(system, options=None, laid=None):
         held.settles = False                # SystemSolver.evaluate settles it when it reports
         return held
 
+    make_line.predictable = True            # rods a catenary may stand in for (predictor)
     return make_line
