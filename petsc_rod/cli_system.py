@@ -8,7 +8,7 @@ non-finite numbers or a PETSc error, 5 the result could not be written).
 
 Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_length,
 -rod_system_body_load, -rod_system_offset, -rod_system_line_length, -rod_system_steps,
--rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
+-rod_system_predictor, -rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
 -rod_system_modes_line_mass), the seabed's plane or profile (-rod_seabed_slope,
 -rod_seabed_direction, -rod_seabed_origin, -rod_seabed_profile: a MoorDyn file carries
 none), the outputs
@@ -52,7 +52,7 @@ from petsc_rod.tables import read_text
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
 SYSTEM_OPTIONS = ("rod_system", "rod_system_element_length", "rod_system_body_load",
                   "rod_system_offset", "rod_system_line_length", "rod_system_steps",
-                  "rod_system_watch_circle", "rod_system_excursion",
+                  "rod_system_predictor", "rod_system_watch_circle", "rod_system_excursion",
                   "rod_system_modes", "rod_system_modes_line_mass",
                   "rod_output", "rod_table", *(f"rod_{name}" for name in MODES_OPTIONS))
 # The single line's options of a sloping or profiled seabed a system file's sea takes: a
@@ -284,8 +284,9 @@ def prepared(values, given, case=None):
     system, notes = read_moordyn(path, values["rod_system_element_length"])
     system = changed(sloped(values, given, system), values, case or {})
     notes = tuple(notes) + friction_notes(system)
-    settings = Settings() if values["rod_system_steps"] is None else Settings(
-        load_steps=values["rod_system_steps"])
+    settings = Settings(predictor=values["rod_system_predictor"],
+                        **({} if values["rod_system_steps"] is None
+                           else {"load_steps": values["rod_system_steps"]}))
     texts = whole_values()
     options = {name.removeprefix("rod_"): texts[name] for name in given
                if name.removeprefix("rod_") in LINE_OPTIONS}

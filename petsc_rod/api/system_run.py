@@ -33,9 +33,11 @@ from petsc_rod.system.equilibrium import Settings, SystemSolver
 from petsc_rod.system.held_line import friction_notes, held_lines
 
 # The options of the system itself (not of its lines): the load continuation's first
-# step is 1 / system_steps of the bodies' loads (Settings.load_steps); the modes of the
+# step is 1 / system_steps of the bodies' loads (Settings.load_steps); whether the first
+# solve starts from the catenaries' equilibrium (Settings.predictor); the modes of the
 # bodies and free points (system/body_modes.py), the lines' mass lumped at their ends.
-SYSTEM_OPTIONS = ("system_steps", "system_modes", "system_modes_line_mass")
+SYSTEM_OPTIONS = ("system_steps", "system_predictor", "system_modes",
+                  "system_modes_line_mass")
 # The modes of each line with its ends held (docs/modes.md): their count and the mass's
 # settings (every line the same), the option names without ``rod_`` and MassSettings'.
 MODES_OPTIONS = {"modes": None, "modes_range": None, "modes_added_mass": "added_mass",
@@ -159,8 +161,13 @@ def split_options(options):
         raise RodInputError(f"system_steps {steps!r}: a whole number of at least 1 (the "
                             "load continuation's first step is 1 / system_steps of the "
                             "loads)")
+    predictor = options.pop("system_predictor", Settings().predictor)
+    if not isinstance(predictor, (bool, np.bool_)):
+        raise RodInputError(f"system_predictor {predictor!r}: True or False (whether the "
+                            "first solve starts from the system's catenaries' equilibrium)")
     values_of(options)                      # a malformed value refused before any work
-    return Settings(load_steps=int(steps)), options, modes, body_modes
+    return (Settings(load_steps=int(steps), predictor=bool(predictor)), options, modes,
+            body_modes)
 
 
 def line_modes(solver, count, settings, band=None):

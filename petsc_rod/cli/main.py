@@ -106,7 +106,8 @@ def check_system_options(given):
                             "FILE; a sweep's cases are single lines: drop it here")
     orphans = [name for name in ("rod_system_element_length", "rod_system_body_load",
                                  "rod_system_offset", "rod_system_line_length",
-                                 "rod_system_steps", "rod_system_watch_circle",
+                                 "rod_system_steps", "rod_system_predictor",
+                                 "rod_system_watch_circle",
                                  "rod_system_excursion", "rod_system_modes",
                                  "rod_system_modes_line_mass") if name in given]
     if orphans:

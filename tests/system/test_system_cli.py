@@ -74,6 +74,19 @@ def test_one_and_two_ranks_give_the_same_numbers(runs):
                     (sweep, name)
 
 
+def test_the_predictor_switched_off_gives_the_same_equilibrium(runs, tmp_path):
+    """-rod_system_predictor 0: the load continuation from the unloaded system, no note
+    of the predictor, the pose, stiffness and end forces of the predicted run's to the
+    Newton's floor (FLOOR of each quantity's largest entry)."""
+    path, process = system_run(tmp_path, 1, "-rod_system_predictor", "0")
+    assert process.returncode == 0, describe(process)
+    assert "catenary predictor" not in process.stdout
+    with h5py.File(runs[1][1], "r") as f, h5py.File(path, "r") as g:
+        for name in ("body_positions", "body_stiffness", "end_forces"):
+            predicted, continued = f["system"][name][()], g["system"][name][()]
+            assert np.abs(predicted - continued).max() < FLOOR * np.abs(predicted).max(), name
+
+
 def test_the_result_file_and_the_tables(runs):
     folder, path, process = runs[1]
     with h5py.File(path, "r") as f:
