@@ -14,9 +14,11 @@ by the API, friction mu = 0.5:
     point of the linearised gradient, which is the lagged iteration's fixed point,
     checked here) so that the differences are those of the fixed point to round-off
     rather than to the lagged iteration's tolerance;
-(b) the body on its three chains on a frictional profile: converged, its 6 x 6 against
-    central differences of the lines re-solved at moved and turned poses, the same pose
-    on one rank and on all.
+(b) the body on its three chains on tests/solver/test_system_profile.py's profile (a row
+    at x = 55 m, the chain to the anchor at x = 65 m grounded across it) with the
+    friction: converged, that chain partly sliding, its 6 x 6 against central
+    differences of the lines re-solved (and settled) at moved and turned poses, the
+    same pose on one rank and on all.
 
 Before, HeldLine.stiffness refused friction on a profile ("no exact stiffness of its
 seabed friction with two coefficients or on a seabed profile").
@@ -28,10 +30,12 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_rod.system.held_line import HeldLine
+from petsc_rod.system.equilibrium import Settings, SystemSolver
+from petsc_rod.system.held_line import HeldLine, held_lines
 
-from test_system_clamped import COMMS
-from test_system_friction import frictional
+from test_system_clamped import COMMS, body_differences
+from test_system_friction import assert_same_pose, frictional, friction_states, pose
+from test_system_profile import TOLERANCE as PROFILE_TOLERANCE, on_a_profile
 
 pytestmark = pytest.mark.solver
 
@@ -132,3 +136,63 @@ def test_one_rank_and_all_give_the_line_on_a_profile_the_same_stiffness():
     print(f"K on one rank and on all differ by {difference:.3g} of the largest entry")
     assert difference < 1e-8
 
+
+
+def on_a_frictional_profile():
+    """tests/solver/test_system_profile.py's system (the body on its three chains, the
+    chain to the anchor at x = 65 m grounded across the row at x = 55 m) with the
+    seabed's friction."""
+    system = on_a_profile()
+    environment = dataclasses.replace(system.environment, seabed_friction=0.5)
+    return dataclasses.replace(system, environment=environment)
+
+
+def solved(comm):
+    """The body on its chains on the frictional profile, solved on ``comm`` (the lines
+    at the profile's tolerance)."""
+    system = on_a_frictional_profile()
+    solver = SystemSolver(system, held_lines(system, PROFILE_TOLERANCE), comm,
+                          settings=Settings(rtol=1e-12))
+    try:
+        result = solver.solve()
+    except BaseException:
+        solver.destroy()
+        raise
+    assert result.load_factor == 1.0
+    return solver, result
+
+
+# the body's equilibrium on one rank (the one-rank spread's, or solved for the test)
+_ALONE = {}
+
+
+@pytest.fixture(scope="module", params=list(COMMS))
+def spread(request):
+    solver, result = solved(COMMS[request.param])
+    if request.param == "one rank":
+        _ALONE["alone"] = result
+    yield solver, result
+    solver.destroy()
+
+
+def test_a_body_on_frictional_lines_on_a_profile(spread):
+    """Converged; the chain across the row partly slides; the 6 x 6 against central
+    differences of the lines re-solved (and settled) at moved and turned poses."""
+    solver, result = spread
+    states = friction_states(solver)
+    print(f"states {states}, pose {pose(result)}")
+    stick, grounded = states[0]
+    assert 0 < stick < grounded
+    K = solver.body_stiffness("Body1").matrix
+    scale = np.abs(K).max()
+    error = np.abs(K - body_differences(solver, settle=True)).max() / scale
+    print(f"K against differences {error:.3g} of {scale:.6g}")
+    assert error < 1e-7
+
+
+def test_one_rank_and_all_give_the_body_on_a_profile_the_same_pose(spread):
+    if "alone" not in _ALONE:
+        solver, _ALONE["alone"] = solved(PETSc.COMM_SELF)
+        solver.destroy()
+    print(f"pose {pose(_ALONE['alone'])}")
+    assert_same_pose(spread[1], _ALONE["alone"])
