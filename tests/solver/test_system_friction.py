@@ -53,8 +53,8 @@ def frictional(mu, load=SIDE):
     return dataclasses.replace(system, environment=environment, bodies=(body,))
 
 
-def solved(system, comm, load_steps=1):
-    solver = SystemSolver(system, held_lines(system, TIGHT), comm,
+def solved(system, comm, load_steps=1, tolerance=TIGHT):
+    solver = SystemSolver(system, held_lines(system, tolerance), comm,
                           settings=Settings(rtol=1e-12, load_steps=load_steps))
     try:
         result = solver.solve()

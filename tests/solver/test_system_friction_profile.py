@@ -30,11 +30,11 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from petsc_rod.system.equilibrium import Settings, SystemSolver
-from petsc_rod.system.held_line import HeldLine, held_lines
+from petsc_rod.system.held_line import HeldLine
 
 from test_system_clamped import COMMS, body_differences
-from test_system_friction import assert_same_pose, frictional, friction_states, pose
+from test_system_friction import (assert_same_pose, frictional, friction_states, pose,
+                                  solved as solved_at)
 from test_system_profile import TOLERANCE as PROFILE_TOLERANCE, on_a_profile
 
 pytestmark = pytest.mark.solver
@@ -150,16 +150,7 @@ def on_a_frictional_profile():
 def solved(comm):
     """The body on its chains on the frictional profile, solved on ``comm`` (the lines
     at the profile's tolerance)."""
-    system = on_a_frictional_profile()
-    solver = SystemSolver(system, held_lines(system, PROFILE_TOLERANCE), comm,
-                          settings=Settings(rtol=1e-12))
-    try:
-        result = solver.solve()
-    except BaseException:
-        solver.destroy()
-        raise
-    assert result.load_factor == 1.0
-    return solver, result
+    return solved_at(on_a_frictional_profile(), comm, tolerance=PROFILE_TOLERANCE)
 
 
 # the body's equilibrium on one rank (the one-rank spread's, or solved for the test)
