@@ -131,8 +131,9 @@ holds the profile's share too).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients (no Newton steps; its axes turn with the
-tangent); a seabed grid (its contact lagged, its secant's derivative not written); any load outside the
-Newton system (the sea surface's wet and dry parts, attachments that reach it).
+tangent); a seabed grid (its contact lagged, its secant's derivative not written); any
+load outside the Newton system (the sea surface's wet and dry parts, attachments that
+reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
