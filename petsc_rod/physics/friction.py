@@ -78,6 +78,16 @@ w_n R_n / |d|_G (I - d d^T / |d|^2), which is positive semidefinite; J the rest.
 global step carries g.f as its work through the heights' chain (add_iterate_load), so
 that its fixed point is the Newton steps' stationary point. Not conservative: friction
 dissipates, so the run gives no stability verdict (as with the drag).
+
+On a seabed profile a line's own run takes no Newton steps (above), and its fixed point
+is the plane's law with the secant gradient g = g(d) e read at each node and
+R = k cos(theta) (z_b(d) - z)_+, z_b the interpolant (environment/bathymetry.py). A line
+of a system whose contact is linearised (SeabedTerm.linearise_profile) takes that fixed
+point's derivative for its stiffness (``held_exact``, _profile_rates): the plane's block
+with the limit's k cos(theta) g replaced by dR/dx = k cos(theta) (z_b' - p g g' cos^2)
+e, G's oblique projection by mu^2 |d|_G d|d|_G/dx = G d + (g.d) g' (d.e) e, and the
+vertical row less (f.e) g' e^T (g.f with g turning), g' the secant's rate
+(Profile.slopes); unsymmetric, into J.
 """
 
 import numpy as np
@@ -179,6 +189,19 @@ class FrictionTerm(NodalLoadTerm):
         self._held = None           # H's share on a plane of the last _plane_law (n, 2, 2)
 
     @property
+    def held_exact(self):
+        """Whether a held line's stiffness with this friction is exact
+        (system/held_line.py): one coefficient, on a flat seabed, a sloping plane or a
+        profile whose contact the line linearises (SeabedTerm.linearise_profile; the
+        law's derivatives with g read at each node along the profile's direction,
+        _profile_rates); not on a grid, whose g turns in two directions."""
+        seabed = self.seabed_term.seabed
+        along_profile = (self.seabed_term.profiled
+                         and hasattr(seabed.shape, "direction"))
+        return ((seabed.flat or seabed.plane or along_profile)
+                and self.friction.axial == self.friction.lateral)
+
+    @property
     def in_newton(self):
         """On a flat seabed or a sloping plane, with one coefficient (module docstring)."""
         seabed = self.seabed_term.seabed
@@ -217,7 +240,8 @@ class FrictionTerm(NodalLoadTerm):
         P2 interpolant's int F.g differs by O(h^2)). Collective."""
         if self.seabed_term.seabed.flat:
             return
-        if self._springs_stale and self.seabed_term.seabed.plane:
+        if self._springs_stale and (self.seabed_term.seabed.plane
+                                    or self.seabed_term.profiled):
             # after Newton steps: the friction at their positions (the last solve's is
             # that of the state before them)
             work = -self._newton_law(state)[0][:, 2]
@@ -395,8 +419,10 @@ class FrictionTerm(NodalLoadTerm):
         k cos(theta) g and -k cos(theta) on the contact. Stick f = -k_s d; slide
         f = -R d / |d|_G, whose derivative in x is
         -R / |d|_G (I - d (G d)^T / (mu^2 |d|_G^2)) - d (k cos(theta) g)^T / |d|_G and in
-        z d k cos(theta) / |d|_G; the vertical part g.f has g^T times them. Returns
-        (-w F (n, 3), -w dF/dx (n, 3, 2), -w dF/dz (n, 3)), N and N/m."""
+        z d k cos(theta) / |d|_G; the vertical part g.f has g^T times them. On a
+        linearised profile g is each node's secant gradient and the derivatives take
+        its turn (_profile_rates). Returns (-w F (n, 3), -w dF/dx (n, 3, 2),
+        -w dF/dz (n, 3)), N and N/m."""
         seabed = self.seabed_term.seabed
         mu, stiffness = self.friction.lateral, self.friction.stiffness
         g = seabed.gradients(r[:, 0], r[:, 1])                            # (n, 2)
@@ -413,10 +439,14 @@ class FrictionTerm(NodalLoadTerm):
         squared = np.where(slide, mu**2 * norm**2, 1.0)
         limit = np.divide(seabed.stiffness * cosine, norm, out=np.zeros_like(norm),
                           where=slide)                                    # k cos / |d|_G
+        lift = turn = None
+        if self.seabed_term.profiled:
+            lift, turn, metric = self._profile_rates(r, d, g, cosine, metric)
         in_x = ((stick * stiffness)[:, None, None] * np.eye(2)
                 + scale[:, None, None] * (np.eye(2) - d[:, :, None] * metric[:, None, :]
                                           / squared[:, None, None])
-                + limit[:, None, None] * d[:, :, None] * g[:, None, :])
+                + limit[:, None, None] * d[:, :, None] * (g if lift is None
+                                                          else lift)[:, None, :])
         in_z = -limit[:, None] * d
         # H's share, the limit held and the slip's turn measured in the horizontal plane:
         # positive semidefinite (the symmetric part of in_x is not: the d g^T of the
@@ -427,11 +457,39 @@ class FrictionTerm(NodalLoadTerm):
             + scale[:, None, None] * (np.eye(2) - d[:, :, None] * d[:, None, :]
                                       / length[:, None, None]))
         rise = np.einsum("nc,nc->n", g, force)
+        vertical = np.einsum("nc,ncj->nj", g, in_x)
+        if turn is not None:                # g.f with g turning: -(f.e) g' e^T
+            vertical -= (np.einsum("nc,nc->n", force, turn)[:, None]
+                         * seabed.shape.direction)
         return (-w[:, None] * np.concatenate([force, rise[:, None]], axis=1),
-                w[:, None, None] * np.concatenate([in_x, np.einsum("nc,ncj->nj", g, in_x)[:, None]],
-                                                  axis=1),
+                w[:, None, None] * np.concatenate([in_x, vertical[:, None]], axis=1),
                 w[:, None] * np.concatenate([in_z, np.einsum("nc,nc->n", g, in_z)[:, None]],
                                             axis=1))
+
+    def _profile_rates(self, r, d, g, cosine, metric):
+        """What a linearised seabed profile (SeabedTerm.linearise_profile) adds to
+        _plane_law's derivatives, at node positions r (n, 3) and slips d (n, 2), with
+        the secant gradient g = g(d_e) e (n, 2) (Profile.slopes: d_e = (x - p0).e, z_b'
+        the interpolant's slope, g' the secant's rate), cos(theta) (n,) and G d
+        (n, 2): the derivative of the fixed point of the line's own iterations, whose
+        friction is the plane's law with g read at each node. Returns
+
+            lift = (z_b' - p g g' cos^2) e       (dR/dx = k cos(theta) lift; p the
+                                                  penetration, R = k cos(theta) p),
+            turn = g' e                          (dg/dx = g' e e^T: the vertical part
+                                                  g.f turns, -(f.e) g' e^T in x),
+            G d + (g.d) g' (d.e) e               (mu^2 |d|_G d|d|_G/dx),
+
+        (n, 2) each, 1 and 1/m and m; on a plane lift = g and the rest vanish."""
+        seabed = self.seabed_term.seabed
+        rise, secant, rate = seabed.shape.slopes(r[:, 0], r[:, 1])
+        along = seabed.shape.direction
+        depth = seabed.penetration(r[:, 2], seabed.heights(r[:, 0], r[:, 1]))
+        lift = (rise - depth * secant * rate * cosine**2)[:, None] * along
+        turn = rate[:, None] * along
+        metric = metric + ((np.einsum("nc,nc->n", g, d) * rate * (d @ along))[:, None]
+                           * along)
+        return lift, turn, metric
 
     def add_gradient(self, g, state):
         """-w_n f_n on the horizontal positions, into g's d3 x and y rows through their

@@ -93,8 +93,8 @@ secant block and the z column of the limit mu R following the contact; on a plan
 three rows, the friction's vertical part g.f = g^T times its horizontal rows, and the
 limit following x as well, k cos(theta) d g^T): unsymmetric, so A is J (its LU), and
 the forces read the block through its transpose. A sliding node's stiffness is the
-loading tangent (the slip continued); unloading it would stick. On a flat seabed or a
-sloping plane with one coefficient only (the friction's Newton steps: ``in_newton``).
+loading tangent (the slip continued); unloading it would stick. With one coefficient
+only (FrictionTerm.held_exact), on a flat seabed, a sloping plane or a profile (below).
 settle() records the friction of the settled state (FrictionTerm.follow_state), which
 the end forces read. At a clamped or flex-jointed end the rotations' response takes the
 same block: the seabed's reaction on the start read through H_n's transpose in the
@@ -123,10 +123,18 @@ B_n is the plane's k w_n N N^T with the node's own normal. settle() takes Newton
 steps on that system: their stationary point is the iteration's fixed point. A seabed
 grid the same way, its slopes vectors in the plan (Grid.slopes: grad z_b, g and
 Dg = dg/d(x, y)), B_n unsymmetric within delta / 2 of a grid line.
+With the seabed's friction (one coefficient) on a profile the fixed point's friction is
+the plane's law with g read at each node, F = (f, g(x).f), R = k cos(theta) (z_b(x) - z)_+:
+its block is the plane's with the limit following x through z_b' and k_v(g), g.f turning
+with g' e e^T, and |d|_G's G = I + g g^T turning too (FrictionTerm._profile_rates),
+added to B_n in the recorded block (the friction's rows after the profile's); a clamp's
+held columns of J are then read off the assembled J whole (_add_jacobian_columns, which
+holds the profile's share too).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
-seabed's friction with two coefficients or on a profile (no Newton steps); any load
-outside the Newton system (the sea surface's wet and dry parts, attachments that reach it).
+seabed's friction with two coefficients (no Newton steps; its axes turn with the
+tangent) or on a seabed grid (its law's turn with Dg not written); any load outside the
+Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
 each line on its own sub-communicator.
@@ -847,7 +855,8 @@ class HeldLine:
                 # J's columns at the clamps' rotations: the drag at the clamped node
                 # turns with it (DragTerm.turn_columns)
                 self._add_turn_columns(hessian, held_data[0], turned, vecs)
-            self._add_profile_columns(hessian, held_data[0], turned, vecs)
+            if not self.friction:   # else J's columns read off whole (below)
+                self._add_profile_columns(hessian, held_data[0], turned, vecs)
             flexed = self._flexed(hessian) if rotations else []
             for entry in flexed:
                 turned.extend(entry[-1])
@@ -856,9 +865,9 @@ class HeldLine:
             for term in problem.terms:
                 if term.position_components and term not in self.friction:
                     term.add_hessian(recorder)
+            self._record_profile(recorder)
             if self.friction:
                 recorder.add_friction(self.friction)
-            self._record_profile(recorder)
             unsymmetric = (hessian.resultants or bool(self.friction)
                            or self.profile is not None)
             columns = hessian.chord_forms(frames[:, 2])
@@ -1359,18 +1368,18 @@ class HeldLine:
 
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
-        if self.friction and any(not term.in_newton for term in self.friction):
+        if any(not term.held_exact for term in self.friction):
             raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
                                 "its seabed friction with two coefficients or on a seabed "
-                                "profile: give the friction one coefficient on a flat or "
-                                "uniformly sloping seabed")
+                                "grid: give the friction one coefficient, on a flat, "
+                                "uniformly sloping or profiled seabed")
         # a profile's or grid's lagged push: its linearisation is the seabed term's
         # (SeabedTerm.linearise_profile)
         lagged = {term for term in self.problem.terms if self.profile is not None
                   and getattr(term, "contact", None) is self.profile}
-        loose = [term for term in self.problem.terms if term not in lagged and (
-            not term.in_newton
-            or not (term.conservative or term.follower or term in self.friction))]
+        loose = [term for term in self.problem.terms
+                 if term not in lagged and term not in self.friction
+                 and not (term.in_newton and (term.conservative or term.follower))]
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))

@@ -59,9 +59,10 @@ def factory(system):
     return make_line
 
 
-def body_differences(solver, h=(1e-4,) * 3 + (1e-5,) * 3):
+def body_differences(solver, h=(1e-4,) * 3 + (1e-5,) * 3, settle=False):
     """-d(the lines' share of the first body's residual)/d(its pose), central
-    differences of the lines re-solved at moved and turned poses, (6, 6)."""
+    differences of the lines re-solved at moved and turned poses, (6, 6); ``settle``:
+    each re-solve settled (SystemSolver.evaluate)."""
     state, layout = solver.state, solver.layout
     numeric = np.empty((6, 6))
     for j in range(6):
@@ -70,7 +71,7 @@ def body_differences(solver, h=(1e-4,) * 3 + (1e-5,) * 3):
             step = np.zeros(layout.size)
             step[layout.body_dofs[0][j]] = sign * h[j]
             moved = state.moved(step, layout)
-            ok, f, lin = solver.evaluate(moved)
+            ok, f, lin = solver.evaluate(moved, settle=settle)
             assert ok
             r, _ = solver.lines_part(moved, f, lin)
             sides.append(r[layout.body_dofs[0]])

@@ -53,8 +53,8 @@ def frictional(mu, load=SIDE):
     return dataclasses.replace(system, environment=environment, bodies=(body,))
 
 
-def solved(system, comm, load_steps=1):
-    solver = SystemSolver(system, held_lines(system, TIGHT), comm,
+def solved(system, comm, load_steps=1, tolerance=TIGHT):
+    solver = SystemSolver(system, held_lines(system, tolerance), comm,
                           settings=Settings(rtol=1e-12, load_steps=load_steps))
     try:
         result = solver.solve()
@@ -250,17 +250,24 @@ def refusal(system_line, environment, ends, ask):
     return message
 
 
-@pytest.mark.parametrize("case", ["two coefficients", "two coefficients on a sloping plane"])
+@pytest.mark.parametrize("case", ["two coefficients", "two coefficients on a sloping plane",
+                                  "one coefficient on a seabed grid"])
 def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
     """mu_a != mu_l takes no Newton steps (physics/friction.py), on a flat seabed or a
-    sloping plane: no exact stiffness; the refusal names the line and what to change.
-    The run says once what the friction is measured from."""
-    system = frictional((0.5, 0.8))
+    sloping plane: no exact stiffness; nor friction on a seabed grid (its law's turn
+    with the secant's derivative in two directions is not written); the refusal names
+    the line and what to change. The run says once what the friction is measured
+    from."""
+    system = frictional(0.5 if "grid" in case else (0.5, 0.8))
     environment = system.environment
     if case == "two coefficients on a sloping plane":
         environment = dataclasses.replace(system.environment, seabed_slope=2.0,
                                           seabed_direction=30.0,
                                           seabed_origin=(-32.5, 56.292))
+    if case == "one coefficient on a seabed grid":
+        level = tuple((x, y, -30.2) for x in (-100.0, 100.0) for y in (-100.0, 100.0))
+        environment = dataclasses.replace(system.environment, seabed=None,
+                                          seabed_profile=level, seabed_origin=(0.0, 0.0))
     ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
     message = refusal(system.lines[1], environment, ends, HeldLine.stiffness)
     assert "one coefficient" in message

@@ -91,3 +91,50 @@ def test_a_profile_with_a_slope_is_refused_naming_both(rows_file, tmp_path):
     line = refused(tmp_path, ["-rod_system", DECK, "-rod_seabed_profile", str(rows_file),
                               "-rod_seabed_slope", "2"])
     assert "-rod_seabed_profile" in line and "-rod_seabed_slope" in line, line
+
+
+@pytest.fixture(scope="module")
+def frictional_deck(tmp_path_factory):
+    """The deck with the seabed's friction in its options (MoorDyn's
+    FrictionCoefficient 0.5)."""
+    path = tmp_path_factory.mktemp("friction") / "frictional.dat"
+    text = open(DECK).read().replace(
+        "30            WtrDpth", "0.5           FrictionCoefficient\n30            WtrDpth")
+    assert "FrictionCoefficient" in text
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_frictional_file_on_a_profile_equals_the_api(frictional_deck, rows_file,
+                                                        tmp_path, ranks):
+    """Friction on a profile, the system's stiffness exact (system/held_line.py): the
+    command line runs it (before, refused: "no exact stiffness of its seabed friction
+    ... on a seabed profile") and equals the API on the same file."""
+    script, numbers = tmp_path / "api.py", tmp_path / "api.npz"
+    script.write_text(f"""
+import dataclasses, numpy as np
+from petsc_rod.api import read_moordyn, solve_system
+system, notes = read_moordyn({str(frictional_deck)!r})
+sea = dataclasses.replace(system.environment, seabed=None, seabed_profile={ROWS!r},
+                          seabed_direction=0.0, seabed_origin=(0.0, 0.0))
+assert sea.seabed_friction is not None
+r = solve_system(dataclasses.replace(system, environment=sea))
+np.savez({str(numbers)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffness)
+""")
+    process = subprocess.run([sys.executable, str(script)], cwd=REPO_ROOT, env=child_env(),
+                             capture_output=True, text=True, timeout=600, check=False)
+    assert process.returncode == 0, describe(process)
+    api = np.load(numbers)
+    out = tmp_path / "friction.h5"
+    process = run_petsc_rod(["-rod_system", str(frictional_deck), "-rod_seabed_profile",
+                             str(rows_file), "-rod_output", str(out)], ranks, 600)
+    assert process.returncode == 0, describe(process)
+    assert "seabed friction measured from the lines' as-laid shapes" in process.stdout
+    with h5py.File(out, "r") as f:
+        x, K = f["system"]["body_positions"][0], f["system"]["body_stiffness"][0]
+    print("body", x)
+    assert same(x[:3], api["x"][:3]) and same(x[3:], api["x"][3:])
+    for rows in (slice(0, 3), slice(3, 6)):
+        for columns in (slice(0, 3), slice(3, 6)):
+            assert same(K[rows, columns], api["K"][rows, columns])
