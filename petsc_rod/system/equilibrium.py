@@ -57,6 +57,7 @@ from petsc_rod.errors import (RodDivergedError, RodError, RodInputError, RodInte
 from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.system.bodies import DOF_NAMES, Bodies, lever_map, skew
 from petsc_rod.system.placement import Placement, line_elements
+from petsc_rod.system.predictor import predict
 from petsc_rod.system.verdict import system_verdict
 
 
@@ -770,9 +771,8 @@ class SystemSolver:
         equilibrium, or that Newton fails: the solver is then as made (its lines made
         again), for the continuation from the unloaded system. ``prediction`` says
         which. Collective (every rank predicts the same state alone)."""
-        from petsc_rod.system.predictor import predict
         self.predictable = False                # the first solve's only
-        state, why = predict(self.system, self.settings)
+        state, why = predict(self.system, self.settings, type(self))
         if state is None:
             self.prediction = f"not used: {why}"
             return None

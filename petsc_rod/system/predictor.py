@@ -256,21 +256,21 @@ def catenary_lines(system):
     return make_line
 
 
-def predict(system, settings):
+def predict(system, settings, solver_type):
     """(State of the catenaries' equilibrium, None) of ``system`` under its loads
-    (``settings``: the system's, with at most HALVINGS halvings)
-    (SystemSolver with catenary_lines on this rank alone: every rank computes the same
-    numbers), or (None, why) where no catenary stands in for a line, the catenaries'
-    system has no equilibrium, or no line's end moves by NEAR of its length from the
-    system's start to it."""
+    (``settings``: the system's, with at most HALVINGS halvings), solved by
+    ``solver_type`` (system/equilibrium.SystemSolver, handed in by the solver that asks:
+    this module stands below it) with catenary_lines on this rank alone (every rank
+    computes the same numbers), or (None, why) where no catenary stands in for a line,
+    the catenaries' system has no equilibrium, or no line's end moves by NEAR of its
+    length from the system's start to it."""
     from petsc4py import PETSc
-    from petsc_rod.system.equilibrium import SystemSolver
     why = refusal(system)
     if why:
         return None, why
-    solver = SystemSolver(system, catenary_lines(system), PETSc.COMM_SELF,
-                          settings=replace(settings, predictor=False,
-                                           max_halvings=min(settings.max_halvings, HALVINGS)))
+    solver = solver_type(system, catenary_lines(system), PETSc.COMM_SELF,
+                         settings=replace(settings, predictor=False,
+                                          max_halvings=min(settings.max_halvings, HALVINGS)))
     try:
         start = solver.end_positions(solver.state)
         solver.solve()
