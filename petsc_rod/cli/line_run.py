@@ -474,7 +474,7 @@ def start_from(problem, values, given, say):
             problem.state.set_from_curve(curve)
     else:
         problem.state.set_straight()
-    lay_friction_anchors(problem, curve, values["rod_steps"], say)
+    lay_friction_anchors(problem, say)
     return 0.0
 
 

@@ -322,17 +322,17 @@ def _rows(frames):
     return rows
 
 
-def solver_for(mesh, scene, settings, steps=1, say=None):
+def solver_for(mesh, scene, settings, say=None):
     """The UzawaSolver of a new RodProblem of ``scene`` on ``mesh`` at the asked penalty
     of ``settings`` (what a script or a test makes), the seabed friction's anchors laid
     as the command line and the API lay them (problem/build.lay_friction_anchors: the
-    catenary at the first of ``steps`` load steps' load factor, whatever start the
+    catenary between the ends at each load step's load factor, whatever start the
     caller sets), its line where none can be drawn said by ``say`` (default: printed on
     the mesh's rank 0). The caller destroys both: ``solver.destroy();
     solver.problem.destroy()``. Collective."""
     problem = RodProblem(mesh, scene, settings.asked_penalty)
     try:
-        lay_friction_anchors(problem, None, steps,
+        lay_friction_anchors(problem,
                              say or (lambda text: PETSc.Sys.Print(text, comm=mesh.comm)))
         return UzawaSolver(problem, settings)
     except Exception:
