@@ -81,9 +81,10 @@ def symmetrised_text(symmetrised):
         return ""
     return (f"K takes the symmetric part of the seabed contact's stiffness at {count} "
             f"grounded node{'s' if count != 1 else ''} within delta/2 of a seabed profile's "
-            f"row or grid line (its antisymmetric part up to {ratio:.3g} of it there: the lagged push "
-            "turns over delta about a row and has no energy; docs/riser.md §3a), so the "
-            "modes are approximate there")
+            f"row or grid line, or in a grid cell that twists (its antisymmetric part up "
+            f"to {ratio:.3g} of it there: the lagged push turns over delta about a row, "
+            "and with the penetration in a twisted cell, and has no energy; docs/riser.md "
+            "§3a), so the modes are approximate there")
 
 
 class ModesRefused(Exception):

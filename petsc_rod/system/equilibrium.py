@@ -313,7 +313,8 @@ class SystemSolver:
         self.placement = Placement.make(comm or PETSc.COMM_WORLD, sizes)
         self.make_line = make_line
         # the catenary predictor (_predicted): whether the first solve tries it, and
-        # what it did (None: not tried; "used"; else why not, or why it failed)
+        # what it did in the last solve (None: not tried there; "used"; else why not,
+        # or why it failed)
         # (not where a continuation in load steps is asked for: Settings.load_steps)
         self.predictable = (settings.predictor and settings.load_steps == 1
                             and getattr(make_line, "predictable", False))
@@ -716,7 +717,10 @@ class SystemSolver:
         the system unloaded), then the continuation of the loads towards the new ones,
         each failing step halved up to ``max_halvings`` times; RodDivergedError saying
         why when that did not help, RodInterrupted where a stop signal ended it (the
-        lines' walks stop at one and fail). Leaves the lines at the solution."""
+        lines' walks stop at one and fail). Leaves the lines at the solution.
+        ``prediction`` says what the catenary predictor did in this solve (None: a
+        re-solve, warm from the last equilibrium, tries none)."""
+        self.prediction = None
         try:
             return self._solve(system)
         except RodDivergedError:

@@ -78,6 +78,21 @@ def test_the_first_solve_starts_from_the_catenaries_and_lands_where_it_did():
     assert np.abs(K - K_plain).max() < 1e-6 * np.abs(K_plain).max()
 
 
+def test_a_warm_re_solve_says_nothing_of_the_predictor():
+    """The first solve predicted ("used"); a re-solve under another load starts from the
+    last equilibrium (a sweep's warm case) and its ``prediction`` is None, so the run
+    does not repeat the note for it."""
+    system = small_system()
+    solver = SystemSolver(system, held_lines(system), PETSc.COMM_WORLD)
+    try:
+        solver.solve()
+        assert solver.prediction == "used"
+        solver.solve(small_system((2e4, 1e4, 0, 0, 0, 0)))
+        assert solver.prediction is None
+    finally:
+        solver.destroy()
+
+
 def test_a_failed_prediction_is_the_plain_solve_bit_for_bit(monkeypatch):
     """The rods failing at the predicted pose (their first evaluation there made to
     fail): the solver's lines are made again and it solves from its start as without
