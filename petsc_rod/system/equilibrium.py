@@ -310,7 +310,8 @@ class SystemSolver:
                                    system.bodies for v in (b.cog, b.cob)]
                           + [float(np.abs(self.layout.local).max(initial=0.0))])
         sizes = [line_elements(line) for line in system.lines] if sizes is None else sizes
-        self.placement = Placement.make(comm or PETSc.COMM_WORLD, sizes)
+        self.comm = comm or PETSc.COMM_WORLD       # the catenary predictor's too
+        self.placement = Placement.make(self.comm, sizes)
         self.make_line = make_line
         # the catenary predictor (_predicted): whether the first solve tries it, and
         # what it did in the last solve (None: not tried there; "used"; else why not,
@@ -774,9 +775,9 @@ class SystemSolver:
         None where no catenary stands in for a line, the catenaries have no
         equilibrium, or that Newton fails: the solver is then as made (its lines made
         again), for the continuation from the unloaded system. ``prediction`` says
-        which. Collective (every rank predicts the same state alone)."""
+        which. Collective (the catenaries dealt over the ranks as the rods are)."""
         self.predictable = False                # the first solve's only
-        state, why = predict(self.system, self.settings, type(self))
+        state, why = predict(self.system, self.settings, type(self), self.comm)
         if state is None:
             self.prediction = f"not used: {why}"
             return None

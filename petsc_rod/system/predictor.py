@@ -256,19 +256,20 @@ def catenary_lines(system):
     return make_line
 
 
-def predict(system, settings, solver_type):
+def predict(system, settings, solver_type, comm):
     """(State of the catenaries' equilibrium, None) of ``system`` under its loads
     (``settings``: the system's, with at most HALVINGS halvings), solved by
     ``solver_type`` (system/equilibrium.SystemSolver, handed in by the solver that asks:
-    this module stands below it) with catenary_lines on this rank alone (every rank
-    computes the same numbers), or (None, why) where no catenary stands in for a line,
-    the catenaries' system has no equilibrium, or no line's end moves by NEAR of its
-    length from the system's start to it."""
-    from petsc4py import PETSc
+    this module stands below it) with catenary_lines on ``comm``, the asking solver's
+    communicator (PETSc.Comm): its placement deals the catenaries over the ranks as it
+    deals the rods, each rank solves its share and the solver shares their forces and
+    stiffnesses, so every rank ends with the same state. (None, why) where no catenary
+    stands in for a line, the catenaries' system has no equilibrium, or no line's end
+    moves by NEAR of its length from the system's start to it. Collective on ``comm``."""
     why = refusal(system)
     if why:
         return None, why
-    solver = solver_type(system, catenary_lines(system), PETSc.COMM_SELF,
+    solver = solver_type(system, catenary_lines(system), comm,
                          settings=replace(settings, predictor=False,
                                           max_halvings=min(settings.max_halvings, HALVINGS)))
     try:

@@ -130,9 +130,9 @@ def test_what_a_catenary_cannot_stand_in_for():
         "line Line2: a clamped or flex-jointed end"
     # a body given where the catenaries rest (1.6464 m up) barely moves: not used
     rest = small_system((0, 0, 0, 0, 0, 0))
-    state, why = predict(rest, Settings(), SystemSolver)
+    state, why = predict(rest, Settings(), SystemSolver, PETSc.COMM_WORLD)
     assert why is None and state.bodies.positions[0][2] == pytest.approx(1.6464, abs=1e-3)
     there = dataclasses.replace(rest.bodies[0], position=(0, 0, 1.6464, 0, 0, 0))
     state, why = predict(dataclasses.replace(rest, bodies=(there,)), Settings(),
-                         SystemSolver)
+                         SystemSolver, PETSc.COMM_WORLD)
     assert state is None and why.startswith("the catenaries' ends move")
