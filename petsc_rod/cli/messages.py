@@ -48,11 +48,20 @@ def halved(event):
 def stability_text(report):
     """The step line's account of which equilibrium was reached (stability.py)."""
     if report.stable is None:
-        return ""
+        return _left_without_verdict(report)
     if not report.stable:
         return ", a saddle (the second variation has a negative direction)"
     left = f" after leaving {report.escapes} saddle(s)" if report.escapes else ""
     return f", stable{left} (second variation positive)"
+
+
+def _left_without_verdict(report):
+    """Where a term has no energy (no verdict): the states with a negative direction of
+    H the step left (driver.UzawaSolver.checks_curvature), or ''."""
+    if not report.escapes:
+        return ""
+    return (f", after leaving {report.escapes} state(s) with negative curvature "
+            "(no stability verdict: not conservative)")
 
 
 def newton_text(report):
@@ -72,7 +81,7 @@ def short_stability(report):
     """The step line's word on which equilibrium was reached: 'stable', 'stable after
     leaving n saddle(s)', 'a saddle', or '' where it was not tested (stability.py)."""
     if report.stable is None:
-        return ""
+        return _left_without_verdict(report)
     if not report.stable:
         return ", a saddle"
     return ", stable" + (f" after leaving {report.escapes} saddle(s)" if report.escapes else "")

@@ -97,9 +97,29 @@ class UzawaSolver:
 
     @property
     def tests_stability(self):
-        """Whether converged steps are tested (§10): asked for, and every term has an
-        energy (a current's drag has none, docs/riser.md)."""
+        """Whether converged steps get a stability verdict (§10): asked for, and every
+        term has an energy (a current's drag has none, docs/riser.md)."""
         return self.settings.check_stability and self.problem.conservative
+
+    @property
+    def checks_curvature(self):
+        """Whether converged steps are tested for a negative direction of H and leave it
+        (§10): asked for (-rod_al_stability, on by default), whatever the terms. On a
+        problem with a term without an energy (a current's drag, seabed friction) H is
+        the second variation of the energy of the line and its conservative loads with
+        the symmetric part of the other terms' linearisation: H positive definite is no
+        stability verdict there (``_verdict``), but a negative direction is a state no
+        engineer wants handed back, such as a line compressed into an arch between its
+        ends, which a straight start with a stiff penalty can converge to; it is left as
+        a conservative line's saddle is, and a step that cannot leave it ends not
+        converged (STOP_SADDLE)."""
+        return self.settings.check_stability
+
+    def _verdict(self, stable):
+        """The step's recorded verdict of a test that found ``stable`` (True, False):
+        a saddle (False) on any problem, stable (True) on a conservative one only (None,
+        no verdict, where a term has no energy)."""
+        return stable if self.tests_stability or stable is False else None
 
     # --- one continuation step ------------------------------------------------------
     def solve_step(self, t, label="", observer=None):
@@ -119,11 +139,11 @@ class UzawaSolver:
             self.settings, self.problem.scale, self._newton_switch(), label, observer)
         try:
             self._iterate(step)
-            while step.converged and self.tests_stability:
+            while step.converged and self.checks_curvature:
                 if step.verified_by_newton:
                     # Newton's last factorisation, at the attempt the step ended at or
                     # one iteration before, showed it stable
-                    step.stability_tested(True)
+                    step.stability_tested(self._verdict(True))
                     break
                 # the iteration's work is not needed while H is factored: its memory
                 # goes to the factorisation (the next solve sets the SNES up again)
@@ -135,7 +155,7 @@ class UzawaSolver:
                     # verdict, a failed attempt of the step (the continuation halves it)
                     step.stop(stopping.STOP_UNTESTED)
                     break
-                step.stability_tested(stable)
+                step.stability_tested(self._verdict(stable))
                 if stable is not False:
                     break
                 angle = step.escape_angle()
@@ -227,7 +247,7 @@ class UzawaSolver:
         # is left early too (after a second indefinite attempt: wants_early_escape), as
         # a straight start must, whose first steps end the line nearer than its length
         # and buckle it (docs/method.md §10)
-        if (outcome != newton.INDEFINITE or not self.tests_stability
+        if (outcome != newton.INDEFINITE or not self.checks_curvature
                 or not step.wants_early_escape()):
             return
         try:
