@@ -112,8 +112,15 @@ class UzawaSolver:
         engineer wants handed back, such as a line compressed into an arch between its
         ends, which a straight start with a stiff penalty can converge to; it is left as
         a conservative line's saddle is, and a step that cannot leave it ends not
-        converged (STOP_SADDLE)."""
-        return self.settings.check_stability
+        converged (STOP_SADDLE). Not where seabed friction holds some node (its
+        FrictionTerm.holds): the slide's dissipation, which H leaves out, can hold a
+        state along H's negative direction. Collective."""
+        if not self.settings.check_stability:
+            return False
+        if self.problem.conservative:
+            return True
+        state = self.problem.state
+        return not any(term.holds(state) for term in self.problem.terms)
 
     def _verdict(self, stable):
         """The step's recorded verdict of a test that found ``stable`` (True, False):

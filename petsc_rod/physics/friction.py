@@ -362,6 +362,18 @@ class FrictionTerm(NodalLoadTerm):
         positions = curve(S.ravel())[0]
         self.anchors = positions[:, :2].reshape(S.shape + (2,)).copy()
 
+    def holds(self, state):
+        """Whether the friction acts on the state: some node on the seabed, on any rank
+        (the law's derivative non-zero there). What the state is left for where H has a
+        negative direction (driver.UzawaSolver.checks_curvature): the slide's
+        dissipation is not in H, and a grounded line pushed across a sloping seabed is
+        held by it where H has a negative direction (tests/solver/test_friction_newton.py).
+        Collective."""
+        if self.anchors is None:
+            return False
+        grounded = np.abs(self._newton_law(state)[1]).sum(axis=(1, 2)) > 0
+        return self.mesh.global_sum(float(np.count_nonzero(grounded))) > 0
+
     @property
     def stick(self):
         """The nodes whose spring is the stick stiffness (ne, 3): grounded and within

@@ -175,6 +175,12 @@ class Term:
         (analysis/modes.py): their K is then symmetrised, not exact."""
         return 0, 0.0
 
+    def holds(self, state):
+        """Whether the term can hold a state along a negative direction of H, which
+        leaves its dissipation out (seabed friction on grounded nodes: FrictionTerm);
+        such a state is then not left (driver.UzawaSolver.checks_curvature). Collective."""
+        return False
+
     def add_jacobian(self, jacobian):
         """An unsymmetric term's entries of the Newton Jacobian beyond H
         (analysis/jacobian.py NewtonJacobian, before assembly): a follower's load's
