@@ -67,7 +67,8 @@ stability test see the friction with its limit held at its current value); the z
 unsymmetric, its symmetric part indefinite where the slip is oblique to the line, and
 the turn of the axes a, l with the tangent, left out, is of the order of R: the steps
 failed there (docs/riser.md §3b), so such a run takes none (``in_newton``); nor on a
-seabed profile (its curvature is not in the Newton steps, slope_load.py).
+seabed profile or grid, whose frictionless contact the steps take (slope_load.py) but
+whose friction's steps are not written for a grid nor measured on a profile.
 
 On a sloping plane z_b = z_0 + g.x (g constant) the force is F_n = (f_n, g.f_n) on
 (x_n, z_n), its size |d|_G = sqrt(d^T G d) / mu with G = I + g g^T (the tangent-plane
@@ -85,11 +86,11 @@ global step carries g.f as its work through the heights' chain (add_iterate_load
 that its fixed point is the Newton steps' stationary point. Not conservative: friction
 dissipates, so the run gives no stability verdict (as with the drag).
 
-On a seabed profile a line's own run takes no Newton steps (above), and its fixed point
-is the plane's law with the secant gradient g = g(d) e read at each node and
-R = k cos(theta) (z_b(d) - z)_+, z_b the interpolant (environment/bathymetry.py). A line
-of a system whose contact is linearised (SeabedTerm.linearise_profile) takes that fixed
-point's derivative for its stiffness (``held_exact``, _profile_rates): the plane's block
+On a seabed profile a line's own run with friction takes no Newton steps (above), and
+its fixed point is the plane's law with the secant gradient g = g(d) e read at each node
+and R = k cos(theta) (z_b(d) - z)_+, z_b the interpolant (environment/bathymetry.py). A
+line of a system (its contact linearised by the seabed term, SeabedTerm.profile) takes
+that fixed point's derivative for its stiffness (``held_exact``, _profile_rates): the plane's block
 with the limit's k cos(theta) g replaced by dR/dx = k cos(theta) (z_b' - p g g' cos^2)
 e, G's oblique projection by mu^2 |d|_G d|d|_G/dx = G d + (g.d) g' (d.e) e, and the
 vertical row less (f.e) g' e^T (g.f with g turning), g' the secant's rate
@@ -203,11 +204,10 @@ class FrictionTerm(NodalLoadTerm):
     def held_exact(self):
         """Whether a held line's stiffness with this friction is exact
         (system/held_line.py): one coefficient, on a flat seabed, a sloping plane or a
-        profile whose contact the line linearises (SeabedTerm.linearise_profile; the
-        law's derivatives with g read at each node along the profile's direction,
-        _profile_rates); not on a grid, whose g turns in two directions."""
+        profile (the law's derivatives with g read at each node along the profile's
+        direction, _profile_rates); not on a grid, whose g turns in two directions."""
         seabed = self.seabed_term.seabed
-        along_profile = (self.seabed_term.profiled
+        along_profile = (self.seabed_term.profile
                          and hasattr(seabed.shape, "direction"))
         return ((seabed.flat or seabed.plane or along_profile)
                 and self.friction.axial == self.friction.lateral)
@@ -257,7 +257,7 @@ class FrictionTerm(NodalLoadTerm):
         if self.seabed_term.seabed.flat:
             return
         if self._springs_stale and (self.seabed_term.seabed.plane
-                                    or self.seabed_term.profiled):
+                                    or self.seabed_term.profile):
             # after Newton steps: the friction at their positions (the last solve's is
             # that of the state before them)
             work = -self._newton_law(state)[0][:, 2]
@@ -448,7 +448,7 @@ class FrictionTerm(NodalLoadTerm):
         f = -R d / |d|_G, whose derivative in x is
         -R / |d|_G (I - d (G d)^T / (mu^2 |d|_G^2)) - d (k cos(theta) g)^T / |d|_G and in
         z d k cos(theta) / |d|_G; the vertical part g.f has g^T times them. On a
-        linearised profile g is each node's secant gradient and the derivatives take
+        profile g is each node's secant gradient and the derivatives take
         its turn (_profile_rates). Returns (-w F (n, 3), -w dF/dx (n, 3, 2),
         -w dF/dz (n, 3)), N and N/m."""
         seabed = self.seabed_term.seabed
@@ -468,7 +468,7 @@ class FrictionTerm(NodalLoadTerm):
         limit = np.divide(seabed.stiffness * cosine, norm, out=np.zeros_like(norm),
                           where=slide)                                    # k cos / |d|_G
         lift = turn = None
-        if self.seabed_term.profiled:
+        if self.seabed_term.profile:
             lift, turn, metric = self._profile_rates(r, d, g, cosine, metric)
         in_x = ((stick * stiffness)[:, None, None] * np.eye(2)
                 + scale[:, None, None] * (np.eye(2) - d[:, :, None] * metric[:, None, :]
@@ -495,7 +495,7 @@ class FrictionTerm(NodalLoadTerm):
                                             axis=1))
 
     def _profile_rates(self, r, d, g, cosine, metric):
-        """What a linearised seabed profile (SeabedTerm.linearise_profile) adds to
+        """What a seabed profile (SeabedTerm.profile) adds to
         _plane_law's derivatives, at node positions r (n, 3) and slips d (n, 2), with
         the secant gradient g = g(d_e) e (n, 2) (Profile.slopes: d_e = (x - p0).e, z_b'
         the interpolant's slope, g' the secant's rate), cos(theta) (n,) and G d

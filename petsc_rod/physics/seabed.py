@@ -12,15 +12,15 @@ node heights, so its gradient in the slopes is the adjoint of their integral
 the Newton system through the heights' chain (SecondVariation.add_height_curvature): a
 semi-smooth Newton step, the active set that of the iterate.
 
-On a seabed profile or grid the run takes no Newton steps (physics/slope_load.py). A
-line of a system asks for its fixed point's linearisation (linearise_profile, for its
-stiffness only): the force at the state's positions in the gradient, and its whole
-derivative B_n (Seabed.profile_derivatives, unsymmetric near a row or grid line) on the
-x, y, z chains, H its symmetric part and the Newton Jacobian the rest (add_jacobian). H
-on a profile or grid is that symmetric part whether linearised or not (the modes' K,
-analysis/modes.py): farther than delta/2 from every row B_n = k w_n N N^T, a plane's
-with the node's own normal, so K is exact there; nearer, symmetrised_nodes says where
-it is not.
+On a seabed profile or grid the Newton steps take the lagged iteration's fixed point
+(physics/slope_load.py) linearised: the force at the state's positions in the gradient,
+and its whole derivative B_n (Seabed.profile_derivatives, unsymmetric near a row or grid
+line) on the x, y, z chains, H its symmetric part and the Newton Jacobian the rest
+(add_jacobian; ``unsymmetric``). Their stationary point is that fixed point, so a line's
+run ends in Newton steps as on a plane, and a line of a system has its exact stiffness
+from the same system (system/held_line.py). H is the modes' K (analysis/modes.py):
+farther than delta/2 from every row B_n = k w_n N N^T, a plane's with the node's own
+normal, so K is exact there; nearer, symmetrised_nodes says where it is not.
 """
 
 import numpy as np
@@ -55,9 +55,6 @@ class SeabedTerm(NodalLoadTerm):
             self.position_components = (0, 1, HEIGHT)
         self.vertical = self.contact = None
         self._solved = None         # the z slope of the contact's last solve (node_loads)
-        # a profile's contact in the Newton system (linearise_profile): a held line's
-        # exact stiffness only; a line's own run leaves it lagged
-        self.profiled = False
 
     @property
     def profile(self):
@@ -66,17 +63,11 @@ class SeabedTerm(NodalLoadTerm):
         return (not self.seabed.flat and not self.seabed.plane
                 and hasattr(self.seabed.shape, "slopes"))
 
-    def linearise_profile(self):
-        """On a seabed profile or grid, put the contact's force at the state's positions
-        and its whole derivative (Seabed.profile_derivatives) into the gradient, H and
-        J: the derivative of the lagged iteration's fixed point (physics/slope_load.py),
-        which a line of a system takes for its exact stiffness (system/held_line.py).
-        The run's iterations are unchanged: the slope load still keeps the run out of
-        Newton's steps (its ``in_newton``). Nothing on another seabed. Call it before
-        the problem's second variation and Newton solver are made."""
-        if not self.profile:
-            return
-        self.profiled = self.unsymmetric = True
+    @property
+    def unsymmetric(self):
+        """On a profile or grid the Newton Jacobian holds its block's antisymmetric part
+        (add_jacobian), beyond H: the steps solve with J (analysis/jacobian.py)."""
+        return self.profile
 
     def build(self, slope_matrices, penalty):
         """The vertical problem with the slope problem's element matrices 2 c3 K + R W
@@ -112,7 +103,7 @@ class SeabedTerm(NodalLoadTerm):
     def _height_derivatives(self, state):
         """dE_s/dz_n = -k w_n (z_b - z_n)_+ and d2E_s/dz_n^2 = k w_n [z_n < z_b] at the owned
         nodes, (n_nodes,) each, N and N/m, at the heights of the state's centreline (on
-        a flat seabed: the Newton steps are not taken on another, slope_load.py)."""
+        a flat seabed; on another, _plane_derivatives)."""
         return self.seabed.height_derivatives(state.node_positions()[:, 2],
                                               state.node_weights)
 
@@ -126,9 +117,9 @@ class SeabedTerm(NodalLoadTerm):
     def add_gradient(self, g, state):
         """dE_s/dr'_z at the nodes (add_position_gradient) into g's d3 z rows; on a
         sloping plane dE_s/dr' of all three components (Seabed.position_derivatives), on
-        a linearised profile -w_n f_n's (Seabed.profile_derivatives). The state's r is
+        a profile or grid -w_n f_n's (Seabed.profile_derivatives). The state's r is
         that of its fields (RodProblem.energy_gradient). Collective."""
-        if self.seabed.plane or self.profiled:
+        if self.seabed.plane or self.profile:
             gradient = self._plane_derivatives(state)[0]
             self.add_position_gradient(g, state, {c: gradient[:, c] for c in range(3)})
             return
@@ -143,7 +134,7 @@ class SeabedTerm(NodalLoadTerm):
         symmetrised_nodes)."""
         if self.seabed.plane or self.profile:
             block = self._plane_derivatives(hessian.problem.state)[1]
-            if self.profile:        # a linearised one's J carries the rest (add_jacobian)
+            if self.profile:        # J carries the rest (add_jacobian)
                 block = 0.5 * (block + block.transpose(0, 2, 1))
             hessian.add_position_curvature(block, self.position_components)
             return
@@ -163,9 +154,9 @@ class SeabedTerm(NodalLoadTerm):
         return int(unsymmetric.sum()), float(ratio.max(initial=0.0))
 
     def add_jacobian(self, jacobian):
-        """On a linearised profile (linearise_profile): the antisymmetric part of its
-        block B_n, which H leaves out, into the Newton Jacobian."""
-        if not self.profiled:
+        """On a profile or grid: the antisymmetric part of its block B_n, which H leaves
+        out, into the Newton Jacobian."""
+        if not self.profile:
             return
         hessian = jacobian.hessian
         block = self._plane_derivatives(hessian.problem.state)[1]
@@ -199,7 +190,7 @@ class SeabedTerm(NodalLoadTerm):
         return vecs
 
     def position_derivatives(self, state):
-        """The whole block B_n (n_nodes, 3, 3), N/m, of a linearised profile at the
+        """The whole block B_n (n_nodes, 3, 3), N/m, of a profile or grid at the
         owned nodes of the state's centreline (Seabed.profile_derivatives): rows the
         gradient's components, columns the positions' (a line's end stiffness,
         system/held_line.py)."""

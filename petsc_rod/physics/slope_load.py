@@ -24,12 +24,13 @@ on the contact, the flat seabed's with N for e_z), so the Newton steps and the
 stability test have the whole force from it and this term adds nothing to them
 (``in_newton``, ``conservative``). Its outputs (the internal force's share) are the
 last vertical solve's reaction where the state is that solve's, and the force at the
-state's positions after Newton steps (SeabedTerm.contact_solved). On a profile, whose slope turns
-smoothly at its rows, the Newton steps would need the curvature of z_b as well: the
-term says so (``conservative``, ``in_newton`` False), so the run takes neither. A line
-of a system has the fixed point's exact linearisation all the same, for its stiffness
-alone: the seabed term then carries this push's derivative (SeabedTerm
-.linearise_profile, system/held_line.py).
+state's positions after Newton steps (SeabedTerm.contact_solved). On a profile or a
+grid, whose slope turns (smoothed) at its rows or grid lines, the seabed term's
+gradient and Jacobian are this iteration's fixed point's force and its whole derivative
+(Seabed.profile_derivatives, unsymmetric near a row), so the Newton steps have this push
+from it too (``in_newton``) and their stationary point is that fixed point; not an
+energy's (``conservative`` False: no stability test). A line of a system reads its
+stiffness from the same system (system/held_line.py).
 """
 
 import numpy as np
@@ -41,15 +42,17 @@ class SeabedSlopeLoad(NodalLoadTerm):
     """f_h of the module docstring for the seabed of the SeabedTerm ``contact``."""
 
     conservative = False
-    in_newton = False
+    # what the refusal of a stability test names (cli/scene_options.check_stability_asked)
     newton_gap = "a seabed that is not flat (docs/riser.md §3a)"
 
     def __init__(self, mesh, contact):
         super().__init__(mesh, "seabed_slope")
         self.contact = contact                  # the SeabedTerm (seabed.py)
         self.seabed = contact.seabed            # environment.Seabed, not flat
-        # on a plane the seabed term's energy holds the whole force (module docstring)
-        self.conservative = self.in_newton = self.seabed.plane
+        # on a plane the seabed term's energy holds the whole force, on a profile or a
+        # grid its gradient and Jacobian hold this push's: in the Newton steps either way
+        # (module docstring)
+        self.conservative = self.seabed.plane
 
     def node_loads(self, state):
         """f_h at the owned P2 nodes (N/m), (n_nodes, 3), z component 0: the reaction of

@@ -108,13 +108,13 @@ solves Y_j = A^-1 P_j, and the seabed's reaction on the start moved in each of i
 by the held data through P_i's held rows (_rotation_response).
 
 **Seabed profile.** The line's equilibrium on a profile is the fixed point of its lagged
-iteration (physics/slope_load.py; its run takes no Newton steps and is not changed
-here): a node's penetration reads the interpolant's height z_b(d), its push the secant
+iteration (physics/slope_load.py; its run ends in Newton steps on the linearisation
+below): a node's penetration reads the interpolant's height z_b(d), its push the secant
 gradient g(d), with k_v = k / (1 + g^2). Its derivative in the ends is the full
 linearisation there, per grounded node the block B_n = d(-w_n f_n)/dr_n of
 Seabed.profile_derivatives (z_b', g, its rate g' and k_v's turn with g), which the
 seabed term puts into the Newton system for this line alone
-(SeabedTerm.linearise_profile, _linearised_profile: H its symmetric part, J the rest):
+(SeabedTerm.profile, as in the line's own run: H its symmetric part, J the rest):
 unsymmetric within delta / 2 of a row, where g != z_b', so A is J (its LU), the
 data are (x_a, c) as on a plane with the block per node, and the forces read it
 through its transpose (as the friction's); a clamp's or a joint's held columns of J
@@ -160,6 +160,7 @@ from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
                                          slope_factor)
 from petsc_rod.physics.friction import FrictionTerm
+from petsc_rod.physics.seabed import SeabedTerm
 from petsc_rod.model.model import Model, Span
 from petsc_rod.model.names import FIELD_NAMES
 from petsc_rod.model.system_check import connection_frame, connection_position
@@ -439,7 +440,7 @@ class HeldLine:
         self.built = self.mesh = self.problem = self.solver = self.newton = self.path = None
         self.jacobian = None
         self.friction = []                  # the FrictionTerm, its anchors held
-        self.profile = None                 # the SeabedTerm of a profile, linearised
+        self.profile = None                 # the SeabedTerm of a profile or grid
         # where a frictional line is laid, (start, end) absolute (None: where its first
         # solve asks): the first solve starts there and walks to its ends
         self.laid = None
@@ -518,7 +519,7 @@ class HeldLine:
         self.mesh, self.problem, self.solver = (self.built.mesh, self.built.problem,
                                                 self.built.solver)
         self.path = self.built.scene
-        self.profile = self._linearised_profile()           # before the Newton solver
+        self.profile = self._profile_term()
         self.newton = self.built.own(NewtonSolver(self.problem))
         # each flex joint's neutral axis at the reference frame (turned by a frame given)
         self.axes = {("start", "end").index(t.which): (t, t.axis.copy())
@@ -1344,15 +1345,11 @@ class HeldLine:
         start -= moved                                      # P_i.dy + sum_n H_n dx_a
         return np.vstack([start, dmu])
 
-    def _linearised_profile(self):
-        """The SeabedTerm of a seabed profile, its contact put into the Newton system
-        (SeabedTerm.linearise_profile: the stiffness's, before the Newton solver is
-        made), or None on another seabed or none."""
-        for term in self.problem.terms:
-            if hasattr(term, "linearise_profile"):
-                term.linearise_profile()
-                return term if term.profiled else None
-        return None
+    def _profile_term(self):
+        """The SeabedTerm of a seabed profile or grid, whose contact its Newton system
+        holds linearised (SeabedTerm.profile), or None on another seabed or none."""
+        return next((term for term in self.problem.terms
+                     if isinstance(term, SeabedTerm) and term.profile), None)
 
     def _record_profile(self, recorder):
         """On a seabed profile, the recorder's block the profile's whole B_n
@@ -1374,7 +1371,7 @@ class HeldLine:
                                 "grid: give the friction one coefficient, on a flat, "
                                 "uniformly sloping or profiled seabed")
         # a profile's or grid's lagged push: its linearisation is the seabed term's
-        # (SeabedTerm.linearise_profile)
+        # (SeabedTerm.profile)
         lagged = {term for term in self.problem.terms if self.profile is not None
                   and getattr(term, "contact", None) is self.profile}
         loose = [term for term in self.problem.terms
