@@ -257,6 +257,9 @@ class NewtonSolver:
             for _ in range(MAX_STEPS):
                 state.set_node_directors(frames)
                 g = problem.energy_gradient(self._product)
+                # the step before this one took the iteration's curvature (no chord step
+                # follows such a step, so ``curved`` is still that step's)
+                after_curvature = curved
                 first = mu is None
                 mu = self._least_squares_multiplier(frames, g) if mu is None else mu
                 # the first step's curvature from the iteration's multipliers where the
@@ -312,9 +315,12 @@ class NewtonSolver:
                 largest = self._largest(omega)
                 # a step that turns no more than the last one, taken on a line whose
                 # heights enter where the last step halved |grad L| (SHRINK), above the
-                # round-off floor (at the first step start_norm is inf and previous too)
+                # round-off floor (at the first step start_norm is inf and previous too);
+                # after a step with the iteration's curvature whatever its turn: that
+                # step's turn is another matrix's, no Newton step's to contract, and the
+                # fall of |grad L| is what says the attempt goes on (docs/method.md §11)
                 settling = (self.reads_positions and previous > FLOOR_TURN
-                            and largest <= previous
+                            and (largest <= previous or after_curvature)
                             and self._residual_norm <= SHRINK * start_norm)
                 start_norm = self._residual_norm
                 if (self.stretch and not regularised and not settling

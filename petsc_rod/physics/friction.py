@@ -18,13 +18,13 @@ the norm is that of the whole force, |f|_mu sqrt(1 + (g.f)^2 / |f|^2) (so a bloc
 incline of angle theta sticks up to tan(theta) = mu).
 
 Friction depends on the path: the anchors are the line as laid. From a run's start
-(problem/build.lay_friction_anchors) they are the catenary between the ends at each load
-step's load factor t whatever the start shape (``laying``, laid again by ``prepare``),
-so that the last step's are the catenary between the ends the user gave: the load steps
-are a numerical continuation from the straight reference, no history of the line, and
-the answer is the equilibrium relative to the line as laid, whatever the number of steps
-(a line given from its fairlead hangs clear of the seabed in its first steps, and
-anchors moved there are where its nodes hung, not where they land). Otherwise (a
+(problem/build.lay_friction_anchors) they are the catenary between the ends the user
+gave, at every load step's load factor t and whatever the start shape (``laying``, laid
+by ``prepare``): the load steps are a numerical continuation from the straight
+reference, no history of the line, and the answer is the equilibrium relative to the
+line as laid, whatever the number of steps (a line given from its fairlead hangs clear
+of the seabed in its first steps, and anchors moved there are where its nodes hung, not
+where they land). Otherwise (a
 restart, whose file's positions are the anchors, or where no catenary can be drawn, the
 nodes' positions where the run starts) at the end of every accepted load step each
 anchor moves to x_n + f_n / k_s (the return map of plasticity: a sticking node keeps
@@ -193,10 +193,10 @@ class FrictionTerm(NodalLoadTerm):
         # line of a system, whose equilibrium is then a function of its ends alone
         # (system/held_line.py)
         self.hold_anchors = False
-        # load factor t -> the line as laid at t (S -> (r, frame, force), or None where
-        # none can be drawn): the anchors of each load step, which no step's end moves
-        # (prepare, accept_step; problem/build.lay_friction_anchors); None: the return
-        # map's path from the first solve's start or a restart's file
+        # the line as laid between the user's ends (S -> (r, frame, force)): the
+        # anchors of every load step, which no step's end moves (prepare, accept_step;
+        # problem/build.lay_friction_anchors); None: the return map's path from the
+        # first solve's start or a restart's file
         self.laying = None
         self._held = None           # H's share on a plane of the last _plane_law (n, 2, 2)
 
@@ -239,11 +239,10 @@ class FrictionTerm(NodalLoadTerm):
 
     def prepare(self, t, start, end):
         """The step's end states in both problems; with a ``laying``, the anchors at the
-        line as laid at t (kept where none can be drawn at t)."""
+        line as laid (the same at every load factor t)."""
         super().prepare(t, start, end)
-        curve = None if self.laying is None or self.hold_anchors else self.laying(t)
-        if curve is not None:
-            self.lay_anchors(curve)
+        if self.laying is not None and not self.hold_anchors:
+            self.lay_anchors(self.laying)
         for problem in self.problems:
             problem.set_end_states(start, end)
 
@@ -596,7 +595,7 @@ class FrictionTerm(NodalLoadTerm):
         """At the end of an accepted load step: every anchor to x_n + f_n / k_s of the
         last solve (the return map: a sticking node keeps its anchor, a sliding one's
         follows it, a node off the seabed has its own position); none where the anchors
-        are held (``hold_anchors``) or laid at each step's load factor (``laying``)."""
+        are held (``hold_anchors``) or laid for every step (``laying``)."""
         if self.positions is not None and not self.hold_anchors and self.laying is None:
             self.anchors = self.positions + self.force[..., :2] / self.friction.stiffness
 

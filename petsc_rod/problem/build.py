@@ -83,33 +83,29 @@ def scene_reports(scene, terms):
 
 
 def lay_friction_anchors(problem, say):
-    """The seabed friction's anchors (physics/friction.py), the line as laid: at each
-    load step's load factor t the catenary between the ends at t (starts.catenary_start,
-    resting on the seabed where it reaches it; ``FrictionTerm.laying``), at t = 1 the
-    catenary between the ends the user gave, whatever the start shape and the number of
-    steps. The load path is a numerical continuation from the straight reference, no
-    history of the line, so the answer is that relative to the line as laid between the
-    user's ends whatever -rod_steps: a line given from its fairlead hangs clear of the
-    seabed in its first steps, and anchors moved at their ends would be where its nodes
-    hung, not where they land; the straight start is no line as laid either
-    (docs/riser.md §3b, "The path"). Where no catenary can be drawn at t = 1 the
-    anchors are the start's positions (the first global step's) and follow the return
-    map, said in one line."""
+    """The seabed friction's anchors (physics/friction.py), the line as laid: the
+    catenary between the ends the user gave (starts.catenary_start at t = 1, resting on
+    the seabed where it reaches it; ``FrictionTerm.laying``), for every load step and
+    every halved attempt, whatever the start shape and the number of steps. The load
+    path is a numerical continuation from the straight reference, no history of the
+    line, so the answer is that relative to the line as laid between the user's ends
+    whatever -rod_steps: a line given from its fairlead hangs clear of the seabed in its
+    first steps, and anchors moved at their ends would be where its nodes hung, not where
+    they land; the straight start is no line as laid either (docs/riser.md §3b, "The
+    path"). The anchors of a step at t < 1 are those of t = 1 too, not the catenary
+    between that step's ends: from the straight start a line across a current then
+    reaches t = 1 through halved steps, where with each step's own catenary every
+    attempt failed (docs/riser.md §3b, "From the straight start"). Where no catenary can
+    be drawn at t = 1 the anchors are the start's positions (the first global step's)
+    and follow the return map, said in one line."""
     terms = [term for term in problem.terms if isinstance(term, FrictionTerm)]
     if not terms:
         return
     try:
-        starts.catenary_start(problem.scene, 1.0)
+        laid = starts.catenary_start(problem.scene, 1.0)
     except RodInputError as reason:     # NoCatenaryStart included
         say(f"petsc_rod: seabed friction: no catenary between the ends ({reason}); its "
             "anchors are the start's positions")
         return
-
-    def laying(t):
-        try:
-            return starts.catenary_start(problem.scene, t)
-        except RodInputError:           # a load factor whose catenary cannot be drawn
-            return None
-
     for term in terms:
-        term.laying = laying
+        term.laying = laid

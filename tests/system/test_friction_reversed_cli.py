@@ -128,3 +128,29 @@ def test_a_line_given_from_its_fairlead_in_two_load_steps_is_still_the_mirror(
     assert np.max(np.abs(r_reversed - mirrored(r_forward))) < 1e-6
     assert reversed_["anchor_tension"] == pytest.approx(forward["anchor_tension"], rel=1e-6)
     assert reversed_["friction_stick_nodes"] == forward["friction_stick_nodes"] > 0
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_line_across_a_current_from_the_straight_start_is_the_catenary_starts(
+        tmp_path, ranks):
+    """The forward line across a 0.4 m/s current from the straight start reaches the
+    catenary start's equilibrium in one step and in two (docs/riser.md §3b, "From the
+    straight start"): its Newton attempt near the solution goes on after its first step
+    (taken with the iteration's curvature) where |grad L| fell twentyfold and the next
+    turn was 4 % larger (newton.py, ``settling``), and the anchors of the step at t = 1/2
+    are the line as laid between the user's ends (problem/build.lay_friction_anchors).
+    Before, every attempt failed (2000 iterations each, halved to t = 1/16, exit 3)."""
+    current = FORWARD + ["-rod_current", "0,0.4,0"]
+    r_catenary, _, catenary = solved(
+        tmp_path, "catenary", current + ["-rod_initial_shape", "catenary"], ranks)
+    assert catenary["converged"] == 1
+    # 43 of 200 grounded nodes stick, the anchor holds 39.32 kN (measured)
+    assert catenary["anchor_tension"] == pytest.approx(39.32e3, rel=1e-3)
+    for steps in ("1", "2"):
+        r, _, straight = solved(tmp_path, f"straight{steps}", current + [
+            "-rod_initial_shape", "straight", "-rod_steps", steps], ranks)
+        assert straight["converged"] == 1 and straight["total_halvings"] == 0
+        assert np.max(np.abs(r - r_catenary)) < 1e-6
+        assert straight["anchor_tension"] == pytest.approx(catenary["anchor_tension"],
+                                                           rel=1e-6)
+        assert straight["friction_stick_nodes"] == catenary["friction_stick_nodes"]
