@@ -406,8 +406,10 @@ OPTIONS = [
     Option("rod_al_stability", _bool, default_of(Settings, "check_stability"), "bool",
            "at each converged step, test the second variation of the energy (Sylvester "
            "inertia); at a saddle turn the frames along its negative curvature and go on; "
-           "not with a current or seabed friction (no energy: 1 given with either is "
-           "refused); on an extensible line the strains are unknowns of it too"),
+           "with a current or seabed friction (no energy) no verdict, but a negative "
+           "direction is still left unless friction holds the line (1 given with either "
+           "is refused: it is the default); on an extensible line the strains are "
+           "unknowns of it too"),
     Option("rod_al_newton", _bool, default_of(Settings, "newton"), "bool",
            f"from iteration {NEWTON_AFTER} of a step, while change and residual are below "
            f"{NEWTON_SWITCH:g} ({NEWTON_SWITCH_FAR:g} with a seabed or a current) and more "
