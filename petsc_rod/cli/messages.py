@@ -56,12 +56,12 @@ def stability_text(report):
 
 
 def _left_without_verdict(report):
-    """Where a term has no energy (no verdict): the states with a negative direction of
-    H the step left (driver.UzawaSolver.checks_curvature), or ''."""
+    """Where there is no verdict (a term without energy, or a step that ended
+    otherwise): the states with a negative direction of H the step left
+    (driver.UzawaSolver.checks_curvature), or ''."""
     if not report.escapes:
         return ""
-    return (f", after leaving {report.escapes} state(s) with negative curvature "
-            "(no stability verdict: not conservative)")
+    return f", after leaving {report.escapes} state(s) with negative curvature"
 
 
 def newton_text(report):

@@ -112,21 +112,26 @@ class UzawaSolver:
         engineer wants handed back, such as a line compressed into an arch between its
         ends, which a straight start with a stiff penalty can converge to; it is left as
         a conservative line's saddle is, and a step that cannot leave it ends not
-        converged (STOP_SADDLE). Not where seabed friction holds some node (its
-        FrictionTerm.holds): the slide's dissipation, which H leaves out, can hold a
-        state along H's negative direction. Collective."""
+        converged (STOP_SADDLE). Only where every term is in the Newton steps (their H
+        exact: not a line through the sea surface, a profile's or grid's friction, two
+        friction coefficients, whose stiffness H leaves out), and not where seabed
+        friction holds some node (its FrictionTerm.holds): the slide's dissipation,
+        which H leaves out, can hold a state along H's negative direction.
+        Collective."""
         if not self.settings.check_stability:
             return False
         if self.problem.conservative:
             return True
+        if not self.problem.in_newton:
+            return False
         state = self.problem.state
         return not any(term.holds(state) for term in self.problem.terms)
 
     def _verdict(self, stable):
-        """The step's recorded verdict of a test that found ``stable`` (True, False):
-        a saddle (False) on any problem, stable (True) on a conservative one only (None,
-        no verdict, where a term has no energy)."""
-        return stable if self.tests_stability or stable is False else None
+        """The step's recorded verdict of a test that found ``stable`` (True, False,
+        None): itself on a conservative problem, None (no verdict: the file's stable -1)
+        where a term has no energy, whatever the test found."""
+        return stable if self.tests_stability else None
 
     # --- one continuation step ------------------------------------------------------
     def solve_step(self, t, label="", observer=None):
@@ -353,8 +358,8 @@ def solver_for(mesh, scene, settings, say=None):
     """The UzawaSolver of a new RodProblem of ``scene`` on ``mesh`` at the asked penalty
     of ``settings`` (what a script or a test makes), the seabed friction's anchors laid
     as the command line and the API lay them (problem/build.lay_friction_anchors: the
-    catenary between the ends at each load step's load factor, whatever start the
-    caller sets), its line where none can be drawn said by ``say`` (default: printed on
+    catenary between the user's ends, for every load step, whatever start the caller
+    sets), its line where none can be drawn said by ``say`` (default: printed on
     the mesh's rank 0). The caller destroys both: ``solver.destroy();
     solver.problem.destroy()``. Collective."""
     problem = RodProblem(mesh, scene, settings.asked_penalty)

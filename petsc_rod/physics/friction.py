@@ -207,10 +207,16 @@ class FrictionTerm(NodalLoadTerm):
         profile (the law's derivatives with g read at each node along the profile's
         direction, _profile_rates); not on a grid, whose g turns in two directions."""
         seabed = self.seabed_term.seabed
-        along_profile = (self.seabed_term.profile
-                         and hasattr(seabed.shape, "direction"))
-        return ((seabed.flat or seabed.plane or along_profile)
+        return ((seabed.flat or seabed.plane or self._along_profile)
                 and self.friction.axial == self.friction.lateral)
+
+    @property
+    def _along_profile(self):
+        """On a seabed profile (heights along a direction), not a grid: where the law's
+        derivatives take the secant gradient's turn (_profile_rates); on a grid g turns
+        in two directions and the law is the plane's with each node's g."""
+        return self.seabed_term.profile and hasattr(self.seabed_term.seabed.shape,
+                                                    "direction")
 
     @property
     def in_newton(self):
@@ -256,7 +262,7 @@ class FrictionTerm(NodalLoadTerm):
         if self.seabed_term.seabed.flat:
             return
         if self._springs_stale and (self.seabed_term.seabed.plane
-                                    or self.seabed_term.profile):
+                                    or self._along_profile):
             # after Newton steps: the friction at their positions (the last solve's is
             # that of the state before them)
             work = -self._newton_law(state)[0][:, 2]
@@ -467,7 +473,7 @@ class FrictionTerm(NodalLoadTerm):
         limit = np.divide(seabed.stiffness * cosine, norm, out=np.zeros_like(norm),
                           where=slide)                                    # k cos / |d|_G
         lift = turn = None
-        if self.seabed_term.profile:
+        if self._along_profile:
             lift, turn, metric = self._profile_rates(r, d, g, cosine, metric)
         in_x = ((stick * stiffness)[:, None, None] * np.eye(2)
                 + scale[:, None, None] * (np.eye(2) - d[:, :, None] * metric[:, None, :]

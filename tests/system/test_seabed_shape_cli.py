@@ -200,3 +200,20 @@ def test_modes_on_a_profile_say_where_their_stiffness_is_symmetrised(tmp_path):
     with h5py.File(plane, "r") as f:
         assert "symmetrised_nodes" not in f["modes"].attrs
     assert "modes: warning" not in text
+
+
+def test_friction_on_a_level_grid_is_the_flat_seabeds(tmp_path):
+    """Seabed friction on a grid (a level one) with a current across: the plane's law
+    with each node's gradient (FrictionTerm._plane_law; the secant's turn is a
+    profile's only), no Newton steps, and the flat seabed's answer, which ends in
+    Newton steps, to 1e-9 m. The grid's friction read a profile's direction and
+    failed (AttributeError) at the first converged step."""
+    grid = write(tmp_path, "level.txt", "-2 -3 0\n-2 3 0\n12 -3 0\n12 3 0\n")
+    wet = ["-rod_seabed_friction", "0.5", "-rod_current", "0,0.3,0",
+           "-rod_drag", "1025,1.2,0.05"]
+    gridded, _ = solved(tmp_path, "grid", ["-rod_seabed_profile", grid] + wet)
+    flat, _ = solved(tmp_path, "flat", ["-rod_seabed", "0"] + wet)
+    with h5py.File(gridded, "r") as f, h5py.File(flat, "r") as g:
+        assert f.attrs["converged"] == 1
+        assert np.abs(f["r"][:] - g["r"][:]).max() < 1e-9
+        assert f.attrs["friction_slide_length"] > 0
