@@ -164,8 +164,11 @@ class UzawaSolver:
                     stable, direction = self.check_stability()
                 except np.linalg.LinAlgError:
                     # H - sigma M singular to round-off at a shift of the test: no
-                    # verdict, a failed attempt of the step (the continuation halves it)
-                    step.stop(stopping.STOP_UNTESTED)
+                    # verdict, a failed attempt of the step (the continuation halves it);
+                    # where a term has no energy (no verdict to give) the step stays
+                    # converged, its curvature unchecked
+                    if self.tests_stability:
+                        step.stop(stopping.STOP_UNTESTED)
                     break
                 step.stability_tested(self._verdict(stable))
                 if stable is not False:
