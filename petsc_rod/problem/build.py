@@ -95,9 +95,10 @@ def lay_friction_anchors(problem, say):
     path"). The anchors of a step at t < 1 are those of t = 1 too, not the catenary
     between that step's ends: with each step's own catenary every attempt of a line
     across a current from the straight start failed, where it now converges in one step
-    (with Newton's rule after a step with the iteration's curvature, iteration/newton.py) (docs/riser.md §3b, "From the straight start"). Where no catenary can
-    be drawn at t = 1 the anchors are the start's positions (the first global step's)
-    and follow the return map, said in one line."""
+    (with Newton's rule after a step with the iteration's curvature, iteration/newton.py;
+    docs/riser.md §3b, "From the straight start"). Where no catenary can be drawn at
+    t = 1 the anchors are the start's positions (the first global step's) and follow the
+    return map, said in one line."""
     terms = [term for term in problem.terms if isinstance(term, FrictionTerm)]
     if not terms:
         return

@@ -115,8 +115,8 @@ def test_solver_for_lays_the_anchors_as_the_command_line(tmp_path):
 def test_a_line_given_from_its_fairlead_in_two_load_steps_is_still_the_mirror(
         tmp_path, ranks):
     """The anchors are the line as laid between the user's ends (problem/build.
-    lay_friction_anchors, every step's), so the load steps, a continuation from the straight reference,
-    leave the answer as it is: in two steps the line given from its fairlead, which
+    lay_friction_anchors, every step's), so the load steps, a continuation from the
+    straight reference, leave the answer as it is: in two steps the line given from its fairlead, which
     hangs clear of the seabed at the first step's load factor, reaches the mirror of the
     forward line's one step (with the anchors laid at the first step and moved at its end
     every grounded node slid: the anchor 37.26 kN, r 2.9 mm off)."""
