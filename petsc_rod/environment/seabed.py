@@ -69,6 +69,19 @@ class Seabed:
         (position_derivatives)."""
         return self.shape is not None and hasattr(self.shape, "slope_vector")
 
+    @property
+    def shaped(self):
+        """A profile or a grid of heights (bathymetry.Profile, bathymetry.Grid), whose
+        slope turns: its contact's linearisation is profile_derivatives'."""
+        return (not self.flat and not self.plane
+                and hasattr(self.shape, "slopes"))
+
+    @property
+    def along_direction(self):
+        """A profile (heights along a direction e), not a grid: its secant gradient
+        turns along e alone (plan_slopes)."""
+        return self.shaped and hasattr(self.shape, "direction")
+
     def heights(self, x, y):
         """z_b at horizontal positions (x, y), m, the shape of x."""
         if self.shape is None:
@@ -148,7 +161,7 @@ class Seabed:
         dg_i/dx_j (n, 2, 2), 1/m (bathymetry.Grid.slopes); a profile's slopes along its
         direction e (Profile.slopes: z_b', g, g') as z_b' e, g e and g' e e^T."""
         slopes = self.shape.slopes(x, y)
-        if not hasattr(self.shape, "direction"):
+        if not self.along_direction:
             return slopes
         rise, g, rate = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in slopes))
         e = self.shape.direction

@@ -215,8 +215,7 @@ class FrictionTerm(NodalLoadTerm):
         """On a seabed profile (heights along a direction), not a grid: where the law's
         derivatives take the secant gradient's turn (_profile_rates); on a grid g turns
         in two directions and the law is the plane's with each node's g."""
-        return self.seabed_term.profile and hasattr(self.seabed_term.seabed.shape,
-                                                    "direction")
+        return self.seabed_term.seabed.along_direction
 
     @property
     def in_newton(self):

@@ -60,8 +60,7 @@ class SeabedTerm(NodalLoadTerm):
     def profile(self):
         """Whether the seabed is a profile or a grid, whose contact has a linearisation
         (Seabed.profile_derivatives: bathymetry.Profile, bathymetry.Grid)."""
-        return (not self.seabed.flat and not self.seabed.plane
-                and hasattr(self.seabed.shape, "slopes"))
+        return self.seabed.shaped
 
     @property
     def unsymmetric(self):
