@@ -307,9 +307,11 @@ def diverged_message(event):
             f"{given_up(event.halvings, event.load_factor, event.nothing_to_halve)}")
 
 
-def not_converged_reason(report, settings, scale):
+def not_converged_reason(report, settings, scale, friction_penalty=None):
     """Why a step stopped without converging, and what to change (``settings``: the
-    run's stopping.Settings, ``scale`` the problem's scale of R, N)."""
+    run's stopping.Settings, ``scale`` the problem's scale of R, N; ``friction_penalty``
+    the R advised for seabed friction on an extensible line, penalty.friction_penalty,
+    or None)."""
     numbers = (f"change {report.change:.2e} for -rod_al_rtol {settings.rtol:.2g}, "
                f"constraint residual {report.constraint_residual:.2e} for -rod_al_ctol "
                f"{settings.ctol:.2g}")
@@ -337,14 +339,19 @@ def not_converged_reason(report, settings, scale):
     if settings.asked_penalty < 0.1 * scale:
         hint = (f"; -rod_al_penalty {settings.asked_penalty:g} is far below the problem's scale "
                 f"{scale:.3g} (the default): raise it")
+    elif friction_penalty is not None and settings.asked_penalty < 0.1 * friction_penalty:
+        hint = (f"; seabed friction on an extensible line converges slowly at R = "
+                f"{settings.asked_penalty:.3g}: try -rod_al_penalty {friction_penalty:.3g} "
+                "(about EA / 10, docs/riser.md §3b)")
     return f"did not converge in {report.iterations} iterations ({numbers}){hint}"
 
 
-def finished(event, settings, scale):
-    """The last line of a run (RunFinished)."""
+def finished(event, settings, scale, friction_penalty=None):
+    """The last line of a run (RunFinished); ``friction_penalty`` as
+    not_converged_reason's."""
     if not event.converged:
         return (f"petsc_rod: error: {event.label} "
-                f"{not_converged_reason(event.report, settings, scale)}"
+                f"{not_converged_reason(event.report, settings, scale, friction_penalty)}"
                 f"{given_up(event.halvings, event.load_factor, event.nothing_to_halve)}"
                 "; the result file says "
                 "converged = 0")

@@ -11,6 +11,7 @@ from petsc_rod.errors import RodDivergedError, RodInterrupted, RodNotConvergedEr
 from petsc_rod.io import outputs
 from petsc_rod.iteration import events
 from petsc_rod.iteration.continuation import PathSettings, continuation
+from petsc_rod.problem.penalty import friction_penalty
 
 
 @dataclass
@@ -97,7 +98,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 if event.converged and last is not None:
                     for line in messages.summary(last[1]):
                         say(line)
-                say(messages.finished(event, solver.settings, problem.scale))
+                say(messages.finished(event, solver.settings, problem.scale,
+                                      friction_penalty(problem.scene)))
             code = 0 if event.converged else RodNotConvergedError.exit_code
             return ContinuationResult(code, event.report, event.iterations)
     raise RuntimeError("the continuation ended without a final event")

@@ -16,6 +16,14 @@ ADAPT_FACTOR = 10.0
 ADAPT_PROGRESS = 0.5
 ADAPT_WINDOW = 200
 
+# Seabed friction on an extensible line: the stick springs hold the grounded line, whose
+# stretch, and the tension with it, then come from the multiplier alone, by steps of R
+# times the strain. Where Newton steps do not finish such a run (two load steps, two
+# coefficients, a line through the surface) the default R converged in none of the
+# measured cases and about FRICTION_SHARE times the least EA did (docs/riser.md §3b);
+# not a default, which slowed a line in a cross current there.
+FRICTION_SHARE = 0.1
+
 
 def default_penalty(scene, start_tension=0.0):
     """R = max(100 sqrt(min K max K) / L^2, F / 2, 2 M^2 / min(K1, K2), T / 2, T_s), N.
@@ -39,6 +47,18 @@ def default_penalty(scene, start_tension=0.0):
       crawls (docs/method.md §3).
     """
     return max(penalty_scales(scene, start_tension).values())
+
+
+def friction_penalty(scene):
+    """R = FRICTION_SHARE min EA (N), the penalty a run with seabed friction on an
+    extensible line is advised where it did not converge (cli/messages.py); None
+    without seabed friction or without a finite EA."""
+    if scene.seabed is None or scene.seabed.friction is None or not scene.extensible:
+        return None
+    values = ([s.axial_stiffness for s in scene.sections] if scene.sections
+              else [scene.axial_stiffness])
+    finite = [float(value) for value in values if np.isfinite(value)]
+    return FRICTION_SHARE * min(finite)
 
 
 def penalty_scales(scene, start_tension=0.0):

@@ -1,0 +1,47 @@
+"""The penalty a run with seabed friction on an extensible line is advised where it did
+not converge (problem/penalty.friction_penalty, cli/messages.not_converged_reason):
+FRICTION_SHARE times the least finite EA, and only where the asked R is far below it
+(docs/riser.md §3b)."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from petsc_rod.cli.messages import not_converged_reason
+from petsc_rod.problem.penalty import FRICTION_SHARE, friction_penalty
+
+
+def scene(friction, axial, sections=()):
+    return SimpleNamespace(seabed=SimpleNamespace(friction=friction),
+                           sections=[SimpleNamespace(axial_stiffness=ea) for ea in sections],
+                           axial_stiffness=axial,
+                           extensible=bool(np.any(np.isfinite(list(sections) or [axial]))))
+
+
+def test_the_advice_is_a_tenth_of_the_least_finite_axial_stiffness():
+    assert friction_penalty(scene(0.3, np.inf, (2e9, np.inf, 1.2e9))) == \
+        pytest.approx(FRICTION_SHARE * 1.2e9, rel=1e-15)
+    assert friction_penalty(scene(0.3, 5e8)) == pytest.approx(5e7, rel=1e-15)
+
+
+def test_no_advice_without_friction_or_stretch():
+    assert friction_penalty(scene(None, 5e8)) is None
+    assert friction_penalty(scene(0.3, np.inf)) is None
+    assert friction_penalty(SimpleNamespace(seabed=None, extensible=True)) is None
+
+
+REPORT = SimpleNamespace(reason=None, stalled=False, iterations=2000, change=1e-4,
+                         constraint_residual=1e-3)
+
+
+def settings(penalty):
+    return SimpleNamespace(rtol=1e-9, ctol=1e-9, asked_penalty=penalty)
+
+
+def test_the_advice_is_given_only_where_the_penalty_is_far_below_it():
+    advised = not_converged_reason(REPORT, settings(1.2e6), 1.2e6, 1.2e8)
+    assert "try -rod_al_penalty 1.2e+08" in advised
+    assert "try -rod_al_penalty" not in not_converged_reason(REPORT, settings(2e7), 1.2e6,
+                                                             1.2e8)
+    assert "try -rod_al_penalty" not in not_converged_reason(REPORT, settings(1.2e6), 1.2e6)
