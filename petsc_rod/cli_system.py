@@ -308,9 +308,11 @@ def saddle_error(results, output=None):
     else at a case of its watch circle or load-excursion curves (the case kept and
     marked, the sweep's group converged = 0). ``output``: the result file, named."""
     if results.verdict is not None and results.verdict.stable is False:
+        check = ("a line pushed into compression between its ends: check its length "
+                 "against the loads" if results.verdict.lines else
+                 "check the bodies' weight against their buoyancy and the loads")
         return (f"the system's equilibrium is {results.verdict.text()}: an equilibrium "
-                "that is not a minimiser (check the bodies' weight against their "
-                "buoyancy and the loads)"
+                f"that is not a minimiser ({check})"
                 + (f"; result {output}, which says converged = 0" if output else ""))
     saddles = sweep_saddles(results.sweeps)
     if not saddles:

@@ -816,8 +816,8 @@ class SystemSolver:
             # ended at a trial, which takes none): no stiffness to report
             raise RodDivergedError(f"system: the lines' stiffness at the equilibrium "
                                    f"failed: {self.failure}")
-        return self.result(factor, total, halvings, self.line_verdicts(),
-                           system_verdict(self))
+        lines = self.line_verdicts()
+        return self.result(factor, total, halvings, lines, system_verdict(self, lines))
 
     def line_verdicts(self):
         """{line name: line.stable()} of every line where it stands, in the system's

@@ -25,6 +25,14 @@ signs of the eigenvalues under the congruence): all eigenvalues positive, a stri
 local minimiser of V (stable); one below -TOLERANCE times the largest |eigenvalue|, a
 saddle; the lowest within it, no verdict (neutral to round-off).
 
+A line that is a saddle of its own energy with its ends held (HeldLine.stable False,
+Equilibrium.unstable) makes the system a saddle too, whatever K says: the total
+potential's Hessian in (the lines' unknowns, q) is congruent to the lines' Hessians with
+their ends held beside K (the Schur complement, which K is), so a negative direction of
+one line is one of the whole (Sylvester). A slack chain pushed into compression at its
+anchor under a large body load is such a line: the watch circle reached different
+equilibria there from different neighbours, each said stable before.
+
 Not conservative, no verdict (None, with the reason), as a single line with drag
 (docs/stability.md): a current (the drag on the lines and points has no potential),
 seabed friction (it dissipates), a body's load with a moment (a moment fixed in space
@@ -32,7 +40,7 @@ is not the gradient of a potential over rotations; it is what leaves K's rotatio
 block unsymmetric at the equilibrium: K - K^T = -[M_load]x).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -47,7 +55,9 @@ class SystemVerdict:
     unknowns, False a saddle, None no verdict (``reason`` says why); ``negative`` the
     number of negative eigenvalues of D H D (module docstring), ``lowest`` the lowest
     (N/m: rotations scaled by ``length``, m), ``dof`` (node, 'x'...'yaw') the unknown
-    with the largest entry of its eigenvector (None where there is no eigenvalue)."""
+    with the largest entry of its eigenvector (None where there is no eigenvalue);
+    ``lines`` the names of the lines that are saddles with their ends held (the system is
+    then a saddle: module docstring)."""
 
     stable: object
     negative: int = 0
@@ -55,12 +65,24 @@ class SystemVerdict:
     dof: tuple = None
     length: float = 1.0
     reason: str = ""
+    lines: tuple = ()
 
     def text(self):
         """The run's words: 'stable', 'a saddle of the system: ...', or 'no verdict:
         ...'."""
         if self.stable is None:
             return f"no verdict: {self.reason}"
+        if self.lines:
+            several = len(self.lines) > 1
+            text = (f"a saddle of the system: line{'s' if several else ''} "
+                    f"{', '.join(self.lines)} {'are saddles' if several else 'is a saddle'} "
+                    f"of {'their' if several else 'its'} energy with the ends held (a lower "
+                    "energy with the points and bodies where they are)")
+            if self.negative:
+                text += (f", and its stiffness has {self.negative} negative eigenvalue(s), "
+                         f"the lowest {self.lowest:.6g} N/m, mostly in {self.dof[0]} "
+                         f"{self.dof[1]}")
+            return text
         if self.stable:
             return (f"stable (the lowest eigenvalue of its stiffness {self.lowest:.6g} "
                     f"N/m, mostly in {self.dof[0]} {self.dof[1]})")
@@ -91,12 +113,24 @@ def not_conservative(system):
     return ""
 
 
-def system_verdict(solver):
+def system_verdict(solver, line_verdicts=None):
     """The SystemVerdict of ``solver``'s system at its state (after its solve: the
-    lines' forces and stiffnesses there). The same on every rank."""
+    lines' forces and stiffnesses there), ``line_verdicts`` {line name: True, False a
+    saddle with its ends held, None} (SystemSolver.line_verdicts): a saddle where some
+    line is one (module docstring). The same on every rank."""
     reason = not_conservative(solver.system)
     if reason:
         return SystemVerdict(None, reason=reason)
+    saddles = tuple(name for name, verdict in (line_verdicts or {}).items()
+                    if verdict is False)
+    verdict = _stiffness_verdict(solver)
+    if saddles:
+        return replace(verdict, stable=False, lines=saddles)
+    return verdict
+
+
+def _stiffness_verdict(solver):
+    """The SystemVerdict of the system's stiffness K alone (module docstring)."""
     layout = solver.layout
     free = layout.free
     if not free.size:

@@ -53,3 +53,23 @@ def test_a_saddle_of_the_system_exits_3_with_its_file(tmp_path, ranks):
         assert int(f["system"].attrs["system_stable"]) == 0
         assert int(f["system"].attrs["converged"]) == 0
         assert f["system"].attrs["system_verdict"].startswith("a saddle of the system")
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_line_that_is_a_saddle_makes_the_system_one(tmp_path, ranks):
+    """200 kN on the body along +x: the leeward chain, slack, is a saddle of its energy
+    with its ends held (the lines' table says SADDLE), so the whole system is one
+    (system/verdict.py: the lines' Hessians beside K, Sylvester), whatever its stiffness
+    K says (positive definite here): exit 3, converged = 0, system_stable = 0. Before,
+    the run said "stable" and exited 0, and a watch circle reached other equilibria
+    there from other neighbours."""
+    output = tmp_path / "pushed.h5"
+    process = run_petsc_rod(["-rod_system", DECK, "-rod_system_element_length", "5",
+                             "-rod_system_body_load", "Body1,200e3,0,0,0,0,0",
+                             "-rod_output", str(output)], ranks)
+    assert process.returncode == 3, describe(process)
+    assert ("  the system's equilibrium: a saddle of the system: line Line1 is a saddle "
+            "of its energy with the ends held") in process.stdout, describe(process)
+    with h5py.File(output, "r") as f:
+        assert int(f["system"].attrs["system_stable"]) == 0
+        assert int(f["system"].attrs["converged"]) == 0
