@@ -6,9 +6,10 @@ riser under the current across its plane on a seabed with mu = 0.5
 toward the anchor and started from the converged unmoved case (-sweep_start nearest).
 With the neighbour's positions as its anchors (the restart's, before) the case held
 683.92 kN at its anchor, 23 of 25 grounded nodes sticking, where alone it holds
-586.62 kN, 2 sticking (positions 0.46 m apart); now the same to 3e-11 m. A user's
-restart from the same file keeps the restart's anchors (-rod_initial_friction_anchors
-file, the default), or takes the run's own with ``laid``. Spawns processes: ``serial``."""
+586.62 kN, 2 sticking (positions 0.46 m apart); now the same to 7e-11 m (1.6e-9 m
+on 2 ranks, the line split). A user's restart from the same file keeps the restart's
+anchors (-rod_initial_friction_anchors file, the default), or takes the run's own with
+``laid``. Spawns processes: ``serial``."""
 
 import csv
 
