@@ -26,8 +26,8 @@ from petsc_rod.model.values import whole
 # a restart (initial) walks a file's scene, which the API leaves to the command line.
 MODEL_OPTIONS = ("line_types", "sections", "length", "stiffness", "load", "load_breaks",
                  "axial_stiffness", "drag", "elements", "mesh_grading", "output", "initial",
-                 "initial_load_factor", "point_loads", "point_load", "current",
-                 "current_profile")
+                 "initial_load_factor", "initial_friction_anchors", "point_loads",
+                 "point_load", "current", "current_profile")
 # The columns of a -rod_line_types table the export writes (model/line_type.py).
 COLUMNS = ("name", "od", "mass", "gj", "ei", "ei1", "ei2", "ei_start", "ei_end", "ea", "cd",
            "drag_d", "id", "smys", "stress_od", "ca")

@@ -52,7 +52,7 @@ from petsc_rod.iteration.driver import UzawaSolver
 from petsc_rod.mesh.mesh import (MIN_RELATIVE_ELEMENT, Mesh, end_element_lengths,
                                  fewest_elements, largest_grading)
 from petsc_rod.model import UniformLine
-from petsc_rod.problem.build import lay_friction_anchors
+from petsc_rod.problem.build import friction_terms, lay_friction_anchors
 from petsc_rod.problem.problem import RodProblem
 from petsc_rod.scenes import starts
 from petsc_rod.scenes.blend import BlendedPath
@@ -164,7 +164,7 @@ class BuiltLine:
         0, the file's state)."""
         say = say or _silent
         values = self.plan.values
-        start = start_from(self.problem, values, self.plan.given, say)
+        start = start_from(self.problem, values, self.plan.given, say, self.plan.scene)
         for note in self.notes:             # once the file is known to fit this run
             say(note)
         self.first_load_factor = start
@@ -443,12 +443,18 @@ def build_solver(mesh, scene, settings, say):
                             "-rod_slope_*, -rod_d1_*, -rod_d2_* and -rod_snes_* options") from None
 
 
-def start_from(problem, values, given, say):
+def start_from(problem, values, given, say, scene=None):
     """Set the state the first step starts from, a restart file or -rod_initial_shape;
     returns the load factor the load path goes on from (0 but for a restart). A catenary
     start that cannot be drawn for a sound scene (NoCatenaryStart: discrete buoyancy
     modules on a grounded line, a buoyancy section whose catenary dips below the seabed)
-    becomes the straight start, in one line saying why."""
+    becomes the straight start, in one line saying why. The seabed friction's anchors of
+    a run from its own start are the line as laid (lay_friction_anchors); a restart's are
+    the file's positions (-rod_initial_friction_anchors file: the path goes on from the
+    file's line), or the line as laid between the ends of ``scene`` (the run's own, the
+    end of a restart's walk; default the problem's) with ``laid``, so that the answer is
+    the run's from its own start whatever file started it (a sweep's warm start,
+    sweep/runner.py), each said in one line on a scene with friction."""
     shape = values["rod_initial_shape"]
     if shape not in starts.SHAPES:
         raise RodInputError(f"-rod_initial_shape {shape}: unknown shape; use one of "
@@ -457,11 +463,25 @@ def start_from(problem, values, given, say):
         if shape != "straight":         # e.g. a scene file's: the restart file starts it
             say(f"petsc_rod: -rod_initial_shape {shape} is not used: the restart file "
                 f"{values['rod_initial']} is the start")
-        return restart_from(problem, values["rod_initial"], values["rod_initial_load_factor"],
-                            say)
-    if "rod_initial_load_factor" in given:
-        raise RodInputError("-rod_initial_load_factor needs -rod_initial (the state it is "
-                            "the load factor of); drop it or give the file")
+        start = restart_from(problem, values["rod_initial"],
+                             values["rod_initial_load_factor"], say)
+        if not friction_terms(problem):
+            return start
+        if values["rod_initial_friction_anchors"] == "laid":
+            if lay_friction_anchors(problem, say, scene):
+                say("petsc_rod: restart: the seabed friction's anchors are laid on this "
+                    "run's catenary between its ends, not the file's positions "
+                    "(-rod_initial_friction_anchors laid)")
+        else:
+            say("petsc_rod: restart: the seabed friction's anchors are the file's "
+                "positions, moved by the return map along this run's path "
+                "(-rod_initial_friction_anchors file; laid: this run's own catenary's)")
+        return start
+    for name, what in (("rod_initial_load_factor", "the state it is the load factor of"),
+                       ("rod_initial_friction_anchors", "the restart whose anchors it places")):
+        if name in given:
+            raise RodInputError(f"-{name} needs -rod_initial ({what}); drop it or give "
+                                "the file")
     curve = None
     if shape == "catenary":
         try:

@@ -44,6 +44,11 @@ SOLVER_PREFIXES = ("rod_slope_", "rod_d1_", "rod_d2_", "rod_snes_", "rod_z_", "r
                    "rod_newton_", "rod_inertia_", "rod_modes_eps_", "rod_modes_st_",
                    "rod_modes_bv_", "rod_modes_ds_", "rod_modes_rg_")
 
+# Where a restart's seabed friction anchors are (-rod_initial_friction_anchors): the
+# file's positions (followed by the return map), or the line as laid between this run's
+# ends (problem/build.lay_friction_anchors).
+FRICTION_ANCHORS = ("file", "laid")
+
 # The largest whole number an integer option may hold: a PETSc integer.
 MAX_INT = int(np.iinfo(PETSc.IntType).max)
 
@@ -243,8 +248,9 @@ OPTIONS = [
            "N/m^2"),
     Option("rod_seabed_friction", _reals(), None, "mu|mu_axial,mu_lateral",
            "Coulomb friction of the seabed, both coefficients positive: the friction at a "
-           "grounded point opposes its slip from where the run starts (updated at every "
-           "load step) and is at most mu times its contact reaction, mu between mu_axial "
+           "grounded point opposes its slip from the line as laid (the catenary between "
+           "the ends; a restart's: -rod_initial_friction_anchors) and is at most mu times "
+           "its contact reaction, mu between mu_axial "
            "along the line and mu_lateral across it (an ellipse); default none",
            POSITIVE, "1"),
     Option("rod_seabed_friction_stiffness", _real, None, "k_s",
@@ -306,6 +312,14 @@ OPTIONS = [
            "in -rod_steps steps; default the file's load_factor (0: walk the whole path "
            "again, e.g. from a file of another scene)",
            (lambda v: 0 <= v <= 1, "must be between 0 and 1")),
+    Option("rod_initial_friction_anchors", _string, "file", "|".join(FRICTION_ANCHORS),
+           "with -rod_initial and seabed friction, where its anchors are: file, the "
+           "file's positions, moved by the return map along the restart's path (a restart "
+           "goes on from the line the file holds); laid, the catenary between this run's "
+           "ends at the full load, as a run from its own start lays them (its answer then "
+           "does not depend on the file; a sweep's warm starts)",
+           (lambda v: v in FRICTION_ANCHORS,
+            f"expected one of {'|'.join(FRICTION_ANCHORS)}"), "text"),
     Option("rod_initial_shape", _string, "straight", "straight|catenary",
            "start of the first step: the straight reference, or the inextensible catenary "
            "of that step with its tension as multiplier (both ends held, uniform load)",
@@ -440,9 +454,9 @@ OPTIONS = [
            "text"),
 ]
 BY_NAME = {option.name: option for option in OPTIONS}
-# Options of how a run is made, not of what it solves: a result file's parameters
-# without them are not an older version's (cli/line_run.walked_scene).
-HOW_RUN = ("rod_ranks_split",)
+# Options of how a run is made or started, not of the scene it solves: a result file's
+# parameters without them are not an older version's (cli/line_run.walked_scene).
+HOW_RUN = ("rod_ranks_split", "rod_initial_friction_anchors")
 
 
 def read_options():

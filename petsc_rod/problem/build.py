@@ -82,9 +82,17 @@ def scene_reports(scene, terms):
     return reports
 
 
-def lay_friction_anchors(problem, say):
+def friction_terms(problem):
+    """The seabed friction's terms (FrictionTerm) of ``problem``: a list, empty without."""
+    return [term for term in problem.terms if isinstance(term, FrictionTerm)]
+
+
+def lay_friction_anchors(problem, say, scene=None):
     """The seabed friction's anchors (physics/friction.py), the line as laid: the
-    catenary between the ends the user gave (starts.catenary_start at t = 1, resting on
+    catenary between the ends the user gave (starts.catenary_start at t = 1 of ``scene``,
+    default the problem's; a restart's walk passes its own scene, the walk's end, so
+    that its anchors are those of the run from its own start: cli/line_run.start_from,
+    -rod_initial_friction_anchors laid), resting on
     the seabed where it reaches it; ``FrictionTerm.laying``), for every load step and
     every halved attempt, whatever the start shape and the number of steps. The load
     path is a numerical continuation from the straight reference, no history of the
@@ -98,15 +106,16 @@ def lay_friction_anchors(problem, say):
     (with Newton's rule after a step with the iteration's curvature, iteration/newton.py;
     docs/riser.md §3b, "From the straight start"). Where no catenary can be drawn at
     t = 1 the anchors are the start's positions (the first global step's) and follow the
-    return map, said in one line."""
-    terms = [term for term in problem.terms if isinstance(term, FrictionTerm)]
+    return map, said in one line. Returns whether the anchors were laid so."""
+    terms = friction_terms(problem)
     if not terms:
-        return
+        return False
     try:
-        laid = starts.catenary_start(problem.scene, 1.0)
+        laid = starts.catenary_start(problem.scene if scene is None else scene, 1.0)
     except RodInputError as reason:     # NoCatenaryStart included
         say(f"petsc_rod: seabed friction: no catenary between the ends ({reason}); its "
             "anchors are the start's positions")
-        return
+        return False
     for term in terms:
         term.laying = laid
+    return True

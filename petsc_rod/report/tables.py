@@ -36,8 +36,9 @@ KEY_RESULTS = [
 # Options that steer the solver, not the model: folded away on the page.
 SOLVER_PREFIXES = ("rod_al_", "rod_d1_", "rod_d2_", "rod_slope_", "rod_z_", "sweep_",
                    "rod_output", "rod_table", "rod_steps", "rod_max_halvings",
-                   "rod_initial_load_factor", "rod_track_link", "rod_initial_shape",
-                   "rod_imperfection", "rod_mesh_grading", "options_file", "log_view")
+                   "rod_initial_load_factor", "rod_initial_friction_anchors", "rod_track_link",
+                   "rod_initial_shape", "rod_imperfection", "rod_mesh_grading", "options_file",
+                   "log_view")
 SOLVER_WORDS = ("_ksp_", "_pc_", "_snes_", "_mat_")
 
 

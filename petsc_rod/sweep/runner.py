@@ -10,7 +10,9 @@ database is put back as it was after it (options added removed, options changed
 restored), so that nothing of one case reaches the next. A case starts
 from the nearest converged case's result file (-rod_initial, walked in
 -sweep_warm_steps steps from that case's scene to its own: docs/method.md §7; by
-default not a case that starts from its catenary, which no neighbour beats), and
+default not a case that starts from its catenary, which no neighbour beats; its seabed
+friction's anchors laid as its own run lays them, -rod_initial_friction_anchors laid,
+not on the neighbour's positions, so that its answer is the case's alone), and
 again from its own start when that fails; a case that fails all the same is recorded
 and the sweep goes on. After each case the summary (DIR/summary.csv, DIR/summary.md) and
 the record DIR/sweep.json are rewritten on rank 0, so a sweep stopped part way keeps
@@ -420,6 +422,10 @@ class Sweep:
             walk = {"rod_initial": path}
             if "rod_steps" not in case.options:
                 walk["rod_steps"] = str(self.settings.warm_steps)
+            if "rod_initial_friction_anchors" not in case.options:
+                # the case's seabed friction anchored as its own run's, not on its
+                # neighbour's positions: its answer is not the sweep's order's
+                walk["rod_initial_friction_anchors"] = "laid"
             self.say(f"sweep: case {number}/{len(self.cases)} {case.name}: {shown}; warm "
                      f"start from {source.name}")
             code = self._run(case, {**options, **walk})
