@@ -15,9 +15,10 @@ the machine's load (os.getloadavg) before and after.
 ``--fit`` measures the cost model of mesh/ranks.py: each pair also runs the scene split
 over 2 ranks (-rod_ranks_split split, where auto does not already), and the time of an
 iteration (solve time over iterations, the pairs' median) is fitted as a + b N over the
-scenes, whole on 1 rank and split on 2 (least squares relative to the time); the
-constants and the crossover N* are printed and written below the table, to be put in
-mesh/ranks.py (WHOLE, SPLIT) from a run on a quiet machine.
+scenes without seabed friction (whose passes mesh/ranks.py models apart, PASS_WHOLE and
+PASS_SPLIT: docs/performance.md), whole on 1 rank and split on 2 (least squares relative
+to the time); the constants and the crossover N* are printed and written below the
+table, to be put in mesh/ranks.py (WHOLE, SPLIT) from a run on a quiet machine.
 
 Written as Markdown to FILE (default docs/scenes_benchmark.md, which
 docs/performance.md links) unless --only is given.
@@ -38,7 +39,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from petsc_rod.mesh.ranks import IterationCost, choose, crossover  # noqa: E402
+from petsc_rod.mesh.ranks import IterationCost, choose, crossover, passes_of  # noqa: E402
 
 PAIRS = 3
 TIMEOUT = 600
@@ -57,6 +58,13 @@ def scenes(only=None):
             continue
         found.append(path)
     return found
+
+
+def passes(path):
+    """The friction's passes an iteration the model gives the scene (mesh/ranks.passes_of:
+    its options file gives -rod_seabed_friction)."""
+    text = path.read_text(encoding="utf-8")
+    return passes_of(re.search(r"^\s*-rod_seabed_friction\s", text, re.M) is not None)
 
 
 def command(path, ranks, split=None):
@@ -94,7 +102,7 @@ def measure(path, pairs, fit):
         runs["one"].append(run(path, 1))
         elements = elements or runs["one"][-1][2]
         runs["two"].append(run(path, 2))
-        if fit and elements and choose("auto", elements, 2) != "split":
+        if fit and elements and choose("auto", elements, 2, passes=passes(path)) != "split":
             runs["split"].append(run(path, 2, "split"))
     if fit and not runs["split"]:
         runs["split"] = runs["two"]
@@ -149,14 +157,14 @@ def main():
         elements, runs = measure(path, arguments.pairs, arguments.fit)
         ratios = [ratio(pair) for pair in zip(runs["one"], runs["two"])]
         row = [path.stem, cell(elements, "d"),
-               choose("auto", elements, 2) if elements else "-",
+               choose("auto", elements, 2, passes=passes(path)) if elements else "-",
                cell(median([r[0] for r in runs["one"]]), ".3g"),
                cell(median([r[0] for r in runs["two"]]), ".3g"),
                cell(median(ratios), ".2f"),
                " / ".join(cell(median([r[1] for r in runs[k]]), ".0f") for k in ("one", "two"))]
         rows.append(row)
         print(" | ".join(row), flush=True)
-        if arguments.fit and elements:
+        if arguments.fit and elements and not passes(path):     # friction: its passes' own fit
             fitted.append((elements, per_iteration(runs["one"]), per_iteration(runs["split"])))
     lines = [f"Measured {started:%Y-%m-%d %H:%M} UTC at commit {measured}, {arguments.pairs} "
              f"alternated pair(s) a scene; load average (1, 5, 15 min) {before} before, "

@@ -449,7 +449,8 @@ OPTIONS = [
            "the first while the others wait (whole: the answers of one rank); auto: "
            "whole where the cost model of mesh/ranks.py, measured by "
            "scripts/benchmark_scenes.py, predicts an iteration faster on one rank (the "
-           "short lines), split elsewhere",
+           "short lines, and with seabed friction longer ones: its secant passes cost "
+           "more split), split elsewhere",
            (lambda v: v in RANKS_MODES, f"expected one of {'|'.join(RANKS_MODES)}"),
            "text"),
 ]

@@ -30,7 +30,7 @@ from petsc4py import PETSc
 
 from petsc_rod.cli.line_run import run_line
 from petsc_rod.errors import RodDivergedError, RodError
-from petsc_rod.mesh.ranks import choose
+from petsc_rod.mesh.ranks import choose, passes_of
 
 # The tag of a waiting rank's stop signal handed to rank 0.
 STOP_TAG = 51
@@ -40,9 +40,12 @@ FIRST_PAUSE, LONGEST_PAUSE = 0.0005, 0.01
 
 def placement(comm, plan):
     """'whole' or 'split': how the LinePlan ``plan`` runs on ``comm``
-    (mesh/ranks.choose of -rod_ranks_split, the mesh's elements and the ranks)."""
+    (mesh/ranks.choose of -rod_ranks_split, the mesh's elements, the ranks and the
+    friction's passes where the scene's seabed has friction)."""
     values = plan.values
-    return choose(values["rod_ranks_split"], values["rod_elements"], comm.getSize())
+    seabed = plan.scene.seabed
+    return choose(values["rod_ranks_split"], values["rod_elements"], comm.getSize(),
+                  passes=passes_of(seabed is not None and seabed.friction is not None))
 
 
 class WholeInterrupts:

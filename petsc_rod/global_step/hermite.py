@@ -59,23 +59,38 @@ class HermiteProblem:
     R W). The KSP (prefix ``prefix``) is the chain solver of the global step
     (ksp.chain_solver: Cholesky in the natural order on one rank, the exact
     substructuring on several).
+
+    ``matrix_of``: another HermiteProblem of the same mesh, slope matrices and added
+    element matrices whose matrix this one shares (the friction's y problem shares x's:
+    the same springs k_n w_n on both coordinates, and the same fixed rows, a held end
+    holding both and a clamp both slopes): only the right-hand side, the fixed values
+    and the solution are this one's, and where the options under both prefixes are the
+    same (the defaults), its KSP solves with the other's PC, so the matrix is factored
+    once for both (on several ranks each factorisation is the substructuring's set-up:
+    collectives, local solves and Python calls, and friction's secant loop factors
+    afresh at every pass; docs/performance.md, "Two ranks or one").
     """
 
-    def __init__(self, mesh, slope_matrices, prefix, component=2):
+    def __init__(self, mesh, slope_matrices, prefix, component=2, matrix_of=None):
         self.mesh = mesh
         self.component = component
         self.name = prefix
+        self.matrix_of = matrix_of
         h = mesh.element_h
         self.rows = hermite_rows(mesh)
-        T = slope_map(h)
-        self.base = assemble_matrix(mesh, np.einsum("eki,ekl,elj->eij", T, slope_matrices, T),
-                                    self.rows)
-        self.to_slope = self._slope_matrix(T)
-        self.matrix = self.base.duplicate(copy=True)
-        self.constrained = self.base.duplicate(copy=True)
+        if matrix_of is None:
+            T = slope_map(h)
+            self.base = assemble_matrix(
+                mesh, np.einsum("eki,ekl,elj->eij", T, slope_matrices, T), self.rows)
+            self.to_slope = self._slope_matrix(T)
+            self.matrix = self.base.duplicate(copy=True)
+            self.constrained = self.base.duplicate(copy=True)
+        else:
+            self.base, self.to_slope, self.matrix, self.constrained = (
+                matrix_of.base, matrix_of.to_slope, matrix_of.matrix, matrix_of.constrained)
         self.added_rhs = self.base.createVecLeft()
-        self.rhs, self.solution, self.bc, self._work, self._product = (
-            self.base.createVecLeft() for _ in range(5))
+        self.rhs, self.solution, self.bc, self._work, self._product, self._projected = (
+            self.base.createVecLeft() for _ in range(6))
         self.fixed = np.zeros(0, dtype=PETSc.IntType)
         self._ends = None               # the last set_end_states' (start, end)
         # 1 + eps at a clamped start and end of an extensible line (set_clamp_stretch)
@@ -84,6 +99,9 @@ class HermiteProblem:
         # the slope problem's solver and defaults: the natural order on one rank, in
         # which the chain is a band matrix without fill
         self.ksp = chain_solver(mesh.comm, self.constrained, prefix)
+        if matrix_of is not None and (options_under(prefix)
+                                      == options_under(matrix_of.name)):
+            self.ksp.setPC(matrix_of.ksp.getPC())
 
     def _slope_matrix(self, T):
         """T as a DMDA matrix: rows the P2 slope dofs, columns the Hermite dofs (the
@@ -108,7 +126,11 @@ class HermiteProblem:
         self._local_fixed = np.array([r - start_row for r, _ in fixed
                                       if start_row <= r < end_row], dtype=np.int64)
         self._set_fixed_values()
-        self._constrain()
+        if self.matrix_of is None:
+            self._constrain()
+        elif not np.array_equal(self.fixed, self.matrix_of.fixed):
+            raise ValueError(f"{self.name}: fixed rows {self.fixed} differ from those of "
+                             f"the matrix it shares ({self.matrix_of.fixed})")
 
     def set_clamp_stretch(self, start, end):
         """1 + eps at a clamped start and end (docs/method.md §12): the slope prescribed
@@ -153,6 +175,9 @@ class HermiteProblem:
         the fixed rows and columns zeroed."""
         matrices = np.asarray(element_matrices, dtype=float)
         vectors = np.asarray(element_vectors, dtype=float)
+        if self.matrix_of is not None:
+            self._add_vectors(vectors)
+            return
         if self._added is None:
             self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self.added_rhs.zeroEntries()
@@ -174,7 +199,7 @@ class HermiteProblem:
         if len(rows):
             delta = matrices[changed] - last_matrices[changed]
             self.matrix.setValuesRCV(rows, rows, delta, addv=PETSc.InsertMode.ADD_VALUES)
-            free = ~np.isin(rows, self.fixed)
+            free = np.all(rows[..., None] != self.fixed, axis=-1)    # a few fixed rows
             self.constrained.setValuesRCV(rows, rows, delta * free[:, :, None] * free[:, None, :],
                                           addv=PETSc.InsertMode.ADD_VALUES)
             self.added_rhs.setValues(rows.ravel(), np.ravel(vectors[changed]
@@ -190,6 +215,27 @@ class HermiteProblem:
         first = self.constrained.getOwnershipRange()[0]
         note_changed_rows(self.ksp, np.concatenate([rows.ravel(), [first, first + 1]]),
                           before)
+
+    def _add_vectors(self, vectors):
+        """set_added of a problem that shares another's matrix (``matrix_of``, which
+        set_added the same element matrices): the right-hand side's sums alone, the
+        same additions as set_added's (the elements whose vectors changed, as the
+        difference)."""
+        if self._added is None:
+            self.added_rhs.zeroEntries()
+            if len(self.rows):
+                self.added_rhs.setValues(self.rows.ravel(), vectors.ravel(),
+                                         addv=PETSc.InsertMode.ADD_VALUES)
+            self._added = (None, vectors.copy())
+        else:
+            last = self._added[1]
+            changed = np.any(vectors != last, axis=1)
+            if np.any(changed):
+                self.added_rhs.setValues(self.rows[changed].ravel(),
+                                         np.ravel(vectors[changed] - last[changed]),
+                                         addv=PETSc.InsertMode.ADD_VALUES)
+                np.copyto(last, vectors)
+        self.added_rhs.assemble()
 
     def set_added_rhs(self, element_vectors):
         """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added
@@ -211,7 +257,21 @@ class HermiteProblem:
     def solve(self, slope_rhs, slope):
         """y from the slope problem's right-hand side ``slope_rhs`` (its z component, a Vec
         in P2 layout); sets ``slope`` (Vec) = T y and returns y (a Vec owned here)."""
-        self.to_slope.multTranspose(slope_rhs, self.rhs)
+        self.project(slope_rhs)
+        self.solve_projected()
+        self.set_slope(slope)
+        return self.solution
+
+    def project(self, slope_rhs):
+        """T^T b of the slope problem's right-hand side ``slope_rhs`` (a Vec in P2 layout),
+        kept for solve_projected: friction's secant loop solves again with new springs
+        and the same b (one product, a ghost exchange, less a pass). Collective."""
+        self.to_slope.multTranspose(slope_rhs, self._projected)
+
+    def solve_projected(self):
+        """y of the last ``project``'s T^T b, the added right-hand side and the fixed
+        values (the lifting by the matrix of now); returns y (a Vec owned here)."""
+        self._projected.copy(self.rhs)
         self.rhs.axpy(1.0, self.added_rhs)
         self.matrix.mult(self.bc, self._product)            # the lifting
         self.rhs.copy(self._work)
@@ -219,8 +279,11 @@ class HermiteProblem:
         self._work.getArray()[self._local_fixed] = self._fixed_values
         self.ksp.solve(self._work, self.solution)
         check_solved(self.ksp, self.name)
-        self.to_slope.mult(self.solution, slope)
         return self.solution
+
+    def set_slope(self, slope):
+        """``slope`` (Vec, P2 layout) = T y of the last solve. Collective."""
+        self.to_slope.mult(self.solution, slope)
 
     def end_residual(self):
         """(b - M y) at the row of z(L) after a solve (summed over the ranks): the
@@ -235,7 +298,15 @@ class HermiteProblem:
         return float(self.mesh.global_sum(local))
 
     def destroy(self):
-        for obj in (self.ksp, self.base, self.to_slope, self.matrix, self.constrained,
-                    self.added_rhs, self.rhs, self.solution, self.bc, self._work,
-                    self._product):
+        shared = (() if self.matrix_of is not None
+                  else (self.base, self.to_slope, self.matrix, self.constrained))
+        for obj in (self.ksp, *shared, self.added_rhs, self.rhs, self.solution, self.bc,
+                    self._work, self._product, self._projected):
             obj.destroy()
+
+
+def options_under(prefix):
+    """{name after ``prefix``: value} of the options database's entries under
+    ``prefix``: two prefixes whose dicts are equal configure their solvers alike."""
+    return {name[len(prefix):]: value for name, value in PETSc.Options().getAll().items()
+            if name.startswith(prefix)}

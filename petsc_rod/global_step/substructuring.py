@@ -432,6 +432,10 @@ class InterfacePC:
         state = pmat.stateGet()
         changed = (self._changes[2] if self._changes is not None
                    and self._changes[:2] == (pmat.handle, state) else None)
+        if changed is not None and 2 * len(changed) > pmat.getLocalSize()[0]:
+            # most rows (friction's springs on a grounded stretch): one read of them all
+            # (MatGetRow in C) is cheaper than a MatGetRow call a row from Python
+            changed = None
         self._changes = None
         self._state = (pmat.handle, state)
         if self.solver is not None and self.solver.refactor(pmat, changed):

@@ -229,8 +229,10 @@ class FrictionTerm(NodalLoadTerm):
         """The x and y problems with the slope problem's element matrices (at the start
         and after every penalty raise; the anchors and the springs are kept)."""
         self._destroy_problems()
-        self.problems = [HermiteProblem(self.mesh, slope_matrices, prefix, component)
-                         for component, prefix in enumerate(PREFIXES)]
+        x = HermiteProblem(self.mesh, slope_matrices, PREFIXES[0], 0)
+        # y shares x's matrix (the same springs on both): factored once for both
+        self.problems = [x, HermiteProblem(self.mesh, slope_matrices, PREFIXES[1], 1,
+                                           matrix_of=x)]
         if self.start_state is not None:
             for problem in self.problems:
                 problem.set_end_states(self.start_state, self.end_state)
@@ -284,11 +286,11 @@ class FrictionTerm(NodalLoadTerm):
         stiffness = self.friction.stiffness
         if self._springs_stale:
             self._springs_from(state, reaction)
+        for c, problem in enumerate(self.problems):
+            problem.project(rhs.components[c])          # b is the same at every pass
         for _ in range(MAX_SOLVES):
             self._set_springs()
-            solutions = [self._ghosted(problem.solve(rhs.components[c],
-                                                     state.slope.components[c]))
-                         for c, problem in enumerate(self.problems)]
+            solutions = [self._ghosted(problem.solve_projected()) for problem in self.problems]
             positions = self._node_values(solutions, self.rows)
             tangents = self._node_values(solutions, self.slope_rows)
             trial = -stiffness * (positions - self.anchors)
@@ -306,6 +308,8 @@ class FrictionTerm(NodalLoadTerm):
         # behind) exceeds it by their last change (docs/riser.md §3b, "Outputs")
         force = -self.spring[..., None] * (positions - self.anchors)
         self._record(force, positions, tangents, reaction, gradients)
+        for c, problem in enumerate(self.problems):     # the slopes of the last pass's y
+            problem.set_slope(state.slope.components[c])
         if bordered:
             for c, problem in enumerate(self.problems):
                 state.chord_multiplier[c] = problem.end_residual()

@@ -7,6 +7,7 @@ waits for a failure of rank 0 as one. Serially both runs are one rank's; under
 import os
 import signal
 import time
+from types import SimpleNamespace
 
 import h5py
 import numpy as np
@@ -15,7 +16,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from petsc_rod.cli import main
-from petsc_rod.cli.ranks import run_whole
+from petsc_rod.cli.ranks import placement, run_whole
 from petsc_rod.errors import RodError, RodInterrupted, RodIOError
 
 # a clamped-pinned rod of 12 elements, two steps (under a second of solve)
@@ -182,3 +183,18 @@ def test_a_file_without_the_placement_still_walks_its_restart(shared_tmp, capfd)
     out = capfd.readouterr().out
     if PETSc.COMM_WORLD.getRank() == 0:
         assert "restart: walks from the file's scene" in out and "lack" not in out, out
+
+
+def test_a_line_with_seabed_friction_is_placed_with_its_passes():
+    """placement gives the model the friction's passes where the scene's seabed has
+    friction: 850 elements (mooring_chain's) split on 2 ranks without it, whole with it
+    (mesh/ranks.py, FRICTION_PASSES)."""
+    two = SimpleNamespace(getSize=lambda: 2)
+    values = {"rod_ranks_split": "auto", "rod_elements": 850}
+
+    def plan(seabed):
+        return SimpleNamespace(values=values, scene=SimpleNamespace(seabed=seabed))
+
+    assert placement(two, plan(SimpleNamespace(friction=object()))) == "whole"
+    assert placement(two, plan(SimpleNamespace(friction=None))) == "split"
+    assert placement(two, plan(None)) == "split"

@@ -475,3 +475,43 @@ def test_a_change_beside_a_rank_boundary_refactors_the_next_rank_s_interface():
         assert global_max(comm, np.abs(y - reference).max()) <= ROUND_OFF * scale
         if comm.getSize() > 1 and comm.getRank() == 1:
             assert mesh.element_start == changed_element + 1      # none of its own
+
+
+def test_a_problem_sharing_another_s_matrix_solves_with_its_factor():
+    """The friction's y problem shares x's matrix and PC (HermiteProblem(matrix_of=...)):
+    after both take the same springs and their own right-hand sides, y's solve is
+    bitwise that of a problem with its own matrix, and the matrix is factored once for
+    both (one PC set-up, x's PC the one y's KSP solves with)."""
+    from petsc_rod.global_step.hermite import HermiteProblem
+    from petsc_rod.scenes.scene import EndState
+    comm = PETSc.COMM_WORLD
+    mesh = Mesh(comm, 24, 2.0)
+    slope_matrices = p2_element_matrices(mesh.element_h, 2.0, 50.0)
+    ends = [EndState("pin", np.array(p, dtype=float), np.eye(3), np.zeros(3))
+            for p in ((0.0, 0.3, 0.0), (2.0, -0.2, 0.5))]
+    owned = np.arange(mesh.element_start, mesh.element_end)
+    k = 10.0 + owned % 5
+    matrices = k[:, None, None] * np.eye(4)
+    x_vectors, y_vectors = 0.1 * k[:, None] * np.ones(4), -0.2 * k[:, None] * np.ones(4)
+    slope_rhs = mesh.da.createGlobalVec()
+    slope = slope_rhs.duplicate()
+    vertices = np.arange(2 * mesh.vertex_start, 2 * mesh.vertex_end)
+    slope_rhs.getArray()[:] = np.cos(0.3 * vertices)
+    x = HermiteProblem(mesh, slope_matrices, "test_share_x_", 0)
+    y = HermiteProblem(mesh, slope_matrices, "test_share_y_", 1, matrix_of=x)
+    alone = HermiteProblem(mesh, slope_matrices, "test_share_alone_", 1)
+    with destroyed_after(alone, y, x, mesh, slope_rhs, slope):
+        for problem, vectors in ((x, x_vectors), (y, y_vectors), (alone, y_vectors)):
+            problem.set_end_states(*ends)
+            problem.set_added(matrices, vectors)
+        assert y.ksp.getPC().handle == x.ksp.getPC().handle
+        PETSc.Log.begin()
+        set_ups = PETSc.Log.Event("PCSetUp")
+        x.solve(slope_rhs, slope)
+        count = set_ups.getPerfInfo()["count"]
+        shared = y.solve(slope_rhs, slope).getArray().copy()
+        assert set_ups.getPerfInfo()["count"] == count      # y's solve set nothing up
+        alone.solve(slope_rhs, slope)
+        assert set_ups.getPerfInfo()["count"] == count + 1  # a problem on its own does
+        assert np.array_equal(shared, alone.solution.getArray())
+        assert not np.array_equal(shared, x.solution.getArray())

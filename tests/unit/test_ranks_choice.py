@@ -56,3 +56,37 @@ def test_the_measured_model_splits_the_long_lines(elements):
     gains today."""
     assert choose("auto", elements, 2) == "split"
     assert ranks.WHOLE.per_element > ranks.SPLIT.per_element
+
+
+def test_friction_passes_add_to_both_costs_and_move_the_crossover(monkeypatch):
+    """P passes of c + d N on each side: the crossover of a + P c, b + P d."""
+    monkeypatch.setattr(ranks, "PASS_WHOLE", IterationCost(1e-3, 0.2e-6))
+    monkeypatch.setattr(ranks, "PASS_SPLIT", IterationCost(4e-3, 0.1e-6))
+    whole, split = ranks.iteration_costs(10, WHOLE, SPLIT)
+    assert (whole.fixed, whole.per_element) == pytest.approx((11e-3, 3e-6))
+    assert (split.fixed, split.per_element) == pytest.approx((43e-3, 1.5e-6))
+    # (43 - 11) ms / (3 - 1.5) us = 21 333 elements, where 4000 without the passes
+    assert crossover(2, WHOLE, SPLIT, passes=10) == pytest.approx(32e-3 / 1.5e-6)
+    assert choose("auto", 21000, 2, WHOLE, SPLIT, passes=10) == "whole"
+    assert choose("auto", 21400, 2, WHOLE, SPLIT, passes=10) == "split"
+    assert predicted(21000, 2, WHOLE, SPLIT, passes=10)[0] == pytest.approx(11e-3 + 3e-6 * 21000)
+
+
+# The measured model with friction's passes (docs/performance.md, "Two ranks or one",
+# "Friction"): mooring_chain with -rod_seabed_friction 0.3 lost split at 340 and 850
+# elements (2 ranks slower than 1); steel_catenary_riser_friction (2400 elements) gained.
+@pytest.mark.parametrize("elements", [340, 850])
+def test_a_friction_line_of_850_elements_is_kept_whole(elements):
+    assert choose("auto", elements, 2, passes=ranks.passes_of(True)) == "whole"
+    assert ranks.passes_of(False) == 0
+
+
+def test_the_frictionless_850_element_line_still_splits():
+    assert choose("auto", 850, 2, passes=ranks.passes_of(False)) == "split"
+
+
+def test_the_measured_friction_crossover_lies_between_the_chain_and_the_riser():
+    passes = ranks.passes_of(True)
+    assert 850 < crossover(2, passes=passes) < 2400
+    assert choose("auto", 2400, 2, passes=passes) == "split"
+    assert ranks.PASS_SPLIT.fixed > ranks.PASS_WHOLE.fixed
