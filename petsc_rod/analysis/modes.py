@@ -67,6 +67,9 @@ RESIDUAL = 1e-3
 # SLICE_DEPTH halvings (_slice)
 SLICE_SPAN = 1e4
 SLICE_DEPTH = 12
+# omega^2 far above any discretisation's eigenvalue (1e30 Hz squared): the inertia of
+# K - COUNT_SHIFT M counts every finite eigenvalue (modes_count)
+COUNT_SHIFT = (2 * np.pi * 1e30) ** 2
 # the pairs a sub-band's solve asks for beyond its count: the eigensolver stops once it
 # has as many as asked, and a free rigid mode of little mass can converge after the
 # nearest vibration (those outside the sub-band are left out)
@@ -301,6 +304,28 @@ def check_options(comm):
         eps.setFromOptions()
     finally:
         eps.destroy()
+
+
+def modes_count(problem, settings=MassSettings()):
+    """How many modes the problem's discretisation has: the finite eigenvalues of
+    K phi = omega^2 M phi (the rank of M on the constrained unknowns; the massless
+    unknowns' are infinite), counted by the inertia of K - sigma M at sigma =
+    COUNT_SHIFT (_below: as -rod_modes_range 0,1e30 counts them). At the problem's
+    state, any (the count is M's rank, which the state leaves; a start that is not
+    stable counts its negative eigenvalues too). One factorisation. Collective."""
+    STAGE.push()
+    made = []
+    try:
+        operators = ModalOperators(problem, settings)
+        made.append(operators)
+        shifted = operators.matrix.duplicate(copy=True)
+        made.append(shifted)
+        shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        return _below(operators, shifted, COUNT_SHIFT)
+    finally:
+        for thing in reversed(made):
+            thing.destroy()
+        STAGE.pop()
 
 
 def solve_modes(problem, count, settings=MassSettings(), band=None):

@@ -13,10 +13,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from petsc_rod.analysis.mass import MassSettings
-from petsc_rod.analysis.modes import ModesRefused, solve_modes
+from petsc_rod.analysis.modes import ModesRefused, modes_count, solve_modes
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
-from petsc_rod.cli.modes import modes_band, table_lines
+from petsc_rod.cli.modes import check_subspace, modes_band, table_lines
 from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
 from petsc_rod.errors import (RodDivergedError, RodInputError, RodInterrupted,
@@ -140,6 +140,8 @@ def modes_request(options):
                             "every mode in a band)")
     if not values["rod_modes"] and band is None:
         return None
+    if values["rod_modes"]:
+        check_subspace(values["rod_modes"])
     return values["rod_modes"], MassSettings(
         **{key: values[f"rod_{name}"] for name, key in MODES_OPTIONS.items() if key}), band
 
@@ -170,13 +172,33 @@ def split_options(options):
             body_modes)
 
 
+def check_line_counts(solver, count, settings):
+    """RodInputError on every rank, in one line, where ``count`` modes are more than a
+    line's discretisation has (analysis/modes.modes_count, one factorisation a line,
+    counted only where ``count`` is above its element count: at least one mode an
+    element), naming the first such line and its count: before any mode is solved
+    and anything written. Collective."""
+    mine = {k: modes_count(line.problem, settings) for k, line in solver.lines.items()
+            if count > line.mesh.n_elements}
+    short = sorted((k, n) for k, n in solver.placement.share(mine).items() if count > n)
+    if short:
+        k, available = short[0]
+        raise RodInputError(f"-rod_modes {count}: line {solver.system.lines[k].name}'s "
+                            f"discretisation has {available} modes; ask for at most "
+                            f"{min(n for _, n in short)}, or for every mode in a band "
+                            "with -rod_modes_range FMIN,FMAX (docs/modes.md)")
+
+
 def line_modes(solver, count, settings, band=None):
     """({line index: Modes or ModesRefused}, {line index: seconds}) on every rank: each
     line's ``count`` lowest modes (every mode in ``band``, Hz, where given) about its
     equilibrium with its ends held
     (analysis/modes.solve_modes on the HeldLine's problem, collective on its group's
     communicator: its ends are pinned there, so its modes are the held line's), the
-    shapes on the line's own ranks, zero rows of them on the others. Collective."""
+    shapes on the line's own ranks, zero rows of them on the others. RodInputError
+    (check_line_counts) where ``count`` is more than a line has. Collective."""
+    if band is None:
+        check_line_counts(solver, count, settings)
     mine, seconds = {}, {}
     for k, line in solver.lines.items():
         start = time.perf_counter()

@@ -308,6 +308,8 @@ def run_line(comm, plan, say=None, *, record=None, keep_last=False, options="",
                 if check_only:
                     return None
                 path = built.start(say)
+                if values["rod_modes"]:     # more than the line has: refused now
+                    modes_of_run().check_modes_count(built.problem, values)
             if values["rod_output"]:
                 made = (record or default_record)(plan, built.solver, built.first_load_factor)
                 writer = failures.writer = io.ResultWriter(

@@ -11,13 +11,16 @@ import numpy as np
 from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
-from petsc_rod.analysis.modes import (CLASSES, RESIDUAL, ModesRefused, check_options,
+from petsc_rod.analysis.modes import (CLASSES, PREFIX, RESIDUAL, SUBSPACE,
+                                      ModesRefused, check_options, modes_count,
                                       solve_modes, symmetrised_text)
 from petsc_rod.errors import RodInputError, RodIOError, petsc_message
 from petsc_rod.cli.options import modes_asked
 from petsc_rod.figures.modes import shapes_path
 from petsc_rod.io.results import check_output_path
 
+# SLEPc's Krylov-Schur (its default EPS) needs ncv >= nev + 1; the other types ncv >= nev
+KRYLOV_SCHUR = "krylovschur"
 TABLE_COLUMNS = ("mode", "frequency_Hz", "period_s", "omega_rad_s", "modal_mass_kg",
                  "class", *(f"share_{name.replace('-', '_')}" for name in CLASSES))
 SHAPE_COLUMNS = ("mode", "S_m", "offset_x_m", "offset_y_m", "offset_z_m", "rotation_x_rad",
@@ -46,6 +49,28 @@ def modes_band(text):
     return band
 
 
+def check_subspace(count):
+    """RodInputError, in one line, where -rod_modes_eps_ncv (the Krylov subspace) is
+    given below what SLEPc needs for ``count`` modes (or -rod_modes_eps_nev, which
+    overrides it): ncv >= nev + 1 for Krylov-Schur (the default -rod_modes_eps_type),
+    ncv >= nev for the others; SLEPc refuses it only inside the solve, after the
+    equilibrium (a line's run and a system's: api/system_run.modes_request)."""
+    options = PETSc.Options(PREFIX)
+    if not options.hasName("eps_ncv"):
+        return
+    ncv = options.getInt("eps_ncv")
+    nev = options.getInt("eps_nev", count)
+    kind = options.getString("eps_type", KRYLOV_SCHUR).lower()
+    least = nev + 1 if kind == KRYLOV_SCHUR else nev
+    if ncv < least:
+        asked = (f"-rod_modes {count}" if nev == count else f"-rod_modes_eps_nev {nev}")
+        raise RodInputError(f"-rod_modes_eps_ncv {ncv}: {asked} needs a Krylov subspace of "
+                            f"at least {least} vectors (SLEPc's {kind}: ncv >= nev"
+                            f"{' + 1' if kind == KRYLOV_SCHUR else ''}); give "
+                            f"-rod_modes_eps_ncv {least} or more, or leave it out (default "
+                            f"nev + max({SUBSPACE}, nev / 2))")
+
+
 def check_modes_inputs(values, scene, comm):
     """Refuse, before any work, -rod_modes on a uniform line that has neither a load nor
     -rod_modes_mass, -rod_modes_range malformed or beside -rod_modes,
@@ -65,6 +90,8 @@ def check_modes_inputs(values, scene, comm):
         except PETSc.Error as error:
             raise RodInputError(f"SLEPc refused the modes' options: {petsc_message(error)}; "
                                 "check the -rod_modes_eps_* and -rod_modes_st_* options") from None
+    if values["rod_modes"]:
+        check_subspace(values["rod_modes"])
     path = values["rod_modes_table"]
     if path and not modes_asked(values):
         raise RodInputError("-rod_modes_table needs -rod_modes N (the number of modes) "
@@ -79,6 +106,23 @@ def check_modes_inputs(values, scene, comm):
             check_output_path(name, comm, "-rod_modes_table")
     if modes_asked(values) and not mass_known(scene, mass_settings(values)):
         raise RodInputError(f"{MISSING_MASS}: give -rod_modes_mass (kg/m)")
+
+
+def check_modes_count(problem, values):
+    """RodInputError, in one line, where -rod_modes N asks for more modes than the
+    line's discretisation has (analysis/modes.modes_count, at the start: before the
+    solve and its file). Counted (one factorisation) only where N is above the element
+    count: every element's midpoint moves sideways with its mass, at least one mode an
+    element. Collective."""
+    count, elements = values["rod_modes"], problem.mesh.n_elements
+    if not count or count <= elements:
+        return
+    available = modes_count(problem, mass_settings(values))
+    if count > available:
+        raise RodInputError(f"-rod_modes {count}: the line's discretisation has "
+                            f"{available} modes ({elements} elements); ask for at most "
+                            f"{available}, or for every mode in a band with "
+                            "-rod_modes_range FMIN,FMAX (docs/modes.md)")
 
 
 def solve_for_run(problem, values, writer):

@@ -84,7 +84,9 @@ class Settings:
     """``rtol``: the scaled residual's norm (forces / the force scale, moments / (the
     force scale x the length scale)) that ends Newton; ``floor``: a scaled residual
     below it that no step of the line search reduces is the lines' own accuracy (their
-    end forces are converged to their tolerances, not to round-off) and is accepted;
+    end forces are converged to their tolerances, not to round-off) and is accepted
+    (above it, before failing, Newton takes the lines to their stationary points and
+    goes on: SystemSolver.newton);
     ``max_iterations`` per attempt (below the floor, two Newton steps in a row that do
     not halve the residual end it too: the same accuracy); ``load_steps``: the continuation's first step is
     1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
@@ -608,7 +610,10 @@ class SystemSolver:
     def newton(self, state, loads, scale):
         """(state, iterations) at equilibrium under ``loads`` (Loads; the held points
         put at its positions), or (None, its iterations) with self.failure saying why.
-        self.forces/stiffnesses: the lines' at the returned state."""
+        self.forces/stiffnesses: the lines' at the returned state. A line search without
+        decrease above Settings.floor first makes Newton precise: the lines settled
+        (HeldLine.settle) at the state and at every later trial, the residual then
+        free of their tolerances' error; a second one fails."""
         settings, free, held = self.settings, self.layout.free, self.layout.held_points
         state = State(state.points.copy(),
                       state.bodies.placed(loads.places, self.layout.held_places))
@@ -618,7 +623,7 @@ class SystemSolver:
             return None, 0
         r, J = self.residual(state, loads, forces, stiffness)
         norm = np.linalg.norm(r[free] / scale[free])
-        stalled = 0
+        stalled, precise = 0, False
         for iteration in range(settings.max_iterations + 1):
             self.forces, self.stiffnesses = forces, stiffness
             self.check_interrupted(iteration)
@@ -648,7 +653,8 @@ class SystemSolver:
             alpha, full = 1.0, ""
             for _ in range(settings.line_search + 1):
                 trial = state.moved(alpha * step, self.layout)
-                ok, t_forces, t_stiffness = self.evaluate(trial, linearise=False)
+                ok, t_forces, t_stiffness = self.evaluate(trial, settle=precise,
+                                                          linearise=False)
                 full = full or ("" if ok or alpha < 1.0 else f" ({self.failure} at the "
                                                              "full step)")
                 if ok:
@@ -661,6 +667,19 @@ class SystemSolver:
                 if norm <= settings.floor:
                     self.norm = norm
                     return state, iteration
+                if not precise:
+                    # Above the floor the residual may still be the lines' own error
+                    # (their end forces converged to -rod_al_rtol/-rod_al_ctol: a stiff
+                    # line's EA times its constraint residual): the lines taken to their
+                    # stationary points (HeldLine.settle, Newton's steps), here and at
+                    # every trial from now on, and Newton goes on with their exact forces.
+                    precise, stalled = True, 0
+                    ok, forces, stiffness = self.evaluate(state, settle=True)
+                    if not ok:
+                        return None, iteration
+                    r, J = self.residual(state, loads, forces, stiffness)
+                    norm = np.linalg.norm(r[free] / scale[free])
+                    continue
                 self.failure = (f"the line search found no decrease of the residual "
                                 f"{norm:.3g}{full}")
                 return None, iteration

@@ -195,6 +195,47 @@ def test_bad_modes_solver_option_refused(option, shared_tmp, capsys):
         assert len(lines) == 1 and "-rod_modes_eps_*" in lines[0] and "step 1" not in out
 
 
+def test_more_modes_than_the_line_has_refused_before_the_solve(shared_tmp, capsys):
+    """-rod_modes 1000 on an inextensible cantilever of 8 elements without rotary
+    inertia: its discretisation has 32 modes (each element's vertex and midpoint move
+    in the 2 bending directions, as -rod_modes_range 0,1e30's inertia counts them; 256
+    at 64 elements): exit 2 with one line saying so, before any step and with no result
+    file (it reported the 32 and warned that a larger -rod_modes_eps_ncv finds the
+    others)."""
+    output = os.path.join(shared_tmp, "too_many_modes.h5")
+    options = {"rod_length": "1", "rod_stiffness": "1,1,1", "rod_start": "clamp",
+               "rod_end": "free", "rod_elements": "8", "rod_modes_mass": "1",
+               "rod_output": output}
+    assert run_cli({**options, "rod_modes": "1000"}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "step 1" not in out
+        assert ("-rod_modes 1000: the line's discretisation has 32 modes (8 elements); "
+                "ask for at most 32") in lines[0]
+    assert run_cli({**options, "rod_modes": "33"}) == 2
+    assert "has 32 modes" in capsys.readouterr().out or PETSc.COMM_WORLD.getRank() != 0
+
+
+@pytest.mark.parametrize("ncv", ["2", "3"])
+def test_a_krylov_subspace_smaller_than_the_modes_asked_refused(ncv, shared_tmp, capsys):
+    """-rod_modes 3 with -rod_modes_eps_ncv 2 or 3 (SLEPc's Krylov-Schur needs ncv >=
+    nev + 1): exit 2 with one line naming -rod_modes_eps_ncv and the least it takes,
+    before any step and with no result file (it failed with exit 4 after the
+    equilibrium, "PETSc failed during the solve")."""
+    output = os.path.join(shared_tmp, "small_ncv.h5")
+    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
+                    "rod_modes_eps_ncv": ncv, "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "step 1" not in out
+        assert lines[0].startswith(f"petsc_rod: error: -rod_modes_eps_ncv {ncv}: "
+                                   "-rod_modes 3 needs a Krylov subspace of at least 4")
+
+
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, the shapes'

@@ -69,6 +69,32 @@ def test_a_system_refuses_a_bad_modes_option():
         solve_system(system, options={"modes": "many"})
 
 
+def test_a_system_refuses_more_modes_than_a_line_has(shared_tmp):
+    """Options {'modes': 100000}: refused in one line naming the first line short of
+    them and how many it has (the inertia's count, analysis/modes.modes_count: 561 for
+    each 70-element chain, as many as {'modes_range': '0,1e30'} finds and verifies), before
+    any mode is solved and with no file (each line reported what it found and warned
+    that a larger -rod_modes_eps_ncv finds the others); -rod_modes_eps_ncv below
+    nev + 1 refused before any work."""
+    from petsc_rod.errors import RodInputError
+    system, _ = read_moordyn(DECK)
+    path = os.path.join(shared_tmp, "too_many.h5")
+    with pytest.raises(RodInputError) as refused:
+        solve_system(system, output=path, options={"modes": 100000})
+    message = str(refused.value)
+    assert "\n" not in message and not os.path.exists(path)
+    assert message.startswith("-rod_modes 100000: line Line1's discretisation has 561 "
+                              "modes; ask for at most 561")
+    database = PETSc.Options()
+    database.setValue("rod_modes_eps_ncv", "5")
+    try:
+        with pytest.raises(RodInputError, match=r"^-rod_modes_eps_ncv 5: -rod_modes 5 "
+                                                r"needs a Krylov subspace of at least 6"):
+            solve_system(system, options={"modes": COUNT})
+    finally:
+        database.delValue("rod_modes_eps_ncv")
+
+
 def test_each_line_s_modes_in_a_band():
     """Options {'modes_range': '0.2,0.4'} on the same system: each line's modes in the
     band, counted by the inertia, are those of its 8 lowest that lie in it (which
