@@ -107,14 +107,6 @@ FROZEN_SHRINK = 0.1
 # The next exact step after a chord step or an untested one tests again. A conservative
 # problem tests every exact step: its last test is the stability verdict (``verified``).
 INERTIA_TURN = 1e-3
-# On such a problem a step with the iteration's curvature (_newton_step: where the
-# heights enter) solves with H's LDL^T, factored for its inertia test, where
-# CURVED_WITH_H, not with J's LU: its matrix is not the state's J anyway (the curvature
-# is the iteration's), leaving out the followers' unsymmetric derivative changes how
-# far the step gets by little (the 18 000-element riser in its current: |grad L| after
-# it 4741 against 4736 N m, from 1.1e5), and J's first assembly and LU wait for the
-# next step, an exact one, whose factors the chord steps reuse (docs/method.md §11).
-CURVED_WITH_H = True
 # A chord step converges linearly, by the factor theta = turn / previous turn (at most
 # FROZEN_SHRINK): the error it leaves is about theta / (1 - theta) times its turn (the
 # geometric rest), and a chord step whose rest is below STEP_TOLERANCE rad is the last
@@ -490,9 +482,7 @@ class NewtonSolver:
         ``frozen``: a chord step, with the matrices and factors of the last exact step,
         and its chord forms' solves (FREEZE_TURN, _keep_kkt; ``run`` takes one only
         where they are kept). Where ``_trusted`` is set (``run``: INERTIA_TURN, a problem
-        that solves with J) an exact step is taken without the inertia test. A step with
-        ``curvature`` on such a problem solves with H's factor of its inertia test, and
-        its chord forms' solves are that test's (CURVED_WITH_H)."""
+        that solves with J) an exact step is taken without the inertia test."""
         gradient = self._gradient(frames, g, mu)
         self._residual_norm = np.sqrt(self.problem.mesh.global_sum(float(np.sum(gradient**2))))
         self._agree(np.isfinite(self._residual_norm))        # the same sum on every rank
@@ -531,13 +521,9 @@ class NewtonSolver:
                 # test of the state's own H, not of one with the iteration's curvature
                 # nor with the roll held
                 self._own_test = curvature is None and not held
-            # the Jacobian with the followers' linearisation, else H's factor; a step
-            # with the iteration's curvature (never a trusted one) with H's factor of
-            # its inertia test (CURVED_WITH_H)
-            with_jacobian = self.unsymmetric and (frozen or curvature is None
-                                                  or not CURVED_WITH_H)
+            # the Jacobian with the followers' linearisation, else H's factor
             solver = (self._jacobian if frozen else self._jacobian_of(hessian)) \
-                if with_jacobian else hessian
+                if self.unsymmetric else hessian
             rhs = hessian.to_vec(-gradient)
             vecs.append(rhs)
             if frozen:
@@ -548,12 +534,12 @@ class NewtonSolver:
                 vecs.append(direction)
             else:
                 columns = hessian.chord_forms(frames[:, 2]) if self._bordered() else []
-                if self._free_roll and with_jacobian and self._near:
+                if self._free_roll and self.unsymmetric and self._near:
                     # the roll held by a constraint of the step, its multiplier dropped
                     # (ROLL_TURN)
                     columns.append(hessian.roll_form(frames[:, 2]))
                 vecs.extend(columns)
-                if columns and hessian.decidable and not with_jacobian:
+                if columns and hessian.decidable and not self.unsymmetric:
                     # the inertia test solved for a basis of the same forms
                     solved = [solver.solve(rhs)] + hessian.solve_in_constraint_span(columns)
                 else:
@@ -562,11 +548,9 @@ class NewtonSolver:
                 vecs.extend(solved)
                 direction, solved = solved[0], solved[1:]
                 schur = np.array([[c.dot(s) for s in solved] for c in columns])
-                if with_jacobian:
+                if self.unsymmetric:
                     # kept for the chord steps that follow (their Vecs leave ``vecs``)
                     self._keep_kkt(columns, solved, schur, vecs)
-                else:
-                    self._drop_kkt()
             dmu = np.zeros(3)
             if columns:
                 # omega = H^-1 (-grad L - C^T dmu) with C omega = -c:
