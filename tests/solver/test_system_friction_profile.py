@@ -1,7 +1,7 @@
 """A system's lines with Coulomb friction on a seabed profile (system/held_line.py,
 "Friction" and "Seabed profile": the plane's friction law with the secant gradient g
 read at each node, its turn g' e e^T and the limit mu R following the interpolant's
-height z_b(d) and k_v(g): FrictionTerm._profile_rates), on
+height z_b(d) and k_v(g): FrictionTerm._shape_rates), on
 tests/data/moordyn/small_free_body.dat (a free buoyant body on three 70 m chains) read
 by the API, friction mu = 0.5:
 
