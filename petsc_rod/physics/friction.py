@@ -97,7 +97,7 @@ stationary point is the iteration's: the plane's block with, per grounded node,
     mu^2 |d|_G d|d|_G/dx = G d + (g.d) Dg^T d                 (2,), m, in place of G d
             (from mu^2 |d|_G^2 = d.d + (g.d)^2),
     d(g.f)/dx = g^T df/dx + f^T Dg                            (2,), N/m^2: the vertical
-            row less -w f^T Dg (g.f with g turning),
+            row -w d(g.f)/dx is g^T times the horizontal rows less w f^T Dg,
 
 grad z_b (2,) the interpolant's own slope (1), Dg_ij = dg_i/dx_j (2, 2) the secant's
 derivative (1/m), both from Seabed.plan_slopes: on a grid the bilinear cells' slopes
@@ -513,7 +513,7 @@ class FrictionTerm(NodalLoadTerm):
             lift = grad z_b - p cos^2(theta) Dg^T g    (n, 2), 1: dR/dx = k cos(theta)
                    lift, as R = k cos(theta) p with d cos/dx = -cos^3 Dg^T g,
             Dg                                         (n, 2, 2), 1/m: dg/dx (the
-                   vertical part g.f turns: -f^T Dg in its row on x),
+                   vertical part g.f turns: -w f^T Dg in its row on x),
             G d + (g.d) Dg^T d                         (n, 2), m: mu^2 |d|_G
                    d|d|_G/dx, from mu^2 |d|_G^2 = d.d + (g.d)^2.
 
