@@ -46,8 +46,9 @@ global step's vertical solve (the seabed term comes first). Why implicit: an exp
 (lagged) spring k_s on a grounded stretch is amplified k_s l^2 / R per iteration
 (global_step/seabed_contact.py).
 
-In the Newton steps (docs/method.md §11, "Terms of the positions"), on a flat seabed or
-a sloping plane and with one coefficient (mu_a = mu_l): within a load step the anchors
+In the Newton steps (docs/method.md §11, "Terms of the positions"), with one
+coefficient (mu_a = mu_l), on any seabed (flat, a sloping plane, a profile or a grid:
+below): within a load step the anchors
 are fixed, and the law above is a function of the node positions, f_n(x_n, z_n), through
 d_n = x_n - a_n and R_n = k (z_b - z_n)_+. Its work enters the gradient like the
 seabed's energy, -w_n f_n on the horizontal positions, carried by their chains
@@ -66,9 +67,7 @@ stability test see the friction with its limit held at its current value); the z
 (``unsymmetric``; analysis/jacobian.py). With mu_a != mu_l the slide's block is
 unsymmetric, its symmetric part indefinite where the slip is oblique to the line, and
 the turn of the axes a, l with the tangent, left out, is of the order of R: the steps
-failed there (docs/riser.md §3b), so such a run takes none (``in_newton``); nor on a
-seabed profile or grid, whose frictionless contact the steps take (slope_load.py) but
-whose friction's steps are not written for a grid nor measured on a profile.
+failed there (docs/riser.md §3b), so such a run takes none (``in_newton``).
 
 On a sloping plane z_b = z_0 + g.x (g constant) the force is F_n = (f_n, g.f_n) on
 (x_n, z_n), its size |d|_G = sqrt(d^T G d) / mu with G = I + g g^T (the tangent-plane
@@ -86,15 +85,27 @@ global step carries g.f as its work through the heights' chain (add_iterate_load
 that its fixed point is the Newton steps' stationary point. Not conservative: friction
 dissipates, so the run gives no stability verdict (as with the drag).
 
-On a seabed profile a line's own run with friction takes no Newton steps (above), and
-its fixed point is the plane's law with the secant gradient g = g(d) e read at each node
-and R = k cos(theta) (z_b(d) - z)_+, z_b the interpolant (environment/bathymetry.py). A
-line of a system (its contact linearised by the seabed term, SeabedTerm.profile) takes
-that fixed point's derivative for its stiffness (``held_exact``, _profile_rates): the plane's block
-with the limit's k cos(theta) g replaced by dR/dx = k cos(theta) (z_b' - p g g' cos^2)
-e, G's oblique projection by mu^2 |d|_G d|d|_G/dx = G d + (g.d) g' (d.e) e, and the
-vertical row less (f.e) g' e^T (g.f with g turning), g' the secant's rate
-(Profile.slopes); unsymmetric, into J.
+On a seabed profile or grid the global step's fixed point (the contact's heights and
+gradients lagged, slope_load.py) has the plane's law with each node's own secant
+gradient g = g(x) (2,) (environment/bathymetry.py), cos(theta) = 1 / sqrt(1 + |g|^2),
+and limit R = k cos(theta) p, p = (z_b(x) - z)_+ under the interpolant z_b (m). The
+Newton steps take that fixed point's derivative (_plane_law, _shape_rates), so their
+stationary point is the iteration's: the plane's block with, per grounded node,
+
+    dR/dx = k cos(theta) (grad z_b - p cos^2(theta) Dg^T g)   (2,), N/m^2, in place of
+            the plane's k cos(theta) g (d cos/dx = -cos^3 Dg^T g),
+    mu^2 |d|_G d|d|_G/dx = G d + (g.d) Dg^T d                 (2,), m, in place of G d
+            (from mu^2 |d|_G^2 = d.d + (g.d)^2),
+    d(g.f)/dx = g^T df/dx + f^T Dg                            (2,), N/m^2: the vertical
+            row -w d(g.f)/dx is g^T times the horizontal rows less w f^T Dg,
+
+grad z_b (2,) the interpolant's own slope (1), Dg_ij = dg_i/dx_j (2, 2) the secant's
+derivative (1/m), both from Seabed.plan_slopes: on a grid the bilinear cells' slopes
+and Dg in two directions (bathymetry.Grid.slopes), on a profile along its direction e,
+Dg = g' e e^T (Profile.slopes). Farther than delta/2 from every row or grid line Dg is
+a profile's 0 and a grid cell's twist (its off-diagonal), and the block is the plane's
+with the node's own g where Dg = 0. Unsymmetric: H takes its share as on a plane, J
+the rest. A line of a system takes the same block for its stiffness (``held_exact``).
 """
 
 import numpy as np
@@ -163,8 +174,7 @@ class FrictionTerm(NodalLoadTerm):
     # the recorded force, reactions and use are the last global step's (_record): a
     # step that Newton steps finish ends at the iteration after them (Term)
     outputs_of_state = False
-    newton_gap = ("seabed friction with two coefficients or on a seabed profile "
-                  "(docs/riser.md §3b)")
+    newton_gap = "seabed friction with two coefficients (docs/riser.md §3b)"
 
     def __init__(self, mesh, seabed_term):
         super().__init__(mesh, "friction")
@@ -201,28 +211,18 @@ class FrictionTerm(NodalLoadTerm):
         self._held = None           # H's share on a plane of the last _plane_law (n, 2, 2)
 
     @property
+    def in_newton(self):
+        """With one coefficient, on any seabed: flat, a sloping plane, a profile or a
+        grid (the law's derivatives with g read at each node and its turn,
+        _shape_rates; module docstring)."""
+        return self.friction.axial == self.friction.lateral
+
+    @property
     def held_exact(self):
         """Whether a held line's stiffness with this friction is exact
-        (system/held_line.py): one coefficient, on a flat seabed, a sloping plane or a
-        profile (the law's derivatives with g read at each node along the profile's
-        direction, _profile_rates); not on a grid, whose g turns in two directions."""
-        seabed = self.seabed_term.seabed
-        return ((seabed.flat or seabed.plane or self._along_profile)
-                and self.friction.axial == self.friction.lateral)
-
-    @property
-    def _along_profile(self):
-        """On a seabed profile (heights along a direction), not a grid: where the law's
-        derivatives take the secant gradient's turn (_profile_rates); on a grid g turns
-        in two directions and the law is the plane's with each node's g."""
-        return self.seabed_term.seabed.along_direction
-
-    @property
-    def in_newton(self):
-        """On a flat seabed or a sloping plane, with one coefficient (module docstring)."""
-        seabed = self.seabed_term.seabed
-        return ((seabed.flat or seabed.plane)
-                and self.friction.axial == self.friction.lateral)
+        (system/held_line.py): where the Newton steps take it (``in_newton``), their
+        block the derivative of the line's own fixed point."""
+        return self.in_newton
 
     # --- the global step --------------------------------------------------------------
     def build(self, slope_matrices, penalty):
@@ -262,8 +262,7 @@ class FrictionTerm(NodalLoadTerm):
         P2 interpolant's int F.g differs by O(h^2)). Collective."""
         if self.seabed_term.seabed.flat:
             return
-        if self._springs_stale and (self.seabed_term.seabed.plane
-                                    or self._along_profile):
+        if self._springs_stale:
             # after Newton steps: the friction at their positions (the last solve's is
             # that of the state before them)
             work = -self._newton_law(state)[0][:, 2]
@@ -338,12 +337,16 @@ class FrictionTerm(NodalLoadTerm):
         self._springs_from_positions(positions, tangents, reaction)
         self._springs_stale = False
 
-    def _springs_from_positions(self, positions, tangents, reaction):
+    def _springs_from_positions(self, positions, tangents, reaction, gradients=False):
         """The secant springs (ne, 3) of the element nodes' horizontal ``positions``
-        (ne, 3, 2), ``tangents`` (ne, 3, 2) and reactions ``reaction`` (ne, 3)."""
+        (ne, 3, 2), ``tangents`` (ne, 3, 2) and reactions ``reaction`` (ne, 3), on the
+        seabed's ``gradients`` g (ne, 3, 2; None: flat; default the contact's, those of
+        the last global step)."""
+        if gradients is False:
+            gradients = self.seabed_term.contact.gradients
         trial = -self.friction.stiffness * (positions - self.anchors)
         size = (elliptic_norm(trial, tangents, self.friction)
-                * tangent_factor(trial, self.seabed_term.contact.gradients))
+                * tangent_factor(trial, gradients))
         self.spring = self.friction.stiffness * np.divide(
             reaction, np.maximum(size, reaction), out=np.zeros_like(size), where=reaction > 0)
 
@@ -456,8 +459,8 @@ class FrictionTerm(NodalLoadTerm):
         f = -R d / |d|_G, whose derivative in x is
         -R / |d|_G (I - d (G d)^T / (mu^2 |d|_G^2)) - d (k cos(theta) g)^T / |d|_G and in
         z d k cos(theta) / |d|_G; the vertical part g.f has g^T times them. On a
-        profile g is each node's secant gradient and the derivatives take
-        its turn (_profile_rates). Returns (-w F (n, 3), -w dF/dx (n, 3, 2),
+        profile or grid g is each node's secant gradient and the derivatives take
+        its turn (_shape_rates). Returns (-w F (n, 3), -w dF/dx (n, 3, 2),
         -w dF/dz (n, 3)), N and N/m."""
         seabed = self.seabed_term.seabed
         mu, stiffness = self.friction.lateral, self.friction.stiffness
@@ -476,8 +479,8 @@ class FrictionTerm(NodalLoadTerm):
         limit = np.divide(seabed.stiffness * cosine, norm, out=np.zeros_like(norm),
                           where=slide)                                    # k cos / |d|_G
         lift = turn = None
-        if self._along_profile:
-            lift, turn, metric = self._profile_rates(r, d, g, cosine, metric)
+        if seabed.shaped:
+            lift, turn, metric = self._shape_rates(r, d, g, cosine, metric)
         in_x = ((stick * stiffness)[:, None, None] * np.eye(2)
                 + scale[:, None, None] * (np.eye(2) - d[:, :, None] * metric[:, None, :]
                                           / squared[:, None, None])
@@ -494,38 +497,39 @@ class FrictionTerm(NodalLoadTerm):
                                       / length[:, None, None]))
         rise = np.einsum("nc,nc->n", g, force)
         vertical = np.einsum("nc,ncj->nj", g, in_x)
-        if turn is not None:                # g.f with g turning: -(f.e) g' e^T
-            vertical -= (np.einsum("nc,nc->n", force, turn)[:, None]
-                         * seabed.shape.direction)
+        if turn is not None:                # g.f with g turning: -f^T Dg
+            vertical -= np.einsum("ni,nij->nj", force, turn)
         return (-w[:, None] * np.concatenate([force, rise[:, None]], axis=1),
                 w[:, None, None] * np.concatenate([in_x, vertical[:, None]], axis=1),
                 w[:, None] * np.concatenate([in_z, np.einsum("nc,nc->n", g, in_z)[:, None]],
                                             axis=1))
 
-    def _profile_rates(self, r, d, g, cosine, metric):
-        """What a seabed profile (SeabedTerm.profile) adds to
-        _plane_law's derivatives, at node positions r (n, 3) and slips d (n, 2), with
-        the secant gradient g = g(d_e) e (n, 2) (Profile.slopes: d_e = (x - p0).e, z_b'
-        the interpolant's slope, g' the secant's rate), cos(theta) (n,) and G d
-        (n, 2): the derivative of the fixed point of the line's own iterations, whose
-        friction is the plane's law with g read at each node. Returns
+    def _shape_rates(self, r, d, g, cosine, metric):
+        """What a seabed profile or grid (SeabedTerm.profile) adds to _plane_law's
+        derivatives, at node positions r (n, 3) and slips d (n, 2), with the secant
+        gradient g (n, 2), cos(theta) = 1 / sqrt(1 + |g|^2) (n,) and G d (n, 2): the
+        derivative of the fixed point of the line's own iterations, whose friction is
+        the plane's law with g = g(x) read at each node (module docstring). With
+        grad z_b the interpolant's own slope (n, 2), Dg_ij = dg_i/dx_j the secant's
+        derivative (n, 2, 2), 1/m (Seabed.plan_slopes: a grid's bilinear slopes; a
+        profile's g' e e^T) and p = (z_b - z)_+ the penetration (n,), m, it returns
 
-            lift = (z_b' - p g g' cos^2) e       (dR/dx = k cos(theta) lift; p the
-                                                  penetration, R = k cos(theta) p),
-            turn = g' e                          (dg/dx = g' e e^T: the vertical part
-                                                  g.f turns, -(f.e) g' e^T in x),
-            G d + (g.d) g' (d.e) e               (mu^2 |d|_G d|d|_G/dx),
+            lift = grad z_b - p cos^2(theta) Dg^T g    (n, 2), 1: dR/dx = k cos(theta)
+                   lift, as R = k cos(theta) p with d cos/dx = -cos^3 Dg^T g,
+            Dg                                         (n, 2, 2), 1/m: dg/dx (the
+                   vertical part g.f turns: -w f^T Dg in its row on x),
+            G d + (g.d) Dg^T d                         (n, 2), m: mu^2 |d|_G
+                   d|d|_G/dx, from mu^2 |d|_G^2 = d.d + (g.d)^2.
 
-        (n, 2) each, 1 and 1/m and m; on a plane lift = g and the rest vanish."""
+        On a plane Dg = 0, lift = g and the rest is the plane's; on a profile
+        Dg^T g = g' (g.e) e and Dg^T d = g' (d.e) e."""
         seabed = self.seabed_term.seabed
-        rise, secant, rate = seabed.shape.slopes(r[:, 0], r[:, 1])
-        along = seabed.shape.direction
+        rise, _, rate = seabed.plan_slopes(r[:, 0], r[:, 1])
         depth = seabed.penetration(r[:, 2], seabed.heights(r[:, 0], r[:, 1]))
-        lift = (rise - depth * secant * rate * cosine**2)[:, None] * along
-        turn = rate[:, None] * along
-        metric = metric + ((np.einsum("nc,nc->n", g, d) * rate * (d @ along))[:, None]
-                           * along)
-        return lift, turn, metric
+        lift = rise - (depth * cosine**2)[:, None] * np.einsum("nij,ni->nj", rate, g)
+        metric = metric + (np.einsum("nc,nc->n", g, d)[:, None]
+                           * np.einsum("nij,ni->nj", rate, d))
+        return lift, rate, metric
 
     def add_gradient(self, g, state):
         """-w_n f_n on the horizontal positions, into g's d3 x and y rows through their
@@ -582,9 +586,10 @@ class FrictionTerm(NodalLoadTerm):
         """Record the friction of the state's own positions (the law of the Newton
         steps at fixed anchors) as if a global step had solved them: after Newton steps
         that no global step follows (HeldLine.settle), the internal force and the end
-        forces read the friction of the state they stand at. A flat seabed or a sloping
-        plane (the Newton steps' cases): the reaction of each node's whole position,
-        k (z_b - z)_+ cos(theta) (Seabed.reaction), and the vertical part g.f.
+        forces read the friction of the state they stand at: the reaction of each
+        node's whole position, k (z_b - z)_+ cos(theta) (Seabed.reaction), the
+        tangent plane's factor and the vertical part g.f with its own gradient g (a
+        profile's or grid's secant there, not the last global step's).
         Collective (a ghost exchange)."""
         if self.anchors is None:
             return
@@ -595,7 +600,7 @@ class FrictionTerm(NodalLoadTerm):
         tangents = self.load.element_values[..., :2].copy()
         reaction = seabed.reaction(nodes.reshape(-1, 3)).reshape(nodes.shape[:2])
         gradients = None if seabed.flat else seabed.gradients(nodes[..., 0], nodes[..., 1])
-        self._springs_from_positions(nodes[..., :2], tangents, reaction)
+        self._springs_from_positions(nodes[..., :2], tangents, reaction, gradients)
         force = -self.spring[..., None] * (nodes[..., :2] - self.anchors)
         self._record(force, nodes[..., :2], tangents, reaction, gradients)
 

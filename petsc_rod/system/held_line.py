@@ -94,7 +94,8 @@ three rows, the friction's vertical part g.f = g^T times its horizontal rows, an
 limit following x as well, k cos(theta) d g^T): unsymmetric, so A is J (its LU), and
 the forces read the block through its transpose. A sliding node's stiffness is the
 loading tangent (the slip continued); unloading it would stick. With one coefficient
-only (FrictionTerm.held_exact), on a flat seabed, a sloping plane or a profile (below).
+only (FrictionTerm.held_exact), on a flat seabed, a sloping plane, a profile or a grid
+(below).
 settle() records the friction of the settled state (FrictionTerm.follow_state), which
 the end forces read. At a clamped or flex-jointed end the rotations' response takes the
 same block: the seabed's reaction on the start read through H_n's transpose in the
@@ -123,17 +124,18 @@ B_n is the plane's k w_n N N^T with the node's own normal. settle() takes Newton
 steps on that system: their stationary point is the iteration's fixed point. A seabed
 grid the same way, its slopes vectors in the plan (Grid.slopes: grad z_b, g and
 Dg = dg/d(x, y)), B_n unsymmetric within delta / 2 of a grid line.
-With the seabed's friction (one coefficient) on a profile the fixed point's friction is
-the plane's law with g read at each node, F = (f, g(x).f), R = k cos(theta) (z_b(x) - z)_+:
-its block is the plane's with the limit following x through z_b' and k_v(g), g.f turning
-with g' e e^T, and |d|_G's G = I + g g^T turning too (FrictionTerm._profile_rates),
+With the seabed's friction (one coefficient) on a profile or grid the fixed point's
+friction is the plane's law with g read at each node, F = (f, g(x).f),
+R = k cos(theta) (z_b(x) - z)_+: its block is the plane's with the limit following x
+through grad z_b and k_v(g), g.f turning with Dg (a profile's g' e e^T), and |d|_G's
+G = I + g g^T turning too (FrictionTerm._shape_rates),
 added to B_n in the recorded block (the friction's rows after the profile's); a clamp's
 held columns of J are then read off the assembled J whole (_add_jacobian_columns, which
 holds the profile's share too).
 
 What it refuses (RodInputError, one line): a stiffness where it would not be exact: the
 seabed's friction with two coefficients (no Newton steps; its axes turn with the
-tangent) or on a seabed grid (its law's turn with Dg not written); any load outside the
+tangent); any load outside the
 Newton system (the sea surface's wet and dry parts, attachments that reach it).
 
 Every call is collective on the line's communicator, never COMM_WORLD: a system puts
@@ -1367,9 +1369,8 @@ class HeldLine:
         """Refuse a stiffness where it would not be exact (module docstring)."""
         if any(not term.held_exact for term in self.friction):
             raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
-                                "its seabed friction with two coefficients or on a seabed "
-                                "grid: give the friction one coefficient, on a flat, "
-                                "uniformly sloping or profiled seabed")
+                                "its seabed friction with two coefficients: give the "
+                                "friction one coefficient")
         # a profile's or grid's lagged push: its linearisation is the seabed term's
         # (SeabedTerm.profile)
         lagged = {term for term in self.problem.terms if self.profile is not None

@@ -275,8 +275,8 @@ def test_newton_steps_take_friction_of_one_coefficient(comm):
             assert problem.in_newton is expected and solver.uses_newton is expected
             gaps = [term.newton_gap for term in problem.terms if not term.in_newton]
             assert gaps == ([] if expected else
-                            ["seabed friction with two coefficients or on a seabed "
-                             "profile (docs/riser.md §3b)"])
+                            ["seabed friction with two coefficients "
+                             "(docs/riser.md §3b)"])
         finally:
             solver.destroy()
             problem.destroy()

@@ -251,20 +251,19 @@ def refusal(system_line, environment, ends, ask):
 
 
 @pytest.mark.parametrize("case", ["two coefficients", "two coefficients on a sloping plane",
-                                  "one coefficient on a seabed grid"])
+                                  "two coefficients on a seabed grid"])
 def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
-    """mu_a != mu_l takes no Newton steps (physics/friction.py), on a flat seabed or a
-    sloping plane: no exact stiffness; nor friction on a seabed grid (its law's turn
-    with the secant's derivative in two directions is not written); the refusal names
-    the line and what to change. The run says once what the friction is measured
-    from."""
-    system = frictional(0.5 if "grid" in case else (0.5, 0.8))
+    """mu_a != mu_l takes no Newton steps (physics/friction.py), on a flat seabed, a
+    sloping plane or a grid: no exact stiffness; the refusal names the line and what
+    to change. The run says once what the friction is measured from. (One
+    coefficient on a grid is exact: tests/solver/test_system_friction_profile.py.)"""
+    system = frictional((0.5, 0.8))
     environment = system.environment
     if case == "two coefficients on a sloping plane":
         environment = dataclasses.replace(system.environment, seabed_slope=2.0,
                                           seabed_direction=30.0,
                                           seabed_origin=(-32.5, 56.292))
-    if case == "one coefficient on a seabed grid":
+    if case == "two coefficients on a seabed grid":
         level = tuple((x, y, -30.2) for x in (-100.0, 100.0) for y in (-100.0, 100.0))
         environment = dataclasses.replace(system.environment, seabed=None,
                                           seabed_profile=level, seabed_origin=(0.0, 0.0))

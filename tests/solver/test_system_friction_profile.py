@@ -1,7 +1,7 @@
 """A system's lines with Coulomb friction on a seabed profile (system/held_line.py,
 "Friction" and "Seabed profile": the plane's friction law with the secant gradient g
 read at each node, its turn g' e e^T and the limit mu R following the interpolant's
-height z_b(d) and k_v(g): FrictionTerm._profile_rates), on
+height z_b(d) and k_v(g): FrictionTerm._shape_rates), on
 tests/data/moordyn/small_free_body.dat (a free buoyant body on three 70 m chains) read
 by the API, friction mu = 0.5:
 
@@ -20,8 +20,15 @@ by the API, friction mu = 0.5:
     differences of the lines re-solved (and settled) at moved and turned poses, the
     same pose on one rank and on all.
 
+(c) the same chain on a grid: that profile plus a twist TWIST (x - x_a) (y - y_a) about
+    the anchor (bilinear, so exact on the grid), whose secant gradient turns in both
+    directions (Dg's off-diagonal at every grounded node): its end stiffness against
+    central differences of re-solves (measured 2.6e-8 of its largest entry, 1.11e5 N/m;
+    with Dg left out of the friction's block 3.6e-6), the same on one rank and on all
+    (1.6e-12).
+
 Before, HeldLine.stiffness refused friction on a profile ("no exact stiffness of its
-seabed friction with two coefficients or on a seabed profile").
+seabed friction with two coefficients or on a seabed profile"), then on a grid.
 """
 
 import dataclasses
@@ -47,6 +54,8 @@ ROW = -28.0
 # the settled re-solves do not need a tighter one
 TOLERANCE = {"al_rtol": 1e-8, "al_ctol": 1e-8, "al_stability": 0}
 STEP = 1e-5
+# the grid's twist, 1/m: 0.08 m at 20 m from the anchor in x and in y
+TWIST = 2e-4
 
 
 def on_the_profile(system, row):
@@ -79,19 +88,33 @@ def settled_differences(line, ends, step):
     return np.array(columns).T
 
 
+def on_the_grid(system, row):
+    """``system``'s environment with its seabed on_the_profile's plus
+    TWIST (x - x_a) (y - y_a), x_a, y_a the anchor's, as a grid of x at the profile's
+    rows and y from -100 to 200 m every 100 m."""
+    xs = np.array([-100.0, row, row + 40.0, 200.0])
+    heights = (-30.2, -30.2, -31.4, -31.4)
+    rows = tuple((x, y, z + TWIST * (x - ANCHOR[0]) * (y - ANCHOR[1]))
+                 for x, z in zip(xs, heights) for y in (-100.0, 0.0, 100.0, 200.0))
+    return dataclasses.replace(system.environment, seabed=None, seabed_profile=rows,
+                               seabed_origin=(0.0, 0.0))
+
+
+SEABEDS = {"profile": on_the_profile, "grid": on_the_grid}
 _LINES = {}
 
 
-def line_stiffness(comm):
+def line_stiffness(comm, seabed="profile"):
     """(K, its settled central differences, (sticking, grounded) element-node counts,
-    the grounded element nodes where the secant turns, the relative move of the end
-    forces by settling the lagged solve) of the deck's second chain on the profile,
+    the grounded element nodes where the secant turns (Dg != 0; on the grid those
+    where it turns across too, Dg_xy != 0), the relative move of the end forces by
+    settling the lagged solve) of the deck's second chain on the ``seabed`` (SEABEDS),
     laid between its anchor and the fairlead and the fairlead then moved 4 m along x;
     kept."""
-    if comm not in _LINES:
+    if (comm, seabed) not in _LINES:
         system = frictional(0.5)
         line = HeldLine.of_system_line(system.lines[1], ANCHOR, FAIRLEAD, COMMS[comm],
-                                       on_the_profile(system, ROW), TOLERANCE)
+                                       SEABEDS[seabed](system, ROW), TOLERANCE)
         try:
             assert line.solve(ANCHOR, FAIRLEAD)
             moved = (ANCHOR, FAIRLEAD + np.array([4.0, 0.0, 0.0]))
@@ -100,38 +123,44 @@ def line_stiffness(comm):
             term = line.friction[0]
             grounded = term.reaction > 0
             nodes = term.positions                  # the line's frame, as its seabed
-            turning = grounded & (line.scene.seabed.shape.slopes(
-                nodes[..., 0], nodes[..., 1])[2] != 0)
+            rate = line.scene.seabed.plan_slopes(nodes[..., 0].ravel(),
+                                                 nodes[..., 1].ravel())[2]
+            turning = grounded.ravel() & (np.abs(rate[:, 0, 1] if seabed == "grid"
+                                                 else rate).sum(axis=-1).sum(axis=-1) > 0)
             counts = [line.mesh.global_sum(float(np.sum(c)))
                       for c in (term.stick & grounded, grounded, turning)]
             K = line.stiffness()
             settle = np.abs(line.end_forces().ravel() - lagged).max() / np.abs(lagged).max()
-            _LINES[comm] = (K, settled_differences(line, moved, STEP), counts[:2],
+            _LINES[comm, seabed] = (K, settled_differences(line, moved, STEP), counts[:2],
                             counts[2], settle)
         finally:
             line.destroy()
-    return _LINES[comm]
+    return _LINES[comm, seabed]
 
 
+@pytest.mark.parametrize("seabed", list(SEABEDS))
 @pytest.mark.parametrize("comm", list(COMMS))
-def test_a_frictional_line_on_a_profile_has_the_exact_stiffness(comm):
-    K, numeric, (stick, total), turning, settle = line_stiffness(comm)
+def test_a_frictional_line_on_a_profile_has_the_exact_stiffness(comm, seabed):
+    """(a) and (c): on the grid the secant turns across (Dg's off-diagonal,
+    FrictionTerm._shape_rates) at 10 or more grounded nodes."""
+    K, numeric, (stick, total), turning, settle = line_stiffness(comm, seabed)
     assert 5 <= stick <= total - 5                  # part sticks, part slides
-    assert turning >= 4                             # the secant's turn in the block
+    assert turning >= (4 if seabed == "profile" else 10)   # the secant's turn in the block
     # settling moves the lagged solve's forces by its tolerance only: the Newton steps'
     # stationary point is the lagged iteration's fixed point
     assert settle < 1e-6
     scale = np.abs(K).max()
     assert np.abs(K - K.T).max() > 1e-4 * scale     # the limit follows the contact
     error = np.abs(K - numeric).max() / scale
-    print(f"{stick:g} of {total:g} grounded nodes stick, {turning:g} in the secant's "
-          f"turn; settling moved the forces {settle:.3g}; K against differences "
+    print(f"{seabed}: {stick:g} of {total:g} grounded nodes stick, {turning:g} in the "
+          f"secant's turn; settling moved the forces {settle:.3g}; K against differences "
           f"{error:.3g} of {scale:.6g}")
     assert error < 2e-7
 
 
-def test_one_rank_and_all_give_the_line_on_a_profile_the_same_stiffness():
-    alone, spread = (line_stiffness(comm)[0] for comm in COMMS)
+@pytest.mark.parametrize("seabed", list(SEABEDS))
+def test_one_rank_and_all_give_the_line_the_same_stiffness(seabed):
+    alone, spread = (line_stiffness(comm, seabed)[0] for comm in COMMS)
     difference = np.abs(spread - alone).max() / np.abs(alone).max()
     print(f"K on one rank and on all differ by {difference:.3g} of the largest entry")
     assert difference < 1e-8

@@ -204,10 +204,9 @@ def test_modes_on_a_profile_say_where_their_stiffness_is_symmetrised(tmp_path):
 
 def test_friction_on_a_level_grid_is_the_flat_seabeds(tmp_path):
     """Seabed friction on a grid (a level one) with a current across: the plane's law
-    with each node's gradient (FrictionTerm._plane_law; the secant's turn is a
-    profile's only), no Newton steps, and the flat seabed's answer, which ends in
-    Newton steps, to 1e-9 m. The grid's friction read a profile's direction and
-    failed (AttributeError) at the first converged step."""
+    with each node's gradient and its turn (FrictionTerm._plane_law, _shape_rates), in
+    the Newton steps, and the flat seabed's answer to 1e-9 m. The grid's friction read
+    a profile's direction and failed (AttributeError) at the first converged step."""
     grid = write(tmp_path, "level.txt", "-2 -3 0\n-2 3 0\n12 -3 0\n12 3 0\n")
     wet = ["-rod_seabed_friction", "0.5", "-rod_current", "0,0.3,0",
            "-rod_drag", "1025,1.2,0.05"]
@@ -217,3 +216,50 @@ def test_friction_on_a_level_grid_is_the_flat_seabeds(tmp_path):
         assert f.attrs["converged"] == 1
         assert np.abs(f["r"][:] - g["r"][:]).max() < 1e-9
         assert f.attrs["friction_slide_length"] > 0
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("case", ["grid 0", "grid 45", "grid 90", "profile 45"])
+def test_friction_on_a_grid_of_a_plane_is_the_planes(tmp_path, case, ranks):
+    """The plane rising at 5 deg toward 0, 45 or 90 deg from the line's plane (x) given
+    as a grid of 3 x 3 heights (the origin, the catenary's anchor, at a grid node: the
+    laid catenary starts on a height interpolated under it, and -1.4e-17 m there moved
+    the friction's anchors by 4e-9 m and the answer by 5e-10 m), or as a profile, with
+    seabed friction mu = 0.5 and the default settings: converged in Newton steps, in as
+    many iterations as the plane (-rod_seabed_slope, 19: 3 Newton, measured on 1 and 2
+    ranks split), the same nodes sticking and sliding, the same r to 1e-10 m (measured
+    2.2e-13 m). Before, friction on a grid or profile took no Newton steps and the grid
+    at 45 deg did not converge (exit 3 after 4 halvings)."""
+    shape, beta = case.split()
+    t, e = np.tan(np.radians(5.0)), np.array([np.cos(np.radians(float(beta))),
+                                              np.sin(np.radians(float(beta)))])
+    if shape == "grid":
+        rows = "".join(f"{x:g} {y:g} {t * (x * e[0] + y * e[1]):.17g}\n"
+                       for x in (-3.0, 0.0, 12.0) for y in (-3.0, 0.0, 3.0))
+        seabed = ["-rod_seabed_profile", write(tmp_path, "grid.txt", rows)]
+    else:
+        seabed = ["-rod_seabed_profile", write(tmp_path, "profile.txt",
+                                               f"-20 {-20 * t:.17g}\n20 {20 * t:.17g}\n"),
+                  "-rod_seabed_direction", beta]
+    common = SCENE + ["-rod_elements", "40", "-rod_seabed_friction", "0.5",
+                      "-rod_initial_shape", "catenary", "-rod_ranks_split", "split"]
+    results = {}
+    for name, args in (("plane", ["-rod_seabed", "0", "-rod_seabed_slope", "5",
+                                  "-rod_seabed_direction", beta]), (shape, seabed)):
+        path = tmp_path / f"{name}.h5"
+        done = run(common + args + ["-rod_output", str(path)], ranks=ranks)
+        assert done.returncode == 0, done.stdout + done.stderr
+        with h5py.File(path, "r") as f:
+            results[name] = (f["r"][:], f["friction_state"][:],
+                             {key: int(f.attrs[key]) for key in ("iterations", "newton_steps")})
+    (r, state, counts), (r_plane, state_plane, counts_plane) = results[shape], results["plane"]
+    assert counts["newton_steps"] > 0
+    assert counts["iterations"] <= counts_plane["iterations"] + 2
+    assert np.array_equal(state, state_plane)
+    assert np.count_nonzero(state == 1) > 0
+    if beta != "90":                    # across the line's plane every grounded node sticks
+        assert np.count_nonzero(state == 2) > 0
+    distance = np.abs(r - r_plane).max()
+    print(f"{case} on {ranks} rank(s): {counts} against the plane's {counts_plane}, "
+          f"r {distance:.2g} m from it")
+    assert distance < 1e-10
