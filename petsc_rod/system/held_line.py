@@ -1368,8 +1368,9 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         if any(not term.held_exact for term in self.friction):
-            raise RodInputError(f"HeldLine.stiffness: {self.name}: no exact stiffness of "
-                                "its seabed friction with two coefficients: give the "
+            raise RodInputError(f"line {self.name}: seabed friction with two coefficients "
+                                "(axial and lateral: MoorDyn's MU_KA and MU_KT) gives no "
+                                "exact stiffness for the system's Newton: give the "
                                 "friction one coefficient")
         # a profile's or grid's lagged push: its linearisation is the seabed term's
         # (SeabedTerm.profile)
@@ -1381,8 +1382,9 @@ class HeldLine:
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))
-            raise RodInputError(f"HeldLine.stiffness: loads outside the Newton system "
-                                f"({loads}): no exact stiffness")
+            raise RodInputError(f"line {self.name}: loads outside the Newton steps "
+                                f"({loads}) give no exact stiffness for the system's "
+                                "Newton")
 
     def destroy(self):
         """Free the line's PETSc objects (its BuiltLine's, its Newton solver's). Collective."""
