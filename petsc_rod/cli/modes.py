@@ -50,25 +50,34 @@ def modes_band(text):
 
 
 def check_subspace(count):
-    """RodInputError, in one line, where -rod_modes_eps_ncv (the Krylov subspace) is
-    given below what SLEPc needs for ``count`` modes (or -rod_modes_eps_nev, which
+    """RodInputError, in one line, where the Krylov subspace (-rod_modes_eps_ncv, by
+    default count + max(SUBSPACE, count / 2): analysis/modes._pairs) is below what SLEPc
+    needs for the modes asked (-rod_modes ``count``, or -rod_modes_eps_nev, which
     overrides it): ncv >= nev + 1 for Krylov-Schur (the default -rod_modes_eps_type),
     ncv >= nev for the others; SLEPc refuses it only inside the solve, after the
-    equilibrium (a line's run and a system's: api/system_run.modes_request)."""
+    equilibrium (a line's run and a system's: api/system_run.modes_request), or a value
+    that is no whole number."""
     options = PETSc.Options(PREFIX)
-    if not options.hasName("eps_ncv"):
+    if not (options.hasName("eps_ncv") or options.hasName("eps_nev")):
         return
-    ncv = options.getInt("eps_ncv")
-    nev = options.getInt("eps_nev", count)
+    try:
+        nev = options.getInt("eps_nev", count)
+        ncv = options.getInt("eps_ncv", count + max(SUBSPACE, count // 2))
+    except PETSc.Error:
+        raise RodInputError("-rod_modes_eps_nev and -rod_modes_eps_ncv take whole numbers "
+                            "(the modes the eigensolver computes, its Krylov subspace)") \
+            from None
     kind = options.getString("eps_type", KRYLOV_SCHUR).lower()
     least = nev + 1 if kind == KRYLOV_SCHUR else nev
     if ncv < least:
         asked = (f"-rod_modes {count}" if nev == count else f"-rod_modes_eps_nev {nev}")
-        raise RodInputError(f"-rod_modes_eps_ncv {ncv}: {asked} needs a Krylov subspace of "
-                            f"at least {least} vectors (SLEPc's {kind}: ncv >= nev"
+        given = (f"-rod_modes_eps_ncv {ncv}" if options.hasName("eps_ncv") else
+                 f"the default -rod_modes_eps_ncv {ncv} (-rod_modes {count} + "
+                 f"max({SUBSPACE}, {count} / 2))")
+        raise RodInputError(f"{given}: {asked} needs a Krylov subspace of at least {least} "
+                            f"vectors (SLEPc's {kind}: ncv >= nev"
                             f"{' + 1' if kind == KRYLOV_SCHUR else ''}); give "
-                            f"-rod_modes_eps_ncv {least} or more, or leave it out (default "
-                            f"nev + max({SUBSPACE}, nev / 2))")
+                            f"-rod_modes_eps_ncv {least} or more")
 
 
 def check_modes_inputs(values, scene, comm):

@@ -422,7 +422,7 @@ class Sweep:
             walk = {"rod_initial": path}
             if "rod_steps" not in case.options:
                 walk["rod_steps"] = str(self.settings.warm_steps)
-            if "rod_initial_friction_anchors" not in case.options:
+            if self.value(case, "rod_initial_friction_anchors") is None:
                 # the case's seabed friction anchored as its own run's, not on its
                 # neighbour's positions: its answer is not the sweep's order's
                 walk["rod_initial_friction_anchors"] = "laid"
@@ -463,6 +463,10 @@ class Sweep:
         Collective."""
         self._error = None
         texts = {**self.base, **options}
+        if "rod_initial" not in texts:
+            # where the restart's anchors come from means nothing to a case run from its
+            # own start (the first, a retry, -sweep_start scene): not refused there
+            texts.pop("rod_initial_friction_anchors", None)
         solvers = {name: text for name, text in options.items() if name not in BY_NAME}
         try:
             return with_options(self.comm, solvers, lambda: run(self.comm, texts))

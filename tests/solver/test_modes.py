@@ -236,6 +236,28 @@ def test_a_krylov_subspace_smaller_than_the_modes_asked_refused(ncv, shared_tmp,
                                    "-rod_modes 3 needs a Krylov subspace of at least 4")
 
 
+def test_an_eigensolver_count_beyond_the_default_subspace_refused(shared_tmp, capsys):
+    """-rod_modes 5 with -rod_modes_eps_nev 50 and no -rod_modes_eps_ncv: the default
+    subspace, 5 + max(15, 5 / 2) = 20 vectors, is below nev + 1; refused in one line
+    before any step (it failed inside the modes' solve after the equilibrium and ended
+    in a segmentation fault), and a value that is no whole number too (the options'
+    check's line)."""
+    for nev, says in (("50", "petsc_rod: error: the default -rod_modes_eps_ncv 20 "
+                             "(-rod_modes 5 + max(15, 5 / 2)): -rod_modes_eps_nev 50 needs "
+                             "a Krylov subspace of at least 51"),
+                      ("abc", "petsc_rod: error: SLEPc refused the modes' options: Input "
+                              "string abc")):
+        output = os.path.join(shared_tmp, "large_nev.h5")
+        assert run_cli({"rod_length": "1", "rod_modes": "5", "rod_modes_mass": "1",
+                        "rod_modes_eps_nev": nev, "rod_output": output}) == 2
+        out = capsys.readouterr().out
+        assert not os.path.exists(output)
+        if PETSc.COMM_WORLD.getRank() == 0:
+            lines = [line for line in out.splitlines() if "error" in line]
+            assert len(lines) == 1 and "step 1" not in out, out
+            assert lines[0].startswith(says), lines[0]
+
+
 def test_cli_modes_table(shared_tmp, capsys):
     """-rod_modes 4 -rod_modes_table on a cantilever: the table's frequencies are the
     closed form's (16 elements), its classes in plane and out of plane, the shapes'

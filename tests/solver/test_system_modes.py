@@ -91,6 +91,11 @@ def test_a_system_refuses_more_modes_than_a_line_has(shared_tmp):
         with pytest.raises(RodInputError, match=r"^-rod_modes_eps_ncv 5: -rod_modes 5 "
                                                 r"needs a Krylov subspace of at least 6"):
             solve_system(system, options={"modes": COUNT})
+        # a value that is no whole number: an input error, not a solve's failure (exit 4)
+        database.setValue("rod_modes_eps_ncv", "abc")
+        with pytest.raises(RodInputError, match=r"^-rod_modes_eps_nev and "
+                                                r"-rod_modes_eps_ncv take whole numbers"):
+            solve_system(system, options={"modes": COUNT})
     finally:
         database.delValue("rod_modes_eps_ncv")
 

@@ -80,6 +80,25 @@ def test_a_warm_started_friction_case_is_the_case_alone(tmp_path, ranks):
     assert "anchors are laid on this run's catenary" in done.stdout
 
 
+def test_the_sweeps_own_choice_of_anchors_is_kept_and_a_cold_case_runs(tmp_path):
+    """-rod_initial_friction_anchors file among the sweep's options: the first case,
+    from its own start (no restart), runs (it was refused, exit 2, as every cold case
+    was), and the warm case keeps the file's anchors as asked (the restart's answer,
+    not the case alone's; the walk's ``laid`` overrode it)."""
+    cases, folder = tmp_path / "cases.txt", tmp_path / "sweep"
+    cases.write_text(CASES)
+    done = run_module("petsc_rod.sweep", RISER + [
+        "-rod_initial_friction_anchors", "file", "-sweep_cases", str(cases),
+        "-sweep_output", str(folder), "-sweep_start", "nearest"], 1)
+    assert done.returncode == 0, describe(done)
+    with open(folder / "summary.csv", newline="") as f:
+        rows = {row["case"]: row for row in csv.DictReader(f)}
+    assert rows["base"]["start"] == "own start" and rows["base"]["exit"] == "0", rows
+    assert rows["near10"]["start"] == "from base", rows["near10"]
+    anchor, nodes, _ = numbers(folder / "near10.h5")
+    assert anchor == pytest.approx(FILE_ANCHOR, rel=1e-4) and nodes == (23, 2)
+
+
 def test_a_restart_keeps_the_files_anchors_unless_laid(tmp_path):
     """A user's restart of near10 from the base case's file: its positions are the
     anchors by default (the path goes on from that line; the answer the sweep's warm

@@ -45,3 +45,19 @@ def test_the_advice_is_given_only_where_the_penalty_is_far_below_it():
     assert "try -rod_al_penalty" not in not_converged_reason(REPORT, settings(2e7), 1.2e6,
                                                              1.2e8)
     assert "try -rod_al_penalty" not in not_converged_reason(REPORT, settings(1.2e6), 1.2e6)
+
+
+def test_no_advice_where_one_steps_newton_steps_finish_the_run():
+    """A short pinned line on a flat seabed converged at its default R = 5000 N in 52
+    iterations and failed at EA / 10 (cli/session.advised_penalty): the advice is for
+    runs that Newton steps do not finish, more than one load step or a term outside
+    them."""
+    from petsc_rod.cli.session import advised_penalty
+    from petsc_rod.iteration.continuation import PathSettings
+    line = scene(0.5, 1e7)
+    assert advised_penalty(SimpleNamespace(in_newton=True, scene=line),
+                           PathSettings(steps=1)) is None
+    assert advised_penalty(SimpleNamespace(in_newton=True, scene=line),
+                           PathSettings(steps=2)) == pytest.approx(1e6, rel=1e-15)
+    assert advised_penalty(SimpleNamespace(in_newton=False, scene=line),
+                           PathSettings(steps=1)) == pytest.approx(1e6, rel=1e-15)
