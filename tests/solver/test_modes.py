@@ -218,44 +218,44 @@ def test_more_modes_than_the_line_has_refused_before_the_solve(shared_tmp, capsy
     assert "has 32 modes" in capsys.readouterr().out or PETSc.COMM_WORLD.getRank() != 0
 
 
+def refused_before_any_step(options, says, shared_tmp, capsys):
+    """Run the CLI on a 1 m line with ``options`` {name: text}: exit 2, one line that
+    starts with ``says``, no step and no result file."""
+    output = os.path.join(shared_tmp, "refused_modes.h5")
+    assert run_cli({"rod_length": "1", "rod_modes_mass": "1", **options,
+                    "rod_output": output}) == 2
+    out = capsys.readouterr().out
+    assert not os.path.exists(output)
+    if PETSc.COMM_WORLD.getRank() == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert len(lines) == 1 and "step 1" not in out, out
+        assert lines[0].startswith(says), lines[0]
+
+
 @pytest.mark.parametrize("ncv", ["2", "3"])
 def test_a_krylov_subspace_smaller_than_the_modes_asked_refused(ncv, shared_tmp, capsys):
     """-rod_modes 3 with -rod_modes_eps_ncv 2 or 3 (SLEPc's Krylov-Schur needs ncv >=
     nev + 1): exit 2 with one line naming -rod_modes_eps_ncv and the least it takes,
     before any step and with no result file (it failed with exit 4 after the
     equilibrium, "PETSc failed during the solve")."""
-    output = os.path.join(shared_tmp, "small_ncv.h5")
-    assert run_cli({"rod_length": "1", "rod_modes": "3", "rod_modes_mass": "1",
-                    "rod_modes_eps_ncv": ncv, "rod_output": output}) == 2
-    out = capsys.readouterr().out
-    assert not os.path.exists(output)
-    if PETSc.COMM_WORLD.getRank() == 0:
-        lines = [line for line in out.splitlines() if "error" in line]
-        assert len(lines) == 1 and "step 1" not in out
-        assert lines[0].startswith(f"petsc_rod: error: -rod_modes_eps_ncv {ncv}: "
-                                   "-rod_modes 3 needs a Krylov subspace of at least 4")
+    refused_before_any_step({"rod_modes": "3", "rod_modes_eps_ncv": ncv},
+                            f"petsc_rod: error: -rod_modes_eps_ncv {ncv}: -rod_modes 3 "
+                            "needs a Krylov subspace of at least 4", shared_tmp, capsys)
 
 
-def test_an_eigensolver_count_beyond_the_default_subspace_refused(shared_tmp, capsys):
+@pytest.mark.parametrize("nev, says", [
+    ("50", "petsc_rod: error: the default -rod_modes_eps_ncv 20 (-rod_modes 5 + max(15, "
+           "5 / 2)): -rod_modes_eps_nev 50 needs a Krylov subspace of at least 51"),
+    ("abc", "petsc_rod: error: SLEPc refused the modes' options: Input string abc")])
+def test_an_eigensolver_count_beyond_the_default_subspace_refused(nev, says, shared_tmp,
+                                                                   capsys):
     """-rod_modes 5 with -rod_modes_eps_nev 50 and no -rod_modes_eps_ncv: the default
     subspace, 5 + max(15, 5 / 2) = 20 vectors, is below nev + 1; refused in one line
     before any step (it failed inside the modes' solve after the equilibrium and ended
     in a segmentation fault), and a value that is no whole number too (the options'
     check's line)."""
-    for nev, says in (("50", "petsc_rod: error: the default -rod_modes_eps_ncv 20 "
-                             "(-rod_modes 5 + max(15, 5 / 2)): -rod_modes_eps_nev 50 needs "
-                             "a Krylov subspace of at least 51"),
-                      ("abc", "petsc_rod: error: SLEPc refused the modes' options: Input "
-                              "string abc")):
-        output = os.path.join(shared_tmp, "large_nev.h5")
-        assert run_cli({"rod_length": "1", "rod_modes": "5", "rod_modes_mass": "1",
-                        "rod_modes_eps_nev": nev, "rod_output": output}) == 2
-        out = capsys.readouterr().out
-        assert not os.path.exists(output)
-        if PETSc.COMM_WORLD.getRank() == 0:
-            lines = [line for line in out.splitlines() if "error" in line]
-            assert len(lines) == 1 and "step 1" not in out, out
-            assert lines[0].startswith(says), lines[0]
+    refused_before_any_step({"rod_modes": "5", "rod_modes_eps_nev": nev}, says,
+                            shared_tmp, capsys)
 
 
 def test_cli_modes_table(shared_tmp, capsys):
