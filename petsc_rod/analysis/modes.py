@@ -492,6 +492,12 @@ def _no_pairs(operators):
     return np.zeros(0), np.zeros((0, n, operators.block)), np.zeros(0), 0
 
 
+def default_subspace(count):
+    """SLEPc's ncv for ``count`` modes asked of the eigensolver unless
+    -rod_modes_eps_ncv says otherwise: count + max(SUBSPACE, count // 2)."""
+    return count + max(SUBSPACE, count // 2)
+
+
 def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
     """(omega2 (k,), vectors (k, n_nodes, block), phi^T M phi (k,), converged) of the
     lowest ``count`` verified eigenpairs of K phi = omega^2 M phi in ``window`` (omega^2
@@ -512,7 +518,7 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
     try:
         eps.setOperators(shifted, M)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count + extra, count + extra + max(SUBSPACE, count // 2))
+        eps.setDimensions(count + extra, extra + default_subspace(count))
         # the purification's solves (one per vector) change no shape: the massless
         # unknowns' components it removes are not read (u and omega are)
         eps.setPurify(False)

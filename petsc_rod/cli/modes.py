@@ -12,6 +12,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MISSING_MASS, MassSettings, mass_known
 from petsc_rod.analysis.modes import (CLASSES, PREFIX, RESIDUAL, SUBSPACE,
+                                      default_subspace,
                                       ModesRefused, check_options, modes_count,
                                       solve_modes, symmetrised_text)
 from petsc_rod.errors import RodInputError, RodIOError, petsc_message
@@ -51,7 +52,7 @@ def modes_band(text):
 
 def check_subspace(count):
     """RodInputError, in one line, where the Krylov subspace (-rod_modes_eps_ncv, by
-    default count + max(SUBSPACE, count / 2): analysis/modes._pairs) is below what SLEPc
+    default analysis/modes.default_subspace) is below what SLEPc
     needs for the modes asked (-rod_modes ``count``, or -rod_modes_eps_nev, which
     overrides it): ncv >= nev + 1 for Krylov-Schur (the default -rod_modes_eps_type),
     ncv >= nev for the others; SLEPc refuses it only inside the solve, after the
@@ -62,7 +63,7 @@ def check_subspace(count):
         return
     try:
         nev = options.getInt("eps_nev", count)
-        ncv = options.getInt("eps_ncv", count + max(SUBSPACE, count // 2))
+        ncv = options.getInt("eps_ncv", default_subspace(count))
     except PETSc.Error:
         raise RodInputError("-rod_modes_eps_nev and -rod_modes_eps_ncv take whole numbers "
                             "(the modes the eigensolver computes, its Krylov subspace)") \

@@ -180,20 +180,16 @@ class HermiteProblem:
             return
         if self._added is None:
             self.base.copy(self.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            self.added_rhs.zeroEntries()
             if len(self.rows):
                 self.matrix.setValuesRCV(self.rows, self.rows, matrices,
                                          addv=PETSc.InsertMode.ADD_VALUES)
-                self.added_rhs.setValues(self.rows.ravel(), vectors.ravel(),
-                                         addv=PETSc.InsertMode.ADD_VALUES)
-            self._added = (matrices.copy(), vectors.copy())
+            self._add_vectors(vectors)
+            self._added = (matrices.copy(), self._added[1])
             self.matrix.assemble()
-            self.added_rhs.assemble()
             self._constrain()
             return
-        last_matrices, last_vectors = self._added
-        changed = (np.any(matrices != last_matrices, axis=(1, 2))
-                   | np.any(vectors != last_vectors, axis=1))
+        last_matrices = self._added[0]
+        changed = np.any(matrices != last_matrices, axis=(1, 2))
         rows = self.rows[changed]
         before = self.constrained.stateGet()
         if len(rows):
@@ -202,12 +198,9 @@ class HermiteProblem:
             free = np.all(rows[..., None] != self.fixed, axis=-1)    # a few fixed rows
             self.constrained.setValuesRCV(rows, rows, delta * free[:, :, None] * free[:, None, :],
                                           addv=PETSc.InsertMode.ADD_VALUES)
-            self.added_rhs.setValues(rows.ravel(), np.ravel(vectors[changed]
-                                                            - last_vectors[changed]),
-                                     addv=PETSc.InsertMode.ADD_VALUES)
             np.copyto(last_matrices, matrices)
-            np.copyto(last_vectors, vectors)
-        for obj in (self.matrix, self.constrained, self.added_rhs):
+        rows = np.concatenate([rows, self._add_vectors(vectors)])
+        for obj in (self.matrix, self.constrained):
             obj.assemble()
         # the rows the changed elements add into, and the first owned vertex's (z, z'),
         # which the previous rank's last element adds into: on several ranks the
@@ -217,25 +210,29 @@ class HermiteProblem:
                           before)
 
     def _add_vectors(self, vectors):
-        """set_added of a problem that shares another's matrix (``matrix_of``, which
-        set_added the same element matrices): the right-hand side's sums alone, the
-        same additions as set_added's (the elements whose vectors changed, as the
-        difference)."""
+        """The right-hand side's part of set_added, the whole of it for a problem that
+        shares another's matrix (``matrix_of``, which set_added the same element
+        matrices): sum_e ``vectors`` (ne, 4) at the first call, after it only the
+        elements whose vectors changed, as the difference. Returns the rows of those
+        elements (k, 4)."""
         if self._added is None:
             self.added_rhs.zeroEntries()
             if len(self.rows):
                 self.added_rhs.setValues(self.rows.ravel(), vectors.ravel(),
                                          addv=PETSc.InsertMode.ADD_VALUES)
             self._added = (None, vectors.copy())
+            rows = self.rows
         else:
             last = self._added[1]
             changed = np.any(vectors != last, axis=1)
-            if np.any(changed):
-                self.added_rhs.setValues(self.rows[changed].ravel(),
+            rows = self.rows[changed]
+            if len(rows):
+                self.added_rhs.setValues(rows.ravel(),
                                          np.ravel(vectors[changed] - last[changed]),
                                          addv=PETSc.InsertMode.ADD_VALUES)
                 np.copyto(last, vectors)
         self.added_rhs.assemble()
+        return rows
 
     def set_added_rhs(self, element_vectors):
         """Replace the added right-hand side by sum_e element_vectors (ne, 4), the added
