@@ -32,7 +32,7 @@ from petsc_rod.api.system_run import (LINE_OPTIONS, MODES_OPTIONS, body_modes_re
 from petsc_rod.api.system_sweeps import parse_sweeps, sweep_gaps, sweep_saddles
 from petsc_rod.cli.line_run import AgreedFailures, petsc_failure
 from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_every_rank,
-                                   check_snes_type, check_substructuring_switches,
+                                   check_factor_switches, check_snes_type,
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
@@ -368,7 +368,7 @@ def run(comm=None):
             values, given = read_options()
             check_anderson_depth()
             check_snes_type()
-            check_substructuring_switches()
+            check_factor_switches()
             if database.hasName("help"):
                 for line in help_text():
                     say(line)

@@ -12,7 +12,7 @@ from petsc4py import PETSc
 
 from petsc_rod.cli.line_run import (AgreedFailures, petsc_failure, plan_line, run_line)
 from petsc_rod.cli.options import (OPTIONS, check_anderson_depth, check_same_on_every_rank,
-                                   check_snes_type, check_substructuring_switches,
+                                   check_factor_switches, check_snes_type,
                                    help_text, read_options, unused_options, values_of)
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.phases import SETUP
@@ -65,7 +65,7 @@ def run(comm=None, texts=None):
                 check_system_options(given)
                 check_anderson_depth()      # before any PETSc object is made
                 check_snes_type()
-                check_substructuring_switches()
+                check_factor_switches()
                 if database.hasName("help"):
                     for line in help_text():
                         say(line)

@@ -22,7 +22,8 @@ from petsc4py import PETSc
 
 from petsc_rod.environment.seabed import DEFAULT_PENETRATION
 from petsc_rod.errors import RodInputError
-from petsc_rod.global_step.ksp import INERTIA_PREFIX, NEWTON_PREFIX, SUBSTRUCTURING
+from petsc_rod.global_step.ksp import (INERTIA_PREFIX, LU_PACKAGE, LU_PACKAGES, NEWTON_PREFIX,
+                                     SUBSTRUCTURING)
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
                                             NEWTON_SWITCH_FAR, NEWTON_WORTH)
@@ -553,11 +554,18 @@ SUBSTRUCTURING_SWITCHES = tuple(f"{prefix}{SUBSTRUCTURING}"
                                 for prefix in (NEWTON_PREFIX, INERTIA_PREFIX))
 
 
-def check_substructuring_switches():
+def check_factor_switches():
     """Refuse a -rod_newton_substructuring or -rod_inertia_substructuring that is not a
-    true or false, before any work (PETSc's own error came only at the first Newton
-    step, after the iterations before it)."""
+    true or false, and a -rod_newton_lu that is not one of ksp.LU_PACKAGES, before any
+    work (PETSc's own error came only at the first Newton step, after the iterations
+    before it)."""
     given = PETSc.Options().getAll()        # read without marking them used
+    name = f"{NEWTON_PREFIX}{LU_PACKAGE}"
+    if name in given and given[name] not in LU_PACKAGES:
+        raise RodInputError(
+            f"-{name} {given[name]}: expected {' or '.join(LU_PACKAGES)} (the package of "
+            "the Newton steps' LU on one rank: PETSc's own in the natural order, or "
+            "MUMPS's)")
     for name in SUBSTRUCTURING_SWITCHES:
         if name in given:
             text = given[name]
@@ -615,7 +623,9 @@ def help_text():
                  "Cholesky on one rank, preonly + the exact substructuring PC (-pc_type "
                  "python) on several.")
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
-                 "their unsymmetric Jacobian (default preonly + MUMPS LU, "
+                 "their unsymmetric Jacobian; on one rank -rod_newton_lu petsc|mumps "
+                 "(default petsc: PETSc's LU in the natural order, checked by its backward "
+                 "error, MUMPS's where that fails); MUMPS's LU "
                  "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering, "
                  "-rod_newton_mat_mumps_icntl_15 -B: on the graph of the nodes, B "
                  "unknowns a node); on several ranks -rod_newton_substructuring <bool> "

@@ -2,7 +2,8 @@
 step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
 the second variation (analysis/stability.py, options -rod_inertia_*) and the MUMPS LU
 of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*),
-both through direct_factor: MUMPS on one rank, by substructuring on several
+both through direct_factor: on one rank MUMPS's LDL^T, and PETSc's own LU in the natural
+order (NaturalLU, MUMPS's where that fails); by substructuring on several
 (chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
@@ -170,11 +171,12 @@ def _with_more_workspace(ksp, factor):
     factor.setMumpsIcntl(14, relaxation)
 
 
-def solve_columns(ksp, columns, rows=None):
+def solve_columns(ksp, columns, rows=None, mumps=True):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
-    the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve
-    (one call into MUMPS's solve phase, whose cost is a fixed part and a part per
-    column: docs/performance.md, "Newton steps").
+    the factored operator A of a set-up inertia_solver or lu_solver (or, ``mumps``
+    False, a NaturalLU's KSP), in one MatMatSolve (one call into MUMPS's solve phase,
+    whose cost is a fixed part and a part per column: docs/performance.md, "Newton
+    steps").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
     rows out), the local indices of its rows in them; the other rows of x_j are b_j.
     Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed
@@ -195,7 +197,7 @@ def solve_columns(ksp, columns, rows=None):
     right.assemble()
     unknown = right.duplicate()
     try:
-        if factor.getMumpsInfog(1) < 0:
+        if mumps and factor.getMumpsInfog(1) < 0:
             unknown.getDenseArray()[:] = np.inf
         else:
             factor.matSolve(right, unknown)
@@ -295,6 +297,116 @@ def solve_vecs(factor, vecs, rows=None):
     return solutions
 
 
+# The package of the Newton Jacobian's LU on one rank (-rod_newton_lu): PETSc's own in
+# the natural order (NaturalLU), or MUMPS's (MumpsFactor).
+LU_PACKAGE = "lu"
+LU_PACKAGES = ("petsc", "mumps")
+# NaturalLU accepts its factorisation where the normwise backward error of its check
+# solve is at most this: 3e-15 to 6e-15 on the 18 000-element riser's two Jacobians
+# (docs/performance.md, "Newton steps"); an elimination without pivoting whose growth
+# spoils the factors shows it here.
+BACKWARD_ERROR_LIMIT = 1e-12
+
+
+def lu_package(prefix):
+    """The LU package ``-<prefix>lu`` names (one of LU_PACKAGES; default petsc); an
+    other value is refused before any work (cli/options.check_factor_switches)."""
+    return PETSc.Options().getString(f"{prefix}{LU_PACKAGE}", LU_PACKAGES[0])
+
+
+class NaturalLU:
+    """PETSc's own LU of a sequential ``operator`` in the natural order, under
+    ``prefix`` (-<prefix>pc_factor_* and the KSP's options apply): the Newton Jacobian
+    on one rank (analysis/jacobian.py), a band of nodes whose elimination in their own
+    order fills only the band. On the 18 000-element riser its first factorisation
+    takes 69 ms and the next 20 ms, MUMPS's 277 and 156 ms, its solve 3 ms against 24
+    (docs/performance.md, "Newton steps").
+
+    It does not pivot. Each set_up checks the factors by one solve,
+    A x = b with b = A 1, and its normwise backward error
+
+        eta = |A x - b|_inf / (|A|_inf |x|_inf + |b|_inf)
+
+    (Rigal and Gaches), which a stable factorisation keeps near the round-off; a zero
+    pivot (PETSc's test: -<prefix>pc_factor_zeropivot times its row's sum) gives Inf,
+    and a diagonal entry not stored fails the symbolic factorisation. Where eta is not
+    finite or above BACKWARD_ERROR_LIMIT the operator is factored by MumpsFactor
+    (threshold pivoting, null pivots detected), for the rest of this object's life
+    (``fell_back``). The interface direct_factor's
+    factorisations share (set_up, solve_columns, destroy; ``substructured`` False).
+    Owns its KSP or its MumpsFactor."""
+
+    substructured = False
+
+    def __init__(self, operator, block, prefix):
+        self.block, self.prefix = block, prefix
+        self.mumps = None
+        self.ksp = PETSc.KSP().create(comm=operator.getComm())
+        self.ksp.setOperators(operator)
+        self.ksp.setType(PETSc.KSP.Type.PREONLY)
+        self.ksp.getPC().setType(PETSc.PC.Type.LU)
+        self.ksp.getPC().setFactorSolverType("petsc")
+        self.ksp.setOptionsPrefix(prefix)
+        set_from_options_with_defaults(
+            self.ksp, {f"{prefix}{key}": value for key, value in SERIAL_DEFAULTS.items()})
+
+    @property
+    def fell_back(self):
+        """Whether MUMPS's LU has taken over (a set_up's check failed)."""
+        return self.mumps is not None
+
+    def set_up(self, operator):
+        """Factor ``operator`` (the symbolic factorisation kept while its pattern
+        stays), by MUMPS from the first factorisation that fails the check."""
+        if self.mumps is None:
+            self.ksp.setOperators(operator)
+            try:
+                self.ksp.setUp()
+                factored = True
+            except PETSc.Error:         # a diagonal entry not stored: no pivot in order
+                factored = False
+            if factored and self.backward_error(operator) <= BACKWARD_ERROR_LIMIT:
+                return
+            self.ksp.destroy()
+            self.ksp = None
+            self.mumps = MumpsFactor(operator, PETSc.PC.Type.LU, self.block, self.prefix)
+        self.mumps.set_up(operator)
+
+    def backward_error(self, operator):
+        """eta of the solve of A x = A 1 with the factors just made (Inf where they
+        fail: the KSP's reason, or a solve that is not finite)."""
+        ones, right, solution, residual = (operator.createVecRight(),
+                                           operator.createVecLeft(),
+                                           operator.createVecRight(),
+                                           operator.createVecLeft())
+        try:
+            ones.set(1.0)
+            operator.mult(ones, right)
+            self.ksp.solve(right, solution)
+            if self.ksp.getConvergedReason() < 0:
+                return np.inf
+            operator.mult(solution, residual)
+            residual.axpy(-1.0, right)
+            infinity = PETSc.NormType.INFINITY
+            scale = (operator.norm(infinity) * solution.norm(infinity)
+                     + right.norm(infinity))
+            error = residual.norm(infinity) / scale
+            return error if np.isfinite(error) else np.inf
+        finally:
+            for vec in (ones, right, solution, residual):
+                vec.destroy()
+
+    def solve_columns(self, columns, rows=None):
+        if self.mumps is not None:
+            return self.mumps.solve_columns(columns, rows)
+        return solve_columns(self.ksp, columns, rows, mumps=False)
+
+    def destroy(self):
+        for obj in (self.ksp, self.mumps):
+            if obj is not None:
+                obj.destroy()
+
+
 # Where the Newton steps' systems are factored by substructuring on several ranks
 # (chain_factor.py) unless -<prefix>substructuring 0: MUMPS on all ranks factors these
 # chains no faster than on one and solves them slower (docs/performance.md).
@@ -383,8 +495,13 @@ def direct_factor(operator, kind, block, prefix):
     on several ranks by substructuring (SubstructuredFactor: each rank its interior by
     sequential MUMPS, the interface's Schur complement on every rank, MUMPS on all ranks
     where that does not apply) unless -<prefix>substructuring 0 or the operator is no
-    chain; else MumpsFactor. Collective."""
+    chain; on one rank the LU by NaturalLU unless -<prefix>lu mumps; else MumpsFactor.
+    Collective."""
     comm = operator.getComm()
+    # the package is read on any number of ranks: given, it is used
+    if (kind == PETSc.PC.Type.LU and lu_package(prefix) == LU_PACKAGES[0]
+            and comm.getSize() == 1):
+        return NaturalLU(operator, block, prefix)
     chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)
     if comm.getSize() > 1 and chosen:
         try:
