@@ -23,9 +23,10 @@ The frames' rows take -t_n x delta b_n (omega) and -d3_n . delta b_n (the stretc
 delta f_l = G_l omega_l (physics/drag.py drag_jacobian). The matrix is that of H
 (analysis/second_variation.py, with the resultants' slots as identity rows) plus these
 entries (a copy of H's values on H's pattern, which holds these places as zeros from
-H's first assembly: Term.jacobian_pattern): unsymmetric, factored by MUMPS's LU
-(global_step/ksp.direct_factor: on several ranks by substructuring, each rank its
-interior; options -rod_newton_*). H's curvature term is the load's at its current
+H's first assembly: Term.jacobian_pattern): unsymmetric, factored by
+global_step/ksp.direct_factor (on one rank PETSc's LU in the natural order, checked,
+MUMPS's LU where the check fails; on several by substructuring with MUMPS, each rank
+its interior; options -rod_newton_*). H's curvature term is the load's at its current
 value, symmetrised: the antisymmetric rest is the torque balance, zero at a solution,
 so the steps still converge quadratically.
 """

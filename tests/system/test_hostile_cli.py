@@ -301,18 +301,26 @@ def test_an_unknown_solver_type_exits_2(tmp_path):
 CANTILEVER = ["-options_file", "options/cantilever.opts", "-rod_elements", "8"]
 
 
-@pytest.mark.parametrize("name, ranks", [("rod_newton_substructuring", 2),
-                                         ("rod_inertia_substructuring", 1)])
-def test_a_substructuring_switch_that_is_no_bool_is_refused_before_any_work(tmp_path, name,
-                                                                           ranks):
-    """PETSc read it only at the first Newton system's factorisation: an error of its
-    own (exit 4) after the iterations before it."""
+@pytest.mark.parametrize("name, value, ranks, expected", [
+    ("rod_newton_substructuring", "maybe", 2, "true or false"),
+    ("rod_inertia_substructuring", "maybe", 1, "true or false"),
+    ("rod_newton_lu", "superlu", 1, "petsc or mumps"),
+    ("rod_inertia_ldlt", "superlu", 2, "petsc or mumps")])
+def test_a_factorisation_switch_not_understood_is_refused_before_any_work(tmp_path, name,
+                                                                         value, ranks,
+                                                                         expected):
+    """PETSc read the substructuring switches only at the first Newton system's
+    factorisation: an error of its own (exit 4) after the iterations before it. The
+    packages (global_step/ksp.PACKAGE_SWITCHES) are petsc or mumps: another would not
+    give the inertia or the null pivots the steps read."""
     path = tmp_path / "out.h5"
-    done = run(CANTILEVER + [f"-{name}", "maybe", "-rod_output", str(path)], ranks)
+    done = run(CANTILEVER + [f"-{name}", value, "-rod_output", str(path)], ranks)
     text = done.stdout + done.stderr
     assert_one_line_and_nothing_left(done.returncode, text, 2,
-                                     [f"-{name} maybe", "true or false"], path)
+                                     [f"-{name} {value}", expected], path)
     assert "elements on" not in text, text          # refused before the run started
+
+
 JACOBIAN_SNES = ["newtonls", "newtontr", "ngs", "ksponly", "fas", "nasm", "composite",
                  "shell", "vinewtonrsls"]
 
