@@ -309,6 +309,14 @@ PACKAGES = ("petsc", "mumps")
 # 1e-15 to 4e-15 on its second variations (docs/performance.md, "Newton steps"); an
 # elimination without pivoting whose growth spoils the factors shows it here.
 BACKWARD_ERROR_LIMIT = 1e-12
+# ... and where the forward error of its check solves is at most this: about 2e-5 on that
+# riser (ill-conditioned: MUMPS's 2e-6), below 1e-7 on the held mooring line of
+# tests/solver/test_held_line.py, but 2e-3 to 24 there where a section's free roll made
+# the second variation singular and the elimination kept the null vector's pivot at the
+# round-off (MUMPS detects it as null, ICNTL 24, and the callers hold the roll:
+# system/held_line.py); kept, the solves carried the round-off along the roll and the
+# line's stiffness came out unsymmetric by 0.4 % of its largest entry.
+FORWARD_ERROR_LIMIT = 1e-3
 # The check's solutions z(i) at the rows i: no zero and no pattern the factors' errors
 # could cancel on (with z = 1 an LDL^T whose first pivot was 1e-10 solved it to the
 # round-off and other right-hand sides to 1e-6; sin(GOLDEN i^1.5), 0 at row 0, did the
@@ -341,21 +349,23 @@ class NaturalFactor:
     steps").
 
     It does not pivot. Each set_up checks the factors by two solves, A x = b with
-    b = A z for the CHECK_SOLUTIONS z, and their normwise backward error
+    b = A z for the CHECK_SOLUTIONS z: their normwise backward error
 
         eta = |A x - b|_inf / (|A|_inf |x|_inf + |b|_inf)
 
-    (Rigal and Gaches), which a stable factorisation keeps near the round-off: then the
-    factors are those of A + E with |E x| of the order of eta |A| |x|, and the LDL^T's
-    inertia is A's but for eigenvalues that small (Sylvester), as MUMPS's is. (Row by
-    row, against each row's largest entry, the errors are larger than MUMPS's in the
-    rows of small entries, the multipliers' of the positions' chains: 1e-9 against
-    1e-13 on the 18 000-element riser; the steps and the counts were the same.) A zero
-    pivot (PETSc's test, relative to its row's entries) gives Inf,
-    and a diagonal entry not stored fails the symbolic factorisation. Where eta is not
-    finite or above BACKWARD_ERROR_LIMIT the operator is factored by MumpsFactor
-    (threshold pivoting, null pivots detected), for the rest of this object's life
-    (``fell_back``). The interface direct_factor's factorisations share (set_up,
+    (Rigal and Gaches), which a stable factorisation keeps near the round-off (then
+    the factors are those of A + E with |E x| of the order of eta |A| |x|, and the
+    LDL^T's inertia is A's but for eigenvalues that small, by Sylvester's law, as
+    MUMPS's is), and their forward error |x - z|_inf / |z|_inf, which a null vector
+    whose pivot the elimination kept at the round-off makes large (FORWARD_ERROR_LIMIT).
+    (Row by row, against each row's largest entry, the backward errors are larger than
+    MUMPS's in the rows of small entries, the multipliers' of the positions' chains:
+    1e-9 against 1e-13 on the 18 000-element riser; each solve is refined once,
+    solve_columns.) A zero pivot (PETSc's test, relative to its row's entries) gives
+    Inf, and a diagonal entry not stored fails the symbolic factorisation. Where eta
+    or the forward error is not finite or above its limit the operator is factored by
+    MumpsFactor (threshold pivoting, null pivots detected), for the rest of this
+    object's life (``fell_back``). The interface direct_factor's factorisations share (set_up,
     solve_columns, negative_pivots, destroy; ``substructured`` False). Owns its KSP or
     its MumpsFactor."""
 
@@ -386,17 +396,20 @@ class NaturalFactor:
                 factored = True
             except PETSc.Error:         # a diagonal entry not stored: no pivot in order
                 factored = False
-            if factored and self.backward_error(operator) <= BACKWARD_ERROR_LIMIT:
-                return
+            if factored:
+                backward, forward = self.errors(operator)
+                if backward <= BACKWARD_ERROR_LIMIT and forward <= FORWARD_ERROR_LIMIT:
+                    return
             self.ksp.destroy()
             self.ksp = None
             self.mumps = MumpsFactor(operator, self.kind, self.block, self.prefix)
         self.mumps.set_up(operator)
 
-    def backward_error(self, operator):
-        """eta of the solves of A x = A z for the CHECK_SOLUTIONS z with the factors just
-        made, the largest (Inf where they fail: the KSP's reason, or a solve that is not
-        finite)."""
+    def errors(self, operator):
+        """(eta, the forward error) of the solves of A x = A z for the CHECK_SOLUTIONS z
+        with the factors just made, the largest of each; the forward error
+        |x - z|_inf / |z|_inf. Inf where they fail (the KSP's reason, or a solve that is
+        not finite)."""
         exact, right, solution, residual = (operator.createVecRight(),
                                             operator.createVecLeft(),
                                             operator.createVecRight(),
@@ -405,27 +418,68 @@ class NaturalFactor:
         norm = operator.norm(infinity)
         try:
             start, end = exact.getOwnershipRange()
-            errors = []
+            backward, forward = [], []
             for solution_of in CHECK_SOLUTIONS:
                 exact.getArray()[:] = solution_of(np.arange(start, end))
                 operator.mult(exact, right)
                 self.ksp.solve(right, solution)
                 if self.ksp.getConvergedReason() < 0:
-                    return np.inf
+                    return np.inf, np.inf
                 operator.mult(solution, residual)
                 residual.axpy(-1.0, right)
-                errors.append(residual.norm(infinity)
-                              / (norm * solution.norm(infinity) + right.norm(infinity)))
-            error = max(errors)
-            return error if np.isfinite(error) else np.inf
+                backward.append(residual.norm(infinity)
+                                / (norm * solution.norm(infinity) + right.norm(infinity)))
+                residual.waxpy(-1.0, exact, solution)
+                forward.append(residual.norm(infinity) / exact.norm(infinity))
+            found = (max(backward), max(forward))
+            return tuple(value if np.isfinite(value) else np.inf for value in found)
         finally:
             for vec in (exact, right, solution, residual):
                 vec.destroy()
 
     def solve_columns(self, columns, rows=None):
+        """As ksp.solve_columns, each solve refined once: x += F^-1 (b - A x), with the
+        residual in the working precision, which makes the solves of an elimination
+        without pivoting as accurate as a pivoting one's (Skeel's one step of
+        iterative refinement: on the held mooring line's stiffness, a Schur
+        complement of these solves, 4e-6 of its largest entry without it against
+        1e-13 with MUMPS)."""
         if self.mumps is not None:
             return self.mumps.solve_columns(columns, rows)
-        return solve_columns(self.ksp, columns, rows, mumps=False)
+        columns = [np.asarray(column) for column in columns]
+        solutions = [column.copy() for column in columns]
+        if not columns:
+            return solutions
+        right = np.empty((columns[0].size if rows is None else len(rows), len(columns)),
+                         dtype=PETSc.ScalarType, order="F")
+        for j, column in enumerate(columns):
+            right[:, j] = column if rows is None else column[rows]
+        values = self._solved(right)
+        operator = self.ksp.getOperators()[0]
+        known = _dense_on(values)
+        product = operator.matMult(known)
+        try:
+            values += self._solved(np.asfortranarray(right - product.getDenseArray()))
+        finally:
+            known.destroy()
+            product.destroy()
+        for j, solution in enumerate(solutions):
+            if rows is None:
+                solution[:] = values[:, j]
+            else:
+                solution[rows] = values[:, j]
+        return solutions
+
+    def _solved(self, right):
+        """F^-1 right for the (n, k) Fortran-ordered ``right``: a new such array."""
+        values = np.empty_like(right, order="F")
+        matrices = [_dense_on(array) for array in (right, values)]
+        try:
+            self.ksp.getPC().getFactorMatrix().matSolve(*matrices)
+        finally:
+            for matrix in matrices:
+                matrix.destroy()
+        return values
 
     def negative_pivots(self):
         """Negative eigenvalues of the last factorised (symmetric) operator: D's negative
