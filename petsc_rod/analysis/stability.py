@@ -4,9 +4,8 @@ constraint set (analysis/second_variation.py), and a direction that leaves a sad
 
 The state is a local minimiser when H is positive semi-definite on the constraint set,
 a saddle when H has a negative eigenvalue there. Sylvester's law of inertia counts those
-without an eigen-solve: an LDL^T factorisation of H (global_step/ksp.direct_factor: on
-one rank PETSc's in the natural order, checked, MUMPS's where the check fails; on
-several ranks MUMPS's by substructuring, global_step/chain_factor.py: the interiors' negative pivots
+without an eigen-solve: the symmetric-indefinite factorisation of H (MUMPS; on several
+ranks by substructuring, global_step/chain_factor.py: the interiors' negative pivots
 plus the interface Schur complement's negative eigenvalues) gives the number of negative
 eigenvalues, and the chord constraint is taken into account by the Schur complement,
 n_neg(H on the constraint) = n_neg(H) + n_pos(C^T H^-1 C) - m (C: its m columns, the
@@ -72,8 +71,8 @@ class StabilityTest(SecondVariation):
         return direction is None, direction
 
     def _create_solver(self):
-        """One LDL^T (global_step/ksp.direct_factor: PETSc's on one rank, MUMPS's by
-        substructuring on several) for H - shift M at every shift: the symbolic factorisation is made once,
+        """One LDL^T (global_step/ksp.direct_factor: MUMPS's, by substructuring on several
+        ranks) for H - shift M at every shift: the symbolic factorisation is made once,
         the numeric one per shift. The factored matrix is a copy of H (``shifted``), its
         diagonal shifted: H itself is not factored in place, because each update of H
         takes its held rows out of its pattern and puts them back (zeroRowsColumns), a

@@ -22,8 +22,8 @@ from petsc4py import PETSc
 
 from petsc_rod.environment.seabed import DEFAULT_PENETRATION
 from petsc_rod.errors import RodInputError
-from petsc_rod.global_step.ksp import (INERTIA_PREFIX, NEWTON_PREFIX, PACKAGE_SWITCHES,
-                                     PACKAGES, SUBSTRUCTURING)
+from petsc_rod.global_step.ksp import (INERTIA_PREFIX, LU_PACKAGE, LU_PACKAGES, NEWTON_PREFIX,
+                                     SUBSTRUCTURING)
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
                                             NEWTON_SWITCH_FAR, NEWTON_WORTH)
@@ -556,17 +556,16 @@ SUBSTRUCTURING_SWITCHES = tuple(f"{prefix}{SUBSTRUCTURING}"
 
 def check_factor_switches():
     """Refuse a -rod_newton_substructuring or -rod_inertia_substructuring that is not a
-    true or false, and a -rod_newton_lu or -rod_inertia_ldlt that is not one of
-    ksp.PACKAGES, before any work (PETSc's own error came only at the first Newton
-    step, after the iterations before it)."""
+    true or false, and a -rod_newton_lu that is not one of ksp.LU_PACKAGES, before any
+    work (PETSc's own error came only at the first Newton step, after the iterations
+    before it)."""
     given = PETSc.Options().getAll()        # read without marking them used
-    for prefix, switch in PACKAGE_SWITCHES.items():
-        name = f"{prefix}{switch}"
-        if name in given and given[name] not in PACKAGES:
-            raise RodInputError(
-                f"-{name} {given[name]}: expected {' or '.join(PACKAGES)} (the package "
-                "of the Newton steps' and the stability test's factorisations on one "
-                "rank: PETSc's own in the natural order, or MUMPS's)")
+    name = f"{NEWTON_PREFIX}{LU_PACKAGE}"
+    if name in given and given[name] not in LU_PACKAGES:
+        raise RodInputError(
+            f"-{name} {given[name]}: expected {' or '.join(LU_PACKAGES)} (the package of "
+            "the Newton steps' LU on one rank: PETSc's own in the natural order, or "
+            "MUMPS's)")
     for name in SUBSTRUCTURING_SWITCHES:
         if name in given:
             text = given[name]
@@ -634,9 +633,7 @@ def help_text():
                  "sequential MUMPS, the ranks' first nodes the interface, whose Schur "
                  "complement every rank solves; false: MUMPS on all ranks.")
     lines.append("  The stability test and the Newton steps' positive-definiteness test: "
-                 "on one rank -rod_inertia_ldlt petsc|mumps (default petsc, as for the "
-                 "Newton steps' LU); -rod_inertia_mat_mumps_* MUMPS's controls of their "
-                 "LDL^T (MUMPS's own "
+                 "-rod_inertia_mat_mumps_* MUMPS's controls of their LDL^T (MUMPS's own "
                  "ordering unless given); -rod_inertia_substructuring <bool> as for the "
                  "Newton steps' LU (the inertia the interiors' and the interface's).")
     lines.append("  The modes (-rod_modes): SLEPc's options under -rod_modes_ "

@@ -2,8 +2,8 @@
 step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
 the second variation (analysis/stability.py, options -rod_inertia_*) and the MUMPS LU
 of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*),
-both through direct_factor: on one rank PETSc's own factorisations in the natural order
-(NaturalFactor, checked, MUMPS's where the check fails); by substructuring on several
+both through direct_factor: on one rank MUMPS's LDL^T, and PETSc's own LU in the natural
+order (NaturalLU, checked, MUMPS's where the check fails); by substructuring on several
 (chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
@@ -174,7 +174,7 @@ def _with_more_workspace(ksp, factor):
 def solve_columns(ksp, columns, rows=None, mumps=True):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
     the factored operator A of a set-up inertia_solver or lu_solver (or, ``mumps``
-    False, a NaturalFactor's KSP), in one MatMatSolve (one call into MUMPS's solve phase,
+    False, a NaturalLU's KSP), in one MatMatSolve (one call into MUMPS's solve phase,
     whose cost is a fixed part and a part per column: docs/performance.md, "Newton
     steps").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
@@ -297,55 +297,47 @@ def solve_vecs(factor, vecs, rows=None):
     return solutions
 
 
-# The package of a factorisation on one rank, by its options prefix: -rod_newton_lu for
-# the Newton Jacobian's LU, -rod_inertia_ldlt for the LDL^T of the second variation (the
-# stability test, the Newton steps' inertia test): PETSc's own in the natural order
-# (NaturalFactor), or MUMPS's (MumpsFactor). The modes' factorisation (shift-and-invert
-# far inside the spectrum) stays MUMPS's.
-PACKAGE_SWITCHES = {NEWTON_PREFIX: "lu", INERTIA_PREFIX: "ldlt"}
-PACKAGES = ("petsc", "mumps")
-# NaturalFactor accepts its factorisation where the normwise backward error of its check
-# solve is at most this: 3e-15 to 6e-15 on the 18 000-element riser's two Jacobians,
-# 1e-15 to 4e-15 on its second variations (docs/performance.md, "Newton steps"); an
-# elimination without pivoting whose growth spoils the factors shows it here.
+# The package of the Newton Jacobian's LU on one rank (-rod_newton_lu): PETSc's own in
+# the natural order (NaturalLU), or MUMPS's (MumpsFactor). The LDL^T of the second
+# variation stays MUMPS's: PETSc's (1x1 pivots, natural order) was 5 times faster on the
+# 18 000-element riser with the same inertia, but where a section's free roll makes H
+# singular it keeps the null vector's pivot at the round-off, which MUMPS detects as null
+# and the callers rely on (a held line's stiffness came out 0.4 % unsymmetric;
+# docs/performance.md, "Measured and not kept").
+LU_PACKAGE = "lu"
+LU_PACKAGES = ("petsc", "mumps")
+# NaturalLU accepts its factorisation where the normwise backward error of its check
+# solves is at most this (1e-15 to 6e-15 on the 18 000-element riser's Jacobians;
+# docs/performance.md, "Newton steps"): an elimination without pivoting whose growth
+# spoils the factors shows it here ...
 BACKWARD_ERROR_LIMIT = 1e-12
-# ... and where the forward error of its check solves is at most this: about 2e-5 on that
-# riser (ill-conditioned: MUMPS's 2e-6), below 1e-7 on the held mooring line of
-# tests/solver/test_held_line.py, but 2e-3 to 24 there where a section's free roll made
-# the second variation singular and the elimination kept the null vector's pivot at the
-# round-off (MUMPS detects it as null, ICNTL 24, and the callers hold the roll:
-# system/held_line.py); kept, the solves carried the round-off along the roll and the
-# line's stiffness came out unsymmetric by 0.4 % of its largest entry.
+# ... and where their forward error is at most this: 1.3e-5 to 2.2e-5 on that riser
+# (ill-conditioned: MUMPS's 2e-6), 2e-3 to 24 where a null vector's pivot was kept at
+# the round-off (the held mooring line of tests/solver/test_held_line.py, whose
+# second variation a free roll made singular, factored without pivoting).
 FORWARD_ERROR_LIMIT = 1e-3
 # The check's solutions z(i) at the rows i: no zero and no pattern the factors' errors
 # could cancel on (with z = 1 an LDL^T whose first pivot was 1e-10 solved it to the
 # round-off and other right-hand sides to 1e-6; sin(GOLDEN i^1.5), 0 at row 0, did the
-# same).
+# same); two, because one alone let a kept null pivot through where the other did not.
 GOLDEN = 0.5 * (1 + 5**0.5)
 CHECK_SOLUTIONS = (lambda i: np.sin(GOLDEN * (i + 1.0) ** 1.5),
                    lambda i: np.cos(GOLDEN * (i + 1.0)))
 
 
-def factor_package(prefix):
-    """The package of the factorisation under ``prefix`` on one rank: what
-    -<prefix><PACKAGE_SWITCHES[prefix]> names (one of PACKAGES; default petsc), MUMPS for
-    a prefix without the switch. An other value is refused before any work
-    (cli/options.check_factor_switches)."""
-    if prefix not in PACKAGE_SWITCHES:
-        return PACKAGES[1]
-    return PETSc.Options().getString(f"{prefix}{PACKAGE_SWITCHES[prefix]}", PACKAGES[0])
+def lu_package(prefix):
+    """The LU package ``-<prefix>lu`` names (one of LU_PACKAGES; default petsc); an
+    other value is refused before any work (cli/options.check_factor_switches)."""
+    return PETSc.Options().getString(f"{prefix}{LU_PACKAGE}", LU_PACKAGES[0])
 
 
-class NaturalFactor:
-    """PETSc's own factorisation ``kind`` (PETSc.PC.Type.LU, or CHOLESKY: an LDL^T with
-    1x1 pivots, its inertia that of D) of a sequential ``operator`` in the natural
-    order (its KSP and PC are not options: the check and the inertia need this
-    factorisation; MUMPS's under ``prefix`` where it falls back): the
-    Newton steps' matrices on one rank (analysis/jacobian.py, analysis/stability.py),
-    bands of nodes whose elimination in their own order fills only the band. On the
-    18 000-element riser the Jacobian's first LU takes 69 ms and the next 20 ms,
-    MUMPS's 277 and 156 ms, a solve 3 ms against 24; the second variation's LDL^T
-    93-127 ms against MUMPS's 610-720 ms on the whole H (docs/performance.md, "Newton
+class NaturalLU:
+    """PETSc's own LU of a sequential ``operator`` in the natural order (its KSP and PC
+    are not options: the check needs this factorisation; MUMPS's under ``prefix``
+    where it hands over): the Newton Jacobian on one rank (analysis/jacobian.py), a
+    band of nodes whose elimination in its own order fills only the band. On the
+    18 000-element riser its first factorisation takes 69 ms and the next 20 ms,
+    MUMPS's 277 and 156 ms, a solve 3 ms against 24 (docs/performance.md, "Newton
     steps").
 
     It does not pivot. Each set_up checks the factors by two solves, A x = b with
@@ -353,31 +345,29 @@ class NaturalFactor:
 
         eta = |A x - b|_inf / (|A|_inf |x|_inf + |b|_inf)
 
-    (Rigal and Gaches), which a stable factorisation keeps near the round-off (then
-    the factors are those of A + E with |E x| of the order of eta |A| |x|, and the
-    LDL^T's inertia is A's but for eigenvalues that small, by Sylvester's law, as
-    MUMPS's is), and their forward error |x - z|_inf / |z|_inf, which a null vector
-    whose pivot the elimination kept at the round-off makes large (FORWARD_ERROR_LIMIT).
-    (Row by row, against each row's largest entry, the backward errors are larger than
-    MUMPS's in the rows of small entries, the multipliers' of the positions' chains:
-    1e-9 against 1e-13 on the 18 000-element riser; each solve is refined once,
-    solve_columns.) A zero pivot (PETSc's test, relative to its row's entries) gives
-    Inf, and a diagonal entry not stored fails the symbolic factorisation. Where eta
-    or the forward error is not finite or above its limit the operator is factored by
-    MumpsFactor (threshold pivoting, null pivots detected), for the rest of this
-    object's life (``fell_back``). The interface direct_factor's factorisations share (set_up,
-    solve_columns, negative_pivots, destroy; ``substructured`` False). Owns its KSP or
-    its MumpsFactor."""
+    (Rigal and Gaches), which a stable factorisation keeps near the round-off, and
+    their forward error |x - z|_inf / |z|_inf, which a null vector whose pivot the
+    elimination kept at the round-off makes large. (Row by row, against each row's
+    largest entry, the backward errors are larger than MUMPS's in the rows of small
+    entries, the multipliers' of the positions' chains: 1e-9 against 1e-13 on that
+    riser; the steps, which correct their own errors, and the results were the same.)
+    A zero pivot (PETSc's test, relative to its row's entries) gives Inf, and a
+    diagonal entry not stored fails the symbolic factorisation. Where either error is
+    not finite or above its limit the operator is factored by MumpsFactor (threshold
+    pivoting, null pivots detected), for the rest of this object's life
+    (``fell_back``). The interface direct_factor's factorisations share (set_up,
+    solve_columns, destroy; ``substructured`` False). Owns its KSP or its
+    MumpsFactor."""
 
     substructured = False
 
-    def __init__(self, operator, kind, block, prefix):
-        self.kind, self.block, self.prefix = kind, block, prefix
+    def __init__(self, operator, block, prefix):
+        self.block, self.prefix = block, prefix
         self.mumps = None
         self.ksp = PETSc.KSP().create(comm=operator.getComm())
         self.ksp.setOperators(operator)
         self.ksp.setType(PETSc.KSP.Type.PREONLY)
-        self.ksp.getPC().setType(kind)
+        self.ksp.getPC().setType(PETSc.PC.Type.LU)
         self.ksp.getPC().setFactorSolverType("petsc")
         self.ksp.getPC().setFactorOrdering(PETSc.Mat.OrderingType.NATURAL)
 
@@ -402,14 +392,13 @@ class NaturalFactor:
                     return
             self.ksp.destroy()
             self.ksp = None
-            self.mumps = MumpsFactor(operator, self.kind, self.block, self.prefix)
+            self.mumps = MumpsFactor(operator, PETSc.PC.Type.LU, self.block, self.prefix)
         self.mumps.set_up(operator)
 
     def errors(self, operator):
         """(eta, the forward error) of the solves of A x = A z for the CHECK_SOLUTIONS z
-        with the factors just made, the largest of each; the forward error
-        |x - z|_inf / |z|_inf. Inf where they fail (the KSP's reason, or a solve that is
-        not finite)."""
+        with the factors just made, the largest of each; Inf where they fail (the KSP's
+        reason, or a solve that is not finite)."""
         exact, right, solution, residual = (operator.createVecRight(),
                                             operator.createVecLeft(),
                                             operator.createVecRight(),
@@ -431,62 +420,16 @@ class NaturalFactor:
                                 / (norm * solution.norm(infinity) + right.norm(infinity)))
                 residual.waxpy(-1.0, exact, solution)
                 forward.append(residual.norm(infinity) / exact.norm(infinity))
-            found = (max(backward), max(forward))
-            return tuple(value if np.isfinite(value) else np.inf for value in found)
+            return tuple(value if np.isfinite(value) else np.inf
+                         for value in (max(backward), max(forward)))
         finally:
             for vec in (exact, right, solution, residual):
                 vec.destroy()
 
     def solve_columns(self, columns, rows=None):
-        """As ksp.solve_columns, each solve refined once: x += F^-1 (b - A x), with the
-        residual in the working precision, which makes the solves of an elimination
-        without pivoting as accurate as a pivoting one's (Skeel's one step of
-        iterative refinement: on the held mooring line's stiffness, a Schur
-        complement of these solves, 4e-6 of its largest entry without it against
-        1e-13 with MUMPS)."""
         if self.mumps is not None:
             return self.mumps.solve_columns(columns, rows)
-        columns = [np.asarray(column) for column in columns]
-        solutions = [column.copy() for column in columns]
-        if not columns:
-            return solutions
-        right = np.empty((columns[0].size if rows is None else len(rows), len(columns)),
-                         dtype=PETSc.ScalarType, order="F")
-        for j, column in enumerate(columns):
-            right[:, j] = column if rows is None else column[rows]
-        values = self._solved(right)
-        operator = self.ksp.getOperators()[0]
-        known = _dense_on(values)
-        product = operator.matMult(known)
-        try:
-            values += self._solved(np.asfortranarray(right - product.getDenseArray()))
-        finally:
-            known.destroy()
-            product.destroy()
-        for j, solution in enumerate(solutions):
-            if rows is None:
-                solution[:] = values[:, j]
-            else:
-                solution[rows] = values[:, j]
-        return solutions
-
-    def _solved(self, right):
-        """F^-1 right for the (n, k) Fortran-ordered ``right``: a new such array."""
-        values = np.empty_like(right, order="F")
-        matrices = [_dense_on(array) for array in (right, values)]
-        try:
-            self.ksp.getPC().getFactorMatrix().matSolve(*matrices)
-        finally:
-            for matrix in matrices:
-                matrix.destroy()
-        return values
-
-    def negative_pivots(self):
-        """Negative eigenvalues of the last factorised (symmetric) operator: D's negative
-        entries, or MUMPS's count (ICNTL 13)."""
-        if self.mumps is not None:
-            return self.mumps.negative_pivots()
-        return int(self.ksp.getPC().getFactorMatrix().getInertia()[0])
+        return solve_columns(self.ksp, columns, rows, mumps=False)
 
     def destroy(self):
         for obj in (self.ksp, self.mumps):
@@ -582,12 +525,13 @@ def direct_factor(operator, kind, block, prefix):
     on several ranks by substructuring (SubstructuredFactor: each rank its interior by
     sequential MUMPS, the interface's Schur complement on every rank, MUMPS on all ranks
     where that does not apply) unless -<prefix>substructuring 0 or the operator is no
-    chain; on one rank NaturalFactor under a prefix of PACKAGE_SWITCHES unless its
-    switch says mumps; else MumpsFactor. Collective."""
+    chain; on one rank the LU by NaturalLU unless -<prefix>lu mumps; else MumpsFactor.
+    Collective."""
     comm = operator.getComm()
     # the package is read on any number of ranks: given, it is used
-    if factor_package(prefix) == PACKAGES[0] and comm.getSize() == 1:
-        return NaturalFactor(operator, kind, block, prefix)
+    if (kind == PETSc.PC.Type.LU and lu_package(prefix) == LU_PACKAGES[0]
+            and comm.getSize() == 1):
+        return NaturalLU(operator, block, prefix)
     chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)
     if comm.getSize() > 1 and chosen:
         try:

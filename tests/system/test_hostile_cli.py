@@ -305,14 +305,14 @@ CANTILEVER = ["-options_file", "options/cantilever.opts", "-rod_elements", "8"]
     ("rod_newton_substructuring", "maybe", 2, "true or false"),
     ("rod_inertia_substructuring", "maybe", 1, "true or false"),
     ("rod_newton_lu", "superlu", 1, "petsc or mumps"),
-    ("rod_inertia_ldlt", "superlu", 2, "petsc or mumps")])
+    ("rod_newton_lu", "superlu", 2, "petsc or mumps")])
 def test_a_factorisation_switch_not_understood_is_refused_before_any_work(tmp_path, name,
                                                                          value, ranks,
                                                                          expected):
     """PETSc read the substructuring switches only at the first Newton system's
     factorisation: an error of its own (exit 4) after the iterations before it. The
-    packages (global_step/ksp.PACKAGE_SWITCHES) are petsc or mumps: another would not
-    give the inertia or the null pivots the steps read."""
+    LU's package (-rod_newton_lu, global_step/ksp.LU_PACKAGES) is petsc or mumps:
+    another would not detect the null pivots the steps read."""
     path = tmp_path / "out.h5"
     done = run(CANTILEVER + [f"-{name}", value, "-rod_output", str(path)], ranks)
     text = done.stdout + done.stderr
