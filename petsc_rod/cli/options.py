@@ -22,8 +22,8 @@ from petsc4py import PETSc
 
 from petsc_rod.environment.seabed import DEFAULT_PENETRATION
 from petsc_rod.errors import RodInputError
-from petsc_rod.global_step.ksp import (INERTIA_PREFIX, LU_PACKAGE, LU_PACKAGES, NEWTON_PREFIX,
-                                     SUBSTRUCTURING)
+from petsc_rod.global_step.ksp import (INERTIA_PREFIX, NEWTON_PREFIX, SUBSTRUCTURING,
+                                       lu_package)
 from petsc_rod.iteration.continuation import MAX_HALVINGS_CAP, PathSettings
 from petsc_rod.iteration.controller import (EARLY_ESCAPE, NEWTON_AFTER, NEWTON_SWITCH,
                                             NEWTON_SWITCH_FAR, NEWTON_WORTH)
@@ -555,17 +555,12 @@ SUBSTRUCTURING_SWITCHES = tuple(f"{prefix}{SUBSTRUCTURING}"
 
 
 def check_factor_switches():
-    """Refuse a -rod_newton_substructuring or -rod_inertia_substructuring that is not a
-    true or false, and a -rod_newton_lu that is not one of ksp.LU_PACKAGES, before any
-    work (PETSc's own error came only at the first Newton step, after the iterations
-    before it)."""
+    """Refuse, before any work, a -rod_newton_substructuring or
+    -rod_inertia_substructuring that is not a true or false (PETSc read them only at
+    the first Newton step, after the iterations before it) and a -rod_newton_lu that
+    is not one of ksp.LU_PACKAGES (ksp.lu_package, read at the first Newton step)."""
+    lu_package(NEWTON_PREFIX)
     given = PETSc.Options().getAll()        # read without marking them used
-    name = f"{NEWTON_PREFIX}{LU_PACKAGE}"
-    if name in given and given[name] not in LU_PACKAGES:
-        raise RodInputError(
-            f"-{name} {given[name]}: expected {' or '.join(LU_PACKAGES)} (the package of "
-            "the Newton steps' LU on one rank: PETSc's own in the natural order, or "
-            "MUMPS's)")
     for name in SUBSTRUCTURING_SWITCHES:
         if name in given:
             text = given[name]
@@ -625,8 +620,8 @@ def help_text():
     lines.append("  Newton steps with a current or seabed friction: -rod_newton_* the LU of "
                  "their unsymmetric Jacobian; on one rank -rod_newton_lu petsc|mumps "
                  "(default petsc: PETSc's LU in the natural order, checked by its backward "
-                 "error, MUMPS's where that fails); MUMPS's LU "
-                 "-rod_newton_mat_mumps_icntl_7 2: the AMF ordering, "
+                 "and forward errors, MUMPS's where that fails); MUMPS's LU "
+                 "(-rod_newton_mat_mumps_icntl_7 2: the AMF ordering, "
                  "-rod_newton_mat_mumps_icntl_15 -B: on the graph of the nodes, B "
                  "unknowns a node); on several ranks -rod_newton_substructuring <bool> "
                  "(default true): each rank factors its part of the chain with "

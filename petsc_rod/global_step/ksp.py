@@ -1,10 +1,10 @@
 """The direct solvers of the project, made in one place: the chain solvers of the global
 step (the three P2 problems, and the seabed's vertical problem), the MUMPS LDL^T of
-the second variation (analysis/stability.py, options -rod_inertia_*) and the MUMPS LU
-of the Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*),
-both through direct_factor: on one rank MUMPS's LDL^T, and PETSc's own LU in the natural
-order (NaturalLU, checked, MUMPS's where the check fails); by substructuring on several
-(chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
+the second variation (analysis/stability.py, options -rod_inertia_*) and the LU of the
+Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*), both
+through direct_factor: on one rank the LDL^T by MUMPS and the LU by PETSc's own in the
+natural order (NaturalLU, checked, MUMPS's where the check fails); on several by
+substructuring (chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
 defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
@@ -16,7 +16,7 @@ override them as for any PETSc KSP.
 import numpy as np
 from petsc4py import PETSc
 
-from petsc_rod.errors import RodDivergedError
+from petsc_rod.errors import RodDivergedError, RodInputError
 from petsc_rod.global_step import substructuring
 from petsc_rod.global_step.chain_factor import ChainFactor
 from petsc_rod.petsc_defaults import defaults_in_effect, set_from_options_with_defaults
@@ -171,12 +171,11 @@ def _with_more_workspace(ksp, factor):
     factor.setMumpsIcntl(14, relaxation)
 
 
-def solve_columns(ksp, columns, rows=None, mumps=True):
+def solve_columns(ksp, columns, rows=None):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
-    the factored operator A of a set-up inertia_solver or lu_solver (or, ``mumps``
-    False, a NaturalLU's KSP), in one MatMatSolve (one call into MUMPS's solve phase,
-    whose cost is a fixed part and a part per column: docs/performance.md, "Newton
-    steps").
+    the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve
+    (one call into MUMPS's solve phase, whose cost is a fixed part and a part per
+    column: docs/performance.md, "Newton steps").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
     rows out), the local indices of its rows in them; the other rows of x_j are b_j.
     Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed
@@ -197,7 +196,7 @@ def solve_columns(ksp, columns, rows=None, mumps=True):
     right.assemble()
     unknown = right.duplicate()
     try:
-        if mumps and factor.getMumpsInfog(1) < 0:
+        if factor.getMumpsInfog(1) < 0:
             unknown.getDenseArray()[:] = np.inf
         else:
             factor.matSolve(right, unknown)
@@ -299,36 +298,38 @@ def solve_vecs(factor, vecs, rows=None):
 
 # The package of the Newton Jacobian's LU on one rank (-rod_newton_lu): PETSc's own in
 # the natural order (NaturalLU), or MUMPS's (MumpsFactor). The LDL^T of the second
-# variation stays MUMPS's: PETSc's (1x1 pivots, natural order) was 5 times faster on the
-# 18 000-element riser with the same inertia, but where a section's free roll makes H
-# singular it keeps the null vector's pivot at the round-off, which MUMPS detects as null
-# and the callers rely on (a held line's stiffness came out 0.4 % unsymmetric;
-# docs/performance.md, "Measured and not kept").
+# variation is MUMPS's: its null pivots (a section's free roll) are detected as null,
+# which the callers rely on (docs/performance.md, "Newton steps").
 LU_PACKAGE = "lu"
 LU_PACKAGES = ("petsc", "mumps")
+DEFAULT_LU_PACKAGE = "petsc"
 # NaturalLU accepts its factorisation where the normwise backward error of its check
 # solves is at most this (1e-15 to 6e-15 on the 18 000-element riser's Jacobians;
-# docs/performance.md, "Newton steps"): an elimination without pivoting whose growth
-# spoils the factors shows it here ...
+# docs/performance.md, "Newton steps"): growth of the elimination shows here ...
 BACKWARD_ERROR_LIMIT = 1e-12
-# ... and where their forward error is at most this: 1.3e-5 to 2.2e-5 on that riser
-# (ill-conditioned: MUMPS's 2e-6), 2e-3 to 24 where a null vector's pivot was kept at
-# the round-off (the held mooring line of tests/solver/test_held_line.py, whose
-# second variation a free roll made singular, factored without pivoting).
+# ... and where their forward error is at most this (1.3e-5 to 2.2e-5 there, the
+# Jacobian ill-conditioned: MUMPS's 2e-6): a null vector whose pivot the elimination
+# keeps at the round-off makes it large (2e-3 to 24 in the second variation of a held
+# line with a free roll, docs/performance.md).
 FORWARD_ERROR_LIMIT = 1e-3
 # The check's solutions z(i) at the rows i: no zero and no pattern the factors' errors
-# could cancel on (with z = 1 an LDL^T whose first pivot was 1e-10 solved it to the
-# round-off and other right-hand sides to 1e-6; sin(GOLDEN i^1.5), 0 at row 0, did the
-# same); two, because one alone let a kept null pivot through where the other did not.
+# could cancel on; two, as one alone can meet a kept null pivot with a small error.
 GOLDEN = 0.5 * (1 + 5**0.5)
 CHECK_SOLUTIONS = (lambda i: np.sin(GOLDEN * (i + 1.0) ** 1.5),
                    lambda i: np.cos(GOLDEN * (i + 1.0)))
 
 
 def lu_package(prefix):
-    """The LU package ``-<prefix>lu`` names (one of LU_PACKAGES; default petsc); an
-    other value is refused before any work (cli/options.check_factor_switches)."""
-    return PETSc.Options().getString(f"{prefix}{LU_PACKAGE}", LU_PACKAGES[0])
+    """The LU package ``-<prefix>lu`` names (one of LU_PACKAGES; default
+    DEFAULT_LU_PACKAGE); RodInputError for another (cli/options.check_factor_switches
+    asks before any work)."""
+    name = f"{prefix}{LU_PACKAGE}"
+    package = PETSc.Options().getString(name, DEFAULT_LU_PACKAGE)
+    if package not in LU_PACKAGES:
+        raise RodInputError(
+            f"-{name} {package}: expected {' or '.join(LU_PACKAGES)} (the package of the "
+            "Newton steps' LU on one rank: PETSc's own in the natural order, or MUMPS's)")
+    return package
 
 
 class NaturalLU:
@@ -397,39 +398,77 @@ class NaturalLU:
 
     def errors(self, operator):
         """(eta, the forward error) of the solves of A x = A z for the CHECK_SOLUTIONS z
-        with the factors just made, the largest of each; Inf where they fail (the KSP's
-        reason, or a solve that is not finite)."""
+        with the factors just made, the largest of each; Inf where a solve is not
+        finite (a failed factorisation solves to Inf). The solves are the factor's own,
+        not the KSP's, which would read the options database's -ksp_*."""
         exact, right, solution, residual = (operator.createVecRight(),
                                             operator.createVecLeft(),
                                             operator.createVecRight(),
                                             operator.createVecLeft())
         infinity = PETSc.NormType.INFINITY
         norm = operator.norm(infinity)
+        factor = self.ksp.getPC().getFactorMatrix()
         try:
             start, end = exact.getOwnershipRange()
             backward, forward = [], []
             for solution_of in CHECK_SOLUTIONS:
                 exact.getArray()[:] = solution_of(np.arange(start, end))
                 operator.mult(exact, right)
-                self.ksp.solve(right, solution)
-                if self.ksp.getConvergedReason() < 0:
-                    return np.inf, np.inf
+                factor.solve(right, solution)
                 operator.mult(solution, residual)
                 residual.axpy(-1.0, right)
                 backward.append(residual.norm(infinity)
                                 / (norm * solution.norm(infinity) + right.norm(infinity)))
                 residual.waxpy(-1.0, exact, solution)
                 forward.append(residual.norm(infinity) / exact.norm(infinity))
-            return tuple(value if np.isfinite(value) else np.inf
-                         for value in (max(backward), max(forward)))
+            found = (np.max(backward), np.max(forward))       # NaN kept
+            return tuple(value if np.isfinite(value) else np.inf for value in found)
         finally:
             for vec in (exact, right, solution, residual):
                 vec.destroy()
 
     def solve_columns(self, columns, rows=None):
+        """As ksp.solve_columns, each solve refined once: x += F^-1 (b - A x), with the
+        residual in the working precision, which makes the solves of an elimination
+        without pivoting as accurate as a pivoting one's (Skeel's one step of
+        iterative refinement): without it the row-by-row errors above let the chain
+        with seabed friction of tests/system/test_friction_penalty_advice_cli.py take
+        555 iterations against MUMPS's 392 and stop 1.2e-6 m from MUMPS's answer."""
         if self.mumps is not None:
             return self.mumps.solve_columns(columns, rows)
-        return solve_columns(self.ksp, columns, rows, mumps=False)
+        columns = [np.asarray(column) for column in columns]
+        solutions = [column.copy() for column in columns]
+        if not columns:
+            return solutions
+        right = np.empty((columns[0].size if rows is None else len(rows), len(columns)),
+                         dtype=PETSc.ScalarType, order="F")
+        for j, column in enumerate(columns):
+            right[:, j] = column if rows is None else column[rows]
+        values = self._solved(right)
+        known = _dense_on(values)
+        product = self.ksp.getOperators()[0].matMult(known)
+        try:
+            values += self._solved(np.asfortranarray(right - product.getDenseArray()))
+        finally:
+            known.destroy()
+            product.destroy()
+        for j, solution in enumerate(solutions):
+            if rows is None:
+                solution[:] = values[:, j]
+            else:
+                solution[rows] = values[:, j]
+        return solutions
+
+    def _solved(self, right):
+        """F^-1 right for the (n, k) Fortran-ordered ``right``: a new such array."""
+        values = np.empty_like(right, order="F")
+        matrices = [_dense_on(array) for array in (right, values)]
+        try:
+            self.ksp.getPC().getFactorMatrix().matSolve(*matrices)
+        finally:
+            for matrix in matrices:
+                matrix.destroy()
+        return values
 
     def destroy(self):
         for obj in (self.ksp, self.mumps):
@@ -529,7 +568,7 @@ def direct_factor(operator, kind, block, prefix):
     Collective."""
     comm = operator.getComm()
     # the package is read on any number of ranks: given, it is used
-    if (kind == PETSc.PC.Type.LU and lu_package(prefix) == LU_PACKAGES[0]
+    if (kind == PETSc.PC.Type.LU and lu_package(prefix) == DEFAULT_LU_PACKAGE
             and comm.getSize() == 1):
         return NaturalLU(operator, block, prefix)
     chosen = PETSc.Options().getBool(f"{prefix}{SUBSTRUCTURING}", True)

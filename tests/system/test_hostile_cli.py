@@ -311,8 +311,8 @@ def test_a_factorisation_switch_not_understood_is_refused_before_any_work(tmp_pa
                                                                          expected):
     """PETSc read the substructuring switches only at the first Newton system's
     factorisation: an error of its own (exit 4) after the iterations before it. The
-    LU's package (-rod_newton_lu, global_step/ksp.LU_PACKAGES) is petsc or mumps:
-    another would not detect the null pivots the steps read."""
+    LU's package (-rod_newton_lu, global_step/ksp.LU_PACKAGES) is petsc or mumps, the
+    two direct_factor knows."""
     path = tmp_path / "out.h5"
     done = run(CANTILEVER + [f"-{name}", value, "-rod_output", str(path)], ranks)
     text = done.stdout + done.stderr
