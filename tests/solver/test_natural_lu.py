@@ -7,7 +7,9 @@ the check (a zero pivot, or growth without pivoting), for the rest of its life.
     a dense LU with pivoting does;
 (b) a diagonal entry not stored, a zero pivot, and a pivot so small that the
     elimination grows by 1e10 hand the factorisation to MUMPS, whose solves are then
-    those of the dense LU (where the unpivoted LU's are off by far more);
+    those of the dense LU (where the unpivoted LU's are off by far more); so does a
+    null vector whose pivot the elimination keeps at the round-off, which only the
+    forward error shows;
 (c) Newton steps in a current reach the same state with -rod_newton_lu petsc (the
     default) as with mumps, in the same iterations, on a line hanging from a clamp and
     on a catenary between pins whose free roll (K1 = K2) makes J nearly singular near
@@ -41,14 +43,19 @@ def banded(first_pivot=None, stored=True):
     dense[i[:-1], i[1:]] = 0.3
     if first_pivot is not None:
         dense[0, 0], dense[0, 1], dense[1, 0] = first_pivot, 1.0, 1.0
-    matrix = PETSc.Mat().createAIJ((SIZE, SIZE), nnz=3, comm=PETSc.COMM_SELF)
     rows, columns = np.nonzero(dense)
     if first_pivot == 0.0 and stored:
         rows, columns = np.append(rows, 0), np.append(columns, 0)
+    return sequential(dense, rows, columns), dense
+
+
+def sequential(dense, rows, columns):
+    """A sequential AIJ Mat of ``dense``'s entries at (rows, columns), assembled."""
+    matrix = PETSc.Mat().createAIJ(dense.shape, nnz=3, comm=PETSc.COMM_SELF)
     for row, column in zip(rows, columns):
         matrix.setValue(int(row), int(column), dense[row, column])
     matrix.assemble()
-    return matrix, dense
+    return matrix
 
 
 def right_hand_sides(count=3):
@@ -117,6 +124,42 @@ def test_a_failed_elimination_hands_the_factorisation_to_mumps(first_pivot, stor
         # what the check caught: the unpivoted solve's error, a million times MUMPS's
         assert unpivoted_error(matrix, dense) > 1e-10
     matrix.destroy()
+
+
+def laplacian_of_a_chain(n=200, seed=2):
+    """An unsymmetric tridiagonal matrix on one rank whose rows sum to zero (weights
+    0.5 to 2 below and above the diagonal), its last entry moved by 1e-15: singular to
+    the round-off, its null vector the ones. (With seed 2 the elimination's last pivot
+    passes PETSc's zero-pivot test; with seeds 0 and 1 it does not, and the check
+    sees Inf.)"""
+    rng = np.random.default_rng(seed)
+    dense = np.zeros((n, n))
+    i = np.arange(n - 1)
+    dense[i, i + 1] = -rng.uniform(0.5, 2.0, n - 1)
+    dense[i + 1, i] = -rng.uniform(0.5, 2.0, n - 1)
+    dense[np.arange(n), np.arange(n)] = -dense.sum(axis=1)
+    dense[-1, -1] += 1e-15 * rng.standard_normal()      # singular to the round-off
+    return sequential(dense, *np.nonzero(dense))
+
+
+def test_a_null_pivot_kept_at_the_round_off_is_caught_by_the_forward_error():
+    """The elimination in order keeps the singular chain's last pivot at the round-off
+    (above PETSc's zero-pivot test): the solves' backward error stays at the round-off,
+    their forward error (the null vector's component) is of order 1; MUMPS takes over
+    (its null pivot detected)."""
+    matrix = laplacian_of_a_chain()
+    alone = NaturalLU(matrix, 1, NEWTON_PREFIX)
+    factor = None
+    try:
+        alone.ksp.setUp()
+        backward, forward = alone.errors(matrix)
+        assert backward < 1e-15 and forward > 1.0
+        factor = factored(matrix)
+        assert factor.fell_back
+    finally:
+        for obj in (alone, factor, matrix):
+            if obj is not None:
+                obj.destroy()
 
 
 # --- (c) -------------------------------------------------------------------------------------
