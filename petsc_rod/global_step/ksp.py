@@ -215,7 +215,8 @@ def solve_columns(ksp, columns, rows=None):
 def solve_dense(ksp, right):
     """X = A^-1 B for the k columns of ``right`` (n, k), in Fortran order (each column
     contiguous, as PETSc's dense matrices hold them), with the factored sequential
-    operator A of a set-up inertia_solver or lu_solver: one MatMatSolve on dense
+    operator A of a set-up inertia_solver or lu_solver (or NaturalLU's KSP, whose
+    factorisations that fail are never solved with): one MatMatSolve on dense
     matrices laid on ``right`` and on the new array X, which it returns, (n, k) in
     Fortran order. No column is copied in Python on the way in or out (PETSc copies B
     into X once, for MUMPS to solve in place): solve_columns copies each twice more and
@@ -224,7 +225,7 @@ def solve_dense(ksp, right):
     Inf."""
     factor = ksp.getPC().getFactorMatrix()
     solution = np.empty(right.shape, dtype=PETSc.ScalarType, order="F")
-    if factor.getMumpsInfog(1) < 0:
+    if ksp.getPC().getFactorSolverType() == "mumps" and factor.getMumpsInfog(1) < 0:
         solution[:] = np.inf
         return solution
     matrices = [_dense_on(array) for array in (right, solution)]
@@ -444,11 +445,11 @@ class NaturalLU:
                          dtype=PETSc.ScalarType, order="F")
         for j, column in enumerate(columns):
             right[:, j] = column if rows is None else column[rows]
-        values = self._solved(right)
+        values = solve_dense(self.ksp, right)
         known = _dense_on(values)
         product = self.ksp.getOperators()[0].matMult(known)
         try:
-            values += self._solved(np.asfortranarray(right - product.getDenseArray()))
+            values += solve_dense(self.ksp, np.asfortranarray(right - product.getDenseArray()))
         finally:
             known.destroy()
             product.destroy()
@@ -458,17 +459,6 @@ class NaturalLU:
             else:
                 solution[rows] = values[:, j]
         return solutions
-
-    def _solved(self, right):
-        """F^-1 right for the (n, k) Fortran-ordered ``right``: a new such array."""
-        values = np.empty_like(right, order="F")
-        matrices = [_dense_on(array) for array in (right, values)]
-        try:
-            self.ksp.getPC().getFactorMatrix().matSolve(*matrices)
-        finally:
-            for matrix in matrices:
-                matrix.destroy()
-        return values
 
     def destroy(self):
         for obj in (self.ksp, self.mumps):
