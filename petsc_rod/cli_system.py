@@ -11,14 +11,14 @@ Of the -rod_* options a system takes its own (-rod_system, -rod_system_element_l
 -rod_system_predictor, -rod_system_watch_circle, -rod_system_excursion, -rod_system_modes,
 -rod_system_modes_line_mass), the seabed's plane or profile (-rod_seabed_slope,
 -rod_seabed_direction, -rod_seabed_origin, -rod_seabed_profile: a MoorDyn file carries
-none), the outputs
-(-rod_output, -rod_table), the modes of
-each line with its ends held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass,
--rod_modes_mass, -rod_modes_inertia) and the line solver's (-rod_al_*,
--rod_max_halvings: every line the same); every other
--rod_* option describes a single line's scene or load path, which the file gives, and is
-refused in one line naming them. It sits above system/ and cli/ (it needs both: the
-option table, and the system's run), run by __main__.py when -rod_system is given."""
+none), a current (-rod_current or -rod_current_profile: MoorDyn's Currents is not
+read), the outputs (-rod_output, -rod_table), the modes of each line with its ends
+held (-rod_modes N or -rod_modes_range, -rod_modes_added_mass, -rod_modes_mass,
+-rod_modes_inertia) and the line solver's (-rod_al_*, -rod_max_halvings: every line the
+same); every other -rod_* option describes a single line's scene or load path, which
+the file gives, and is refused in one line naming them. It sits above system/ and cli/
+(it needs both: the option table, and the system's run), run by __main__.py when
+-rod_system is given."""
 
 import dataclasses
 import os
@@ -36,7 +36,7 @@ from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
 from petsc_rod.cli.signals import Interrupts
-from petsc_rod.environment.profiles import read_seabed_profile
+from petsc_rod.environment.profiles import read_profile, read_seabed_profile
 from petsc_rod.errors import (RodDivergedError, RodError, RodInputError,
                               RodNotConvergedError, on_every_rank)
 from petsc_rod.io.same_file import replaced_input
@@ -46,7 +46,7 @@ from petsc_rod.model.system_check import check_reach
 from petsc_rod.model.values import MAX_MAGNITUDE
 from petsc_rod.system.body_modes import SystemModes
 from petsc_rod.system.equilibrium import Settings
-from petsc_rod.system.held_line import friction_notes
+from petsc_rod.system.held_line import friction_notes, line_sea
 from petsc_rod.tables import read_text
 
 # What a system's run takes beside the line solver's options (LINE_OPTIONS).
@@ -62,12 +62,19 @@ SEABED_OPTIONS = ("rod_seabed_slope", "rod_seabed_direction", "rod_seabed_origin
                   "rod_seabed_profile")
 SEABED_NAMES = Names({**{name.removeprefix("rod_"): f"-{name}" for name in SEABED_OPTIONS},
                       "seabed": "seabed (the file's WtrDpth)"}, FIELD_NAMES.__getitem__)
+# The single line's options of a current a system's sea takes (a MoorDyn file's own,
+# Currents and its grid files, are not read): uniform, or by depth below the system's
+# sea surface, z = 0 (docs/systems.md, "The sea of a system's lines"); its drag on each
+# line from the line type's Cd and Diam, on each free point from its CdA.
+CURRENT_OPTIONS = ("rod_current", "rod_current_profile")
+CURRENT_NAMES = Names({"current": "-rod_current", "current_profile": "-rod_current_profile"},
+                      FIELD_NAMES.__getitem__)
 
 
 def refused_options(given):
     """The -rod_* options of ``given`` a system does not take (a single line's scene and
     load path), in the table's order."""
-    taken = (set(SYSTEM_OPTIONS) | set(SEABED_OPTIONS)
+    taken = (set(SYSTEM_OPTIONS) | set(SEABED_OPTIONS) | set(CURRENT_OPTIONS)
              | {f"rod_{name}" for name in LINE_OPTIONS})
     return [name for name in BY_NAME if name in given and name not in taken]
 
@@ -203,6 +210,39 @@ def sloped(values, given, system):
     return system
 
 
+def in_current(values, given, system):
+    """``system`` in the current of -rod_current (ux,uy,uz, m/s, uniform) or of
+    -rod_current_profile's rows (depth below the sea surface z = 0, m; ux, uy, uz, m/s:
+    environment/profiles.read_profile), given in ``values``, the file's sea kept
+    (Environment.current), checked again (System.check) with those options named in
+    the refusals (a drag too large), and refused where it pushes nothing (no line type
+    with a Cd, no point with a CdA: held_line.line_sea); ``system`` itself where neither
+    is given."""
+    if "rod_current" in given and "rod_current_profile" in given:
+        raise RodInputError("-rod_current and -rod_current_profile both give the current; "
+                            "give one of them")
+    if "rod_current_profile" in given:
+        depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
+        current = np.column_stack([depths, velocities])
+    elif "rod_current" in given:
+        current = np.asarray(values["rod_current"], dtype=float)
+    else:
+        return system
+    system = dataclasses.replace(system, environment=dataclasses.replace(
+        system.environment, current=current))
+    system.check(CURRENT_NAMES)
+    pushed = ([line.name for line in system.lines
+               if line_sea(line, system.environment).current is not None]
+              + [point.name for point in system.points if point.cda > 0])
+    if not pushed:
+        option = ("-rod_current_profile" if "rod_current_profile" in given
+                  else "-rod_current")
+        raise RodInputError(f"{option}: the current pushes nothing: every line type's Cd "
+                            "is 0 (LINE TYPES) and no point has a CdA (POINTS); give them "
+                            "or drop the option")
+    return system
+
+
 def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
     """Refuse an output that names an input (the system file, an options file), which
     writing it would replace: every file the run writes (written_paths: the result file,
@@ -213,6 +253,8 @@ def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
                                 body_modes is not None)
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
         read.append(("-rod_system", values["rod_system"]))
+        if values["rod_current_profile"]:
+            read.append(("-rod_current_profile", values["rod_current_profile"]))
         clash = replaced_input(written, read)
     clash = comm.tompi4py().bcast(clash, root=0)
     if clash:
@@ -282,7 +324,8 @@ def prepared(values, given, case=None):
                             "drop them")
     path = values["rod_system"]
     system, notes = read_moordyn(path, values["rod_system_element_length"])
-    system = changed(sloped(values, given, system), values, case or {})
+    system = changed(in_current(values, given, sloped(values, given, system)), values,
+                     case or {})
     notes = tuple(notes) + friction_notes(system)
     settings = Settings(predictor=values["rod_system_predictor"],
                         **({} if values["rod_system_steps"] is None

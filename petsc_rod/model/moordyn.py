@@ -175,8 +175,10 @@ def options(rows, path):
         if key in ("currents", "waterkin", "seafloorfile") and value not in ("0", '""', "''"):
             raise RodInputError(
                 f"{path}:{line}: OPTIONS: {data[1]} {value}: a current or a seabed read "
-                "from MoorDyn's grid files is not read; give the current or seabed "
-                "profile in the Environment, or drop the option")
+                "from MoorDyn's grid files is not read; give the current by "
+                "-rod_current or -rod_current_profile and the seabed by "
+                "-rod_seabed_profile (Environment.current, Environment.seabed_profile "
+                "in the API), or drop the option")
         if key in ("currents", "waterkin", "seafloorfile") or key in DYNAMIC_OPTIONS:
             ignored.append(data[1])
         elif key in STATIC_OPTIONS:

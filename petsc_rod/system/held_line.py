@@ -158,6 +158,7 @@ from petsc_rod.iteration.continuation import PathSettings, continuation
 from petsc_rod.iteration.newton import CONVERGED, NewtonSolver
 from petsc_rod.frames import REFERENCE_FRAME
 from petsc_rod.global_step.chain_factor import NULL_PIVOT
+from petsc_rod.model.derived import Loads
 from petsc_rod.model.end import End
 from petsc_rod.physics.flex_joint import (FlexJoint, curvature_factor, joint_angle,
                                          slope_factor)
@@ -1403,6 +1404,22 @@ def friction_notes(system):
             '(docs/systems.md, "Seabed friction")',)
 
 
+def line_sea(line, environment):
+    """The sea a system line ``line`` is solved in: the system's ``environment``, without
+    its current where nothing of the line takes drag (its line types' c = rho Cd D / 2
+    all 0, MoorDyn's Cd 0 columns, and no attachment with a drag area): the system's
+    current pushes its other lines and its free points, and a single line's check of a
+    current on a line without drag (model/derived.check_current_drag) would refuse the
+    whole system for it."""
+    if environment.current is None:
+        return environment
+    span = Span(line.line, End("pin"), End("pin"), tuple(line.attachments))
+    loads = Loads.of(span, environment)
+    if loads.drag or np.any(loads.drag_areas > 0):
+        return environment
+    return dataclasses.replace(environment, current=None)
+
+
 def held_lines(system, options=None, laid=None):
     """The ``make_line(system_line, comm)`` of system/equilibrium.SystemSolver for the
     real lines of ``system`` (a model.system.System): each a HeldLine whose ends are
@@ -1434,8 +1451,8 @@ def held_lines(system, options=None, laid=None):
         frames = tuple(connection_frame(system.node(c.to), c, e == 1)
                        if c.kind == "clamp" and not hasattr(system.node(c.to), "kind")
                        else None for e, c in enumerate((line.start, line.end)))
-        held = HeldLine.of_system_line(line, start, end, comm, environment, options,
-                                       frames)
+        held = HeldLine.of_system_line(line, start, end, comm,
+                                       line_sea(line, environment), options, frames)
         if laid is not None and environment.seabed_friction is not None:
             ends = tuple(connection_position(laid.node(c.to), c)
                          for c in (line.start, line.end))

@@ -53,9 +53,11 @@ np.savez({str(out)!r}, x=r.bodies["Body1"].position, K=r.bodies["Body1"].stiffne
     return np.load(out)
 
 
-def cli_numbers(tmp_path, ranks):
-    out = tmp_path / f"slope{ranks}.h5"
-    process = run_petsc_rod(["-rod_system", DECK, *SLOPE, "-rod_output", str(out)], ranks,
+def cli_numbers(tmp_path, ranks, options=tuple(SLOPE)):
+    """The command line's body pose, stiffness, end forces and tensions and Line1's
+    centreline of the deck with ``options`` (the plane's), on ``ranks``."""
+    out = tmp_path / f"system{ranks}.h5"
+    process = run_petsc_rod(["-rod_system", DECK, *options, "-rod_output", str(out)], ranks,
                             300)
     assert process.returncode == 0, describe(process)
     assert "warning" not in process.stdout, describe(process)
