@@ -30,6 +30,7 @@ Options: the EPS reads -rod_modes_eps_* (and -rod_modes_st_*), the factorisation
 -rod_modes_st_mat_mumps_icntl_* and -rod_modes_st_substructuring.
 """
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,6 +38,7 @@ from petsc4py import PETSc
 
 from petsc_rod.analysis.mass import MassSettings, line_inertia, nodal_mass
 from petsc_rod.analysis.second_variation import SecondVariation, unit
+from petsc_rod.errors import RodDivergedError, petsc_message
 from petsc_rod.global_step.ksp import direct_factor
 from petsc_rod.scenes.boundary import is_held
 
@@ -101,6 +103,50 @@ class ModesRefused(Exception):
                          "modes about it" + (f" ({note})" if note else ""))
         self.negative = negative
         self.symmetrised = symmetrised
+
+
+class ModesFailed(RodDivergedError):
+    """PETSc or SLEPc failed in the modes' eigensolver (its set-up or its solve: an
+    -rod_modes_eps_* or -rod_modes_st_* setting that check_options passes but EPSSetUp
+    or EPSSolve refuses, the spectral transformation's solve): exit 4, no result file.
+    The message is PETSc's, read where the error was raised (petsc4py keeps one
+    traceback for all errors, which the EPS's destroy after it rewrites)."""
+
+    def __init__(self, error):
+        super().__init__(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
+                         "check the -rod_modes_eps_* and -rod_modes_st_* options")
+
+
+@contextlib.contextmanager
+def destroyed():
+    """``with destroyed() as made:`` what is appended to ``made`` (PETSc objects, or
+    ours with a destroy()) destroyed in reverse order when the block ends, every one
+    even where another's destroy fails. Where the block raised, its exception goes on
+    and a destroy's failure is dropped: an EPS whose solve failed inside SLEPc cannot be
+    destroyed (its DS's dense matrix is left checked out, "Need to call
+    MatDenseRestoreSubMatrix() first"), and that failure would replace the solve's and
+    skip the destroys after it (FactorKSP's among them). Where the block succeeded, the
+    first destroy's failure is raised once every one was tried."""
+    made = []
+    try:
+        yield made
+    except BaseException:
+        _destroy(made, raising=False)
+        raise
+    _destroy(made, raising=True)
+
+
+def _destroy(made, raising):
+    """destroy() each of ``made``, last first; the first failure raised after all of
+    them where ``raising``."""
+    failure = None
+    for thing in reversed(made):
+        try:
+            thing.destroy()
+        except Exception as error:          # noqa: BLE001 (the others are destroyed too)
+            failure = failure or error
+    if raising and failure is not None:
+        raise failure
 
 
 @dataclass
@@ -280,16 +326,35 @@ class FactorPC:
         y.getArray()[:] = self.factor.solve_columns([x.getArray(readonly=True)])[0]
 
 
-def factor_ksp(operator, factor):
-    """preonly + FactorPC(factor) for ``operator``, options under PREFIX + 'st_'."""
-    ksp = PETSc.KSP().create(comm=operator.getComm())
-    ksp.setOptionsPrefix(PREFIX + "st_")
-    ksp.setOperators(operator)
-    ksp.setType(PETSc.KSP.Type.PREONLY)
-    pc = ksp.getPC()
-    pc.setType(PETSc.PC.Type.PYTHON)
-    pc.setPythonContext(FactorPC(factor))
-    return ksp
+class FactorKSP:
+    """The spectral transformation's KSP ``ksp``: preonly + FactorPC(factor) for
+    ``operator``, options under PREFIX + 'st_'. destroy() turns its PC into PCNONE
+    first, which drops the python context while the interpreter runs: a reference to
+    the PC that outlives the solve (the one PETSc hands FactorPC.apply, kept by the
+    traceback of an error raised in the solve) is destroyed by PETSc's garbage
+    collection in PetscFinalize, after the interpreter has ended, where a python PC's
+    destroy would call it: a segmentation fault."""
+
+    def __init__(self, operator, factor):
+        self.ksp = PETSc.KSP().create(comm=operator.getComm())
+        try:
+            self.ksp.setOptionsPrefix(PREFIX + "st_")
+            self.ksp.setOperators(operator)
+            self.ksp.setType(PETSc.KSP.Type.PREONLY)
+            pc = self.ksp.getPC()
+            pc.setType(PETSc.PC.Type.PYTHON)
+            pc.setPythonContext(FactorPC(factor))
+        except BaseException:
+            self.destroy()
+            raise
+
+    def destroy(self):
+        pc = self.ksp.getPC()
+        try:
+            pc.setType(PETSc.PC.Type.NONE)
+        finally:
+            pc.destroy()
+            self.ksp.destroy()
 
 
 def check_options(comm):
@@ -314,17 +379,15 @@ def modes_count(problem, settings=MassSettings()):
     state, any (the count is M's rank, which the state leaves; a start that is not
     stable counts its negative eigenvalues too). One factorisation. Collective."""
     STAGE.push()
-    made = []
     try:
-        operators = ModalOperators(problem, settings)
-        made.append(operators)
-        shifted = operators.matrix.duplicate(copy=True)
-        made.append(shifted)
-        shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        return _below(operators, shifted, COUNT_SHIFT)
+        with destroyed() as made:
+            operators = ModalOperators(problem, settings)
+            made.append(operators)
+            shifted = operators.matrix.duplicate(copy=True)
+            made.append(shifted)
+            shifted.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            return _below(operators, shifted, COUNT_SHIFT)
     finally:
-        for thing in reversed(made):
-            thing.destroy()
         STAGE.pop()
 
 
@@ -361,8 +424,7 @@ def _shift_to(shifted, K, M, sigma):
 def _solve_modes(problem, count, settings, SLEPc, band=None):
     """solve_modes in its -log_view stage."""
     # what was made, destroyed in reverse order however far the set-up got
-    made = []
-    try:
+    with destroyed() as made:
         with EVENTS["operators"]:
             operators = ModalOperators(problem, settings)
             made.append(operators)
@@ -397,9 +459,6 @@ def _solve_modes(problem, count, settings, SLEPc, band=None):
         modes.slices = [tuple(np.sqrt(np.maximum(w, 0.0)) / (2 * np.pi)) for w in failed]
         modes.symmetrised = operators.symmetrised
         return modes
-    finally:
-        for thing in reversed(made):
-            thing.destroy()
 
 
 def _empty_modes(mesh, band):
@@ -415,11 +474,10 @@ def _below(operators, shifted, sigma):
     """The eigenvalues of K - omega^2 M below ``sigma`` (rad^2/s^2): the negative pivots
     of the LDL^T of K - sigma M (left in ``shifted``) less the chains' constraints
     (Sylvester). Collective."""
-    factor = _factored(operators, shifted, sigma)
-    try:
+    with destroyed() as made:
+        factor = _factored(operators, shifted, sigma)
+        made.append(factor)
         return int(factor.negative_pivots() - operators.chain_constraints)
-    finally:
-        factor.destroy()
 
 
 def _factored(operators, shifted, sigma):
@@ -465,11 +523,10 @@ def _slice(operators, shifted, SLEPc, window, ends, depth):
         # small mass the Krylov space misses about a shift above them, found as
         # without a band
         shift = SHIFT if window[0] <= SHIFT else 0.5 * (window[0] + window[1])
-        factor = _factored(operators, shifted, shift)
-        try:
+        with destroyed() as made:
+            factor = _factored(operators, shifted, shift)
+            made.append(factor)
             found = _pairs(operators, shifted, factor, SLEPc, count, shift, window, EXTRA)
-        finally:
-            factor.destroy()
         if len(found[0]) == count:
             return found, []
         if depth >= SLICE_DEPTH:
@@ -510,27 +567,36 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
     residual below RESIDUAL ||K||_inf ||phi||), phi^T M phi > 0 and
     omega^2 in the window. An eigenvalue below SHIFT is one of the massless unknowns'
     infinite ones that the spectral transformation returned with the wrong sign: left
-    out. Collective."""
-    ksp = factor_ksp(shifted, factor)
-    eps = SLEPc.EPS().create(comm=operators.comm)
+    out. ModesFailed where PETSc or SLEPc fails in the eigensolver. Collective."""
     K, M = operators.matrix, operators.mass_matrix
-    vector, Kx, Mx = M.createVecRight(), M.createVecRight(), M.createVecRight()
-    try:
-        eps.setOperators(shifted, M)
-        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count + extra, extra + default_subspace(count))
-        # the purification's solves (one per vector) change no shape: the massless
-        # unknowns' components it removes are not read (u and omega are)
-        eps.setPurify(False)
-        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-        eps.setTarget(0.0)
+    # everything made or referenced here (the EPS's ST too: getST's reference) is
+    # destroyed here, however the solve ended (destroyed(), FactorKSP)
+    with destroyed() as made:
+        ksp = FactorKSP(shifted, factor)
+        made.append(ksp)
+        eps = SLEPc.EPS().create(comm=operators.comm)
+        made.append(eps)
         st = eps.getST()
-        st.setType(SLEPc.ST.Type.SINVERT)
-        st.setKSP(ksp)
-        eps.setOptionsPrefix(PREFIX)
-        eps.setFromOptions()
-        with EVENTS["eps"]:
-            eps.solve()
+        made.append(st)
+        vector, Kx, Mx = M.createVecRight(), M.createVecRight(), M.createVecRight()
+        made.extend((vector, Kx, Mx))
+        try:
+            eps.setOperators(shifted, M)
+            eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+            eps.setDimensions(count + extra, extra + default_subspace(count))
+            # the purification's solves (one per vector) change no shape: the massless
+            # unknowns' components it removes are not read (u and omega are)
+            eps.setPurify(False)
+            eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+            eps.setTarget(0.0)
+            st.setType(SLEPc.ST.Type.SINVERT)
+            st.setKSP(ksp.ksp)
+            eps.setOptionsPrefix(PREFIX)
+            eps.setFromOptions()
+            with EVENTS["eps"]:
+                eps.solve()
+        except PETSc.Error as error:
+            raise ModesFailed(error) from None
         converged = eps.getConverged()
         scale = K.norm(PETSc.NormType.INFINITY)
         values, vectors, masses = [], [], []
@@ -565,9 +631,6 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
         return (np.array(values)[order].reshape(-1),
                 np.array(vectors).reshape(-1, n, operators.block)[order],
                 np.array(masses)[order].reshape(-1), converged)
-    finally:
-        for thing in (vector, Kx, Mx, eps, ksp):
-            thing.destroy()
 
 
 def _assemble(operators, omega2, vectors, masses, converged):

@@ -10,13 +10,18 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from helpers import continuation, destroy, fitted_order, make_solver, run_cli
+from helpers import (continuation, destroy, fitted_order, make_solver, partial_files,
+                     run_cli)
 
 pytest.importorskip("slepc4py")
 
 L = 1.0
 G = 9.80665
 MESHES = (8, 16, 32)
+# a cantilever of 8 elements whose modes the eigensolver's options make fail
+FAILING_CANTILEVER = {"rod_length": "1", "rod_stiffness": "1,1,1", "rod_start": "clamp",
+                      "rod_end": "free", "rod_elements": "8", "rod_modes": "3",
+                      "rod_modes_mass": "1"}
 
 
 def modes_of(scene, n_elements, count, comm=PETSc.COMM_WORLD, stability=True, **mass):
@@ -143,10 +148,64 @@ def test_failed_set_up_destroys_what_was_made(monkeypatch):
     made_factor = modes.direct_factor
     monkeypatch.setattr(modes.ModalOperators, "destroy", destroy_operators)
     monkeypatch.setattr(modes, "direct_factor", counted_factor)
-    monkeypatch.setattr(modes, "factor_ksp", failing_ksp)
+    monkeypatch.setattr(modes, "FactorKSP", failing_ksp)
     with pytest.raises(PETSc.Error):
         modes_of(pinned(100.0, 1e6, 1e-6)[0], 8, 2, mass=1.0)
     assert destroyed == ["factor", "operators"]
+
+
+# PETSc errors inside the modes' eigensolver that the options' check before the run
+# (analysis/modes.check_options: set from the options, not set up) lets through
+EIGENSOLVER_FAILURES = [
+    # EPSSetUp: a Cayley transform about the target 0 without an antishift
+    ({"rod_modes_st_type": "cayley"},
+     "Values of shift and antishift cannot be zero simultaneously"),
+    # EPSSolve: the spectral transformation's KSP, Richardson steps 3 times the exact
+    # one, doubles its residual in the first application (the divergence tolerance
+    # 1.5), which SLEPc's ST raises as an error; the EPS cannot be destroyed after it
+    ({"rod_modes_st_ksp_type": "richardson", "rod_modes_st_ksp_richardson_scale": "3",
+      "rod_modes_st_ksp_divtol": "1.5"},
+     "KSPSolve has not converged, reason DIVERGED_DTOL")]
+
+
+@pytest.mark.parametrize("split", ["whole", "split"])
+@pytest.mark.parametrize("options, says", EIGENSOLVER_FAILURES)
+def test_an_eigensolver_failure_ends_the_run_in_one_line(options, says, split, shared_tmp,
+                                                        capsys, monkeypatch):
+    """A PETSc error inside the modes' eigensolver, after the equilibrium (its set-up or
+    its solve): exit 4 with one line naming the eigensolver and PETSc's message, no
+    result file, and every FactorPC released once the run has returned. A python PC
+    left to PETSc's garbage collection in PetscFinalize (the EPS's ST that the solve's
+    traceback held, or a KSP whose destroy was skipped when the EPS's failed) is
+    destroyed there after the interpreter has ended: the process ended in a
+    segmentation fault, exit 59 (tests/system/test_modes_cli.py: the command line's
+    exit code on 1 and 2 ranks). -rod_ranks_split: the line on rank 0 (COMM_SELF) or
+    split over the ranks."""
+    import gc
+    import weakref
+    from petsc_rod.analysis import modes
+    contexts = []
+    made = modes.FactorPC.__init__
+
+    def counted(self, factor):
+        made(self, factor)
+        contexts.append(weakref.ref(self))
+    monkeypatch.setattr(modes.FactorPC, "__init__", counted)
+    output = os.path.join(shared_tmp, "failed_modes.h5")
+    assert run_cli({**FAILING_CANTILEVER, "rod_output": output, "rod_ranks_split": split,
+                    **options}) == 4
+    out = capsys.readouterr().out
+    # the solve's frames, held by cycles of its traceback, freed: no PC holds a context
+    gc.collect()
+    rank = PETSc.COMM_WORLD.getRank()
+    assert len(contexts) == (1 if rank == 0 or split == "split" else 0)
+    assert [ref() for ref in contexts] == [None] * len(contexts)
+    assert not os.path.exists(output) and not partial_files(output)
+    if rank == 0:
+        lines = [line for line in out.splitlines() if "error" in line]
+        assert lines == [f"petsc_rod: error: the modes' eigensolver (SLEPc) failed: {says}; "
+                         "check the -rod_modes_eps_* and -rod_modes_st_* options"], out
+        assert "step 1/1: load factor 1, converged" in out
 
 
 @pytest.mark.parametrize("options, message", [
