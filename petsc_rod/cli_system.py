@@ -35,8 +35,9 @@ from petsc_rod.cli.options import (BY_NAME, check_anderson_depth, check_same_on_
                                    check_factor_switches, check_snes_type,
                                    help_text, read_options, unused_options, whole_values)
 from petsc_rod.cli.options_files import every_options_file
+from petsc_rod.cli.scene_options import current_from_options
 from petsc_rod.cli.signals import Interrupts
-from petsc_rod.environment.profiles import read_profile, read_seabed_profile
+from petsc_rod.environment.profiles import read_seabed_profile
 from petsc_rod.errors import (RodDivergedError, RodError, RodInputError,
                               RodNotConvergedError, on_every_rank)
 from petsc_rod.io.same_file import replaced_input
@@ -212,34 +213,28 @@ def sloped(values, given, system):
 
 def in_current(values, given, system):
     """``system`` in the current of -rod_current (ux,uy,uz, m/s, uniform) or of
-    -rod_current_profile's rows (depth below the sea surface z = 0, m; ux, uy, uz, m/s:
-    environment/profiles.read_profile), given in ``values``, the file's sea kept
-    (Environment.current), checked again (System.check) with those options named in
-    the refusals (a drag too large), and refused where it pushes nothing (no line type
-    with a Cd, no point with a CdA: held_line.line_sea); ``system`` itself where neither
-    is given."""
-    if "rod_current" in given and "rod_current_profile" in given:
-        raise RodInputError("-rod_current and -rod_current_profile both give the current; "
-                            "give one of them")
-    if "rod_current_profile" in given:
-        depths, velocities = read_profile(values["rod_current_profile"], MAX_MAGNITUDE)
-        current = np.column_stack([depths, velocities])
-    elif "rod_current" in given:
-        current = np.asarray(values["rod_current"], dtype=float)
-    else:
+    -rod_current_profile's rows (depth below the sea surface z = 0, m; ux, uy, uz, m/s),
+    given in ``values`` (scene_options.current_from_options), the file's sea kept
+    (Environment.current), checked again (System.check, those options named in its
+    refusals), and refused where it pushes nothing: no line of a line type with a Cd
+    (held_line.line_sea) and no free point with a CdA (the drag's only other place);
+    ``system`` itself where neither is given."""
+    current = current_from_options(values, given)
+    if current is None:
         return system
     system = dataclasses.replace(system, environment=dataclasses.replace(
         system.environment, current=current))
     system.check(CURRENT_NAMES)
     pushed = ([line.name for line in system.lines
                if line_sea(line, system.environment).current is not None]
-              + [point.name for point in system.points if point.cda > 0])
+              + [point.name for point in system.points
+                 if point.kind == "free" and point.cda > 0])
     if not pushed:
         option = ("-rod_current_profile" if "rod_current_profile" in given
                   else "-rod_current")
         raise RodInputError(f"{option}: the current pushes nothing: every line type's Cd "
-                            "is 0 (LINE TYPES) and no point has a CdA (POINTS); give them "
-                            "or drop the option")
+                            "is 0 (LINE TYPES) and no free point has a CdA (POINTS); give "
+                            "them or drop the option")
     return system
 
 
@@ -253,8 +248,9 @@ def check_outputs_kept(values, comm, system, sweeps, body_modes=None):
                                 body_modes is not None)
         read = [("-options_file", path) for path in every_options_file(sys.argv)]
         read.append(("-rod_system", values["rod_system"]))
-        if values["rod_current_profile"]:
-            read.append(("-rod_current_profile", values["rod_current_profile"]))
+        read += [(f"-{name}", values[name]) for name in ("rod_current_profile",
+                                                         "rod_seabed_profile")
+                 if values[name]]
         clash = replaced_input(written, read)
     clash = comm.tompi4py().bcast(clash, root=0)
     if clash:

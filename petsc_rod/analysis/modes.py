@@ -113,6 +113,11 @@ class ModesFailed(RodDivergedError):
     traceback for all errors, which the EPS's destroy after it rewrites)."""
 
     def __init__(self, error):
+        """From the PETSc.Error raised, or the text of one made before (a system's line
+        named: api/system_run.line_modes)."""
+        if isinstance(error, str):
+            super().__init__(error)
+            return
         super().__init__(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
                          "check the -rod_modes_eps_* and -rod_modes_st_* options")
 
@@ -349,12 +354,19 @@ class FactorKSP:
             raise
 
     def destroy(self):
-        pc = self.ksp.getPC()
+        """Free the KSP and its PC, the PC made PCNONE first; a second call does
+        nothing."""
+        if self.ksp is None:
+            return
+        ksp, self.ksp = self.ksp, None
+        pc = ksp.getPC()
         try:
             pc.setType(PETSc.PC.Type.NONE)
         finally:
-            pc.destroy()
-            self.ksp.destroy()
+            try:
+                pc.destroy()
+            finally:
+                ksp.destroy()
 
 
 def check_options(comm):

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from petsc_rod.analysis.mass import MassSettings
-from petsc_rod.analysis.modes import ModesRefused, modes_count, solve_modes
+from petsc_rod.analysis.modes import (ModesFailed, ModesRefused, modes_count,
+                                     solve_modes)
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
 from petsc_rod.cli.modes import check_subspace, modes_band, table_lines
@@ -196,7 +197,9 @@ def line_modes(solver, count, settings, band=None):
     (analysis/modes.solve_modes on the HeldLine's problem, collective on its group's
     communicator: its ends are pinned there, so its modes are the held line's), the
     shapes on the line's own ranks, zero rows of them on the others. RodInputError
-    (check_line_counts) where ``count`` is more than a line has. Collective."""
+    (check_line_counts) where ``count`` is more than a line has; ModesFailed, the line
+    named, on every rank where a line's eigensolver failed (on its own ranks: the
+    others learn it from the lines' share, where they would otherwise wait). Collective."""
     if band is None:
         check_line_counts(solver, count, settings)
     mine, seconds = {}, {}
@@ -204,11 +207,13 @@ def line_modes(solver, count, settings, band=None):
         start = time.perf_counter()
         try:
             mine[k] = solve_modes(line.problem, count, settings, band)
-        except ModesRefused as refused:
-            mine[k] = refused
+        except (ModesRefused, ModesFailed) as not_found:
+            mine[k] = not_found
         seconds[k] = line.mesh.global_max(time.perf_counter() - start)
 
     def numbers(found):
+        if isinstance(found, ModesFailed):
+            return str(found)
         if isinstance(found, ModesRefused):
             return found.negative
         n = len(found.omega2)
@@ -216,6 +221,11 @@ def line_modes(solver, count, settings, band=None):
                        rotation=np.zeros((n, 0, 3)), S_mid=np.zeros(0),
                        curvature=np.zeros((n, 0, 3)))
     shared = solver.placement.share({k: (numbers(m), seconds[k]) for k, m in mine.items()})
+    failed = sorted((k, value) for k, (value, _) in shared.items()
+                    if isinstance(value, str))
+    if failed:
+        k, text = failed[0]
+        raise ModesFailed(f"line {solver.system.lines[k].name}: {text}")
     found = {k: mine[k] if k in mine else
              ModesRefused(value) if isinstance(value, (int, np.integer)) else value
              for k, (value, _) in shared.items()}

@@ -279,7 +279,8 @@ OPTIONS = [
            "-rod_seabed",
            unit="text"),
     Option("rod_current", _reals(3), None, "ux,uy,uz",
-           "uniform steady current, m/s (normal Morison drag, needs -rod_drag)", unit="m/s"),
+           "uniform steady current, m/s (normal Morison drag, needs -rod_drag; in a system "
+           "each line type's Cd and Diam)", unit="m/s"),
     Option("rod_current_profile", _string, None, "FILE",
            "current profile: rows 'depth ux uy uz' (m, m/s), depths increasing, linear in "
            "between, constant beyond", unit="text"),

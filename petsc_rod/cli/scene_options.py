@@ -118,17 +118,25 @@ def model_from_options(values, given, profile=None, line_types=None, points=None
                  environment_from_options(values, given, profile, seabed_rows), attachments)
 
 
-def environment_from_options(values, given, profile=None, seabed_rows=None):
-    """The Environment of the sea's options (model_from_options: ``profile`` and
-    ``seabed_rows`` the current's and the seabed's rows when already read)."""
+def current_from_options(values, given, profile=None):
+    """Environment.current of -rod_current (ux,uy,uz, m/s) or of -rod_current_profile's
+    rows (depth m, ux, uy, uz m/s; ``profile`` (depths, velocities) when already read),
+    None where neither is given; RodInputError where both are (a line's and a system's
+    sea alike: cli_system.in_current)."""
     if "rod_current" in given and "rod_current_profile" in given:
         raise RodInputError("-rod_current and -rod_current_profile both give the current; "
                             "give one of them")
-    current = given_value(values, given, "rod_current")
     if "rod_current_profile" in given:
         depths, velocities = (profile if profile is not None else
                               read_profile(values["rod_current_profile"], MAX_MAGNITUDE))
-        current = np.column_stack([depths, velocities])
+        return np.column_stack([depths, velocities])
+    return given_value(values, given, "rod_current")
+
+
+def environment_from_options(values, given, profile=None, seabed_rows=None):
+    """The Environment of the sea's options (model_from_options: ``profile`` and
+    ``seabed_rows`` the current's and the seabed's rows when already read)."""
+    current = current_from_options(values, given, profile)
     seabed_profile = seabed_rows
     if seabed_profile is None and "rod_seabed_profile" in given:
         seabed_profile = read_seabed_profile(values["rod_seabed_profile"], MAX_MAGNITUDE)

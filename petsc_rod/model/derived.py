@@ -169,9 +169,10 @@ def check_default_stiffness(loads, n):
 
 
 def check_current_drag(loads, n):
-    """Refuse a current on sections whose line types have no drag (nothing for it to
-    push on)."""
-    if loads.span.sections and loads.velocities is not None and loads.drag == 0:
+    """Refuse a current on sections whose line types have no drag and whose attachments
+    have no drag area (nothing for it to push on)."""
+    if (loads.span.sections and loads.velocities is not None and loads.drag == 0
+            and not np.any(loads.drag_areas > 0)):
         raise RodInputError(f"a current on {n['sections']} whose line types have no "
                             "drag: give the line types a cd column")
 

@@ -85,8 +85,8 @@ def make_cases(settings, system):
     the case file's rows and the offsets."""
     if settings.current_headings:
         raise RodInputError("-sweep_current_headings turns a single line's current; a "
-                            "system's current is its file's: give -sweep_cases or "
-                            "-sweep_offsets")
+                            "system's current is the base options' (-rod_current or "
+                            "-rod_current_profile): give -sweep_cases or -sweep_offsets")
     if bool(settings.offsets) != bool(settings.offset_of):
         raise RodInputError("-sweep_offsets and -sweep_offset_of NAME go together with "
                             "-rod_system: the offsets move the point or held body NAME")

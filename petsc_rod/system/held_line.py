@@ -1406,14 +1406,16 @@ def friction_notes(system):
 
 def line_sea(line, environment):
     """The sea a system line ``line`` is solved in: the system's ``environment``, without
-    its current where nothing of the line takes drag (its line types' c = rho Cd D / 2
-    all 0, MoorDyn's Cd 0 columns, and no attachment with a drag area): the system's
-    current pushes its other lines and its free points, and a single line's check of a
-    current on a line without drag (model/derived.check_current_drag) would refuse the
-    whole system for it."""
+    its current where the line is one of sections that takes no drag (its line types'
+    c = rho Cd D / 2 all 0, MoorDyn's Cd 0 columns, and no attachment with a drag area),
+    which a single line in a current is refused for (model/derived.check_current_drag):
+    the system's current pushes its other lines and its free points. A uniform line
+    keeps it (its drag, given with the line, may be 0)."""
     if environment.current is None:
         return environment
     span = Span(line.line, End("pin"), End("pin"), tuple(line.attachments))
+    if not span.sections:
+        return environment
     loads = Loads.of(span, environment)
     if loads.drag or np.any(loads.drag_areas > 0):
         return environment

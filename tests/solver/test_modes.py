@@ -177,9 +177,8 @@ def test_an_eigensolver_failure_ends_the_run_in_one_line(options, says, split, s
     result file, and every FactorPC released once the run has returned. A python PC
     left to PETSc's garbage collection in PetscFinalize (the EPS's ST that the solve's
     traceback held, or a KSP whose destroy was skipped when the EPS's failed) is
-    destroyed there after the interpreter has ended: the process ended in a
-    segmentation fault, exit 59 (tests/system/test_modes_cli.py: the command line's
-    exit code on 1 and 2 ranks). -rod_ranks_split: the line on rank 0 (COMM_SELF) or
+    destroyed there after the interpreter has ended, a segmentation fault, exit 59
+    (tests/system/test_modes_cli.py: the command line's exit code on 1 and 2 ranks). -rod_ranks_split: the line on rank 0 (COMM_SELF) or
     split over the ranks."""
     import gc
     import weakref

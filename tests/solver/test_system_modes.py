@@ -133,3 +133,32 @@ def test_each_line_s_modes_in_a_band_wider_than_its_spectrum():
         assert np.all(found.modal_mass > 0)
         assert np.allclose(found.frequencies[:8], every.frequencies, rtol=1e-9, atol=1e-6)
     assert "every mode of the band verified" in "\n".join(said)
+
+
+def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
+    """The eigensolver failing on one line only (ModesFailed: on 2 ranks, on one rank's
+    lines only) ends the system's run on every rank, the line named (exit 4's
+    RodDivergedError), where the other ranks would wait for its modes in the lines'
+    share."""
+    from petsc_rod.analysis.modes import ModesFailed
+    from petsc_rod.api import system_run
+    from petsc_rod.errors import RodDivergedError
+    real, calls = system_run.solve_modes, []
+    last = PETSc.COMM_WORLD.getSize() - 1
+
+    def failing_first_on_the_last_rank(problem, *args, **kwargs):
+        calls.append(problem)
+        if PETSc.COMM_WORLD.getRank() == last and len(calls) == 1:
+            raise ModesFailed("the modes' eigensolver (SLEPc) failed: a test's")
+        return real(problem, *args, **kwargs)
+
+    monkeypatch.setattr(system_run, "solve_modes", failing_first_on_the_last_rank)
+    system, _ = read_moordyn(DECK)
+    with pytest.raises(RodDivergedError) as raised:
+        solve_system(system, options={"modes": COUNT})
+    assert isinstance(raised.value, ModesFailed)
+    text = str(raised.value)
+    assert text.startswith("line Line") and text.endswith(
+        ": the modes' eigensolver (SLEPc) failed: a test's")
+    names = PETSc.COMM_WORLD.tompi4py().allgather(text)
+    assert len(set(names)) == 1                     # the same line named on every rank

@@ -1,8 +1,8 @@
 """The modes' failures at the command line's exit (python -m petsc_rod -rod_modes): a
 PETSc error inside the modes' eigensolver ends the process with exit 4 and one line, no
-result file, on 1 and 2 ranks; it ended in a segmentation fault at PetscFinalize (exit
-59), where PETSc's garbage collection destroyed the spectral transformation's python PC
-(analysis/modes.FactorKSP) after the interpreter had ended. The same runs in-process:
+result file, on 1 and 2 ranks, not a segmentation fault at PetscFinalize (exit 59),
+where PETSc's garbage collection would destroy a spectral transformation's python PC
+after the interpreter has ended (analysis/modes.FactorKSP). The same runs in-process:
 tests/solver/test_modes.py, test_an_eigensolver_failure_ends_the_run_in_one_line."""
 
 import pytest

@@ -137,10 +137,14 @@ def test_the_file_in_a_current_equals_the_api_in_it(api, tmp_path, ranks):
     assert same(cli["r"], expected["Line1_r"])
 
 
-def test_the_file_in_a_current_profile_equals_the_api_in_it(api, tmp_path):
-    cli = cli_numbers(tmp_path, 1, ["-rod_current_profile", str(profile_file(tmp_path))])
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_file_in_a_current_profile_equals_the_api_in_it(api, tmp_path, ranks):
+    cli = cli_numbers(tmp_path, ranks, ["-rod_current_profile", str(profile_file(tmp_path))])
     expected = api["profile"]
     assert same(cli["x"][:3], expected["x"][:3]) and same(cli["x"][3:], expected["x"][3:])
+    for rows in (slice(0, 3), slice(3, 6)):
+        for columns in (slice(0, 3), slice(3, 6)):
+            assert same(cli["K"][rows, columns], expected["K"][rows, columns])
     for name in ("F", "T"):
         assert same(cli[name], expected[name]), name
     assert same(cli["r"], expected["Line1_r"])
@@ -167,6 +171,13 @@ def test_the_current_options_are_listed_and_checked(tmp_path):
     assert process.returncode == 2, describe(process)
     assert "-rod_current_profile" in process.stdout
     assert open(profile).read() == text
+    seabed = tmp_path / "seabed.txt"                  # flat at the file's depth
+    seabed.write_text("-200 -30\n200 -30\n")
+    process = run_petsc_rod(["-rod_system", DECK, "-rod_seabed_profile", str(seabed),
+                             "-rod_output", str(seabed)], 1, 120)
+    assert process.returncode == 2, describe(process)
+    assert "-rod_seabed_profile" in process.stdout
+    assert seabed.read_text() == "-200 -30\n200 -30\n"
 
 
 def deck_with_bare_type(tmp_path, lines):
@@ -186,9 +197,10 @@ def deck_with_bare_type(tmp_path, lines):
 
 def test_a_line_type_without_drag_takes_none_and_a_current_on_nothing_is_refused(tmp_path):
     """A line of Cd 0 in the system's current carries no drag (its horizontal end forces
-    balance, to the system's accuracy) while the others do (held_line.line_sea: a single
-    line's check refused the whole system); where no line type has a Cd and no point a
-    CdA, the current is refused in one line."""
+    balance, to the system's accuracy) while the others do (held_line.line_sea, where a
+    single line of such types in a current is refused); where no line type has a Cd and
+    no free point a CdA (a fixed one's is never pushed), the current is refused in one
+    line."""
     out = tmp_path / "bare.h5"
     process = run_petsc_rod(["-rod_system", deck_with_bare_type(tmp_path, [1]),
                              "-rod_current", "1,0,0", "-rod_output", str(out)], 1, 300)
@@ -198,7 +210,15 @@ def test_a_line_type_without_drag_takes_none_and_a_current_on_nothing_is_refused
     tension = np.abs(forces[0]).max()
     assert np.abs(forces[0].sum(axis=0)[:2]).max() <= FLOOR * tension
     assert forces[1].sum(axis=0)[0] > 1e3 and forces[2].sum(axis=0)[0] > 1e3   # N
-    assert refused(tmp_path, ["-rod_system", deck_with_bare_type(tmp_path, [1, 2, 3]),
-                              "-rod_current", "1,0,0"]) == (
-        "petsc_rod: error: -rod_current: the current pushes nothing: every line type's Cd "
-        "is 0 (LINE TYPES) and no point has a CdA (POINTS); give them or drop the option")
+    bare = deck_with_bare_type(tmp_path, [1, 2, 3])
+    with open(bare, encoding="utf-8") as source:      # the anchor Point1 given a CdA
+        text = source.read().replace("1     Fixed       65.0    0        -30.0   0      0       0",
+                                     "1     Fixed       65.0    0        -30.0   0      0       5")
+    assert "-30.0   0      0       5      0" in text
+    anchored = tmp_path / "anchored.dat"
+    anchored.write_text(text)
+    for deck in (bare, str(anchored)):
+        assert refused(tmp_path, ["-rod_system", deck, "-rod_current", "1,0,0"]) == (
+            "petsc_rod: error: -rod_current: the current pushes nothing: every line type's "
+            "Cd is 0 (LINE TYPES) and no free point has a CdA (POINTS); give them or drop "
+            "the option")

@@ -202,7 +202,7 @@ def test_offsets_of_a_free_body_or_point_are_refused_before_any_case(tmp_path, n
     (["-sweep_offsets", "1", "-sweep_offset_of", "Body9"], "no point or body of that name"),
     (["-sweep_offsets", "1", "-sweep_offset_of", "Body1", "-sweep_headings", "far"],
      "-sweep_headings"),
-    (["-sweep_current_headings", "0"], "a system's current is its file's"),
+    (["-sweep_current_headings", "0"], "a system's current is the base options'"),
     (["-sweep_cases", "lengths.txt"], "column rod_length is not an option a system's case"),
     (["-rod_system_line_length", "Line1,-3", "-sweep_offsets", "1", "-sweep_offset_of", "Body1"],
      "a positive length"),
