@@ -396,7 +396,11 @@ def system_datasets(system, results):
         "end_tensions": np.array([results.end_tensions[n] for n in lines]).reshape(-1, 2),
         "line_converged": np.array([results.lines_converged[n] for n in lines], dtype=float),
     }
-    units = {"point_positions": "m", "body_positions": "m, m, m, rad, rad, rad",
+    rows = system.environment.current_rows()
+    if rows is not None:          # the current the run was in: a uniform one at depth 0
+        data["current"] = np.column_stack(rows)
+    units = {"current": "m, m/s, m/s, m/s (depth below z = 0, ux, uy, uz)",
+             "point_positions": "m", "body_positions": "m, m, m, rad, rad, rad",
              "body_rotations": "1", "body_stiffness": "N/m, N, N m/rad (rows F, M; "
              "columns dX, dtheta)", "body_stiffness_reference": "m",
              "body_stiffness_moment": "N m", "body_stiffness_asymmetry": "1",
@@ -614,8 +618,9 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     ({'line_mass': bool}) asks for them (system/body_modes.system_modes), the result
     file and the tables when asked; the lines destroyed. ``interrupts``
     (cli/signals.Interrupts) asked before every iteration of the system's Newton (and
-    so of its sweeps) and once the equilibrium is found: a stop signal then ends the
-    run before anything is written (RodInterrupted). ``sweeps``
+    so of its sweeps), once the equilibrium is found and again before the file is
+    written: a stop signal then ends the run before anything is written
+    (RodInterrupted). ``sweeps``
     (api/system_sweeps.Sweeps): the watch circle and the load-excursion curves run
     after the equilibrium, in the results, the file and the tables. Returns the
     SystemResults. ``solver``: a SystemSolver of a system that differs from ``system``
@@ -661,6 +666,16 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
             solver.destroy()
 
 
+def stop_if_interrupted(interrupts, when):
+    """RodInterrupted (exit 128 + the signal's number, nothing written) where a rank
+    received a stop signal (cli/signals.Interrupts; None: no signals asked for), the
+    message saying ``when``. Collective."""
+    number = 0 if interrupts is None else interrupts.received()
+    if number:
+        raise RodInterrupted(f"stopped by {interrupts.name(number)} {when}; nothing "
+                             "written", number)
+
+
 def _solved(comm, solver, system, say, output, table, text, notes, interrupts, sweeps,
             modes, failures, body_modes=None):
     """run_system's work once its lines are built: the equilibrium, the records, the
@@ -677,11 +692,7 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
     if solver.prediction is not None and not solver.prediction.startswith("not used"):
         # the first solve started from the catenaries' equilibrium (system/predictor.py)
         say(f"petsc_rod: note: the system's catenary predictor {solver.prediction}")
-    number = 0 if interrupts is None else interrupts.received()
-    if number:
-        raise RodInterrupted(f"stopped by {interrupts.name(number)} after the "
-                             "system's equilibrium was found; nothing written",
-                             number)
+    stop_if_interrupted(interrupts, "after the system's equilibrium was found")
     stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
     # at the equilibrium, before the sweeps move the solver (numpy: every rank the same)
     coupled = None
@@ -730,6 +741,8 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
     results.sweeps = run_sweeps(solver, sweeps) if sweeps else {}
     for line in run_lines(results.sweeps):
         say(line)
+    # the stiffness, the modes and the sweeps take as long as the equilibrium, or longer
+    stop_if_interrupted(interrupts, "before the system's results were written")
     if output:
         write_file(comm, output, system, results, records, text, notes, failures)
     if table:

@@ -282,8 +282,8 @@ OPTIONS = [
            "uniform steady current, m/s (normal Morison drag, needs -rod_drag; in a system "
            "each line type's Cd and Diam)", unit="m/s"),
     Option("rod_current_profile", _string, None, "FILE",
-           "current profile: rows 'depth ux uy uz' (m, m/s), depths increasing, linear in "
-           "between, constant beyond", unit="text"),
+           "current profile: rows 'depth ux uy uz' (m, m/s), depths from 0 down, "
+           "increasing, linear in between, constant beyond", unit="text"),
     Option("rod_sea_surface", _real, None, "z",
            "height of the sea surface, m: the current profile's depths and the external "
            "pressure of line types are measured from it; default the highest held end",

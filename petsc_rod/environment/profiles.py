@@ -9,7 +9,8 @@ from petsc_rod.tables import numbered_rows, read_text
 
 def read_profile(path, largest=np.inf):
     """(depths (m,), velocities (m, 3)) from a text file of rows 'depth ux uy uz' (m,
-    m/s; '#' starts a comment), depths strictly increasing, every magnitude at most
+    m/s; '#' starts a comment), depths strictly increasing from 0 or more (below the sea
+    surface: a negative one is a height z given for a depth), every magnitude at most
     ``largest`` (the bound of the options' numbers). RodInputError otherwise."""
     def refuse(what):
         raise RodInputError(f"-rod_current_profile {path}: {what}")
@@ -32,6 +33,9 @@ def read_profile(path, largest=np.inf):
                "velocities in m/s")
     if np.any(np.diff(table[:, 0]) <= 0):
         refuse("the depths must increase strictly from row to row")
+    if table[0, 0] < 0:
+        refuse(f"row 1's depth {table[0, 0]:g} m is above the sea surface: depths are "
+               "measured down from it (m, 0 or more), not heights z")
     return table[:, 0], table[:, 1:]
 
 

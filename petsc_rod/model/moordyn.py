@@ -119,6 +119,9 @@ def parse_moordyn(text, path="<MoorDyn text>", element_length=ELEMENT_LENGTH):
         notes.append("CONTROL: the lines' length control is a time history's; the lines "
                      "keep their unstretched lengths")
     bodies = body_rows(sections.get("bodies", []), path)
+    notes.extend(f"body {name}: CdA {fields['cda']:g} m^2 not read (a body takes no drag "
+                 "in a current: give that force by -rod_system_body_load)"
+                 for name, fields in bodies.items() if fields["cda"])
     points, attached = point_rows(sections.get("points", []), bodies, path)
     apply_loads(sections.get("loads", []), points, bodies, path)
     depth = sea["depth"]
@@ -227,8 +230,8 @@ def body_rows(rows, path):
     """{'Body<ID>': Body's fields} of the BODIES rows: ID Attachment X0 Y0 Z0 r0 p0 y0
     (deg) Mass CG* I* Volume CdA* Ca*: I (one number for all three, or Ix|Iy|Iz, about
     the cog, body axes) and Ca (one or three numbers) for the system's modes
-    (body_fields); CdA is dynamic and not read. Buoyancy acts at the reference point
-    (MoorDyn's)."""
+    (body_fields); CdA kept for a note only (a body takes no drag: read_moordyn says
+    so where it is not 0). Buoyancy acts at the reference point (MoorDyn's)."""
     bodies = {}
     for line, data in rows:
         where = f"{path}:{line}: BODIES: body {data[0]}"
@@ -254,7 +257,8 @@ def body_rows(rows, path):
             mass=number(where, "Mass", data[8]), cog=triple(where, "CG", data[9]),
             volume=number(where, "Volume", data[11]), held=held,
             inertia=np.diag(np.broadcast_to(inertia, 3)).astype(float),
-            ca=np.broadcast_to(ca, 3).astype(float))
+            ca=np.broadcast_to(ca, 3).astype(float),
+            cda=number(where, "CdA", data[12]) if len(data) > 12 else 0.0)
     return bodies
 
 
@@ -265,6 +269,7 @@ def body_fields(fields, rho):
     rotations), body axes."""
     fields = dict(fields)
     inertia, ca = fields.pop("inertia"), fields.pop("ca")
+    fields.pop("cda", None)
     volume = fields.pop("own_volume", fields["volume"])
     fields["inertia"] = tuple(inertia.ravel().tolist()) if np.any(inertia) else None
     added = np.zeros((6, 6))

@@ -174,6 +174,25 @@ def test_a_stop_signal_is_acted_on_between_the_newton_s_iterations(tmp_path):
     assert interrupts.asked == 3
 
 
+def test_a_stop_signal_after_the_equilibrium_ends_the_run_before_the_file(tmp_path,
+                                                                         monkeypatch):
+    """A signal received after the equilibrium, while its records, the modes or the
+    sweeps are made (here: once the equilibrium's lines are said), ends the run before
+    the file is written, where it went on to write it and exit 0."""
+    from petsc_rod.api import system_run
+    interrupts = SignalledLater(10**9)
+    reported = system_run.report_lines
+
+    def signalled_once_reported(*args):
+        interrupts.calls = 0                  # from now on every rank has SIGTERM
+        return reported(*args)
+
+    monkeypatch.setattr(system_run, "report_lines", signalled_once_reported)
+    stopped = interrupted_joined_lines(tmp_path, interrupts)
+    assert stopped == ("stopped by SIGTERM before the system's results were written; "
+                       "nothing written")
+
+
 def test_a_stop_signal_during_a_line_s_walk_ends_the_walk_and_the_run(tmp_path):
     """A signal received while a line walks (a watch circle's case under a load no
     line can hold spends minutes in its lines' iterations and halvings) stops the walk

@@ -127,6 +127,8 @@ def test_each_lines_drag_is_the_line_types_on_its_shape(api, label, current):
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_the_file_in_a_current_equals_the_api_in_it(api, tmp_path, ranks):
     cli = cli_numbers(tmp_path, ranks, ["-rod_current", ",".join(map(str, UNIFORM))])
+    with h5py.File(tmp_path / f"system{ranks}.h5", "r") as f:
+        assert np.array_equal(f["system/current"][()], [[0.0, *UNIFORM]])
     expected = api["uniform"]
     assert same(cli["x"][:3], expected["x"][:3]) and same(cli["x"][3:], expected["x"][3:])
     for rows in (slice(0, 3), slice(3, 6)):       # N/m, N/rad; N, N m/rad
@@ -140,6 +142,8 @@ def test_the_file_in_a_current_equals_the_api_in_it(api, tmp_path, ranks):
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_the_file_in_a_current_profile_equals_the_api_in_it(api, tmp_path, ranks):
     cli = cli_numbers(tmp_path, ranks, ["-rod_current_profile", str(profile_file(tmp_path))])
+    with h5py.File(tmp_path / f"system{ranks}.h5", "r") as f:   # the run's current kept
+        assert np.array_equal(f["system/current"][()], np.array(PROFILE))
     expected = api["profile"]
     assert same(cli["x"][:3], expected["x"][:3]) and same(cli["x"][3:], expected["x"][3:])
     for rows in (slice(0, 3), slice(3, 6)):

@@ -340,3 +340,18 @@ def test_a_body_s_inertia_and_added_mass_are_read(tmp_path):
     assert np.count_nonzero(added - np.diag(np.diag(added))) == 0
     assert read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
                                      "small_free_body.dat"))[0].bodies[0].inertia is None
+
+
+def test_a_body_s_drag_area_is_said_not_read():
+    """A body's CdA (MoorDyn's drag in a current) is not read: a note says so where it
+    is not 0, none where it is."""
+    with open(os.path.join(DATA, "small_free_body.dat"), encoding="utf-8") as source:
+        deck = source.read()
+    row = "20000 -2       0        30      0      0"
+    assert row in deck
+    _, notes = parse_moordyn(deck.replace(row, "20000 -2       0        30      10     0"))
+    assert [n for n in notes if "CdA" in n] == [
+        "body Body1: CdA 10 m^2 not read (a body takes no drag in a current: give that "
+        "force by -rod_system_body_load)"]
+    _, notes = parse_moordyn(deck)
+    assert not [n for n in notes if "CdA" in n]

@@ -96,7 +96,8 @@ def test_current_profile_is_linear_in_depth_and_constant_beyond():
     ("0 1 0 x\n", "rows of 4 numbers"),
     ("# nothing\n", "rows of 4 numbers"),
     ("0 nan 0 0\n", "not finite"),
-], ids=["missing", "not monotone", "3 columns", "not a number", "empty", "nan"])
+    ("-30 0 0.3 0\n0 1 0 0\n", "row 1's depth -30 m is above the sea surface"),
+], ids=["missing", "not monotone", "3 columns", "not a number", "empty", "nan", "heights"])
 def test_a_bad_profile_file_is_refused_in_one_line(tmp_path, text, words):
     path = tmp_path / "profile.txt"
     if text is not None:
