@@ -119,7 +119,7 @@ class ModesFailed(RodDivergedError):
             super().__init__(error)
             return
         super().__init__(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
-                         "check the -rod_modes_eps_* and -rod_modes_st_* options")
+                         f"check the -{PREFIX}eps_* and -{PREFIX}st_* options")
 
 
 @contextlib.contextmanager

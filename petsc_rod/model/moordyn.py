@@ -120,7 +120,7 @@ def parse_moordyn(text, path="<MoorDyn text>", element_length=ELEMENT_LENGTH):
                      "keep their unstretched lengths")
     bodies = body_rows(sections.get("bodies", []), path)
     notes.extend(f"body {name}: CdA {fields['cda']:g} m^2 not read (a body takes no drag "
-                 "in a current: give that force by -rod_system_body_load)"
+                 "in a current: give that force as a load on the body)"
                  for name, fields in bodies.items() if fields["cda"])
     points, attached = point_rows(sections.get("points", []), bodies, path)
     apply_loads(sections.get("loads", []), points, bodies, path)
@@ -178,10 +178,9 @@ def options(rows, path):
         if key in ("currents", "waterkin", "seafloorfile") and value not in ("0", '""', "''"):
             raise RodInputError(
                 f"{path}:{line}: OPTIONS: {data[1]} {value}: a current or a seabed read "
-                "from MoorDyn's grid files is not read; give the current by "
-                "-rod_current or -rod_current_profile and the seabed by "
-                "-rod_seabed_profile (Environment.current, Environment.seabed_profile "
-                "in the API), or drop the option")
+                "from MoorDyn's grid files is not read; give the run its current and "
+                "seabed profile (the command line's current and seabed profile options, "
+                "the API's Environment), or drop the option")
         if key in ("currents", "waterkin", "seafloorfile") or key in DYNAMIC_OPTIONS:
             ignored.append(data[1])
         elif key in STATIC_OPTIONS:

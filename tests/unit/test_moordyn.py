@@ -352,6 +352,6 @@ def test_a_body_s_drag_area_is_said_not_read():
     _, notes = parse_moordyn(deck.replace(row, "20000 -2       0        30      10     0"))
     assert [n for n in notes if "CdA" in n] == [
         "body Body1: CdA 10 m^2 not read (a body takes no drag in a current: give that "
-        "force by -rod_system_body_load)"]
+        "force as a load on the body)"]
     _, notes = parse_moordyn(deck)
     assert not [n for n in notes if "CdA" in n]
