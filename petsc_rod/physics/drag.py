@@ -150,37 +150,30 @@ class DragTerm(NodalLoadTerm):
             return
         x_rows, turns, psi, row, other, rows_map, integrals, tails, G, heights = parts
         ne, U = len(x_rows), jacobian.hessian.unknowns
-        columns = [turns, psi[:, 1]], [turns, other]
-        if heights is not None:
-            height_columns, frames_rows, chain_rows, Z = heights
-            for kept in columns:
-                kept.append(height_columns)
-        width = 12 + (Z.shape[2] if heights is not None else 0)
-        # each element's two blocks, written in place: the frames' rows (ne, a, U,
-        # columns) and the chain's (ne, 3, columns), the columns those of _jacobian_blocks
-        # (the turns (b, 3), the far vertex's resultants, the heights)
-        frames = np.empty((ne, 3, U, width))
-        chain = np.empty((ne, 3, width))
-        # the frames' rows on the turns: rows_map_a tails_ab G_b for each node pair (a, b)
-        # by a batched matmul (a three-operand einsum loops over every index:
-        # docs/performance.md) into its place, (ne, a, b, U, 3) as a view of the block
-        coupling = frames[..., :9].reshape(ne, 3, U, 3, 3).transpose(0, 1, 3, 2, 4)
-        np.matmul(rows_map[:, :, None], G[:, None], out=coupling)
+        # the frames' rows on the element's turns and on the far vertex's resultants (and
+        # the heights), in one block per element, the columns of _jacobian_blocks:
+        # rows_map_a tails_ab G_b for each node pair (a, b), (ne, a, b, U, 3), by a
+        # batched matmul (a three-operand einsum loops over every index:
+        # docs/performance.md), then in the order of the rows (a, U) and columns (b, 3)
+        coupling = np.matmul(rows_map[:, :, None], G[:, None])
         coupling *= tails[:, :, :, None, None]
-        # ... and on the far vertex's resultants
-        np.multiply(rows_map, integrals[:, :, None, None], out=frames[..., 9:12])
+        frames = [coupling.transpose(0, 1, 3, 2, 4).reshape(ne, 3 * U, 9),
+                  (rows_map * integrals[:, :, None, None]).reshape(ne, 3 * U, 3)]
         # the chain: Psi_e - Psi_e+1 - sum_l I_l G_l omega_l = 0 in Psi_e's row from a
         # held start, its negative in Psi_e+1's from a held end (the diagonal 1 is H's)
         sign = -1.0 if is_held(self.start_state) else 1.0
-        np.multiply(sign, np.einsum("eb,ebjk->ejbk", integrals, G),
-                    out=chain[:, :, :9].reshape(ne, 3, 3, 3))
-        chain[:, :, 9:12] = -np.eye(3)
-        frames = frames.reshape(ne, 3 * U, width)
+        chain = [sign * np.einsum("eb,ebjk->ejbk", integrals, G).reshape(ne, 3, 9),
+                 np.broadcast_to(-np.eye(3), (ne, 3, 3))]
+        columns = [turns, psi[:, 1]], [turns, other]
         if heights is not None:
-            np.matmul(frames_rows, Z, out=frames[:, :, 12:])
-            np.matmul(chain_rows, Z, out=chain[:, :, 12:])
-        jacobian.add(x_rows, np.concatenate(columns[0], axis=1), frames)
-        jacobian.add(row, np.concatenate(columns[1], axis=1), chain)
+            height_columns, frames_rows, chain_rows, Z = heights
+            frames.append(np.matmul(frames_rows, Z))
+            chain.append(np.matmul(chain_rows, Z))
+            for kept in columns:
+                kept.append(height_columns)
+        jacobian.add(x_rows, np.concatenate(columns[0], axis=1),
+                     np.concatenate(frames, axis=2))
+        jacobian.add(row, np.concatenate(columns[1], axis=1), np.concatenate(chain, axis=2))
 
     def add_hessian(self, hessian):
         """No curvature (the drag has no energy); where the heights' chain is for the
