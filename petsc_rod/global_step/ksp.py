@@ -174,61 +174,59 @@ def _with_more_workspace(ksp, factor):
 def solve_columns(ksp, columns, rows=None):
     """x_j = A^-1 b_j for the local arrays ``columns`` (k of them, (n_local,) each) with
     the factored operator A of a set-up inertia_solver or lu_solver, in one MatMatSolve
-    (one call into MUMPS's solve phase, whose cost is a fixed part and a part per
-    column: docs/performance.md, "Newton steps").
+    (solve_dense: one call into MUMPS's solve phase, whose cost is a fixed part and a
+    part per column: docs/performance.md, "Newton steps").
     ``rows``: where A is a submatrix of the columns' layout (analysis/stability.py leaves
     rows out), the local indices of its rows in them; the other rows of x_j are b_j.
-    Returns the k arrays x_j. Collective; a failed factorisation gives Inf, as a failed
-    KSP solve does (the Newton steps stop at a step that is not finite)."""
+    Returns the k arrays x_j (solved_columns). Collective; a failed factorisation gives
+    Inf, as a failed KSP solve does (the Newton steps stop at a step that is not
+    finite)."""
+    return solved_columns(columns, rows, lambda right: solve_dense(ksp, right))
+
+
+def solved_columns(columns, rows, solve):
+    """The k arrays x_j = b_j with their ``rows`` (every row where None) replaced by the
+    solutions of the block solve ``solve``, for the local arrays b_j ``columns`` (k of
+    them, (n_local,) each): the ``rows`` of each b_j packed as the columns of a new
+    Fortran-ordered array B (r, k) of PETSc's scalar type (r = n_local or len(rows)),
+    as solve_dense takes it, and ``solve(B)`` -> X (r, k), whose column j is unpacked
+    into x_j's rows. The packing of solve_columns and NaturalLU.solve_columns; no
+    columns give an empty list without a solve."""
     columns = [np.asarray(column) for column in columns]
     solutions = [column.copy() for column in columns]
     if not columns:
         return solutions
-    factor = ksp.getPC().getFactorMatrix()
-    operator = ksp.getOperators()[0]
-    local, total = operator.getSizes()[0]
-    right = PETSc.Mat().createDense(((local, total), (PETSc.DECIDE, len(columns))),
-                                    comm=operator.getComm())
-    right.setUp()
-    block = right.getDenseArray()
+    right = np.empty((columns[0].size if rows is None else len(rows), len(columns)),
+                     dtype=PETSc.ScalarType, order="F")
     for j, column in enumerate(columns):
-        block[:, j] = column if rows is None else column[rows]
-    right.assemble()
-    unknown = right.duplicate()
-    try:
-        if factor.getMumpsInfog(1) < 0:
-            unknown.getDenseArray()[:] = np.inf
+        right[:, j] = column if rows is None else column[rows]
+    values = solve(right)
+    for j, solution in enumerate(solutions):
+        if rows is None:
+            solution[:] = values[:, j]
         else:
-            factor.matSolve(right, unknown)
-        values = unknown.getDenseArray(readonly=True)
-        for j, solution in enumerate(solutions):
-            if rows is None:
-                solution[:] = values[:, j]
-            else:
-                solution[rows] = values[:, j]
-    finally:
-        right.destroy()
-        unknown.destroy()
+            solution[rows] = values[:, j]
     return solutions
 
 
 def solve_dense(ksp, right):
     """X = A^-1 B for the k columns of ``right`` (n, k), in Fortran order (each column
-    contiguous, as PETSc's dense matrices hold them), with the factored sequential
-    operator A of a set-up inertia_solver or lu_solver (or NaturalLU's KSP, whose
-    factorisations that fail are never solved with): one MatMatSolve on dense
-    matrices laid on ``right`` and on the new array X, which it returns, (n, k) in
-    Fortran order. No column is copied in Python on the way in or out (PETSc copies B
-    into X once, for MUMPS to solve in place): solve_columns copies each twice more and
-    allocates both matrices anew, work that a rank's half of a chain pays as the whole
-    chain does (docs/performance.md, "Newton steps"). A failed factorisation gives
-    Inf."""
+    contiguous, as PETSc's dense matrices hold them), with the factored operator A of
+    a set-up inertia_solver or lu_solver (or NaturalLU's KSP, whose factorisations
+    that fail are never solved with); on several ranks n is the rank's rows of A. One
+    MatMatSolve on dense matrices laid on ``right`` and on the new array X, which it
+    returns, (n, k) in Fortran order. No column is copied in Python on the way in or
+    out (PETSc copies B into X once, for MUMPS to solve in place): solve_columns copies
+    each twice more (into B, out of X), work that a rank's half of a chain pays as the
+    whole chain does (docs/performance.md, "Newton steps"). A failed factorisation
+    gives Inf. Collective."""
     factor = ksp.getPC().getFactorMatrix()
     solution = np.empty(right.shape, dtype=PETSc.ScalarType, order="F")
     if ksp.getPC().getFactorSolverType() == "mumps" and factor.getMumpsInfog(1) < 0:
         solution[:] = np.inf
         return solution
-    matrices = [_dense_on(array) for array in (right, solution)]
+    comm = ksp.getOperators()[0].getComm()
+    matrices = [_dense_on(array, comm) for array in (right, solution)]
     try:
         factor.matSolve(*matrices)
     finally:
@@ -271,16 +269,20 @@ def solve_sparse_columns(ksp, rows, values):
                 obj.destroy()
 
 
-def _dense_on(array):
-    """A sequential dense Mat whose values are the (n, k) ``array`` itself (petsc4py
-    keeps a reference to it), assembled. The array must be writeable, Fortran-ordered
-    and of PETSc's scalar type: petsc4py would otherwise copy it without a word, and a
-    solve into the Mat would leave the array as it was."""
+def _dense_on(array, comm=PETSc.COMM_SELF):
+    """A dense Mat on ``comm`` whose values are the (n, k) ``array`` itself (petsc4py
+    keeps a reference to it), assembled: on several ranks each rank's n rows, the k
+    columns whole on every rank (PETSc's MPI dense storage). The array must be
+    writeable, Fortran-ordered and of PETSc's scalar type: petsc4py would otherwise
+    copy it without a word, and a solve into the Mat would leave the array as it was.
+    Collective."""
     if not (array.flags.f_contiguous and array.flags.writeable
             and array.dtype == PETSc.ScalarType):
         raise ValueError("a dense Mat laid on an array needs a writeable Fortran-ordered "
                          f"{np.dtype(PETSc.ScalarType)} array")
-    matrix = PETSc.Mat().createDense(array.shape, array=array, comm=PETSc.COMM_SELF)
+    rows, k = array.shape
+    matrix = PETSc.Mat().createDense(((rows, PETSc.DECIDE), (PETSc.DECIDE, k)), array=array,
+                                     comm=comm)
     matrix.assemble()
     return matrix
 
@@ -437,14 +439,11 @@ class NaturalLU:
         555 iterations against MUMPS's 392 and stop 1.2e-6 m from MUMPS's answer."""
         if self.mumps is not None:
             return self.mumps.solve_columns(columns, rows)
-        columns = [np.asarray(column) for column in columns]
-        solutions = [column.copy() for column in columns]
-        if not columns:
-            return solutions
-        right = np.empty((columns[0].size if rows is None else len(rows), len(columns)),
-                         dtype=PETSc.ScalarType, order="F")
-        for j, column in enumerate(columns):
-            right[:, j] = column if rows is None else column[rows]
+        return solved_columns(columns, rows, self._refined_solve)
+
+    def _refined_solve(self, right):
+        """X = A^-1 B for the Fortran-ordered (n, k) ``right`` B (solve_dense's), refined
+        once as solve_columns says."""
         values = solve_dense(self.ksp, right)
         known = _dense_on(values)
         product = self.ksp.getOperators()[0].matMult(known)
@@ -453,12 +452,7 @@ class NaturalLU:
         finally:
             known.destroy()
             product.destroy()
-        for j, solution in enumerate(solutions):
-            if rows is None:
-                solution[:] = values[:, j]
-            else:
-                solution[rows] = values[:, j]
-        return solutions
+        return values
 
     def destroy(self):
         for obj in (self.ksp, self.mumps):
