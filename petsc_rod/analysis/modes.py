@@ -113,13 +113,18 @@ class ModesFailed(RodDivergedError):
     traceback for all errors, which the EPS's destroy after it rewrites)."""
 
     def __init__(self, error):
-        """From the PETSc.Error raised, or the text of one made before (a system's line
-        named: api/system_run.line_modes)."""
-        if isinstance(error, str):
-            super().__init__(error)
-            return
+        """From the PETSc.Error raised in the eigensolver (solve_modes)."""
         super().__init__(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
                          f"check the -{PREFIX}eps_* and -{PREFIX}st_* options")
+
+    @classmethod
+    def of_line(cls, name, text):
+        """The failure of a system's line ``name``, from ``text``, the message of the
+        ModesFailed its eigensolver raised (str(): the lines' share carries it as text
+        to the ranks without the line, api/system_run.line_modes): "line NAME: TEXT"."""
+        failed = cls.__new__(cls)
+        RodDivergedError.__init__(failed, f"line {name}: {text}")
+        return failed
 
 
 @contextlib.contextmanager

@@ -225,7 +225,7 @@ def line_modes(solver, count, settings, band=None):
                     if isinstance(value, str))
     if failed:
         k, text = failed[0]
-        raise ModesFailed(f"line {solver.system.lines[k].name}: {text}")
+        raise ModesFailed.of_line(solver.system.lines[k].name, text)
     found = {k: mine[k] if k in mine else
              ModesRefused(value) if isinstance(value, (int, np.integer)) else value
              for k, (value, _) in shared.items()}

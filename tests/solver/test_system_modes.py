@@ -149,7 +149,7 @@ def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
     def failing_first_on_the_last_rank(problem, *args, **kwargs):
         calls.append(problem)
         if PETSc.COMM_WORLD.getRank() == last and len(calls) == 1:
-            raise ModesFailed("the modes' eigensolver (SLEPc) failed: a test's")
+            raise ModesFailed(RuntimeError("[0] a test's"))  # a PETSc.Error's report
         return real(problem, *args, **kwargs)
 
     monkeypatch.setattr(system_run, "solve_modes", failing_first_on_the_last_rank)
@@ -159,6 +159,7 @@ def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
     assert isinstance(raised.value, ModesFailed)
     text = str(raised.value)
     assert text.startswith("line Line") and text.endswith(
-        ": the modes' eigensolver (SLEPc) failed: a test's")
+        ": the modes' eigensolver (SLEPc) failed: a test's; check the -rod_modes_eps_* and "
+        "-rod_modes_st_* options")
     names = PETSc.COMM_WORLD.tompi4py().allgather(text)
     assert len(set(names)) == 1                     # the same line named on every rank
