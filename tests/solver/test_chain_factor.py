@@ -11,7 +11,8 @@ on several ranks unless -<prefix>substructuring 0 (here the prefix test_chain_).
 serial run the factor is the interior's alone; under 3 or more ranks a middle rank has
 both interfaces (run by hand, `mpiexec -n 3` and `-n 4`: CI runs 1 and 2). An operator
 that is no chain, or a regular one with a singular interior, is factored by MUMPS on all
-ranks."""
+ranks; on one rank direct_factor's LU is PETSc's own in the natural order
+(global_step/ksp.NaturalLU, MUMPS's only where its check fails) and its LDL^T MUMPS's."""
 
 import numpy as np
 import pytest
@@ -236,8 +237,9 @@ def test_direct_factor_substructures_on_several_ranks_unless_told_not_to(given):
 def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
     """A coupling of the first node to the last (a ring, as no Newton system of a line
     has): on several ranks the interface does not separate the ranks' interiors, so
-    direct_factor falls back to MUMPS on all ranks, whose solve agrees with the dense
-    one."""
+    direct_factor falls back to MUMPS on all ranks (on one rank the LU is PETSc's own in
+    the natural order, NaturalLU, whose check the ring's factors pass), whose solve
+    agrees with the dense one."""
     comm = PETSc.COMM_WORLD
     mesh, matrix, dense = chain(comm, PETSc.PC.Type.LU)
     n = len(dense)
@@ -252,6 +254,10 @@ def test_an_operator_that_is_no_chain_is_factored_by_mumps_on_all_ranks():
     try:
         assert not factor.substructured
         factor.set_up(matrix)
+        if comm.getSize() == 1:
+            assert isinstance(factor, solvers.NaturalLU) and not factor.fell_back
+        else:
+            assert isinstance(factor, solvers.MumpsFactor)
         start, end = matrix.getOwnershipRange()
         column = np.sin(np.arange(start, end) + 0.3)
         solution = factor.solve_columns([column])[0]
@@ -379,7 +385,10 @@ def test_a_singular_interior_of_a_regular_matrix_is_factored_whole(kind):
     with no diagonal (a saddle's multiplier: rows j and g read x_g = b_j and fix x_j):
     the whole matrix is regular, the interior singular (a null pivot, MUMPS's INFOG 28),
     so the substructuring does not apply. From that set_up on, the factor is MUMPS's on
-    all ranks, whose solves and inertia are the dense matrix's."""
+    all ranks, whose solves and inertia are the dense matrix's. On one rank, where the
+    interior is the whole matrix, the LU is PETSc's own in the natural order
+    (NaturalLU, whose check its factors pass: the rows eliminated before j, g the first,
+    make j's pivot nonzero) and the LDL^T MUMPS's."""
     comm = PETSc.COMM_WORLD
     mesh, matrix, dense = chain(comm, kind)
     start, end = matrix.getOwnershipRange()
@@ -399,6 +408,10 @@ def test_a_singular_interior_of_a_regular_matrix_is_factored_whole(kind):
     try:
         factor.set_up(matrix)
         assert not factor.substructured
+        if comm.getSize() == 1 and kind == PETSc.PC.Type.LU:
+            assert isinstance(factor, solvers.NaturalLU) and not factor.fell_back
+        else:
+            assert isinstance(getattr(factor, "factor", factor), solvers.MumpsFactor)
         column = np.cos(0.3 * np.arange(start, end))
         solution = factor.solve_columns([column])[0]
         expected = np.linalg.solve(dense, gather(comm, column))
