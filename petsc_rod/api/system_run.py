@@ -16,7 +16,8 @@ from petsc_rod.analysis.mass import MassSettings
 from petsc_rod.analysis.modes import (ModesFailed, ModesRefused, modes_count,
                                      solve_modes)
 from petsc_rod.api.results import Results
-from petsc_rod.api.system_sweeps import Sweeps, file_group, run_lines, run_sweeps, table_text
+from petsc_rod.api.system_sweeps import (Sweeps, check_sweeps, file_group, run_lines,
+                                         run_sweeps, table_text)
 from petsc_rod.cli.modes import check_subspace, modes_band, table_lines
 from petsc_rod.cli.line_run import AgreedFailures, values_of
 from petsc_rod.cli.options import BY_NAME
@@ -631,12 +632,14 @@ def run_system(comm, system, settings, line_options, say, output=None, table=Non
     (held_line.held_lines).
     RodInputError for a system the checks refuse (exit 2: System.check, and
     system_check.check_reach where the run starts: a line that cannot start, taut lines
-    that nothing pulls),
+    that nothing pulls) or a sweep it cannot run (api/system_sweeps.check_sweeps: a body
+    held where the sweep's load pushes it),
     RodNotConvergedError when no equilibrium was found (exit 3: the coupled solver's
     RodDivergedError, its Newton or a line not converged after its halvings),
     RodDivergedError for non-finite numbers (exit 4); nothing is written then.
     Collective."""
     on_every_rank(comm, system.check)
+    on_every_rank(comm, check_sweeps, sweeps, system)
     if solver is None:
         # every line able to start where the run starts (the command line checked it
         # first, naming the options that moved its ends; a sweep's cases, re-solved on

@@ -14,6 +14,11 @@ equilibrium but without a lowest eigenvalue (its verdict none: a stiffness that 
 finite) keeps its row, NaN in the file's ``lowest_eigenvalue`` and an empty cell in the
 table.
 
+A sweep needs a body its load moves: one held where the load pushes it (a Coupled,
+CoupledPinned or Fixed body of a MoorDyn file) is refused in one line before anything
+is solved (swept_body: the option named on the command line, parse_sweeps; the
+``Sweeps`` field through the API, check_sweeps), as no offset but 0 m could come out.
+
 Each case carries the system's verdict (system/excursions.py): the table's ``verdict``
 (stable, saddle, none; the file's codes 1, 0, -1 of ``system_stable``) and
 ``lowest_eigenvalue``; a saddle's row is kept and marked, the group's ``converged`` is
@@ -26,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from petsc_rod.errors import RodInputError
-from petsc_rod.system.excursions import (TABLE_UNITS, VERDICT_WORDS, load_excursion,
-                                         watch_circle)
+from petsc_rod.system.excursions import (TABLE_UNITS, VERDICT_WORDS, held_text,
+                                         load_excursion, watch_circle)
 
 # The watch circle's headings when none are given: every 15 degrees.
 WATCH_HEADINGS = 24
@@ -89,11 +94,18 @@ USAGE = {"rod_system_watch_circle": "BODY,LOAD[,N_HEADINGS] (a body's name, the 
          "headings in degrees, default 0)"}
 
 
-def _body(option, text, name, system):
+def swept_body(where, name, headings, system):
+    """``name``, a body of ``system`` that a horizontal load along ``headings`` (deg)
+    moves; else RodInputError in one line that starts with ``where`` (the option and its
+    text, or the Sweeps field): no such body, or one held where the load pushes it
+    (excursions.held_text)."""
     names = [body.name for body in system.bodies]
     if name not in names:
-        raise RodInputError(f"-{option} {text!r}: no body {name!r} in the system; its "
-                            f"bodies: {', '.join(names) or 'none'}")
+        raise RodInputError(f"{where}: no body {name!r} in the system; its bodies: "
+                            f"{', '.join(names) or 'none'}")
+    held = held_text(system.bodies[names.index(name)], headings)
+    if held:
+        raise RodInputError(f"{where}: {held}")
     return name
 
 
@@ -104,22 +116,45 @@ def parse_sweeps(watch_text, excursion_text, system):
     if watch_text:
         option = "rod_system_watch_circle"
         fields = _fields(option, watch_text, 2, 3)
-        body = _body(option, watch_text, fields[0], system)
         load = _number(option, watch_text, fields[1], "a positive load in N")
         count = (_count(option, watch_text, fields[2], "a whole number of headings")
                  if len(fields) > 2 else WATCH_HEADINGS)
-        circle = (body, load, 360.0 * np.arange(count) / count)
+        headings = 360.0 * np.arange(count) / count
+        circle = (swept_body(f"-{option} {watch_text!r}", fields[0], headings, system),
+                  load, headings)
     if excursion_text:
         option = "rod_system_excursion"
         fields = _fields(option, excursion_text, 2, 2 + 360)
-        body = _body(option, excursion_text, fields[0], system)
         largest = _number(option, excursion_text, fields[1], "a positive load in N")
         count = (_count(option, excursion_text, fields[2], "a whole number of load steps")
                  if len(fields) > 2 else EXCURSION_LOADS)
         headings = np.array([_number(option, excursion_text, value, "a heading in degrees",
                                      positive=False) for value in fields[3:]] or [0.0])
-        excursion = (body, largest * np.arange(count + 1) / count, headings)
+        excursion = (swept_body(f"-{option} {excursion_text!r}", fields[0], headings,
+                                system), largest * np.arange(count + 1) / count, headings)
     return Sweeps(circle, excursion)
+
+
+# The API's form of each sweep (check_sweeps' refusal of another).
+FORMS = {"watch_circle": "(body name, load N, headings deg)",
+         "excursion": "(body name, loads N, headings deg)"}
+
+
+def check_sweeps(sweeps, system):
+    """RodInputError in one line, naming the ``Sweeps`` field, for a sweep of ``sweeps``
+    that ``system`` cannot run: not of its form (FORMS), or of a body it does not have
+    or holds where the load pushes it (swept_body); before anything is solved
+    (api/system_run.run_system)."""
+    for kind, form in FORMS.items():
+        given = getattr(sweeps, kind, None)
+        if given is None:
+            continue
+        try:
+            body, _, headings = given
+            headings = np.asarray(headings, dtype=float)
+        except (TypeError, ValueError):
+            raise RodInputError(f"Sweeps.{kind}: expected {form}") from None
+        swept_body(f"Sweeps.{kind}", body, headings, system)
 
 
 def run_sweeps(solver, sweeps):

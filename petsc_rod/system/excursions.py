@@ -28,6 +28,11 @@ the system (a warm Newton under a large load can land on one: its numbers are ke
 the case is marked), -1 no verdict (not conservative, or neutral to round-off), and
 the lowest eigenvalue of its scaled stiffness, N/m (NaN where there is none).
 
+A load on a body held where it pushes it (Body.held in x or y along a heading: a
+Coupled, CoupledPinned or Fixed body of a MoorDyn file) moves nothing: its position
+there is imposed, every offset would be 0 m and every case the rest. Such a sweep is
+refused (held_text) before anything is solved.
+
 A case no equilibrium is found for (the solver's RodDivergedError: a line that cannot
 reach, a load beyond what the lines hold) is a gap in the results (NaN, its reason in
 ``failed``), and the next case starts from the last equilibrium found.
@@ -56,6 +61,9 @@ TABLE_UNITS = {"heading": "deg", "load": "N", "offset": "m", "restoring": "N",
                "max_tension_line": "", "min_grounded": "m", "min_grounded_line": "",
                "verdict": "", "lowest_eigenvalue": "N/m"}
 POSE = ("x", "y", "z", "roll", "pitch", "yaw")
+# A heading's direction cosine along x or y below this is none (cos 90 deg in floating
+# point is 6e-17): the load does not push the body along that axis.
+NO_PUSH = 1e-12
 # The table's ``verdict`` words of the ``stable`` codes (SystemVerdict.code: the result
 # file's system_stable).
 VERDICT_WORDS = {1: "stable", 0: "saddle", -1: "none"}
@@ -289,6 +297,22 @@ def loaded(system, body, force):
     return replace(system, bodies=bodies)
 
 
+def held_text(body, headings):
+    """Why a horizontal load along ``headings`` (deg) cannot sweep the Body ``body``: the
+    axes among x and y that some heading's direction e_h = (cos h, sin h, 0) pushes it
+    along (a cosine above NO_PUSH) and that it holds (Body.held), where its position is
+    imposed and the load moves nothing; '' where it is free along each axis pushed."""
+    angles = np.radians(np.asarray(headings, dtype=float).ravel())
+    pushed = np.any(np.abs([np.cos(angles), np.sin(angles)]) > NO_PUSH, axis=1)   # (2,)
+    held = [axis for axis, push, hold in zip("xy", pushed, body.held[:2]) if push and hold]
+    if not held:
+        return ""
+    return (f"body {body.name} is held in {' and '.join(held)} (Coupled, CoupledPinned "
+            "or Fixed in a MoorDyn file; Body.held): its position there is imposed, so "
+            "the load moves nothing and every offset would be 0 m; sweep a body free "
+            "where the load pushes it (Free in the file)")
+
+
 def _direction(heading):
     angle = np.radians(heading)
     return np.array([np.cos(angle), np.sin(angle), 0.0])
@@ -305,6 +329,9 @@ def _cases(solver, body, cases):
         raise RodInputError(f"excursions: no body is named {body!r}; the system's bodies: "
                             f"{', '.join(names) or 'none'}")
     index = names.index(body)
+    held = held_text(base.bodies[index], [heading for heading, _ in cases])
+    if held:
+        raise RodInputError(f"excursions: {held}")
     rest = solver.solve(base).bodies[body].copy()
     rest_force = lines_force(solver, index)
     poses, forces, worst, failed, verdicts = [], [], [], [], []

@@ -206,6 +206,39 @@ def test_a_stop_signal_during_a_line_s_walk_ends_the_walk_and_the_run(tmp_path):
     assert 5 <= interrupts.line_asked <= 6
 
 
+def test_a_sweep_of_a_held_body_is_refused_before_anything_is_solved(tmp_path):
+    """solve_system's watch circle of the coupled body of small_spread.dat (its offsets
+    all 0 m before) refused on every rank, naming Sweeps.watch_circle, the output that
+    existed kept; the same through system/excursions.watch_circle on a solver, before
+    its rest is solved. Serially and under mpiexec -n 2."""
+    from petsc_rod.api import Sweeps, read_moordyn
+    from petsc_rod.errors import RodInputError
+    from petsc_rod.system.equilibrium import SystemSolver
+    from petsc_rod.system.excursions import watch_circle
+    from petsc_rod.system.held_line import held_lines
+    system, _ = read_moordyn(os.path.join(os.path.dirname(__file__), "..", "data",
+                                          "moordyn", "small_spread.dat"), 10.0)
+    folder = PETSc.COMM_WORLD.tompi4py().bcast(str(tmp_path))
+    out = os.path.join(folder, "kept.h5")
+    PETSc.COMM_WORLD.tompi4py().Barrier()
+    if PETSc.COMM_WORLD.getRank() == 0:
+        with open(out, "wb") as f:
+            f.write(b"an earlier result")
+    PETSc.COMM_WORLD.tompi4py().Barrier()
+    with pytest.raises(RodInputError, match=r"^Sweeps.watch_circle: body Body1 is held in "
+                                            "x and y .*its position there is imposed"):
+        solve_system(system, output=out, sweeps=Sweeps(watch_circle=("Body1", 1e5,
+                                                                     [0.0, 90.0])))
+    with open(out, "rb") as f:
+        assert f.read() == b"an earlier result"
+    solver = SystemSolver(system, held_lines(system, TIGHT), PETSc.COMM_WORLD)
+    try:
+        with pytest.raises(RodInputError, match="^excursions: body Body1 is held in x "):
+            watch_circle(solver, "Body1", 1e5, [0.0, 180.0])
+    finally:
+        solver.destroy()
+
+
 def test_options_a_system_does_not_take_are_refused():
     from petsc_rod.errors import RodInputError
     system = System(lines=(SystemLine("one", uniform(100.0, 40), Connection("A"),

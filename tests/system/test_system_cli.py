@@ -272,6 +272,44 @@ def test_bad_input_is_one_line_and_leaves_no_file(tmp_path):
                                                      "-rod_system_steps", "2"])
 
 
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_sweep_of_a_held_body_is_refused_and_the_output_kept(tmp_path, ranks):
+    """The watch circle and the load-excursion curves of the coupled body of
+    small_spread.dat (held in all six degrees of freedom) exited 0 with "largest offset
+    0 m": now one line naming the body and why, exit 2, an existing -rod_output and no
+    table written; the same option on a system's sweep (petsc_rod.sweep) likewise,
+    before its folder is made."""
+    held = os.path.join(REPO_ROOT, "tests", "data", "moordyn", "small_spread.dat")
+    out = tmp_path / "kept.h5"
+    out.write_bytes(b"an earlier result")
+    why = ("body Body1 is held in {} (Coupled, CoupledPinned or Fixed in a MoorDyn file; "
+           "Body.held): its position there is imposed, so the load moves nothing and every "
+           "offset would be 0 m; sweep a body free where the load pushes it (Free in the "
+           "file)")
+    for option, value, axes in (("watch_circle", "Body1,1e5,4", "x and y"),
+                                ("excursion", "Body1,1e5,2,90", "y")):
+        process = run_petsc_rod(["-rod_system", held, f"-rod_system_{option}", value,
+                                 "-rod_output", str(out), "-rod_table",
+                                 str(tmp_path / "t.csv")], ranks, 120)
+        assert process.returncode == 2, describe(process)
+        assert process.stdout.splitlines() == [
+            f"petsc_rod: error: -rod_system_{option} {value!r}: {why.format(axes)}"], \
+            describe(process)
+        assert "Traceback" not in process.stderr
+        assert out.read_bytes() == b"an earlier result"
+        assert sorted(os.listdir(tmp_path)) == ["kept.h5"]
+    folder = tmp_path / "sweep"
+    process = run_module("petsc_rod.sweep", ["-rod_system", held, "-rod_system_watch_circle",
+                                             "Body1,1e5", "-sweep_offsets", "0,1",
+                                             "-sweep_offset_of", "Body1", "-sweep_output",
+                                             str(folder)], ranks)
+    assert process.returncode == 2, describe(process)
+    assert process.stdout.splitlines() == [
+        f"petsc_rod.sweep: error: -rod_system_watch_circle 'Body1,1e5': "
+        f"{why.format('x and y')}"], describe(process)
+    assert not folder.exists()
+
+
 def test_a_line_too_short_after_the_options_names_them(tmp_path):
     """A line that cannot reach its ends once -rod_system_line_length or
     -rod_system_offset changed it (a strain above any line type's to stretch to them):
