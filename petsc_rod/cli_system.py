@@ -68,7 +68,9 @@ SEABED_NAMES = Names({**{name.removeprefix("rod_"): f"-{name}" for name in SEABE
 # sea surface, z = 0 (docs/systems.md, "The sea of a system's lines"); its drag on each
 # line from the line type's Cd and Diam, on each free point from its CdA.
 CURRENT_OPTIONS = ("rod_current", "rod_current_profile")
-CURRENT_NAMES = Names({"current": "-rod_current", "current_profile": "-rod_current_profile"},
+CURRENT_NAMES = Names({"current": "-rod_current", "current_profile": "-rod_current_profile",
+                       "line_types": "the -rod_system file's LINE TYPES",
+                       "sections": "the -rod_system file's LINES (UnstrLen)"},
                       FIELD_NAMES.__getitem__)
 
 
@@ -215,8 +217,9 @@ def in_current(values, given, system):
     """``system`` in the current of -rod_current (ux,uy,uz, m/s, uniform) or of
     -rod_current_profile's rows (depth below the sea surface z = 0, m; ux, uy, uz, m/s),
     given in ``values`` (scene_options.current_from_options), the file's sea kept
-    (Environment.current), checked again (System.check, those options named in its
-    refusals), and refused where it pushes nothing: no line of a line type with a Cd
+    (Environment.current), checked again (System.check, those options and the file's
+    columns named in its refusals: a current whose drag on a line is above the model's
+    bound, system_check.check_lines), and refused where it pushes nothing: no line of a line type with a Cd
     (held_line.line_sea) and no free point with a CdA (the drag's only other place);
     ``system`` itself where neither is given."""
     current = current_from_options(values, given)

@@ -1,7 +1,9 @@
 """Every check that decides whether a System (model/system.py) can be solved, before any
 line is meshed: the names, what each line's ends are connected to, each line's own
-checks (those of a single line, model/model.py), a line too short for the held points it
-joins, a point without a line, and a body's degree of freedom that nothing restores.
+checks (those of a single line, model/model.py, and of its derived forces that do not
+depend on where its ends are: a current's drag, the applied force, model/derived.py), a
+line too short for the held points it joins, a point without a line, and a body's degree
+of freedom that nothing restores.
 Each refusal is one RodInputError saying what is wrong and how to fix it.
 
 The seabed under a sloped or profiled sea is checked per line where the line is compiled
@@ -12,7 +14,7 @@ import numpy as np
 
 from petsc_rod.errors import RodInputError
 from petsc_rod.model.end import End
-from petsc_rod.model.derived import TAUT_GAP
+from petsc_rod.model.derived import TAUT_GAP, Loads, check_applied_forces
 from petsc_rod.model.model import Span, check_pipe, check_sea, check_span
 from petsc_rod.model.values import MAX_STRAIN
 
@@ -172,18 +174,29 @@ def check_connections(line, nodes):
 def check_lines(system, names):
     """Each line's own checks as a single line's (model.check_span, check_pipe), on a
     Span pinned at both ends whose positions are left to the system (the chord between
-    held points: check_held_spans), and the sea's with all of them (check_sea)."""
-    spans = []
-    for line in system.lines:
-        span = Span(line.line, End("pin"), End("pin"), tuple(line.attachments))
-        try:
-            check_span(span, system.environment, names)
-            if span.sections:
-                check_pipe(span.line, names)
-        except RodInputError as error:
-            raise RodInputError(f"line {line.name}: {error}") from None
-        spans.append(span)
+    held points: check_held_spans), the sea's with all of them (check_sea), then each
+    line's derived forces in the system's sea (derived.check_applied_forces: a current's
+    largest drag, the applied force; the line's build checks them again, with the
+    model's names), so that the option that gave the current is the one named
+    (``names``: the command line's)."""
+    spans = [Span(line.line, End("pin"), End("pin"), tuple(line.attachments))
+             for line in system.lines]
+    for line, span in zip(system.lines, spans):
+        of_line(line, check_span, span, system.environment, names)
+        if span.sections:
+            of_line(line, check_pipe, span.line, names)
     check_sea(system.environment, spans, names)
+    for line, span in zip(system.lines, spans):
+        of_line(line, lambda: check_applied_forces(Loads.of(span, system.environment),
+                                                   names))
+
+
+def of_line(line, check, *args):
+    """``check(*args)``, its RodInputError's message led by the SystemLine's name."""
+    try:
+        check(*args)
+    except RodInputError as error:
+        raise RodInputError(f"line {line.name}: {error}") from None
 
 
 def check_points(system):

@@ -284,6 +284,36 @@ def test_a_line_s_own_checks_name_the_line():
         "Environment.seabed_profile")
 
 
+def test_a_current_too_strong_for_a_line_is_refused_before_it_is_built():
+    """The lines' derived forces in the system's current (derived.check_applied_forces)
+    checked by System.check, naming the line and the field the names give: a chain of
+    Cd 1.2, D 0.1 m in 1025 kg/m^3 (c = 61.5 kg/m^2) under 1e15 m/s drags 6.15e31 N/m,
+    above the bound 1e30 (it was refused only where the line was built, naming no
+    line; the command line names its option: test_system_current_cli.py); 1e13 m/s
+    (6.15e27 N/m) over 600 m, 3.69e30 N, is the applied force's refusal."""
+    from petsc_rod.model.names import FIELD_NAMES, Names
+    dragged = dataclasses.replace(CHAIN, cd=1.2)
+    lines = tuple(dataclasses.replace(line, line=Line([(dragged, 600.0)], element_length=10.0))
+                  for line in spread().lines)
+    system = spread(lines=lines, environment=Environment(seabed=-200.0,
+                                                         current=(1e15, 0.0, 0.0)))
+    assert refused(system) == (
+        "line L1: Environment.current with the line types' cd and drag_d (the LineTypes): "
+        "the largest drag c max |v|^2 = 6.15e+31 N/m is above 1e+30; give the current in "
+        "m/s")
+    option = Names({"current": "-rod_current"}, FIELD_NAMES.__getitem__)
+    with pytest.raises(RodInputError, match=r"^line L1: -rod_current with .* 6.15e\+31 N/m"):
+        system.check(option)
+    slower = dataclasses.replace(system, environment=Environment(seabed=-200.0,
+                                                                 current=(1e13, 0.0, 0.0)))
+    assert refused(slower).startswith(
+        "line L1: Environment.current with the line types' cd and drag_d (the LineTypes) and "
+        "Line.sections: the applied force (int |f| dS + the end forces + the drag) is "
+        "3.69e+30 N, above 1e+30")
+    dataclasses.replace(system, environment=Environment(seabed=-200.0,
+                                                        current=(1.0, 0.0, 0.0))).check()
+
+
 def test_a_held_point_below_the_flat_seabed_is_refused():
     message = refused(spread(environment=Environment(seabed=-199.0)))
     assert message == ("point A1 (fixed) is held at z = -200 m, 1 m below the seabed "
