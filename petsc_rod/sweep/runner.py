@@ -20,7 +20,9 @@ the table of what ran.
 
 Exit code: 0 when every case converged, 3 when some did not (the table says which and
 why), 2 for bad sweep input before any run, 128 + n when a signal stopped a case (the
-sweep stops there).
+sweep stops there); a case whose record says the sweep ``stops`` (a system's case whose
+lines' modes failed: sweep/system.py) ends it with that case's exit code, 4. A stopped
+sweep's summary says so in its title and its record in ``stopped``.
 """
 
 import difflib
@@ -376,6 +378,7 @@ class Sweep:
         self.scales = sweep_cases.spreads([self.swept(c) for c in cases])
         self.records = []
         self.converged = []                      # (case, its file) of the converged cases
+        self.stopped = ""                        # why the sweep ended before its last case
         # where the ranks agree on a case's failure (made now: creating it is collective)
         self._failures = comm.tompi4py().Dup()
         self._error = None                       # the last case's failure, its words
@@ -501,12 +504,14 @@ class Sweep:
             return None
         header, rows = self.table()
         folder = self.settings.output
+        stopped = (f"; stopped {self.stopped}; {len(self.cases) - len(self.records)} "
+                   "case(s) not run" if self.stopped else "")
         summary.write_csv(os.path.join(folder, "summary.csv"), header, rows)
         summary.write_markdown(os.path.join(folder, "summary.md"), header, rows,
-                               title=f"Sweep of {len(self.cases)} case(s){self.of}")
+                               title=f"Sweep of {len(self.cases)} case(s){self.of}{stopped}")
         summary.write_record(os.path.join(folder, "sweep.json"), {
             "base_options": self.base, "varied": self.varied, "cases": self.records,
-            **self.record_entries,
+            **self.record_entries, **({"stopped": stopped[2:]} if stopped else {}),
             "settings": {k: list(v) if isinstance(v, tuple) else v
                          for k, v in vars(self.settings).items()}})
         return summary.markdown(header, rows)
@@ -572,15 +577,22 @@ def run_cases(comm, sweep, settings, lock):
         for number, case in enumerate(made, start=1):
             received = interrupts.received()
             if received:
-                say(f"petsc_rod.sweep: stopped by {Interrupts.name(received)} before case "
-                    f"{case.name}")
+                sweep.stopped = f"by {Interrupts.name(received)} before case {case.name}"
+                say(f"petsc_rod.sweep: stopped {sweep.stopped}")
                 stopped = 128 + received
                 break
             record = sweep.run_case(number, case)
             sweep.records.append(record)
-            sweep.write()
-            if record["code"] >= 128:
+            if record["code"] >= 128 or record.get("stops"):
+                sweep.stopped = (f"after case {case.name}: {record['stops']}"
+                                 if record.get("stops") else
+                                 f"by {Interrupts.name(record['code'] - 128)} during "
+                                 f"case {case.name}")
+                if record.get("stops"):
+                    say(f"petsc_rod.sweep: stopped {sweep.stopped}")
                 stopped = record["code"]
+            sweep.write()
+            if stopped is not None:
                 break
     sweep.destroy()
     text = sweep.write()

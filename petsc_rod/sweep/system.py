@@ -19,6 +19,13 @@ system's result file); after each, DIR/summary.csv, DIR/summary.md and DIR/sweep
 are rewritten on rank 0 with a row per case: the bodies' positions, each line's
 fairlead tension and the largest tension over the lines.
 
+A case whose lines' modes fail in their eigensolver (analysis/modes.ModesFailed: an
+-rod_modes_eps_* or -rod_modes_st_* setting SLEPc refuses) stops the sweep there, after
+its one line, exit 4 (runner.run_cases, as a stop signal): every case asks for the
+same modes with the same options, so each later one would fail alike, each after a
+failed PETSc solve whose state stays in the process; the summary keeps the cases run and
+says that the sweep stopped and how many were not run.
+
 Exit code as runner.run_sweep's: 0 every case converged, 3 some did not (a case whose
 equilibrium, or a case of its watch circle or load-excursion curves, is a saddle of the
 system is such a case: exit 3 as its run alone, cli_system.saddle_error, its file
@@ -32,6 +39,7 @@ import sys
 import numpy as np
 from petsc4py import PETSc
 
+from petsc_rod.analysis.modes import ModesFailed
 from petsc_rod.api.system_run import run_system
 from petsc_rod.cli.options import check_same_on_every_rank, read_options, values_of
 from petsc_rod.cli.options_files import every_options_file
@@ -171,6 +179,7 @@ class SystemSweep(Sweep):
         super().__init__(comm, settings, cases, base)
         self.interrupts = None
         self.solver = None
+        self._stops = None
 
     def drop_solver(self):
         if self.solver is not None:
@@ -204,6 +213,11 @@ class SystemSweep(Sweep):
         code, results = self._run(case, made)
         start = ("from the last case" if warm else
                  "own start (its lines differ)" if relined else "own start")
+        if self._stops:
+            # the modes' options are every case's: no retry, no next case
+            self.drop_solver()
+            record.update(code=code, start=start, error=self._error, stops=self._stops)
+            return record
         if warm and code in (3, 4, FAILED) and self.settings.retry:
             self.say(f"sweep: case {case.name}: the warm start ended with exit {code}; "
                      "again from the case's own start")
@@ -228,9 +242,11 @@ class SystemSweep(Sweep):
 
     def _run(self, case, made):
         """(exit code, SystemResults or None) of the system's run of ``case`` on the
-        kept solver (made first where there is none). Collective."""
+        kept solver (made first where there is none); a ModesFailed (on every rank:
+        api/system_run.line_modes shares it) sets ``_stops``, why the sweep ends after
+        this case (module docstring). Collective."""
         system, notes, text, settings, options, sweeps, modes, body_modes = made
-        self._error = None
+        self._error = self._stops = None
         try:
             if self.solver is None:
                 laid = on_every_rank(self.comm, laid_system, values_of(self.base)[0],
@@ -243,6 +259,13 @@ class SystemSweep(Sweep):
             # a saddle or a sweep's gap: the case's run alone's exit 3 (cli_system.run),
             # its file kept
             return finished_error(results, self.say, self.file(case)), results
+        except ModesFailed as error:
+            self.say(f"petsc_rod: error: {error}")
+            self._error = "the modes' eigensolver failed"
+            self._stops = ("the lines' modes failed in their eigensolver, and every case "
+                           "asks for the same modes with the same options (-rod_modes*): "
+                           "each would fail alike")
+            return error.exit_code, None
         except RodError as error:
             self.say(f"petsc_rod: error: {error}")
             return error.exit_code, None

@@ -8,6 +8,7 @@ tension); bad sweep input in one line, exit 2. Small decks of tests/data/moordyn
 10 m elements. Spawns processes: marked ``serial``."""
 
 import csv
+import json
 import os
 
 import h5py
@@ -215,3 +216,38 @@ def test_bad_system_sweep_input_is_one_line_and_exit_2(tmp_path, args, message):
     lines = process.stdout.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("petsc_rod.sweep: error: ")
     assert message in lines[0] and "Traceback" not in process.stderr
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_the_lines_modes_failing_stop_the_sweep_at_that_case(tmp_path, ranks):
+    """-rod_modes with -rod_modes_st_type cayley (SLEPc refuses a Cayley transform of
+    shift 0: analysis/modes.ModesFailed) on every case of a 3-case offset sweep: the
+    first case's one line, the sweep stopped there (the same modes' options would fail
+    every case alike, each after PETSc's failed solve), exit 4, no case file, the
+    summary titled stopped with its one row and the record's ``stopped``. Before: every
+    case ran and failed alike (exit 4 each, status diverged) and the sweep exited 3."""
+    folder = tmp_path / "out"
+    process = sweep(folder, HELD, ranks, "-sweep_offsets", "0,1,2", "-sweep_offset_of",
+                    "Body1", "-rod_modes", "2", "-rod_modes_st_type", "cayley")
+    assert process.returncode == 4, describe(process)
+    said = [line for line in process.stdout.splitlines() if line.startswith("petsc_rod")]
+    why = ("the lines' modes failed in their eigensolver, and every case asks for the "
+           "same modes with the same options (-rod_modes*): each would fail alike")
+    assert said[2:4] == [
+        "petsc_rod: error: line Line1: the modes' eigensolver (SLEPc) failed: Values of "
+        "shift and antishift cannot be zero simultaneously; check the -rod_modes_eps_* and "
+        "-rod_modes_st_* options",
+        f"petsc_rod.sweep: stopped after case offset0: {why}"], describe(process)
+    assert said[-1] == ("petsc_rod.sweep: 0 of 3 case(s) converged; not: offset0; 2 not "
+                        f"run; summary in {folder / 'summary.md'}"), describe(process)
+    assert "sweep: case 2/3" not in process.stdout and "Traceback" not in process.stderr
+    assert sorted(os.listdir(folder)) == ["summary.csv", "summary.md", "sweep.json"]
+    rows = summary_rows(folder)
+    assert list(rows) == ["offset0"]
+    assert (rows["offset0"]["exit"], rows["offset0"]["status"]) == (
+        "4", "failed (the modes' eigensolver failed)")
+    stopped = f"stopped after case offset0: {why}; 2 case(s) not run"
+    assert (folder / "summary.md").read_text().splitlines()[0] == (
+        f"# Sweep of 3 case(s) of a system; {stopped}")
+    with open(folder / "sweep.json", encoding="utf-8") as f:
+        assert json.load(f)["stopped"] == stopped

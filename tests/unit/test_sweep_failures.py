@@ -26,22 +26,23 @@ def folder(tmp_path_factory):
     return comm.bcast(path, root=0)
 
 
-def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch):
+def sweep_in_process(folder, names, outcome, monkeypatch):
+    """(exit code, the cases run, the output folder) of a sweep of the cases ``names``
+    (-rod_length 1, 2, ...) whose runs are ``outcome(name)`` (an exit code; it may
+    raise). Collective."""
     comm = PETSc.COMM_WORLD
     cases = os.path.join(folder, "cases.txt")
     if comm.getRank() == 0:
         with open(cases, "w") as f:
             f.write("name rod_length\n" + "".join(f"{name} {i + 1}\n"
-                                                   for i, name in enumerate(CASES)))
+                                                   for i, name in enumerate(names)))
     comm.tompi4py().Barrier()
     ran = []
 
     def run(comm, texts):
         name = os.path.basename(texts["rod_output"])[:-3]
         ran.append(name)
-        if CASES[name] is not None:
-            raise CASES[name]
-        return 0
+        return outcome(name)
 
     monkeypatch.setattr(runner, "run", run)
     output = os.path.join(folder, "out")
@@ -50,10 +51,21 @@ def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch)
     for name, value in options.items():
         database.setValue(name, value)
     try:
-        code = runner.run_sweep(comm)
+        return runner.run_sweep(comm), ran, output
     finally:
         for name in options:
             database.delValue(name)
+
+
+def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch):
+    comm = PETSc.COMM_WORLD
+
+    def outcome(name):
+        if CASES[name] is not None:
+            raise CASES[name]
+        return 0
+
+    code, ran, output = sweep_in_process(folder, list(CASES), outcome, monkeypatch)
     assert code == 3
     assert ran == list(CASES)
     if comm.getRank() == 0:
@@ -67,6 +79,25 @@ def test_a_case_that_raises_is_marked_and_the_sweep_goes_on(folder, monkeypatch)
         with open(os.path.join(output, "sweep.json")) as f:
             record = json.load(f)
         assert [case["code"] for case in record["cases"]] == [0, 1, 1, 0]
+
+
+def test_a_case_stopped_by_a_signal_ends_the_sweep_and_its_summary_says_so(folder,
+                                                                           monkeypatch):
+    """A case's run that a SIGTERM stopped (exit 143): the sweep ends there with 143,
+    the next cases not run, the summary's title and the record's ``stopped`` saying
+    where and how many were not run (a table that is not the whole sweep's)."""
+    code, ran, output = sweep_in_process(
+        folder, ["first", "stopped", "third", "fourth"],
+        lambda name: 143 if name == "stopped" else 0, monkeypatch)
+    assert code == 143 and ran == ["first", "stopped"]
+    if PETSc.COMM_WORLD.getRank() == 0:
+        stopped = "stopped by SIGTERM during case stopped; 2 case(s) not run"
+        with open(os.path.join(output, "summary.md")) as f:
+            assert f.readline() == f"# Sweep of 4 case(s); {stopped}\n"
+        with open(os.path.join(output, "sweep.json")) as f:
+            record = json.load(f)
+        assert record["stopped"] == stopped
+        assert [case["code"] for case in record["cases"]] == [0, 143]
 
 
 def test_an_earlier_sweep_s_file_that_cannot_be_removed_is_one_line_on_every_rank(
