@@ -2,7 +2,8 @@
 line is meshed: the names, what each line's ends are connected to, each line's own
 checks (those of a single line, model/model.py, and of its derived forces that do not
 depend on where its ends are: a current's drag, the applied force, model/derived.py), a
-line too short for the held points it joins, a point without a line, and a body's degree
+current's drag on a free point within the model's bound, a line too short for the held
+points it joins, a point without a line, and a body's degree
 of freedom that nothing restores.
 Each refusal is one RodInputError saying what is wrong and how to fix it.
 
@@ -16,7 +17,7 @@ from petsc_rod.errors import RodInputError
 from petsc_rod.model.end import End
 from petsc_rod.model.derived import TAUT_GAP, Loads, check_applied_forces
 from petsc_rod.model.model import Span, check_pipe, check_sea, check_span
-from petsc_rod.model.values import MAX_STRAIN
+from petsc_rod.model.values import MAX_MAGNITUDE, MAX_STRAIN
 
 # The degrees of freedom of a body, in Body.position's order.
 DOFS = ("x", "y", "z", "roll", "pitch", "yaw")
@@ -80,6 +81,7 @@ def check_system(system, names, made_by=None):
     for line in system.lines:
         check_connections(line, nodes)
     check_lines(system, names)
+    check_point_drag(system, names)
     check_points(system)
     check_held_spans(system, nodes, made_by or {})
     check_seabed_under(system, names)
@@ -189,6 +191,26 @@ def check_lines(system, names):
     for line, span in zip(system.lines, spans):
         of_line(line, lambda: check_applied_forces(Loads.of(span, system.environment),
                                                    names))
+
+
+def check_point_drag(system, names):
+    """Refuse a current whose drag on a free point, 0.5 rho CdA max |v|^2 (N: its drag
+    area CdA, m^2, in the current's fastest row), is above MAX_MAGNITUDE, the bound of
+    the model's numbers (the lines' own: check_lines), naming the point and what gave
+    the current (``names``); a fixed or prescribed point's drag pushes nothing."""
+    rows = system.environment.current_rows()
+    if rows is None:
+        return
+    current = names["current_profile"] if system.environment.profile() is not None \
+        else names["current"]
+    speed = float(np.max(np.sum(np.asarray(rows[1]) ** 2, axis=1)))
+    for point in system.points:
+        drag = 0.5 * system.environment.water_density * point.cda * speed
+        if point.kind == "free" and drag > MAX_MAGNITUDE:
+            raise RodInputError(
+                f"point {point.name}: {current} with its drag area CdA {point.cda:g} m^2: "
+                f"the largest drag 0.5 rho CdA max |v|^2 = {drag:.3g} N is above "
+                f"{MAX_MAGNITUDE:g}; give the current in m/s")
 
 
 def of_line(line, check, *args):

@@ -249,3 +249,13 @@ def test_a_current_too_strong_for_a_line_names_the_option(tmp_path):
         "-rod_system file's LINE TYPES) and the -rod_system file's LINES (UnstrLen): the "
         f"applied force (int |f| dS + the end forces + the drag) is {70 * DRAG * 9e26:.3g} "
         "N, above 1e+30; give loads in N/m, forces in N and lengths in m")
+    # a free point's drag, its tendons of Cd 0 (before: exit 3, no equilibrium found)
+    with open(f"{REPO_ROOT}/tests/data/moordyn/buoy_level.dat", encoding="utf-8") as source:
+        text = source.read()
+    buoy = tmp_path / "buoy.dat"
+    buoy.write_text(text.replace("0          1.2    1.0", "0          0.0    1.0").replace(
+        "-50.0   1000   10      0", "-50.0   1000   10      5"))
+    assert refused(tmp_path, ["-rod_system", str(buoy), "-rod_current", "0,1e15,0"]) == (
+        "petsc_rod: error: point Point2: -rod_current with its drag area CdA 5 m^2: the "
+        "largest drag 0.5 rho CdA max |v|^2 = 2.56e+33 N is above 1e+30; give the current "
+        "in m/s")

@@ -314,6 +314,24 @@ def test_a_current_too_strong_for_a_line_is_refused_before_it_is_built():
                                                         current=(1.0, 0.0, 0.0))).check()
 
 
+def test_a_current_too_strong_for_a_free_point_is_refused():
+    """The buoy of tests/data/moordyn/buoy_level.dat given a drag area of 5000 m^2 in a
+    1e12 m/s current: 0.5 rho CdA |v|^2 = 2.56e30 N, above the bound 1e30, while its
+    tendons' drag (c = 430.5 kg/m^2: 4.3e26 N/m, 2.2e28 N over 49.99 m) is not; it ran
+    into a Newton without an equilibrium. A fixed point's CdA pushes nothing."""
+    from petsc_rod.model.moordyn import read_moordyn
+    buoy, _ = read_moordyn("tests/data/moordyn/buoy_level.dat")
+    points = tuple(dataclasses.replace(p, cda=5000.0) for p in buoy.points)
+    system = dataclasses.replace(buoy, points=points, environment=dataclasses.replace(
+        buoy.environment, current=(0.0, 1e12, 0.0)))
+    assert refused(system) == (
+        "point Point2: Environment.current with its drag area CdA 5000 m^2: the largest "
+        "drag 0.5 rho CdA max |v|^2 = 2.56e+30 N is above 1e+30; give the current in m/s")
+    dataclasses.replace(system, points=tuple(
+        p if p.kind != "free" else dataclasses.replace(p, cda=1000.0)
+        for p in points)).check()
+
+
 def test_a_held_point_below_the_flat_seabed_is_refused():
     message = refused(spread(environment=Environment(seabed=-199.0)))
     assert message == ("point A1 (fixed) is held at z = -200 m, 1 m below the seabed "
