@@ -218,8 +218,9 @@ def in_current(values, given, system):
     -rod_current_profile's rows (depth below the sea surface z = 0, m; ux, uy, uz, m/s),
     given in ``values`` (scene_options.current_from_options), the file's sea kept
     (Environment.current), checked again (System.check, those options and the file's
-    columns named in its refusals: a current whose drag on a line is above the model's
-    bound, system_check.check_lines), and refused where it pushes nothing: no line of a line type with a Cd
+    columns named in its refusals: a current whose drag on a line or a free point is
+    above the model's bound, system_check.check_lines and check_point_drag), and
+    refused where it pushes nothing: no line of a line type with a Cd
     (held_line.line_sea) and no free point with a CdA (the drag's only other place);
     ``system`` itself where neither is given."""
     current = current_from_options(values, given)

@@ -388,13 +388,14 @@ OPTIONS = [
            "always the load continuation from the unloaded system"),
     Option("rod_system_watch_circle", _string, None, "BODY,LOAD[,N]",
            "with -rod_system: after the equilibrium, body BODY's watch circle (a Free "
-           "body: a held one is refused): its position under a horizontal load LOAD (N) turned through N headings (default "
-           "24, every 15 deg), each equilibrium warm from the last; in the result file's "
-           "group system/watch_circle and the table FILE_watch_circle.csv", unit="text"),
+           "body: a held one is refused): its position under a horizontal load LOAD (N) "
+           "turned through N headings (default 24, every 15 deg), each equilibrium warm "
+           "from the last; in the result file's group system/watch_circle and the table "
+           "FILE_watch_circle.csv", unit="text"),
     Option("rod_system_excursion", _string, None, "BODY,LOADMAX[,N[,HEADING,...]]",
            "with -rod_system: after the equilibrium, body BODY's load-excursion curves "
-           "(a Free body: a held one is refused): "
-           "the restoring force against the offset under horizontal loads 0 to LOADMAX "
+           "(a Free body: a held one is refused): the restoring force against the offset "
+           "under horizontal loads 0 to LOADMAX "
            "(N) in N steps (default 10) along each heading (deg from +x towards +y, "
            "default 0); in the result file's group system/excursion and the table "
            "FILE_excursion.csv", unit="text"),

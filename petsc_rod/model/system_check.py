@@ -3,8 +3,8 @@ line is meshed: the names, what each line's ends are connected to, each line's o
 checks (those of a single line, model/model.py, and of its derived forces that do not
 depend on where its ends are: a current's drag, the applied force, model/derived.py), a
 current's drag on a free point within the model's bound, a line too short for the held
-points it joins, a point without a line, and a body's degree
-of freedom that nothing restores.
+points it joins, a point without a line, and a body's degree of freedom that nothing
+restores.
 Each refusal is one RodInputError saying what is wrong and how to fix it.
 
 The seabed under a sloped or profiled sea is checked per line where the line is compiled
@@ -189,8 +189,7 @@ def check_lines(system, names):
             of_line(line, check_pipe, span.line, names)
     check_sea(system.environment, spans, names)
     for line, span in zip(system.lines, spans):
-        of_line(line, lambda: check_applied_forces(Loads.of(span, system.environment),
-                                                   names))
+        of_line(line, check_applied_forces, Loads.of(span, system.environment), names)
 
 
 def check_point_drag(system, names):

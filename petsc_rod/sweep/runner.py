@@ -507,8 +507,8 @@ class Sweep:
         stopped = (f"; stopped {self.stopped}; {len(self.cases) - len(self.records)} "
                    "case(s) not run" if self.stopped else "")
         summary.write_csv(os.path.join(folder, "summary.csv"), header, rows)
-        summary.write_markdown(os.path.join(folder, "summary.md"), header, rows,
-                               title=f"Sweep of {len(self.cases)} case(s){self.of}{stopped}")
+        title = f"Sweep of {len(self.cases)} case(s){self.of}{stopped}"
+        summary.write_markdown(os.path.join(folder, "summary.md"), header, rows, title=title)
         summary.write_record(os.path.join(folder, "sweep.json"), {
             "base_options": self.base, "varied": self.varied, "cases": self.records,
             **self.record_entries, **({"stopped": stopped[2:]} if stopped else {}),

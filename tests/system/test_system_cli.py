@@ -299,10 +299,9 @@ def test_a_sweep_of_a_held_body_is_refused_and_the_output_kept(tmp_path, ranks):
         assert out.read_bytes() == b"an earlier result"
         assert sorted(os.listdir(tmp_path)) == ["kept.h5"]
     folder = tmp_path / "sweep"
-    process = run_module("petsc_rod.sweep", ["-rod_system", held, "-rod_system_watch_circle",
-                                             "Body1,1e5", "-sweep_offsets", "0,1",
-                                             "-sweep_offset_of", "Body1", "-sweep_output",
-                                             str(folder)], ranks)
+    process = run_module("petsc_rod.sweep", [
+        "-rod_system", held, "-rod_system_watch_circle", "Body1,1e5", "-sweep_offsets", "0,1",
+        "-sweep_offset_of", "Body1", "-sweep_output", str(folder)], ranks)
     assert process.returncode == 2, describe(process)
     assert process.stdout.splitlines() == [
         f"petsc_rod.sweep: error: -rod_system_watch_circle 'Body1,1e5': "

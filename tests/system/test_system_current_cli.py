@@ -233,20 +233,22 @@ def test_a_current_too_strong_for_a_line_names_the_option(tmp_path):
     the deck's line type, above the model's bound 1e30) was refused naming
     Environment.current, the API's field, with the reader's notes before it: now the
     option given (-rod_current or -rod_current_profile) and the file's columns, in one
-    line, exit 2, no file; the API keeps its field's name (tests/unit/test_system_model.py)."""
+    line, exit 2, no file; the API keeps its field's name
+    (tests/unit/test_system_model.py)."""
     drag = f"{DRAG * 1e30:.3g}"
     assert drag == "7.38e+31"
     profile = tmp_path / "strong.txt"
     profile.write_text("0 1e15 0 0\n30 1e15 0 0\n")
-    for option, value in (("-rod_current", "1e15,0,0"), ("-rod_current_profile", str(profile))):
+    for option, value in (("-rod_current", "1e15,0,0"),
+                          ("-rod_current_profile", str(profile))):
         assert refused(tmp_path, ["-rod_system", DECK, option, value]) == (
-            f"petsc_rod: error: line Line1: {option} with the line types' cd and drag_d (the "
-            f"-rod_system file's LINE TYPES): the largest drag c max |v|^2 = {drag} N/m is "
-            "above 1e+30; give the current in m/s")
+            f"petsc_rod: error: line Line1: {option} with the line types' cd and drag_d "
+            f"(the -rod_system file's LINE TYPES): the largest drag c max |v|^2 = {drag} "
+            "N/m is above 1e+30; give the current in m/s")
     # below that bound per metre, above it over the line's 70 m: the applied force's check
     assert refused(tmp_path, ["-rod_system", DECK, "-rod_current", "3e13,0,0"]) == (
-        "petsc_rod: error: line Line1: -rod_current with the line types' cd and drag_d (the "
-        "-rod_system file's LINE TYPES) and the -rod_system file's LINES (UnstrLen): the "
+        "petsc_rod: error: line Line1: -rod_current with the line types' cd and drag_d "
+        "(the -rod_system file's LINE TYPES) and the -rod_system file's LINES (UnstrLen): the "
         f"applied force (int |f| dS + the end forces + the drag) is {70 * DRAG * 9e26:.3g} "
         "N, above 1e+30; give loads in N/m, forces in N and lengths in m")
     # a free point's drag, its tendons of Cd 0 (before: exit 3, no equilibrium found)

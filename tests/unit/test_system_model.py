@@ -293,7 +293,8 @@ def test_a_current_too_strong_for_a_line_is_refused_before_it_is_built():
     (6.15e27 N/m) over 600 m, 3.69e30 N, is the applied force's refusal."""
     from petsc_rod.model.names import FIELD_NAMES, Names
     dragged = dataclasses.replace(CHAIN, cd=1.2)
-    lines = tuple(dataclasses.replace(line, line=Line([(dragged, 600.0)], element_length=10.0))
+    lines = tuple(dataclasses.replace(line, line=Line([(dragged, 600.0)],
+                                                      element_length=10.0))
                   for line in spread().lines)
     system = spread(lines=lines, environment=Environment(seabed=-200.0,
                                                          current=(1e15, 0.0, 0.0)))
@@ -302,13 +303,14 @@ def test_a_current_too_strong_for_a_line_is_refused_before_it_is_built():
         "the largest drag c max |v|^2 = 6.15e+31 N/m is above 1e+30; give the current in "
         "m/s")
     option = Names({"current": "-rod_current"}, FIELD_NAMES.__getitem__)
-    with pytest.raises(RodInputError, match=r"^line L1: -rod_current with .* 6.15e\+31 N/m"):
+    with pytest.raises(RodInputError,
+                       match=r"^line L1: -rod_current with .* 6.15e\+31 N/m"):
         system.check(option)
     slower = dataclasses.replace(system, environment=Environment(seabed=-200.0,
                                                                  current=(1e13, 0.0, 0.0)))
     assert refused(slower).startswith(
-        "line L1: Environment.current with the line types' cd and drag_d (the LineTypes) and "
-        "Line.sections: the applied force (int |f| dS + the end forces + the drag) is "
+        "line L1: Environment.current with the line types' cd and drag_d (the LineTypes) "
+        "and Line.sections: the applied force (int |f| dS + the end forces + the drag) is "
         "3.69e+30 N, above 1e+30")
     dataclasses.replace(system, environment=Environment(seabed=-200.0,
                                                         current=(1.0, 0.0, 0.0))).check()
