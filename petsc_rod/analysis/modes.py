@@ -122,9 +122,18 @@ class ModesFailed(RodDivergedError):
         """The failure of a system's line ``name``, from ``text``, the message of the
         ModesFailed its eigensolver raised (str(): the lines' share carries it as text
         to the ranks without the line, api/system_run.line_modes): "line NAME: TEXT"."""
+        return cls._of_message(f"line {name}: {text}")
+
+    @classmethod
+    def _of_message(cls, message):
+        """A ModesFailed whose message is ``message`` as it is."""
         failed = cls.__new__(cls)
-        RodDivergedError.__init__(failed, f"line {name}: {text}")
+        RodDivergedError.__init__(failed, message)
         return failed
+
+    def __reduce__(self):
+        """Pickled (an MPI share of it) as its message, which __init__ would wrap again."""
+        return ModesFailed._of_message, (str(self),)
 
 
 @contextlib.contextmanager

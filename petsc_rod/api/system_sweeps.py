@@ -14,9 +14,9 @@ equilibrium but without a lowest eigenvalue (its verdict none: a stiffness that 
 finite) keeps its row, NaN in the file's ``lowest_eigenvalue`` and an empty cell in the
 table.
 
-A sweep needs a body its load moves: one held where the load pushes it (a Coupled,
-CoupledPinned or Fixed body of a MoorDyn file) is refused in one line before anything
-is solved (swept_body: the option named on the command line, parse_sweeps; the
+A sweep needs a body its load moves: one held wherever its headings push it (a
+Coupled, CoupledPinned or Fixed body of a MoorDyn file) is refused in one line before
+anything is solved (swept_body: the option named on the command line, parse_sweeps; the
 ``Sweeps`` field through the API, check_sweeps), as no offset but 0 m could come out.
 
 Each case carries the system's verdict (system/excursions.py): the table's ``verdict``
@@ -136,24 +136,33 @@ def parse_sweeps(watch_text, excursion_text, system):
 
 
 # The API's form of each sweep (check_sweeps' refusal of another).
-FORMS = {"watch_circle": "(body name, load N, headings deg)",
-         "excursion": "(body name, loads N, headings deg)"}
+FORMS = {"watch_circle": "(body name, load N, headings deg): a finite positive load and "
+                         "at least one finite heading",
+         "excursion": "(body name, loads N, headings deg): at least one load, each finite "
+                      "and not negative, and at least one finite heading"}
 
 
 def check_sweeps(sweeps, system):
     """RodInputError in one line, naming the ``Sweeps`` field, for a sweep of ``sweeps``
-    that ``system`` cannot run: not of its form (FORMS), or of a body it does not have
-    or holds where the load pushes it (swept_body); before anything is solved
-    (api/system_run.run_system)."""
+    that ``system`` cannot run: not of its form (FORMS: the numbers the command line's
+    parse_sweeps accepts), or of a body it does not have or holds wherever the load
+    pushes it (swept_body); before anything is solved (api/system_run.run_system)."""
     for kind, form in FORMS.items():
         given = getattr(sweeps, kind, None)
         if given is None:
             continue
         try:
-            body, _, headings = given
+            body, loads, headings = given
+            loads = np.asarray(loads, dtype=float)
             headings = np.asarray(headings, dtype=float)
         except (TypeError, ValueError):
             raise RodInputError(f"Sweeps.{kind}: expected {form}") from None
+        circle = kind == "watch_circle"
+        if (loads.ndim != (0 if circle else 1) or headings.ndim != 1 or not headings.size
+                or not loads.size or not np.all(np.isfinite(loads))
+                or not np.all(np.isfinite(headings))
+                or np.any(loads <= 0 if circle else loads < 0)):
+            raise RodInputError(f"Sweeps.{kind}: expected {form}")
         swept_body(f"Sweeps.{kind}", body, headings, system)
 
 

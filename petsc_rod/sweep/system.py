@@ -30,7 +30,8 @@ Exit code as runner.run_sweep's: 0 every case converged, 3 some did not (a case 
 equilibrium, or a case of its watch circle or load-excursion curves, is a saddle of the
 system is such a case: exit 3 as its run alone, cli_system.saddle_error, its file
 written; so is one whose watch circle or curves left a case without an equilibrium,
-cli_system.gap_error), 2 bad sweep input before any run, 128 + n a stop signal.
+cli_system.gap_error), 2 bad sweep input before any run, 4 a case whose lines' modes
+failed (above: the sweep stops there), 128 + n a stop signal.
 """
 
 import os
@@ -213,17 +214,17 @@ class SystemSweep(Sweep):
         code, results = self._run(case, made)
         start = ("from the last case" if warm else
                  "own start (its lines differ)" if relined else "own start")
-        if self._stops:
-            # the modes' options are every case's: no retry, no next case
-            self.drop_solver()
-            record.update(code=code, start=start, error=self._error, stops=self._stops)
-            return record
-        if warm and code in (3, 4, FAILED) and self.settings.retry:
+        if warm and code in (3, 4, FAILED) and self.settings.retry and not self._stops:
             self.say(f"sweep: case {case.name}: the warm start ended with exit {code}; "
                      "again from the case's own start")
             self.drop_solver()
             start = f"own start (warm: exit {code})"
             code, results = self._run(case, made)
+        if self._stops:
+            # the modes' options are every case's: no (further) retry, no next case
+            self.drop_solver()
+            record.update(code=code, start=start, error=self._error, stops=self._stops)
+            return record
         if code != 0:
             self.drop_solver()
         record.update(code=code, start=start if code != 2 else "")

@@ -30,8 +30,8 @@ the lowest eigenvalue of its scaled stiffness, N/m (NaN where there is none).
 
 A load on a body held where it pushes it (Body.held in x or y along a heading: a
 Coupled, CoupledPinned or Fixed body of a MoorDyn file) moves nothing: its position
-there is imposed, every offset would be 0 m and every case the rest. Such a sweep is
-refused (held_text) before anything is solved.
+there is imposed. A sweep none of whose headings moves the body (every offset 0 m,
+every case the rest) is refused (held_text) before anything is solved.
 
 A case no equilibrium is found for (the solver's RodDivergedError: a line that cannot
 reach, a load beyond what the lines hold) is a gap in the results (NaN, its reason in
@@ -298,19 +298,25 @@ def loaded(system, body, force):
 
 
 def held_text(body, headings):
-    """Why a horizontal load along ``headings`` (deg) cannot sweep the Body ``body``: the
-    axes among x and y that some heading's direction e_h = (cos h, sin h, 0) pushes it
-    along (a cosine above NO_PUSH) and that it holds (Body.held), where its position is
-    imposed and the load moves nothing; '' where it is free along each axis pushed."""
+    """Why a horizontal load along ``headings`` (deg) cannot sweep the Body ``body``: at
+    no heading does the direction e_h = (cos h, sin h, 0) push it along an axis among x
+    and y that it leaves free (a cosine above NO_PUSH on an axis Body.held does not
+    hold), so its position is imposed wherever the load pushes it and every offset
+    would be 0 m; '' where some heading moves it (a body held in x alone is swept at
+    any heading but 0 and 180 deg, where its offset is 0)."""
     angles = np.radians(np.asarray(headings, dtype=float).ravel())
-    pushed = np.any(np.abs([np.cos(angles), np.sin(angles)]) > NO_PUSH, axis=1)   # (2,)
-    held = [axis for axis, push, hold in zip("xy", pushed, body.held[:2]) if push and hold]
+    pushed = np.abs([np.cos(angles), np.sin(angles)]) > NO_PUSH            # (2, headings)
+    holds = np.asarray(body.held[:2], dtype=bool)
+    if np.any(pushed & ~holds[:, None]):
+        return ""
+    held = [axis for axis, push, hold in zip("xy", pushed.any(axis=1), holds)
+            if push and hold]
     if not held:
         return ""
     return (f"body {body.name} is held in {' and '.join(held)} (Coupled, CoupledPinned "
             "or Fixed in a MoorDyn file; Body.held): its position there is imposed, so "
-            "the load moves nothing and every offset would be 0 m; sweep a body free "
-            "where the load pushes it (Free in the file)")
+            "the load moves it at no heading and every offset would be 0 m; sweep a "
+            "body free where the load pushes it (Free in the file)")
 
 
 def _direction(heading):

@@ -1369,7 +1369,7 @@ class HeldLine:
     def _check_exact(self):
         """Refuse a stiffness where it would not be exact (module docstring)."""
         if any(not term.held_exact for term in self.friction):
-            raise RodInputError(f"line {self.name}: seabed friction with two coefficients "
+            raise RodInputError(f"{self.name}: seabed friction with two coefficients "
                                 "(axial and lateral: MoorDyn's MU_KA and MU_KT) gives no "
                                 "exact stiffness for the system's Newton: give the "
                                 "friction one coefficient")
@@ -1383,7 +1383,7 @@ class HeldLine:
         if loose:
             loads = "; ".join(dict.fromkeys(term.newton_gap or type(term).__name__
                                             for term in loose))
-            raise RodInputError(f"line {self.name}: loads outside the Newton steps "
+            raise RodInputError(f"{self.name}: loads outside the Newton steps "
                                 f"({loads}) give no exact stiffness for the system's "
                                 "Newton")
 

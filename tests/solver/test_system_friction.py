@@ -269,6 +269,7 @@ def test_two_coefficients_are_refused_in_one_line_naming_the_line(case):
                                           seabed_profile=level, seabed_origin=(0.0, 0.0))
     ends = (np.array([-32.5, 56.292, -30.0]), np.array([-2.5, 4.33, -5.0]))
     message = refusal(system.lines[1], environment, ends, HeldLine.stiffness)
+    assert message.startswith("line Line2: seabed friction with two coefficients")
     assert "one coefficient" in message
     assert friction_notes(frictional(None)) == ()
     (note,) = friction_notes(system)

@@ -140,6 +140,8 @@ def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
     lines only) ends the system's run on every rank, the line named (exit 4's
     RodDivergedError), where the other ranks would wait for its modes in the lines'
     share."""
+    import pickle
+
     from petsc_rod.analysis.modes import ModesFailed
     from petsc_rod.api import system_run
     from petsc_rod.errors import RodDivergedError
@@ -163,3 +165,6 @@ def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
         "-rod_modes_st_* options")
     names = PETSc.COMM_WORLD.tompi4py().allgather(text)
     assert len(set(names)) == 1                     # the same line named on every rank
+    # a pickle of it (an MPI share's) keeps its message, not wrapped again
+    shared = pickle.loads(pickle.dumps(raised.value))
+    assert isinstance(shared, ModesFailed) and str(shared) == text

@@ -208,7 +208,7 @@ def test_a_stop_signal_during_a_line_s_walk_ends_the_walk_and_the_run(tmp_path):
 
 def test_a_sweep_of_a_held_body_is_refused_before_anything_is_solved(tmp_path):
     """solve_system's watch circle of the coupled body of small_spread.dat (its offsets
-    all 0 m before) refused on every rank, naming Sweeps.watch_circle, the output that
+    would all be 0 m) refused on every rank, naming Sweeps.watch_circle, the output that
     existed kept; the same through system/excursions.watch_circle on a solver, before
     its rest is solved. Serially and under mpiexec -n 2."""
     from petsc_rod.api import Sweeps, read_moordyn

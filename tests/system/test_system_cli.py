@@ -283,9 +283,9 @@ def test_a_sweep_of_a_held_body_is_refused_and_the_output_kept(tmp_path, ranks):
     out = tmp_path / "kept.h5"
     out.write_bytes(b"an earlier result")
     why = ("body Body1 is held in {} (Coupled, CoupledPinned or Fixed in a MoorDyn file; "
-           "Body.held): its position there is imposed, so the load moves nothing and every "
-           "offset would be 0 m; sweep a body free where the load pushes it (Free in the "
-           "file)")
+           "Body.held): its position there is imposed, so the load moves it at no heading "
+           "and every offset would be 0 m; sweep a body free where the load pushes it (Free "
+           "in the file)")
     for option, value, axes in (("watch_circle", "Body1,1e5,4", "x and y"),
                                 ("excursion", "Body1,1e5,2,90", "y")):
         process = run_petsc_rod(["-rod_system", held, f"-rod_system_{option}", value,

@@ -152,3 +152,57 @@ def test_a_case_s_options_reach_its_run_as_values_not_the_database(folder, monke
         for name in options:
             database.delValue(name)
     assert seen == [("2", "1e-9", False, "nrichardson"), ("3", "1e-9", False, "anderson")]
+
+
+def test_a_system_case_whose_retry_fails_its_modes_stops_the_sweep(folder, monkeypatch):
+    """A system's sweep (sweep/system.py) whose warm case ends with exit 3 and whose
+    retry from the case's own start fails in the modes' eigensolver: the sweep stops
+    there (exit 4, the third case not run, the record's ``stopped``), as when the first
+    run of a case fails so. The system's run replaced by a stub (SystemSweep._run): no
+    solve."""
+    from petsc_rod.sweep import system as system_sweep
+
+    runs = []
+
+    class Kept:                              # a solver kept for the next case's warm start
+        def __init__(self, system):
+            self.system = system
+
+        def destroy(self):
+            pass
+
+    def run(self, case, made):
+        runs.append(case.name)
+        self._error = self._stops = None
+        if len(runs) == 1:                   # the first case converges, its solver kept
+            self.solver = Kept(made[0])
+            return 0, None
+        if len(runs) == 2:                   # the second, warm: not converged
+            return 3, None
+        self._error = "the modes' eigensolver failed"      # its retry: the modes fail
+        self._stops = "the lines' modes failed in their eigensolver (a stub)"
+        return 4, None
+
+    monkeypatch.setattr(system_sweep.SystemSweep, "_run", run)
+    monkeypatch.setattr(system_sweep, "case_numbers", lambda system, results: {})
+    output = os.path.join(folder, "out")
+    database = PETSc.Options()
+    deck = os.path.join(os.path.dirname(__file__), "..", "data", "moordyn",
+                        "small_free_body.dat")
+    options = {"rod_system": deck, "sweep_offsets": "0,1,2", "sweep_offset_of": "Point1",
+               "sweep_output": output}
+    for name, value in options.items():
+        database.setValue(name, value)
+    try:
+        code = system_sweep.run_system_sweep(PETSc.COMM_WORLD)
+    finally:
+        for name in options:
+            database.delValue(name)
+    assert code == 4 and runs == ["offset0", "heading0_offset1", "heading0_offset1"]
+    if PETSc.COMM_WORLD.getRank() == 0:
+        with open(os.path.join(output, "sweep.json")) as f:
+            record = json.load(f)
+        assert record["stopped"].startswith(
+            "stopped after case heading0_offset1: the lines' modes failed")
+        assert record["stopped"].endswith("; 1 case(s) not run")
+        assert [case["code"] for case in record["cases"]] == [0, 4]

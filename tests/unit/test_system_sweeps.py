@@ -99,16 +99,17 @@ def test_a_sweep_of_a_body_held_where_its_load_pushes_is_refused():
     """The coupled body of small_spread.dat: the options and the API's Sweeps refused in
     one line naming the body and the axes (a held body's offsets are all 0 m); a body
     held in x alone is swept along y (heading 90 deg: cos 90 deg, 6e-17, pushes nothing
-    along x) and refused at 45 deg; the free body of small_free_body.dat is swept."""
+    along x) and at 45 deg (it moves along y), refused at 0 and 180 deg alone; the free
+    body of small_free_body.dat is swept."""
     import dataclasses
     from petsc_rod.api import Sweeps
     from petsc_rod.api.system_sweeps import check_sweeps
     from petsc_rod.system.excursions import held_text
     held, _ = read_moordyn("tests/data/moordyn/small_spread.dat")
     why = ("body Body1 is held in {} (Coupled, CoupledPinned or Fixed in a MoorDyn file; "
-           "Body.held): its position there is imposed, so the load moves nothing and every "
-           "offset would be 0 m; sweep a body free where the load pushes it (Free in the "
-           "file)")
+           "Body.held): its position there is imposed, so the load moves it at no heading "
+           "and every offset would be 0 m; sweep a body free where the load pushes it (Free "
+           "in the file)")
     with pytest.raises(RodInputError) as refused:
         parse_sweeps("Body1,1e5", None, held)
     assert str(refused.value) == ("-rod_system_watch_circle 'Body1,1e5': "
@@ -123,10 +124,23 @@ def test_a_sweep_of_a_body_held_where_its_load_pushes_is_refused():
         check_sweeps(Sweeps(watch_circle=("Body2", 1e5, [0.0])), held)
     with pytest.raises(RodInputError, match=r"Sweeps.watch_circle: expected \(body name"):
         check_sweeps(Sweeps(watch_circle=("Body1", 1e5)), held)
+    free, _ = read_moordyn("tests/data/moordyn/small_free_body.dat")
+    # the numbers parse_sweeps would refuse on the command line, refused by name
+    for kind, bad in (("watch_circle", ("Body1", "big", [0.0])),
+                      ("watch_circle", ("Body1", -1e5, [0.0])),
+                      ("watch_circle", ("Body1", 1e5, None)),
+                      ("watch_circle", ("Body1", 1e5, [np.nan])),
+                      ("watch_circle", ("Body1", 1e5, 4)),
+                      ("watch_circle", ("Body1", 1e5, [])),
+                      ("excursion", ("Body1", [0.0, -1e5], [0.0])),
+                      ("excursion", ("Body1", 1e5, [0.0])),
+                      ("excursion", ("Body1", [0.0, np.inf], [0.0]))):
+        with pytest.raises(RodInputError, match=rf"^Sweeps.{kind}: expected \(body name"):
+            check_sweeps(Sweeps(**{kind: bad}), free)
     body = dataclasses.replace(held.bodies[0], held=(True,) + (False,) * 5)
     assert held_text(body, [90.0, 270.0]) == ""
-    assert held_text(body, [90.0, 45.0]) == why.format("x")
-    free, _ = read_moordyn("tests/data/moordyn/small_free_body.dat")
+    assert held_text(body, [90.0, 45.0]) == held_text(body, [0.0, 90.0]) == ""
+    assert held_text(body, [0.0, 180.0]) == why.format("x")
     check_sweeps(Sweeps(watch_circle=("Body1", 1e5, np.arange(0.0, 360.0, 15.0))), free)
     assert parse_sweeps("Body1,1e5", "Body1,1e5", free)
 
