@@ -504,14 +504,17 @@ class Sweep:
             return None
         header, rows = self.table()
         folder = self.settings.output
-        stopped = (f"; stopped {self.stopped}; {len(self.cases) - len(self.records)} "
+        # the title's last part and the record's "stopped", where the sweep stopped
+        stopped = (f"stopped {self.stopped}; {len(self.cases) - len(self.records)} "
                    "case(s) not run" if self.stopped else "")
         summary.write_csv(os.path.join(folder, "summary.csv"), header, rows)
-        title = f"Sweep of {len(self.cases)} case(s){self.of}{stopped}"
+        title = f"Sweep of {len(self.cases)} case(s){self.of}"
+        if stopped:
+            title += f"; {stopped}"
         summary.write_markdown(os.path.join(folder, "summary.md"), header, rows, title=title)
         summary.write_record(os.path.join(folder, "sweep.json"), {
             "base_options": self.base, "varied": self.varied, "cases": self.records,
-            **self.record_entries, **({"stopped": stopped[2:]} if stopped else {}),
+            **self.record_entries, **({"stopped": stopped} if stopped else {}),
             "settings": {k: list(v) if isinstance(v, tuple) else v
                          for k, v in vars(self.settings).items()}})
         return summary.markdown(header, rows)
@@ -569,7 +572,7 @@ def run_cases(comm, sweep, settings, lock):
         PETSc.Sys.Print(text, comm=comm)
 
     sweep.write()           # the folder is this sweep's from the start
-    stopped = None
+    stop_code = None                # the exit code of a sweep that stopped
     # a stop signal between two cases (each run records its own: cli/signals.py) ends
     # the sweep before the next, as one during a case ends it after that one
     with Interrupts(comm) as interrupts:
@@ -579,7 +582,7 @@ def run_cases(comm, sweep, settings, lock):
             if received:
                 sweep.stopped = f"by {Interrupts.name(received)} before case {case.name}"
                 say(f"petsc_rod.sweep: stopped {sweep.stopped}")
-                stopped = 128 + received
+                stop_code = 128 + received
                 break
             record = sweep.run_case(number, case)
             sweep.records.append(record)
@@ -590,9 +593,9 @@ def run_cases(comm, sweep, settings, lock):
                                  f"case {case.name}")
                 if record.get("stops"):
                     say(f"petsc_rod.sweep: stopped {sweep.stopped}")
-                stopped = record["code"]
+                stop_code = record["code"]
             sweep.write()
-            if stopped is not None:
+            if stop_code is not None:
                 break
     sweep.destroy()
     text = sweep.write()
@@ -601,11 +604,11 @@ def run_cases(comm, sweep, settings, lock):
     failed = [r["name"] for r in sweep.records if r["code"] != 0]
     say(f"petsc_rod.sweep: {len(sweep.records) - len(failed)} of {len(made)} case(s) "
         f"converged" + (f"; not: {', '.join(failed)}" if failed else "")
-        + (f"; {len(made) - len(sweep.records)} not run" if stopped is not None else "")
+        + (f"; {len(made) - len(sweep.records)} not run" if stop_code is not None else "")
         + f"; summary in {os.path.join(settings.output, 'summary.md')}")
     PETSc.Options().setValue("options_left", "0")
     if lock is not None:    # else released when the process ends
         os.close(lock)
-    if stopped is not None:
-        return stopped
+    if stop_code is not None:
+        return stop_code
     return 0 if not failed else RodNotConvergedError.exit_code
