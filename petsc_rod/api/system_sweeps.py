@@ -68,12 +68,21 @@ def _fields(option, text, least, most):
     return fields
 
 
+def _finite(values, floor=None, strict=True):
+    """Whether every one of ``values`` (a number or an array) is finite and, given a
+    ``floor``, above it (``strict``) or not below it: the test of a sweep's numbers, the
+    same on the command line's text (_number) and on the API's Sweeps (check_sweeps)."""
+    values = np.asarray(values, dtype=float)
+    return bool(np.all(np.isfinite(values)) and (
+        floor is None or np.all(values > floor if strict else values >= floor)))
+
+
 def _number(option, text, value, what, positive=True):
     try:
         number = float(value)
     except ValueError:
         number = np.nan
-    if not np.isfinite(number) or (positive and number <= 0):
+    if not _finite(number, 0.0 if positive else None):
         raise RodInputError(f"-{option} {text!r}: {value!r} is not {what}; expected "
                             f"{USAGE[option]}")
     return number
@@ -159,9 +168,8 @@ def check_sweeps(sweeps, system):
             raise RodInputError(f"Sweeps.{kind}: expected {form}") from None
         circle = kind == "watch_circle"
         if (loads.ndim != (0 if circle else 1) or headings.ndim != 1 or not headings.size
-                or not loads.size or not np.all(np.isfinite(loads))
-                or not np.all(np.isfinite(headings))
-                or np.any(loads <= 0 if circle else loads < 0)):
+                or not loads.size or not _finite(headings)
+                or not _finite(loads, 0.0, strict=circle)):     # a load > 0; loads >= 0
             raise RodInputError(f"Sweeps.{kind}: expected {form}")
         swept_body(f"Sweeps.{kind}", body, headings, system)
 
