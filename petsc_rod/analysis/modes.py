@@ -112,28 +112,26 @@ class ModesFailed(RodDivergedError):
     The message is PETSc's, read where the error was raised (petsc4py keeps one
     traceback for all errors, which the EPS's destroy after it rewrites)."""
 
-    def __init__(self, error):
+    def __init__(self, message):
+        """A ModesFailed whose message is ``message`` as it is (of_error, of_line)."""
+        super().__init__(message)
+
+    @classmethod
+    def of_error(cls, error):
         """From the PETSc.Error raised in the eigensolver (solve_modes)."""
-        super().__init__(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
-                         f"check the -{PREFIX}eps_* and -{PREFIX}st_* options")
+        return cls(f"the modes' eigensolver (SLEPc) failed: {petsc_message(error)}; "
+                   f"check the -{PREFIX}eps_* and -{PREFIX}st_* options")
 
     @classmethod
     def of_line(cls, name, text):
         """The failure of a system's line ``name``, from ``text``, the message of the
         ModesFailed its eigensolver raised (str(): the lines' share carries it as text
         to the ranks without the line, api/system_run.line_modes): "line NAME: TEXT"."""
-        return cls._of_message(f"line {name}: {text}")
-
-    @classmethod
-    def _of_message(cls, message):
-        """A ModesFailed whose message is ``message`` as it is."""
-        failed = cls.__new__(cls)
-        RodDivergedError.__init__(failed, message)
-        return failed
+        return cls(f"line {name}: {text}")
 
     def __reduce__(self):
-        """Pickled (an MPI share of it) as its message, which __init__ would wrap again."""
-        return ModesFailed._of_message, (str(self),)
+        """Pickled (an MPI share of it) as its message."""
+        return type(self), (str(self),)
 
 
 @contextlib.contextmanager
@@ -622,7 +620,7 @@ def _pairs(operators, shifted, factor, SLEPc, count, shift, window, extra=0):
             with EVENTS["eps"]:
                 eps.solve()
         except PETSc.Error as error:
-            raise ModesFailed(error) from None
+            raise ModesFailed.of_error(error) from None
         converged = eps.getConverged()
         scale = K.norm(PETSc.NormType.INFINITY)
         values, vectors, masses = [], [], []

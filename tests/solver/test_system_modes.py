@@ -151,7 +151,7 @@ def test_a_line_whose_eigensolver_fails_is_named_on_every_rank(monkeypatch):
     def failing_first_on_the_last_rank(problem, *args, **kwargs):
         calls.append(problem)
         if PETSc.COMM_WORLD.getRank() == last and len(calls) == 1:
-            raise ModesFailed(RuntimeError("[0] a test's"))  # a PETSc.Error's report
+            raise ModesFailed.of_error(RuntimeError("[0] a test's"))  # a PETSc.Error's report
         return real(problem, *args, **kwargs)
 
     monkeypatch.setattr(system_run, "solve_modes", failing_first_on_the_last_rank)
