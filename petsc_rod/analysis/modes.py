@@ -381,11 +381,23 @@ class FactorKSP:
                 ksp.destroy()
 
 
+def start_slepc():
+    """SLEPc, initialised on first use (slepc4py's import): every rank of a run must make
+    this call before any rank's first modes, even where its own lines need none (their
+    modes refused or failed first, or none of the run's lines on that rank). SLEPc
+    initialised on some ranks only leaves the process hanging at its exit: PETSc's
+    clean-up of deferred destructions at finalisation is collective on
+    PETSC_COMM_WORLD, and only the ranks that started SLEPc enter it. Returns the
+    SLEPc module. Collective in that sense."""
+    from slepc4py import SLEPc
+    return SLEPc
+
+
 def check_options(comm):
     """Set up, from the options database, an EPS with the modes' prefix (its ST a shift
     and invert, as solve_modes's) and destroy it: a PETSc.Error for a bad
     -rod_modes_eps_* or -rod_modes_st_* option, found before any work. Collective."""
-    from slepc4py import SLEPc
+    SLEPc = start_slepc()
     eps = SLEPc.EPS().create(comm=comm)
     try:
         eps.getST().setType(SLEPc.ST.Type.SINVERT)
@@ -423,7 +435,7 @@ def solve_modes(problem, count, settings=MassSettings(), band=None):
     sub-bands (_slice), each solved about its middle omega^2 for the many its inertia
     counts (every other eigenvalue is farther from the middle); ``Modes.slices`` names
     those left short. Every pair is verified (_pairs). Collective."""
-    from slepc4py import SLEPc
+    SLEPc = start_slepc()
     if band is None and count < 1:
         raise ValueError(f"solve_modes needs a positive number of modes, got {count}")
     STAGE.push()

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from petsc_rod.analysis.mass import MassSettings
-from petsc_rod.analysis.modes import (ModesFailed, ModesRefused, modes_count,
+from petsc_rod.analysis.modes import (ModesFailed, ModesRefused, modes_count, start_slepc,
                                      solve_modes)
 from petsc_rod.api.results import Results
 from petsc_rod.api.system_sweeps import (Sweeps, check_sweeps, file_group, run_lines,
@@ -203,6 +203,7 @@ def line_modes(solver, count, settings, band=None):
     others learn it from the lines' share, where they would otherwise wait). Collective."""
     if band is None:
         check_line_counts(solver, count, settings)
+    start_slepc()               # on every rank, whatever its lines do (start_slepc)
     mine, seconds = {}, {}
     for k, line in solver.lines.items():
         start = time.perf_counter()

@@ -488,6 +488,43 @@ def test_one_rank_failing_alone_ends_the_system_run(tmp_path, path):
         describe(done)
 
 
+# rank 1's first line's modes fail before that rank has started SLEPc
+MODES_ALONE = """
+from petsc_rod.analysis.modes import ModesFailed
+from petsc_rod.api import system_run
+solve_modes, calls = system_run.solve_modes, []
+def failing_first(problem, *args, **kwargs):
+    calls.append(problem)
+    if PETSc.COMM_WORLD.getRank() == 1 and len(calls) == 1:
+        raise ModesFailed.of_error(RuntimeError("[0] injected on rank 1"))
+    return solve_modes(problem, *args, **kwargs)
+system_run.solve_modes = failing_first
+if sys.argv[1] == "api":
+    from petsc_rod.api import read_moordyn, solve_system
+    solve_system(read_moordyn(sys.argv[2])[0], options={"modes": 3})
+else:
+    from petsc_rod import cli_system
+    sys.exit(cli_system.run())
+"""
+
+
+@pytest.mark.parametrize("path", ["api", "cli"])
+def test_a_line_whose_modes_fail_on_one_rank_ends_the_run_and_the_process(tmp_path, path):
+    """A system's run with line modes (the API's options {'modes': 3}, the command
+    line's -rod_modes 3) in which the eigensolver of rank 1's first line fails before
+    that rank has started SLEPc: the run ends on every rank naming the line, exit 4,
+    and the processes exit (SLEPc started on one rank only left PETSc's finalisation
+    waiting on the other for ever: analysis/modes.start_slepc)."""
+    pytest.importorskip("slepc4py")
+    from helpers import run_failing_on_rank_1
+
+    args = [path, DECK] if path == "api" else ["cli", "-rod_system", DECK, "-rod_modes", "3"]
+    done = run_failing_on_rank_1(tmp_path / "modes_alone.py", MODES_ALONE, args, timeout=90)
+    assert done.returncode == (1 if path == "api" else 4), describe(done)
+    said = done.stdout + done.stderr
+    assert "the modes' eigensolver (SLEPc) failed: injected on rank 1" in said, describe(done)
+
+
 def test_a_table_that_would_replace_the_system_file_is_refused(tmp_path):
     """-rod_table X.dat with -rod_system X_system.dat (the system's table) or
     X_Line1_ends.dat (a line's ends' table): exit 2 in one line naming -rod_table, the
