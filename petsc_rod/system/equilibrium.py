@@ -88,7 +88,8 @@ class Settings:
     (above it, before failing, Newton takes the lines to their stationary points and
     goes on: SystemSolver.newton);
     ``max_iterations`` per attempt (below the floor, two Newton steps in a row that do
-    not halve the residual end it too: the same accuracy); ``load_steps``: the continuation's first step is
+    not halve the residual end it too, and so do the iterations spent: the same
+    accuracy); ``load_steps``: the continuation's first step is
     1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
     Newton step; ``predictor``: a solver's first solve starts where the system's
     catenaries settle (system/predictor.py) when its lines allow it (``make_line``'s
@@ -624,13 +625,18 @@ class SystemSolver:
         r, J = self.residual(state, loads, forces, stiffness)
         norm = np.linalg.norm(r[free] / scale[free])
         stalled, precise = 0, False
-        for iteration in range(settings.max_iterations + 1):
+        iteration = 0
+        while True:
             self.forces, self.stiffnesses = forces, stiffness
             self.check_interrupted(iteration)
             if norm <= settings.rtol:
                 self.norm = norm
                 return state, iteration
-            if iteration == settings.max_iterations:
+            if iteration >= settings.max_iterations and not (
+                    norm <= settings.floor and iteration > 0 and stalled == 0):
+                # spent; below the floor Newton goes on while each step halves the
+                # residual (its quadratic tail after a long damped approach: each such
+                # step takes the residual at least halfway to rtol, so few are taken)
                 break
             if J is None:
                 # the lines' stiffnesses, left out of the evaluation until a step needs
@@ -679,6 +685,7 @@ class SystemSolver:
                         return None, iteration
                     r, J = self.residual(state, loads, forces, stiffness)
                     norm = np.linalg.norm(r[free] / scale[free])
+                    iteration += 1              # counted as a step
                     continue
                 self.failure = (f"the line search found no decrease of the residual "
                                 f"{norm:.3g}{full}")
@@ -686,13 +693,19 @@ class SystemSolver:
             stalled = stalled + 1 if t_norm > 0.5 * norm else 0
             state, forces, stiffness, r, J, norm = (trial, t_forces, t_stiffness, t_r,
                                                     t_J, t_norm)
+            iteration += 1
             if norm <= settings.floor and stalled >= 2:
                 # An exact Jacobian's step at least halves a residual that is not the
                 # lines' own error: two steps in a row that did not are at the lines'
                 # accuracy (a line re-solved after a tiny move takes one step of its
                 # own iteration, and its end forces creep).
                 self.forces, self.stiffnesses, self.norm = forces, stiffness, norm
-                return state, iteration + 1
+                return state, iteration
+        if norm <= settings.floor:
+            # spent below the floor, the last step short of halving the residual: the
+            # lines' accuracy, as two such steps in a row are
+            self.norm = norm
+            return state, iteration
         self.failure = (f"Newton did not converge in {settings.max_iterations} "
                         f"iterations (residual {norm:.3g})")
         return None, settings.max_iterations

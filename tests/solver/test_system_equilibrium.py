@@ -356,9 +356,10 @@ def test_a_loaded_body_balances_forces_and_moments_to_round_off():
 def test_a_large_offset_is_reached_by_halving_the_load_steps():
     system = spread(load=(6e6, 0, 0, 0, 0, 0))
     _, direct, _ = equilibrium(system)
-    # too few Newton iterations for the whole offset at once
+    # too few Newton iterations for the whole offset at once (the residual still above
+    # the floor when they are spent)
     solver = SystemSolver(system, spring, PETSc.COMM_SELF,
-                          settings=Settings(rtol=1e-10, max_iterations=3))
+                          settings=Settings(rtol=1e-10, max_iterations=2))
     try:
         result = solver.solve()
     finally:
@@ -366,6 +367,32 @@ def test_a_large_offset_is_reached_by_halving_the_load_steps():
     assert direct.bodies["floater"][0] > 20.0
     assert result.halvings > 0 and result.load_factor == 1.0
     assert result.bodies["floater"] == pytest.approx(direct.bodies["floater"], abs=1e-9)
+
+
+def test_newton_spent_below_the_floor_goes_on_while_each_step_halves_the_residual():
+    """Newton's iterations spent with the scaled residual below Settings.floor and
+    halved by the last step (the quadratic tail of a long damped approach) go on while
+    each step halves it, to rtol; above the floor they fail. Without halvings, rtol
+    1e-13 out of reach in 3 iterations a load step."""
+    system = spread(load=(2e6, 0, 0, 0, 0, 0))
+    _, direct, _ = equilibrium(system)
+    found = {}
+    for budget in (2, 3):
+        solver = SystemSolver(system, spring, PETSc.COMM_SELF,
+                              settings=Settings(rtol=1e-13, max_iterations=budget,
+                                                max_halvings=0))
+        try:
+            found[budget] = solver.solve()
+        except RodDivergedError as error:
+            found[budget] = error
+        finally:
+            solver.destroy()
+    assert isinstance(found[2], RodDivergedError)
+    assert "Newton did not converge in 2 iterations" in str(found[2])
+    result = found[3]
+    assert result.residual <= 1e-13 and result.load_factor == 1.0
+    assert result.iterations > 6
+    assert result.bodies["floater"] == pytest.approx(direct.bodies["floater"], abs=1e-12)
 
 
 def test_a_solver_re_solves_under_new_loads_from_its_last_equilibrium():
