@@ -29,9 +29,11 @@ the chord alone (x_a moves them as -x_b does).
 **Where a catenary stands in.** A line of one section of one line type (no
 attachments, bending negligible: its bending length sqrt(EI / (w L)) below
 BENDING_LENGTH of L, a MoorDyn chain's or rope's), pinned at both ends (a clamp or a
-flex joint has moments a catenary has none of), sinking (w > 0), in still water (no
-current, whose drag a catenary does not carry), on no seabed or a flat one without
-friction (a slope, a profile or a grid, or friction: the rods' equilibrium differs).
+flex joint has moments a catenary has none of), sinking (w > 0), on no seabed or a flat
+one without friction (a slope, a profile or a grid, or friction: the rods' equilibrium
+differs), in still water or a current: a catenary carries none of its line's drag (the
+free points' drag is the system's, in the prediction too), so the prediction is the
+pose without it and the rods' Newton under the full loads moves the system from there.
 Anything else: ``refusal`` says why and the solver takes its usual path. A line whose
 catenary has no solution (too short for its span, a lower end above the seabed whose
 catenary would pass below it) fails its solve, and the prediction with it.
@@ -67,9 +69,6 @@ def refusal(system):
     environment = system.environment
     if not system.lines:
         return "no lines"
-    if environment.current is not None and np.any(np.asarray(environment.current,
-                                                              dtype=float)):
-        return "a current (its drag)"
     if environment.seabed_profile is not None or environment.seabed_slope:
         return "a seabed that is not flat"
     if environment.seabed is not None and environment.seabed_friction is not None:
