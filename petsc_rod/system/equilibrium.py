@@ -94,7 +94,9 @@ class Settings:
     Newton step; ``predictor``: a solver's first solve starts where the system's
     catenaries settle (system/predictor.py) when its lines allow it (``make_line``'s
     ``predictable``) and ``load_steps`` is 1; False: always the continuation from the
-    unloaded system."""
+    unloaded system; ``prediction_budget``: the iterations each line's first solve at
+    the prediction may take (one attempt, no halvings: HeldLine.budget), beyond which
+    the prediction is given up (SystemSolver._predicted)."""
 
     rtol: float = 1e-10
     floor: float = 1e-7
@@ -103,6 +105,7 @@ class Settings:
     max_halvings: int = 12
     line_search: int = 10
     predictor: bool = True
+    prediction_budget: int = 200
 
 
 @dataclass
@@ -323,6 +326,9 @@ class SystemSolver:
         self.predictable = (settings.predictor and settings.load_steps == 1
                             and getattr(make_line, "predictable", False))
         self.prediction = None
+        # {line name: iterations} of the lines' first solves at the prediction (None:
+        # none tried), on every rank
+        self.predicted_iterations = None
         self.lines = {}
         # the run's stop signals (cli/signals.Interrupts: received() collective, name()),
         # asked before every Newton iteration and after a failed one, and handed to the
@@ -816,7 +822,7 @@ class SystemSolver:
         target = Loads.of(self.system, self.layout)
         try:
             self.state = State(state.points, state.bodies)
-            self.check_restoring()              # the lines' first solves, there
+            self._first_solves()
             self.checked, self.factor = True, 1.0
             solved, iterations = self.newton(self.state, target, self.scales())
             if solved is None:
@@ -832,6 +838,25 @@ class SystemSolver:
         self.prediction = "used"
         self.state, self.loads = solved, target
         return self._finish(1.0, iterations, 0)
+
+    def _first_solves(self):
+        """check_restoring at the predicted state, each line's first solve there held to
+        Settings.prediction_budget iterations in one attempt (HeldLine.budget): a
+        prediction the rods cannot reach within it fails early, where the lines' own
+        halvings and caps would spend thousands of iterations on it. The iterations
+        each line took are left in ``predicted_iterations``. Collective."""
+        capped = [line for line in self.lines.values() if hasattr(line, "budget")]
+        for line in capped:
+            line.budget = self.settings.prediction_budget
+        try:
+            self.check_restoring()              # the lines' first solves, there
+        finally:
+            for line in capped:
+                line.budget = None
+            spent = self.placement.share({k: int(getattr(line, "iterations", 0))
+                                          for k, line in self.lines.items()})
+            self.predicted_iterations = {self.system.lines[k].name: spent[k]
+                                         for k in sorted(spent)}
 
     def _finish(self, factor, total, halvings):
         """The Equilibrium at the solver's state (solve), the lines left there."""

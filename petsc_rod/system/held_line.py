@@ -423,7 +423,9 @@ class HeldLine:
     end_forces() -> (2, 3); end_moments() -> (2, 3); stiffness() -> (6, 6);
     end_stiffness() -> (12, 12); settle(); stable() -> bool or None;
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
-    destroy(). ``iterations``: those of the last solve."""
+    destroy(). ``iterations``: those of the last solve (of its one attempt where it
+    diverged). ``budget``: None, or the iteration cap of a first solve (one attempt, no
+    halvings: a system's prediction, SystemSolver._predicted)."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -451,6 +453,9 @@ class HeldLine:
         self.axes = {}
         self.iterations = 0
         self.converged = False
+        # the iteration cap of a first solve at a system's prediction (SystemSolver.
+        # _predicted), one attempt without halvings; None: the line's own budget
+        self.budget = None
         # the run's stop signals (cli/signals.Interrupts), asked on the line's
         # communicator after every iteration of its solves (a walk stops at once, a
         # failure); None: not asked (the system's solver sets it: SystemSolver.evaluate)
@@ -598,6 +603,11 @@ class HeldLine:
         return q
 
     def _first(self):
+        """The first solve, from the catenary (or the chord, or straight) in one step,
+        halved up to 4 times at the solver's iteration cap each; with a ``budget``, one
+        attempt within it: a start a system's predictor guessed may be far from any
+        equilibrium of the line, and giving it up early costs little (the system then
+        starts from its unloaded pose)."""
         problem = self.problem
         if starts.lies_straight(self.path, 1.0):        # taut: no catenary
             problem.state.set_from_curve(starts.chord_start(self.path, 1.0))
@@ -608,7 +618,15 @@ class HeldLine:
                 problem.state.set_straight()
             else:
                 problem.state.set_from_curve(curve)
-        self.converged = self._run(PathSettings(steps=1, track_link=False))
+        path, settings = PathSettings(steps=1, track_link=False), self.solver.settings
+        if self.budget is not None:         # a prediction's: one attempt, capped
+            path = dataclasses.replace(path, max_halvings=0)
+            self.solver.settings = dataclasses.replace(
+                settings, max_it=min(settings.max_it, int(self.budget)))
+        try:
+            self.converged = self._run(path)
+        finally:
+            self.solver.settings = settings
         return self.converged
 
     def _walk(self, a, b, frames):
@@ -656,6 +674,8 @@ class HeldLine:
                     converged = bool(event.converged)
                     break
                 if isinstance(event, events.RunDiverged):
+                    # the attempt's own (a run without halvings: all it spent)
+                    self.iterations = int(getattr(event.error, "iterations", 0) or 0)
                     break
         except (RodError, PETSc.Error, FloatingPointError):
             pass

@@ -138,6 +138,46 @@ def test_a_failed_prediction_is_the_plain_solve_bit_for_bit(monkeypatch):
     assert failed.iterations == plain.iterations
 
 
+def drag_buoy(current):
+    """The free buoy (1000 kg, 10 m^3, a drag area of 5 m^2) on two 110 m chains from
+    anchors 200 m apart in 30 m of water, 10 m down at the start, in ``current``."""
+    system, _ = read_moordyn(os.path.join(REPO_ROOT, "tests", "data", "moordyn",
+                                          "drag_buoy.dat"))
+    return dataclasses.replace(system, environment=dataclasses.replace(
+        system.environment, current=current))
+
+
+def test_a_failed_prediction_costs_the_lines_at_most_their_cap():
+    """In 0.5 m/s across, the catenaries' pose (the buoy without the lines' drag) is one
+    the rods do not reach from their catenary starts within their cap: each line's first
+    solve there stops at Settings.prediction_budget iterations in one attempt (without
+    the cap they ran 1785 and 1834 iterations there, in 1 m/s 22 074 together), the
+    prediction fails, and the solver solves from the unloaded system to the pose
+    without the predictor (bit for bit: the same solve), 3.70 m across and 0.38 m above
+    the surface."""
+    budget = Settings().prediction_budget
+    system = drag_buoy((0.0, 0.5, 0.0))
+    solver = SystemSolver(system, held_lines(system), PETSc.COMM_WORLD)
+    try:
+        result = solver.solve()
+        why, spent = solver.prediction, solver.predicted_iterations
+    finally:
+        solver.destroy()
+    plain = SystemSolver(system, held_lines(system), PETSc.COMM_WORLD,
+                         settings=Settings(predictor=False))
+    try:
+        expected = plain.solve()
+        assert plain.predicted_iterations is None
+    finally:
+        plain.destroy()
+    assert why.startswith("failed (system: at the start, line Line1 did not converge)")
+    assert sorted(spent) == ["Line1", "Line2"]
+    assert all(0 < n <= budget for n in spent.values()), spent
+    assert np.array_equal(result.points["Point2"], expected.points["Point2"])
+    assert result.iterations == expected.iterations
+    assert np.abs(result.points["Point2"] - (0.0, 3.7000, 0.3816)).max() < 1e-4
+
+
 def test_what_a_catenary_cannot_stand_in_for():
     system = small_system()
     assert refusal(system) is None
