@@ -809,11 +809,13 @@ class SystemSolver:
 
     def _predicted(self):
         """The first solve from the catenaries' equilibrium (system/predictor.py): the
-        lines' first solves at the ends it puts them, then Newton under the full loads;
+        lines' first solves at the ends it puts them (each within
+        Settings.prediction_budget: _first_solves), then Newton under the full loads;
         None where no catenary stands in for a line, the catenaries have no
-        equilibrium, or that Newton fails: the solver is then as made (its lines made
-        again), for the continuation from the unloaded system. ``prediction`` says
-        which. Collective (the catenaries dealt over the ranks as the rods are)."""
+        equilibrium, a line fails there, or that Newton fails: the solver is then as
+        made (its lines made again), for the continuation from the unloaded system.
+        ``prediction`` says which. Collective (the catenaries dealt over the ranks as
+        the rods are)."""
         self.predictable = False                # the first solve's only
         state, why = predict(self.system, self.settings, type(self), self.comm)
         if state is None:
