@@ -110,10 +110,10 @@ def applied_forces(ends, load_values, start_force, end_force, point_forces, drag
     (n_p, 3), N}: the scale of the internal force n (Scene.applied_force)."""
     total_drag = 0.0
     if velocities is not None:            # the largest drag the current can exert
-        speed = float(np.max(np.sum(velocities**2, axis=1)))
-        total_drag = float(ends[-1]) * float(drag * np.max(np.sum(velocities**2, axis=1)))
+        largest_square = float(np.max(np.sum(velocities**2, axis=1)))     # max |v|^2
+        total_drag = float(ends[-1]) * float(drag * largest_square)
         # and the attachments', 1/2 rho_w C_d A max |v|^2 each
-        total_drag += 0.5 * water_density * drag_areas.sum() * speed
+        total_drag += 0.5 * water_density * drag_areas.sum() * largest_square
     return {"load": float(np.diff(ends) @ np.linalg.norm(load_values, axis=1)),
             "drag": total_drag, "start_force": float(np.linalg.norm(start_force)),
             "end_force": float(np.linalg.norm(end_force)),
