@@ -383,9 +383,10 @@ OPTIONS = [
            "the system solver's (1)", POSITIVE),
     Option("rod_system_predictor", _bool, True, "bool",
            "with -rod_system: the first solve starts where the system's elastic "
-           "catenaries settle, where every line can be one (pinned, one line type, no "
-           "current, a flat seabed without friction; docs/systems.md, \"Speed\"); 0: "
-           "always the load continuation from the unloaded system"),
+           "catenaries settle, where every line can be one (pinned, one line type, a "
+           "flat seabed without friction; in a current, without the lines' drag; "
+           "docs/systems.md, \"Speed\"); 0: always the load continuation from the "
+           "unloaded system"),
     Option("rod_system_watch_circle", _string, None, "BODY,LOAD[,N]",
            "with -rod_system: after the equilibrium, body BODY's watch circle (a Free "
            "body: a held one is refused): its position under a horizontal load LOAD (N) "

@@ -620,7 +620,9 @@ class SystemSolver:
         self.forces/stiffnesses: the lines' at the returned state. A line search without
         decrease above Settings.floor first makes Newton precise: the lines settled
         (HeldLine.settle) at the state and at every later trial, the residual then
-        free of their tolerances' error; a second one fails."""
+        free of their tolerances' error; a second one fails. ``max_iterations`` spent,
+        it goes on below the floor while each step halves the residual, and ends at the
+        lines' accuracy at the first that does not (docs/systems.md)."""
         settings, free, held = self.settings, self.layout.free, self.layout.held_points
         state = State(state.points.copy(),
                       state.bodies.placed(loads.places, self.layout.held_places))
@@ -847,18 +849,29 @@ class SystemSolver:
         prediction the rods cannot reach within it fails early, where the lines' own
         halvings and caps would spend thousands of iterations on it. The iterations
         each line took are left in ``predicted_iterations``. Collective."""
+        budget = self.settings.prediction_budget
         capped = [line for line in self.lines.values() if hasattr(line, "budget")]
         for line in capped:
-            line.budget = self.settings.prediction_budget
+            line.budget = budget
         try:
             self.check_restoring()              # the lines' first solves, there
+            failure = None
+        except RodInterrupted:
+            raise
+        except RodDivergedError:
+            failure = (f"at the prediction, each line's first solve within {budget} "
+                       f"iterations: {self.failure}")
         finally:
             for line in capped:
                 line.budget = None
-            spent = self.placement.share({k: int(getattr(line, "iterations", 0))
-                                          for k, line in self.lines.items()})
-            self.predicted_iterations = {self.system.lines[k].name: spent[k]
-                                         for k in sorted(spent)}
+        # collective: not in ``finally``, where one rank's own exception would meet
+        # the others' next share
+        spent = self.placement.share({k: int(getattr(line, "iterations", 0))
+                                      for k, line in self.lines.items()})
+        self.predicted_iterations = {self.system.lines[k].name: spent[k]
+                                     for k in sorted(spent)}
+        if failure is not None:
+            raise RodDivergedError(failure)
 
     def _finish(self, factor, total, halvings):
         """The Equilibrium at the solver's state (solve), the lines left there."""

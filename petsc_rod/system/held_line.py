@@ -425,7 +425,7 @@ class HeldLine:
     positions() -> (2, 3); summary() -> dict; centreline() -> (n + 1, 3) or None;
     destroy(). ``iterations``: those of the last solve (of its one attempt where it
     diverged). ``budget``: None, or the iteration cap of a first solve (one attempt, no
-    halvings: a system's prediction, SystemSolver._predicted)."""
+    halvings: a system's prediction, SystemSolver._first_solves)."""
 
     def __init__(self, span, comm, environment=None, options=None):
         if isinstance(span, Model):
@@ -454,7 +454,7 @@ class HeldLine:
         self.iterations = 0
         self.converged = False
         # the iteration cap of a first solve at a system's prediction (SystemSolver.
-        # _predicted), one attempt without halvings; None: the line's own budget
+        # _first_solves), one attempt without halvings; None: the line's own budget
         self.budget = None
         # the run's stop signals (cli/signals.Interrupts), asked on the line's
         # communicator after every iteration of its solves (a walk stops at once, a

@@ -557,6 +557,24 @@ def test_a_residual_at_the_lines_accuracy_is_accepted_below_the_floor():
     assert result.bodies["floater"] == pytest.approx(exact.bodies["floater"], abs=1e-7)
 
 
+def test_newton_spent_at_the_lines_accuracy_ends_there():
+    """Newton's iterations spent below the floor after a step that did not halve the
+    residual (lines whose end forces carry an error of 1e-9 of themselves: NoisyLine)
+    end it there, converged at the lines' accuracy; rtol 1e-15 out of reach, 3
+    iterations a load step, no halvings."""
+    system = spread(load=(1e6, 0, 0, 0, 0, 0))
+    noisy = lambda line, comm: NoisyLine(line.line.stiffness[0], line.line.length, comm)
+    solver = SystemSolver(system, noisy, PETSc.COMM_SELF,
+                          settings=Settings(rtol=1e-15, max_iterations=3, max_halvings=0))
+    try:
+        result = solver.solve()
+    finally:
+        solver.destroy()
+    _, exact, _ = equilibrium(system)
+    assert 1e-15 < result.residual <= Settings().floor and result.load_factor == 1.0
+    assert result.bodies["floater"] == pytest.approx(exact.bodies["floater"], abs=1e-9)
+
+
 def test_a_body_on_its_hydrostatics_alone_floats_where_its_weight_is_buoyed():
     """No line: heave z = (rho V - m) g / (rho g A), on every rank."""
     body = Body("barge", mass=1e6, volume=1000.0, waterplane_area=400.0,

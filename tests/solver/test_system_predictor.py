@@ -125,14 +125,15 @@ def test_a_failed_prediction_is_the_plain_solve_bit_for_bit(monkeypatch):
 
     def failing_first(self):
         if self.settings.predictor and not getattr(self, "failed_once", False):
-            self.failed_once = True
-            raise RodDivergedError("system: at the start, made to fail")
+            self.failed_once, self.failure = True, "made to fail"    # as evaluate's
+            raise RodDivergedError(f"system: at the start, {self.failure}")
         return check(self)
     monkeypatch.setattr(SystemSolver, "check_restoring", failing_first)
     system = small_system()
     failed, K, why = solved(system, True)
     plain, K_plain, _ = solved(system, False)
-    assert why.startswith("failed (system: at the start, made to fail)")
+    assert why.startswith("failed (at the prediction, each line's first solve within "
+                          f"{Settings().prediction_budget} iterations: made to fail)")
     assert np.array_equal(failed.bodies["Body1"], plain.bodies["Body1"])
     assert np.array_equal(K, K_plain)
     assert failed.iterations == plain.iterations
@@ -154,7 +155,8 @@ def test_a_failed_prediction_costs_the_lines_at_most_their_cap():
     the cap they ran 1785 and 1834 iterations there, in 1 m/s 22 074 together), the
     prediction fails, and the solver solves from the unloaded system to the pose
     without the predictor (bit for bit: the same solve), 3.70 m across and 0.38 m above
-    the surface."""
+    the surface (a free point keeps its volume's buoyancy there, as MoorDyn's does:
+    its 10 m^3 lift more than the chains weigh)."""
     budget = Settings().prediction_budget
     system = drag_buoy((0.0, 0.5, 0.0))
     solver = SystemSolver(system, held_lines(system), PETSc.COMM_WORLD)
@@ -170,7 +172,8 @@ def test_a_failed_prediction_costs_the_lines_at_most_their_cap():
         assert plain.predicted_iterations is None
     finally:
         plain.destroy()
-    assert why.startswith("failed (system: at the start, line Line1 did not converge)")
+    assert why.startswith(f"failed (at the prediction, each line's first solve within "
+                          f"{budget} iterations: line Line1 did not converge)")
     assert sorted(spent) == ["Line1", "Line2"]
     assert all(0 < n <= budget for n in spent.values()), spent
     assert np.array_equal(result.points["Point2"], expected.points["Point2"])

@@ -512,8 +512,8 @@ else:
 def test_a_line_whose_modes_fail_on_one_rank_ends_the_run_and_the_process(tmp_path, path):
     """A system's run with line modes (the API's options {'modes': 3}, the command
     line's -rod_modes 3) in which the eigensolver of rank 1's first line fails before
-    that rank has started SLEPc: the run ends on every rank naming the line, exit 4,
-    and the processes exit (SLEPc started on one rank only left PETSc's finalisation
+    that rank has started SLEPc: the run ends on every rank with the eigensolver's
+    failure (the command line's exit 4; the API raises it), and the processes exit (SLEPc started on one rank only left PETSc's finalisation
     waiting on the other for ever: analysis/modes.start_slepc)."""
     pytest.importorskip("slepc4py")
     from helpers import run_failing_on_rank_1
