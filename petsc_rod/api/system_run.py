@@ -609,6 +609,21 @@ def discard_tables(comm, table, system, say, sweeps=Sweeps(), body_modes=False):
         + (f"; removed {len(found)} table(s) of an earlier run" if found else ""))
 
 
+def surfaced_points(system, points):
+    """The notes on the free points with a volume that end above the sea surface
+    (the Environment's surface, z = 0 where none) at ``points`` {name: (3,) m}: a
+    point's volume buoys it wherever it is (rho_w V g, as in MoorDyn, whose points have
+    no waterplane), so such a buoy's height is the lines' balance of its whole
+    buoyancy, not a float's: worth the engineer's look."""
+    surface = system.environment.surface or 0.0
+    return [f"point {p.name} ends {points[p.name][2] - surface:.3g} m above the sea "
+            f"surface, buoyed all the same by its {p.volume:g} m^3 (a point's volume is "
+            "buoyant wherever it is, as in MoorDyn; a buoy that floats at the surface "
+            "is a body with its waterplane)"
+            for p in system.points
+            if p.kind == "free" and p.volume > 0 and points[p.name][2] > surface]
+
+
 def run_system(comm, system, settings, line_options, say, output=None, table=None,
                text=None, notes=(), interrupts=None, sweeps=Sweeps(), modes=None,
                body_modes=None, solver=None, line_mass_option="system_modes_line_mass",
@@ -696,6 +711,8 @@ def _solved(comm, solver, system, say, output, table, text, notes, interrupts, s
     if solver.prediction is not None and not solver.prediction.startswith("not used"):
         # the first solve started from the catenaries' equilibrium (system/predictor.py)
         say(f"petsc_rod: note: the system's catenary predictor {solver.prediction}")
+    for note in surfaced_points(system, found.points):
+        say(f"petsc_rod: note: {note}")
     stop_if_interrupted(interrupts, "after the system's equilibrium was found")
     stiffness = {b.name: solver.body_stiffness(b.name) for b in system.bodies}
     # at the equilibrium, before the sweeps move the solver (numpy: every rank the same)

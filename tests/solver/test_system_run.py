@@ -16,7 +16,7 @@ import pytest
 from petsc4py import PETSc
 
 from petsc_rod.api import (Connection, End, Environment, Model, Point, System, SystemLine,
-                           UniformLine, solve, solve_system)
+                           UniformLine, read_moordyn, solve, solve_system)
 
 pytestmark = pytest.mark.solver
 
@@ -356,3 +356,31 @@ def test_a_nan_along_a_line_is_never_written(monkeypatch, tmp_path):
     with pytest.raises(RodDivergedError, match="non-finite"):
         solve_system(free_body_system(), output=path, table=path[:-3] + ".csv")
     assert not [name for name in os.listdir(os.path.dirname(path))]
+
+
+def test_a_buoyant_free_point_above_the_surface_is_noted(tmp_path):
+    """tests/data/moordyn/drag_buoy.dat at rest: its free buoy's 10 m^3 lift more than
+    its chains weigh, and it ends 0.50 m above the sea surface with its whole buoyancy
+    (a point's, as in MoorDyn): the run says so in a note naming it and the height;
+    with 6 m^3 it stays 7.7 m under water, and no note."""
+    path = os.path.join(os.path.dirname(__file__), "..", "data", "moordyn", "drag_buoy.dat")
+    with open(path, encoding="utf-8") as deck:
+        text = deck.read()
+    row = "2     Free        0.0     0.0      -10.0   1000   10      5      0"
+    assert row in text
+    smaller = tmp_path / "smaller_buoy.dat"            # each rank's own folder
+    smaller.write_text(text.replace(row, row.replace("1000   10 ", "1000   6  ")))
+    for deck, noted in ((path, True), (str(smaller), False)):
+        system, notes = read_moordyn(deck)
+        said = []
+        results = solve_system(system, say=said.append, notes=notes)
+        above = [line for line in said if "above the sea surface" in line]
+        height = results.points["Point2"][2]
+        if noted:
+            assert 0.4 < height < 0.6
+            assert above == [f"petsc_rod: note: point Point2 ends {height:.3g} m above the "
+                             "sea surface, buoyed all the same by its 10 m^3 (a point's "
+                             "volume is buoyant wherever it is, as in MoorDyn; a buoy that "
+                             "floats at the surface is a body with its waterplane)"]
+        else:
+            assert -8.0 < height < -7.4 and above == []
