@@ -87,16 +87,17 @@ class Settings:
     end forces are converged to their tolerances, not to round-off) and is accepted
     (above it, before failing, Newton takes the lines to their stationary points and
     goes on: SystemSolver.newton);
-    ``max_iterations`` per attempt (below the floor, two Newton steps in a row that do
-    not halve the residual end it too, and so do the iterations spent: the same
-    accuracy); ``load_steps``: the continuation's first step is
-    1 / load_steps; ``max_halvings`` of a failing step; ``line_search`` halvings of a
+    ``max_iterations`` per attempt, beyond which Newton goes on only below the floor
+    while each step halves the residual (below the floor, two Newton steps in a row that
+    do not halve the residual end it too: the same accuracy); ``load_steps``: the
+    continuation's first step is 1 / load_steps; ``max_halvings`` of a failing step;
+    ``line_search`` halvings of a
     Newton step; ``predictor``: a solver's first solve starts where the system's
     catenaries settle (system/predictor.py) when its lines allow it (``make_line``'s
     ``predictable``) and ``load_steps`` is 1; False: always the continuation from the
     unloaded system; ``prediction_budget``: the iterations each line's first solve at
     the prediction may take (one attempt, no halvings: HeldLine.budget), beyond which
-    the prediction is given up (SystemSolver._predicted)."""
+    the prediction is given up (SystemSolver._first_solves)."""
 
     rtol: float = 1e-10
     floor: float = 1e-7
