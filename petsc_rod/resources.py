@@ -23,14 +23,18 @@ BYTES_PER_ELEMENT_HEIGHTS = 56 * 2**10
 # element): 576 bytes per element and unit of depth, allocated (and written: PETSc zeroes
 # them) when the SNES is set up. Its default depth is the largest up to DEFAULT_DEPTH
 # whose history fits the larger of HISTORY_FLOOR (per machine, shared by its ranks: the
-# depth that hard scenes need, e.g. options/greenhill.opts, kept up to about 2e4
-# elements) and HISTORY_PER_ELEMENT per element (so that a run stays within 10 KiB per
-# element at 1e5 elements and more, with the map's 5 KiB and the SNES's own vectors),
-# and at most ANDERSON_SHARE of the memory available; never below MIN_DEPTH.
+# depth that hard scenes need, e.g. options/greenhill.opts, kept up to FULL_DEPTH_ELEMENTS;
+# beyond, its set-up, the first touch of those pages, would cost more than 0.1 s and the
+# long lines converge in a few tens of iterations with Newton steps:
+# docs/performance.md, "Memory in proportion") and HISTORY_PER_ELEMENT per element (so
+# that a run stays within 10 KiB per element at 1e5 elements and more, with the map's
+# 5 KiB and the SNES's own vectors), and at most ANDERSON_SHARE of the memory available;
+# never below MIN_DEPTH.
 ANDERSON_BYTES = 2 * 18 * 2 * 8
 DEFAULT_DEPTH = 30
 MIN_DEPTH = 5
-HISTORY_FLOOR = 320 * 2**20
+FULL_DEPTH_ELEMENTS = 10**4
+HISTORY_FLOOR = DEFAULT_DEPTH * ANDERSON_BYTES * FULL_DEPTH_ELEMENTS
 HISTORY_PER_ELEMENT = 3 * 2**10
 ANDERSON_SHARE = 0.25
 # The DMDA has 2 dofs per vertex, indexed by PETSc integers.
