@@ -10,15 +10,19 @@ substructuring.py does for its scalar chains, the first node of every rank but t
 first is the interface (G_p, B rows, on rank p) and the rest of a rank's rows its
 interior I_p, which couples to G_p and G_p+1 only:
 
-    A_II y = b_I                      (each rank its own interior: sequential MUMPS)
+    A_II y = b_I                      (each rank its own interior, sequentially)
     S x_G = b_G - A_GI y,   S = A_GG - A_GI W,   W = A_II^-1 A_IG,
     x_I = y - W x_G.
+
+The interiors are factored as the whole is on one rank: an LU by PETSc's own in the
+natural order (ksp.NaturalLU: checked, MUMPS's where the check fails; -rod_newton_lu
+mumps for MUMPS's throughout), an LDL^T by MUMPS (its null pivots and inertia).
 
 W has 2 B columns a rank (B where a rank has one neighbour) and is made at each
 factorisation, with one solve of sparse right-hand sides (A_IG is nonzero on the
 interior's first and last few rows only: MUMPS's forward elimination visits the paths
 of its elimination tree from them to the root, near which the AMF ordering places the
-first rows of the numbering; the first rank, whose coupling is its interior's tail,
+first rows of the numbering; PETSc's LU solves them as dense columns; the first rank, whose coupling is its interior's tail,
 numbers its interior from its end for an LU, while an LDL^T, whose factorisation that
 order slows by more than it saves in W, keeps the natural order and then factors the
 rank's diagonal block itself, without extracting it); S is ((P - 1) B) square, block
@@ -38,7 +42,7 @@ by the ranks, plus the interface's on every rank (its inverse O(((P - 1) B)^3) a
 factorisation, its product O(((P - 1) B)^2 k) a solve: small on a few ranks, not
 scalable to many; the costs: docs/performance.md, "Newton steps"). The ChainFactor owns
 its PETSc objects (the interior submatrix, on the first rank of an LDL^T a reference to the
-diagonal block itself, and its sequential MUMPS solver, the index set of the interior
+diagonal block itself, and its sequential factorisation, the index set of the interior
 rows where it is not the whole block): ``destroy()``.
 """
 
@@ -66,12 +70,13 @@ class ChainFactor:
     """The factorisation of the module docstring of an assembled MPIAIJ ``matrix`` (its
     pattern; the values are read at each ``set_up``) with ``block`` unknowns a node:
     ``kind`` PETSc.PC.Type.LU or CHOLESKY (then symmetric, with its inertia). The
-    interiors' sequential MUMPS factorisations are the solvers ``make_solver(comm,
-    operator)`` gives (ksp.lu_solver or ksp.inertia_solver on COMM_SELF, options under
-    their prefix), set up with ``set_up(ksp, block)`` (ksp.set_up_mumps) and solved
-    with ``solve(ksp, right)`` ((n_I, k) Fortran-ordered columns; it returns a new,
-    writeable (n_I, k) array, which the solves correct in place: ksp.solve_dense) and
-    ``solve_sparse(ksp, rows, values)`` (ksp.solve_sparse_columns: W's). Raises
+    interiors' sequential factorisations are those ``make_interior(operator)`` gives
+    (ksp.MumpsFactor, or of an LU ksp.NaturalLU, as on one rank), each with
+    ``set_up(operator)``, ``null_pivot()``, ``failed()``, ``negative_pivots()`` (of an
+    LDL^T), ``solve(right)`` ((n_I, k) Fortran-ordered columns; it returns a new,
+    writeable (n_I, k) array, which the solves correct in place) and
+    ``solve_sparse(rows, values)`` (W's: (k, n_I)) and ``destroy()``; ``reorder``
+    False where they eliminate in the order given (NaturalLU). Raises
     NotAChainError where a rank's rows couple otherwise (on every rank): a rank without
     an interior node, a middle rank whose interface reaches the next one's (a single
     element).
@@ -86,25 +91,27 @@ class ChainFactor:
     the right-hand sides to the scatter of the solutions; ``_natural`` reads a range of
     the natural order from them (the interface's couplings)."""
 
-    def __init__(self, matrix, kind, block, make_solver, set_up, solve, solve_sparse):
+    def __init__(self, matrix, kind, block, make_interior, reorder=True):
         comm = matrix.getComm()
         self._mpi = comm.tompi4py()
         self.size, self.rank = comm.getSize(), comm.getRank()
         self.kind, self.block = kind, block
-        self._make_solver, self._set_up, self._solve = make_solver, set_up, solve
-        self._solve_sparse = solve_sparse
+        self._make_interior = make_interior
         self.symmetric = kind == PETSc.PC.Type.CHOLESKY
         start, end = matrix.getOwnershipRange()
         self.n = end - start
         self.offset = block if self.rank > 0 else 0
         self.has_next = self.rank < self.size - 1
         self._split(matrix)
-        # the first rank's interior of an LU numbered from its end: its couplings, to
-        # the next interface, come first, near the root of the elimination tree (W's
-        # solve); an LDL^T's factorisation takes longer in that order than W's solve
-        # saves (docs/performance.md, "Newton steps"): the natural order, in which the
-        # first rank's interior is its diagonal block, taken without a copy
-        self.reversed = self.offset == 0 and self.has_next and not self.symmetric
+        # the first rank's interior of an LU numbered from its end (``reorder``: for
+        # MUMPS's): its couplings, to the next interface, come first, near the root of
+        # the elimination tree (W's solve); an LDL^T's factorisation takes longer in that
+        # order than W's solve saves (docs/performance.md, "Newton steps"): the natural
+        # order, in which the first rank's interior is its diagonal block, taken without
+        # a copy. An elimination without pivoting (NaturalLU) keeps the natural order:
+        # from the end it meets the zero diagonal of a chain's multiplier first
+        self.reversed = (reorder and self.offset == 0 and self.has_next
+                         and not self.symmetric)
         # the interior rows: None where they are the whole diagonal block (the first
         # rank's LDL^T; one rank, in tests only: direct_factor substructures on
         # several), whose interior is then the block itself, a reference taken at each
@@ -121,7 +128,7 @@ class ChainFactor:
         else:
             self._index = None
         self.interior = None
-        self.ksp = None
+        self.solver = None
         self.failed = False
         self.negative = None
 
@@ -189,10 +196,10 @@ class ChainFactor:
         if self._mpi.allreduce(int(stored_entries(matrix) != self._nonzeros)):
             # the pattern grew (a new nonzero): the reaches and the interior anew
             self._split(matrix)
-            for obj in (self.ksp, self.interior):
+            for obj in (self.solver, self.interior):
                 if obj is not None:
                     obj.destroy()
-            self.ksp = self.interior = None
+            self.solver = self.interior = None
         diagonal = matrix.getDiagonalBlock()        # a reference of its own
         if self._index is None:
             if self.interior is not None:
@@ -202,20 +209,17 @@ class ChainFactor:
             self.interior = diagonal.createSubMatrix(self._index, self._index,
                                                      submat=self.interior)
             diagonal.destroy()
-        if self.ksp is None:
-            self.ksp = self._make_solver(PETSc.COMM_SELF, self.interior)
-        else:
-            self.ksp.setOperators(self.interior)
-        self._set_up(self.ksp, B)
-        factor = self.ksp.getPC().getFactorMatrix()
+        if self.solver is None:
+            self.solver = self._make_interior(self.interior)
+        self.solver.set_up(self.interior)
         # a null pivot of an interior (MUMPS detects it, ICNTL 24, and goes on) voids
         # W, S and the inertia count (Haynsworth needs A_II nonsingular), though the
         # whole matrix may be regular (a saddle's multiplier coupled to the interface
         # alone): the caller factors the whole instead (ksp.direct_factor). On one rank
         # the interior is the whole, whose null pivots are its own (as MUMPS's)
-        if self.size > 1 and self._mpi.allreduce(int(factor.getMumpsInfog(28) > 0)):
+        if self.size > 1 and self._mpi.allreduce(int(self.solver.null_pivot())):
             raise SingularInteriorError("a rank's interior has a null pivot")
-        self.failed = bool(self._mpi.allreduce(int(factor.getMumpsInfog(1) < 0)))
+        self.failed = bool(self._mpi.allreduce(int(self.solver.failed())))
         # a failed factorisation: solves give Inf, and a symmetric matrix counts as all
         # negative (no step is taken with it)
         self.negative = matrix.getSize()[0] if self.symmetric else None
@@ -247,7 +251,7 @@ class ChainFactor:
         received = self._mpi.allgather(previous)
         self._next_rows = received[self.rank + 1] if self.has_next else np.zeros((0, 0))
         self.W = self._coupling_solve(coupled, couplings)
-        self._factor_interface(int(factor.getInertia()[0]) if self.symmetric else 0)
+        self._factor_interface(self.solver.negative_pivots() if self.symmetric else 0)
 
     def _coupling_solve(self, rows, values):
         """W = A_II^-1 A_IG, (k, n_interior) in the factor's order, from A_IG's nonzero
@@ -258,7 +262,7 @@ class ChainFactor:
             return np.zeros((values.shape[1], n_interior))
         if self.reversed:
             rows = n_interior - 1 - rows
-        return self._solve_sparse(self.ksp, rows, values)
+        return self.solver.solve_sparse(rows, values)
 
     def _natural(self, array, start, stop):
         """The interior's natural positions start to stop - 1 of ``array`` (along its
@@ -319,8 +323,8 @@ class ChainFactor:
         """x_j = A^-1 b_j for the local arrays ``columns`` (as ksp.solve_columns: ``rows``
         the local rows of a submatrix in the columns' layout, the others returning b_j;
         Inf where the factorisation failed). Each column's interior rows are read once
-        into a Fortran-ordered right-hand side in the factor's order, MUMPS solves into
-        a new array of the same layout (ksp.solve_dense), the interface's corrections
+        into a Fortran-ordered right-hand side in the factor's order, the interior's
+        factorisation solves into a new array of the same layout, the interface's corrections
         act on it in place, and each solution is written from it once (where ``rows``
         is given, over a copy of the column). Collective."""
         columns = [np.asarray(column) for column in columns]
@@ -347,7 +351,7 @@ class ChainFactor:
         if self.failed:
             y, x_interface = np.full((k, n_interior), np.inf), np.full((k, off), np.inf)
         else:
-            y = self._solve(self.ksp, right).T              # (k, n_I), factor's order
+            y = self.solver.solve(right).T                  # (k, n_I), factor's order
             sent = np.zeros((2, B, k))
             if off:
                 sent[0] = b_interface.T - self._own_rows @ self._natural(
@@ -379,7 +383,7 @@ class ChainFactor:
         return self.negative
 
     def destroy(self):
-        for obj in (self.ksp, self.interior, self._index):
+        for obj in (self.solver, self.interior, self._index):
             if obj is not None:
                 obj.destroy()
 

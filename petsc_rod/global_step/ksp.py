@@ -4,7 +4,7 @@ the second variation (analysis/stability.py, options -rod_inertia_*) and the LU 
 Newton Jacobian with a drag or friction (analysis/jacobian.py, -rod_newton_*), both
 through direct_factor: on one rank the LDL^T by MUMPS and the LU by PETSc's own in the
 natural order (NaturalLU, checked, MUMPS's where the check fails); on several by
-substructuring (chain_factor.ChainFactor, each rank's interior by sequential MUMPS).
+substructuring (chain_factor.ChainFactor, each rank's interior as on one rank).
 
 A chain solver is preonly + Cholesky under its own options prefix, with the project's
 defaults in effect where the user gave none (petsc_defaults.py): PETSc's Cholesky in
@@ -299,7 +299,8 @@ def solve_vecs(factor, vecs, rows=None):
     return solutions
 
 
-# The package of the Newton Jacobian's LU on one rank (-rod_newton_lu): PETSc's own in
+# The package of the Newton Jacobian's LU on one rank and of each rank's interior on
+# several (-rod_newton_lu): PETSc's own in
 # the natural order (NaturalLU), or MUMPS's (MumpsFactor). The LDL^T of the second
 # variation is MUMPS's: its null pivots (a section's free roll) are detected as null,
 # which the callers rely on (docs/performance.md, "Newton steps").
@@ -331,15 +332,16 @@ def lu_package(prefix):
     if package not in LU_PACKAGES:
         raise RodInputError(
             f"-{name} {package}: expected {' or '.join(LU_PACKAGES)} (the package of the "
-            "Newton steps' LU on one rank: PETSc's own in the natural order, or MUMPS's)")
+            "Newton steps' LU: PETSc's own in the natural order, or MUMPS's)")
     return package
 
 
 class NaturalLU:
     """PETSc's own LU of a sequential ``operator`` in the natural order (its KSP and PC
     are not options: the check needs this factorisation; MUMPS's under ``prefix``
-    where it hands over): the Newton Jacobian on one rank (analysis/jacobian.py), a
-    band of nodes whose elimination in its own order fills only the band. On the
+    where it hands over): the Newton Jacobian on one rank (analysis/jacobian.py) and
+    each rank's interior of it on several (chain_factor.py), a band of nodes whose
+    elimination in its own order fills only the band. On the
     18 000-element riser its first factorisation takes 69 ms and the next 20 ms,
     MUMPS's 277 and 156 ms, a solve 3 ms against 24 (docs/performance.md, "Newton
     steps").
@@ -430,6 +432,34 @@ class NaturalLU:
             for vec in (exact, right, solution, residual):
                 vec.destroy()
 
+    def null_pivot(self):
+        """Whether the factorisation has a null pivot: MUMPS's detection, where it has
+        taken over (a kept null pivot fails this one's check)."""
+        return self.mumps is not None and self.mumps.null_pivot()
+
+    def failed(self):
+        """Whether the last factorisation failed (MUMPS's, where it has taken over: this
+        one's failures hand over)."""
+        return self.mumps is not None and self.mumps.failed()
+
+    def solve(self, right):
+        """X = A^-1 B for the Fortran-ordered (n, k) ``right``, a new (n, k) array in
+        Fortran order, refined once (solve_columns)."""
+        if self.mumps is not None:
+            return self.mumps.solve(right)
+        return self._refined_solve(right)
+
+    def solve_sparse(self, rows, values):
+        """As MumpsFactor.solve_sparse (x (k, n), C-contiguous), by a dense solve of the
+        right-hand sides made whole: an elimination in the natural order visits every
+        row whatever the right-hand side."""
+        if self.mumps is not None:
+            return self.mumps.solve_sparse(rows, values)
+        n = self.ksp.getOperators()[0].getSize()[0]
+        right = np.zeros((n, values.shape[1]), dtype=PETSc.ScalarType, order="F")
+        right[rows] = values
+        return self._refined_solve(right).T
+
     def solve_columns(self, columns, rows=None):
         """As ksp.solve_columns, each solve refined once: x += F^-1 (b - A x), with the
         residual in the working precision, which makes the solves of an elimination
@@ -496,6 +526,23 @@ class MumpsFactor:
     def solve_columns(self, columns, rows=None):
         return solve_columns(self.ksp, columns, rows)
 
+    def null_pivot(self):
+        """Whether MUMPS found a null pivot in the last factorisation (INFOG(28),
+        ICNTL 24)."""
+        return self.ksp.getPC().getFactorMatrix().getMumpsInfog(28) > 0
+
+    def failed(self):
+        """Whether the last factorisation failed (INFOG(1) < 0)."""
+        return self.ksp.getPC().getFactorMatrix().getMumpsInfog(1) < 0
+
+    def solve(self, right):
+        """solve_dense with this factorisation."""
+        return solve_dense(self.ksp, right)
+
+    def solve_sparse(self, rows, values):
+        """solve_sparse_columns with this (sequential) factorisation."""
+        return solve_sparse_columns(self.ksp, rows, values)
+
     def negative_pivots(self):
         """Negative eigenvalues of the last factorised (symmetric) operator (ICNTL 13)."""
         return int(self.ksp.getPC().getFactorMatrix().getInertia()[0])
@@ -508,15 +555,22 @@ class SubstructuredFactor:
     """A ChainFactor while it applies, MumpsFactor from the first set_up where it does
     not (a pattern grown into no chain, a singular interior: chain_factor's
     NotAChainError), for the rest of its life; the interface direct_factor's
-    factorisations share. ``substructured`` says which. Owns the one it holds."""
+    factorisations share. ``substructured`` says which. The interiors of an LU are
+    NaturalLU's unless -<prefix>lu mumps (``natural``), in their natural order; else
+    MUMPS's. Owns the one it holds."""
 
     def __init__(self, operator, kind, block, prefix):
         self.kind, self.block, self.prefix = kind, block, prefix
+        self.natural = kind == PETSc.PC.Type.LU and lu_package(prefix) == DEFAULT_LU_PACKAGE
+        self.factor = ChainFactor(operator, kind, block, self._interior_factor,
+                                  reorder=not self.natural)
 
-        def make(local_comm, local):
-            return mumps_solver(local_comm, local, kind, prefix)
-        self.factor = ChainFactor(operator, kind, block, make, set_up_mumps, solve_dense,
-                                  solve_sparse_columns)
+    def _interior_factor(self, interior):
+        """The factorisation of a rank's (sequential) ``interior``: an LU as on one rank
+        (NaturalLU unless -<prefix>lu mumps), an LDL^T by MUMPS."""
+        if self.natural:
+            return NaturalLU(interior, self.block, self.prefix)
+        return MumpsFactor(interior, self.kind, self.block, self.prefix)
 
     @property
     def substructured(self):
@@ -545,8 +599,8 @@ class SubstructuredFactor:
 def direct_factor(operator, kind, block, prefix):
     """The factorisation ``kind`` (LU or CHOLESKY) of the Newton steps' ``operator``, a
     chain of nodes of ``block`` unknowns (analysis/jacobian.py, analysis/second_variation.py):
-    on several ranks by substructuring (SubstructuredFactor: each rank its interior by
-    sequential MUMPS, the interface's Schur complement on every rank, MUMPS on all ranks
+    on several ranks by substructuring (SubstructuredFactor: each rank its interior as
+    on one rank, the interface's Schur complement on every rank, MUMPS on all ranks
     where that does not apply) unless -<prefix>substructuring 0 or the operator is no
     chain; on one rank the LU by NaturalLU unless -<prefix>lu mumps; else MumpsFactor.
     Collective."""

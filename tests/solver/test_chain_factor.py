@@ -90,23 +90,33 @@ def self_and_transposed(comm, a, b):
             for pair in ((a_r, b_r), (b_r, a_r))]
 
 
-def factor_of(matrix, kind):
-    def make(comm, local):
-        return solvers.mumps_solver(comm, local, kind, "test_chain_")
-    factor = ChainFactor(matrix, kind, BLOCK, make, solvers.set_up_mumps, solvers.solve_dense,
-                         solvers.solve_sparse_columns)
+def factor_of(matrix, kind, interior=solvers.MumpsFactor):
+    """The ChainFactor of ``matrix``, set up, its interiors factored by ``interior``
+    (ksp.MumpsFactor, or ksp.NaturalLU of an LU)."""
+    def make(local):
+        if interior is solvers.NaturalLU:
+            return solvers.NaturalLU(local, BLOCK, "test_chain_")
+        return interior(local, kind, BLOCK, "test_chain_")
+    factor = ChainFactor(matrix, kind, BLOCK, make, reorder=interior is not solvers.NaturalLU)
     factor.set_up(matrix)
     return factor
 
 
-@pytest.mark.parametrize("kind, scales, column_scales", [
-    (kind, scales, None) for kind in (PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY)
+@pytest.mark.parametrize("kind, scales, column_scales, interior", [
+    (kind, scales, None, solvers.MumpsFactor)
+    for kind in (PETSc.PC.Type.LU, PETSc.PC.Type.CHOLESKY)
     for scales in ((1.0, 1.0, 1.0), (1.0, 1e4, 1e-4))] + [
-    (PETSc.PC.Type.LU, (1e3, 1.0, 1e-3), (1e-2, 1e3, 1.0))])
-def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, column_scales):
+    (PETSc.PC.Type.LU, (1e3, 1.0, 1e-3), (1e-2, 1e3, 1.0), solvers.MumpsFactor)] + [
+    (PETSc.PC.Type.LU, scales, column_scales, solvers.NaturalLU)
+    for scales, column_scales in (((1.0, 1.0, 1.0), None), ((1.0, 1e4, 1e-4), None),
+                                  ((1e3, 1.0, 1e-3), (1e-2, 1e3, 1.0)))])
+def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, column_scales,
+                                                             interior):
     """Unknowns of units 1e8 apart too (D A D, D the slots' scales): the interface's
     Schur complement spans 1e16 there, and its inertia and inverse must not lose the
-    small ones; of the LU also equations and unknowns of other scales (R A C). The
+    small ones; of the LU also equations and unknowns of other scales (R A C), with
+    the interiors factored by MUMPS and by PETSc's own LU in the natural order (as
+    ksp.direct_factor does by default), which must not hand over to MUMPS here. The
     solutions are compared in the unscaled unknowns C x, with A's own dense solve (the
     scaled matrix's is 1e8 times worse conditioned), to round-off."""
     comm = PETSc.COMM_WORLD
@@ -114,7 +124,9 @@ def test_solves_and_inertia_agree_with_a_dense_factorisation(kind, scales, colum
     slots = np.tile(np.asarray(scales), len(dense) // BLOCK)
     column_slots = slots if column_scales is None else np.tile(
         np.asarray(column_scales), len(dense) // BLOCK)
-    factor = factor_of(matrix, kind)
+    factor = factor_of(matrix, kind, interior)
+    if interior is solvers.NaturalLU:
+        assert not factor.solver.fell_back
 
     def assert_solves(column, solution):
         unscaled = dense / slots[:, None] / column_slots[None, :]
@@ -170,10 +182,9 @@ def test_a_submatrix_s_left_out_rows_return_the_right_hand_side(kind):
     index = PETSc.IS().createGeneral(kept.astype(PETSc.IntType), comm=comm)
     sub = matrix.createSubMatrix(index, index)
 
-    def make(local_comm, local):
-        return solvers.mumps_solver(local_comm, local, kind, "test_chain_")
-    factor = ChainFactor(sub, kind, BLOCK - 1, make, solvers.set_up_mumps,
-                         solvers.solve_dense, solvers.solve_sparse_columns)
+    def make(local):
+        return solvers.MumpsFactor(local, kind, BLOCK - 1, "test_chain_")
+    factor = ChainFactor(sub, kind, BLOCK - 1, make)
     try:
         factor.set_up(sub)
         column = np.cos(np.arange(start, end))
@@ -361,7 +372,7 @@ def test_each_row_s_column_range_is_its_least_and_greatest_column(stray, monkeyp
     try:
         if stray and comm.getSize() > 1:          # collective: before any assertion
             with pytest.raises(NotAChainError):
-                ChainFactor(matrix, PETSc.PC.Type.LU, BLOCK, None, None, None, None)
+                ChainFactor(matrix, PETSc.PC.Type.LU, BLOCK, None)
         edge_rows.clear()
         lowest, highest = _column_range(matrix, start, end, edge=edge)
         if comm.getSize() == 1:

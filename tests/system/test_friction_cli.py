@@ -57,7 +57,7 @@ def test_a_bad_newton_lu_option_exits_4_naming_its_prefix(tmp_path):
     first factorisation during the solve): one line that names the prefix among the
     solvers' options to check, exit 4, no file (it named -rod_slope_* and the directors'
     only before, measured). MUMPS's LU asked for (-rod_newton_lu mumps): PETSc's own,
-    the default on one rank, reads no MUMPS control unless it hands over to MUMPS."""
+    the default, reads no MUMPS control unless it hands over to MUMPS."""
     path = tmp_path / "out.h5"
     done = run_petsc_rod(CROSS_CURRENT + ["-rod_seabed_friction", str(MU),
                                           "-rod_newton_lu", "mumps",
