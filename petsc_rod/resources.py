@@ -56,7 +56,7 @@ def needed_memory(elements, ranks, per_element=BYTES_PER_ELEMENT):
 
 def anderson_depth(local_elements, ranks_here):
     """The default depth m of Anderson mixing for a rank with ``local_elements``
-    elements on a machine shared by ``ranks_here`` ranks: its history 2 m x 576 bytes
+    elements on a machine shared by ``ranks_here`` ranks: its history m x 576 bytes
     per element within max(HISTORY_FLOOR / ranks_here, HISTORY_PER_ELEMENT per element)
     and ANDERSON_SHARE of the memory available (see the constants)."""
     if local_elements == 0:

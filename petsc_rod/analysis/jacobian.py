@@ -25,8 +25,8 @@ delta f_l = G_l omega_l (physics/drag.py drag_jacobian). The matrix is that of H
 entries (a copy of H's values on H's pattern, which holds these places as zeros from
 H's first assembly: Term.jacobian_pattern): unsymmetric, factored by
 global_step/ksp.direct_factor (on one rank PETSc's LU in the natural order, checked,
-MUMPS's LU where the check fails; on several by substructuring with MUMPS, each rank
-its interior; options -rod_newton_*). H's curvature term is the load's at its current
+MUMPS's LU where the check fails; on several by substructuring, each rank its interior
+by that same checked LU; options -rod_newton_*). H's curvature term is the load's at its current
 value, symmetrised: the antisymmetric rest is the torque balance, zero at a solution,
 so the steps still converge quadratically.
 """

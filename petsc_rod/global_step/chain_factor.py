@@ -22,10 +22,11 @@ W has 2 B columns a rank (B where a rank has one neighbour) and is made at each
 factorisation, with one solve of sparse right-hand sides (A_IG is nonzero on the
 interior's first and last few rows only: MUMPS's forward elimination visits the paths
 of its elimination tree from them to the root, near which the AMF ordering places the
-first rows of the numbering; PETSc's LU solves them as dense columns; the first rank, whose coupling is its interior's tail,
-numbers its interior from its end for an LU, while an LDL^T, whose factorisation that
+first rows of the numbering, so the first rank, whose coupling is its interior's tail,
+numbers a MUMPS LU's interior from its end, while an LDL^T, whose factorisation that
 order slows by more than it saves in W, keeps the natural order and then factors the
-rank's diagonal block itself, without extracting it); S is ((P - 1) B) square, block
+rank's diagonal block itself, without extracting it; PETSc's LU solves them as dense
+columns, in the natural order on every rank); S is ((P - 1) B) square, block
 tridiagonal, assembled from every rank's contribution and inverted on every rank: dense,
 equilibrated (R S C by Ruiz's iteration, every row and column's largest entry about
 1; E S E of a symmetric S: its unknowns are turns, heights and resultants, whose

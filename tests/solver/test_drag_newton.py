@@ -380,3 +380,52 @@ def test_a_first_step_with_the_iterations_curvature_vouches_for_no_trusted_step(
     assert events.count("J") >= 3
     first, second = [k for k, event in enumerate(events) if event == "J"][:2]
     assert "H" in events[:first] and "H" in events[first:second]
+
+
+def test_each_rank_s_interior_of_a_riser_s_jacobian_is_factored_in_its_natural_order(
+        solver_factory):
+    """On several ranks each rank's interior of J is PETSc's LU in the natural order
+    (ksp.NaturalLU, as one rank factors the whole J), which passes its check on a steel
+    riser with a seabed in a current across (options/riser_catenary.opts at 900
+    elements, converged): numbered from its end, as MUMPS's interior of the first rank
+    is (ChainFactor's ``reorder``), the elimination meets the zero diagonal of a chain's
+    multiplier first, and the check hands that interior over to MUMPS."""
+    from test_seabed_newton import STEEL_RISER
+    from petsc_rod.global_step.chain_factor import ChainFactor
+    from petsc_rod.global_step.ksp import NaturalLU
+    from petsc_rod.problem.penalty import default_penalty
+    from petsc_rod.scenes.scene import Scene
+    from petsc_rod.scenes.starts import largest_tension
+    comm = PETSc.COMM_WORLD
+    if comm.getSize() == 1:
+        pytest.skip("the interiors are those of several ranks")
+    riser = dict(STEEL_RISER, current=Current.uniform((0.0, 1.0, 0.0), 1025.0, 1.2, 0.3))
+    scene = Scene(**riser)
+    mesh, solver = solver_factory(comm, 900, riser,
+                                  default_penalty(scene, largest_tension(scene)),
+                                  rtol=1e-9, ctol=1e-9, max_it=2000, newton=True)
+    solver.problem.state.set_from_curve(catenary_start(Scene(**STEEL_RISER), 1.0))
+    assert solver.solve_step(1.0).converged
+    polish = NewtonSolver(solver.problem)
+    reordered = None
+    try:
+        state = solver.problem.state
+        polish.lagrangian_gradient(state.tau.copy(), state.chord_multiplier.copy())
+        hessian = solver.problem.second_variation()
+        jacobian = polish._jacobian_of(hessian)
+        factor = jacobian.factor
+        # every rank's (substructured, reversed, handed over), gathered before any
+        # assertion: an assertion on one rank would leave the others in a collective
+        ranks = comm.tompi4py().allgather((
+            factor.substructured, factor.factor.reversed, factor.factor.solver.fell_back))
+        assert ranks == [(True, False, False)] * comm.getSize()
+        block = hessian.block
+        reordered = ChainFactor(jacobian.matrix, PETSc.PC.Type.LU, block,
+                                lambda interior: NaturalLU(interior, block, "test_reorder_"))
+        reordered.set_up(jacobian.matrix)
+        ranks = comm.tompi4py().allgather((reordered.reversed, reordered.solver.fell_back))
+        assert ranks == [(True, True)] + [(False, False)] * (comm.getSize() - 1)
+    finally:
+        if reordered is not None:
+            reordered.destroy()
+        polish.destroy()

@@ -124,10 +124,11 @@ def test_a_mesh_too_large_for_the_memory_is_refused_with_the_numbers(comm):
 def test_the_anderson_depth_keeps_the_history_in_proportion(monkeypatch):
     """Issue 21: the default depth is 30 on lines up to 1e4 elements a machine (the
     hard scenes need it); beyond, the depth whose history (576 bytes per element per
-    unit) fits 30 units at 1e4 elements (its set-up about 0.1 s: 16 at 18 000
-    elements), and at 3 KiB per element: 5 at 1e5 and 1e6 elements, where the whole
-    run then stays within 10 KiB per element (docs/performance.md, "Memory in
-    proportion"). The machine's memory only lowers it."""
+    unit) fits what 30 units take at 1e4 elements (its set-up about 0.1 s: 16 at
+    18 000 elements) or 3 KiB per element, whichever is larger: 5 at 1e5 and 1e6
+    elements, where the whole run then stays within 10 KiB per element
+    (docs/performance.md, "Memory in proportion"). The machine's memory only lowers
+    it."""
     monkeypatch.setattr(resources, "available_memory", lambda: 64 * 2**30)
     depth = resources.anderson_depth
     assert depth(1800, 1) == depth(10**4, 1) == depth(5000, 2) == 30
