@@ -466,10 +466,9 @@ class NaturalLU:
         without pivoting as accurate as a pivoting one's (Skeel's one step of
         iterative refinement): without it the row-by-row errors above let the chain
         with seabed friction of tests/system/test_friction_penalty_advice_cli.py take
-        555 iterations against MUMPS's 392 and stop 1.2e-6 m from MUMPS's answer."""
-        if self.mumps is not None:
-            return self.mumps.solve_columns(columns, rows)
-        return solved_columns(columns, rows, self._refined_solve)
+        555 iterations against MUMPS's 392 and stop 1.2e-6 m from MUMPS's answer.
+        MUMPS's unrefined solves where it has taken over (``solve``)."""
+        return solved_columns(columns, rows, self.solve)
 
     def _refined_solve(self, right):
         """X = A^-1 B for the Fortran-ordered (n, k) ``right`` B (solve_dense's), refined
