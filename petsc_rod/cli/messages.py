@@ -278,11 +278,13 @@ def summary(attributes):
 
 def raised(label, raises, scale):
     """The line that says the penalty was raised in a step: its events.PenaltyRaised
-    ``raises``; ``scale`` the problem's scale of R (N)."""
+    ``raises``; ``scale`` the ceiling of the raises (N; RodProblem.adapt_ceiling: the
+    problem's scale of R, or a tenth of the least EA with seabed friction)."""
     listed = ", ".join(f"{event.penalty:.3g} at iteration {event.iteration}" for event in raises)
     return (f"petsc_rod: {label}: R raised to {listed} (matrices refactored): the "
             f"constraint residual fell by less than half in {ADAPT_WINDOW} iterations with "
-            f"R far below the problem's scale {scale:.3g} (-rod_al_adapt_penalty), "
+            f"R far below {scale:.3g} (the problem's scale, or a tenth of the least EA "
+            "with seabed friction; -rod_al_adapt_penalty), "
             "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)")
 
 

@@ -34,7 +34,8 @@ from petsc_rod.mesh.ranks import MODES as RANKS_MODES
 from petsc_rod.model.line import DEFAULT_ELEMENTS
 from petsc_rod.model.moordyn import read_moordyn
 from petsc_rod.model.values import MAX_MAGNITUDE  # noqa: F401 (the options' bound)
-from petsc_rod.problem.penalty import ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS, ADAPT_WINDOW
+from petsc_rod.problem.penalty import (ADAPT_BELOW, ADAPT_FACTOR, ADAPT_PROGRESS,
+                                      ADAPT_WINDOW, FRICTION_SHARE)
 from petsc_rod.scenes.scene import Scene
 
 # Prefixes of PETSc objects: the KSPs of the global step, the SNES of the iteration and
@@ -447,8 +448,10 @@ OPTIONS = [
            "print change and residual at each iteration"),
     Option("rod_al_adapt_penalty", _bool, default_of(Settings, "adapt_penalty"), "bool",
            f"raise R {ADAPT_FACTOR:g} times, refactoring the matrices, while it is below "
-           f"{ADAPT_BELOW:g} of the default and the constraint residual stays above "
-           f"{ADAPT_PROGRESS:g} of its value {ADAPT_WINDOW} iterations before"),
+           f"{ADAPT_BELOW:g} of its ceiling (the default; with seabed friction on an "
+           f"extensible line {FRICTION_SHARE:g} times the least EA where larger) and the "
+           f"constraint residual stays above {ADAPT_PROGRESS:g} of its value "
+           f"{ADAPT_WINDOW} iterations before"),
     Option("rod_ranks_split", _string, "auto", "|".join(RANKS_MODES),
            "on several ranks, the line's run split over them (split) or done whole on "
            "the first while the others wait (whole: the answers of one rank); auto: "

@@ -75,7 +75,7 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 if verbose:
                     say(messages.step_details(event, record))
             if raises:
-                say(messages.raised(event.label, raises, problem.scale))
+                say(messages.raised(event.label, raises, problem.adapt_ceiling))
             raises = []
             last = (group, record.attributes)
         elif isinstance(event, events.RunDiverged):

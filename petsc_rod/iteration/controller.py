@@ -91,8 +91,9 @@ ITERATE = Decision(Action.ITERATE)
 
 class StepController:
     """One step's state machine (module docstring). ``settings`` (stopping.Settings),
-    ``scale`` the problem's scale of R (N), ``newton`` whether Newton steps may be tried
-    (True, or the switch's threshold in place of NEWTON_SWITCH),
+    ``scale`` the ceiling of R's raises (N; RodProblem.adapt_ceiling), ``newton``
+    whether Newton steps may be tried (True, or the switch's threshold in place of
+    NEWTON_SWITCH),
     ``label`` the step's name in messages, ``observer(iteration, change, residual)``
     asked after every iteration (True: stop, STOP_OBSERVER), with change and residual
     divided by the deformation's size, as the stopping test reads them."""

@@ -148,7 +148,8 @@ class UzawaSolver:
         """
         self.problem.prepare(t)
         step = self._controller = control.StepController(
-            self.settings, self.problem.scale, self._newton_switch(), label, observer)
+            self.settings, self.problem.adapt_ceiling, self._newton_switch(), label,
+            observer)
         try:
             self._iterate(step)
             while step.converged and self.checks_curvature:
@@ -214,7 +215,7 @@ class UzawaSolver:
             elif decision.action is control.Action.RAISE_PENALTY:
                 step.resume()
                 self._raise_penalty(step, penalty_policy.raised_penalty(
-                    self.penalty, self.problem.scale), events.RAISED_STALLING)
+                    self.penalty, self.problem.adapt_ceiling), events.RAISED_STALLING)
             else:
                 return
 

@@ -19,9 +19,10 @@ ADAPT_WINDOW = 200
 # Seabed friction on an extensible line: the stick springs hold the grounded line, whose
 # stretch, and the tension with it, then come from the multiplier alone, by steps of R
 # times the strain. Where Newton steps do not finish such a run (two load steps, two
-# coefficients, a line through the surface) the default R converged in none of the
-# measured cases and about FRICTION_SHARE times the least EA did (docs/riser.md §3b);
-# not a default, which slowed a line in a cross current there.
+# coefficients, a line through the surface, a chain in a current across it) the default
+# R converged in none of the measured cases and about FRICTION_SHARE times the least EA
+# did (docs/riser.md §3b); not a default, which slowed a line in a cross current there,
+# but the ceiling of the raises of a stalling iteration (adapt_ceiling).
 FRICTION_SHARE = 0.1
 
 
@@ -59,6 +60,16 @@ def friction_penalty(scene):
               else [scene.axial_stiffness])
     finite = [float(value) for value in values if np.isfinite(value)]
     return FRICTION_SHARE * min(finite)
+
+
+def adapt_ceiling(scene, scale):
+    """The largest penalty R (N) that penalty_too_low's raises reach: the problem's
+    ``scale`` (default_penalty), or friction_penalty where that is larger (seabed
+    friction on an extensible line, whose stalling iteration the scale does not cure:
+    docs/riser.md §3b). A raise is made only where the constraint residual stalls, so
+    a run that converges at its penalty is the same."""
+    friction = friction_penalty(scene)
+    return scale if friction is None else max(scale, friction)
 
 
 def penalty_scales(scene, start_tension=0.0):
@@ -133,7 +144,8 @@ def matrix_split(split):
 
 def penalty_too_low(history, penalty, scale):
     """Whether a step's (change, residual, time) rows call for a larger penalty: R below
-    ADAPT_BELOW times ``scale`` and the residual of the last row more than
+    ADAPT_BELOW times ``scale`` (the ceiling of the raises, adapt_ceiling) and the
+    residual of the last row more than
     ADAPT_PROGRESS times that of ADAPT_WINDOW rows before (the multiplier creeps
     towards the internal forces by at most 2R per iteration)."""
     if penalty >= ADAPT_BELOW * scale or len(history) <= ADAPT_WINDOW:
@@ -142,5 +154,6 @@ def penalty_too_low(history, penalty, scale):
 
 
 def raised_penalty(penalty, scale):
-    """The next penalty after penalty_too_low: min(ADAPT_FACTOR R, scale), N."""
+    """The next penalty after penalty_too_low: min(ADAPT_FACTOR R, scale), N, with
+    ``scale`` the ceiling of the raises (adapt_ceiling)."""
     return min(ADAPT_FACTOR * penalty, scale)

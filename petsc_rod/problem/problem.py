@@ -53,6 +53,8 @@ class RodProblem:
                                               penalty_policy.matrix_split)
         # the problem's scale of R, N (penalty.default_penalty): what "far below" means
         self.scale = penalty_policy.default_penalty(scene)
+        # the largest R a stalling iteration raises it to (penalty.adapt_ceiling)
+        self.adapt_ceiling = penalty_policy.adapt_ceiling(scene, self.scale)
         # flex joints on an extensible end act in the local step at their node (§12),
         # not in the global step: marked before it is built
         self._local_joints = []

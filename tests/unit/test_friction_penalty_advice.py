@@ -1,7 +1,8 @@
 """The penalty a run with seabed friction on an extensible line is advised where it did
 not converge (problem/penalty.friction_penalty, cli/messages.not_converged_reason):
 FRICTION_SHARE times the least finite EA, and only where the asked R is far below it
-(docs/riser.md §3b)."""
+(docs/riser.md §3b); the same is the ceiling of a stalling iteration's raises there
+(penalty.adapt_ceiling), the problem's scale elsewhere."""
 
 from types import SimpleNamespace
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from petsc_rod.cli.messages import not_converged_reason
-from petsc_rod.problem.penalty import FRICTION_SHARE, friction_penalty
+from petsc_rod.problem.penalty import FRICTION_SHARE, adapt_ceiling, friction_penalty
 
 
 def scene(friction, axial, sections=()):
@@ -29,6 +30,13 @@ def test_no_advice_without_friction_or_stretch():
     assert friction_penalty(scene(None, 5e8)) is None
     assert friction_penalty(scene(0.3, np.inf)) is None
     assert friction_penalty(SimpleNamespace(seabed=None, extensible=True)) is None
+
+
+def test_the_raises_reach_the_advice_with_friction_and_the_scale_elsewhere():
+    assert adapt_ceiling(scene(0.3, 5e8), 1.2e6) == pytest.approx(5e7, rel=1e-15)
+    assert adapt_ceiling(scene(0.3, 5e6), 1.2e6) == 1.2e6        # the scale is larger
+    assert adapt_ceiling(scene(None, 5e8), 1.2e6) == 1.2e6       # no friction
+    assert adapt_ceiling(scene(0.3, np.inf), 1.2e6) == 1.2e6     # inextensible
 
 
 REPORT = SimpleNamespace(reason=None, stalled=False, iterations=2000, change=1e-4,
