@@ -276,15 +276,18 @@ def summary(attributes):
     return ["petsc_rod: at load factor 1:"] + out if out else []
 
 
-def raised(label, raises, scale):
+def raised(label, raises, ceiling, by_friction=False):
     """The line that says the penalty was raised in a step: its events.PenaltyRaised
-    ``raises``; ``scale`` the ceiling of the raises (N; RodProblem.adapt_ceiling: the
-    problem's scale of R, or a tenth of the least EA with seabed friction)."""
+    ``raises``; ``ceiling`` the largest R the raises reach (N; RodProblem.adapt_ceiling),
+    ``by_friction`` whether it is a tenth of the least EA (seabed friction on an
+    extensible line) rather than the problem's scale."""
     listed = ", ".join(f"{event.penalty:.3g} at iteration {event.iteration}" for event in raises)
+    what = ("a tenth of the least EA, for seabed friction on an extensible line"
+            if by_friction else "the problem's scale")
     return (f"petsc_rod: {label}: R raised to {listed} (matrices refactored): the "
             f"constraint residual fell by less than half in {ADAPT_WINDOW} iterations with "
-            f"R far below {scale:.3g} (the problem's scale, or a tenth of the least EA "
-            "with seabed friction; -rod_al_adapt_penalty), "
+            f"R below a tenth of its ceiling {ceiling:.3g} ({what}; "
+            "-rod_al_adapt_penalty), "
             "or a Newton solution needed a larger R to stay a fixed point (-rod_al_newton)")
 
 

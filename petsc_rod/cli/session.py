@@ -75,7 +75,8 @@ def run_continuation(solver, path=PathSettings(), *, say=None, writer=None, opti
                 if verbose:
                     say(messages.step_details(event, record))
             if raises:
-                say(messages.raised(event.label, raises, problem.adapt_ceiling))
+                say(messages.raised(event.label, raises, problem.adapt_ceiling,
+                                    problem.adapt_ceiling > problem.scale))
             raises = []
             last = (group, record.attributes)
         elif isinstance(event, events.RunDiverged):

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from petsc_rod.cli.messages import not_converged_reason
+from petsc_rod.cli.messages import not_converged_reason, raised
 from petsc_rod.problem.penalty import FRICTION_SHARE, adapt_ceiling, friction_penalty
 
 
@@ -37,6 +37,14 @@ def test_the_raises_reach_the_advice_with_friction_and_the_scale_elsewhere():
     assert adapt_ceiling(scene(0.3, 5e6), 1.2e6) == 1.2e6        # the scale is larger
     assert adapt_ceiling(scene(None, 5e8), 1.2e6) == 1.2e6       # no friction
     assert adapt_ceiling(scene(0.3, np.inf), 1.2e6) == 1.2e6     # inextensible
+
+
+def test_the_raise_s_line_names_its_ceiling():
+    raises = [SimpleNamespace(penalty=1.18e7, iteration=400)]
+    friction = raised("step 1/1", raises, 1.23e8, True)
+    assert "R raised to 1.18e+07 at iteration 400" in friction
+    assert "ceiling 1.23e+08 (a tenth of the least EA" in friction
+    assert "ceiling 1.2e+06 (the problem's scale;" in raised("step 1/1", raises, 1.2e6)
 
 
 REPORT = SimpleNamespace(reason=None, stalled=False, iterations=2000, change=1e-4,
