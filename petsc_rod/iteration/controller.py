@@ -10,7 +10,7 @@ A Decision is one of
     CONVERGED      both stopping tests hold (§6)
     TRY_NEWTON     near a solution and still slow: Newton steps (§11), then the SNES again
                    (or CONVERGED at the attempt: newton_converged)
-    RAISE_PENALTY  R far below the problem's scale and the residual not falling: refactor
+    RAISE_PENALTY  R far below its ceiling, the residual not falling: refactor
     STOP           not converged, with a reason (stopping.STOP_* or "snes_<reason>")
     DIVERGED       the iteration diverged; ``error`` holds the RodDivergedError
 
@@ -91,15 +91,15 @@ ITERATE = Decision(Action.ITERATE)
 
 class StepController:
     """One step's state machine (module docstring). ``settings`` (stopping.Settings),
-    ``scale`` the ceiling of R's raises (N; RodProblem.adapt_ceiling), ``newton``
+    ``ceiling`` that of R's raises (N; RodProblem.adapt_ceiling), ``newton``
     whether Newton steps may be tried (True, or the switch's threshold in place of
     NEWTON_SWITCH),
     ``label`` the step's name in messages, ``observer(iteration, change, residual)``
     asked after every iteration (True: stop, STOP_OBSERVER), with change and residual
     divided by the deformation's size, as the stopping test reads them."""
 
-    def __init__(self, settings, scale, newton, label="", observer=None):
-        self.settings, self.scale, self.newton = settings, scale, bool(newton)
+    def __init__(self, settings, ceiling, newton, label="", observer=None):
+        self.settings, self.ceiling, self.newton = settings, ceiling, bool(newton)
         self.newton_switch = NEWTON_SWITCH if newton is True else float(newton or 0.0)
         # a far-reaching Newton system (NEWTON_SWITCH_FAR): no NEWTON_WORTH test
         self.newton_far = self.newton and newton is not True
@@ -180,7 +180,7 @@ class StepController:
                     self.history, settings.rtol, settings.ctol) > NEWTON_WORTH)):
             return Decision(Action.TRY_NEWTON)
         if (settings.adapt_penalty and iteration % ADAPT_WINDOW == 0
-                and penalty_too_low(self.history, penalty, self.scale)):
+                and penalty_too_low(self.history, penalty, self.ceiling)):
             return Decision(Action.RAISE_PENALTY)
         stop = stopping.stall_reason(settings, self.history, self.deformation)
         return ITERATE if stop is None else Decision(Action.STOP, stop)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 
 # Why the penalty was raised (PenaltyRaised.reason).
-RAISED_STALLING = "stalling"    # far below the scale, the residual not falling (penalty.py)
+RAISED_STALLING = "stalling"    # far below its ceiling, residual not falling (penalty.py)
 RAISED_NEWTON = "newton"        # a Newton solution needs a larger R to stay a fixed point
 
 

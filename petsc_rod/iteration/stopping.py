@@ -46,7 +46,7 @@ class Settings:
     rtol: float = 1e-9
     ctol: float = 1e-9
     monitor: bool = False
-    adapt_penalty: bool = True      # raise a penalty far below the scale (penalty.py)
+    adapt_penalty: bool = True      # raise a penalty far below its ceiling (penalty.py)
     check_stability: bool = True    # test the second variation at convergence (§10)
     newton: bool = True             # Newton steps near a solution (newton.py)
 

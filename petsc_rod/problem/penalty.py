@@ -142,18 +142,17 @@ def matrix_split(split):
     return np.where(split < 0, split.max(axis=-1, keepdims=True), split)
 
 
-def penalty_too_low(history, penalty, scale):
+def penalty_too_low(history, penalty, ceiling):
     """Whether a step's (change, residual, time) rows call for a larger penalty: R below
-    ADAPT_BELOW times ``scale`` (the ceiling of the raises, adapt_ceiling) and the
-    residual of the last row more than
-    ADAPT_PROGRESS times that of ADAPT_WINDOW rows before (the multiplier creeps
-    towards the internal forces by at most 2R per iteration)."""
-    if penalty >= ADAPT_BELOW * scale or len(history) <= ADAPT_WINDOW:
+    ADAPT_BELOW times the ``ceiling`` of the raises (adapt_ceiling) and the residual of
+    the last row more than ADAPT_PROGRESS times that of ADAPT_WINDOW rows before (the
+    multiplier creeps towards the internal forces by at most 2R per iteration)."""
+    if penalty >= ADAPT_BELOW * ceiling or len(history) <= ADAPT_WINDOW:
         return False
     return history[-1][1] > ADAPT_PROGRESS * history[-1 - ADAPT_WINDOW][1]
 
 
-def raised_penalty(penalty, scale):
-    """The next penalty after penalty_too_low: min(ADAPT_FACTOR R, scale), N, with
-    ``scale`` the ceiling of the raises (adapt_ceiling)."""
-    return min(ADAPT_FACTOR * penalty, scale)
+def raised_penalty(penalty, ceiling):
+    """The next penalty after penalty_too_low: min(ADAPT_FACTOR R, ceiling), N, with
+    ``ceiling`` that of the raises (adapt_ceiling)."""
+    return min(ADAPT_FACTOR * penalty, ceiling)

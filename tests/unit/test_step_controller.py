@@ -15,7 +15,7 @@ SETTINGS = Settings(asked_penalty=1.0, max_it=100, rtol=1e-9, ctol=1e-9)
 def fed(rows, newton=False, settings=SETTINGS, observer=None):
     """A controller that has seen ``rows`` (change, residual), deciding after each; the
     decisions."""
-    step = control.StepController(settings, scale=1.0, newton=newton, label="step 1/1 ",
+    step = control.StepController(settings, ceiling=1.0, newton=newton, label="step 1/1 ",
                                   observer=observer)
     decisions = [step.observe(change, residual, penalty=1.0) for change, residual in rows]
     return step, decisions
